@@ -1,136 +1,15 @@
-// The demcal program: a thin command line over the library.
+// The demcal program: a thin command line over the library. Each
+// subcommand lives in its own cmd_*.cpp.
 #include <CLI/CLI.hpp>
-#include <cmath>
-#include <filesystem>
-#include <fstream>
-#include <iomanip>
 #include <iostream>
-#include <sstream>
 
-#include "demcal/biaxial.hpp"
+#include "commands.hpp"
 #include "demcal/config.hpp"
-#include "demcal/output.hpp"
-#include "demcal/packing.hpp"
-#include "demcal/scoring.hpp"
-#include "demcal/trial.hpp"
-
-namespace {
-
-using namespace demcal;
-
-// Exit statuses: 0 ok, 1 the computation failed, 2 bad input.
-constexpr int kBadInput = 2;
-
-/// Load CONFIG (or the embedded default when empty) and apply --set.
-SceneConfig load_scene(const std::string& path, const std::vector<std::string>& sets) {
-  std::string text, source;
-  if (path.empty()) {
-    text = std::string(default_config_text());
-    source = "<embedded default: configs/hex_10x10.json>";
-  } else {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw InputError(path, "", "cannot open file");
-    std::ostringstream s;
-    s << in.rdbuf();
-    text = s.str();
-    source = path;
-  }
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::parse_error& e) {
-    throw InputError(source, "", std::string("malformed JSON: ") + e.what());
-  }
-  apply_overrides(j, sets, source);
-  SceneConfig config = parse_config(j, source);
-  config.text = sets.empty() ? text : j.dump();
-  return config;
-}
-
-void print_scales(const SceneConfig& config, const World& world) {
-  const ReferenceScales s = world.reference_scales();
-  std::cout << "scene " << config.name << ": " << world.size() << " particles\n"
-            << "  dt_crit                 " << s.dt_crit << " s  (2 sqrt(m_min/kn))\n"
-            << "  damping_translation_crit " << s.damping_translation_crit
-            << " N s/m (2 sqrt(kn m_min))\n"
-            << "  damping_rotation_crit   " << s.damping_rotation_crit
-            << " N m s (2 sqrt(kt r^2 I), m_min)\n";
-}
-
-int cmd_check(const std::string& path, const std::vector<std::string>& sets) {
-  SceneConfig config = load_scene(path, sets);
-  Assembly assembly = make_assembly(config);
-  std::cout << "config " << config.source << ": valid\n";
-  const ConsolidatedState state = consolidate(config, assembly);
-  print_scales(config, state.world);
-  const StabilityEstimate est = state.world.stability_estimate();
-  std::cout << "  consolidated in " << state.steps << " steps (" << std::setprecision(3)
-            << state.wall_time_s << " s), box " << state.width0 << " x " << state.height0 << " m\n"
-            << std::setprecision(6) << "  stable dt_ratio (Lanczos, rotation coupled) "
-            << est.dt_ratio_stable << "\n"
-            << "  stable dt_ratio (Gershgorin bound)         " << est.dt_ratio_stable_gershgorin
-            << "\n"
-            << "  stable dt_ratio (translation only)         " << est.dt_ratio_stable_translation
-            << "\n";
-  if (config.algorithm.dt_ratio > est.dt_ratio_stable)
-    std::cout << "  WARNING: algorithm.dt_ratio " << config.algorithm.dt_ratio
-              << " is beyond the estimated stable step\n";
-  if (auto peak = analytical_peak_stress(config)) {
-    std::cout << "  analytical peak sigma1/sigma3 " << -*peak / config.test.lateral_stress
-              << " (walled box), " << hexagonal_peak_ratio(config.material.particle.friction)
-              << " (periodic)\n";
-  }
-  return 0;
-}
-
-int cmd_run(const std::string& path, const std::vector<std::string>& sets,
-            const std::string& out_dir) {
-  SceneConfig config = load_scene(path, sets);
-  Assembly assembly = make_assembly(config);
-  const std::string dir = out_dir.empty() ? "demcal-run-" + config.name : out_dir;
-  const ConsolidatedState state = consolidate(config, assembly);
-  World final_state = state.world;
-  const LoadingResult run = run_loading(state, config.test, config.algorithm, {}, &final_state);
-  const Tolerances tolerances;
-  const Score score =
-      score_run(run, config.test.lateral_stress, tolerances, analytical_peak_stress(config));
-  nlohmann::json summary = run_summary(config, run, score);
-  summary["tolerances"] = to_json(tolerances);
-  summary["consolidation"] = {{"steps", state.steps}, {"wall_time_s", state.wall_time_s}};
-  summary["config_sha256"] = sha256_hex(config.text);
-  summary["version"] = DEMCAL_VERSION;
-
-  make_output_dir(dir);
-  write_file_atomic(dir + "/summary.json", summary.dump(2) + "\n");
-  write_file_atomic(dir + "/series.csv", series_csv(run.series));
-  if (config.output.vtk)
-    write_file_atomic(dir + "/final.vtk", world_vtk(final_state, "demcal " + config.name));
-
-  const auto& c = score.criteria;
-  std::cout << std::setprecision(4) << "scene " << config.name << ": " << run.particles
-            << " particles, " << run.steps_run << " steps, dt " << run.integration.dt << " s\n"
-            << "  peak sigma_yy " << c.peak_stress_yy << " Pa at strain " << c.peak_strain_yy
-            << " (sigma1/sigma3 " << -c.peak_stress_yy / config.test.lateral_stress << ")\n";
-  if (auto a = analytical_peak_stress(config))
-    std::cout << "  analytical (walled, rotation locked) sigma1/sigma3 "
-              << -*a / config.test.lateral_stress << "\n";
-  std::cout << "  force balance " << c.force_balance << " (paper form " << c.force_balance_paper
-            << "), moment balance " << c.moment_balance << ", servo " << c.servo << ", oscillation "
-            << c.oscillation << "\n"
-            << "  " << (score.passed ? "PASS" : "FAIL") << ": " << score.diagnosis.message << "\n"
-            << "  wall time " << run.wall_time_s << " s, "
-            << summary["particle_steps_per_s"].get<double>() << " particle-steps/s\n"
-            << "  wrote " << dir << "/summary.json, series.csv"
-            << (config.output.vtk ? ", final.vtk" : "") << "\n";
-  if (run.diverged)
-    std::cout << "  DIVERGED at step " << run.divergence_step << ": " << to_string(run.divergence)
-              << "\n";
-  return 0;
-}
-
-}  // namespace
 
 int main(int argc, char** argv) {
+  using namespace demcal::cli;
+  // Exit statuses: 0 ok, 1 the computation failed, 2 bad input.
+  constexpr int kBadInput = 2;
   CLI::App app{
       "demcal: calibrate the algorithmic parameters (dt, steps, damping) of quasi-static "
       "DEM runs"};
@@ -147,11 +26,22 @@ int main(int argc, char** argv) {
   run->add_option("--set", sets, "override a key: section.key=value (repeatable)");
   run->add_option("-o,--output", out_dir, "output folder (default demcal-run-NAME)");
 
+  SweepOptions sweep_options;
+  auto* sweep =
+      app.add_subcommand("sweep", "the signature atlas: one parameter out of bounds at a time");
+  sweep->add_option("config", sweep_options.config,
+                    "scene config (JSON); default: the embedded one");
+  sweep->add_option("--set", sweep_options.sets, "override a key: section.key=value (repeatable)");
+  sweep->add_option("-o,--output", sweep_options.out_dir,
+                    "output folder (default demcal-sweep-NAME)");
+  sweep->add_option("-j,--jobs", sweep_options.jobs, "trials in parallel (default: cores)");
+
   CLI11_PARSE(app, argc, argv);
   try {
     if (check->parsed()) return cmd_check(config_path, sets);
     if (run->parsed()) return cmd_run(config_path, sets, out_dir);
-  } catch (const InputError& e) {
+    if (sweep->parsed()) return cmd_sweep(sweep_options);
+  } catch (const demcal::InputError& e) {
     std::cerr << "demcal: error: " << e.what() << "\n";
     return kBadInput;
   } catch (const std::exception& e) {

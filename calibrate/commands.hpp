@@ -1,0 +1,27 @@
+// The subcommands of the demcal program, one file each. Each returns the
+// exit status; bad input is thrown as demcal::InputError (exit 2).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "demcal/config.hpp"
+
+namespace demcal::cli {
+
+/// Load CONFIG (or the embedded default when empty) and apply --set.
+SceneConfig load_scene(const std::string& path, const std::vector<std::string>& sets);
+
+int cmd_check(const std::string& path, const std::vector<std::string>& sets);
+int cmd_run(const std::string& path, const std::vector<std::string>& sets,
+            const std::string& out_dir);
+
+struct SweepOptions {
+  std::string config;
+  std::vector<std::string> sets;
+  std::string out_dir;
+  int jobs = 0;  ///< 0: one per core
+};
+int cmd_sweep(const SweepOptions& options);
+
+}  // namespace demcal::cli
