@@ -1,8 +1,75 @@
-// `demcal sweep`: see demcal/sweep.hpp (being written).
-#include <stdexcept>
+// `demcal sweep CONFIG [--jobs N] [-o DIR]`: the signature atlas
+// (DESIGN.md §3, demcal/sweep.hpp). The config's algorithm block is the
+// benchmark; every other case changes one parameter.
+#include <iomanip>
+#include <iostream>
 
 #include "commands.hpp"
+#include "demcal/biaxial.hpp"
+#include "demcal/output.hpp"
+#include "demcal/packing.hpp"
+#include "demcal/sweep.hpp"
 
 namespace demcal::cli {
-int cmd_sweep(const SweepOptions&) { throw std::runtime_error("demcal sweep is not built yet"); }
+
+int cmd_sweep(const SweepOptions& options) {
+  SceneConfig config = load_scene(options.config, options.sets);
+  Assembly assembly = make_assembly(config);
+  const std::string dir = options.out_dir.empty() ? "demcal-sweep-" + config.name : options.out_dir;
+  std::cerr << "sweep " << config.name << ": consolidating " << assembly.r.size()
+            << " particles (once)\n";
+  const ConsolidatedState state = consolidate(config, assembly);
+  const double alpha_stable = state.world.stability_estimate().dt_ratio_stable;
+  const std::vector<SweepCase> cases = atlas_cases(config.algorithm, alpha_stable);
+
+  SweepSettings settings;
+  settings.jobs = options.jobs;
+  settings.accuracy = config.calibration.accuracy;
+  settings.progress = [](int k, int n, const std::string& name, double seconds) {
+    std::cerr << "  [" << k << "/" << n << "] " << name << " (" << std::fixed
+              << std::setprecision(1) << seconds << " s)\n";
+  };
+  std::cerr << "  " << cases.size() << " trials, benchmark Nstep " << config.algorithm.steps
+            << ", alpha_stable " << std::setprecision(3) << alpha_stable << "\n";
+  const SweepResult result = run_sweep(config, state, cases, settings);
+
+  make_output_dir(dir);
+  make_output_dir(dir + "/series");
+  for (const auto& r : result.cases)
+    write_file_atomic(dir + "/series/" + r.spec.name + ".csv", series_csv(r.run.series));
+  write_file_atomic(dir + "/evidence.csv", evidence_csv(result));
+  nlohmann::json j = to_json(result);
+  j["config_sha256"] = sha256_hex(config.text);
+  j["version"] = DEMCAL_VERSION;
+  write_file_atomic(dir + "/atlas.json", j.dump(2) + "\n");
+  write_file_atomic(dir + "/atlas.md", atlas_markdown(result));
+
+  const double s3 = config.test.lateral_stress;
+  std::cout << std::setprecision(4) << "sweep " << config.name << ": " << result.cases.size()
+            << " trials in " << result.wall_time_s << " s on " << result.jobs << " threads\n"
+            << "  converged peak sigma1/sigma3 " << -result.reference.peak_stress_yy / s3
+            << (result.reference.converged ? "" : " (NOT converged)") << "\n"
+            << "  false passes " << result.false_passes << ", false rejects "
+            << result.false_rejects << "\n";
+  for (const auto& r : result.cases) {
+    if (r.spec.group != "benchmark" && r.spec.group != "atlas") continue;
+    std::cout << "  " << std::left << std::setw(20) << r.spec.name << std::right;
+    if (r.run.diverged)
+      std::cout << " diverged      ";
+    else
+      std::cout << " peak " << std::setw(6) << std::fixed << std::setprecision(3)
+                << -r.score.criteria.peak_stress_yy / s3 << " "
+                << (r.score.criteria.peak_error
+                        ? (*r.score.criteria.peak_error >= 0 ? "+" : "") +
+                              std::to_string(100.0 * *r.score.criteria.peak_error).substr(0, 5) +
+                              "%"
+                        : std::string(""));
+    std::cout << "  " << (r.score.passed ? "PASS" : "FAIL") << "  " << r.score.diagnosis.message
+              << "\n"
+              << std::defaultfloat;
+  }
+  std::cout << "  wrote " << dir << "/atlas.md, atlas.json, evidence.csv, series/*.csv\n";
+  return 0;
+}
+
 }  // namespace demcal::cli

@@ -24,4 +24,17 @@ struct SweepOptions {
 };
 int cmd_sweep(const SweepOptions& options);
 
+struct CalibrateOptions {
+  std::string config;  ///< "" = the embedded default
+  std::vector<std::string> sets;
+  std::string out_dir;
+  int jobs = 0;           ///< 0: one per core
+  int max_trials = 0;     ///< 0: the config's calibration.max_trials
+  double accuracy = 0.0;  ///< 0: the config's calibration.accuracy
+  std::string strategy = "model";
+  bool resume = false;
+  bool quiet = false;
+};
+int cmd_calibrate(const CalibrateOptions& options);
+
 }  // namespace demcal::cli

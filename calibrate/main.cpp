@@ -36,11 +36,25 @@ int main(int argc, char** argv) {
                     "output folder (default demcal-sweep-NAME)");
   sweep->add_option("-j,--jobs", sweep_options.jobs, "trials in parallel (default: cores)");
 
+  CalibrateOptions cal;
+  auto* calibrate = app.add_subcommand("calibrate", "calibrate dt, steps and damping on the REV");
+  calibrate->add_option("config", cal.config, "scene config (JSON); default: the embedded one");
+  calibrate->add_option("--set", cal.sets, "override a key: section.key=value (repeatable)");
+  calibrate->add_option("-o,--output", cal.out_dir, "output folder (default demcal-NAME)");
+  calibrate->add_option("-j,--jobs", cal.jobs, "trials in parallel (default: cores)");
+  calibrate->add_option("--max-trials", cal.max_trials, "search trials (default: config, 80)");
+  calibrate->add_option("--accuracy", cal.accuracy, "peak accuracy target (default 0.02)");
+  calibrate->add_option("--strategy", cal.strategy, "NLopt strategy")
+      ->check(CLI::IsMember({"model", "cobyla", "auglag", "penalty", "direct"}));
+  calibrate->add_flag("--resume", cal.resume, "continue from DIR/trials.jsonl");
+  calibrate->add_flag("-q,--quiet", cal.quiet, "no progress lines on stderr");
+
   CLI11_PARSE(app, argc, argv);
   try {
     if (check->parsed()) return cmd_check(config_path, sets);
     if (run->parsed()) return cmd_run(config_path, sets, out_dir);
     if (sweep->parsed()) return cmd_sweep(sweep_options);
+    if (calibrate->parsed()) return cmd_calibrate(cal);
   } catch (const demcal::InputError& e) {
     std::cerr << "demcal: error: " << e.what() << "\n";
     return kBadInput;

@@ -179,7 +179,7 @@ bool World::step(int64_t count) {
     compute_forces();
     ++steps_;
     time_ += integration_.dt;
-    if (steps_ % interval == 0 || s + 1 == count) {
+    if (steps_ % interval == 0) {
       if (check_divergence()) {
         divergence_step_ = steps_;
         return false;
