@@ -605,11 +605,12 @@ CalibrationSummary calibrate(const SceneConfig& config, const ConsolidatedState&
   space.lower[3] = 0.0;
   space.upper[3] = options.damping_max;
 
-  // Starts: the paper's recommendation with a size-based Nstep (1000 per
-  // particle), and a second one nearer the stability bound with lighter
-  // damping. Both always run (in parallel when jobs > 1), so the result does
-  // not depend on jobs.
-  const double log_n0 = std::log10(1000.0 * n);
+  // Starts: the paper's recommendation with a size-based Nstep (500 per
+  // particle: the model strategy extrapolates from there, so it need not
+  // be a passing value), and a second one nearer the stability bound with
+  // lighter damping. Both always run (in parallel when jobs > 1), so the
+  // result does not depend on jobs.
+  const double log_n0 = std::log10(500.0 * n);
   const double start0[4] = {std::min(0.2, space.upper[0]), log_n0, 1.0, 1.0};
   const double start1[4] = {0.85 * space.upper[0], log_n0 - 0.3, 0.5, 0.5};
   const int budget = options.max_trials;
