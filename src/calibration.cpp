@@ -566,7 +566,7 @@ CalibrationSummary calibrate(const SceneConfig& config, const ConsolidatedState&
   Evaluator evaluator(config, state, options);
   if (options.resume && !options.trials_path.empty()) {
     std::ifstream in(options.trials_path);
-    std::string line;
+    std::string line, kept;
     int line_no = 0;
     while (std::getline(in, line)) {
       ++line_no;
@@ -580,7 +580,11 @@ CalibrationSummary calibrate(const SceneConfig& config, const ConsolidatedState&
       }
       evaluator.preload(
           trial_from_json(j, options.trials_path + ": line " + std::to_string(line_no)));
+      kept += line + "\n";
     }
+    in.close();
+    // Drop a cut last line so that new trials do not append to it.
+    write_file_atomic(options.trials_path, kept);
   }
 
   // Bounds. The stable step comes from the consolidated contact network.
