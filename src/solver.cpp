@@ -72,6 +72,10 @@ void World::set_integration(const Integration& integration) {
   if (!(integration.mass_scaling > 0.0))
     throw std::invalid_argument("World: mass_scaling must be > 0");
   integration_ = integration;
+  // Locked rotation means ω ≡ 0: a spin left from before the lock would
+  // otherwise keep loading the tangential springs through the contact-point
+  // velocity while θ stays frozen.
+  if (integration_.lock_rotation) std::fill(omega_.begin(), omega_.end(), 0.0);
   const double rho_t = material_.density * material_.thickness * integration_.mass_scaling;
   for (int i = 0; i < size(); ++i) {
     m_[i] = rho_t * std::numbers::pi * r_[i] * r_[i];
@@ -99,7 +103,7 @@ void World::update_damping_coefficients() {
 void World::set_velocity(int i, double vx, double vy, double omega) {
   vx_[i] = vx;
   vy_[i] = vy;
-  omega_[i] = omega;
+  omega_[i] = integration_.lock_rotation ? 0.0 : omega;
 }
 
 void World::set_position(int i, double x, double y) {

@@ -43,7 +43,7 @@ struct Integration {
   double damping_ratio_translation = 1.0;  ///< ζ_t = D_t / D_t^crit
   double damping_ratio_rotation = 1.0;     ///< ζ_r = D_r / D_r^crit
   double mass_scaling = 1.0;               ///< f_ms, multiplies m and I
-  bool lock_rotation = false;              ///< diagnostic: ω ≡ 0
+  bool lock_rotation = false;              ///< diagnostic: ω ≡ 0 (spins are zeroed)
 };
 
 /// Reference scales of DESIGN.md §2 for the current assembly. Damping
@@ -168,7 +168,7 @@ class World {
   std::span<const double> torque() const { return tq_; }
 
   /// Direct state edits for tests and scene set-up; they invalidate the
-  /// neighbour list.
+  /// neighbour list. With rotation locked, the spin ω is ignored (kept 0).
   void set_velocity(int i, double vx, double vy, double omega);
   void set_position(int i, double x, double y);
 
