@@ -1,4 +1,7 @@
 // `demcal check` and `demcal run`, and the config loading every command shares.
+#include <unistd.h>
+
+#include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
@@ -19,6 +22,7 @@ SceneConfig load_scene(const std::string& path, const std::vector<std::string>& 
     text = std::string(default_config_text());
     source = "<embedded default: configs/hex_10x10.json>";
   } else {
+    if (std::filesystem::is_directory(path)) throw InputError(path, "", "is a folder, not a file");
     std::ifstream in(path, std::ios::binary);
     if (!in) throw InputError(path, "", "cannot open file");
     std::ostringstream s;
@@ -29,8 +33,12 @@ SceneConfig load_scene(const std::string& path, const std::vector<std::string>& 
   nlohmann::json j;
   try {
     j = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::parse_error& e) {
-    throw InputError(source, "", std::string("malformed JSON: ") + e.what());
+  } catch (const nlohmann::json::exception&) {
+    // Any JSON error (syntax, or a number like 1e999 that overflows, which
+    // nlohmann reports as out_of_range): parse_config_text fails on the same
+    // text with the InputError that names the line or the key.
+    parse_config_text(text, source);
+    throw;
   }
   apply_overrides(j, sets, source);
   SceneConfig config = parse_config(j, source);
@@ -39,6 +47,85 @@ SceneConfig load_scene(const std::string& path, const std::vector<std::string>& 
 }
 
 namespace {
+
+namespace fs = std::filesystem;
+
+/// An output folder written all or nothing. check() proves, before any
+/// computation, that the folder can be made and written, and leaves no
+/// trace (bad path: InputError, exit 2). The constructor makes the missing
+/// folders; write() adds files atomically; unless commit() is called, the
+/// destructor removes the files written and the folders made, so a failure
+/// half-way leaves no partial output.
+class OutputFolder {
+ public:
+  static void check(const std::string& dir) { OutputFolder probe(dir, true); }
+
+  explicit OutputFolder(const std::string& dir) : OutputFolder(dir, false) {}
+  OutputFolder(const OutputFolder&) = delete;
+  OutputFolder& operator=(const OutputFolder&) = delete;
+  ~OutputFolder() {
+    if (committed_) return;
+    std::error_code ec;
+    for (auto it = written_.rbegin(); it != written_.rend(); ++it) fs::remove(*it, ec);
+    for (auto it = created_.rbegin(); it != created_.rend(); ++it) fs::remove(*it, ec);
+  }
+
+  void write(const std::string& name, const std::string& content) {
+    const std::string path = (dir_ / name).string();
+    write_file_atomic(path, content);  // on failure it leaves nothing behind itself
+    written_.push_back(path);
+  }
+  void commit() { committed_ = true; }
+
+ private:
+  OutputFolder(const std::string& dir, bool probe_only) : name_(dir) {
+    fs::path p = fs::path(dir).lexically_normal();
+    if (!p.has_filename() && p.has_parent_path()) p = p.parent_path();  // "out/" → "out"
+    dir_ = p;
+    std::vector<fs::path> missing;  // deepest first
+    std::error_code ec;
+    fs::path q = p;
+    while (!q.empty() && !fs::exists(q, ec)) {
+      missing.push_back(q);
+      q = q.parent_path();
+    }
+    if (!q.empty() && !fs::is_directory(q, ec))
+      fail(q == p ? "exists and is not a folder" : q.string() + " is not a folder");
+    for (auto it = missing.rbegin(); it != missing.rend(); ++it) {
+      if (!fs::create_directory(*it, ec))
+        fail("cannot create folder " + it->string() + (ec ? " (" + ec.message() + ")" : ""));
+      created_.push_back(*it);
+    }
+    // A folder that exists may still refuse files (permissions, read-only).
+    const fs::path probe = p / (".demcal-probe-" + std::to_string(::getpid()));
+    {
+      std::ofstream out(probe, std::ios::binary | std::ios::trunc);
+      if (!out) fail("cannot write files in this folder");
+      written_.push_back(probe);
+    }
+    fs::remove(probe, ec);
+    written_.pop_back();
+    if (probe_only) {
+      for (auto it = created_.rbegin(); it != created_.rend(); ++it) fs::remove(*it, ec);
+      created_.clear();
+      committed_ = true;
+    }
+  }
+  [[noreturn]] void fail(const std::string& what) {
+    std::error_code ec;
+    for (auto it = written_.rbegin(); it != written_.rend(); ++it) fs::remove(*it, ec);
+    for (auto it = created_.rbegin(); it != created_.rend(); ++it) fs::remove(*it, ec);
+    written_.clear();
+    created_.clear();
+    committed_ = true;
+    throw InputError(name_, "", "output folder unusable: " + what);
+  }
+
+  std::string name_;
+  fs::path dir_;
+  std::vector<fs::path> created_, written_;
+  bool committed_ = false;
+};
 
 void print_scales(const SceneConfig& config, const World& world) {
   const ReferenceScales s = world.reference_scales();
@@ -83,6 +170,7 @@ int cmd_run(const std::string& path, const std::vector<std::string>& sets,
   SceneConfig config = load_scene(path, sets);
   Assembly assembly = make_assembly(config);
   const std::string dir = out_dir.empty() ? "demcal-run-" + config.name : out_dir;
+  OutputFolder::check(dir);  // an unwritable -o fails now, not after the run
   const ConsolidatedState state = consolidate(config, assembly);
   World final_state = state.world;
   const LoadingResult run = run_loading(state, config.test, config.algorithm, {}, &final_state);
@@ -95,11 +183,13 @@ int cmd_run(const std::string& path, const std::vector<std::string>& sets,
   summary["config_sha256"] = sha256_hex(config.text);
   summary["version"] = DEMCAL_VERSION;
 
-  make_output_dir(dir);
-  write_file_atomic(dir + "/summary.json", summary.dump(2) + "\n");
-  write_file_atomic(dir + "/series.csv", series_csv(run.series));
-  if (config.output.vtk)
-    write_file_atomic(dir + "/final.vtk", world_vtk(final_state, "demcal " + config.name));
+  {
+    OutputFolder out(dir);
+    out.write("summary.json", summary.dump(2) + "\n");
+    out.write("series.csv", series_csv(run.series));
+    if (config.output.vtk) out.write("final.vtk", world_vtk(final_state, "demcal " + config.name));
+    out.commit();
+  }
 
   const auto& c = score.criteria;
   std::cout << std::setprecision(4) << "scene " << config.name << ": " << run.particles

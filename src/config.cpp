@@ -4,11 +4,15 @@
 
 #include <openssl/evp.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <set>
 #include <sstream>
+#include <string>
+#include <vector>
 
 namespace demcal {
 
@@ -234,19 +238,70 @@ SceneConfig parse_config(const nlohmann::json& root_json, const std::string& sou
   return c;
 }
 
-SceneConfig parse_config_text(std::string_view text, const std::string& source) {
-  nlohmann::json j;
+namespace {
+
+// JSON text to a tree. Every nlohmann error becomes an InputError: a syntax
+// error names the line and column, a number that overflows a double
+// (1e999: nlohmann throws out_of_range, not parse_error) names its key.
+nlohmann::json parse_json_text(std::string_view text, const std::string& source) {
+  std::vector<std::string> keys;  // the key being read in each open object
+  auto track = [&](int, json::parse_event_t event, json& parsed) {
+    switch (event) {
+      case json::parse_event_t::object_start:
+        keys.emplace_back();
+        break;
+      case json::parse_event_t::object_end:
+        if (!keys.empty()) keys.pop_back();
+        break;
+      case json::parse_event_t::key:
+        if (!keys.empty()) keys.back() = parsed.get<std::string>();
+        break;
+      default:
+        break;
+    }
+    return true;
+  };
+  auto key_path = [&]() {
+    std::string path;
+    for (const auto& k : keys)
+      if (!k.empty()) path += (path.empty() ? "" : ".") + k;
+    return path;
+  };
   try {
-    j = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::parse_error& e) {
-    throw InputError(source, "", std::string("malformed JSON: ") + e.what());
+    return json::parse(text, track);
+  } catch (const json::parse_error& e) {
+    // e.byte is the 1-based offset of the offending character.
+    const size_t at = std::min(e.byte > 0 ? e.byte - 1 : 0, text.size());
+    size_t line = 1, column = 1;
+    for (size_t i = 0; i < at; ++i) {
+      if (text[i] == '\n') {
+        ++line;
+        column = 1;
+      } else {
+        ++column;
+      }
+    }
+    std::string near = key_path();
+    throw InputError(source, "line " + std::to_string(line) + ", column " + std::to_string(column),
+                     std::string("malformed JSON") +
+                         (near.empty() ? "" : " (after key " + near + ")") + ": " + e.what());
+  } catch (const json::exception& e) {
+    throw InputError(source, key_path(),
+                     std::string("number out of range (not a finite double): ") + e.what());
   }
+}
+
+}  // namespace
+
+SceneConfig parse_config_text(std::string_view text, const std::string& source) {
+  const nlohmann::json j = parse_json_text(text, source);
   SceneConfig c = parse_config(j, source);
   c.text = std::string(text);
   return c;
 }
 
 SceneConfig load_config(const std::string& path) {
+  if (std::filesystem::is_directory(path)) throw InputError(path, "", "is a folder, not a file");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path, "", "cannot open file");
   std::ostringstream s;
@@ -264,27 +319,31 @@ void apply_overrides(nlohmann::json& j, const std::vector<std::string>& sets,
   for (const auto& set : sets) {
     const auto eq = set.find('=');
     if (eq == std::string::npos || eq == 0)
-      throw InputError(source, set, "--set wants section.key=value");
+      throw InputError(source, "--set " + set, "wants section.key=value");
     const std::string key = set.substr(0, eq), value = set.substr(eq + 1);
     nlohmann::json v;
     try {
       v = nlohmann::json::parse(value);
     } catch (const nlohmann::json::parse_error&) {
       v = value;  // a bare word is a string
+    } catch (const nlohmann::json::exception& e) {
+      throw InputError(source, key, "--set value " + value + " is out of range: " + e.what());
     }
     nlohmann::json* node = &j;
     std::string rest = key;
     for (;;) {
       const auto dot = rest.find('.');
       const std::string part = rest.substr(0, dot);
-      if (part.empty()) throw InputError(source, key, "--set key has an empty part");
+      if (part.empty()) throw InputError(source, "--set " + set, "key has an empty part");
       if (dot == std::string::npos) {
         (*node)[part] = v;
         break;
       }
       if (!node->contains(part)) (*node)[part] = nlohmann::json::object();
       node = &(*node)[part];
-      if (!node->is_object()) throw InputError(source, key, "--set path is not an object");
+      if (!node->is_object())
+        throw InputError(source, key.substr(0, key.size() - rest.size() + part.size()),
+                         "--set " + set + ": not a section (holds " + node->dump() + ")");
       rest = rest.substr(dot + 1);
     }
   }

@@ -43,9 +43,10 @@ void append_line_durable(const std::string& path, const std::string& line) {
 void make_output_dir(const std::string& dir) {
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
+  // The folder is the user's -o: failing to make it is bad input (exit 2).
   if (ec || !std::filesystem::is_directory(dir))
-    throw std::runtime_error(dir + ": cannot create output folder" +
-                             (ec ? " (" + ec.message() + ")" : std::string()));
+    throw InputError(
+        dir, "", "cannot create output folder" + (ec ? " (" + ec.message() + ")" : std::string()));
 }
 
 std::string series_csv(const std::vector<MonitorPoint>& series) {

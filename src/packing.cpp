@@ -3,7 +3,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
+#include <limits>
 #include <numbers>
 #include <random>
 #include <sstream>
@@ -97,15 +99,32 @@ Assembly random_gas(const AssemblySpec& spec) {
   return a;
 }
 
+namespace {
+
+/// The whole of `field` (blanks around it allowed) as a number.
+bool parse_number(const std::string& field, double& value) {
+  const char* s = field.c_str();
+  char* end = nullptr;
+  value = std::strtod(s, &end);
+  if (end == s) return false;
+  while (*end == ' ' || *end == '\t') ++end;
+  return *end == '\0';
+}
+
+}  // namespace
+
 Assembly read_particle_file(const std::string& path) {
-  std::ifstream in(path);
+  std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path, "", "cannot open particle file");
   Assembly a;
+  std::vector<int> lines;  // line of each particle, for the overlap error
   std::string line;
   int line_no = 0;
+  bool seen_content = false;  // a header or a particle
   auto where = [&]() { return "line " + std::to_string(line_no); };
   while (std::getline(in, line)) {
     ++line_no;
+    if (line_no == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);  // UTF-8 BOM
     if (!line.empty() && line.back() == '\r') line.pop_back();
     const auto first = line.find_first_not_of(" \t");
     if (first == std::string::npos || line[first] == '#') continue;
@@ -114,27 +133,30 @@ Assembly read_particle_file(const std::string& path) {
     std::string f;
     while (std::getline(ss, f, ',')) fields.push_back(f);
     double v[3];
-    bool numeric = fields.size() == 3;
-    for (size_t k = 0; numeric && k < 3; ++k) {
-      const char* s = fields[k].c_str();
-      char* end = nullptr;
-      v[k] = std::strtod(s, &end);
-      while (end && (*end == ' ' || *end == '\t')) ++end;
-      numeric = end != s && end && *end == '\0';
-    }
-    if (!numeric) {
-      if (a.x.empty() && fields.size() == 3 && line_no == 1 + 0) continue;  // header
+    int numbers = 0;
+    for (size_t k = 0; k < fields.size() && k < 3; ++k) numbers += parse_number(fields[k], v[k]);
+    if (fields.size() != 3 || numbers != 3) {
+      // A header is the first line that is not blank or a comment, and has
+      // three fields none of which is a number ("x,y,r"); a line with some
+      // numbers is a broken particle line, never silently skipped.
+      if (!seen_content && fields.size() == 3 && numbers == 0) {
+        seen_content = true;
+        continue;
+      }
       throw InputError(path, where(), "expected three numbers x,y,r, got \"" + line + "\"");
     }
+    seen_content = true;
     if (!std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2]))
-      throw InputError(path, where(), "values must be finite");
-    if (!(v[2] > 0.0)) throw InputError(path, where(), "radius must be > 0");
+      throw InputError(path, where(), "values must be finite, got \"" + line + "\"");
+    if (!(v[2] > 0.0)) throw InputError(path, where(), "radius must be > 0, got \"" + line + "\"");
     a.x.push_back(v[0]);
     a.y.push_back(v[1]);
     a.r.push_back(v[2]);
+    lines.push_back(line_no);
   }
   if (in.bad()) throw InputError(path, "", "cannot read particle file");
-  if (a.size() < 2) throw InputError(path, "", "needs at least two particles");
+  if (a.size() < 2)
+    throw InputError(path, "", "needs at least two particles, found " + std::to_string(a.size()));
   // Overlaps beyond 5 % of the smaller radius are not a packing but an error
   // (a cell grid keeps the check O(N)).
   const int n = a.size();
@@ -168,10 +190,11 @@ Assembly read_particle_file(const std::string& path) {
           const double d = std::hypot(a.x[j] - a.x[i], a.y[j] - a.y[i]);
           const double overlap = a.r[i] + a.r[j] - d;
           if (overlap > 0.05 * std::min(a.r[i], a.r[j]))
-            throw InputError(path, "line of particle " + std::to_string(j + 1),
-                             "overlaps particle " + std::to_string(i + 1) + " by " +
+            throw InputError(path, "line " + std::to_string(lines[std::max(i, j)]),
+                             "particle overlaps the one on line " +
+                                 std::to_string(lines[std::min(i, j)]) + " by " +
                                  std::to_string(100.0 * overlap / std::min(a.r[i], a.r[j])) +
-                                 " % of its radius (limit 5 %)");
+                                 " % of the smaller radius (limit 5 %)");
         }
       }
   }

@@ -1,0 +1,436 @@
+// The demcal program end to end (issues #3 and #9 §1): bad input gives exit
+// status 2, one line on stderr naming the file and the key (or line), and no
+// output at all; `demcal check` prints the derived scales; `demcal run`
+// writes summary.json, series.csv and a valid legacy VTK file.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kBinary = DEMCAL_BINARY;
+const std::string kSource = DEMCAL_SOURCE_DIR;
+const std::string kHex5 = kSource + "/configs/hex_5x5.json";
+
+std::string read(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::vector<std::string> lines_of(const std::string& text) {
+  std::vector<std::string> lines;
+  std::stringstream s(text);
+  for (std::string line; std::getline(s, line);) lines.push_back(line);
+  return lines;
+}
+
+std::vector<std::string> split(const std::string& line, char sep) {
+  std::vector<std::string> out;
+  std::stringstream s(line);
+  for (std::string f; std::getline(s, f, sep);) out.push_back(f);
+  return out;
+}
+
+std::string quote(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+struct Result {
+  int status = -1;
+  std::string out, err;
+};
+
+/// A fresh folder per test (the working directory of the runs), removed
+/// afterwards.
+class CliEndToEnd : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = fs::temp_directory_path() /
+           ("demcal_test_cli_" + std::to_string(::getpid()) + "_" + info->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_ / "work");
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  /// Run `demcal ARGS` in dir_/work with stdout and stderr captured.
+  Result demcal(const std::vector<std::string>& args) {
+    std::string cmd = "cd " + quote((dir_ / "work").string()) + " && " + quote(kBinary);
+    for (const auto& a : args) cmd += " " + quote(a);
+    cmd += " >" + quote((dir_ / "stdout").string()) + " 2>" + quote((dir_ / "stderr").string());
+    const int raw = std::system(cmd.c_str());
+    Result r;
+    r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+    r.out = read(dir_ / "stdout");
+    r.err = read(dir_ / "stderr");
+    return r;
+  }
+  std::string write(const std::string& name, const std::string& content) {
+    const fs::path path = dir_ / name;
+    std::ofstream(path, std::ios::binary) << content;
+    return path.string();
+  }
+  /// Everything under dir_/work (the runs' working directory).
+  std::set<std::string> work_contents() {
+    std::set<std::string> names;
+    for (const auto& e : fs::recursive_directory_iterator(dir_ / "work"))
+      names.insert(fs::relative(e.path(), dir_ / "work").string());
+    return names;
+  }
+
+  /// Bad input: exit 2, exactly one line on stderr that contains every one
+  /// of `mentions`, nothing on stdout, and nothing written.
+  void expect_bad_input(const std::vector<std::string>& args,
+                        const std::vector<std::string>& mentions) {
+    std::string trace;
+    for (const auto& a : args) trace += a + " ";
+    SCOPED_TRACE(trace);
+    const Result r = demcal(args);
+    EXPECT_EQ(r.status, 2) << r.err;
+    const auto err_lines = lines_of(r.err);
+    EXPECT_EQ(err_lines.size(), 1u) << r.err;
+    EXPECT_EQ(r.err.rfind("demcal: error: ", 0), 0u) << r.err;
+    for (const auto& m : mentions) EXPECT_NE(r.err.find(m), std::string::npos) << r.err;
+    EXPECT_EQ(r.out, "");
+    EXPECT_TRUE(work_contents().empty()) << "left output behind: " << *work_contents().begin();
+  }
+
+  fs::path dir_;
+};
+
+// --- bad input ------------------------------------------------------------
+
+TEST_F(CliEndToEnd, BadConfigsExitTwoNameFileAndKeyAndWriteNothing) {
+  const std::string out = (dir_ / "work" / "out").string();
+  struct Case {
+    std::string name, content, key;
+  };
+  const std::vector<Case> cases = {
+      {"negative.json", R"({"material": {"kn": -1}})", "material.kn"},
+      {"nested.json", R"({"material": {"wall": {"foo": 1}}})", "material.wall.foo"},
+      {"unknown.json", R"({"foo": 1})", "foo"},
+      {"type.json", R"({"algorithm": {"steps": "many"}})", "algorithm.steps"},
+      {"inf.json", R"({"test": {"lateral_stress": 1e999}})", "test.lateral_stress"},
+      {"bounds.json", R"({"assembly": {"type": "random", "radius_min": 1, "radius_max": 0.5}})",
+       "assembly.radius_min"},
+      {"required.json", R"({"assembly": {"type": "file"}})", "assembly.file"},
+      {"malformed.json", "{\n  \"name\": \"x\",\n  oops\n}", "line 3"},
+  };
+  for (const auto& c : cases) {
+    const std::string path = write(c.name, c.content);
+    expect_bad_input({"run", path, "-o", out}, {path, c.key});
+    // The default output folder (demcal-run-NAME in the working directory)
+    // is not created either.
+    expect_bad_input({"run", path}, {path, c.key});
+    expect_bad_input({"check", path}, {path, c.key});
+  }
+}
+
+TEST_F(CliEndToEnd, BadOverridesAndMissingFilesExitTwo) {
+  const std::string out = (dir_ / "work" / "out").string();
+  expect_bad_input({"run", kHex5, "--set", "algorithm.steps", "-o", out},
+                   {kHex5, "algorithm.steps"});
+  expect_bad_input({"run", kHex5, "--set", "algorithm.steps=-5", "-o", out},
+                   {kHex5, "algorithm.steps"});
+  expect_bad_input({"run", kHex5, "--set", "algorithm.stepz=5", "-o", out},
+                   {kHex5, "algorithm.stepz"});
+  expect_bad_input({"run", kHex5, "--set", "material.kn=1e999", "-o", out}, {kHex5, "material.kn"});
+  const std::string missing = (dir_ / "missing.json").string();
+  expect_bad_input({"run", missing, "-o", out}, {missing});
+  expect_bad_input({"run", dir_.string(), "-o", out}, {dir_.string()});  // a folder
+}
+
+TEST_F(CliEndToEnd, BadParticleFileNamesFileAndLine) {
+  const std::string out = (dir_ / "work" / "out").string();
+  const std::string csv = write("p.csv", "x,y,r\n0,0,5e-4\n1e-3,0,-5e-4\n");
+  const std::string config =
+      write("file.json", R"({"assembly": {"type": "file", "file": "p.csv"}})");
+  expect_bad_input({"run", config, "-o", out}, {csv, "line 3", "radius"});
+  const std::string overlap = write("o.csv", "# two\n0,0,5e-4\n5e-4,0,5e-4\n");
+  expect_bad_input({"run", config, "--set", "assembly.file=" + overlap, "-o", out},
+                   {overlap, "line 3"});
+  expect_bad_input({"check", config, "--set", "assembly.file=nothere.csv"}, {"nothere.csv"});
+}
+
+// An output path that cannot be written is bad input too, found before the
+// run (it would otherwise fail after all the computing), and leaves nothing.
+TEST_F(CliEndToEnd, UnwritableOutputExitsTwoBeforeRunning) {
+  const std::string file = write("work/plain.txt", "not a folder\n");
+  const std::set<std::string> before = work_contents();
+  for (const std::string& out : {file + "/out", file + "/deeper/out", file}) {
+    SCOPED_TRACE(out);
+    const Result r = demcal({"run", kHex5, "--set", "algorithm.steps=2000", "-o", out});
+    EXPECT_EQ(r.status, 2) << r.err;
+    EXPECT_EQ(lines_of(r.err).size(), 1u) << r.err;
+    EXPECT_NE(r.err.find(out), std::string::npos) << r.err;
+    EXPECT_EQ(r.out, "");  // nothing ran
+    EXPECT_EQ(work_contents(), before);
+    EXPECT_EQ(read(file), "not a folder\n");
+  }
+  // A folder the kernel refuses (as root too).
+  const Result r = demcal({"run", kHex5, "-o", "/proc/demcal-forbidden/out"});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("/proc/demcal-forbidden/out"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists("/proc/demcal-forbidden"));
+}
+
+// --- check ----------------------------------------------------------------
+
+double number_after(const std::string& text, const std::string& label) {
+  const auto at = text.find(label);
+  if (at == std::string::npos) return NAN;
+  return std::strtod(text.c_str() + at + label.size(), nullptr);
+}
+
+TEST_F(CliEndToEnd, CheckPrintsTheDerivedScales) {
+  const Result r = demcal({"check", kHex5});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("valid"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("25 particles"), std::string::npos) << r.out;
+  // Δt_crit = 2·sqrt(m/kn), m = ρπr²t; D_t^crit = 2·sqrt(kn·m);
+  // D_r^crit = 2·sqrt(kt·r²·I), I = m r²/2 (printed to 6 digits).
+  const double r0 = 5e-4, m = 2650.0 * M_PI * r0 * r0, kn = 1e8, kt = 5e7;
+  EXPECT_NEAR(number_after(r.out, "dt_crit"), 2 * std::sqrt(m / kn), 1e-5 * 2 * std::sqrt(m / kn))
+      << r.out;
+  EXPECT_NEAR(number_after(r.out, "damping_translation_crit"), 2 * std::sqrt(kn * m),
+              1e-5 * 2 * std::sqrt(kn * m));
+  const double dr = 2 * std::sqrt(kt * r0 * r0 * m * r0 * r0 / 2);
+  EXPECT_NEAR(number_after(r.out, "damping_rotation_crit"), dr, 1e-5 * dr);
+  const double stable = number_after(r.out, "stable dt_ratio (Lanczos, rotation coupled)");
+  EXPECT_GT(stable, 0.2);
+  EXPECT_LT(stable, 1.0);
+  EXPECT_NEAR(number_after(r.out, "analytical peak sigma1/sigma3"), 7.725, 1e-3) << r.out;
+  EXPECT_TRUE(work_contents().empty());  // check writes nothing
+}
+
+TEST_F(CliEndToEnd, CheckAcceptsAParticleFile) {
+  std::string csv = "# hexagonal 4x3, r = 5e-4\nx,y,r\n";
+  const double r = 5e-4, h = std::sqrt(3.0) * r;
+  for (int k = 0; k < 3; ++k)
+    for (int i = 0; i < 4; ++i) {
+      std::ostringstream line;
+      line.precision(17);
+      line << r + (k % 2 ? r : 0.0) + 2 * r * i << "," << r + h * k << "," << r << "\r\n";
+      csv += line.str();
+    }
+  write("hex.csv", csv);
+  const std::string config =
+      write("file.json", R"({"assembly": {"type": "file", "file": "hex.csv"}})");
+  const Result res = demcal({"check", config});
+  EXPECT_EQ(res.status, 0) << res.err;
+  EXPECT_NE(res.out.find("12 particles"), std::string::npos) << res.out;
+}
+
+// --- run outputs ------------------------------------------------------------
+
+/// Legacy VTK polydata as world_vtk writes it: check every count against
+/// the data that follows.
+void expect_valid_vtk(const std::string& text, int particles, bool contacts = true) {
+  std::stringstream s(text);
+  std::string line;
+  std::getline(s, line);
+  EXPECT_EQ(line, "# vtk DataFile Version 3.0");
+  std::getline(s, line);  // title
+  EXPECT_LE(line.size(), 256u);
+  std::getline(s, line);
+  EXPECT_EQ(line, "ASCII");
+  std::getline(s, line);
+  EXPECT_EQ(line, "DATASET POLYDATA");
+  std::string word, type;
+  long n = -1, cells = -1;
+  s >> word >> n >> type;
+  ASSERT_EQ(word, "POINTS");
+  EXPECT_EQ(n, particles);
+  EXPECT_EQ(type, "double");
+  for (long i = 0; i < 3 * n; ++i) {
+    double v;
+    ASSERT_TRUE(s >> v) << "point " << i / 3;
+    EXPECT_TRUE(std::isfinite(v));
+  }
+  long count = -1, size = -1;
+  s >> word >> count >> size;
+  ASSERT_EQ(word, "VERTICES");
+  EXPECT_EQ(count, n);
+  EXPECT_EQ(size, 2 * n);
+  for (long i = 0; i < count; ++i) {
+    long one, index;
+    ASSERT_TRUE(s >> one >> index);
+    EXPECT_EQ(one, 1);
+    EXPECT_EQ(index, i);
+  }
+  long lines = -1;
+  s >> word >> lines >> size;
+  ASSERT_EQ(word, "LINES");
+  if (contacts) {
+    EXPECT_GT(lines, 0);  // a loaded packing has contacts
+  }
+  EXPECT_EQ(size, 3 * lines);
+  for (long i = 0; i < lines; ++i) {
+    long two, a, b;
+    ASSERT_TRUE(s >> two >> a >> b);
+    EXPECT_EQ(two, 2);
+    EXPECT_TRUE(a >= 0 && a < n && b >= 0 && b < n && a != b) << a << " " << b;
+  }
+  // POINT_DATA n: SCALARS/VECTORS blocks of n values; CELL_DATA n + lines.
+  long data_count = -1;
+  s >> word >> data_count;
+  ASSERT_EQ(word, "POINT_DATA");
+  EXPECT_EQ(data_count, n);
+  std::set<std::string> names;
+  for (;;) {
+    if (!(s >> word)) break;
+    if (word == "CELL_DATA") {
+      s >> data_count;
+      EXPECT_EQ(data_count, n + lines);
+      cells = data_count;
+      continue;
+    }
+    std::string name, vtype;
+    s >> name >> vtype;
+    names.insert(name);
+    int components = 1;
+    if (word == "SCALARS") {
+      s >> components;
+      std::string lut, table;
+      s >> lut >> table;
+      EXPECT_EQ(lut, "LOOKUP_TABLE");
+    } else {
+      ASSERT_EQ(word, "VECTORS") << "unexpected section";
+      components = 3;
+    }
+    for (long i = 0; i < data_count * components; ++i) {
+      double v;
+      ASSERT_TRUE(s >> v) << name << " value " << i;
+    }
+  }
+  EXPECT_EQ(cells, n + lines);
+  for (const char* field : {"radius", "rotation", "velocity", "normal_force", "tangential_force"})
+    EXPECT_TRUE(names.count(field)) << field;
+}
+
+TEST_F(CliEndToEnd, RunWritesSummarySeriesAndVtk) {
+  const fs::path out = dir_ / "work" / "a" / "b";  // parents are made
+  const Result r = demcal({"run", kHex5, "--set", "algorithm.steps=2000", "-o", out.string()});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("peak sigma_yy"), std::string::npos) << r.out;
+  // Exactly the three files: no temporary or probe file left behind.
+  std::set<std::string> files;
+  for (const auto& e : fs::directory_iterator(out)) files.insert(e.path().filename().string());
+  EXPECT_EQ(files, (std::set<std::string>{"summary.json", "series.csv", "final.vtk"}));
+
+  const auto s = nlohmann::json::parse(read(out / "summary.json"));
+  EXPECT_EQ(s.at("particles"), 25);
+  const auto& p = s.at("params");
+  for (const char* key :
+       {"dt", "dt_ratio", "steps", "damping_translation", "damping_ratio_translation",
+        "damping_rotation", "damping_ratio_rotation", "mass_scaling"})
+    EXPECT_TRUE(p.contains(key)) << key;
+  EXPECT_EQ(p.at("steps"), 2000);
+  EXPECT_EQ(p.at("dt_ratio"), 0.2);
+  EXPECT_NEAR(p.at("dt").get<double>(), 0.2 * 2 * std::sqrt(2650.0 * M_PI * 25e-8 / 1e8), 1e-15);
+  EXPECT_NEAR(p.at("damping_translation").get<double>(), 2 * std::sqrt(1e8 * 2650.0 * M_PI * 25e-8),
+              1e-6);
+  EXPECT_EQ(p.at("mass_scaling"), 1.0);
+  EXPECT_TRUE(s.at("criteria").at("force_balance").is_number());
+  EXPECT_TRUE(s.at("criteria").at("moment_balance").is_number());
+  EXPECT_LT(s.at("peak").at("stress_yy").get<double>(), -1e5);  // beyond σ3, compressive
+  EXPECT_LT(s.at("peak").at("strain_yy").get<double>(), 0.0);
+  EXPECT_NEAR(s.at("analytical_peak").at("ratio").get<double>(), 7.725, 1e-3);
+  EXPECT_NEAR(s.at("analytical_peak").at("ratio_periodic").get<double>(), 7.3267, 1e-4);
+  EXPECT_EQ(s.at("diverged"), false);
+  EXPECT_GT(s.at("wall_time_s").get<double>(), 0.0);
+  EXPECT_GT(s.at("particle_steps_per_s").get<double>(), 0.0);
+
+  const auto rows = lines_of(read(out / "series.csv"));
+  ASSERT_EQ(rows.size(), 202u);  // header + monitor_points + 1
+  const std::vector<std::string> expected = {"step",
+                                             "strain_yy",
+                                             "b_xx",
+                                             "b_xy",
+                                             "b_yx",
+                                             "b_yy",
+                                             "s_xx",
+                                             "s_xy",
+                                             "s_yx",
+                                             "s_yy",
+                                             "kinetic_energy",
+                                             "unbalanced_force_ratio",
+                                             "lateral_stress_error"};
+  const auto header = split(rows[0], ',');
+  ASSERT_GE(header.size(), expected.size());
+  EXPECT_EQ(std::vector<std::string>(header.begin(), header.begin() + expected.size()), expected);
+  for (size_t k = 1; k < rows.size(); ++k) {
+    const auto fields = split(rows[k], ',');
+    ASSERT_EQ(fields.size(), header.size()) << "row " << k;
+    for (const auto& f : fields) {
+      char* end = nullptr;
+      std::strtod(f.c_str(), &end);
+      ASSERT_TRUE(end != f.c_str() && *end == '\0') << "row " << k << ": " << f;
+    }
+  }
+  EXPECT_EQ(split(rows[1], ',')[0], "0");
+  EXPECT_EQ(split(rows.back(), ',')[0], "2000");
+
+  expect_valid_vtk(read(out / "final.vtk"), 25);
+}
+
+TEST_F(CliEndToEnd, RunIntoAnExistingFolderAndWithoutVtk) {
+  const fs::path out = dir_ / "work" / "out";
+  fs::create_directories(out);
+  std::ofstream(out / "keep.txt") << "mine\n";
+  const Result r = demcal({"run", kHex5, "--set", "algorithm.steps=2000", "--set",
+                           "output.vtk=false", "-o", out.string()});
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::set<std::string> files;
+  for (const auto& e : fs::directory_iterator(out)) files.insert(e.path().filename().string());
+  EXPECT_EQ(files, (std::set<std::string>{"keep.txt", "summary.json", "series.csv"}));
+  // The default folder is demcal-run-NAME in the working directory.
+  const Result d = demcal({"run", kHex5, "--set", "algorithm.steps=2000", "--set", "name=tiny"});
+  ASSERT_EQ(d.status, 0) << d.err;
+  EXPECT_TRUE(fs::exists(dir_ / "work" / "demcal-run-tiny" / "summary.json"));
+}
+
+// A computation that fails (consolidation gives up) is not bad input: exit
+// 1, one line, and again nothing written.
+TEST_F(CliEndToEnd, FailedConsolidationExitsOneAndWritesNothing) {
+  const std::string config = write(
+      "gas.json",
+      R"({"assembly": {"type": "random", "count": 60}, "test": {"consolidation_max_steps": 1000}})");
+  const Result r = demcal({"run", config, "-o", (dir_ / "work" / "out").string()});
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_EQ(lines_of(r.err).size(), 1u) << r.err;
+  EXPECT_NE(r.err.find("consolidation"), std::string::npos) << r.err;
+  EXPECT_TRUE(work_contents().empty());
+}
+
+// A diverged trial is a result, not a crash: written, flagged, exit 0.
+TEST_F(CliEndToEnd, DivergedRunIsReportedNotFatal) {
+  const fs::path out = dir_ / "work" / "out";
+  const Result r = demcal({"run", kHex5, "--set", "algorithm.dt_ratio=1.5", "--set",
+                           "algorithm.damping_ratio_translation=0", "--set",
+                           "algorithm.damping_ratio_rotation=0", "--set", "algorithm.steps=20000",
+                           "-o", out.string()});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto s = nlohmann::json::parse(read(out / "summary.json"));
+  EXPECT_EQ(s.at("diverged"), true);
+  EXPECT_TRUE(s.at("divergence").at("reason").is_string());
+  EXPECT_LT(s.at("steps_run").get<int>(), 20000);
+  expect_valid_vtk(read(out / "final.vtk"), 25, false);  // finite, counts consistent
+}
+
+}  // namespace
