@@ -38,16 +38,14 @@ double servo_velocity(const World& world, WallSide side, double target_stress, d
       gain * error * length * world.material().thickness / (world.material().wall.kn * contacts);
   // Never more than 2 % of the smallest radius per step (a gas far from the
   // walls is approached at this speed; a packing never gets near it).
-  const auto r = world.radius();
-  const double r_min = r.empty() ? 1.0 : *std::min_element(r.begin(), r.end());
+  const double r_min = world.min_radius();
   move = std::clamp(move, -0.02 * r_min, 0.02 * r_min);
   return kInward[side] * move / dt;
 }
 
 Integration integration_for(const World& world, const AlgorithmSpec& algorithm) {
   // Δt_crit = 2·sqrt(m_min/kn) with the mass scaling of this run.
-  const auto r = world.radius();
-  const double r_min = r.empty() ? 0.0 : *std::min_element(r.begin(), r.end());
+  const double r_min = world.min_radius();
   const Material& mat = world.material();
   const double m_min =
       mat.density * mat.thickness * std::numbers::pi * r_min * r_min * algorithm.mass_scaling;

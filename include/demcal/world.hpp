@@ -162,6 +162,8 @@ class World {
   std::span<const double> rotation() const { return theta_; }
   std::span<const double> omega() const { return omega_; }
   std::span<const double> radius() const { return r_; }
+  double min_radius() const { return r_min_; }
+  double max_radius() const { return r_max_; }
   std::span<const double> mass() const { return m_; }  ///< scaled masses
   std::span<const double> fx() const { return fx_; }   ///< net contact force
   std::span<const double> fy() const { return fy_; }
