@@ -116,6 +116,10 @@ bool parse_number(const std::string& field, double& value) {
 Assembly read_particle_file(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path, "", "cannot open particle file");
+  return read_particles(in, path);
+}
+
+Assembly read_particles(std::istream& in, const std::string& path) {
   Assembly a;
   std::vector<int> lines;  // line of each particle, for the overlap error
   std::string line;
@@ -161,12 +165,20 @@ Assembly read_particle_file(const std::string& path) {
   // (a cell grid keeps the check O(N)).
   const int n = a.size();
   const double r_max = *std::max_element(a.r.begin(), a.r.end());
-  const double cell = 2.0 * r_max;
-  double x0 = a.x[0], y0 = a.y[0];
+  double x0 = a.x[0], y0 = a.y[0], x1 = a.x[0], y1 = a.y[0];
   for (int i = 0; i < n; ++i) {
     x0 = std::min(x0, a.x[i]);
     y0 = std::min(y0, a.y[i]);
+    x1 = std::max(x1, a.x[i]);
+    y1 = std::max(y1, a.y[i]);
   }
+  // Cells of at least 2·r_max, and never more than 2^20 a side (a sparse,
+  // huge domain would otherwise overflow the integer cell keys); larger
+  // cells only cost time, never a missed pair.
+  const double extent = std::max(x1 - x0, y1 - y0);
+  const double cell = std::max(2.0 * r_max, extent / static_cast<double>(1 << 20));
+  if (!std::isfinite(extent) || !std::isfinite(cell) || !(cell > 0.0))
+    throw InputError(path, "", "coordinates span more than a double can hold");
   std::vector<std::pair<int64_t, int>> keyed(n);
   auto cell_of = [&](int i) {
     return std::pair<int64_t, int64_t>(static_cast<int64_t>((a.x[i] - x0) / cell),

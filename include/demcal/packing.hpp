@@ -1,6 +1,7 @@
 // Particle assemblies: generators and the particle-file reader.
 #pragma once
 
+#include <istream>
 #include <string>
 #include <vector>
 
@@ -31,6 +32,8 @@ Assembly random_gas(const AssemblySpec& spec);
 /// CSV x,y,r (header optional, '#' comments); walls at the bounding box.
 /// Errors name the file and the line.
 Assembly read_particle_file(const std::string& path);
+/// The same from a stream; `source` names it in errors.
+Assembly read_particles(std::istream& in, const std::string& source);
 /// Build the assembly a config asks for.
 Assembly make_assembly(const SceneConfig& config);
 
