@@ -1,7 +1,15 @@
-// `demcal calibrate`: the main job. Writes DIR/params.json and
-// DIR/trials.jsonl (appended per trial, so --resume loses nothing).
+// `demcal calibrate`: the main job. Writes DIR/params.json,
+// DIR/trials.jsonl (appended per trial, so --resume loses nothing) and the
+// report, DIR/report.html and DIR/report.md; with --evidence also
+// DIR/evidence.jsonl (the paper-recipe baseline and the reference runs).
+#include <algorithm>
+#include <cctype>
+#include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <iostream>
+#include <optional>
+#include <string_view>
 #include <thread>
 
 #include "commands.hpp"
@@ -9,6 +17,7 @@
 #include "demcal/calibration.hpp"
 #include "demcal/output.hpp"
 #include "demcal/packing.hpp"
+#include "demcal/report.hpp"
 #include "demcal/trial.hpp"
 
 namespace demcal::cli {
@@ -27,6 +36,37 @@ nlohmann::json param_block(const AlgorithmSpec& p, const ReferenceScales& s, int
           {"damping_rotation", p.damping_ratio_rotation * s.damping_rotation_crit},
           {"damping_ratio_rotation", p.damping_ratio_rotation},
           {"mass_scaling", p.mass_scaling}};
+}
+
+/// Shell-quoted for display: the user copies it into a shell.
+std::string shell_word(const std::string& w) {
+  const bool plain = !w.empty() && std::all_of(w.begin(), w.end(), [](unsigned char c) {
+    return std::isalnum(c) || std::string_view("_./=:,+-@%").find(c) != std::string_view::npos;
+  });
+  if (plain) return w;
+  std::string q = "'";
+  for (char c : w) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+std::string reproduce_command(const CalibrateOptions& o, const SceneConfig& config,
+                              const std::string& dir) {
+  std::vector<std::string> args{"demcal", "calibrate"};
+  if (!o.config.empty()) args.push_back(o.config);
+  for (const auto& s : o.sets) {
+    args.push_back("--set");
+    args.push_back(s);
+  }
+  args.insert(args.end(), {"-o", dir, "--max-trials", std::to_string(config.calibration.max_trials),
+                           "--accuracy", nlohmann::json(config.calibration.accuracy).dump(),
+                           "--strategy", o.strategy});
+  if (o.evidence) args.push_back("--evidence");
+  std::string out;
+  for (const auto& a : args) {
+    if (!out.empty()) out += ' ';
+    out += shell_word(a);
+  }
+  return out;
 }
 
 }  // namespace
@@ -105,10 +145,126 @@ int cmd_calibrate(const CalibrateOptions& o) {
       {"config_sha256", sha256_hex(config.text)},
       {"version", DEMCAL_VERSION}};
   if (auto a = analytical_peak_stress(config)) params["analytical_peak_stress_yy"] = *a;
+
+  const bool have_best = summary.best_trial.particle_steps > 0.0;
+  const int jobs = o.jobs > 0 ? o.jobs : std::max(1u, std::thread::hardware_concurrency());
+  auto say = [&](const std::string& line) {
+    if (!o.quiet) std::cerr << "demcal: " << line << "\n";
+  };
+
+  // --evidence: the paper's recipe done mechanically (α = 0.2, ζ = 1,
+  // Nstep doubled from the search's size-based start until it passes) and a
+  // converged reference from the calibrated multipliers.
+  std::optional<BaselineResult> baseline;
+  std::optional<ReferenceEvidence> reference;
+  if (o.evidence && have_best) {
+    say("evidence: paper-recipe baseline and converged reference (8x, 16x Nstep = " +
+        std::to_string(16 * summary.best.steps) + ")");
+    auto run_baseline = [&] {
+      baseline = paper_recipe_baseline(config, state, options.tolerances, 500LL * n_rev);
+    };
+    auto run_reference = [&] {
+      reference = converged_reference(config, state, summary.best, options.tolerances, 1);
+    };
+    if (jobs > 1) {
+      std::exception_ptr error;
+      std::thread t([&] {
+        try {
+          run_baseline();
+        } catch (...) {
+          error = std::current_exception();
+        }
+      });
+      run_reference();
+      t.join();
+      if (error) std::rethrow_exception(error);
+    } else {
+      run_baseline();
+      run_reference();
+    }
+    auto peak_error = [&](const TrialRecord& t) -> nlohmann::json {
+      if (!t.complete || t.diverged || t.criteria.peak_stress_yy >= 0.0) return nullptr;
+      return (reference->peak - t.criteria.peak_stress_yy) / std::abs(reference->peak);
+    };
+    std::string lines;
+    for (const auto* t : {&reference->coarse, &reference->fine}) {
+      nlohmann::json j = to_json(*t);
+      j["peak_error"] = peak_error(*t);
+      lines += j.dump() + "\n";
+    }
+    for (const auto& t : baseline->trials) {
+      nlohmann::json j = to_json(t);
+      j["peak_error"] = peak_error(t);
+      lines += j.dump() + "\n";
+    }
+    write_file_atomic(dir + "/evidence.jsonl", lines);
+    nlohmann::json b{{"passed", baseline->passed},
+                     {"start_steps", 500LL * n_rev},
+                     {"trials", static_cast<int>(baseline->trials.size())},
+                     {"particle_steps_total", baseline->particle_steps_total}};
+    if (baseline->passed) {
+      b["steps"] = baseline->params.steps;
+      b["particle_steps"] = baseline->trials.back().particle_steps;
+      b["peak_stress_yy"] = baseline->trials.back().criteria.peak_stress_yy;
+      b["peak_error"] = peak_error(baseline->trials.back());
+    }
+    params["evidence"] = {
+        {"reference",
+         {{"law", "Richardson, error proportional to 1/Nstep: 2 P(16 Nstep) - P(8 Nstep)"},
+          {"steps_8x", reference->coarse.params.steps},
+          {"peak_stress_yy_8x", reference->coarse.criteria.peak_stress_yy},
+          {"steps_16x", reference->fine.params.steps},
+          {"peak_stress_yy_16x", reference->fine.criteria.peak_stress_yy},
+          {"peak_stress_yy", reference->peak},
+          {"calibrated_peak_error", peak_error(summary.best_trial)}}},
+        {"baseline", b}};
+  }
   write_file_atomic(dir + "/params.json", params.dump(2) + "\n");
 
+  // The report: the start point and the result rerun with their series,
+  // the picture at the peak, then plots and text.
+  std::string report_note;
+  try {
+    const auto t0 = std::chrono::steady_clock::now();
+    ReportInput in;
+    in.scene = config.name;
+    in.command = reproduce_command(o, config, dir);
+    in.params = params;
+    in.summary = summary;
+    in.tolerances = options.tolerances;
+    in.accuracy = options.accuracy;
+    in.lateral_stress = config.test.lateral_stress;
+    in.dt_ratio_max =
+        std::max(options.dt_ratio_min, options.dt_ratio_safety * summary.dt_ratio_stable);
+    in.particles = n_rev;
+    in.prototype_particles = n_proto;
+    in.analytical_peak = analytical_peak_stress(config);
+    in.baseline = std::move(baseline);
+    in.reference = std::move(reference);
+    // The search's first start (calibration.cpp): the paper's multipliers
+    // with a size-based Nstep of 500 per particle, α capped by the bound.
+    AlgorithmSpec start = config.algorithm;
+    start.dt_ratio = std::round(std::min(0.2, in.dt_ratio_max) * 1e6) / 1e6;
+    start.steps = 500LL * n_rev;
+    start.damping_ratio_translation = 1.0;
+    start.damping_ratio_rotation = 1.0;
+    collect_runs(in, config, state, start, jobs);
+    const auto t1 = std::chrono::steady_clock::now();
+    const Report report = make_report(in);
+    write_file_atomic(dir + "/report.html", report.html);
+    write_file_atomic(dir + "/report.md", report.markdown);
+    const auto t2 = std::chrono::steady_clock::now();
+    auto secs = [](auto a, auto b) { return std::chrono::duration<double>(b - a).count(); };
+    say("report: reruns " + std::to_string(secs(t0, t1)) + " s, writing " +
+        std::to_string(secs(t1, t2)) + " s; " + report.plot_status);
+    report_note = ", " + dir + "/report.html, " + dir + "/report.md";
+  } catch (const std::exception& e) {
+    std::cerr << "demcal: warning: the report was not written: " << e.what() << "\n";
+  }
+
   std::cout << summary.BriefReport() << "  wrote " << dir << "/params.json, " << dir
-            << "/trials.jsonl\n";
+            << "/trials.jsonl" << report_note
+            << (o.evidence && have_best ? ", " + dir + "/evidence.jsonl" : "") << "\n";
   return summary.success ? 0 : 1;
 }
 

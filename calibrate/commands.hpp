@@ -2,10 +2,15 @@
 // exit status; bad input is thrown as demcal::InputError (exit 2).
 #pragma once
 
+#include <functional>
 #include <string>
 #include <vector>
 
 #include "demcal/config.hpp"
+
+namespace CLI {
+class App;
+}  // namespace CLI
 
 namespace demcal::cli {
 
@@ -34,7 +39,15 @@ struct CalibrateOptions {
   std::string strategy = "model";
   bool resume = false;
   bool quiet = false;
+  /// Also run the paper-recipe baseline and a converged reference (8× and
+  /// 16× Nstep) for the report's accuracy evidence (costs trials).
+  bool evidence = false;
 };
 int cmd_calibrate(const CalibrateOptions& options);
+
+// Issue #6: upscale, verify, scaling, export, rev (options in
+// upscaling_cli.hpp). Adds the subcommands to `app`; the function returned
+// runs the one that was parsed, or returns -1 when none of them was.
+std::function<int()> add_upscaling_commands(CLI::App& app);
 
 }  // namespace demcal::cli

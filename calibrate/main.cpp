@@ -48,6 +48,11 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"model", "cobyla", "auglag", "penalty", "direct"}));
   calibrate->add_flag("--resume", cal.resume, "continue from DIR/trials.jsonl");
   calibrate->add_flag("-q,--quiet", cal.quiet, "no progress lines on stderr");
+  calibrate->add_flag("--evidence", cal.evidence,
+                      "also run the paper-recipe baseline and a converged reference (8x and 16x "
+                      "Nstep) so the report shows every trial's peak error");
+
+  const auto run_upscaling = add_upscaling_commands(app);  // upscale, verify, scaling, export, rev
 
   CLI11_PARSE(app, argc, argv);
   try {
@@ -55,6 +60,7 @@ int main(int argc, char** argv) {
     if (run->parsed()) return cmd_run(config_path, sets, out_dir);
     if (sweep->parsed()) return cmd_sweep(sweep_options);
     if (calibrate->parsed()) return cmd_calibrate(cal);
+    if (const int status = run_upscaling(); status >= 0) return status;
   } catch (const demcal::InputError& e) {
     std::cerr << "demcal: error: " << e.what() << "\n";
     return kBadInput;

@@ -1,0 +1,480 @@
+// The calibration report (report.html, report.md): well-formed HTML that
+// references nothing outside itself, the same facts in the Markdown, plots
+// inline when gnuplot is there and a clear note when it is not.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "demcal/report.hpp"
+
+namespace fs = std::filesystem;
+using namespace demcal;
+
+namespace {
+
+std::string lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return s;
+}
+
+/// A small HTML5 checker: every element closed in order (void elements and
+/// XML-style self-closing tags excepted), attributes quoted or bare without
+/// '<', no stray '<', every '&' an entity, raw text of <style>/<script>
+/// skipped, one <html> root. Returns "" when well-formed, else the problem
+/// and where.
+std::string html_problem(const std::string& h) {
+  static const std::vector<std::string> kVoid{"area",   "base",  "br",    "col",  "embed",
+                                              "hr",     "img",   "input", "link", "meta",
+                                              "source", "track", "wbr"};
+  std::vector<std::string> stack;
+  int roots = 0;
+  auto where = [&](size_t i) {
+    const size_t a = i > 60 ? i - 60 : 0;
+    return " at offset " + std::to_string(i) + ": ..." + h.substr(a, 120) + "...";
+  };
+  size_t i = 0;
+  while (i < h.size()) {
+    const char c = h[i];
+    if (c == '&') {
+      size_t j = i + 1;
+      if (j < h.size() && h[j] == '#') ++j;
+      const size_t start = j;
+      while (j < h.size() && std::isalnum(static_cast<unsigned char>(h[j]))) ++j;
+      if (j == start || j >= h.size() || h[j] != ';') return "bare '&'" + where(i);
+      i = j + 1;
+      continue;
+    }
+    if (c != '<') {
+      ++i;
+      continue;
+    }
+    if (h.compare(i, 4, "<!--") == 0) {
+      const size_t e = h.find("-->", i + 4);
+      if (e == std::string::npos) return "unterminated comment" + where(i);
+      i = e + 3;
+      continue;
+    }
+    if (h.compare(i, 2, "<!") == 0) {
+      const size_t e = h.find('>', i);
+      if (e == std::string::npos) return "unterminated declaration" + where(i);
+      i = e + 1;
+      continue;
+    }
+    const bool closing = i + 1 < h.size() && h[i + 1] == '/';
+    size_t j = i + (closing ? 2 : 1);
+    const size_t name_start = j;
+    while (j < h.size() && (std::isalnum(static_cast<unsigned char>(h[j])) || h[j] == '-' ||
+                            h[j] == ':' || h[j] == '_'))
+      ++j;
+    if (j == name_start) return "stray '<'" + where(i);
+    const std::string name = lower(h.substr(name_start, j - name_start));
+    // Attributes up to '>', quotes respected.
+    bool self_closing = false;
+    while (j < h.size() && h[j] != '>') {
+      if (h[j] == '"' || h[j] == '\'') {
+        const size_t e = h.find(h[j], j + 1);
+        if (e == std::string::npos) return "unterminated attribute value" + where(j);
+        if (h.substr(j, e - j).find('<') != std::string::npos)
+          return "'<' inside an attribute value" + where(j);
+        j = e + 1;
+        continue;
+      }
+      if (h[j] == '<') return "'<' inside a tag" + where(j);
+      if (h[j] == '/' && j + 1 < h.size() && h[j + 1] == '>') self_closing = true;
+      ++j;
+    }
+    if (j >= h.size()) return "unterminated tag <" + name + where(i);
+    i = j + 1;
+    if (closing) {
+      if (stack.empty()) return "</" + name + "> without an open element" + where(i);
+      if (stack.back() != name) return "</" + name + "> closes <" + stack.back() + ">" + where(i);
+      stack.pop_back();
+      continue;
+    }
+    if (self_closing || std::find(kVoid.begin(), kVoid.end(), name) != kVoid.end()) continue;
+    if (stack.empty()) {
+      if (name != "html") return "content outside <html>: <" + name + ">" + where(i);
+      ++roots;
+    }
+    if (name == "style" || name == "script") {
+      const size_t e = lower(h).find("</" + name, i);
+      if (e == std::string::npos) return "unterminated <" + name + ">" + where(i);
+      i = e;
+    }
+    stack.push_back(name);
+  }
+  if (!stack.empty()) return "unclosed <" + stack.back() + "> at the end";
+  if (roots != 1) return "expected one <html> root, found " + std::to_string(roots);
+  return "";
+}
+
+/// Everything that would make the page fetch something: URLs, src=,
+/// <link>, @import, url() other than a local #fragment, href other than
+/// a #fragment.
+std::vector<std::string> external_references(const std::string& html) {
+  const std::string h = lower(html);
+  std::vector<std::string> out;
+  for (const char* bad : {"http:", "https:", "ftp:", "file:", "src=", "<link", "@import", "<iframe",
+                          "<object", "<embed"})
+    if (h.find(bad) != std::string::npos) out.push_back(bad);
+  for (size_t k = 0; (k = h.find("url(", k)) != std::string::npos; k += 4) {
+    size_t j = k + 4;
+    while (j < h.size() && (h[j] == ' ' || h[j] == '\'' || h[j] == '"')) ++j;
+    if (j >= h.size() || h[j] != '#') out.push_back("url(" + h.substr(k + 4, 30));
+  }
+  for (size_t k = 0; (k = h.find("href=", k)) != std::string::npos; k += 5) {
+    size_t j = k + 5;
+    if (j < h.size() && (h[j] == '"' || h[j] == '\'')) ++j;
+    if (j >= h.size() || h[j] != '#') out.push_back("href=" + h.substr(k + 5, 30));
+  }
+  return out;
+}
+
+int count(const std::string& s, const std::string& what) {
+  int n = 0;
+  for (size_t k = 0; (k = s.find(what, k)) != std::string::npos; k += what.size()) ++n;
+  return n;
+}
+
+/// A loading run with the shape of the hexagonal scene's: linear rise to a
+/// peak, softening; σ trails b by `gap`; the servo lags by `servo`.
+LoadingResult synthetic_run(int64_t steps, double gap, double servo) {
+  LoadingResult r;
+  r.particles = 100;
+  r.steps_planned = r.steps_run = steps;
+  r.scales.dt_crit = 9e-6;
+  r.integration.dt = 0.25 * 9e-6;
+  const int m = 60;
+  for (int k = 0; k <= m; ++k) {
+    MonitorPoint p;
+    p.step = steps * k / m;
+    const double e = 0.01 * k / m;  // compressive strain
+    p.strain_yy = -e;
+    const double q = e < 0.005 ? 1e5 + 1.1e8 * e : 6.5e5 - 2e6 * (e - 0.005);
+    p.b << -1e5 * (1 + servo * k / m), -3e3 * e / 0.01, -3e3 * e / 0.01, -q;
+    p.sigma = p.b;
+    p.sigma(0, 0) *= 1.0 + gap * k / m;
+    p.sigma(1, 1) *= 1.0 + 0.2 * gap * k / m;
+    p.lateral_stress_error = servo * k / m;
+    r.series.push_back(p);
+  }
+  const Peak peak = find_peak(r.series);
+  r.peak_stress_yy = peak.stress_yy;
+  r.peak_strain_yy = peak.strain_yy;
+  return r;
+}
+
+TrialRecord trial(int id, const std::string& phase, double alpha, int64_t steps, double fb,
+                  bool passed, bool complete = true, bool diverged = false) {
+  TrialRecord t;
+  t.id = id;
+  t.phase = phase;
+  t.params.dt_ratio = alpha;
+  t.params.steps = steps;
+  t.params.damping_ratio_translation = 0.5;
+  t.params.damping_ratio_rotation = 0.0;
+  t.criteria.force_balance = fb;
+  t.criteria.moment_balance = 1e-7;
+  t.criteria.servo = 0.002;
+  t.criteria.oscillation = 1e-6;
+  t.criteria.peak_stress_yy = -6.2e5 * (1.0 + 2e4 / static_cast<double>(steps));
+  t.passed = passed;
+  t.complete = complete;
+  t.diverged = diverged;
+  if (diverged) t.criteria.force_balance = std::numeric_limits<double>::infinity();
+  t.steps_run = complete ? steps : steps / 3;
+  t.particle_steps = 100.0 * static_cast<double>(steps);
+  t.wall_time_s = 1e-8 * static_cast<double>(t.steps_run) * 100.0;
+  t.diagnosis = passed
+                    ? "quasi-static: every criterion is within tolerance"
+                    : "b and sigma disagree <smoothly> & the loading is too fast | increase steps";
+  return t;
+}
+
+ReportInput synthetic_input(bool evidence) {
+  ReportInput in;
+  in.scene = "synthetic_<scene>";
+  in.command = "demcal calibrate configs/x.json -o 'out dir' --max-trials 80";
+  in.accuracy = 0.02;
+  in.lateral_stress = 1e5;
+  in.dt_ratio_max = 0.277;
+  in.particles = 100;
+  in.prototype_particles = 40000;
+  in.analytical_peak = -7.48e5;
+  auto& S = in.summary;
+  S.success = true;
+  S.message = "calibrated: every criterion passed";
+  S.strategy = "model";
+  S.dt_ratio_stable = 0.292;
+  S.trials = {trial(0, "search", 0.2, 50000, 0.03, false),
+              trial(1, "search", 0.27, 25060, 0.05, false, false),
+              trial(2, "search", 0.9, 25060, 0.05, false, false, true),
+              trial(3, "verify", 0.277, 89370, 0.0075, true),
+              trial(4, "verify", 0.277, 85000, 0.0085, false),
+              trial(5, "certificate", 0.277, 178740, 0.004, true)};
+  S.best_trial = S.trials[3];
+  S.best = S.best_trial.params;
+  S.certificate = {89370, -6.255e5, -6.232e5, 0.0037, 0.0074, true};
+  S.trials_run = 6;
+  S.wall_time_s = 7.5;
+  in.params = {{"rev",
+                {{"particles", 100},
+                 {"dt_ratio", 0.277},
+                 {"dt", 2.5e-6},
+                 {"dt_crit", 9.1e-6},
+                 {"steps", 89370},
+                 {"damping_ratio_translation", 0.5},
+                 {"damping_translation", 456.0},
+                 {"damping_ratio_rotation", 0.0},
+                 {"damping_rotation", 0.0},
+                 {"mass_scaling", 1.0}}},
+               {"prototype",
+                {{"particles", 40000},
+                 {"dt_ratio", 0.277},
+                 {"dt", 2.5e-6},
+                 {"dt_crit", 9.1e-6},
+                 {"steps", 35748000},
+                 {"damping_ratio_translation", 0.5},
+                 {"damping_translation", 456.0},
+                 {"damping_ratio_rotation", 0.0},
+                 {"damping_rotation", 0.0},
+                 {"mass_scaling", 1.0}}},
+               {"config_sha256", "abc123"},
+               {"seed", 1},
+               {"version", "test"}};
+  Tolerances tol;
+  in.tolerances = tol;
+  for (int k = 0; k < 2; ++k) {
+    ReportRun r;
+    r.label = k == 0 ? "start point" : "calibrated";
+    r.params = k == 0 ? S.trials[0].params : S.best;
+    r.run = synthetic_run(r.params.steps, k == 0 ? 0.03 : 0.002, k == 0 ? 0.004 : 0.002);
+    r.score = score_run(r.run, in.lateral_stress, tol);
+    (k == 0 ? in.start : in.best) = r;
+  }
+  AssemblyPicture pic;
+  pic.x = {1e-3, 2e-3, 1.5e-3};
+  pic.y = {1e-3, 1e-3, 1.866e-3};
+  pic.r = {5e-4, 5e-4, 5e-4};
+  pic.rotation = {0.01, -0.02, 0.0};
+  pic.left = 5e-4;
+  pic.right = 2.5e-3;
+  pic.bottom = 5e-4;
+  pic.top = 2.4e-3;
+  pic.forces = {{1e-3, 1e-3, 2e-3, 1e-3, 300.0, false}, {1e-3, 1e-3, 1e-3, 5e-4, 500.0, true}};
+  pic.step = 44000;
+  pic.steps = 89370;
+  pic.strain_yy = -0.005;
+  pic.stress_yy = -6.25e5;
+  in.picture = pic;
+  if (evidence) {
+    BaselineResult b;
+    b.trials = {trial(0, "baseline", 0.2, 50000, 0.03, false),
+                trial(1, "baseline", 0.2, 100000, 0.015, false),
+                trial(2, "baseline", 0.2, 200000, 0.006, true)};
+    b.passed = true;
+    b.params = b.trials.back().params;
+    b.particle_steps_total = 3.5e7;
+    in.baseline = b;
+    ReferenceEvidence ref;
+    ref.coarse = trial(0, "reference", 0.277, 8 * 89370, 0.001, true);
+    ref.fine = trial(1, "reference", 0.277, 16 * 89370, 0.0005, true);
+    ref.fine_series = synthetic_run(16 * 89370, 0.0, 0.0).series;
+    ref.peak = 2 * ref.fine.criteria.peak_stress_yy - ref.coarse.criteria.peak_stress_yy;
+    in.reference = ref;
+  }
+  return in;
+}
+
+void expect_well_formed_and_self_contained(const Report& r) {
+  EXPECT_EQ(html_problem(r.html), "");
+  EXPECT_EQ(external_references(r.html), std::vector<std::string>{});
+  EXPECT_EQ(r.html.rfind("<!DOCTYPE html>", 0), 0u);
+  // User text is escaped, in the HTML and kept readable in the Markdown.
+  EXPECT_NE(r.html.find("synthetic_&lt;scene&gt;"), std::string::npos);
+  EXPECT_EQ(r.html.find("<scene>"), std::string::npos);
+  EXPECT_NE(r.markdown.find("\\| increase steps"), std::string::npos);
+}
+
+/// The facts a user needs first, present in both files.
+void expect_facts(const Report& r) {
+  for (const char* fact :
+       {"89,370", "35,748,000", "0.277", "2.5e-06", "456", "0.740 %",
+        "The answer: calibrated parameters", "Convergence certificate",
+        "demcal calibrate configs/x.json -o &#39;out dir&#39;", "Diagnosis in words",
+        "Search history", "Speed against accuracy", "Pareto front", "Upscaling to the prototype",
+        "The assembly at the peak"}) {
+    const std::string f = fact;
+    EXPECT_NE(r.html.find(f), std::string::npos) << "HTML lacks " << f;
+    std::string md;  // the Markdown has the apostrophes the HTML escapes
+    for (size_t k = 0; k < f.size(); ++k) {
+      if (f.compare(k, 5, "&#39;") == 0) {
+        md += '\'';
+        k += 4;
+      } else {
+        md += f[k];
+      }
+    }
+    EXPECT_NE(r.markdown.find(md), std::string::npos) << "Markdown lacks " << md;
+  }
+}
+
+}  // namespace
+
+TEST(Report, CheckerCatchesWhatItShould) {
+  const std::string ok =
+      "<!DOCTYPE html><html><head><meta charset=\"utf-8\"><style>a<b</style>"
+      "</head><body><p>x &amp; y</p><svg><path d='M0 0'/></svg></body></html>";
+  EXPECT_EQ(html_problem(ok), "");
+  EXPECT_NE(html_problem("<html><body><p>x</body></html>"), "");  // </body> closes <p>
+  EXPECT_NE(html_problem("<html><body><p>x</p>"), "");            // unclosed
+  EXPECT_NE(html_problem("<html><p>a < b</p></html>"), "");       // stray '<'
+  EXPECT_NE(html_problem("<html><p>a & b</p></html>"), "");       // bare '&'
+  EXPECT_NE(html_problem("<html></html><html></html>"), "");      // two roots
+  EXPECT_FALSE(external_references("<img src=\"x.png\">").empty());
+  EXPECT_FALSE(external_references("<a href=\"https://x\">").empty());
+  EXPECT_FALSE(external_references("<link rel=stylesheet href=a.css>").empty());
+  EXPECT_FALSE(external_references("<rect fill=\"url(pic.png)\"/>").empty());
+  EXPECT_TRUE(external_references("<use xlink:href='#gpPt1'/><rect fill=\"url(#g)\"/>").empty());
+}
+
+TEST(Report, WithoutGnuplotEveryNumberAndHowToGetThePlots) {
+  ReportOptions options;
+  options.gnuplot = "demcal-test-no-such-gnuplot";
+  for (bool evidence : {false, true}) {
+    const Report r = make_report(synthetic_input(evidence), options);
+    EXPECT_FALSE(r.plots);
+    expect_well_formed_and_self_contained(r);
+    expect_facts(r);
+    EXPECT_NE(r.html.find("apt-get install gnuplot-nox"), std::string::npos);
+    EXPECT_NE(r.plot_status.find("apt-get install gnuplot-nox"), std::string::npos);
+    // The assembly picture needs no gnuplot.
+    EXPECT_EQ(count(r.html, "<svg"), 1);
+    EXPECT_NE(r.html.find("class=\"assembly\""), std::string::npos);
+    // The start point's diagnosis and the rejected neighbour are in words.
+    EXPECT_NE(r.markdown.find("Start point (α 0.2, Nstep 50,000"), std::string::npos);
+    EXPECT_NE(r.markdown.find("Nstep 85,000 (-5 %)"), std::string::npos);
+    if (evidence) {
+      EXPECT_NE(r.markdown.find("converged reference 2·P(16N) − P(8N)"), std::string::npos);
+      EXPECT_NE(r.markdown.find("paper's recipe done mechanically"), std::string::npos);
+      EXPECT_NE(r.markdown.find("| b2 |"), std::string::npos);
+    } else {
+      EXPECT_NE(r.markdown.find("measured with --evidence"), std::string::npos);
+    }
+  }
+}
+
+TEST(Report, WithGnuplotThePlotsAreInlineAndDeterministic) {
+  if (find_program("gnuplot").empty())
+    GTEST_SKIP() << "gnuplot is not installed (apt-get install gnuplot-nox): plot checks skipped";
+  const ReportInput in = synthetic_input(true);
+  const Report r = make_report(in);
+  EXPECT_TRUE(r.plots) << r.plot_status;
+  expect_well_formed_and_self_contained(r);
+  expect_facts(r);
+  // Panels a, b, lateral, servo, history, speed, upscaling + the assembly.
+  EXPECT_EQ(count(r.html, "<svg"), 8);
+  EXPECT_EQ(count(r.html, "class=\"plot"), 7);
+  EXPECT_EQ(r.html.find("<?xml"), std::string::npos);
+  EXPECT_EQ(r.html.find("apt-get install gnuplot-nox"), std::string::npos);
+  // Ids are unique across the inline figures.
+  EXPECT_EQ(count(r.html, "id='g0-gpPt1'"), 1);
+  EXPECT_EQ(count(r.html, "id='gpPt1'"), 0);
+  // Same input, same bytes.
+  EXPECT_EQ(make_report(in).html, r.html);
+}
+
+TEST(Report, AFailedCalibrationStillReportsWhatItTried) {
+  ReportInput in = synthetic_input(false);
+  in.summary.success = false;
+  in.summary.message = "no trial passed every criterion within 6 trials";
+  in.summary.best_trial = TrialRecord{};
+  in.summary.best = AlgorithmSpec{};
+  in.summary.certificate = Certificate{};
+  in.summary.trials.erase(in.summary.trials.begin() + 3);
+  in.best.reset();
+  in.picture.reset();
+  in.params = nlohmann::json::object();
+  for (const std::string gnuplot : {"demcal-test-no-such-gnuplot", "gnuplot"}) {
+    ReportOptions options;
+    options.gnuplot = gnuplot;
+    const Report r = make_report(in, options);
+    EXPECT_EQ(html_problem(r.html), "") << gnuplot;
+    EXPECT_EQ(external_references(r.html), std::vector<std::string>{});
+    EXPECT_NE(r.markdown.find("**FAILURE**: no trial passed"), std::string::npos);
+    EXPECT_NE(r.markdown.find("No trial passed every criterion"), std::string::npos);
+    EXPECT_NE(r.markdown.find("Start point (α 0.2"), std::string::npos);
+    EXPECT_NE(r.markdown.find("The answer: no parameter set passed"), std::string::npos);
+  }
+}
+
+TEST(Report, GnuplotRunnerNeedsNoShell) {
+  std::string error;
+  auto none = run_gnuplot("demcal-test-no-such-gnuplot", "", {}, {"a.svg"}, &error);
+  EXPECT_TRUE(none.empty());
+  EXPECT_NE(error.find("not found"), std::string::npos);
+  if (find_program("gnuplot").empty()) GTEST_SKIP() << "gnuplot is not installed";
+  // A data file name with shell metacharacters is only ever a file name.
+  auto out = run_gnuplot("gnuplot",
+                         "set terminal svg\nset output 'a.svg'\nplot 'd;$(x).dat' u 1:2 w l\n"
+                         "unset output\n",
+                         {{"d;$(x).dat", "0 0\n1 1\n"}}, {"a.svg"}, &error);
+  ASSERT_EQ(out.count("a.svg"), 1u) << error;
+  EXPECT_NE(out["a.svg"].find("</svg>"), std::string::npos);
+  // A failing script reports gnuplot's complaint.
+  out = run_gnuplot("gnuplot", "set nonsense_option\n", {}, {"a.svg"}, &error);
+  EXPECT_TRUE(out.empty());
+  EXPECT_NE(error.find("gnuplot failed"), std::string::npos);
+}
+
+TEST(Report, CalibrateWritesBothFiles) {
+  const fs::path dir =
+      fs::temp_directory_path() / ("demcal_test_report_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  const pid_t pid = fork();
+  if (pid == 0) {
+    const std::string out = dir.string();
+    freopen("/dev/null", "w", stdout);
+    execl(DEMCAL_BINARY, DEMCAL_BINARY, "calibrate", "-q", "--jobs", "2", "-o", out.c_str(),
+          DEMCAL_SOURCE_DIR "/configs/hex_5x5.json", static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  int status = 0;
+  waitpid(pid, &status, 0);
+  // 0: calibrated, 1: the calibration failed; the report is written either way.
+  ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) <= 1);
+  auto read = [](const fs::path& p) {
+    std::ifstream f(p);
+    std::stringstream s;
+    s << f.rdbuf();
+    return s.str();
+  };
+  const std::string html = read(dir / "report.html"), md = read(dir / "report.md");
+  EXPECT_EQ(html_problem(html), "");
+  EXPECT_EQ(external_references(html), std::vector<std::string>{});
+  for (const char* section :
+       {"The answer:", "Convergence certificate", "Start point and result", "Diagnosis in words",
+        "Speed against accuracy", "The assembly at the peak"}) {
+    EXPECT_NE(html.find(section), std::string::npos) << section;
+    EXPECT_NE(md.find(section), std::string::npos) << section;
+  }
+  EXPECT_NE(html.find("class=\"assembly\""), std::string::npos);
+  if (!find_program("gnuplot").empty()) {
+    EXPECT_GE(count(html, "class=\"plot"), 6);
+  }
+  // No temporary files left behind.
+  for (const auto& e : fs::directory_iterator(dir))
+    EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos) << e.path();
+  fs::remove_all(dir);
+}
