@@ -127,7 +127,8 @@ int cmd_calibrate(const CalibrateOptions& o) {
       {"rev", param_block(summary.best, scales, n_rev)},
       {"prototype", param_block(proto, scales, n_proto)},
       {"upscaling", {{"law", "linear"}, {"factor", static_cast<double>(n_proto) / n_rev}}},
-      {"criteria", to_json(summary.best_trial.criteria)},
+      {"criteria", summary.best_trial.criteria_json.is_null() ? to_json(summary.best_trial.criteria)
+                                                              : summary.best_trial.criteria_json},
       {"tolerances", to_json(options.tolerances)},
       {"accuracy", options.accuracy},
       {"certificate",

@@ -92,6 +92,7 @@ TrialRecord run_trial(const SceneConfig& config, const ConsolidatedState& state,
   TrialRecord r;
   r.params = params;
   r.criteria = score.criteria;
+  r.criteria_json = to_json(score.criteria);
   r.passed = score.passed;
   r.diverged = score.diverged;
   r.complete = score.complete;
@@ -108,7 +109,7 @@ nlohmann::json to_json(const TrialRecord& r) {
   return {{"id", r.id},
           {"phase", r.phase},
           {"params", params_to_json(r.params)},
-          {"criteria", to_json(r.criteria)},
+          {"criteria", r.criteria_json.is_null() ? to_json(r.criteria) : r.criteria_json},
           {"peak_stress_yy", r.criteria.peak_stress_yy},
           {"peak_strain_yy", r.criteria.peak_strain_yy},
           {"passed", r.passed},
@@ -134,23 +135,24 @@ TrialRecord trial_from_json(const nlohmann::json& j, const std::string& source) 
     r.params.mass_scaling = p.at("mass_scaling").get<double>();
     r.params.lock_rotation = p.at("lock_rotation").get<bool>();
     const auto& c = j.at("criteria");
+    r.criteria_json = c;
     auto& k = r.criteria;
-    k.force_balance = c.at("force_balance").get<double>();
-    k.force_balance_paper = c.at("force_balance_paper").get<double>();
-    k.force_balance_xx = c.at("force_balance_xx").get<double>();
-    k.force_balance_yy = c.at("force_balance_yy").get<double>();
-    k.force_balance_xy = c.at("force_balance_xy").get<double>();
-    k.force_balance_yx = c.at("force_balance_yx").get<double>();
-    k.moment_balance = c.at("moment_balance").get<double>();
-    k.servo = c.at("servo").get<double>();
-    k.oscillation = c.at("oscillation").get<double>();
-    k.zigzag = c.at("zigzag").get<double>();
-    k.post_peak_softening = c.at("post_peak_softening").get<double>();
-    k.plateau_spread = c.at("plateau_spread").get<double>();
-    k.kinetic_energy_ratio_max = c.at("kinetic_energy_ratio_max").get<double>();
-    k.unbalanced_force_ratio_mean = c.at("unbalanced_force_ratio_mean").get<double>();
-    k.unbalanced_force_ratio_max = c.at("unbalanced_force_ratio_max").get<double>();
-    k.inertial_number_max = c.at("inertial_number_max").get<double>();
+    k.force_balance = c.value("force_balance", 0.0);
+    k.force_balance_paper = c.value("force_balance_paper", 0.0);
+    k.force_balance_xx = c.value("force_balance_xx", 0.0);
+    k.force_balance_yy = c.value("force_balance_yy", 0.0);
+    k.force_balance_xy = c.value("force_balance_xy", 0.0);
+    k.force_balance_yx = c.value("force_balance_yx", 0.0);
+    k.moment_balance = c.value("moment_balance", 0.0);
+    k.servo = c.value("servo", 0.0);
+    k.oscillation = c.value("oscillation", 0.0);
+    k.zigzag = c.value("zigzag", 0.0);
+    k.post_peak_softening = c.value("post_peak_softening", 0.0);
+    k.plateau_spread = c.value("plateau_spread", 0.0);
+    k.kinetic_energy_ratio_max = c.value("kinetic_energy_ratio_max", 0.0);
+    k.unbalanced_force_ratio_mean = c.value("unbalanced_force_ratio_mean", 0.0);
+    k.unbalanced_force_ratio_max = c.value("unbalanced_force_ratio_max", 0.0);
+    k.inertial_number_max = c.value("inertial_number_max", 0.0);
     k.peak_stress_yy = j.at("peak_stress_yy").get<double>();
     k.peak_strain_yy = j.at("peak_strain_yy").get<double>();
     r.passed = j.at("passed").get<bool>();

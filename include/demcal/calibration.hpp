@@ -63,6 +63,9 @@ struct TrialRecord {
   std::string phase;  ///< search, certificate, baseline, reference
   AlgorithmSpec params;
   Criteria criteria;
+  /// to_json(criteria) as written to trials.jsonl; a resumed trial keeps the
+  /// stored object, so its params.json is the same as an uninterrupted run's.
+  nlohmann::json criteria_json;
   bool passed = false, diverged = false, complete = true;
   double worst_excess = 0.0;
   int64_t steps_run = 0;
