@@ -23,9 +23,7 @@ namespace {
 
 using demcal_bench::Scene;
 
-int64_t preload_steps(int n) {
-  return std::clamp<int64_t>(20'000'000 / std::max(n, 1), 200, 2000);
-}
+int64_t preload_steps(int n) { return std::clamp<int64_t>(20'000'000 / std::max(n, 1), 200, 2000); }
 int64_t chunk_steps(int n) { return std::max<int64_t>(32, 4'000'000 / std::max(n, 1)); }
 
 // The timed steps restart from a fresh pre-loaded packing (outside the
@@ -33,12 +31,13 @@ int64_t chunk_steps(int n) { return std::max<int64_t>(32, 4'000'000 / std::max(n
 // strain and every case measures the same lightly compressed state.
 constexpr int64_t kMaxSteps = 100'000;
 
-void run_case(benchmark::State& state, const Scene& scene) {
+void run_case(benchmark::State& state, const Scene& scene, int threads = 1) {
   std::unique_ptr<demcal::World> world;
   int64_t since_reset = 0, rebuilds = 0, steps = 0;
   auto reset = [&] {
     if (world) rebuilds += world->rebuilds();
     world = demcal_bench::make_compression_world(scene);
+    world->set_threads(threads);
     const bool ok = world->step(preload_steps(world->size()));
     rebuilds -= world->rebuilds();
     since_reset = 0;
@@ -70,9 +69,9 @@ void run_case(benchmark::State& state, const Scene& scene) {
   rebuilds += world->rebuilds();
   const auto m = world->measure();
   state.counters["particles"] = n;
-  state.counters["particle_steps/s"] =
-      benchmark::Counter(static_cast<double>(n) * static_cast<double>(steps),
-                         benchmark::Counter::kIsRate);
+  state.counters["threads"] = world->threads();
+  state.counters["particle_steps/s"] = benchmark::Counter(
+      static_cast<double>(n) * static_cast<double>(steps), benchmark::Counter::kIsRate);
   state.counters["steps/s"] =
       benchmark::Counter(static_cast<double>(steps), benchmark::Counter::kIsRate);
   state.counters["contacts"] = m.particle_contacts;
@@ -89,15 +88,31 @@ void BM_StepHex(benchmark::State& state) {
 }
 BENCHMARK(BM_StepHex)
     ->ArgName("side")
-    ->Arg(10)    // 100
-    ->Arg(20)    // 400
-    ->Arg(32)    // 1 024
-    ->Arg(50)    // 2 500
-    ->Arg(71)    // 5 041
-    ->Arg(100)   // 10 000
-    ->Arg(141)   // 19 881
-    ->Arg(224)   // 50 176
-    ->Arg(316)   // 99 856
+    ->Arg(10)   // 100
+    ->Arg(20)   // 400
+    ->Arg(32)   // 1 024
+    ->Arg(50)   // 2 500
+    ->Arg(71)   // 5 041
+    ->Arg(100)  // 10 000
+    ->Arg(141)  // 19 881
+    ->Arg(224)  // 50 176
+    ->Arg(316)  // 99 856
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(1.0)
+    ->UseRealTime();
+
+// The large hexagonal cases on 2 threads (KernelOptions::threads): compare
+// with BM_StepHex of the same size. Real (wall-clock) time: the machine must
+// have two idle cores for the figure to mean anything.
+void BM_StepHexThreads(benchmark::State& state) {
+  const int side = static_cast<int>(state.range(0));
+  run_case(state, demcal_bench::hex_scene(side, side), static_cast<int>(state.range(1)));
+}
+BENCHMARK(BM_StepHexThreads)
+    ->ArgNames({"side", "threads"})
+    ->Args({100, 2})  // 10 000
+    ->Args({224, 2})  // 50 176
+    ->Args({316, 2})  // 99 856
     ->Unit(benchmark::kMillisecond)
     ->MinTime(1.0)
     ->UseRealTime();
@@ -116,4 +131,11 @@ BENCHMARK(BM_StepRandom)->Unit(benchmark::kMillisecond)->MinTime(1.0)->UseRealTi
 
 }  // namespace
 
-BENCHMARK_MAIN();
+int main(int argc, char** argv) {
+  benchmark::AddCustomContext("demcal_simd", demcal::kernel_simd());
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

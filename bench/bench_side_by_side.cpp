@@ -4,6 +4,7 @@
 //
 //   bench_side_by_side --scene hex --n 400 --steps 50000 --preload 2000
 //   bench_side_by_side --scene hex --n 400 --write-lammps /tmp/hex400 --no-run
+//   bench_side_by_side --scene hex --n 100000 --steps 400 --threads 2
 //
 // Output: one line of key=value pairs, e.g.
 //   engine=demcal scene=hex_20x20 particles=400 steps=50000 seconds=0.31
@@ -14,11 +15,11 @@
 // LAMMPS reports as −Σ stress/atom (pair) — the cross-check that both codes
 // see the same contact network under the same load.
 #include <chrono>
-#include <ctime>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <ctime>
 #include <fstream>
 #include <numbers>
 #include <string>
@@ -30,7 +31,7 @@ namespace {
 void usage() {
   std::fprintf(stderr,
                "usage: bench_side_by_side [--scene hex|random] [--n N] [--steps S] "
-               "[--preload P] [--write-lammps PREFIX] [--no-run]\n");
+               "[--preload P] [--threads T] [--write-lammps PREFIX] [--no-run]\n");
 }
 
 // LAMMPS data (atom_style sphere) + variables for bench/lammps/in.compress.
@@ -52,8 +53,7 @@ void write_lammps(const demcal_bench::Scene& s, const demcal::World& w, const st
       // sphere value 0.4·m·r², not the disk's 0.5·m·r².)
       const double r = s.r[i];
       const double dens = 0.75 * rho * t / r;
-      f << i + 1 << " 1 " << 2.0 * r << " " << dens << " " << s.x[i] << " " << s.y[i]
-        << " 0\n";
+      f << i + 1 << " 1 " << 2.0 * r << " " << dens << " " << s.x[i] << " " << s.y[i] << " 0\n";
     }
   }
   // Mean per-particle critical damping, as one global viscous coefficient.
@@ -61,7 +61,8 @@ void write_lammps(const demcal_bench::Scene& s, const demcal::World& w, const st
   for (size_t i = 0; i < s.x.size(); ++i) {
     const double m = rho * std::numbers::pi * s.r[i] * s.r[i] * t;
     mass_sum += m;
-    gamma += w.integration().damping_ratio_translation * 2.0 * std::sqrt(s.material.particle.kn * m);
+    gamma +=
+        w.integration().damping_ratio_translation * 2.0 * std::sqrt(s.material.particle.kn * m);
   }
   gamma /= static_cast<double>(s.x.size());
   std::ofstream v(prefix + ".vars");
@@ -75,8 +76,8 @@ void write_lammps(const demcal_bench::Scene& s, const demcal::World& w, const st
   v << "variable muw equal " << s.material.wall.friction << "\n";
   v << "variable dt equal " << w.integration().dt << "\n";
   v << "variable gamma equal " << gamma << "\n";
-  v << "variable skin equal " << w.options().skin_ratio * demcal_bench::kRadius *
-                                     (s.name.rfind("random", 0) == 0 ? 0.8 : 1.0)
+  v << "variable skin equal "
+    << w.options().skin_ratio * demcal_bench::kRadius * (s.name.rfind("random", 0) == 0 ? 0.8 : 1.0)
     << "\n";
   v << "variable wleft equal " << s.left << "\n";
   v << "variable wright equal " << s.right << "\n";
@@ -92,7 +93,7 @@ void write_lammps(const demcal_bench::Scene& s, const demcal::World& w, const st
 
 int main(int argc, char** argv) {
   std::string scene_kind = "hex", lammps_prefix;
-  int n = 400;
+  int n = 400, threads = 1;
   int64_t steps = 10000, preload = 2000;
   bool run = true;
   for (int a = 1; a < argc; ++a) {
@@ -103,18 +104,27 @@ int main(int argc, char** argv) {
       }
       return argv[++a];
     };
-    if (!std::strcmp(argv[a], "--scene")) scene_kind = next();
-    else if (!std::strcmp(argv[a], "--n")) n = std::atoi(next());
-    else if (!std::strcmp(argv[a], "--steps")) steps = std::atoll(next());
-    else if (!std::strcmp(argv[a], "--preload")) preload = std::atoll(next());
-    else if (!std::strcmp(argv[a], "--write-lammps")) lammps_prefix = next();
-    else if (!std::strcmp(argv[a], "--no-run")) run = false;
+    if (!std::strcmp(argv[a], "--scene"))
+      scene_kind = next();
+    else if (!std::strcmp(argv[a], "--n"))
+      n = std::atoi(next());
+    else if (!std::strcmp(argv[a], "--steps"))
+      steps = std::atoll(next());
+    else if (!std::strcmp(argv[a], "--preload"))
+      preload = std::atoll(next());
+    else if (!std::strcmp(argv[a], "--write-lammps"))
+      lammps_prefix = next();
+    else if (!std::strcmp(argv[a], "--threads"))
+      threads = std::atoi(next());
+    else if (!std::strcmp(argv[a], "--no-run"))
+      run = false;
     else {
       usage();
       return 2;
     }
   }
-  if (n < 1 || steps < 1 || preload < 0 || (scene_kind != "hex" && scene_kind != "random")) {
+  if (n < 1 || steps < 1 || preload < 0 || threads < 1 ||
+      (scene_kind != "hex" && scene_kind != "random")) {
     usage();
     return 2;
   }
@@ -128,6 +138,7 @@ int main(int argc, char** argv) {
   auto world = demcal_bench::make_compression_world(scene);
   if (!lammps_prefix.empty()) write_lammps(scene, *world, lammps_prefix, steps, preload);
   if (!run) return 0;
+  world->set_threads(threads);
 
   if (!world->step(preload)) {
     std::fprintf(stderr, "diverged during pre-load: %s\n", demcal::to_string(world->divergence()));
@@ -161,9 +172,10 @@ int main(int argc, char** argv) {
   std::printf(
       "engine=demcal scene=%s particles=%d steps=%lld seconds=%.6f cpu_seconds=%.6f "
       "particle_steps_per_s=%.6e contacts=%d wall_contacts=%d Wxx_pair=%.6e Wyy_pair=%.6e "
-      "rebuilds=%lld\n",
+      "rebuilds=%lld threads=%d simd=%s\n",
       scene.name.c_str(), world->size(), static_cast<long long>(steps), sec, cpu,
       world->size() * static_cast<double>(steps) / sec, m.particle_contacts, m.wall_contacts, wxx,
-      wyy, static_cast<long long>(world->rebuilds() - rebuilds0));
+      wyy, static_cast<long long>(world->rebuilds() - rebuilds0), world->threads(),
+      demcal::kernel_simd());
   return 0;
 }

@@ -3,6 +3,7 @@
 // benchmark; every other case changes one parameter.
 #include <iomanip>
 #include <iostream>
+#include <sstream>
 
 #include "commands.hpp"
 #include "demcal/biaxial.hpp"
@@ -53,20 +54,20 @@ int cmd_sweep(const SweepOptions& options) {
             << result.false_rejects << "\n";
   for (const auto& r : result.cases) {
     if (r.spec.group != "benchmark" && r.spec.group != "atlas") continue;
-    std::cout << "  " << std::left << std::setw(20) << r.spec.name << std::right;
-    if (r.run.diverged)
-      std::cout << " diverged      ";
-    else
-      std::cout << " peak " << std::setw(6) << std::fixed << std::setprecision(3)
-                << -r.score.criteria.peak_stress_yy / s3 << " "
-                << (r.score.criteria.peak_error
-                        ? (*r.score.criteria.peak_error >= 0 ? "+" : "") +
-                              std::to_string(100.0 * *r.score.criteria.peak_error).substr(0, 5) +
-                              "%"
-                        : std::string(""));
-    std::cout << "  " << (r.score.passed ? "PASS" : "FAIL") << "  " << r.score.diagnosis.message
-              << "\n"
-              << std::defaultfloat;
+    std::ostringstream line;
+    line << "  " << std::left << std::setw(18) << r.spec.name << std::right;
+    if (r.run.diverged) {
+      line << "  diverged          ";
+    } else {
+      line << "  peak " << std::fixed << std::setprecision(3) << std::setw(7)
+           << -r.score.criteria.peak_stress_yy / s3;
+      if (r.score.criteria.peak_error)
+        line << " " << std::showpos << std::setprecision(1) << std::setw(6)
+             << 100.0 * *r.score.criteria.peak_error << "%" << std::noshowpos;
+    }
+    line << "  " << (r.score.passed ? "PASS" : "FAIL") << "  " << r.score.diagnosis.parameter
+         << (r.score.diagnosis.direction.empty() ? "" : " " + r.score.diagnosis.direction);
+    std::cout << line.str() << "\n";
   }
   std::cout << "  wrote " << dir << "/atlas.md, atlas.json, evidence.csv, series/*.csv\n";
   return 0;

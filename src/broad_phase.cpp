@@ -1,6 +1,11 @@
 // Broad phase: cell grid + Verlet skin. The neighbour list holds every pair
 // closer than r_i + r_j + skin; it is rebuilt only when some particle (or a
-// wall) has moved far enough that a pair outside the list could touch.
+// wall) has moved far enough that a pair outside the list could touch (the
+// displacement scan is fused into the integration pass, solver.cpp).
+//
+// The list is full (each pair from both sides) and stored as sliced
+// ELLPACK in blocks of 8 particles (world.hpp). The tangential history of a
+// pair carries over a rebuild in both of its copies.
 #include <algorithm>
 #include <cmath>
 
@@ -8,11 +13,14 @@
 
 namespace demcal {
 
+namespace {
+constexpr int kBlock = 8;
+}
+
 bool World::needs_rebuild() const {
   if (!list_valid_) return true;
-  const int n = size();
   double max_d2 = 0.0;
-  for (int i = 0; i < n; ++i) {
+  for (int i = 0; i < n_; ++i) {
     const double dx = x_[i] - x_built_[i];
     const double dy = y_[i] - y_built_[i];
     max_d2 = std::max(max_d2, dx * dx + dy * dy);
@@ -21,13 +29,11 @@ bool World::needs_rebuild() const {
   double max_wall = 0.0;
   for (int w = 0; w < 4; ++w)
     max_wall = std::max(max_wall, std::abs(walls_[w].position - wall_built_[w]));
-  // Two particles approach each other by at most 2·max_disp; a particle and
-  // a wall by max_disp + max_wall.
   return 2.0 * max_disp >= skin_ || max_disp + max_wall >= skin_;
 }
 
 void World::rebuild_neighbours() {
-  const int n = size();
+  const int n = n_;
   ++rebuilds_;
   // Grid over the box (particles that left it are clamped to the edge cells).
   const double cell = 2.0 * r_max_ + skin_;
@@ -48,7 +54,6 @@ void World::rebuild_neighbours() {
     cx = std::isfinite(fx) ? std::clamp(static_cast<int>(std::floor(fx)), 0, ncx - 1) : 0;
     cy = std::isfinite(fy) ? std::clamp(static_cast<int>(std::floor(fy)), 0, ncy - 1) : 0;
   };
-  // Insert in reverse so that each cell's list runs in increasing index.
   for (int i = n - 1; i >= 0; --i) {
     int cx, cy;
     cell_of(i, cx, cy);
@@ -57,12 +62,14 @@ void World::rebuild_neighbours() {
     cell_start_[c] = i;
   }
 
-  new_i_.clear();
-  new_j_.clear();
+  // Full neighbour lists (CSR), each sorted by index. The cut-off test is
+  // symmetric in i and j bit for bit, so j is i's neighbour iff i is j's.
+  nbr_start_.assign(static_cast<size_t>(n) + 1, 0);
+  nbr_list_.clear();
   for (int i = 0; i < n; ++i) {
     int cx, cy;
     cell_of(i, cx, cy);
-    const size_t first = new_j_.size();
+    const size_t first = nbr_list_.size();
     for (int dy = -1; dy <= 1; ++dy) {
       const int yy = cy + dy;
       if (yy < 0 || yy >= ncy) continue;
@@ -70,36 +77,58 @@ void World::rebuild_neighbours() {
         const int xx = cx + dx;
         if (xx < 0 || xx >= ncx) continue;
         for (int j = cell_start_[yy * ncx + xx]; j >= 0; j = cell_next_[j]) {
-          if (j <= i) continue;
+          if (j == i) continue;
           const double ddx = x_[j] - x_[i], ddy = y_[j] - y_[i];
           const double cut = r_[i] + r_[j] + skin_;
-          if (ddx * ddx + ddy * ddy < cut * cut) {
-            new_i_.push_back(i);
-            new_j_.push_back(j);
-          }
+          if (ddx * ddx + ddy * ddy < cut * cut) nbr_list_.push_back(j);
         }
       }
     }
-    // Keep (i, j) sorted so that history carries over by a linear merge.
-    std::sort(new_j_.begin() + static_cast<std::ptrdiff_t>(first), new_j_.end());
+    std::sort(nbr_list_.begin() + static_cast<std::ptrdiff_t>(first), nbr_list_.end());
+    nbr_start_[i + 1] = static_cast<int>(nbr_list_.size());
   }
 
-  // Carry the tangential history of pairs present in both lists.
-  const size_t np = new_i_.size();
-  new_ft_.assign(np, 0.0);
-  size_t o = 0;
-  const size_t no = pair_i_.size();
-  for (size_t k = 0; k < np; ++k) {
-    const int64_t key = static_cast<int64_t>(new_i_[k]) * n + new_j_[k];
-    while (o < no && static_cast<int64_t>(pair_i_[o]) * n + pair_j_[o] < key) ++o;
-    if (o < no && pair_i_[o] == new_i_[k] && pair_j_[o] == new_j_[k]) new_ft_[k] = pair_ft_[o];
+  // Sliced ELLPACK: block b gets as many rows as its longest list.
+  new_block_slot_.assign(static_cast<size_t>(nblocks_) + 1, 0);
+  for (int b = 0; b < nblocks_; ++b) {
+    int rows = 0;
+    for (int i = kBlock * b; i < std::min(n, kBlock * (b + 1)); ++i)
+      rows = std::max(rows, nbr_start_[i + 1] - nbr_start_[i]);
+    new_block_slot_[b + 1] = new_block_slot_[b] + kBlock * rows;
   }
-  pair_i_.swap(new_i_);
-  pair_j_.swap(new_j_);
-  pair_ft_.swap(new_ft_);
-  pair_fn_.assign(np, 0.0);
-  pair_nx_.assign(np, 0.0);
-  pair_ny_.assign(np, 0.0);
+  const size_t ns = static_cast<size_t>(new_block_slot_[nblocks_]);
+  new_slot_j_.assign(ns, ghost_);
+  new_slot_ft_.assign(ns, 0.0);
+  new_slot_r_.assign(ns, 0.0);
+  pair_i_.clear();
+  pair_j_.clear();
+  pair_slot_.clear();
+  for (int i = 0; i < n; ++i) {
+    const int b = i / kBlock, lane = i % kBlock;
+    const int nb = new_block_slot_[b] + lane, ob = block_slot_[b] + lane;
+    const int old_end = block_slot_[b + 1];
+    // Carry the tangential history over by a merge of the two sorted lists
+    // (old slots of i run in increasing j, then ghosts).
+    int o = ob;
+    for (int k = nbr_start_[i]; k < nbr_start_[i + 1]; ++k) {
+      const int j = nbr_list_[k];
+      const int s = nb + kBlock * (k - nbr_start_[i]);
+      new_slot_j_[s] = j;
+      new_slot_r_[s] = r_[j];
+      while (o < old_end && slot_j_[o] < j) o += kBlock;
+      if (o < old_end && slot_j_[o] == j) new_slot_ft_[s] = slot_ft_[o];
+      if (j > i) {
+        pair_i_.push_back(i);
+        pair_j_.push_back(j);
+        pair_slot_.push_back(s);
+      }
+    }
+  }
+  block_slot_.swap(new_block_slot_);
+  slot_j_.swap(new_slot_j_);
+  slot_ft_.swap(new_slot_ft_);
+  slot_r_.swap(new_slot_r_);
+  update_thread_bounds();
 
   // Wall candidates: particles within skin of a wall.
   for (int s = 0; s < 4; ++s) wall_candidates_[s].clear();
@@ -117,8 +146,8 @@ void World::rebuild_neighbours() {
     }
   }
 
-  x_built_ = x_;
-  y_built_ = y_;
+  std::copy(x_.begin(), x_.begin() + n, x_built_.begin());
+  std::copy(y_.begin(), y_.begin() + n, y_built_.begin());
   for (int s = 0; s < 4; ++s) wall_built_[s] = walls_[s].position;
   list_valid_ = true;
 }

@@ -3,14 +3,114 @@
 //   v(n+½) = [(1 − D·Δt/2m)·v(n−½) + F·Δt/m] / (1 + D·Δt/2m)
 // with D = ζ_t·2·sqrt(kn·m) per particle (and ζ_r·2·sqrt(kt·r²·I) for ω),
 // so every particle has the same damping ratio.
+//
+// Threads (KernelOptions::threads > 1): a team of workers shares the two
+// SIMD passes of each step — integrate and the pair forces — by ranges of
+// particle blocks; the rest (walls, neighbour-list rebuilds, divergence
+// checks) runs on the calling thread. Each particle's force is summed by one
+// thread in its own fixed order, and the maxima the passes return are
+// exact, so results are bit-identical for any thread count.
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
+#include <thread>
 
 #include "demcal/world.hpp"
 
+#if defined(__x86_64__) || defined(__i386__)
+#include <immintrin.h>
+#define DEMCAL_PAUSE() _mm_pause()
+#else
+#define DEMCAL_PAUSE() ((void)0)
+#endif
+
 namespace demcal {
+
+namespace detail {
+
+// Fork-join team: run(fn, ctx) calls fn(ctx, t) for t = 0 .. size − 1, t = 0
+// on the calling thread, and returns when all are done. Workers spin briefly
+// and then sleep on the epoch counter (the machine may be shared).
+class KernelTeam {
+ public:
+  explicit KernelTeam(int size) : size_(size) {
+    for (int t = 1; t < size; ++t) workers_.emplace_back([this, t] { work(t); });
+  }
+  ~KernelTeam() {
+    stop_.store(true, std::memory_order_relaxed);
+    epoch_.fetch_add(1, std::memory_order_release);
+    epoch_.notify_all();
+    for (auto& w : workers_) w.join();
+  }
+  KernelTeam(const KernelTeam&) = delete;
+  KernelTeam& operator=(const KernelTeam&) = delete;
+  int size() const { return size_; }
+
+  void run(void (*fn)(void*, int), void* ctx) {
+    fn_ = fn;
+    ctx_ = ctx;
+    pending_.store(size_ - 1, std::memory_order_relaxed);
+    epoch_.fetch_add(1, std::memory_order_release);
+    epoch_.notify_all();
+    fn(ctx, 0);
+    for (int spin = 0;; ++spin) {
+      const int left = pending_.load(std::memory_order_acquire);
+      if (left == 0) break;
+      if (spin < kSpin)
+        DEMCAL_PAUSE();
+      else
+        pending_.wait(left, std::memory_order_acquire);
+    }
+  }
+
+ private:
+  static constexpr int kSpin = 4000;
+  void work(int t) {
+    uint64_t seen = 0;
+    for (;;) {
+      uint64_t now;
+      for (int spin = 0;; ++spin) {
+        now = epoch_.load(std::memory_order_acquire);
+        if (now != seen) break;
+        if (spin < kSpin)
+          DEMCAL_PAUSE();
+        else
+          epoch_.wait(seen, std::memory_order_acquire);
+      }
+      seen = now;
+      if (stop_.load(std::memory_order_relaxed)) return;
+      fn_(ctx_, t);
+      if (pending_.fetch_sub(1, std::memory_order_acq_rel) == 1) pending_.notify_one();
+    }
+  }
+
+  int size_;
+  std::vector<std::thread> workers_;
+  std::atomic<uint64_t> epoch_{0};
+  std::atomic<int> pending_{0};
+  std::atomic<bool> stop_{false};
+  void (*fn_)(void*, int) = nullptr;
+  void* ctx_ = nullptr;
+};
+
+TeamHandle::TeamHandle() noexcept = default;
+TeamHandle::TeamHandle(const TeamHandle&) noexcept {}
+TeamHandle::TeamHandle(TeamHandle&&) noexcept = default;
+TeamHandle& TeamHandle::operator=(const TeamHandle&) noexcept {
+  team.reset();
+  return *this;
+}
+TeamHandle& TeamHandle::operator=(TeamHandle&&) noexcept = default;
+TeamHandle::~TeamHandle() = default;
+
+}  // namespace detail
+
+namespace {
+constexpr int kBlock = 8;
+constexpr double kFar = 1e100;  // padding lanes at (+kFar, +kFar), the ghost at (−kFar, −kFar)
+}  // namespace
 
 const char* to_string(Divergence d) {
   switch (d) {
@@ -35,35 +135,107 @@ World::World(const Material& material, std::span<const double> x, std::span<cons
     throw std::invalid_argument("World: x, y and radius differ in length");
   if (!(right > left) || !(top > bottom))
     throw std::invalid_argument("World: walls must enclose a positive area");
-  x_.assign(x.begin(), x.end());
-  y_.assign(y.begin(), y.end());
-  r_.assign(radius.begin(), radius.end());
-  for (double r : r_)
+  if (n > static_cast<size_t>(1) << 28) throw std::invalid_argument("World: too many particles");
+  for (double r : radius)
     if (!(r > 0.0) || !std::isfinite(r)) throw std::invalid_argument("World: radius must be > 0");
-  vx_.assign(n, 0.0);
-  vy_.assign(n, 0.0);
-  theta_.assign(n, 0.0);
-  omega_.assign(n, 0.0);
-  fx_.assign(n, 0.0);
-  fy_.assign(n, 0.0);
-  tq_.assign(n, 0.0);
-  m_.resize(n);
-  inertia_.resize(n);
-  ca_t_.resize(n);
-  cb_t_.resize(n);
-  ca_r_.resize(n);
-  cb_r_.resize(n);
+  n_ = static_cast<int>(n);
+  nblocks_ = (n_ + kBlock - 1) / kBlock;
+  ghost_ = kBlock * nblocks_;
+  const size_t cap = static_cast<size_t>(ghost_) + kBlock;  // padding, ghost, one spare block
+  auto init = [&](Array& a, double value) { a.assign(cap, value); };
+  init(x_, kFar);
+  init(y_, kFar);
+  std::copy(x.begin(), x.end(), x_.begin());
+  std::copy(y.begin(), y.end(), y_.begin());
+  x_[ghost_] = y_[ghost_] = -kFar;
+  init(r_, 0.0);
+  std::copy(radius.begin(), radius.end(), r_.begin());
+  init(inv_r_, 0.0);
+  for (int i = 0; i < n_; ++i) inv_r_[i] = 1.0 / r_[i];
+  for (Array* a : {&vx_, &vy_, &theta_, &omega_, &fx_, &fy_, &tq_, &m_, &inertia_, &ca_t_, &cb_t_,
+                   &ca_r_, &cb_r_})
+    init(*a, 0.0);
+  x_built_ = x_;
+  y_built_ = y_;
   for (auto& h : wall_ft_) h.assign(n, 0.0);
   for (auto& h : wall_fn_) h.assign(n, 0.0);
-  r_min_ = n ? *std::min_element(r_.begin(), r_.end()) : 1.0;
-  r_max_ = n ? *std::max_element(r_.begin(), r_.end()) : 1.0;
+  block_slot_.assign(static_cast<size_t>(nblocks_) + 1, 0);
+  r_min_ = n ? *std::min_element(radius.begin(), radius.end()) : 1.0;
+  r_max_ = n ? *std::max_element(radius.begin(), radius.end()) : 1.0;
   skin_ = options_.skin_ratio * r_min_;
   walls_[kLeft].position = left;
   walls_[kRight].position = right;
   walls_[kBottom].position = bottom;
   walls_[kTop].position = top;
+  set_threads(options_.threads);
   set_integration(integration_);
   update_forces();
+}
+
+void World::set_threads(int threads) {
+  if (threads < 0) throw std::invalid_argument("World: threads must be >= 0");
+  if (threads == 0) threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  options_.threads = threads;
+  threads_ = threads;
+  if (team_.team && team_.team->size() != active_threads()) team_.team.reset();
+  update_thread_bounds();
+}
+
+int World::active_threads() const {
+  // At least 8 blocks (64 particles) per thread, or the hand-over costs
+  // more than it saves.
+  return std::max(1, std::min({threads_, nblocks_ / 8, 64}));
+}
+
+void World::update_thread_bounds() {
+  const int t = active_threads();
+  particle_bounds_.assign(static_cast<size_t>(t) + 1, 0);
+  pair_bounds_.assign(static_cast<size_t>(t) + 1, 0);
+  for (int k = 0; k <= t; ++k)
+    particle_bounds_[k] = static_cast<int>(static_cast<int64_t>(nblocks_) * k / t);
+  // Pair pass: equal shares of slots (block_slot_ is non-decreasing).
+  const int64_t total = block_slot_.back();
+  int b = 0;
+  for (int k = 1; k < t; ++k) {
+    const int64_t target = total * k / t;
+    while (b < nblocks_ && block_slot_[b] < target) ++b;
+    pair_bounds_[k] = b;
+  }
+  pair_bounds_[t] = nblocks_;
+}
+
+double World::run_pair_pass() {
+  const int t = active_threads();
+  if (t <= 1) return pair_pass(0, nblocks_);
+  if (!team_.team) team_.team = std::make_unique<detail::KernelTeam>(t);
+  struct Ctx {
+    World* w;
+    double out[64];
+  } ctx{this, {}};
+  team_.team->run(
+      [](void* p, int k) {
+        auto* c = static_cast<Ctx*>(p);
+        c->out[k] = c->w->pair_pass(c->w->pair_bounds_[k], c->w->pair_bounds_[k + 1]);
+      },
+      &ctx);
+  return *std::max_element(ctx.out, ctx.out + t);
+}
+
+double World::run_integrate_pass() {
+  const int t = active_threads();
+  if (t <= 1) return integrate_pass(0, nblocks_);
+  if (!team_.team) team_.team = std::make_unique<detail::KernelTeam>(t);
+  struct Ctx {
+    World* w;
+    double out[64];
+  } ctx{this, {}};
+  team_.team->run(
+      [](void* p, int k) {
+        auto* c = static_cast<Ctx*>(p);
+        c->out[k] = c->w->integrate_pass(c->w->particle_bounds_[k], c->w->particle_bounds_[k + 1]);
+      },
+      &ctx);
+  return *std::max_element(ctx.out, ctx.out + t);
 }
 
 void World::set_integration(const Integration& integration) {
@@ -122,21 +294,17 @@ void World::update_forces() {
 }
 
 void World::integrate() {
-  const int n = size();
-  const double dt = integration_.dt;
-  for (int i = 0; i < n; ++i) {
-    vx_[i] = ca_t_[i] * vx_[i] + cb_t_[i] * fx_[i];
-    vy_[i] = ca_t_[i] * vy_[i] + cb_t_[i] * fy_[i];
-    x_[i] += vx_[i] * dt;
-    y_[i] += vy_[i] * dt;
-  }
-  if (!integration_.lock_rotation) {
-    for (int i = 0; i < n; ++i) {
-      omega_[i] = ca_r_[i] * omega_[i] + cb_r_[i] * tq_[i];
-      theta_[i] += omega_[i] * dt;
-    }
-  }
-  for (auto& w : walls_) w.position += w.velocity * dt;
+  // Fused with the displacement scan of the neighbour-list check.
+  const double max_d2 = run_integrate_pass();
+  for (auto& w : walls_) w.position += w.velocity * integration_.dt;
+  if (!list_valid_) return;
+  const double max_disp = std::sqrt(max_d2);
+  double max_wall = 0.0;
+  for (int w = 0; w < 4; ++w)
+    max_wall = std::max(max_wall, std::abs(walls_[w].position - wall_built_[w]));
+  // Two particles approach each other by at most 2·max_disp; a particle and
+  // a wall by max_disp + max_wall.
+  if (2.0 * max_disp >= skin_ || max_disp + max_wall >= skin_) list_valid_ = false;
 }
 
 bool World::check_divergence() {
@@ -157,10 +325,7 @@ bool World::check_divergence() {
   for (int i = 0; i < n; ++i)
     ke += m_[i] * (vx_[i] * vx_[i] + vy_[i] * vy_[i]) + inertia_[i] * omega_[i] * omega_[i];
   ke *= 0.5;
-  double el = 0.0;
-  const double kn = material_.particle.kn, kt = material_.particle.kt;
-  for (size_t k = 0; k < pair_fn_.size(); ++k)
-    el += 0.5 * (pair_fn_[k] * pair_fn_[k] / kn + (kt > 0 ? pair_ft_[k] * pair_ft_[k] / kt : 0.0));
+  const double el = pair_elastic_energy();
   energy_scale_ = std::max({energy_scale_, el, initial_energy_});
   if (!std::isfinite(ke) ||
       (energy_scale_ > 0.0 && ke > options_.max_energy_ratio * energy_scale_)) {
@@ -179,7 +344,7 @@ bool World::step(int64_t count) {
   const int interval = std::max(1, options_.check_interval);
   for (int64_t s = 0; s < count; ++s) {
     integrate();
-    if (needs_rebuild()) rebuild_neighbours();
+    if (!list_valid_) rebuild_neighbours();
     compute_forces();
     ++steps_;
     time_ += integration_.dt;

@@ -184,12 +184,11 @@ StabilityEstimate World::stability_estimate(int iterations) const {
   // A sliding contact can stick again: count its tangential spring too.
   const double kt = material_.particle.friction > 0.0 ? material_.particle.kt : 0.0;
   for (size_t k = 0; k < pair_i_.size(); ++k) {
-    if (pair_fn_[k] <= 0.0) continue;
     const int i = pair_i_[k], j = pair_j_[k];
-    const double d = std::hypot(x_[j] - x_[i], y_[j] - y_[i]);
-    const double overlap = r_[i] + r_[j] - d;
+    const PairState p = pair_state(i, j);
+    if (p.fn <= 0.0) continue;
     contacts.push_back(
-        {i, j, pair_nx_[k], pair_ny_[k], r_[i] - 0.5 * overlap, r_[j] - 0.5 * overlap, kn, kt});
+        {i, j, p.nx, p.ny, r_[i] - 0.5 * p.overlap, r_[j] - 0.5 * p.overlap, kn, kt});
   }
   constexpr double kNormals[4][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}};
   const double kw = material_.wall.kn;

@@ -3,6 +3,9 @@
 //   σ_ij = (1/V) Σ_p Σ_{c∈p} (x^c − x^p)_i f^c_j   (wall contacts included)
 // For a particle pair the two particles' terms add up to (x^j − x^i) ⊗ f_i,
 // independent of where the contact point sits; f_i is the force on i.
+// Pair normals and normal forces are not stored by the force pass; they are
+// re-evaluated here from the positions by the contact law's own formulas
+// (World::pair_state), the tangential forces read from the list.
 #include <cmath>
 #include <numbers>
 
@@ -29,11 +32,12 @@ Measures World::measure(double strain_rate) const {
   const double kn = material_.particle.kn, kt = material_.particle.kt;
 
   for (size_t k = 0; k < pair_i_.size(); ++k) {
-    const double fn = pair_fn_[k];
-    if (fn <= 0.0 && pair_ft_[k] == 0.0) continue;
     const int i = pair_i_[k], j = pair_j_[k];
-    const double nx = pair_nx_[k], ny = pair_ny_[k];
-    const double ft = pair_ft_[k];
+    const double ft = slot_ft_[pair_slot_[k]];
+    const PairState p = pair_state(i, j);
+    const double fn = p.fn;
+    if (fn <= 0.0 && ft == 0.0) continue;
+    const double nx = p.nx, ny = p.ny;
     const Eigen::Vector2d f(-fn * nx - ft * ny, -fn * ny + ft * nx);  // on i
     const Eigen::Vector2d branch(x_[j] - x_[i], y_[j] - y_[i]);
     sigma += branch * f.transpose();
@@ -102,10 +106,11 @@ Eigen::Matrix2d World::net_force_moment() const {
 std::vector<World::ContactView> World::contacts() const {
   std::vector<ContactView> out;
   for (size_t k = 0; k < pair_i_.size(); ++k) {
-    if (pair_fn_[k] <= 0.0 && pair_ft_[k] == 0.0) continue;
     const int i = pair_i_[k], j = pair_j_[k];
-    const double d = std::hypot(x_[j] - x_[i], y_[j] - y_[i]);
-    out.push_back({i, j, pair_nx_[k], pair_ny_[k], pair_fn_[k], pair_ft_[k], r_[i] + r_[j] - d});
+    const double ft = slot_ft_[pair_slot_[k]];
+    const PairState p = pair_state(i, j);
+    if (p.fn <= 0.0 && ft == 0.0) continue;
+    out.push_back({i, j, p.nx, p.ny, p.fn, ft, p.overlap});
   }
   return out;
 }

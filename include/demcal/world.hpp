@@ -6,11 +6,27 @@
 // the integrator (solver.cpp), the stress measures (stress.cpp) and the
 // stability estimates (stability.cpp) are one file each. The kernel knows
 // nothing about biaxial tests or calibration.
+//
+// Layout for speed (reports/performance.md): particles are processed in
+// blocks of 8 (arrays padded to whole blocks, 64-byte aligned). Every
+// particle keeps its full neighbour list — each pair appears twice, once
+// from either side — in a sliced-ELLPACK layout: block b holds rows of 8
+// slots, slot (row, lane) being the row-th neighbour of particle 8b + lane
+// (a ghost index where a lane has fewer neighbours). A pair is thus
+// evaluated twice, but a particle's force is a plain sum over its own slots:
+// no scatter, SIMD lanes never conflict, and each particle's summation order
+// (its neighbours in increasing index, then the walls) does not depend on
+// how blocks are shared among threads. Both copies of a pair compute
+// bit-identical forces (the formulas are symmetric under i <-> j), so the
+// two copies of the tangential history never drift apart.
 #pragma once
 
 #include <Eigen/Core>
 #include <array>
+#include <cstddef>
 #include <cstdint>
+#include <memory>
+#include <new>
 #include <span>
 #include <string>
 #include <vector>
@@ -114,7 +130,54 @@ struct KernelOptions {
   /// Kinetic energy beyond this multiple of max(elastic energy, work scale)
   /// means energy is growing without bound.
   double max_energy_ratio = 1e3;
+  /// Threads that share one World's step (1: the calling thread only). Worth
+  /// it from about 10^4 particles; small REVs stay single-threaded (a
+  /// calibration runs trials in parallel instead). Results are bit-identical
+  /// for any thread count. 0 means std::thread::hardware_concurrency().
+  int threads = 1;
 };
+
+/// The SIMD code path the kernel uses on this machine: "avx512" (x86-64-v4),
+/// "avx2" (x86-64-v3) or "sse2" (any x86-64), chosen once at start-up from
+/// the CPU (DEMCAL_SIMD=sse2|avx2|avx512 in the environment overrides it, for
+/// benchmarks). Results are deterministic on a given path; the paths with
+/// FMA may differ from the sse2 one in the last bits.
+const char* kernel_simd();
+
+namespace detail {
+/// 64-byte aligned storage for the particle and slot arrays (one SIMD
+/// register of 8 doubles per load).
+template <class T>
+struct AlignedAllocator {
+  using value_type = T;
+  AlignedAllocator() noexcept = default;
+  template <class U>
+  AlignedAllocator(const AlignedAllocator<U>&) noexcept {}
+  T* allocate(std::size_t n) {
+    return static_cast<T*>(::operator new(n * sizeof(T), std::align_val_t(64)));
+  }
+  void deallocate(T* p, std::size_t) noexcept { ::operator delete(p, std::align_val_t(64)); }
+  template <class U>
+  bool operator==(const AlignedAllocator<U>&) const noexcept {
+    return true;
+  }
+};
+template <class T>
+using AlignedVector = std::vector<T, AlignedAllocator<T>>;
+
+class KernelTeam;  // worker threads of one World (solver.cpp)
+/// Owns a World's worker threads. Copying a World does not copy its threads:
+/// the copy starts its own on first use.
+struct TeamHandle {
+  std::unique_ptr<KernelTeam> team;
+  TeamHandle() noexcept;
+  TeamHandle(const TeamHandle&) noexcept;
+  TeamHandle(TeamHandle&&) noexcept;
+  TeamHandle& operator=(const TeamHandle&) noexcept;
+  TeamHandle& operator=(TeamHandle&&) noexcept;
+  ~TeamHandle();
+};
+}  // namespace detail
 
 /// A 2D assembly of disks in a rectangular box of four walls.
 class World {
@@ -128,6 +191,9 @@ class World {
   const Integration& integration() const { return integration_; }
   const Material& material() const { return material_; }
   const KernelOptions& options() const { return options_; }
+  /// Threads for stepping this World (see KernelOptions::threads).
+  void set_threads(int threads);
+  int threads() const { return threads_; }
   /// Set the friction coefficient of particle–particle contacts (used by
   /// consolidation: frictionless compression, then friction on).
   void set_particle_friction(double mu) { material_.particle.friction = mu; }
@@ -154,20 +220,20 @@ class World {
   Eigen::Matrix2d net_force_moment() const;
 
   // --- state access (flat arrays) ----------------------------------------
-  int size() const { return static_cast<int>(x_.size()); }
-  std::span<const double> x() const { return x_; }
-  std::span<const double> y() const { return y_; }
-  std::span<const double> vx() const { return vx_; }
-  std::span<const double> vy() const { return vy_; }
-  std::span<const double> rotation() const { return theta_; }
-  std::span<const double> omega() const { return omega_; }
-  std::span<const double> radius() const { return r_; }
+  int size() const { return n_; }
+  std::span<const double> x() const { return view(x_); }
+  std::span<const double> y() const { return view(y_); }
+  std::span<const double> vx() const { return view(vx_); }
+  std::span<const double> vy() const { return view(vy_); }
+  std::span<const double> rotation() const { return view(theta_); }
+  std::span<const double> omega() const { return view(omega_); }
+  std::span<const double> radius() const { return view(r_); }
   double min_radius() const { return r_min_; }
   double max_radius() const { return r_max_; }
-  std::span<const double> mass() const { return m_; }  ///< scaled masses
-  std::span<const double> fx() const { return fx_; }   ///< net contact force
-  std::span<const double> fy() const { return fy_; }
-  std::span<const double> torque() const { return tq_; }
+  std::span<const double> mass() const { return view(m_); }  ///< scaled masses
+  std::span<const double> fx() const { return view(fx_); }   ///< net contact force
+  std::span<const double> fy() const { return view(fy_); }
+  std::span<const double> torque() const { return view(tq_); }
 
   /// Direct state edits for tests and scene set-up; they invalidate the
   /// neighbour list. With rotation locked, the spin ω is ignored (kept 0).
@@ -197,42 +263,73 @@ class World {
   void update_forces();
 
  private:
+  using Array = detail::AlignedVector<double>;
+  std::span<const double> view(const Array& a) const { return {a.data(), static_cast<size_t>(n_)}; }
+
   // broad_phase.cpp
   void rebuild_neighbours();
-  bool needs_rebuild() const;
-  // contact.cpp
+  bool needs_rebuild() const;  // full displacement scan (after edits)
+  // contact.cpp: the SIMD passes over blocks [b0, b1), and the walls
+  double pair_pass(int b0, int b1);       // returns the largest overlap/r
+  double integrate_pass(int b0, int b1);  // returns the largest displacement²
+  void wall_pass();
   void compute_forces();
+  /// Geometry and normal force of the pair (i, j) in the current state,
+  /// exactly as the contact law evaluates it (for measures and views).
+  struct PairState {
+    double nx, ny, overlap, fn;
+    bool touching;
+  };
+  PairState pair_state(int i, int j) const;
+  double pair_elastic_energy() const;  // Σ_pairs fn²/2kn + ft²/2kt
   // solver.cpp
   void integrate();
   void update_damping_coefficients();
   bool check_divergence();
+  // The SIMD passes over all blocks, shared among the threads (solver.cpp).
+  double run_pair_pass();
+  double run_integrate_pass();
+  int active_threads() const;   // threads worth using for this size
+  void update_thread_bounds();  // particle_bounds_ and pair_bounds_
 
   Material material_;
   KernelOptions options_;
   Integration integration_;
+  int threads_ = 1;
 
-  // particle state (structure of arrays)
-  std::vector<double> x_, y_, vx_, vy_, theta_, omega_, r_;
-  std::vector<double> m_, inertia_;   // scaled mass and inertia
-  std::vector<double> fx_, fy_, tq_;  // net contact force and torque
-  // per-particle integration coefficients: v ← a·v + b·F
-  std::vector<double> ca_t_, cb_t_, ca_r_, cb_r_;
+  // Particle state (structure of arrays). Index n_ .. 8·nblocks_ − 1 are
+  // inert padding lanes; index ghost_ = 8·nblocks_ is the ghost particle
+  // that empty slots point to (far away, radius 0: never in contact).
+  int n_ = 0, nblocks_ = 0, ghost_ = 0;
+  Array x_, y_, vx_, vy_, theta_, omega_, r_, inv_r_;
+  Array m_, inertia_;   // scaled mass and inertia
+  Array fx_, fy_, tq_;  // net contact force and torque
+  // per-particle integration coefficients: v ← a·v + b·F (0 for padding)
+  Array ca_t_, cb_t_, ca_r_, cb_r_;
   // wall contacts: tangential force history per particle and wall
   std::array<std::vector<double>, 4> wall_ft_;
   std::array<std::vector<double>, 4> wall_fn_;  // last normal force (0 when apart)
 
-  // Verlet neighbour list: pairs (i < j) sorted by (i, j), with the
-  // tangential force of each pair kept across rebuilds.
-  std::vector<int> pair_i_, pair_j_;
-  std::vector<double> pair_ft_;
-  std::vector<double> pair_fn_;  // last normal force (0 when apart)
-  std::vector<double> pair_nx_, pair_ny_;
+  // Verlet neighbour list (full, sliced ELLPACK, see the file comment):
+  // block b's slots are [block_slot_[b], block_slot_[b + 1]), rows of 8;
+  // each particle's neighbours in increasing index, then ghosts. slot_ft_ is
+  // the tangential force of each slot, kept across rebuilds.
+  std::vector<int> block_slot_;
+  detail::AlignedVector<int> slot_j_;
+  Array slot_ft_;
+  Array slot_r_;  // radius of the slot's neighbour (contiguous: one gather less)
+  // The pairs i < j of the list, sorted by (i, j), and the slot of i's copy.
+  std::vector<int> pair_i_, pair_j_, pair_slot_;
+  // Block ranges of the threads for the pair pass (balanced by slots) and
+  // for the particle pass.
+  std::vector<int> pair_bounds_, particle_bounds_;
   // scratch for rebuilds (kept to avoid allocation)
-  std::vector<int> new_i_, new_j_;
-  std::vector<double> new_ft_;
-  std::vector<int> cell_start_, cell_next_;
+  std::vector<int> nbr_start_, nbr_list_, cell_start_, cell_next_;
+  std::vector<int> new_block_slot_;
+  detail::AlignedVector<int> new_slot_j_;
+  Array new_slot_ft_, new_slot_r_;
   std::array<std::vector<int>, 4> wall_candidates_;
-  std::vector<double> x_built_, y_built_;
+  Array x_built_, y_built_;
   std::array<double, 4> wall_built_{};
   double skin_ = 0.0;
   double r_max_ = 0.0, r_min_ = 0.0;
@@ -248,6 +345,7 @@ class World {
   int64_t divergence_step_ = -1;
   int64_t steps_ = 0;
   double time_ = 0.0;
+  detail::TeamHandle team_;
 };
 
 }  // namespace demcal

@@ -1,0 +1,82 @@
+// `demcal export PARAMS.json --format lammps|liggghts [-o FILE]`: an input
+// deck for the prototype run in another code, with the particle file it
+// reads (demcal's consolidated state of the prototype) next to it.
+#include <filesystem>
+#include <iostream>
+
+#include "commands.hpp"
+#include "demcal/biaxial.hpp"
+#include "demcal/export.hpp"
+#include "demcal/output.hpp"
+#include "demcal/rev.hpp"
+#include "demcal/upscaling.hpp"
+#include "upscaling_cli.hpp"
+
+namespace demcal::cli {
+
+int cmd_export(const ExportCmdOptions& o) {
+  namespace fs = std::filesystem;
+  const nlohmann::json params = read_json_file(o.params);
+  const RevParams rev = rev_params_from_json(params, o.params);
+  if (o.format != "lammps" && o.format != "liggghts")
+    throw InputError("--format", "", "must be lammps or liggghts, got \"" + o.format + "\"");
+  const auto config_opt = params_scene(params, o.params, o.config, o.sets);
+  if (!config_opt)
+    throw InputError(
+        o.params, "config",
+        "no scene config inside; pass --config CONFIG (the scene it was calibrated on)");
+  const SceneConfig& config = *config_opt;
+  const ScalingLaw law = resolve_law(params, o.params, o.law, o.exponent);
+  std::string file = o.prototype;
+  int64_t particles = o.particles;
+  if (file.empty() && particles == 0 && params.contains("prototype") &&
+      params["prototype"].is_object()) {
+    const auto& p = params["prototype"];
+    if (p.contains("source") && p["source"].contains("file"))
+      file = p["source"]["file"].get<std::string>();
+    else if (p.contains("particles") && p["particles"].is_number_integer())
+      particles = p["particles"].get<int64_t>();
+  }
+  PrototypeSource source;
+  Assembly proto = prototype_assembly(config, particles, file, &source);
+  const AlgorithmSpec up = upscale(rev.params, rev.particles, proto.size(), law);
+
+  const std::string deck_path =
+      o.output.empty() ? "demcal-" + config.name + "." + o.format : o.output;
+  const fs::path deck_fs(deck_path);
+  if (fs::is_directory(deck_fs)) throw InputError(deck_path, "", "is a folder; give a file name");
+  ExportOptions eo;
+  eo.format = o.format;
+  const std::string ext = deck_fs.extension().string();
+  const bool known = ext == ".lammps" || ext == ".liggghts" || ext == ".in" || ext == ".lmp";
+  eo.data_name = (known ? deck_fs.stem() : deck_fs.filename()).string() + ".data";
+  eo.provenance = o.params + " (REV " + std::to_string(rev.particles) + " particles, " +
+                  std::to_string(rev.params.steps) + " steps; " + law.name() + " law, exponent " +
+                  std::to_string(law.exponent) + ")";
+
+  if (!o.no_consolidate) {
+    std::cerr << "demcal export: consolidating the prototype (" << source.description
+              << ") to sigma3 with demcal's kernel\n";
+    const ConsolidatedState state = consolidate(config, proto);
+    std::cerr << "demcal export: consolidated in " << state.steps << " steps, " << state.wall_time_s
+              << " s\n";
+    proto = assembly_of(state.world);
+  }
+  const ExportResult r = export_deck(config, up, proto, eo);
+  const fs::path dir = deck_fs.has_parent_path() ? deck_fs.parent_path() : fs::path(".");
+  if (!dir.empty() && dir != ".") make_output_dir(dir.string());
+  for (const auto& [name, content] : r.files) write_file_atomic((dir / name).string(), content);
+  write_file_atomic(deck_path, r.deck);
+  std::cout << "wrote " << deck_path << " (" << o.format << ", " << proto.size()
+            << " particles, timestep " << r.dt << " s, " << r.steps << " steps, " << r.types
+            << " radius class(es))";
+  for (const auto& [name, content] : r.files) std::cout << ", " << (dir / name).string();
+  std::cout << "\n";
+  for (const auto& note : r.notes) std::cout << "  note: " << note << "\n";
+  std::cout << "  run it in its folder: cd " << dir.string() << " && "
+            << (o.format == "lammps" ? "lmp" : "liggghts") << " -in " << deck_fs.filename().string()
+            << "\n";
+  return 0;
+}
+
+}  // namespace demcal::cli

@@ -1,0 +1,106 @@
+// `demcal upscale PARAMS.json --particles N | --prototype FILE`: the REV's
+// calibrated parameters for a prototype named after the calibration.
+// Multipliers unchanged, Nstep by the scaling law, Δt and damping from the
+// prototype's own particles. Also the config resolution that `verify` and
+// `export` share.
+#include <filesystem>
+#include <iostream>
+
+#include "commands.hpp"
+#include "demcal/output.hpp"
+#include "demcal/upscaling.hpp"
+#include "upscaling_cli.hpp"
+
+namespace demcal::cli {
+
+std::optional<SceneConfig> params_scene(const nlohmann::json& params, const std::string& path,
+                                        const std::string& config_path,
+                                        const std::vector<std::string>& sets) {
+  if (!config_path.empty()) return load_scene(config_path, sets);
+  if (auto c = config_from_params(params, path)) {
+    if (sets.empty()) return c;
+    nlohmann::json j = to_json(*c);
+    apply_overrides(j, sets, path + ": config");
+    return parse_config(j, path + ": config");
+  }
+  // A params.json of the embedded default scene needs no config.
+  const SceneConfig def = default_config();
+  if (params.is_object() && params.value("scene", std::string()) == def.name) {
+    if (sets.empty()) return def;
+    nlohmann::json j = to_json(def);
+    apply_overrides(j, sets, def.source);
+    return parse_config(j, def.source);
+  }
+  return std::nullopt;
+}
+
+ScalingLaw resolve_law(const nlohmann::json& params, const std::string& params_path,
+                       const std::string& law_path, double exponent) {
+  if (exponent > 0.0) {
+    if (exponent > 3.0) throw InputError("--exponent", "", "must be in (0, 3]");
+    ScalingLaw law;
+    law.exponent = exponent;
+    law.source = "--exponent";
+    return law;
+  }
+  if (!law_path.empty()) {
+    const nlohmann::json j = read_json_file(law_path);
+    if (!j.contains("law")) throw InputError(law_path, "law", "missing (not a scaling.json?)");
+    ScalingLaw law = scaling_law_from_json(j["law"], law_path);
+    law.source = law_path + ": " + law.source;
+    return law;
+  }
+  if (params.contains("upscaling") && params["upscaling"].is_object() &&
+      params["upscaling"].contains("exponent"))
+    return scaling_law_from_json(params["upscaling"], params_path + ": upscaling");
+  return ScalingLaw{};
+}
+
+int cmd_upscale(const UpscaleOptions& o) {
+  const nlohmann::json params = read_json_file(o.params);
+  const RevParams rev = rev_params_from_json(params, o.params);
+  if (o.particles < 0) throw InputError("--particles", "", "must be positive");
+  if (o.particles == 0 && o.prototype.empty())
+    throw InputError("--particles", "", "give the prototype's particle count or --prototype FILE");
+  const ScalingLaw law = resolve_law(params, o.params, o.law, o.exponent);
+  const auto config = params_scene(params, o.params, o.config, o.sets);
+
+  nlohmann::json block;
+  int64_t n_proto = 0;
+  if (config) {
+    block = prototype_block(*config, rev.params, rev.particles, law, o.particles, o.prototype);
+    n_proto = block.at("particles").get<int64_t>();
+  } else {
+    if (!o.prototype.empty())
+      throw InputError(o.params, "config",
+                       "no scene config inside; pass --config CONFIG to read a prototype file");
+    // No config: the prototype is taken to have the REV's particle sizes
+    // (same smallest particle, same masses): Δt and damping carry over.
+    n_proto = o.particles;
+    ParticleScales s = rev.scales;
+    s.particles = n_proto;
+    block = param_block(upscale(rev.params, rev.particles, n_proto, law), s);
+    for (const char* k : {"radius_min", "radius_max", "radius_mean", "mass_min", "mass_mean",
+                          "damping_translation_mean", "damping_rotation_mean"})
+      block.erase(k);
+    block["source"] = {
+        {"kind", "count"},
+        {"description", std::to_string(n_proto) + " particles assumed to have the REV's size "
+                                                  "distribution (no config: pass --config for the "
+                                                  "generator's own particles)"}};
+  }
+  nlohmann::json out = params;
+  out["prototype"] = block;
+  out["upscaling"] = upscaling_block(rev.particles, n_proto, law);
+  const std::string text = out.dump(2) + "\n";
+  if (o.output.empty() || o.output == "-") {
+    std::cout << text;
+  } else {
+    write_file_atomic(o.output, text);
+    std::cerr << "demcal upscale: " << n_proto << " particles, " << block["steps"] << " steps, dt "
+              << block["dt"] << " s; wrote " << o.output << "\n";
+  }
+  return 0;
+}
+
+}  // namespace demcal::cli

@@ -1,0 +1,96 @@
+// The subcommands of issue #6 (REV, upscaling, verification, export): their
+// options and the helpers they share. Registered on the command line by
+// add_upscaling_commands() (cmd_upscaling_cli.cpp), declared in commands.hpp.
+#pragma once
+
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "commands.hpp"
+#include "demcal/upscaling.hpp"
+
+namespace demcal::cli {
+
+struct UpscaleOptions {
+  std::string params;     ///< params.json of a calibration
+  int64_t particles = 0;  ///< the prototype's particle count
+  std::string prototype;  ///< or its particle file
+  std::string config;     ///< scene config when params.json carries none
+  std::vector<std::string> sets;
+  std::string law;        ///< scaling.json whose "law" to use
+  double exponent = 0.0;  ///< or an explicit exponent (0: params' or linear)
+  std::string output;     ///< "" or "-": stdout
+};
+int cmd_upscale(const UpscaleOptions& options);
+
+struct VerifyOptions {
+  std::string params;
+  std::string prototype;
+  int64_t particles = 0;
+  std::string config;
+  std::vector<std::string> sets;
+  std::string law;
+  double exponent = 0.0;
+  std::string out_dir;
+  double max_minutes = 8.0;  ///< refuse loading runs estimated beyond this
+  /// Consolidate the prototype, write DIR/prototype.csv and stop: a
+  /// prototype prepared once for later verify and export runs.
+  bool consolidate_only = false;
+  /// "NXxNY": the prototype is --prototype mirror-tiled NX×NY times.
+  std::string tile;
+};
+int cmd_verify(const VerifyOptions& options);
+
+struct ScalingOptions {
+  std::string config;
+  std::vector<std::string> sets;
+  std::string sizes = "25,100,400,1600";
+  int64_t calibrate_max = 400;  ///< larger sizes are only checked forward
+  std::string out_dir;          ///< report folder (default reports)
+  std::string work_dir;         ///< per-size work (default demcal-scaling-NAME)
+  int jobs = 0;
+  int max_trials = 0;
+  bool resume = false;
+  bool quiet = false;
+};
+int cmd_scaling(const ScalingOptions& options);
+
+struct ExportCmdOptions {
+  std::string params;
+  std::string format = "lammps";
+  std::string output;
+  std::string prototype;
+  int64_t particles = 0;
+  std::string config;
+  std::vector<std::string> sets;
+  std::string law;
+  double exponent = 0.0;
+  bool no_consolidate = false;
+};
+int cmd_export(const ExportCmdOptions& options);
+
+struct RevCmdOptions {
+  std::string config;
+  std::vector<std::string> sets;
+  std::string prototype;
+  int64_t particles = 400;
+  std::string method = "cut";
+  std::string out_dir;
+};
+int cmd_rev(const RevCmdOptions& options);
+
+/// The scene a params.json was calibrated on: --config, else its "config"
+/// object, else the embedded default when the scene names match; nothing
+/// when none applies.
+std::optional<SceneConfig> params_scene(const nlohmann::json& params, const std::string& path,
+                                        const std::string& config_path,
+                                        const std::vector<std::string>& sets);
+/// The scaling law: --exponent, else --law scaling.json, else params.json's
+/// "upscaling" block, else linear.
+ScalingLaw resolve_law(const nlohmann::json& params, const std::string& params_path,
+                       const std::string& law_path, double exponent);
+
+}  // namespace demcal::cli

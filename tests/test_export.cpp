@@ -1,0 +1,239 @@
+// Export (issue #6 §4): radius classes, the content of the LAMMPS and
+// LIGGGHTS decks, and — when LAMMPS is installed — a short run of the
+// exported deck: it starts, its timestep is ours, and the consolidated
+// state it reads carries σ3 on its walls from the first step.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "demcal/biaxial.hpp"
+#include "demcal/export.hpp"
+#include "demcal/packing.hpp"
+#include "demcal/rev.hpp"
+
+namespace demcal {
+namespace {
+
+namespace fs = std::filesystem;
+
+AlgorithmSpec params() {
+  AlgorithmSpec p;
+  p.dt_ratio = 0.22;
+  p.steps = 44390;
+  p.damping_ratio_translation = 0.7;
+  p.damping_ratio_rotation = 1.0;
+  return p;
+}
+
+TEST(RadiusClasses, MonodisperseFewAndMany) {
+  int types = 0;
+  auto t = radius_classes(std::vector<double>(50, 1.0), 8, &types);
+  EXPECT_EQ(types, 1);
+  t = radius_classes({3.0, 1.0, 2.0, 1.0, 3.0}, 8, &types);
+  EXPECT_EQ(types, 3);
+  EXPECT_EQ(t, (std::vector<int>{3, 1, 2, 1, 3}));
+  std::vector<double> r;
+  for (int i = 0; i < 1000; ++i) r.push_back(1.0 + 0.001 * ((i * 37) % 1000));
+  t = radius_classes(r, 8, &types);
+  EXPECT_EQ(types, 8);
+  // Ordered by radius: a larger type never holds a smaller radius.
+  for (int i = 0; i < 1000; ++i)
+    for (int j = 0; j < 1000; j += 17)
+      if (t[i] < t[j]) {
+        EXPECT_LE(r[i], r[j]);
+      }
+}
+
+TEST(Export, LammpsDeckMapsEveryParameter) {
+  const SceneConfig c = default_config();
+  const Assembly a = hexagonal_packing(5, 5, 5e-4);
+  ExportOptions o;
+  o.data_name = "proto.data";
+  const ExportResult r = export_deck(c, params(), a, o);
+  const ParticleScales s = particle_scales(a.r, c.material);
+  EXPECT_NEAR(r.dt, 0.22 * s.dt_crit, 1e-18);
+  EXPECT_EQ(r.steps, 44390);
+  EXPECT_EQ(r.types, 1);
+  for (const char* needle :
+       {"units           si", "dimension       2", "density/disc 2650", "nve/sphere disc",
+        "pair_style      gran/hooke/history ${kn} ${kt} 0 0.0 ${mu} 0",
+        "fix             twod all enforce2d", "wall/gran/region hooke/history",
+        "fix             dampt all viscous", "#fix            dampr all viscous/sphere",
+        "variable run_steps index 44390", "read_data       proto.data",
+        "variable kn        equal 100000000"})
+    EXPECT_NE(r.deck.find(needle), std::string::npos) << needle;
+  // ζ_t·2·sqrt(kn·m) for the one class.
+  const double gamma = 0.7 * s.damping_translation_crit;
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "viscous %.10g", gamma);
+  EXPECT_NE(r.deck.find(buf), std::string::npos) << buf;
+  ASSERT_EQ(r.files.count("proto.data"), 1u);
+  EXPECT_NE(r.files.at("proto.data").find("25 atoms"), std::string::npos);
+  EXPECT_FALSE(r.notes.empty());  // rotational damping is not applied
+  EXPECT_THROW(
+      [&] {
+        ExportOptions bad;
+        bad.format = "yade";
+        export_deck(c, params(), a, bad);
+      }(),
+      InputError);
+}
+
+TEST(Export, PolydisperseDampingPerClass) {
+  SceneConfig c = default_config();
+  c.assembly.type = "random";
+  c.assembly.count = 300;
+  const Assembly a = make_assembly(c);
+  const ExportResult r = export_deck(c, params(), a, {});
+  EXPECT_EQ(r.types, 8);
+  EXPECT_NE(r.deck.find(" scale 1 1 2 "), std::string::npos);
+  // Radii from 0.375 to 0.625 mm in 8 classes: each class spans ~1/8 of it.
+  EXPECT_GT(r.damping_class_error, 0.0);
+  EXPECT_LT(r.damping_class_error, 0.05);
+}
+
+TEST(Export, LiggghtsDeckHasMeshesAndServo) {
+  const SceneConfig c = default_config();
+  const Assembly a = hexagonal_packing(5, 5, 5e-4);
+  ExportOptions o;
+  o.format = "liggghts";
+  o.data_name = "proto.data";
+  const ExportResult r = export_deck(c, params(), a, o);
+  for (const char* needle :
+       {"pair_style gran model hooke/stiffness tangential history", "mesh/surface/stress/servo",
+        "move/mesh", "fix twod all enforce2d", "NOT RUN HERE"})
+    EXPECT_NE(r.deck.find(needle), std::string::npos) << needle;
+  EXPECT_EQ(r.files.count("proto-top.stl"), 1u);
+  EXPECT_EQ(r.files.count("proto-left.stl"), 1u);
+}
+
+/// The first `lmp` on PATH, or "".
+std::string find_lammps() {
+  const char* path = std::getenv("PATH");
+  std::stringstream s(path ? path : "");
+  for (std::string dir; std::getline(s, dir, ':');) {
+    const fs::path p = fs::path(dir) / "lmp";
+    if (fs::exists(p) && ::access(p.c_str(), X_OK) == 0) return p.string();
+  }
+  return "";
+}
+
+TEST(Export, LammpsRunsTheDeck) {
+  const std::string lmp = find_lammps();
+  if (lmp.empty()) GTEST_SKIP() << "LAMMPS (lmp) is not installed: the exported deck is not run";
+  SceneConfig c = default_config();
+  c.assembly.columns = c.assembly.rows = 5;
+  const ConsolidatedState state = consolidate(c, make_assembly(c));
+  const Assembly a = assembly_of(state.world);
+  ExportOptions o;
+  o.data_name = "hex5.data";
+  const ExportResult r = export_deck(c, params(), a, o);
+
+  const fs::path dir =
+      fs::temp_directory_path() / ("demcal_test_lammps_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ofstream(dir / "in.hex5") << r.deck;
+  for (const auto& [name, content] : r.files) std::ofstream(dir / name) << content;
+  const std::string cmd = "cd '" + dir.string() + "' && '" + lmp +
+                          "' -var run_steps 300 -in in.hex5 -log log.lammps -screen none "
+                          ">/dev/null 2>&1";
+  const int raw = std::system(cmd.c_str());
+  std::stringstream log;
+  log << std::ifstream(dir / "log.lammps").rdbuf();
+  fs::remove_all(dir);
+  ASSERT_TRUE(WIFEXITED(raw) && WEXITSTATUS(raw) == 0) << log.str();
+  const std::string text = log.str();
+  ASSERT_NE(text.find("Loop time"), std::string::npos) << text;
+  // Thermo rows: step dt time epsyy p_top p_left p_right W H ke.
+  std::stringstream lines(text.substr(text.find("Step Dt Time")));
+  std::string header, line;
+  std::getline(lines, header);
+  std::vector<std::vector<double>> rows;
+  while (std::getline(lines, line) && line.find("Loop time") == std::string::npos) {
+    std::stringstream f(line);
+    std::vector<double> v;
+    for (double x; f >> x;) v.push_back(x);
+    if (v.size() == 10) rows.push_back(v);
+  }
+  ASSERT_GE(rows.size(), 2u) << text;
+  EXPECT_EQ(rows.front()[0], 0);
+  EXPECT_EQ(rows.back()[0], 300);
+  for (const auto& row : rows) EXPECT_NEAR(row[1] / r.dt, 1.0, 1e-6);  // our timestep
+  // demcal's consolidated state holds σ3 on every wall in LAMMPS too.
+  const double s3 = c.test.lateral_stress;
+  EXPECT_NEAR(rows.front()[4] / s3, 1.0, 0.01);
+  EXPECT_NEAR(rows.front()[5] / s3, 1.0, 0.01);
+  EXPECT_NEAR(rows.front()[6] / s3, 1.0, 0.01);
+  // The top wall loads the sample; the servo keeps the lateral walls at σ3.
+  EXPECT_GT(rows.back()[4], rows.front()[4]);
+  EXPECT_NEAR(rows.back()[5] / s3, 1.0, 0.01);
+  EXPECT_NEAR(rows.back()[6] / s3, 1.0, 0.01);
+}
+
+/// Thermo rows (step dt time epsyy p_top p_left p_right W H ke) of a log.
+std::vector<std::vector<double>> thermo_rows(const std::string& text) {
+  std::vector<std::vector<double>> rows;
+  const auto at = text.find("Step Dt Time");
+  if (at == std::string::npos) return rows;
+  std::stringstream lines(text.substr(at));
+  std::string line;
+  std::getline(lines, line);
+  while (std::getline(lines, line) && line.find("Loop time") == std::string::npos) {
+    std::stringstream f(line);
+    std::vector<double> v;
+    for (double x; f >> x;) v.push_back(x);
+    if (v.size() == 10) rows.push_back(v);
+  }
+  return rows;
+}
+
+TEST(Export, LammpsReproducesDemcalsPeak) {
+  // The whole loading of the 25-particle sample in both codes (ζ_r = 0:
+  // this LAMMPS has no rotational damping, so both run the same model):
+  // the axial peak agrees within 1 %. ~1·10⁶ particle-steps each.
+  const std::string lmp = find_lammps();
+  if (lmp.empty()) GTEST_SKIP() << "LAMMPS (lmp) is not installed: the exported deck is not run";
+  SceneConfig c = default_config();
+  c.assembly.columns = c.assembly.rows = 5;
+  const ConsolidatedState state = consolidate(c, make_assembly(c));
+  AlgorithmSpec p = params();
+  p.damping_ratio_rotation = 0.0;
+  const LoadingResult run = run_loading(state, c.test, p);
+  ASSERT_FALSE(run.diverged);
+  ExportOptions o;
+  o.data_name = "hex5.data";
+  const ExportResult r = export_deck(c, p, assembly_of(state.world), o);
+  const fs::path dir =
+      fs::temp_directory_path() / ("demcal_test_lammps_peak_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ofstream(dir / "in.hex5") << r.deck;
+  for (const auto& [name, content] : r.files) std::ofstream(dir / name) << content;
+  const std::string cmd = "cd '" + dir.string() + "' && '" + lmp +
+                          "' -in in.hex5 -log log.lammps -screen none >/dev/null 2>&1";
+  const int raw = std::system(cmd.c_str());
+  std::stringstream log;
+  log << std::ifstream(dir / "log.lammps").rdbuf();
+  fs::remove_all(dir);
+  ASSERT_TRUE(WIFEXITED(raw) && WEXITSTATUS(raw) == 0) << log.str();
+  const auto rows = thermo_rows(log.str());
+  ASSERT_GT(rows.size(), 100u);
+  EXPECT_EQ(rows.back()[0], p.steps);
+  double lammps_peak = 0.0;
+  for (const auto& row : rows) lammps_peak = std::max(lammps_peak, row[4]);
+  const double demcal_peak = -run.peak_stress_yy;
+  EXPECT_NEAR(lammps_peak / demcal_peak, 1.0, 0.01)
+      << "LAMMPS " << lammps_peak << " Pa, demcal " << demcal_peak << " Pa";
+  // The servo held σ3 in LAMMPS too.
+  EXPECT_NEAR(rows.back()[5] / c.test.lateral_stress, 1.0, 0.01);
+}
+
+}  // namespace
+}  // namespace demcal

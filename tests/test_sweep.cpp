@@ -1,0 +1,271 @@
+// Scoring and diagnosis on short real runs of hex_10x10, and the sweep
+// (issue #4 §3–§4). The clear-cut cases our kernel shows: Δt beyond the
+// rotational stability limit (α = 0.32: rotational chatter, σxy ≠ σyx),
+// Nstep far too small, D_r far too large. The identity V·(b − σ) =
+// Σ_p x^p ⊗ F^p (World::net_force_moment()) is used by the scoring's
+// consistency check, and checked here on the final states.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
+
+#include "demcal/biaxial.hpp"
+#include "demcal/config.hpp"
+#include "demcal/packing.hpp"
+#include "demcal/scoring.hpp"
+#include "demcal/sweep.hpp"
+
+namespace demcal {
+namespace {
+
+namespace fs = std::filesystem;
+
+// hex_10x10, consolidated once for the whole file (a few ms).
+struct Hex {
+  SceneConfig config;
+  std::unique_ptr<ConsolidatedState> state;
+};
+const Hex& hex() {
+  static const Hex h = [] {
+    Hex x;
+    x.config = load_config(std::string(DEMCAL_SOURCE_DIR) + "/configs/hex_10x10.json");
+    x.state = std::make_unique<ConsolidatedState>(consolidate(x.config, make_assembly(x.config)));
+    return x;
+  }();
+  return h;
+}
+
+struct Trial {
+  LoadingResult run;
+  Score score;
+  World final_state;
+};
+Trial trial(const AlgorithmSpec& a) {
+  const Hex& h = hex();
+  World final_state = h.state->world;
+  LoadingResult run = run_loading(*h.state, h.config.test, a, {}, &final_state);
+  Score score = score_run(run, h.config.test.lateral_stress, Tolerances{});
+  return {std::move(run), score, std::move(final_state)};
+}
+
+TEST(ScoringRealRuns, DtBeyondRotationalLimitIsDiagnosedAsDt) {
+  AlgorithmSpec a;
+  a.dt_ratio = 0.32;  // stable limit of the rotational mode ≈ 0.29 here
+  a.steps = 20000;
+  const Trial t = trial(a);
+  ASSERT_FALSE(t.run.diverged);
+  const Criteria& c = t.score.criteria;
+  EXPECT_GT(c.moment_balance, 0.01);  // σxy ≠ σyx, of the order of σ3
+  EXPECT_GT(c.rotational_energy_share, 0.3);
+  EXPECT_FALSE(t.score.passed);
+  EXPECT_EQ(t.score.diagnosis.parameter, "dt");
+  EXPECT_EQ(t.score.diagnosis.direction, "decrease");
+  EXPECT_GE(t.score.diagnosis.confidence, 0.7);
+}
+
+TEST(ScoringRealRuns, NstepFarTooSmallIsDiagnosedAsSteps) {
+  AlgorithmSpec a;
+  a.steps = 5000;  // 1/20 of the default
+  const Trial t = trial(a);
+  const Criteria& c = t.score.criteria;
+  EXPECT_GT(c.force_balance, 10 * Tolerances{}.force_balance);
+  EXPECT_GT(c.servo, Tolerances{}.servo);
+  EXPECT_LT(c.rotational_energy_share, 0.3);
+  EXPECT_EQ(t.score.diagnosis.parameter, "steps");
+  EXPECT_EQ(t.score.diagnosis.direction, "increase");
+  // The paper's form still reads about 1 %: it cannot see this.
+  EXPECT_LT(c.force_balance_paper, 0.02);
+}
+
+TEST(ScoringRealRuns, RotationalDampingFarTooLargeIsDiagnosedAsDr) {
+  AlgorithmSpec a;
+  a.damping_ratio_rotation = 20.0;
+  const Trial t = trial(a);
+  const Criteria& c = t.score.criteria;
+  EXPECT_GT(c.moment_balance, 10 * Tolerances{}.moment_balance);
+  EXPECT_LT(c.moment_balance, 0.01);  // steady and small: no chatter
+  EXPECT_LT(c.rotational_energy_share, 0.3);
+  EXPECT_EQ(t.score.diagnosis.parameter, "damping_rotation");
+  EXPECT_EQ(t.score.diagnosis.direction, "decrease");
+}
+
+TEST(ScoringRealRuns, SlowLightlyDampedRunPasses) {
+  AlgorithmSpec a;
+  a.steps = 200000;
+  a.damping_ratio_translation = 0.3;
+  a.damping_ratio_rotation = 0.0;
+  const Trial t = trial(a);
+  EXPECT_TRUE(t.score.passed) << to_json(t.score.criteria).dump();
+  EXPECT_EQ(t.score.diagnosis.parameter, "none");
+  EXPECT_GT(objective(t.score, Tolerances{}), 0.0);
+  EXPECT_LT(objective(t.score, Tolerances{}), 1.0);
+}
+
+TEST(ScoringRealRuns, GapIdentityHoldsOnFinalStates) {
+  // force_balance_gap() is net_force_moment(); it equals b − σ of measure().
+  AlgorithmSpec a;
+  a.steps = 5000;
+  const Trial t = trial(a);
+  EXPECT_LT(gap_identity_residual(t.final_state), 1e-9);
+  const Measures m = t.final_state.measure();
+  const Eigen::Matrix2d gap = force_balance_gap(t.final_state);
+  EXPECT_LT((gap - (m.boundary_stress - m.homogenized_stress)).norm(),
+            1e-9 * m.boundary_stress.norm());
+  // And the last monitoring point's lateral gap is that of the final state.
+  const auto& last = t.run.series.back();
+  EXPECT_NEAR(last.b(0, 0) - last.sigma(0, 0), gap(0, 0), 1e-6 * std::abs(last.b(0, 0)));
+}
+
+// --- the sweep -----------------------------------------------------------
+
+TEST(Sweep, CasesChangeOneParameterAtATime) {
+  AlgorithmSpec b;
+  b.steps = 120000;
+  const auto cases = atlas_cases(b, 0.29, false);
+  std::set<std::string> names;
+  for (const auto& c : cases) EXPECT_TRUE(names.insert(c.name).second) << c.name;
+  auto find = [&](const std::string& n) -> const SweepCase& {
+    for (const auto& c : cases)
+      if (c.name == n) return c;
+    ADD_FAILURE() << "missing " << n;
+    return cases.front();
+  };
+  EXPECT_EQ(find("steps_x1_6").algorithm.steps, 20000);
+  EXPECT_EQ(find("steps_x33").algorithm.steps, 120000 * 33);
+  EXPECT_DOUBLE_EQ(find("dt_x0.1").algorithm.dt_ratio, 0.02);
+  EXPECT_DOUBLE_EQ(find("dt_x1.5").algorithm.dt_ratio, 0.3);
+  EXPECT_DOUBLE_EQ(find("zeta_t_x0.7").algorithm.damping_ratio_translation, 0.7);
+  EXPECT_DOUBLE_EQ(find("zeta_t_x4.3").algorithm.damping_ratio_translation, 4.3);
+  EXPECT_DOUBLE_EQ(find("zeta_r_x0").algorithm.damping_ratio_rotation, 0.0);
+  EXPECT_DOUBLE_EQ(find("zeta_r_x2").algorithm.damping_ratio_rotation, 2.0);
+  const auto& m4 = find("mass_1e4_undamped").algorithm;
+  EXPECT_DOUBLE_EQ(m4.mass_scaling, 1e4);
+  EXPECT_DOUBLE_EQ(m4.damping_ratio_translation, 0.0);
+  EXPECT_DOUBLE_EQ(m4.damping_ratio_rotation, 0.0);
+  EXPECT_NEAR(m4.dt_ratio * std::sqrt(m4.mass_scaling), b.dt_ratio, 1e-12);  // same Δt
+  EXPECT_DOUBLE_EQ(find("mass_1e8_undamped").algorithm.mass_scaling, 1e8);
+  for (int f : {2, 4, 8, 16})
+    EXPECT_EQ(find("steps_x" + std::to_string(f)).algorithm.steps, 120000 * f);
+  // α scan: same loading time, up to beyond the stable limit.
+  double alpha_max = 0.0;
+  for (const auto& c : cases) {
+    if (c.group != "alpha_scan") continue;
+    alpha_max = std::max(alpha_max, c.algorithm.dt_ratio);
+    EXPECT_NEAR(c.algorithm.dt_ratio * static_cast<double>(c.algorithm.steps),
+                b.dt_ratio * static_cast<double>(b.steps), 2.0 * c.algorithm.dt_ratio);
+  }
+  EXPECT_GT(alpha_max, 1.3 * 0.29);
+  // Everything else equal to the benchmark in the one-at-a-time cases.
+  const auto& z = find("zeta_t_x4.3").algorithm;
+  EXPECT_EQ(z.steps, b.steps);
+  EXPECT_DOUBLE_EQ(z.dt_ratio, b.dt_ratio);
+  EXPECT_DOUBLE_EQ(z.damping_ratio_rotation, b.damping_ratio_rotation);
+  EXPECT_GT(atlas_cases(b, 0.29, true).size(), cases.size());
+}
+
+TEST(Sweep, RichardsonReferenceIsExactForOneOverNErrors) {
+  // p(N) = p∞ + c/N.
+  const double p_inf = -6.2e5, c = 2e9;
+  std::vector<std::pair<int64_t, double>> peaks;
+  for (int64_t n : {400000, 100000, 200000, 3300000, 800000, 1600000})
+    peaks.emplace_back(n, p_inf + c / static_cast<double>(n));
+  const ConvergedReference r = converged_reference(peaks, 0.005);
+  ASSERT_EQ(r.ladder.size(), 6u);
+  EXPECT_EQ(r.ladder.front().steps, 100000);  // sorted
+  EXPECT_NEAR(r.peak_stress_yy, p_inf, 1e-6 * std::abs(p_inf));
+  for (size_t i = 1; i < r.ladder.size(); ++i)
+    EXPECT_NEAR(r.ladder[i].richardson, p_inf, 1e-6 * std::abs(p_inf));
+  EXPECT_TRUE(r.converged);
+  // Far from converged: the last doubling still moves the peak by 10 %.
+  const ConvergedReference far = converged_reference({{1000, -1.2e5}, {2000, -1.1e5}}, 0.005);
+  EXPECT_FALSE(far.converged);
+}
+
+TEST(Sweep, RunsInParallelAndScoresAgainstTheLadder) {
+  const Hex& h = hex();
+  SceneConfig config = h.config;
+  config.algorithm.steps = 10000;
+  AlgorithmSpec b = config.algorithm;
+  std::vector<SweepCase> cases;
+  cases.push_back({"benchmark", "benchmark", "none", "", b});
+  for (int f : {2, 4}) {
+    AlgorithmSpec a = b;
+    a.steps = b.steps * f;
+    cases.push_back({"steps_x" + std::to_string(f), "convergence", "", "", a});
+  }
+  AlgorithmSpec chatter = b;
+  chatter.dt_ratio = 0.33;
+  cases.push_back({"dt_x1.65", "atlas", "dt x1.65", "chatter", chatter});
+  AlgorithmSpec diverge = b;
+  diverge.dt_ratio = 0.9;
+  diverge.damping_ratio_translation = 0.0;
+  diverge.damping_ratio_rotation = 0.0;
+  cases.push_back({"dt_x4.5", "atlas", "dt x4.5", "divergence", diverge});
+
+  SweepSettings settings;
+  settings.jobs = 2;
+  int calls = 0;
+  settings.progress = [&](int k, int n, const std::string&, double) {
+    ++calls;
+    EXPECT_LE(k, n);
+  };
+  const SweepResult r = run_sweep(config, *h.state, cases, settings);
+  EXPECT_EQ(calls, 5);
+  ASSERT_EQ(r.cases.size(), cases.size());
+  for (size_t i = 0; i < cases.size(); ++i) EXPECT_EQ(r.cases[i].spec.name, cases[i].name);
+  ASSERT_EQ(r.reference.ladder.size(), 3u);
+  EXPECT_LT(r.reference.peak_stress_yy, 0.0);
+  // Faster loading, higher peak: the benchmark over-predicts.
+  ASSERT_TRUE(r.cases[0].score.criteria.peak_error.has_value());
+  EXPECT_GT(*r.cases[0].score.criteria.peak_error, 0.0);
+  EXPECT_EQ(r.cases[3].score.diagnosis.parameter, "dt");
+  EXPECT_TRUE(r.cases[4].run.diverged);
+  EXPECT_EQ(r.cases[4].score.diagnosis.parameter, "dt");
+  EXPECT_GT(objective(r.cases[4].score, r.tolerances), 2.0);
+  for (const auto& c : r.cases)
+    if (!c.run.diverged) EXPECT_LT(c.identity_residual, 1e-9) << c.spec.name;
+  EXPECT_EQ(r.evidence.size(), 15u);
+
+  const nlohmann::json j = to_json(r);
+  EXPECT_EQ(j["schema"], "demcal.sweep/1");
+  EXPECT_EQ(j["cases"].size(), cases.size());
+  const std::string md = atlas_markdown(r);
+  EXPECT_NE(md.find("| benchmark |"), std::string::npos);
+  EXPECT_NE(md.find("diverged"), std::string::npos);
+  const std::string csv = evidence_csv(r);
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), static_cast<long>(cases.size()) + 1);
+}
+
+TEST(Sweep, CommandWritesTheAtlas) {
+  // hex_5x5 at a benchmark of 2000 steps: the whole atlas in about a second.
+  const fs::path dir =
+      fs::temp_directory_path() / ("demcal-sweep-test-" + std::to_string(getpid()));
+  fs::remove_all(dir);
+  const std::string cmd = std::string(DEMCAL_BINARY) + " sweep " + DEMCAL_SOURCE_DIR +
+                          "/configs/hex_5x5.json --set algorithm.steps=2000 --jobs 2 -o " +
+                          dir.string() + " > " + dir.string() + ".out 2> " + dir.string() + ".err";
+  const int status = std::system(cmd.c_str());
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 0);
+  for (const char* f : {"atlas.md", "atlas.json", "evidence.csv", "series/benchmark.csv",
+                        "series/steps_x33.csv", "series/mass_1e8_undamped.csv"})
+    EXPECT_TRUE(fs::exists(dir / f)) << f;
+  std::ifstream in(dir / "atlas.json");
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_EQ(j["scene"], "hex_5x5");
+  EXPECT_GT(j["cases"].size(), 60u);
+  EXPECT_EQ(j["benchmark"]["steps"], 2000);
+  fs::remove_all(dir);
+  fs::remove(dir.string() + ".out");
+  fs::remove(dir.string() + ".err");
+}
+
+}  // namespace
+}  // namespace demcal

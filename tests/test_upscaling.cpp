@@ -1,0 +1,304 @@
+// Upscaling (issue #6 §2–3): reference scales from the particles, the
+// Nstep law, the prototype block of params.json, the fits, the smallest
+// passing Nstep at fixed multipliers, and `demcal upscale` end to end.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "demcal/biaxial.hpp"
+#include "demcal/packing.hpp"
+#include "demcal/rev.hpp"
+#include "demcal/upscaling.hpp"
+
+namespace demcal {
+namespace {
+
+namespace fs = std::filesystem;
+
+SceneConfig hex(int n) {
+  SceneConfig c = default_config();
+  c.assembly.columns = c.assembly.rows = n;
+  c.prototype.particles = 0;
+  return c;
+}
+
+TEST(ParticleScales, MatchTheKernelsReferenceScales) {
+  for (const char* kind : {"hexagonal", "random"}) {
+    SCOPED_TRACE(kind);
+    SceneConfig c = default_config();
+    if (std::string(kind) == "random") {
+      c.assembly.type = "random";
+      c.assembly.count = 60;
+    }
+    const Assembly a = make_assembly(c);
+    for (double fms : {1.0, 100.0}) {
+      World w(c.material, a.x, a.y, a.r, a.left, a.right, a.bottom, a.top);
+      Integration in;
+      in.mass_scaling = fms;
+      w.set_integration(in);
+      const ReferenceScales k = w.reference_scales();
+      const ParticleScales s = particle_scales(a.r, c.material, fms);
+      EXPECT_NEAR(s.dt_crit / k.dt_crit, 1.0, 1e-12);
+      EXPECT_NEAR(s.damping_translation_crit / k.damping_translation_crit, 1.0, 1e-12);
+      EXPECT_NEAR(s.damping_rotation_crit / k.damping_rotation_crit, 1.0, 1e-12);
+      EXPECT_NEAR(s.damping_translation_crit_mean / k.damping_translation_crit_mean, 1.0, 1e-12);
+      EXPECT_NEAR(s.mass_min / k.mass_min, 1.0, 1e-12);
+      EXPECT_EQ(s.particles, a.size());
+    }
+  }
+}
+
+TEST(Upscale, LinearAndPowerLaws) {
+  EXPECT_EQ(upscale_steps(1000, 100, 400), 4000);
+  EXPECT_EQ(upscale_steps(44390, 25, 40000), 44390LL * 1600);
+  ScalingLaw half;
+  half.exponent = 0.5;
+  EXPECT_EQ(upscale_steps(1000, 100, 400, half), 2000);
+  EXPECT_EQ(half.name(), "power");
+  EXPECT_EQ(ScalingLaw{}.name(), "linear");
+  AlgorithmSpec p;
+  p.dt_ratio = 0.21;
+  p.steps = 5000;
+  p.damping_ratio_translation = 0.4;
+  p.damping_ratio_rotation = 0.0;
+  p.mass_scaling = 3.0;
+  const AlgorithmSpec q = upscale(p, 100, 1000);
+  EXPECT_EQ(q.steps, 50000);
+  EXPECT_EQ(q.dt_ratio, p.dt_ratio);
+  EXPECT_EQ(q.damping_ratio_translation, p.damping_ratio_translation);
+  EXPECT_EQ(q.damping_ratio_rotation, p.damping_ratio_rotation);
+  EXPECT_EQ(q.mass_scaling, p.mass_scaling);
+  // The law round-trips through JSON and rejects nonsense.
+  EXPECT_DOUBLE_EQ(scaling_law_from_json(to_json(half), "x").exponent, 0.5);
+  EXPECT_THROW(scaling_law_from_json({{"exponent", -1}}, "x"), InputError);
+  EXPECT_THROW(scaling_law_from_json({{"exponent", "one"}}, "x"), InputError);
+}
+
+TEST(Upscale, PrototypeBlockRecomputesDtAndDampingFromThePrototypesParticles) {
+  SceneConfig c = default_config();  // hexagonal, r = 0.5 mm
+  AlgorithmSpec rev;
+  rev.dt_ratio = 0.2;
+  rev.steps = 90000;
+  rev.damping_ratio_translation = 0.4;
+  rev.damping_ratio_rotation = 0.5;
+  const ParticleScales rev_scales =
+      particle_scales(make_assembly(c).r, c.material, rev.mass_scaling);
+
+  // Generated prototype of the same lattice: same particles, same Δt.
+  const nlohmann::json same = prototype_block(c, rev, 100, {}, 2500);
+  EXPECT_EQ(same["particles"].get<int64_t>(), 2500);
+  EXPECT_EQ(same["steps"].get<int64_t>(), 90000 * 25);
+  EXPECT_NEAR(same["dt"].get<double>(), 0.2 * rev_scales.dt_crit, 1e-18);
+  EXPECT_NEAR(same["damping_translation"].get<double>(), 0.4 * rev_scales.damping_translation_crit,
+              1e-9);
+  EXPECT_EQ(same["source"]["kind"], "generated");
+
+  // A prototype file with a smaller smallest particle: Δt_crit ∝ r_min
+  // (m ∝ r²), D_t^crit ∝ r_min, D_r^crit ∝ r_min³.
+  const fs::path dir = fs::temp_directory_path() / ("demcal_test_up_" + std::to_string(getpid()));
+  fs::create_directories(dir);
+  Assembly p = hexagonal_packing(20, 20, 5e-4);
+  p.r[7] = 2.5e-4;  // one half-size disk
+  const std::string file = (dir / "proto.csv").string();
+  std::ofstream(file) << particle_csv(p);
+  const nlohmann::json b = prototype_block(c, rev, 100, {}, 0, file);
+  fs::remove_all(dir);
+  EXPECT_EQ(b["particles"].get<int64_t>(), 400);
+  EXPECT_EQ(b["steps"].get<int64_t>(), 360000);
+  EXPECT_NEAR(b["dt_crit"].get<double>() / rev_scales.dt_crit, 0.5, 1e-12);
+  EXPECT_NEAR(b["dt"].get<double>() / (0.2 * rev_scales.dt_crit), 0.5, 1e-12);
+  EXPECT_NEAR(b["damping_translation"].get<double>() / (0.4 * rev_scales.damping_translation_crit),
+              0.5, 1e-12);
+  EXPECT_NEAR(b["damping_rotation"].get<double>() / (0.5 * rev_scales.damping_rotation_crit), 0.125,
+              1e-12);
+  EXPECT_EQ(b["dt_ratio"].get<double>(), 0.2);
+  EXPECT_EQ(b["source"]["kind"], "file");
+}
+
+TEST(Upscale, RevParamsRoundTripThroughAParamBlock) {
+  const SceneConfig c = default_config();
+  AlgorithmSpec p;
+  p.dt_ratio = 0.213;
+  p.steps = 89480;
+  p.damping_ratio_translation = 0.39;
+  p.damping_ratio_rotation = 0.0;
+  const ParticleScales s = particle_scales(make_assembly(c).r, c.material);
+  const nlohmann::json params{{"rev", param_block(p, s)}, {"config", to_json(c)}};
+  const RevParams r = rev_params_from_json(params, "params.json");
+  EXPECT_EQ(r.particles, 100);
+  EXPECT_EQ(r.params.steps, 89480);
+  EXPECT_DOUBLE_EQ(r.params.dt_ratio, 0.213);
+  EXPECT_DOUBLE_EQ(r.params.damping_ratio_translation, 0.39);
+  EXPECT_NEAR(r.scales.dt_crit, s.dt_crit, 1e-18);
+  const auto back = config_from_params(params, "params.json");
+  ASSERT_TRUE(back.has_value());
+  EXPECT_EQ(back->name, c.name);
+  EXPECT_EQ(back->assembly.columns, c.assembly.columns);
+  // Errors name the file and the key.
+  try {
+    rev_params_from_json({{"rev", {{"dt_ratio", "x"}}}}, "p.json");
+    ADD_FAILURE();
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.file(), "p.json");
+    EXPECT_EQ(e.field(), "rev.dt_ratio");
+  }
+  EXPECT_THROW(rev_params_from_json(nlohmann::json::object(), "p.json"), InputError);
+}
+
+TEST(Upscale, SceneOfSizeKeepsTheGeneratorAndChangesTheCount) {
+  SceneConfig c = default_config();
+  EXPECT_EQ(scene_of_size(c, 400).assembly.columns, 20);
+  EXPECT_EQ(scene_of_size(c, 400).assembly.rows, 20);
+  c.assembly.columns = 20;
+  c.assembly.rows = 10;  // 2:1 kept
+  const SceneConfig w = scene_of_size(c, 800);
+  EXPECT_EQ(w.assembly.columns, 40);
+  EXPECT_EQ(w.assembly.rows, 20);
+  c.assembly.type = "random";
+  const SceneConfig r = scene_of_size(c, 1600);
+  EXPECT_EQ(r.assembly.count, 1600);
+  EXPECT_EQ(r.assembly.seed, c.assembly.seed);
+  c.assembly.type = "file";
+  EXPECT_THROW(scene_of_size(c, 100), InputError);
+}
+
+TEST(Fits, LinearAndPower) {
+  const std::vector<double> x{25, 100, 400, 1600};
+  std::vector<double> y;
+  for (double v : x) y.push_back(300.0 * v + 5000.0);
+  const LinearFit f = fit_linear(x, y);
+  EXPECT_NEAR(f.slope, 300.0, 1e-9);
+  EXPECT_NEAR(f.intercept, 5000.0, 1e-6);
+  EXPECT_NEAR(f.r2, 1.0, 1e-12);
+  std::vector<double> z;
+  for (double v : x) z.push_back(7.0 * std::pow(v, 0.75));
+  const LinearFit g = fit_power(x, z);
+  EXPECT_NEAR(g.slope, 0.75, 1e-12);
+  EXPECT_NEAR(std::exp(g.intercept), 7.0, 1e-9);
+}
+
+TEST(StepSearch, FindsTheSmallestPassingNstepAtFixedMultipliers) {
+  const SceneConfig c = hex(5);
+  const ConsolidatedState state = consolidate(c, make_assembly(c));
+  AlgorithmSpec p;
+  p.dt_ratio = 0.2;
+  p.damping_ratio_translation = 0.7;
+  p.damping_ratio_rotation = 1.0;
+  p.steps = 10000;  // too fast for 25 particles
+  const StepSearch s = smallest_passing_steps(c, state, p);
+  ASSERT_TRUE(s.found);
+  EXPECT_TRUE(s.best.passed);
+  EXPECT_GT(s.best.params.steps, 10000);
+  EXPECT_LE(s.trials.size(), 8u);
+  EXPECT_EQ(s.best.params.dt_ratio, 0.2);
+  // Every failing run was shorter than the answer.
+  for (const auto& t : s.trials)
+    if (!t.passed) {
+      EXPECT_LT(t.params.steps, s.best.params.steps);
+    }
+}
+
+// --- `demcal upscale` end to end ---------------------------------------------
+
+struct Cli {
+  int status = -1;
+  std::string out, err;
+};
+
+class UpscaleCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = fs::temp_directory_path() /
+           ("demcal_test_upscale_" + std::to_string(::getpid()) + "_" + info->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  Cli run(const std::string& args) {
+    const std::string cmd = "cd '" + dir_.string() + "' && '" + std::string(DEMCAL_BINARY) + "' " +
+                            args + " >out.txt 2>err.txt";
+    const int raw = std::system(cmd.c_str());
+    Cli r;
+    r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+    std::stringstream o, e;
+    o << std::ifstream(dir_ / "out.txt").rdbuf();
+    e << std::ifstream(dir_ / "err.txt").rdbuf();
+    r.out = o.str();
+    r.err = e.str();
+    return r;
+  }
+  /// A params.json as `demcal calibrate` writes it, for the default scene.
+  void write_params(bool with_config) {
+    const SceneConfig c = default_config();
+    AlgorithmSpec p;
+    p.dt_ratio = 0.213;
+    p.steps = 89480;
+    p.damping_ratio_translation = 0.39;
+    p.damping_ratio_rotation = 0.0;
+    const ParticleScales s = particle_scales(make_assembly(c).r, c.material);
+    nlohmann::json j{{"schema", "demcal.params/1"}, {"scene", c.name}, {"rev", param_block(p, s)}};
+    if (with_config) j["config"] = to_json(c);
+    std::ofstream(dir_ / "params.json") << j.dump(2);
+  }
+  fs::path dir_;
+};
+
+TEST_F(UpscaleCli, UpscalesToACountAndWritesParams) {
+  write_params(false);  // the embedded default scene needs no config
+  const Cli r = run("upscale params.json --particles 2500 -o up.json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::ifstream in(dir_ / "up.json");
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_EQ(j["prototype"]["particles"].get<int64_t>(), 2500);
+  EXPECT_EQ(j["prototype"]["steps"].get<int64_t>(), 89480LL * 25);
+  EXPECT_DOUBLE_EQ(j["prototype"]["dt"].get<double>(), j["rev"]["dt"].get<double>());
+  EXPECT_EQ(j["upscaling"]["law"], "linear");
+  EXPECT_DOUBLE_EQ(j["upscaling"]["factor"].get<double>(), 25.0);
+
+  const Cli half = run("upscale params.json --particles 2500 --exponent 0.5");
+  ASSERT_EQ(half.status, 0) << half.err;
+  const nlohmann::json h = nlohmann::json::parse(half.out);
+  EXPECT_EQ(h["prototype"]["steps"].get<int64_t>(), 89480LL * 5);
+}
+
+TEST_F(UpscaleCli, BadInputExitsTwoNamingTheProblem) {
+  write_params(true);
+  Cli r = run("upscale params.json");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("--particles"), std::string::npos) << r.err;
+  r = run("upscale missing.json --particles 10");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("missing.json"), std::string::npos) << r.err;
+  std::ofstream(dir_ / "broken.json") << "{\"rev\": {\"dt_ratio\": 0.2}}";
+  r = run("upscale broken.json --particles 10");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("broken.json"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("rev.steps"), std::string::npos) << r.err;
+  r = run("verify params.json --particles 100000 --max-minutes 1");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("--max-minutes"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "demcal-verify-hex_10x10"));
+}
+
+TEST_F(UpscaleCli, VerifyRunsASmallPrototypeAndScoresIt) {
+  write_params(true);
+  // 400 particles, 4·89480 steps: ~1.4·10⁸ particle-steps, a few seconds.
+  const Cli r = run("verify params.json --particles 400 -o v");
+  ASSERT_TRUE(r.status == 0 || r.status == 1) << r.err;
+  std::ifstream in(dir_ / "v" / "verify.json");
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_EQ(j["prototype"]["particles"].get<int64_t>(), 400);
+  EXPECT_EQ(j["params"]["steps"].get<int64_t>(), 4 * 89480);
+  EXPECT_EQ(j["passed"].get<bool>(), r.status == 0);
+  EXPECT_TRUE(fs::exists(dir_ / "v" / "prototype.csv"));
+  EXPECT_EQ(read_particle_file((dir_ / "v" / "prototype.csv").string()).size(), 400);
+}
+
+}  // namespace
+}  // namespace demcal
