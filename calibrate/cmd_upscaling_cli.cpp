@@ -58,8 +58,8 @@ std::function<int()> add_upscaling_commands(CLI::App& app) {
   auto ex = std::make_shared<ExportCmdOptions>();
   auto* exp = app.add_subcommand("export", "an input deck for LAMMPS or LIGGGHTS");
   exp->add_option("params", ex->params, "params.json of a calibration")->required();
-  exp->add_option("--format", ex->format, "lammps (default) or liggghts")
-      ->check(CLI::IsMember({"lammps", "liggghts"}));
+  // Values are checked by the command (exit 2, one message), not by CLI11.
+  exp->add_option("--format", ex->format, "lammps (default) or liggghts");
   exp->add_option("-o,--output", ex->output, "the deck (default demcal-NAME.FORMAT)");
   exp->add_option("--prototype", ex->prototype, "the prototype's particle file (CSV x,y,r)");
   exp->add_option("--particles", ex->particles, "a generated prototype of N particles");
@@ -77,8 +77,7 @@ std::function<int()> add_upscaling_commands(CLI::App& app) {
   rev->add_option("--set", rv->sets, "override a key: section.key=value (repeatable)");
   rev->add_option("--prototype", rv->prototype, "the prototype's particle file (CSV x,y,r)");
   rev->add_option("--particles", rv->particles, "particles in the REV (default 400)");
-  rev->add_option("--method", rv->method, "cut (a window of the prototype) or generate")
-      ->check(CLI::IsMember({"cut", "generate"}));
+  rev->add_option("--method", rv->method, "cut (a window of the prototype) or generate");
   rev->add_option("-o,--output", rv->out_dir, "output folder (default demcal-rev-NAME)");
 
   return [=]() -> int {

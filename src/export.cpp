@@ -11,6 +11,12 @@ namespace demcal {
 
 namespace {
 
+std::string fmt3(double v) {
+  char b[40];
+  std::snprintf(b, sizeof b, "%.3g", v);
+  return b;
+}
+
 std::string num(double v) {
   char b[40];
   std::snprintf(b, sizeof b, "%.10g", v);
@@ -102,7 +108,7 @@ std::string mapping_header(const SceneConfig& c, const AlgorithmSpec& p, const P
     << ": D_t = zeta_t * 2 sqrt(kn m_i), per particle (proportional to r)\n"
     << "#     -> global viscous damping per radius class (atom type): " << plan.types
     << " class(es), gamma of the class's mid radius,\n"
-    << "#        largest error against the per-particle value " << num(100 * plan.class_error)
+    << "#        largest error against the per-particle value " << fmt3(100 * plan.class_error)
     << " %\n"
     << "#   zeta_r = " << num(p.damping_ratio_rotation)
     << ": D_r = zeta_r * 2 sqrt(kt r^2 I), per particle (proportional to r^3)\n"
@@ -184,7 +190,7 @@ ExportResult lammps(const SceneConfig& c, const AlgorithmSpec& p, const Assembly
       << "#    so the particles are grouped in " << plan.types << " radius classes (types 1.."
       << plan.types << ").\n";
     out.notes.push_back("translational damping per radius class (" + std::to_string(plan.types) +
-                        " atom types), at most " + num(100 * plan.class_error) +
+                        " atom types), at most " + fmt3(100 * plan.class_error) +
                         " % off demcal's per-particle value");
   }
   out.notes.push_back(
@@ -281,11 +287,9 @@ ExportResult lammps(const SceneConfig& c, const AlgorithmSpec& p, const Assembly
     s << "# gamma per class, N*s/m:";
     for (int k = 0; k < plan.types; ++k) s << " " << num(plan.gamma_t[k]);
     s << "\nfix             dampt all viscous " << num(plan.gamma_t[0]);
-    if (plan.types > 1) {
-      s << " scale";
-      for (int k = 0; k < plan.types; ++k)
-        s << " " << k + 1 << " " << num(plan.gamma_t[k] / plan.gamma_t[0]);
-    }
+    // one "scale type ratio" keyword per type
+    for (int k = 1; k < plan.types; ++k)
+      s << " scale " << k + 1 << " " << num(plan.gamma_t[k] / plan.gamma_t[0]);
     s << "\n";
   } else {
     s << "# zeta_t = 0: no translational damping\n";
@@ -293,11 +297,8 @@ ExportResult lammps(const SceneConfig& c, const AlgorithmSpec& p, const Assembly
   if (p.damping_ratio_rotation > 0.0) {
     s << "# LAMMPS >= 2022 only (absent in 29 Sep 2021): rotational damping, N*m*s\n"
       << "#fix            dampr all viscous/sphere " << num(plan.gamma_r[0]);
-    if (plan.types > 1) {
-      s << " scale";
-      for (int k = 0; k < plan.types; ++k)
-        s << " " << k + 1 << " " << num(plan.gamma_r[k] / plan.gamma_r[0]);
-    }
+    for (int k = 1; k < plan.types; ++k)
+      s << " scale " << k + 1 << " " << num(plan.gamma_r[k] / plan.gamma_r[0]);
     s << "\n";
   }
   s << "fix             twod all enforce2d\n\n";
@@ -451,11 +452,8 @@ ExportResult liggghts(const SceneConfig& c, const AlgorithmSpec& p, const Assemb
     << "fix integrate all nve/sphere\n";
   if (p.damping_ratio_translation > 0.0) {
     s << "fix dampt all viscous " << num(plan.gamma_t[0]);
-    if (plan.types > 1) {
-      s << " scale";
-      for (int k = 0; k < plan.types; ++k)
-        s << " " << k + 1 << " " << num(plan.gamma_t[k] / plan.gamma_t[0]);
-    }
+    for (int k = 1; k < plan.types; ++k)
+      s << " scale " << k + 1 << " " << num(plan.gamma_t[k] / plan.gamma_t[0]);
     s << "\n";
   }
   s << "fix twod all enforce2d\n\n"

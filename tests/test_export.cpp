@@ -92,7 +92,10 @@ TEST(Export, PolydisperseDampingPerClass) {
   const Assembly a = make_assembly(c);
   const ExportResult r = export_deck(c, params(), a, {});
   EXPECT_EQ(r.types, 8);
-  EXPECT_NE(r.deck.find(" scale 1 1 2 "), std::string::npos);
+  // One "scale type ratio" per type after the first (LAMMPS's syntax).
+  EXPECT_NE(r.deck.find(" scale 2 "), std::string::npos);
+  EXPECT_NE(r.deck.find(" scale 8 "), std::string::npos);
+  EXPECT_EQ(r.deck.find(" scale 1 "), std::string::npos);
   // Radii from 0.375 to 0.625 mm in 8 classes: each class spans ~1/8 of it.
   EXPECT_GT(r.damping_class_error, 0.0);
   EXPECT_LT(r.damping_class_error, 0.05);
@@ -124,11 +127,18 @@ std::string find_lammps() {
   return "";
 }
 
-TEST(Export, LammpsRunsTheDeck) {
+class LammpsRun : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(LammpsRun, TheDeckStartsWithOurTimestepAndSigma3OnTheWalls) {
   const std::string lmp = find_lammps();
   if (lmp.empty()) GTEST_SKIP() << "LAMMPS (lmp) is not installed: the exported deck is not run";
   SceneConfig c = default_config();
-  c.assembly.columns = c.assembly.rows = 5;
+  if (std::string(GetParam()) == "hexagonal") {
+    c.assembly.columns = c.assembly.rows = 5;
+  } else {  // polydisperse: 8 radius classes, per-type damping
+    c.assembly.type = "random";
+    c.assembly.count = 100;
+  }
   const ConsolidatedState state = consolidate(c, make_assembly(c));
   const Assembly a = assembly_of(state.world);
   ExportOptions o;
@@ -176,6 +186,8 @@ TEST(Export, LammpsRunsTheDeck) {
   EXPECT_NEAR(rows.back()[5] / s3, 1.0, 0.01);
   EXPECT_NEAR(rows.back()[6] / s3, 1.0, 0.01);
 }
+
+INSTANTIATE_TEST_SUITE_P(Export, LammpsRun, ::testing::Values("hexagonal", "random"));
 
 /// Thermo rows (step dt time epsyy p_top p_left p_right W H ke) of a log.
 std::vector<std::vector<double>> thermo_rows(const std::string& text) {
