@@ -19,6 +19,7 @@
 #include "demcal/packing.hpp"
 #include "demcal/report.hpp"
 #include "demcal/trial.hpp"
+#include "demcal/upscaling.hpp"
 
 namespace demcal::cli {
 
@@ -112,12 +113,6 @@ int cmd_calibrate(const CalibrateOptions& o) {
   }();
   const int64_t n_rev = state.world.size();
   const int64_t n_proto = config.prototype.particles > 0 ? config.prototype.particles : n_rev;
-  AlgorithmSpec proto = summary.best;
-  // Tu & Andrade: Nstep grows linearly with the particle count; the
-  // multipliers do not depend on size.
-  proto.steps =
-      static_cast<int64_t>(std::llround(static_cast<double>(summary.best.steps) *
-                                        static_cast<double>(n_proto) / static_cast<double>(n_rev)));
 
   nlohmann::json params{
       {"schema", "demcal.params/1"},
@@ -125,8 +120,10 @@ int cmd_calibrate(const CalibrateOptions& o) {
       {"success", summary.success},
       {"message", summary.message},
       {"rev", param_block(summary.best, scales, n_rev)},
-      {"prototype", param_block(proto, scales, n_proto)},
-      {"upscaling", {{"law", "linear"}, {"factor", static_cast<double>(n_proto) / n_rev}}},
+      // Δt and damping recomputed from the prototype's own particles.
+      {"prototype", prototype_block(config, summary.best, n_rev)},
+      {"upscaling", upscaling_block(n_rev, n_proto)},
+      {"config", to_json(config)},
       {"criteria", summary.best_trial.criteria_json.is_null() ? to_json(summary.best_trial.criteria)
                                                               : summary.best_trial.criteria_json},
       {"tolerances", to_json(options.tolerances)},
