@@ -84,11 +84,13 @@ int cmd_calibrate(const CalibrateOptions& o) {
     throw InputError(trials_path, "", "--resume needs the trials.jsonl of an earlier run");
 
   Assembly assembly = make_assembly(config);
-  std::cerr << "demcal: consolidating " << assembly.size() << " particles of " << config.name
-            << " to sigma3 = " << config.test.lateral_stress << " Pa\n";
+  if (!o.quiet)
+    std::cerr << "demcal: consolidating " << assembly.size() << " particles of " << config.name
+              << " to sigma3 = " << config.test.lateral_stress << " Pa\n";
   const ConsolidatedState state = consolidate(config, assembly);
-  std::cerr << "demcal: consolidated in " << state.steps << " steps (" << state.wall_time_s
-            << " s)\n";
+  if (!o.quiet)
+    std::cerr << "demcal: consolidated in " << state.steps << " steps (" << state.wall_time_s
+              << " s)\n";
 
   make_output_dir(dir);
   if (!o.resume) std::filesystem::remove(trials_path);

@@ -743,7 +743,7 @@ std::string CalibrationSummary::BriefReport() const {
   std::ostringstream s;
   s.precision(4);
   s << (success ? "SUCCESS" : "FAILURE") << ": " << message << "\n";
-  if (best_trial.params.steps > 0)
+  if (best_trial.particle_steps > 0)
     s << "  dt_ratio " << best.dt_ratio << ", steps " << best.steps
       << ", damping_ratio_translation " << best.damping_ratio_translation
       << ", damping_ratio_rotation " << best.damping_ratio_rotation << "\n";
@@ -757,7 +757,7 @@ std::string CalibrationSummary::FullReport() const {
   s.precision(4);
   s << BriefReport();
   s << "  strategy " << strategy << ", stable dt_ratio " << dt_ratio_stable << "\n";
-  if (best_trial.params.steps > 0) {
+  if (best_trial.particle_steps > 0) {
     const auto& c = best_trial.criteria;
     s << "  criteria: force balance " << c.force_balance << ", moment balance " << c.moment_balance
       << ", servo " << c.servo << ", oscillation " << c.oscillation << "\n"
