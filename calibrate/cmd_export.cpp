@@ -20,23 +20,9 @@ int cmd_export(const ExportCmdOptions& o) {
   const RevParams rev = rev_params_from_json(params, o.params);
   if (o.format != "lammps" && o.format != "liggghts")
     throw InputError("--format", "", "must be lammps or liggghts, got \"" + o.format + "\"");
-  const auto config_opt = params_scene(params, o.params, o.config, o.sets);
-  if (!config_opt)
-    throw InputError(
-        o.params, "config",
-        "no scene config inside; pass --config CONFIG (the scene it was calibrated on)");
-  const SceneConfig& config = *config_opt;
+  const SceneConfig config = required_scene(params, o.params, o.config, o.sets);
   const ScalingLaw law = resolve_law(params, o.params, o.law, o.exponent);
-  std::string file = o.prototype;
-  int64_t particles = o.particles;
-  if (file.empty() && particles == 0 && params.contains("prototype") &&
-      params["prototype"].is_object()) {
-    const auto& p = params["prototype"];
-    if (p.contains("source") && p["source"].contains("file"))
-      file = p["source"]["file"].get<std::string>();
-    else if (p.contains("particles") && p["particles"].is_number_integer())
-      particles = p["particles"].get<int64_t>();
-  }
+  auto [file, particles] = named_prototype(params, o.prototype, o.particles);
   PrototypeSource source;
   Assembly proto = prototype_assembly(config, particles, file, &source);
   const AlgorithmSpec up = upscale(rev.params, rev.particles, proto.size(), law);

@@ -34,6 +34,29 @@ std::optional<SceneConfig> params_scene(const nlohmann::json& params, const std:
   return std::nullopt;
 }
 
+SceneConfig required_scene(const nlohmann::json& params, const std::string& path,
+                           const std::string& config, const std::vector<std::string>& sets) {
+  auto scene = params_scene(params, path, config, sets);
+  if (!scene)
+    throw InputError(
+        path, "config",
+        "no scene config inside; pass --config CONFIG (the scene it was calibrated on)");
+  return *scene;
+}
+
+std::pair<std::string, int64_t> named_prototype(const nlohmann::json& params,
+                                                const std::string& file, int64_t particles) {
+  if (!file.empty() || particles != 0 || !params.contains("prototype") ||
+      !params["prototype"].is_object())
+    return {file, particles};
+  const auto& p = params["prototype"];
+  if (p.contains("source") && p["source"].contains("file"))
+    return {p["source"]["file"].get<std::string>(), 0};
+  if (p.contains("particles") && p["particles"].is_number_integer())
+    return {"", p["particles"].get<int64_t>()};
+  return {file, particles};
+}
+
 ScalingLaw resolve_law(const nlohmann::json& params, const std::string& params_path,
                        const std::string& law_path, double exponent) {
   if (exponent > 0.0) {

@@ -29,24 +29,9 @@ constexpr double kAssumedSpeed = 3e7;
 int cmd_verify(const VerifyOptions& o) {
   const nlohmann::json params = read_json_file(o.params);
   const RevParams rev = rev_params_from_json(params, o.params);
-  const auto config_opt = params_scene(params, o.params, o.config, o.sets);
-  if (!config_opt)
-    throw InputError(
-        o.params, "config",
-        "no scene config inside; pass --config CONFIG (the scene it was calibrated on)");
-  const SceneConfig& config = *config_opt;
+  const SceneConfig config = required_scene(params, o.params, o.config, o.sets);
   const ScalingLaw law = resolve_law(params, o.params, o.law, o.exponent);
-  // The prototype: --prototype, --particles, else the one params.json names.
-  std::string file = o.prototype;
-  int64_t particles = o.particles;
-  if (file.empty() && particles == 0 && params.contains("prototype") &&
-      params["prototype"].is_object()) {
-    const auto& p = params["prototype"];
-    if (p.contains("source") && p["source"].contains("file"))
-      file = p["source"]["file"].get<std::string>();
-    else if (p.contains("particles") && p["particles"].is_number_integer())
-      particles = p["particles"].get<int64_t>();
-  }
+  auto [file, particles] = named_prototype(params, o.prototype, o.particles);
   PrototypeSource source;
   Assembly proto = prototype_assembly(config, particles, file, &source);
   if (!o.tile.empty()) {

@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "commands.hpp"
@@ -90,6 +91,14 @@ std::optional<SceneConfig> params_scene(const nlohmann::json& params, const std:
                                         const std::vector<std::string>& sets);
 /// The scaling law: --exponent, else --law scaling.json, else params.json's
 /// "upscaling" block, else linear.
+/// params_scene(), or an InputError asking for --config when there is none.
+SceneConfig required_scene(const nlohmann::json& params, const std::string& path,
+                           const std::string& config, const std::vector<std::string>& sets);
+/// The prototype to use: --prototype FILE or --particles N when given, else
+/// the one params.json names (its file, else its particle count).
+std::pair<std::string, int64_t> named_prototype(const nlohmann::json& params,
+                                                const std::string& file, int64_t particles);
+
 ScalingLaw resolve_law(const nlohmann::json& params, const std::string& params_path,
                        const std::string& law_path, double exponent);
 
