@@ -25,20 +25,6 @@ namespace demcal::cli {
 
 namespace {
 
-nlohmann::json param_block(const AlgorithmSpec& p, const ReferenceScales& s, int64_t particles) {
-  const double dt = p.dt_ratio * s.dt_crit;
-  return {{"particles", particles},
-          {"dt", dt},
-          {"dt_ratio", p.dt_ratio},
-          {"dt_crit", s.dt_crit},
-          {"steps", p.steps},
-          {"damping_translation", p.damping_ratio_translation * s.damping_translation_crit},
-          {"damping_ratio_translation", p.damping_ratio_translation},
-          {"damping_rotation", p.damping_ratio_rotation * s.damping_rotation_crit},
-          {"damping_ratio_rotation", p.damping_ratio_rotation},
-          {"mass_scaling", p.mass_scaling}};
-}
-
 /// Shell-quoted for display: the user copies it into a shell.
 std::string shell_word(const std::string& w) {
   const bool plain = !w.empty() && std::all_of(w.begin(), w.end(), [](unsigned char c) {
@@ -106,13 +92,6 @@ int cmd_calibrate(const CalibrateOptions& o) {
   if (!o.quiet) options.progress = [](const std::string& line) { std::cerr << line << "\n"; };
   const CalibrationSummary summary = calibrate(config, state, options);
 
-  const ReferenceScales scales = [&] {
-    World w = state.world;
-    Integration in;
-    in.mass_scaling = summary.best.mass_scaling;
-    w.set_integration(in);
-    return w.reference_scales();
-  }();
   const int64_t n_rev = state.world.size();
   const int64_t n_proto = config.prototype.particles > 0 ? config.prototype.particles : n_rev;
 
@@ -121,7 +100,8 @@ int cmd_calibrate(const CalibrateOptions& o) {
       {"scene", config.name},
       {"success", summary.success},
       {"message", summary.message},
-      {"rev", param_block(summary.best, scales, n_rev)},
+      {"rev", param_block(summary.best, particle_scales(state.world.radius(), config.material,
+                                                        summary.best.mass_scaling))},
       // Δt and damping recomputed from the prototype's own particles.
       {"prototype", prototype_block(config, summary.best, n_rev)},
       {"upscaling", upscaling_block(n_rev, n_proto)},
