@@ -1,7 +1,11 @@
-// `demcal calibrate`: the main job. Writes DIR/params.json,
-// DIR/trials.jsonl (appended per trial, so --resume loses nothing) and the
-// report, DIR/report.html and DIR/report.md; with --evidence also
+// `demcal calibrate`: the main job. Writes DIR/params.json (deterministic:
+// the same config and seed give the same bytes, whatever --jobs or
+// --resume), DIR/run.json (this invocation: wall time, jobs, trials run and
+// reused), DIR/trials.jsonl (appended per trial, so --resume loses nothing)
+// and the report, DIR/report.html and DIR/report.md; with --evidence also
 // DIR/evidence.jsonl (the paper-recipe baseline and the reference runs).
+// SIGINT/SIGTERM stop it cleanly after consolidation: finished trials stay
+// in trials.jsonl, nothing else is written, the exit status is 128 + signal.
 #include <algorithm>
 #include <cctype>
 #include <chrono>
@@ -20,6 +24,7 @@
 #include "demcal/report.hpp"
 #include "demcal/trial.hpp"
 #include "demcal/upscaling.hpp"
+#include "stop_signal.hpp"
 
 namespace demcal::cli {
 
@@ -56,9 +61,22 @@ std::string reproduce_command(const CalibrateOptions& o, const SceneConfig& conf
   return out;
 }
 
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+/// Particle-steps actually run by the search (early stops counted as run):
+/// a deterministic measure of the calibration's cost.
+double particle_steps_run(const std::vector<TrialRecord>& trials, int64_t particles) {
+  double sum = 0.0;
+  for (const auto& t : trials) sum += static_cast<double>(t.steps_run);
+  return sum * static_cast<double>(particles);
+}
+
 }  // namespace
 
 int cmd_calibrate(const CalibrateOptions& o) {
+  const auto t_start = std::chrono::steady_clock::now();
   SceneConfig config = load_scene(o.config, o.sets);
   if (o.max_trials > 0) config.calibration.max_trials = o.max_trials;
   if (o.accuracy > 0) config.calibration.accuracy = o.accuracy;
@@ -78,8 +96,16 @@ int cmd_calibrate(const CalibrateOptions& o) {
     std::cerr << "demcal: consolidated in " << state.steps << " steps (" << state.wall_time_s
               << " s)\n";
 
+  // From here on a signal stops cleanly (consolidation writes nothing, so
+  // the default action is fine before).
+  const StopOnSignal stop;
   make_output_dir(dir);
+  remove_stale_temporaries(dir);
   if (!o.resume) std::filesystem::remove(trials_path);
+  // Results of an earlier run in this folder would not match the trials
+  // from here on; they are rewritten at the end.
+  for (const char* name : {"params.json", "run.json", "report.html", "report.md", "evidence.jsonl"})
+    std::filesystem::remove(dir + "/" + name);
 
   CalibrationOptions options;
   options.strategy = o.strategy;
@@ -90,7 +116,15 @@ int cmd_calibrate(const CalibrateOptions& o) {
   options.trials_path = trials_path;
   options.resume = o.resume;
   if (!o.quiet) options.progress = [](const std::string& line) { std::cerr << line << "\n"; };
+  options.stop = &stop.flag();
   const CalibrationSummary summary = calibrate(config, state, options);
+  const auto interrupted = [&](const std::string& what) {
+    std::cerr << "demcal: interrupted" << what << "; " << summary.trials.size()
+              << " finished trials are in " << trials_path << ". Continue with:\n  "
+              << reproduce_command(o, config, dir) << " --resume\n";
+    return stop.exit_status();
+  };
+  if (summary.interrupted) return interrupted("");
 
   const int64_t n_rev = state.world.size();
   const int64_t n_proto = config.prototype.particles > 0 ? config.prototype.particles : n_rev;
@@ -120,7 +154,7 @@ int cmd_calibrate(const CalibrateOptions& o) {
       {"dt_ratio_stable", summary.dt_ratio_stable},
       {"strategy", summary.strategy},
       {"trials", static_cast<int>(summary.trials.size())},
-      {"wall_time_s", summary.wall_time_s},
+      {"particle_steps_run", particle_steps_run(summary.trials, n_rev)},
       {"seed", config.calibration.seed},
       {"config_sha256", sha256_hex(config.text)},
       {"version", DEMCAL_VERSION}};
@@ -199,6 +233,7 @@ int cmd_calibrate(const CalibrateOptions& o) {
           {"calibrated_peak_error", peak_error(summary.best_trial)}}},
         {"baseline", b}};
   }
+  if (stop.stopped()) return interrupted(" during the evidence runs (nothing written)");
   write_file_atomic(dir + "/params.json", params.dump(2) + "\n");
 
   // The report: the start point and the result rerun with their series,
@@ -229,6 +264,7 @@ int cmd_calibrate(const CalibrateOptions& o) {
     start.damping_ratio_translation = 1.0;
     start.damping_ratio_rotation = 1.0;
     collect_runs(in, config, state, start, jobs);
+    if (stop.stopped()) return interrupted(" before the report was written (params.json is)");
     const auto t1 = std::chrono::steady_clock::now();
     const Report report = make_report(in);
     write_file_atomic(dir + "/report.html", report.html);
@@ -242,8 +278,21 @@ int cmd_calibrate(const CalibrateOptions& o) {
     std::cerr << "demcal: warning: the report was not written: " << e.what() << "\n";
   }
 
+  // What varies between invocations stays out of params.json.
+  const nlohmann::json run{{"schema", "demcal.run/1"},
+                           {"wall_time_s", seconds_since(t_start)},
+                           {"calibration_wall_time_s", summary.wall_time_s},
+                           {"consolidation_wall_time_s", state.wall_time_s},
+                           {"jobs", jobs},
+                           {"resumed", o.resume},
+                           {"trials_run", summary.trials_run},
+                           {"trials_reused", summary.trials_reused},
+                           {"kernel_simd", kernel_simd()},
+                           {"version", DEMCAL_VERSION}};
+  write_file_atomic(dir + "/run.json", run.dump(2) + "\n");
+
   std::cout << summary.BriefReport() << "  wrote " << dir << "/params.json, " << dir
-            << "/trials.jsonl" << report_note
+            << "/run.json, " << dir << "/trials.jsonl" << report_note
             << (o.evidence && have_best ? ", " + dir + "/evidence.jsonl" : "") << "\n";
   return summary.success ? 0 : 1;
 }

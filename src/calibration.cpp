@@ -7,6 +7,7 @@
 #include <cmath>
 #include <fstream>
 #include <future>
+#include <limits>
 #include <map>
 #include <mutex>
 #include <set>
@@ -64,7 +65,7 @@ nlohmann::json params_to_json(const AlgorithmSpec& p) {
 
 TrialRecord run_trial(const SceneConfig& config, const ConsolidatedState& state,
                       const AlgorithmSpec& params, const Tolerances& tol, bool early_stop,
-                      double factor, LoadingResult* run_out) {
+                      double factor, LoadingResult* run_out, const std::atomic<bool>* stop) {
   const double s3 = config.test.lateral_stress;
   const double m = config.test.monitor_points;
   // Running sums of squares of the σ3-normalised measures: the final RMS
@@ -72,8 +73,12 @@ TrialRecord run_trial(const SceneConfig& config, const ConsolidatedState& state,
   // factor × tolerance the trial has certainly failed.
   double sum_xx = 0.0, sum_xy = 0.0, sum_yx = 0.0, sum_mb = 0.0, sum_servo = 0.0;
   MonitorCallback monitor;
+  if (stop) {
+    monitor = [stop](const MonitorPoint&) { return !stop->load(std::memory_order_relaxed); };
+  }
   if (early_stop) {
     monitor = [&](const MonitorPoint& p) {
+      if (stop && stop->load(std::memory_order_relaxed)) return false;
       if (p.step == 0) return true;
       auto sq = [](double v) { return v * v; };
       sum_xx += sq((p.b(0, 0) - p.sigma(0, 0)) / s3);
@@ -189,8 +194,15 @@ class Evaluator {
     next_id_ = std::max(next_id_, r.id + 1);
   }
 
+  /// The caller asked to stop (CalibrationOptions::stop).
+  bool stopped() const { return options_.stop && options_.stop->load(); }
+
+  /// Run (or look up) one trial. Once stopped(), no new trial starts, and a
+  /// trial cut short by the stop is neither cached nor written: it returns
+  /// marked incomplete and failed, and the searches wind down.
   TrialRecord evaluate(AlgorithmSpec params, const std::string& phase) {
     params = rounded(params);
+    if (stopped()) return interrupted_record(params, phase);
     const Key key = key_of(params);
     std::shared_future<TrialRecord> future;
     std::promise<TrialRecord> promise;
@@ -211,12 +223,20 @@ class Evaluator {
     TrialRecord r;
     try {
       r = run_trial(config_, state_, params, options_.tolerances, options_.early_stop,
-                    options_.early_stop_factor);
+                    options_.early_stop_factor, nullptr, options_.stop);
     } catch (...) {
       promise.set_exception(std::current_exception());
       throw;
     }
     r.phase = phase;
+    if (!r.complete && stopped()) {
+      // Possibly cut by the stop: not a finished trial. --resume reruns it.
+      r = interrupted_record(params, phase);
+      std::lock_guard<std::mutex> lock(mutex_);
+      cache_.erase(key);
+      promise.set_value(r);
+      return r;
+    }
     {
       std::lock_guard<std::mutex> lock(mutex_);
       r.id = next_id_++;
@@ -262,6 +282,16 @@ class Evaluator {
   int reused_count() const { return reused_; }
 
  private:
+  static TrialRecord interrupted_record(const AlgorithmSpec& params, const std::string& phase) {
+    TrialRecord r;
+    r.params = params;
+    r.phase = phase;
+    r.complete = false;
+    r.worst_excess = std::numeric_limits<double>::infinity();
+    r.diagnosis = "interrupted";
+    return r;
+  }
+
   const SceneConfig& config_;
   const ConsolidatedState& state_;
   const CalibrationOptions& options_;
@@ -311,10 +341,13 @@ struct SearchContext {
   Tolerances tolerances;
   std::string phase;
   bool penalty = false;
+  nlopt_opt opt = nullptr;  ///< the running optimiser, stopped with the evaluator
 };
 
 TrialRecord eval_at(SearchContext& c, const double* x) {
-  return c.evaluator->evaluate(params_at(*c.space, x), c.phase);
+  TrialRecord r = c.evaluator->evaluate(params_at(*c.space, x), c.phase);
+  if (c.opt && c.evaluator->stopped()) nlopt_force_stop(c.opt);
+  return r;
 }
 
 double objective(unsigned, const double* x, double*, void* data) {
@@ -349,6 +382,7 @@ void local_search(const std::string& strategy, SearchContext context, const doub
   }
   context.penalty = !constrained;
   nlopt_opt opt = nlopt_create(algorithm, 4);
+  context.opt = opt;
   nlopt_opt local = nullptr;
   if (strategy == "auglag") {
     local = nlopt_create(NLOPT_LN_BOBYQA, 4);
@@ -381,6 +415,7 @@ void global_phase(SearchContext context, int max_evals) {
   const SearchSpace& s = *context.space;
   context.penalty = true;
   nlopt_opt opt = nlopt_create(NLOPT_GN_DIRECT_L, 4);
+  context.opt = opt;
   nlopt_set_lower_bounds(opt, s.lower);
   nlopt_set_upper_bounds(opt, s.upper);
   nlopt_set_min_objective(opt, objective, &context);
@@ -407,6 +442,7 @@ struct ModelSearch {
   double best_prediction = 0.0;
   double best_x[3] = {0, 0, 0};
   int evaluations = 0;
+  nlopt_opt opt = nullptr;
 };
 
 constexpr double kModelMargin = 1.1;  // aim a little below the tolerances
@@ -421,6 +457,10 @@ double model_objective(unsigned, const double* x, double*, void* data) {
   ++m.evaluations;
   const double full[4] = {x[0], std::log10(m.n_guess), x[1], x[2]};
   const TrialRecord r = m.evaluator->evaluate(params_at(*m.space, full), "search");
+  if (m.evaluator->stopped()) {
+    nlopt_force_stop(m.opt);
+    return HUGE_VAL;
+  }
   if (r.diverged) return std::log10(m.n_guess) + 3.0;
   const double predicted = m.n_guess * std::max(rate_excess(r, m.tolerances), 1e-3) * kModelMargin;
   const double osc = std::log(std::max(r.criteria.oscillation, 1e-12) / m.tolerances.oscillation);
@@ -446,6 +486,7 @@ std::optional<TrialRecord> model_search(Evaluator& evaluator, const SearchSpace&
   const int per_round = std::max(4, (max_evals - verify_budget) / 2);
   for (int round = 0; round < 2; ++round) {
     nlopt_opt opt = nlopt_create(NLOPT_LN_BOBYQA, 3);
+    m.opt = opt;
     nlopt_set_lower_bounds(opt, lower);
     nlopt_set_upper_bounds(opt, upper);
     nlopt_set_min_objective(opt, model_objective, &m);
@@ -456,7 +497,8 @@ std::optional<TrialRecord> model_search(Evaluator& evaluator, const SearchSpace&
     double f = 0.0;
     nlopt_optimize(opt, x, &f);
     nlopt_destroy(opt);
-    if (m.best_prediction == 0.0) return std::nullopt;
+    m.opt = nullptr;
+    if (evaluator.stopped() || m.best_prediction == 0.0) return std::nullopt;
     // Re-centre the 1/N model on its own prediction.
     if (std::abs(std::log10(m.best_prediction / m.n_guess)) < 0.05) break;
     m.n_guess = m.best_prediction;
@@ -470,7 +512,7 @@ std::optional<TrialRecord> model_search(Evaluator& evaluator, const SearchSpace&
   for (int k = 0; k < verify_budget; ++k) {
     const double full[4] = {m.best_x[0], std::log10(n), m.best_x[1], m.best_x[2]};
     const TrialRecord r = evaluator.evaluate(params_at(space, full), "verify");
-    if (r.diverged) break;
+    if (r.diverged || evaluator.stopped()) break;
     const double excess = rate_excess(r, tolerances);
     if (r.passed && r.complete) {
       if (!best || r.params.steps < best->params.steps) best = r;
@@ -648,6 +690,18 @@ CalibrationSummary calibrate(const SceneConfig& config, const ConsolidatedState&
                  jobs);
   };
   search_round(start0, start1, budget, "search");
+  const auto finish_interrupted = [&] {
+    out.trials = evaluator.all();
+    out.trials_run = evaluator.run_count();
+    out.trials_reused = evaluator.reused_count();
+    out.interrupted = true;
+    out.message =
+        "interrupted: " + std::to_string(out.trials.size()) + " finished trials are kept" +
+        (options.trials_path.empty() ? "" : " in " + options.trials_path) + "; resume to continue";
+    out.wall_time_s = seconds_since(t0);
+    return out;
+  };
+  if (evaluator.stopped()) return finish_interrupted();
 
   // Certificate; when it fails, tighten the tolerances and search again
   // from the best point, then fall back to doubling Nstep.
@@ -666,6 +720,7 @@ CalibrationSummary calibrate(const SceneConfig& config, const ConsolidatedState&
     }
     if (!best) break;
     out.certificate = certify(evaluator, *best, options.accuracy, jobs);
+    if (evaluator.stopped()) return finish_interrupted();
     if (out.certificate.passed) break;
     if (round < 2) {
       const double factor = std::clamp(
@@ -694,6 +749,7 @@ CalibrationSummary calibrate(const SceneConfig& config, const ConsolidatedState&
     }
   }
 
+  if (evaluator.stopped()) return finish_interrupted();
   out.trials = evaluator.all();
   out.trials_run = evaluator.run_count();
   out.trials_reused = evaluator.reused_count();
@@ -742,7 +798,7 @@ BaselineResult paper_recipe_baseline(const SceneConfig& config, const Consolidat
 std::string CalibrationSummary::BriefReport() const {
   std::ostringstream s;
   s.precision(4);
-  s << (success ? "SUCCESS" : "FAILURE") << ": " << message << "\n";
+  s << (success ? "SUCCESS" : interrupted ? "INTERRUPTED" : "FAILURE") << ": " << message << "\n";
   if (best_trial.particle_steps > 0)
     s << "  dt_ratio " << best.dt_ratio << ", steps " << best.steps
       << ", damping_ratio_translation " << best.damping_ratio_translation

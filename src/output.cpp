@@ -1,8 +1,10 @@
 #include "demcal/output.hpp"
 
 #include <fcntl.h>
+#include <signal.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -47,6 +49,22 @@ void make_output_dir(const std::string& dir) {
   if (ec || !std::filesystem::is_directory(dir))
     throw InputError(
         dir, "", "cannot create output folder" + (ec ? " (" + ec.message() + ")" : std::string()));
+}
+
+void remove_stale_temporaries(const std::string& dir) {
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator(dir, ec)) {
+    const std::string name = entry.path().filename().string();
+    const auto at = name.rfind(".tmp.");
+    if (at == std::string::npos || at + 5 >= name.size()) continue;
+    const std::string pid_text = name.substr(at + 5);
+    if (pid_text.find_first_not_of("0123456789") != std::string::npos || pid_text.size() > 9)
+      continue;
+    const pid_t pid = static_cast<pid_t>(std::stol(pid_text));
+    // Alive (or not ours to signal): leave it.
+    if (pid == ::getpid() || ::kill(pid, 0) == 0 || errno == EPERM) continue;
+    std::filesystem::remove(entry.path(), ec);
+  }
 }
 
 std::string series_csv(const std::vector<MonitorPoint>& series) {

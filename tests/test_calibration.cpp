@@ -5,6 +5,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -17,6 +18,7 @@
 
 #include "demcal/biaxial.hpp"
 #include "demcal/calibration.hpp"
+#include "demcal/output.hpp"
 #include "demcal/packing.hpp"
 
 namespace fs = std::filesystem;
@@ -61,12 +63,6 @@ nlohmann::json read_json(const fs::path& p) {
   return nlohmann::json::parse(in);
 }
 
-/// params.json without the one key that measures the machine, not the result.
-nlohmann::json comparable(nlohmann::json j) {
-  j.erase("wall_time_s");
-  return j;
-}
-
 std::vector<nlohmann::json> read_trials(const fs::path& p) {
   std::vector<nlohmann::json> out;
   std::ifstream in(p);
@@ -80,6 +76,30 @@ std::vector<nlohmann::json> read_trials(const fs::path& p) {
     }
   }
   return out;
+}
+
+std::string read_bytes(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+/// Wait until `path` has at least `lines` whole trial lines, or the process
+/// has exited; false when it exited first.
+bool wait_for_trials(const fs::path& path, size_t lines, pid_t pid) {
+  for (int k = 0; k < 6000; ++k) {
+    int status = 0;
+    if (waitpid(pid, &status, WNOHANG) == pid) return false;
+    if (fs::exists(path) && read_trials(path).size() >= lines) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  return false;
+}
+
+/// No NAME.tmp.PID left behind by an interrupted atomic write.
+bool has_temporaries(const fs::path& dir) {
+  for (const auto& e : fs::directory_iterator(dir))
+    if (e.path().filename().string().find(".tmp.") != std::string::npos) return true;
+  return false;
 }
 
 }  // namespace
@@ -120,7 +140,11 @@ TEST(Calibration, SameResultWithAnyJobs) {
   const fs::path a = fresh_dir("cal_j1"), b = fresh_dir("cal_j2");
   ASSERT_EQ(wait_exit(spawn_calibrate(a, false, "1")), 0);
   ASSERT_EQ(wait_exit(spawn_calibrate(b, false, "2")), 0);
-  EXPECT_EQ(comparable(read_json(a / "params.json")), comparable(read_json(b / "params.json")));
+  // Byte for byte: params.json holds nothing that depends on the machine or
+  // the run (wall time and jobs are in run.json).
+  EXPECT_EQ(read_bytes(a / "params.json"), read_bytes(b / "params.json"));
+  EXPECT_EQ(read_json(a / "run.json")["jobs"], 1);
+  EXPECT_EQ(read_json(b / "run.json")["jobs"], 2);
   fs::remove_all(a);
   fs::remove_all(b);
 }
@@ -151,8 +175,68 @@ TEST(Calibration, ResumeAfterSigkillEqualsUninterrupted) {
   // No parameter set was run twice.
   std::set<std::string> keys;
   for (const auto& t : trials) EXPECT_TRUE(keys.insert(t["params"].dump()).second);
-  EXPECT_EQ(comparable(read_json(killed / "params.json")),
-            comparable(read_json(reference / "params.json")));
+  EXPECT_EQ(read_bytes(killed / "params.json"), read_bytes(reference / "params.json"));
   fs::remove_all(reference);
   fs::remove_all(killed);
+}
+
+// SIGINT, then SIGTERM, stop a calibration cleanly: exit 128 + signal,
+// every trial line whole, no params.json and no temporary file; --resume
+// reruns no finished trial and ends with the uninterrupted run's params.json.
+TEST(Calibration, SigintAndSigtermStopCleanlyAndResumeContinues) {
+  // The default 10x10 scene on one job: some 50 trials, seconds of work,
+  // so the signals arrive mid-search.
+  const std::string config = "";
+  const fs::path reference = fresh_dir("cal_sig_ref"), stopped = fresh_dir("cal_sig");
+  ASSERT_EQ(wait_exit(spawn_calibrate(reference, false, "1", config)), 0);
+
+  std::vector<nlohmann::json> kept;
+  bool resume = false;
+  for (const int signo : {SIGINT, SIGTERM}) {
+    const pid_t pid = spawn_calibrate(stopped, resume, "1", config);
+    ASSERT_TRUE(wait_for_trials(stopped / "trials.jsonl", kept.size() + 3, pid))
+        << "the calibration ended before the signal";
+    kill(pid, signo);
+    EXPECT_EQ(wait_exit(pid), 128 + signo);
+    EXPECT_FALSE(fs::exists(stopped / "params.json"));
+    EXPECT_FALSE(has_temporaries(stopped));
+    // Every line is a whole record, and earlier lines are untouched.
+    const std::string text = read_bytes(stopped / "trials.jsonl");
+    ASSERT_FALSE(text.empty());
+    EXPECT_EQ(text.back(), '\n');
+    const auto trials = read_trials(stopped / "trials.jsonl");
+    EXPECT_EQ(static_cast<size_t>(std::count(text.begin(), text.end(), '\n')), trials.size());
+    ASSERT_GE(trials.size(), kept.size() + 3);
+    for (size_t k = 0; k < kept.size(); ++k) EXPECT_EQ(trials[k], kept[k]);
+    kept = trials;
+    resume = true;
+  }
+  ASSERT_EQ(wait_exit(spawn_calibrate(stopped, true, "1", config)), 0);
+  const auto trials = read_trials(stopped / "trials.jsonl");
+  std::set<std::string> keys;
+  for (const auto& t : trials) EXPECT_TRUE(keys.insert(t["params"].dump()).second);
+  EXPECT_EQ(read_json(stopped / "run.json")["trials_reused"].get<size_t>(), kept.size());
+  EXPECT_EQ(read_bytes(stopped / "params.json"), read_bytes(reference / "params.json"));
+  fs::remove_all(reference);
+  fs::remove_all(stopped);
+}
+
+// A kill in mid-write leaves NAME.tmp.PID; the next run into the folder
+// removes those of processes that are gone, and only those.
+TEST(Output, StaleTemporariesOfDeadProcessesAreRemoved) {
+  const fs::path dir = fresh_dir("stale_tmp");
+  fs::create_directories(dir);
+  // A child that exits at once gives a PID that is certainly not running.
+  const pid_t dead = fork();
+  if (dead == 0) _exit(0);
+  wait_exit(dead);
+  const fs::path stale = dir / ("params.json.tmp." + std::to_string(dead));
+  const fs::path live = dir / ("report.html.tmp." + std::to_string(::getppid()));
+  const fs::path user = dir / "notes.tmp.txt";
+  for (const auto& p : {stale, live, user}) std::ofstream(p) << "x";
+  remove_stale_temporaries(dir.string());
+  EXPECT_FALSE(fs::exists(stale));
+  EXPECT_TRUE(fs::exists(live));
+  EXPECT_TRUE(fs::exists(user));
+  fs::remove_all(dir);
 }

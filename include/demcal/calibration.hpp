@@ -7,6 +7,7 @@
 // defaults in, CalibrationSummary with BriefReport()/FullReport() out.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <functional>
 #include <nlohmann/json.hpp>
@@ -55,6 +56,12 @@ struct CalibrationOptions {
   bool resume = false;      ///< read trials_path first and reuse its trials
   /// Progress callback (trial finished); may be empty.
   std::function<void(const std::string&)> progress;
+  /// Set by the caller (e.g. a SIGINT handler) to stop cleanly: running
+  /// trials are abandoned at their next monitoring point and not recorded,
+  /// no new trial starts, and calibrate() returns with `interrupted` set.
+  /// Every finished trial is already in trials_path, so `resume` continues.
+  /// May be null.
+  const std::atomic<bool>* stop = nullptr;
 };
 
 /// One finished trial, as stored in trials.jsonl.
@@ -85,7 +92,8 @@ struct Certificate {
 };
 
 struct CalibrationSummary {
-  bool success = false;  ///< a passing, certified parameter set was found
+  bool success = false;      ///< a passing, certified parameter set was found
+  bool interrupted = false;  ///< options.stop was set: the result is incomplete
   std::string message;
   AlgorithmSpec best;
   TrialRecord best_trial;
@@ -118,9 +126,11 @@ BaselineResult paper_recipe_baseline(const SceneConfig& config, const Consolidat
                                      int max_doublings = 8);
 
 /// Run one trial and score it (no cache, no file).
+/// With `stop` set during the run, the run ends at its next monitoring
+/// point and the record is incomplete (check *stop before using it).
 TrialRecord run_trial(const SceneConfig& config, const ConsolidatedState& state,
                       const AlgorithmSpec& params, const Tolerances& tolerances,
                       bool early_stop = false, double early_stop_factor = 3.0,
-                      LoadingResult* run_out = nullptr);
+                      LoadingResult* run_out = nullptr, const std::atomic<bool>* stop = nullptr);
 
 }  // namespace demcal

@@ -17,6 +17,9 @@ void write_file_atomic(const std::string& path, const std::string& content);
 void append_line_durable(const std::string& path, const std::string& line);
 /// Create an output folder (and parents). Throws naming the path.
 void make_output_dir(const std::string& dir);
+/// Remove temporary files write_file_atomic left in `dir` when a process
+/// was killed mid-write (NAME.tmp.PID with PID no longer running).
+void remove_stale_temporaries(const std::string& dir);
 
 /// series.csv: step,strain_yy,b_xx,b_xy,b_yx,b_yy,s_xx,s_xy,s_yx,s_yy,
 /// kinetic_energy,unbalanced_force_ratio,lateral_stress_error, then extras.
