@@ -122,6 +122,8 @@ const char* to_string(Divergence d) {
       return "overlap beyond limit";
     case Divergence::kEnergy:
       return "kinetic energy growing without bound";
+    case Divergence::kEnergyCreated:
+      return "energy created by the integrator (step beyond the stable one)";
   }
   return "unknown";
 }
@@ -179,6 +181,12 @@ void World::set_threads(int threads) {
   threads_ = threads;
   if (team_.team && team_.team->size() != active_threads()) team_.team.reset();
   update_thread_bounds();
+}
+
+void World::set_options(const KernelOptions& options) {
+  options_ = options;
+  ledger_ = {};
+  set_threads(options.threads);
 }
 
 int World::active_threads() const {
@@ -244,6 +252,7 @@ void World::set_integration(const Integration& integration) {
   if (!(integration.mass_scaling > 0.0))
     throw std::invalid_argument("World: mass_scaling must be > 0");
   integration_ = integration;
+  ledger_ = {};
   // Locked rotation means ω ≡ 0: a spin left from before the lock would
   // otherwise keep loading the tangential springs through the contact-point
   // velocity while θ stays frozen.
@@ -273,12 +282,14 @@ void World::update_damping_coefficients() {
 }
 
 void World::set_velocity(int i, double vx, double vy, double omega) {
+  ledger_ = {};
   vx_[i] = vx;
   vy_[i] = vy;
   omega_[i] = integration_.lock_rotation ? 0.0 : omega;
 }
 
 void World::set_position(int i, double x, double y) {
+  ledger_ = {};
   x_[i] = x;
   y_[i] = y;
   list_valid_ = false;
@@ -332,7 +343,7 @@ bool World::check_divergence() {
     divergence_ = Divergence::kEnergy;
     return true;
   }
-  return false;
+  return energy_created_beyond_limit();
 }
 
 bool World::step(int64_t count) {
