@@ -45,6 +45,17 @@ struct CalibrateOptions {
 };
 int cmd_calibrate(const CalibrateOptions& options);
 
+struct StabilityOptions {
+  std::string config;
+  std::vector<std::string> sets;
+  std::string out_dir;
+  int jobs = 0;
+  double from = 0.5, to = 2.0;
+  int points = 16;
+  long long steps = 20000;
+};
+int cmd_stability(const StabilityOptions& options);
+
 // Issue #6: upscale, verify, scaling, export, rev (options in
 // upscaling_cli.hpp). Adds the subcommands to `app`; the function returned
 // runs the one that was parsed, or returns -1 when none of them was.

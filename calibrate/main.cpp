@@ -52,14 +52,39 @@ int main(int argc, char** argv) {
                       "also run the paper-recipe baseline and a converged reference (8x and 16x "
                       "Nstep) so the report shows every trial's peak error");
 
+  StabilityOptions stab;
+  auto* stability = app.add_subcommand(
+      "stability", "find the time step at which the REV diverges and compare it with the estimate");
+  stability->add_option("config", stab.config, "scene config (JSON); default: the embedded one");
+  stability->add_option("--set", stab.sets, "override a key: section.key=value (repeatable)");
+  stability->add_option("-o,--output", stab.out_dir,
+                        "output folder (default demcal-stability-NAME)");
+  stability->add_option("-j,--jobs", stab.jobs, "trials in parallel (default: cores)");
+  stability->add_option("--from", stab.from, "first rung, x the estimated stable dt_ratio (0.5)")
+      ->check(CLI::PositiveNumber);
+  stability->add_option("--to", stab.to, "last rung, x the estimated stable dt_ratio (2)")
+      ->check(CLI::PositiveNumber);
+  stability->add_option("--points", stab.points, "rungs of the ladder (16)")
+      ->check(CLI::Range(2, 1000));
+  stability->add_option("--steps", stab.steps, "loading steps per trial (20000)")
+      ->check(CLI::PositiveNumber);
+
   const auto run_upscaling = add_upscaling_commands(app);  // upscale, verify, scaling, export, rev
 
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    // --help prints and exits 0; a usage error is bad input: one line, 2.
+    if (e.get_exit_code() == static_cast<int>(CLI::ExitCodes::Success)) return app.exit(e);
+    std::cerr << "demcal: error: " << e.what() << " (see --help)\n";
+    return kBadInput;
+  }
   try {
     if (check->parsed()) return cmd_check(config_path, sets);
     if (run->parsed()) return cmd_run(config_path, sets, out_dir);
     if (sweep->parsed()) return cmd_sweep(sweep_options);
     if (calibrate->parsed()) return cmd_calibrate(cal);
+    if (stability->parsed()) return cmd_stability(stab);
     if (const int status = run_upscaling(); status >= 0) return status;
   } catch (const demcal::InputError& e) {
     std::cerr << "demcal: error: " << e.what() << "\n";

@@ -155,6 +155,31 @@ TEST_F(CliEndToEnd, BadOverridesAndMissingFilesExitTwo) {
   expect_bad_input({"run", dir_.string(), "-o", out}, {dir_.string()});  // a folder
 }
 
+// Usage errors (CLI11's checks) are bad input too: one line, exit 2.
+TEST_F(CliEndToEnd, UsageErrorsExitTwo) {
+  const std::string out = (dir_ / "work" / "out").string();
+  expect_bad_input({"calibrate", kHex5, "--strategy", "bogus", "-o", out}, {"--strategy", "bogus"});
+  expect_bad_input({"stability", kHex5, "--points", "1", "-o", out}, {"--points"});
+  expect_bad_input({"stability", kHex5, "--from", "2", "--to", "1", "-o", out}, {"--to"});
+  expect_bad_input({"frobnicate"}, {"subcommand"});
+  const Result help = demcal({"--help"});
+  EXPECT_EQ(help.status, 0);
+  EXPECT_NE(help.out.find("stability"), std::string::npos);
+}
+
+// `demcal stability`: the limit against the estimate, both files written.
+TEST_F(CliEndToEnd, StabilityScanWritesItsReport) {
+  const fs::path out = dir_ / "work" / "scan";
+  const Result r = demcal({"stability", kHex5, "--steps", "5000", "-o", out.string()});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("x the estimate"), std::string::npos) << r.out;
+  const auto j = nlohmann::json::parse(read(out / "stability.json"));
+  EXPECT_NEAR(j["measured_over_estimate"].get<double>(), 1.0, 0.03);
+  for (const auto& t : j["trials"])
+    if (t["diverged"].get<bool>()) EXPECT_GT(t["divergence_step"].get<int>(), 0);
+  EXPECT_NE(read(out / "stability.md").find("| alpha |"), std::string::npos);
+}
+
 TEST_F(CliEndToEnd, BadParticleFileNamesFileAndLine) {
   const std::string out = (dir_ / "work" / "out").string();
   const std::string csv = write("p.csv", "x,y,r\n0,0,5e-4\n1e-3,0,-5e-4\n");
