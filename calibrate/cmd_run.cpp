@@ -139,11 +139,30 @@ void print_scales(const SceneConfig& config, const World& world) {
 
 }  // namespace
 
+namespace {
+
+/// A prescribed Δt beyond the stable step of the consolidated REV is bad
+/// input (the run would diverge or rattle), unless asked for.
+void require_stable_step(const SceneConfig& config, const ConsolidatedState& state,
+                         bool allow_unstable) {
+  const double stable = estimated_stable_dt_ratio(state, config.algorithm);
+  if (allow_unstable || config.algorithm.dt_ratio <= stable) return;
+  std::ostringstream s;
+  s << std::setprecision(4) << config.algorithm.dt_ratio
+    << " is beyond the stable step estimated from the consolidated contact network, " << stable
+    << " (use a smaller value; `demcal stability` measures the limit, "
+    << "`demcal run --allow-unstable` runs it anyway)";
+  throw InputError(config.source, "algorithm.dt_ratio", s.str());
+}
+
+}  // namespace
+
 int cmd_check(const std::string& path, const std::vector<std::string>& sets) {
   SceneConfig config = load_scene(path, sets);
   Assembly assembly = make_assembly(config);
-  std::cout << "config " << config.source << ": valid\n";
   const ConsolidatedState state = consolidate(config, assembly);
+  require_stable_step(config, state, false);
+  std::cout << "config " << config.source << ": valid\n";
   print_scales(config, state.world);
   const StabilityEstimate est = state.world.stability_estimate();
   std::cout << "  consolidated in " << state.steps << " steps (" << std::setprecision(3)
@@ -154,9 +173,6 @@ int cmd_check(const std::string& path, const std::vector<std::string>& sets) {
             << "\n"
             << "  stable dt_ratio (translation only)         " << est.dt_ratio_stable_translation
             << "\n";
-  if (config.algorithm.dt_ratio > est.dt_ratio_stable)
-    std::cout << "  WARNING: algorithm.dt_ratio " << config.algorithm.dt_ratio
-              << " is beyond the estimated stable step\n";
   if (auto peak = analytical_peak_stress(config)) {
     std::cout << "  analytical peak sigma1/sigma3 " << -*peak / config.test.lateral_stress
               << " (walled box), " << hexagonal_peak_ratio(config.material.particle.friction)
@@ -166,12 +182,13 @@ int cmd_check(const std::string& path, const std::vector<std::string>& sets) {
 }
 
 int cmd_run(const std::string& path, const std::vector<std::string>& sets,
-            const std::string& out_dir) {
+            const std::string& out_dir, bool allow_unstable) {
   SceneConfig config = load_scene(path, sets);
   Assembly assembly = make_assembly(config);
   const std::string dir = out_dir.empty() ? "demcal-run-" + config.name : out_dir;
   OutputFolder::check(dir);  // an unwritable -o fails now, not after the run
   const ConsolidatedState state = consolidate(config, assembly);
+  require_stable_step(config, state, allow_unstable);
   World final_state = state.world;
   const LoadingResult run = run_loading(state, config.test, config.algorithm, {}, &final_state);
   const Tolerances tolerances;

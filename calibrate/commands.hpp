@@ -18,8 +18,10 @@ namespace demcal::cli {
 SceneConfig load_scene(const std::string& path, const std::vector<std::string>& sets);
 
 int cmd_check(const std::string& path, const std::vector<std::string>& sets);
+/// `allow_unstable`: run a Δt beyond the estimated stable step (otherwise
+/// bad input).
 int cmd_run(const std::string& path, const std::vector<std::string>& sets,
-            const std::string& out_dir);
+            const std::string& out_dir, bool allow_unstable = false);
 
 struct SweepOptions {
   std::string config;

@@ -25,6 +25,9 @@ int main(int argc, char** argv) {
   run->add_option("config", config_path, "scene config (JSON); default: the embedded one");
   run->add_option("--set", sets, "override a key: section.key=value (repeatable)");
   run->add_option("-o,--output", out_dir, "output folder (default demcal-run-NAME)");
+  bool allow_unstable = false;
+  run->add_flag("--allow-unstable", allow_unstable,
+                "run a dt_ratio beyond the estimated stable step (to watch it diverge)");
 
   SweepOptions sweep_options;
   auto* sweep =
@@ -81,7 +84,7 @@ int main(int argc, char** argv) {
   }
   try {
     if (check->parsed()) return cmd_check(config_path, sets);
-    if (run->parsed()) return cmd_run(config_path, sets, out_dir);
+    if (run->parsed()) return cmd_run(config_path, sets, out_dir, allow_unstable);
     if (sweep->parsed()) return cmd_sweep(sweep_options);
     if (calibrate->parsed()) return cmd_calibrate(cal);
     if (stability->parsed()) return cmd_stability(stab);

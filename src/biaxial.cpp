@@ -117,6 +117,15 @@ ConsolidatedState consolidate(const SceneConfig& config, const Assembly& assembl
   return state;
 }
 
+double estimated_stable_dt_ratio(const ConsolidatedState& state, const AlgorithmSpec& algorithm) {
+  World probe = state.world;
+  AlgorithmSpec a = algorithm;
+  a.dt_ratio = std::min(a.dt_ratio, 0.1);  // any valid step: the estimate does not use it
+  probe.set_integration(integration_for(probe, a));
+  probe.update_forces();
+  return probe.stability_estimate().dt_ratio_stable;
+}
+
 LoadingResult run_loading(const ConsolidatedState& start, const TestSpec& test,
                           const AlgorithmSpec& algorithm, const MonitorCallback& monitor,
                           World* final_state) {

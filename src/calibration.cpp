@@ -633,13 +633,7 @@ CalibrationSummary calibrate(const SceneConfig& config, const ConsolidatedState&
 
   // Bounds. The stable step comes from the consolidated contact network.
   AlgorithmSpec base = config.algorithm;
-  World probe = state.world;
-  Integration in = probe.integration();
-  in.mass_scaling = base.mass_scaling;
-  in.lock_rotation = base.lock_rotation;
-  probe.set_integration(in);
-  probe.update_forces();
-  out.dt_ratio_stable = probe.stability_estimate().dt_ratio_stable;
+  out.dt_ratio_stable = estimated_stable_dt_ratio(state, base);
   SearchSpace space;
   space.base = base;
   const int64_t steps_min = options.steps_min > 0 ? options.steps_min : 50LL * n;

@@ -350,29 +350,6 @@ World::PairState World::pair_state(int i, int j) const {
   return p;
 }
 
-double World::pair_elastic_energy() const {
-  // Σ over the pairs i < j of fn²/(2kn) + ft²/(2kt), in list order, fn as
-  // pair_state() gives it (for the divergence check, every few steps).
-  const double kn = material_.particle.kn, kt = material_.particle.kt;
-  const bool damped = material_.contact_damping_ratio > 0.0;
-  double el = 0.0;
-  for (size_t k = 0; k < pair_i_.size(); ++k) {
-    const int i = pair_i_[k], j = pair_j_[k];
-    double fn;
-    if (damped) {
-      fn = pair_state(i, j).fn;
-    } else {
-      const double dx = x_[j] - x_[i], dy = y_[j] - y_[i];
-      const double d2 = dx * dx + dy * dy;
-      const double rs = r_[i] + r_[j];
-      fn = d2 < rs * rs ? kn * (rs - std::sqrt(d2)) : 0.0;
-    }
-    const double ft = slot_ft_[pair_slot_[k]];
-    el += 0.5 * (fn * fn / kn + (kt > 0 ? ft * ft / kt : 0.0));
-  }
-  return el;
-}
-
 void World::wall_pass() {
   // Walls. Contact point on the wall line; lever arm = distance to the wall.
   // Added to the pair forces, after them, wall by wall.

@@ -72,7 +72,7 @@ World::EnergySample World::energy_sample() const {
       fn = std::max(0.0, fn - beta2 * std::sqrt(kn * meff) * vn);
     }
     const double ft = slot_ft_[pair_slot_[k]];
-    e.energy += 0.5 * fn_elastic * ov + (kt > 0.0 ? 0.5 * ft * ft / kt : 0.0);
+    e.elastic += 0.5 * fn_elastic * ov + (kt > 0.0 ? 0.5 * ft * ft / kt : 0.0);
     e.power_lost += (fn_elastic - fn) * vn;
   }
 
@@ -96,17 +96,20 @@ World::EnergySample World::energy_sample() const {
       const double fn_elastic = kw * ov;
       const double fn = wall_fn_[s][i];
       const double ft = wall_ft_[s][i];
-      e.energy += 0.5 * fn_elastic * ov + (ktw > 0.0 ? 0.5 * ft * ft / ktw : 0.0);
+      e.elastic += 0.5 * fn_elastic * ov + (ktw > 0.0 ? 0.5 * ft * ft / ktw : 0.0);
       if (beta > 0.0) e.power_lost += (fn_elastic - fn) * vn;
     }
   }
+  e.energy += e.elastic;
   return e;
 }
 
-bool World::energy_created_beyond_limit() {
+bool World::ledger_due() const {
+  return !ledger_.started || steps_ - ledger_.step >= std::max(1, options_.energy_check_interval);
+}
+
+bool World::ledger_record(const EnergySample& e) {
   Ledger& l = ledger_;
-  if (l.started && steps_ - l.step < std::max(1, options_.energy_check_interval)) return false;
-  const EnergySample e = energy_sample();
   if (!l.started) {
     l = {};
     l.started = true;

@@ -75,13 +75,7 @@ StabilityScanResult stability_scan(const SceneConfig& config, const Consolidated
   out.steps = options.steps;
   out.damping_ratio_translation = config.algorithm.damping_ratio_translation;
   out.damping_ratio_rotation = config.algorithm.damping_ratio_rotation;
-  // The estimate for the integration the trials use (mass scaling, locks).
-  World probe = state.world;
-  AlgorithmSpec a = config.algorithm;
-  a.dt_ratio = 0.1;
-  probe.set_integration(integration_for(probe, a));
-  probe.update_forces();
-  out.dt_ratio_estimate = probe.stability_estimate().dt_ratio_stable;
+  out.dt_ratio_estimate = estimated_stable_dt_ratio(state, config.algorithm);
 
   std::vector<StabilityTrial> ladder(options.points);
   for_each_parallel(options.points, jobs, [&](int k) {

@@ -444,10 +444,20 @@ TEST_F(CliEndToEnd, FailedConsolidationExitsOneAndWritesNothing) {
 }
 
 // A diverged trial is a result, not a crash: written, flagged, exit 0.
+// A Δt beyond the estimated stable step is bad input for `run` and
+// `check` (issue #9 §1), named with the estimate.
+TEST_F(CliEndToEnd, DtBeyondTheStableStepIsBadInput) {
+  const std::string out = (dir_ / "work" / "out").string();
+  expect_bad_input({"run", kHex5, "--set", "algorithm.dt_ratio=0.4", "-o", out},
+                   {kHex5, "algorithm.dt_ratio", "0.4", "stable step", "0.30"});
+  expect_bad_input({"check", kHex5, "--set", "algorithm.dt_ratio=0.4"},
+                   {kHex5, "algorithm.dt_ratio"});
+}
+
 TEST_F(CliEndToEnd, DivergedRunIsReportedNotFatal) {
   const fs::path out = dir_ / "work" / "out";
-  const Result r = demcal({"run", kHex5, "--set", "algorithm.dt_ratio=1.5", "--set",
-                           "algorithm.damping_ratio_translation=0", "--set",
+  const Result r = demcal({"run", kHex5, "--allow-unstable", "--set", "algorithm.dt_ratio=1.5",
+                           "--set", "algorithm.damping_ratio_translation=0", "--set",
                            "algorithm.damping_ratio_rotation=0", "--set", "algorithm.steps=20000",
                            "-o", out.string()});
   ASSERT_EQ(r.status, 0) << r.err;

@@ -80,6 +80,11 @@ using MonitorCallback = std::function<bool(const MonitorPoint&)>;
 /// Absolute integration parameters for an algorithm spec on a state.
 Integration integration_for(const World& world, const AlgorithmSpec& algorithm);
 
+/// The stable α = Δt/Δt_crit estimated from the stiffnesses of the
+/// consolidated contact network (World::stability_estimate()), for the
+/// mass scaling and rotation lock of `algorithm`.
+double estimated_stable_dt_ratio(const ConsolidatedState& state, const AlgorithmSpec& algorithm);
+
 /// Load a copy of the consolidated state. `final_state`, if given, receives
 /// the world at the end (for pictures and VTK).
 LoadingResult run_loading(const ConsolidatedState& start, const TestSpec& test,

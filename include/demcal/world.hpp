@@ -305,15 +305,16 @@ class World {
     bool touching;
   };
   PairState pair_state(int i, int j) const;
-  double pair_elastic_energy() const;  // Σ_pairs fn²/2kn + ft²/2kt
   // energy_balance.cpp: one reading of the energy ledger's rates
   struct EnergySample {
     double energy = 0.0;      // kinetic + elastic (pairs and walls) [J]
+    double elastic = 0.0;     // elastic alone [J]
     double power_in = 0.0;    // work rate of the moving walls on the particles [W]
     double power_lost = 0.0;  // global and contact damping [W] (not friction)
   };
   EnergySample energy_sample() const;
-  bool energy_created_beyond_limit();  // updates ledger_, true when diverged
+  bool ledger_due() const;                         // a ledger sample is due at this step
+  bool ledger_record(const EnergySample& sample);  // true when diverged
   // solver.cpp
   void integrate();
   void update_damping_coefficients();
