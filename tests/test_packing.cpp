@@ -135,6 +135,15 @@ TEST_F(PackingFile, OverlapFoundAcrossCellsAndInLargeFiles) {
   expect_rejected(content + "21,21,0.5\n", "line 402");
 }
 
+// Regression: a sparse, huge domain once overflowed the overlap check's
+// integer cell keys. Far-apart disks are valid; a span beyond a double is
+// rejected with a message, not undefined behaviour.
+TEST_F(PackingFile, HugeCoordinatesDoNotOverflowTheCellGrid) {
+  EXPECT_EQ(read_particle_file(write("0,0,1\n1e300,1e300,1\n3,0,1\n")).size(), 3);
+  expect_rejected("0,0,1\n1e300,1e300,1\n1e300,1e300,1\n", "line 3");  // coincident pair found
+  expect_rejected("-1.5e308,0,1\n1.5e308,0,1\n", "", "span");
+}
+
 TEST_F(PackingFile, FewerThanTwoParticles) {
   expect_rejected("", "", "two particles");
   expect_rejected("x,y,r\n", "", "two particles");
