@@ -67,29 +67,14 @@ TrialRecord run_trial(const SceneConfig& config, const ConsolidatedState& state,
                       const AlgorithmSpec& params, const Tolerances& tol, bool early_stop,
                       double factor, LoadingResult* run_out, const std::atomic<bool>* stop) {
   const double s3 = config.test.lateral_stress;
-  const double m = config.test.monitor_points;
-  // Running sums of squares of the σ3-normalised measures: the final RMS
-  // over M points is at least sqrt(sum/M), so once that lower bound passes
-  // factor × tolerance the trial has certainly failed.
-  double sum_xx = 0.0, sum_xy = 0.0, sum_yx = 0.0, sum_mb = 0.0, sum_servo = 0.0;
+  // Early stop: only once the trial has certainly failed (scoring's bounds).
+  std::optional<EarlyFailure> failure;
+  if (early_stop) failure.emplace(tol, factor, config.test.monitor_points, s3);
   MonitorCallback monitor;
-  if (stop) {
-    monitor = [stop](const MonitorPoint&) { return !stop->load(std::memory_order_relaxed); };
-  }
-  if (early_stop) {
+  if (stop || failure) {
     monitor = [&](const MonitorPoint& p) {
       if (stop && stop->load(std::memory_order_relaxed)) return false;
-      if (p.step == 0) return true;
-      auto sq = [](double v) { return v * v; };
-      sum_xx += sq((p.b(0, 0) - p.sigma(0, 0)) / s3);
-      sum_xy += sq((p.b(0, 1) - p.sigma(0, 1)) / s3);
-      sum_yx += sq((p.b(1, 0) - p.sigma(1, 0)) / s3);
-      sum_mb += sq((p.sigma(0, 1) - p.sigma(1, 0)) / s3);
-      sum_servo += sq(p.lateral_stress_error);
-      const double fb = std::sqrt(std::max({sum_xx, sum_xy, sum_yx}) / m);
-      return fb <= factor * tol.force_balance &&
-             std::sqrt(sum_mb / m) <= factor * tol.moment_balance &&
-             std::sqrt(sum_servo / m) <= factor * tol.servo;
+      return !(failure && failure->add(p));
     };
   }
   LoadingResult run = run_loading(state, config.test, params, monitor);
@@ -324,15 +309,11 @@ AlgorithmSpec params_at(const SearchSpace& space, const double* x) {
 constexpr int kConstraints = 4;
 
 std::array<double, kConstraints> constraint_values(const TrialRecord& r, const Tolerances& t) {
-  if (r.diverged) return {3.0, 3.0, 3.0, 3.0};
-  auto g = [](double v, double tol) { return std::log(std::max(v, 1e-12) / tol); };
-  std::array<double, kConstraints> out{
-      g(r.criteria.force_balance, t.force_balance), g(r.criteria.moment_balance, t.moment_balance),
-      g(r.criteria.servo, t.servo), g(r.criteria.oscillation, t.oscillation)};
-  // A trial stopped early is certainly failed: make sure it reads so.
-  if (!r.complete)
-    for (double& v : out) v = std::max(v, 0.1);
-  return out;
+  Score score;
+  score.criteria = r.criteria;
+  score.diverged = r.diverged;
+  score.complete = r.complete;
+  return demcal::constraint_values(score, t);
 }
 
 struct SearchContext {

@@ -142,6 +142,52 @@ Criteria compute_criteria(const LoadingResult& run, double s3,
   return c;
 }
 
+std::array<double, 3> force_balance_terms(const MonitorPoint& p, double s3) {
+  const double syy = std::max(std::abs(p.b(1, 1)), s3);
+  return {(p.b(0, 0) - p.sigma(0, 0)) / s3, (p.b(1, 1) - p.sigma(1, 1)) / syy,
+          (0.5 * (p.b(0, 1) + p.b(1, 0)) - 0.5 * (p.sigma(0, 1) + p.sigma(1, 0))) / s3};
+}
+
+double moment_term(const MonitorPoint& p, double s3) {
+  return (p.sigma(0, 1) - p.sigma(1, 0)) / s3;
+}
+
+EarlyFailure::EarlyFailure(const Tolerances& tolerances, double factor, int monitor_points,
+                           double s3)
+    : tolerances_(tolerances), factor_(factor), s3_(s3), monitor_points_(monitor_points) {}
+
+bool EarlyFailure::add(const MonitorPoint& p) {
+  if (failed_) return true;
+  const int index = points_++;
+  // find_peak(): the first most compressive b_yy.
+  if (peak_index_ < 0 || p.b(1, 1) < peak_) {
+    peak_ = p.b(1, 1);
+    peak_index_ = index;
+  }
+  if (index == 0 || s3_ <= 0.0) return false;  // the start is not scored
+  const auto g = force_balance_terms(p, s3_);
+  for (int c = 0; c < 3; ++c) g_[c].push_back(g[c]);
+  const double a = moment_term(p, s3_);
+  moment_sum_ += a * a;
+  if (std::sqrt(moment_sum_ / monitor_points_) > factor_ * tolerances_.moment_balance)
+    return failed_ = true;
+  // g index k is series index k + 1; compute_criteria takes force balance
+  // up to g index peak − 1, and the final peak is at or after peak_index_.
+  const size_t n = g_[0].size();
+  const int h = kTrendHalfWidth;
+  const double bound = factor_ * tolerances_.force_balance + tolerances_.oscillation;
+  while (peak_index_ >= 1 && next_trend_ + h < n &&
+         next_trend_ <= static_cast<size_t>(peak_index_ - 1)) {
+    for (int c = 0; c < 3; ++c) {
+      double sum = 0.0;
+      for (size_t j = next_trend_ - h; j <= next_trend_ + h; ++j) sum += g_[c][j];
+      if (std::abs(sum / (2 * h + 1)) > bound) return failed_ = true;
+    }
+    ++next_trend_;
+  }
+  return false;
+}
+
 Criteria compute_criteria(const std::vector<MonitorPoint>& series, double s3,
                           std::optional<double> reference_peak) {
   Criteria c;
@@ -150,13 +196,13 @@ Criteria compute_criteria(const std::vector<MonitorPoint>& series, double s3,
   std::vector<double> gyy_raw, byy_raw, rot_share, ke_ratio;
   for (size_t k = 1; k < series.size(); ++k) {
     const auto& p = series[k];
-    const double syy = std::max(std::abs(p.b(1, 1)), s3);
-    gxx.push_back((p.b(0, 0) - p.sigma(0, 0)) / s3);
-    gyy.push_back((p.b(1, 1) - p.sigma(1, 1)) / syy);
-    gs.push_back((0.5 * (p.b(0, 1) + p.b(1, 0)) - 0.5 * (p.sigma(0, 1) + p.sigma(1, 0))) / s3);
+    const auto g = force_balance_terms(p, s3);
+    gxx.push_back(g[0]);
+    gyy.push_back(g[1]);
+    gs.push_back(g[2]);
     gxy.push_back((p.b(0, 1) - p.sigma(0, 1)) / s3);
     gyx.push_back((p.b(1, 0) - p.sigma(1, 0)) / s3);
-    asym.push_back((p.sigma(0, 1) - p.sigma(1, 0)) / s3);
+    asym.push_back(moment_term(p, s3));
     servo.push_back(p.lateral_stress_error);
     interior.push_back((-p.sigma(0, 0) - s3) / s3);
     syy_raw.push_back(p.sigma(1, 1));

@@ -240,3 +240,43 @@ TEST(Output, StaleTemporariesOfDeadProcessesAreRemoved) {
   EXPECT_TRUE(fs::exists(user));
   fs::remove_all(dir);
 }
+
+// The early stop only stops trials that could not have passed: over random
+// points of the search space, every trial that passes when run to the end
+// also runs to the end, and passes, with the early stop on; and the early
+// stop does stop some of the failing ones (or it would save nothing).
+TEST(Calibration, EarlyStopNeverStopsATrialThatWouldPass) {
+  SceneConfig config = default_config();
+  config.assembly.columns = config.assembly.rows = 5;
+  const ConsolidatedState state = consolidate(config, make_assembly(config));
+  const double alpha_max = 0.95 * estimated_stable_dt_ratio(state, config.algorithm);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  int passed = 0, stopped = 0;
+  for (int k = 0; k < 40; ++k) {
+    AlgorithmSpec p = config.algorithm;
+    p.dt_ratio = 0.02 + (alpha_max - 0.02) * u(rng);
+    p.steps = std::llround(std::pow(10.0, std::log10(50.0 * 25) + 2.5 * u(rng)));
+    p.damping_ratio_translation = 0.05 + 3.95 * u(rng) * u(rng);
+    p.damping_ratio_rotation = 4.0 * u(rng) * u(rng);
+    const TrialRecord full = run_trial(config, state, p, Tolerances{}, false);
+    const TrialRecord early = run_trial(config, state, p, Tolerances{}, true);
+    SCOPED_TRACE(testing::Message()
+                 << "alpha " << p.dt_ratio << " steps " << p.steps << " zeta_t "
+                 << p.damping_ratio_translation << " zeta_r " << p.damping_ratio_rotation);
+    if (full.passed) {
+      ++passed;
+      EXPECT_TRUE(early.complete);
+      EXPECT_TRUE(early.passed);
+    }
+    if (!early.complete) {
+      ++stopped;
+      EXPECT_FALSE(full.passed);
+      EXPECT_LT(early.steps_run, full.steps_run);
+    }
+  }
+  EXPECT_GT(passed, 0);
+  EXPECT_GT(stopped, 0);
+  RecordProperty("passed", passed);
+  RecordProperty("stopped_early", stopped);
+}

@@ -161,6 +161,42 @@ Diagnosis diagnose(const Criteria& criteria, const Tolerances& tolerances, bool 
 /// The algorithmic parameters a run was made with (α from Δt/Δt_crit).
 AlgorithmSpec run_parameters(const LoadingResult& run);
 
+/// The force-balance measures (g_xx, g_yy, g_s) and the moment-balance
+/// measure a of one monitoring point, as compute_criteria() takes them.
+std::array<double, 3> force_balance_terms(const MonitorPoint& point, double s3);
+double moment_term(const MonitorPoint& point, double s3);
+
+/// Certain failure before a run ends (the calibration's early stop). Fed the
+/// monitoring points in order, it says when the finished run could no longer
+/// pass, from bounds that hold whatever the rest of the run does:
+///  - moment balance: the RMS over the M points is at least
+///    sqrt(Σ a² so far / M);
+///  - force balance: the trend at point k (a centred average, final once
+///    k + kTrendHalfWidth points are in) counts in the final maximum when k
+///    is before the running peak (the final peak can only come later); the
+///    noise floor subtracted from it is at most the oscillation tolerance, or
+///    the run fails oscillation anyway.
+/// It stops when a bound exceeds `factor` × the tolerance (servo error has
+/// no such bound: its floor is not limited by any criterion).
+class EarlyFailure {
+ public:
+  EarlyFailure(const Tolerances& tolerances, double factor, int monitor_points, double s3);
+  /// Add the next point (the consolidated start first); true once failed.
+  bool add(const MonitorPoint& point);
+
+ private:
+  Tolerances tolerances_;
+  double factor_, s3_;
+  int monitor_points_;
+  int points_ = 0;  // added so far, the start included
+  double peak_ = 0.0;
+  int peak_index_ = -1;  // of the most compressive b_yy so far (series index)
+  std::array<std::vector<double>, 3> g_;
+  size_t next_trend_ = kTrendHalfWidth;  // next g index whose trend is checked
+  double moment_sum_ = 0.0;
+  bool failed_ = false;
+};
+
 /// Constraint values for a constrained search, one per criterion in the
 /// order force balance, moment balance, servo, oscillation:
 /// log(value/tolerance), ≤ 0 when met. A diverged run gives +3 for each; a
