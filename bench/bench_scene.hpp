@@ -41,9 +41,9 @@ struct Scene {
 };
 
 inline constexpr double kRadius = 5e-4;
-inline constexpr double kPreStrain = 1e-3;  // ε: overlap = 2r·ε
-inline constexpr double kAlpha = 0.2;       // Δt / Δt_crit
-inline constexpr double kStrain = 0.01;     // top-wall strain ...
+inline constexpr double kPreStrain = 1e-3;   // ε: overlap = 2r·ε
+inline constexpr double kAlpha = 0.2;        // Δt / Δt_crit
+inline constexpr double kStrain = 0.01;      // top-wall strain ...
 inline constexpr double kStrainSteps = 1e5;  // ... over this many steps
 
 inline demcal::Material bench_material() {
@@ -63,7 +63,7 @@ inline Scene hex_scene(int nx, int ny) {
   s.material = bench_material();
   const double r = kRadius;
   const double overlap = 2.0 * r * kPreStrain;
-  const double sp = 2.0 * r - overlap;           // centre spacing
+  const double sp = 2.0 * r - overlap;          // centre spacing
   const double dy = sp * std::sqrt(3.0) / 2.0;  // row spacing
   s.x.reserve(static_cast<size_t>(nx) * ny);
   for (int j = 0; j < ny; ++j)
@@ -105,11 +105,13 @@ inline double top_velocity(double height, double dt) {
 /// A world for the biaxial-like compression: fixed bottom/left/right walls,
 /// top wall moving down.
 inline std::unique_ptr<demcal::World> make_compression_world(const Scene& s) {
-  auto w = std::make_unique<demcal::World>(s.material, s.x, s.y, s.r, s.left, s.right, s.bottom,
-                                           s.top);
+  auto w =
+      std::make_unique<demcal::World>(s.material, s.x, s.y, s.r, s.left, s.right, s.bottom, s.top);
   set_bench_integration(*w);
   w->wall(demcal::kTop).velocity = top_velocity(w->height(), w->integration().dt);
   w->update_forces();
+  // As demcal's consolidation does: particles numbered for full SIMD blocks.
+  w->reorder(w->block_friendly_order());
   return w;
 }
 
@@ -156,12 +158,14 @@ inline Scene random_scene(int n, uint64_t seed = 12345, double target_pressure =
   };
   set_speed(v);
   auto wall_stress = [&] {
-    const double sx = 0.5 * (std::abs(w.wall(demcal::kLeft).force.x()) +
-                             std::abs(w.wall(demcal::kRight).force.x())) /
-                      (w.height() * t);
-    const double sy = 0.5 * (std::abs(w.wall(demcal::kBottom).force.y()) +
-                             std::abs(w.wall(demcal::kTop).force.y())) /
-                      (w.width() * t);
+    const double sx =
+        0.5 *
+        (std::abs(w.wall(demcal::kLeft).force.x()) + std::abs(w.wall(demcal::kRight).force.x())) /
+        (w.height() * t);
+    const double sy =
+        0.5 *
+        (std::abs(w.wall(demcal::kBottom).force.y()) + std::abs(w.wall(demcal::kTop).force.y())) /
+        (w.width() * t);
     return 0.5 * (sx + sy);
   };
   int64_t guard = 0;

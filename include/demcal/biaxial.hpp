@@ -35,6 +35,8 @@ struct MonitorPoint {
 
 /// The consolidated sample, saved once and copied by every trial.
 struct ConsolidatedState {
+  /// The static packing. Its particles are renumbered for the kernel
+  /// (World::block_friendly_order()), so they need not be in the assembly's order.
   World world;
   double width0 = 0.0, height0 = 0.0;  ///< box after consolidation
   int64_t steps = 0;                   ///< consolidation steps taken
