@@ -17,6 +17,17 @@ namespace {
 constexpr int kBlock = 8;
 }
 
+void World::layout_blocks(const std::vector<int>& start, std::vector<int>& block_slot) const {
+  // Sliced ELLPACK: block b gets as many rows as its longest list.
+  block_slot.assign(static_cast<size_t>(nblocks_) + 1, 0);
+  for (int b = 0; b < nblocks_; ++b) {
+    int rows = 0;
+    for (int i = kBlock * b; i < std::min(n_, kBlock * (b + 1)); ++i)
+      rows = std::max(rows, start[i + 1] - start[i]);
+    block_slot[b + 1] = block_slot[b] + kBlock * rows;
+  }
+}
+
 bool World::needs_rebuild() const {
   if (!list_valid_) return true;
   double max_d2 = 0.0;
@@ -88,14 +99,7 @@ void World::rebuild_neighbours() {
     nbr_start_[i + 1] = static_cast<int>(nbr_list_.size());
   }
 
-  // Sliced ELLPACK: block b gets as many rows as its longest list.
-  new_block_slot_.assign(static_cast<size_t>(nblocks_) + 1, 0);
-  for (int b = 0; b < nblocks_; ++b) {
-    int rows = 0;
-    for (int i = kBlock * b; i < std::min(n, kBlock * (b + 1)); ++i)
-      rows = std::max(rows, nbr_start_[i + 1] - nbr_start_[i]);
-    new_block_slot_[b + 1] = new_block_slot_[b] + kBlock * rows;
-  }
+  layout_blocks(nbr_start_, new_block_slot_);
   const size_t ns = static_cast<size_t>(new_block_slot_[nblocks_]);
   new_slot_j_.assign(ns, ghost_);
   new_slot_ft_.assign(ns, 0.0);

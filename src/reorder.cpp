@@ -80,13 +80,7 @@ void World::reorder(std::span<const int> order) {
   std::vector<int> start(static_cast<size_t>(n) + 1, 0);
   for (const auto& h : history) ++start[std::get<0>(h) + 1];
   for (int i = 0; i < n; ++i) start[i + 1] += start[i];
-  block_slot_.assign(static_cast<size_t>(nblocks_) + 1, 0);
-  for (int b = 0; b < nblocks_; ++b) {
-    int rows = 0;
-    for (int i = kBlock * b; i < std::min(n, kBlock * (b + 1)); ++i)
-      rows = std::max(rows, start[i + 1] - start[i]);
-    block_slot_[b + 1] = block_slot_[b] + kBlock * rows;
-  }
+  layout_blocks(start, block_slot_);
   slot_j_.assign(static_cast<size_t>(block_slot_[nblocks_]), ghost_);
   slot_ft_.assign(slot_j_.size(), 0.0);
   for (int i = 0; i < n; ++i) {

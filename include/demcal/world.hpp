@@ -310,6 +310,9 @@ class World {
   // broad_phase.cpp
   void rebuild_neighbours();
   bool needs_rebuild() const;  // full displacement scan (after edits)
+  // Block offsets of the sliced ELLPACK list for per-particle lists
+  // [start[i], start[i + 1]): each block as many rows as its longest list.
+  void layout_blocks(const std::vector<int>& start, std::vector<int>& block_slot) const;
   // contact.cpp: the SIMD passes over blocks [b0, b1), and the walls
   double pair_pass(int b0, int b1);       // returns the largest overlap/r
   double integrate_pass(int b0, int b1);  // returns the largest displacement²
