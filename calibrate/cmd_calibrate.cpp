@@ -4,8 +4,11 @@
 // reused), DIR/trials.jsonl (appended per trial, so --resume loses nothing)
 // and the report, DIR/report.html and DIR/report.md; with --evidence also
 // DIR/evidence.jsonl (the paper-recipe baseline and the reference runs).
-// SIGINT/SIGTERM stop it cleanly after consolidation: finished trials stay
-// in trials.jsonl, nothing else is written, the exit status is 128 + signal.
+// SIGINT/SIGTERM stop it cleanly after consolidation, exit status 128 +
+// signal: finished trials stay in trials.jsonl; during the search or the
+// evidence runs nothing else is written; once params.json (and run.json)
+// are written, the report is skipped if its reruns have not started, or
+// finished if they have.
 #include <algorithm>
 #include <cctype>
 #include <chrono>
@@ -24,6 +27,7 @@
 #include "demcal/report.hpp"
 #include "demcal/trial.hpp"
 #include "demcal/upscaling.hpp"
+#include "output_folder.hpp"
 #include "stop_signal.hpp"
 
 namespace demcal::cli {
@@ -84,6 +88,7 @@ int cmd_calibrate(const CalibrateOptions& o) {
     throw InputError("--accuracy", "", "must be a fraction in (0, 1), e.g. 0.02");
   const std::string dir = o.out_dir.empty() ? "demcal-" + config.name : o.out_dir;
   const std::string trials_path = dir + "/trials.jsonl";
+  OutputFolder::check(dir);  // an unwritable -o fails now, not after the search
   if (o.resume && !std::filesystem::exists(trials_path))
     throw InputError(trials_path, "", "--resume needs the trials.jsonl of an earlier run");
 
@@ -171,6 +176,7 @@ int cmd_calibrate(const CalibrateOptions& o) {
   // converged reference from the calibrated multipliers.
   std::optional<BaselineResult> baseline;
   std::optional<ReferenceEvidence> reference;
+  std::string evidence_lines;  // evidence.jsonl, written with params.json
   if (o.evidence && have_best) {
     say("evidence: paper-recipe baseline and converged reference (8x, 16x Nstep = " +
         std::to_string(16 * summary.best.steps) + ")");
@@ -211,7 +217,7 @@ int cmd_calibrate(const CalibrateOptions& o) {
       j["peak_error"] = peak_error(t);
       lines += j.dump() + "\n";
     }
-    write_file_atomic(dir + "/evidence.jsonl", lines);
+    evidence_lines = std::move(lines);
     nlohmann::json b{{"passed", baseline->passed},
                      {"start_steps", 500LL * n_rev},
                      {"trials", static_cast<int>(baseline->trials.size())},
@@ -233,8 +239,31 @@ int cmd_calibrate(const CalibrateOptions& o) {
           {"calibrated_peak_error", peak_error(summary.best_trial)}}},
         {"baseline", b}};
   }
+  // The evidence and report runs do not poll the flag (seconds on a REV):
+  // a stop asked for during them takes effect here.
   if (stop.stopped()) return interrupted(" during the evidence runs (nothing written)");
+  if (!evidence_lines.empty()) write_file_atomic(dir + "/evidence.jsonl", evidence_lines);
   write_file_atomic(dir + "/params.json", params.dump(2) + "\n");
+  // What varies between invocations stays out of params.json. Written now
+  // and again after the report, so params.json never stands without it.
+  const auto write_run_json = [&] {
+    const nlohmann::json run{{"schema", "demcal.run/1"},
+                             {"wall_time_s", seconds_since(t_start)},
+                             {"calibration_wall_time_s", summary.wall_time_s},
+                             {"consolidation_wall_time_s", state.wall_time_s},
+                             {"jobs", jobs},
+                             {"resumed", o.resume},
+                             {"trials_run", summary.trials_run},
+                             {"trials_reused", summary.trials_reused},
+                             {"kernel_simd", kernel_simd()},
+                             {"version", DEMCAL_VERSION}};
+    write_file_atomic(dir + "/run.json", run.dump(2) + "\n");
+  };
+  write_run_json();
+  if (stop.stopped())
+    return interrupted(
+        " before the report (params.json and run.json are written; --resume reuses every trial "
+        "and writes the report)");
 
   // The report: the start point and the result rerun with their series,
   // the picture at the peak, then plots and text.
@@ -263,8 +292,7 @@ int cmd_calibrate(const CalibrateOptions& o) {
     start.steps = 500LL * n_rev;
     start.damping_ratio_translation = 1.0;
     start.damping_ratio_rotation = 1.0;
-    collect_runs(in, config, state, start, jobs);
-    if (stop.stopped()) return interrupted(" before the report was written (params.json is)");
+    collect_runs(in, config, state, start, jobs);  // a stop now: finish, the runs are done
     const auto t1 = std::chrono::steady_clock::now();
     const Report report = make_report(in);
     write_file_atomic(dir + "/report.html", report.html);
@@ -278,22 +306,14 @@ int cmd_calibrate(const CalibrateOptions& o) {
     std::cerr << "demcal: warning: the report was not written: " << e.what() << "\n";
   }
 
-  // What varies between invocations stays out of params.json.
-  const nlohmann::json run{{"schema", "demcal.run/1"},
-                           {"wall_time_s", seconds_since(t_start)},
-                           {"calibration_wall_time_s", summary.wall_time_s},
-                           {"consolidation_wall_time_s", state.wall_time_s},
-                           {"jobs", jobs},
-                           {"resumed", o.resume},
-                           {"trials_run", summary.trials_run},
-                           {"trials_reused", summary.trials_reused},
-                           {"kernel_simd", kernel_simd()},
-                           {"version", DEMCAL_VERSION}};
-  write_file_atomic(dir + "/run.json", run.dump(2) + "\n");
-
+  write_run_json();
   std::cout << summary.BriefReport() << "  wrote " << dir << "/params.json, " << dir
             << "/run.json, " << dir << "/trials.jsonl" << report_note
             << (o.evidence && have_best ? ", " + dir + "/evidence.jsonl" : "") << "\n";
+  if (stop.stopped()) {
+    std::cerr << "demcal: interrupted after the last run; every output was written\n";
+    return stop.exit_status();
+  }
   return summary.success ? 0 : 1;
 }
 

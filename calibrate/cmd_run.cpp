@@ -13,6 +13,7 @@
 #include "demcal/packing.hpp"
 #include "demcal/scoring.hpp"
 #include "demcal/trial.hpp"
+#include "output_folder.hpp"
 
 namespace demcal::cli {
 
@@ -49,83 +50,6 @@ SceneConfig load_scene(const std::string& path, const std::vector<std::string>& 
 namespace {
 
 namespace fs = std::filesystem;
-
-/// An output folder written all or nothing. check() proves, before any
-/// computation, that the folder can be made and written, and leaves no
-/// trace (bad path: InputError, exit 2). The constructor makes the missing
-/// folders; write() adds files atomically; unless commit() is called, the
-/// destructor removes the files written and the folders made, so a failure
-/// half-way leaves no partial output.
-class OutputFolder {
- public:
-  static void check(const std::string& dir) { OutputFolder probe(dir, true); }
-
-  explicit OutputFolder(const std::string& dir) : OutputFolder(dir, false) {}
-  OutputFolder(const OutputFolder&) = delete;
-  OutputFolder& operator=(const OutputFolder&) = delete;
-  ~OutputFolder() {
-    if (committed_) return;
-    std::error_code ec;
-    for (auto it = written_.rbegin(); it != written_.rend(); ++it) fs::remove(*it, ec);
-    for (auto it = created_.rbegin(); it != created_.rend(); ++it) fs::remove(*it, ec);
-  }
-
-  void write(const std::string& name, const std::string& content) {
-    const std::string path = (dir_ / name).string();
-    write_file_atomic(path, content);  // on failure it leaves nothing behind itself
-    written_.push_back(path);
-  }
-  void commit() { committed_ = true; }
-
- private:
-  OutputFolder(const std::string& dir, bool probe_only) : name_(dir) {
-    fs::path p = fs::path(dir).lexically_normal();
-    if (!p.has_filename() && p.has_parent_path()) p = p.parent_path();  // "out/" → "out"
-    dir_ = p;
-    std::vector<fs::path> missing;  // deepest first
-    std::error_code ec;
-    fs::path q = p;
-    while (!q.empty() && !fs::exists(q, ec)) {
-      missing.push_back(q);
-      q = q.parent_path();
-    }
-    if (!q.empty() && !fs::is_directory(q, ec))
-      fail(q == p ? "exists and is not a folder" : q.string() + " is not a folder");
-    for (auto it = missing.rbegin(); it != missing.rend(); ++it) {
-      if (!fs::create_directory(*it, ec))
-        fail("cannot create folder " + it->string() + (ec ? " (" + ec.message() + ")" : ""));
-      created_.push_back(*it);
-    }
-    // A folder that exists may still refuse files (permissions, read-only).
-    const fs::path probe = p / (".demcal-probe-" + std::to_string(::getpid()));
-    {
-      std::ofstream out(probe, std::ios::binary | std::ios::trunc);
-      if (!out) fail("cannot write files in this folder");
-      written_.push_back(probe);
-    }
-    fs::remove(probe, ec);
-    written_.pop_back();
-    if (probe_only) {
-      for (auto it = created_.rbegin(); it != created_.rend(); ++it) fs::remove(*it, ec);
-      created_.clear();
-      committed_ = true;
-    }
-  }
-  [[noreturn]] void fail(const std::string& what) {
-    std::error_code ec;
-    for (auto it = written_.rbegin(); it != written_.rend(); ++it) fs::remove(*it, ec);
-    for (auto it = created_.rbegin(); it != created_.rend(); ++it) fs::remove(*it, ec);
-    written_.clear();
-    created_.clear();
-    committed_ = true;
-    throw InputError(name_, "", "output folder unusable: " + what);
-  }
-
-  std::string name_;
-  fs::path dir_;
-  std::vector<fs::path> created_, written_;
-  bool committed_ = false;
-};
 
 void print_scales(const SceneConfig& config, const World& world) {
   const ReferenceScales s = world.reference_scales();

@@ -9,6 +9,7 @@
 #include "demcal/output.hpp"
 #include "demcal/packing.hpp"
 #include "demcal/stability_scan.hpp"
+#include "output_folder.hpp"
 
 namespace demcal::cli {
 
@@ -16,6 +17,7 @@ int cmd_stability(const StabilityOptions& o) {
   if (!(o.to > o.from)) throw InputError("--to", "", "must be larger than --from");
   SceneConfig config = load_scene(o.config, o.sets);
   const std::string dir = o.out_dir.empty() ? "demcal-stability-" + config.name : o.out_dir;
+  OutputFolder::check(dir);  // an unwritable -o fails now, not after the scan
   Assembly assembly = make_assembly(config);
   std::cerr << "stability " << config.name << ": consolidating " << assembly.size()
             << " particles\n";
@@ -29,13 +31,16 @@ int cmd_stability(const StabilityOptions& o) {
   options.jobs = o.jobs;
   const StabilityScanResult r = stability_scan(config, state, options);
 
-  make_output_dir(dir);
   nlohmann::json j = to_json(r);
   j["scene"] = config.name;
   j["config_sha256"] = sha256_hex(config.text);
   j["version"] = DEMCAL_VERSION;
-  write_file_atomic(dir + "/stability.json", j.dump(2) + "\n");
-  write_file_atomic(dir + "/stability.md", stability_markdown(r, config.name));
+  {
+    OutputFolder out(dir);
+    out.write("stability.json", j.dump(2) + "\n");
+    out.write("stability.md", stability_markdown(r, config.name));
+    out.commit();
+  }
 
   int diverged = 0;
   for (const auto& t : r.trials) diverged += t.diverged ? 1 : 0;
@@ -44,8 +49,10 @@ int cmd_stability(const StabilityOptions& o) {
   if (r.ratio() > 0.0)
     std::cout << ", measured: stable at " << r.dt_ratio_last_stable << ", diverged at "
               << r.dt_ratio_first_diverged << " (" << r.ratio() << " x the estimate)";
+  else if (!r.trials.empty() && r.trials.front().diverged)
+    std::cout << ", diverged already at the first rung: lower --from";
   else
-    std::cout << ", no limit between the rungs";
+    std::cout << ", no divergence up to the last rung: raise --to";
   std::cout << "\n  " << r.trials.size() << " trials, " << diverged << " diverged, "
             << r.stable_above_limit << " stable above the limit, " << r.wall_time_s << " s; wrote "
             << dir << "/stability.json, " << dir << "/stability.md\n";

@@ -10,6 +10,7 @@
 #include "demcal/output.hpp"
 #include "demcal/packing.hpp"
 #include "demcal/sweep.hpp"
+#include "output_folder.hpp"
 
 namespace demcal::cli {
 
@@ -17,6 +18,7 @@ int cmd_sweep(const SweepOptions& options) {
   SceneConfig config = load_scene(options.config, options.sets);
   Assembly assembly = make_assembly(config);
   const std::string dir = options.out_dir.empty() ? "demcal-sweep-" + config.name : options.out_dir;
+  OutputFolder::check(dir);  // an unwritable -o fails now, not after the sweep
   std::cerr << "sweep " << config.name << ": consolidating " << assembly.r.size()
             << " particles (once)\n";
   const ConsolidatedState state = consolidate(config, assembly);

@@ -1,7 +1,7 @@
 // SIGINT/SIGTERM as a clean stop: while a StopOnSignal lives, the first
 // signal only sets a flag (the calibration polls it and winds down, keeping
-// every finished trial); the handler is then reset, so a second signal
-// ends the process at once.
+// every finished trial); both handlers are then reset, so a second signal
+// of either kind ends the process at once.
 #pragma once
 
 #include <atomic>

@@ -187,6 +187,8 @@ void World::set_threads(int threads) {
 void World::set_options(const KernelOptions& options) {
   options_ = options;
   ledger_ = {};
+  skin_ = options_.skin_ratio * r_min_;
+  list_valid_ = false;  // the next step rebuilds the list with this skin
   set_threads(options.threads);
 }
 

@@ -143,8 +143,10 @@ std::string stability_markdown(const StabilityScanResult& r, const std::string& 
   if (r.ratio() > 0.0)
     s << "Measured: stable at alpha = " << r.dt_ratio_last_stable << ", diverged at "
       << r.dt_ratio_first_diverged << ", so the limit is " << r.ratio() << " x the estimate.\n\n";
+  else if (!r.trials.empty() && r.trials.front().diverged)
+    s << "Every rung diverged: the limit is below the first one (lower --from).\n\n";
   else
-    s << "No limit found between the first and the last rung.\n\n";
+    s << "No rung diverged: the limit is above the last one (raise --to).\n\n";
   if (r.stable_above_limit > 0)
     s << "Warning: " << r.stable_above_limit
       << " rung(s) above the first diverged one ran to the end.\n\n";

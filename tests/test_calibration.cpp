@@ -20,6 +20,7 @@
 #include "demcal/calibration.hpp"
 #include "demcal/output.hpp"
 #include "demcal/packing.hpp"
+#include "stop_signal.hpp"
 
 namespace fs = std::filesystem;
 using namespace demcal;
@@ -279,4 +280,38 @@ TEST(Calibration, EarlyStopNeverStopsATrialThatWouldPass) {
   EXPECT_GT(stopped, 0);
   RecordProperty("passed", passed);
   RecordProperty("stopped_early", stopped);
+}
+
+// The first SIGINT or SIGTERM only sets the flag and resets both handlers,
+// so a second signal of either kind quits at once; the handlers in place
+// before come back when the StopOnSignal ends. (In-process: a child could
+// finish its clean stop before a second signal arrives.)
+TEST(StopOnSignal, FirstSignalSetsTheFlagSecondOfEitherKindIsFatal) {
+  struct sigaction current;
+  for (const int first : {SIGINT, SIGTERM}) {
+    {
+      const demcal::cli::StopOnSignal stop;
+      EXPECT_FALSE(stop.stopped());
+      ASSERT_EQ(raise(first), 0);
+      EXPECT_TRUE(stop.stopped());
+      EXPECT_EQ(stop.signal_number(), first);
+      EXPECT_EQ(stop.exit_status(), 128 + first);
+      for (const int signo : {SIGINT, SIGTERM}) {
+        sigaction(signo, nullptr, &current);
+        EXPECT_EQ(current.sa_handler, SIG_DFL) << signo;
+      }
+    }
+    // Restored: gtest's (default) dispositions.
+    sigaction(SIGINT, nullptr, &current);
+    EXPECT_EQ(current.sa_handler, SIG_DFL);
+  }
+  // A handler installed before is what comes back.
+  struct sigaction ignore {};
+  ignore.sa_handler = SIG_IGN;
+  sigaction(SIGTERM, &ignore, nullptr);
+  { const demcal::cli::StopOnSignal stop; }
+  sigaction(SIGTERM, nullptr, &current);
+  EXPECT_EQ(current.sa_handler, SIG_IGN);
+  ignore.sa_handler = SIG_DFL;
+  sigaction(SIGTERM, &ignore, nullptr);
 }

@@ -201,6 +201,14 @@ TEST_F(CliEndToEnd, UnwritableOutputExitsTwoBeforeRunning) {
     SCOPED_TRACE(out);
     const Result r = demcal({"run", kHex5, "--set", "algorithm.steps=2000", "-o", out});
     EXPECT_EQ(r.status, 2) << r.err;
+    // The other commands that write a folder check it first too (the
+    // calibration would otherwise fail after its search).
+    for (const char* command : {"calibrate", "stability", "sweep"}) {
+      const Result c = demcal({command, kHex5, "-o", out});
+      EXPECT_EQ(c.status, 2) << command << ": " << c.err;
+      EXPECT_NE(c.err.find("output folder unusable"), std::string::npos) << c.err;
+      EXPECT_EQ(c.out, "");
+    }
     EXPECT_EQ(lines_of(r.err).size(), 1u) << r.err;
     EXPECT_NE(r.err.find(out), std::string::npos) << r.err;
     EXPECT_EQ(r.out, "");  // nothing ran
