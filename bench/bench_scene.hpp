@@ -29,6 +29,7 @@
 #include <string>
 #include <vector>
 
+#include "demcal/packing.hpp"
 #include "demcal/world.hpp"
 
 namespace demcal_bench {
@@ -61,22 +62,15 @@ inline Scene hex_scene(int nx, int ny) {
   Scene s;
   s.name = "hex_" + std::to_string(nx) + "x" + std::to_string(ny);
   s.material = bench_material();
-  const double r = kRadius;
-  const double overlap = 2.0 * r * kPreStrain;
-  const double sp = 2.0 * r - overlap;          // centre spacing
-  const double dy = sp * std::sqrt(3.0) / 2.0;  // row spacing
-  s.x.reserve(static_cast<size_t>(nx) * ny);
-  for (int j = 0; j < ny; ++j)
-    for (int i = 0; i < nx; ++i) {
-      s.x.push_back(r + i * sp + ((j % 2) ? 0.5 * sp : 0.0));
-      s.y.push_back(r + j * dy);
-      s.r.push_back(r);
-    }
-  // Walls overlap the outermost disks by `overlap`.
-  s.left = overlap;
-  s.right = r + (nx - 1) * sp + (ny > 1 ? 0.5 * sp : 0.0) + r - overlap;
-  s.bottom = overlap;
-  s.top = r + (ny - 1) * dy + r - overlap;
+  // Every contact and each wall overlaps by 2r·ε.
+  const demcal::Assembly a = demcal::hexagonal_packing(nx, ny, kRadius, kPreStrain);
+  s.x = a.x;
+  s.y = a.y;
+  s.r = a.r;
+  s.left = a.left;
+  s.right = a.right;
+  s.bottom = a.bottom;
+  s.top = a.top;
   return s;
 }
 

@@ -12,21 +12,26 @@
 
 namespace demcal {
 
-Assembly hexagonal_packing(int columns, int rows, double radius) {
+Assembly hexagonal_packing(int columns, int rows, double radius, double contact_strain) {
   Assembly a;
-  const double h = std::sqrt(3.0) * radius;
+  // Every length of the lattice shrinks by (1 − ε) about the lower-left
+  // corner, which is then 2rε inside the walls (at ε = 0 the factors are
+  // exactly 1: the touching lattice, bit for bit).
+  const double shrink = 1.0 - contact_strain;
+  const double h0 = std::sqrt(3.0) * radius;
+  const double h = h0 * shrink, spacing = 2.0 * radius * shrink;
   for (int k = 0; k < rows; ++k) {
-    const double offset = (k % 2) ? radius : 0.0;
+    const double offset = (k % 2) ? radius * shrink : 0.0;
     for (int i = 0; i < columns; ++i) {
-      a.x.push_back(radius + offset + 2.0 * radius * i);
+      a.x.push_back(radius + offset + spacing * i);
       a.y.push_back(radius + h * k);
       a.r.push_back(radius);
     }
   }
-  a.left = 0.0;
-  a.right = (2.0 * columns + (rows > 1 ? 1.0 : 0.0)) * radius;
-  a.bottom = 0.0;
-  a.top = 2.0 * radius + (rows - 1) * h;
+  a.left = 2.0 * radius * contact_strain;
+  a.right = (2.0 * columns + (rows > 1 ? 1.0 : 0.0)) * radius * shrink;
+  a.bottom = a.left;
+  a.top = (2.0 * radius + (rows - 1) * h0) * shrink;
   return a;
 }
 

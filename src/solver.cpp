@@ -215,39 +215,29 @@ void World::update_thread_bounds() {
   pair_bounds_[t] = nblocks_;
 }
 
-double World::run_pair_pass() {
+double World::run_pass(double (World::*pass)(int, int), const std::vector<int>& bounds) {
   const int t = active_threads();
-  if (t <= 1) return pair_pass(0, nblocks_);
+  if (t <= 1) return (this->*pass)(0, nblocks_);
   if (!team_.team) team_.team = std::make_unique<detail::KernelTeam>(t);
   struct Ctx {
     World* w;
+    double (World::*pass)(int, int);
+    const std::vector<int>* bounds;
     double out[64];
-  } ctx{this, {}};
+  } ctx{this, pass, &bounds, {}};
   team_.team->run(
       [](void* p, int k) {
         auto* c = static_cast<Ctx*>(p);
-        c->out[k] = c->w->pair_pass(c->w->pair_bounds_[k], c->w->pair_bounds_[k + 1]);
+        c->out[k] = (c->w->*c->pass)((*c->bounds)[k], (*c->bounds)[k + 1]);
       },
       &ctx);
+  // Maxima are exact whatever the split: the result does not depend on t.
   return *std::max_element(ctx.out, ctx.out + t);
 }
 
-double World::run_integrate_pass() {
-  const int t = active_threads();
-  if (t <= 1) return integrate_pass(0, nblocks_);
-  if (!team_.team) team_.team = std::make_unique<detail::KernelTeam>(t);
-  struct Ctx {
-    World* w;
-    double out[64];
-  } ctx{this, {}};
-  team_.team->run(
-      [](void* p, int k) {
-        auto* c = static_cast<Ctx*>(p);
-        c->out[k] = c->w->integrate_pass(c->w->particle_bounds_[k], c->w->particle_bounds_[k + 1]);
-      },
-      &ctx);
-  return *std::max_element(ctx.out, ctx.out + t);
-}
+double World::run_pair_pass() { return run_pass(&World::pair_pass, pair_bounds_); }
+
+double World::run_integrate_pass() { return run_pass(&World::integrate_pass, particle_bounds_); }
 
 void World::set_integration(const Integration& integration) {
   if (!(integration.dt >= 0.0) || !std::isfinite(integration.dt))

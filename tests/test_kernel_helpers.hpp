@@ -12,6 +12,7 @@
 #include <random>
 #include <vector>
 
+#include "demcal/packing.hpp"
 #include "demcal/world.hpp"
 
 namespace demcal::kernel_test {
@@ -42,21 +43,8 @@ struct Scene {
 /// contact overlaps by 2rε, and each wall overlaps the outermost disks by the
 /// same amount (the shifted rows do not touch the side walls).
 inline Scene hex_scene(int nx, int ny, double eps = 1e-3, double r = kR) {
-  Scene s;
-  const double overlap = 2.0 * r * eps;
-  const double sp = 2.0 * r - overlap;
-  const double dy = sp * std::sqrt(3.0) / 2.0;
-  for (int j = 0; j < ny; ++j)
-    for (int i = 0; i < nx; ++i) {
-      s.x.push_back(r + i * sp + ((j % 2) ? 0.5 * sp : 0.0));
-      s.y.push_back(r + j * dy);
-      s.r.push_back(r);
-    }
-  s.left = overlap;
-  s.right = r + (nx - 1) * sp + (ny > 1 ? 0.5 * sp : 0.0) + r - overlap;
-  s.bottom = overlap;
-  s.top = r + (ny - 1) * dy + r - overlap;
-  return s;
+  const Assembly a = hexagonal_packing(nx, ny, r, eps);
+  return {a.x, a.y, a.r, a.left, a.right, a.bottom, a.top};
 }
 
 /// nx × ny polydisperse disks (radii uniform in [1 − spread, 1 + spread]·r)

@@ -198,6 +198,24 @@ TEST(PackingLattice, HexagonalGeometry) {
   EXPECT_EQ(neighbours, 6);
 }
 
+// Pre-compressed (ε = 1e-3): every lattice contact and each wall contact
+// overlaps by 2rε; the box shrinks by (1 − ε).
+TEST(PackingLattice, PrecompressedHexagonalOverlapsEverywhereBy2rEps) {
+  const double r = 5e-4, eps = 1e-3, overlap = 2 * r * eps;
+  const Assembly a = hexagonal_packing(5, 4, r, eps);
+  EXPECT_NEAR(a.right - a.left, 11 * r * (1 - eps) - overlap, 1e-15);
+  EXPECT_NEAR(min_gap(a), -overlap, 1e-15);
+  for (int i = 0; i < a.size(); ++i)
+    for (int j = i + 1; j < a.size(); ++j) {
+      const double gap = std::hypot(a.x[i] - a.x[j], a.y[i] - a.y[j]) - 2 * r;
+      if (gap < r) EXPECT_NEAR(gap, -overlap, 1e-15);  // a lattice neighbour
+    }
+  EXPECT_NEAR(a.x[0] - r - a.left, -overlap, 1e-15);
+  EXPECT_NEAR(a.y[0] - r - a.bottom, -overlap, 1e-15);
+  EXPECT_NEAR(a.right - (a.x[5 + 4] + r), -overlap, 1e-15);  // row 1 is the shifted one
+  EXPECT_NEAR(a.top - (a.y[15] + r), -overlap, 1e-15);
+}
+
 TEST(PackingLattice, SquareGeometry) {
   const Assembly a = square_packing(4, 3, 1.0);
   ASSERT_EQ(a.size(), 12);

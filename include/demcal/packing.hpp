@@ -21,8 +21,10 @@ struct Assembly {
 
 /// Hexagonal: `rows` horizontal rows of `columns` disks, alternate rows
 /// offset by one radius, walls touching. Box (2·columns + 1)·r wide and
-/// (2 + (rows − 1)·√3)·r high.
-Assembly hexagonal_packing(int columns, int rows, double radius);
+/// (2 + (rows − 1)·√3)·r high. With `contact_strain` ε > 0 the lattice is
+/// pre-compressed: centre spacing 2r(1 − ε), so every lattice contact and
+/// each wall overlaps by 2rε (the kernel tests' and benchmarks' scene).
+Assembly hexagonal_packing(int columns, int rows, double radius, double contact_strain = 0.0);
 /// Square lattice, walls touching.
 Assembly square_packing(int columns, int rows, double radius);
 /// A loose random gas of polydisperse disks (no overlaps) on a jittered

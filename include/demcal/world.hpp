@@ -342,6 +342,9 @@ class World {
   // The SIMD passes over all blocks, shared among the threads (solver.cpp).
   double run_pair_pass();
   double run_integrate_pass();
+  // One pass over the blocks, split among the threads by `bounds`; returns
+  // the largest value the pass returned.
+  double run_pass(double (World::*pass)(int, int), const std::vector<int>& bounds);
   int active_threads() const;   // threads worth using for this size
   void update_thread_bounds();  // particle_bounds_ and pair_bounds_
 
