@@ -127,6 +127,16 @@ std::string mapping_header(const SceneConfig& c, const AlgorithmSpec& p, const P
   return s.str();
 }
 
+/// The figures of a plan every export reports (the files are added after).
+ExportResult result_of(const Plan& plan) {
+  ExportResult out;
+  out.dt = plan.dt;
+  out.steps = plan.steps;
+  out.types = plan.types;
+  out.damping_class_error = plan.class_error;
+  return out;
+}
+
 // ---------------------------------------------------------------------------
 // LAMMPS (29 Sep 2021)
 
@@ -134,11 +144,7 @@ ExportResult lammps(const SceneConfig& c, const AlgorithmSpec& p, const Assembly
                     const ExportOptions& o) {
   const Plan plan = make_plan(c, p, a, o.max_types);
   const auto& m = c.material;
-  ExportResult out;
-  out.dt = plan.dt;
-  out.steps = plan.steps;
-  out.types = plan.types;
-  out.damping_class_error = plan.class_error;
+  ExportResult out = result_of(plan);
 
   // Data file: atom_style sphere rows "id type diameter density x y z"; the
   // density column is overwritten by set density/disc below.
@@ -348,11 +354,7 @@ ExportResult liggghts(const SceneConfig& c, const AlgorithmSpec& p, const Assemb
                       const ExportOptions& o) {
   const Plan plan = make_plan(c, p, a, o.max_types);
   const auto& m = c.material;
-  ExportResult out;
-  out.dt = plan.dt;
-  out.steps = plan.steps;
-  out.types = plan.types;
-  out.damping_class_error = plan.class_error;
+  ExportResult out = result_of(plan);
   const int wall_type = plan.types + 1;
   const int ntypes = plan.types + 1;
 
