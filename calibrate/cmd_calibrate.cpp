@@ -17,13 +17,13 @@
 #include <iostream>
 #include <optional>
 #include <string_view>
-#include <thread>
 
 #include "commands.hpp"
 #include "demcal/biaxial.hpp"
 #include "demcal/calibration.hpp"
 #include "demcal/output.hpp"
 #include "demcal/packing.hpp"
+#include "demcal/parallel.hpp"
 #include "demcal/report.hpp"
 #include "demcal/trial.hpp"
 #include "demcal/upscaling.hpp"
@@ -166,7 +166,7 @@ int cmd_calibrate(const CalibrateOptions& o) {
   if (auto a = analytical_peak_stress(config)) params["analytical_peak_stress_yy"] = *a;
 
   const bool have_best = summary.best_trial.particle_steps > 0.0;
-  const int jobs = o.jobs > 0 ? o.jobs : std::max(1u, std::thread::hardware_concurrency());
+  const int jobs = resolve_jobs(o.jobs);
   auto say = [&](const std::string& line) {
     if (!o.quiet) std::cerr << "demcal: " << line << "\n";
   };
@@ -186,22 +186,7 @@ int cmd_calibrate(const CalibrateOptions& o) {
     auto run_reference = [&] {
       reference = converged_reference(config, state, summary.best, options.tolerances, 1);
     };
-    if (jobs > 1) {
-      std::exception_ptr error;
-      std::thread t([&] {
-        try {
-          run_baseline();
-        } catch (...) {
-          error = std::current_exception();
-        }
-      });
-      run_reference();
-      t.join();
-      if (error) std::rethrow_exception(error);
-    } else {
-      run_baseline();
-      run_reference();
-    }
+    run_parallel({run_baseline, run_reference}, jobs);
     auto peak_error = [&](const TrialRecord& t) -> nlohmann::json {
       if (!t.complete || t.diverged || t.criteria.peak_stress_yy >= 0.0) return nullptr;
       return (reference->peak - t.criteria.peak_stress_yy) / std::abs(reference->peak);

@@ -12,9 +12,9 @@
 #include <mutex>
 #include <set>
 #include <sstream>
-#include <thread>
 
 #include "demcal/output.hpp"
+#include "demcal/parallel.hpp"
 
 namespace demcal {
 
@@ -517,44 +517,6 @@ std::optional<TrialRecord> cheapest_passing(const std::vector<TrialRecord>& tria
       best = t;
   }
   return best;
-}
-
-int resolve_jobs(int jobs) {
-  if (jobs > 0) return jobs;
-  const unsigned hc = std::thread::hardware_concurrency();
-  return hc ? static_cast<int>(hc) : 1;
-}
-
-/// Run `tasks` with at most `jobs` at once (in order when jobs == 1).
-void run_parallel(std::vector<std::function<void()>> tasks, int jobs) {
-  if (jobs <= 1 || tasks.size() <= 1) {
-    for (auto& t : tasks) t();
-    return;
-  }
-  std::mutex m;
-  size_t next = 0;
-  std::exception_ptr error;
-  auto worker = [&]() {
-    for (;;) {
-      size_t k;
-      {
-        std::lock_guard<std::mutex> lock(m);
-        if (next >= tasks.size() || error) return;
-        k = next++;
-      }
-      try {
-        tasks[k]();
-      } catch (...) {
-        std::lock_guard<std::mutex> lock(m);
-        if (!error) error = std::current_exception();
-      }
-    }
-  };
-  std::vector<std::thread> threads;
-  for (int j = 0; j < std::min<int>(jobs, static_cast<int>(tasks.size())); ++j)
-    threads.emplace_back(worker);
-  for (auto& t : threads) t.join();
-  if (error) std::rethrow_exception(error);
 }
 
 Certificate certify(Evaluator& evaluator, const TrialRecord& best, double accuracy, int jobs) {

@@ -19,6 +19,8 @@
 #include <sstream>
 #include <thread>
 
+#include "demcal/parallel.hpp"
+
 namespace demcal {
 
 namespace fs = std::filesystem;
@@ -53,29 +55,6 @@ AssemblyPicture picture_of(const World& world) {
   return p;
 }
 
-namespace {
-
-void run_both(const std::function<void()>& a, const std::function<void()>& b, int jobs) {
-  if (jobs > 1) {
-    std::exception_ptr error;
-    std::thread t([&] {
-      try {
-        b();
-      } catch (...) {
-        error = std::current_exception();
-      }
-    });
-    a();
-    t.join();
-    if (error) std::rethrow_exception(error);
-  } else {
-    a();
-    b();
-  }
-}
-
-}  // namespace
-
 void collect_runs(ReportInput& in, const SceneConfig& config, const ConsolidatedState& state,
                   const AlgorithmSpec& start, int jobs) {
   const double s3 = config.test.lateral_stress;
@@ -88,12 +67,13 @@ void collect_runs(ReportInput& in, const SceneConfig& config, const Consolidated
     return r;
   };
   const bool have_best = in.summary.best_trial.particle_steps > 0.0;  // a trial ran
-  run_both([&] { in.start = one("start point", start); },
-           [&] {
-             if (have_best)
-               in.best = one(in.summary.success ? "calibrated" : "best found", in.summary.best);
-           },
-           jobs);
+  run_parallel({[&] { in.start = one("start point", start); },
+                [&] {
+                  if (have_best)
+                    in.best =
+                        one(in.summary.success ? "calibrated" : "best found", in.summary.best);
+                }},
+               jobs);
   if (!in.best || in.best->run.series.empty()) return;
   // The state at the peak: the same run again, stopped at the monitoring
   // point of the peak.
@@ -122,8 +102,10 @@ ReferenceEvidence converged_reference(const SceneConfig& config, const Consolida
   coarse.steps = 8 * best.steps;
   fine.steps = 16 * best.steps;
   LoadingResult fine_run;
-  run_both([&] { out.fine = run_trial(config, state, fine, tolerances, false, 3.0, &fine_run); },
-           [&] { out.coarse = run_trial(config, state, coarse, tolerances); }, jobs);
+  run_parallel(
+      {[&] { out.fine = run_trial(config, state, fine, tolerances, false, 3.0, &fine_run); },
+       [&] { out.coarse = run_trial(config, state, coarse, tolerances); }},
+      jobs);
   out.coarse.phase = out.fine.phase = "reference";
   out.coarse.id = 0;
   out.fine.id = 1;

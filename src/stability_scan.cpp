@@ -1,14 +1,12 @@
 #include "demcal/stability_scan.hpp"
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
-#include <exception>
-#include <mutex>
 #include <sstream>
 #include <stdexcept>
-#include <thread>
+
+#include "demcal/parallel.hpp"
 
 namespace demcal {
 
@@ -31,29 +29,6 @@ StabilityTrial run_one(const SceneConfig& config, const ConsolidatedState& state
   return t;
 }
 
-/// Run f(k) for k in [0, n) on `jobs` threads; results land in their slot.
-template <class F>
-void for_each_parallel(int n, int jobs, F f) {
-  std::atomic<int> next{0};
-  std::exception_ptr error;
-  std::mutex m;
-  auto worker = [&] {
-    for (int k; (k = next++) < n;) {
-      try {
-        f(k);
-      } catch (...) {
-        std::lock_guard<std::mutex> lock(m);
-        if (!error) error = std::current_exception();
-      }
-    }
-  };
-  std::vector<std::thread> threads;
-  for (int j = 1; j < std::min(jobs, n); ++j) threads.emplace_back(worker);
-  worker();
-  for (auto& t : threads) t.join();
-  if (error) std::rethrow_exception(error);
-}
-
 }  // namespace
 
 double StabilityScanResult::ratio() const {
@@ -68,9 +43,7 @@ StabilityScanResult stability_scan(const SceneConfig& config, const Consolidated
       options.steps < 1 || options.bisections < 0)
     throw std::invalid_argument("stability_scan: need 0 < from < to, points >= 2, steps >= 1");
   const auto t0 = std::chrono::steady_clock::now();
-  const int jobs = options.jobs > 0
-                       ? options.jobs
-                       : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  const int jobs = resolve_jobs(options.jobs);
   StabilityScanResult out;
   out.steps = options.steps;
   out.damping_ratio_translation = config.algorithm.damping_ratio_translation;

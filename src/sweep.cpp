@@ -9,8 +9,8 @@
 #include <mutex>
 #include <numeric>
 #include <sstream>
-#include <thread>
 
+#include "demcal/parallel.hpp"
 #include "demcal/trial.hpp"
 
 namespace demcal {
@@ -309,32 +309,23 @@ SweepResult run_sweep(const SceneConfig& config, const ConsolidatedState& state,
   std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
     return cases[a].algorithm.steps > cases[b].algorithm.steps;
   });
-  int jobs =
-      settings.jobs > 0 ? settings.jobs : static_cast<int>(std::thread::hardware_concurrency());
-  jobs = std::clamp(jobs, 1, std::max(1, static_cast<int>(cases.size())));
+  const int jobs =
+      std::clamp(resolve_jobs(settings.jobs), 1, std::max(1, static_cast<int>(cases.size())));
   res.jobs = jobs;
-  std::atomic<size_t> next{0};
   std::atomic<int> done{0};
   std::mutex progress_mutex;
-  auto worker = [&]() {
-    for (;;) {
-      const size_t k = next.fetch_add(1);
-      if (k >= order.size()) return;
-      SweepCaseResult& r = res.cases[order[k]];
-      const ConsolidatedState local = state;  // each trial its own copy
-      World final_state = local.world;
-      r.run = run_loading(local, config.test, r.spec.algorithm, {}, &final_state);
-      r.identity_residual = gap_identity_residual(final_state);
-      const int finished = ++done;
-      if (settings.progress) {
-        std::lock_guard<std::mutex> lock(progress_mutex);
-        settings.progress(finished, static_cast<int>(order.size()), r.spec.name, r.run.wall_time_s);
-      }
+  for_each_parallel(static_cast<int>(order.size()), jobs, [&](int k) {
+    SweepCaseResult& r = res.cases[order[k]];
+    const ConsolidatedState local = state;  // each trial its own copy
+    World final_state = local.world;
+    r.run = run_loading(local, config.test, r.spec.algorithm, {}, &final_state);
+    r.identity_residual = gap_identity_residual(final_state);
+    const int finished = ++done;
+    if (settings.progress) {
+      std::lock_guard<std::mutex> lock(progress_mutex);
+      settings.progress(finished, static_cast<int>(order.size()), r.spec.name, r.run.wall_time_s);
     }
-  };
-  std::vector<std::thread> pool;
-  for (int j = 0; j < jobs; ++j) pool.emplace_back(worker);
-  for (auto& t : pool) t.join();
+  });
 
   // The reference: benchmark, convergence ladder, ×33.
   std::vector<std::pair<int64_t, double>> peaks;
