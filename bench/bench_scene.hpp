@@ -29,8 +29,8 @@
 #include <string>
 #include <vector>
 
-#include "demcal/packing.hpp"
-#include "demcal/world.hpp"
+#include "demcal/scene/packing.hpp"
+#include "demcal/kernel/world.hpp"
 
 namespace demcal_bench {
 

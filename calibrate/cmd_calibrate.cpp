@@ -19,14 +19,16 @@
 #include <string_view>
 
 #include "commands.hpp"
-#include "demcal/biaxial.hpp"
-#include "demcal/calibration.hpp"
-#include "demcal/output.hpp"
-#include "demcal/packing.hpp"
-#include "demcal/parallel.hpp"
-#include "demcal/report.hpp"
-#include "demcal/trial.hpp"
-#include "demcal/upscaling.hpp"
+#include "demcal/io/format.hpp"
+#include "demcal/scene/biaxial.hpp"
+#include "demcal/search/calibration.hpp"
+#include "demcal/io/files.hpp"
+#include "demcal/scene/run_output.hpp"
+#include "demcal/scene/packing.hpp"
+#include "demcal/search/parallel.hpp"
+#include "demcal/report/report.hpp"
+#include "demcal/scoring/trial.hpp"
+#include "demcal/upscaling/upscaling.hpp"
 #include "output_folder.hpp"
 #include "stop_signal.hpp"
 
@@ -63,10 +65,6 @@ std::string reproduce_command(const CalibrateOptions& o, const SceneConfig& conf
     out += shell_word(a);
   }
   return out;
-}
-
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
 /// Particle-steps actually run by the search (early stops counted as run):

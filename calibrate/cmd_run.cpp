@@ -8,11 +8,12 @@
 #include <sstream>
 
 #include "commands.hpp"
-#include "demcal/biaxial.hpp"
-#include "demcal/output.hpp"
-#include "demcal/packing.hpp"
-#include "demcal/scoring.hpp"
-#include "demcal/trial.hpp"
+#include "demcal/scene/biaxial.hpp"
+#include "demcal/io/files.hpp"
+#include "demcal/scene/run_output.hpp"
+#include "demcal/scene/packing.hpp"
+#include "demcal/scoring/scoring.hpp"
+#include "demcal/scoring/trial.hpp"
 #include "output_folder.hpp"
 
 namespace demcal::cli {

@@ -18,13 +18,15 @@
 #include <sstream>
 
 #include "commands.hpp"
-#include "demcal/biaxial.hpp"
-#include "demcal/calibration.hpp"
-#include "demcal/output.hpp"
-#include "demcal/packing.hpp"
-#include "demcal/rev.hpp"
-#include "demcal/scoring.hpp"
-#include "demcal/upscaling.hpp"
+#include "demcal/io/format.hpp"
+#include "demcal/scene/biaxial.hpp"
+#include "demcal/search/calibration.hpp"
+#include "demcal/io/files.hpp"
+#include "demcal/scene/run_output.hpp"
+#include "demcal/scene/packing.hpp"
+#include "demcal/upscaling/rev.hpp"
+#include "demcal/scoring/scoring.hpp"
+#include "demcal/upscaling/upscaling.hpp"
 #include "upscaling_cli.hpp"
 
 namespace demcal::cli {
@@ -33,10 +35,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
-
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
 
 json algo_json(const AlgorithmSpec& p) {
   return {{"dt_ratio", p.dt_ratio},

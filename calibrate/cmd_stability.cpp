@@ -5,10 +5,11 @@
 #include <iostream>
 
 #include "commands.hpp"
-#include "demcal/biaxial.hpp"
-#include "demcal/output.hpp"
-#include "demcal/packing.hpp"
-#include "demcal/stability_scan.hpp"
+#include "demcal/scene/biaxial.hpp"
+#include "demcal/io/files.hpp"
+#include "demcal/scene/run_output.hpp"
+#include "demcal/scene/packing.hpp"
+#include "demcal/search/stability_scan.hpp"
 #include "output_folder.hpp"
 
 namespace demcal::cli {

@@ -6,10 +6,11 @@
 #include <sstream>
 
 #include "commands.hpp"
-#include "demcal/biaxial.hpp"
-#include "demcal/output.hpp"
-#include "demcal/packing.hpp"
-#include "demcal/sweep.hpp"
+#include "demcal/scene/biaxial.hpp"
+#include "demcal/io/files.hpp"
+#include "demcal/scene/run_output.hpp"
+#include "demcal/scene/packing.hpp"
+#include "demcal/search/sweep.hpp"
 #include "output_folder.hpp"
 
 namespace demcal::cli {

@@ -7,8 +7,9 @@
 #include <iostream>
 
 #include "commands.hpp"
-#include "demcal/output.hpp"
-#include "demcal/upscaling.hpp"
+#include "demcal/io/files.hpp"
+#include "demcal/scene/run_output.hpp"
+#include "demcal/upscaling/upscaling.hpp"
 #include "upscaling_cli.hpp"
 
 namespace demcal::cli {

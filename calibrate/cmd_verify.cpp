@@ -8,13 +8,14 @@
 #include <iostream>
 
 #include "commands.hpp"
-#include "demcal/biaxial.hpp"
-#include "demcal/calibration.hpp"
-#include "demcal/output.hpp"
-#include "demcal/rev.hpp"
-#include "demcal/scoring.hpp"
-#include "demcal/trial.hpp"
-#include "demcal/upscaling.hpp"
+#include "demcal/scene/biaxial.hpp"
+#include "demcal/search/calibration.hpp"
+#include "demcal/io/files.hpp"
+#include "demcal/scene/run_output.hpp"
+#include "demcal/upscaling/rev.hpp"
+#include "demcal/scoring/scoring.hpp"
+#include "demcal/scoring/trial.hpp"
+#include "demcal/upscaling/upscaling.hpp"
 #include "upscaling_cli.hpp"
 
 namespace demcal::cli {

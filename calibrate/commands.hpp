@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "demcal/config.hpp"
+#include "demcal/scene/config.hpp"
 
 namespace CLI {
 class App;

@@ -4,7 +4,7 @@
 #include <iostream>
 
 #include "commands.hpp"
-#include "demcal/config.hpp"
+#include "demcal/scene/config.hpp"
 
 int main(int argc, char** argv) {
   using namespace demcal::cli;

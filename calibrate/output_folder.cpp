@@ -4,8 +4,9 @@
 
 #include <fstream>
 
-#include "demcal/config.hpp"
-#include "demcal/output.hpp"
+#include "demcal/scene/config.hpp"
+#include "demcal/io/files.hpp"
+#include "demcal/scene/run_output.hpp"
 
 namespace demcal::cli {
 

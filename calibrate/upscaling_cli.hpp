@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "commands.hpp"
-#include "demcal/upscaling.hpp"
+#include "demcal/upscaling/upscaling.hpp"
 
 namespace demcal::cli {
 

@@ -7,9 +7,9 @@
 #include <cmath>
 #include <string>
 
-#include "demcal/biaxial.hpp"
-#include "demcal/config.hpp"
-#include "demcal/packing.hpp"
+#include "demcal/scene/biaxial.hpp"
+#include "demcal/scene/config.hpp"
+#include "demcal/scene/packing.hpp"
 
 namespace demcal {
 namespace {

@@ -16,10 +16,11 @@
 #include <string>
 #include <thread>
 
-#include "demcal/biaxial.hpp"
-#include "demcal/calibration.hpp"
-#include "demcal/output.hpp"
-#include "demcal/packing.hpp"
+#include "demcal/scene/biaxial.hpp"
+#include "demcal/search/calibration.hpp"
+#include "demcal/io/files.hpp"
+#include "demcal/scene/run_output.hpp"
+#include "demcal/scene/packing.hpp"
 #include "stop_signal.hpp"
 
 namespace fs = std::filesystem;

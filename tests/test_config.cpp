@@ -11,7 +11,7 @@
 #include <sstream>
 #include <string>
 
-#include "demcal/config.hpp"
+#include "demcal/scene/config.hpp"
 
 namespace demcal {
 namespace {

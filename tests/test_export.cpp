@@ -12,10 +12,10 @@
 #include <fstream>
 #include <sstream>
 
-#include "demcal/biaxial.hpp"
-#include "demcal/export.hpp"
-#include "demcal/packing.hpp"
-#include "demcal/rev.hpp"
+#include "demcal/scene/biaxial.hpp"
+#include "demcal/upscaling/export.hpp"
+#include "demcal/scene/packing.hpp"
+#include "demcal/upscaling/rev.hpp"
 
 namespace demcal {
 namespace {

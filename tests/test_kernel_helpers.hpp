@@ -12,8 +12,8 @@
 #include <random>
 #include <vector>
 
-#include "demcal/packing.hpp"
-#include "demcal/world.hpp"
+#include "demcal/scene/packing.hpp"
+#include "demcal/kernel/world.hpp"
 
 namespace demcal::kernel_test {
 

@@ -12,7 +12,7 @@
 #include <optional>
 #include <string>
 
-#include "demcal/packing.hpp"
+#include "demcal/scene/packing.hpp"
 
 namespace demcal {
 namespace {

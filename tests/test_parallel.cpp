@@ -5,7 +5,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "demcal/parallel.hpp"
+#include "demcal/search/parallel.hpp"
 
 namespace demcal {
 namespace {

@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "demcal/report.hpp"
+#include "demcal/report/report.hpp"
 
 namespace fs = std::filesystem;
 using namespace demcal;

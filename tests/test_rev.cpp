@@ -10,9 +10,9 @@
 #include <numbers>
 #include <random>
 
-#include "demcal/biaxial.hpp"
-#include "demcal/packing.hpp"
-#include "demcal/rev.hpp"
+#include "demcal/scene/biaxial.hpp"
+#include "demcal/scene/packing.hpp"
+#include "demcal/upscaling/rev.hpp"
 
 namespace demcal {
 namespace {

@@ -10,7 +10,7 @@
 #include <random>
 #include <vector>
 
-#include "demcal/scoring.hpp"
+#include "demcal/scoring/scoring.hpp"
 
 namespace demcal {
 namespace {

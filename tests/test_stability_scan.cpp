@@ -5,8 +5,8 @@
 
 #include <string>
 
-#include "demcal/packing.hpp"
-#include "demcal/stability_scan.hpp"
+#include "demcal/scene/packing.hpp"
+#include "demcal/search/stability_scan.hpp"
 
 namespace demcal {
 namespace {

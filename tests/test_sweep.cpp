@@ -17,11 +17,11 @@
 #include <set>
 #include <sstream>
 
-#include "demcal/biaxial.hpp"
-#include "demcal/config.hpp"
-#include "demcal/packing.hpp"
-#include "demcal/scoring.hpp"
-#include "demcal/sweep.hpp"
+#include "demcal/scene/biaxial.hpp"
+#include "demcal/scene/config.hpp"
+#include "demcal/scene/packing.hpp"
+#include "demcal/scoring/scoring.hpp"
+#include "demcal/search/sweep.hpp"
 
 namespace demcal {
 namespace {

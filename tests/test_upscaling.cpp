@@ -10,10 +10,10 @@
 #include <fstream>
 #include <sstream>
 
-#include "demcal/biaxial.hpp"
-#include "demcal/packing.hpp"
-#include "demcal/rev.hpp"
-#include "demcal/upscaling.hpp"
+#include "demcal/scene/biaxial.hpp"
+#include "demcal/scene/packing.hpp"
+#include "demcal/upscaling/rev.hpp"
+#include "demcal/upscaling/upscaling.hpp"
 
 namespace demcal {
 namespace {

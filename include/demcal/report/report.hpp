@@ -1,0 +1,129 @@
+// The calibration report (DESIGN.md §6): DIR/report.html, self-contained
+// (inline SVG and CSS, nothing fetched, opens offline), and DIR/report.md,
+// the same facts in text.
+//
+// Contents, the answer first: the parameter table (multipliers and absolute
+// values, REV and prototype), the criteria reached against their
+// tolerances, the convergence certificate and the command that reproduces
+// the run; then the paper's panels for the start point and the calibrated
+// run (b_yy and σ_yy, σxy and σyx, the lateral components b_xx and σ_xx,
+// the servo error, all against the vertical strain), the diagnosis in words
+// (start point and rejected neighbours of the result), the search history,
+// speed against accuracy (every trial's cost against its force-balance
+// error and, with the evidence runs, its peak error against a converged
+// reference; Pareto front, chosen point and paper-recipe baseline marked),
+// the upscaling line, and the assembly at the peak (disks coloured by
+// rotation, contact forces as lines of width ∝ force).
+//
+// Plots are rendered by gnuplot (`set terminal svg`) in a private temporary
+// folder, with no shell and no user text in the scripts; without gnuplot the
+// report carries every number and says how to get the plots. The assembly
+// picture is drawn directly as SVG and needs nothing.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "demcal/scene/biaxial.hpp"
+#include "demcal/search/calibration.hpp"
+#include "demcal/scene/config.hpp"
+#include "demcal/scoring/scoring.hpp"
+
+namespace demcal {
+
+/// A run shown in the report with its whole monitored series.
+struct ReportRun {
+  std::string label;  ///< "start point", "calibrated"
+  AlgorithmSpec params;
+  LoadingResult run;
+  Score score;
+};
+
+/// The assembly at one instant: enough to draw it.
+struct AssemblyPicture {
+  std::vector<double> x, y, r, rotation;  ///< rotation [rad], counter-clockwise positive
+  struct Force {
+    double x1 = 0, y1 = 0, x2 = 0, y2 = 0;  ///< particle centre to centre (or to the wall)
+    double fn = 0;                          ///< normal force [N]
+    bool wall = false;
+  };
+  std::vector<Force> forces;
+  double left = 0, right = 0, bottom = 0, top = 0;
+  int64_t step = 0, steps = 0;  ///< loading step of the picture, of the run
+  double strain_yy = 0, stress_yy = 0;
+};
+/// The picture of a world state (particle–particle contacts from
+/// World::contacts(), wall contacts from the overlap and the wall's kn).
+AssemblyPicture picture_of(const World& world);
+
+/// The --evidence runs: a converged reference from the calibrated
+/// multipliers at 8× and 16× Nstep, P_ref = 2·P(16N) − P(8N) (error ∝ 1/N),
+/// and the paper's recipe done mechanically.
+struct ReferenceEvidence {
+  TrialRecord coarse, fine;  ///< 8×Nstep and 16×Nstep
+  std::vector<MonitorPoint> fine_series;
+  double peak = 0.0;  ///< Richardson-extrapolated peak b_yy (negative)
+};
+ReferenceEvidence converged_reference(const SceneConfig& config, const ConsolidatedState& state,
+                                      const AlgorithmSpec& best, const Tolerances& tolerances,
+                                      int jobs);
+
+struct ReportInput {
+  std::string scene;
+  std::string command;    ///< the command line that reproduces the run
+  nlohmann::json params;  ///< params.json as written (rev/prototype blocks)
+  CalibrationSummary summary;
+  Tolerances tolerances;
+  double accuracy = 0.02;
+  double lateral_stress = 0.0;  ///< σ3 [Pa]
+  double dt_ratio_max = 0.0;    ///< the search's upper bound on α (0: unknown)
+  int64_t particles = 0;        ///< REV
+  int64_t prototype_particles = 0;
+  std::optional<double> analytical_peak;  ///< b_yy, rotation locked (hexagonal scenes)
+  std::optional<ReportRun> start, best;
+  std::optional<AssemblyPicture> picture;  ///< the calibrated run at its peak
+  std::optional<BaselineResult> baseline;
+  std::optional<ReferenceEvidence> reference;
+};
+
+/// Rerun the start point and the calibrated parameters with their series
+/// (in parallel when jobs > 1), then the calibrated run once more, stopped
+/// at its peak, for the picture. About two and a half trials.
+void collect_runs(ReportInput& input, const SceneConfig& config, const ConsolidatedState& state,
+                  const AlgorithmSpec& start, int jobs);
+
+struct ReportOptions {
+  /// The gnuplot program (a name looked up on PATH, or a path); "" renders
+  /// no plots.
+  std::string gnuplot = "gnuplot";
+  int near_failures = 6;  ///< rejected neighbours of the result described
+};
+
+struct Report {
+  std::string html, markdown;
+  bool plots = false;       ///< every gnuplot figure was rendered
+  std::string plot_status;  ///< what happened to the plots, in words
+};
+
+/// Deterministic for given input and gnuplot version.
+Report make_report(const ReportInput& input, const ReportOptions& options = {});
+
+/// A program on PATH (or a path with '/'), "" when not found/executable.
+std::string find_program(const std::string& name);
+
+/// Run gnuplot on `script` in a fresh private temporary folder that holds
+/// `files` (name → content; plain names, no '/'); return the content of each
+/// name in `outputs` the script wrote. No shell is involved; HOME points at
+/// the temporary folder (no user init file) and LC_ALL=C.UTF-8 (decimal points, UTF-8 labels).
+/// `error` receives gnuplot's complaint when it fails.
+std::map<std::string, std::string> run_gnuplot(const std::string& program,
+                                               const std::string& script,
+                                               const std::map<std::string, std::string>& files,
+                                               const std::vector<std::string>& outputs,
+                                               std::string* error = nullptr);
+
+}  // namespace demcal

@@ -1,0 +1,104 @@
+// The biaxial test (DESIGN.md §2): consolidation to isotropic σ3 with four
+// servo walls, then loading: bottom fixed, top wall strain-controlled to a
+// total vertical strain ε over Nstep steps, left and right walls servoed at
+// σ3. Monitored at M points.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <vector>
+
+#include "demcal/scene/config.hpp"
+#include "demcal/scene/packing.hpp"
+#include "demcal/kernel/world.hpp"
+
+namespace demcal {
+
+/// One monitoring point of a loading run. Stresses tension positive.
+struct MonitorPoint {
+  int64_t step = 0;
+  double strain_yy = 0.0;                           ///< (H − H0)/H0, negative in compression
+  Eigen::Matrix2d b = Eigen::Matrix2d::Zero();      ///< boundary stress
+  Eigen::Matrix2d sigma = Eigen::Matrix2d::Zero();  ///< homogenized stress
+  double kinetic_energy = 0.0;                      ///< translation + rotation
+  double kinetic_energy_rotation = 0.0;
+  double elastic_energy = 0.0;
+  double unbalanced_force_ratio = 0.0;
+  double inertial_number = 0.0;
+  double coordination_number = 0.0;
+  /// Lateral walls: (mean wall pressure − σ3)/σ3, signed.
+  double lateral_stress_error = 0.0;
+  double left = 0, right = 0, bottom = 0, top = 0;  ///< wall positions
+};
+
+/// The consolidated sample, saved once and copied by every trial.
+struct ConsolidatedState {
+  /// The static packing. Its particles are renumbered for the kernel
+  /// (World::block_friendly_order()), so they need not be in the assembly's order.
+  World world;
+  double width0 = 0.0, height0 = 0.0;  ///< box after consolidation
+  int64_t steps = 0;                   ///< consolidation steps taken
+  double wall_time_s = 0.0;
+  bool converged = false;
+  double stress_error = 0.0;      ///< max |p − σ3|/σ3 over the walls at the end
+  double unbalanced_ratio = 0.0;  ///< at the end
+};
+
+/// Servo: each step move the wall by gain·(σ3 − p)·L·t/(kn_wall·n_c) toward
+/// the sample (see TestSpec::servo_gain). Returns the wall velocity.
+double servo_velocity(const World& world, WallSide side, double target_stress, double gain);
+/// Compressive pressure on a wall from the particles [Pa].
+double wall_pressure(const World& world, WallSide side);
+
+/// Consolidate: frictionless servo compression to σ3 until static, then
+/// friction on and static again. Throws std::runtime_error if it cannot.
+ConsolidatedState consolidate(const SceneConfig& config, const Assembly& assembly);
+
+struct LoadingResult {
+  std::vector<MonitorPoint> series;
+  int particles = 0;
+  Integration integration;  ///< what was run (absolute Δt)
+  ReferenceScales scales;
+  int64_t steps_planned = 0;
+  int64_t steps_run = 0;
+  bool diverged = false;
+  Divergence divergence = Divergence::kNone;
+  int64_t divergence_step = -1;
+  bool stopped_early = false;  ///< the monitor callback asked to stop
+  double wall_time_s = 0.0;
+  double strain_rate = 0.0;  ///< ε / (Nstep·Δt) [1/s]
+  /// The peak tracked at every step (monitoring points alone can miss a
+  /// sharp peak by a monitoring interval): most compressive vertical wall
+  /// stress −(p_top + p_bottom)/2, equal to b_yy for frictionless walls.
+  double peak_stress_yy = 0.0;
+  double peak_strain_yy = 0.0;
+};
+
+/// Called at each monitoring point; return false to stop the run early.
+using MonitorCallback = std::function<bool(const MonitorPoint&)>;
+
+/// Absolute integration parameters for an algorithm spec on a state.
+Integration integration_for(const World& world, const AlgorithmSpec& algorithm);
+
+/// The stable α = Δt/Δt_crit estimated from the stiffnesses of the
+/// consolidated contact network (World::stability_estimate()), for the
+/// mass scaling and rotation lock of `algorithm`.
+double estimated_stable_dt_ratio(const ConsolidatedState& state, const AlgorithmSpec& algorithm);
+
+/// Load a copy of the consolidated state. `final_state`, if given, receives
+/// the world at the end (for pictures and VTK).
+LoadingResult run_loading(const ConsolidatedState& start, const TestSpec& test,
+                          const AlgorithmSpec& algorithm, const MonitorCallback& monitor = {},
+                          World* final_state = nullptr);
+
+/// The most compressive b_yy of a series and where it happened.
+struct Peak {
+  double stress_yy = 0.0;  ///< negative (compression)
+  double strain_yy = 0.0;
+  int index = -1;
+};
+Peak find_peak(const std::vector<MonitorPoint>& series);
+
+}  // namespace demcal

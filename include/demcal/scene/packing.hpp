@@ -1,0 +1,51 @@
+// Particle assemblies: generators and the particle-file reader.
+#pragma once
+
+#include <istream>
+#include <string>
+#include <vector>
+
+#include "demcal/scene/config.hpp"
+
+namespace demcal {
+
+/// Disks and the box of walls around them.
+struct Assembly {
+  std::vector<double> x, y, r;
+  double left = 0, right = 0, bottom = 0, top = 0;
+  /// True when the disks are already a dense, touching packing (regular
+  /// lattices, files); false for a random gas that consolidation compresses.
+  bool dense = true;
+  int size() const { return static_cast<int>(x.size()); }
+};
+
+/// Hexagonal: `rows` horizontal rows of `columns` disks, alternate rows
+/// offset by one radius, walls touching. Box (2·columns + 1)·r wide and
+/// (2 + (rows − 1)·√3)·r high. With `contact_strain` ε > 0 the lattice is
+/// pre-compressed: centre spacing 2r(1 − ε), so every lattice contact and
+/// each wall overlaps by 2rε (the kernel tests' and benchmarks' scene).
+Assembly hexagonal_packing(int columns, int rows, double radius, double contact_strain = 0.0);
+/// Square lattice, walls touching.
+Assembly square_packing(int columns, int rows, double radius);
+/// A loose random gas of polydisperse disks (no overlaps) on a jittered
+/// grid; consolidation makes it dense (frictionless compression, then
+/// friction on). Deterministic for a seed on every platform.
+Assembly random_gas(const AssemblySpec& spec);
+/// CSV x,y,r (header optional, '#' comments); walls at the bounding box.
+/// Errors name the file and the line.
+Assembly read_particle_file(const std::string& path);
+/// The same from a stream; `source` names it in errors.
+Assembly read_particles(std::istream& in, const std::string& source);
+/// Build the assembly a config asks for.
+Assembly make_assembly(const SceneConfig& config);
+
+/// σ1/σ3 at sliding failure of a periodic hexagonal packing (horizontal
+/// rows) with interparticle friction μ: tan 60°·tan(60° + φ_μ), tan φ_μ = μ.
+/// Infinite (no sliding failure) when μ ≥ 1/√3.
+double hexagonal_peak_ratio(double friction);
+/// The same for the walled columns × rows sample (see the derivation in
+/// packing.cpp): the box is wider and higher than the periodic cell that
+/// carries the same contact forces.
+double hexagonal_peak_ratio_walled(double friction, int columns, int rows);
+
+}  // namespace demcal

@@ -1,0 +1,66 @@
+// Export: the calibrated, upscaled parameters as an input deck for another
+// DEM code (issue #6 §4). One deck per format:
+//
+//   lammps   — LAMMPS (checked with the Debian 12 build, 29 Sep 2021,
+//              GRANULAR package): units si, dimension 2, discs
+//              (set density/disc, fix nve/sphere disc), pair_style
+//              gran/hooke/history kn kt 0 0 μ 0, global viscous damping on
+//              translation per radius class (fix viscous ... scale), walls
+//              as fix wall/gran and wall/gran/region (the top wall a region
+//              moving at the loading speed, the lateral walls regions moved
+//              by a servo built from variables: the same per-step law as
+//              demcal's), run length Nstep.
+//   liggghts — LIGGGHTS-PUBLIC 3.x (not installed here, written from its
+//              documentation): gran model hooke/stiffness with absolute
+//              damping off, per-atom-type-pair kn/kt, mesh walls with a
+//              servo (fix mesh/surface/stress/servo) on the lateral walls.
+//
+// Every mapping, and every place where the other code cannot do exactly
+// what demcal does, is written as comments into the deck itself.
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "demcal/scene/config.hpp"
+#include "demcal/scene/packing.hpp"
+#include "demcal/upscaling/upscaling.hpp"
+
+namespace demcal {
+
+struct ExportOptions {
+  std::string format = "lammps";  ///< lammps | liggghts
+  /// File name the deck reads its particles from (written next to it).
+  std::string data_name = "prototype.data";
+  /// Radius classes (atom types) for the per-type translational damping;
+  /// a monodisperse assembly gets one.
+  int max_types = 8;
+  std::string provenance;  ///< one line: where the parameters came from
+};
+
+struct ExportResult {
+  std::string deck;  ///< the input script
+  /// Other files the deck reads, by name (the data file, meshes).
+  std::map<std::string, std::string> files;
+  double dt = 0.0;    ///< the timestep written into the deck [s]
+  int64_t steps = 0;  ///< the run length written into the deck
+  int types = 0;      ///< radius classes
+  /// Largest relative error of the per-type damping against demcal's
+  /// per-particle D_t = ζ_t·2·sqrt(kn·m_i).
+  double damping_class_error = 0.0;
+  std::vector<std::string> notes;  ///< what could not be mapped exactly
+};
+
+/// The deck for running `params` (the prototype's: Nstep upscaled) on
+/// `assembly` (best a consolidated state: its walls are the starting wall
+/// positions) with the config's material and test. Throws InputError for
+/// an unknown format.
+ExportResult export_deck(const SceneConfig& config, const AlgorithmSpec& params,
+                         const Assembly& assembly, const ExportOptions& options);
+
+/// Radius classes: type (1-based) of every particle, at most `max_types`
+/// classes of (nearly) equal counts; equal radii share a class.
+std::vector<int> radius_classes(const std::vector<double>& radii, int max_types, int* types);
+
+}  // namespace demcal

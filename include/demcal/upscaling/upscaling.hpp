@@ -1,0 +1,150 @@
+// Upscaling (DESIGN.md §4 "Upscaling"): from the parameters calibrated on a
+// small REV to the user's prototype.
+//
+// The dimensionless multipliers α = Δt/Δt_crit, ζ_t = D_t/D_t^crit,
+// ζ_r = D_r/D_r^crit and the mass scaling carry over unchanged; Nstep grows
+// with the particle count (Tu & Andrade: linearly; ScalingLaw lets a
+// measured exponent replace it, see reports/scaling.md); the absolute Δt,
+// D_t and D_r are recomputed from the prototype's own particles: Δt_crit
+// from its smallest particle, the damping coefficients from its masses
+// (quoted for the lightest particle and for the mean, as the kernel applies
+// them per particle).
+#pragma once
+
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "demcal/scene/biaxial.hpp"
+#include "demcal/search/calibration.hpp"
+#include "demcal/scene/config.hpp"
+#include "demcal/scene/packing.hpp"
+#include "demcal/kernel/world.hpp"
+
+namespace demcal {
+
+/// The reference scales of DESIGN.md §2 from the particles alone (no
+/// contact network needed): what fixes the absolute Δt, D_t, D_r.
+struct ParticleScales {
+  int64_t particles = 0;
+  double radius_min = 0.0, radius_max = 0.0, radius_mean = 0.0;
+  double mass_min = 0.0, mass_mean = 0.0;      ///< scaled by f_ms [kg]
+  double dt_crit = 0.0;                        ///< 2·sqrt(m_min/kn) [s]
+  double damping_translation_crit = 0.0;       ///< 2·sqrt(kn·m_min) [N·s/m]
+  double damping_rotation_crit = 0.0;          ///< 2·sqrt(kt·r²·I) of the lightest [N·m·s]
+  double damping_translation_crit_mean = 0.0;  ///< mean over the particles
+  double damping_rotation_crit_mean = 0.0;
+};
+/// Scales of a set of radii for a material (m = f_ms·ρ·t·π·r², I = m·r²/2).
+ParticleScales particle_scales(std::span<const double> radii, const Material& material,
+                               double mass_scaling = 1.0);
+
+/// How the loading length Nstep grows with the particle count:
+/// Nstep(N) = Nstep_REV·(N/N_REV)^exponent. Tu & Andrade's law is linear
+/// (exponent 1); `demcal scaling` measures the exponent for our kernel.
+struct ScalingLaw {
+  double exponent = 1.0;
+  std::string source = "Tu & Andrade (2008): Nstep proportional to N";
+  std::string name() const;  ///< "linear" or "power"
+};
+/// The law as JSON ({law, exponent, source}) and back. A missing
+/// "exponent" reads as linear; errors name `source`.
+nlohmann::json to_json(const ScalingLaw& law);
+ScalingLaw scaling_law_from_json(const nlohmann::json& j, const std::string& source);
+
+/// Nstep for `n_proto` particles from a calibration on `n_rev` particles.
+int64_t upscale_steps(int64_t steps_rev, int64_t n_rev, int64_t n_proto,
+                      const ScalingLaw& law = {});
+/// The REV's parameters for the prototype: Nstep upscaled, every
+/// multiplier unchanged.
+AlgorithmSpec upscale(const AlgorithmSpec& rev, int64_t n_rev, int64_t n_proto,
+                      const ScalingLaw& law = {});
+
+/// A parameter block of params.json (the keys of `rev` and `prototype`):
+/// particles, dt, dt_ratio, dt_crit, steps, damping_translation,
+/// damping_ratio_translation, damping_rotation, damping_ratio_rotation,
+/// mass_scaling, plus the reference values they come from (radius_min,
+/// mass_min, the critical damping of the lightest and of the mean
+/// particle, and the mean damping coefficients).
+nlohmann::json param_block(const AlgorithmSpec& params, const ParticleScales& scales);
+
+/// Where a prototype's particles come from.
+struct PrototypeSource {
+  std::string kind;  ///< "file", "generated" or "rev" (the REV itself)
+  std::string file;  ///< for "file"
+  int64_t particles = 0;
+  std::string description;  ///< one line for reports
+};
+
+/// The config's assembly resized to about `particles` particles: the same
+/// generator with the same distribution and seed (hexagonal/square: the
+/// column:row ratio kept; random: count). A family of scenes that differ
+/// only in size. Throws InputError for a file assembly (cut a REV instead,
+/// rev.hpp).
+SceneConfig scene_of_size(const SceneConfig& config, int64_t particles);
+
+/// The prototype the config names (prototype.file, else prototype.particles
+/// with the config's generator, else the REV itself); `particles` and
+/// `file` override the config when set. The assembly is as generated or
+/// read (not consolidated).
+Assembly prototype_assembly(const SceneConfig& config, int64_t particles = 0,
+                            const std::string& file = "", PrototypeSource* source = nullptr);
+
+/// The `prototype` block of params.json for a calibration: the REV's
+/// parameters `rev` (calibrated on `n_rev` particles) upscaled to the
+/// prototype the config names, with Δt and damping recomputed from the
+/// prototype's particles. Meant to be called by `demcal calibrate`:
+///   params["prototype"] = prototype_block(config, summary.best, n_rev);
+///   params["upscaling"] = upscaling_block(config, n_rev);
+nlohmann::json prototype_block(const SceneConfig& config, const AlgorithmSpec& rev, int64_t n_rev,
+                               const ScalingLaw& law = {}, int64_t particles = 0,
+                               const std::string& file = "");
+/// {law, exponent, factor = Nstep_proto/Nstep_REV, n_rev, n_proto, source}.
+nlohmann::json upscaling_block(int64_t n_rev, int64_t n_proto, const ScalingLaw& law = {});
+
+/// A JSON file (params.json, scaling.json); errors name the file.
+nlohmann::json read_json_file(const std::string& path);
+
+/// The REV's algorithmic parameters back from a params.json (its `rev`
+/// block). Errors name the file and the key.
+struct RevParams {
+  AlgorithmSpec params;
+  int64_t particles = 0;
+  ParticleScales scales;  ///< as recorded (dt_crit, damping crit values)
+};
+RevParams rev_params_from_json(const nlohmann::json& params, const std::string& source);
+/// The scene config a params.json was calibrated with: its "config" object
+/// when present (nothing otherwise).
+std::optional<SceneConfig> config_from_params(const nlohmann::json& params,
+                                              const std::string& source);
+
+/// The smallest Nstep that passes every criterion with the multipliers of
+/// `params` held fixed (params.steps is the first guess). Force balance,
+/// servo and moment balance fall like 1/Nstep at fixed multipliers
+/// (reports/optimizers.md), so each run predicts the next guess; the
+/// search brackets and stops when a passing run is within 7 % of the
+/// tolerances or after `max_runs` runs.
+struct StepSearch {
+  bool found = false;
+  TrialRecord best;                 ///< the smallest passing run
+  std::vector<TrialRecord> trials;  ///< every run, in order
+  double particle_steps = 0.0;      ///< total cost
+};
+StepSearch smallest_passing_steps(const SceneConfig& config, const ConsolidatedState& state,
+                                  const AlgorithmSpec& params, const Tolerances& tolerances = {},
+                                  int max_runs = 8);
+
+/// Least-squares fits of Nstep against N (scaling.md).
+struct LinearFit {
+  double slope = 0.0, intercept = 0.0, r2 = 0.0;
+};
+/// y = slope·x + intercept, R² of the fit.
+LinearFit fit_linear(std::span<const double> x, std::span<const double> y);
+/// y = c·x^p by a linear fit of log y on log x: slope = p,
+/// intercept = log c, r2 in log space.
+LinearFit fit_power(std::span<const double> x, std::span<const double> y);
+
+}  // namespace demcal

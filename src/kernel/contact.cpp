@@ -1,0 +1,413 @@
+// Contact law (DESIGN.md §2): linear normal spring kn·δ; incremental
+// tangential spring kt capped by Coulomb μ·Fn. The tangential force is kept
+// as a scalar along the contact tangent t = (−n_y, n_x), so it turns with the
+// contact as the pair rolls around itself.
+//
+// Contact point: x^c = x_i + (r_i − δ/2)·n, the middle of the overlap. The
+// same lever arms enter the torques and the stress, so a moment-free particle
+// contributes a symmetric term to σ exactly.
+//
+// The particle–particle loop runs over the full neighbour list in blocks of
+// 8 particles (world.hpp), W lanes at a time with GCC vector extensions:
+// W = 8 on x86-64-v4 (AVX-512), 4 on x86-64-v3 (AVX2), 2 on baseline
+// x86-64 (SSE2). The path is chosen once from the CPU; the default build
+// needs no -march flag. Every pair is evaluated from both sides, by the same
+// instructions with the roles of i and j swapped. Every quantity the
+// tangential history depends on is then either invariant or exactly negated
+// under the swap — including under FMA contraction, which is why the
+// rotational term ω_i·a_i + ω_j·a_j is written in the symmetric form
+// ½[(ω_i + ω_j)(a_i + a_j) + (ω_i − ω_j)(a_i − a_j)] — so both copies of a
+// pair's history stay bit-identical and the forces on i and j are exact
+// opposites.
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <string_view>
+
+#include "demcal/kernel/world.hpp"
+
+#if defined(__x86_64__) && defined(__GNUC__)
+#include <emmintrin.h>
+#define DEMCAL_X86_64 1
+#endif
+
+namespace demcal {
+
+namespace {
+
+constexpr int kBlock = 8;
+
+struct WallGeometry {
+  double nx, ny;  // inward unit normal
+};
+constexpr WallGeometry kWallGeometry[4] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}};
+
+// ---------------------------------------------------------------- SIMD
+
+// The vector helpers are always inlined: no vector crosses a call boundary,
+// so the ABI note about passing AVX vectors does not apply.
+#pragma GCC diagnostic ignored "-Wpsabi"
+
+template <int W>
+struct Simd {
+  typedef double D __attribute__((vector_size(8 * W)));
+  typedef long long M __attribute__((vector_size(8 * W)));  // lane masks (0 or −1)
+};
+
+#define DEMCAL_INLINE inline __attribute__((always_inline))
+
+template <int W>
+DEMCAL_INLINE typename Simd<W>::D load(const double *p) {
+  typename Simd<W>::D v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+template <int W>
+DEMCAL_INLINE void store(double *p, typename Simd<W>::D v) {
+  std::memcpy(p, &v, sizeof v);
+}
+template <int W>
+DEMCAL_INLINE typename Simd<W>::D gather(const double *__restrict b, const int *__restrict j) {
+  if constexpr (W == 8)
+    return
+        typename Simd<W>::D{b[j[0]], b[j[1]], b[j[2]], b[j[3]], b[j[4]], b[j[5]], b[j[6]], b[j[7]]};
+  else if constexpr (W == 4)
+    return typename Simd<W>::D{b[j[0]], b[j[1]], b[j[2]], b[j[3]]};
+  else
+    return typename Simd<W>::D{b[j[0]], b[j[1]]};
+}
+
+// Correctly rounded square roots. The 256- and 512-bit forms are inline
+// assembly because the template bodies are compiled for the baseline target
+// and only inlined into the AVX2 / AVX-512 entry points below (an intrinsic
+// there would not inline); the assembler takes the instruction as it is.
+DEMCAL_INLINE Simd<2>::D vsqrt(Simd<2>::D a) {
+#ifdef DEMCAL_X86_64
+  return reinterpret_cast<Simd<2>::D>(_mm_sqrt_pd(reinterpret_cast<__m128d>(a)));
+#else
+  return Simd<2>::D{std::sqrt(a[0]), std::sqrt(a[1])};
+#endif
+}
+#ifdef DEMCAL_X86_64
+DEMCAL_INLINE Simd<4>::D vsqrt(Simd<4>::D a) {
+  Simd<4>::D r;
+  asm("vsqrtpd %1, %0" : "=x"(r) : "x"(a));
+  return r;
+}
+DEMCAL_INLINE Simd<8>::D vsqrt(Simd<8>::D a) {
+  Simd<8>::D r;
+  asm("vsqrtpd %1, %0" : "=v"(r) : "v"(a));
+  return r;
+}
+#endif
+
+template <int W>
+DEMCAL_INLINE typename Simd<W>::D select(typename Simd<W>::M m, typename Simd<W>::D a,
+                                         typename Simd<W>::D b) {
+  return m ? a : b;
+}
+
+template <int W>
+DEMCAL_INLINE double hmax(typename Simd<W>::D v) {
+  double m = v[0];
+  for (int l = 1; l < W; ++l) m = v[l] > m ? v[l] : m;
+  return m;
+}
+
+struct PairArgs {
+  const int *__restrict block_slot;
+  const int *__restrict slot_j;
+  double *__restrict slot_ft;
+  const double *__restrict slot_r;  // radius of each slot's neighbour
+  const double *__restrict x, *__restrict y, *__restrict vx, *__restrict vy, *__restrict om;
+  const double *__restrict r, *__restrict inv_r, *__restrict m;
+  double *__restrict fx, *__restrict fy, *__restrict tq;
+  double kn, kdt, mu, beta2;  // beta2 = 2·contact damping ratio
+};
+
+// Forces of blocks [b0, b1): each particle's sum over its own slots, written
+// (not added) to fx, fy, tq. Returns the largest overlap/r_own, which over
+// both copies of a pair is overlap/min(r_i, r_j).
+template <int W, bool kDamped>
+DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
+  using D = typename Simd<W>::D;
+  const D zero{};
+  D mo = zero;
+  const double kn = a.kn, kdt = a.kdt, mu = a.mu;
+  for (int b = b0; b < b1; ++b) {
+    const int s0 = a.block_slot[b], s1 = a.block_slot[b + 1];
+    for (int sub = 0; sub < kBlock; sub += W) {
+      const int i0 = kBlock * b + sub;
+      const D xi = load<W>(a.x + i0), yi = load<W>(a.y + i0);
+      const D vxi = load<W>(a.vx + i0), vyi = load<W>(a.vy + i0), omi = load<W>(a.om + i0);
+      const D ri = load<W>(a.r + i0), iri = load<W>(a.inv_r + i0);
+      D mi = zero;
+      if constexpr (kDamped) mi = load<W>(a.m + i0);
+      D fx = zero, fy = zero, tq = zero;
+      for (int s = s0 + sub; s < s1; s += kBlock) {
+        const int *J = a.slot_j + s;
+        const D rj = load<W>(a.slot_r + s);
+        const D dx = gather<W>(a.x, J) - xi, dy = gather<W>(a.y, J) - yi;
+        const D d2 = dx * dx + dy * dy;
+        const D rs = ri + rj;
+        const typename Simd<W>::M touch = d2 < rs * rs;
+        const D d = vsqrt(d2);
+        const D inv = 1.0 / d;
+        const D nx = dx * inv, ny = dy * inv;
+        const D ov = rs - d;
+        const D ai = ri - 0.5 * ov, aj = rj - 0.5 * ov;
+        const D omj = gather<W>(a.om, J);
+        const D dvx = gather<W>(a.vx, J) - vxi, dvy = gather<W>(a.vy, J) - vyi;
+        D fn = kn * ov;
+        if constexpr (kDamped) {
+          const D mj = gather<W>(a.m, J);
+          const D meff = mi * mj / (mi + mj);
+          const D vn = dvx * nx + dvy * ny;  // > 0 when separating
+          fn = fn - a.beta2 * vsqrt(kn * meff) * vn;
+          fn = fn > zero ? fn : zero;
+        }
+        fn = select<W>(touch, fn, zero);
+        // Tangential velocity of j's contact point relative to i's, along t.
+        const D rot = 0.5 * ((omi + omj) * (ai + aj) + (omi - omj) * (ai - aj));
+        const D vt = (dvy * nx - dvx * ny) - rot;
+        const D cap = mu * fn;
+        D t = load<W>(a.slot_ft + s) + kdt * vt;
+        t = t < -cap ? -cap : t;
+        t = t > cap ? cap : t;
+        t = select<W>(touch, t, zero);
+        store<W>(a.slot_ft + s, t);
+        // Force on i: −fn·n + ft·t.
+        fx += -fn * nx - t * ny;
+        fy += -fn * ny + t * nx;
+        tq += ai * t;
+        const D ovr = select<W>(touch, ov * iri, zero);
+        mo = mo > ovr ? mo : ovr;
+      }
+      store<W>(a.fx + i0, fx);
+      store<W>(a.fy + i0, fy);
+      store<W>(a.tq + i0, tq);
+    }
+  }
+  return hmax<W>(mo);
+}
+
+struct IntegrateArgs {
+  double *__restrict x, *__restrict y, *__restrict vx, *__restrict vy, *__restrict th,
+                                                                           *__restrict om;
+  const double *__restrict fx, *__restrict fy, *__restrict tq;
+  const double *__restrict ca_t, *__restrict cb_t, *__restrict ca_r, *__restrict cb_r;
+  const double *__restrict x_built, *__restrict y_built;
+  double dt;
+};
+
+// Central difference with global damping for blocks [b0, b1); returns the
+// largest squared displacement since the last neighbour-list build.
+template <int W, bool kRotation>
+DEMCAL_INLINE double integrate_blocks(const IntegrateArgs &a, int b0, int b1) {
+  using D = typename Simd<W>::D;
+  D md = D{};
+  const double dt = a.dt;
+  for (int i = kBlock * b0; i < kBlock * b1; i += W) {
+    const D vx = load<W>(a.ca_t + i) * load<W>(a.vx + i) + load<W>(a.cb_t + i) * load<W>(a.fx + i);
+    const D vy = load<W>(a.ca_t + i) * load<W>(a.vy + i) + load<W>(a.cb_t + i) * load<W>(a.fy + i);
+    const D x = load<W>(a.x + i) + vx * dt, y = load<W>(a.y + i) + vy * dt;
+    store<W>(a.vx + i, vx);
+    store<W>(a.vy + i, vy);
+    store<W>(a.x + i, x);
+    store<W>(a.y + i, y);
+    if constexpr (kRotation) {
+      const D om =
+          load<W>(a.ca_r + i) * load<W>(a.om + i) + load<W>(a.cb_r + i) * load<W>(a.tq + i);
+      store<W>(a.om + i, om);
+      store<W>(a.th + i, load<W>(a.th + i) + om * dt);
+    }
+    const D dx = x - load<W>(a.x_built + i), dy = y - load<W>(a.y_built + i);
+    const D d2 = dx * dx + dy * dy;
+    md = d2 > md ? d2 : md;
+  }
+  return hmax<W>(md);
+}
+
+// ---------------------------------------------------------------- dispatch
+
+using PairFn = double (*)(const PairArgs &, int, int);
+using IntegrateFn = double (*)(const IntegrateArgs &, int, int);
+
+struct Kernels {
+  PairFn pairs, pairs_damped;
+  IntegrateFn integrate, integrate_locked;
+  const char *name;
+};
+
+#define DEMCAL_KERNELS(SUFFIX, TARGET, W)                                                        \
+  TARGET double pairs_##SUFFIX(const PairArgs &a, int b0, int b1) {                              \
+    return pair_blocks<W, false>(a, b0, b1);                                                     \
+  }                                                                                              \
+  TARGET double pairs_damped_##SUFFIX(const PairArgs &a, int b0, int b1) {                       \
+    return pair_blocks<W, true>(a, b0, b1);                                                      \
+  }                                                                                              \
+  TARGET double integrate_##SUFFIX(const IntegrateArgs &a, int b0, int b1) {                     \
+    return integrate_blocks<W, true>(a, b0, b1);                                                 \
+  }                                                                                              \
+  TARGET double integrate_locked_##SUFFIX(const IntegrateArgs &a, int b0, int b1) {              \
+    return integrate_blocks<W, false>(a, b0, b1);                                                \
+  }                                                                                              \
+  constexpr Kernels kKernels_##SUFFIX{pairs_##SUFFIX, pairs_damped_##SUFFIX, integrate_##SUFFIX, \
+                                      integrate_locked_##SUFFIX, #SUFFIX};
+
+#define DEMCAL_NO_TARGET
+DEMCAL_KERNELS(sse2, DEMCAL_NO_TARGET, 2)
+#ifdef DEMCAL_X86_64
+DEMCAL_KERNELS(avx2, __attribute__((target("arch=x86-64-v3"))), 4)
+DEMCAL_KERNELS(avx512, __attribute__((target("arch=x86-64-v4"))), 8)
+#endif
+
+const Kernels &kernels() {
+  static const Kernels chosen = [] {
+#ifdef DEMCAL_X86_64
+    __builtin_cpu_init();
+    const bool v4 = __builtin_cpu_supports("x86-64-v4") != 0;
+    const bool v3 = __builtin_cpu_supports("x86-64-v3") != 0;
+    if (const char *env = std::getenv("DEMCAL_SIMD")) {
+      const std::string_view want(env);
+      if (want == "sse2") return kKernels_sse2;
+      if (want == "avx2" && v3) return kKernels_avx2;
+      if (want == "avx512" && v4) return kKernels_avx512;
+    }
+    if (v4) return kKernels_avx512;
+    if (v3) return kKernels_avx2;
+#endif
+    return kKernels_sse2;
+  }();
+  return chosen;
+}
+
+}  // namespace
+
+const char *kernel_simd() {
+#ifdef DEMCAL_X86_64
+  return kernels().name;
+#else
+  return "generic";
+#endif
+}
+
+double World::pair_pass(int b0, int b1) {
+  const PairArgs a{block_slot_.data(),
+                   slot_j_.data(),
+                   slot_ft_.data(),
+                   slot_r_.data(),
+                   x_.data(),
+                   y_.data(),
+                   vx_.data(),
+                   vy_.data(),
+                   omega_.data(),
+                   r_.data(),
+                   inv_r_.data(),
+                   m_.data(),
+                   fx_.data(),
+                   fy_.data(),
+                   tq_.data(),
+                   material_.particle.kn,
+                   material_.particle.kt * integration_.dt,
+                   material_.particle.friction,
+                   2.0 * material_.contact_damping_ratio};
+  const Kernels &k = kernels();
+  return material_.contact_damping_ratio > 0.0 ? k.pairs_damped(a, b0, b1) : k.pairs(a, b0, b1);
+}
+
+double World::integrate_pass(int b0, int b1) {
+  const IntegrateArgs a{x_.data(),     y_.data(),       vx_.data(),      vy_.data(),
+                        theta_.data(), omega_.data(),   fx_.data(),      fy_.data(),
+                        tq_.data(),    ca_t_.data(),    cb_t_.data(),    ca_r_.data(),
+                        cb_r_.data(),  x_built_.data(), y_built_.data(), integration_.dt};
+  const Kernels &k = kernels();
+  return integration_.lock_rotation ? k.integrate_locked(a, b0, b1) : k.integrate(a, b0, b1);
+}
+
+World::PairState World::pair_state(int i, int j) const {
+  // The same operations as pair_blocks, one lane.
+  PairState p{};
+  const double dx = x_[j] - x_[i], dy = y_[j] - y_[i];
+  const double d2 = dx * dx + dy * dy;
+  const double rs = r_[i] + r_[j];
+  p.touching = d2 < rs * rs;
+  const double d = std::sqrt(d2);
+  const double inv = 1.0 / d;
+  p.nx = dx * inv;
+  p.ny = dy * inv;
+  p.overlap = rs - d;
+  const double kn = material_.particle.kn;
+  double fn = kn * p.overlap;
+  const double beta2 = 2.0 * material_.contact_damping_ratio;
+  if (beta2 > 0.0) {
+    const double meff = m_[i] * m_[j] / (m_[i] + m_[j]);
+    const double vn = (vx_[j] - vx_[i]) * p.nx + (vy_[j] - vy_[i]) * p.ny;
+    fn = std::max(0.0, fn - beta2 * std::sqrt(kn * meff) * vn);
+  }
+  p.fn = p.touching ? fn : 0.0;
+  return p;
+}
+
+void World::wall_pass() {
+  // Walls. Contact point on the wall line; lever arm = distance to the wall.
+  // Added to the pair forces, after them, wall by wall.
+  const double dt = integration_.dt;
+  const double beta = material_.contact_damping_ratio;
+  const double kw = material_.wall.kn, ktw = material_.wall.kt, muw = material_.wall.friction;
+  double max_overlap = 0.0;
+  for (int s = 0; s < 4; ++s) {
+    Wall &wall = walls_[s];
+    const auto g = kWallGeometry[s];
+    const double tx = -g.ny, ty = g.nx;
+    const bool vertical = (s == kLeft || s == kRight);
+    const double wvx = vertical ? wall.velocity : 0.0, wvy = vertical ? 0.0 : wall.velocity;
+    double wfx = 0.0, wfy = 0.0;
+    int count = 0;
+    double *hist = wall_ft_[s].data();
+    double *hist_fn = wall_fn_[s].data();
+    for (int i : wall_candidates_[s]) {
+      // Signed distance from the wall line to the centre, along the inward normal.
+      const double dist =
+          vertical ? (x_[i] - wall.position) * g.nx : (y_[i] - wall.position) * g.ny;
+      const double overlap = r_[i] - dist;
+      if (overlap <= 0.0) {
+        hist[i] = 0.0;
+        hist_fn[i] = 0.0;
+        continue;
+      }
+      ++count;
+      max_overlap = std::max(max_overlap, overlap / r_[i]);
+      double fn = kw * overlap;
+      const double dvx = wvx - vx_[i], dvy = wvy - vy_[i];  // wall relative to particle
+      if (beta > 0.0) {
+        const double vn = -(dvx * g.nx + dvy * g.ny);  // particle leaving the wall > 0
+        fn = std::max(0.0, fn - beta * 2.0 * std::sqrt(kw * m_[i]) * vn);
+      }
+      // Particle contact point moves with v − ω·dist·t (arm = −dist·n).
+      const double vt = dvx * tx + dvy * ty + omega_[i] * dist;
+      double ft = hist[i] + ktw * vt * dt;
+      const double cap = muw * fn;
+      ft = std::clamp(ft, -cap, cap);
+      hist[i] = ft;
+      hist_fn[i] = fn;
+      const double fxi = fn * g.nx + ft * tx, fyi = fn * g.ny + ft * ty;
+      fx_[i] += fxi;
+      fy_[i] += fyi;
+      tq_[i] += -dist * ft;
+      wfx -= fxi;
+      wfy -= fyi;
+    }
+    wall.force = Eigen::Vector2d(wfx, wfy);
+    wall.contacts = count;
+  }
+  max_overlap_ratio_seen_ = std::max(max_overlap_ratio_seen_, max_overlap);
+}
+
+void World::compute_forces() {
+  max_overlap_ratio_seen_ = run_pair_pass();
+  wall_pass();
+}
+
+}  // namespace demcal

@@ -1,0 +1,99 @@
+// Renumbering the particles (World::reorder) and the order that fills the
+// SIMD blocks (World::block_friendly_order). See world.hpp.
+#include <algorithm>
+#include <stdexcept>
+#include <tuple>
+#include <vector>
+
+#include "demcal/kernel/world.hpp"
+
+namespace demcal {
+
+namespace {
+constexpr int kBlock = 8;
+constexpr int kWindow = 64;  // particles sorted together: 8 blocks
+}  // namespace
+
+double World::neighbour_slot_fill() const {
+  const int slots = block_slot_[nblocks_];
+  if (slots == 0) return 1.0;
+  int real = 0;
+  for (int s = 0; s < slots; ++s) real += slot_j_[s] != ghost_;
+  return static_cast<double>(real) / slots;
+}
+
+std::vector<int> World::block_friendly_order() const {
+  const int n = n_;
+  std::vector<int> count(n, 0);
+  for (int i = 0; i < n; ++i) {
+    const int b = i / kBlock, lane = i % kBlock;
+    for (int s = block_slot_[b] + lane; s < block_slot_[b + 1]; s += kBlock)
+      if (slot_j_[s] != ghost_) ++count[i];
+  }
+  std::vector<int> order(n);
+  for (int i = 0; i < n; ++i) order[i] = i;
+  for (int w = 0; w < n; w += kWindow) {
+    const auto first = order.begin() + w, last = order.begin() + std::min(n, w + kWindow);
+    std::stable_sort(first, last, [&](int a, int b) { return count[a] > count[b]; });
+  }
+  return order;
+}
+
+void World::reorder(std::span<const int> order) {
+  const int n = n_;
+  if (static_cast<int>(order.size()) != n)
+    throw std::invalid_argument("World::reorder: order must list every particle once");
+  std::vector<int> new_index(n, -1);
+  for (int k = 0; k < n; ++k) {
+    const int i = order[k];
+    if (i < 0 || i >= n || new_index[i] >= 0)
+      throw std::invalid_argument("World::reorder: order is not a permutation");
+    new_index[i] = k;
+  }
+
+  // Contact histories by (particle, neighbour), in the new numbering.
+  std::vector<std::tuple<int, int, double>> history;
+  for (int i = 0; i < n; ++i) {
+    const int b = i / kBlock, lane = i % kBlock;
+    for (int s = block_slot_[b] + lane; s < block_slot_[b + 1]; s += kBlock)
+      if (slot_j_[s] != ghost_)
+        history.emplace_back(new_index[i], new_index[slot_j_[s]], slot_ft_[s]);
+  }
+  std::sort(history.begin(), history.end());
+
+  // Per-particle state.
+  Array tmp(static_cast<size_t>(n));
+  for (Array* a : {&x_, &y_, &vx_, &vy_, &theta_, &omega_, &r_, &inv_r_, &m_, &inertia_, &fx_, &fy_,
+                   &tq_, &ca_t_, &cb_t_, &ca_r_, &cb_r_, &x_built_, &y_built_}) {
+    for (int k = 0; k < n; ++k) tmp[k] = (*a)[order[k]];
+    std::copy(tmp.begin(), tmp.end(), a->begin());
+  }
+  for (auto* walls : {&wall_ft_, &wall_fn_})
+    for (auto& h : *walls) {
+      for (int k = 0; k < n; ++k) tmp[k] = h[order[k]];
+      std::copy(tmp.begin(), tmp.end(), h.begin());
+    }
+
+  // The histories as an "old" list in the new numbering (each particle's
+  // neighbours in increasing index, as rebuild_neighbours() expects), which
+  // the rebuild then carries over slot by slot.
+  std::vector<int> start(static_cast<size_t>(n) + 1, 0);
+  for (const auto& h : history) ++start[std::get<0>(h) + 1];
+  for (int i = 0; i < n; ++i) start[i + 1] += start[i];
+  layout_blocks(start, block_slot_);
+  slot_j_.assign(static_cast<size_t>(block_slot_[nblocks_]), ghost_);
+  slot_ft_.assign(slot_j_.size(), 0.0);
+  for (int i = 0; i < n; ++i) {
+    const int b = i / kBlock, lane = i % kBlock;
+    for (int k = start[i]; k < start[i + 1]; ++k) {
+      const int s = block_slot_[b] + lane + kBlock * (k - start[i]);
+      slot_j_[s] = std::get<1>(history[k]);
+      slot_ft_[s] = std::get<2>(history[k]);
+    }
+  }
+  list_valid_ = false;
+  rebuild_neighbours();
+  update_forces();
+}
+
+}  // namespace demcal

@@ -1,0 +1,372 @@
+// Central-difference integration with global (mass-proportional) damping,
+// DESIGN.md §2:
+//   v(n+½) = [(1 − D·Δt/2m)·v(n−½) + F·Δt/m] / (1 + D·Δt/2m)
+// with D = ζ_t·2·sqrt(kn·m) per particle (and ζ_r·2·sqrt(kt·r²·I) for ω),
+// so every particle has the same damping ratio.
+//
+// Threads (KernelOptions::threads > 1): a team of workers shares the two
+// SIMD passes of each step — integrate and the pair forces — by ranges of
+// particle blocks; the rest (walls, neighbour-list rebuilds, divergence
+// checks) runs on the calling thread. Each particle's force is summed by one
+// thread in its own fixed order, and the maxima the passes return are
+// exact, so results are bit-identical for any thread count.
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <numbers>
+#include <optional>
+#include <stdexcept>
+#include <thread>
+
+#include "demcal/kernel/world.hpp"
+
+#if defined(__x86_64__) || defined(__i386__)
+#include <immintrin.h>
+#define DEMCAL_PAUSE() _mm_pause()
+#else
+#define DEMCAL_PAUSE() ((void)0)
+#endif
+
+namespace demcal {
+
+namespace detail {
+
+// Fork-join team: run(fn, ctx) calls fn(ctx, t) for t = 0 .. size − 1, t = 0
+// on the calling thread, and returns when all are done. Workers spin briefly
+// and then sleep on the epoch counter (the machine may be shared).
+class KernelTeam {
+ public:
+  explicit KernelTeam(int size) : size_(size) {
+    for (int t = 1; t < size; ++t) workers_.emplace_back([this, t] { work(t); });
+  }
+  ~KernelTeam() {
+    stop_.store(true, std::memory_order_relaxed);
+    epoch_.fetch_add(1, std::memory_order_release);
+    epoch_.notify_all();
+    for (auto& w : workers_) w.join();
+  }
+  KernelTeam(const KernelTeam&) = delete;
+  KernelTeam& operator=(const KernelTeam&) = delete;
+  int size() const { return size_; }
+
+  void run(void (*fn)(void*, int), void* ctx) {
+    fn_ = fn;
+    ctx_ = ctx;
+    pending_.store(size_ - 1, std::memory_order_relaxed);
+    epoch_.fetch_add(1, std::memory_order_release);
+    epoch_.notify_all();
+    fn(ctx, 0);
+    for (int spin = 0;; ++spin) {
+      const int left = pending_.load(std::memory_order_acquire);
+      if (left == 0) break;
+      if (spin < kSpin)
+        DEMCAL_PAUSE();
+      else
+        pending_.wait(left, std::memory_order_acquire);
+    }
+  }
+
+ private:
+  static constexpr int kSpin = 4000;
+  void work(int t) {
+    uint64_t seen = 0;
+    for (;;) {
+      uint64_t now;
+      for (int spin = 0;; ++spin) {
+        now = epoch_.load(std::memory_order_acquire);
+        if (now != seen) break;
+        if (spin < kSpin)
+          DEMCAL_PAUSE();
+        else
+          epoch_.wait(seen, std::memory_order_acquire);
+      }
+      seen = now;
+      if (stop_.load(std::memory_order_relaxed)) return;
+      fn_(ctx_, t);
+      if (pending_.fetch_sub(1, std::memory_order_acq_rel) == 1) pending_.notify_one();
+    }
+  }
+
+  int size_;
+  std::vector<std::thread> workers_;
+  std::atomic<uint64_t> epoch_{0};
+  std::atomic<int> pending_{0};
+  std::atomic<bool> stop_{false};
+  void (*fn_)(void*, int) = nullptr;
+  void* ctx_ = nullptr;
+};
+
+TeamHandle::TeamHandle() noexcept = default;
+TeamHandle::TeamHandle(const TeamHandle&) noexcept {}
+TeamHandle::TeamHandle(TeamHandle&&) noexcept = default;
+TeamHandle& TeamHandle::operator=(const TeamHandle&) noexcept {
+  team.reset();
+  return *this;
+}
+TeamHandle& TeamHandle::operator=(TeamHandle&&) noexcept = default;
+TeamHandle::~TeamHandle() = default;
+
+}  // namespace detail
+
+namespace {
+constexpr int kBlock = 8;
+constexpr double kFar = 1e100;  // padding lanes at (+kFar, +kFar), the ghost at (−kFar, −kFar)
+}  // namespace
+
+const char* to_string(Divergence d) {
+  switch (d) {
+    case Divergence::kNone:
+      return "none";
+    case Divergence::kNotFinite:
+      return "non-finite state";
+    case Divergence::kOverlap:
+      return "overlap beyond limit";
+    case Divergence::kEnergy:
+      return "kinetic energy growing without bound";
+    case Divergence::kEnergyCreated:
+      return "energy created by the integrator (step beyond the stable one)";
+  }
+  return "unknown";
+}
+
+World::World(const Material& material, std::span<const double> x, std::span<const double> y,
+             std::span<const double> radius, double left, double right, double bottom, double top,
+             KernelOptions options)
+    : material_(material), options_(options) {
+  const size_t n = x.size();
+  if (y.size() != n || radius.size() != n)
+    throw std::invalid_argument("World: x, y and radius differ in length");
+  if (!(right > left) || !(top > bottom))
+    throw std::invalid_argument("World: walls must enclose a positive area");
+  if (n > static_cast<size_t>(1) << 28) throw std::invalid_argument("World: too many particles");
+  for (double r : radius)
+    if (!(r > 0.0) || !std::isfinite(r)) throw std::invalid_argument("World: radius must be > 0");
+  n_ = static_cast<int>(n);
+  nblocks_ = (n_ + kBlock - 1) / kBlock;
+  ghost_ = kBlock * nblocks_;
+  const size_t cap = static_cast<size_t>(ghost_) + kBlock;  // padding, ghost, one spare block
+  auto init = [&](Array& a, double value) { a.assign(cap, value); };
+  init(x_, kFar);
+  init(y_, kFar);
+  std::copy(x.begin(), x.end(), x_.begin());
+  std::copy(y.begin(), y.end(), y_.begin());
+  x_[ghost_] = y_[ghost_] = -kFar;
+  init(r_, 0.0);
+  std::copy(radius.begin(), radius.end(), r_.begin());
+  init(inv_r_, 0.0);
+  for (int i = 0; i < n_; ++i) inv_r_[i] = 1.0 / r_[i];
+  for (Array* a : {&vx_, &vy_, &theta_, &omega_, &fx_, &fy_, &tq_, &m_, &inertia_, &ca_t_, &cb_t_,
+                   &ca_r_, &cb_r_})
+    init(*a, 0.0);
+  x_built_ = x_;
+  y_built_ = y_;
+  for (auto& h : wall_ft_) h.assign(n, 0.0);
+  for (auto& h : wall_fn_) h.assign(n, 0.0);
+  block_slot_.assign(static_cast<size_t>(nblocks_) + 1, 0);
+  r_min_ = n ? *std::min_element(radius.begin(), radius.end()) : 1.0;
+  r_max_ = n ? *std::max_element(radius.begin(), radius.end()) : 1.0;
+  skin_ = options_.skin_ratio * r_min_;
+  walls_[kLeft].position = left;
+  walls_[kRight].position = right;
+  walls_[kBottom].position = bottom;
+  walls_[kTop].position = top;
+  set_threads(options_.threads);
+  set_integration(integration_);
+  update_forces();
+}
+
+void World::set_threads(int threads) {
+  if (threads < 0) throw std::invalid_argument("World: threads must be >= 0");
+  if (threads == 0) threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  options_.threads = threads;
+  threads_ = threads;
+  if (team_.team && team_.team->size() != active_threads()) team_.team.reset();
+  update_thread_bounds();
+}
+
+void World::set_options(const KernelOptions& options) {
+  options_ = options;
+  ledger_ = {};
+  skin_ = options_.skin_ratio * r_min_;
+  list_valid_ = false;  // the next step rebuilds the list with this skin
+  set_threads(options.threads);
+}
+
+int World::active_threads() const {
+  // At least 8 blocks (64 particles) per thread, or the hand-over costs
+  // more than it saves.
+  return std::max(1, std::min({threads_, nblocks_ / 8, 64}));
+}
+
+void World::update_thread_bounds() {
+  const int t = active_threads();
+  particle_bounds_.assign(static_cast<size_t>(t) + 1, 0);
+  pair_bounds_.assign(static_cast<size_t>(t) + 1, 0);
+  for (int k = 0; k <= t; ++k)
+    particle_bounds_[k] = static_cast<int>(static_cast<int64_t>(nblocks_) * k / t);
+  // Pair pass: equal shares of slots (block_slot_ is non-decreasing).
+  const int64_t total = block_slot_.back();
+  int b = 0;
+  for (int k = 1; k < t; ++k) {
+    const int64_t target = total * k / t;
+    while (b < nblocks_ && block_slot_[b] < target) ++b;
+    pair_bounds_[k] = b;
+  }
+  pair_bounds_[t] = nblocks_;
+}
+
+double World::run_pass(double (World::*pass)(int, int), const std::vector<int>& bounds) {
+  const int t = active_threads();
+  if (t <= 1) return (this->*pass)(0, nblocks_);
+  if (!team_.team) team_.team = std::make_unique<detail::KernelTeam>(t);
+  struct Ctx {
+    World* w;
+    double (World::*pass)(int, int);
+    const std::vector<int>* bounds;
+    double out[64];
+  } ctx{this, pass, &bounds, {}};
+  team_.team->run(
+      [](void* p, int k) {
+        auto* c = static_cast<Ctx*>(p);
+        c->out[k] = (c->w->*c->pass)((*c->bounds)[k], (*c->bounds)[k + 1]);
+      },
+      &ctx);
+  // Maxima are exact whatever the split: the result does not depend on t.
+  return *std::max_element(ctx.out, ctx.out + t);
+}
+
+double World::run_pair_pass() { return run_pass(&World::pair_pass, pair_bounds_); }
+
+double World::run_integrate_pass() { return run_pass(&World::integrate_pass, particle_bounds_); }
+
+void World::set_integration(const Integration& integration) {
+  if (!(integration.dt >= 0.0) || !std::isfinite(integration.dt))
+    throw std::invalid_argument("World: dt must be finite and >= 0");
+  if (!(integration.mass_scaling > 0.0))
+    throw std::invalid_argument("World: mass_scaling must be > 0");
+  integration_ = integration;
+  ledger_ = {};
+  // Locked rotation means ω ≡ 0: a spin left from before the lock would
+  // otherwise keep loading the tangential springs through the contact-point
+  // velocity while θ stays frozen.
+  if (integration_.lock_rotation) std::fill(omega_.begin(), omega_.end(), 0.0);
+  const double rho_t = material_.density * material_.thickness * integration_.mass_scaling;
+  for (int i = 0; i < size(); ++i) {
+    m_[i] = rho_t * std::numbers::pi * r_[i] * r_[i];
+    inertia_[i] = 0.5 * m_[i] * r_[i] * r_[i];
+  }
+  update_damping_coefficients();
+}
+
+void World::update_damping_coefficients() {
+  const double dt = integration_.dt;
+  const double kn = material_.particle.kn, kt = material_.particle.kt;
+  for (int i = 0; i < size(); ++i) {
+    const double dtc = integration_.damping_ratio_translation * 2.0 * std::sqrt(kn * m_[i]);
+    const double c = dtc * dt / (2.0 * m_[i]);
+    ca_t_[i] = (1.0 - c) / (1.0 + c);
+    cb_t_[i] = dt / m_[i] / (1.0 + c);
+    const double drc =
+        integration_.damping_ratio_rotation * 2.0 * std::sqrt(kt * r_[i] * r_[i] * inertia_[i]);
+    const double cr = drc * dt / (2.0 * inertia_[i]);
+    ca_r_[i] = (1.0 - cr) / (1.0 + cr);
+    cb_r_[i] = dt / inertia_[i] / (1.0 + cr);
+  }
+}
+
+void World::set_velocity(int i, double vx, double vy, double omega) {
+  ledger_ = {};
+  vx_[i] = vx;
+  vy_[i] = vy;
+  omega_[i] = integration_.lock_rotation ? 0.0 : omega;
+}
+
+void World::set_position(int i, double x, double y) {
+  ledger_ = {};
+  x_[i] = x;
+  y_[i] = y;
+  list_valid_ = false;
+}
+
+void World::update_forces() {
+  if (needs_rebuild()) rebuild_neighbours();
+  const double dt = integration_.dt;
+  // Re-evaluating forces in place must not add a tangential increment twice.
+  integration_.dt = 0.0;
+  compute_forces();
+  integration_.dt = dt;
+}
+
+void World::integrate() {
+  // Fused with the displacement scan of the neighbour-list check.
+  const double max_d2 = run_integrate_pass();
+  for (auto& w : walls_) w.position += w.velocity * integration_.dt;
+  if (!list_valid_) return;
+  const double max_disp = std::sqrt(max_d2);
+  double max_wall = 0.0;
+  for (int w = 0; w < 4; ++w)
+    max_wall = std::max(max_wall, std::abs(walls_[w].position - wall_built_[w]));
+  // Two particles approach each other by at most 2·max_disp; a particle and
+  // a wall by max_disp + max_wall.
+  if (2.0 * max_disp >= skin_ || max_disp + max_wall >= skin_) list_valid_ = false;
+}
+
+bool World::check_divergence() {
+  const int n = size();
+  double ke = 0.0;
+  bool finite = true;
+  for (int i = 0; i < n; ++i) {
+    finite = finite && std::isfinite(x_[i]) && std::isfinite(y_[i]) && std::isfinite(omega_[i]);
+    ke += m_[i] * (vx_[i] * vx_[i] + vy_[i] * vy_[i]) + inertia_[i] * omega_[i] * omega_[i];
+  }
+  ke *= 0.5;
+  if (!finite || !std::isfinite(ke)) {
+    divergence_ = Divergence::kNotFinite;
+    return true;
+  }
+  if (max_overlap_ratio_seen_ > options_.max_overlap_ratio) {
+    divergence_ = Divergence::kOverlap;
+    return true;
+  }
+  // The pair loop of the energy ledger also refreshes the energy scale (every
+  // energy_check_interval steps; the scale is a running maximum, so a
+  // slightly older value only makes the check below a little stricter).
+  std::optional<EnergySample> sample;
+  if (ledger_due()) {
+    sample = energy_sample();
+    energy_scale_ = std::max({energy_scale_, sample->elastic, initial_energy_});
+  }
+  // Kinetic energy far beyond anything the springs have ever stored cannot
+  // come from the loading: an unstable mode is growing.
+  const double scale = std::max(energy_scale_, initial_energy_);
+  if (scale > 0.0 && ke > options_.max_energy_ratio * scale) {
+    divergence_ = Divergence::kEnergy;
+    return true;
+  }
+  return sample && ledger_record(*sample);
+}
+
+bool World::step(int64_t count) {
+  if (divergence_ != Divergence::kNone) return false;
+  if (initial_energy_ < 0.0) {
+    const Measures m = measure();
+    initial_energy_ = m.kinetic_energy_translation + m.kinetic_energy_rotation + m.elastic_energy;
+  }
+  const int interval = std::max(1, options_.check_interval);
+  for (int64_t s = 0; s < count; ++s) {
+    integrate();
+    if (!list_valid_) rebuild_neighbours();
+    compute_forces();
+    ++steps_;
+    time_ += integration_.dt;
+    if (steps_ % interval == 0) {
+      if (check_divergence()) {
+        divergence_step_ = steps_;
+        return false;
+      }
+    }
+  }
+  return true;
+}
+
+}  // namespace demcal

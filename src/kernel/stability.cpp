@@ -1,0 +1,261 @@
+// Reference scales and stable-step estimates.
+//
+// The explicit scheme with this form of global damping is stable for
+// ω_max·Δt < 2 whatever the damping ratio (the characteristic polynomial
+// (1+c)z² − (2 − ω²Δt²)z + (1−c) has its roots inside the unit circle iff
+// 0 < ω²Δt² < 4 for c ≥ 0). ω²_max is the largest eigenvalue of
+// A = M^-½ K M^-½, K the stiffness of the current contact network with
+// translation and rotation coupled. We compute it two ways:
+//  - Lanczos (no re-orthogonalisation: the extreme Ritz value converges
+//    first and copies do not exceed it), a sharp lower estimate;
+//  - Gershgorin row sums of A (as YADE's GlobalStiffnessTimeStepper does per
+//    body), a rigorous but loose upper bound.
+// The rotational mode of a frictional packing is the binding one: with six
+// contacts and kt = kn/2 the in-phase rotation needs α < 1/√12 ≈ 0.29,
+// Gershgorin says 0.20. The search uses the Lanczos value.
+#include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "demcal/kernel/world.hpp"
+
+namespace demcal {
+
+ReferenceScales World::reference_scales() const {
+  ReferenceScales s;
+  const int n = size();
+  if (n == 0) return s;
+  int imin = 0;
+  for (int i = 1; i < n; ++i)
+    if (m_[i] < m_[imin]) imin = i;
+  const double kn = material_.particle.kn, kt = material_.particle.kt;
+  s.mass_min = m_[imin];
+  s.dt_crit = 2.0 * std::sqrt(m_[imin] / kn);
+  s.damping_translation_crit = 2.0 * std::sqrt(kn * m_[imin]);
+  s.damping_rotation_crit = 2.0 * std::sqrt(kt * r_[imin] * r_[imin] * inertia_[imin]);
+  double dt_sum = 0.0, dr_sum = 0.0;
+  for (int i = 0; i < n; ++i) {
+    dt_sum += 2.0 * std::sqrt(kn * m_[i]);
+    dr_sum += 2.0 * std::sqrt(kt * r_[i] * r_[i] * inertia_[i]);
+  }
+  s.damping_translation_crit_mean = dt_sum / n;
+  s.damping_rotation_crit_mean = dr_sum / n;
+  return s;
+}
+
+namespace {
+
+// One contact of the linearised network: dofs (u_i, θ_i[, u_j, θ_j]).
+struct LinearContact {
+  int i, j;  // j < 0: wall contact
+  double nx, ny, ai, aj, kn, kt;
+};
+
+// y = A·x for A = M^-½ K M^-½ (x, y: 3 dofs per particle).
+void apply(const std::vector<LinearContact>& contacts, const std::vector<double>& inv_sqrt_mass,
+           const std::vector<double>& inv_sqrt_inertia, bool rotation, const Eigen::VectorXd& x,
+           Eigen::VectorXd& y) {
+  y.setZero();
+  auto ux = [&](int p) { return x[3 * p] * inv_sqrt_mass[p]; };
+  auto uy = [&](int p) { return x[3 * p + 1] * inv_sqrt_mass[p]; };
+  auto th = [&](int p) { return rotation ? x[3 * p + 2] * inv_sqrt_inertia[p] : 0.0; };
+  for (const auto& c : contacts) {
+    const double tx = -c.ny, ty = c.nx;
+    const int i = c.i, j = c.j;
+    double dn, dt;
+    if (j >= 0) {
+      const double dux = ux(j) - ux(i), duy = uy(j) - uy(i);
+      dn = dux * c.nx + duy * c.ny;
+      dt = dux * tx + duy * ty - c.aj * th(j) - c.ai * th(i);
+    } else {
+      dn = ux(i) * c.nx + uy(i) * c.ny;
+      dt = ux(i) * tx + uy(i) * ty - c.ai * th(i);
+    }
+    const double fn = c.kn * dn, ft = c.kt * dt;
+    // Generalised forces = ∂E/∂u (E = ½kn·dn² + ½kt·dt²).
+    if (j >= 0) {
+      y[3 * i] -= fn * c.nx + ft * tx;
+      y[3 * i + 1] -= fn * c.ny + ft * ty;
+      y[3 * j] += fn * c.nx + ft * tx;
+      y[3 * j + 1] += fn * c.ny + ft * ty;
+      y[3 * i + 2] -= ft * c.ai;
+      y[3 * j + 2] -= ft * c.aj;
+    } else {
+      y[3 * i] += fn * c.nx + ft * tx;
+      y[3 * i + 1] += fn * c.ny + ft * ty;
+      y[3 * i + 2] -= ft * c.ai;
+    }
+  }
+  const int n = static_cast<int>(inv_sqrt_mass.size());
+  for (int p = 0; p < n; ++p) {
+    y[3 * p] *= inv_sqrt_mass[p];
+    y[3 * p + 1] *= inv_sqrt_mass[p];
+    y[3 * p + 2] = rotation ? y[3 * p + 2] * inv_sqrt_inertia[p] : 0.0;
+  }
+}
+
+// Largest eigenvalue of the symmetric tridiagonal matrix (diagonal `d`,
+// off-diagonal `e`, one entry shorter) by Sturm-sequence bisection. Eigen's
+// SelfAdjointEigenSolver::computeFromTridiagonal runs out of QR iterations
+// on the long Lanczos matrices of large packings (their spectra hold many
+// near-copies of the converged Ritz values) and then returns wrong
+// eigenvalues silently; bisection cannot fail and costs O(m) per halving.
+double tridiagonal_max_eigenvalue(const std::vector<double>& d, const std::vector<double>& e) {
+  const size_t m = d.size();
+  if (m == 0) return 0.0;
+  // Gershgorin interval of the tridiagonal matrix.
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (size_t k = 0; k < m; ++k) {
+    const double off = (k > 0 ? std::abs(e[k - 1]) : 0.0) + (k + 1 < m ? std::abs(e[k]) : 0.0);
+    lo = std::min(lo, d[k] - off);
+    hi = std::max(hi, d[k] + off);
+  }
+  // Number of eigenvalues below x: negative pivots of the LDLᵀ of T − x·I.
+  auto count_below = [&](double x) {
+    size_t count = 0;
+    double q = 1.0;
+    const double tiny = std::numeric_limits<double>::min() / std::numeric_limits<double>::epsilon();
+    for (size_t k = 0; k < m; ++k) {
+      q = d[k] - x - (k > 0 ? e[k - 1] * e[k - 1] / q : 0.0);
+      if (q == 0.0) q = -tiny;
+      if (q < 0.0) ++count;
+    }
+    return count;
+  };
+  // Invariant: count_below(lo) < m ≤ count_below(hi), i.e. λ_max ∈ [lo, hi).
+  const double scale = std::max(std::abs(lo), std::abs(hi));
+  hi += 4.0 * std::numeric_limits<double>::epsilon() * scale + std::numeric_limits<double>::min();
+  for (int it = 0; it < 200 && hi - lo > 2.0 * std::numeric_limits<double>::epsilon() * scale;
+       ++it) {
+    const double mid = 0.5 * (lo + hi);
+    if (mid <= lo || mid >= hi) break;
+    if (count_below(mid) >= m)
+      hi = mid;
+    else
+      lo = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+// Largest eigenvalue by Lanczos without re-orthogonalisation.
+double lanczos_max(const std::vector<LinearContact>& contacts,
+                   const std::vector<double>& inv_sqrt_mass,
+                   const std::vector<double>& inv_sqrt_inertia, bool rotation, int iterations) {
+  const int n = static_cast<int>(inv_sqrt_mass.size());
+  const int dofs = 3 * n;
+  if (dofs == 0 || contacts.empty()) return 0.0;
+  Eigen::VectorXd v(dofs), v_prev = Eigen::VectorXd::Zero(dofs), w(dofs);
+  // Deterministic, generic start vector.
+  uint64_t state = 0x9E3779B97F4A7C15ull;
+  for (int k = 0; k < dofs; ++k) {
+    state ^= state << 13;
+    state ^= state >> 7;
+    state ^= state << 17;
+    v[k] = static_cast<double>(state % 2001) / 1000.0 - 1.0;
+    if (!rotation && k % 3 == 2) v[k] = 0.0;
+  }
+  v.normalize();
+  std::vector<double> alpha, beta;
+  double b = 0.0;
+  const int steps = std::min(iterations, rotation ? dofs : 2 * n);
+  for (int k = 0; k < steps; ++k) {
+    apply(contacts, inv_sqrt_mass, inv_sqrt_inertia, rotation, v, w);
+    const double a = w.dot(v);
+    w -= a * v + b * v_prev;
+    alpha.push_back(a);
+    b = w.norm();
+    if (b < 1e-12 * std::abs(a) || k + 1 == steps) break;
+    beta.push_back(b);
+    v_prev = v;
+    v = w / b;
+  }
+  return tridiagonal_max_eigenvalue(alpha, beta);
+}
+
+}  // namespace
+
+StabilityEstimate World::stability_estimate(int iterations) const {
+  StabilityEstimate est;
+  const int n = size();
+  const bool rotation = !integration_.lock_rotation;
+  std::vector<LinearContact> contacts;
+  const double kn = material_.particle.kn;
+  // A sliding contact can stick again: count its tangential spring too.
+  const double kt = material_.particle.friction > 0.0 ? material_.particle.kt : 0.0;
+  for (size_t k = 0; k < pair_i_.size(); ++k) {
+    const int i = pair_i_[k], j = pair_j_[k];
+    const PairState p = pair_state(i, j);
+    if (p.fn <= 0.0) continue;
+    contacts.push_back(
+        {i, j, p.nx, p.ny, r_[i] - 0.5 * p.overlap, r_[j] - 0.5 * p.overlap, kn, kt});
+  }
+  constexpr double kNormals[4][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}};
+  const double kw = material_.wall.kn;
+  const double ktw = material_.wall.friction > 0.0 ? material_.wall.kt : 0.0;
+  for (int s = 0; s < 4; ++s) {
+    for (int i : wall_candidates_[s]) {
+      if (wall_fn_[s][i] <= 0.0) continue;
+      const bool vertical = (s == kLeft || s == kRight);
+      const double dist = vertical ? (x_[i] - walls_[s].position) * kNormals[s][0]
+                                   : (y_[i] - walls_[s].position) * kNormals[s][1];
+      contacts.push_back({i, -1, kNormals[s][0], kNormals[s][1], dist, 0.0, kw, ktw});
+    }
+  }
+  std::vector<double> ism(n), isi(n);
+  for (int p = 0; p < n; ++p) {
+    ism[p] = 1.0 / std::sqrt(m_[p]);
+    isi[p] = 1.0 / std::sqrt(inertia_[p]);
+  }
+
+  // Gershgorin: row sums of |A| bounded contact by contact.
+  std::vector<double> row(3 * static_cast<size_t>(n), 0.0);
+  for (const auto& c : contacts) {
+    const double tx = -c.ny, ty = c.nx;
+    // dof list, |B_n| and |B_t| entries, and the 1/sqrt(mass) of each dof
+    int dof[6];
+    double bn[6], bt[6], s[6];
+    int nd = 0;
+    auto add = [&](int d, double vn, double vt, double sc) {
+      dof[nd] = d;
+      bn[nd] = std::abs(vn);
+      bt[nd] = std::abs(vt);
+      s[nd] = sc;
+      ++nd;
+    };
+    add(3 * c.i, c.nx, tx, ism[c.i]);
+    add(3 * c.i + 1, c.ny, ty, ism[c.i]);
+    if (rotation) add(3 * c.i + 2, 0.0, c.ai, isi[c.i]);
+    if (c.j >= 0) {
+      add(3 * c.j, c.nx, tx, ism[c.j]);
+      add(3 * c.j + 1, c.ny, ty, ism[c.j]);
+      if (rotation) add(3 * c.j + 2, 0.0, c.aj, isi[c.j]);
+    }
+    double sum_n = 0.0, sum_t = 0.0;
+    for (int q = 0; q < nd; ++q) {
+      sum_n += bn[q] * s[q];
+      sum_t += bt[q] * s[q];
+    }
+    for (int p = 0; p < nd; ++p)
+      row[dof[p]] += s[p] * (c.kn * bn[p] * sum_n + c.kt * bt[p] * sum_t);
+  }
+  est.omega2_gershgorin = row.empty() ? 0.0 : *std::max_element(row.begin(), row.end());
+  est.omega2_max = lanczos_max(contacts, ism, isi, rotation, iterations);
+  const double omega2_translation = lanczos_max(contacts, ism, isi, false, iterations);
+
+  const double dt_crit = reference_scales().dt_crit;
+  // No contact: no limit from the springs.
+  auto step_for = [](double w2) {
+    return w2 > 0.0 ? 2.0 / std::sqrt(w2) : std::numeric_limits<double>::infinity();
+  };
+  est.dt_stable = step_for(est.omega2_max);
+  est.dt_stable_gershgorin = step_for(est.omega2_gershgorin);
+  if (dt_crit > 0.0) {
+    est.dt_ratio_stable = est.dt_stable / dt_crit;
+    est.dt_ratio_stable_gershgorin = est.dt_stable_gershgorin / dt_crit;
+    est.dt_ratio_stable_translation = step_for(omega2_translation) / dt_crit;
+  }
+  return est;
+}
+
+}  // namespace demcal

@@ -1,0 +1,216 @@
+#include "demcal/scene/biaxial.hpp"
+#include "demcal/io/format.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+
+namespace demcal {
+
+namespace {
+
+// +1 when the wall's inward direction is +axis.
+constexpr double kInward[4] = {+1.0, -1.0, +1.0, -1.0};
+
+}  // namespace
+
+double wall_pressure(const World& world, WallSide side) {
+  const Wall& w = world.wall(side);
+  const bool vertical = side == kLeft || side == kRight;
+  const double length = vertical ? world.height() : world.width();
+  const double normal_force = vertical ? w.force.x() : w.force.y();
+  // The particles push the wall outward: −inward·F is the compressive force.
+  return -kInward[side] * normal_force / (length * world.material().thickness);
+}
+
+double servo_velocity(const World& world, WallSide side, double target_stress, double gain) {
+  const bool vertical = side == kLeft || side == kRight;
+  const double length = vertical ? world.height() : world.width();
+  const double dt = world.integration().dt;
+  const int contacts = std::max(1, world.wall(side).contacts);
+  const double error = target_stress - wall_pressure(world, side);
+  double move =
+      gain * error * length * world.material().thickness / (world.material().wall.kn * contacts);
+  // Never more than 2 % of the smallest radius per step (a gas far from the
+  // walls is approached at this speed; a packing never gets near it).
+  const double r_min = world.min_radius();
+  move = std::clamp(move, -0.02 * r_min, 0.02 * r_min);
+  return kInward[side] * move / dt;
+}
+
+Integration integration_for(const World& world, const AlgorithmSpec& algorithm) {
+  // Δt_crit = 2·sqrt(m_min/kn) with the mass scaling of this run.
+  const double r_min = world.min_radius();
+  const Material& mat = world.material();
+  const double m_min =
+      mat.density * mat.thickness * std::numbers::pi * r_min * r_min * algorithm.mass_scaling;
+  Integration in;
+  in.mass_scaling = algorithm.mass_scaling;
+  in.dt = algorithm.dt_ratio * 2.0 * std::sqrt(m_min / mat.particle.kn);
+  in.damping_ratio_translation = algorithm.damping_ratio_translation;
+  in.damping_ratio_rotation = algorithm.damping_ratio_rotation;
+  in.lock_rotation = algorithm.lock_rotation;
+  return in;
+}
+
+ConsolidatedState consolidate(const SceneConfig& config, const Assembly& assembly) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const TestSpec& test = config.test;
+  ConsolidatedState state{World(config.material, assembly.x, assembly.y, assembly.r, assembly.left,
+                                assembly.right, assembly.bottom, assembly.top)};
+  World& world = state.world;
+  const double mu = config.material.particle.friction;
+  AlgorithmSpec settle;  // α = 0.2, critical damping: the paper's start point
+  settle.lock_rotation = config.algorithm.lock_rotation;
+  world.set_integration(integration_for(world, settle));
+
+  const double sigma3 = test.lateral_stress;
+  constexpr int kCheckEvery = 200;
+  int64_t steps = 0;
+  const int64_t max_steps = test.consolidation_max_steps;
+  // Phase 0: frictionless compression (a dense packing without friction
+  // finds its densest state); phase 1: friction on, static again.
+  for (int phase = 0; phase < 2; ++phase) {
+    world.set_particle_friction(phase == 0 ? 0.0 : mu);
+    bool done = false;
+    while (!done) {
+      for (int k = 0; k < kCheckEvery; ++k) {
+        for (int s = 0; s < 4; ++s)
+          world.wall(static_cast<WallSide>(s)).velocity =
+              servo_velocity(world, static_cast<WallSide>(s), sigma3, test.servo_gain);
+        if (!world.step(1))
+          throw std::runtime_error(std::string("consolidation diverged: ") +
+                                   to_string(world.divergence()));
+      }
+      steps += kCheckEvery;
+      double err = 0.0;
+      for (int s = 0; s < 4; ++s)
+        err = std::max(err,
+                       std::abs(wall_pressure(world, static_cast<WallSide>(s)) - sigma3) / sigma3);
+      const double ufr = world.measure().unbalanced_force_ratio;
+      state.stress_error = err;
+      state.unbalanced_ratio = ufr;
+      done = err < test.consolidation_tolerance && ufr < test.consolidation_unbalanced;
+      if (steps >= max_steps) break;
+    }
+    if (!done) break;
+    state.converged = phase == 1;
+  }
+  for (int s = 0; s < 4; ++s) world.wall(static_cast<WallSide>(s)).velocity = 0.0;
+  for (int i = 0; i < world.size(); ++i) world.set_velocity(i, 0.0, 0.0, 0.0);
+  world.update_forces();
+  // Every trial starts from this state: number the particles so that the
+  // kernel's SIMD blocks are full (the same physical state).
+  world.reorder(world.block_friendly_order());
+  state.width0 = world.width();
+  state.height0 = world.height();
+  state.steps = steps;
+  state.wall_time_s = seconds_since(t0);
+  if (!state.converged)
+    throw std::runtime_error("consolidation did not reach a static state in " +
+                             std::to_string(max_steps) + " steps (wall stress error " +
+                             std::to_string(state.stress_error) + ", unbalanced-force ratio " +
+                             std::to_string(state.unbalanced_ratio) +
+                             "); raise test.consolidation_max_steps or loosen the tolerances");
+  return state;
+}
+
+double estimated_stable_dt_ratio(const ConsolidatedState& state, const AlgorithmSpec& algorithm) {
+  World probe = state.world;
+  AlgorithmSpec a = algorithm;
+  a.dt_ratio = std::min(a.dt_ratio, 0.1);  // any valid step: the estimate does not use it
+  probe.set_integration(integration_for(probe, a));
+  probe.update_forces();
+  return probe.stability_estimate().dt_ratio_stable;
+}
+
+LoadingResult run_loading(const ConsolidatedState& start, const TestSpec& test,
+                          const AlgorithmSpec& algorithm, const MonitorCallback& monitor,
+                          World* final_state) {
+  const auto t0 = std::chrono::steady_clock::now();
+  World world = start.world;
+  LoadingResult out;
+  out.particles = world.size();
+  out.integration = integration_for(world, algorithm);
+  world.set_integration(out.integration);
+  out.scales = world.reference_scales();
+  const double dt = out.integration.dt;
+  const int64_t nstep = algorithm.steps;
+  out.steps_planned = nstep;
+  const double sigma3 = test.lateral_stress;
+  const double h0 = start.height0;
+  const double top_velocity = -test.vertical_strain * h0 / (static_cast<double>(nstep) * dt);
+  out.strain_rate = test.vertical_strain / (static_cast<double>(nstep) * dt);
+  world.wall(kBottom).velocity = 0.0;
+  world.wall(kTop).velocity = top_velocity;
+
+  const int m = test.monitor_points;
+  out.series.reserve(m + 1);
+  auto record = [&](int64_t step) {
+    const Measures ms = world.measure(out.strain_rate);
+    MonitorPoint p;
+    p.step = step;
+    p.strain_yy = (world.height() - h0) / h0;
+    p.b = ms.boundary_stress;
+    p.sigma = ms.homogenized_stress;
+    p.kinetic_energy = ms.kinetic_energy_translation + ms.kinetic_energy_rotation;
+    p.kinetic_energy_rotation = ms.kinetic_energy_rotation;
+    p.elastic_energy = ms.elastic_energy;
+    p.unbalanced_force_ratio = ms.unbalanced_force_ratio;
+    p.inertial_number = ms.inertial_number;
+    p.coordination_number = ms.coordination_number;
+    const double lateral = 0.5 * (wall_pressure(world, kLeft) + wall_pressure(world, kRight));
+    p.lateral_stress_error = (lateral - sigma3) / sigma3;
+    p.left = world.wall(kLeft).position;
+    p.right = world.wall(kRight).position;
+    p.bottom = world.wall(kBottom).position;
+    p.top = world.wall(kTop).position;
+    out.series.push_back(p);
+    return !monitor || monitor(p);
+  };
+
+  bool keep_going = record(0);
+  int64_t done = 0;
+  for (int k = 1; k <= m && keep_going; ++k) {
+    const int64_t target = nstep * k / m;
+    while (done < target) {
+      world.wall(kLeft).velocity = servo_velocity(world, kLeft, sigma3, test.servo_gain);
+      world.wall(kRight).velocity = servo_velocity(world, kRight, sigma3, test.servo_gain);
+      if (!world.step(1)) break;
+      ++done;
+      const double vertical = -0.5 * (wall_pressure(world, kTop) + wall_pressure(world, kBottom));
+      if (vertical < out.peak_stress_yy) {
+        out.peak_stress_yy = vertical;
+        out.peak_strain_yy = (world.height() - h0) / h0;
+      }
+    }
+    if (world.divergence() != Divergence::kNone) {
+      out.diverged = true;
+      out.divergence = world.divergence();
+      out.divergence_step = world.divergence_step() - start.world.steps_taken();
+      break;
+    }
+    keep_going = record(done);
+  }
+  out.stopped_early = !out.diverged && !keep_going && done < nstep;
+  out.steps_run = done;
+  out.wall_time_s = seconds_since(t0);
+  if (final_state) *final_state = std::move(world);
+  return out;
+}
+
+Peak find_peak(const std::vector<MonitorPoint>& series) {
+  Peak p;
+  for (int i = 0; i < static_cast<int>(series.size()); ++i) {
+    if (p.index < 0 || series[i].b(1, 1) < p.stress_yy) {
+      p.index = i;
+      p.stress_yy = series[i].b(1, 1);
+      p.strain_yy = series[i].strain_yy;
+    }
+  }
+  return p;
+}
+
+}  // namespace demcal

@@ -1,0 +1,514 @@
+#include "demcal/upscaling/export.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <numeric>
+#include <sstream>
+
+namespace demcal {
+
+namespace {
+
+std::string fmt3(double v) {
+  char b[40];
+  std::snprintf(b, sizeof b, "%.3g", v);
+  return b;
+}
+
+std::string num(double v) {
+  char b[40];
+  std::snprintf(b, sizeof b, "%.10g", v);
+  return b;
+}
+
+/// Everything both decks need, computed once.
+struct Plan {
+  int n = 0;
+  int types = 0;
+  std::vector<int> type;           // per particle, 1-based
+  std::vector<double> r_lo, r_hi;  // per class (index type−1)
+  double dt = 0.0, dt_crit = 0.0;
+  int64_t steps = 0;
+  double areal_density = 0.0;  // f_ms·ρ·t [kg/m²]
+  double width0 = 0.0, height0 = 0.0;
+  double top_speed = 0.0;                // [m/s], downward
+  std::vector<double> gamma_t, gamma_r;  // per class [N·s/m], [N·m·s]
+  double class_error = 0.0;
+  double r_min = 0.0;
+  int thermo_every = 1;
+  ParticleScales scales;
+};
+
+Plan make_plan(const SceneConfig& c, const AlgorithmSpec& p, const Assembly& a, int max_types) {
+  Plan plan;
+  plan.n = a.size();
+  plan.type = radius_classes(a.r, std::max(1, max_types), &plan.types);
+  plan.r_lo.assign(plan.types, std::numeric_limits<double>::infinity());
+  plan.r_hi.assign(plan.types, 0.0);
+  for (int i = 0; i < plan.n; ++i) {
+    const int k = plan.type[i] - 1;
+    plan.r_lo[k] = std::min(plan.r_lo[k], a.r[i]);
+    plan.r_hi[k] = std::max(plan.r_hi[k], a.r[i]);
+  }
+  plan.scales = particle_scales(a.r, c.material, p.mass_scaling);
+  plan.r_min = plan.scales.radius_min;
+  plan.dt_crit = plan.scales.dt_crit;
+  plan.dt = p.dt_ratio * plan.dt_crit;
+  plan.steps = p.steps;
+  plan.areal_density = p.mass_scaling * c.material.density * c.material.thickness;
+  plan.width0 = a.right - a.left;
+  plan.height0 = a.top - a.bottom;
+  plan.top_speed = c.test.vertical_strain * plan.height0 / (static_cast<double>(p.steps) * plan.dt);
+  // D_t = ζ_t·2·sqrt(kn·m) ∝ r and D_r = ζ_r·2·sqrt(kt·r²·I) ∝ r³ for discs
+  // of one density: each class gets the value of its mid radius, which
+  // bounds the error by (r_hi − r_lo)/(r_hi + r_lo) for D_t.
+  const double kn = c.material.particle.kn, kt = c.material.particle.kt;
+  for (int k = 0; k < plan.types; ++k) {
+    const double r = 0.5 * (plan.r_lo[k] + plan.r_hi[k]);
+    const double m = plan.areal_density * std::numbers::pi * r * r;
+    plan.gamma_t.push_back(p.damping_ratio_translation * 2.0 * std::sqrt(kn * m));
+    plan.gamma_r.push_back(p.damping_ratio_rotation * 2.0 *
+                           std::sqrt(kt * r * r * 0.5 * m * r * r));
+    plan.class_error =
+        std::max(plan.class_error, (plan.r_hi[k] - plan.r_lo[k]) / (plan.r_hi[k] + plan.r_lo[k]));
+  }
+  plan.thermo_every =
+      static_cast<int>(std::max<int64_t>(1, p.steps / std::max(1, c.test.monitor_points)));
+  return plan;
+}
+
+std::string mapping_header(const SceneConfig& c, const AlgorithmSpec& p, const Plan& plan,
+                           const ExportOptions& o, const std::string& code) {
+  std::ostringstream s;
+  const auto& m = c.material;
+  s << "# ===========================================================================\n"
+    << "# demcal " << DEMCAL_VERSION << " export: " << code << " input deck, 2D biaxial test\n"
+    << "# scene " << c.name << "; prototype " << plan.n << " particles (" << o.data_name << ")\n";
+  if (!o.provenance.empty()) s << "# parameters: " << o.provenance << "\n";
+  s << "#\n"
+    << "# How demcal's parameters map (demcal -> " << code << "):\n"
+    << "#   dt = alpha * dt_crit = " << num(p.dt_ratio) << " * " << num(plan.dt_crit)
+    << " s = " << num(plan.dt) << " s -> timestep\n"
+    << "#     dt_crit = 2 sqrt(m_min/kn) of the smallest disc (r = " << num(plan.r_min) << " m)\n"
+    << "#   Nstep = " << p.steps << " loading steps (upscaled) -> run length; the top wall moves\n"
+    << "#     eps * H0 / (Nstep * dt) = " << num(c.test.vertical_strain) << " * "
+    << num(plan.height0) << " / (" << p.steps << " * " << num(plan.dt)
+    << ") = " << num(plan.top_speed) << " m/s\n"
+    << "#   kn = " << num(m.particle.kn) << " N/m, kt = " << num(m.particle.kt)
+    << " N/m, mu = " << num(m.particle.friction)
+    << " -> linear normal spring, incremental tangential spring, Coulomb cap\n"
+    << "#   contact (local) damping: "
+    << (m.contact_damping_ratio > 0 ? num(m.contact_damping_ratio) + " of critical" : "none")
+    << " -> gamma_n"
+    << (m.contact_damping_ratio > 0 ? " (per pair in demcal; mean mass here)" : " = gamma_t = 0")
+    << "\n"
+    << "#   zeta_t = " << num(p.damping_ratio_translation)
+    << ": D_t = zeta_t * 2 sqrt(kn m_i), per particle (proportional to r)\n"
+    << "#     -> global viscous damping per radius class (atom type): " << plan.types
+    << " class(es), gamma of the class's mid radius,\n"
+    << "#        largest error against the per-particle value " << fmt3(100 * plan.class_error)
+    << " %\n"
+    << "#   zeta_r = " << num(p.damping_ratio_rotation)
+    << ": D_r = zeta_r * 2 sqrt(kt r^2 I), per particle (proportional to r^3)\n"
+    << "#   mass scaling f_ms = " << num(p.mass_scaling)
+    << " -> areal density f_ms*rho*t = " << num(plan.areal_density)
+    << " kg/m^2 (rho = " << num(m.density) << " kg/m^3, t = " << num(m.thickness) << " m)\n"
+    << "#   walls: kn = " << num(m.wall.kn) << " N/m, kt = " << num(m.wall.kt)
+    << " N/m, mu = " << num(m.wall.friction) << "; bottom fixed, top at constant speed,\n"
+    << "#     left/right servo-controlled to sigma3 = " << num(c.test.lateral_stress)
+    << " Pa (gain " << num(c.test.servo_gain) << ")\n"
+    << "#   stresses: tension positive in demcal; the thermo columns below give the\n"
+    << "#     compressive wall pressures (positive) instead\n"
+    << "# The particle file holds the state demcal consolidated to sigma3 (walls at its\n"
+    << "# box); the run starts loading from it. Contact histories start at zero.\n"
+    << "# ===========================================================================\n";
+  return s.str();
+}
+
+/// The figures of a plan every export reports (the files are added after).
+ExportResult result_of(const Plan& plan) {
+  ExportResult out;
+  out.dt = plan.dt;
+  out.steps = plan.steps;
+  out.types = plan.types;
+  out.damping_class_error = plan.class_error;
+  return out;
+}
+
+// ---------------------------------------------------------------------------
+// LAMMPS (29 Sep 2021)
+
+ExportResult lammps(const SceneConfig& c, const AlgorithmSpec& p, const Assembly& a,
+                    const ExportOptions& o) {
+  const Plan plan = make_plan(c, p, a, o.max_types);
+  const auto& m = c.material;
+  ExportResult out = result_of(plan);
+
+  // Data file: atom_style sphere rows "id type diameter density x y z"; the
+  // density column is overwritten by set density/disc below.
+  {
+    std::ostringstream d;
+    const double mx = 0.5 * plan.width0, my = 0.1 * plan.height0;
+    d << "LAMMPS data file written by demcal " << DEMCAL_VERSION << " (scene " << c.name
+      << ", consolidated to sigma3)\n\n"
+      << plan.n << " atoms\n"
+      << plan.types << " atom types\n\n"
+      << num(a.left - mx) << " " << num(a.right + mx) << " xlo xhi\n"
+      << num(a.bottom - my) << " " << num(a.top + my) << " ylo yhi\n"
+      << num(-0.5 * m.thickness) << " " << num(0.5 * m.thickness) << " zlo zhi\n\n"
+      << "Atoms # sphere\n\n";
+    char line[160];
+    for (int i = 0; i < plan.n; ++i) {
+      std::snprintf(line, sizeof line, "%d %d %.17g %.10g %.17g %.17g 0\n", i + 1, plan.type[i],
+                    2.0 * a.r[i], plan.areal_density, a.x[i], a.y[i]);
+      d << line;
+    }
+    out.files[o.data_name] = d.str();
+  }
+
+  std::ostringstream s;
+  s << mapping_header(c, p, plan, o, "LAMMPS");
+  s << "#\n# What this LAMMPS cannot do as demcal does, and what the deck does instead:\n"
+    << "#  - rotational damping: this release (29 Sep 2021) has no rotational viscous fix;\n";
+  if (p.damping_ratio_rotation > 0.0) {
+    s << "#    zeta_r = " << num(p.damping_ratio_rotation)
+      << " is NOT applied. LAMMPS releases from 2022 on have fix viscous/sphere:\n"
+      << "#    uncomment the line marked viscous/sphere below there.\n";
+    out.notes.push_back("rotational damping zeta_r = " + num(p.damping_ratio_rotation) +
+                        " not applied: LAMMPS 29 Sep 2021 has no rotational viscous fix "
+                        "(fix viscous/sphere is in later releases; the deck has the line, "
+                        "commented out)");
+  } else {
+    s << "#    not needed here, the calibrated zeta_r is 0.\n";
+  }
+  s << "#  - damping is applied explicitly by fix viscous (force -gamma*v from the\n"
+    << "#    velocity-Verlet velocity), semi-implicitly by demcal's central difference;\n"
+    << "#    same continuous equation, discretisations differ at order zeta*alpha.\n"
+    << "#  - servo walls are not native: the lateral walls are fix wall/gran/region\n"
+    << "#    planes whose displacement is the running sum of demcal's per-step servo\n"
+    << "#    move gain*(sigma3 - p)*H*t/(kn_wall*n_contacts), capped at 2 % of r_min,\n"
+    << "#    kept by fix ave/time (running mean times the step count). Run the loading\n"
+    << "#    as ONE run command: the sum counts samples from step 0.\n";
+  if (plan.types > 1) {
+    s << "#  - per-particle damping D_t ~ sqrt(m): fix viscous has one gamma per atom type,\n"
+      << "#    so the particles are grouped in " << plan.types << " radius classes (types 1.."
+      << plan.types << ").\n";
+    out.notes.push_back("translational damping per radius class (" + std::to_string(plan.types) +
+                        " atom types), at most " + fmt3(100 * plan.class_error) +
+                        " % off demcal's per-particle value");
+  }
+  out.notes.push_back(
+      "lateral servo walls emulated with variables (running sum of demcal's per-step servo "
+      "move): one run command only");
+
+  s << "\n# --- parameters (edit here) -------------------------------------------------\n"
+    << "variable dt        equal " << num(plan.dt) << "      # s\n"
+    << "variable nstep     equal " << plan.steps << "      # loading steps Nstep\n"
+    << "variable run_steps index " << plan.steps
+    << "      # lmp -var run_steps 300 ... for a short check\n"
+    << "variable kn        equal " << num(m.particle.kn) << "\n"
+    << "variable kt        equal " << num(m.particle.kt) << "\n"
+    << "variable mu        equal " << num(m.particle.friction) << "\n"
+    << "variable kn_wall   equal " << num(m.wall.kn) << "\n"
+    << "variable kt_wall   equal " << num(m.wall.kt) << "\n"
+    << "variable mu_wall   equal " << num(m.wall.friction) << "\n"
+    << "variable thick     equal " << num(m.thickness) << "      # disc thickness t, m\n"
+    << "variable sigma3    equal " << num(c.test.lateral_stress) << "      # Pa\n"
+    << "variable gain      equal " << num(c.test.servo_gain) << "\n"
+    << "variable cap       equal " << num(0.02 * plan.r_min) << "      # m per step\n"
+    << "variable vtop      equal " << num(plan.top_speed) << "      # m/s, downward\n"
+    << "variable xl0       equal " << num(a.left) << "\n"
+    << "variable xr0       equal " << num(a.right) << "\n"
+    << "variable yb0       equal " << num(a.bottom) << "\n"
+    << "variable yt0       equal " << num(a.top) << "\n";
+
+  double gamma_n = 0.0;
+  if (m.contact_damping_ratio > 0.0) {
+    // demcal: ratio·2·sqrt(kn·m_eff); LAMMPS: m_eff·gamma_n → gamma_n =
+    // ratio·2·sqrt(kn/m_eff), taken at the mean mass (m_eff = m/2).
+    gamma_n =
+        m.contact_damping_ratio * 2.0 * std::sqrt(m.particle.kn / (0.5 * plan.scales.mass_mean));
+    out.notes.push_back("contact damping mapped at the mean particle mass");
+  }
+  s << "\n# --- system ------------------------------------------------------------------\n"
+    << "units           si\n"
+    << "dimension       2\n"
+    << "boundary        f f p\n"
+    << "atom_style      sphere\n"
+    << "atom_modify     map array\n"
+    << "comm_modify     vel yes\n"
+    << "read_data       " << o.data_name << "\n"
+    << "# disc masses m = f_ms*rho*t*pi*r^2 and inertia m*r^2/2 (fix nve/sphere disc)\n"
+    << "set             type 1*" << plan.types << " density/disc " << num(plan.areal_density)
+    << "\n\n"
+    << "pair_style      gran/hooke/history ${kn} ${kt} " << num(gamma_n) << " 0.0 ${mu} 0\n"
+    << "pair_coeff      * *\n"
+    << "neighbor        " << num(0.3 * plan.r_min) << " bin\n"
+    << "neigh_modify    delay 0 every 1 check yes\n"
+    << "timestep        ${dt}\n\n"
+    << "fix             integrate all nve/sphere disc\n\n";
+
+  s << "# --- walls -------------------------------------------------------------------\n"
+    << "# top: a plane moving down at vtop; left/right: planes moved by the servo\n"
+    << "variable dytop  equal -v_vtop*step*dt\n"
+    << "variable dxl    equal f_servol*step\n"
+    << "variable dxr    equal f_servor*step\n"
+    << "region          rtop   plane 0 ${yt0} 0  0 -1 0 side in move NULL v_dytop NULL units box\n"
+    << "region          rleft  plane ${xl0} 0 0  1 0 0  side in move v_dxl NULL NULL units box\n"
+    << "region          rright plane ${xr0} 0 0  -1 0 0 side in move v_dxr NULL NULL units box\n"
+    << "fix             wbottom all wall/gran hooke/history ${kn_wall} ${kt_wall} 0 0 ${mu_wall} 0 "
+       "yplane ${yb0} NULL\n"
+    << "fix             wtop all wall/gran/region hooke/history ${kn_wall} ${kt_wall} 0 0 "
+       "${mu_wall} "
+       "0 region rtop contacts\n"
+    << "fix             wleft all wall/gran/region hooke/history ${kn_wall} ${kt_wall} 0 0 "
+       "${mu_wall} 0 region rleft contacts\n"
+    << "fix             wright all wall/gran/region hooke/history ${kn_wall} ${kt_wall} 0 0 "
+       "${mu_wall} 0 region rright contacts\n"
+    << "# wall contacts (column 1) and the wall forces on the particles (columns 2, 3)\n"
+    << "compute         cl all reduce sum f_wleft[1] f_wleft[2]\n"
+    << "compute         cr all reduce sum f_wright[1] f_wright[2]\n"
+    << "compute         ct all reduce sum f_wtop[1] f_wtop[3]\n"
+    << "variable        H  equal (v_yt0+v_dytop)-v_yb0\n"
+    << "variable        W  equal (v_xr0+v_dxr)-(v_xl0+v_dxl)\n"
+    << "variable        pl equal c_cl[2]/(v_H*v_thick)\n"
+    << "variable        pr equal -c_cr[2]/(v_H*v_thick)\n"
+    << "variable        pt equal -c_ct[2]/(v_W*v_thick)\n"
+    << "# demcal's servo, one move per step toward the sample when p < sigma3\n"
+    << "# (this release has no min/max of two numbers: min(a,b) = (a+b-abs(a-b))/2)\n"
+    << "variable        ncl   equal (1+c_cl[1]+abs(1-c_cl[1]))/2\n"
+    << "variable        ncr   equal (1+c_cr[1]+abs(1-c_cr[1]))/2\n"
+    << "variable        rawl  equal v_gain*(v_sigma3-v_pl)*v_H*v_thick/(v_kn_wall*v_ncl)\n"
+    << "variable        rawr  equal v_gain*(v_sigma3-v_pr)*v_H*v_thick/(v_kn_wall*v_ncr)\n"
+    << "# clamp(x, -cap, cap) = (abs(x+cap) - abs(x-cap))/2\n"
+    << "variable        movel equal (abs(v_rawl+v_cap)-abs(v_rawl-v_cap))/2\n"
+    << "variable        mover equal -(abs(v_rawr+v_cap)-abs(v_rawr-v_cap))/2\n"
+    << "fix             servol all ave/time 1 1 1 v_movel ave running\n"
+    << "fix             servor all ave/time 1 1 1 v_mover ave running\n\n";
+
+  s << "# --- global damping ----------------------------------------------------------\n";
+  if (p.damping_ratio_translation > 0.0) {
+    s << "# gamma per class, N*s/m:";
+    for (int k = 0; k < plan.types; ++k) s << " " << num(plan.gamma_t[k]);
+    s << "\nfix             dampt all viscous " << num(plan.gamma_t[0]);
+    // one "scale type ratio" keyword per type
+    for (int k = 1; k < plan.types; ++k)
+      s << " scale " << k + 1 << " " << num(plan.gamma_t[k] / plan.gamma_t[0]);
+    s << "\n";
+  } else {
+    s << "# zeta_t = 0: no translational damping\n";
+  }
+  if (p.damping_ratio_rotation > 0.0) {
+    s << "# LAMMPS >= 2022 only (absent in 29 Sep 2021): rotational damping, N*m*s\n"
+      << "#fix            dampr all viscous/sphere " << num(plan.gamma_r[0]);
+    for (int k = 1; k < plan.types; ++k)
+      s << " scale " << k + 1 << " " << num(plan.gamma_r[k] / plan.gamma_r[0]);
+    s << "\n";
+  }
+  s << "fix             twod all enforce2d\n\n";
+
+  s << "# --- output and run ----------------------------------------------------------\n"
+    << "# p_left, p_right: lateral wall pressures (servo target sigma3); p_top: axial\n"
+    << "variable        epsyy equal (v_H-" << num(plan.height0) << ")/" << num(plan.height0) << "\n"
+    << "thermo_style    custom step dt time v_epsyy v_pt v_pl v_pr v_W v_H ke\n"
+    << "thermo_modify   norm no\n"
+    << "thermo          " << plan.thermo_every << "\n"
+    << "run             ${run_steps}\n";
+  out.deck = s.str();
+  return out;
+}
+
+// ---------------------------------------------------------------------------
+// LIGGGHTS-PUBLIC 3.x (documentation-based; not run here)
+
+std::string stl_rectangle(const std::string& name, double x0, double y0, double x1, double y1,
+                          double z0, double z1) {
+  // A vertical rectangle from (x0, y0) to (x1, y1), z0..z1, as two facets.
+  std::ostringstream s;
+  const double nx = y1 - y0, ny = -(x1 - x0);
+  const double len = std::hypot(nx, ny);
+  auto v = [&](double x, double y, double z) {
+    s << "      vertex " << num(x) << " " << num(y) << " " << num(z) << "\n";
+  };
+  s << "solid " << name << "\n";
+  for (int f = 0; f < 2; ++f) {
+    s << "  facet normal " << num(nx / len) << " " << num(ny / len) << " 0\n    outer loop\n";
+    if (f == 0) {
+      v(x0, y0, z0);
+      v(x1, y1, z0);
+      v(x1, y1, z1);
+    } else {
+      v(x0, y0, z0);
+      v(x1, y1, z1);
+      v(x0, y0, z1);
+    }
+    s << "    endloop\n  endfacet\n";
+  }
+  s << "endsolid " << name << "\n";
+  return s.str();
+}
+
+ExportResult liggghts(const SceneConfig& c, const AlgorithmSpec& p, const Assembly& a,
+                      const ExportOptions& o) {
+  const Plan plan = make_plan(c, p, a, o.max_types);
+  const auto& m = c.material;
+  ExportResult out = result_of(plan);
+  const int wall_type = plan.types + 1;
+  const int ntypes = plan.types + 1;
+
+  // LIGGGHTS computes a sphere's mass 4/3·π·r³·ρ: a per-atom density
+  // 3·f_ms·ρ·t/(4·r) gives the disc's mass f_ms·ρ·t·π·r².
+  {
+    std::ostringstream d;
+    const double mx = 0.5 * plan.width0, my = 0.1 * plan.height0;
+    d << "LIGGGHTS data file written by demcal " << DEMCAL_VERSION << " (scene " << c.name
+      << ")\n\n"
+      << plan.n << " atoms\n"
+      << ntypes << " atom types\n\n"
+      << num(a.left - mx) << " " << num(a.right + mx) << " xlo xhi\n"
+      << num(a.bottom - my) << " " << num(a.top + my) << " ylo yhi\n"
+      << num(-0.5 * m.thickness) << " " << num(0.5 * m.thickness) << " zlo zhi\n\n"
+      << "Atoms\n\n";
+    char line[160];
+    for (int i = 0; i < plan.n; ++i) {
+      std::snprintf(line, sizeof line, "%d %d %.17g %.10g %.17g %.17g 0\n", i + 1, plan.type[i],
+                    2.0 * a.r[i], 3.0 * plan.areal_density / (4.0 * a.r[i]), a.x[i], a.y[i]);
+      d << line;
+    }
+    out.files[o.data_name] = d.str();
+  }
+  const double z0 = -0.5 * m.thickness, z1 = 0.5 * m.thickness;
+  const double ylo = a.bottom - 0.1 * plan.height0, yhi = a.top + 0.1 * plan.height0;
+  const double xlo = a.left - 0.5 * plan.width0, xhi = a.right + 0.5 * plan.width0;
+  const std::string stem = o.data_name.substr(0, o.data_name.rfind('.'));
+  const std::string top = stem + "-top.stl", left = stem + "-left.stl", right = stem + "-right.stl";
+  out.files[top] = stl_rectangle("top", xhi, a.top, xlo, a.top, z0, z1);
+  out.files[left] = stl_rectangle("left", a.left, ylo, a.left, yhi, z0, z1);
+  out.files[right] = stl_rectangle("right", a.right, yhi, a.right, ylo, z0, z1);
+
+  auto pair_matrix = [&](double pp, double pw) {
+    std::ostringstream s;
+    for (int i = 1; i <= ntypes; ++i)
+      for (int j = 1; j <= ntypes; ++j)
+        s << " " << num((i == wall_type || j == wall_type) ? pw : pp);
+    return s.str();
+  };
+
+  std::ostringstream s;
+  s << mapping_header(c, p, plan, o, "LIGGGHTS");
+  s << "#\n# NOT RUN HERE: LIGGGHTS is not installed on the machine that wrote this deck;\n"
+    << "# it follows the LIGGGHTS-PUBLIC 3.x documentation. Differences from demcal:\n"
+    << "#  - LIGGGHTS has no disc inertia: particles rotate as spheres (I = 2/5 m r^2,\n"
+    << "#    not 1/2 m r^2); masses are made disc masses through a per-atom density.\n"
+    << "#    The rotational stability limit of alpha moves by sqrt(0.8) = 0.89.\n"
+    << "#  - rotational damping (zeta_r = " << num(p.damping_ratio_rotation)
+    << ") has no fix here and is not applied.\n"
+    << "#  - lateral walls: fix mesh/surface/stress/servo holds the wall FORCE at\n"
+    << "#    sigma3*H0*t (H0 the initial height), not the stress on the current height.\n"
+    << "#  - translational damping per radius class via fix viscous ... scale.\n";
+  out.notes.push_back("LIGGGHTS deck not run here (LIGGGHTS not installed)");
+  s << "\natom_style      granular\n"
+    << "atom_modify     map array\n"
+    << "boundary        f f p\n"
+    << "newton          off\n"
+    << "communicate     single vel yes\n"
+    << "units           si\n"
+    << "dimension       2\n"
+    << "read_data       " << o.data_name << "\n"
+    << "neighbor        " << num(0.3 * plan.r_min) << " bin\n"
+    << "neigh_modify    delay 0\n\n"
+    << "# type " << wall_type << " is the walls' material\n"
+    << "fix m1 all property/global kn peratomtypepair " << ntypes
+    << pair_matrix(m.particle.kn, m.wall.kn) << "\n"
+    << "fix m2 all property/global kt peratomtypepair " << ntypes
+    << pair_matrix(m.particle.kt, m.wall.kt) << "\n"
+    << "fix m3 all property/global gamman_abs peratomtypepair " << ntypes << pair_matrix(0, 0)
+    << "\n"
+    << "fix m4 all property/global gammat_abs peratomtypepair " << ntypes << pair_matrix(0, 0)
+    << "\n"
+    << "fix m5 all property/global coefficientFriction peratomtypepair " << ntypes
+    << pair_matrix(m.particle.friction, m.wall.friction) << "\n\n"
+    << "pair_style gran model hooke/stiffness tangential history absolute_damping on "
+       "tangential_damping off\n"
+    << "pair_coeff * *\n"
+    << "timestep " << num(plan.dt) << "\n\n"
+    << "fix bottom all wall/gran model hooke/stiffness tangential history absolute_damping on "
+       "tangential_damping off primitive type "
+    << wall_type << " yplane " << num(a.bottom) << "\n"
+    << "fix mtop all mesh/surface file " << top << " type " << wall_type << "\n"
+    << "fix mleft all mesh/surface/stress/servo file " << left << " type " << wall_type << " com "
+    << num(a.left) << " " << num(0.5 * (a.bottom + a.top))
+    << " 0 ctrlPV force axis 1 0 0 target_val "
+    << num(-c.test.lateral_stress * plan.height0 * m.thickness) << " vel_max "
+    << num(0.02 * plan.r_min / plan.dt) << " kp 1.0\n"
+    << "fix mright all mesh/surface/stress/servo file " << right << " type " << wall_type << " com "
+    << num(a.right) << " " << num(0.5 * (a.bottom + a.top))
+    << " 0 ctrlPV force axis 1 0 0 target_val "
+    << num(c.test.lateral_stress * plan.height0 * m.thickness) << " vel_max "
+    << num(0.02 * plan.r_min / plan.dt) << " kp 1.0\n"
+    << "fix walls all wall/gran model hooke/stiffness tangential history absolute_damping on "
+       "tangential_damping off mesh n_meshes 3 meshes mtop mleft mright\n"
+    << "fix movetop all move/mesh mesh mtop linear 0 " << num(-plan.top_speed) << " 0\n\n"
+    << "fix integrate all nve/sphere\n";
+  if (p.damping_ratio_translation > 0.0) {
+    s << "fix dampt all viscous " << num(plan.gamma_t[0]);
+    for (int k = 1; k < plan.types; ++k)
+      s << " scale " << k + 1 << " " << num(plan.gamma_t[k] / plan.gamma_t[0]);
+    s << "\n";
+  }
+  s << "fix twod all enforce2d\n\n"
+    << "thermo_style custom step dt time ke\n"
+    << "thermo " << plan.thermo_every << "\n"
+    << "run " << plan.steps << "\n";
+  out.deck = s.str();
+  return out;
+}
+
+}  // namespace
+
+std::vector<int> radius_classes(const std::vector<double>& radii, int max_types, int* types) {
+  const int n = static_cast<int>(radii.size());
+  std::vector<int> order(n);
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(), [&](int a, int b) { return radii[a] < radii[b]; });
+  std::vector<int> type(n, 1);
+  // Equal radii (to 1e-9 relative) are one value.
+  std::vector<int> value(n, 0);
+  int distinct = 0;
+  for (int k = 0; k < n; ++k) {
+    if (k > 0 && radii[order[k]] > radii[order[k - 1]] * (1.0 + 1e-9)) ++distinct;
+    value[order[k]] = distinct;
+  }
+  ++distinct;
+  const int classes = std::max(1, std::min(max_types, distinct));
+  if (classes == distinct) {
+    for (int i = 0; i < n; ++i) type[i] = value[i] + 1;
+  } else {
+    // Equal-count classes over the sorted radii, never splitting a value.
+    int cls = 0, in_class = 0;
+    for (int k = 0; k < n; ++k) {
+      const bool new_value = k > 0 && value[order[k]] != value[order[k - 1]];
+      if (new_value && in_class >= (n * (cls + 1)) / classes - (n * cls) / classes &&
+          cls + 1 < classes) {
+        ++cls;
+        in_class = 0;
+      }
+      type[order[k]] = cls + 1;
+      ++in_class;
+    }
+  }
+  if (types) *types = n > 0 ? *std::max_element(type.begin(), type.end()) : 0;
+  return type;
+}
+
+ExportResult export_deck(const SceneConfig& config, const AlgorithmSpec& params,
+                         const Assembly& assembly, const ExportOptions& options) {
+  if (assembly.size() == 0) throw InputError("export", "prototype", "no particles");
+  if (options.format == "lammps") return lammps(config, params, assembly, options);
+  if (options.format == "liggghts") return liggghts(config, params, assembly, options);
+  throw InputError("--format", "", "must be lammps or liggghts, got \"" + options.format + "\"");
+}
+
+}  // namespace demcal

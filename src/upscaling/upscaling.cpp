@@ -1,0 +1,390 @@
+#include "demcal/upscaling/upscaling.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <numeric>
+#include <sstream>
+
+#include "demcal/upscaling/rev.hpp"
+
+namespace demcal {
+
+ParticleScales particle_scales(std::span<const double> radii, const Material& material,
+                               double mass_scaling) {
+  ParticleScales s;
+  s.particles = static_cast<int64_t>(radii.size());
+  if (radii.empty()) return s;
+  const double kn = material.particle.kn, kt = material.particle.kt;
+  const double area_mass = mass_scaling * material.density * material.thickness * std::numbers::pi;
+  s.radius_min = *std::min_element(radii.begin(), radii.end());
+  s.radius_max = *std::max_element(radii.begin(), radii.end());
+  double sum_r = 0.0, sum_m = 0.0, sum_dt = 0.0, sum_dr = 0.0;
+  for (double r : radii) {
+    const double m = area_mass * r * r;
+    const double inertia = 0.5 * m * r * r;
+    sum_r += r;
+    sum_m += m;
+    sum_dt += 2.0 * std::sqrt(kn * m);
+    sum_dr += 2.0 * std::sqrt(kt * r * r * inertia);
+  }
+  const double n = static_cast<double>(radii.size());
+  s.radius_mean = sum_r / n;
+  s.mass_mean = sum_m / n;
+  s.mass_min = area_mass * s.radius_min * s.radius_min;
+  s.dt_crit = 2.0 * std::sqrt(s.mass_min / kn);
+  s.damping_translation_crit = 2.0 * std::sqrt(kn * s.mass_min);
+  s.damping_rotation_crit = 2.0 * std::sqrt(kt * s.radius_min * s.radius_min * 0.5 * s.mass_min *
+                                            s.radius_min * s.radius_min);
+  s.damping_translation_crit_mean = sum_dt / n;
+  s.damping_rotation_crit_mean = sum_dr / n;
+  return s;
+}
+
+std::string ScalingLaw::name() const {
+  return std::abs(exponent - 1.0) < 1e-12 ? "linear" : "power";
+}
+
+nlohmann::json to_json(const ScalingLaw& law) {
+  return {{"law", law.name()}, {"exponent", law.exponent}, {"source", law.source}};
+}
+
+ScalingLaw scaling_law_from_json(const nlohmann::json& j, const std::string& source) {
+  ScalingLaw law;
+  if (!j.is_object()) throw InputError(source, "", "scaling law: expected an object");
+  if (j.contains("exponent")) {
+    if (!j["exponent"].is_number())
+      throw InputError(source, "exponent", "must be a number, got " + j["exponent"].dump());
+    law.exponent = j["exponent"].get<double>();
+    if (!(law.exponent > 0.0 && law.exponent <= 3.0))
+      throw InputError(source, "exponent", "must be in (0, 3], got " + j["exponent"].dump());
+  }
+  if (j.contains("source") && j["source"].is_string())
+    law.source = j["source"].get<std::string>();
+  else
+    law.source = source;
+  return law;
+}
+
+int64_t upscale_steps(int64_t steps_rev, int64_t n_rev, int64_t n_proto, const ScalingLaw& law) {
+  if (n_rev <= 0 || n_proto <= 0 || steps_rev <= 0) return steps_rev;
+  const double ratio = static_cast<double>(n_proto) / static_cast<double>(n_rev);
+  return std::max<int64_t>(
+      1, std::llround(static_cast<double>(steps_rev) * std::pow(ratio, law.exponent)));
+}
+
+AlgorithmSpec upscale(const AlgorithmSpec& rev, int64_t n_rev, int64_t n_proto,
+                      const ScalingLaw& law) {
+  AlgorithmSpec p = rev;
+  p.steps = upscale_steps(rev.steps, n_rev, n_proto, law);
+  return p;
+}
+
+nlohmann::json param_block(const AlgorithmSpec& p, const ParticleScales& s) {
+  const double dt = p.dt_ratio * s.dt_crit;
+  return {
+      {"particles", s.particles},
+      {"dt", dt},
+      {"dt_ratio", p.dt_ratio},
+      {"dt_crit", s.dt_crit},
+      {"steps", p.steps},
+      {"damping_translation", p.damping_ratio_translation * s.damping_translation_crit},
+      {"damping_ratio_translation", p.damping_ratio_translation},
+      {"damping_rotation", p.damping_ratio_rotation * s.damping_rotation_crit},
+      {"damping_ratio_rotation", p.damping_ratio_rotation},
+      {"mass_scaling", p.mass_scaling},
+      // The reference values behind the absolute numbers. Damping is
+      // per particle (same ratio for every particle, D ∝ sqrt(m)); the
+      // values above are the lightest particle's, these the mean.
+      {"damping_translation_mean", p.damping_ratio_translation * s.damping_translation_crit_mean},
+      {"damping_rotation_mean", p.damping_ratio_rotation * s.damping_rotation_crit_mean},
+      {"damping_translation_crit", s.damping_translation_crit},
+      {"damping_rotation_crit", s.damping_rotation_crit},
+      {"radius_min", s.radius_min},
+      {"radius_max", s.radius_max},
+      {"radius_mean", s.radius_mean},
+      {"mass_min", s.mass_min},
+      {"mass_mean", s.mass_mean},
+      {"duration", dt * static_cast<double>(p.steps)}};
+}
+
+SceneConfig scene_of_size(const SceneConfig& config, int64_t particles) {
+  if (particles < 2)
+    throw InputError(config.source, "",
+                     "a scene needs at least 2 particles, asked for " + std::to_string(particles));
+  SceneConfig c = config;
+  auto& a = c.assembly;
+  if (a.type == "hexagonal" || a.type == "square") {
+    const double ratio = static_cast<double>(a.columns) / static_cast<double>(a.rows);
+    const int columns = std::max(
+        1, static_cast<int>(std::lround(std::sqrt(static_cast<double>(particles) * ratio))));
+    const int rows =
+        std::max(1, static_cast<int>(std::lround(static_cast<double>(particles) / columns)));
+    a.columns = columns;
+    a.rows = rows;
+  } else if (a.type == "random") {
+    if (particles > 10000000)
+      throw InputError(config.source, "assembly.count", "at most 10,000,000 particles");
+    a.count = static_cast<int>(particles);
+  } else {
+    throw InputError(config.source, "assembly.type",
+                     "a particle file has one size; cut REVs from it instead (demcal rev)");
+  }
+  c.name = config.name + "@" + std::to_string(particles);
+  return c;
+}
+
+Assembly prototype_assembly(const SceneConfig& config, int64_t particles, const std::string& file,
+                            PrototypeSource* source) {
+  PrototypeSource src;
+  Assembly a;
+  auto generated = [&](int64_t n) {
+    src.kind = "generated";
+    if (config.assembly.type == "file") {
+      // No generator to resize: draw the radii from the REV's file.
+      const Assembly rev = read_particle_file(config.assembly.file);
+      a = gas_of_radii(resample_radii(rev.r, n, config.calibration.seed), 1.0,
+                       config.calibration.seed);
+      src.description =
+          std::to_string(n) + " particles with radii drawn from " + config.assembly.file;
+    } else {
+      const SceneConfig c = scene_of_size(config, n);
+      a = make_assembly(c);
+      src.description = std::to_string(a.size()) + " particles from the " + c.assembly.type +
+                        " generator of " + config.name;
+    }
+  };
+  if (!file.empty()) {
+    a = read_particle_file(file);
+    src.kind = "file";
+    src.file = file;
+    src.description = std::to_string(a.size()) + " particles read from " + file;
+  } else if (particles > 0) {
+    generated(particles);
+  } else if (!config.prototype.file.empty()) {
+    a = read_particle_file(config.prototype.file);
+    src.kind = "file";
+    src.file = config.prototype.file;
+    src.description = std::to_string(a.size()) + " particles read from " + src.file;
+  } else if (config.prototype.particles > 0) {
+    generated(config.prototype.particles);
+  } else {
+    a = make_assembly(config);
+    src.kind = "rev";
+    src.description = "the REV itself (" + std::to_string(a.size()) + " particles)";
+  }
+  src.particles = a.size();
+  if (source) *source = src;
+  return a;
+}
+
+nlohmann::json upscaling_block(int64_t n_rev, int64_t n_proto, const ScalingLaw& law) {
+  const double ratio =
+      static_cast<double>(n_proto) / static_cast<double>(std::max<int64_t>(1, n_rev));
+  return {{"law", law.name()},
+          {"exponent", law.exponent},
+          {"factor", std::pow(ratio, law.exponent)},
+          {"particles_rev", n_rev},
+          {"particles_prototype", n_proto},
+          {"source", law.source},
+          {"formula",
+           "steps_prototype = steps_rev * (particles_prototype / particles_rev)^exponent; "
+           "dt_ratio, damping ratios and mass scaling unchanged; dt and damping "
+           "recomputed from the prototype's particles"}};
+}
+
+nlohmann::json prototype_block(const SceneConfig& config, const AlgorithmSpec& rev, int64_t n_rev,
+                               const ScalingLaw& law, int64_t particles, const std::string& file) {
+  PrototypeSource src;
+  const Assembly proto = prototype_assembly(config, particles, file, &src);
+  const ParticleScales scales = particle_scales(proto.r, config.material, rev.mass_scaling);
+  nlohmann::json block = param_block(upscale(rev, n_rev, proto.size(), law), scales);
+  block["source"] = {{"kind", src.kind}, {"description", src.description}};
+  if (!src.file.empty()) block["source"]["file"] = src.file;
+  return block;
+}
+
+namespace {
+
+double number_at(const nlohmann::json& block, const std::string& key, const std::string& source,
+                 const std::string& where) {
+  if (!block.contains(key))
+    throw InputError(source, where + "." + key, "missing (not a demcal params.json?)");
+  if (!block[key].is_number())
+    throw InputError(source, where + "." + key, "must be a number, got " + block[key].dump());
+  return block[key].get<double>();
+}
+
+}  // namespace
+
+RevParams rev_params_from_json(const nlohmann::json& params, const std::string& source) {
+  if (!params.is_object() || !params.contains("rev") || !params["rev"].is_object())
+    throw InputError(source, "rev", "missing (not a demcal params.json?)");
+  const auto& b = params["rev"];
+  RevParams out;
+  auto& p = out.params;
+  p.dt_ratio = number_at(b, "dt_ratio", source, "rev");
+  const double steps = number_at(b, "steps", source, "rev");
+  p.damping_ratio_translation = number_at(b, "damping_ratio_translation", source, "rev");
+  p.damping_ratio_rotation = number_at(b, "damping_ratio_rotation", source, "rev");
+  p.mass_scaling = b.contains("mass_scaling") ? number_at(b, "mass_scaling", source, "rev") : 1.0;
+  const double particles = number_at(b, "particles", source, "rev");
+  if (!(p.dt_ratio > 0.0 && p.dt_ratio < 2.0))
+    throw InputError(source, "rev.dt_ratio", "must be in (0, 2), got " + b["dt_ratio"].dump());
+  if (!(steps >= 1.0 && steps < 9e18))
+    throw InputError(source, "rev.steps", "must be a positive integer, got " + b["steps"].dump());
+  if (!(particles >= 1.0))
+    throw InputError(source, "rev.particles", "must be positive, got " + b["particles"].dump());
+  if (p.damping_ratio_translation < 0.0 || p.damping_ratio_rotation < 0.0)
+    throw InputError(source, "rev.damping_ratio_translation", "damping ratios must be >= 0");
+  if (!(p.mass_scaling > 0.0)) throw InputError(source, "rev.mass_scaling", "must be > 0");
+  p.steps = std::llround(steps);
+  out.particles = std::llround(particles);
+  auto& s = out.scales;
+  s.particles = out.particles;
+  s.dt_crit = number_at(b, "dt_crit", source, "rev");
+  auto crit = [&](const char* abs_key, const char* crit_key, double ratio) {
+    if (b.contains(crit_key)) return number_at(b, crit_key, source, "rev");
+    if (ratio > 0.0 && b.contains(abs_key)) return number_at(b, abs_key, source, "rev") / ratio;
+    return 0.0;
+  };
+  s.damping_translation_crit =
+      crit("damping_translation", "damping_translation_crit", p.damping_ratio_translation);
+  s.damping_rotation_crit =
+      crit("damping_rotation", "damping_rotation_crit", p.damping_ratio_rotation);
+  s.damping_translation_crit_mean = s.damping_translation_crit;
+  s.damping_rotation_crit_mean = s.damping_rotation_crit;
+  if (b.contains("radius_min")) s.radius_min = number_at(b, "radius_min", source, "rev");
+  if (b.contains("mass_min")) s.mass_min = number_at(b, "mass_min", source, "rev");
+  s.mass_mean = s.mass_min;
+  return out;
+}
+
+std::optional<SceneConfig> config_from_params(const nlohmann::json& params,
+                                              const std::string& source) {
+  if (!params.is_object() || !params.contains("config")) return std::nullopt;
+  if (!params["config"].is_object())
+    throw InputError(source, "config", "must be the scene config object");
+  SceneConfig c = parse_config(params["config"], source + ": config");
+  c.text = params["config"].dump();
+  return c;
+}
+
+LinearFit fit_linear(std::span<const double> x, std::span<const double> y) {
+  LinearFit f;
+  const size_t n = std::min(x.size(), y.size());
+  if (n < 2) return f;
+  const double mx = std::accumulate(x.begin(), x.begin() + n, 0.0) / n;
+  const double my = std::accumulate(y.begin(), y.begin() + n, 0.0) / n;
+  double sxx = 0.0, sxy = 0.0, syy = 0.0;
+  for (size_t i = 0; i < n; ++i) {
+    sxx += (x[i] - mx) * (x[i] - mx);
+    sxy += (x[i] - mx) * (y[i] - my);
+    syy += (y[i] - my) * (y[i] - my);
+  }
+  if (sxx <= 0.0) return f;
+  f.slope = sxy / sxx;
+  f.intercept = my - f.slope * mx;
+  double ss_res = 0.0;
+  for (size_t i = 0; i < n; ++i) {
+    const double e = y[i] - (f.slope * x[i] + f.intercept);
+    ss_res += e * e;
+  }
+  f.r2 = syy > 0.0 ? 1.0 - ss_res / syy : 1.0;
+  return f;
+}
+
+LinearFit fit_power(std::span<const double> x, std::span<const double> y) {
+  std::vector<double> lx, ly;
+  for (size_t i = 0; i < std::min(x.size(), y.size()); ++i) {
+    if (x[i] <= 0.0 || y[i] <= 0.0) continue;
+    lx.push_back(std::log(x[i]));
+    ly.push_back(std::log(y[i]));
+  }
+  return fit_linear(lx, ly);
+}
+
+}  // namespace demcal
+
+namespace demcal {
+
+namespace {
+
+double rate_excess_of(const TrialRecord& r, const Tolerances& t) {
+  return std::max({r.criteria.force_balance / t.force_balance, r.criteria.servo / t.servo,
+                   r.criteria.moment_balance / t.moment_balance});
+}
+
+int64_t round4(double steps) {
+  const double mag = std::pow(10.0, std::floor(std::log10(std::max(steps, 10.0))) - 3.0);
+  return std::max<int64_t>(10, std::llround(std::round(steps / mag) * mag));
+}
+
+}  // namespace
+
+StepSearch smallest_passing_steps(const SceneConfig& config, const ConsolidatedState& state,
+                                  const AlgorithmSpec& start, const Tolerances& tol, int max_runs) {
+  StepSearch out;
+  AlgorithmSpec p = start;
+  p.steps = round4(static_cast<double>(start.steps));
+  int64_t largest_failing = 0;
+  for (int k = 0; k < max_runs; ++k) {
+    TrialRecord r = run_trial(config, state, p, tol);
+    r.id = k;
+    r.phase = "steps-search";
+    out.trials.push_back(r);
+    out.particle_steps += r.particle_steps;
+    if (r.diverged) break;
+    const double excess = rate_excess_of(r, tol);
+    double next;
+    if (r.passed) {
+      if (!out.found || p.steps < out.best.params.steps) out.best = r;
+      out.found = true;
+      if (excess > 0.93) break;  // within 7 % of the boundary
+      next = static_cast<double>(p.steps) * std::max(excess, 0.3) * 1.04;
+    } else {
+      largest_failing = std::max(largest_failing, p.steps);
+      // Rate-driven failure: the 1/Nstep model predicts; anything else
+      // (oscillation) is not cured by more steps, but try twice as many once.
+      next = static_cast<double>(p.steps) * (excess > 1.0 ? excess * 1.05 : 2.0);
+    }
+    if (out.found && next >= static_cast<double>(out.best.params.steps)) {
+      // Between the largest failing and the smallest passing run.
+      if (largest_failing == 0) break;
+      next = std::sqrt(static_cast<double>(largest_failing) *
+                       static_cast<double>(out.best.params.steps));
+    }
+    if (next <= static_cast<double>(largest_failing)) next = 1.05 * largest_failing;
+    const int64_t n = round4(next);
+    if (out.found &&
+        (n >= out.best.params.steps || static_cast<double>(out.best.params.steps - n) <
+                                           0.03 * static_cast<double>(out.best.params.steps)))
+      break;
+    bool seen = false;
+    for (const auto& t : out.trials) seen |= t.params.steps == n;
+    if (seen) break;
+    p.steps = n;
+  }
+  return out;
+}
+
+}  // namespace demcal
+
+namespace demcal {
+
+nlohmann::json read_json_file(const std::string& path) {
+  if (std::filesystem::is_directory(path)) throw InputError(path, "", "is a folder, not a file");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path, "", "cannot open file");
+  std::ostringstream s;
+  s << in.rdbuf();
+  try {
+    return nlohmann::json::parse(s.str());
+  } catch (const nlohmann::json::parse_error& e) {
+    throw InputError(path, "byte " + std::to_string(e.byte), "not valid JSON");
+  }
+}
+
+}  // namespace demcal
