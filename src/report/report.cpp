@@ -25,94 +25,10 @@ namespace demcal {
 
 namespace fs = std::filesystem;
 
-// ---------------------------------------------------------------------------
-// Runs
-
-AssemblyPicture picture_of(const World& world) {
-  AssemblyPicture p;
-  const int n = world.size();
-  p.x.assign(world.x().begin(), world.x().end());
-  p.y.assign(world.y().begin(), world.y().end());
-  p.r.assign(world.radius().begin(), world.radius().end());
-  p.rotation.assign(world.rotation().begin(), world.rotation().end());
-  p.left = world.wall(kLeft).position;
-  p.right = world.wall(kRight).position;
-  p.bottom = world.wall(kBottom).position;
-  p.top = world.wall(kTop).position;
-  for (const auto& c : world.contacts()) {
-    if (c.fn <= 0.0) continue;
-    p.forces.push_back({p.x[c.i], p.y[c.i], p.x[c.j], p.y[c.j], c.fn, false});
-  }
-  // Wall contacts: linear law on the overlap with each wall.
-  const double kn = world.material().wall.kn;
-  for (int i = 0; i < n; ++i) {
-    const double x = p.x[i], y = p.y[i], r = p.r[i];
-    const double d[4] = {r - (x - p.left), r - (p.right - x), r - (y - p.bottom), r - (p.top - y)};
-    const double cx[4] = {p.left, p.right, x, x}, cy[4] = {y, y, p.bottom, p.top};
-    for (int w = 0; w < 4; ++w)
-      if (d[w] > 0.0) p.forces.push_back({x, y, cx[w], cy[w], kn * d[w], true});
-  }
-  return p;
-}
-
-void collect_runs(ReportInput& in, const SceneConfig& config, const ConsolidatedState& state,
-                  const AlgorithmSpec& start, int jobs) {
-  const double s3 = config.test.lateral_stress;
-  auto one = [&](const std::string& label, const AlgorithmSpec& p) {
-    ReportRun r;
-    r.label = label;
-    r.params = p;
-    r.run = run_loading(state, config.test, p);
-    r.score = score_run(r.run, s3, in.tolerances);
-    return r;
-  };
-  const bool have_best = in.summary.best_trial.particle_steps > 0.0;  // a trial ran
-  run_parallel({[&] { in.start = one("start point", start); },
-                [&] {
-                  if (have_best)
-                    in.best =
-                        one(in.summary.success ? "calibrated" : "best found", in.summary.best);
-                }},
-               jobs);
-  if (!in.best || in.best->run.series.empty()) return;
-  // The state at the peak: the same run again, stopped at the monitoring
-  // point of the peak.
-  const auto& series = in.best->run.series;
-  const Peak peak = find_peak(series);
-  if (peak.index < 0) return;
-  const int64_t peak_step = series[peak.index].step;
-  World world = state.world;
-  if (peak_step > 0)
-    run_loading(
-        state, config.test, in.summary.best,
-        [&](const MonitorPoint& p) { return p.step < peak_step; }, &world);
-  AssemblyPicture picture = picture_of(world);
-  picture.step = peak_step;
-  picture.steps = in.summary.best.steps;
-  picture.strain_yy = series[peak.index].strain_yy;
-  picture.stress_yy = peak.stress_yy;
-  in.picture = std::move(picture);
-}
-
-ReferenceEvidence converged_reference(const SceneConfig& config, const ConsolidatedState& state,
-                                      const AlgorithmSpec& best, const Tolerances& tolerances,
-                                      int jobs) {
-  ReferenceEvidence out;
-  AlgorithmSpec coarse = best, fine = best;
-  coarse.steps = 8 * best.steps;
-  fine.steps = 16 * best.steps;
-  LoadingResult fine_run;
-  run_parallel(
-      {[&] { out.fine = run_trial(config, state, fine, tolerances, false, 3.0, &fine_run); },
-       [&] { out.coarse = run_trial(config, state, coarse, tolerances); }},
-      jobs);
-  out.coarse.phase = out.fine.phase = "reference";
-  out.coarse.id = 0;
-  out.fine.id = 1;
-  out.fine_series = std::move(fine_run.series);
-  // Peak error ∝ 1/Nstep: P(∞) ≈ P(16N) + (P(16N) − P(8N)).
-  out.peak = 2.0 * out.fine.criteria.peak_stress_yy - out.coarse.criteria.peak_stress_yy;
-  return out;
+void attach_runs(ReportInput& input, ResultRuns runs) {
+  input.start = std::move(runs.start);
+  input.best = std::move(runs.best);
+  input.picture = std::move(runs.picture);
 }
 
 // ---------------------------------------------------------------------------
