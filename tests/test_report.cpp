@@ -16,6 +16,8 @@
 #include <vector>
 
 #include "demcal/report/report.hpp"
+#include "demcal/scene/packing.hpp"
+#include "demcal/search/evidence.hpp"
 
 namespace fs = std::filesystem;
 using namespace demcal;
@@ -436,6 +438,44 @@ TEST(Report, GnuplotRunnerNeedsNoShell) {
   out = run_gnuplot("gnuplot", "set nonsense_option\n", {}, {"a.svg"}, &error);
   EXPECT_TRUE(out.empty());
   EXPECT_NE(error.find("gnuplot failed"), std::string::npos);
+}
+
+// The picture's wall contacts are the forces the walls feel: on each wall
+// they sum to the wall's force as the scene measures it (wall_pressure ×
+// wall length × thickness). Frictionless walls without contact damping carry
+// kn·overlap per contact, and the kernel sums the same overlaps at the same
+// positions, so the sums agree to rounding.
+TEST(Report, PictureWallForcesSumToTheWallPressure) {
+  const SceneConfig c = parse_config_text(R"({
+    "assembly": {"type": "hexagonal", "columns": 5, "rows": 5, "radius": 5e-4},
+    "test": {"lateral_stress": 1e5}})",
+                                          "test");
+  const ConsolidatedState state = consolidate(c, make_assembly(c));
+  const World& w = state.world;
+  const AssemblyPicture p = picture_of(w);
+  double sum[4] = {0, 0, 0, 0};
+  int particle_contacts = 0;
+  for (const auto& f : p.forces) {
+    if (!f.wall) {
+      ++particle_contacts;
+      continue;
+    }
+    // The wall end of the line sits on the wall.
+    const int side = f.x2 == p.left     ? kLeft
+                     : f.x2 == p.right  ? kRight
+                     : f.y2 == p.bottom ? kBottom
+                                        : kTop;
+    sum[side] += f.fn;
+  }
+  EXPECT_GT(particle_contacts, 0);
+  for (int side = 0; side < 4; ++side) {
+    const bool vertical = side == kLeft || side == kRight;
+    const double length = vertical ? w.height() : w.width();
+    const double measured =
+        wall_pressure(w, static_cast<WallSide>(side)) * length * w.material().thickness;
+    ASSERT_GT(measured, 0.0) << "wall " << side;
+    EXPECT_NEAR(sum[side], measured, 1e-9 * measured) << "wall " << side;
+  }
 }
 
 TEST(Report, CalibrateWritesBothFiles) {
