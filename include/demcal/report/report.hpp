@@ -21,7 +21,11 @@
 // picture is drawn directly as SVG and needs nothing.
 //
 // The report renders facts; it runs nothing itself. The runs it shows
-// besides the search's trials come from search/evidence.hpp.
+// besides the search's trials come from search/evidence.hpp. Inside
+// src/report: facts.cpp gathers what the sections share (ReportFacts),
+// sections_*.cpp write one section each to both documents (doc.cpp),
+// plots.cpp plans and renders the gnuplot figures (gnuplot.cpp runs it),
+// assembly_svg.cpp draws the assembly and html.cpp holds the page and CSS.
 #pragma once
 
 #include <cstdint>
