@@ -118,8 +118,12 @@ ReportFacts gather_facts(const ReportInput& in) {
   };
   for (const auto& t : S.trials) add(t, std::to_string(t.id));
   if (in.baseline)
-    for (size_t k = 0; k < in.baseline->trials.size(); ++k)
-      add(in.baseline->trials[k], "b" + std::to_string(k));
+    for (size_t k = 0; k < in.baseline->trials.size(); ++k) {
+      // Appended rather than "b" + to_string(k): GCC 12 warns wrongly on
+      // that concatenation once inlined here (-Wrestrict, its bug 105329).
+      std::string label = "b";
+      add(in.baseline->trials[k], label.append(std::to_string(k)));
+    }
   if (in.reference) {
     add(in.reference->coarse, "r8");
     add(in.reference->fine, "r16");
