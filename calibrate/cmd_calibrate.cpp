@@ -182,7 +182,7 @@ int cmd_calibrate(const CalibrateOptions& o) {
       baseline = paper_recipe_baseline(config, state, options.tolerances, 500LL * n_rev);
     };
     auto run_reference = [&] {
-      reference = converged_reference(config, state, summary.best, options.tolerances, 1);
+      reference = run_refined_reference(config, state, summary.best, options.tolerances, 1);
     };
     run_parallel({run_baseline, run_reference}, jobs);
     auto peak_error = [&](const TrialRecord& t) -> nlohmann::json {
@@ -275,7 +275,8 @@ int cmd_calibrate(const CalibrateOptions& o) {
     start.steps = 500LL * n_rev;
     start.damping_ratio_translation = 1.0;
     start.damping_ratio_rotation = 1.0;
-    collect_runs(in, config, state, start, jobs);  // a stop now: finish, the runs are done
+    // A stop now: finish, the runs are done.
+    attach_runs(in, rerun_start_and_result(config, state, start, summary, in.tolerances, jobs));
     const auto t1 = std::chrono::steady_clock::now();
     const Report report = make_report(in);
     write_file_atomic(dir + "/report.html", report.html);

@@ -16,6 +16,8 @@
 #include <vector>
 
 #include "demcal/report/report.hpp"
+#include "demcal/scene/packing.hpp"
+#include "demcal/search/evidence.hpp"
 
 namespace fs = std::filesystem;
 using namespace demcal;
@@ -436,6 +438,87 @@ TEST(Report, GnuplotRunnerNeedsNoShell) {
   out = run_gnuplot("gnuplot", "set nonsense_option\n", {}, {"a.svg"}, &error);
   EXPECT_TRUE(out.empty());
   EXPECT_NE(error.find("gnuplot failed"), std::string::npos);
+}
+
+// The picture's wall contacts are the forces the walls feel: on each wall
+// they sum to the wall's force as the scene measures it (wall_pressure ×
+// wall length × thickness). Frictionless walls without contact damping carry
+// kn·overlap per contact, and the kernel sums the same overlaps at the same
+// positions, so the sums agree to rounding.
+TEST(Report, PictureWallForcesSumToTheWallPressure) {
+  const SceneConfig c = parse_config_text(R"({
+    "assembly": {"type": "hexagonal", "columns": 5, "rows": 5, "radius": 5e-4},
+    "test": {"lateral_stress": 1e5}})",
+                                          "test");
+  const ConsolidatedState state = consolidate(c, make_assembly(c));
+  const World& w = state.world;
+  const AssemblyPicture p = picture_of(w);
+  double sum[4] = {0, 0, 0, 0};
+  int particle_contacts = 0;
+  for (const auto& f : p.forces) {
+    if (!f.wall) {
+      ++particle_contacts;
+      continue;
+    }
+    // The wall end of the line sits on the wall.
+    const int side = f.x2 == p.left     ? kLeft
+                     : f.x2 == p.right  ? kRight
+                     : f.y2 == p.bottom ? kBottom
+                                        : kTop;
+    sum[side] += f.fn;
+  }
+  EXPECT_GT(particle_contacts, 0);
+  for (int side = 0; side < 4; ++side) {
+    const bool vertical = side == kLeft || side == kRight;
+    const double length = vertical ? w.height() : w.width();
+    const double measured =
+        wall_pressure(w, static_cast<WallSide>(side)) * length * w.material().thickness;
+    ASSERT_GT(measured, 0.0) << "wall " << side;
+    EXPECT_NEAR(sum[side], measured, 1e-9 * measured) << "wall " << side;
+  }
+}
+
+// The evidence runs are reruns of what the search ran: deterministic, so a
+// rerun reproduces the trial's numbers exactly, and the picture is the
+// result at its peak. The reference is the result at 8× and 16× Nstep with
+// the peak extrapolated for an error ∝ 1/Nstep: P(∞) = 2·P(16N) − P(8N).
+TEST(Report, EvidenceRunsReproduceTheTrialsAndExtrapolateThePeak) {
+  const SceneConfig c = parse_config_text(R"({
+    "assembly": {"type": "hexagonal", "columns": 5, "rows": 5, "radius": 5e-4},
+    "test": {"lateral_stress": 1e5, "monitor_points": 40}})",
+                                          "test");
+  const ConsolidatedState state = consolidate(c, make_assembly(c));
+  const Tolerances tol;
+  AlgorithmSpec best = c.algorithm, start = c.algorithm;
+  best.steps = 3000;
+  start.steps = 2000;
+  CalibrationSummary summary;
+  summary.success = true;
+  summary.best = best;
+  summary.best_trial = run_trial(c, state, best, tol);
+  const TrialRecord start_trial = run_trial(c, state, start, tol);
+
+  const ResultRuns runs = rerun_start_and_result(c, state, start, summary, tol, 2);
+  ASSERT_TRUE(runs.start && runs.best && runs.picture);
+  EXPECT_EQ(runs.best->label, "calibrated");
+  EXPECT_EQ(runs.best->score.criteria.peak_stress_yy, summary.best_trial.criteria.peak_stress_yy);
+  EXPECT_EQ(runs.best->score.criteria.force_balance, summary.best_trial.criteria.force_balance);
+  EXPECT_EQ(runs.start->score.criteria.force_balance, start_trial.criteria.force_balance);
+  const Peak peak = find_peak(runs.best->run.series);
+  EXPECT_EQ(runs.picture->step, runs.best->run.series[peak.index].step);
+  EXPECT_EQ(runs.picture->stress_yy, peak.stress_yy);
+  EXPECT_EQ(runs.picture->steps, best.steps);
+  EXPECT_EQ(runs.picture->x.size(), state.world.x().size());
+
+  const ReferenceEvidence ref = run_refined_reference(c, state, best, tol, 2);
+  EXPECT_EQ(ref.coarse.params.steps, 8 * best.steps);
+  EXPECT_EQ(ref.fine.params.steps, 16 * best.steps);
+  EXPECT_EQ(ref.coarse.phase, "reference");
+  EXPECT_EQ(ref.fine.phase, "reference");
+  EXPECT_DOUBLE_EQ(ref.peak,
+                   2.0 * ref.fine.criteria.peak_stress_yy - ref.coarse.criteria.peak_stress_yy);
+  ASSERT_FALSE(ref.fine_series.empty());
+  EXPECT_EQ(ref.fine_series.back().step, ref.fine.params.steps);
 }
 
 TEST(Report, CalibrateWritesBothFiles) {

@@ -1,4 +1,4 @@
-// The calibration report (DESIGN.md §6): DIR/report.html, self-contained
+// The calibration report: DIR/report.html, self-contained
 // (inline SVG and CSS, nothing fetched, opens offline), and DIR/report.md,
 // the same facts in text.
 //
@@ -19,6 +19,13 @@
 // folder, with no shell and no user text in the scripts; without gnuplot the
 // report carries every number and says how to get the plots. The assembly
 // picture is drawn directly as SVG and needs nothing.
+//
+// The report renders facts; it runs nothing itself. The runs it shows
+// besides the search's trials come from search/evidence.hpp. Inside
+// src/report: facts.cpp gathers what the sections share (ReportFacts),
+// sections_*.cpp write one section each to both documents (doc.cpp),
+// plots.cpp plans and renders the gnuplot figures (gnuplot.cpp runs it),
+// assembly_svg.cpp draws the assembly and html.cpp holds the page and CSS.
 #pragma once
 
 #include <cstdint>
@@ -29,48 +36,12 @@
 #include <vector>
 
 #include "demcal/scene/biaxial.hpp"
-#include "demcal/search/calibration.hpp"
 #include "demcal/scene/config.hpp"
 #include "demcal/scoring/scoring.hpp"
+#include "demcal/search/calibration.hpp"
+#include "demcal/search/evidence.hpp"
 
 namespace demcal {
-
-/// A run shown in the report with its whole monitored series.
-struct ReportRun {
-  std::string label;  ///< "start point", "calibrated"
-  AlgorithmSpec params;
-  LoadingResult run;
-  Score score;
-};
-
-/// The assembly at one instant: enough to draw it.
-struct AssemblyPicture {
-  std::vector<double> x, y, r, rotation;  ///< rotation [rad], counter-clockwise positive
-  struct Force {
-    double x1 = 0, y1 = 0, x2 = 0, y2 = 0;  ///< particle centre to centre (or to the wall)
-    double fn = 0;                          ///< normal force [N]
-    bool wall = false;
-  };
-  std::vector<Force> forces;
-  double left = 0, right = 0, bottom = 0, top = 0;
-  int64_t step = 0, steps = 0;  ///< loading step of the picture, of the run
-  double strain_yy = 0, stress_yy = 0;
-};
-/// The picture of a world state (particle–particle contacts from
-/// World::contacts(), wall contacts from the overlap and the wall's kn).
-AssemblyPicture picture_of(const World& world);
-
-/// The --evidence runs: a converged reference from the calibrated
-/// multipliers at 8× and 16× Nstep, P_ref = 2·P(16N) − P(8N) (error ∝ 1/N),
-/// and the paper's recipe done mechanically.
-struct ReferenceEvidence {
-  TrialRecord coarse, fine;  ///< 8×Nstep and 16×Nstep
-  std::vector<MonitorPoint> fine_series;
-  double peak = 0.0;  ///< Richardson-extrapolated peak b_yy (negative)
-};
-ReferenceEvidence converged_reference(const SceneConfig& config, const ConsolidatedState& state,
-                                      const AlgorithmSpec& best, const Tolerances& tolerances,
-                                      int jobs);
 
 struct ReportInput {
   std::string scene;
@@ -90,11 +61,8 @@ struct ReportInput {
   std::optional<ReferenceEvidence> reference;
 };
 
-/// Rerun the start point and the calibrated parameters with their series
-/// (in parallel when jobs > 1), then the calibrated run once more, stopped
-/// at its peak, for the picture. About two and a half trials.
-void collect_runs(ReportInput& input, const SceneConfig& config, const ConsolidatedState& state,
-                  const AlgorithmSpec& start, int jobs);
+/// The runs of rerun_start_and_result() (search/evidence.hpp) into `input`.
+void attach_runs(ReportInput& input, ResultRuns runs);
 
 struct ReportOptions {
   /// The gnuplot program (a name looked up on PATH, or a path); "" renders

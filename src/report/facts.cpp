@@ -1,0 +1,144 @@
+#include "facts.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "demcal/io/format.hpp"
+
+namespace demcal::report {
+
+std::string grouped(int64_t v) {
+  std::string s = std::to_string(v < 0 ? -v : v), out;
+  for (size_t i = 0; i < s.size(); ++i) {
+    if (i > 0 && (s.size() - i) % 3 == 0) out += ',';
+    out += s[i];
+  }
+  return (v < 0 ? "-" : "") + out;
+}
+
+std::string kpa(double pa) { return num(pa / 1e3, 4) + " kPa"; }
+
+std::string sentence(std::string s) {
+  while (!s.empty() && s.back() == ' ') s.pop_back();
+  if (s.empty()) return s;
+  if (s[0] >= 'a' && s[0] <= 'z') s[0] = static_cast<char>(s[0] - 'a' + 'A');
+  if (s.back() != '.') s += '.';
+  return s;
+}
+
+std::string params_text(const AlgorithmSpec& p) {
+  return "α " + num(p.dt_ratio, 4) + ", Nstep " + grouped(p.steps) + ", ζ_t " +
+         num(p.damping_ratio_translation, 4) + ", ζ_r " + num(p.damping_ratio_rotation, 4);
+}
+
+std::string params_gp(const AlgorithmSpec& p) {
+  return "α = " + num(p.dt_ratio, 3) + ",  N_{step} = " + std::to_string(p.steps) +
+         ",  ζ_t = " + num(p.damping_ratio_translation, 3) +
+         ",  ζ_r = " + num(p.damping_ratio_rotation, 3);
+}
+
+std::string verdict(const TrialRecord& t) {
+  if (t.diverged) return "diverged";
+  if (!t.complete) return "stopped early";
+  return t.passed ? "pass" : "FAIL";
+}
+
+double Ratios::worst() const {
+  return std::max({force_balance, moment_balance, servo, oscillation});
+}
+
+std::string Ratios::worst_name() const {
+  const double w = worst();
+  if (w == force_balance) return "force balance";
+  if (w == moment_balance) return "moment balance";
+  if (w == servo) return "servo";
+  return "oscillation";
+}
+
+Ratios ratios(const Criteria& c, const Tolerances& t) {
+  return {c.force_balance / t.force_balance, c.moment_balance / t.moment_balance, c.servo / t.servo,
+          c.oscillation / t.oscillation};
+}
+
+double objective_of(const TrialRecord& t, const Tolerances& tol) {
+  Score s;
+  s.criteria = t.criteria;
+  s.diverged = t.diverged;
+  s.complete = t.complete;
+  s.passed = t.passed;
+  s.completed_fraction =
+      t.params.steps > 0 ? static_cast<double>(t.steps_run) / static_cast<double>(t.params.steps)
+                         : 0.0;
+  s.particle_steps = t.particle_steps;
+  return objective(s, tol);
+}
+
+namespace {
+
+Point point_of(const ReportInput& in, bool have_best, const TrialRecord& t,
+               const std::string& label) {
+  const auto& S = in.summary;
+  Point p;
+  p.label = label;
+  p.phase = t.phase;
+  p.trial = &t;
+  p.cost = t.particle_steps;
+  p.seconds = t.wall_time_s;
+  if (!t.complete && t.steps_run > 0 && t.params.steps > t.steps_run)
+    p.seconds *= static_cast<double>(t.params.steps) / static_cast<double>(t.steps_run);
+  if (in.reference && t.complete && !t.diverged && t.criteria.peak_stress_yy < 0.0)
+    p.peak_error = (in.reference->peak - t.criteria.peak_stress_yy) / std::abs(in.reference->peak);
+  p.best = have_best && t.phase == S.best_trial.phase && t.id == S.best_trial.id &&
+           t.params.steps == S.best_trial.params.steps;
+  return p;
+}
+
+/// Nstep of the prototype: params.json's when written, else the REV's
+/// scaled with the particle count.
+int64_t prototype_steps(const ReportInput& in) {
+  const auto& best = in.summary.best;
+  int64_t steps = std::llround(static_cast<double>(best.steps) *
+                               static_cast<double>(std::max(in.prototype_particles, in.particles)) /
+                               static_cast<double>(in.particles));
+  if (in.params.is_object() && in.params.contains("prototype") &&
+      in.params["prototype"].contains("steps"))
+    steps = in.params["prototype"]["steps"].get<int64_t>();
+  return steps;
+}
+
+}  // namespace
+
+ReportFacts gather_facts(const ReportInput& in) {
+  ReportFacts f;
+  f.in = &in;
+  const auto& S = in.summary;
+  f.have_best = S.best_trial.particle_steps > 0.0;  // default-constructed: none
+  auto add = [&](const TrialRecord& t, const std::string& label) {
+    f.points.push_back(point_of(in, f.have_best, t, label));
+  };
+  for (const auto& t : S.trials) add(t, std::to_string(t.id));
+  if (in.baseline)
+    for (size_t k = 0; k < in.baseline->trials.size(); ++k) {
+      // Appended rather than "b" + to_string(k): GCC 12 warns wrongly on
+      // that concatenation once inlined here (-Wrestrict, its bug 105329).
+      std::string label = "b";
+      add(in.baseline->trials[k], label.append(std::to_string(k)));
+    }
+  if (in.reference) {
+    add(in.reference->coarse, "r8");
+    add(in.reference->fine, "r16");
+  }
+  for (size_t k = 0; k < f.points.size(); ++k) {
+    const Point& p = f.points[k];
+    if (p.best) f.best_peak_error = p.peak_error;
+    if (p.phase == "baseline" && p.trial->passed) f.baseline_index = static_cast<int>(k);
+  }
+  if (in.start) f.runs.push_back(&*in.start);
+  if (in.best) f.runs.push_back(&*in.best);
+  f.have_ref_series = in.reference && !in.reference->fine_series.empty();
+  f.upscale = f.have_best && in.prototype_particles > in.particles && in.particles > 0;
+  if (f.have_best && in.particles > 0) f.proto_steps = prototype_steps(in);
+  return f;
+}
+
+}  // namespace demcal::report

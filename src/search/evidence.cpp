@@ -1,0 +1,109 @@
+#include "demcal/search/evidence.hpp"
+
+#include <utility>
+
+#include "demcal/search/parallel.hpp"
+
+namespace demcal {
+
+AssemblyPicture picture_of(const World& world) {
+  AssemblyPicture p;
+  const int n = world.size();
+  p.x.assign(world.x().begin(), world.x().end());
+  p.y.assign(world.y().begin(), world.y().end());
+  p.r.assign(world.radius().begin(), world.radius().end());
+  p.rotation.assign(world.rotation().begin(), world.rotation().end());
+  p.left = world.wall(kLeft).position;
+  p.right = world.wall(kRight).position;
+  p.bottom = world.wall(kBottom).position;
+  p.top = world.wall(kTop).position;
+  for (const auto& c : world.contacts()) {
+    if (c.fn <= 0.0) continue;
+    p.forces.push_back({p.x[c.i], p.y[c.i], p.x[c.j], p.y[c.j], c.fn, false});
+  }
+  // Wall contacts: linear law on the overlap with each wall. The kernel
+  // keeps its per-particle wall forces private; with the default (zero)
+  // contact damping they are exactly kn·overlap.
+  const double kn = world.material().wall.kn;
+  for (int i = 0; i < n; ++i) {
+    const double x = p.x[i], y = p.y[i], r = p.r[i];
+    const double d[4] = {r - (x - p.left), r - (p.right - x), r - (y - p.bottom), r - (p.top - y)};
+    const double cx[4] = {p.left, p.right, x, x}, cy[4] = {y, y, p.bottom, p.top};
+    for (int w = 0; w < 4; ++w)
+      if (d[w] > 0.0) p.forces.push_back({x, y, cx[w], cy[w], kn * d[w], true});
+  }
+  return p;
+}
+
+namespace {
+
+/// The result rerun up to the monitoring point of its peak, drawn there.
+std::optional<AssemblyPicture> picture_at_peak(const SceneConfig& config,
+                                               const ConsolidatedState& state,
+                                               const ReportRun& best) {
+  const auto& series = best.run.series;
+  if (series.empty()) return std::nullopt;
+  const Peak peak = find_peak(series);
+  if (peak.index < 0) return std::nullopt;
+  const int64_t peak_step = series[peak.index].step;
+  World world = state.world;
+  if (peak_step > 0)
+    run_loading(
+        state, config.test, best.params, [&](const MonitorPoint& p) { return p.step < peak_step; },
+        &world);
+  AssemblyPicture picture = picture_of(world);
+  picture.step = peak_step;
+  picture.steps = best.params.steps;
+  picture.strain_yy = series[peak.index].strain_yy;
+  picture.stress_yy = peak.stress_yy;
+  return picture;
+}
+
+}  // namespace
+
+ResultRuns rerun_start_and_result(const SceneConfig& config, const ConsolidatedState& state,
+                                  const AlgorithmSpec& start, const CalibrationSummary& summary,
+                                  const Tolerances& tolerances, int jobs) {
+  const double s3 = config.test.lateral_stress;
+  auto one = [&](const std::string& label, const AlgorithmSpec& p) {
+    ReportRun r;
+    r.label = label;
+    r.params = p;
+    r.run = run_loading(state, config.test, p);
+    r.score = score_run(r.run, s3, tolerances);
+    return r;
+  };
+  ResultRuns out;
+  const bool have_best = summary.best_trial.particle_steps > 0.0;  // a trial ran
+  run_parallel({[&] { out.start = one("start point", start); },
+                [&] {
+                  if (have_best)
+                    out.best = one(summary.success ? "calibrated" : "best found", summary.best);
+                }},
+               jobs);
+  if (out.best) out.picture = picture_at_peak(config, state, *out.best);
+  return out;
+}
+
+ReferenceEvidence run_refined_reference(const SceneConfig& config, const ConsolidatedState& state,
+                                        const AlgorithmSpec& best, const Tolerances& tolerances,
+                                        int jobs) {
+  ReferenceEvidence out;
+  AlgorithmSpec coarse = best, fine = best;
+  coarse.steps = 8 * best.steps;
+  fine.steps = 16 * best.steps;
+  LoadingResult fine_run;
+  run_parallel(
+      {[&] { out.fine = run_trial(config, state, fine, tolerances, false, 3.0, &fine_run); },
+       [&] { out.coarse = run_trial(config, state, coarse, tolerances); }},
+      jobs);
+  out.coarse.phase = out.fine.phase = "reference";
+  out.coarse.id = 0;
+  out.fine.id = 1;
+  out.fine_series = std::move(fine_run.series);
+  // Peak error ∝ 1/Nstep: P(∞) ≈ P(16N) + (P(16N) − P(8N)).
+  out.peak = 2.0 * out.fine.criteria.peak_stress_yy - out.coarse.criteria.peak_stress_yy;
+  return out;
+}
+
+}  // namespace demcal
