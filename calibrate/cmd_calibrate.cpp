@@ -68,6 +68,21 @@ std::string reproduce_command(const CalibrateOptions& o, const SceneConfig& conf
   return out;
 }
 
+/// run.json: what varies between invocations (kept out of params.json).
+nlohmann::json run_record(double wall_time_s, const CalibrationSummary& summary,
+                          const ConsolidatedState& state, int jobs, bool resumed) {
+  return {{"schema", "demcal.run/1"},
+          {"wall_time_s", wall_time_s},
+          {"calibration_wall_time_s", summary.wall_time_s},
+          {"consolidation_wall_time_s", state.wall_time_s},
+          {"jobs", jobs},
+          {"resumed", resumed},
+          {"trials_run", summary.trials_run},
+          {"trials_reused", summary.trials_reused},
+          {"kernel_simd", kernel_simd()},
+          {"version", DEMCAL_VERSION}};
+}
+
 }  // namespace
 
 int cmd_calibrate(const CalibrateOptions& o) {
@@ -160,17 +175,9 @@ int cmd_calibrate(const CalibrateOptions& o) {
   // What varies between invocations stays out of params.json. Written now
   // and again after the report, so params.json never stands without it.
   const auto write_run_json = [&] {
-    const nlohmann::json run{{"schema", "demcal.run/1"},
-                             {"wall_time_s", seconds_since(t_start)},
-                             {"calibration_wall_time_s", summary.wall_time_s},
-                             {"consolidation_wall_time_s", state.wall_time_s},
-                             {"jobs", jobs},
-                             {"resumed", o.resume},
-                             {"trials_run", summary.trials_run},
-                             {"trials_reused", summary.trials_reused},
-                             {"kernel_simd", kernel_simd()},
-                             {"version", DEMCAL_VERSION}};
-    write_file_atomic(dir + "/run.json", run.dump(2) + "\n");
+    const double wall_time_s = seconds_since(t_start);
+    write_file_atomic(dir + "/run.json",
+                      run_record(wall_time_s, summary, state, jobs, o.resume).dump(2) + "\n");
   };
   write_run_json();
   if (stop.stopped())

@@ -271,10 +271,10 @@ TEST(ScalingStudy, ASizeRoundTripsThroughItsJson) {
   r.richardson = 0.01;
   r.peak = -6e5;
   r.trials = 30;
-  r.fixed_found = true;
-  r.fixed_steps = 12345;
-  r.fixed = sample_trial();
-  r.fixed_trials = {sample_trial(), sample_trial()};
+  r.fixed.found = true;
+  r.fixed.steps = 12345;
+  r.fixed.best = sample_trial();
+  r.fixed.trials = {sample_trial(), sample_trial()};
   const json j = to_json(r);
   EXPECT_EQ(to_json(scaling_size_from_json(j, "result.json")), j);
   EXPECT_THROW(scaling_size_from_json(json{{"particles", 3}}, "result.json"), InputError);
@@ -298,8 +298,8 @@ TEST(ScalingStudy, ReportStatesTheVerdictAndTheLaw) {
     r.success = r.calibrated;
     r.best = sample_params();
     r.best.steps = 500 * n;
-    r.fixed_found = true;
-    r.fixed_steps = 500 * n;
+    r.fixed.found = true;
+    r.fixed.steps = 500 * n;
   }
   st.have_forward = st.forward_ok = true;
   st.linear_run = st.reference = sample_trial();

@@ -52,67 +52,60 @@ Key key_of(const AlgorithmSpec& p) {
 
 }  // namespace
 
-std::string to_string(Strategy strategy) {
-  switch (strategy) {
-    case Strategy::model:
-      return "model";
-    case Strategy::cobyla:
-      return "cobyla";
-    case Strategy::auglag:
-      return "auglag";
-    case Strategy::penalty:
-      return "penalty";
-    case Strategy::direct:
-      return "direct";
-  }
-  return "model";  // unreachable: every enumerator is named above
-}
-
-Strategy parse_strategy(std::string_view name, const std::string& option) {
-  std::string valid;
-  for (Strategy s : kStrategies) {
-    if (to_string(s) == name) return s;
-    valid += (valid.empty() ? "" : ", ") + to_string(s);
-  }
-  throw InputError(option, "", "unknown strategy \"" + std::string(name) + "\"; one of " + valid);
-}
-
 namespace {
-constexpr TrialPhase kTrialPhases[] = {TrialPhase::search,      TrialPhase::search_tightened,
-                                       TrialPhase::verify,      TrialPhase::certificate,
-                                       TrialPhase::baseline,    TrialPhase::reference,
-                                       TrialPhase::steps_search};
+
+/// An enum's names, for to_string() and the parsers: one table each.
+template <class E>
+struct Named {
+  E value;
+  const char* name;
+};
+constexpr Named<Strategy> kStrategyNames[] = {{Strategy::model, "model"},
+                                              {Strategy::cobyla, "cobyla"},
+                                              {Strategy::auglag, "auglag"},
+                                              {Strategy::penalty, "penalty"},
+                                              {Strategy::direct, "direct"}};
+constexpr Named<TrialPhase> kPhaseNames[] = {{TrialPhase::search, "search"},
+                                             {TrialPhase::search_tightened, "search-tightened"},
+                                             {TrialPhase::verify, "verify"},
+                                             {TrialPhase::certificate, "certificate"},
+                                             {TrialPhase::baseline, "baseline"},
+                                             {TrialPhase::reference, "reference"},
+                                             {TrialPhase::steps_search, "steps-search"}};
+
+template <class E, size_t N>
+std::string name_in(const Named<E> (&table)[N], E value) {
+  for (const auto& n : table)
+    if (n.value == value) return n.name;
+  return table[0].name;  // unreachable: every enumerator is in its table
+}
+
+/// The value named `name`, or InputError(source, field) listing the names.
+template <class E, size_t N>
+E parse_in(const Named<E> (&table)[N], std::string_view name, const std::string& what,
+           const std::string& source, const std::string& field) {
+  std::string valid;
+  for (const auto& n : table) {
+    if (name == n.name) return n.value;
+    valid += (valid.empty() ? "" : ", ") + std::string(n.name);
+  }
+  throw InputError(source, field,
+                   "unknown " + what + " \"" + std::string(name) + "\"; one of " + valid);
+}
+
 }  // namespace
 
-std::string to_string(TrialPhase phase) {
-  switch (phase) {
-    case TrialPhase::search:
-      return "search";
-    case TrialPhase::search_tightened:
-      return "search-tightened";
-    case TrialPhase::verify:
-      return "verify";
-    case TrialPhase::certificate:
-      return "certificate";
-    case TrialPhase::baseline:
-      return "baseline";
-    case TrialPhase::reference:
-      return "reference";
-    case TrialPhase::steps_search:
-      return "steps-search";
-  }
-  return "search";  // unreachable: every enumerator is named above
+std::string to_string(Strategy strategy) { return name_in(kStrategyNames, strategy); }
+
+Strategy parse_strategy(std::string_view name, const std::string& option) {
+  return parse_in(kStrategyNames, name, "strategy", option, "");
 }
+
+std::string to_string(TrialPhase phase) { return name_in(kPhaseNames, phase); }
 
 TrialPhase parse_trial_phase(std::string_view name, const std::string& source,
                              const std::string& field) {
-  std::string valid;
-  for (TrialPhase p : kTrialPhases) {
-    if (to_string(p) == name) return p;
-    valid += (valid.empty() ? "" : ", ") + to_string(p);
-  }
-  throw InputError(source, field,
-                   "unknown trial phase \"" + std::string(name) + "\"; one of " + valid);
+  return parse_in(kPhaseNames, name, "trial phase", source, field);
 }
 
 int64_t round_steps(double steps) {
@@ -617,6 +610,29 @@ Certificate certify(Evaluator& evaluator, const TrialRecord& best, double accura
   return c;
 }
 
+/// --resume: every whole line of trials.jsonl into the evaluator's cache.
+void preload_trials(Evaluator& evaluator, const std::string& path) {
+  std::ifstream in(path);
+  std::string line, kept;
+  int line_no = 0;
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (line.empty()) continue;
+    nlohmann::json j;
+    try {
+      j = nlohmann::json::parse(line);
+    } catch (const nlohmann::json::parse_error&) {
+      // A line cut by a kill in mid-write: everything before it is whole.
+      break;
+    }
+    evaluator.preload(trial_from_json(j, path + ": line " + std::to_string(line_no)));
+    kept += line + "\n";
+  }
+  in.close();
+  // Drop a cut last line so that new trials do not append to it.
+  write_file_atomic(path, kept);
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------
@@ -630,28 +646,8 @@ CalibrationSummary calibrate(const SceneConfig& config, const ConsolidatedState&
   const int n = state.world.size();
 
   Evaluator evaluator(config, state, options);
-  if (options.resume && !options.trials_path.empty()) {
-    std::ifstream in(options.trials_path);
-    std::string line, kept;
-    int line_no = 0;
-    while (std::getline(in, line)) {
-      ++line_no;
-      if (line.empty()) continue;
-      nlohmann::json j;
-      try {
-        j = nlohmann::json::parse(line);
-      } catch (const nlohmann::json::parse_error&) {
-        // A line cut by a kill in mid-write: everything before it is whole.
-        break;
-      }
-      evaluator.preload(
-          trial_from_json(j, options.trials_path + ": line " + std::to_string(line_no)));
-      kept += line + "\n";
-    }
-    in.close();
-    // Drop a cut last line so that new trials do not append to it.
-    write_file_atomic(options.trials_path, kept);
-  }
+  if (options.resume && !options.trials_path.empty())
+    preload_trials(evaluator, options.trials_path);
 
   // Bounds. The stable step comes from the consolidated contact network.
   AlgorithmSpec base = config.algorithm;

@@ -72,11 +72,11 @@ void write_fixed(std::ostringstream& md, const ScalingStudy& st) {
     const ScalingSize& r = st.results.at(n);
     const int64_t pred = upscale_steps(ref.best.steps, ref.particles, r.particles);
     md << "| " << r.particles << (n == st.ref_size ? " (REV)" : "") << " | "
-       << (r.fixed_found ? std::to_string(r.fixed_steps) : "none") << " | "
-       << (r.fixed_found ? num(static_cast<double>(r.fixed_steps) / r.particles, 4) : "–") << " | "
-       << pred << " | " << (r.fixed_found ? num(static_cast<double>(r.fixed_steps) / pred, 3) : "–")
+       << (r.fixed.found ? std::to_string(r.fixed.steps) : "none") << " | "
+       << (r.fixed.found ? num(static_cast<double>(r.fixed.steps) / r.particles, 4) : "–") << " | "
+       << pred << " | " << (r.fixed.found ? num(static_cast<double>(r.fixed.steps) / pred, 3) : "–")
        << " | "
-       << (n == st.ref_size ? std::string("calibration") : std::to_string(r.fixed_trials.size()))
+       << (n == st.ref_size ? std::string("calibration") : std::to_string(r.fixed.trials.size()))
        << " |\n";
   }
   md << "\nFrom the REV up (" << st.n_rep << " sizes): linear Nstep = " << num(st.lin_rep.slope, 5)

@@ -49,14 +49,14 @@ json to_json(const ScalingSize& r) {
               {"peak_stress_yy", r.peak},
               {"trials", r.trials},
               {"wall_time_s", r.wall_time_s}});
-  if (!r.fixed_trials.empty()) {
+  if (!r.fixed.trials.empty()) {
     json runs = json::array();
-    for (const auto& t : r.fixed_trials) runs.push_back(to_json(t));
-    j["fixed_multipliers"] = {{"found", r.fixed_found},
-                              {"steps", r.fixed_steps},
-                              {"best", r.fixed_found ? to_json(r.fixed) : json()},
+    for (const auto& t : r.fixed.trials) runs.push_back(to_json(t));
+    j["fixed_multipliers"] = {{"found", r.fixed.found},
+                              {"steps", r.fixed.steps},
+                              {"best", r.fixed.found ? to_json(r.fixed.best) : json()},
                               {"runs", runs},
-                              {"wall_time_s", r.fixed_wall_time_s}};
+                              {"wall_time_s", r.fixed.wall_time_s}};
   }
   return j;
 }
@@ -79,13 +79,13 @@ ScalingSize scaling_size_from_json(const json& j, const std::string& source) {
     }
     if (j.contains("fixed_multipliers")) {
       const json& f = j.at("fixed_multipliers");
-      r.fixed_found = f.at("found").get<bool>();
-      r.fixed_steps = f.at("steps").get<int64_t>();
-      r.fixed_wall_time_s = f.value("wall_time_s", 0.0);
-      if (r.fixed_found)
-        r.fixed = trial_from_json(f.at("best"), source + ": fixed_multipliers.best");
+      r.fixed.found = f.at("found").get<bool>();
+      r.fixed.steps = f.at("steps").get<int64_t>();
+      r.fixed.wall_time_s = f.value("wall_time_s", 0.0);
+      if (r.fixed.found)
+        r.fixed.best = trial_from_json(f.at("best"), source + ": fixed_multipliers.best");
       for (const auto& t : f.at("runs"))
-        r.fixed_trials.push_back(trial_from_json(t, source + ": fixed_multipliers.runs"));
+        r.fixed.trials.push_back(trial_from_json(t, source + ": fixed_multipliers.runs"));
     }
     return r;
   } catch (const json::exception& e) {
@@ -215,11 +215,7 @@ void fixed_multipliers(Family& family, const ScalingStudyOptions& o, const Scali
   if (o.resume && fs::exists(fixed_path)) {
     const ScalingSize stored = scaling_size_from_json(read_json(fixed_path), fixed_path);
     r.particles = stored.particles;
-    r.fixed_found = stored.fixed_found;
-    r.fixed_steps = stored.fixed_steps;
     r.fixed = stored.fixed;
-    r.fixed_trials = stored.fixed_trials;
-    r.fixed_wall_time_s = stored.fixed_wall_time_s;
     family.log("size " + std::to_string(n) + ": reusing " + fixed_path);
     return;
   }
@@ -233,11 +229,11 @@ void fixed_multipliers(Family& family, const ScalingStudyOptions& o, const Scali
              num(static_cast<double>(start.steps) * r.particles, 3) + " particle-steps)");
   const auto t0 = std::chrono::steady_clock::now();
   const StepSearch search = smallest_passing_steps(family.scene(n), state, start, tolerances);
-  r.fixed_found = search.found;
-  r.fixed_steps = search.found ? search.best.params.steps : 0;
-  r.fixed = search.best;
-  r.fixed_trials = search.trials;
-  r.fixed_wall_time_s = seconds_since(t0);
+  r.fixed.found = search.found;
+  r.fixed.steps = search.found ? search.best.params.steps : 0;
+  r.fixed.best = search.best;
+  r.fixed.trials = search.trials;
+  r.fixed.wall_time_s = seconds_since(t0);
   write_file_atomic(fixed_path, to_json(r).dump(2) + "\n");
   for (const auto& t : search.trials)
     family.log("  " + std::to_string(t.params.steps) + " steps: " + (t.passed ? "pass" : "fail") +
@@ -261,12 +257,12 @@ void fit_laws(ScalingStudy& st) {
   // (the representative sizes: the law is carried upward from the REV).
   for (int64_t n : st.sizes) {
     const ScalingSize& r = st.results[n];
-    if (!r.fixed_found) continue;
+    if (!r.fixed.found) continue;
     n_fix.push_back(static_cast<double>(r.particles));
-    steps_fix.push_back(static_cast<double>(r.fixed_steps));
+    steps_fix.push_back(static_cast<double>(r.fixed.steps));
     if (n >= st.ref_size) {
       n_rep.push_back(static_cast<double>(r.particles));
-      steps_rep.push_back(static_cast<double>(r.fixed_steps));
+      steps_rep.push_back(static_cast<double>(r.fixed.steps));
     }
   }
   st.lin_cal = fit_linear(n_cal, steps_cal), st.pow_cal = fit_power(n_cal, steps_cal);
@@ -366,16 +362,16 @@ ScalingStudy run_scaling_study(const SceneConfig& config, const ScalingStudyOpti
     ScalingSize& r = st.results[n];
     r.requested = n;
     if (n == st.ref_size) {
-      r.fixed_found = true;
-      r.fixed_steps = r.best.steps;
+      r.fixed.found = true;
+      r.fixed.steps = r.best.steps;
       continue;
     }
     fixed_multipliers(family, o, ref, st.tolerances, n, r);
   }
   fit_laws(st);
   const ScalingSize& fwd = st.results[st.forward_size];
-  if (st.forward_size > o.calibrate_max && !fwd.fixed_trials.empty())
-    forward_check(family, o, st, fwd.fixed_trials.front());
+  if (st.forward_size > o.calibrate_max && !fwd.fixed.trials.empty())
+    forward_check(family, o, st, fwd.fixed.trials.front());
   st.forward_ok =
       st.have_forward && st.linear_run.passed && std::abs(st.linear_peak_error) <= st.accuracy;
   // The law upscaling uses: linear while the forward check confirms it (a

@@ -40,6 +40,15 @@ struct ScalingStudyOptions {
   std::function<void(const std::string&)> log;
 };
 
+/// The smallest passing Nstep at the REV's multipliers, at one size.
+struct FixedMultipliers {
+  bool found = false;
+  int64_t steps = 0;
+  TrialRecord best;                 ///< the smallest passing run
+  std::vector<TrialRecord> trials;  ///< every run, in order
+  double wall_time_s = 0.0;
+};
+
 /// One size of the family.
 struct ScalingSize {
   int64_t requested = 0, particles = 0;
@@ -49,12 +58,7 @@ struct ScalingSize {
   int trials = 0;
   double wall_time_s = 0.0, consolidation_s = 0.0;
   int64_t consolidation_steps = 0;
-  // The smallest passing Nstep at the reference multipliers.
-  bool fixed_found = false;
-  int64_t fixed_steps = 0;
-  TrialRecord fixed;
-  std::vector<TrialRecord> fixed_trials;
-  double fixed_wall_time_s = 0.0;
+  FixedMultipliers fixed;
 };
 /// A size as scaling.json records it (and as result.json stores a
 /// calibrated size for resume), and back; errors name `source`.
