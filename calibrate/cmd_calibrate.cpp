@@ -19,15 +19,16 @@
 #include <string_view>
 
 #include "commands.hpp"
-#include "demcal/io/format.hpp"
-#include "demcal/scene/biaxial.hpp"
-#include "demcal/search/calibration.hpp"
 #include "demcal/io/files.hpp"
-#include "demcal/scene/run_output.hpp"
-#include "demcal/scene/packing.hpp"
-#include "demcal/search/parallel.hpp"
+#include "demcal/io/format.hpp"
 #include "demcal/report/report.hpp"
+#include "demcal/scene/biaxial.hpp"
+#include "demcal/scene/packing.hpp"
+#include "demcal/scene/run_output.hpp"
 #include "demcal/scoring/trial.hpp"
+#include "demcal/search/calibration.hpp"
+#include "demcal/search/parallel.hpp"
+#include "demcal/upscaling/params_file.hpp"
 #include "demcal/upscaling/upscaling.hpp"
 #include "output_folder.hpp"
 #include "stop_signal.hpp"
@@ -67,12 +68,19 @@ std::string reproduce_command(const CalibrateOptions& o, const SceneConfig& conf
   return out;
 }
 
-/// Particle-steps actually run by the search (early stops counted as run):
-/// a deterministic measure of the calibration's cost.
-double particle_steps_run(const std::vector<TrialRecord>& trials, int64_t particles) {
-  double sum = 0.0;
-  for (const auto& t : trials) sum += static_cast<double>(t.steps_run);
-  return sum * static_cast<double>(particles);
+/// run.json: what varies between invocations (kept out of params.json).
+nlohmann::json run_record(double wall_time_s, const CalibrationSummary& summary,
+                          const ConsolidatedState& state, int jobs, bool resumed) {
+  return {{"schema", "demcal.run/1"},
+          {"wall_time_s", wall_time_s},
+          {"calibration_wall_time_s", summary.wall_time_s},
+          {"consolidation_wall_time_s", state.wall_time_s},
+          {"jobs", jobs},
+          {"resumed", resumed},
+          {"trials_run", summary.trials_run},
+          {"trials_reused", summary.trials_reused},
+          {"kernel_simd", kernel_simd()},
+          {"version", DEMCAL_VERSION}};
 }
 
 }  // namespace
@@ -84,6 +92,7 @@ int cmd_calibrate(const CalibrateOptions& o) {
   if (o.accuracy > 0) config.calibration.accuracy = o.accuracy;
   if (o.accuracy < 0 || o.accuracy >= 1)
     throw InputError("--accuracy", "", "must be a fraction in (0, 1), e.g. 0.02");
+  const Strategy strategy = parse_strategy(o.strategy, "--strategy");
   const std::string dir = o.out_dir.empty() ? "demcal-" + config.name : o.out_dir;
   const std::string trials_path = dir + "/trials.jsonl";
   OutputFolder::check(dir);  // an unwritable -o fails now, not after the search
@@ -110,12 +119,9 @@ int cmd_calibrate(const CalibrateOptions& o) {
   for (const char* name : {"params.json", "run.json", "report.html", "report.md", "evidence.jsonl"})
     std::filesystem::remove(dir + "/" + name);
 
-  CalibrationOptions options;
-  options.strategy = o.strategy;
-  options.max_trials = config.calibration.max_trials;
+  CalibrationOptions options = CalibrationOptions::from(config.calibration);
+  options.strategy = strategy;
   options.jobs = o.jobs;
-  options.accuracy = config.calibration.accuracy;
-  options.seed = config.calibration.seed;
   options.trials_path = trials_path;
   options.resume = o.resume;
   if (!o.quiet) options.progress = [](const std::string& line) { std::cerr << line << "\n"; };
@@ -131,37 +137,7 @@ int cmd_calibrate(const CalibrateOptions& o) {
 
   const int64_t n_rev = state.world.size();
   const int64_t n_proto = config.prototype.particles > 0 ? config.prototype.particles : n_rev;
-
-  nlohmann::json params{
-      {"schema", "demcal.params/1"},
-      {"scene", config.name},
-      {"success", summary.success},
-      {"message", summary.message},
-      {"rev", param_block(summary.best, particle_scales(state.world.radius(), config.material,
-                                                        summary.best.mass_scaling))},
-      // Δt and damping recomputed from the prototype's own particles.
-      {"prototype", prototype_block(config, summary.best, n_rev)},
-      {"upscaling", upscaling_block(n_rev, n_proto)},
-      {"config", to_json(config)},
-      {"criteria", summary.best_trial.criteria_json.is_null() ? to_json(summary.best_trial.criteria)
-                                                              : summary.best_trial.criteria_json},
-      {"tolerances", to_json(options.tolerances)},
-      {"accuracy", options.accuracy},
-      {"certificate",
-       {{"steps", summary.certificate.steps},
-        {"peak_stress_yy", summary.certificate.peak},
-        {"peak_stress_yy_steps_doubled", summary.certificate.peak_doubled},
-        {"steps_doubled_peak_change", summary.certificate.steps_doubled_peak_change},
-        {"richardson_error", summary.certificate.richardson_error},
-        {"passed", summary.certificate.passed}}},
-      {"dt_ratio_stable", summary.dt_ratio_stable},
-      {"strategy", summary.strategy},
-      {"trials", static_cast<int>(summary.trials.size())},
-      {"particle_steps_run", particle_steps_run(summary.trials, n_rev)},
-      {"seed", config.calibration.seed},
-      {"config_sha256", sha256_hex(config.text)},
-      {"version", DEMCAL_VERSION}};
-  if (auto a = analytical_peak_stress(config)) params["analytical_peak_stress_yy"] = *a;
+  nlohmann::json params = params_file(config, state, options, summary);
 
   const bool have_best = summary.best_trial.particle_steps > 0.0;
   const int jobs = resolve_jobs(o.jobs);
@@ -179,48 +155,17 @@ int cmd_calibrate(const CalibrateOptions& o) {
     say("evidence: paper-recipe baseline and converged reference (8x, 16x Nstep = " +
         std::to_string(16 * summary.best.steps) + ")");
     auto run_baseline = [&] {
-      baseline = paper_recipe_baseline(config, state, options.tolerances, 500LL * n_rev);
+      baseline =
+          paper_recipe_baseline(config, state, options.tolerances, kStartStepsPerParticle * n_rev);
     };
     auto run_reference = [&] {
       reference = run_refined_reference(config, state, summary.best, options.tolerances, 1);
     };
     run_parallel({run_baseline, run_reference}, jobs);
-    auto peak_error = [&](const TrialRecord& t) -> nlohmann::json {
-      if (!t.complete || t.diverged || t.criteria.peak_stress_yy >= 0.0) return nullptr;
-      return (reference->peak - t.criteria.peak_stress_yy) / std::abs(reference->peak);
-    };
-    std::string lines;
-    for (const auto* t : {&reference->coarse, &reference->fine}) {
-      nlohmann::json j = to_json(*t);
-      j["peak_error"] = peak_error(*t);
-      lines += j.dump() + "\n";
-    }
-    for (const auto& t : baseline->trials) {
-      nlohmann::json j = to_json(t);
-      j["peak_error"] = peak_error(t);
-      lines += j.dump() + "\n";
-    }
-    evidence_lines = std::move(lines);
-    nlohmann::json b{{"passed", baseline->passed},
-                     {"start_steps", 500LL * n_rev},
-                     {"trials", static_cast<int>(baseline->trials.size())},
-                     {"particle_steps_total", baseline->particle_steps_total}};
-    if (baseline->passed) {
-      b["steps"] = baseline->params.steps;
-      b["particle_steps"] = baseline->trials.back().particle_steps;
-      b["peak_stress_yy"] = baseline->trials.back().criteria.peak_stress_yy;
-      b["peak_error"] = peak_error(baseline->trials.back());
-    }
-    params["evidence"] = {
-        {"reference",
-         {{"law", "Richardson, error proportional to 1/Nstep: 2 P(16 Nstep) - P(8 Nstep)"},
-          {"steps_8x", reference->coarse.params.steps},
-          {"peak_stress_yy_8x", reference->coarse.criteria.peak_stress_yy},
-          {"steps_16x", reference->fine.params.steps},
-          {"peak_stress_yy_16x", reference->fine.criteria.peak_stress_yy},
-          {"peak_stress_yy", reference->peak},
-          {"calibrated_peak_error", peak_error(summary.best_trial)}}},
-        {"baseline", b}};
+    const CalibrationEvidence evidence{reference->coarse, reference->fine, reference->peak,
+                                       *baseline, kStartStepsPerParticle * n_rev};
+    evidence_lines = demcal::evidence_lines(evidence);
+    params["evidence"] = evidence_block(evidence, summary.best_trial);
   }
   // The evidence and report runs do not poll the flag (seconds on a REV):
   // a stop asked for during them takes effect here.
@@ -230,17 +175,9 @@ int cmd_calibrate(const CalibrateOptions& o) {
   // What varies between invocations stays out of params.json. Written now
   // and again after the report, so params.json never stands without it.
   const auto write_run_json = [&] {
-    const nlohmann::json run{{"schema", "demcal.run/1"},
-                             {"wall_time_s", seconds_since(t_start)},
-                             {"calibration_wall_time_s", summary.wall_time_s},
-                             {"consolidation_wall_time_s", state.wall_time_s},
-                             {"jobs", jobs},
-                             {"resumed", o.resume},
-                             {"trials_run", summary.trials_run},
-                             {"trials_reused", summary.trials_reused},
-                             {"kernel_simd", kernel_simd()},
-                             {"version", DEMCAL_VERSION}};
-    write_file_atomic(dir + "/run.json", run.dump(2) + "\n");
+    const double wall_time_s = seconds_since(t_start);
+    write_file_atomic(dir + "/run.json",
+                      run_record(wall_time_s, summary, state, jobs, o.resume).dump(2) + "\n");
   };
   write_run_json();
   if (stop.stopped())
@@ -261,20 +198,15 @@ int cmd_calibrate(const CalibrateOptions& o) {
     in.tolerances = options.tolerances;
     in.accuracy = options.accuracy;
     in.lateral_stress = config.test.lateral_stress;
-    in.dt_ratio_max =
-        std::max(options.dt_ratio_min, options.dt_ratio_safety * summary.dt_ratio_stable);
+    in.dt_ratio_max = dt_ratio_max(options, summary.dt_ratio_stable);
     in.particles = n_rev;
     in.prototype_particles = n_proto;
     in.analytical_peak = analytical_peak_stress(config);
     in.baseline = std::move(baseline);
     in.reference = std::move(reference);
-    // The search's first start (calibration.cpp): the paper's multipliers
-    // with a size-based Nstep of 500 per particle, α capped by the bound.
-    AlgorithmSpec start = config.algorithm;
-    start.dt_ratio = std::round(std::min(0.2, in.dt_ratio_max) * 1e6) / 1e6;
-    start.steps = 500LL * n_rev;
-    start.damping_ratio_translation = 1.0;
-    start.damping_ratio_rotation = 1.0;
+    // The search's first start, as it ran.
+    const AlgorithmSpec start =
+        rounded_params(search_start(config.algorithm, n_rev, in.dt_ratio_max));
     // A stop now: finish, the runs are done.
     attach_runs(in, rerun_start_and_result(config, state, start, summary, in.tolerances, jobs));
     const auto t1 = std::chrono::steady_clock::now();

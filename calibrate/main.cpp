@@ -5,6 +5,7 @@
 
 #include "commands.hpp"
 #include "demcal/scene/config.hpp"
+#include "demcal/search/calibration.hpp"
 
 int main(int argc, char** argv) {
   using namespace demcal::cli;
@@ -47,8 +48,10 @@ int main(int argc, char** argv) {
   calibrate->add_option("-j,--jobs", cal.jobs, "trials in parallel (default: cores)");
   calibrate->add_option("--max-trials", cal.max_trials, "search trials (default: config, 80)");
   calibrate->add_option("--accuracy", cal.accuracy, "peak accuracy target (default 0.02)");
-  calibrate->add_option("--strategy", cal.strategy, "NLopt strategy")
-      ->check(CLI::IsMember({"model", "cobyla", "auglag", "penalty", "direct"}));
+  std::string strategies;
+  for (demcal::Strategy s : demcal::kStrategies)
+    strategies += (strategies.empty() ? "" : ", ") + demcal::to_string(s);
+  calibrate->add_option("--strategy", cal.strategy, "search strategy: " + strategies);
   calibrate->add_flag("--resume", cal.resume, "continue from DIR/trials.jsonl");
   calibrate->add_flag("-q,--quiet", cal.quiet, "no progress lines on stderr");
   calibrate->add_flag("--evidence", cal.evidence,

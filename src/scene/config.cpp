@@ -127,7 +127,38 @@ ContactLaw read_contact(Reader& r, const ContactLaw& fallback) {
   return c;
 }
 
+/// The algorithm block: every key optional (missing ones keep `base`),
+/// checked, unknown keys rejected. Shared by the config and every record
+/// that stores an AlgorithmSpec (trials.jsonl, the scaling study's files).
+AlgorithmSpec read_algorithm(Reader& a, AlgorithmSpec s) {
+  s.dt_ratio = a.positive("dt_ratio", s.dt_ratio);
+  if (s.dt_ratio > 2.0) a.fail("dt_ratio", "must be <= 2 (beyond the single-spring limit)");
+  s.steps = a.integer("steps", s.steps, 10, 10000000000LL);
+  s.damping_ratio_translation =
+      a.non_negative("damping_ratio_translation", s.damping_ratio_translation);
+  s.damping_ratio_rotation = a.non_negative("damping_ratio_rotation", s.damping_ratio_rotation);
+  s.mass_scaling = a.positive("mass_scaling", s.mass_scaling);
+  s.lock_rotation = a.boolean("lock_rotation", s.lock_rotation);
+  a.reject_unknown();
+  return s;
+}
+
 }  // namespace
+
+nlohmann::json to_json(const AlgorithmSpec& g) {
+  return {{"dt_ratio", g.dt_ratio},
+          {"steps", g.steps},
+          {"damping_ratio_translation", g.damping_ratio_translation},
+          {"damping_ratio_rotation", g.damping_ratio_rotation},
+          {"mass_scaling", g.mass_scaling},
+          {"lock_rotation", g.lock_rotation}};
+}
+
+AlgorithmSpec algorithm_from_json(const nlohmann::json& json, const std::string& source,
+                                  const std::string& field, const AlgorithmSpec& base) {
+  Reader a(json, source, field);
+  return read_algorithm(a, base);
+}
 
 SceneConfig parse_config(const nlohmann::json& root_json, const std::string& source) {
   SceneConfig c;
@@ -197,16 +228,7 @@ SceneConfig parse_config(const nlohmann::json& root_json, const std::string& sou
   }
   {
     Reader a = root.child("algorithm");
-    auto& s = c.algorithm;
-    s.dt_ratio = a.positive("dt_ratio", s.dt_ratio);
-    if (s.dt_ratio > 2.0) a.fail("dt_ratio", "must be <= 2 (beyond the single-spring limit)");
-    s.steps = a.integer("steps", s.steps, 10, 10000000000LL);
-    s.damping_ratio_translation =
-        a.non_negative("damping_ratio_translation", s.damping_ratio_translation);
-    s.damping_ratio_rotation = a.non_negative("damping_ratio_rotation", s.damping_ratio_rotation);
-    s.mass_scaling = a.positive("mass_scaling", s.mass_scaling);
-    s.lock_rotation = a.boolean("lock_rotation", s.lock_rotation);
-    a.reject_unknown();
+    c.algorithm = read_algorithm(a, c.algorithm);
   }
   {
     Reader k = root.child("calibration");
@@ -376,7 +398,6 @@ nlohmann::json to_json(const SceneConfig& c) {
     assembly["file"] = a.file;
   }
   const auto& t = c.test;
-  const auto& g = c.algorithm;
   json prototype{{"particles", c.prototype.particles}};
   if (!c.prototype.file.empty()) prototype["file"] = c.prototype.file;
   return json{{"name", c.name},
@@ -391,13 +412,7 @@ nlohmann::json to_json(const SceneConfig& c) {
                 {"consolidation_tolerance", t.consolidation_tolerance},
                 {"consolidation_unbalanced", t.consolidation_unbalanced},
                 {"consolidation_max_steps", t.consolidation_max_steps}}},
-              {"algorithm",
-               {{"dt_ratio", g.dt_ratio},
-                {"steps", g.steps},
-                {"damping_ratio_translation", g.damping_ratio_translation},
-                {"damping_ratio_rotation", g.damping_ratio_rotation},
-                {"mass_scaling", g.mass_scaling},
-                {"lock_rotation", g.lock_rotation}}},
+              {"algorithm", to_json(c.algorithm)},
               {"calibration",
                {{"accuracy", c.calibration.accuracy},
                 {"max_trials", c.calibration.max_trials},

@@ -5,6 +5,8 @@
 #include <cstdint>
 #include <cstdio>
 
+#include "demcal/io/format.hpp"
+
 namespace demcal {
 
 namespace {
@@ -326,11 +328,8 @@ double confidence_from(double excess, double base, double top) {
   return std::min(top, base + 0.1 * std::log(excess) / std::log(4.0));
 }
 
-std::string percent(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.2g %%", 100.0 * v);
-  return buf;
-}
+/// Two significant digits: "140 %", "3.5 %".
+std::string percent(double v) { return num(100.0 * v, 2) + " %"; }
 
 }  // namespace
 
@@ -500,6 +499,27 @@ std::array<double, 4> constraint_values(const Score& s, const Tolerances& t) {
   if (!s.complete)
     for (double& v : out) v = std::max(v, 0.1);
   return out;
+}
+
+double rate_excess(const Criteria& c, const Tolerances& t) {
+  return std::max(
+      {c.force_balance / t.force_balance, c.servo / t.servo, c.moment_balance / t.moment_balance});
+}
+
+double search_objective(int64_t steps, const Score& score, const Tolerances& tolerances,
+                        bool penalised) {
+  double f = std::log10(static_cast<double>(steps));
+  if (penalised)
+    for (double g : constraint_values(score, tolerances)) f += 10.0 * std::max(0.0, g);
+  return f;
+}
+
+double richardson_limit(double n_coarse, double p_coarse, double n_fine, double p_fine) {
+  return n_fine > n_coarse ? (n_fine * p_fine - n_coarse * p_coarse) / (n_fine - n_coarse) : p_fine;
+}
+
+double richardson_error(double relative_change, double refinement) {
+  return refinement / (refinement - 1.0) * relative_change;
 }
 
 double cost_term(double particle_steps) {

@@ -18,18 +18,14 @@ nlohmann::json params_json(const AlgorithmSpec& a, const Integration& in,
                            const ReferenceScales& s) {
   // Damping is per particle (same ratio for all); the absolute values are
   // given for the lightest particle, the one that also sets Δt_crit.
-  return {{"dt", in.dt},
-          {"dt_ratio", a.dt_ratio},
-          {"dt_crit", s.dt_crit},
-          {"steps", a.steps},
-          {"damping_translation", a.damping_ratio_translation * s.damping_translation_crit},
-          {"damping_ratio_translation", a.damping_ratio_translation},
-          {"damping_translation_crit", s.damping_translation_crit},
-          {"damping_rotation", a.damping_ratio_rotation * s.damping_rotation_crit},
-          {"damping_ratio_rotation", a.damping_ratio_rotation},
-          {"damping_rotation_crit", s.damping_rotation_crit},
-          {"mass_scaling", a.mass_scaling},
-          {"lock_rotation", a.lock_rotation}};
+  nlohmann::json j = to_json(a);
+  j.update({{"dt", in.dt},
+            {"dt_crit", s.dt_crit},
+            {"damping_translation", a.damping_ratio_translation * s.damping_translation_crit},
+            {"damping_translation_crit", s.damping_translation_crit},
+            {"damping_rotation", a.damping_ratio_rotation * s.damping_rotation_crit},
+            {"damping_rotation_crit", s.damping_rotation_crit}});
+  return j;
 }
 
 nlohmann::json run_summary(const SceneConfig& config, const LoadingResult& run,

@@ -1,5 +1,4 @@
 #include "demcal/search/calibration.hpp"
-#include "demcal/io/format.hpp"
 
 #include <nlopt.h>
 
@@ -15,6 +14,7 @@
 #include <sstream>
 
 #include "demcal/io/files.hpp"
+#include "demcal/io/format.hpp"
 #include "demcal/scene/run_output.hpp"
 #include "demcal/search/parallel.hpp"
 
@@ -27,16 +27,19 @@ namespace {
 /// exactly the trial it stands for.
 using Key = std::tuple<int64_t, int64_t, int64_t, int64_t, int64_t, bool>;
 
-AlgorithmSpec rounded(AlgorithmSpec p) {
+}  // namespace
+
+AlgorithmSpec rounded_params(const AlgorithmSpec& params) {
+  AlgorithmSpec p = params;
   auto r6 = [](double v) { return std::round(v * 1e6) / 1e6; };
   p.dt_ratio = r6(p.dt_ratio);
   p.damping_ratio_translation = r6(p.damping_ratio_translation);
   p.damping_ratio_rotation = r6(p.damping_ratio_rotation);
-  // Four significant digits of Nstep: 0.1 % of the loading rate.
-  const double mag = std::pow(10.0, std::floor(std::log10(static_cast<double>(p.steps))) - 3.0);
-  p.steps = std::max<int64_t>(10, std::llround(std::round(p.steps / mag) * mag));
+  p.steps = round_steps(static_cast<double>(p.steps));
   return p;
 }
+
+namespace {
 
 Key key_of(const AlgorithmSpec& p) {
   return {std::llround(p.dt_ratio * 1e6),
@@ -47,16 +50,98 @@ Key key_of(const AlgorithmSpec& p) {
           p.lock_rotation};
 }
 
-nlohmann::json params_to_json(const AlgorithmSpec& p) {
-  return {{"dt_ratio", p.dt_ratio},
-          {"steps", p.steps},
-          {"damping_ratio_translation", p.damping_ratio_translation},
-          {"damping_ratio_rotation", p.damping_ratio_rotation},
-          {"mass_scaling", p.mass_scaling},
-          {"lock_rotation", p.lock_rotation}};
+}  // namespace
+
+namespace {
+
+/// An enum's names, for to_string() and the parsers: one table each.
+template <class E>
+struct Named {
+  E value;
+  const char* name;
+};
+constexpr Named<Strategy> kStrategyNames[] = {{Strategy::model, "model"},
+                                              {Strategy::cobyla, "cobyla"},
+                                              {Strategy::auglag, "auglag"},
+                                              {Strategy::penalty, "penalty"},
+                                              {Strategy::direct, "direct"}};
+constexpr Named<TrialPhase> kPhaseNames[] = {{TrialPhase::search, "search"},
+                                             {TrialPhase::search_tightened, "search-tightened"},
+                                             {TrialPhase::verify, "verify"},
+                                             {TrialPhase::certificate, "certificate"},
+                                             {TrialPhase::baseline, "baseline"},
+                                             {TrialPhase::reference, "reference"},
+                                             {TrialPhase::steps_search, "steps-search"}};
+
+template <class E, size_t N>
+std::string name_in(const Named<E> (&table)[N], E value) {
+  for (const auto& n : table)
+    if (n.value == value) return n.name;
+  return table[0].name;  // unreachable: every enumerator is in its table
+}
+
+/// The value named `name`, or InputError(source, field) listing the names.
+template <class E, size_t N>
+E parse_in(const Named<E> (&table)[N], std::string_view name, const std::string& what,
+           const std::string& source, const std::string& field) {
+  std::string valid;
+  for (const auto& n : table) {
+    if (name == n.name) return n.value;
+    valid += (valid.empty() ? "" : ", ") + std::string(n.name);
+  }
+  throw InputError(source, field,
+                   "unknown " + what + " \"" + std::string(name) + "\"; one of " + valid);
 }
 
 }  // namespace
+
+std::string to_string(Strategy strategy) { return name_in(kStrategyNames, strategy); }
+
+Strategy parse_strategy(std::string_view name, const std::string& option) {
+  return parse_in(kStrategyNames, name, "strategy", option, "");
+}
+
+std::string to_string(TrialPhase phase) { return name_in(kPhaseNames, phase); }
+
+TrialPhase parse_trial_phase(std::string_view name, const std::string& source,
+                             const std::string& field) {
+  return parse_in(kPhaseNames, name, "trial phase", source, field);
+}
+
+int64_t round_steps(double steps) {
+  const double mag = std::pow(10.0, std::floor(std::log10(std::max(steps, 10.0))) - 3.0);
+  return std::max<int64_t>(10, std::llround(std::round(steps / mag) * mag));
+}
+
+AlgorithmSpec search_start(const AlgorithmSpec& base, int64_t particles, double dt_ratio_max) {
+  AlgorithmSpec p = base;
+  p.dt_ratio = std::min(0.2, dt_ratio_max);
+  p.steps = kStartStepsPerParticle * particles;
+  p.damping_ratio_translation = 1.0;
+  p.damping_ratio_rotation = 1.0;
+  return p;
+}
+
+double dt_ratio_max(const CalibrationOptions& options, double dt_ratio_stable) {
+  return std::max(options.dt_ratio_min, options.dt_ratio_safety * dt_ratio_stable);
+}
+
+nlohmann::json to_json(const Certificate& c) {
+  return {{"steps", c.steps},
+          {"peak_stress_yy", c.peak},
+          {"peak_stress_yy_steps_doubled", c.peak_doubled},
+          {"steps_doubled_peak_change", c.steps_doubled_peak_change},
+          {"richardson_error", c.richardson_error},
+          {"passed", c.passed}};
+}
+
+CalibrationOptions CalibrationOptions::from(const CalibrationSpec& spec) {
+  CalibrationOptions o;
+  o.max_trials = spec.max_trials;
+  o.accuracy = spec.accuracy;
+  o.seed = spec.seed;
+  return o;
+}
 
 // ---------------------------------------------------------------------------
 // One trial
@@ -76,28 +161,49 @@ TrialRecord run_trial(const SceneConfig& config, const ConsolidatedState& state,
     };
   }
   LoadingResult run = run_loading(state, config.test, params, monitor);
-  const Score score = score_run(run, s3, tol);
+  TrialRecord r = trial_record(params, score_run(run, s3, tol), run);
+  if (run_out) *run_out = std::move(run);
+  return r;
+}
+
+TrialRecord trial_record(const AlgorithmSpec& params, const Score& score,
+                         const LoadingResult& run) {
   TrialRecord r;
   r.params = params;
   r.criteria = score.criteria;
-  r.criteria_json = to_json(score.criteria);
   r.passed = score.passed;
   r.diverged = score.diverged;
   r.complete = score.complete;
   r.worst_excess = score.worst_excess;
   r.steps_run = run.steps_run;
-  r.particle_steps = static_cast<double>(run.particles) * static_cast<double>(params.steps);
+  r.particle_steps = score.particle_steps;
   r.wall_time_s = run.wall_time_s;
   r.diagnosis = score.diagnosis.message;
-  if (run_out) *run_out = std::move(run);
   return r;
 }
 
+Score score_of(const TrialRecord& r) {
+  Score score;
+  score.criteria = r.criteria;
+  score.diverged = r.diverged;
+  score.complete = r.complete;
+  score.passed = r.passed;
+  score.worst_excess = r.worst_excess;
+  score.particle_steps = r.particle_steps;
+  score.completed_fraction =
+      r.params.steps > 0 ? static_cast<double>(r.steps_run) / static_cast<double>(r.params.steps)
+                         : 0.0;
+  score.diagnosis.message = r.diagnosis;
+  return score;
+}
+
+// trials.jsonl: one line per trial. The keys are those of every earlier
+// version (the peak repeated beside the criteria), so old files resume.
 nlohmann::json to_json(const TrialRecord& r) {
   return {{"id", r.id},
           {"phase", r.phase},
-          {"params", params_to_json(r.params)},
-          {"criteria", r.criteria_json.is_null() ? to_json(r.criteria) : r.criteria_json},
+          {"params", to_json(r.params)},
+          {"criteria", to_json(r.criteria)},
           {"peak_stress_yy", r.criteria.peak_stress_yy},
           {"peak_strain_yy", r.criteria.peak_strain_yy},
           {"passed", r.passed},
@@ -114,35 +220,12 @@ TrialRecord trial_from_json(const nlohmann::json& j, const std::string& source) 
   try {
     TrialRecord r;
     r.id = j.at("id").get<int>();
-    r.phase = j.at("phase").get<std::string>();
-    const auto& p = j.at("params");
-    r.params.dt_ratio = p.at("dt_ratio").get<double>();
-    r.params.steps = p.at("steps").get<int64_t>();
-    r.params.damping_ratio_translation = p.at("damping_ratio_translation").get<double>();
-    r.params.damping_ratio_rotation = p.at("damping_ratio_rotation").get<double>();
-    r.params.mass_scaling = p.at("mass_scaling").get<double>();
-    r.params.lock_rotation = p.at("lock_rotation").get<bool>();
-    const auto& c = j.at("criteria");
-    r.criteria_json = c;
-    auto& k = r.criteria;
-    k.force_balance = c.value("force_balance", 0.0);
-    k.force_balance_paper = c.value("force_balance_paper", 0.0);
-    k.force_balance_xx = c.value("force_balance_xx", 0.0);
-    k.force_balance_yy = c.value("force_balance_yy", 0.0);
-    k.force_balance_xy = c.value("force_balance_xy", 0.0);
-    k.force_balance_yx = c.value("force_balance_yx", 0.0);
-    k.moment_balance = c.value("moment_balance", 0.0);
-    k.servo = c.value("servo", 0.0);
-    k.oscillation = c.value("oscillation", 0.0);
-    k.zigzag = c.value("zigzag", 0.0);
-    k.post_peak_softening = c.value("post_peak_softening", 0.0);
-    k.plateau_spread = c.value("plateau_spread", 0.0);
-    k.kinetic_energy_ratio_max = c.value("kinetic_energy_ratio_max", 0.0);
-    k.unbalanced_force_ratio_mean = c.value("unbalanced_force_ratio_mean", 0.0);
-    k.unbalanced_force_ratio_max = c.value("unbalanced_force_ratio_max", 0.0);
-    k.inertial_number_max = c.value("inertial_number_max", 0.0);
-    k.peak_stress_yy = j.at("peak_stress_yy").get<double>();
-    k.peak_strain_yy = j.at("peak_strain_yy").get<double>();
+    r.phase = to_string(parse_trial_phase(j.at("phase").get<std::string>(), source));
+    r.params = algorithm_from_json(j.at("params"), source, "params");
+    r.criteria = criteria_from_json(j.at("criteria"));
+    // Records older than the peak inside the criteria carry it beside them.
+    r.criteria.peak_stress_yy = j.at("peak_stress_yy").get<double>();
+    r.criteria.peak_strain_yy = j.at("peak_strain_yy").get<double>();
     r.passed = j.at("passed").get<bool>();
     r.diverged = j.at("diverged").get<bool>();
     r.complete = j.at("complete").get<bool>();
@@ -183,8 +266,8 @@ class Evaluator {
   /// Run (or look up) one trial. Once stopped(), no new trial starts, and a
   /// trial cut short by the stop is neither cached nor written: it returns
   /// marked incomplete and failed, and the searches wind down.
-  TrialRecord evaluate(AlgorithmSpec params, const std::string& phase) {
-    params = rounded(params);
+  TrialRecord evaluate(AlgorithmSpec params, TrialPhase phase) {
+    params = rounded_params(params);
     if (stopped()) return interrupted_record(params, phase);
     const Key key = key_of(params);
     std::shared_future<TrialRecord> future;
@@ -211,7 +294,7 @@ class Evaluator {
       promise.set_exception(std::current_exception());
       throw;
     }
-    r.phase = phase;
+    r.phase = to_string(phase);
     if (!r.complete && stopped()) {
       // Possibly cut by the stop: not a finished trial. --resume reruns it.
       r = interrupted_record(params, phase);
@@ -230,8 +313,8 @@ class Evaluator {
         std::ostringstream s;
         s.precision(3);
         const double elapsed = seconds_since(t0_);
-        s << "trial " << r.id + 1 << "/" << options_.max_trials << " (" << phase << "): alpha "
-          << params.dt_ratio << ", steps " << params.steps << ", zeta_t "
+        s << "trial " << r.id + 1 << "/" << options_.max_trials << " (" << to_string(phase)
+          << "): alpha " << params.dt_ratio << ", steps " << params.steps << ", zeta_t "
           << params.damping_ratio_translation << ", zeta_r " << params.damping_ratio_rotation
           << " -> "
           << (r.diverged ? "diverged"
@@ -265,10 +348,10 @@ class Evaluator {
   int reused_count() const { return reused_; }
 
  private:
-  static TrialRecord interrupted_record(const AlgorithmSpec& params, const std::string& phase) {
+  static TrialRecord interrupted_record(const AlgorithmSpec& params, TrialPhase phase) {
     TrialRecord r;
     r.params = params;
-    r.phase = phase;
+    r.phase = to_string(phase);
     r.complete = false;
     r.worst_excess = std::numeric_limits<double>::infinity();
     r.diagnosis = "interrupted";
@@ -307,18 +390,14 @@ AlgorithmSpec params_at(const SearchSpace& space, const double* x) {
 constexpr int kConstraints = 4;
 
 std::array<double, kConstraints> constraint_values(const TrialRecord& r, const Tolerances& t) {
-  Score score;
-  score.criteria = r.criteria;
-  score.diverged = r.diverged;
-  score.complete = r.complete;
-  return demcal::constraint_values(score, t);
+  return demcal::constraint_values(score_of(r), t);
 }
 
 struct SearchContext {
   Evaluator* evaluator;
   const SearchSpace* space;
   Tolerances tolerances;
-  std::string phase;
+  TrialPhase phase;
   bool penalty = false;
   nlopt_opt opt = nullptr;  ///< the running optimiser, stopped with the evaluator
 };
@@ -332,11 +411,7 @@ TrialRecord eval_at(SearchContext& c, const double* x) {
 double objective(unsigned, const double* x, double*, void* data) {
   auto& c = *static_cast<SearchContext*>(data);
   const TrialRecord r = eval_at(c, x);
-  double f = std::log10(static_cast<double>(params_at(*c.space, x).steps));
-  if (c.penalty) {
-    for (double g : constraint_values(r, c.tolerances)) f += 10.0 * std::max(0.0, g);
-  }
-  return f;
+  return search_objective(params_at(*c.space, x).steps, score_of(r), c.tolerances, c.penalty);
 }
 
 template <int K>
@@ -347,23 +422,22 @@ double constraint(unsigned, const double* x, double*, void* data) {
 
 /// One local search from `start`; returns nothing, the trials are in the
 /// evaluator.
-void local_search(const std::string& strategy, SearchContext context, const double* start,
-                  int max_evals) {
+void local_search(Strategy strategy, SearchContext context, const double* start, int max_evals) {
   if (max_evals <= 0) return;
   const SearchSpace& s = *context.space;
   nlopt_algorithm algorithm = NLOPT_LN_COBYLA;
   bool constrained = true;
-  if (strategy == "penalty") {
+  if (strategy == Strategy::penalty) {
     algorithm = NLOPT_LN_SBPLX;
     constrained = false;
-  } else if (strategy == "auglag") {
+  } else if (strategy == Strategy::auglag) {
     algorithm = NLOPT_AUGLAG;
   }
   context.penalty = !constrained;
   nlopt_opt opt = nlopt_create(algorithm, 4);
   context.opt = opt;
   nlopt_opt local = nullptr;
-  if (strategy == "auglag") {
+  if (strategy == Strategy::auglag) {
     local = nlopt_create(NLOPT_LN_BOBYQA, 4);
     nlopt_set_xtol_rel(local, 1e-3);
     nlopt_set_ftol_abs(local, 1e-3);
@@ -426,22 +500,18 @@ struct ModelSearch {
 
 constexpr double kModelMargin = 1.1;  // aim a little below the tolerances
 
-double rate_excess(const TrialRecord& r, const Tolerances& t) {
-  return std::max({r.criteria.force_balance / t.force_balance, r.criteria.servo / t.servo,
-                   r.criteria.moment_balance / t.moment_balance});
-}
-
 double model_objective(unsigned, const double* x, double*, void* data) {
   auto& m = *static_cast<ModelSearch*>(data);
   ++m.evaluations;
   const double full[4] = {x[0], std::log10(m.n_guess), x[1], x[2]};
-  const TrialRecord r = m.evaluator->evaluate(params_at(*m.space, full), "search");
+  const TrialRecord r = m.evaluator->evaluate(params_at(*m.space, full), TrialPhase::search);
   if (m.evaluator->stopped()) {
     nlopt_force_stop(m.opt);
     return HUGE_VAL;
   }
   if (r.diverged) return std::log10(m.n_guess) + 3.0;
-  const double predicted = m.n_guess * std::max(rate_excess(r, m.tolerances), 1e-3) * kModelMargin;
+  const double predicted =
+      m.n_guess * std::max(rate_excess(r.criteria, m.tolerances), 1e-3) * kModelMargin;
   const double osc = std::log(std::max(r.criteria.oscillation, 1e-12) / m.tolerances.oscillation);
   const double penalty = 10.0 * std::max(0.0, osc);
   if (penalty == 0.0 && (m.best_prediction == 0.0 || predicted < m.best_prediction)) {
@@ -490,9 +560,9 @@ std::optional<TrialRecord> model_search(Evaluator& evaluator, const SearchSpace&
   double n = m.best_prediction;
   for (int k = 0; k < verify_budget; ++k) {
     const double full[4] = {m.best_x[0], std::log10(n), m.best_x[1], m.best_x[2]};
-    const TrialRecord r = evaluator.evaluate(params_at(space, full), "verify");
+    const TrialRecord r = evaluator.evaluate(params_at(space, full), TrialPhase::verify);
     if (r.diverged || evaluator.stopped()) break;
-    const double excess = rate_excess(r, tolerances);
+    const double excess = rate_excess(r.criteria, tolerances);
     if (r.passed && r.complete) {
       if (!best || r.params.steps < best->params.steps) best = r;
       if (excess > 0.9) break;  // close enough to the boundary
@@ -502,14 +572,19 @@ std::optional<TrialRecord> model_search(Evaluator& evaluator, const SearchSpace&
   return best;
 }
 
-/// The cheapest passing trial (ties: the smaller α error-free order of the
-/// parameters, so the choice never depends on which thread finished first).
+/// The cheapest passing trial (ties: the smaller key of the parameters, so
+/// the choice never depends on which thread finished first). With
+/// `judged_by`, a trial must also meet those (possibly tightened)
+/// tolerances.
 std::optional<TrialRecord> cheapest_passing(const std::vector<TrialRecord>& trials,
-                                            const std::string& phase_filter = "") {
+                                            const Tolerances* judged_by = nullptr) {
   std::optional<TrialRecord> best;
   for (const auto& t : trials) {
     if (!t.passed || !t.complete) continue;
-    if (!phase_filter.empty() && t.phase != phase_filter) continue;
+    if (judged_by) {
+      const auto g = constraint_values(t, *judged_by);
+      if (*std::max_element(g.begin(), g.end()) > 0.0) continue;
+    }
     if (!best || t.params.steps < best->params.steps ||
         (t.params.steps == best->params.steps && key_of(t.params) < key_of(best->params)))
       best = t;
@@ -521,8 +596,8 @@ Certificate certify(Evaluator& evaluator, const TrialRecord& best, double accura
   AlgorithmSpec doubled = best.params;
   doubled.steps = 2 * best.params.steps;
   TrialRecord a, b;
-  run_parallel({[&] { a = evaluator.evaluate(best.params, "certificate"); },
-                [&] { b = evaluator.evaluate(doubled, "certificate"); }},
+  run_parallel({[&] { a = evaluator.evaluate(best.params, TrialPhase::certificate); },
+                [&] { b = evaluator.evaluate(doubled, TrialPhase::certificate); }},
                jobs);
   Certificate c;
   c.steps = best.params.steps;
@@ -530,10 +605,32 @@ Certificate certify(Evaluator& evaluator, const TrialRecord& best, double accura
   c.peak_doubled = b.criteria.peak_stress_yy;
   c.steps_doubled_peak_change =
       c.peak_doubled != 0.0 ? std::abs(c.peak - c.peak_doubled) / std::abs(c.peak_doubled) : 1.0;
-  // Error decaying like 1/Nstep: P(N) − P(∞) ≈ 2·(P(N) − P(2N)).
-  c.richardson_error = 2.0 * c.steps_doubled_peak_change;
+  c.richardson_error = richardson_error(c.steps_doubled_peak_change, 2.0);
   c.passed = !b.diverged && b.complete && c.richardson_error <= accuracy;
   return c;
+}
+
+/// --resume: every whole line of trials.jsonl into the evaluator's cache.
+void preload_trials(Evaluator& evaluator, const std::string& path) {
+  std::ifstream in(path);
+  std::string line, kept;
+  int line_no = 0;
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (line.empty()) continue;
+    nlohmann::json j;
+    try {
+      j = nlohmann::json::parse(line);
+    } catch (const nlohmann::json::parse_error&) {
+      // A line cut by a kill in mid-write: everything before it is whole.
+      break;
+    }
+    evaluator.preload(trial_from_json(j, path + ": line " + std::to_string(line_no)));
+    kept += line + "\n";
+  }
+  in.close();
+  // Drop a cut last line so that new trials do not append to it.
+  write_file_atomic(path, kept);
 }
 
 }  // namespace
@@ -544,33 +641,13 @@ CalibrationSummary calibrate(const SceneConfig& config, const ConsolidatedState&
                              const CalibrationOptions& options) {
   const auto t0 = std::chrono::steady_clock::now();
   CalibrationSummary out;
-  out.strategy = options.strategy;
+  out.strategy = to_string(options.strategy);
   const int jobs = resolve_jobs(options.jobs);
   const int n = state.world.size();
 
   Evaluator evaluator(config, state, options);
-  if (options.resume && !options.trials_path.empty()) {
-    std::ifstream in(options.trials_path);
-    std::string line, kept;
-    int line_no = 0;
-    while (std::getline(in, line)) {
-      ++line_no;
-      if (line.empty()) continue;
-      nlohmann::json j;
-      try {
-        j = nlohmann::json::parse(line);
-      } catch (const nlohmann::json::parse_error&) {
-        // A line cut by a kill in mid-write: everything before it is whole.
-        break;
-      }
-      evaluator.preload(
-          trial_from_json(j, options.trials_path + ": line " + std::to_string(line_no)));
-      kept += line + "\n";
-    }
-    in.close();
-    // Drop a cut last line so that new trials do not append to it.
-    write_file_atomic(options.trials_path, kept);
-  }
+  if (options.resume && !options.trials_path.empty())
+    preload_trials(evaluator, options.trials_path);
 
   // Bounds. The stable step comes from the consolidated contact network.
   AlgorithmSpec base = config.algorithm;
@@ -580,7 +657,7 @@ CalibrationSummary calibrate(const SceneConfig& config, const ConsolidatedState&
   const int64_t steps_min = options.steps_min > 0 ? options.steps_min : 50LL * n;
   const int64_t steps_max = options.steps_max > 0 ? options.steps_max : 20000LL * n;
   space.lower[0] = options.dt_ratio_min;
-  space.upper[0] = std::max(options.dt_ratio_min, options.dt_ratio_safety * out.dt_ratio_stable);
+  space.upper[0] = dt_ratio_max(options, out.dt_ratio_stable);
   space.lower[1] = std::log10(static_cast<double>(steps_min));
   space.upper[1] = std::log10(static_cast<double>(steps_max));
   space.lower[2] = options.damping_min;
@@ -593,21 +670,23 @@ CalibrationSummary calibrate(const SceneConfig& config, const ConsolidatedState&
   // be a passing value), and a second one nearer the stability bound with
   // lighter damping. Both always run (in parallel when jobs > 1), so the
   // result does not depend on jobs.
-  const double log_n0 = std::log10(500.0 * n);
-  const double start0[4] = {std::min(0.2, space.upper[0]), log_n0, 1.0, 1.0};
+  const AlgorithmSpec start = search_start(base, n, space.upper[0]);
+  const double log_n0 = std::log10(static_cast<double>(start.steps));
+  const double start0[4] = {start.dt_ratio, log_n0, start.damping_ratio_translation,
+                            start.damping_ratio_rotation};
   const double start1[4] = {0.85 * space.upper[0], log_n0 - 0.3, 0.5, 0.5};
   const int budget = options.max_trials;
   Tolerances tolerances = options.tolerances;
 
-  auto search_round = [&](const double* a, const double* b, int evals, const std::string& phase) {
+  auto search_round = [&](const double* a, const double* b, int evals, TrialPhase phase) {
     SearchContext context{&evaluator, &space, tolerances, phase};
-    if (options.strategy == "model") {
+    if (options.strategy == Strategy::model) {
       run_parallel({[&] { model_search(evaluator, space, tolerances, a, evals / 2); },
                     [&] { model_search(evaluator, space, tolerances, b, evals - evals / 2); }},
                    jobs);
       return;
     }
-    if (options.strategy == "direct") {
+    if (options.strategy == Strategy::direct) {
       global_phase(context, evals / 3);
       auto best = cheapest_passing(evaluator.all());
       double x[4] = {a[0], a[1], a[2], a[3]};
@@ -617,14 +696,14 @@ CalibrationSummary calibrate(const SceneConfig& config, const ConsolidatedState&
         x[2] = best->params.damping_ratio_translation;
         x[3] = best->params.damping_ratio_rotation;
       }
-      local_search("cobyla", context, x, evals - evals / 3);
+      local_search(Strategy::cobyla, context, x, evals - evals / 3);
       return;
     }
     run_parallel({[&] { local_search(options.strategy, context, a, evals / 2); },
                   [&] { local_search(options.strategy, context, b, evals - evals / 2); }},
                  jobs);
   };
-  search_round(start0, start1, budget, "search");
+  search_round(start0, start1, budget, TrialPhase::search);
   const auto finish_interrupted = [&] {
     out.trials = evaluator.all();
     out.trials_run = evaluator.run_count();
@@ -642,17 +721,8 @@ CalibrationSummary calibrate(const SceneConfig& config, const ConsolidatedState&
   // from the best point, then fall back to doubling Nstep.
   std::optional<TrialRecord> best;
   for (int round = 0; round < 6; ++round) {
-    auto all = evaluator.all();
-    best.reset();
-    for (const auto& t : all) {
-      if (!t.passed || !t.complete) continue;
-      // Judge against the current (possibly tightened) tolerances.
-      const auto g = constraint_values(t, tolerances);
-      if (*std::max_element(g.begin(), g.end()) > 0.0) continue;
-      if (!best || t.params.steps < best->params.steps ||
-          (t.params.steps == best->params.steps && key_of(t.params) < key_of(best->params)))
-        best = t;
-    }
+    // Judged against the current (possibly tightened) tolerances.
+    best = cheapest_passing(evaluator.all(), &tolerances);
     if (!best) break;
     out.certificate = certify(evaluator, *best, options.accuracy, jobs);
     if (evaluator.stopped()) return finish_interrupted();
@@ -668,18 +738,18 @@ CalibrationSummary calibrate(const SceneConfig& config, const ConsolidatedState&
                            std::log10(static_cast<double>(best->params.steps)) - std::log10(factor),
                            best->params.damping_ratio_translation,
                            best->params.damping_ratio_rotation};
-      if (options.strategy == "model") {
+      if (options.strategy == Strategy::model) {
         model_search(evaluator, space, tolerances, x, std::max(8, budget / 4));
       } else {
-        SearchContext context{&evaluator, &space, tolerances, "search-tightened"};
-        local_search(options.strategy == "direct" ? "cobyla" : options.strategy, context, x,
-                     std::max(8, budget / 4));
+        SearchContext context{&evaluator, &space, tolerances, TrialPhase::search_tightened};
+        local_search(options.strategy == Strategy::direct ? Strategy::cobyla : options.strategy,
+                     context, x, std::max(8, budget / 4));
       }
     } else {
       // Fall back: the same multipliers, Nstep doubled.
       AlgorithmSpec p = best->params;
       p.steps *= 2;
-      evaluator.evaluate(p, "certificate");
+      evaluator.evaluate(p, TrialPhase::certificate);
       tolerances = options.tolerances;  // the doubled run is judged as any other
     }
   }
@@ -689,7 +759,7 @@ CalibrationSummary calibrate(const SceneConfig& config, const ConsolidatedState&
   out.trials_run = evaluator.run_count();
   out.trials_reused = evaluator.reused_count();
   if (best) {
-    out.best = rounded(best->params);
+    out.best = rounded_params(best->params);
     out.best_trial = *best;
   }
   out.success = best.has_value() && out.certificate.passed;
@@ -716,7 +786,7 @@ BaselineResult paper_recipe_baseline(const SceneConfig& config, const Consolidat
   p.steps = start_steps;
   for (int k = 0; k <= max_doublings; ++k) {
     TrialRecord r = run_trial(config, state, p, tolerances);
-    r.phase = "baseline";
+    r.phase = to_string(TrialPhase::baseline);
     r.id = k;
     out.trials.push_back(r);
     out.particle_steps_total += r.particle_steps;

@@ -6,6 +6,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "demcal/io/format.hpp"
 #include "demcal/search/parallel.hpp"
 
 namespace demcal {
@@ -76,7 +77,7 @@ StabilityScanResult stability_scan(const SceneConfig& config, const Consolidated
   std::sort(
       out.trials.begin(), out.trials.end(),
       [](const StabilityTrial& x, const StabilityTrial& y) { return x.dt_ratio < y.dt_ratio; });
-  out.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  out.wall_time_s = seconds_since(t0);
   return out;
 }
 

@@ -10,20 +10,17 @@
 #include <numeric>
 #include <sstream>
 
-#include "demcal/search/parallel.hpp"
+#include "demcal/io/format.hpp"
 #include "demcal/scoring/trial.hpp"
+#include "demcal/search/parallel.hpp"
 
 namespace demcal {
 
 namespace {
 
-std::string fixed(double v, int digits) {
-  std::ostringstream s;
-  s << std::fixed << std::setprecision(digits) << v;
-  return s.str();
-}
-
-std::string sci(double v, int digits = 2) {
+/// Scientific notation with `digits` decimals ("1.2e+05"): the atlas's
+/// compact cells (io/format.hpp's sci() switches to plain numbers).
+std::string scientific(double v, int digits = 2) {
   std::ostringstream s;
   s << std::scientific << std::setprecision(digits) << v;
   return s.str();
@@ -174,9 +171,8 @@ ConvergedReference converged_reference(std::vector<std::pair<int64_t, double>> p
   for (size_t i = 0; i < peaks.size(); ++i) {
     ConvergedReference::Rung r{peaks[i].first, peaks[i].second, 0.0};
     if (i > 0) {
-      const double n1 = static_cast<double>(peaks[i - 1].first), p1 = peaks[i - 1].second;
-      const double n2 = static_cast<double>(peaks[i].first), p2 = peaks[i].second;
-      r.richardson = n2 > n1 ? (n2 * p2 - n1 * p1) / (n2 - n1) : p2;
+      r.richardson = richardson_limit(static_cast<double>(peaks[i - 1].first), peaks[i - 1].second,
+                                      static_cast<double>(peaks[i].first), peaks[i].second);
     }
     ref.ladder.push_back(r);
   }
@@ -348,9 +344,18 @@ SweepResult run_sweep(const SceneConfig& config, const ConsolidatedState& state,
         r.score.criteria.peak_error && std::abs(*r.score.criteria.peak_error) <= settings.accuracy;
   }
   compute_evidence(res);
-  res.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  res.wall_time_s = seconds_since(t0);
   return res;
 }
+
+namespace {
+/// A case's parameters and the absolute Δt they gave.
+nlohmann::json params_with_dt(const AlgorithmSpec& params, double dt) {
+  nlohmann::json j = to_json(params);
+  j["dt"] = dt;
+  return j;
+}
+}  // namespace
 
 nlohmann::json to_json(const SweepResult& res) {
   using nlohmann::json;
@@ -360,13 +365,7 @@ nlohmann::json to_json(const SweepResult& res) {
            {"group", r.spec.group},
            {"change", r.spec.change},
            {"expected", r.spec.expected},
-           {"params",
-            {{"dt_ratio", r.spec.algorithm.dt_ratio},
-             {"steps", r.spec.algorithm.steps},
-             {"damping_ratio_translation", r.spec.algorithm.damping_ratio_translation},
-             {"damping_ratio_rotation", r.spec.algorithm.damping_ratio_rotation},
-             {"mass_scaling", r.spec.algorithm.mass_scaling},
-             {"dt", r.run.integration.dt}}},
+           {"params", params_with_dt(r.spec.algorithm, r.run.integration.dt)},
            {"criteria", to_json(r.score.criteria)},
            {"peak_ratio", -r.score.criteria.peak_stress_yy / res.lateral_stress},
            {"passed", r.score.passed},
@@ -389,11 +388,11 @@ nlohmann::json to_json(const SweepResult& res) {
                       {"richardson", rung.richardson}});
   json evidence = json::array();
   for (const auto& e : res.evidence) {
-    auto num = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
-    json j{{"name", e.name}, {"safe_alone", num(e.safe_alone)}};
+    auto finite_or_null = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
+    json j{{"name", e.name}, {"safe_alone", finite_or_null(e.safe_alone)}};
     if (e.tolerance > 0.0) {
       j["tolerance"] = e.tolerance;
-      j["safe_joint"] = num(e.safe_joint);
+      j["safe_joint"] = finite_or_null(e.safe_joint);
       j["binding"] = e.binding;
     }
     evidence.push_back(j);
@@ -401,12 +400,7 @@ nlohmann::json to_json(const SweepResult& res) {
   json j{{"schema", "demcal.sweep/1"},
          {"scene", res.scene},
          {"particles", res.particles},
-         {"benchmark",
-          {{"dt_ratio", res.benchmark.dt_ratio},
-           {"steps", res.benchmark.steps},
-           {"damping_ratio_translation", res.benchmark.damping_ratio_translation},
-           {"damping_ratio_rotation", res.benchmark.damping_ratio_rotation},
-           {"mass_scaling", res.benchmark.mass_scaling}}},
+         {"benchmark", to_json(res.benchmark)},
          {"alpha_stable", res.alpha_stable},
          {"lateral_stress", res.lateral_stress},
          {"reference",
@@ -435,17 +429,12 @@ nlohmann::json to_json(const SweepResult& res) {
 
 namespace {
 
-std::string pct(std::optional<double> v) {
-  if (!v) return "–";
-  std::ostringstream s;
-  s << std::showpos << std::fixed << std::setprecision(1) << 100.0 * *v << " %";
-  return s.str();
-}
+std::string pct(std::optional<double> v) { return v ? signed_pct(*v, 1) : "–"; }
 
-std::string num(double v) {
+std::string compact(double v) {
   if (v == 0.0) return "0";
   if (!std::isfinite(v)) return "∞";
-  return sci(v, 1);
+  return scientific(v, 1);
 }
 
 }  // namespace
@@ -476,7 +465,7 @@ std::string atlas_markdown(const SweepResult& res) {
         "RMS(b_yy−σ_yy)/RMS(b_yy), MB = moment balance RMS(σxy−σyx)/σ3, servo = max |trend| of "
         "the lateral wall stress error, osc = noise of b−σ, zig = noise b_yy and σ_yy share, "
         "soft = post-peak softening. Values above tolerance in **bold**.\n\n";
-  auto bold = [](double v, double tol) { return v > tol ? "**" + num(v) + "**" : num(v); };
+  auto bold = [](double v, double tol) { return v > tol ? "**" + compact(v) + "**" : compact(v); };
   const std::vector<std::string> groups = {"benchmark", "atlas", "convergence", "alpha_scan",
                                            "grid"};
   for (const auto& g : groups) {
@@ -500,11 +489,11 @@ std::string atlas_markdown(const SweepResult& res) {
         continue;
       }
       md << fixed(-c.peak_stress_yy / s3, 3) << " | " << pct(c.peak_error) << " | "
-         << bold(c.force_balance, t.force_balance) << " | " << num(c.force_balance_xx) << " | "
-         << num(c.force_balance_yy) << " | " << num(c.force_balance_shear) << " | "
-         << num(c.force_balance_paper) << " | " << bold(c.moment_balance, t.moment_balance) << " | "
-         << bold(c.servo, t.servo) << " | " << bold(c.oscillation, t.oscillation) << " | "
-         << num(c.zigzag) << " | " << num(c.post_peak_softening) << " | "
+         << bold(c.force_balance, t.force_balance) << " | " << compact(c.force_balance_xx) << " | "
+         << compact(c.force_balance_yy) << " | " << compact(c.force_balance_shear) << " | "
+         << compact(c.force_balance_paper) << " | " << bold(c.moment_balance, t.moment_balance)
+         << " | " << bold(c.servo, t.servo) << " | " << bold(c.oscillation, t.oscillation) << " | "
+         << compact(c.zigzag) << " | " << compact(c.post_peak_softening) << " | "
          << (r.score.passed ? "pass" : "fail") << (r.accurate ? "" : " (inacc.)") << " | "
          << r.score.diagnosis.parameter << " " << r.score.diagnosis.direction << " ("
          << fixed(r.score.diagnosis.confidence, 2) << ") | " << r.score.diagnosis.signature
@@ -526,9 +515,9 @@ std::string atlas_markdown(const SweepResult& res) {
      << fixed(100.0 * res.worst_paper_form_error, 1) << " % off.\n\n"
      << "| measure | tolerance | safe alone | safe joint | binding |\n|---|---:|---:|---:|---:|\n";
   for (const auto& e : res.evidence) {
-    md << "| " << e.name << " | " << (e.tolerance > 0.0 ? num(e.tolerance) : "–") << " | "
-       << num(e.safe_alone) << " | " << (e.tolerance > 0.0 ? num(e.safe_joint) : "–") << " | "
-       << (e.tolerance > 0.0 ? std::to_string(e.binding) : "–") << " |\n";
+    md << "| " << e.name << " | " << (e.tolerance > 0.0 ? compact(e.tolerance) : "–") << " | "
+       << compact(e.safe_alone) << " | " << (e.tolerance > 0.0 ? compact(e.safe_joint) : "–")
+       << " | " << (e.tolerance > 0.0 ? std::to_string(e.binding) : "–") << " |\n";
   }
   // Each criterion against the peak error, binned by value/tolerance.
   {

@@ -84,30 +84,30 @@ AlgorithmSpec upscale(const AlgorithmSpec& rev, int64_t n_rev, int64_t n_proto,
 
 nlohmann::json param_block(const AlgorithmSpec& p, const ParticleScales& s) {
   const double dt = p.dt_ratio * s.dt_crit;
-  return {
-      {"particles", s.particles},
-      {"dt", dt},
-      {"dt_ratio", p.dt_ratio},
-      {"dt_crit", s.dt_crit},
-      {"steps", p.steps},
-      {"damping_translation", p.damping_ratio_translation * s.damping_translation_crit},
-      {"damping_ratio_translation", p.damping_ratio_translation},
-      {"damping_rotation", p.damping_ratio_rotation * s.damping_rotation_crit},
-      {"damping_ratio_rotation", p.damping_ratio_rotation},
-      {"mass_scaling", p.mass_scaling},
-      // The reference values behind the absolute numbers. Damping is
-      // per particle (same ratio for every particle, D ∝ sqrt(m)); the
-      // values above are the lightest particle's, these the mean.
-      {"damping_translation_mean", p.damping_ratio_translation * s.damping_translation_crit_mean},
-      {"damping_rotation_mean", p.damping_ratio_rotation * s.damping_rotation_crit_mean},
-      {"damping_translation_crit", s.damping_translation_crit},
-      {"damping_rotation_crit", s.damping_rotation_crit},
-      {"radius_min", s.radius_min},
-      {"radius_max", s.radius_max},
-      {"radius_mean", s.radius_mean},
-      {"mass_min", s.mass_min},
-      {"mass_mean", s.mass_mean},
-      {"duration", dt * static_cast<double>(p.steps)}};
+  nlohmann::json block = to_json(p);
+  // The calibrated parameters; lock_rotation is a diagnostic switch, never
+  // calibrated, and not part of params.json's blocks.
+  block.erase("lock_rotation");
+  block.update(
+      {{"particles", s.particles},
+       {"dt", dt},
+       {"dt_crit", s.dt_crit},
+       {"damping_translation", p.damping_ratio_translation * s.damping_translation_crit},
+       {"damping_rotation", p.damping_ratio_rotation * s.damping_rotation_crit},
+       // The reference values behind the absolute numbers. Damping is
+       // per particle (same ratio for every particle, D ∝ sqrt(m)); the
+       // values above are the lightest particle's, these the mean.
+       {"damping_translation_mean", p.damping_ratio_translation * s.damping_translation_crit_mean},
+       {"damping_rotation_mean", p.damping_ratio_rotation * s.damping_rotation_crit_mean},
+       {"damping_translation_crit", s.damping_translation_crit},
+       {"damping_rotation_crit", s.damping_rotation_crit},
+       {"radius_min", s.radius_min},
+       {"radius_max", s.radius_max},
+       {"radius_mean", s.radius_mean},
+       {"mass_min", s.mass_min},
+       {"mass_mean", s.mass_mean},
+       {"duration", dt * static_cast<double>(p.steps)}});
+  return block;
 }
 
 SceneConfig scene_of_size(const SceneConfig& config, int64_t particles) {
@@ -310,34 +310,20 @@ LinearFit fit_power(std::span<const double> x, std::span<const double> y) {
 
 namespace demcal {
 
-namespace {
-
-double rate_excess_of(const TrialRecord& r, const Tolerances& t) {
-  return std::max({r.criteria.force_balance / t.force_balance, r.criteria.servo / t.servo,
-                   r.criteria.moment_balance / t.moment_balance});
-}
-
-int64_t round4(double steps) {
-  const double mag = std::pow(10.0, std::floor(std::log10(std::max(steps, 10.0))) - 3.0);
-  return std::max<int64_t>(10, std::llround(std::round(steps / mag) * mag));
-}
-
-}  // namespace
-
 StepSearch smallest_passing_steps(const SceneConfig& config, const ConsolidatedState& state,
                                   const AlgorithmSpec& start, const Tolerances& tol, int max_runs) {
   StepSearch out;
   AlgorithmSpec p = start;
-  p.steps = round4(static_cast<double>(start.steps));
+  p.steps = round_steps(static_cast<double>(start.steps));
   int64_t largest_failing = 0;
   for (int k = 0; k < max_runs; ++k) {
     TrialRecord r = run_trial(config, state, p, tol);
     r.id = k;
-    r.phase = "steps-search";
+    r.phase = to_string(TrialPhase::steps_search);
     out.trials.push_back(r);
     out.particle_steps += r.particle_steps;
     if (r.diverged) break;
-    const double excess = rate_excess_of(r, tol);
+    const double excess = rate_excess(r.criteria, tol);
     double next;
     if (r.passed) {
       if (!out.found || p.steps < out.best.params.steps) out.best = r;
@@ -357,7 +343,7 @@ StepSearch smallest_passing_steps(const SceneConfig& config, const ConsolidatedS
                        static_cast<double>(out.best.params.steps));
     }
     if (next <= static_cast<double>(largest_failing)) next = 1.05 * largest_failing;
-    const int64_t n = round4(next);
+    const int64_t n = round_steps(next);
     if (out.found &&
         (n >= out.best.params.steps || static_cast<double>(out.best.params.steps - n) <
                                            0.03 * static_cast<double>(out.best.params.steps)))

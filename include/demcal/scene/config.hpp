@@ -64,6 +64,19 @@ struct AlgorithmSpec {
   bool lock_rotation = false;              ///< diagnostic
 };
 
+/// The one JSON form of an AlgorithmSpec (the config's `algorithm` block,
+/// trials.jsonl's `params`, the sweep's and the scaling study's records):
+/// every member by its name.
+nlohmann::json to_json(const AlgorithmSpec& algorithm);
+/// Its inverse, checked as the config is: missing keys keep `base`, a wrong
+/// type, a value out of range or an unknown key throws InputError naming
+/// `source` and `field`.key.
+AlgorithmSpec algorithm_from_json(const nlohmann::json& json, const std::string& source,
+                                  const std::string& field = "algorithm",
+                                  const AlgorithmSpec& base = {});
+
+/// The calibration block of a config; CalibrationOptions (search layer)
+/// takes its defaults from here.
 struct CalibrationSpec {
   double accuracy = 0.02;  ///< target relative error of the peak
   int max_trials = 80;

@@ -197,6 +197,12 @@ class EarlyFailure {
   bool failed_ = false;
 };
 
+/// The largest value/tolerance of the criteria that come from the loading
+/// rate (force balance, servo, moment balance): at fixed multipliers they
+/// fall like 1/Nstep (reports/optimizers.md), so a run at Nstep = N
+/// predicts the smallest passing Nstep N·rate_excess.
+double rate_excess(const Criteria& criteria, const Tolerances& tolerances);
+
 /// Constraint values for a constrained search, one per criterion in the
 /// order force balance, moment balance, servo, oscillation:
 /// log(value/tolerance), ≤ 0 when met. A diverged run gives +3 for each; a
@@ -207,7 +213,27 @@ std::array<double, 4> constraint_values(const Score& score, const Tolerances& to
 /// up to 10²⁰ particle-steps; linear in log Nstep, as the search is.
 double cost_term(double particle_steps);
 
-/// One scalar for the search, lower is better, always finite:
+/// What the NLopt strategies of the search minimise over
+/// x = (α, log10 Nstep, ζ_t, ζ_r): log10 Nstep (the cost, linear in the
+/// search variable). Constrained strategies (cobyla, auglag) add the
+/// constraint_values() as constraints; unconstrained ones (penalty, the
+/// direct global phase) set `penalised` and minimise
+///   log10 Nstep + 10·Σ max(0, g_c).
+/// The model strategy minimises a predicted Nstep (calibration.cpp).
+double search_objective(int64_t steps, const Score& score, const Tolerances& tolerances,
+                        bool penalised);
+
+/// The quasi-static error of a peak whose error decays like 1/Nstep
+/// (measured: reports/optimizers.md), from two runs with Nstep and
+/// refinement·Nstep: Richardson extrapolation.
+///   Limit:  P(∞) ≈ (n_fine·P_fine − n_coarse·P_coarse)/(n_fine − n_coarse).
+///   Error of the coarse run, relative: r/(r − 1)·|P_coarse − P_fine|/|P_fine|
+///   with r = refinement (2 for Nstep doubled: twice the change).
+double richardson_limit(double n_coarse, double p_coarse, double n_fine, double p_fine);
+double richardson_error(double relative_change, double refinement = 2.0);
+
+/// A ranking of runs for atlases and reports (the sweep's `objective`, the
+/// report's trial table), lower is better, always finite:
 ///   passed:         f = c                         ∈ [0, 1]
 ///   finished, not:  f = 1 + 0.9·V/(1 + V) + 0.1·c ∈ (1, 2)
 ///   diverged:       f = 3 − completed_fraction    ∈ [2, 3]

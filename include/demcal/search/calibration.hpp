@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "demcal/scene/biaxial.hpp"
@@ -20,6 +21,37 @@
 #include "demcal/scoring/scoring.hpp"
 
 namespace demcal {
+
+/// The search strategies (CalibrationOptions::strategy documents each).
+enum class Strategy { model, cobyla, auglag, penalty, direct };
+/// Every strategy, in the order the CLI lists them.
+inline constexpr Strategy kStrategies[] = {Strategy::model, Strategy::cobyla, Strategy::auglag,
+                                           Strategy::penalty, Strategy::direct};
+std::string to_string(Strategy strategy);
+/// The strategy named `name`; an unknown name throws InputError naming
+/// `option` (e.g. "--strategy") and the valid names.
+Strategy parse_strategy(std::string_view name, const std::string& option = "strategy");
+
+/// Why a trial was run: its `phase` in trials.jsonl and the reports.
+enum class TrialPhase {
+  search,            ///< a search trial
+  search_tightened,  ///< a search with tightened tolerances after a failed certificate
+  verify,            ///< the model strategy verifying its prediction
+  certificate,       ///< the convergence certificate (Nstep and 2·Nstep)
+  baseline,          ///< the paper's recipe (evidence)
+  reference,         ///< the converged reference (evidence)
+  steps_search,      ///< the smallest passing Nstep at fixed multipliers (upscaling)
+};
+/// The name written to trials.jsonl ("search-tightened", "steps-search", …).
+std::string to_string(TrialPhase phase);
+/// The phase named `name`; an unknown name throws InputError naming
+/// `source` and `field`.
+TrialPhase parse_trial_phase(std::string_view name, const std::string& source,
+                             const std::string& field = "phase");
+
+/// Nstep rounded to four significant digits (0.1 % of the loading rate,
+/// what the searches resolve), at least 10.
+int64_t round_steps(double steps);
 
 /// Search space (all bounds inclusive):
 ///   α = Δt/Δt_crit in [dt_ratio_min, dt_ratio_safety · α_stable], α_stable
@@ -36,12 +68,14 @@ struct CalibrationOptions {
   /// auglag: AUGLAG around BOBYQA with the same constraints;
   /// penalty: SBPLX on log10(Nstep) + 10·Σ max(0, log(value/tolerance));
   /// direct: a short DIRECT-L global phase on the penalty, then COBYLA.
-  std::string strategy = "model";
-  int max_trials = 80;     ///< search trials (the certificate comes on top)
-  int jobs = 0;            ///< parallel trials; 0: one per core
-  double accuracy = 0.02;  ///< peak accuracy target (Richardson estimate)
-  Tolerances tolerances;   ///< criteria every accepted run meets
-  uint64_t seed = 1;       ///< stochastic parts (start perturbations)
+  Strategy strategy = Strategy::model;
+  /// search trials (the certificate comes on top)
+  int max_trials = CalibrationSpec{}.max_trials;
+  int jobs = 0;  ///< parallel trials; 0: one per core
+  /// peak accuracy target (Richardson estimate)
+  double accuracy = CalibrationSpec{}.accuracy;
+  Tolerances tolerances;                   ///< criteria every accepted run meets
+  uint64_t seed = CalibrationSpec{}.seed;  ///< stochastic parts (start perturbations)
   double dt_ratio_min = 0.02;
   double dt_ratio_safety = 0.95;  ///< fraction of the estimated stable α
   double damping_min = 0.05;
@@ -62,17 +96,20 @@ struct CalibrationOptions {
   /// Every finished trial is already in trials_path, so `resume` continues.
   /// May be null.
   const std::atomic<bool>* stop = nullptr;
+
+  /// The options a config's calibration block asks for (max_trials,
+  /// accuracy, seed); everything else at its default.
+  static CalibrationOptions from(const CalibrationSpec& spec);
 };
 
 /// One finished trial, as stored in trials.jsonl.
 struct TrialRecord {
   int id = 0;
-  std::string phase;  ///< search, certificate, baseline, reference
+  /// to_string(TrialPhase): a name, checked by parse_trial_phase() on read.
+  /// (A string still because the report compares names.)
+  std::string phase;
   AlgorithmSpec params;
   Criteria criteria;
-  /// to_json(criteria) as written to trials.jsonl; a resumed trial keeps the
-  /// stored object, so its params.json is the same as an uninterrupted run's.
-  nlohmann::json criteria_json;
   bool passed = false, diverged = false, complete = true;
   double worst_excess = 0.0;
   int64_t steps_run = 0;
@@ -80,8 +117,17 @@ struct TrialRecord {
   double wall_time_s = 0.0;
   std::string diagnosis;
 };
+/// The one JSON form of a trial (a line of trials.jsonl, the evidence and
+/// scaling files) and its inverse; errors name `source`.
 nlohmann::json to_json(const TrialRecord& record);
 TrialRecord trial_from_json(const nlohmann::json& j, const std::string& source);
+/// A trial from its score and run: the one place a TrialRecord is filled
+/// from a Score.
+TrialRecord trial_record(const AlgorithmSpec& params, const Score& score, const LoadingResult& run);
+/// The Score a record keeps (criteria, verdicts, worst excess, cost,
+/// completed fraction, the diagnosis message): what constraint_values()
+/// and objective() need. The per-criterion excesses are not kept.
+Score score_of(const TrialRecord& record);
 
 struct Certificate {
   int64_t steps = 0;
@@ -90,6 +136,8 @@ struct Certificate {
   double richardson_error = 0.0;           ///< 2·change: error of P(N) for 1/N decay
   bool passed = false;
 };
+/// The certificate as params.json records it.
+nlohmann::json to_json(const Certificate& certificate);
 
 struct CalibrationSummary {
   bool success = false;      ///< a passing, certified parameter set was found
@@ -102,7 +150,7 @@ struct CalibrationSummary {
   std::vector<TrialRecord> trials;  ///< every trial, in id order
   int trials_run = 0, trials_reused = 0;
   double wall_time_s = 0.0;
-  std::string strategy;
+  std::string strategy;  ///< to_string(options.strategy), as the reports print it
 
   std::string BriefReport() const;
   std::string FullReport() const;
@@ -112,6 +160,21 @@ struct CalibrationSummary {
 /// options and seed, whatever `jobs` is.
 CalibrationSummary calibrate(const SceneConfig& config, const ConsolidatedState& state,
                              const CalibrationOptions& options);
+
+/// Nstep per particle of the search's first start and of the paper-recipe
+/// baseline's first run.
+inline constexpr int64_t kStartStepsPerParticle = 500;
+/// The search's first start point: the paper's multipliers (α = 0.2 capped
+/// at `dt_ratio_max`, ζ_t = ζ_r = 1, the rest from `base`) with a
+/// size-based Nstep of 500 per particle (the model strategy extrapolates
+/// from there, so it need not pass).
+AlgorithmSpec search_start(const AlgorithmSpec& base, int64_t particles, double dt_ratio_max);
+/// `params` as a trial runs them: rounded to what the search resolves (α
+/// and ζ to 1e-6, Nstep by round_steps()).
+AlgorithmSpec rounded_params(const AlgorithmSpec& params);
+/// The largest α the search may try: dt_ratio_safety × the estimated
+/// stable α, at least dt_ratio_min.
+double dt_ratio_max(const CalibrationOptions& options, double dt_ratio_stable);
 
 /// The paper's recipe done mechanically: α = 0.2, ζ_t = ζ_r = 1, Nstep
 /// doubled from `start_steps` until every criterion passes.

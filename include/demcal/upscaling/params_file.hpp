@@ -1,0 +1,47 @@
+// params.json, the answer of `demcal calibrate`: its schema in one place.
+// It lives in the upscaling layer because it carries the prototype block
+// (the REV's parameters upscaled). Deterministic: the same config and seed
+// give the same bytes, whatever --jobs or --resume.
+#pragma once
+
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "demcal/scene/biaxial.hpp"
+#include "demcal/scene/config.hpp"
+#include "demcal/search/calibration.hpp"
+
+namespace demcal {
+
+/// Particle-steps actually run by the trials (early stops counted as run):
+/// a deterministic measure of a calibration's cost.
+double particle_steps_run(const std::vector<TrialRecord>& trials, int64_t particles);
+
+/// params.json (schema demcal.params/1) of a calibration of `config` on the
+/// consolidated REV `state` with `options`: the REV block, the prototype
+/// block and the upscaling law, the criteria of the best trial, the
+/// certificate, and what reproduces it (config, seed, hash, version).
+nlohmann::json params_file(const SceneConfig& config, const ConsolidatedState& state,
+                           const CalibrationOptions& options, const CalibrationSummary& summary);
+
+/// The accuracy evidence of `demcal calibrate --evidence`: the converged
+/// reference (Nstep ×8 and ×16, Richardson) and the paper-recipe baseline.
+struct CalibrationEvidence {
+  TrialRecord coarse, fine;     ///< the reference runs, 8× and 16× Nstep
+  double reference_peak = 0.0;  ///< Richardson-extrapolated peak b_yy (negative)
+  BaselineResult baseline;
+  int64_t baseline_start_steps = 0;
+};
+/// A trial's peak error against the reference, (P_ref − P)/|P_ref|, or null
+/// for a run without a valid peak (stopped, diverged).
+nlohmann::json peak_error_json(const TrialRecord& trial, double reference_peak);
+/// The `evidence` block of params.json; `best` is the calibrated trial.
+nlohmann::json evidence_block(const CalibrationEvidence& evidence, const TrialRecord& best);
+/// evidence.jsonl: the reference runs, then the baseline trials, one
+/// to_json(TrialRecord) with its peak_error per line.
+std::string evidence_lines(const CalibrationEvidence& evidence);
+
+}  // namespace demcal

@@ -1,0 +1,112 @@
+// The scaling study behind `demcal scaling`: the proof of the upscaling law
+// (issue #6 §3). A family of scenes that differ only in size is calibrated
+// at every size up to calibrate_max; Nstep is fitted against N (linear:
+// slope, intercept, R²; power: exponent), the multipliers' spread across
+// sizes is measured, the smallest passing Nstep at FIXED multipliers (the
+// largest calibrated REV's) is found at every size, and the law is checked
+// forward: the largest size is run with the REV's multipliers and Nstep
+// upscaled from it, and scored against a run with twice the steps.
+//
+// Per-size work (trials, results) goes to a work folder and is reused with
+// `resume`; to_json() and scaling_markdown() give scaling.json and
+// scaling.md.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "demcal/scene/config.hpp"
+#include "demcal/search/calibration.hpp"
+#include "demcal/upscaling/upscaling.hpp"
+
+namespace demcal {
+
+/// Particle counts "25,100,400": sorted, without repeats, each >= 4, at
+/// least two; errors name `option`.
+std::vector<int64_t> parse_sizes(const std::string& text, const std::string& option = "--sizes");
+
+struct ScalingStudyOptions {
+  std::vector<int64_t> sizes;   ///< parse_sizes(); the largest is the forward size
+  std::string sizes_text;       ///< as the user wrote them (for the report)
+  int64_t calibrate_max = 400;  ///< larger sizes are only checked forward
+  std::string work_dir;         ///< per-size work (created)
+  int jobs = 0;
+  bool resume = false;  ///< reuse the sizes already done in work_dir
+  /// Progress lines; may be empty.
+  std::function<void(const std::string&)> log;
+};
+
+/// The smallest passing Nstep at the REV's multipliers, at one size.
+struct FixedMultipliers {
+  bool found = false;
+  int64_t steps = 0;
+  TrialRecord best;                 ///< the smallest passing run
+  std::vector<TrialRecord> trials;  ///< every run, in order
+  double wall_time_s = 0.0;
+};
+
+/// One size of the family.
+struct ScalingSize {
+  int64_t requested = 0, particles = 0;
+  bool calibrated = false, success = false;
+  AlgorithmSpec best;
+  double richardson = 0.0, peak = 0.0;
+  int trials = 0;
+  double wall_time_s = 0.0, consolidation_s = 0.0;
+  int64_t consolidation_steps = 0;
+  FixedMultipliers fixed;
+};
+/// A size as scaling.json records it (and as result.json stores a
+/// calibrated size for resume), and back; errors name `source`.
+nlohmann::json to_json(const ScalingSize& size);
+ScalingSize scaling_size_from_json(const nlohmann::json& json, const std::string& source);
+
+/// (max − min)/mean of a multiplier across sizes.
+struct Spread {
+  double mean = 0, min = 0, max = 0, relative = 0;
+};
+Spread spread_of(const std::vector<double>& values);
+
+struct ScalingStudy {
+  std::string scene, family;  ///< family: one line, e.g. "hexagonal generator"
+  bool from_file = false;
+  std::vector<int64_t> sizes, calibrated_sizes;
+  std::string sizes_text;
+  int64_t calibrate_max = 0, ref_size = 0, forward_size = 0;
+  std::map<int64_t, ScalingSize> results;  ///< by requested size
+  /// Fits of the calibrated Nstep, of Nstep at fixed multipliers over all
+  /// sizes and from the REV up; the number of sizes in each.
+  LinearFit lin_cal, pow_cal, lin_fix, pow_fix, lin_rep, pow_rep;
+  size_t n_cal = 0, n_fix = 0, n_rep = 0;
+  Spread alpha, zeta_t, zeta_r;
+  ScalingLaw measured, chosen;
+  bool linear_holds = false;
+  /// The forward check: the linear law's run and its 2× reference.
+  bool have_forward = false, forward_ok = false;
+  TrialRecord linear_run, reference;
+  double linear_peak_error = 0.0;
+  double accuracy = 0.0;
+  Tolerances tolerances;
+  bool resumed = false;
+  double wall_time_s = 0.0;
+};
+
+/// The sizes' plan is usable: at least two sizes up to calibrate_max, one
+/// of them below the largest (the REV the law is carried from). Throws
+/// InputError naming --sizes; run_scaling_study() checks it first.
+void check_scaling_sizes(const ScalingStudyOptions& options);
+
+/// Run the study on the family of `config` (resized generators, or REVs cut
+/// from the prototype file for a file assembly).
+ScalingStudy run_scaling_study(const SceneConfig& config, const ScalingStudyOptions& options);
+
+/// scaling.json (schema demcal.scaling/1).
+nlohmann::json to_json(const ScalingStudy& study, const SceneConfig& config);
+/// scaling.md.
+std::string scaling_markdown(const ScalingStudy& study, const SceneConfig& config);
+
+}  // namespace demcal

@@ -1,0 +1,88 @@
+#include "demcal/upscaling/params_file.hpp"
+
+#include <cmath>
+
+#include "demcal/scoring/trial.hpp"
+#include "demcal/upscaling/upscaling.hpp"
+
+namespace demcal {
+
+double particle_steps_run(const std::vector<TrialRecord>& trials, int64_t particles) {
+  double sum = 0.0;
+  for (const auto& t : trials) sum += static_cast<double>(t.steps_run);
+  return sum * static_cast<double>(particles);
+}
+
+nlohmann::json params_file(const SceneConfig& config, const ConsolidatedState& state,
+                           const CalibrationOptions& options, const CalibrationSummary& summary) {
+  const int64_t n_rev = state.world.size();
+  const int64_t n_proto = config.prototype.particles > 0 ? config.prototype.particles : n_rev;
+  nlohmann::json params{
+      {"schema", "demcal.params/1"},
+      {"scene", config.name},
+      {"success", summary.success},
+      {"message", summary.message},
+      {"rev", param_block(summary.best, particle_scales(state.world.radius(), config.material,
+                                                        summary.best.mass_scaling))},
+      // Δt and damping recomputed from the prototype's own particles.
+      {"prototype", prototype_block(config, summary.best, n_rev)},
+      {"upscaling", upscaling_block(n_rev, n_proto)},
+      {"config", to_json(config)},
+      {"criteria", to_json(summary.best_trial.criteria)},
+      {"tolerances", to_json(options.tolerances)},
+      {"accuracy", options.accuracy},
+      {"certificate", to_json(summary.certificate)},
+      {"dt_ratio_stable", summary.dt_ratio_stable},
+      {"strategy", summary.strategy},
+      {"trials", static_cast<int>(summary.trials.size())},
+      {"particle_steps_run", particle_steps_run(summary.trials, n_rev)},
+      {"seed", config.calibration.seed},
+      {"config_sha256", sha256_hex(config.text)},
+      {"version", DEMCAL_VERSION}};
+  if (auto a = analytical_peak_stress(config)) params["analytical_peak_stress_yy"] = *a;
+  return params;
+}
+
+nlohmann::json peak_error_json(const TrialRecord& t, double reference_peak) {
+  if (!t.complete || t.diverged || t.criteria.peak_stress_yy >= 0.0) return nullptr;
+  return (reference_peak - t.criteria.peak_stress_yy) / std::abs(reference_peak);
+}
+
+nlohmann::json evidence_block(const CalibrationEvidence& e, const TrialRecord& best) {
+  const BaselineResult& baseline = e.baseline;
+  nlohmann::json b{{"passed", baseline.passed},
+                   {"start_steps", e.baseline_start_steps},
+                   {"trials", static_cast<int>(baseline.trials.size())},
+                   {"particle_steps_total", baseline.particle_steps_total}};
+  if (baseline.passed) {
+    const TrialRecord& last = baseline.trials.back();
+    b["steps"] = baseline.params.steps;
+    b["particle_steps"] = last.particle_steps;
+    b["peak_stress_yy"] = last.criteria.peak_stress_yy;
+    b["peak_error"] = peak_error_json(last, e.reference_peak);
+  }
+  return {{"reference",
+           {{"law", "Richardson, error proportional to 1/Nstep: 2 P(16 Nstep) - P(8 Nstep)"},
+            {"steps_8x", e.coarse.params.steps},
+            {"peak_stress_yy_8x", e.coarse.criteria.peak_stress_yy},
+            {"steps_16x", e.fine.params.steps},
+            {"peak_stress_yy_16x", e.fine.criteria.peak_stress_yy},
+            {"peak_stress_yy", e.reference_peak},
+            {"calibrated_peak_error", peak_error_json(best, e.reference_peak)}}},
+          {"baseline", b}};
+}
+
+std::string evidence_lines(const CalibrationEvidence& e) {
+  std::string lines;
+  auto add = [&](const TrialRecord& t) {
+    nlohmann::json j = to_json(t);
+    j["peak_error"] = peak_error_json(t, e.reference_peak);
+    lines += j.dump() + "\n";
+  };
+  add(e.coarse);
+  add(e.fine);
+  for (const auto& t : e.baseline.trials) add(t);
+  return lines;
+}
+
+}  // namespace demcal

@@ -1,0 +1,320 @@
+// The records' one JSON form each (AlgorithmSpec, TrialRecord, a scaling
+// size, the certificate), the enums parsed with a clear error, Richardson
+// extrapolation against an exact 1/N law, and the library pieces the CLI
+// used to hold: params.json's schema, the search's start point, the scaling
+// study's plan and report.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "demcal/io/input_error.hpp"
+#include "demcal/scene/biaxial.hpp"
+#include "demcal/scene/config.hpp"
+#include "demcal/scene/packing.hpp"
+#include "demcal/scoring/scoring.hpp"
+#include "demcal/search/calibration.hpp"
+#include "demcal/upscaling/params_file.hpp"
+#include "demcal/upscaling/scaling_study.hpp"
+
+using namespace demcal;
+using nlohmann::json;
+
+namespace {
+
+/// The message of the InputError `f` throws ("" when it does not throw).
+template <class F>
+std::string input_error_of(F&& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+AlgorithmSpec sample_params() {
+  AlgorithmSpec p;
+  p.dt_ratio = 0.137;
+  p.steps = 12345;
+  p.damping_ratio_translation = 0.71;
+  p.damping_ratio_rotation = 0.0;
+  p.mass_scaling = 2.0;
+  p.lock_rotation = true;
+  return p;
+}
+
+TrialRecord sample_trial() {
+  TrialRecord t;
+  t.id = 7;
+  t.phase = to_string(TrialPhase::search_tightened);
+  t.params = sample_params();
+  t.criteria.force_balance = 0.0031;
+  t.criteria.moment_balance = 2.5e-6;
+  t.criteria.servo = 0.0012;
+  t.criteria.oscillation = 4e-4;
+  t.criteria.zigzag = 0.02;
+  t.criteria.peak_stress_yy = -6.1e5;
+  t.criteria.peak_strain_yy = -0.004;
+  t.criteria.points = 199;
+  t.criteria.peak_error = 0.013;
+  t.passed = true;
+  t.worst_excess = 0.4;
+  t.steps_run = 12345;
+  t.particle_steps = 25.0 * 12345;
+  t.wall_time_s = 0.25;
+  t.diagnosis = "quasi-static";
+  return t;
+}
+
+}  // namespace
+
+TEST(Records, AlgorithmSpecRoundTripsThroughItsOneJsonForm) {
+  const AlgorithmSpec p = sample_params();
+  const json j = to_json(p);
+  EXPECT_EQ(j.size(), 6u);
+  const AlgorithmSpec q = algorithm_from_json(j, "x.json");
+  EXPECT_EQ(to_json(q), j);
+  // The config's block is the same form.
+  SceneConfig c = default_config();
+  c.algorithm = p;
+  EXPECT_EQ(to_json(c).at("algorithm"), j);
+}
+
+TEST(Records, AlgorithmSpecReaderNamesFileAndField) {
+  json j = to_json(sample_params());
+  j["dt_ratio"] = "fast";
+  EXPECT_NE(input_error_of([&] {
+              algorithm_from_json(j, "trials.jsonl", "params");
+            }).find("params.dt_ratio"),
+            std::string::npos);
+  j = to_json(sample_params());
+  j["bogus"] = 1;
+  const std::string e = input_error_of([&] { algorithm_from_json(j, "f.json", "params"); });
+  EXPECT_NE(e.find("f.json"), std::string::npos);
+  EXPECT_NE(e.find("params.bogus"), std::string::npos);
+  // Missing keys keep the base (older files without lock_rotation).
+  j = to_json(sample_params());
+  j.erase("lock_rotation");
+  EXPECT_FALSE(algorithm_from_json(j, "f.json").lock_rotation);
+}
+
+TEST(Records, StrategiesParseAndUnknownNamesAreBadInput) {
+  for (Strategy s : kStrategies) EXPECT_EQ(parse_strategy(to_string(s)), s);
+  const std::string e = input_error_of([] { parse_strategy("bogus", "--strategy"); });
+  EXPECT_NE(e.find("--strategy"), std::string::npos);
+  EXPECT_NE(e.find("bogus"), std::string::npos);
+  EXPECT_NE(e.find("cobyla"), std::string::npos);  // the valid names are listed
+}
+
+TEST(Records, TrialPhasesParseAndUnknownNamesAreBadInput) {
+  for (TrialPhase p : {TrialPhase::search, TrialPhase::search_tightened, TrialPhase::verify,
+                       TrialPhase::certificate, TrialPhase::baseline, TrialPhase::reference,
+                       TrialPhase::steps_search})
+    EXPECT_EQ(parse_trial_phase(to_string(p), "t"), p);
+  EXPECT_EQ(to_string(TrialPhase::search_tightened), "search-tightened");
+  EXPECT_NE(input_error_of([] { parse_trial_phase("warmup", "t.jsonl"); }).find("warmup"),
+            std::string::npos);
+}
+
+TEST(Records, TrialRecordRoundTripsAndKeepsItsScore) {
+  const TrialRecord t = sample_trial();
+  const json j = to_json(t);
+  const TrialRecord u = trial_from_json(j, "trials.jsonl: line 1");
+  EXPECT_EQ(to_json(u), j);
+  EXPECT_EQ(u.criteria.peak_error, t.criteria.peak_error);
+  EXPECT_EQ(u.criteria.zigzag, t.criteria.zigzag);
+  // The score a record keeps drives the search as the original would.
+  const Tolerances tol;
+  EXPECT_EQ(constraint_values(score_of(u), tol), constraint_values(score_of(t), tol));
+  EXPECT_DOUBLE_EQ(score_of(u).completed_fraction, 1.0);
+}
+
+TEST(Records, ATrialsJsonlLineOfTheEarlierFormatStillResumes) {
+  // A line as the previous version wrote it (criteria without the newer
+  // fields): it must read, and the missing fields stay at their defaults.
+  const json line = json::parse(R"({"complete":true,"criteria":{"force_balance":0.004,
+    "moment_balance":1e-6,"servo":0.001,"oscillation":0.0002,"points":199},
+    "diagnosis":"quasi-static","diverged":false,"id":3,"params":{"damping_ratio_rotation":1.0,
+    "damping_ratio_translation":1.0,"dt_ratio":0.2,"lock_rotation":false,"mass_scaling":1.0,
+    "steps":50000},"particle_steps":1250000.0,"passed":true,"peak_strain_yy":-0.004,
+    "peak_stress_yy":-612000.0,"phase":"certificate","steps_run":50000,"wall_time_s":0.4,
+    "worst_excess":0.5})");
+  const TrialRecord t = trial_from_json(line, "old.jsonl");
+  EXPECT_EQ(t.params.steps, 50000);
+  EXPECT_EQ(t.criteria.peak_stress_yy, -612000.0);
+  EXPECT_EQ(t.criteria.zigzag, 0.0);
+  EXPECT_EQ(t.phase, "certificate");
+  json bad = line;
+  bad["phase"] = "warmup";
+  EXPECT_THROW(trial_from_json(bad, "old.jsonl"), InputError);
+}
+
+TEST(Records, RichardsonRecoversAnExactOneOverNLaw) {
+  // P(N) = P∞ + c/N exactly: the extrapolation gives P∞, and the error
+  // estimate of the coarse run is its true error.
+  const double p_inf = -6.0e5, c = 3.0e9;
+  auto P = [&](double n) { return p_inf + c / n; };
+  for (double r : {2.0, 4.0}) {
+    const double n = 1.0e5;
+    EXPECT_NEAR(richardson_limit(n, P(n), r * n, P(r * n)), p_inf, 1e-9 * std::abs(p_inf));
+    const double change = std::abs(P(n) - P(r * n)) / std::abs(P(r * n));
+    const double true_error = std::abs(P(n) - p_inf) / std::abs(P(r * n));
+    EXPECT_NEAR(richardson_error(change, r), true_error, 1e-12);
+  }
+  EXPECT_EQ(richardson_error(0.01), 0.02);  // Nstep doubled: twice the change
+}
+
+TEST(Records, CalibrationOptionsTakeTheirDefaultsFromTheConfigBlock) {
+  const CalibrationSpec spec;
+  const CalibrationOptions o;
+  EXPECT_EQ(o.max_trials, spec.max_trials);
+  EXPECT_EQ(o.accuracy, spec.accuracy);
+  EXPECT_EQ(o.seed, spec.seed);
+  CalibrationSpec custom;
+  custom.max_trials = 12;
+  custom.accuracy = 0.05;
+  custom.seed = 9;
+  const CalibrationOptions f = CalibrationOptions::from(custom);
+  EXPECT_EQ(f.max_trials, 12);
+  EXPECT_EQ(f.accuracy, 0.05);
+  EXPECT_EQ(f.seed, 9u);
+}
+
+TEST(Records, SearchStartIsThePapersRecipeWithASizeBasedNstep) {
+  const AlgorithmSpec base = sample_params();
+  const AlgorithmSpec s = search_start(base, 100, 0.5);
+  EXPECT_EQ(s.dt_ratio, 0.2);
+  EXPECT_EQ(s.steps, kStartStepsPerParticle * 100);
+  EXPECT_EQ(s.damping_ratio_translation, 1.0);
+  EXPECT_EQ(s.damping_ratio_rotation, 1.0);
+  EXPECT_EQ(s.mass_scaling, base.mass_scaling);
+  EXPECT_EQ(search_start(base, 100, 0.13).dt_ratio, 0.13);  // capped by the stable bound
+  EXPECT_EQ(round_steps(6172500.0), 6173000);
+  EXPECT_EQ(round_steps(3.0), 10);
+}
+
+TEST(Records, ParamsFileCarriesTheCalibratedBlocks) {
+  SceneConfig config = default_config();
+  config.assembly.columns = config.assembly.rows = 5;
+  const ConsolidatedState state = consolidate(config, make_assembly(config));
+  CalibrationOptions options = CalibrationOptions::from(config.calibration);
+  CalibrationSummary summary;
+  summary.success = true;
+  summary.message = "calibrated";
+  summary.best = sample_params();
+  summary.best.lock_rotation = false;
+  summary.best_trial = sample_trial();
+  summary.trials = {summary.best_trial, summary.best_trial};
+  summary.certificate.steps = summary.best.steps;
+  summary.certificate.richardson_error = 0.004;
+  summary.certificate.passed = true;
+  summary.strategy = to_string(Strategy::model);
+  const json p = params_file(config, state, options, summary);
+  EXPECT_EQ(p.at("schema"), "demcal.params/1");
+  EXPECT_EQ(p.at("rev").at("dt_ratio"), summary.best.dt_ratio);
+  EXPECT_EQ(p.at("rev").at("steps"), summary.best.steps);
+  EXPECT_EQ(p.at("rev").at("particles"), state.world.size());
+  EXPECT_FALSE(p.at("rev").contains("lock_rotation"));
+  EXPECT_EQ(p.at("criteria"), to_json(summary.best_trial.criteria));
+  EXPECT_EQ(p.at("certificate"), to_json(summary.certificate));
+  EXPECT_EQ(p.at("strategy"), "model");
+  EXPECT_EQ(p.at("trials"), 2);
+  EXPECT_DOUBLE_EQ(p.at("particle_steps_run").get<double>(),
+                   2.0 * 12345 * static_cast<double>(state.world.size()));
+  EXPECT_TRUE(p.contains("analytical_peak_stress_yy"));  // a hexagonal scene
+}
+
+TEST(Records, EvidenceBlockMeasuresPeakErrorsAgainstTheReference) {
+  CalibrationEvidence e;
+  e.coarse = e.fine = sample_trial();
+  e.reference_peak = -6.0e5;
+  TrialRecord best = sample_trial();
+  best.criteria.peak_stress_yy = -6.3e5;  // 5 % stronger: a positive error
+  const json b = evidence_block(e, best);
+  EXPECT_NEAR(b.at("reference").at("calibrated_peak_error").get<double>(), 0.05, 1e-12);
+  best.diverged = true;
+  EXPECT_TRUE(peak_error_json(best, e.reference_peak).is_null());
+  const std::string lines = evidence_lines(e);  // the two reference runs, no baseline
+  EXPECT_EQ(std::count(lines.begin(), lines.end(), '\n'), 2);
+}
+
+TEST(ScalingStudy, SizesParseSortedAndBadPlansAreBadInput) {
+  EXPECT_EQ(parse_sizes("400,25,100,25"), (std::vector<int64_t>{25, 100, 400}));
+  EXPECT_THROW(parse_sizes("25"), InputError);
+  EXPECT_THROW(parse_sizes("25,x"), InputError);
+  EXPECT_THROW(parse_sizes("2,25"), InputError);
+  ScalingStudyOptions o;
+  o.sizes = {25, 100, 1600};
+  o.calibrate_max = 400;
+  EXPECT_NO_THROW(check_scaling_sizes(o));
+  o.calibrate_max = 50;  // one calibrated size only
+  EXPECT_NE(input_error_of([&] { check_scaling_sizes(o); }).find("--sizes"), std::string::npos);
+}
+
+TEST(ScalingStudy, SpreadIsRangeOverMean) {
+  const Spread s = spread_of({0.1, 0.2, 0.3});
+  EXPECT_DOUBLE_EQ(s.mean, 0.2);
+  EXPECT_DOUBLE_EQ(s.relative, 1.0);
+  EXPECT_EQ(spread_of({}).relative, 0.0);
+}
+
+TEST(ScalingStudy, ASizeRoundTripsThroughItsJson) {
+  ScalingSize r;
+  r.requested = 100;
+  r.particles = 100;
+  r.calibrated = true;
+  r.success = true;
+  r.best = sample_params();
+  r.richardson = 0.01;
+  r.peak = -6e5;
+  r.trials = 30;
+  r.fixed.found = true;
+  r.fixed.steps = 12345;
+  r.fixed.best = sample_trial();
+  r.fixed.trials = {sample_trial(), sample_trial()};
+  const json j = to_json(r);
+  EXPECT_EQ(to_json(scaling_size_from_json(j, "result.json")), j);
+  EXPECT_THROW(scaling_size_from_json(json{{"particles", 3}}, "result.json"), InputError);
+}
+
+TEST(ScalingStudy, ReportStatesTheVerdictAndTheLaw) {
+  // A synthetic study: two calibrated sizes and a forward size where
+  // Nstep grows exactly linearly.
+  ScalingStudy st;
+  st.scene = "hex";
+  st.sizes = {25, 100, 400};
+  st.sizes_text = "25,100,400";
+  st.calibrated_sizes = {25, 100};
+  st.calibrate_max = 100;
+  st.ref_size = 100;
+  st.forward_size = 400;
+  for (int64_t n : st.sizes) {
+    ScalingSize& r = st.results[n];
+    r.requested = r.particles = n;
+    r.calibrated = n <= 100;
+    r.success = r.calibrated;
+    r.best = sample_params();
+    r.best.steps = 500 * n;
+    r.fixed.found = true;
+    r.fixed.steps = 500 * n;
+  }
+  st.have_forward = st.forward_ok = true;
+  st.linear_run = st.reference = sample_trial();
+  st.linear_peak_error = 0.004;
+  st.measured.exponent = 1.0;
+  st.linear_holds = true;
+  st.accuracy = 0.02;
+  const SceneConfig config = default_config();
+  const std::string md = scaling_markdown(st, config);
+  EXPECT_NE(md.find("Forward check of the linear law (Tu & Andrade) at 400 particles: **passed**"),
+            std::string::npos);
+  EXPECT_NE(md.find("the linear law holds"), std::string::npos);
+  EXPECT_NE(md.find("peak 0.4 % from the reference, target ±2 %"), std::string::npos);
+  const json j = to_json(st, config);
+  EXPECT_EQ(j.at("law").at("law"), "linear");
+  EXPECT_EQ(j.at("forward").at("passed"), true);
+  EXPECT_EQ(j.at("results").size(), 3u);
+}
