@@ -9,6 +9,8 @@
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <stdexcept>
 
 namespace demcal {
@@ -102,6 +104,25 @@ void require_regular_file_target(const std::string& path) {
   if (ec && s.type() == fs::file_type::none)
     throw InputError(path, "", "cannot be written (" + ec.message() + ")");
   throw InputError(path, "", "exists and is " + kind_of(s) + "; demcal writes only regular files");
+}
+
+void require_readable_file(const std::string& path) {
+  std::error_code ec;
+  const fs::file_status s = fs::status(path, ec);
+  if (s.type() == fs::file_type::not_found) throw InputError(path, "", "no such file");
+  if (ec) throw InputError(path, "", "cannot open (" + ec.message() + ")");  // ELOOP, EACCES
+  if (s.type() != fs::file_type::regular)
+    throw InputError(path, "", "is " + kind_of(s) + ", not a file");
+}
+
+std::string read_text_file(const std::string& path) {
+  require_readable_file(path);
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path, "", std::string("cannot open (") + std::strerror(errno) + ")");
+  std::ostringstream s;
+  s << in.rdbuf();
+  if (in.bad()) throw InputError(path, "", "cannot read file");
+  return s.str();
 }
 
 void write_file_atomic(const std::string& path, const std::string& content) {

@@ -29,6 +29,13 @@ std::string temporary_name(const std::string& name);
 /// symlinks): InputError naming the path and what it is, exit 2.
 void require_regular_file_target(const std::string& path);
 
+/// Refuse an input path that cannot be read as a regular file: missing, a
+/// folder, a device node or fifo (/dev/zero would never end), a symlink
+/// loop. One InputError naming the path and the reason, exit 2.
+void require_readable_file(const std::string& path);
+/// The whole of a regular file (require_readable_file first).
+std::string read_text_file(const std::string& path);
+
 /// Write `content` to `path` atomically (temporary + fsync + rename). A
 /// non-regular target is an InputError; a failed write throws
 /// std::runtime_error naming the path and the system's reason ("No space
