@@ -50,6 +50,9 @@ OutputFolder::OutputFolder(const std::string& dir, bool probe_only) : name_(dir)
   }
   // A folder that exists may still refuse files (permissions, read-only):
   // making the staging folder proves it can be written.
+  // What a killed earlier command left here (its staging folder): only
+  // .demcal-tmp-PID-… of processes that are gone.
+  if (!probe_only) remove_stale_temporaries(dir_.string());
   try {
     files_ = std::make_unique<OutputTransaction>(dir_.string());
   } catch (const InputError&) {

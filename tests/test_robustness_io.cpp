@@ -284,7 +284,11 @@ TEST_F(RobustIo, FailedCommandLeavesNoFolderItMade) {
 TEST_F(RobustIo, CliRunReplacesAnEarlierRunAndKeepsUserFiles) {
   const fs::path out = dir_ / "out";
   put_old_run(out);
-  std::ofstream(out / ("thesis.tmp." + std::to_string(dead_pid()))) << "mine";
+  const pid_t dead = dead_pid();
+  std::ofstream(out / ("thesis.tmp." + std::to_string(dead))) << "mine";
+  // A killed earlier run's staging folder is cleared.
+  fs::create_directories(out / temporary_name("stage1", dead));
+  std::ofstream(out / temporary_name("stage1", dead) / "summary.json") << "half";
   const Result r = demcal({"run", kHex5, "--set", "algorithm.steps=400", "-o", out.string()}, dir_);
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(read(out / "summary.json"), "old summary");
