@@ -1,33 +1,33 @@
 #include "output_folder.hpp"
 
-#include <unistd.h>
-
-#include <fstream>
-
-#include "demcal/scene/config.hpp"
-#include "demcal/io/files.hpp"
-#include "demcal/scene/run_output.hpp"
+#include "demcal/io/input_error.hpp"
 
 namespace demcal::cli {
 
 namespace fs = std::filesystem;
 
 OutputFolder::~OutputFolder() {
-  if (!committed_) discard();
+  if (committed_) return;
+  files_.reset();  // removes the staged files
+  remove_created();
 }
 
-void OutputFolder::discard() {
+void OutputFolder::remove_created() noexcept {
   std::error_code ec;
-  for (auto it = written_.rbegin(); it != written_.rend(); ++it) fs::remove(*it, ec);
+  // fs::remove leaves a folder that is not empty (someone else wrote there).
   for (auto it = created_.rbegin(); it != created_.rend(); ++it) fs::remove(*it, ec);
-  written_.clear();
   created_.clear();
 }
 
 void OutputFolder::write(const std::string& name, const std::string& content) {
-  const std::string path = (dir_ / name).string();
-  write_file_atomic(path, content);  // on failure it leaves nothing behind itself
-  written_.push_back(path);
+  files_->add(name, content);
+}
+
+void OutputFolder::retire(const std::string& name) { files_->retire(name); }
+
+void OutputFolder::commit() {
+  files_->commit();
+  committed_ = true;
 }
 
 OutputFolder::OutputFolder(const std::string& dir, bool probe_only) : name_(dir) {
@@ -37,7 +37,7 @@ OutputFolder::OutputFolder(const std::string& dir, bool probe_only) : name_(dir)
   std::vector<fs::path> missing;  // deepest first
   std::error_code ec;
   fs::path q = p;
-  while (!q.empty() && !fs::exists(q, ec)) {
+  while (!q.empty() && fs::symlink_status(q, ec).type() == fs::file_type::not_found) {
     missing.push_back(q);
     q = q.parent_path();
   }
@@ -48,24 +48,28 @@ OutputFolder::OutputFolder(const std::string& dir, bool probe_only) : name_(dir)
       fail("cannot create folder " + it->string() + (ec ? " (" + ec.message() + ")" : ""));
     created_.push_back(*it);
   }
-  // A folder that exists may still refuse files (permissions, read-only).
-  const fs::path probe = p / (".demcal-probe-" + std::to_string(::getpid()));
-  {
-    std::ofstream out(probe, std::ios::binary | std::ios::trunc);
-    if (!out) fail("cannot write files in this folder");
-    written_.push_back(probe);
+  // A folder that exists may still refuse files (permissions, read-only):
+  // making the staging folder proves it can be written.
+  // What a killed earlier command left here (its staging folder): only
+  // .demcal-tmp-PID-… of processes that are gone.
+  if (!probe_only) remove_stale_temporaries(dir_.string());
+  try {
+    files_ = std::make_unique<OutputTransaction>(dir_.string());
+  } catch (const InputError&) {
+    fail("cannot write files in this folder");
+  } catch (const std::exception& e) {
+    fail(e.what());
   }
-  fs::remove(probe, ec);
-  written_.pop_back();
   if (probe_only) {
-    for (auto it = created_.rbegin(); it != created_.rend(); ++it) fs::remove(*it, ec);
-    created_.clear();
+    files_.reset();
+    remove_created();
     committed_ = true;
   }
 }
 
 void OutputFolder::fail(const std::string& what) {
-  discard();
+  files_.reset();
+  remove_created();
   committed_ = true;
   throw InputError(name_, "", "output folder unusable: " + what);
 }

@@ -1,15 +1,19 @@
-// An output folder written all or nothing (the CLI's commands that write
-// several files). check() proves, before any computation, that the folder
-// can be made and written, and leaves no trace (bad path: InputError, exit
-// 2). The constructor makes the missing folders; write() adds files
-// atomically; unless commit() is called, the destructor removes the files
-// written and the folders made, so a failure half-way leaves no partial
-// output.
+// The output folder of a CLI command, written all or nothing. check()
+// proves, before any computation, that the folder can be made and written,
+// and leaves no trace (bad path: InputError, exit 2). The constructor makes
+// the missing folders; write() stages files (OutputTransaction in
+// demcal/io/files.hpp); commit() puts them all in place at once, replacing
+// the files of an earlier run together. Without commit() the destructor
+// removes the staged files and the folders it made: a failure half-way
+// leaves the folder as it was, and no empty folder behind.
 #pragma once
 
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <vector>
+
+#include "demcal/io/files.hpp"
 
 namespace demcal::cli {
 
@@ -22,17 +26,23 @@ class OutputFolder {
   OutputFolder& operator=(const OutputFolder&) = delete;
   ~OutputFolder();
 
+  /// Stage dir/`name` (may hold subfolders: "series/a.csv").
   void write(const std::string& name, const std::string& content);
-  void commit() { committed_ = true; }
+  /// dir/`name` of an earlier run that this one does not write: removed at
+  /// commit, so the folder holds one run.
+  void retire(const std::string& name);
+  void commit();
+  const std::string& path() const { return name_; }
 
  private:
   OutputFolder(const std::string& dir, bool probe_only);
   [[noreturn]] void fail(const std::string& what);
-  void discard();  // remove the files written, then the folders made
+  void remove_created() noexcept;  // the folders made, deepest first, if empty
 
   std::string name_;
   std::filesystem::path dir_;
-  std::vector<std::filesystem::path> created_, written_;
+  std::vector<std::filesystem::path> created_;
+  std::unique_ptr<OutputTransaction> files_;
   bool committed_ = false;
 };
 

@@ -14,7 +14,15 @@
 namespace demcal {
 namespace {
 
-SceneConfig scene(const std::string& json) { return parse_config_text(json, "test"); }
+/// `json` with the material keys a config must give added where absent.
+SceneConfig scene(const std::string& json) {
+  nlohmann::json j = nlohmann::json::parse(json);
+  const nlohmann::json required = {
+      {"density", 2650}, {"kn", 1e8}, {"kt", 5e7}, {"friction", 0.3}};
+  for (const auto& [key, value] : required.items())
+    if (!j["material"].contains(key)) j["material"][key] = value;
+  return parse_config_text(j.dump(), "test");
+}
 
 double peak_ratio(const LoadingResult& run, const TestSpec& test) {
   return -run.peak_stress_yy / test.lateral_stress;

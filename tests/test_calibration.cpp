@@ -97,10 +97,10 @@ bool wait_for_trials(const fs::path& path, size_t lines, pid_t pid) {
   return false;
 }
 
-/// No NAME.tmp.PID left behind by an interrupted atomic write.
+/// No .demcal-tmp-PID-NAME left behind by an interrupted atomic write.
 bool has_temporaries(const fs::path& dir) {
   for (const auto& e : fs::directory_iterator(dir))
-    if (e.path().filename().string().find(".tmp.") != std::string::npos) return true;
+    if (e.path().filename().string().rfind(".demcal-tmp-", 0) == 0) return true;
   return false;
 }
 
@@ -223,8 +223,9 @@ TEST(Calibration, SigintAndSigtermStopCleanlyAndResumeContinues) {
   fs::remove_all(stopped);
 }
 
-// A kill in mid-write leaves NAME.tmp.PID; the next run into the folder
-// removes those of processes that are gone, and only those.
+// A kill in mid-write leaves .demcal-tmp-PID-NAME; the next run into the
+// folder removes those of processes that are gone, and only those (a user's
+// NAME.tmp.PID is not demcal's: tests/test_robustness_io.cpp).
 TEST(Output, StaleTemporariesOfDeadProcessesAreRemoved) {
   const fs::path dir = fresh_dir("stale_tmp");
   fs::create_directories(dir);
@@ -232,8 +233,8 @@ TEST(Output, StaleTemporariesOfDeadProcessesAreRemoved) {
   const pid_t dead = fork();
   if (dead == 0) _exit(0);
   wait_exit(dead);
-  const fs::path stale = dir / ("params.json.tmp." + std::to_string(dead));
-  const fs::path live = dir / ("report.html.tmp." + std::to_string(::getppid()));
+  const fs::path stale = dir / temporary_name("params.json", dead);
+  const fs::path live = dir / temporary_name("report.html", ::getppid());
   const fs::path user = dir / "notes.tmp.txt";
   for (const auto& p : {stale, live, user}) std::ofstream(p) << "x";
   remove_stale_temporaries(dir.string());

@@ -18,7 +18,28 @@ namespace {
 
 constexpr const char* kFile = "scene.json";
 
-SceneConfig parse(const std::string& text) { return parse_config_text(text, kFile); }
+/// `text` with the keys a config must give (the material's density, kn, kt
+/// and friction: ConfigRequired.MaterialAndItsKeys) added where absent, so
+/// that the tests below see only the key they are about. Text that is not a
+/// JSON object, or whose material is not one, is passed as it is.
+std::string with_material(const std::string& text) {
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::exception&) {
+    return text;
+  }
+  if (!j.is_object()) return text;
+  nlohmann::json& m = j["material"];
+  if (m.is_null()) m = nlohmann::json::object();
+  if (!m.is_object()) return text;
+  const nlohmann::json required = {{"density", 2650}, {"kn", 1e8}, {"kt", 5e7}, {"friction", 0.3}};
+  for (const auto& [key, value] : required.items())
+    if (!m.contains(key)) m[key] = value;
+  return j.dump();
+}
+
+SceneConfig parse(const std::string& text) { return parse_config_text(with_material(text), kFile); }
 
 /// The InputError `f` throws, or nothing (then the test fails).
 std::optional<InputError> input_error(const std::function<void()>& f) {
@@ -54,9 +75,10 @@ void expect_rejected(const std::string& text, const std::string& field) {
 // The documented defaults (config.hpp, DESIGN.md §5), written out once more
 // so that a silent change of a default is caught here.
 TEST(ConfigDefaults, EmptyObjectGivesEveryDocumentedDefault) {
+  // The material's density, kn, kt and friction have no default any more
+  // (with_material gives them): thickness still has one.
   const SceneConfig c = parse("{}");
   EXPECT_EQ(c.name, "scene");
-  EXPECT_EQ(c.material.density, 2650.0);
   EXPECT_EQ(c.material.thickness, 1.0);
   EXPECT_EQ(c.material.particle.kn, 1e8);
   EXPECT_EQ(c.material.particle.kt, 5e7);
@@ -167,11 +189,11 @@ TEST(ConfigDefaults, WholeNumbersInExponentFormAreIntegers) {
 }
 
 TEST(ConfigDefaults, FileRelativeToTheConfigFolder) {
-  const SceneConfig c =
-      parse_config_text(R"({"assembly": {"type": "file", "file": "p.csv"}})", "dir/sub/scene.json");
+  const SceneConfig c = parse_config_text(
+      with_material(R"({"assembly": {"type": "file", "file": "p.csv"}})"), "dir/sub/scene.json");
   EXPECT_EQ(std::filesystem::path(c.assembly.file), std::filesystem::path("dir/sub/p.csv"));
-  const SceneConfig abs =
-      parse_config_text(R"({"assembly": {"type": "file", "file": "/x/p.csv"}})", "dir/s.json");
+  const SceneConfig abs = parse_config_text(
+      with_material(R"({"assembly": {"type": "file", "file": "/x/p.csv"}})"), "dir/s.json");
   EXPECT_EQ(abs.assembly.file, "/x/p.csv");
 }
 
@@ -333,7 +355,7 @@ TEST(ConfigErrors, MissingFileAndFolder) {
 // --- --set overrides --------------------------------------------------------
 
 SceneConfig with_sets(const std::string& text, const std::vector<std::string>& sets) {
-  nlohmann::json j = nlohmann::json::parse(text);
+  nlohmann::json j = nlohmann::json::parse(with_material(text));
   apply_overrides(j, sets, kFile);
   return parse_config(j, kFile);
 }
@@ -351,7 +373,8 @@ TEST(ConfigOverrides, NestedTypedAndNewSections) {
   EXPECT_EQ(c.test.servo_gain, 0.25);
   EXPECT_EQ(c.assembly.columns, 3);
   // Later overrides win.
-  EXPECT_EQ(with_sets("{}", {"algorithm.steps=10", "algorithm.steps=20"}).algorithm.steps, 20);
+  EXPECT_EQ(with_sets("{}", {"algorithm.steps=1000", "algorithm.steps=2000"}).algorithm.steps,
+            2000);
 }
 
 void expect_set_rejected(const std::string& set, const std::string& field) {

@@ -160,8 +160,10 @@ TEST_F(PackingFile, MissingFileAndConfigDispatch) {
   }
   // make_assembly reads the config's file, resolved against the config.
   write("0,0,1e-3\n2e-3,0,1e-3\n4e-3,0,1e-3\n");
-  const SceneConfig c = parse_config_text(R"({"assembly": {"type": "file", "file": "p.csv"}})",
-                                          (dir_ / "scene.json").string());
+  const SceneConfig c = parse_config_text(
+      R"({"material": {"density": 2650, "kn": 1e8, "kt": 5e7, "friction": 0.3},
+          "assembly": {"type": "file", "file": "p.csv"}})",
+      (dir_ / "scene.json").string());
   EXPECT_EQ(make_assembly(c).size(), 3);
 }
 

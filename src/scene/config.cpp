@@ -14,11 +14,22 @@
 #include <string>
 #include <vector>
 
+#include "demcal/io/files.hpp"
+
 namespace demcal {
 
 namespace {
 
 using nlohmann::json;
+
+/// A key as the user wrote it, or quoted and cut when it is long or holds
+/// control characters (the message stays one short line).
+std::string shown_key(const std::string& key) {
+  const bool plain = key.size() <= 80 && std::none_of(key.begin(), key.end(), [](char ch) {
+                       return static_cast<unsigned char>(ch) < 0x20 || ch == 0x7f;
+                     });
+  return plain ? key : quoted_value(key);
+}
 
 class Reader {
  public:
@@ -40,7 +51,9 @@ class Reader {
     used_.insert(key);
     if (!has(key)) return fallback;
     const json& v = object_.at(key);
-    if (!v.is_number()) fail(key, "must be a number, got " + std::string(v.type_name()));
+    if (!v.is_number())
+      fail(key,
+           "must be a number, got " + std::string(v.type_name()) + " " + quoted_value(v.dump()));
     const double d = v.get<double>();
     if (!std::isfinite(d)) fail(key, "must be finite");
     return d;
@@ -55,28 +68,42 @@ class Reader {
     if (!(d >= 0.0)) fail(key, "must be >= 0, got " + format(d));
     return d;
   }
+  /// A whole number, read as an integer (never through a double that could
+  /// overflow the cast): 100000, or 1e5 in exponent form when that is exact
+  /// (at most 2^53; beyond it a double is not the number written).
   int64_t integer(const std::string& key, int64_t fallback, int64_t min, int64_t max) {
     used_.insert(key);
     if (!has(key)) return fallback;
     const json& v = object_.at(key);
-    double d = 0.0;
-    if (v.is_number_integer()) {
-      d = static_cast<double>(v.get<int64_t>());
-    } else if (v.is_number_float() && std::floor(v.get<double>()) == v.get<double>()) {
-      d = v.get<double>();  // 1e5 written in exponent form is still a whole number
-    } else {
-      fail(key, "must be a whole number, got " + v.dump());
+    const std::string range =
+        "must be between " + std::to_string(min) + " and " + std::to_string(max) + ", got ";
+    if (v.is_number_unsigned()) {
+      const uint64_t u = v.get<uint64_t>();
+      if (u > static_cast<uint64_t>(max) || (min > 0 && u < static_cast<uint64_t>(min)))
+        fail(key, range + v.dump());
+      return static_cast<int64_t>(u);
     }
-    if (d < static_cast<double>(min) || d > static_cast<double>(max))
-      fail(key, "must be between " + std::to_string(min) + " and " + std::to_string(max) +
-                    ", got " + v.dump());
-    return static_cast<int64_t>(d);
+    if (v.is_number_integer()) {
+      const int64_t i = v.get<int64_t>();
+      if (i < min || i > max) fail(key, range + v.dump());
+      return i;
+    }
+    if (!v.is_number_float() || std::floor(v.get<double>()) != v.get<double>())
+      fail(key, "must be a whole number, got " + quoted_value(v.dump()));
+    const double d = v.get<double>();
+    constexpr double kExact = 9007199254740992.0;  // 2^53
+    if (std::abs(d) > kExact)
+      fail(key, "must be written as an integer (" + v.dump() +
+                    " in exponent form is beyond 2^53, where a double is not exact)");
+    const auto i = static_cast<int64_t>(d);  // |d| <= 2^53: exact, no overflow
+    if (i < min || i > max) fail(key, range + v.dump());
+    return i;
   }
   bool boolean(const std::string& key, bool fallback) {
     used_.insert(key);
     if (!has(key)) return fallback;
     const json& v = object_.at(key);
-    if (!v.is_boolean()) fail(key, "must be true or false, got " + v.dump());
+    if (!v.is_boolean()) fail(key, "must be true or false, got " + quoted_value(v.dump()));
     return v.get<bool>();
   }
   std::string string(const std::string& key, const std::string& fallback,
@@ -84,7 +111,7 @@ class Reader {
     used_.insert(key);
     if (!has(key)) return fallback;
     const json& v = object_.at(key);
-    if (!v.is_string()) fail(key, "must be a string, got " + v.dump());
+    if (!v.is_string()) fail(key, "must be a string, got " + quoted_value(v.dump()));
     std::string s = v.get<std::string>();
     if (!choices.empty()) {
       bool ok = false;
@@ -93,7 +120,7 @@ class Reader {
         ok = ok || c == s;
         list += (list.empty() ? "" : ", ") + c;
       }
-      if (!ok) fail(key, "must be one of " + list + ", got \"" + s + "\"");
+      if (!ok) fail(key, "must be one of " + list + ", got " + quoted_value(s));
     }
     return s;
   }
@@ -105,7 +132,13 @@ class Reader {
   }
   void reject_unknown() const {
     for (auto it = object_.begin(); it != object_.end(); ++it)
-      if (!used_.count(it.key())) fail(it.key(), "unknown key");
+      if (!used_.count(it.key())) fail(shown_key(it.key()), "unknown key");
+  }
+  /// Keys with no sensible default: absent is an error naming the key.
+  void require(const std::vector<std::string>& keys, const std::string& why) const {
+    if (!object_.is_object()) return;
+    for (const auto& k : keys)
+      if (!has(k)) fail(k, "required (" + why + ")");
   }
 
  private:
@@ -143,6 +176,97 @@ AlgorithmSpec read_algorithm(Reader& a, AlgorithmSpec s) {
   return s;
 }
 
+// The scene name becomes part of default output paths ("demcal-run-NAME"):
+// it must be a plain file name, or "/../../tmp/x" writes elsewhere and
+// "a/b" makes nested folders. Rejected rather than rewritten: a silently
+// changed name would put the results where the user does not look.
+void check_scene_name(const Reader& root, const std::string& name) {
+  if (name.empty()) root.fail("name", "must not be empty");
+  if (name.size() > 200)
+    root.fail("name", "must be at most 200 characters (it becomes a file name), got " +
+                          std::to_string(name.size()));
+  for (char ch : name) {
+    const auto u = static_cast<unsigned char>(ch);
+    if (ch == '/' || ch == '\\' || u < 0x20 || u == 0x7f)
+      root.fail("name",
+                "must be a plain file name (no / or \\ or control characters: it names "
+                "the default output folder), got " +
+                    quoted_value(name));
+  }
+}
+
+// Mindlin's elastic contact has kt/kn = 2(1 - nu)/(2 - nu), between 2/3
+// (nu = 0.5) and 1 (nu = 0): kt > kn means a negative Poisson ratio, no
+// granular material. It is also where the run breaks: dt_ratio is relative
+// to 2*sqrt(m/kn), and the tangential-rotational mode of a solid disk
+// (omega^2 = 3 kt/m against kn/m for the normal one) then outruns the
+// normal springs, so consolidation at dt_ratio 0.2 diverges (kt = 1.2 kn on
+// hex_5x5; kt = kn runs). Walls do not rotate: their kt is not bound.
+void check_tangential_stiffness(const Reader& m, const ContactLaw& particle) {
+  if (particle.kt > particle.kn)
+    m.fail("kt", "must not exceed kn (" + std::to_string(particle.kn) +
+                     "): kt/kn = 2(1-nu)/(2-nu) "
+                     "<= 1 for an elastic contact, and beyond it the tangential-rotational mode "
+                     "outruns the normal step dt_ratio refers to; got " +
+                     std::to_string(particle.kt));
+}
+
+// Overlap at sigma3: a disk of radius r carries about sigma3*2r*t per
+// contact, so delta/r = 2*sigma3*t/kn whatever r. The kernel stops a run as
+// diverged when an overlap exceeds half the smallest radius
+// (Options::max_overlap_ratio), and at the peak sigma1 reaches several
+// times sigma3: delta/r <= 5 % at sigma3 leaves a factor 10. (The lower
+// bound depends on the box and is checked with the assembly:
+// check_resolvable in packing.cpp.)
+void check_lateral_stress(const Reader& t, const Material& material, double sigma3) {
+  const double kn = std::min(material.particle.kn, material.wall.kn);
+  const double limit = kMaxOverlapAtSigma3 / 2.0 * kn / material.thickness;
+  if (sigma3 > limit) {
+    std::ostringstream msg;
+    msg << "must be at most " << limit << " Pa for kn " << kn << " N/m and thickness "
+        << material.thickness
+        << " m: the overlap at sigma3, 2*sigma3*t/kn = " << 2.0 * sigma3 * material.thickness / kn
+        << " of the radius, must stay below " << kMaxOverlapAtSigma3
+        << " (the run stops at 0.5 and the peak stress is several "
+        << "times sigma3); got " << sigma3;
+    t.fail("lateral_stress", msg.str());
+  }
+}
+
+// The servo removes at most the fraction `gain` of the wall-stress error per
+// step (the true stiffness is lower than the one it assumes), and a packing
+// starts unstressed (error 1): reaching consolidation_tolerance takes at
+// least ln(1/tol)/(-ln(1 - gain)) steps. A gain that needs more than
+// consolidation_max_steps can never consolidate.
+void check_servo_gain(const Reader& t, const TestSpec& test) {
+  const double needed =
+      std::log(1.0 / test.consolidation_tolerance) / -std::log1p(-test.servo_gain);
+  if (needed > static_cast<double>(test.consolidation_max_steps)) {
+    const double min_gain = -std::expm1(-std::log(1.0 / test.consolidation_tolerance) /
+                                        static_cast<double>(test.consolidation_max_steps));
+    std::ostringstream msg;
+    msg << "must be at least " << min_gain << ": the servo removes at most the fraction gain of "
+        << "the stress error per step, so reaching consolidation_tolerance "
+        << test.consolidation_tolerance << " takes at least ln(1/tol)/(-ln(1-gain)) = " << needed
+        << " steps, more than consolidation_max_steps " << test.consolidation_max_steps << "; got "
+        << test.servo_gain;
+    t.fail("servo_gain", msg.str());
+  }
+}
+
+// The material is the physics being calibrated: a default density,
+// stiffness or friction would be a calibration of a material the user never
+// gave. thickness (2D: per metre, 1 by convention), contact_damping_ratio
+// (a model option, off unless asked) and the walls (boundary conditions,
+// frictionless by default) keep their documented defaults. Checked after
+// every other key, so that a wrong value is named before a missing one.
+void require_material(const Reader& root, const json& root_json, const std::string& source) {
+  const std::string why = "the material is the physics being calibrated; no default stands in";
+  if (!root.has("material")) root.fail("material", "required (" + why + ")");
+  Reader(root_json.at("material"), source, "material")
+      .require({"density", "kn", "kt", "friction"}, why);
+}
+
 }  // namespace
 
 nlohmann::json to_json(const AlgorithmSpec& g) {
@@ -165,13 +289,14 @@ SceneConfig parse_config(const nlohmann::json& root_json, const std::string& sou
   c.source = source;
   Reader root(root_json, source, "");
   c.name = root.string("name", c.name);
-  if (c.name.empty()) root.fail("name", "must not be empty");
+  check_scene_name(root, c.name);
 
   {
     Reader m = root.child("material");
     c.material.density = m.positive("density", c.material.density);
     c.material.thickness = m.positive("thickness", c.material.thickness);
     c.material.particle = read_contact(m, c.material.particle);
+    check_tangential_stiffness(m, c.material.particle);
     c.material.contact_damping_ratio =
         m.non_negative("contact_damping_ratio", c.material.contact_damping_ratio);
     Reader w = m.child("wall");
@@ -184,11 +309,18 @@ SceneConfig parse_config(const nlohmann::json& root_json, const std::string& sou
     auto& s = c.assembly;
     s.type = a.string("type", s.type, {"hexagonal", "square", "random", "file"});
     if (s.type == "hexagonal" || s.type == "square") {
-      s.columns = static_cast<int>(a.integer("columns", s.columns, 1, 100000));
-      s.rows = static_cast<int>(a.integer("rows", s.rows, 1, 100000));
+      constexpr int64_t kIntMax = std::numeric_limits<int>::max();
+      s.columns = static_cast<int>(a.integer("columns", s.columns, 1, kIntMax));
+      s.rows = static_cast<int>(a.integer("rows", s.rows, 1, kIntMax));
+      if (int64_t{s.columns} * s.rows > kMaxParticles)
+        a.fail("columns", "columns x rows = " + std::to_string(int64_t{s.columns} * s.rows) +
+                              " particles, more than the limit " + kMaxParticlesWhy);
       s.radius = a.positive("radius", s.radius);
     } else if (s.type == "random") {
-      s.count = static_cast<int>(a.integer("count", s.count, 2, 10000000));
+      s.count = static_cast<int>(a.integer("count", s.count, 2, std::numeric_limits<int>::max()));
+      if (s.count > kMaxParticles)
+        a.fail("count",
+               std::to_string(s.count) + " particles, more than the limit " + kMaxParticlesWhy);
       s.distribution = a.string("distribution", s.distribution, {"uniform", "lognormal"});
       if (s.distribution == "uniform") {
         s.radius_min = a.positive("radius_min", s.radius_min);
@@ -221,14 +353,24 @@ SceneConfig parse_config(const nlohmann::json& root_json, const std::string& sou
     s.servo_gain = t.positive("servo_gain", s.servo_gain);
     if (s.servo_gain > 1.0) t.fail("servo_gain", "must be <= 1 (a larger gain overshoots)");
     s.consolidation_tolerance = t.positive("consolidation_tolerance", s.consolidation_tolerance);
+    if (s.consolidation_tolerance >= 1.0)
+      t.fail("consolidation_tolerance", "must be < 1 (a fraction of lateral_stress)");
     s.consolidation_unbalanced = t.positive("consolidation_unbalanced", s.consolidation_unbalanced);
     s.consolidation_max_steps =
         t.integer("consolidation_max_steps", s.consolidation_max_steps, 1000, 1000000000);
+    check_lateral_stress(t, c.material, s.lateral_stress);
+    check_servo_gain(t, s);
     t.reject_unknown();
   }
   {
     Reader a = root.child("algorithm");
     c.algorithm = read_algorithm(a, c.algorithm);
+    // M points of the curve need at least M steps: more would repeat steps
+    // in series.csv and slow every run by the extra measurements.
+    if (c.test.monitor_points > c.algorithm.steps)
+      throw InputError(source, "test.monitor_points",
+                       "must not exceed algorithm.steps (" + std::to_string(c.algorithm.steps) +
+                           "), got " + std::to_string(c.test.monitor_points));
   }
   {
     Reader k = root.child("calibration");
@@ -257,37 +399,46 @@ SceneConfig parse_config(const nlohmann::json& root_json, const std::string& sou
     o.reject_unknown();
   }
   root.reject_unknown();
+  require_material(root, root_json, source);
   return c;
 }
 
-namespace {
-
 // JSON text to a tree. Every nlohmann error becomes an InputError: a syntax
 // error names the line and column, a number that overflows a double
-// (1e999: nlohmann throws out_of_range, not parse_error) names its key.
-nlohmann::json parse_json_text(std::string_view text, const std::string& source) {
-  std::vector<std::string> keys;  // the key being read in each open object
+// (1e999: nlohmann throws out_of_range, not parse_error) names its key, and
+// a key given twice in one object (nlohmann would keep the last silently)
+// names the key.
+nlohmann::json parse_config_json(std::string_view text, const std::string& source) {
+  struct Open {
+    std::string key;             // the key being read
+    std::set<std::string> seen;  // the keys of this object so far
+  };
+  std::vector<Open> open;  // one per object being read
+  auto key_path = [&]() {
+    std::string path;
+    for (const auto& o : open)
+      if (!o.key.empty()) path += (path.empty() ? "" : ".") + shown_key(o.key);
+    return path;
+  };
   auto track = [&](int, json::parse_event_t event, json& parsed) {
     switch (event) {
       case json::parse_event_t::object_start:
-        keys.emplace_back();
+        open.emplace_back();
         break;
       case json::parse_event_t::object_end:
-        if (!keys.empty()) keys.pop_back();
+        if (!open.empty()) open.pop_back();
         break;
       case json::parse_event_t::key:
-        if (!keys.empty()) keys.back() = parsed.get<std::string>();
+        if (!open.empty()) {
+          open.back().key = parsed.get<std::string>();
+          if (!open.back().seen.insert(open.back().key).second)
+            throw InputError(source, key_path(), "duplicate key (given twice in one object)");
+        }
         break;
       default:
         break;
     }
     return true;
-  };
-  auto key_path = [&]() {
-    std::string path;
-    for (const auto& k : keys)
-      if (!k.empty()) path += (path.empty() ? "" : ".") + k;
-    return path;
   };
   try {
     return json::parse(text, track);
@@ -304,32 +455,37 @@ nlohmann::json parse_json_text(std::string_view text, const std::string& source)
       }
     }
     std::string near = key_path();
+    // nlohmann quotes the last token read, which can be megabytes: cut it.
     throw InputError(source, "line " + std::to_string(line) + ", column " + std::to_string(column),
                      std::string("malformed JSON") +
-                         (near.empty() ? "" : " (after key " + near + ")") + ": " + e.what());
+                         (near.empty() ? "" : " (after key " + near + ")") + ": " +
+                         quoted_value(e.what(), 160));
   } catch (const json::exception& e) {
     throw InputError(source, key_path(),
-                     std::string("number out of range (not a finite double): ") + e.what());
+                     "number out of range (not a finite double): " + quoted_value(e.what(), 160));
   }
 }
 
-}  // namespace
-
 SceneConfig parse_config_text(std::string_view text, const std::string& source) {
-  const nlohmann::json j = parse_json_text(text, source);
+  const nlohmann::json j = parse_config_json(text, source);
   SceneConfig c = parse_config(j, source);
   c.text = std::string(text);
   return c;
 }
 
 SceneConfig load_config(const std::string& path) {
-  if (std::filesystem::is_directory(path)) throw InputError(path, "", "is a folder, not a file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path, "", "cannot open file");
-  std::ostringstream s;
-  s << in.rdbuf();
-  if (in.bad()) throw InputError(path, "", "cannot read file");
-  return parse_config_text(s.str(), path);
+  return parse_config_text(read_text_file(path), path);
+}
+
+SceneConfig load_config(const std::string& path, const std::vector<std::string>& sets) {
+  const bool embedded = path.empty();
+  const std::string source = embedded ? "<embedded default: configs/hex_10x10.json>" : path;
+  const std::string text = embedded ? std::string(default_config_text()) : read_text_file(path);
+  nlohmann::json j = parse_config_json(text, source);
+  apply_overrides(j, sets, source);
+  SceneConfig config = parse_config(j, source);
+  config.text = sets.empty() ? text : j.dump();
+  return config;
 }
 
 SceneConfig default_config() {
@@ -349,7 +505,7 @@ void apply_overrides(nlohmann::json& j, const std::vector<std::string>& sets,
     } catch (const nlohmann::json::parse_error&) {
       v = value;  // a bare word is a string
     } catch (const nlohmann::json::exception& e) {
-      throw InputError(source, key, "--set value " + value + " is out of range: " + e.what());
+      throw InputError(source, key, "--set value " + quoted_value(value) + " is out of range");
     }
     nlohmann::json* node = &j;
     std::string rest = key;
@@ -365,7 +521,8 @@ void apply_overrides(nlohmann::json& j, const std::vector<std::string>& sets,
       node = &(*node)[part];
       if (!node->is_object())
         throw InputError(source, key.substr(0, key.size() - rest.size() + part.size()),
-                         "--set " + set + ": not a section (holds " + node->dump() + ")");
+                         "--set " + quoted_value(set) + ": not a section (holds " +
+                             quoted_value(node->dump()) + ")");
       rest = rest.substr(dot + 1);
     }
   }

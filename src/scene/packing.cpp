@@ -2,6 +2,7 @@
 #include "demcal/scene/packing.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -9,6 +10,8 @@
 #include <numbers>
 #include <random>
 #include <sstream>
+
+#include "demcal/io/files.hpp"
 
 namespace demcal {
 
@@ -119,10 +122,105 @@ bool parse_number(const std::string& field, double& value) {
 }  // namespace
 
 Assembly read_particle_file(const std::string& path) {
+  require_readable_file(path);  // a folder, a device, a symlink loop: one line, exit 2
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path, "", "cannot open particle file");
   return read_particles(in, path);
 }
+
+namespace {
+
+/// Throws naming both lines when two particles overlap by more than 5 % of
+/// the smaller radius (beyond that a file is not a packing but an error).
+///
+/// O(N) for any radius distribution: particles are grouped in levels by
+/// radius (level = binary exponent of r, so radii within a level differ by
+/// less than 2x), each level on its own grid of cells 2·r_max(level) wide.
+/// A pair is tested once, from its smaller particle: that one looks at the
+/// at most 3 x 3 cells of each level at or above its own that can hold a
+/// partner. Cells of one level hold O(1) particles that do not overlap, so
+/// the work is N·9·O(1) per occupied level (a single grid sized by the
+/// largest disk degenerates to O(N^2) when one disk is 100x the others).
+void check_overlaps(const Assembly& a, const std::vector<int>& lines, const std::string& path) {
+  const int n = a.size();
+  double x0 = a.x[0], y0 = a.y[0], x1 = a.x[0], y1 = a.y[0];
+  for (int i = 0; i < n; ++i) {
+    x0 = std::min(x0, a.x[i]);
+    y0 = std::min(y0, a.y[i]);
+    x1 = std::max(x1, a.x[i]);
+    y1 = std::max(y1, a.y[i]);
+  }
+  const double extent = std::max(x1 - x0, y1 - y0);
+  if (!std::isfinite(extent))
+    throw InputError(path, "", "coordinates span more than a double can hold");
+
+  struct Level {
+    int exponent = 0;
+    double r_max = 0.0, cell = 0.0;
+    std::vector<std::array<int64_t, 3>> cells;  // (cy, cx, particle), sorted
+  };
+  std::vector<Level> levels;  // by increasing exponent
+  std::vector<int> level_of(n);
+  {
+    std::vector<int> exponents(n);
+    for (int i = 0; i < n; ++i) exponents[i] = std::ilogb(a.r[i]);
+    std::vector<int> distinct = exponents;
+    std::sort(distinct.begin(), distinct.end());
+    distinct.erase(std::unique(distinct.begin(), distinct.end()), distinct.end());
+    levels.resize(distinct.size());
+    for (size_t k = 0; k < distinct.size(); ++k) levels[k].exponent = distinct[k];
+    for (int i = 0; i < n; ++i) {
+      level_of[i] = static_cast<int>(
+          std::lower_bound(distinct.begin(), distinct.end(), exponents[i]) - distinct.begin());
+      levels[level_of[i]].r_max = std::max(levels[level_of[i]].r_max, a.r[i]);
+    }
+  }
+  // Cells never more than 2^40 a side (a sparse, huge domain would overflow
+  // the integer cell keys): larger cells only cost time, never a missed pair.
+  constexpr double kMaxCellsPerSide = 1099511627776.0;  // 2^40
+  for (auto& level : levels) level.cell = std::max(2.0 * level.r_max, extent / kMaxCellsPerSide);
+  // Clamped: a coordinate plus a radius may pass the last cell (even
+  // overflow to inf near the largest double); no particle lies beyond it.
+  auto cell_index = [&](double v, double origin, double cell) {
+    return static_cast<int64_t>(std::clamp(std::floor((v - origin) / cell), -0x1p62, 0x1p62));
+  };
+  for (int i = 0; i < n; ++i) {
+    Level& level = levels[level_of[i]];
+    level.cells.push_back(
+        {cell_index(a.y[i], y0, level.cell), cell_index(a.x[i], x0, level.cell), i});
+  }
+  for (auto& level : levels) std::sort(level.cells.begin(), level.cells.end());
+
+  for (int i = 0; i < n; ++i) {
+    for (size_t b = level_of[i]; b < levels.size(); ++b) {
+      const Level& level = levels[b];
+      const double reach = a.r[i] + level.r_max;  // centres closer than this may overlap
+      const int64_t cx0 = cell_index(a.x[i] - reach, x0, level.cell);
+      const int64_t cx1 = cell_index(a.x[i] + reach, x0, level.cell);
+      const int64_t cy0 = cell_index(a.y[i] - reach, y0, level.cell);
+      const int64_t cy1 = cell_index(a.y[i] + reach, y0, level.cell);
+      for (int64_t cy = cy0; cy <= cy1; ++cy) {
+        auto it = std::lower_bound(level.cells.begin(), level.cells.end(),
+                                   std::array<int64_t, 3>{cy, cx0, -1});
+        for (; it != level.cells.end() && (*it)[0] == cy && (*it)[1] <= cx1; ++it) {
+          const int j = static_cast<int>((*it)[2]);
+          if (static_cast<int>(b) == level_of[i] && j <= i) continue;  // once per pair
+          const double d = std::hypot(a.x[j] - a.x[i], a.y[j] - a.y[i]);
+          const double overlap = a.r[i] + a.r[j] - d;
+          const double smaller = std::min(a.r[i], a.r[j]);
+          if (overlap > 0.05 * smaller)
+            throw InputError(path, "line " + std::to_string(lines[std::max(i, j)]),
+                             "particle overlaps the one on line " +
+                                 std::to_string(lines[std::min(i, j)]) + " by " +
+                                 std::to_string(100.0 * overlap / smaller) +
+                                 " % of the smaller radius (limit 5 %)");
+        }
+      }
+    }
+  }
+}
+
+}  // namespace
 
 Assembly read_particles(std::istream& in, const std::string& path) {
   Assembly a;
@@ -135,6 +233,11 @@ Assembly read_particles(std::istream& in, const std::string& path) {
     ++line_no;
     if (line_no == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);  // UTF-8 BOM
     if (!line.empty() && line.back() == '\r') line.pop_back();
+    // strtod would stop at a NUL and take "1.5\0garbage" for 1.5.
+    if (const auto nul = line.find('\0'); nul != std::string::npos)
+      throw InputError(
+          path, where(),
+          "holds a NUL byte at column " + std::to_string(nul + 1) + " (not a text line)");
     const auto first = line.find_first_not_of(" \t");
     if (first == std::string::npos || line[first] == '#') continue;
     std::vector<std::string> fields;
@@ -152,12 +255,21 @@ Assembly read_particles(std::istream& in, const std::string& path) {
         seen_content = true;
         continue;
       }
-      throw InputError(path, where(), "expected three numbers x,y,r, got \"" + line + "\"");
+      throw InputError(path, where(), "expected three numbers x,y,r, got " + quoted_value(line));
     }
     seen_content = true;
     if (!std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2]))
-      throw InputError(path, where(), "values must be finite, got \"" + line + "\"");
-    if (!(v[2] > 0.0)) throw InputError(path, where(), "radius must be > 0, got \"" + line + "\"");
+      throw InputError(path, where(), "values must be finite, got " + quoted_value(line));
+    if (!(v[2] > 0.0))
+      throw InputError(path, where(), "radius must be > 0, got " + quoted_value(line));
+    // The overlap test adds a few radii to a coordinate: that must stay finite.
+    if (!std::isfinite(std::abs(v[0]) + 4.0 * v[2]) || !std::isfinite(std::abs(v[1]) + 4.0 * v[2]))
+      throw InputError(
+          path, where(),
+          "values too large (|x| + 4 r overflows a double), got " + quoted_value(line));
+    if (a.size() >= kMaxParticles)
+      throw InputError(path, where(),
+                       std::string("more particles than the limit ") + kMaxParticlesWhy);
     a.x.push_back(v[0]);
     a.y.push_back(v[1]);
     a.r.push_back(v[2]);
@@ -166,55 +278,8 @@ Assembly read_particles(std::istream& in, const std::string& path) {
   if (in.bad()) throw InputError(path, "", "cannot read particle file");
   if (a.size() < 2)
     throw InputError(path, "", "needs at least two particles, found " + std::to_string(a.size()));
-  // Overlaps beyond 5 % of the smaller radius are not a packing but an error
-  // (a cell grid keeps the check O(N)).
+  check_overlaps(a, lines, path);
   const int n = a.size();
-  const double r_max = *std::max_element(a.r.begin(), a.r.end());
-  double x0 = a.x[0], y0 = a.y[0], x1 = a.x[0], y1 = a.y[0];
-  for (int i = 0; i < n; ++i) {
-    x0 = std::min(x0, a.x[i]);
-    y0 = std::min(y0, a.y[i]);
-    x1 = std::max(x1, a.x[i]);
-    y1 = std::max(y1, a.y[i]);
-  }
-  // Cells of at least 2·r_max, and never more than 2^20 a side (a sparse,
-  // huge domain would otherwise overflow the integer cell keys); larger
-  // cells only cost time, never a missed pair.
-  const double extent = std::max(x1 - x0, y1 - y0);
-  const double cell = std::max(2.0 * r_max, extent / static_cast<double>(1 << 20));
-  if (!std::isfinite(extent) || !std::isfinite(cell) || !(cell > 0.0))
-    throw InputError(path, "", "coordinates span more than a double can hold");
-  std::vector<std::pair<int64_t, int>> keyed(n);
-  auto cell_of = [&](int i) {
-    return std::pair<int64_t, int64_t>(static_cast<int64_t>((a.x[i] - x0) / cell),
-                                       static_cast<int64_t>((a.y[i] - y0) / cell));
-  };
-  constexpr int64_t kStride = 1 << 30;
-  for (int i = 0; i < n; ++i) {
-    auto [cx, cy] = cell_of(i);
-    keyed[i] = {cy * kStride + cx, i};
-  }
-  std::sort(keyed.begin(), keyed.end());
-  for (int i = 0; i < n; ++i) {
-    auto [cx, cy] = cell_of(i);
-    for (int64_t dy = -1; dy <= 1; ++dy)
-      for (int64_t dx = -1; dx <= 1; ++dx) {
-        const int64_t key = (cy + dy) * kStride + (cx + dx);
-        auto it = std::lower_bound(keyed.begin(), keyed.end(), std::pair<int64_t, int>(key, -1));
-        for (; it != keyed.end() && it->first == key; ++it) {
-          const int j = it->second;
-          if (j <= i) continue;
-          const double d = std::hypot(a.x[j] - a.x[i], a.y[j] - a.y[i]);
-          const double overlap = a.r[i] + a.r[j] - d;
-          if (overlap > 0.05 * std::min(a.r[i], a.r[j]))
-            throw InputError(path, "line " + std::to_string(lines[std::max(i, j)]),
-                             "particle overlaps the one on line " +
-                                 std::to_string(lines[std::min(i, j)]) + " by " +
-                                 std::to_string(100.0 * overlap / std::min(a.r[i], a.r[j])) +
-                                 " % of the smaller radius (limit 5 %)");
-        }
-      }
-  }
   a.left = a.x[0] - a.r[0];
   a.right = a.x[0] + a.r[0];
   a.bottom = a.y[0] - a.r[0];
@@ -228,12 +293,50 @@ Assembly read_particles(std::istream& in, const std::string& path) {
   return a;
 }
 
+namespace {
+
+// The smallest sigma3 the kernel can resolve. A contact's overlap at sigma3
+// is delta = 2*sigma3*t*r/kn (force sigma3*2r*t on the disk), computed from
+// positions whose round-off is u*|x| (u = 2^-53). The consolidation asks the
+// wall stress within consolidation_tolerance of sigma3; unless that round-off
+// is below a tenth of it, the stress is noise (hex_5x5: 1e-3 Pa runs,
+// 1e-4 Pa "diverges" in the energy ledger, 1e-9 Pa fails the same way).
+void check_resolvable(const SceneConfig& config, const Assembly& a) {
+  if (a.size() == 0) return;
+  const double coordinate =
+      std::max({std::abs(a.left), std::abs(a.right), std::abs(a.bottom), std::abs(a.top)});
+  const double r_min = *std::min_element(a.r.begin(), a.r.end());
+  const Material& m = config.material;
+  const double kn = std::max(m.particle.kn, m.wall.kn);
+  const double sigma3 = config.test.lateral_stress;
+  const double delta = 2.0 * sigma3 * m.thickness * r_min / kn;
+  const double roundoff = 0.5 * std::numeric_limits<double>::epsilon() * coordinate;
+  const double wanted = 0.1 * config.test.consolidation_tolerance;  // relative
+  if (roundoff <= wanted * delta) return;
+  const double minimum = roundoff / wanted * kn / (2.0 * m.thickness * r_min);
+  std::ostringstream msg;
+  msg << "must be at least " << minimum << " Pa for this assembly: the overlap at sigma3, "
+      << "2*sigma3*t*r_min/kn = " << delta << " m, is not resolved by positions up to "
+      << coordinate << " m (round-off " << roundoff << " m must stay below a tenth of "
+      << "consolidation_tolerance of it); got " << sigma3;
+  throw InputError(config.source, "test.lateral_stress", msg.str());
+}
+
+}  // namespace
+
 Assembly make_assembly(const SceneConfig& config) {
   const auto& s = config.assembly;
-  if (s.type == "hexagonal") return hexagonal_packing(s.columns, s.rows, s.radius);
-  if (s.type == "square") return square_packing(s.columns, s.rows, s.radius);
-  if (s.type == "random") return random_gas(s);
-  return read_particle_file(s.file);
+  Assembly a;
+  if (s.type == "hexagonal")
+    a = hexagonal_packing(s.columns, s.rows, s.radius);
+  else if (s.type == "square")
+    a = square_packing(s.columns, s.rows, s.radius);
+  else if (s.type == "random")
+    a = random_gas(s);
+  else
+    a = read_particle_file(s.file);
+  check_resolvable(config, a);
+  return a;
 }
 
 double hexagonal_peak_ratio(double friction) {

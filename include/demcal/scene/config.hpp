@@ -17,6 +17,20 @@
 
 namespace demcal {
 
+/// The most particles an assembly may have. The kernel keeps about 1 kB of
+/// state per particle (positions, velocities, forces, the neighbour list
+/// and its contact history) and every parallel trial holds its own copy:
+/// 10^7 particles is about 10 GB per trial, and the REV a calibration needs
+/// has 10^2 to 10^5. Larger requests are refused up front (exit 2) instead
+/// of dying in an allocation.
+inline constexpr int64_t kMaxParticles = 10'000'000;
+inline constexpr const char* kMaxParticlesWhy =
+    "10000000 (about 1 kB of kernel state per particle and trial: 10 GB; a calibration REV "
+    "has 1e2 to 1e5)";
+/// The largest overlap at sigma3, relative to the radius, a config may ask
+/// for (test.lateral_stress): see check_lateral_stress in config.cpp.
+inline constexpr double kMaxOverlapAtSigma3 = 0.05;
+
 struct AssemblySpec {
   std::string type = "hexagonal";        ///< hexagonal | square | random | file
   int columns = 10;                      ///< hexagonal/square
@@ -110,6 +124,15 @@ struct SceneConfig {
 SceneConfig parse_config(const nlohmann::json& json, const std::string& source);
 SceneConfig parse_config_text(std::string_view text, const std::string& source);
 SceneConfig load_config(const std::string& path);
+/// What every command loads: `path` (empty: the embedded default) with the
+/// --set overrides applied. Any problem with the file (missing, a folder, a
+/// device, a symlink loop), its JSON (syntax, a duplicate key, a number out
+/// of range) or a value is one InputError naming the file and the key.
+/// config.text is the file's text, or the JSON with the overrides applied.
+SceneConfig load_config(const std::string& path, const std::vector<std::string>& sets);
+/// JSON text to a tree, with the checks of load_config: a duplicate key is
+/// an InputError naming it.
+nlohmann::json parse_config_json(std::string_view text, const std::string& source);
 SceneConfig default_config();
 std::string_view default_config_text();
 
