@@ -8,10 +8,10 @@
 #include <sstream>
 
 #include "commands.hpp"
-#include "demcal/scene/biaxial.hpp"
 #include "demcal/io/files.hpp"
-#include "demcal/scene/run_output.hpp"
+#include "demcal/scene/biaxial.hpp"
 #include "demcal/scene/packing.hpp"
+#include "demcal/scene/run_output.hpp"
 #include "demcal/scoring/scoring.hpp"
 #include "demcal/scoring/trial.hpp"
 #include "output_folder.hpp"
@@ -19,33 +19,7 @@
 namespace demcal::cli {
 
 SceneConfig load_scene(const std::string& path, const std::vector<std::string>& sets) {
-  std::string text, source;
-  if (path.empty()) {
-    text = std::string(default_config_text());
-    source = "<embedded default: configs/hex_10x10.json>";
-  } else {
-    if (std::filesystem::is_directory(path)) throw InputError(path, "", "is a folder, not a file");
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw InputError(path, "", "cannot open file");
-    std::ostringstream s;
-    s << in.rdbuf();
-    text = s.str();
-    source = path;
-  }
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::exception&) {
-    // Any JSON error (syntax, or a number like 1e999 that overflows, which
-    // nlohmann reports as out_of_range): parse_config_text fails on the same
-    // text with the InputError that names the line or the key.
-    parse_config_text(text, source);
-    throw;
-  }
-  apply_overrides(j, sets, source);
-  SceneConfig config = parse_config(j, source);
-  config.text = sets.empty() ? text : j.dump();
-  return config;
+  return load_config(path, sets);
 }
 
 namespace {
@@ -129,7 +103,10 @@ int cmd_run(const std::string& path, const std::vector<std::string>& sets,
     OutputFolder out(dir);
     out.write("summary.json", summary.dump(2) + "\n");
     out.write("series.csv", series_csv(run.series));
-    if (config.output.vtk) out.write("final.vtk", world_vtk(final_state, "demcal " + config.name));
+    if (config.output.vtk)
+      out.write("final.vtk", world_vtk(final_state, "demcal " + config.name));
+    else
+      out.retire("final.vtk");  // an earlier run's, not this one's
     out.commit();
   }
 

@@ -183,8 +183,9 @@ TEST_F(CliEndToEnd, StabilityScanWritesItsReport) {
 TEST_F(CliEndToEnd, BadParticleFileNamesFileAndLine) {
   const std::string out = (dir_ / "work" / "out").string();
   const std::string csv = write("p.csv", "x,y,r\n0,0,5e-4\n1e-3,0,-5e-4\n");
-  const std::string config =
-      write("file.json", R"({"assembly": {"type": "file", "file": "p.csv"}})");
+  const std::string config = write(
+      "file.json",
+      R"({"material": {"density": 2650, "kn": 1e8, "kt": 5e7, "friction": 0.3}, "assembly": {"type": "file", "file": "p.csv"}})");
   expect_bad_input({"run", config, "-o", out}, {csv, "line 3", "radius"});
   const std::string overlap = write("o.csv", "# two\n0,0,5e-4\n5e-4,0,5e-4\n");
   expect_bad_input({"run", config, "--set", "assembly.file=" + overlap, "-o", out},
@@ -262,8 +263,9 @@ TEST_F(CliEndToEnd, CheckAcceptsAParticleFile) {
       csv += line.str();
     }
   write("hex.csv", csv);
-  const std::string config =
-      write("file.json", R"({"assembly": {"type": "file", "file": "hex.csv"}})");
+  const std::string config = write(
+      "file.json",
+      R"({"material": {"density": 2650, "kn": 1e8, "kt": 5e7, "friction": 0.3}, "assembly": {"type": "file", "file": "hex.csv"}})");
   const Result res = demcal({"check", config});
   EXPECT_EQ(res.status, 0) << res.err;
   EXPECT_NE(res.out.find("12 particles"), std::string::npos) << res.out;
@@ -443,7 +445,7 @@ TEST_F(CliEndToEnd, RunIntoAnExistingFolderAndWithoutVtk) {
 TEST_F(CliEndToEnd, FailedConsolidationExitsOneAndWritesNothing) {
   const std::string config = write(
       "gas.json",
-      R"({"assembly": {"type": "random", "count": 60}, "test": {"consolidation_max_steps": 1000}})");
+      R"({"material": {"density": 2650, "kn": 1e8, "kt": 5e7, "friction": 0.3}, "assembly": {"type": "random", "count": 60}, "test": {"consolidation_max_steps": 1000}})");
   const Result r = demcal({"run", config, "-o", (dir_ / "work" / "out").string()});
   EXPECT_EQ(r.status, 1) << r.err;
   EXPECT_EQ(lines_of(r.err).size(), 1u) << r.err;

@@ -447,6 +447,7 @@ TEST(Report, GnuplotRunnerNeedsNoShell) {
 // positions, so the sums agree to rounding.
 TEST(Report, PictureWallForcesSumToTheWallPressure) {
   const SceneConfig c = parse_config_text(R"({
+    "material": {"density": 2650, "kn": 1e8, "kt": 5e7, "friction": 0.3}, 
     "assembly": {"type": "hexagonal", "columns": 5, "rows": 5, "radius": 5e-4},
     "test": {"lateral_stress": 1e5}})",
                                           "test");
@@ -484,6 +485,7 @@ TEST(Report, PictureWallForcesSumToTheWallPressure) {
 // the peak extrapolated for an error ∝ 1/Nstep: P(∞) = 2·P(16N) − P(8N).
 TEST(Report, EvidenceRunsReproduceTheTrialsAndExtrapolateThePeak) {
   const SceneConfig c = parse_config_text(R"({
+    "material": {"density": 2650, "kn": 1e8, "kt": 5e7, "friction": 0.3}, 
     "assembly": {"type": "hexagonal", "columns": 5, "rows": 5, "radius": 5e-4},
     "test": {"lateral_stress": 1e5, "monitor_points": 40}})",
                                           "test");
