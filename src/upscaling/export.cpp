@@ -140,6 +140,100 @@ ExportResult result_of(const Plan& plan) {
 // ---------------------------------------------------------------------------
 // LAMMPS (29 Sep 2021)
 
+/// The LAMMPS deck's monitoring series: b, sigma, kinetic energy, wall
+/// stresses, servo error and torque sum at every monitoring interval, in the
+/// CSV that `demcal score` reads (include/demcal/scoring/external_series.hpp).
+constexpr const char* kColumns =
+    "step,strain_yy,b_xx,b_xy,b_yx,b_yy,s_xx,s_xy,s_yx,s_yy,kinetic_energy,"
+    "kinetic_energy_rotation,lateral_stress_error,p_left,p_right,p_bottom,p_top,wall_left,"
+    "wall_right,wall_bottom,wall_top,torque_stress";
+
+std::string lammps_series_block(const SceneConfig& c, const AlgorithmSpec& p, const Plan& plan) {
+  std::ostringstream s;
+  s << "# --- monitoring series (demcal score FILE) -----------------------------------\n"
+    << "# Written to ${series} every monitor_every steps (and at the start), one row\n"
+    << "# per monitoring point, tension positive, SI units, origin at the box centre:\n"
+    << "#   step, strain_yy          (H - H0)/H0\n"
+    << "#   b_xx b_xy b_yx b_yy      boundary stress (1/V) sum_wall x^c (x) f^c, from the\n"
+    << "#                            four walls' contact arrays (contact point, force)\n"
+    << "#   s_xx s_xy s_yx s_yy      homogenized stress, from the identity\n"
+    << "#                            V (b - sigma) = sum_p (x_p - c) (x) F_p, F_p the\n"
+    << "#                            contact force of fix store/force (before damping)\n"
+    << "#   kinetic_energy           translation + rotation, disc inertia m r^2/2 [J]\n"
+    << "#   kinetic_energy_rotation\n"
+    << "#   lateral_stress_error     ((p_left + p_right)/2 - sigma3)/sigma3 (servo)\n"
+    << "#   p_left p_right p_bottom p_top  compressive wall pressures [Pa]\n"
+    << "#   wall_left wall_right wall_bottom wall_top  wall positions [m]\n"
+    << "#   torque_stress            sum of the particles' contact torques / V [Pa]\n"
+    << "# Approximated: LAMMPS applies a contact's tangential force at the lever arm\n"
+    << "# r_i (demcal: r_i - delta/2), so s_xy - s_yx carries a static term\n"
+    << "# -sum_c delta_c f_t,c / V that no algorithmic parameter removes; demcal score\n"
+    << "# measures moment balance on torque_stress (zero at rotational equilibrium in\n"
+    << "# either code) and reports that floor apart.\n"
+    << "variable        epsyy equal (v_H-v_H0)/v_H0\n"
+    << "variable        cx equal (v_xl+v_xr)/2\n"
+    << "variable        cy equal (v_yb0+v_yt)/2\n"
+    << "variable        V  equal v_W*v_H*v_thick\n";
+  const char* walls[] = {"wleft", "wright", "wtop", "wbottom"};
+  auto wall_sum = [&](int a, int b) {
+    std::string out;
+    for (const char* w : walls) {
+      if (!out.empty()) out += "+";
+      out += std::string("f_") + w + "[" + std::to_string(a) + "]";
+      if (b > 0) out += std::string("*f_") + w + "[" + std::to_string(b) + "]";
+    }
+    return out;
+  };
+  s << "variable        bxx_a atom " << wall_sum(5, 2) << "\n"
+    << "variable        bxy_a atom " << wall_sum(5, 3) << "\n"
+    << "variable        byx_a atom " << wall_sum(6, 2) << "\n"
+    << "variable        byy_a atom " << wall_sum(6, 3) << "\n"
+    << "variable        fwx_a atom " << wall_sum(2, 0) << "\n"
+    << "variable        fwy_a atom " << wall_sum(3, 0) << "\n"
+    << "variable        mxx_a atom x*f_fcon[1]\n"
+    << "variable        mxy_a atom x*f_fcon[2]\n"
+    << "variable        myx_a atom y*f_fcon[1]\n"
+    << "variable        myy_a atom y*f_fcon[2]\n"
+    << "compute         pa all property/atom radius omegaz tqz\n"
+    << "variable        ker_a atom 0.25*mass*c_pa[1]*c_pa[1]*c_pa[2]*c_pa[2]\n"
+    << "compute         meas all reduce sum v_bxx_a v_bxy_a v_byx_a v_byy_a v_fwx_a v_fwy_a &\n"
+    << "                v_mxx_a v_mxy_a v_myx_a v_myy_a f_fcon[1] f_fcon[2] v_ker_a c_pa[3]\n"
+    << "compute         ket all ke\n"
+    << "variable        b_xx equal (c_meas[1]-v_cx*c_meas[5])/v_V\n"
+    << "variable        b_xy equal (c_meas[2]-v_cx*c_meas[6])/v_V\n"
+    << "variable        b_yx equal (c_meas[3]-v_cy*c_meas[5])/v_V\n"
+    << "variable        b_yy equal (c_meas[4]-v_cy*c_meas[6])/v_V\n"
+    << "variable        s_xx equal v_b_xx-(c_meas[7]-v_cx*c_meas[11])/v_V\n"
+    << "variable        s_xy equal v_b_xy-(c_meas[8]-v_cx*c_meas[12])/v_V\n"
+    << "variable        s_yx equal v_b_yx-(c_meas[9]-v_cy*c_meas[11])/v_V\n"
+    << "variable        s_yy equal v_b_yy-(c_meas[10]-v_cy*c_meas[12])/v_V\n"
+    << "variable        ke equal c_ket+c_meas[13]\n"
+    << "variable        ke_rot equal c_meas[13]\n"
+    << "variable        servo_err equal ((v_pl+v_pr)/2-v_sigma3)/v_sigma3\n"
+    << "variable        torque equal c_meas[14]/v_V\n"
+    << "variable        stepn equal step\n";
+  const std::string row =
+      "${stepn},${epsyy},${b_xx},${b_xy},${b_yx},${b_yy},${s_xx},${s_xy},${s_yx},${s_yy},"
+      "${ke},${ke_rot},${servo_err},${pl},${pr},${pb},${pt},${xl},${xr},${yb0},${yt},${torque}";
+  s << "# the header: what demcal score needs to know about the run\n"
+    << "print           \"# demcal.series/1: LAMMPS deck written by demcal " << DEMCAL_VERSION
+    << ", scene " << c.name << "\" file ${series} screen no\n"
+    << "print           \"# particles = " << plan.n << "\" append ${series} screen no\n"
+    << "print           \"# lateral_stress = ${sigma3}\" append ${series} screen no\n"
+    << "print           \"# steps = ${nstep}\" append ${series} screen no\n"
+    << "print           \"# dt = ${dt}\" append ${series} screen no\n"
+    << "print           \"# dt_crit = " << num(plan.dt_crit) << "\" append ${series} screen no\n"
+    << "print           \"# damping_ratio_translation = " << num(p.damping_ratio_translation)
+    << "\" append ${series} screen no\n"
+    << "print           \"# damping_ratio_rotation = 0\" append ${series} screen no\n"
+    << "print           \"# mass_scaling = " << num(p.mass_scaling)
+    << "\" append ${series} screen no\n"
+    << "print           \"# moment_lever_arm = radius\" append ${series} screen no\n"
+    << "fix             series all print ${monitor_every} \"" << row
+    << "\" append ${series} screen no title \"" << kColumns << "\"\n\n";
+  return s.str();
+}
+
 ExportResult lammps(const SceneConfig& c, const AlgorithmSpec& p, const Assembly& a,
                     const ExportOptions& o) {
   const Plan plan = make_plan(c, p, a, o.max_types);
@@ -204,10 +298,15 @@ ExportResult lammps(const SceneConfig& c, const AlgorithmSpec& p, const Assembly
       "move): one run command only");
 
   s << "\n# --- parameters (edit here) -------------------------------------------------\n"
+    << "# Everything below the block is derived from it: editing dt or nstep keeps the\n"
+    << "# strain, the loading rate per step count, the servo cap and the monitoring\n"
+    << "# points right.\n"
     << "variable dt        equal " << num(plan.dt) << "      # s\n"
     << "variable nstep     equal " << plan.steps << "      # loading steps Nstep\n"
-    << "variable run_steps index " << plan.steps
-    << "      # lmp -var run_steps 300 ... for a short check\n"
+    << "variable strain    equal " << num(c.test.vertical_strain)
+    << "      # total vertical strain over nstep\n"
+    << "variable monitor_points equal " << c.test.monitor_points
+    << "      # rows of the series file\n"
     << "variable kn        equal " << num(m.particle.kn) << "\n"
     << "variable kt        equal " << num(m.particle.kt) << "\n"
     << "variable mu        equal " << num(m.particle.friction) << "\n"
@@ -217,12 +316,18 @@ ExportResult lammps(const SceneConfig& c, const AlgorithmSpec& p, const Assembly
     << "variable thick     equal " << num(m.thickness) << "      # disc thickness t, m\n"
     << "variable sigma3    equal " << num(c.test.lateral_stress) << "      # Pa\n"
     << "variable gain      equal " << num(c.test.servo_gain) << "\n"
-    << "variable cap       equal " << num(0.02 * plan.r_min) << "      # m per step\n"
-    << "variable vtop      equal " << num(plan.top_speed) << "      # m/s, downward\n"
-    << "variable xl0       equal " << num(a.left) << "\n"
+    << "variable r_min     equal " << num(plan.r_min) << "      # m, smallest radius\n"
+    << "variable xl0       equal " << num(a.left) << "      # walls at the start, m\n"
     << "variable xr0       equal " << num(a.right) << "\n"
     << "variable yb0       equal " << num(a.bottom) << "\n"
-    << "variable yt0       equal " << num(a.top) << "\n";
+    << "variable yt0       equal " << num(a.top) << "\n"
+    << "variable series    index series.csv      # the monitoring series (demcal score)\n"
+    << "variable run_steps index ${nstep}      # lmp -var run_steps 300 ... for a short check\n"
+    << "\n# --- derived (do not edit) ---------------------------------------------------\n"
+    << "variable H0        equal $(v_yt0-v_yb0)\n"
+    << "variable vtop      equal $(v_strain*v_H0/(v_nstep*v_dt))      # m/s, top wall, down\n"
+    << "variable cap       equal $(0.02*v_r_min)      # m per step, servo move cap\n"
+    << "variable monitor_every equal $(floor(v_nstep/v_monitor_points))\n";
 
   double gamma_n = 0.0;
   if (m.contact_damping_ratio > 0.0) {
@@ -251,7 +356,9 @@ ExportResult lammps(const SceneConfig& c, const AlgorithmSpec& p, const Assembly
     << "fix             integrate all nve/sphere disc\n\n";
 
   s << "# --- walls -------------------------------------------------------------------\n"
-    << "# top: a plane moving down at vtop; left/right: planes moved by the servo\n"
+    << "# top: a plane moving down at vtop; left/right: planes moved by the servo.\n"
+    << "# The fix order matters: the walls, then fix store/force (contact forces\n"
+    << "# only), then the damping.\n"
     << "variable dytop  equal -v_vtop*step*dt\n"
     << "variable dxl    equal f_servol*step\n"
     << "variable dxr    equal f_servor*step\n"
@@ -259,23 +366,30 @@ ExportResult lammps(const SceneConfig& c, const AlgorithmSpec& p, const Assembly
     << "region          rleft  plane ${xl0} 0 0  1 0 0  side in move v_dxl NULL NULL units box\n"
     << "region          rright plane ${xr0} 0 0  -1 0 0 side in move v_dxr NULL NULL units box\n"
     << "fix             wbottom all wall/gran hooke/history ${kn_wall} ${kt_wall} 0 0 ${mu_wall} 0 "
-       "yplane ${yb0} NULL\n"
+       "yplane ${yb0} NULL contacts\n"
     << "fix             wtop all wall/gran/region hooke/history ${kn_wall} ${kt_wall} 0 0 "
-       "${mu_wall} "
-       "0 region rtop contacts\n"
+       "${mu_wall} 0 region rtop contacts\n"
     << "fix             wleft all wall/gran/region hooke/history ${kn_wall} ${kt_wall} 0 0 "
        "${mu_wall} 0 region rleft contacts\n"
     << "fix             wright all wall/gran/region hooke/history ${kn_wall} ${kt_wall} 0 0 "
        "${mu_wall} 0 region rright contacts\n"
-    << "# wall contacts (column 1) and the wall forces on the particles (columns 2, 3)\n"
+    << "# contact force on every particle (pairs and walls), before the damping\n"
+    << "fix             fcon all store/force\n"
+    << "# wall contact arrays: [1] contacts, [2] [3] force on the particle, [5] [6]\n"
+    << "# contact point\n"
     << "compute         cl all reduce sum f_wleft[1] f_wleft[2]\n"
     << "compute         cr all reduce sum f_wright[1] f_wright[2]\n"
     << "compute         ct all reduce sum f_wtop[1] f_wtop[3]\n"
-    << "variable        H  equal (v_yt0+v_dytop)-v_yb0\n"
-    << "variable        W  equal (v_xr0+v_dxr)-(v_xl0+v_dxl)\n"
+    << "compute         cb all reduce sum f_wbottom[1] f_wbottom[3]\n"
+    << "variable        xl equal v_xl0+v_dxl\n"
+    << "variable        xr equal v_xr0+v_dxr\n"
+    << "variable        yt equal v_yt0+v_dytop\n"
+    << "variable        H  equal v_yt-v_yb0\n"
+    << "variable        W  equal v_xr-v_xl\n"
     << "variable        pl equal c_cl[2]/(v_H*v_thick)\n"
     << "variable        pr equal -c_cr[2]/(v_H*v_thick)\n"
     << "variable        pt equal -c_ct[2]/(v_W*v_thick)\n"
+    << "variable        pb equal c_cb[2]/(v_W*v_thick)\n"
     << "# demcal's servo, one move per step toward the sample when p < sigma3\n"
     << "# (this release has no min/max of two numbers: min(a,b) = (a+b-abs(a-b))/2)\n"
     << "variable        ncl   equal (1+c_cl[1]+abs(1-c_cl[1]))/2\n"
@@ -308,13 +422,13 @@ ExportResult lammps(const SceneConfig& c, const AlgorithmSpec& p, const Assembly
     s << "\n";
   }
   s << "fix             twod all enforce2d\n\n";
-
+  s << lammps_series_block(c, p, plan);
   s << "# --- output and run ----------------------------------------------------------\n"
     << "# p_left, p_right: lateral wall pressures (servo target sigma3); p_top: axial\n"
-    << "variable        epsyy equal (v_H-" << num(plan.height0) << ")/" << num(plan.height0) << "\n"
+    << "variable        epsyy equal (v_H-v_H0)/v_H0\n"
     << "thermo_style    custom step dt time v_epsyy v_pt v_pl v_pr v_W v_H ke\n"
     << "thermo_modify   norm no\n"
-    << "thermo          " << plan.thermo_every << "\n"
+    << "thermo          ${monitor_every}\n"
     << "run             ${run_steps}\n";
   out.deck = s.str();
   return out;

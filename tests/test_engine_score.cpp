@@ -1,0 +1,215 @@
+// Scoring another engine's series (issue #16): demcal's own series.csv read
+// back gives demcal's criteria; the moment balance of a file with
+// torque_stress is measured on the torques and the lever-arm floor is
+// reported apart; bad files are one clear InputError; and, where LAMMPS is
+// installed, the exported deck's own series scores as demcal's run does.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "demcal/scene/biaxial.hpp"
+#include "demcal/scene/run_output.hpp"
+#include "demcal/scoring/external_series.hpp"
+#include "demcal/upscaling/export.hpp"
+#include "demcal/upscaling/rev.hpp"
+
+namespace demcal {
+namespace {
+
+namespace fs = std::filesystem;
+
+AlgorithmSpec quasi_static() {
+  AlgorithmSpec p;
+  p.dt_ratio = 0.19341;
+  p.steps = 43850;
+  p.damping_ratio_translation = 0.370356;
+  p.damping_ratio_rotation = 0.0;  // LAMMPS 2021 has no rotational damping
+  return p;
+}
+
+SceneConfig hex5() {
+  SceneConfig c = default_config();
+  c.assembly.columns = c.assembly.rows = 5;
+  return c;
+}
+
+TEST(ExternalSeries, DemcalsOwnSeriesScoresAsTheRun) {
+  const SceneConfig c = hex5();
+  const ConsolidatedState state = consolidate(c, make_assembly(c));
+  const LoadingResult run = run_loading(state, c.test, quasi_static());
+  const Criteria direct = compute_criteria(run.series, c.test.lateral_stress);
+  const ExternalSeries read =
+      parse_external_series(series_csv(run.series), "series.csv", c.test.lateral_stress);
+  ASSERT_EQ(read.run.series.size(), run.series.size());
+  EXPECT_FALSE(read.torque_column);
+  const Criteria back = score_external(read, Tolerances{}).score.criteria;
+  // series.csv carries 10 significant digits: the criteria agree to that.
+  EXPECT_NEAR(back.force_balance, direct.force_balance, 1e-7);
+  EXPECT_NEAR(back.moment_balance, direct.moment_balance, 1e-9);
+  EXPECT_NEAR(back.servo, direct.servo, 1e-8);
+  EXPECT_NEAR(back.peak_stress_yy / direct.peak_stress_yy, 1.0, 1e-9);
+  EXPECT_EQ(back.points, direct.points);
+}
+
+TEST(ExternalSeries, MomentBalanceOnTorquesAndTheLeverArmFloorApart) {
+  // Static rows (b = σ) whose σxy − σyx is a lever-arm term of 1e-3·σ3 and
+  // whose net torques are zero: moment balance 0, floor 1e-3.
+  std::ostringstream f;
+  f << "# lateral_stress = 100000\n# steps = 100\n"
+    << "step,strain_yy,b_xx,b_xy,b_yx,b_yy,s_xx,s_xy,s_yx,s_yy,torque_stress,p_left,p_right\n";
+  for (int k = 0; k <= 100; k += 10) {
+    const double syy = -1e5 * (1.0 + 0.01 * k);
+    f << k << "," << -1e-4 * k << ",-1e5,50,-50," << syy << ",-1e5,50,-50," << syy
+      << ",0,1e5,1e5\n";
+  }
+  const ExternalSeries s = parse_external_series(f.str(), "t.csv");
+  ASSERT_TRUE(s.torque_column);
+  const ExternalScore sc = score_external(s, Tolerances{});
+  EXPECT_NEAR(sc.score.criteria.moment_balance, 0.0, 1e-15);
+  EXPECT_NEAR(sc.lever_arm_floor_rms, 1e-3, 1e-12);
+  EXPECT_NEAR(sc.score.criteria.force_balance, 0.0, 1e-15);
+  EXPECT_TRUE(sc.score.passed);
+  EXPECT_EQ(sc.score.criteria.peak_stress_yy, -2e5);
+  // Without the torque column the same rows fail moment balance (1e-3).
+  std::string no_torque = f.str();
+  const ExternalSeries plain =
+      parse_external_series(std::string("# lateral_stress = 100000\n") +
+                                "step,strain_yy,b_xx,b_xy,b_yx,b_yy,s_xx,s_xy,s_yx,s_yy\n0,0,-1e5,"
+                                "50,-50,-1e5,-1e5,50,-50,"
+                                "-1e5\n10,-0.001,-1e5,50,-50,-1.1e5,-1e5,50,-50,-1.1e5\n",
+                            "p.csv");
+  EXPECT_NEAR(score_external(plain, Tolerances{}).score.criteria.moment_balance, 1e-3, 1e-12);
+}
+
+TEST(ExternalSeries, BadFilesNameTheFileAndTheLine) {
+  const std::string head = "step,strain_yy,b_xx,b_xy,b_yx,b_yy,s_xx,s_xy,s_yx,s_yy\n";
+  auto message = [](const std::string& text, std::optional<double> s3 = 1e5) {
+    try {
+      parse_external_series(text, "x.csv", s3);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(message(head + "0,0,1,2,3\n").find("x.csv: line 2: 5 values for 10 columns"),
+            std::string::npos);
+  EXPECT_NE(message(head + "0,0,1,2,3,4,5,6,7,abc\n").find("line 2: not a number: \"abc\""),
+            std::string::npos);
+  EXPECT_NE(message("step,b_xx\n0,1\n1,2\n").find("no column \"strain_yy\""), std::string::npos);
+  EXPECT_NE(message(head + "0,0,1,2,3,4,5,6,7,8\n1,0,1,2,3,4,5,6,7,8\n", std::nullopt)
+                .find("# lateral_stress: missing"),
+            std::string::npos);
+  EXPECT_NE(message("").find("no column header"), std::string::npos);
+  // A blown-up engine run: scored up to the first non-finite row, diverged.
+  const ExternalSeries d = parse_external_series(
+      head + "0,0,1,0,0,1,1,0,0,1\n10,0,1,0,0,1,1,0,0,1\n20,0,nan,0,0,1,1,0,0,1\n", "d.csv", 1e5);
+  EXPECT_TRUE(d.run.diverged);
+  EXPECT_EQ(d.run.divergence_step, 20);
+  EXPECT_EQ(d.run.series.size(), 2u);
+  EXPECT_FALSE(score_external(d, Tolerances{}).score.passed);
+}
+
+/// The first `lmp` on PATH, or "".
+std::string find_lammps() {
+  const char* path = std::getenv("PATH");
+  std::stringstream s(path ? path : "");
+  for (std::string dir; std::getline(s, dir, ':');) {
+    const fs::path p = fs::path(dir) / "lmp";
+    if (fs::exists(p) && ::access(p.c_str(), X_OK) == 0) return p.string();
+  }
+  return "";
+}
+
+TEST(EngineLammps, TheDecksOwnSeriesScoresAsDemcalsRun) {
+  // The whole loading of the 25-particle sample in LAMMPS; its series.csv,
+  // scored, against demcal's run of the same parameters: same verdict, the
+  // peak within 0.5 %, each criterion of the same size.
+  const std::string lmp = find_lammps();
+  if (lmp.empty())
+    GTEST_SKIP() << "LAMMPS (lmp) is not installed (apt-get install lammps): the deck's "
+                    "series is not scored";
+  const SceneConfig c = hex5();
+  const ConsolidatedState state = consolidate(c, make_assembly(c));
+  const AlgorithmSpec p = quasi_static();
+  const LoadingResult run = run_loading(state, c.test, p);
+  const Score ours = score_run(run, c.test.lateral_stress, Tolerances{});
+  ExportOptions o;
+  o.data_name = "hex5.data";
+  const ExportResult r = export_deck(c, p, assembly_of(state.world), o);
+  const fs::path dir =
+      fs::temp_directory_path() / ("demcal_test_engine_score_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ofstream(dir / "in.hex5") << r.deck;
+  for (const auto& [name, content] : r.files) std::ofstream(dir / name) << content;
+  const std::string cmd = "cd '" + dir.string() + "' && '" + lmp +
+                          "' -in in.hex5 -log log.lammps -screen none >/dev/null 2>&1";
+  const int raw = std::system(cmd.c_str());
+  std::stringstream log, csv;
+  log << std::ifstream(dir / "log.lammps").rdbuf();
+  csv << std::ifstream(dir / "series.csv").rdbuf();
+  fs::remove_all(dir);
+  ASSERT_TRUE(WIFEXITED(raw) && WEXITSTATUS(raw) == 0) << log.str();
+  const ExternalSeries series = parse_external_series(csv.str(), "series.csv");
+  EXPECT_EQ(series.lateral_stress, c.test.lateral_stress);
+  EXPECT_EQ(static_cast<int>(series.run.series.size()), c.test.monitor_points + 1);
+  const ExternalScore theirs = score_external(series, Tolerances{});
+  EXPECT_TRUE(theirs.score.complete);
+  EXPECT_EQ(theirs.score.passed, ours.passed);
+  EXPECT_NEAR(theirs.score.criteria.peak_stress_yy / ours.criteria.peak_stress_yy, 1.0, 0.005);
+  // The consolidated start is static in LAMMPS too: b = σ there.
+  const MonitorPoint& first = series.run.series.front();
+  EXPECT_LT((first.b - first.sigma).norm() / c.test.lateral_stress, 1e-5);
+  // Same physics, same size of each criterion (the damping discretisations
+  // differ): within a factor 1.5 for the rate-driven ones.
+  EXPECT_NEAR(theirs.score.criteria.force_balance / ours.criteria.force_balance, 1.0, 0.5);
+  EXPECT_NEAR(theirs.score.criteria.servo / ours.criteria.servo, 1.0, 0.5);
+  EXPECT_LT(theirs.score.criteria.moment_balance, Tolerances{}.moment_balance);
+}
+
+TEST(EngineLammps, EditingNstepInTheDeckKeepsTheStrain) {
+  // The user shortens the run in the parameters block: the top wall speed
+  // and the monitoring interval follow, so the full strain is reached at the
+  // new Nstep and the series still has M + 1 rows.
+  const std::string lmp = find_lammps();
+  if (lmp.empty())
+    GTEST_SKIP() << "LAMMPS (lmp) is not installed (apt-get install lammps): the deck is not run";
+  SceneConfig c = hex5();
+  c.test.monitor_points = 20;
+  const ConsolidatedState state = consolidate(c, make_assembly(c));
+  ExportOptions o;
+  o.data_name = "hex5.data";
+  const ExportResult r = export_deck(c, quasi_static(), assembly_of(state.world), o);
+  std::string deck = r.deck;
+  const std::string line = "variable nstep     equal 43850";
+  ASSERT_NE(deck.find(line), std::string::npos);
+  deck.replace(deck.find(line), line.size(), "variable nstep     equal 2000");
+  const fs::path dir =
+      fs::temp_directory_path() / ("demcal_test_engine_edit_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ofstream(dir / "in.hex5") << deck;
+  for (const auto& [name, content] : r.files) std::ofstream(dir / name) << content;
+  const std::string cmd = "cd '" + dir.string() + "' && '" + lmp +
+                          "' -in in.hex5 -log log.lammps -screen none >/dev/null 2>&1";
+  const int raw = std::system(cmd.c_str());
+  std::stringstream log, csv;
+  log << std::ifstream(dir / "log.lammps").rdbuf();
+  csv << std::ifstream(dir / "series.csv").rdbuf();
+  fs::remove_all(dir);
+  ASSERT_TRUE(WIFEXITED(raw) && WEXITSTATUS(raw) == 0) << log.str();
+  const ExternalSeries s = parse_external_series(csv.str(), "series.csv");
+  ASSERT_EQ(s.run.series.size(), 21u);
+  EXPECT_EQ(s.run.series.back().step, 2000);
+  EXPECT_NEAR(s.run.series.back().strain_yy, -c.test.vertical_strain, 1e-9);
+  EXPECT_EQ(s.meta.at("steps"), "2000");
+}
+
+}  // namespace
+}  // namespace demcal
