@@ -36,7 +36,7 @@ struct Plan {
   double top_speed = 0.0;                // [m/s], downward
   std::vector<double> gamma_t, gamma_r;  // per class [N·s/m], [N·m·s]
   double class_error = 0.0;
-  double r_min = 0.0;
+  double r_min = 0.0, r_max = 0.0;
   int thermo_every = 1;
   ParticleScales scales;
 };
@@ -54,6 +54,7 @@ Plan make_plan(const SceneConfig& c, const AlgorithmSpec& p, const Assembly& a, 
   }
   plan.scales = particle_scales(a.r, c.material, p.mass_scaling);
   plan.r_min = plan.scales.radius_min;
+  plan.r_max = plan.scales.radius_max;
   plan.dt_crit = plan.scales.dt_crit;
   plan.dt = p.dt_ratio * plan.dt_crit;
   plan.steps = p.steps;
@@ -229,6 +230,9 @@ std::string lammps_series_block(const SceneConfig& c, const AlgorithmSpec& p, co
     << "print           \"# mass_scaling = " << num(p.mass_scaling)
     << "\" append ${series} screen no\n"
     << "print           \"# moment_lever_arm = radius\" append ${series} screen no\n"
+    << "fix             halt_top all halt ${monitor_every} v_clear_top < 0.0 error hard\n"
+    << "fix             halt_left all halt ${monitor_every} v_clear_left < 0.0 error hard\n"
+    << "fix             halt_right all halt ${monitor_every} v_clear_right < 0.0 error hard\n"
     << "fix             series all print ${monitor_every} \"" << row
     << "\" append ${series} screen no title \"" << kColumns << "\"\n\n";
   return s.str();
@@ -283,8 +287,9 @@ ExportResult lammps(const SceneConfig& c, const AlgorithmSpec& p, const Assembly
     << "#  - servo walls are not native: the lateral walls are fix wall/gran/region\n"
     << "#    planes whose displacement is the running sum of demcal's per-step servo\n"
     << "#    move gain*(sigma3 - p)*H*t/(kn_wall*n_contacts), capped at 2 % of r_min,\n"
-    << "#    kept by fix ave/time (running mean times the step count). Run the loading\n"
-    << "#    as ONE run command: the sum counts samples from step 0.\n";
+    << "#    kept by fix ave/time (running mean times the step count): run the loading\n"
+    << "#    as ONE run command (the sum counts samples from step 0).\n"
+    << "#  - the moving walls act on bands of particles near them (see the walls).\n";
   if (plan.types > 1) {
     s << "#  - per-particle damping D_t ~ sqrt(m): fix viscous has one gamma per atom type,\n"
       << "#    so the particles are grouped in " << plan.types << " radius classes (types 1.."
@@ -317,6 +322,7 @@ ExportResult lammps(const SceneConfig& c, const AlgorithmSpec& p, const Assembly
     << "variable sigma3    equal " << num(c.test.lateral_stress) << "      # Pa\n"
     << "variable gain      equal " << num(c.test.servo_gain) << "\n"
     << "variable r_min     equal " << num(plan.r_min) << "      # m, smallest radius\n"
+    << "variable r_max     equal " << num(plan.r_max) << "      # m, largest radius\n"
     << "variable xl0       equal " << num(a.left) << "      # walls at the start, m\n"
     << "variable xr0       equal " << num(a.right) << "\n"
     << "variable yb0       equal " << num(a.bottom) << "\n"
@@ -327,7 +333,9 @@ ExportResult lammps(const SceneConfig& c, const AlgorithmSpec& p, const Assembly
     << "variable H0        equal $(v_yt0-v_yb0)\n"
     << "variable vtop      equal $(v_strain*v_H0/(v_nstep*v_dt))      # m/s, top wall, down\n"
     << "variable cap       equal $(0.02*v_r_min)      # m per step, servo move cap\n"
-    << "variable monitor_every equal $(floor(v_nstep/v_monitor_points))\n";
+    << "variable monitor_every equal $(floor(v_nstep/v_monitor_points))\n"
+    << "variable band_v    equal $(v_strain*v_H0+6*v_r_max)      # m, see the walls\n"
+    << "variable band_h    equal $(2*v_strain*(v_xr0-v_xl0)+6*v_r_max)\n";
 
   double gamma_n = 0.0;
   if (m.contact_damping_ratio > 0.0) {
@@ -365,21 +373,34 @@ ExportResult lammps(const SceneConfig& c, const AlgorithmSpec& p, const Assembly
     << "region          rtop   plane 0 ${yt0} 0  0 -1 0 side in move NULL v_dytop NULL units box\n"
     << "region          rleft  plane ${xl0} 0 0  1 0 0  side in move v_dxl NULL NULL units box\n"
     << "region          rright plane ${xr0} 0 0  -1 0 0 side in move v_dxr NULL NULL units box\n"
+    << "# Each moving wall acts on the particles that can reach it (a wall fix loops\n"
+    << "# over its group every step): those within band_v of the top, band_h of a\n"
+    << "# lateral wall at the start. fix halt stops the run with an error should a\n"
+    << "# particle outside a band ever touch that wall (then widen the bands).\n"
+    << "region          bandtop block INF INF $(v_yt0-v_band_v) INF INF INF units box\n"
+    << "region          bandleft block INF $(v_xl0+v_band_h) INF INF INF INF units box\n"
+    << "region          bandright block $(v_xr0-v_band_h) INF INF INF INF INF units box\n"
+    << "group           gtop region bandtop\n"
+    << "group           gleft region bandleft\n"
+    << "group           gright region bandright\n"
+    << "group           ntop subtract all gtop\n"
+    << "group           nleft subtract all gleft\n"
+    << "group           nright subtract all gright\n"
     << "fix             wbottom all wall/gran hooke/history ${kn_wall} ${kt_wall} 0 0 ${mu_wall} 0 "
        "yplane ${yb0} NULL contacts\n"
-    << "fix             wtop all wall/gran/region hooke/history ${kn_wall} ${kt_wall} 0 0 "
+    << "fix             wtop gtop wall/gran/region hooke/history ${kn_wall} ${kt_wall} 0 0 "
        "${mu_wall} 0 region rtop contacts\n"
-    << "fix             wleft all wall/gran/region hooke/history ${kn_wall} ${kt_wall} 0 0 "
+    << "fix             wleft gleft wall/gran/region hooke/history ${kn_wall} ${kt_wall} 0 0 "
        "${mu_wall} 0 region rleft contacts\n"
-    << "fix             wright all wall/gran/region hooke/history ${kn_wall} ${kt_wall} 0 0 "
+    << "fix             wright gright wall/gran/region hooke/history ${kn_wall} ${kt_wall} 0 0 "
        "${mu_wall} 0 region rright contacts\n"
     << "# contact force on every particle (pairs and walls), before the damping\n"
     << "fix             fcon all store/force\n"
     << "# wall contact arrays: [1] contacts, [2] [3] force on the particle, [5] [6]\n"
     << "# contact point\n"
-    << "compute         cl all reduce sum f_wleft[1] f_wleft[2]\n"
-    << "compute         cr all reduce sum f_wright[1] f_wright[2]\n"
-    << "compute         ct all reduce sum f_wtop[1] f_wtop[3]\n"
+    << "compute         cl gleft reduce sum f_wleft[1] f_wleft[2]\n"
+    << "compute         cr gright reduce sum f_wright[1] f_wright[2]\n"
+    << "compute         ct gtop reduce sum f_wtop[1] f_wtop[3]\n"
     << "compute         cb all reduce sum f_wbottom[1] f_wbottom[3]\n"
     << "variable        xl equal v_xl0+v_dxl\n"
     << "variable        xr equal v_xr0+v_dxr\n"
@@ -390,15 +411,29 @@ ExportResult lammps(const SceneConfig& c, const AlgorithmSpec& p, const Assembly
     << "variable        pr equal -c_cr[2]/(v_H*v_thick)\n"
     << "variable        pt equal -c_ct[2]/(v_W*v_thick)\n"
     << "variable        pb equal c_cb[2]/(v_W*v_thick)\n"
-    << "# demcal's servo, one move per step toward the sample when p < sigma3\n"
-    << "# (this release has no min/max of two numbers: min(a,b) = (a+b-abs(a-b))/2)\n"
-    << "variable        ncl   equal (1+c_cl[1]+abs(1-c_cl[1]))/2\n"
-    << "variable        ncr   equal (1+c_cr[1]+abs(1-c_cr[1]))/2\n"
-    << "variable        rawl  equal v_gain*(v_sigma3-v_pl)*v_H*v_thick/(v_kn_wall*v_ncl)\n"
-    << "variable        rawr  equal v_gain*(v_sigma3-v_pr)*v_H*v_thick/(v_kn_wall*v_ncr)\n"
-    << "# clamp(x, -cap, cap) = (abs(x+cap) - abs(x-cap))/2\n"
-    << "variable        movel equal (abs(v_rawl+v_cap)-abs(v_rawl-v_cap))/2\n"
-    << "variable        mover equal -(abs(v_rawr+v_cap)-abs(v_rawr-v_cap))/2\n"
+    << "# clearance of the particles outside each band from its wall (> 0)\n"
+    << "compute         rad all property/atom radius\n"
+    << "variable        gap_top atom v_yt-y-c_rad\n"
+    << "variable        gap_left atom x-c_rad-v_xl\n"
+    << "variable        gap_right atom v_xr-x-c_rad\n"
+    << "compute         clear_top ntop reduce min v_gap_top\n"
+    << "compute         clear_left nleft reduce min v_gap_left\n"
+    << "compute         clear_right nright reduce min v_gap_right\n"
+    << "variable        clear_top equal c_clear_top\n"
+    << "variable        clear_left equal c_clear_left\n"
+    << "variable        clear_right equal c_clear_right\n"
+    << "# demcal's servo, one move per step toward the sample when p < sigma3:\n"
+    << "#   move = gain*(sigma3*H*t - F)/(kn_wall*max(1, n)), clamped to +-cap,\n"
+    << "# F the wall force, n its contacts. One flat formula per wall, the numbers\n"
+    << "# substituted now: a chain of variables re-parsed every step cost more than\n"
+    << "# the granular step itself (this release has no min/max of two numbers:\n"
+    << "# max(1, n) = (1+n+abs(1-n))/2, clamp(x) = (abs(x+cap)-abs(x-cap))/2).\n"
+    << "variable        rawl  equal ${gain}*(${sigma3}*(${H0}-${vtop}*step*dt)*${thick}-c_cl[2])/"
+       "(${kn_wall}*(1+c_cl[1]+abs(1-c_cl[1]))/2)\n"
+    << "variable        rawr  equal ${gain}*(${sigma3}*(${H0}-${vtop}*step*dt)*${thick}+c_cr[2])/"
+       "(${kn_wall}*(1+c_cr[1]+abs(1-c_cr[1]))/2)\n"
+    << "variable        movel equal (abs(v_rawl+${cap})-abs(v_rawl-${cap}))/2\n"
+    << "variable        mover equal -(abs(v_rawr+${cap})-abs(v_rawr-${cap}))/2\n"
     << "fix             servol all ave/time 1 1 1 v_movel ave running\n"
     << "fix             servor all ave/time 1 1 1 v_mover ave running\n\n";
 
