@@ -11,6 +11,8 @@
 #
 #   bench/lammps_overhead.sh PARAMS.json [BUILD_DIR]
 # Environment: SIZES="400 20000" STEPS=5000 NP="1 2" KEEP=dir
+#   EXPORT_FLAGS="--no-consolidate" (the generated packing as it is: no
+#   minutes of consolidation before a timing)
 # Installs nothing; needs lmp (and mpirun for NP > 1).
 set -euo pipefail
 params="${1:?usage: bench/lammps_overhead.sh PARAMS.json [BUILD_DIR]}"
@@ -26,7 +28,7 @@ here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 echo "# $(lmp -h | grep -m1 'Large-scale' | sed 's/^ *//'); $(nproc) cores; start $(date -u +%FT%TZ)"
 for n in $SIZES; do
   d="$work/n$n"; mkdir -p "$d"
-  "$build/demcal" export "$params" --particles "$n" -o "$d/deck.lammps" >/dev/null 2>&1
+  "$build/demcal" export "$params" --particles "$n" ${EXPORT_FLAGS:-} -o "$d/deck.lammps" >/dev/null 2>&1
   # the deck's own numbers, for the bare run
   get() { sed -n "s/^variable $1 *equal \([^ ]*\).*/\1/p" "$d/deck.lammps" | head -1; }
   gamma=$(sed -n 's/^fix *dampt all viscous \([^ ]*\).*/\1/p' "$d/deck.lammps")

@@ -110,10 +110,13 @@ TEST(Export, LiggghtsDeckHasMeshesAndServo) {
   o.format = "liggghts";
   o.data_name = "proto.data";
   const ExportResult r = export_deck(c, params(), a, o);
-  for (const char* needle :
-       {"pair_style gran model hooke/stiffness tangential history", "mesh/surface/stress/servo",
-        "move/mesh", "fix twod all enforce2d", "NOT RUN HERE"})
+  for (const char* needle : {"pair_style gran model hooke/stiffness tangential history",
+                             "mesh/surface/stress/servo", "move/mesh", "fix twod all enforce2d",
+                             "Checked with LIGGGHTS 3.8", "primitive type 2 yplane"})
     EXPECT_NE(r.deck.find(needle), std::string::npos) << needle;
+  // 2D masses: LIGGGHTS takes pi r^2 * density, so the density column is
+  // the areal density f_ms*rho*t.
+  EXPECT_NE(r.files.at("proto.data").find(" 0.001 2650 "), std::string::npos);
   EXPECT_EQ(r.files.count("proto-top.stl"), 1u);
   EXPECT_EQ(r.files.count("proto-left.stl"), 1u);
 }

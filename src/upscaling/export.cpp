@@ -470,7 +470,7 @@ ExportResult lammps(const SceneConfig& c, const AlgorithmSpec& p, const Assembly
 }
 
 // ---------------------------------------------------------------------------
-// LIGGGHTS-PUBLIC 3.x (documentation-based; not run here)
+// LIGGGHTS-PUBLIC 3.x (runs with LIGGGHTS 3.8; servo not tuned)
 
 std::string stl_rectangle(const std::string& name, double x0, double y0, double x1, double y1,
                           double z0, double z1) {
@@ -507,8 +507,8 @@ ExportResult liggghts(const SceneConfig& c, const AlgorithmSpec& p, const Assemb
   const int wall_type = plan.types + 1;
   const int ntypes = plan.types + 1;
 
-  // LIGGGHTS computes a sphere's mass 4/3·π·r³·ρ: a per-atom density
-  // 3·f_ms·ρ·t/(4·r) gives the disc's mass f_ms·ρ·t·π·r².
+  // LIGGGHTS with dimension 2 computes a particle's mass as π·r²·density:
+  // the areal density f_ms·ρ·t gives the disc's mass f_ms·ρ·t·π·r².
   {
     std::ostringstream d;
     const double mx = 0.5 * plan.width0, my = 0.1 * plan.height0;
@@ -523,7 +523,7 @@ ExportResult liggghts(const SceneConfig& c, const AlgorithmSpec& p, const Assemb
     char line[160];
     for (int i = 0; i < plan.n; ++i) {
       std::snprintf(line, sizeof line, "%d %d %.17g %.10g %.17g %.17g 0\n", i + 1, plan.type[i],
-                    2.0 * a.r[i], 3.0 * plan.areal_density / (4.0 * a.r[i]), a.x[i], a.y[i]);
+                    2.0 * a.r[i], plan.areal_density, a.x[i], a.y[i]);
       d << line;
     }
     out.files[o.data_name] = d.str();
@@ -547,17 +547,24 @@ ExportResult liggghts(const SceneConfig& c, const AlgorithmSpec& p, const Assemb
 
   std::ostringstream s;
   s << mapping_header(c, p, plan, o, "LIGGGHTS");
-  s << "#\n# NOT RUN HERE: LIGGGHTS is not installed on the machine that wrote this deck;\n"
-    << "# it follows the LIGGGHTS-PUBLIC 3.x documentation. Differences from demcal:\n"
+  s << "#\n# Checked with LIGGGHTS 3.8 (Debian): the deck runs (a test runs 2000 steps where\n"
+    << "# liggghts is installed). NOT VERIFIED against demcal: the servo of\n"
+    << "# fix mesh/surface/stress/servo with kp 1 and vel_max = cap/dt makes the lateral\n"
+    << "# walls bounce (wall force alternating between 0 and ~3x the target on the\n"
+    << "# 25-disc sample); tune kp and vel_max before trusting the strength.\n"
+    << "# Run it with a screen (liggghts 3.8 crashes reading meshes with -screen none).\n"
+    << "# Differences from demcal:\n"
     << "#  - LIGGGHTS has no disc inertia: particles rotate as spheres (I = 2/5 m r^2,\n"
-    << "#    not 1/2 m r^2); masses are made disc masses through a per-atom density.\n"
+    << "#    not 1/2 m r^2); masses are disc masses (2D: pi r^2 * areal density).\n"
     << "#    The rotational stability limit of alpha moves by sqrt(0.8) = 0.89.\n"
     << "#  - rotational damping (zeta_r = " << num(p.damping_ratio_rotation)
     << ") has no fix here and is not applied.\n"
     << "#  - lateral walls: fix mesh/surface/stress/servo holds the wall FORCE at\n"
-    << "#    sigma3*H0*t (H0 the initial height), not the stress on the current height.\n"
+    << "#    sigma3*H0*t (H0 the initial height), not the stress on the current height;\n"
+    << "#    the target is the force on the mesh along +x: positive on the left wall.\n"
     << "#  - translational damping per radius class via fix viscous ... scale.\n";
-  out.notes.push_back("LIGGGHTS deck not run here (LIGGGHTS not installed)");
+  out.notes.push_back(
+      "LIGGGHTS deck: runs with LIGGGHTS 3.8, not verified against demcal (servo gain untuned)");
   s << "\natom_style      granular\n"
     << "atom_modify     map array\n"
     << "boundary        f f p\n"
@@ -583,22 +590,21 @@ ExportResult liggghts(const SceneConfig& c, const AlgorithmSpec& p, const Assemb
        "tangential_damping off\n"
     << "pair_coeff * *\n"
     << "timestep " << num(plan.dt) << "\n\n"
-    << "fix bottom all wall/gran model hooke/stiffness tangential history absolute_damping on "
-       "tangential_damping off primitive type "
-    << wall_type << " yplane " << num(a.bottom) << "\n"
+    << "fix bottom all wall/gran model hooke/stiffness tangential history primitive type "
+    << wall_type << " yplane " << num(a.bottom) << " absolute_damping on tangential_damping off\n"
     << "fix mtop all mesh/surface file " << top << " type " << wall_type << "\n"
     << "fix mleft all mesh/surface/stress/servo file " << left << " type " << wall_type << " com "
     << num(a.left) << " " << num(0.5 * (a.bottom + a.top))
     << " 0 ctrlPV force axis 1 0 0 target_val "
-    << num(-c.test.lateral_stress * plan.height0 * m.thickness) << " vel_max "
+    << num(c.test.lateral_stress * plan.height0 * m.thickness) << " vel_max "
     << num(0.02 * plan.r_min / plan.dt) << " kp 1.0\n"
     << "fix mright all mesh/surface/stress/servo file " << right << " type " << wall_type << " com "
     << num(a.right) << " " << num(0.5 * (a.bottom + a.top))
     << " 0 ctrlPV force axis 1 0 0 target_val "
-    << num(c.test.lateral_stress * plan.height0 * m.thickness) << " vel_max "
+    << num(-c.test.lateral_stress * plan.height0 * m.thickness) << " vel_max "
     << num(0.02 * plan.r_min / plan.dt) << " kp 1.0\n"
-    << "fix walls all wall/gran model hooke/stiffness tangential history absolute_damping on "
-       "tangential_damping off mesh n_meshes 3 meshes mtop mleft mright\n"
+    << "fix walls all wall/gran model hooke/stiffness tangential history mesh n_meshes 3 meshes "
+       "mtop mleft mright absolute_damping on tangential_damping off\n"
     << "fix movetop all move/mesh mesh mtop linear 0 " << num(-plan.top_speed) << " 0\n\n"
     << "fix integrate all nve/sphere\n";
   if (p.damping_ratio_translation > 0.0) {
@@ -608,9 +614,12 @@ ExportResult liggghts(const SceneConfig& c, const AlgorithmSpec& p, const Assemb
     s << "\n";
   }
   s << "fix twod all enforce2d\n\n"
-    << "thermo_style custom step dt time ke\n"
+    << "variable fl equal f_mleft[1]\n"
+    << "variable fr equal f_mright[1]\n"
+    << "thermo_style custom step dt time ke v_fl v_fr\n"
     << "thermo " << plan.thermo_every << "\n"
-    << "run " << plan.steps << "\n";
+    << "variable run_steps index " << plan.steps << "\n"
+    << "run ${run_steps}\n";
   out.deck = s.str();
   return out;
 }
