@@ -211,6 +211,56 @@ TEST(EngineLammps, EditingNstepInTheDeckKeepsTheStrain) {
   EXPECT_EQ(s.meta.at("steps"), "2000");
 }
 
+TEST(EngineLammps, ASplitRunContinuesTheSameTest) {
+  // The loading run in one piece, and split at step 21 900 with
+  // write_restart / read_restart (the deck's continuation: the args file it
+  // writes gives the lateral walls' positions). The series agree: the servo
+  // restarts its sum at the split, so b_xx may differ by one step's move.
+  const std::string lmp = find_lammps();
+  if (lmp.empty())
+    GTEST_SKIP() << "LAMMPS (lmp) is not installed (apt-get install lammps): the deck is not run";
+  const SceneConfig c = hex5();
+  const ConsolidatedState state = consolidate(c, make_assembly(c));
+  ExportOptions o;
+  o.data_name = "hex5.data";
+  const ExportResult r = export_deck(c, quasi_static(), assembly_of(state.world), o);
+  const fs::path dir =
+      fs::temp_directory_path() / ("demcal_test_engine_split_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  for (const char* part : {"whole", "split"}) {
+    fs::create_directories(dir / part);
+    std::ofstream(dir / part / "in.hex5") << r.deck;
+    for (const auto& [name, content] : r.files) std::ofstream(dir / part / name) << content;
+  }
+  const std::string run = " -in in.hex5 -screen none >/dev/null 2>&1";
+  const std::string cmd = "cd '" + (dir / "whole").string() + "' && '" + lmp + "' -log log" + run +
+                          " && cd '" + (dir / "split").string() + "' && '" + lmp +
+                          "' -var run_steps 21900 -log log1" + run + " && '" + lmp +
+                          "' $(cat final.restart.args) -log log2" + run;
+  const int raw = std::system(cmd.c_str());
+  std::stringstream whole, split, log;
+  whole << std::ifstream(dir / "whole" / "series.csv").rdbuf();
+  split << std::ifstream(dir / "split" / "series.csv").rdbuf();
+  log << std::ifstream(dir / "split" / "log2").rdbuf();
+  fs::remove_all(dir);
+  ASSERT_TRUE(WIFEXITED(raw) && WEXITSTATUS(raw) == 0) << log.str();
+  const ExternalSeries a = parse_external_series(whole.str(), "whole.csv");
+  const ExternalSeries b = parse_external_series(split.str(), "split.csv");
+  ASSERT_EQ(a.run.series.size(), b.run.series.size());
+  const double s3 = c.test.lateral_stress;
+  for (size_t k = 0; k < a.run.series.size(); ++k) {
+    const MonitorPoint &p = a.run.series[k], &q = b.run.series[k];
+    ASSERT_EQ(p.step, q.step);
+    EXPECT_NEAR(q.b(1, 1) / p.b(1, 1), 1.0, 1e-5) << "step " << p.step;
+    EXPECT_NEAR((q.b(0, 0) - p.b(0, 0)) / s3, 0.0, 1e-3) << "step " << p.step;
+    EXPECT_NEAR(q.strain_yy, p.strain_yy, 1e-12) << "step " << p.step;
+  }
+  const Score sa = score_external(a, Tolerances{}).score,
+              sb = score_external(b, Tolerances{}).score;
+  EXPECT_NEAR(sb.criteria.peak_stress_yy / sa.criteria.peak_stress_yy, 1.0, 1e-5);
+  EXPECT_EQ(sa.passed, sb.passed);
+}
+
 /// The first `liggghts` on PATH, or "".
 std::string find_liggghts() {
   const char* path = std::getenv("PATH");

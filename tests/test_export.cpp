@@ -67,7 +67,7 @@ TEST(Export, LammpsDeckMapsEveryParameter) {
         "fix             dampt all viscous", "#fix            dampr all viscous/sphere",
         "variable nstep     equal 44390", "variable run_steps index ${nstep}",
         "fix             fcon all store/force", "fix             series all print ${monitor_every}",
-        "variable vtop      equal $(v_strain*v_H0/(v_nstep*v_dt))", "read_data       proto.data",
+        "variable vtop      equal $(v_strain*v_H0/(v_nstep*v_dt))", "then \"read_data proto.data\"",
         "variable kn        equal 100000000"})
     EXPECT_NE(r.deck.find(needle), std::string::npos) << needle;
   // ζ_t·2·sqrt(kn·m) for the one class.

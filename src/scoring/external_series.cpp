@@ -75,6 +75,9 @@ ExternalSeries parse_external_series(const std::string& text, const std::string&
       }
       continue;
     }
+    // The continuation of a split run repeats the header and the row of the
+    // step it restarted from: both are skipped.
+    if (split_commas(line) == columns) continue;
     const auto fields = split_commas(line);
     if (fields.size() != columns.size())
       throw InputError(source, where,
@@ -87,6 +90,7 @@ ExternalSeries parse_external_series(const std::string& text, const std::string&
       diverged = true;  // the engine's run blew up here: score what came before
       diverged_step = static_cast<int64_t>(std::isfinite(row[0]) ? row[0] : -1);
     }
+    if (!diverged && !rows.empty() && row[0] == rows.back()[0]) continue;
     if (!diverged) rows.push_back(std::move(row));
   }
   if (columns.empty()) throw InputError(source, "", "no column header (and no data)");

@@ -216,7 +216,9 @@ std::string lammps_series_block(const SceneConfig& c, const AlgorithmSpec& p, co
   const std::string row =
       "${stepn},${epsyy},${b_xx},${b_xy},${b_yx},${b_yy},${s_xx},${s_xy},${s_yx},${s_yy},"
       "${ke},${ke_rot},${servo_err},${pl},${pr},${pb},${pt},${xl},${xr},${yb0},${yt},${torque}";
-  s << "# the header: what demcal score needs to know about the run\n"
+  s << "# the header: what demcal score needs to know about the run (not repeated by\n"
+    << "# the continuation of a split run, which appends its rows)\n"
+    << "if              \"${continued} != 0\" then \"jump SELF series_rows\"\n"
     << "print           \"# demcal.series/1: LAMMPS deck written by demcal " << DEMCAL_VERSION
     << ", scene " << c.name << "\" file ${series} screen no\n"
     << "print           \"# particles = " << plan.n << "\" append ${series} screen no\n"
@@ -230,6 +232,7 @@ std::string lammps_series_block(const SceneConfig& c, const AlgorithmSpec& p, co
     << "print           \"# mass_scaling = " << num(p.mass_scaling)
     << "\" append ${series} screen no\n"
     << "print           \"# moment_lever_arm = radius\" append ${series} screen no\n"
+    << "label           series_rows\n"
     << "fix             halt_top all halt ${monitor_every} v_clear_top < 0.0 error hard\n"
     << "fix             halt_left all halt ${monitor_every} v_clear_left < 0.0 error hard\n"
     << "fix             halt_right all halt ${monitor_every} v_clear_right < 0.0 error hard\n"
@@ -287,8 +290,8 @@ ExportResult lammps(const SceneConfig& c, const AlgorithmSpec& p, const Assembly
     << "#  - servo walls are not native: the lateral walls are fix wall/gran/region\n"
     << "#    planes whose displacement is the running sum of demcal's per-step servo\n"
     << "#    move gain*(sigma3 - p)*H*t/(kn_wall*n_contacts), capped at 2 % of r_min,\n"
-    << "#    kept by fix ave/time (running mean times the step count): run the loading\n"
-    << "#    as ONE run command (the sum counts samples from step 0).\n"
+    << "#    kept by fix ave/time (running mean times the steps of this run); a split\n"
+    << "#    run restarts it from the walls' positions (see restart_from).\n"
     << "#  - the moving walls act on bands of particles near them (see the walls).\n";
   if (plan.types > 1) {
     s << "#  - per-particle damping D_t ~ sqrt(m): fix viscous has one gamma per atom type,\n"
@@ -328,7 +331,17 @@ ExportResult lammps(const SceneConfig& c, const AlgorithmSpec& p, const Assembly
     << "variable yb0       equal " << num(a.bottom) << "\n"
     << "variable yt0       equal " << num(a.top) << "\n"
     << "variable series    index series.csv      # the monitoring series (demcal score)\n"
-    << "variable run_steps index ${nstep}      # lmp -var run_steps 300 ... for a short check\n"
+    << "# A split run: the first part writes ${restart_out} and ${restart_out}.args at its\n"
+    << "# end; continue it with  lmp $(cat final.restart.args) -in THIS_DECK\n"
+    << "# (the args give continued, restart_from and the lateral walls' positions, xl_now, "
+       "xr_now).\n"
+    << "variable continued index 0      # 1: continue from ${restart_from}\n"
+    << "variable restart_from index final.restart\n"
+    << "variable restart_out index final.restart\n"
+    << "variable xl_now    index ${xl0}      # lateral walls where this run starts\n"
+    << "variable xr_now    index ${xr0}\n"
+    << "variable run_steps index ${nstep}      # run up to this step; -var run_steps 300 for a "
+       "check\n"
     << "\n# --- derived (do not edit) ---------------------------------------------------\n"
     << "variable H0        equal $(v_yt0-v_yb0)\n"
     << "variable vtop      equal $(v_strain*v_H0/(v_nstep*v_dt))      # m/s, top wall, down\n"
@@ -352,7 +365,9 @@ ExportResult lammps(const SceneConfig& c, const AlgorithmSpec& p, const Assembly
     << "atom_style      sphere\n"
     << "atom_modify     map array\n"
     << "comm_modify     vel yes\n"
-    << "read_data       " << o.data_name << "\n"
+    << "if              \"${continued} == 0\" then \"read_data " << o.data_name
+    << "\" else \"read_restart ${restart_from}\"\n"
+    << "variable        step0 equal $(step)\n"
     << "# disc masses m = f_ms*rho*t*pi*r^2 and inertia m*r^2/2 (fix nve/sphere disc)\n"
     << "set             type 1*" << plan.types << " density/disc " << num(plan.areal_density)
     << "\n\n"
@@ -368,11 +383,11 @@ ExportResult lammps(const SceneConfig& c, const AlgorithmSpec& p, const Assembly
     << "# The fix order matters: the walls, then fix store/force (contact forces\n"
     << "# only), then the damping.\n"
     << "variable dytop  equal -v_vtop*step*dt\n"
-    << "variable dxl    equal f_servol*step\n"
-    << "variable dxr    equal f_servor*step\n"
+    << "variable dxl    equal f_servol*(step-v_step0)\n"
+    << "variable dxr    equal f_servor*(step-v_step0)\n"
     << "region          rtop   plane 0 ${yt0} 0  0 -1 0 side in move NULL v_dytop NULL units box\n"
-    << "region          rleft  plane ${xl0} 0 0  1 0 0  side in move v_dxl NULL NULL units box\n"
-    << "region          rright plane ${xr0} 0 0  -1 0 0 side in move v_dxr NULL NULL units box\n"
+    << "region          rleft  plane ${xl_now} 0 0  1 0 0  side in move v_dxl NULL NULL units box\n"
+    << "region          rright plane ${xr_now} 0 0  -1 0 0 side in move v_dxr NULL NULL units box\n"
     << "# Each moving wall acts on the particles that can reach it (a wall fix loops\n"
     << "# over its group every step): those within band_v of the top, band_h of a\n"
     << "# lateral wall at the start. fix halt stops the run with an error should a\n"
@@ -402,8 +417,8 @@ ExportResult lammps(const SceneConfig& c, const AlgorithmSpec& p, const Assembly
     << "compute         cr gright reduce sum f_wright[1] f_wright[2]\n"
     << "compute         ct gtop reduce sum f_wtop[1] f_wtop[3]\n"
     << "compute         cb all reduce sum f_wbottom[1] f_wbottom[3]\n"
-    << "variable        xl equal v_xl0+v_dxl\n"
-    << "variable        xr equal v_xr0+v_dxr\n"
+    << "variable        xl equal v_xl_now+v_dxl\n"
+    << "variable        xr equal v_xr_now+v_dxr\n"
     << "variable        yt equal v_yt0+v_dytop\n"
     << "variable        H  equal v_yt-v_yb0\n"
     << "variable        W  equal v_xr-v_xl\n"
@@ -464,7 +479,11 @@ ExportResult lammps(const SceneConfig& c, const AlgorithmSpec& p, const Assembly
     << "thermo_style    custom step dt time v_epsyy v_pt v_pl v_pr v_W v_H ke\n"
     << "thermo_modify   norm no\n"
     << "thermo          ${monitor_every}\n"
-    << "run             ${run_steps}\n";
+    << "run             ${run_steps} upto\n"
+    << "write_restart   ${restart_out}\n"
+    << "print           \"-var continued 1 -var restart_from ${restart_out} -var xl_now ${xl} -var "
+       "xr_now ${xr}\" "
+       "file ${restart_out}.args screen no\n";
   out.deck = s.str();
   return out;
 }
