@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "demcal/scene/biaxial.hpp"
@@ -259,6 +260,45 @@ TEST(EngineLammps, ASplitRunContinuesTheSameTest) {
               sb = score_external(b, Tolerances{}).score;
   EXPECT_NEAR(sb.criteria.peak_stress_yy / sa.criteria.peak_stress_yy, 1.0, 1e-5);
   EXPECT_EQ(sa.passed, sb.passed);
+}
+
+TEST(EngineLammps, VerifyInLammpsAgreesWithDemcal) {
+  // `demcal verify --engine lammps` on the 25-disc prototype of a hex_5x5
+  // calibration (ζ_r set to 0: this LAMMPS has none): the LAMMPS-scored
+  // verdict and peak agree with demcal's own verify within 0.5 %.
+  const std::string lmp = find_lammps();
+  if (lmp.empty())
+    GTEST_SKIP() << "LAMMPS (lmp) is not installed (apt-get install lammps): verify --engine "
+                    "lammps is not run";
+  const fs::path dir =
+      fs::temp_directory_path() / ("demcal_test_engine_verify_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string demcal = DEMCAL_BINARY;
+  const std::string cd = "cd '" + dir.string() + "' && '" + demcal + "' ";
+  ASSERT_EQ(std::system((cd + "calibrate '" + DEMCAL_SOURCE_DIR +
+                         "/configs/hex_5x5.json' -o cal -j1 -q >/dev/null 2>&1")
+                            .c_str()),
+            0);
+  nlohmann::json params = nlohmann::json::parse(std::ifstream(dir / "cal" / "params.json"));
+  params["rev"]["damping_ratio_rotation"] = 0.0;
+  params["rev"]["damping_rotation"] = 0.0;
+  std::ofstream(dir / "p0.json") << params.dump(1);
+  const int ours =
+      std::system((cd + "verify p0.json --particles 25 -o vd >/dev/null 2>&1").c_str());
+  const int theirs = std::system(
+      (cd + "verify p0.json --particles 25 --engine lammps -o vl >/dev/null 2>&1").c_str());
+  const nlohmann::json d = nlohmann::json::parse(std::ifstream(dir / "vd" / "verify.json"));
+  const nlohmann::json l = nlohmann::json::parse(std::ifstream(dir / "vl" / "verify.json"));
+  const bool series_written = fs::exists(dir / "vl" / "lammps" / "series.csv");
+  fs::remove_all(dir);
+  ASSERT_TRUE(WIFEXITED(ours) && WIFEXITED(theirs));
+  EXPECT_EQ(WEXITSTATUS(ours), WEXITSTATUS(theirs));
+  EXPECT_TRUE(series_written);
+  EXPECT_EQ(l["engine"]["name"], "lammps");
+  EXPECT_EQ(d["passed"], l["passed"]);
+  EXPECT_NEAR(l["peak"]["stress_yy"].get<double>() / d["peak"]["stress_yy"].get<double>(), 1.0,
+              0.005);
 }
 
 /// The first `liggghts` on PATH, or "".
