@@ -525,6 +525,14 @@ ExportResult liggghts(const SceneConfig& c, const AlgorithmSpec& p, const Assemb
   ExportResult out = result_of(plan);
   const int wall_type = plan.types + 1;
   const int ntypes = plan.types + 1;
+  // The lateral walls' contacts at the start and the servo gain that makes
+  // LIGGGHTS' mesh servo move as demcal's (see the deck's header).
+  int n_contacts = 0;
+  for (int i = 0; i < plan.n; ++i)
+    if (a.x[i] - a.r[i] <= a.left + 1e-9 * a.r[i]) ++n_contacts;
+  n_contacts = std::max(1, n_contacts);
+  const double force_target = c.test.lateral_stress * plan.height0 * m.thickness;
+  const double kp = c.test.servo_gain * force_target / (m.wall.kn * n_contacts * 0.02 * plan.r_min);
 
   // LIGGGHTS with dimension 2 computes a particle's mass as π·r²·density:
   // the areal density f_ms·ρ·t gives the disc's mass f_ms·ρ·t·π·r².
@@ -566,11 +574,12 @@ ExportResult liggghts(const SceneConfig& c, const AlgorithmSpec& p, const Assemb
 
   std::ostringstream s;
   s << mapping_header(c, p, plan, o, "LIGGGHTS");
-  s << "#\n# Checked with LIGGGHTS 3.8 (Debian): the deck runs (a test runs 2000 steps where\n"
-    << "# liggghts is installed). NOT VERIFIED against demcal: the servo of\n"
-    << "# fix mesh/surface/stress/servo with kp 1 and vel_max = cap/dt makes the lateral\n"
-    << "# walls bounce (wall force alternating between 0 and ~3x the target on the\n"
-    << "# 25-disc sample); tune kp and vel_max before trusting the strength.\n"
+  s << "#\n# Checked with LIGGGHTS 3.8 (Debian): on a 25-disc sample its peak is within\n"
+    << "# 1 % of demcal's (a test, where liggghts is installed; reports/engines.md).\n"
+    << "# Servo: LIGGGHTS moves the mesh at vel_max * kp * (F_target - F)/|F_target|;\n"
+    << "# vel_max = cap/dt and kp = gain*F_target/(kn_wall*n_c*cap), n_c the wall\n"
+    << "# contacts at the start (" << n_contacts << "), give demcal's per-step move\n"
+    << "# gain*(F_target - F)/(kn_wall*n_c).\n"
     << "# Run it with a screen (liggghts 3.8 crashes reading meshes with -screen none).\n"
     << "# Differences from demcal:\n"
     << "#  - LIGGGHTS has no disc inertia: particles rotate as spheres (I = 2/5 m r^2,\n"
@@ -583,7 +592,8 @@ ExportResult liggghts(const SceneConfig& c, const AlgorithmSpec& p, const Assemb
     << "#    the target is the force on the mesh along +x: positive on the left wall.\n"
     << "#  - translational damping per radius class via fix viscous ... scale.\n";
   out.notes.push_back(
-      "LIGGGHTS deck: runs with LIGGGHTS 3.8, not verified against demcal (servo gain untuned)");
+      "LIGGGHTS deck: lateral force held at sigma3*H0*t (not on the current height); discs "
+      "rotate as spheres");
   s << "\natom_style      granular\n"
     << "atom_modify     map array\n"
     << "boundary        f f p\n"
@@ -611,17 +621,17 @@ ExportResult liggghts(const SceneConfig& c, const AlgorithmSpec& p, const Assemb
     << "timestep " << num(plan.dt) << "\n\n"
     << "fix bottom all wall/gran model hooke/stiffness tangential history primitive type "
     << wall_type << " yplane " << num(a.bottom) << " absolute_damping on tangential_damping off\n"
-    << "fix mtop all mesh/surface file " << top << " type " << wall_type << "\n"
+    << "fix mtop all mesh/surface/stress file " << top << " type " << wall_type << "\n"
     << "fix mleft all mesh/surface/stress/servo file " << left << " type " << wall_type << " com "
     << num(a.left) << " " << num(0.5 * (a.bottom + a.top))
     << " 0 ctrlPV force axis 1 0 0 target_val "
     << num(c.test.lateral_stress * plan.height0 * m.thickness) << " vel_max "
-    << num(0.02 * plan.r_min / plan.dt) << " kp 1.0\n"
+    << num(0.02 * plan.r_min / plan.dt) << " kp " << num(kp) << "\n"
     << "fix mright all mesh/surface/stress/servo file " << right << " type " << wall_type << " com "
     << num(a.right) << " " << num(0.5 * (a.bottom + a.top))
     << " 0 ctrlPV force axis 1 0 0 target_val "
     << num(-c.test.lateral_stress * plan.height0 * m.thickness) << " vel_max "
-    << num(0.02 * plan.r_min / plan.dt) << " kp 1.0\n"
+    << num(0.02 * plan.r_min / plan.dt) << " kp " << num(kp) << "\n"
     << "fix walls all wall/gran model hooke/stiffness tangential history mesh n_meshes 3 meshes "
        "mtop mleft mright absolute_damping on tangential_damping off\n"
     << "fix movetop all move/mesh mesh mtop linear 0 " << num(-plan.top_speed) << " 0\n\n"
@@ -633,9 +643,13 @@ ExportResult liggghts(const SceneConfig& c, const AlgorithmSpec& p, const Assemb
     s << "\n";
   }
   s << "fix twod all enforce2d\n\n"
-    << "variable fl equal f_mleft[1]\n"
-    << "variable fr equal f_mright[1]\n"
-    << "thermo_style custom step dt time ke v_fl v_fr\n"
+    << "# p_top: axial stress on the top wall; p_left, p_right: lateral (Pa)\n"
+    << "variable xl equal f_mleft[7]\n"
+    << "variable xr equal f_mright[7]\n"
+    << "variable p_top equal f_mtop[2]/((v_xr-v_xl)*" << num(m.thickness) << ")\n"
+    << "variable p_left equal -f_mleft[1]/(" << num(plan.height0 * m.thickness) << ")\n"
+    << "variable p_right equal f_mright[1]/(" << num(plan.height0 * m.thickness) << ")\n"
+    << "thermo_style custom step dt time ke v_p_top v_p_left v_p_right v_xl v_xr\n"
     << "thermo " << plan.thermo_every << "\n"
     << "variable run_steps index " << plan.steps << "\n"
     << "run ${run_steps}\n";
