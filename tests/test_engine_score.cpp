@@ -116,6 +116,33 @@ TEST(ExternalSeries, BadFilesNameTheFileAndTheLine) {
   EXPECT_FALSE(score_external(d, Tolerances{}).score.passed);
 }
 
+TEST(ScoreCli, ScoresAFileAndRejectsBadInputWithStatus2) {
+  const fs::path dir =
+      fs::temp_directory_path() / ("demcal_test_score_cli_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const SceneConfig c = hex5();
+  const ConsolidatedState state = consolidate(c, make_assembly(c));
+  std::ofstream(dir / "series.csv")
+      << series_csv(run_loading(state, c.test, quasi_static()).series);
+  std::ofstream(dir / "bad.csv") << "step,strain_yy\n0,x\n";
+  const std::string cd = "cd '" + dir.string() + "' && '" + std::string(DEMCAL_BINARY) + "' score ";
+  const int ok = std::system((cd + "series.csv --lateral-stress 1e5 -o s >/dev/null 2>&1").c_str());
+  const int bad = std::system((cd + "bad.csv --lateral-stress 1e5 -o b >/dev/null 2>&1").c_str());
+  const int missing = std::system((cd + "none.csv -o m >/dev/null 2>&1").c_str());
+  const int no_s3 = std::system((cd + "series.csv -o n >/dev/null 2>&1").c_str());
+  const bool summary = fs::exists(dir / "s" / "summary.json");
+  const bool partial = fs::exists(dir / "b") || fs::exists(dir / "m") || fs::exists(dir / "n");
+  fs::remove_all(dir);
+  ASSERT_TRUE(WIFEXITED(ok) && WIFEXITED(bad) && WIFEXITED(missing) && WIFEXITED(no_s3));
+  EXPECT_EQ(WEXITSTATUS(ok), 0);  // this run passes
+  EXPECT_TRUE(summary);
+  EXPECT_EQ(WEXITSTATUS(bad), 2);
+  EXPECT_EQ(WEXITSTATUS(missing), 2);
+  EXPECT_EQ(WEXITSTATUS(no_s3), 2);  // demcal's series.csv has no "# lateral_stress"
+  EXPECT_FALSE(partial);
+}
+
 /// The first `lmp` on PATH, or "".
 std::string find_lammps() {
   const char* path = std::getenv("PATH");
