@@ -346,7 +346,8 @@ ExportResult lammps(const SceneConfig& c, const AlgorithmSpec& p, const Assembly
     << "variable H0        equal $(v_yt0-v_yb0)\n"
     << "variable vtop      equal $(v_strain*v_H0/(v_nstep*v_dt))      # m/s, top wall, down\n"
     << "variable cap       equal $(0.02*v_r_min)      # m per step, servo move cap\n"
-    << "variable monitor_every equal $(floor(v_nstep/v_monitor_points))\n"
+    << "variable monitor_every equal "
+       "$(floor((1+v_nstep/v_monitor_points+abs(1-v_nstep/v_monitor_points))/2))\n"
     << "variable band_v    equal $(v_strain*v_H0+6*v_r_max)      # m, see the walls\n"
     << "variable band_h    equal $(2*v_strain*(v_xr0-v_xl0)+6*v_r_max)\n";
 
