@@ -38,6 +38,10 @@ std::function<int()> add_upscaling_commands(CLI::App& app) {
                    "consolidate the prototype, write DIR/prototype.csv, and stop");
   verify->add_option("--tile", ve->tile,
                      "NXxNY: mirror-tile the --prototype packing into a larger test prototype");
+  verify->add_option("--engine", ve->engine,
+                     "demcal (default) or lammps: run the exported deck with lmp and score it");
+  verify->add_option("--np", ve->np, "MPI ranks for --engine lammps (mpirun -np N; default 1)")
+      ->check(CLI::Range(1, 4096));
 
   auto sc = std::make_shared<ScalingOptions>();
   auto* scaling = app.add_subcommand(

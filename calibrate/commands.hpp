@@ -58,6 +58,15 @@ struct StabilityOptions {
 };
 int cmd_stability(const StabilityOptions& options);
 
+/// `demcal score FILE`: another engine's monitoring series, scored.
+struct ScoreOptions {
+  std::string file;
+  double lateral_stress = 0.0;  ///< 0: the file's "# lateral_stress"
+  double reference_peak = 0.0;  ///< |b_yy| to hold the peak against (0: none)
+  std::string out_dir;
+};
+int cmd_score(const ScoreOptions& options);
+
 // Issue #6: upscale, verify, scaling, export, rev (options in
 // upscaling_cli.hpp). Adds the subcommands to `app`; the function returned
 // runs the one that was parsed, or returns -1 when none of them was.

@@ -75,6 +75,18 @@ int main(int argc, char** argv) {
   stability->add_option("--steps", stab.steps, "loading steps per trial (20000)")
       ->check(CLI::PositiveNumber);
 
+  ScoreOptions score_options;
+  auto* score = app.add_subcommand(
+      "score", "criteria, verdict and diagnosis of another engine's monitoring series (CSV)");
+  score->add_option("file", score_options.file, "series file (e.g. the LAMMPS deck's series.csv)")
+      ->required();
+  score->add_option("--lateral-stress", score_options.lateral_stress,
+                    "sigma3 in Pa, if the file has no '# lateral_stress = ' line");
+  score->add_option("--reference-peak", score_options.reference_peak,
+                    "a reference peak |sigma_yy| in Pa to report the peak error against");
+  score->add_option("-o,--output", score_options.out_dir,
+                    "output folder (default demcal-score-STEM)");
+
   const auto run_upscaling = add_upscaling_commands(app);  // upscale, verify, scaling, export, rev
 
   try {
@@ -91,6 +103,7 @@ int main(int argc, char** argv) {
     if (sweep->parsed()) return cmd_sweep(sweep_options);
     if (calibrate->parsed()) return cmd_calibrate(cal);
     if (stability->parsed()) return cmd_stability(stab);
+    if (score->parsed()) return cmd_score(score_options);
     if (const int status = run_upscaling(); status >= 0) return status;
   } catch (const demcal::InputError& e) {
     std::cerr << "demcal: error: " << e.what() << "\n";

@@ -42,6 +42,10 @@ struct VerifyOptions {
   bool consolidate_only = false;
   /// "NXxNY": the prototype is --prototype mirror-tiled NX×NY times.
   std::string tile;
+  /// "demcal" (the kernel) or "lammps": export the deck, run it with lmp
+  /// (under mpirun -np `np` when np > 1) and score its series.
+  std::string engine = "demcal";
+  int np = 1;
 };
 int cmd_verify(const VerifyOptions& options);
 

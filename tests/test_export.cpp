@@ -13,8 +13,8 @@
 #include <sstream>
 
 #include "demcal/scene/biaxial.hpp"
-#include "demcal/upscaling/export.hpp"
 #include "demcal/scene/packing.hpp"
+#include "demcal/upscaling/export.hpp"
 #include "demcal/upscaling/rev.hpp"
 
 namespace demcal {
@@ -65,7 +65,9 @@ TEST(Export, LammpsDeckMapsEveryParameter) {
         "pair_style      gran/hooke/history ${kn} ${kt} 0 0.0 ${mu} 0",
         "fix             twod all enforce2d", "wall/gran/region hooke/history",
         "fix             dampt all viscous", "#fix            dampr all viscous/sphere",
-        "variable run_steps index 44390", "read_data       proto.data",
+        "variable nstep     equal 44390", "variable run_steps index ${nstep}",
+        "fix             fcon all store/force", "fix             series all print ${monitor_every}",
+        "variable vtop      equal $(v_strain*v_H0/(v_nstep*v_dt))", "then \"read_data proto.data\"",
         "variable kn        equal 100000000"})
     EXPECT_NE(r.deck.find(needle), std::string::npos) << needle;
   // ζ_t·2·sqrt(kn·m) for the one class.
@@ -108,10 +110,13 @@ TEST(Export, LiggghtsDeckHasMeshesAndServo) {
   o.format = "liggghts";
   o.data_name = "proto.data";
   const ExportResult r = export_deck(c, params(), a, o);
-  for (const char* needle :
-       {"pair_style gran model hooke/stiffness tangential history", "mesh/surface/stress/servo",
-        "move/mesh", "fix twod all enforce2d", "NOT RUN HERE"})
+  for (const char* needle : {"pair_style gran model hooke/stiffness tangential history",
+                             "mesh/surface/stress/servo", "move/mesh", "fix twod all enforce2d",
+                             "Checked with LIGGGHTS 3.8", "primitive type 2 yplane"})
     EXPECT_NE(r.deck.find(needle), std::string::npos) << needle;
+  // 2D masses: LIGGGHTS takes pi r^2 * density, so the density column is
+  // the areal density f_ms*rho*t.
+  EXPECT_NE(r.files.at("proto.data").find(" 0.001 2650 "), std::string::npos);
   EXPECT_EQ(r.files.count("proto-top.stl"), 1u);
   EXPECT_EQ(r.files.count("proto-left.stl"), 1u);
 }

@@ -36,7 +36,7 @@ struct Plan {
   double top_speed = 0.0;                // [m/s], downward
   std::vector<double> gamma_t, gamma_r;  // per class [N·s/m], [N·m·s]
   double class_error = 0.0;
-  double r_min = 0.0;
+  double r_min = 0.0, r_max = 0.0;
   int thermo_every = 1;
   ParticleScales scales;
 };
@@ -54,6 +54,7 @@ Plan make_plan(const SceneConfig& c, const AlgorithmSpec& p, const Assembly& a, 
   }
   plan.scales = particle_scales(a.r, c.material, p.mass_scaling);
   plan.r_min = plan.scales.radius_min;
+  plan.r_max = plan.scales.radius_max;
   plan.dt_crit = plan.scales.dt_crit;
   plan.dt = p.dt_ratio * plan.dt_crit;
   plan.steps = p.steps;
@@ -140,6 +141,106 @@ ExportResult result_of(const Plan& plan) {
 // ---------------------------------------------------------------------------
 // LAMMPS (29 Sep 2021)
 
+/// The LAMMPS deck's monitoring series: b, sigma, kinetic energy, wall
+/// stresses, servo error and torque sum at every monitoring interval, in the
+/// CSV that `demcal score` reads (include/demcal/scoring/external_series.hpp).
+constexpr const char* kColumns =
+    "step,strain_yy,b_xx,b_xy,b_yx,b_yy,s_xx,s_xy,s_yx,s_yy,kinetic_energy,"
+    "kinetic_energy_rotation,lateral_stress_error,p_left,p_right,p_bottom,p_top,wall_left,"
+    "wall_right,wall_bottom,wall_top,torque_stress";
+
+std::string lammps_series_block(const SceneConfig& c, const AlgorithmSpec& p, const Plan& plan) {
+  std::ostringstream s;
+  s << "# --- monitoring series (demcal score FILE) -----------------------------------\n"
+    << "# Written to ${series} every monitor_every steps (and at the start), one row\n"
+    << "# per monitoring point, tension positive, SI units, origin at the box centre:\n"
+    << "#   step, strain_yy          (H - H0)/H0\n"
+    << "#   b_xx b_xy b_yx b_yy      boundary stress (1/V) sum_wall x^c (x) f^c, from the\n"
+    << "#                            four walls' contact arrays (contact point, force)\n"
+    << "#   s_xx s_xy s_yx s_yy      homogenized stress, from the identity\n"
+    << "#                            V (b - sigma) = sum_p (x_p - c) (x) F_p, F_p the\n"
+    << "#                            contact force of fix store/force (before damping)\n"
+    << "#   kinetic_energy           translation + rotation, disc inertia m r^2/2 [J]\n"
+    << "#   kinetic_energy_rotation\n"
+    << "#   lateral_stress_error     ((p_left + p_right)/2 - sigma3)/sigma3 (servo)\n"
+    << "#   p_left p_right p_bottom p_top  compressive wall pressures [Pa]\n"
+    << "#   wall_left wall_right wall_bottom wall_top  wall positions [m]\n"
+    << "#   torque_stress            sum of the particles' contact torques / V [Pa]\n"
+    << "# Approximated: LAMMPS applies a contact's tangential force at the lever arm\n"
+    << "# r_i (demcal: r_i - delta/2), so s_xy - s_yx carries a static term\n"
+    << "# -sum_c delta_c f_t,c / V that no algorithmic parameter removes; demcal score\n"
+    << "# measures moment balance on torque_stress (zero at rotational equilibrium in\n"
+    << "# either code) and reports that floor apart.\n"
+    << "variable        epsyy equal (v_H-v_H0)/v_H0\n"
+    << "variable        cx equal (v_xl+v_xr)/2\n"
+    << "variable        cy equal (v_yb0+v_yt)/2\n"
+    << "variable        V  equal v_W*v_H*v_thick\n";
+  const char* walls[] = {"wleft", "wright", "wtop", "wbottom"};
+  auto wall_sum = [&](int a, int b) {
+    std::string out;
+    for (const char* w : walls) {
+      if (!out.empty()) out += "+";
+      out += std::string("f_") + w + "[" + std::to_string(a) + "]";
+      if (b > 0) out += std::string("*f_") + w + "[" + std::to_string(b) + "]";
+    }
+    return out;
+  };
+  s << "variable        bxx_a atom " << wall_sum(5, 2) << "\n"
+    << "variable        bxy_a atom " << wall_sum(5, 3) << "\n"
+    << "variable        byx_a atom " << wall_sum(6, 2) << "\n"
+    << "variable        byy_a atom " << wall_sum(6, 3) << "\n"
+    << "variable        fwx_a atom " << wall_sum(2, 0) << "\n"
+    << "variable        fwy_a atom " << wall_sum(3, 0) << "\n"
+    << "variable        mxx_a atom x*f_fcon[1]\n"
+    << "variable        mxy_a atom x*f_fcon[2]\n"
+    << "variable        myx_a atom y*f_fcon[1]\n"
+    << "variable        myy_a atom y*f_fcon[2]\n"
+    << "compute         pa all property/atom radius omegaz tqz\n"
+    << "variable        ker_a atom 0.25*mass*c_pa[1]*c_pa[1]*c_pa[2]*c_pa[2]\n"
+    << "compute         meas all reduce sum v_bxx_a v_bxy_a v_byx_a v_byy_a v_fwx_a v_fwy_a &\n"
+    << "                v_mxx_a v_mxy_a v_myx_a v_myy_a f_fcon[1] f_fcon[2] v_ker_a c_pa[3]\n"
+    << "compute         ket all ke\n"
+    << "variable        b_xx equal (c_meas[1]-v_cx*c_meas[5])/v_V\n"
+    << "variable        b_xy equal (c_meas[2]-v_cx*c_meas[6])/v_V\n"
+    << "variable        b_yx equal (c_meas[3]-v_cy*c_meas[5])/v_V\n"
+    << "variable        b_yy equal (c_meas[4]-v_cy*c_meas[6])/v_V\n"
+    << "variable        s_xx equal v_b_xx-(c_meas[7]-v_cx*c_meas[11])/v_V\n"
+    << "variable        s_xy equal v_b_xy-(c_meas[8]-v_cx*c_meas[12])/v_V\n"
+    << "variable        s_yx equal v_b_yx-(c_meas[9]-v_cy*c_meas[11])/v_V\n"
+    << "variable        s_yy equal v_b_yy-(c_meas[10]-v_cy*c_meas[12])/v_V\n"
+    << "variable        ke equal c_ket+c_meas[13]\n"
+    << "variable        ke_rot equal c_meas[13]\n"
+    << "variable        servo_err equal ((v_pl+v_pr)/2-v_sigma3)/v_sigma3\n"
+    << "variable        torque equal c_meas[14]/v_V\n"
+    << "variable        stepn equal step\n";
+  const std::string row =
+      "${stepn},${epsyy},${b_xx},${b_xy},${b_yx},${b_yy},${s_xx},${s_xy},${s_yx},${s_yy},"
+      "${ke},${ke_rot},${servo_err},${pl},${pr},${pb},${pt},${xl},${xr},${yb0},${yt},${torque}";
+  s << "# the header: what demcal score needs to know about the run (not repeated by\n"
+    << "# the continuation of a split run, which appends its rows)\n"
+    << "if              \"${continued} != 0\" then \"jump SELF series_rows\"\n"
+    << "print           \"# demcal.series/1: LAMMPS deck written by demcal " << DEMCAL_VERSION
+    << ", scene " << c.name << "\" file ${series} screen no\n"
+    << "print           \"# particles = " << plan.n << "\" append ${series} screen no\n"
+    << "print           \"# lateral_stress = ${sigma3}\" append ${series} screen no\n"
+    << "print           \"# steps = ${nstep}\" append ${series} screen no\n"
+    << "print           \"# dt = ${dt}\" append ${series} screen no\n"
+    << "print           \"# dt_crit = " << num(plan.dt_crit) << "\" append ${series} screen no\n"
+    << "print           \"# damping_ratio_translation = " << num(p.damping_ratio_translation)
+    << "\" append ${series} screen no\n"
+    << "print           \"# damping_ratio_rotation = 0\" append ${series} screen no\n"
+    << "print           \"# mass_scaling = " << num(p.mass_scaling)
+    << "\" append ${series} screen no\n"
+    << "print           \"# moment_lever_arm = radius\" append ${series} screen no\n"
+    << "label           series_rows\n"
+    << "fix             halt_top all halt ${monitor_every} v_clear_top < 0.0 error hard\n"
+    << "fix             halt_left all halt ${monitor_every} v_clear_left < 0.0 error hard\n"
+    << "fix             halt_right all halt ${monitor_every} v_clear_right < 0.0 error hard\n"
+    << "fix             series all print ${monitor_every} \"" << row
+    << "\" append ${series} screen no title \"" << kColumns << "\"\n\n";
+  return s.str();
+}
+
 ExportResult lammps(const SceneConfig& c, const AlgorithmSpec& p, const Assembly& a,
                     const ExportOptions& o) {
   const Plan plan = make_plan(c, p, a, o.max_types);
@@ -189,8 +290,9 @@ ExportResult lammps(const SceneConfig& c, const AlgorithmSpec& p, const Assembly
     << "#  - servo walls are not native: the lateral walls are fix wall/gran/region\n"
     << "#    planes whose displacement is the running sum of demcal's per-step servo\n"
     << "#    move gain*(sigma3 - p)*H*t/(kn_wall*n_contacts), capped at 2 % of r_min,\n"
-    << "#    kept by fix ave/time (running mean times the step count). Run the loading\n"
-    << "#    as ONE run command: the sum counts samples from step 0.\n";
+    << "#    kept by fix ave/time (running mean times the steps of this run); a split\n"
+    << "#    run restarts it from the walls' positions (see restart_from).\n"
+    << "#  - the moving walls act on bands of particles near them (see the walls).\n";
   if (plan.types > 1) {
     s << "#  - per-particle damping D_t ~ sqrt(m): fix viscous has one gamma per atom type,\n"
       << "#    so the particles are grouped in " << plan.types << " radius classes (types 1.."
@@ -204,10 +306,15 @@ ExportResult lammps(const SceneConfig& c, const AlgorithmSpec& p, const Assembly
       "move): one run command only");
 
   s << "\n# --- parameters (edit here) -------------------------------------------------\n"
+    << "# Everything below the block is derived from it: editing dt or nstep keeps the\n"
+    << "# strain, the loading rate per step count, the servo cap and the monitoring\n"
+    << "# points right.\n"
     << "variable dt        equal " << num(plan.dt) << "      # s\n"
     << "variable nstep     equal " << plan.steps << "      # loading steps Nstep\n"
-    << "variable run_steps index " << plan.steps
-    << "      # lmp -var run_steps 300 ... for a short check\n"
+    << "variable strain    equal " << num(c.test.vertical_strain)
+    << "      # total vertical strain over nstep\n"
+    << "variable monitor_points equal " << c.test.monitor_points
+    << "      # rows of the series file\n"
     << "variable kn        equal " << num(m.particle.kn) << "\n"
     << "variable kt        equal " << num(m.particle.kt) << "\n"
     << "variable mu        equal " << num(m.particle.friction) << "\n"
@@ -217,12 +324,32 @@ ExportResult lammps(const SceneConfig& c, const AlgorithmSpec& p, const Assembly
     << "variable thick     equal " << num(m.thickness) << "      # disc thickness t, m\n"
     << "variable sigma3    equal " << num(c.test.lateral_stress) << "      # Pa\n"
     << "variable gain      equal " << num(c.test.servo_gain) << "\n"
-    << "variable cap       equal " << num(0.02 * plan.r_min) << "      # m per step\n"
-    << "variable vtop      equal " << num(plan.top_speed) << "      # m/s, downward\n"
-    << "variable xl0       equal " << num(a.left) << "\n"
+    << "variable r_min     equal " << num(plan.r_min) << "      # m, smallest radius\n"
+    << "variable r_max     equal " << num(plan.r_max) << "      # m, largest radius\n"
+    << "variable xl0       equal " << num(a.left) << "      # walls at the start, m\n"
     << "variable xr0       equal " << num(a.right) << "\n"
     << "variable yb0       equal " << num(a.bottom) << "\n"
-    << "variable yt0       equal " << num(a.top) << "\n";
+    << "variable yt0       equal " << num(a.top) << "\n"
+    << "variable series    index series.csv      # the monitoring series (demcal score)\n"
+    << "# A split run: the first part writes ${restart_out} and ${restart_out}.args at its\n"
+    << "# end; continue it with  lmp $(cat final.restart.args) -in THIS_DECK\n"
+    << "# (the args give continued, restart_from and the lateral walls' positions, xl_now, "
+       "xr_now).\n"
+    << "variable continued index 0      # 1: continue from ${restart_from}\n"
+    << "variable restart_from index final.restart\n"
+    << "variable restart_out index final.restart\n"
+    << "variable xl_now    index ${xl0}      # lateral walls where this run starts\n"
+    << "variable xr_now    index ${xr0}\n"
+    << "variable run_steps index ${nstep}      # run up to this step; -var run_steps 300 for a "
+       "check\n"
+    << "\n# --- derived (do not edit) ---------------------------------------------------\n"
+    << "variable H0        equal $(v_yt0-v_yb0)\n"
+    << "variable vtop      equal $(v_strain*v_H0/(v_nstep*v_dt))      # m/s, top wall, down\n"
+    << "variable cap       equal $(0.02*v_r_min)      # m per step, servo move cap\n"
+    << "variable monitor_every equal "
+       "$(floor((1+v_nstep/v_monitor_points+abs(1-v_nstep/v_monitor_points))/2))\n"
+    << "variable band_v    equal $(v_strain*v_H0+6*v_r_max)      # m, see the walls\n"
+    << "variable band_h    equal $(2*v_strain*(v_xr0-v_xl0)+6*v_r_max)\n";
 
   double gamma_n = 0.0;
   if (m.contact_damping_ratio > 0.0) {
@@ -239,7 +366,9 @@ ExportResult lammps(const SceneConfig& c, const AlgorithmSpec& p, const Assembly
     << "atom_style      sphere\n"
     << "atom_modify     map array\n"
     << "comm_modify     vel yes\n"
-    << "read_data       " << o.data_name << "\n"
+    << "if              \"${continued} == 0\" then \"read_data " << o.data_name
+    << "\" else \"read_restart ${restart_from}\"\n"
+    << "variable        step0 equal $(step)\n"
     << "# disc masses m = f_ms*rho*t*pi*r^2 and inertia m*r^2/2 (fix nve/sphere disc)\n"
     << "set             type 1*" << plan.types << " density/disc " << num(plan.areal_density)
     << "\n\n"
@@ -251,40 +380,76 @@ ExportResult lammps(const SceneConfig& c, const AlgorithmSpec& p, const Assembly
     << "fix             integrate all nve/sphere disc\n\n";
 
   s << "# --- walls -------------------------------------------------------------------\n"
-    << "# top: a plane moving down at vtop; left/right: planes moved by the servo\n"
+    << "# top: a plane moving down at vtop; left/right: planes moved by the servo.\n"
+    << "# The fix order matters: the walls, then fix store/force (contact forces\n"
+    << "# only), then the damping.\n"
     << "variable dytop  equal -v_vtop*step*dt\n"
-    << "variable dxl    equal f_servol*step\n"
-    << "variable dxr    equal f_servor*step\n"
+    << "variable dxl    equal f_servol*(step-v_step0)\n"
+    << "variable dxr    equal f_servor*(step-v_step0)\n"
     << "region          rtop   plane 0 ${yt0} 0  0 -1 0 side in move NULL v_dytop NULL units box\n"
-    << "region          rleft  plane ${xl0} 0 0  1 0 0  side in move v_dxl NULL NULL units box\n"
-    << "region          rright plane ${xr0} 0 0  -1 0 0 side in move v_dxr NULL NULL units box\n"
+    << "region          rleft  plane ${xl_now} 0 0  1 0 0  side in move v_dxl NULL NULL units box\n"
+    << "region          rright plane ${xr_now} 0 0  -1 0 0 side in move v_dxr NULL NULL units box\n"
+    << "# Each moving wall acts on the particles that can reach it (a wall fix loops\n"
+    << "# over its group every step): those within band_v of the top, band_h of a\n"
+    << "# lateral wall at the start. fix halt stops the run with an error should a\n"
+    << "# particle outside a band ever touch that wall (then widen the bands).\n"
+    << "region          bandtop block INF INF $(v_yt0-v_band_v) INF INF INF units box\n"
+    << "region          bandleft block INF $(v_xl0+v_band_h) INF INF INF INF units box\n"
+    << "region          bandright block $(v_xr0-v_band_h) INF INF INF INF INF units box\n"
+    << "group           gtop region bandtop\n"
+    << "group           gleft region bandleft\n"
+    << "group           gright region bandright\n"
+    << "group           ntop subtract all gtop\n"
+    << "group           nleft subtract all gleft\n"
+    << "group           nright subtract all gright\n"
     << "fix             wbottom all wall/gran hooke/history ${kn_wall} ${kt_wall} 0 0 ${mu_wall} 0 "
-       "yplane ${yb0} NULL\n"
-    << "fix             wtop all wall/gran/region hooke/history ${kn_wall} ${kt_wall} 0 0 "
-       "${mu_wall} "
-       "0 region rtop contacts\n"
-    << "fix             wleft all wall/gran/region hooke/history ${kn_wall} ${kt_wall} 0 0 "
+       "yplane ${yb0} NULL contacts\n"
+    << "fix             wtop gtop wall/gran/region hooke/history ${kn_wall} ${kt_wall} 0 0 "
+       "${mu_wall} 0 region rtop contacts\n"
+    << "fix             wleft gleft wall/gran/region hooke/history ${kn_wall} ${kt_wall} 0 0 "
        "${mu_wall} 0 region rleft contacts\n"
-    << "fix             wright all wall/gran/region hooke/history ${kn_wall} ${kt_wall} 0 0 "
+    << "fix             wright gright wall/gran/region hooke/history ${kn_wall} ${kt_wall} 0 0 "
        "${mu_wall} 0 region rright contacts\n"
-    << "# wall contacts (column 1) and the wall forces on the particles (columns 2, 3)\n"
-    << "compute         cl all reduce sum f_wleft[1] f_wleft[2]\n"
-    << "compute         cr all reduce sum f_wright[1] f_wright[2]\n"
-    << "compute         ct all reduce sum f_wtop[1] f_wtop[3]\n"
-    << "variable        H  equal (v_yt0+v_dytop)-v_yb0\n"
-    << "variable        W  equal (v_xr0+v_dxr)-(v_xl0+v_dxl)\n"
+    << "# contact force on every particle (pairs and walls), before the damping\n"
+    << "fix             fcon all store/force\n"
+    << "# wall contact arrays: [1] contacts, [2] [3] force on the particle, [5] [6]\n"
+    << "# contact point\n"
+    << "compute         cl gleft reduce sum f_wleft[1] f_wleft[2]\n"
+    << "compute         cr gright reduce sum f_wright[1] f_wright[2]\n"
+    << "compute         ct gtop reduce sum f_wtop[1] f_wtop[3]\n"
+    << "compute         cb all reduce sum f_wbottom[1] f_wbottom[3]\n"
+    << "variable        xl equal v_xl_now+v_dxl\n"
+    << "variable        xr equal v_xr_now+v_dxr\n"
+    << "variable        yt equal v_yt0+v_dytop\n"
+    << "variable        H  equal v_yt-v_yb0\n"
+    << "variable        W  equal v_xr-v_xl\n"
     << "variable        pl equal c_cl[2]/(v_H*v_thick)\n"
     << "variable        pr equal -c_cr[2]/(v_H*v_thick)\n"
     << "variable        pt equal -c_ct[2]/(v_W*v_thick)\n"
-    << "# demcal's servo, one move per step toward the sample when p < sigma3\n"
-    << "# (this release has no min/max of two numbers: min(a,b) = (a+b-abs(a-b))/2)\n"
-    << "variable        ncl   equal (1+c_cl[1]+abs(1-c_cl[1]))/2\n"
-    << "variable        ncr   equal (1+c_cr[1]+abs(1-c_cr[1]))/2\n"
-    << "variable        rawl  equal v_gain*(v_sigma3-v_pl)*v_H*v_thick/(v_kn_wall*v_ncl)\n"
-    << "variable        rawr  equal v_gain*(v_sigma3-v_pr)*v_H*v_thick/(v_kn_wall*v_ncr)\n"
-    << "# clamp(x, -cap, cap) = (abs(x+cap) - abs(x-cap))/2\n"
-    << "variable        movel equal (abs(v_rawl+v_cap)-abs(v_rawl-v_cap))/2\n"
-    << "variable        mover equal -(abs(v_rawr+v_cap)-abs(v_rawr-v_cap))/2\n"
+    << "variable        pb equal c_cb[2]/(v_W*v_thick)\n"
+    << "# clearance of the particles outside each band from its wall (> 0)\n"
+    << "compute         rad all property/atom radius\n"
+    << "variable        gap_top atom v_yt-y-c_rad\n"
+    << "variable        gap_left atom x-c_rad-v_xl\n"
+    << "variable        gap_right atom v_xr-x-c_rad\n"
+    << "compute         clear_top ntop reduce min v_gap_top\n"
+    << "compute         clear_left nleft reduce min v_gap_left\n"
+    << "compute         clear_right nright reduce min v_gap_right\n"
+    << "variable        clear_top equal c_clear_top\n"
+    << "variable        clear_left equal c_clear_left\n"
+    << "variable        clear_right equal c_clear_right\n"
+    << "# demcal's servo, one move per step toward the sample when p < sigma3:\n"
+    << "#   move = gain*(sigma3*H*t - F)/(kn_wall*max(1, n)), clamped to +-cap,\n"
+    << "# F the wall force, n its contacts. One flat formula per wall, the numbers\n"
+    << "# substituted now: a chain of variables re-parsed every step cost more than\n"
+    << "# the granular step itself (this release has no min/max of two numbers:\n"
+    << "# max(1, n) = (1+n+abs(1-n))/2, clamp(x) = (abs(x+cap)-abs(x-cap))/2).\n"
+    << "variable        rawl  equal ${gain}*(${sigma3}*(${H0}-${vtop}*step*dt)*${thick}-c_cl[2])/"
+       "(${kn_wall}*(1+c_cl[1]+abs(1-c_cl[1]))/2)\n"
+    << "variable        rawr  equal ${gain}*(${sigma3}*(${H0}-${vtop}*step*dt)*${thick}+c_cr[2])/"
+       "(${kn_wall}*(1+c_cr[1]+abs(1-c_cr[1]))/2)\n"
+    << "variable        movel equal (abs(v_rawl+${cap})-abs(v_rawl-${cap}))/2\n"
+    << "variable        mover equal -(abs(v_rawr+${cap})-abs(v_rawr-${cap}))/2\n"
     << "fix             servol all ave/time 1 1 1 v_movel ave running\n"
     << "fix             servor all ave/time 1 1 1 v_mover ave running\n\n";
 
@@ -308,20 +473,24 @@ ExportResult lammps(const SceneConfig& c, const AlgorithmSpec& p, const Assembly
     s << "\n";
   }
   s << "fix             twod all enforce2d\n\n";
-
+  s << lammps_series_block(c, p, plan);
   s << "# --- output and run ----------------------------------------------------------\n"
     << "# p_left, p_right: lateral wall pressures (servo target sigma3); p_top: axial\n"
-    << "variable        epsyy equal (v_H-" << num(plan.height0) << ")/" << num(plan.height0) << "\n"
+    << "variable        epsyy equal (v_H-v_H0)/v_H0\n"
     << "thermo_style    custom step dt time v_epsyy v_pt v_pl v_pr v_W v_H ke\n"
     << "thermo_modify   norm no\n"
-    << "thermo          " << plan.thermo_every << "\n"
-    << "run             ${run_steps}\n";
+    << "thermo          ${monitor_every}\n"
+    << "run             ${run_steps} upto\n"
+    << "write_restart   ${restart_out}\n"
+    << "print           \"-var continued 1 -var restart_from ${restart_out} -var xl_now ${xl} -var "
+       "xr_now ${xr}\" "
+       "file ${restart_out}.args screen no\n";
   out.deck = s.str();
   return out;
 }
 
 // ---------------------------------------------------------------------------
-// LIGGGHTS-PUBLIC 3.x (documentation-based; not run here)
+// LIGGGHTS-PUBLIC 3.x (runs with LIGGGHTS 3.8; servo not tuned)
 
 std::string stl_rectangle(const std::string& name, double x0, double y0, double x1, double y1,
                           double z0, double z1) {
@@ -357,9 +526,17 @@ ExportResult liggghts(const SceneConfig& c, const AlgorithmSpec& p, const Assemb
   ExportResult out = result_of(plan);
   const int wall_type = plan.types + 1;
   const int ntypes = plan.types + 1;
+  // The lateral walls' contacts at the start and the servo gain that makes
+  // LIGGGHTS' mesh servo move as demcal's (see the deck's header).
+  int n_contacts = 0;
+  for (int i = 0; i < plan.n; ++i)
+    if (a.x[i] - a.r[i] <= a.left + 1e-9 * a.r[i]) ++n_contacts;
+  n_contacts = std::max(1, n_contacts);
+  const double force_target = c.test.lateral_stress * plan.height0 * m.thickness;
+  const double kp = c.test.servo_gain * force_target / (m.wall.kn * n_contacts * 0.02 * plan.r_min);
 
-  // LIGGGHTS computes a sphere's mass 4/3·π·r³·ρ: a per-atom density
-  // 3·f_ms·ρ·t/(4·r) gives the disc's mass f_ms·ρ·t·π·r².
+  // LIGGGHTS with dimension 2 computes a particle's mass as π·r²·density:
+  // the areal density f_ms·ρ·t gives the disc's mass f_ms·ρ·t·π·r².
   {
     std::ostringstream d;
     const double mx = 0.5 * plan.width0, my = 0.1 * plan.height0;
@@ -374,7 +551,7 @@ ExportResult liggghts(const SceneConfig& c, const AlgorithmSpec& p, const Assemb
     char line[160];
     for (int i = 0; i < plan.n; ++i) {
       std::snprintf(line, sizeof line, "%d %d %.17g %.10g %.17g %.17g 0\n", i + 1, plan.type[i],
-                    2.0 * a.r[i], 3.0 * plan.areal_density / (4.0 * a.r[i]), a.x[i], a.y[i]);
+                    2.0 * a.r[i], plan.areal_density, a.x[i], a.y[i]);
       d << line;
     }
     out.files[o.data_name] = d.str();
@@ -398,17 +575,26 @@ ExportResult liggghts(const SceneConfig& c, const AlgorithmSpec& p, const Assemb
 
   std::ostringstream s;
   s << mapping_header(c, p, plan, o, "LIGGGHTS");
-  s << "#\n# NOT RUN HERE: LIGGGHTS is not installed on the machine that wrote this deck;\n"
-    << "# it follows the LIGGGHTS-PUBLIC 3.x documentation. Differences from demcal:\n"
+  s << "#\n# Checked with LIGGGHTS 3.8 (Debian): on a 25-disc sample its peak is within\n"
+    << "# 1 % of demcal's (a test, where liggghts is installed; reports/engines.md).\n"
+    << "# Servo: LIGGGHTS moves the mesh at vel_max * kp * (F_target - F)/|F_target|;\n"
+    << "# vel_max = cap/dt and kp = gain*F_target/(kn_wall*n_c*cap), n_c the wall\n"
+    << "# contacts at the start (" << n_contacts << "), give demcal's per-step move\n"
+    << "# gain*(F_target - F)/(kn_wall*n_c).\n"
+    << "# Run it with a screen (liggghts 3.8 crashes reading meshes with -screen none).\n"
+    << "# Differences from demcal:\n"
     << "#  - LIGGGHTS has no disc inertia: particles rotate as spheres (I = 2/5 m r^2,\n"
-    << "#    not 1/2 m r^2); masses are made disc masses through a per-atom density.\n"
+    << "#    not 1/2 m r^2); masses are disc masses (2D: pi r^2 * areal density).\n"
     << "#    The rotational stability limit of alpha moves by sqrt(0.8) = 0.89.\n"
     << "#  - rotational damping (zeta_r = " << num(p.damping_ratio_rotation)
     << ") has no fix here and is not applied.\n"
     << "#  - lateral walls: fix mesh/surface/stress/servo holds the wall FORCE at\n"
-    << "#    sigma3*H0*t (H0 the initial height), not the stress on the current height.\n"
+    << "#    sigma3*H0*t (H0 the initial height), not the stress on the current height;\n"
+    << "#    the target is the force on the mesh along +x: positive on the left wall.\n"
     << "#  - translational damping per radius class via fix viscous ... scale.\n";
-  out.notes.push_back("LIGGGHTS deck not run here (LIGGGHTS not installed)");
+  out.notes.push_back(
+      "LIGGGHTS deck: lateral force held at sigma3*H0*t (not on the current height); discs "
+      "rotate as spheres");
   s << "\natom_style      granular\n"
     << "atom_modify     map array\n"
     << "boundary        f f p\n"
@@ -434,22 +620,21 @@ ExportResult liggghts(const SceneConfig& c, const AlgorithmSpec& p, const Assemb
        "tangential_damping off\n"
     << "pair_coeff * *\n"
     << "timestep " << num(plan.dt) << "\n\n"
-    << "fix bottom all wall/gran model hooke/stiffness tangential history absolute_damping on "
-       "tangential_damping off primitive type "
-    << wall_type << " yplane " << num(a.bottom) << "\n"
-    << "fix mtop all mesh/surface file " << top << " type " << wall_type << "\n"
+    << "fix bottom all wall/gran model hooke/stiffness tangential history primitive type "
+    << wall_type << " yplane " << num(a.bottom) << " absolute_damping on tangential_damping off\n"
+    << "fix mtop all mesh/surface/stress file " << top << " type " << wall_type << "\n"
     << "fix mleft all mesh/surface/stress/servo file " << left << " type " << wall_type << " com "
     << num(a.left) << " " << num(0.5 * (a.bottom + a.top))
     << " 0 ctrlPV force axis 1 0 0 target_val "
-    << num(-c.test.lateral_stress * plan.height0 * m.thickness) << " vel_max "
-    << num(0.02 * plan.r_min / plan.dt) << " kp 1.0\n"
+    << num(c.test.lateral_stress * plan.height0 * m.thickness) << " vel_max "
+    << num(0.02 * plan.r_min / plan.dt) << " kp " << num(kp) << "\n"
     << "fix mright all mesh/surface/stress/servo file " << right << " type " << wall_type << " com "
     << num(a.right) << " " << num(0.5 * (a.bottom + a.top))
     << " 0 ctrlPV force axis 1 0 0 target_val "
-    << num(c.test.lateral_stress * plan.height0 * m.thickness) << " vel_max "
-    << num(0.02 * plan.r_min / plan.dt) << " kp 1.0\n"
-    << "fix walls all wall/gran model hooke/stiffness tangential history absolute_damping on "
-       "tangential_damping off mesh n_meshes 3 meshes mtop mleft mright\n"
+    << num(-c.test.lateral_stress * plan.height0 * m.thickness) << " vel_max "
+    << num(0.02 * plan.r_min / plan.dt) << " kp " << num(kp) << "\n"
+    << "fix walls all wall/gran model hooke/stiffness tangential history mesh n_meshes 3 meshes "
+       "mtop mleft mright absolute_damping on tangential_damping off\n"
     << "fix movetop all move/mesh mesh mtop linear 0 " << num(-plan.top_speed) << " 0\n\n"
     << "fix integrate all nve/sphere\n";
   if (p.damping_ratio_translation > 0.0) {
@@ -459,9 +644,16 @@ ExportResult liggghts(const SceneConfig& c, const AlgorithmSpec& p, const Assemb
     s << "\n";
   }
   s << "fix twod all enforce2d\n\n"
-    << "thermo_style custom step dt time ke\n"
+    << "# p_top: axial stress on the top wall; p_left, p_right: lateral (Pa)\n"
+    << "variable xl equal f_mleft[7]\n"
+    << "variable xr equal f_mright[7]\n"
+    << "variable p_top equal f_mtop[2]/((v_xr-v_xl)*" << num(m.thickness) << ")\n"
+    << "variable p_left equal -f_mleft[1]/(" << num(plan.height0 * m.thickness) << ")\n"
+    << "variable p_right equal f_mright[1]/(" << num(plan.height0 * m.thickness) << ")\n"
+    << "thermo_style custom step dt time ke v_p_top v_p_left v_p_right v_xl v_xr\n"
     << "thermo " << plan.thermo_every << "\n"
-    << "run " << plan.steps << "\n";
+    << "variable run_steps index " << plan.steps << "\n"
+    << "run ${run_steps}\n";
   out.deck = s.str();
   return out;
 }

@@ -6,14 +6,19 @@
 //              (set density/disc, fix nve/sphere disc), pair_style
 //              gran/hooke/history kn kt 0 0 μ 0, global viscous damping on
 //              translation per radius class (fix viscous ... scale), walls
-//              as fix wall/gran and wall/gran/region (the top wall a region
-//              moving at the loading speed, the lateral walls regions moved
-//              by a servo built from variables: the same per-step law as
-//              demcal's), run length Nstep.
-//   liggghts — LIGGGHTS-PUBLIC 3.x (not installed here, written from its
-//              documentation): gran model hooke/stiffness with absolute
-//              damping off, per-atom-type-pair kn/kt, mesh walls with a
-//              servo (fix mesh/surface/stress/servo) on the lateral walls.
+//              as fix wall/gran and wall/gran/region on bands of particles
+//              (the top wall a region moving at the loading speed, the
+//              lateral walls regions moved by demcal's per-step servo law,
+//              one flat formula each), run length Nstep. Every derived
+//              quantity is computed by LAMMPS from the parameters block; the
+//              run can be split (write_restart and an args file); the deck
+//              writes series.csv, which `demcal score` reads
+//              (demcal/scoring/external_series.hpp).
+//   liggghts — LIGGGHTS-PUBLIC 3.x (checked with 3.8): gran model
+//              hooke/stiffness with absolute damping off, per-atom-type-pair
+//              kn/kt, mesh walls with a servo (fix
+//              mesh/surface/stress/servo, gain from demcal's servo law) on
+//              the lateral walls.
 //
 // Every mapping, and every place where the other code cannot do exactly
 // what demcal does, is written as comments into the deck itself.

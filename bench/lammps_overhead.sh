@@ -1,0 +1,54 @@
+#!/usr/bin/env bash
+# Cost of the exported LAMMPS deck over a bare granular step, serial and
+# under MPI (issue #16). For each prototype size N:
+#   deck  = `demcal export` of PARAMS for N particles, run for STEPS steps;
+#   bare  = the same data file, pair style, nve/sphere disc, viscous damping
+#           and enforce2d, with the four walls as static `fix wall/gran`
+#           planes (the least a biaxial test needs; no servo, no output).
+# Prints LAMMPS' "Loop time", the Pair and Modify shares and the process
+# CPU time, and the load average (the machine may be shared: compare CPU
+# times and shares, and rerun on a quiet machine).
+#
+#   bench/lammps_overhead.sh PARAMS.json [BUILD_DIR]
+# Environment: SIZES="400 20000" STEPS=5000 NP="1 2" KEEP=dir
+#   EXPORT_FLAGS="--no-consolidate" (the generated packing as it is: no
+#   minutes of consolidation before a timing)
+# Installs nothing; needs lmp (and mpirun for NP > 1).
+set -euo pipefail
+params="${1:?usage: bench/lammps_overhead.sh PARAMS.json [BUILD_DIR]}"
+build="${2:-$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)/build}"
+SIZES="${SIZES:-400 20000}"
+STEPS="${STEPS:-5000}"
+NP="${NP:-1 2}"
+command -v lmp >/dev/null || { echo "lmp (LAMMPS) not found: apt-get install lammps"; exit 0; }
+params="$(realpath "$params")"
+if [[ -n "${KEEP:-}" ]]; then work="$KEEP"; mkdir -p "$work"; else
+  work="$(mktemp -d)"; trap 'rm -rf "$work"' EXIT; fi
+here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
+echo "# $(lmp -h | grep -m1 'Large-scale' | sed 's/^ *//'); $(nproc) cores; start $(date -u +%FT%TZ)"
+for n in $SIZES; do
+  d="$work/n$n"; mkdir -p "$d"
+  "$build/demcal" export "$params" --particles "$n" ${EXPORT_FLAGS:-} -o "$d/deck.lammps" >/dev/null 2>&1
+  # the deck's own numbers, for the bare run
+  get() { sed -n "s/^variable $1 *equal \([^ ]*\).*/\1/p" "$d/deck.lammps" | head -1; }
+  gamma=$(sed -n 's/^fix *dampt all viscous \([^ ]*\).*/\1/p' "$d/deck.lammps")
+  dens=$(sed -n 's/^set .*density\/disc \([^ ]*\)/\1/p' "$d/deck.lammps")
+  skin=$(sed -n 's/^neighbor *\([^ ]*\) bin/\1/p' "$d/deck.lammps")
+  sed -e "s/@DT@/$(get dt)/; s/@KN@/$(get kn)/; s/@KT@/$(get kt)/; s/@MU@/$(get mu)/" \
+      -e "s/@KW@/$(get kn_wall)/; s/@KTW@/$(get kt_wall)/; s/@XL@/$(get xl0)/; s/@XR@/$(get xr0)/; s/@YB@/$(get yb0)/" \
+      -e "s/@YT@/$(get yt0)/; s/@GAMMA@/${gamma:-0}/; s/@DENS@/$dens/; s/@SKIN@/$skin/" \
+      "$here/lammps/in.bare" > "$d/bare.lammps"
+  for np in $NP; do
+    for kind in bare deck; do
+      launch=(lmp); [[ "$np" -gt 1 ]] && launch=(mpirun --allow-run-as-root --oversubscribe -np "$np" lmp)
+      load=$(cut -d' ' -f1 /proc/loadavg)
+      cpu=$( { cd "$d" && /usr/bin/time -f "%U %S" "${launch[@]}" -in "$kind.lammps" \
+               -var run_steps "$STEPS" -log "log.$kind.$np" -screen none >/dev/null; } 2>&1 | tail -1)
+      if grep -q "^ERROR" "$d/log.$kind.$np"; then grep -m1 "^ERROR" "$d/log.$kind.$np"; exit 1; fi
+      loop=$(sed -n 's/^Loop time of \([^ ]*\).*/\1/p' "$d/log.$kind.$np")
+      pair=$(awk '/^Pair /{print $(NF)}' "$d/log.$kind.$np")
+      modify=$(awk '/^Modify /{print $(NF)}' "$d/log.$kind.$np")
+      echo "N=$n np=$np $kind: loop ${loop} s, cpu(user sys) ${cpu} s, Pair ${pair} %, Modify ${modify} %, load ${load}"
+    done
+  done
+done

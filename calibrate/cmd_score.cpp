@@ -1,0 +1,66 @@
+// `demcal score FILE [--lateral-stress PA] [-o DIR]`: the criteria, verdict
+// and diagnosis of a monitoring series written by another engine (the
+// exported LAMMPS deck's series.csv, or any code writing the documented
+// CSV), as `demcal run` prints them for its own runs; DIR/summary.json.
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+
+#include "commands.hpp"
+#include "demcal/scoring/external_series.hpp"
+#include "output_folder.hpp"
+
+namespace demcal::cli {
+
+int cmd_score(const ScoreOptions& o) {
+  namespace fs = std::filesystem;
+  if (fs::is_directory(o.file)) throw InputError(o.file, "", "is a folder, not a file");
+  std::ifstream in(o.file, std::ios::binary);
+  if (!in) throw InputError(o.file, "", "cannot open file");
+  std::ostringstream text;
+  text << in.rdbuf();
+  std::optional<double> s3;
+  if (o.lateral_stress > 0.0) s3 = o.lateral_stress;
+  const ExternalSeries series = parse_external_series(text.str(), o.file, s3);
+  const std::string dir =
+      o.out_dir.empty() ? "demcal-score-" + fs::path(o.file).stem().string() : o.out_dir;
+  OutputFolder::check(dir);
+  const Tolerances tolerances;
+  std::optional<double> reference;
+  if (o.reference_peak != 0.0) reference = -std::abs(o.reference_peak);
+  const ExternalScore scored = score_external(series, tolerances, reference);
+  {
+    OutputFolder out(dir);
+    out.write("summary.json", external_summary(series, scored, tolerances).dump(2) + "\n");
+    out.commit();
+  }
+  const Score& score = scored.score;
+  const auto& c = score.criteria;
+  const double sigma3 = series.lateral_stress;
+  std::cout << std::setprecision(4) << "series " << o.file << ": " << series.run.series.size()
+            << " monitoring points, " << series.run.steps_run << " steps"
+            << (score.complete ? "" : " (incomplete)") << "\n"
+            << "  peak sigma_yy " << c.peak_stress_yy << " Pa at strain " << c.peak_strain_yy
+            << " (sigma1/sigma3 " << -c.peak_stress_yy / sigma3 << ")\n"
+            << "  force balance " << c.force_balance << " (tol " << tolerances.force_balance
+            << "; paper form " << c.force_balance_paper << "), moment balance " << c.moment_balance
+            << " (tol " << tolerances.moment_balance << "), servo " << c.servo << " (tol "
+            << tolerances.servo << "), oscillation " << c.oscillation << " (tol "
+            << tolerances.oscillation << ")\n";
+  if (series.torque_column)
+    std::cout << "  moment balance measured on the engine's net torques; lever-arm floor of "
+                 "s_xy - s_yx (not counted): RMS "
+              << scored.lever_arm_floor_rms << ", max " << scored.lever_arm_floor_max << "\n";
+  if (c.peak_error)
+    std::cout << "  peak error against " << -std::abs(o.reference_peak)
+              << " Pa: " << 100.0 * *c.peak_error << " %\n";
+  std::cout << "  " << (score.passed ? "PASS" : "FAIL") << ": " << score.diagnosis.message << "\n";
+  if (series.run.diverged)
+    std::cout << "  DIVERGED: non-finite values from step " << series.run.divergence_step << "\n";
+  std::cout << "  wrote " << dir << "/summary.json\n";
+  return score.passed ? 0 : 1;
+}
+
+}  // namespace demcal::cli

@@ -1,0 +1,68 @@
+// A monitoring series written by another engine (the LAMMPS deck of
+// `demcal export`, or any code that writes the documented CSV), scored with
+// the criteria demcal applies to its own runs.
+//
+// The file (README "Scoring another engine's run"): comment lines start
+// with '#'; a comment "# key = value" is metadata (lateral_stress [Pa],
+// steps, dt, dt_crit [s], particles, damping_ratio_translation,
+// damping_ratio_rotation, mass_scaling, moment_lever_arm); the first other
+// line names the columns, comma-separated; every further line is one
+// monitoring point, tension positive, SI units. Columns are found by name,
+// in any order: required step, strain_yy, b_xx, b_xy, b_yx, b_yy, s_xx,
+// s_xy, s_yx, s_yy; optional kinetic_energy, kinetic_energy_rotation,
+// elastic_energy, unbalanced_force_ratio, inertial_number,
+// coordination_number, lateral_stress_error (else from p_left and p_right),
+// wall_left, wall_right, wall_bottom, wall_top, torque_stress. demcal's own
+// series.csv is such a file.
+//
+// Moment balance. In demcal V(σxy − σyx) = Σ_p T_p, the particles' net
+// contact torques, exactly. An engine that applies a contact's tangential
+// force at the lever arm r_i instead of r_i − δ/2 (LAMMPS) adds a static
+// term −Σ_c δ_c f_t,c / V to σxy − σyx that vanishes with no choice of
+// algorithmic parameter. When the file has torque_stress (Σ_p T_p / V), the
+// moment-balance criterion is measured on it — rotational equilibrium in
+// the engine's own model, the same quantity as demcal's — and the
+// remainder ((σxy − σyx) − torque_stress)/σ3 is reported as the lever-arm
+// floor. Without that column σxy − σyx is used as it is.
+#pragma once
+
+#include <map>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+
+#include "demcal/scoring/scoring.hpp"
+
+namespace demcal {
+
+struct ExternalSeries {
+  std::string source;                       ///< the file, for messages
+  std::map<std::string, std::string> meta;  ///< "# key = value" lines
+  LoadingResult run;                        ///< series and what is known of the run
+  double lateral_stress = 0.0;              ///< σ3 [Pa]
+  bool torque_column = false;               ///< torque_stress was given
+  /// Per monitoring point: ((σxy − σyx) − torque_stress)/σ3 (empty without
+  /// torque_stress).
+  std::vector<double> lever_arm_floor;
+};
+
+/// Parse `text` (the content of `source`). `lateral_stress` overrides the
+/// file's. Throws InputError naming the file and the line or column.
+ExternalSeries parse_external_series(const std::string& text, const std::string& source,
+                                     std::optional<double> lateral_stress = std::nullopt);
+
+struct ExternalScore {
+  Score score;
+  double lever_arm_floor_rms = 0.0;  ///< RMS of ExternalSeries::lever_arm_floor
+  double lever_arm_floor_max = 0.0;  ///< largest |value|
+};
+
+/// The criteria, verdict and diagnosis of the series (score_run()).
+ExternalScore score_external(const ExternalSeries& series, const Tolerances& tolerances,
+                             std::optional<double> reference_peak = std::nullopt);
+
+/// summary.json of `demcal score`.
+nlohmann::json external_summary(const ExternalSeries& series, const ExternalScore& score,
+                                const Tolerances& tolerances);
+
+}  // namespace demcal
