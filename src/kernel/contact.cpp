@@ -25,6 +25,7 @@
 #include <cstring>
 #include <string_view>
 
+#include "contact_law.hpp"
 #include "demcal/kernel/world.hpp"
 
 #if defined(__x86_64__) && defined(__GNUC__)
@@ -37,11 +38,6 @@ namespace demcal {
 namespace {
 
 constexpr int kBlock = 8;
-
-struct WallGeometry {
-  double nx, ny;  // inward unit normal
-};
-constexpr WallGeometry kWallGeometry[4] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}};
 
 // ---------------------------------------------------------------- SIMD
 
@@ -123,12 +119,15 @@ struct PairArgs {
   const double *__restrict x, *__restrict y, *__restrict vx, *__restrict vy, *__restrict om;
   const double *__restrict r, *__restrict inv_r, *__restrict m;
   double *__restrict fx, *__restrict fy, *__restrict tq;
-  double kn, kdt, mu, beta2;  // beta2 = 2·contact damping ratio
+  double *__restrict block_power;  // per block: power of the contact dashpots (damped pass)
+  double kn, kdt, mu, beta2;       // beta2 = 2·contact damping ratio
 };
 
 // Forces of blocks [b0, b1): each particle's sum over its own slots, written
 // (not added) to fx, fy, tq. Returns the largest overlap/r_own, which over
-// both copies of a pair is overlap/min(r_i, r_j).
+// both copies of a pair is overlap/min(r_i, r_j). The damped pass also
+// writes each block's dashpot power, Σ (fe − fn)·v_n over its slots (every
+// pair counted from both sides), for the energy ledger.
 template <int W, bool kDamped>
 DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
   using D = typename Simd<W>::D;
@@ -137,6 +136,7 @@ DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
   const double kn = a.kn, kdt = a.kdt, mu = a.mu;
   for (int b = b0; b < b1; ++b) {
     const int s0 = a.block_slot[b], s1 = a.block_slot[b + 1];
+    D power = zero;
     for (int sub = 0; sub < kBlock; sub += W) {
       const int i0 = kBlock * b + sub;
       const D xi = load<W>(a.x + i0), yi = load<W>(a.y + i0);
@@ -159,22 +159,20 @@ DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
         const D ai = ri - 0.5 * ov, aj = rj - 0.5 * ov;
         const D omj = gather<W>(a.om, J);
         const D dvx = gather<W>(a.vx, J) - vxi, dvy = gather<W>(a.vy, J) - vyi;
-        D fn = kn * ov;
+        D fn = law::elastic_normal_force(kn, ov);
         if constexpr (kDamped) {
-          const D mj = gather<W>(a.m, J);
-          const D meff = mi * mj / (mi + mj);
+          const D meff = law::reduced_mass(mi, gather<W>(a.m, J));
           const D vn = dvx * nx + dvy * ny;  // > 0 when separating
-          fn = fn - a.beta2 * vsqrt(kn * meff) * vn;
-          fn = fn > zero ? fn : zero;
+          const D fe = fn;
+          fn = law::damped_normal_force(fe, a.beta2, vsqrt(kn * meff), vn);
+          power += select<W>(touch, law::dashpot_power(fe, fn, vn), zero);
         }
         fn = select<W>(touch, fn, zero);
         // Tangential velocity of j's contact point relative to i's, along t.
         const D rot = 0.5 * ((omi + omj) * (ai + aj) + (omi - omj) * (ai - aj));
         const D vt = (dvy * nx - dvx * ny) - rot;
         const D cap = mu * fn;
-        D t = load<W>(a.slot_ft + s) + kdt * vt;
-        t = t < -cap ? -cap : t;
-        t = t > cap ? cap : t;
+        D t = law::coulomb_clamp(load<W>(a.slot_ft + s) + kdt * vt, cap);
         t = select<W>(touch, t, zero);
         store<W>(a.slot_ft + s, t);
         // Force on i: −fn·n + ft·t.
@@ -187,6 +185,11 @@ DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
       store<W>(a.fx + i0, fx);
       store<W>(a.fy + i0, fy);
       store<W>(a.tq + i0, tq);
+    }
+    if constexpr (kDamped) {
+      double sum = 0.0;
+      for (int l = 0; l < W; ++l) sum += power[l];
+      a.block_power[b] = sum;
     }
   }
   return hmax<W>(mo);
@@ -309,6 +312,7 @@ double World::pair_pass(int b0, int b1) {
                    fx_.data(),
                    fy_.data(),
                    tq_.data(),
+                   block_power_.data(),
                    material_.particle.kn,
                    material_.particle.kt * integration_.dt,
                    material_.particle.friction,
@@ -339,13 +343,13 @@ World::PairState World::pair_state(int i, int j) const {
   p.ny = dy * inv;
   p.overlap = rs - d;
   const double kn = material_.particle.kn;
-  double fn = kn * p.overlap;
+  p.vn = (vx_[j] - vx_[i]) * p.nx + (vy_[j] - vy_[i]) * p.ny;
+  const double fe = law::elastic_normal_force(kn, p.overlap);
+  double fn = fe;
   const double beta2 = 2.0 * material_.contact_damping_ratio;
-  if (beta2 > 0.0) {
-    const double meff = m_[i] * m_[j] / (m_[i] + m_[j]);
-    const double vn = (vx_[j] - vx_[i]) * p.nx + (vy_[j] - vy_[i]) * p.ny;
-    fn = std::max(0.0, fn - beta2 * std::sqrt(kn * meff) * vn);
-  }
+  if (beta2 > 0.0)
+    fn = law::damped_normal_force(fe, beta2, std::sqrt(kn * law::reduced_mass(m_[i], m_[j])), p.vn);
+  p.fn_elastic = p.touching ? fe : 0.0;
   p.fn = p.touching ? fn : 0.0;
   return p;
 }
@@ -354,13 +358,14 @@ void World::wall_pass() {
   // Walls. Contact point on the wall line; lever arm = distance to the wall.
   // Added to the pair forces, after them, wall by wall.
   const double dt = integration_.dt;
-  const double beta = material_.contact_damping_ratio;
+  const double beta2 = 2.0 * material_.contact_damping_ratio;
   const double kw = material_.wall.kn, ktw = material_.wall.kt, muw = material_.wall.friction;
   double max_overlap = 0.0;
+  double power = 0.0;  // of the wall dashpots
   for (int s = 0; s < 4; ++s) {
     Wall &wall = walls_[s];
-    const auto g = kWallGeometry[s];
-    const double tx = -g.ny, ty = g.nx;
+    const double gx = law::kWallNormal[s][0], gy = law::kWallNormal[s][1];
+    const double tx = -gy, ty = gx;
     const bool vertical = (s == kLeft || s == kRight);
     const double wvx = vertical ? wall.velocity : 0.0, wvy = vertical ? 0.0 : wall.velocity;
     double wfx = 0.0, wfy = 0.0;
@@ -369,8 +374,7 @@ void World::wall_pass() {
     double *hist_fn = wall_fn_[s].data();
     for (int i : wall_candidates_[s]) {
       // Signed distance from the wall line to the centre, along the inward normal.
-      const double dist =
-          vertical ? (x_[i] - wall.position) * g.nx : (y_[i] - wall.position) * g.ny;
+      const double dist = vertical ? (x_[i] - wall.position) * gx : (y_[i] - wall.position) * gy;
       const double overlap = r_[i] - dist;
       if (overlap <= 0.0) {
         hist[i] = 0.0;
@@ -379,20 +383,23 @@ void World::wall_pass() {
       }
       ++count;
       max_overlap = std::max(max_overlap, overlap / r_[i]);
-      double fn = kw * overlap;
+      // The wall as a partner of infinite mass: m_eff = m_i.
+      const double fe = law::elastic_normal_force(kw, overlap);
+      double fn = fe;
       const double dvx = wvx - vx_[i], dvy = wvy - vy_[i];  // wall relative to particle
-      if (beta > 0.0) {
-        const double vn = -(dvx * g.nx + dvy * g.ny);  // particle leaving the wall > 0
-        fn = std::max(0.0, fn - beta * 2.0 * std::sqrt(kw * m_[i]) * vn);
+      if (beta2 > 0.0) {
+        const double vn = -(dvx * gx + dvy * gy);  // particle leaving the wall > 0
+        fn = law::damped_normal_force(fe, beta2, std::sqrt(kw * m_[i]), vn);
+        power += law::dashpot_power(fe, fn, vn);
       }
       // Particle contact point moves with v − ω·dist·t (arm = −dist·n).
       const double vt = dvx * tx + dvy * ty + omega_[i] * dist;
       double ft = hist[i] + ktw * vt * dt;
       const double cap = muw * fn;
-      ft = std::clamp(ft, -cap, cap);
+      ft = law::coulomb_clamp(ft, cap);
       hist[i] = ft;
       hist_fn[i] = fn;
-      const double fxi = fn * g.nx + ft * tx, fyi = fn * g.ny + ft * ty;
+      const double fxi = fn * gx + ft * tx, fyi = fn * gy + ft * ty;
       fx_[i] += fxi;
       fy_[i] += fyi;
       tq_[i] += -dist * ft;
@@ -403,11 +410,20 @@ void World::wall_pass() {
     wall.contacts = count;
   }
   max_overlap_ratio_seen_ = std::max(max_overlap_ratio_seen_, max_overlap);
+  wall_dashpot_power_ = power;
 }
 
 void World::compute_forces() {
   max_overlap_ratio_seen_ = run_pair_pass();
   wall_pass();
+}
+
+double World::dashpot_power() const {
+  if (!(material_.contact_damping_ratio > 0.0)) return 0.0;
+  // Block by block in a fixed order: the same sum for any thread count.
+  double pairs = 0.0;
+  for (int b = 0; b < nblocks_; ++b) pairs += block_power_[b];
+  return 0.5 * pairs + wall_dashpot_power_;  // each pair was counted from both sides
 }
 
 }  // namespace demcal

@@ -13,7 +13,6 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
-#include <numbers>
 #include <optional>
 #include <stdexcept>
 #include <thread>
@@ -163,6 +162,7 @@ World::World(const Material& material, std::span<const double> x, std::span<cons
   for (auto& h : wall_ft_) h.assign(n, 0.0);
   for (auto& h : wall_fn_) h.assign(n, 0.0);
   block_slot_.assign(static_cast<size_t>(nblocks_) + 1, 0);
+  block_power_.assign(static_cast<size_t>(nblocks_) + 1, 0.0);
   r_min_ = n ? *std::min_element(radius.begin(), radius.end()) : 1.0;
   r_max_ = n ? *std::max_element(radius.begin(), radius.end()) : 1.0;
   skin_ = options_.skin_ratio * r_min_;
@@ -250,10 +250,10 @@ void World::set_integration(const Integration& integration) {
   // otherwise keep loading the tangential springs through the contact-point
   // velocity while θ stays frozen.
   if (integration_.lock_rotation) std::fill(omega_.begin(), omega_.end(), 0.0);
-  const double rho_t = material_.density * material_.thickness * integration_.mass_scaling;
+  const double areal_density = disk_areal_density(material_, integration_.mass_scaling);
   for (int i = 0; i < size(); ++i) {
-    m_[i] = rho_t * std::numbers::pi * r_[i] * r_[i];
-    inertia_[i] = 0.5 * m_[i] * r_[i] * r_[i];
+    m_[i] = disk_mass(areal_density, r_[i]);
+    inertia_[i] = disk_inertia(m_[i], r_[i]);
   }
   update_damping_coefficients();
 }
@@ -262,12 +262,13 @@ void World::update_damping_coefficients() {
   const double dt = integration_.dt;
   const double kn = material_.particle.kn, kt = material_.particle.kt;
   for (int i = 0; i < size(); ++i) {
-    const double dtc = integration_.damping_ratio_translation * 2.0 * std::sqrt(kn * m_[i]);
+    const double dtc =
+        integration_.damping_ratio_translation * critical_damping_translation(kn, m_[i]);
     const double c = dtc * dt / (2.0 * m_[i]);
     ca_t_[i] = (1.0 - c) / (1.0 + c);
     cb_t_[i] = dt / m_[i] / (1.0 + c);
     const double drc =
-        integration_.damping_ratio_rotation * 2.0 * std::sqrt(kt * r_[i] * r_[i] * inertia_[i]);
+        integration_.damping_ratio_rotation * critical_damping_rotation(kt, r_[i], inertia_[i]);
     const double cr = drc * dt / (2.0 * inertia_[i]);
     ca_r_[i] = (1.0 - cr) / (1.0 + cr);
     cb_r_[i] = dt / inertia_[i] / (1.0 + cr);
@@ -353,7 +354,11 @@ bool World::step(int64_t count) {
     initial_energy_ = m.kinetic_energy_translation + m.kinetic_energy_rotation + m.elastic_energy;
   }
   const int interval = std::max(1, options_.check_interval);
+  const bool dashpots = material_.contact_damping_ratio > 0.0;
   for (int64_t s = 0; s < count; ++s) {
+    // The contact dashpots' dissipation over this step, with the forces
+    // about to be applied (energy ledger).
+    if (dashpots && ledger_.started) ledger_.dashpot += integration_.dt * dashpot_power();
     integrate();
     if (!list_valid_) rebuild_neighbours();
     compute_forces();

@@ -13,35 +13,28 @@
 // The rotational mode of a frictional packing is the binding one: with six
 // contacts and kt = kn/2 the in-phase rotation needs α < 1/√12 ≈ 0.29,
 // Gershgorin says 0.20. The search uses the Lanczos value.
+//
+// Contact dashpots (Material::contact_damping_ratio ζ_c) are explicit: the
+// force at step n uses the velocity v(n−½). For one mode, m·ẍ = −k·x − c·ẋ
+// with 2ζω = c/m, the scheme is x(n+1) = (2 − 2ζωΔt − ω²Δt²)·x(n) −
+// (1 − 2ζωΔt)·x(n−1), whose roots stay in the unit circle iff
+// ω²Δt² + 4ζωΔt < 4, i.e. ωΔt < 2·(sqrt(1 + ζ²) − ζ). The dashpots damp
+// each contact in proportion to its stiffness, c_k = γ_k·k_k with
+// γ_k = 2ζ_c·sqrt(m_eff/kn), so a mode of frequency ω carries at most
+// ζ = γ_max·ω/2 (vᵀCv ≤ γ_max·vᵀKv): the estimate uses that bound. The
+// global damping is centred (solver.cpp) and does not shorten the step.
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
+#include "contact_law.hpp"
 #include "demcal/kernel/world.hpp"
 
 namespace demcal {
 
 ReferenceScales World::reference_scales() const {
-  ReferenceScales s;
-  const int n = size();
-  if (n == 0) return s;
-  int imin = 0;
-  for (int i = 1; i < n; ++i)
-    if (m_[i] < m_[imin]) imin = i;
-  const double kn = material_.particle.kn, kt = material_.particle.kt;
-  s.mass_min = m_[imin];
-  s.dt_crit = 2.0 * std::sqrt(m_[imin] / kn);
-  s.damping_translation_crit = 2.0 * std::sqrt(kn * m_[imin]);
-  s.damping_rotation_crit = 2.0 * std::sqrt(kt * r_[imin] * r_[imin] * inertia_[imin]);
-  double dt_sum = 0.0, dr_sum = 0.0;
-  for (int i = 0; i < n; ++i) {
-    dt_sum += 2.0 * std::sqrt(kn * m_[i]);
-    dr_sum += 2.0 * std::sqrt(kt * r_[i] * r_[i] * inertia_[i]);
-  }
-  s.damping_translation_crit_mean = dt_sum / n;
-  s.damping_rotation_crit_mean = dr_sum / n;
-  return s;
+  return particle_scales(radius(), material_, integration_.mass_scaling);
 }
 
 namespace {
@@ -186,20 +179,20 @@ StabilityEstimate World::stability_estimate(int iterations) const {
   for (size_t k = 0; k < pair_i_.size(); ++k) {
     const int i = pair_i_[k], j = pair_j_[k];
     const PairState p = pair_state(i, j);
-    if (p.fn <= 0.0) continue;
+    if (p.fn_elastic <= 0.0) continue;  // apart (a dashpot's fn = 0 is still a contact)
     contacts.push_back(
         {i, j, p.nx, p.ny, r_[i] - 0.5 * p.overlap, r_[j] - 0.5 * p.overlap, kn, kt});
   }
-  constexpr double kNormals[4][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}};
   const double kw = material_.wall.kn;
   const double ktw = material_.wall.friction > 0.0 ? material_.wall.kt : 0.0;
   for (int s = 0; s < 4; ++s) {
     for (int i : wall_candidates_[s]) {
-      if (wall_fn_[s][i] <= 0.0) continue;
       const bool vertical = (s == kLeft || s == kRight);
-      const double dist = vertical ? (x_[i] - walls_[s].position) * kNormals[s][0]
-                                   : (y_[i] - walls_[s].position) * kNormals[s][1];
-      contacts.push_back({i, -1, kNormals[s][0], kNormals[s][1], dist, 0.0, kw, ktw});
+      const double dist = vertical ? (x_[i] - walls_[s].position) * law::kWallNormal[s][0]
+                                   : (y_[i] - walls_[s].position) * law::kWallNormal[s][1];
+      if (law::elastic_normal_force(kw, r_[i] - dist) <= 0.0) continue;
+      contacts.push_back(
+          {i, -1, law::kWallNormal[s][0], law::kWallNormal[s][1], dist, 0.0, kw, ktw});
     }
   }
   std::vector<double> ism(n), isi(n);
@@ -244,9 +237,21 @@ StabilityEstimate World::stability_estimate(int iterations) const {
   const double omega2_translation = lanczos_max(contacts, ism, isi, false, iterations);
 
   const double dt_crit = reference_scales().dt_crit;
+  // γ_max of the contact dashpots (0 without them), see the file comment.
+  double gamma = 0.0;
+  if (const double zeta_c = material_.contact_damping_ratio; zeta_c > 0.0) {
+    for (const auto& c : contacts) {
+      const double m_eff = c.j >= 0 ? law::reduced_mass(m_[c.i], m_[c.j]) : m_[c.i];
+      gamma = std::max(gamma, 2.0 * zeta_c * std::sqrt(m_eff / c.kn));
+    }
+  }
   // No contact: no limit from the springs.
-  auto step_for = [](double w2) {
-    return w2 > 0.0 ? 2.0 / std::sqrt(w2) : std::numeric_limits<double>::infinity();
+  auto step_for = [gamma](double w2) {
+    if (!(w2 > 0.0)) return std::numeric_limits<double>::infinity();
+    const double omega = std::sqrt(w2);
+    if (gamma == 0.0) return 2.0 / omega;
+    const double zeta = 0.5 * gamma * omega;
+    return 2.0 / omega * (std::sqrt(1.0 + zeta * zeta) - zeta);
   };
   est.dt_stable = step_for(est.omega2_max);
   est.dt_stable_gershgorin = step_for(est.omega2_gershgorin);

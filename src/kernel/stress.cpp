@@ -9,6 +9,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "contact_law.hpp"
 #include "demcal/kernel/world.hpp"
 
 namespace demcal {
@@ -36,6 +37,9 @@ Measures World::measure(double strain_rate) const {
     const double ft = slot_ft_[pair_slot_[k]];
     const PairState p = pair_state(i, j);
     const double fn = p.fn;
+    // The springs' energy, by the contact law: the elastic part of the
+    // normal force (with a dashpot, fn is not kn·δ).
+    elastic += law::spring_energy(p.fn_elastic, kn) + law::spring_energy(ft, kt);
     if (fn <= 0.0 && ft == 0.0) continue;
     const double nx = p.nx, ny = p.ny;
     const Eigen::Vector2d f(-fn * nx - ft * ny, -fn * ny + ft * nx);  // on i
@@ -44,21 +48,23 @@ Measures World::measure(double strain_rate) const {
     sum_contact_force += f.norm();
     ++contact_count;
     ++out.particle_contacts;
-    elastic += 0.5 * fn * fn / kn + (kt > 0 ? 0.5 * ft * ft / kt : 0.0);
   }
 
   // Wall contacts, re-evaluated from the stored history (the force on each
   // particle exactly as the last compute_forces() applied it).
-  constexpr double kNormals[4][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}};
   const double kw = material_.wall.kn, ktw = material_.wall.kt;
   for (int s = 0; s < 4; ++s) {
-    const double gnx = kNormals[s][0], gny = kNormals[s][1];
+    const double gnx = law::kWallNormal[s][0], gny = law::kWallNormal[s][1];
     const bool vertical = (s == kLeft || s == kRight);
     for (int i : wall_candidates_[s]) {
       const double dist =
           vertical ? (x_[i] - walls_[s].position) * gnx : (y_[i] - walls_[s].position) * gny;
       const double fn = wall_fn_[s][i];
       const double ft = wall_ft_[s][i];
+      const double overlap = r_[i] - dist;
+      if (overlap > 0.0)
+        elastic += law::spring_energy(law::elastic_normal_force(kw, overlap), kw) +
+                   law::spring_energy(ft, ktw);
       if (fn <= 0.0 && ft == 0.0) continue;
       const Eigen::Vector2d f(fn * gnx - ft * gny, fn * gny + ft * gnx);
       const Eigen::Vector2d xc(x_[i] - dist * gnx, y_[i] - dist * gny);
@@ -68,7 +74,6 @@ Measures World::measure(double strain_rate) const {
       sum_contact_force += f.norm();
       ++contact_count;
       ++out.wall_contacts;
-      elastic += 0.5 * fn * fn / kw + (ktw > 0 ? 0.5 * ft * ft / ktw : 0.0);
     }
   }
   out.homogenized_stress = sigma / volume;

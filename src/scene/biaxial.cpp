@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <numbers>
 #include <stdexcept>
 
 namespace demcal {
@@ -42,13 +41,12 @@ double servo_velocity(const World& world, WallSide side, double target_stress, d
 
 Integration integration_for(const World& world, const AlgorithmSpec& algorithm) {
   // Δt_crit = 2·sqrt(m_min/kn) with the mass scaling of this run.
-  const double r_min = world.min_radius();
   const Material& mat = world.material();
   const double m_min =
-      mat.density * mat.thickness * std::numbers::pi * r_min * r_min * algorithm.mass_scaling;
+      disk_mass(disk_areal_density(mat, algorithm.mass_scaling), world.min_radius());
   Integration in;
   in.mass_scaling = algorithm.mass_scaling;
-  in.dt = algorithm.dt_ratio * 2.0 * std::sqrt(m_min / mat.particle.kn);
+  in.dt = algorithm.dt_ratio * critical_time_step(m_min, mat.particle.kn);
   in.damping_ratio_translation = algorithm.damping_ratio_translation;
   in.damping_ratio_rotation = algorithm.damping_ratio_rotation;
   in.lock_rotation = algorithm.lock_rotation;

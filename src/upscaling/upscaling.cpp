@@ -4,44 +4,12 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <numbers>
 #include <numeric>
 #include <sstream>
 
 #include "demcal/upscaling/rev.hpp"
 
 namespace demcal {
-
-ParticleScales particle_scales(std::span<const double> radii, const Material& material,
-                               double mass_scaling) {
-  ParticleScales s;
-  s.particles = static_cast<int64_t>(radii.size());
-  if (radii.empty()) return s;
-  const double kn = material.particle.kn, kt = material.particle.kt;
-  const double area_mass = mass_scaling * material.density * material.thickness * std::numbers::pi;
-  s.radius_min = *std::min_element(radii.begin(), radii.end());
-  s.radius_max = *std::max_element(radii.begin(), radii.end());
-  double sum_r = 0.0, sum_m = 0.0, sum_dt = 0.0, sum_dr = 0.0;
-  for (double r : radii) {
-    const double m = area_mass * r * r;
-    const double inertia = 0.5 * m * r * r;
-    sum_r += r;
-    sum_m += m;
-    sum_dt += 2.0 * std::sqrt(kn * m);
-    sum_dr += 2.0 * std::sqrt(kt * r * r * inertia);
-  }
-  const double n = static_cast<double>(radii.size());
-  s.radius_mean = sum_r / n;
-  s.mass_mean = sum_m / n;
-  s.mass_min = area_mass * s.radius_min * s.radius_min;
-  s.dt_crit = 2.0 * std::sqrt(s.mass_min / kn);
-  s.damping_translation_crit = 2.0 * std::sqrt(kn * s.mass_min);
-  s.damping_rotation_crit = 2.0 * std::sqrt(kt * s.radius_min * s.radius_min * 0.5 * s.mass_min *
-                                            s.radius_min * s.radius_min);
-  s.damping_translation_crit_mean = sum_dt / n;
-  s.damping_rotation_crit_mean = sum_dr / n;
-  return s;
-}
 
 std::string ScalingLaw::name() const {
   return std::abs(exponent - 1.0) < 1e-12 ? "linear" : "power";

@@ -1,5 +1,26 @@
+// How dimension enters: two kernels of the same shape, not one template.
+// This World is the 2D kernel (disks); a 3D kernel (spheres, SphereWorld)
+// sits beside it as its own class with the same coarse interface: build
+// from particles and walls, set_integration, step(n), measure() (boundary
+// and homogenized stress, energies, unbalanced force), wall(side),
+// reference_scales(), stability_estimate(). The layers above talk to a
+// sample only through these calls, so scene, scoring and search take the
+// kernel as a type parameter or through a thin adapter, and never see its
+// arrays. Why not one World<Dim>: what is costly and tuned is not
+// dimension-free — the contact law's tangential history is a scalar along
+// one tangent in 2D and a vector that must be rotated with the contact in
+// 3D, rotation is a scalar ω in 2D and a vector with a 3×3 inertia in 3D,
+// the SIMD pass, the ELLPACK layout and the wall set differ, and the
+// stability estimate's dofs per particle are 3 against 6. A template would
+// be if-constexpr on every page. What is truly dimension-free is small and
+// shared as free functions instead: the particle scales
+// (particle_scales.hpp, where a sphere's mass and inertia can sit beside
+// the disk's)
+// and the normal contact law (src/kernel/contact_law.hpp, templated on the
+// value type). This is the Box2D / Box3D split.
+//
 // The 2D DEM kernel: disks between four rigid walls, linear contacts, global
-// damping, central-difference integration (DESIGN.md §2).
+// damping, central-difference integration.
 //
 // Data-oriented in the manner of Box2D v3: particle state lives in flat
 // arrays, the broad phase (broad_phase.cpp), the contact law (contact.cpp),
@@ -31,27 +52,10 @@
 #include <string>
 #include <vector>
 
+#include "demcal/kernel/material.hpp"
+#include "demcal/kernel/particle_scales.hpp"
+
 namespace demcal {
-
-/// Linear spring contact law: normal force kn·δ, incremental tangential
-/// spring kt capped by Coulomb friction·|Fn|.
-struct ContactLaw {
-  double kn = 1e8;        ///< normal stiffness [N/m]
-  double kt = 5e7;        ///< tangential stiffness [N/m]
-  double friction = 0.3;  ///< Coulomb coefficient μ [-]
-};
-
-/// Material of the particles and the walls.
-struct Material {
-  double density = 2650.0;  ///< ρ [kg/m³]
-  double thickness = 1.0;   ///< disk = cylinder of thickness t [m]
-  ContactLaw particle{1e8, 5e7, 0.3};
-  ContactLaw wall{1e8, 5e7, 0.0};  ///< walls are frictionless by default
-  /// Local (contact) viscous damping on the normal force, as a ratio of the
-  /// critical value 2·sqrt(kn·m_eff). Off by default: the paper's damping is
-  /// global.
-  double contact_damping_ratio = 0.0;
-};
 
 /// The algorithmic parameters the kernel integrates with.
 struct Integration {
@@ -62,18 +66,6 @@ struct Integration {
   bool lock_rotation = false;              ///< diagnostic: ω ≡ 0 (spins are zeroed)
 };
 
-/// Reference scales of DESIGN.md §2 for the current assembly. Damping
-/// coefficients are per particle (every particle gets the same damping
-/// ratio); the values below are for the lightest particle and for the mean.
-struct ReferenceScales {
-  double dt_crit = 0.0;                   ///< 2·sqrt(m_min/kn) [s]
-  double damping_translation_crit = 0.0;  ///< 2·sqrt(kn·m) for m_min [N·s/m]
-  double damping_rotation_crit = 0.0;     ///< 2·sqrt(kt·r²·I) for m_min [N·m·s]
-  double damping_translation_crit_mean = 0.0;
-  double damping_rotation_crit_mean = 0.0;
-  double mass_min = 0.0;  ///< smallest (scaled) mass [kg]
-};
-
 /// Estimates of the largest stable step for the current contact network.
 struct StabilityEstimate {
   /// Largest angular frequency² of the linearised, undamped system
@@ -82,7 +74,9 @@ struct StabilityEstimate {
   double omega2_max = 0.0;
   /// Gershgorin bound on ω²_max (always ≥ omega2_max; a safe upper bound).
   double omega2_gershgorin = 0.0;
-  double dt_stable = 0.0;             ///< 2/ω_max [s]
+  /// 2/ω_max [s]; with contact dashpots 2/ω_max·(sqrt(1+ζ²) − ζ), ζ the
+  /// bound on the top mode's dashpot damping (stability.cpp).
+  double dt_stable = 0.0;
   double dt_stable_gershgorin = 0.0;  ///< 2/sqrt(Gershgorin bound) [s]
   double dt_ratio_stable = 0.0;       ///< dt_stable / dt_crit
   double dt_ratio_stable_gershgorin = 0.0;
@@ -321,7 +315,10 @@ class World {
   /// Geometry and normal force of the pair (i, j) in the current state,
   /// exactly as the contact law evaluates it (for measures and views).
   struct PairState {
-    double nx, ny, overlap, fn;
+    double nx, ny, overlap;
+    double vn;          // normal relative velocity, > 0 when opening
+    double fn;          // normal force, with the dashpot (0 when apart)
+    double fn_elastic;  // the spring's part kn·δ (0 when apart)
     bool touching;
   };
   PairState pair_state(int i, int j) const;
@@ -330,11 +327,19 @@ class World {
     double energy = 0.0;      // kinetic + elastic (pairs and walls) [J]
     double elastic = 0.0;     // elastic alone [J]
     double power_in = 0.0;    // work rate of the moving walls on the particles [W]
-    double power_lost = 0.0;  // global and contact damping [W] (not friction)
+    double power_lost = 0.0;  // global damping [W]
   };
   EnergySample energy_sample() const;
   bool ledger_due() const;                         // a ledger sample is due at this step
   bool ledger_record(const EnergySample& sample);  // true when diverged
+  // Power of the contact dashpots at the last force evaluation [W] (0
+  // without contact damping). The ledger integrates it step by step: it
+  // lives in the contact vibrations, which one sample in
+  // energy_check_interval steps would alias.
+  double dashpot_power() const;
+  // Work rate of the moving walls on the particles at the last force
+  // evaluation [W].
+  double wall_power() const;
   // solver.cpp
   void integrate();
   void update_damping_coefficients();
@@ -360,6 +365,8 @@ class World {
   Array x_, y_, vx_, vy_, theta_, omega_, r_, inv_r_;
   Array m_, inertia_;   // scaled mass and inertia
   Array fx_, fy_, tq_;  // net contact force and torque
+  Array block_power_;   // dashpot power of each block's slots (damped pass only)
+  double wall_dashpot_power_ = 0.0;
   // per-particle integration coefficients: v ← a·v + b·F (0 for padding)
   Array ca_t_, cb_t_, ca_r_, cb_r_;
   // wall contacts: tangential force history per particle and wall
@@ -400,6 +407,7 @@ class World {
     bool started = false;
     int64_t step = 0;  // of the last sample
     double energy0 = 0.0, work = 0.0, lost = 0.0, power_in = 0.0, power_lost = 0.0;
+    double dashpot = 0.0;  // dissipated by the contact dashpots, summed every step
     double created = 0.0;  // last reading, relative
   } ledger_;
 

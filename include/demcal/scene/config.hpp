@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "demcal/io/input_error.hpp"
-#include "demcal/kernel/world.hpp"
+#include "demcal/kernel/material.hpp"
 
 namespace demcal {
 

@@ -22,25 +22,14 @@
 #include "demcal/search/calibration.hpp"
 #include "demcal/scene/config.hpp"
 #include "demcal/scene/packing.hpp"
+#include "demcal/kernel/particle_scales.hpp"
 #include "demcal/kernel/world.hpp"
 
 namespace demcal {
 
-/// The reference scales of DESIGN.md §2 from the particles alone (no
-/// contact network needed): what fixes the absolute Δt, D_t, D_r.
-struct ParticleScales {
-  int64_t particles = 0;
-  double radius_min = 0.0, radius_max = 0.0, radius_mean = 0.0;
-  double mass_min = 0.0, mass_mean = 0.0;      ///< scaled by f_ms [kg]
-  double dt_crit = 0.0;                        ///< 2·sqrt(m_min/kn) [s]
-  double damping_translation_crit = 0.0;       ///< 2·sqrt(kn·m_min) [N·s/m]
-  double damping_rotation_crit = 0.0;          ///< 2·sqrt(kt·r²·I) of the lightest [N·m·s]
-  double damping_translation_crit_mean = 0.0;  ///< mean over the particles
-  double damping_rotation_crit_mean = 0.0;
-};
-/// Scales of a set of radii for a material (m = f_ms·ρ·t·π·r², I = m·r²/2).
-ParticleScales particle_scales(std::span<const double> radii, const Material& material,
-                               double mass_scaling = 1.0);
+// ParticleScales and particle_scales(radii, material, mass_scaling) live in
+// the kernel layer (demcal/kernel/particle_scales.hpp), included here so that
+// callers of this header keep compiling.
 
 /// How the loading length Nstep grows with the particle count:
 /// Nstep(N) = Nstep_REV·(N/N_REV)^exponent. Tu & Andrade's law is linear

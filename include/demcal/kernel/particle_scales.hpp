@@ -1,0 +1,76 @@
+// The reference scales of a disk assembly, in one place: every layer that
+// needs a disk's mass, its critical time step or its critical damping calls
+// these functions (the kernel for its own particles, the scene for Δt, the
+// upscaling for a prototype it never builds).
+//
+//   disk mass          m = f_ms·ρ·t·π·r²   (a cylinder of thickness t)
+//   inertia            I = m·r²/2
+//   critical step      Δt_crit = 2·sqrt(m_min/kn)
+//   critical damping   D_t^crit = 2·sqrt(kn·m),  D_r^crit = 2·sqrt(kt·r²·I)
+//
+// The order of the floating-point operations is part of the contract: the
+// kernel integrates with these masses, and the calibration's outputs quote
+// these numbers, so every caller must get the same bits.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <numbers>
+#include <span>
+
+#include "demcal/kernel/material.hpp"
+
+namespace demcal {
+
+/// f_ms·ρ·t [kg/m²]: the mass of the unit disk area (times π·r² in disk_mass).
+inline double disk_areal_density(const Material& material, double mass_scaling) {
+  return material.density * material.thickness * mass_scaling;
+}
+/// m = (f_ms·ρ·t)·π·r² [kg], with areal_density from disk_areal_density().
+inline double disk_mass(double areal_density, double radius) {
+  return areal_density * std::numbers::pi * radius * radius;
+}
+/// I = m·r²/2 [kg·m²] of a uniform disk.
+inline double disk_inertia(double mass, double radius) { return 0.5 * mass * radius * radius; }
+/// Δt_crit = 2·sqrt(m/kn) [s]: twice the inverse angular frequency of a
+/// mass on one spring.
+inline double critical_time_step(double mass, double kn) { return 2.0 * std::sqrt(mass / kn); }
+/// D_t^crit = 2·sqrt(kn·m) [N·s/m].
+inline double critical_damping_translation(double kn, double mass) {
+  return 2.0 * std::sqrt(kn * mass);
+}
+/// D_r^crit = 2·sqrt(kt·r²·I) [N·m·s].
+inline double critical_damping_rotation(double kt, double radius, double inertia) {
+  return 2.0 * std::sqrt(kt * radius * radius * inertia);
+}
+
+/// D_r^crit of a disk of mass m, with the inertia m·r²/2 written out:
+/// 2·sqrt(kt·r²·(m/2)·r²). The same value as critical_damping_rotation(kt,
+/// r, disk_inertia(m, r)) up to the last bit; this order is the one the
+/// quoted scales (params.json) have always been computed in.
+inline double critical_damping_rotation_of_disk(double kt, double radius, double mass) {
+  return 2.0 * std::sqrt(kt * radius * radius * 0.5 * mass * radius * radius);
+}
+
+/// The reference scales of an assembly, from its radii alone (no contact
+/// network needed): what fixes the absolute Δt, D_t and D_r. Damping is
+/// applied per particle (every particle gets the same ratio); the critical
+/// values are quoted for the lightest particle and as the mean over all.
+struct ParticleScales {
+  int64_t particles = 0;
+  double radius_min = 0.0, radius_max = 0.0, radius_mean = 0.0;
+  double mass_min = 0.0, mass_mean = 0.0;      ///< scaled by f_ms [kg]
+  double dt_crit = 0.0;                        ///< 2·sqrt(m_min/kn) [s]
+  double damping_translation_crit = 0.0;       ///< 2·sqrt(kn·m_min) [N·s/m]
+  double damping_rotation_crit = 0.0;          ///< 2·sqrt(kt·r²·I) of the lightest [N·m·s]
+  double damping_translation_crit_mean = 0.0;  ///< mean over the particles
+  double damping_rotation_crit_mean = 0.0;
+};
+/// The kernel's name for the same record (World::reference_scales()).
+using ReferenceScales = ParticleScales;
+
+/// Scales of a set of radii for a material and a mass scaling f_ms.
+ParticleScales particle_scales(std::span<const double> radii, const Material& material,
+                               double mass_scaling = 1.0);
+
+}  // namespace demcal

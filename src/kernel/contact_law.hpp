@@ -1,0 +1,81 @@
+// The contact laws, written once (private to the kernel).
+//
+// Particle–particle and particle–wall contacts share one law:
+//   normal     fn = max(0, kn·δ − c·v_n),  c = 2ζ·sqrt(kn·m_eff)
+//              (v_n > 0 when the contact opens; the dashpot never pulls)
+//   tangential ft = clamp(ft_prev + kt·Δu_t, −μ·fn, μ·fn)
+//   energy     ½·fe²/kn in the normal spring (fe = kn·δ, the elastic part
+//              alone), ½·ft²/kt in the tangential one
+//   dissipated by the dashpot: (fe − fn)·v_n ≥ 0 (per unit time)
+//
+// Every user evaluates the law through these functions: the SIMD force pass
+// (contact.cpp, with V a GCC vector of doubles), the scalar re-evaluation
+// for measures and views (World::pair_state), the walls, the energy ledger
+// (energy_balance.cpp), the stress measure (stress.cpp) and the stability
+// estimate (stability.cpp). The operations and their order are part of the
+// law: the SIMD pass and the scalar paths must give the same bits.
+#pragma once
+
+#include <cmath>
+
+// The templates are always inlined: no SIMD vector crosses a call boundary,
+// so the ABI note about passing AVX vectors does not apply.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wpsabi"
+
+namespace demcal::law {
+
+#define DEMCAL_LAW inline __attribute__((always_inline))
+
+/// Inward unit normals of the walls, indexed by WallSide (left, right,
+/// bottom, top).
+constexpr double kWallNormal[4][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}};
+
+/// Reduced mass m_i·m_j/(m_i + m_j) of a pair.
+template <class V>
+DEMCAL_LAW V reduced_mass(V mi, V mj) {
+  return mi * mj / (mi + mj);
+}
+
+/// The elastic normal force kn·δ (δ > 0: overlap).
+template <class V>
+DEMCAL_LAW V elastic_normal_force(double kn, V overlap) {
+  return kn * overlap;
+}
+
+/// The normal force with the contact dashpot: fe − 2ζ·sqrt(kn·m_eff)·v_n,
+/// never below 0. `two_zeta` is 2·contact_damping_ratio, `sqrt_kn_meff`
+/// sqrt(kn·m_eff) (the caller's square root: the SIMD pass has its own).
+template <class V>
+DEMCAL_LAW V damped_normal_force(V fn_elastic, double two_zeta, V sqrt_kn_meff, V vn) {
+  const V fn = fn_elastic - two_zeta * sqrt_kn_meff * vn;
+  const V zero{};
+  return fn > zero ? fn : zero;
+}
+
+/// Coulomb's cap on the trial tangential force: clamp to [−cap, cap].
+template <class V>
+DEMCAL_LAW V coulomb_clamp(V ft, V cap) {
+  ft = ft < -cap ? -cap : ft;
+  return ft > cap ? cap : ft;
+}
+
+/// Energy ½·f²/k stored in a linear spring carrying force f (0 for k = 0:
+/// no spring).
+DEMCAL_LAW double spring_energy(double force, double stiffness) {
+  return stiffness > 0.0 ? 0.5 * force * force / stiffness : 0.0;
+}
+
+/// Power taken by the dashpot: (fe − fn)·v_n, the force it removed from the
+/// spring times the opening speed (≥ 0; with the clamp at fn = 0 it is
+/// fe·v_n: the spring's energy released without work).
+template <class V>
+DEMCAL_LAW V dashpot_power(V fn_elastic, V fn, V vn) {
+  return (fn_elastic - fn) * vn;
+}
+
+#undef DEMCAL_LAW
+
+}  // namespace demcal::law
+
+#pragma GCC diagnostic pop
