@@ -1,0 +1,102 @@
+// The energy ledger of the sphere kernel's divergence check, the same
+// bookkeeping as the 2D kernel's (energy_balance.cpp explains it): for the
+// continuous system E(t) − E(0) = W_walls − D_damping − D_friction with both
+// D ≥ 0, so E − E(0) − W + D_damping ≥ 0 by physics and a reading above
+// KernelOptions::max_energy_created of the energy scale is energy the
+// integrator made (a step beyond the stable one). Friction is left out (a
+// lower bound). Rates are sampled every energy_check_interval steps and
+// integrated with the trapezoidal rule.
+#include <algorithm>
+#include <cmath>
+
+#include "demcal/kernel/sphere_world.hpp"
+
+namespace demcal {
+
+SphereWorld::EnergySample SphereWorld::energy_sample() const {
+  EnergySample e;
+  const double kn = material_.particle.kn, kt = material_.particle.kt;
+  const bool rotation = !integration_.lock_rotation;
+
+  // Kinetic energy and global damping D_t|v|² + D_r|ω|² (the coefficients of
+  // update_damping_coefficients()).
+  for (int i = 0; i < n_; ++i) {
+    const double v2 = vx_[i] * vx_[i] + vy_[i] * vy_[i] + vz_[i] * vz_[i];
+    const double w2 = rotation ? wx_[i] * wx_[i] + wy_[i] * wy_[i] + wz_[i] * wz_[i] : 0.0;
+    e.energy += 0.5 * (m_[i] * v2 + inertia_[i] * w2);
+    const double dt_coef = integration_.damping_ratio_translation * 2.0 * std::sqrt(kn * m_[i]);
+    const double dr_coef =
+        integration_.damping_ratio_rotation * 2.0 * std::sqrt(kt * r_[i] * r_[i] * inertia_[i]);
+    e.power_lost += dt_coef * v2 + dr_coef * w2;
+  }
+
+  // Pairs: spring energy and contact damping (the non-elastic part of fn
+  // times the separation speed).
+  for (int i = 0; i < n_; ++i)
+    for (int k = nbr_start_[i]; k < nbr_start_[i + 1]; ++k) {
+      const int j = nbr_j_[k];
+      const PairGeometry g = pair_geometry(i, j);
+      if (!g.touching) continue;
+      const double fn_elastic = kn * g.overlap;
+      const double vn = (vx_[j] - vx_[i]) * g.n.x() + (vy_[j] - vy_[i]) * g.n.y() +
+                        (vz_[j] - vz_[i]) * g.n.z();  // > 0 when separating
+      const double h2 = hx_[k] * hx_[k] + hy_[k] * hy_[k] + hz_[k] * hz_[k];
+      e.elastic += 0.5 * fn_elastic * g.overlap + (kt > 0.0 ? 0.5 * h2 / kt : 0.0);
+      e.power_lost += (fn_elastic - g.fn) * vn;
+    }
+
+  // Walls: spring energy, the work rate of the moving walls, contact damping.
+  const double kw = material_.wall.kn, ktw = material_.wall.kt;
+  const bool damped = material_.contact_damping_ratio > 0.0;
+  for (int s = 0; s < 6; ++s) {
+    const SphereWall& wall = walls_[s];
+    const int axis = s / 2;
+    const double sign = (s % 2 == 0) ? 1.0 : -1.0;
+    // wall.force is the particles' force on the wall; the wall's on them is −force.
+    e.power_in -= wall.force[axis] * wall.velocity;
+    const double* v[3] = {vx_.data(), vy_.data(), vz_.data()};
+    for (int i : wall_candidates_[s]) {
+      const double ov = r_[i] - wall_distance(s, i);
+      if (ov <= 0.0) continue;
+      const double vn = (v[axis][i] - wall.velocity) * sign;  // leaving the wall > 0
+      const double fn_elastic = kw * ov;
+      const double h2 = wall_hx_[s][i] * wall_hx_[s][i] + wall_hy_[s][i] * wall_hy_[s][i] +
+                        wall_hz_[s][i] * wall_hz_[s][i];
+      e.elastic += 0.5 * fn_elastic * ov + (ktw > 0.0 ? 0.5 * h2 / ktw : 0.0);
+      if (damped) e.power_lost += (fn_elastic - wall_fn_[s][i]) * vn;
+    }
+  }
+  e.energy += e.elastic;
+  return e;
+}
+
+bool SphereWorld::ledger_due() const {
+  return !ledger_.started || steps_ - ledger_.step >= std::max(1, options_.energy_check_interval);
+}
+
+bool SphereWorld::ledger_record(const EnergySample& e) {
+  Ledger& l = ledger_;
+  if (!l.started) {
+    l = {};
+    l.started = true;
+    l.step = steps_;
+    l.energy0 = e.energy;
+    l.power_in = e.power_in;
+    l.power_lost = e.power_lost;
+    return false;
+  }
+  const double h = static_cast<double>(steps_ - l.step) * integration_.dt;
+  l.work += 0.5 * (l.power_in + e.power_in) * h;
+  l.lost += 0.5 * (l.power_lost + e.power_lost) * h;
+  l.power_in = e.power_in;
+  l.power_lost = e.power_lost;
+  l.step = steps_;
+  const double created = e.energy - l.energy0 - l.work + l.lost;
+  const double scale = l.energy0 + std::abs(l.work) + l.lost;
+  l.created = scale > 0.0 ? created / scale : 0.0;
+  if (std::isfinite(l.created) && l.created <= options_.max_energy_created) return false;
+  divergence_ = Divergence::kEnergyCreated;
+  return true;
+}
+
+}  // namespace demcal
