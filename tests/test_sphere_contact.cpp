@@ -202,19 +202,19 @@ TurnResult turn_loaded_pair(const Vector3d& axis, const Vector3d& load, bool gen
   const double d = (sphere_test::position(w, 1) - sphere_test::position(w, 0)).norm();
 
   // A zero `axis` means the branch itself (the loading tilted it a little).
-  const Vector3d e = axis.isZero() ? Vector3d(sphere_test::position(w, 1) -
-                                              sphere_test::position(w, 0))
-                                             .normalized()
-                                   : axis.normalized();
+  const Vector3d e =
+      axis.isZero()
+          ? Vector3d(sphere_test::position(w, 1) - sphere_test::position(w, 0)).normalized()
+          : axis.normalized();
   const int steps = 100000;
   const double theta = 0.5 * std::numbers::pi, wdt = theta / steps;
   const Vector3d Omega = e * wdt / in.dt;
   const Eigen::Matrix3d R = Eigen::AngleAxisd(wdt, e).toRotationMatrix();
   for (int k = 0; k < steps; ++k) {
     for (int i = 0; i < 2; ++i)
-      w.set_velocity(i, (R - Eigen::Matrix3d::Identity()) * (sphere_test::position(w, i) - centre) /
-                            in.dt,
-                     Omega);
+      w.set_velocity(
+          i, (R - Eigen::Matrix3d::Identity()) * (sphere_test::position(w, i) - centre) / in.dt,
+          Omega);
     w.step(1);
   }
   const Eigen::Matrix3d Rt = Eigen::AngleAxisd(theta, e).toRotationMatrix();

@@ -213,8 +213,7 @@ StabilityEstimate SphereWorld::stability_estimate(int iterations) const {
       const int j = nbr_j_[k];
       const PairGeometry g = pair_geometry(i, j);
       if (!g.touching || g.fn <= 0.0) continue;
-      contacts.push_back(
-          {i, j, g.n, r_[i] - 0.5 * g.overlap, r_[j] - 0.5 * g.overlap, kn, kt});
+      contacts.push_back({i, j, g.n, r_[i] - 0.5 * g.overlap, r_[j] - 0.5 * g.overlap, kn, kt});
     }
   const double kw = material_.wall.kn;
   const double ktw = material_.wall.friction > 0.0 ? material_.wall.kt : 0.0;

@@ -82,8 +82,7 @@ SphereMeasures SphereWorld::measure(double strain_rate) const {
   out.coordination_number = n_ ? 2.0 * out.particle_contacts / n_ : 0.0;
   const double rho = material_.density * integration_.mass_scaling;
   if (n_ && out.mean_pressure > 0.0)
-    out.inertial_number =
-        std::abs(strain_rate) * (sum_d / n_) * std::sqrt(rho / out.mean_pressure);
+    out.inertial_number = std::abs(strain_rate) * (sum_d / n_) * std::sqrt(rho / out.mean_pressure);
   return out;
 }
 

@@ -133,9 +133,9 @@ class SphereWorld {
   std::span<const double> radius() const { return r_; }
   double min_radius() const { return r_min_; }
   double max_radius() const { return r_max_; }
-  std::span<const double> mass() const { return m_; }        ///< scaled masses
+  std::span<const double> mass() const { return m_; }           ///< scaled masses
   std::span<const double> inertia() const { return inertia_; }  ///< scaled moments
-  std::span<const double> fx() const { return fx_; }         ///< net contact force
+  std::span<const double> fx() const { return fx_; }            ///< net contact force
   std::span<const double> fy() const { return fy_; }
   std::span<const double> fz() const { return fz_; }
   std::span<const double> torque_x() const { return tx_; }
@@ -189,7 +189,8 @@ class SphereWorld {
   double wall_distance(int s, int i) const;
   // sphere_energy_balance.cpp
   struct EnergySample {
-    double energy = 0.0, elastic = 0.0, power_in = 0.0, power_lost = 0.0;
+    double energy = 0.0, elastic = 0.0, power_in = 0.0;
+    double power_lost = 0.0;  // contact damping [W] (global damping is summed each step)
   };
   EnergySample energy_sample() const;
   bool ledger_due() const;
@@ -208,6 +209,8 @@ class SphereWorld {
   std::vector<double> m_, inertia_;
   std::vector<double> fx_, fy_, fz_, tx_, ty_, tz_;
   std::vector<double> ca_t_, cb_t_, ca_r_, cb_r_;  // v ← a·v + b·F per particle
+  std::vector<double> d_t_, d_r_;                  // damping coefficients D_t, D_r
+  double damping_dissipated_ = 0.0;                // by global damping since construction [J]
 
   // Verlet half list (pairs i < j) in CSR form, each row sorted by j; the
   // tangential force on i of each pair (3 components), kept across rebuilds.
@@ -234,6 +237,7 @@ class SphereWorld {
     bool started = false;
     int64_t step = 0;
     double energy0 = 0.0, work = 0.0, lost = 0.0, power_in = 0.0, power_lost = 0.0;
+    double dissipated0 = 0.0;  // damping_dissipated_ at the start
     double created = 0.0;
   } ledger_;
 
