@@ -248,3 +248,53 @@ TEST(SphereContact, TangentialForceTurnsWithRigidlyRotatingPair) {
 
 }  // namespace
 }  // namespace demcal
+
+namespace demcal {
+namespace {
+
+// A heavy sphere pressed onto the bottom wall (wall friction μ_w) slides
+// horizontally at constant speed V along u. The wall's incremental spring
+// gives F_t = kt_w·V·t_elapsed against the motion while below μ_w·Fn, then
+// exactly μ_w·Fn; the torque about the centre is (−dist·g) × F_t, dist =
+// r − δ; the wall feels the opposite of the force on the sphere. Mass
+// scaling 1e15: the forces change the velocity by < 1e-6 relative.
+TEST(SphereContact, WallFrictionSticksThenSlidesWithTorque) {
+  const double mu_w = 0.4, r = kR, delta = 1e-6, V = 1e-3;
+  const SphereMaterial mat = test_material(0.3, mu_w);
+  sphere_test::Scene s;
+  s.add(Vector3d(0.0, 0.0, r - delta), r);
+  s.lo = {-20 * r, -20 * r, 0.0};
+  s.hi = {20 * r, 20 * r, 10 * r};
+  SphereWorld w = s.make(mat);
+  Integration in = sphere_test::set_undamped(w, 0.0, 1e15);
+  in.dt = 1e-6;
+  w.set_integration(in);
+  const Vector3d u = Vector3d(1.0, 2.0, 0.0).normalized(), g(0.0, 0.0, 1.0);
+  w.set_velocity(0, V * u, Vector3d::Zero());
+  const double fn = mat.wall.kn * delta, ktw = mat.wall.kt;
+  int stuck = 0, slid = 0;
+  for (int k = 1; k <= 1500; ++k) {
+    ASSERT_TRUE(w.step(1));
+    const Vector3d f = sphere_test::force(w, 0);
+    EXPECT_NEAR(f.dot(g), fn, 1e-6 * fn);  // the sphere stays at its height
+    const Vector3d ft = f - f.dot(g) * g;
+    EXPECT_NEAR(ft.normalized().dot(-u), 1.0, 1e-12);
+    const double stick = ktw * V * in.dt * k, tol = 1e-6 * stick;
+    if (stick < mu_w * fn - tol) {
+      EXPECT_NEAR(ft.norm(), stick, tol);
+      ++stuck;
+    } else if (stick > mu_w * fn + tol) {
+      EXPECT_NEAR(ft.norm(), mu_w * f.dot(g), 1e-13 * fn);
+      ++slid;
+    }
+    const double dist = w.z()[0];
+    EXPECT_NEAR((sphere_test::torque(w, 0) - (-dist * g).cross(ft)).norm(), 0.0, 1e-13 * fn * r);
+    EXPECT_NEAR((w.wall(kZMin).force + f).norm(), 0.0, 1e-13 * fn);
+    EXPECT_EQ(w.wall(kZMin).contacts, 1);
+  }
+  EXPECT_GT(stuck, 700);  // μ_w·Fn/(kt_w·V·Δt) = 800 steps
+  EXPECT_GT(slid, 600);
+}
+
+}  // namespace
+}  // namespace demcal

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <random>
 #include <vector>
 
@@ -284,6 +285,49 @@ TEST(SphereNeighbours, SkinDoesNotChangeTheTrajectory) {
   }
   // The run slid and collided: the histories were exercised.
   EXPECT_GT(b.measure().particle_contacts, 0);
+}
+
+}  // namespace
+}  // namespace demcal
+
+namespace demcal {
+namespace {
+
+// The stable step of the coupled 6-DOF network is sharp: a vibrating FCC
+// packing (all contacts closed and sticking, so the system is linear) run
+// undamped just below 2/ω_max stays bounded, just above it blows up — the
+// unstable mode grows by |z| ≈ 1.2 per step at ω·Δt = 2.01 (roots of
+// z² − (2 − ω²Δt²)z + 1). The Gershgorin bound is safe (not above it).
+TEST(SphereStability, LanczosStepIsTheSharpStabilityLimitOfAPacking) {
+  auto run = [](double factor, bool& stable, double& gershgorin_ratio) {
+    SphereWorld w = fcc_world(2, 1e-3, 0.0);
+    relax(w, 20000);
+    w.set_particle_friction(10.0);
+    const StabilityEstimate e = w.stability_estimate();
+    gershgorin_ratio = e.dt_stable_gershgorin / e.dt_stable;
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    const double vamp = 0.01 * 2e-3 * kR * std::sqrt(1e8 / w.mass()[0]);
+    for (int i = 0; i < w.size(); ++i)
+      w.set_velocity(i, vamp * Vector3d(u(rng), u(rng), u(rng)),
+                     vamp / kR * Vector3d(u(rng), u(rng), u(rng)));
+    Integration in = sphere_test::set_undamped(w, 0.1);
+    in.dt = factor * e.dt_stable;
+    w.set_integration(in);
+    const double e0 = w.measure().kinetic_energy_translation + w.measure().kinetic_energy_rotation;
+    stable = w.step(20000);
+    const SphereMeasures m = w.measure();
+    if (stable) stable = m.kinetic_energy_translation + m.kinetic_energy_rotation < 1e3 * e0;
+  };
+  bool below = false, above = true;
+  double g = 0.0;
+  run(0.99, below, g);
+  run(1.01, above, g);
+  EXPECT_TRUE(below);
+  EXPECT_FALSE(above);
+  std::printf("FCC 2x2x2 sticking: Gershgorin step / Lanczos step = %.3f\n", g);
+  EXPECT_LE(g, 1.0 + 1e-12);
+  EXPECT_GT(g, 0.2);  // and not uselessly small
 }
 
 }  // namespace
