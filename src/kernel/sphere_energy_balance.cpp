@@ -82,7 +82,7 @@ bool SphereWorld::ledger_record(const EnergySample& e) {
     l.energy0 = e.energy;
     l.power_in = e.power_in;
     l.power_lost = e.power_lost;
-    l.dissipated0 = damping_dissipated_;
+    damping_dissipated_ = 0.0;
     return false;
   }
   const double h = static_cast<double>(steps_ - l.step) * integration_.dt;
@@ -91,7 +91,7 @@ bool SphereWorld::ledger_record(const EnergySample& e) {
   l.power_in = e.power_in;
   l.power_lost = e.power_lost;
   l.step = steps_;
-  const double lost = l.lost + (damping_dissipated_ - l.dissipated0);
+  const double lost = l.lost + damping_dissipated_;
   const double created = e.energy - l.energy0 - l.work + lost;
   const double scale = l.energy0 + std::abs(l.work) + lost;
   l.created = scale > 0.0 ? created / scale : 0.0;

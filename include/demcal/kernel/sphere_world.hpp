@@ -53,8 +53,10 @@ enum SphereWallSide : int { kXMin = 0, kXMax = 1, kYMin = 2, kYMax = 3, kZMin = 
 
 /// A rigid axis-aligned plane. `position` is its coordinate along its axis
 /// (side / 2: 0 = x, 1 = y, 2 = z), `velocity` along the same axis. The
-/// kernel moves it by velocity·Δt each step; a protocol above may also set
-/// `position` directly (servo control).
+/// kernel moves it by velocity·Δt each step. A protocol servoes a wall
+/// through its velocity, as the 2D biaxial protocol does: the energy ledger
+/// counts the work of a moving wall from its velocity, so a `position` set
+/// directly between steps (allowed, e.g. for set-up) is work it cannot see.
 struct SphereWall {
   double position = 0.0;
   double velocity = 0.0;
@@ -210,7 +212,10 @@ class SphereWorld {
   std::vector<double> fx_, fy_, fz_, tx_, ty_, tz_;
   std::vector<double> ca_t_, cb_t_, ca_r_, cb_r_;  // v ← a·v + b·F per particle
   std::vector<double> d_t_, d_r_;                  // damping coefficients D_t, D_r
-  double damping_dissipated_ = 0.0;                // by global damping since construction [J]
+  // Energy taken by global damping since the energy ledger started [J] (a
+  // running total from the start, not a difference of two totals: that
+  // would cancel catastrophically once most of the energy is gone).
+  double damping_dissipated_ = 0.0;
 
   // Verlet half list (pairs i < j) in CSR form, each row sorted by j; the
   // tangential force on i of each pair (3 components), kept across rebuilds.
@@ -237,7 +242,6 @@ class SphereWorld {
     bool started = false;
     int64_t step = 0;
     double energy0 = 0.0, work = 0.0, lost = 0.0, power_in = 0.0, power_lost = 0.0;
-    double dissipated0 = 0.0;  // damping_dissipated_ at the start
     double created = 0.0;
   } ledger_;
 
