@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <numbers>
 #include <random>
 #include <vector>
 
@@ -145,6 +146,7 @@ TEST(SphereDamping, FreeSphereDecaysAtTheDiscreteRate) {
   const int n = 200;
   ASSERT_TRUE(w.step(n));
   const double m = w.mass()[0], inertia = w.inertia()[0];
+  EXPECT_NEAR(m, 2650.0 * 4.0 / 3.0 * std::numbers::pi * kR * kR * kR, 4.0 * kEps * m);
   EXPECT_DOUBLE_EQ(inertia, 0.4 * m * kR * kR);
   const double c = 0.7 * std::sqrt(1e8 / m) * in.dt;
   const double cr = 0.4 * kR * std::sqrt(5e7 / inertia) * in.dt;

@@ -106,9 +106,10 @@ TriaxialResult run_fcc_triaxial(int n, double mu, bool lock_rotation, int64_t ns
 // Rotation locked: within 2 % of the walled-cube value 2(1 + μ)/(1 − μ)
 // (3.714 at μ = 0.3; for a cube the walls change nothing). The ratio rises
 // to a plateau (the sliding regime) at the analytical value. Measured:
-// 3.7152 (+0.02 %) at 40 000 steps, 3.7233 (+0.24 %) at 20 000; the
-// remaining differences are the loading rate and the elastic tilt of the
-// contacts (~1e-4).
+// 3.7152 (+0.02 %) at 40 000 steps, 3.7233 (+0.24 %) at 20 000 (4×4×4
+// cells, 256 spheres: 3.7221, +0.21 %, at 40 000); the remaining
+// differences are the loading rate and the elastic tilt of the contacts
+// (~1e-4).
 TEST(SphereTriaxial, FccPeakWithRotationLockedMatchesThornton) {
   const double mu = 0.3;
   const int n = 3;
@@ -126,8 +127,8 @@ TEST(SphereTriaxial, FccPeakWithRotationLockedMatchesThornton) {
 
 // Free rotation: the spheres can roll, which opens failure mechanisms the
 // locked lattice does not have, so the peak cannot exceed the locked
-// (analytical) one. Measured 3.178 at 40 000 steps, 14 % below — the 2D
-// kernel's hexagonal samples show the same 10–15 %.
+// (analytical) one. Measured 3.178 at 40 000 steps, 14 % below (4×4×4:
+// 3.327, 10 % below) — the 2D kernel's hexagonal samples show 10–15 %.
 TEST(SphereTriaxial, FccPeakWithFreeRotationIsBelowTheLockedOne) {
   const double mu = 0.3;
   const int n = 3;
