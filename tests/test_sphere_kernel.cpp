@@ -323,6 +323,15 @@ TEST(SphereStability, LanczosStepIsTheSharpStabilityLimitOfAPacking) {
     w.set_integration(in);
     const double e0 = w.measure().kinetic_energy_translation + w.measure().kinetic_energy_rotation;
     stable = w.step(20000);
+    {
+      const SphereMeasures mm = w.measure();
+      std::printf(
+          "FCC 2x2x2 sticking at %.2f x the Lanczos step (alpha %.3f): divergence %s, KE/KE0 "
+          "%.2e, ledger %.2e, KE/elastic %.2e\n",
+          factor, factor * e.dt_ratio_stable, to_string(w.divergence()),
+          (mm.kinetic_energy_translation + mm.kinetic_energy_rotation) / e0, w.energy_created(),
+          (mm.kinetic_energy_translation + mm.kinetic_energy_rotation) / mm.elastic_energy);
+    }
     const SphereMeasures m = w.measure();
     if (stable) stable = m.kinetic_energy_translation + m.kinetic_energy_rotation < 1e3 * e0;
   };

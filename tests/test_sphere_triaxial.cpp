@@ -45,6 +45,7 @@ struct TriaxialResult {
   double peak_strain = 0.0;    // axial strain at the peak
   double lateral_error = 0.0;  // max |σ_lateral/σ3 − 1| up to the peak
   double consolidated = 0.0;   // mean wall stress after consolidation / σ3
+  double ledger_max = -1e300;  // largest energy-ledger reading while loading
 };
 
 TriaxialResult run_fcc_triaxial(int n, double mu, bool lock_rotation, int64_t nstep) {
@@ -87,6 +88,7 @@ TriaxialResult run_fcc_triaxial(int n, double mu, bool lock_rotation, int64_t ns
       ADD_FAILURE() << "diverged: " << to_string(w.divergence());
       break;
     }
+    out.ledger_max = std::max(out.ledger_max, w.energy_created());
     const double sxx = 0.5 * (wall_stress(w, kXMin) + wall_stress(w, kXMax));
     const double syy = 0.5 * (wall_stress(w, kYMin) + wall_stress(w, kYMax));
     const double szz = 0.5 * (wall_stress(w, kZMin) + wall_stress(w, kZMax));
@@ -118,9 +120,9 @@ TEST(SphereTriaxial, FccPeakWithRotationLockedMatchesThornton) {
   const TriaxialResult r = run_fcc_triaxial(n, mu, true, 40000);
   std::printf(
       "FCC %dx%dx%d, mu %.2f, rotation locked: peak %.4f (analytical %.4f, %+.2f %%) at "
-      "strain %.2e, consolidated %.4f sigma3, lateral error %.2e\n",
+      "strain %.2e, consolidated %.4f sigma3, lateral error %.2e, ledger <= %.2e\n",
       n, n, n, mu, r.peak_ratio, analytical, 100.0 * (r.peak_ratio / analytical - 1.0),
-      r.peak_strain, r.consolidated, r.lateral_error);
+      r.peak_strain, r.consolidated, r.lateral_error, r.ledger_max);
   EXPECT_NEAR(r.consolidated, 1.0, 1e-3);
   EXPECT_NEAR(r.peak_ratio, analytical, 0.02 * analytical);
 }
@@ -136,9 +138,9 @@ TEST(SphereTriaxial, FccPeakWithFreeRotationIsBelowTheLockedOne) {
   const TriaxialResult r = run_fcc_triaxial(n, mu, false, 40000);
   std::printf(
       "FCC %dx%dx%d, mu %.2f, free rotation: peak %.4f (%+.2f %% of the locked "
-      "analytical %.4f) at strain %.2e\n",
+      "analytical %.4f) at strain %.2e, ledger <= %.2e\n",
       n, n, n, mu, r.peak_ratio, 100.0 * (r.peak_ratio / analytical - 1.0), analytical,
-      r.peak_strain);
+      r.peak_strain, r.ledger_max);
   EXPECT_GT(r.peak_ratio, 1.0);
   EXPECT_LT(r.peak_ratio, analytical);
 }
