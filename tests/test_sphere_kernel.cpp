@@ -305,8 +305,11 @@ namespace {
 // undamped just below 2/ω_max stays bounded, just above it blows up — the
 // unstable mode grows by |z| ≈ 1.2 per step at ω·Δt = 2.01 (roots of
 // z² − (2 − ω²Δt²)z + 1). The Gershgorin bound is safe (not above it).
+// The kernel's own check must see it: past the step the growing mode
+// rattles contacts open and shut, and the ledger reads the energy created
+// once friction's loss (the springs released at opening) is booked.
 TEST(SphereStability, LanczosStepIsTheSharpStabilityLimitOfAPacking) {
-  auto run = [](double factor, bool& stable, double& gershgorin_ratio) {
+  auto run = [](double factor, bool& stable, double& gershgorin_ratio, Divergence& flagged) {
     SphereWorld w = fcc_world(2, 1e-3, 0.0);
     relax(w, 20000);
     w.set_particle_friction(10.0);
@@ -323,6 +326,7 @@ TEST(SphereStability, LanczosStepIsTheSharpStabilityLimitOfAPacking) {
     w.set_integration(in);
     const double e0 = w.measure().kinetic_energy_translation + w.measure().kinetic_energy_rotation;
     stable = w.step(20000);
+    flagged = w.divergence();
     {
       const SphereMeasures mm = w.measure();
       std::printf(
@@ -337,10 +341,13 @@ TEST(SphereStability, LanczosStepIsTheSharpStabilityLimitOfAPacking) {
   };
   bool below = false, above = true;
   double g = 0.0;
-  run(0.99, below, g);
-  run(1.01, above, g);
+  Divergence below_flag = Divergence::kNone, above_flag = Divergence::kNone;
+  run(0.99, below, g, below_flag);
+  run(1.01, above, g, above_flag);
   EXPECT_TRUE(below);
   EXPECT_FALSE(above);
+  EXPECT_EQ(below_flag, Divergence::kNone);
+  EXPECT_NE(above_flag, Divergence::kNone);
   std::printf("FCC 2x2x2 sticking: Gershgorin step / Lanczos step = %.3f\n", g);
   EXPECT_LE(g, 1.0 + 1e-12);
   EXPECT_GT(g, 0.2);  // and not uselessly small

@@ -26,6 +26,20 @@
 // (sliding). The force on i is −Fn·n + h, on j its opposite; the torques
 // are a_i·n × h on i and a_j·n × h on j.
 //
+// Friction's share of the energy ledger (sphere_energy_balance.cpp). The
+// tangential spring stores |h|²/(2·kt). When the cap bites, the trial force
+// h_trial is cut back to μFn: the contact slides by (|h_trial| − μFn)/kt
+// while carrying μFn, so Coulomb friction takes μFn·(|h_trial| − μFn)/kt.
+// (Not the spring energy (|h_trial|² − (μFn)²)/(2·kt) the cut removes: its
+// excess over the Coulomb work is trial energy never stored — for a
+// frictionless contact the whole (kt·|v_t|·Δt)²/(2·kt) of every step.) In
+// continuous time the two agree. When a contact opens, Fn has fallen to 0
+// and with it the cap: the spring has slid back to zero on the way, so the
+// |h|²/(2·kt) it still held at the last touching step is dissipated too.
+// Left out of the books, these losses hide energy the integrator creates: a
+// step just past the stable one rattles contacts open and shut, and the
+// ledger without them reads strongly negative.
+//
 // Walls: the inward normal g is fixed and the wall does not rotate, so a
 // wall history stays in the wall plane with no turning; the contact point is
 // the foot of the centre on the plane (lever arm −dist·g).
@@ -89,8 +103,9 @@ SphereWorld::PairGeometry SphereWorld::pair_geometry(int i, int j) const {
 
 void SphereWorld::pair_forces() {
   const double dt = integration_.dt;
-  const double kdt = material_.particle.kt * dt, mu = material_.particle.friction;
-  double max_overlap = 0.0;
+  const double kt = material_.particle.kt, kdt = kt * dt, mu = material_.particle.friction;
+  const double compliance = kt > 0.0 ? 1.0 / kt : 0.0, half_compliance = 0.5 * compliance;
+  double max_overlap = 0.0, released = 0.0, slid = 0.0;
   for (int i = 0; i < n_; ++i) {
     const V3 vi(vx_[i], vy_[i], vz_[i]), wi(wx_[i], wy_[i], wz_[i]);
     V3 fi(fx_[i], fy_[i], fz_[i]), ti(tx_[i], ty_[i], tz_[i]);
@@ -98,6 +113,7 @@ void SphereWorld::pair_forces() {
       const int j = nbr_j_[k];
       const PairGeometry g = pair_geometry(i, j);
       if (!g.touching) {
+        released += hx_[k] * hx_[k] + hy_[k] * hy_[k] + hz_[k] * hz_[k];
         hx_[k] = hy_[k] = hz_[k] = 0.0;
         continue;
       }
@@ -109,7 +125,11 @@ void SphereWorld::pair_forces() {
       V3 h = turn_history(V3(hx_[k], hy_[k], hz_[k]), n, 0.5 * dt * n.dot(wi + wj));
       h += kdt * vt;
       const double cap = mu * g.fn, h2 = h.squaredNorm();
-      if (h2 > cap * cap) h *= cap / std::sqrt(h2);
+      if (h2 > cap * cap) {
+        const double mag = std::sqrt(h2);
+        slid += cap * (mag - cap);
+        h *= cap / mag;
+      }
       hx_[k] = h.x();
       hy_[k] = h.y();
       hz_[k] = h.z();
@@ -133,6 +153,7 @@ void SphereWorld::pair_forces() {
     tz_[i] = ti.z();
   }
   max_overlap_ratio_seen_ = max_overlap;
+  friction_dissipated_ += released * half_compliance + slid * compliance;
 }
 
 void SphereWorld::wall_forces() {
@@ -140,7 +161,9 @@ void SphereWorld::wall_forces() {
   const double beta = material_.contact_damping_ratio;
   const double kw = material_.wall.kn, ktw_dt = material_.wall.kt * dt;
   const double muw = material_.wall.friction;
-  double max_overlap = 0.0;
+  const double compliance = material_.wall.kt > 0.0 ? 1.0 / material_.wall.kt : 0.0;
+  const double half_compliance = 0.5 * compliance;
+  double max_overlap = 0.0, released = 0.0, slid = 0.0;
   for (int s = 0; s < 6; ++s) {
     SphereWall& wall = walls_[s];
     const int axis = s / 2;
@@ -153,6 +176,8 @@ void SphereWorld::wall_forces() {
       const double dist = wall_distance(s, i);
       const double overlap = r_[i] - dist;
       if (overlap <= 0.0) {
+        released += wall_hx_[s][i] * wall_hx_[s][i] + wall_hy_[s][i] * wall_hy_[s][i] +
+                    wall_hz_[s][i] * wall_hz_[s][i];
         wall_hx_[s][i] = wall_hy_[s][i] = wall_hz_[s][i] = 0.0;
         wall_fn_[s][i] = 0.0;
         continue;
@@ -169,7 +194,11 @@ void SphereWorld::wall_forces() {
       V3 h(wall_hx_[s][i], wall_hy_[s][i], wall_hz_[s][i]);
       h += ktw_dt * (dv - dv.dot(g) * g);
       const double cap = muw * fn, h2 = h.squaredNorm();
-      if (h2 > cap * cap) h *= cap / std::sqrt(h2);
+      if (h2 > cap * cap) {
+        const double mag = std::sqrt(h2);
+        slid += cap * (mag - cap);
+        h *= cap / mag;
+      }
       wall_hx_[s][i] = h.x();
       wall_hy_[s][i] = h.y();
       wall_hz_[s][i] = h.z();
@@ -188,6 +217,7 @@ void SphereWorld::wall_forces() {
     wall.contacts = count;
   }
   max_overlap_ratio_seen_ = std::max(max_overlap_ratio_seen_, max_overlap);
+  friction_dissipated_ += released * half_compliance + slid * compliance;
 }
 
 void SphereWorld::compute_forces() {

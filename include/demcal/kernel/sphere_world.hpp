@@ -216,6 +216,11 @@ class SphereWorld {
   // running total from the start, not a difference of two totals: that
   // would cancel catastrophically once most of the energy is gone).
   double damping_dissipated_ = 0.0;
+  // Energy taken by Coulomb friction since the ledger started [J]: the
+  // tangential spring energy a contact gives up when its force is capped
+  // (sliding) or when it opens (sphere_contact.cpp explains why that is
+  // dissipated, not created).
+  double friction_dissipated_ = 0.0;
 
   // Verlet half list (pairs i < j) in CSR form, each row sorted by j; the
   // tangential force on i of each pair (3 components), kept across rebuilds.
