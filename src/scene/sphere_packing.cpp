@@ -1,9 +1,16 @@
 // The FCC lattice and its analytical peak (sphere_packing.hpp).
 #include "demcal/scene/sphere_packing.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <fstream>
 #include <limits>
+#include <sstream>
 #include <stdexcept>
+
+#include "demcal/io/input_error.hpp"
+#include "demcal/scene/random_radii.hpp"
 
 namespace demcal {
 
@@ -29,6 +36,148 @@ SphereAssembly fcc_packing(int nx, int ny, int nz, double radius, double contact
     a.lo[axis] = 2.0 * radius * contact_strain;
     a.hi[axis] = (2.0 * radius + (2 * n[axis] - 1) * half) * shrink;
   }
+  return a;
+}
+
+SphereAssembly random_sphere_gas(const AssemblySpec& spec) {
+  if (spec.count < 1) throw std::invalid_argument("random_sphere_gas: count must be >= 1");
+  std::mt19937_64 rng(spec.seed);
+  SphereAssembly a;
+  const int n = spec.count;
+  a.r = random_radii::sample(spec, rng);
+  const double r_max = *std::max_element(a.r.begin(), a.r.end());
+  const double spacing = 2.2 * r_max;
+  const int across =
+      std::max(1, static_cast<int>(std::ceil(std::cbrt(static_cast<double>(n) * spec.aspect))));
+  const int layers = (n + across * across - 1) / (across * across);
+  a.x.resize(n);
+  a.y.resize(n);
+  a.z.resize(n);
+  for (int i = 0; i < n; ++i) {
+    const int cx = i % across, cy = (i / across) % across, cz = i / (across * across);
+    // Jitter that keeps each sphere inside its own cell: no overlaps.
+    const double room = 0.5 * spacing - a.r[i];
+    a.x[i] = (cx + 0.5) * spacing + room * (2.0 * random_radii::uniform01(rng) - 1.0);
+    a.y[i] = (cy + 0.5) * spacing + room * (2.0 * random_radii::uniform01(rng) - 1.0);
+    a.z[i] = (cz + 0.5) * spacing + room * (2.0 * random_radii::uniform01(rng) - 1.0);
+  }
+  a.hi = {across * spacing, across * spacing, layers * spacing};
+  return a;
+}
+
+namespace {
+
+/// The whole of `field` (blanks around it allowed) as a number.
+bool parse_number(const std::string& field, double& value) {
+  const char* s = field.c_str();
+  char* end = nullptr;
+  value = std::strtod(s, &end);
+  if (end == s) return false;
+  while (*end == ' ' || *end == '\t') ++end;
+  return *end == '\0';
+}
+
+}  // namespace
+
+SphereAssembly read_sphere_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path, "", "cannot open particle file");
+  return read_spheres(in, path);
+}
+
+SphereAssembly read_spheres(std::istream& in, const std::string& path) {
+  SphereAssembly a;
+  std::vector<int> lines;  // line of each sphere, for the overlap error
+  std::string line;
+  int line_no = 0;
+  bool seen_content = false;  // a header or a sphere
+  auto where = [&]() { return "line " + std::to_string(line_no); };
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (line_no == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);  // UTF-8 BOM
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    const auto first = line.find_first_not_of(" \t");
+    if (first == std::string::npos || line[first] == '#') continue;
+    std::vector<std::string> fields;
+    std::stringstream ss(line);
+    std::string f;
+    while (std::getline(ss, f, ',')) fields.push_back(f);
+    double v[4];
+    int numbers = 0;
+    for (size_t k = 0; k < fields.size() && k < 4; ++k) numbers += parse_number(fields[k], v[k]);
+    if (fields.size() != 4 || numbers != 4) {
+      // The header is the first content line with four fields, none a
+      // number ("x,y,z,r"); a line with some numbers is a broken sphere
+      // line, never silently skipped.
+      if (!seen_content && fields.size() == 4 && numbers == 0) {
+        seen_content = true;
+        continue;
+      }
+      throw InputError(path, where(), "expected four numbers x,y,z,r, got \"" + line + "\"");
+    }
+    seen_content = true;
+    if (!std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2]) ||
+        !std::isfinite(v[3]))
+      throw InputError(path, where(), "values must be finite, got \"" + line + "\"");
+    if (!(v[3] > 0.0)) throw InputError(path, where(), "radius must be > 0, got \"" + line + "\"");
+    a.x.push_back(v[0]);
+    a.y.push_back(v[1]);
+    a.z.push_back(v[2]);
+    a.r.push_back(v[3]);
+    lines.push_back(line_no);
+  }
+  if (in.bad()) throw InputError(path, "", "cannot read particle file");
+  if (a.size() < 2)
+    throw InputError(path, "", "needs at least two spheres, found " + std::to_string(a.size()));
+  const int n = a.size();
+  const std::vector<double>* pos[3] = {&a.x, &a.y, &a.z};
+  for (int axis = 0; axis < 3; ++axis) {
+    a.lo[axis] = std::numeric_limits<double>::infinity();
+    a.hi[axis] = -std::numeric_limits<double>::infinity();
+    for (int i = 0; i < n; ++i) {
+      a.lo[axis] = std::min(a.lo[axis], (*pos[axis])[i] - a.r[i]);
+      a.hi[axis] = std::max(a.hi[axis], (*pos[axis])[i] + a.r[i]);
+    }
+  }
+  // Overlaps beyond 5 % of the smaller radius are not a packing but an
+  // error. A cell grid (cells of at least 2·r_max, at most 2^20 a side so
+  // the keys cannot overflow; larger cells only cost time) keeps it O(N).
+  const double r_max = *std::max_element(a.r.begin(), a.r.end());
+  double extent = 0.0;
+  for (int axis = 0; axis < 3; ++axis) extent = std::max(extent, a.hi[axis] - a.lo[axis]);
+  const double cell = std::max(2.0 * r_max, extent / static_cast<double>(1 << 20));
+  if (!std::isfinite(extent) || !std::isfinite(cell) || !(cell > 0.0))
+    throw InputError(path, "", "coordinates span more than a double can hold");
+  auto key_of = [&](int i, int dx, int dy, int dz) {
+    const int64_t c[3] = {static_cast<int64_t>((a.x[i] - a.lo[0]) / cell) + dx,
+                          static_cast<int64_t>((a.y[i] - a.lo[1]) / cell) + dy,
+                          static_cast<int64_t>((a.z[i] - a.lo[2]) / cell) + dz};
+    constexpr int64_t kStride = int64_t{1} << 21;
+    return (c[2] * kStride + c[1]) * kStride + c[0];
+  };
+  std::vector<std::pair<int64_t, int>> keyed(n);
+  for (int i = 0; i < n; ++i) keyed[i] = {key_of(i, 0, 0, 0), i};
+  std::sort(keyed.begin(), keyed.end());
+  for (int i = 0; i < n; ++i)
+    for (int dz = -1; dz <= 1; ++dz)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          const int64_t key = key_of(i, dx, dy, dz);
+          auto it = std::lower_bound(keyed.begin(), keyed.end(), std::pair<int64_t, int>(key, -1));
+          for (; it != keyed.end() && it->first == key; ++it) {
+            const int j = it->second;
+            if (j <= i) continue;
+            const double d = std::sqrt(std::pow(a.x[j] - a.x[i], 2) + std::pow(a.y[j] - a.y[i], 2) +
+                                       std::pow(a.z[j] - a.z[i], 2));
+            const double overlap = a.r[i] + a.r[j] - d;
+            const double smaller = std::min(a.r[i], a.r[j]);
+            if (overlap > 0.05 * smaller)
+              throw InputError(path, "line " + std::to_string(lines[j]),
+                               "sphere overlaps the one on line " + std::to_string(lines[i]) +
+                                   " by " + std::to_string(100.0 * overlap / smaller) +
+                                   " % of the smaller radius (limit 5 %)");
+          }
+        }
   return a;
 }
 

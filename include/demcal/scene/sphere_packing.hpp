@@ -3,7 +3,11 @@
 #pragma once
 
 #include <array>
+#include <istream>
+#include <string>
 #include <vector>
+
+#include "demcal/scene/config.hpp"
 
 namespace demcal {
 
@@ -22,6 +26,22 @@ struct SphereAssembly {
 /// pre-compressed: every length shrinks by (1 − ε), so every lattice
 /// contact and each wall overlaps by 2rε.
 SphereAssembly fcc_packing(int nx, int ny, int nz, double radius, double contact_strain = 0.0);
+
+/// A loose random gas of polydisperse spheres, no two overlapping: radii
+/// from spec.distribution as for the 2D gas (random_radii.hpp: uniform in
+/// [radius_min, radius_max] or lognormal with radius_mean, radius_std), one
+/// sphere per cell of a grid of spacing 2.2·r_max jittered within its cell,
+/// nx = ny = ceil(cbrt(count·aspect)) cells across, as many layers as needed
+/// (aspect = width/height); walls at the grid's faces. Deterministic for
+/// spec.seed on every platform. Consolidation (compression) makes it dense.
+SphereAssembly random_sphere_gas(const AssemblySpec& spec);
+/// CSV x,y,z,r (header optional, '#' comments, blank lines skipped); walls at
+/// the bounding box of the spheres. Bad lines, non-finite values, radii
+/// ≤ 0 and overlaps beyond 5 % of the smaller radius are an InputError
+/// naming the file and the line.
+SphereAssembly read_sphere_file(const std::string& path);
+/// The same from a stream; `source` names it in errors.
+SphereAssembly read_spheres(std::istream& in, const std::string& source);
 
 /// σ_zz/σ_xx at sliding failure of a periodic FCC array of uniform spheres
 /// (cube axes along the box) under axisymmetric compression along z with
