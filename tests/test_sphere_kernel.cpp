@@ -355,3 +355,43 @@ TEST(SphereStability, LanczosStepIsTheSharpStabilityLimitOfAPacking) {
 
 }  // namespace
 }  // namespace demcal
+
+namespace demcal {
+namespace {
+
+// The ledger books a moving wall's work every step: a wall that hits a
+// resting sphere and throws it off within one sampling interval of the
+// ledger (a contact lasts π/ω ≈ 16 steps here, the ledger samples every
+// 128) does work the samples alone would miss — the sphere's energy would
+// read as created (from a start with no energy at all, any amount is
+// "everything"). Undamped, frictionless: the books balance to the scheme's
+// error per collision, (ω·Δt)²/2 of the collision energy (test_sphere_gas.cpp).
+TEST(SphereEnergy, MovingWallWorkIsBookedWithinASamplingInterval) {
+  sphere_test::Scene s;
+  s.add(Vector3d(5.0 * kR, 5.0 * kR, 8.999 * kR), kR);  // 0.001·r below the top wall
+  s.lo = {0.0, 0.0, 0.0};
+  s.hi = {10.0 * kR, 10.0 * kR, 10.0 * kR};
+  SphereWorld w = s.make(sphere_test::test_material(0.0, 0.0));
+  const Integration in = sphere_test::set_undamped(w, 0.1);
+  // A slow drift along x: a little energy at the start, so that the ledger
+  // has a scale to read against.
+  w.set_velocity(0, Vector3d(1e-2, 0.0, 0.0), Vector3d::Zero());
+  w.wall(kZMax).velocity = -0.5;  // reaches the sphere in ~40 steps
+  int64_t steps = 0;
+  while (w.wall(kZMax).velocity != 0.0 && steps < 2000) {
+    ASSERT_TRUE(w.step(1)) << to_string(w.divergence());
+    ++steps;
+    if (w.vz()[0] < -0.9) w.wall(kZMax).velocity = 0.0;  // thrown off at ~2·|v_wall|
+  }
+  ASSERT_EQ(w.wall(kZMax).velocity, 0.0);
+  // Past the collision and a bounce off the bottom wall, well beyond
+  // several sampling intervals.
+  ASSERT_TRUE(w.step(4000)) << to_string(w.divergence());
+  const double h = std::sqrt(1e8 / w.mass()[0]) * in.dt;
+  EXPECT_LE(std::abs(w.energy_created()), 0.5 * h * h);
+  std::printf("wall throws a sphere: ledger %.2e (scheme bound %.2e)\n", w.energy_created(),
+              0.5 * h * h);
+}
+
+}  // namespace
+}  // namespace demcal

@@ -8,12 +8,13 @@
 // Coulomb cap or at opening, summed every step (sphere_contact.cpp); left
 // out (as the 2D ledger does), it reads as a deficit that hides created
 // energy. The global damping's loss is summed every step, exactly
-// (SphereWorld::integrate); the work of the walls and the contact damping
-// are sampled every energy_check_interval steps and integrated with the
-// trapezoidal rule. (Sampling the global damping too, as the 2D ledger
-// does, overestimates the loss many times over when the kinetic energy
-// decays within a sampling interval — a free sphere at ζ = 0.7, α = 0.1
-// read as creating energy.)
+// (SphereWorld::integrate), and so is the work of the moving walls
+// (SphereWorld::book_wall_work: sampled, it missed collisions shorter than
+// the interval, and a wall throwing a resting sphere read as energy
+// created); the contact damping is sampled every energy_check_interval
+// steps and integrated with the trapezoidal rule. (Sampling the global damping too, as the 2D
+// ledger does, overestimates the loss many times over when the kinetic energy decays within a
+// sampling interval — a free sphere at ζ = 0.7, α = 0.1 read as creating energy.)
 #include <algorithm>
 #include <cmath>
 
@@ -47,15 +48,13 @@ SphereWorld::EnergySample SphereWorld::energy_sample() const {
       e.power_lost += (fn_elastic - g.fn) * vn;
     }
 
-  // Walls: spring energy, the work rate of the moving walls, contact damping.
+  // Walls: spring energy, contact damping.
   const double kw = material_.wall.kn, ktw = material_.wall.kt;
   const bool damped = material_.contact_damping_ratio > 0.0;
   for (int s = 0; s < 6; ++s) {
     const SphereWall& wall = walls_[s];
     const int axis = s / 2;
     const double sign = (s % 2 == 0) ? 1.0 : -1.0;
-    // wall.force is the particles' force on the wall; the wall's on them is −force.
-    e.power_in -= wall.force[axis] * wall.velocity;
     const double* v[3] = {vx_.data(), vy_.data(), vz_.data()};
     for (int i : wall_candidates_[s]) {
       const double ov = r_[i] - wall_distance(s, i);
@@ -83,21 +82,19 @@ bool SphereWorld::ledger_record(const EnergySample& e) {
     l.started = true;
     l.step = steps_;
     l.energy0 = e.energy;
-    l.power_in = e.power_in;
     l.power_lost = e.power_lost;
     damping_dissipated_ = 0.0;
+    wall_work_ = 0.0;
     friction_dissipated_ = 0.0;
     return false;
   }
   const double h = static_cast<double>(steps_ - l.step) * integration_.dt;
-  l.work += 0.5 * (l.power_in + e.power_in) * h;
   l.lost += 0.5 * (l.power_lost + e.power_lost) * h;
-  l.power_in = e.power_in;
   l.power_lost = e.power_lost;
   l.step = steps_;
   const double lost = l.lost + damping_dissipated_ + friction_dissipated_;
-  const double created = e.energy - l.energy0 - l.work + lost;
-  const double scale = l.energy0 + std::abs(l.work) + lost;
+  const double created = e.energy - l.energy0 - wall_work_ + lost;
+  const double scale = l.energy0 + std::abs(wall_work_) + lost;
   l.created = scale > 0.0 ? created / scale : 0.0;
   if (std::isfinite(l.created) && l.created <= options_.max_energy_created) return false;
   divergence_ = Divergence::kEnergyCreated;

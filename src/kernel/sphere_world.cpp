@@ -126,6 +126,18 @@ void SphereWorld::update_forces() {
   integration_.dt = 0.0;
   compute_forces();
   integration_.dt = dt;
+  for (int s = 0; s < 6; ++s) wall_push_[s] = -walls_[s].force[s / 2];
+}
+
+void SphereWorld::book_wall_work() {
+  for (int s = 0; s < 6; ++s) {
+    // wall.force is the spheres' force on the wall; the wall's on them is −force.
+    const double push = -walls_[s].force[s / 2];
+    const double work = 0.5 * (wall_push_[s] + push) * wall_move_[s];
+    wall_work_ += work;
+    wall_work_abs_ += std::abs(work);
+    wall_push_[s] = push;
+  }
 }
 
 void SphereWorld::integrate() {
@@ -159,7 +171,10 @@ void SphereWorld::integrate() {
     }
   }
   damping_dissipated_ += lost * dt;
-  for (auto& w : walls_) w.position += w.velocity * dt;
+  for (int s = 0; s < 6; ++s) {
+    wall_move_[s] = walls_[s].velocity * dt;
+    walls_[s].position += wall_move_[s];
+  }
   if (!list_valid_) return;
   const double max_disp = std::sqrt(max_d2);
   double max_wall = 0.0;
@@ -193,9 +208,11 @@ bool SphereWorld::check_divergence() {
     sample = energy_sample();
     energy_scale_ = std::max({energy_scale_, sample->elastic, initial_energy_});
   }
-  // Kinetic energy far beyond anything the springs have ever stored cannot
-  // come from the loading: an unstable mode is growing.
-  const double scale = std::max(energy_scale_, initial_energy_);
+  // Kinetic energy far beyond anything the springs have ever stored, or the
+  // walls have ever done as work (a wall can throw a sphere within one
+  // sampling interval), cannot come from the loading: an unstable mode is
+  // growing.
+  const double scale = std::max({energy_scale_, initial_energy_, wall_work_abs_});
   if (scale > 0.0 && ke > options_.max_energy_ratio * scale) {
     divergence_ = Divergence::kEnergy;
     return true;
@@ -214,6 +231,7 @@ bool SphereWorld::step(int64_t count) {
     integrate();
     if (!list_valid_) rebuild_neighbours();
     compute_forces();
+    book_wall_work();
     ++steps_;
     time_ += integration_.dt;
     if (steps_ % interval == 0 && check_divergence()) {

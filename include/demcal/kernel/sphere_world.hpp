@@ -55,8 +55,9 @@ enum SphereWallSide : int { kXMin = 0, kXMax = 1, kYMin = 2, kYMax = 3, kZMin = 
 /// (side / 2: 0 = x, 1 = y, 2 = z), `velocity` along the same axis. The
 /// kernel moves it by velocity·Δt each step. A protocol servoes a wall
 /// through its velocity, as the 2D biaxial protocol does: the energy ledger
-/// counts the work of a moving wall from its velocity, so a `position` set
-/// directly between steps (allowed, e.g. for set-up) is work it cannot see.
+/// counts the work of a moving wall from the moves the kernel makes, so a
+/// `position` set directly between steps (allowed, e.g. for set-up) is work
+/// it cannot see.
 struct SphereWall {
   double position = 0.0;
   double velocity = 0.0;
@@ -191,7 +192,7 @@ class SphereWorld {
   double wall_distance(int s, int i) const;
   // sphere_energy_balance.cpp
   struct EnergySample {
-    double energy = 0.0, elastic = 0.0, power_in = 0.0;
+    double energy = 0.0, elastic = 0.0;
     double power_lost = 0.0;  // contact damping [W] (global damping is summed each step)
   };
   EnergySample energy_sample() const;
@@ -199,6 +200,7 @@ class SphereWorld {
   bool ledger_record(const EnergySample& sample);
   // sphere_world.cpp
   void integrate();
+  void book_wall_work();
   void update_damping_coefficients();
   bool check_divergence();
 
@@ -221,6 +223,16 @@ class SphereWorld {
   // (sliding) or when it opens (sphere_contact.cpp explains why that is
   // dissipated, not created).
   double friction_dissipated_ = 0.0;
+  // Work of the moving walls on the spheres since the ledger started [J],
+  // summed every step by the trapezoidal rule over each wall's move: the
+  // wall's push along its axis before and after the move (wall_push_) times
+  // the move (wall_move_). (Sampled every energy_check_interval steps it
+  // missed a collision shorter than the interval.)
+  double wall_work_ = 0.0;
+  // Σ|work| of the walls since construction (never reset): energy the
+  // walls may have put into motion directly, a scale of the kEnergy check.
+  double wall_work_abs_ = 0.0;
+  std::array<double, 6> wall_push_{}, wall_move_{};
 
   // Verlet half list (pairs i < j) in CSR form, each row sorted by j; the
   // tangential force on i of each pair (3 components), kept across rebuilds.
@@ -246,7 +258,7 @@ class SphereWorld {
   struct Ledger {
     bool started = false;
     int64_t step = 0;
-    double energy0 = 0.0, work = 0.0, lost = 0.0, power_in = 0.0, power_lost = 0.0;
+    double energy0 = 0.0, lost = 0.0, power_lost = 0.0;
     double created = 0.0;
   } ledger_;
 
