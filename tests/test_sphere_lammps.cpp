@@ -269,12 +269,14 @@ TEST(SphereLammps, RandomSampleCompressionMatchesLammps) {
   w.set_integration(in);
   // Cycles of a short inward move of all six walls and a relaxation with the
   // walls held, until the relaxed packing holds 20 MPa (unbalanced force
-  // below 10 %); the moves shrink from 0.1·r to 0.005·r once contacts form
-  // (near jamming the pressure rises steeply with the strain).
+  // below 10 %); the moves shrink from 0.1·r to 0.02·r once contacts form
+  // and to 0.005·r near jamming (where the pressure rises steeply with the
+  // strain).
   SphereMeasures m = w.measure();
   for (int cycle = 0; cycle < 400 && !(m.mean_pressure > 2e7 && m.unbalanced_force_ratio < 0.1);
        ++cycle) {
-    const double move = (m.coordination_number < 1.0 ? 0.1 : 0.005) * kR;
+    const double z = m.coordination_number;
+    const double move = (z < 1.0 ? 0.1 : z < 3.0 ? 0.02 : 0.005) * kR;
     for (int s = 0; s < 6; ++s)
       w.wall(static_cast<SphereWallSide>(s)).velocity =
           (s % 2 == 0 ? 1.0 : -1.0) * move / (500 * in.dt);
