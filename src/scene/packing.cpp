@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "demcal/io/files.hpp"
+#include "demcal/scene/random_radii.hpp"
 
 namespace demcal {
 
@@ -51,43 +52,12 @@ Assembly square_packing(int columns, int rows, double radius) {
   return a;
 }
 
-namespace {
-
-// Uniform in [0, 1) from the top 53 bits: mt19937_64 is fully specified by
-// the standard, so this is the same on every platform (std::uniform_real_
-// distribution is not).
-double uniform01(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
-
-double normal(std::mt19937_64& rng) {
-  // Box–Muller; 1 − u keeps the logarithm finite.
-  const double u = 1.0 - uniform01(rng), v = uniform01(rng);
-  return std::sqrt(-2.0 * std::log(u)) * std::cos(2.0 * std::numbers::pi * v);
-}
-
-}  // namespace
-
 Assembly random_gas(const AssemblySpec& spec) {
   std::mt19937_64 rng(spec.seed);
   Assembly a;
   a.dense = false;
   const int n = spec.count;
-  a.r.resize(n);
-  if (spec.distribution == "lognormal") {
-    const double m = spec.radius_mean, s = spec.radius_std;
-    const double s2 = std::log(1.0 + (s * s) / (m * m));
-    const double mu = std::log(m) - 0.5 * s2;
-    // Truncated at ±3 standard deviations of the log so that no disk is
-    // absurdly small (it would set the time step) or large.
-    for (int i = 0; i < n; ++i) {
-      double z;
-      do z = normal(rng);
-      while (std::abs(z) > 3.0);
-      a.r[i] = std::exp(mu + std::sqrt(s2) * z);
-    }
-  } else {
-    for (int i = 0; i < n; ++i)
-      a.r[i] = spec.radius_min + (spec.radius_max - spec.radius_min) * uniform01(rng);
-  }
+  a.r = random_radii::sample(spec, rng);
   const double r_max = *std::max_element(a.r.begin(), a.r.end());
   const double spacing = 2.2 * r_max;
   const int columns = std::max(1, static_cast<int>(std::ceil(std::sqrt(n * spec.aspect))));
@@ -97,8 +67,8 @@ Assembly random_gas(const AssemblySpec& spec) {
   for (int i = 0; i < n; ++i) {
     const int cx = i % columns, cy = i / columns;
     const double room = 0.5 * spacing - a.r[i];  // jitter that keeps cells disjoint
-    a.x[i] = (cx + 0.5) * spacing + room * (2.0 * uniform01(rng) - 1.0);
-    a.y[i] = (cy + 0.5) * spacing + room * (2.0 * uniform01(rng) - 1.0);
+    a.x[i] = (cx + 0.5) * spacing + room * (2.0 * random_radii::uniform01(rng) - 1.0);
+    a.y[i] = (cy + 0.5) * spacing + room * (2.0 * random_radii::uniform01(rng) - 1.0);
   }
   a.left = 0.0;
   a.right = columns * spacing;

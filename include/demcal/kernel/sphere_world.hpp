@@ -1,0 +1,271 @@
+// The 3D DEM kernel: spheres in a box of six rigid walls, linear contacts,
+// global damping, central-difference integration. The same shape and
+// conventions as the 2D kernel (world.hpp), as Box3D mirrors Box2D:
+// particle state in flat arrays, one file per concern —
+//   sphere_world.cpp           set-up, integration, stepping, divergence
+//   sphere_broad_phase.cpp     cell grid + Verlet skin, contact histories
+//   sphere_contact.cpp         the contact law (pairs and walls)
+//   sphere_stress.cpp          b, σ, energies, ratios
+//   sphere_stability.cpp       reference scales, stable-step estimates
+//   sphere_energy_balance.cpp  the energy ledger of the divergence check
+// The contact, integration, damping and option types are the 2D kernel's
+// (one definition each): ContactLaw, Integration (thickness unused),
+// ReferenceScales, StabilityEstimate, Divergence, KernelOptions (threads
+// unused: this kernel is scalar and single-threaded for now).
+//
+// Physics (SI, tension positive):
+//  - m = ρ·(4/3)·π·r³·f_ms, I = (2/5)·m·r²;
+//  - normal force kn·δ along the centre line (δ = overlap), optional
+//    contact damping on it (off by default);
+//  - tangential force: an incremental spring kt with a 3-vector history,
+//    kept in the current contact plane and turned with the contact every
+//    step (see sphere_contact.cpp), capped by Coulomb μ·Fn; no rolling or
+//    twisting resistance;
+//  - v(n+½) = [(1 − D Δt/2m)·v(n−½) + F·Δt/m]/(1 + D Δt/2m), the same for the
+//    vector ω with D_r and I; D_t = ζ_t·2·sqrt(kn·m), D_r = ζ_r·2·sqrt(kt·r²·I)
+//    per particle; x(n+1) = x(n) + v(n+½)·Δt. Orientations are not tracked
+//    (a sphere's orientation enters no force).
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <array>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "demcal/kernel/world.hpp"
+
+namespace demcal {
+
+/// Material of the spheres and the walls.
+struct SphereMaterial {
+  double density = 2650.0;  ///< ρ [kg/m³]
+  ContactLaw particle{1e8, 5e7, 0.3};
+  ContactLaw wall{1e8, 5e7, 0.0};  ///< walls are frictionless by default
+  /// Local viscous damping on the normal force, as a ratio of the critical
+  /// value 2·sqrt(kn·m_eff). Off by default: the damping is global.
+  double contact_damping_ratio = 0.0;
+};
+
+/// The six walls: the lower and upper plane normal to each axis.
+enum SphereWallSide : int { kXMin = 0, kXMax = 1, kYMin = 2, kYMax = 3, kZMin = 4, kZMax = 5 };
+
+/// A rigid axis-aligned plane. `position` is its coordinate along its axis
+/// (side / 2: 0 = x, 1 = y, 2 = z), `velocity` along the same axis. The
+/// kernel moves it by velocity·Δt each step. A protocol servoes a wall
+/// through its velocity, as the 2D biaxial protocol does: the energy ledger
+/// counts the work of a moving wall from the moves the kernel makes, so a
+/// `position` set directly between steps (allowed, e.g. for set-up) is work
+/// it cannot see.
+struct SphereWall {
+  double position = 0.0;
+  double velocity = 0.0;
+  Eigen::Vector3d force = Eigen::Vector3d::Zero();  ///< force of the particles on the wall [N]
+  int contacts = 0;
+};
+
+/// Full (non-symmetric) 3×3 tensors and scalar equilibrium measures.
+struct SphereMeasures {
+  Eigen::Matrix3d boundary_stress = Eigen::Matrix3d::Zero();     ///< b [Pa]
+  Eigen::Matrix3d homogenized_stress = Eigen::Matrix3d::Zero();  ///< σ [Pa]
+  double kinetic_energy_translation = 0.0;                       ///< [J]
+  double kinetic_energy_rotation = 0.0;                          ///< [J]
+  double elastic_energy = 0.0;                                   ///< stored in the springs [J]
+  double unbalanced_force_ratio = 0.0;                           ///< mean|F_net| / mean|f_contact|
+  double inertial_number = 0.0;                                  ///< ε̇·d·sqrt(ρ/p)
+  double mean_pressure = 0.0;                                    ///< −tr(σ)/3 [Pa]
+  double coordination_number = 0.0;                              ///< 2·contacts / particles
+  int particle_contacts = 0;
+  int wall_contacts = 0;
+  double volume = 0.0;  ///< box volume [m³]
+};
+
+/// An assembly of spheres in a box of six walls.
+class SphereWorld {
+ public:
+  /// Walls at lo[a] and hi[a] along each axis a.
+  SphereWorld(const SphereMaterial& material, std::span<const double> x, std::span<const double> y,
+              std::span<const double> z, std::span<const double> radius,
+              const std::array<double, 3>& lo, const std::array<double, 3>& hi,
+              KernelOptions options = {});
+
+  // --- setup -----------------------------------------------------------
+  void set_integration(const Integration& integration);
+  const Integration& integration() const { return integration_; }
+  const SphereMaterial& material() const { return material_; }
+  const KernelOptions& options() const { return options_; }
+  /// Replace the kernel options; the energy ledger restarts.
+  void set_options(const KernelOptions& options);
+  /// Friction of particle–particle contacts (frictionless consolidation,
+  /// then friction on).
+  void set_particle_friction(double mu) {
+    material_.particle.friction = mu;
+    ledger_ = {};
+  }
+
+  // --- stepping --------------------------------------------------------
+  /// Advance `n` steps; false as soon as the run diverged (see divergence()).
+  bool step(int64_t n = 1);
+  Divergence divergence() const { return divergence_; }
+  /// The energy ledger's last reading (World::energy_created has the meaning).
+  double energy_created() const { return ledger_.created; }
+  int64_t divergence_step() const { return divergence_step_; }
+  int64_t steps_taken() const { return steps_; }
+  double time() const { return time_; }
+
+  // --- measures --------------------------------------------------------
+  SphereMeasures measure(double strain_rate = 0.0) const;
+  ReferenceScales reference_scales() const;
+  /// Stable-step estimates for the current contact network, 6 DOF per sphere.
+  StabilityEstimate stability_estimate(int iterations = 300) const;
+  /// (1/V)·Σ_p x^p ⊗ F_p (origin at the box centre): equals b − σ.
+  Eigen::Matrix3d net_force_moment() const;
+
+  // --- state access (flat arrays) ----------------------------------------
+  int size() const { return n_; }
+  std::span<const double> x() const { return x_; }
+  std::span<const double> y() const { return y_; }
+  std::span<const double> z() const { return z_; }
+  std::span<const double> vx() const { return vx_; }
+  std::span<const double> vy() const { return vy_; }
+  std::span<const double> vz() const { return vz_; }
+  std::span<const double> omega_x() const { return wx_; }
+  std::span<const double> omega_y() const { return wy_; }
+  std::span<const double> omega_z() const { return wz_; }
+  std::span<const double> radius() const { return r_; }
+  double min_radius() const { return r_min_; }
+  double max_radius() const { return r_max_; }
+  std::span<const double> mass() const { return m_; }           ///< scaled masses
+  std::span<const double> inertia() const { return inertia_; }  ///< scaled moments
+  std::span<const double> fx() const { return fx_; }            ///< net contact force
+  std::span<const double> fy() const { return fy_; }
+  std::span<const double> fz() const { return fz_; }
+  std::span<const double> torque_x() const { return tx_; }
+  std::span<const double> torque_y() const { return ty_; }
+  std::span<const double> torque_z() const { return tz_; }
+
+  /// Direct state edits for tests and scene set-up. With rotation locked the
+  /// spin is ignored (kept 0).
+  void set_velocity(int i, const Eigen::Vector3d& v, const Eigen::Vector3d& omega);
+  void set_position(int i, const Eigen::Vector3d& p);
+
+  SphereWall& wall(SphereWallSide side) { return walls_[side]; }
+  const SphereWall& wall(SphereWallSide side) const { return walls_[side]; }
+  /// Box edge along axis a (0 = x, 1 = y, 2 = z).
+  double extent(int axis) const {
+    return walls_[2 * axis + 1].position - walls_[2 * axis].position;
+  }
+  double volume() const { return extent(0) * extent(1) * extent(2); }
+  Eigen::Vector3d centre() const;
+
+  /// Active particle–particle contacts (after the last force evaluation).
+  struct ContactView {
+    int i, j;
+    Eigen::Vector3d normal;      ///< unit, from i to j
+    double fn;                   ///< normal force, compressive > 0
+    Eigen::Vector3d tangential;  ///< tangential force on i (in the contact plane)
+    double overlap;
+  };
+  std::vector<ContactView> contacts() const;
+  int64_t rebuilds() const { return rebuilds_; }
+
+  /// Recompute forces for the current state without moving anything and
+  /// without a tangential increment.
+  void update_forces();
+
+ private:
+  // sphere_broad_phase.cpp
+  void rebuild_neighbours();
+  bool needs_rebuild() const;
+  // sphere_contact.cpp
+  struct PairGeometry {
+    Eigen::Vector3d n;  // unit, i to j
+    double overlap, fn;
+    bool touching;
+  };
+  PairGeometry pair_geometry(int i, int j) const;
+  void pair_forces();
+  void wall_forces();
+  void compute_forces();
+  /// Signed distance from wall s to the centre of i, along the inward normal.
+  double wall_distance(int s, int i) const;
+  // sphere_energy_balance.cpp
+  struct EnergySample {
+    double energy = 0.0, elastic = 0.0;
+    double power_lost = 0.0;  // contact damping [W] (global damping is summed each step)
+  };
+  EnergySample energy_sample() const;
+  bool ledger_due() const;
+  bool ledger_record(const EnergySample& sample);
+  // sphere_world.cpp
+  void integrate();
+  void book_wall_work();
+  void update_damping_coefficients();
+  bool check_divergence();
+
+  SphereMaterial material_;
+  KernelOptions options_;
+  Integration integration_;
+
+  int n_ = 0;
+  std::vector<double> x_, y_, z_, vx_, vy_, vz_, wx_, wy_, wz_, r_;
+  std::vector<double> m_, inertia_;
+  std::vector<double> fx_, fy_, fz_, tx_, ty_, tz_;
+  std::vector<double> ca_t_, cb_t_, ca_r_, cb_r_;  // v ← a·v + b·F per particle
+  std::vector<double> d_t_, d_r_;                  // damping coefficients D_t, D_r
+  // Energy taken by global damping since the energy ledger started [J] (a
+  // running total from the start, not a difference of two totals: that
+  // would cancel catastrophically once most of the energy is gone).
+  double damping_dissipated_ = 0.0;
+  // Energy taken by Coulomb friction since the ledger started [J]: the
+  // tangential spring energy a contact gives up when its force is capped
+  // (sliding) or when it opens (sphere_contact.cpp explains why that is
+  // dissipated, not created).
+  double friction_dissipated_ = 0.0;
+  // Work of the moving walls on the spheres since the ledger started [J],
+  // summed every step by the trapezoidal rule over each wall's move: the
+  // wall's push along its axis before and after the move (wall_push_) times
+  // the move (wall_move_). (Sampled every energy_check_interval steps it
+  // missed a collision shorter than the interval.)
+  double wall_work_ = 0.0;
+  // Σ|work| of the walls since construction (never reset): energy the
+  // walls may have put into motion directly, a scale of the kEnergy check.
+  double wall_work_abs_ = 0.0;
+  std::array<double, 6> wall_push_{}, wall_move_{};
+
+  // Verlet half list (pairs i < j) in CSR form, each row sorted by j; the
+  // tangential force on i of each pair (3 components), kept across rebuilds.
+  std::vector<int> nbr_start_, nbr_j_;
+  std::vector<double> hx_, hy_, hz_;
+  // Wall contacts: candidates within skin, tangential force history and
+  // last normal force per wall and particle.
+  std::array<std::vector<int>, 6> wall_candidates_;
+  std::array<std::vector<double>, 6> wall_hx_, wall_hy_, wall_hz_, wall_fn_;
+  // Scratch for rebuilds (kept to avoid allocation).
+  std::vector<int> new_start_, new_j_, cell_start_, cell_next_;
+  std::vector<double> new_hx_, new_hy_, new_hz_;
+  std::vector<double> x_built_, y_built_, z_built_;
+  std::array<double, 6> wall_built_{};
+  double skin_ = 0.0, r_min_ = 0.0, r_max_ = 0.0;
+  bool list_valid_ = false;
+  int64_t rebuilds_ = 0;
+
+  std::array<SphereWall, 6> walls_;
+  double max_overlap_ratio_seen_ = 0.0;
+  double initial_energy_ = -1.0;
+  double energy_scale_ = 0.0;
+  struct Ledger {
+    bool started = false;
+    int64_t step = 0;
+    double energy0 = 0.0, lost = 0.0, power_lost = 0.0;
+    double created = 0.0;
+  } ledger_;
+
+  Divergence divergence_ = Divergence::kNone;
+  int64_t divergence_step_ = -1;
+  int64_t steps_ = 0;
+  double time_ = 0.0;
+};
+
+}  // namespace demcal

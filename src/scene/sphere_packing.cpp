@@ -1,0 +1,227 @@
+// The FCC lattice and its analytical peak (sphere_packing.hpp).
+#include "demcal/scene/sphere_packing.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+#include "demcal/io/input_error.hpp"
+#include "demcal/scene/random_radii.hpp"
+
+namespace demcal {
+
+SphereAssembly fcc_packing(int nx, int ny, int nz, double radius, double contact_strain) {
+  if (nx < 1 || ny < 1 || nz < 1 || !(radius > 0.0))
+    throw std::invalid_argument("fcc_packing: cells must be >= 1 and radius > 0");
+  SphereAssembly a;
+  // Every length shrinks by (1 − ε) about the lower corner, which is then
+  // 2rε inside the walls (at ε = 0 the touching lattice, bit for bit).
+  const double shrink = 1.0 - contact_strain;
+  const double half = std::sqrt(2.0) * radius;  // a/2, the site spacing
+  const int n[3] = {nx, ny, nz};
+  for (int k = 0; k < 2 * nz; ++k)
+    for (int j = 0; j < 2 * ny; ++j)
+      for (int i = 0; i < 2 * nx; ++i) {
+        if ((i + j + k) % 2 != 0) continue;
+        a.x.push_back(radius + half * shrink * i);
+        a.y.push_back(radius + half * shrink * j);
+        a.z.push_back(radius + half * shrink * k);
+        a.r.push_back(radius);
+      }
+  for (int axis = 0; axis < 3; ++axis) {
+    a.lo[axis] = 2.0 * radius * contact_strain;
+    a.hi[axis] = (2.0 * radius + (2 * n[axis] - 1) * half) * shrink;
+  }
+  return a;
+}
+
+SphereAssembly random_sphere_gas(const AssemblySpec& spec) {
+  if (spec.count < 1) throw std::invalid_argument("random_sphere_gas: count must be >= 1");
+  std::mt19937_64 rng(spec.seed);
+  SphereAssembly a;
+  const int n = spec.count;
+  a.r = random_radii::sample(spec, rng);
+  const double r_max = *std::max_element(a.r.begin(), a.r.end());
+  const double spacing = 2.2 * r_max;
+  const int across =
+      std::max(1, static_cast<int>(std::ceil(std::cbrt(static_cast<double>(n) * spec.aspect))));
+  const int layers = (n + across * across - 1) / (across * across);
+  a.x.resize(n);
+  a.y.resize(n);
+  a.z.resize(n);
+  for (int i = 0; i < n; ++i) {
+    const int cx = i % across, cy = (i / across) % across, cz = i / (across * across);
+    // Jitter that keeps each sphere inside its own cell: no overlaps.
+    const double room = 0.5 * spacing - a.r[i];
+    a.x[i] = (cx + 0.5) * spacing + room * (2.0 * random_radii::uniform01(rng) - 1.0);
+    a.y[i] = (cy + 0.5) * spacing + room * (2.0 * random_radii::uniform01(rng) - 1.0);
+    a.z[i] = (cz + 0.5) * spacing + room * (2.0 * random_radii::uniform01(rng) - 1.0);
+  }
+  a.hi = {across * spacing, across * spacing, layers * spacing};
+  return a;
+}
+
+namespace {
+
+/// The whole of `field` (blanks around it allowed) as a number.
+bool parse_number(const std::string& field, double& value) {
+  const char* s = field.c_str();
+  char* end = nullptr;
+  value = std::strtod(s, &end);
+  if (end == s) return false;
+  while (*end == ' ' || *end == '\t') ++end;
+  return *end == '\0';
+}
+
+}  // namespace
+
+SphereAssembly read_sphere_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path, "", "cannot open particle file");
+  return read_spheres(in, path);
+}
+
+SphereAssembly read_spheres(std::istream& in, const std::string& path) {
+  SphereAssembly a;
+  std::vector<int> lines;  // line of each sphere, for the overlap error
+  std::string line;
+  int line_no = 0;
+  bool seen_content = false;  // a header or a sphere
+  auto where = [&]() { return "line " + std::to_string(line_no); };
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (line_no == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);  // UTF-8 BOM
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    const auto first = line.find_first_not_of(" \t");
+    if (first == std::string::npos || line[first] == '#') continue;
+    std::vector<std::string> fields;
+    std::stringstream ss(line);
+    std::string f;
+    while (std::getline(ss, f, ',')) fields.push_back(f);
+    double v[4];
+    int numbers = 0;
+    for (size_t k = 0; k < fields.size() && k < 4; ++k) numbers += parse_number(fields[k], v[k]);
+    if (fields.size() != 4 || numbers != 4) {
+      // The header is the first content line with four fields, none a
+      // number ("x,y,z,r"); a line with some numbers is a broken sphere
+      // line, never silently skipped.
+      if (!seen_content && fields.size() == 4 && numbers == 0) {
+        seen_content = true;
+        continue;
+      }
+      throw InputError(path, where(), "expected four numbers x,y,z,r, got \"" + line + "\"");
+    }
+    seen_content = true;
+    if (!std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2]) ||
+        !std::isfinite(v[3]))
+      throw InputError(path, where(), "values must be finite, got \"" + line + "\"");
+    if (!(v[3] > 0.0)) throw InputError(path, where(), "radius must be > 0, got \"" + line + "\"");
+    a.x.push_back(v[0]);
+    a.y.push_back(v[1]);
+    a.z.push_back(v[2]);
+    a.r.push_back(v[3]);
+    lines.push_back(line_no);
+  }
+  if (in.bad()) throw InputError(path, "", "cannot read particle file");
+  if (a.size() < 2)
+    throw InputError(path, "", "needs at least two spheres, found " + std::to_string(a.size()));
+  const int n = a.size();
+  const std::vector<double>* pos[3] = {&a.x, &a.y, &a.z};
+  for (int axis = 0; axis < 3; ++axis) {
+    a.lo[axis] = std::numeric_limits<double>::infinity();
+    a.hi[axis] = -std::numeric_limits<double>::infinity();
+    for (int i = 0; i < n; ++i) {
+      a.lo[axis] = std::min(a.lo[axis], (*pos[axis])[i] - a.r[i]);
+      a.hi[axis] = std::max(a.hi[axis], (*pos[axis])[i] + a.r[i]);
+    }
+  }
+  // Overlaps beyond 5 % of the smaller radius are not a packing but an
+  // error. A cell grid (cells of at least 2·r_max, at most 2^20 a side so
+  // the keys cannot overflow; larger cells only cost time) keeps it O(N).
+  const double r_max = *std::max_element(a.r.begin(), a.r.end());
+  double extent = 0.0;
+  for (int axis = 0; axis < 3; ++axis) extent = std::max(extent, a.hi[axis] - a.lo[axis]);
+  const double cell = std::max(2.0 * r_max, extent / static_cast<double>(1 << 20));
+  if (!std::isfinite(extent) || !std::isfinite(cell) || !(cell > 0.0))
+    throw InputError(path, "", "coordinates span more than a double can hold");
+  auto key_of = [&](int i, int dx, int dy, int dz) {
+    const int64_t c[3] = {static_cast<int64_t>((a.x[i] - a.lo[0]) / cell) + dx,
+                          static_cast<int64_t>((a.y[i] - a.lo[1]) / cell) + dy,
+                          static_cast<int64_t>((a.z[i] - a.lo[2]) / cell) + dz};
+    constexpr int64_t kStride = int64_t{1} << 21;
+    return (c[2] * kStride + c[1]) * kStride + c[0];
+  };
+  std::vector<std::pair<int64_t, int>> keyed(n);
+  for (int i = 0; i < n; ++i) keyed[i] = {key_of(i, 0, 0, 0), i};
+  std::sort(keyed.begin(), keyed.end());
+  for (int i = 0; i < n; ++i)
+    for (int dz = -1; dz <= 1; ++dz)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          const int64_t key = key_of(i, dx, dy, dz);
+          auto it = std::lower_bound(keyed.begin(), keyed.end(), std::pair<int64_t, int>(key, -1));
+          for (; it != keyed.end() && it->first == key; ++it) {
+            const int j = it->second;
+            if (j <= i) continue;
+            const double d = std::sqrt(std::pow(a.x[j] - a.x[i], 2) + std::pow(a.y[j] - a.y[i], 2) +
+                                       std::pow(a.z[j] - a.z[i], 2));
+            const double overlap = a.r[i] + a.r[j] - d;
+            const double smaller = std::min(a.r[i], a.r[j]);
+            if (overlap > 0.05 * smaller)
+              throw InputError(path, "line " + std::to_string(lines[j]),
+                               "sphere overlaps the one on line " + std::to_string(lines[i]) +
+                                   " by " + std::to_string(100.0 * overlap / smaller) +
+                                   " % of the smaller radius (limit 5 %)");
+          }
+        }
+  return a;
+}
+
+// Thornton (1979). An FCC sphere has 12 contacts along <110>: 4 horizontal
+// (normals (±1, ±1, 0)/√2) and 8 inclined ((±1, 0, ±1)/√2, (0, ±1, ±1)/√2).
+// With σ_ij = (1/V_p)·Σ_c 2r·n_i·f_j over the 6 contacts of one sphere
+// counted once, take an inclined contact n = (1, 0, 1)/√2 with normal force
+// N and tangential force T in its vertical plane, t = (−1, 0, 1)/√2
+// (resisting the upper sphere sliding down): f = N·n + T·t, so
+// f_x = (N − T)/√2 and f_z = (N + T)/√2; by symmetry all 8 inclined contacts
+// carry the same N and T, the horizontal ones N_h. Then
+//   σ_zz ∝ Σ n_z f_z = 4·(N + T)/2 = 2(N + T),
+//   σ_xx ∝ Σ n_x f_x = 2·(N − T)/2 + 2·N_h/2 = N − T + N_h.
+// Under axial compression at constant σ_xx the ratio grows with T/N and as
+// N_h falls; an upper sphere can slide down into the gap of the four below
+// only by pushing them apart, which opens the horizontal contacts. At
+// failure T = μN and N_h = 0:
+//   σ_zz/σ_xx = 2·(1 + μ)/(1 − μ)   (3.714 for μ = 0.3).
+double fcc_peak_ratio(double friction) {
+  if (friction >= 1.0) return std::numeric_limits<double>::infinity();
+  return 2.0 * (1.0 + friction) / (1.0 - friction);
+}
+
+// Walled sample. With the inclined contacts carrying equal forces, count
+// those crossing a cut. Sites of a plane k: (i, j) with i + j + k even, of
+// which ny have i = 0 and ny have i = 2nx − 1. Each sphere has two xz
+// neighbours in the plane above ((i ± 1, j, k + 1)) except those on the x
+// walls, which have one: a horizontal cut crosses 2·ny·(2nx − 1) xz
+// contacts and 2·nx·(2ny − 1) yz contacts, each carrying (N + T)/√2
+// vertically, over the area Lx·Ly. A cut normal to x crosses 2·ny·(2nz − 1)
+// xz contacts (the open horizontal ones carry nothing), each carrying
+// (N − T)/√2, over Ly·Lz. Hence
+//   σ_zz/σ_xx = (1 + μ)/(1 − μ) · [2ny(2nx − 1) + 2nx(2ny − 1)]·Lz
+//                                  / [2ny(2nz − 1)·Lx],
+// L = (2 + (2n − 1)·√2)·r. The periodic cell is the limit n → ∞ (factor 2).
+// For a cube (nx = ny = nz) the walls change nothing: the factor is 2
+// exactly, the contacts lost at the x walls balancing those lost at the top.
+double fcc_peak_ratio_walled(double friction, int nx, int ny, int nz) {
+  if (friction >= 1.0) return std::numeric_limits<double>::infinity();
+  const double s2 = std::sqrt(2.0);
+  const double lx = 2.0 + (2 * nx - 1) * s2, lz = 2.0 + (2 * nz - 1) * s2;
+  const double vertical = 2.0 * ny * (2 * nx - 1) + 2.0 * nx * (2 * ny - 1);
+  const double lateral = 2.0 * ny * (2 * nz - 1);
+  return (1.0 + friction) / (1.0 - friction) * vertical * lz / (lateral * lx);
+}
+
+}  // namespace demcal

@@ -1,0 +1,300 @@
+// Contact law of the sphere kernel against closed-form results: normal
+// force kn·δ, duration and restitution of a head-on collision, the
+// tangential spring sticking then sliding at μ·Fn with the torques it
+// makes, and the tangential history turning with a rigidly rotating pair.
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+#include "test_sphere_helpers.hpp"
+
+namespace demcal {
+namespace {
+
+using Eigen::Vector3d;
+using sphere_test::kEps;
+using sphere_test::kR;
+using sphere_test::test_material;
+
+// Two equal spheres approach head-on at ±v0 along a direction oblique to
+// every axis, undamped, and separate again. Linear spring, reduced mass
+// m_eff = m/2, ω = sqrt(kn/m_eff): fn = kn·δ at every instant, contact
+// duration T = π·sqrt(m_eff/kn), restitution 1, largest overlap v_rel/ω.
+// The discrete bounds are the 2D kernel's (test_kernel_contact.cpp derives
+// them): the samples lie on a discrete sine of angle θ = 2·asin(h/2),
+// h = ω·Δt; linear interpolation of the crossings errs by ≤ θ²·Δt/16 each
+// side; the discrete half period differs from T by ≤ T·h²/24; |e − 1| ≤ h²/8;
+// |max δ/δ_max − 1| ≤ θ²/8.
+TEST(SphereContact, HeadOnCollisionForceDurationAndRestitution) {
+  const SphereMaterial mat = test_material(0.3);
+  const double r = kR, v0 = 0.05;
+  const Vector3d u = Vector3d(1.0, 2.0, 2.0) / 3.0;
+  sphere_test::Scene s;
+  s.add(Vector3d::Zero(), r);
+  s.add((2.0 * r + 1e-4 * r) * u, r);  // gap 5e-8 m, ~200 steps to close
+  s.lo = {-10 * r, -10 * r, -10 * r};
+  s.hi = {12 * r, 12 * r, 12 * r};
+  SphereWorld w = s.make(mat);
+  const double alpha = 0.01;
+  const Integration in = sphere_test::set_undamped(w, alpha);
+  w.set_velocity(0, v0 * u, Vector3d::Zero());
+  w.set_velocity(1, -v0 * u, Vector3d::Zero());
+
+  const double m = w.mass()[0], kn = mat.particle.kn, kt = mat.particle.kt;
+  const double meff = 0.5 * m, omega = std::sqrt(kn / meff), h = omega * in.dt;
+  const double v_rel = 2.0 * v0;
+  auto overlap = [&] {
+    return 2.0 * r - (sphere_test::position(w, 1) - sphere_test::position(w, 0)).norm();
+  };
+  double t_in = -1.0, t_out = -1.0, max_overlap = 0.0, prev = overlap();
+  int contact_steps = 0;
+  for (int step = 0; step < 2000 && t_out < 0.0; ++step) {
+    ASSERT_TRUE(w.step(1));
+    const double cur = overlap();
+    const auto c = w.contacts();
+    if (cur > 0.0) {
+      ++contact_steps;
+      ASSERT_EQ(c.size(), 1u);
+      // δ = 2r − d: a few ulps of 2r.
+      EXPECT_NEAR(c[0].fn, kn * cur, kn * 8.0 * kEps * 2.0 * r);
+      // Head-on: the tangential velocity is round-off (a few ulps of v_rel),
+      // accumulated over at most the ~110 contact steps.
+      EXPECT_LE(c[0].tangential.norm(), kt * in.dt * 200.0 * 8.0 * kEps * v_rel);
+      EXPECT_NEAR(c[0].normal.dot(u), 1.0, 8.0 * kEps);
+      // Newton's third law, repulsive.
+      EXPECT_NEAR((sphere_test::force(w, 0) + c[0].fn * u).norm(), 0.0, 1e-12 * c[0].fn);
+      EXPECT_NEAR((sphere_test::force(w, 1) + sphere_test::force(w, 0)).norm(), 0.0,
+                  1e-14 * c[0].fn);
+      max_overlap = std::max(max_overlap, cur);
+    } else {
+      EXPECT_TRUE(c.empty());
+    }
+    const double t1 = w.time(), t0 = t1 - in.dt;
+    if (prev <= 0.0 && cur > 0.0) t_in = t0 + in.dt * (-prev) / (cur - prev);
+    if (prev > 0.0 && cur <= 0.0) t_out = t0 + in.dt * prev / (prev - cur);
+    prev = cur;
+  }
+  ASSERT_GT(t_in, 0.0);
+  ASSERT_GT(t_out, t_in);
+  ASSERT_GT(contact_steps, 100);
+  const double T = std::numbers::pi * std::sqrt(meff / kn);
+  const double theta = 2.0 * std::asin(0.5 * h);
+  EXPECT_NEAR(t_out - t_in, std::numbers::pi * in.dt / theta, theta * theta * in.dt / 16.0);
+  EXPECT_NEAR(t_out - t_in, T, T * h * h / 24.0 + theta * theta * in.dt / 16.0);
+  const double e = (sphere_test::velocity(w, 1) - sphere_test::velocity(w, 0)).dot(u) / v_rel;
+  EXPECT_NEAR(e, 1.0, h * h / 8.0);
+  const double dmax = v_rel / omega;
+  EXPECT_NEAR(max_overlap, dmax, dmax * theta * theta / 8.0);
+}
+
+// Two spheres overlapping by δ along an oblique normal n; sphere 1 slides
+// past sphere 0 at constant speed V along a tangent t. Heavy spheres (mass
+// scaling 1e15): the contact forces change the velocities by a fraction
+// F·T/(m·V) < 1e-7 over the test. Incremental spring: Ft = kt·V·t_elapsed
+// along the (turning) tangent while below μ·Fn, then exactly μ·Fn. The
+// normal turns by φ ≤ s/d (s the slip), which shortens each increment's
+// projection by at most φ²/2. Forces −Fn·n + Ft on 0 and the opposite on 1;
+// torques a_0·n × Ft and a_1·n × Ft, a = r − δ/2.
+TEST(SphereContact, ObliqueContactSticksThenSlidesAtCoulombLimit) {
+  const double mu = 0.3, r = kR, delta = 1e-6, V = 1e-3;
+  const SphereMaterial mat = test_material(mu);
+  const Vector3d n0 = Vector3d(2.0, 3.0, 6.0) / 7.0, t = Vector3d(3.0, -6.0, 2.0) / 7.0;
+  sphere_test::Scene s;
+  s.add(Vector3d::Zero(), r);
+  s.add((2.0 * r - delta) * n0, r);
+  s.lo = {-10 * r, -10 * r, -10 * r};
+  s.hi = {10 * r, 10 * r, 10 * r};
+  SphereWorld w = s.make(mat);
+  Integration in = sphere_test::set_undamped(w, 0.0, 1e15);
+  in.dt = 1e-6;
+  w.set_integration(in);
+  w.set_velocity(1, V * t, Vector3d::Zero());
+  const double kn = mat.particle.kn, kt = mat.particle.kt;
+  const int steps = 1000;
+  const double slip_max = V * in.dt * steps, phi = slip_max / (2.0 * r - delta);
+  const double force_max = kn * 2.0 * delta;  // far above anything reached
+  const double drift = force_max * steps * in.dt / (w.mass()[0] * V);
+  ASSERT_LT(drift, 1e-6);
+  int stuck = 0, slid = 0;
+  for (int k = 1; k <= steps; ++k) {
+    ASSERT_TRUE(w.step(1));
+    const auto c = w.contacts();
+    ASSERT_EQ(c.size(), 1u);
+    const Vector3d n = c[0].normal, ft = c[0].tangential;
+    const double d = (sphere_test::position(w, 1) - sphere_test::position(w, 0)).norm();
+    const double fn = kn * (2.0 * r - d);
+    EXPECT_NEAR(c[0].fn, fn, kn * 8.0 * kEps * 2.0 * r);
+    EXPECT_NEAR(ft.dot(n), 0.0, 1e-12 * ft.norm());
+    // Direction: the current tangent, the one t turns into.
+    const Vector3d t_now = (t - t.dot(n) * n).normalized();
+    EXPECT_NEAR(ft.normalized().dot(t_now), 1.0, 1e-12);
+    const double stick = kt * V * in.dt * k;
+    const double tol = stick * (phi * phi / 2.0 + drift) + 1e-12 * stick;
+    if (stick < mu * fn - tol) {
+      EXPECT_NEAR(ft.norm(), stick, tol);
+      ++stuck;
+    } else if (stick > mu * fn + tol) {
+      EXPECT_NEAR(ft.norm(), mu * fn, 1e-13 * mu * fn);
+      ++slid;
+    }
+    const Vector3d f0 = -c[0].fn * n + ft;
+    EXPECT_NEAR((sphere_test::force(w, 0) - f0).norm(), 0.0, 1e-13 * fn);
+    EXPECT_NEAR((sphere_test::force(w, 1) + f0).norm(), 0.0, 1e-13 * fn);
+    const double a = r - 0.5 * c[0].overlap;
+    EXPECT_NEAR((sphere_test::torque(w, 0) - a * n.cross(ft)).norm(), 0.0, 1e-13 * fn * r);
+    EXPECT_NEAR((sphere_test::torque(w, 1) - a * n.cross(ft)).norm(), 0.0, 1e-13 * fn * r);
+  }
+  EXPECT_GT(stuck, 500);  // μ·Fn/(kt·V·Δt) = 600 steps of sticking
+  EXPECT_GT(slid, 300);
+}
+
+// A contact pair loaded in shear, then turned rigidly by Θ = 90° about an
+// axis through its centre (the driver prescribes the rigid velocity field
+// every step: v = (R(Ω·Δt) − I)(x − c)/Δt, so the centres move exactly on
+// the rotated positions, and ω = Ω). The tangential force must turn with the
+// pair: F_t(end) = R(Θ)·F_t(start), magnitude kept. Error sources, bounded:
+//  - the chord velocity leaves a tangential slip rate |d|·Ω·(ΩΔt)²/6 per step,
+//    i.e. kt·d·Θ·(ΩΔt)²/6 of force over the turn;
+//  - per step the turning is a tilt (rescaled projection: exact for a tilt
+//    axis normal to F_t) and a twist about n (exact); splitting a rotation
+//    into the two errs by at most (ΩΔt)²·|F_t| per step, and the rescaled
+//    projection turns a force with components both in and out of the tilt
+//    plane with an error of at most (ΩΔt)²·|F_t|: 2·Θ·ΩΔt·|F_t| in all.
+//    For the pure tilt of a force in the tilt plane and for the pure twist
+//    only round-off remains;
+//  - the incremental law itself: velocities at n+½ against the normal at
+//    n+1 leave, per step, a slip ½(ΩΔt)²·|d|·(Ω̂·n)·|Ω̂ × n| along the
+//    contact plane (first order in Δt overall, zero for a pure tilt or
+//    twist): at most kt·d·Θ·ΩΔt/4 of force over the turn;
+//  - the contact forces' own change of the prescribed velocities within a
+//    step: a slip ≤ Δt²·|F_t|·(2/m + 2a²/I) = 7·Δt²·|F_t|/m per step,
+//    negligible with mass scaling 1e18.
+struct TurnResult {
+  Vector3d expected, got;
+  double force, tolerance;
+};
+
+TurnResult turn_loaded_pair(const Vector3d& axis, const Vector3d& load, bool general_axis) {
+  const double r = kR, delta = 1e-5;  // Fn = 1000 N
+  const SphereMaterial mat = test_material(1.0);
+  sphere_test::Scene s;
+  s.add(Vector3d::Zero(), r);
+  s.add(Vector3d(2.0 * r - delta, 0.0, 0.0), r);
+  s.lo = {-10 * r, -10 * r, -10 * r};
+  s.hi = {10 * r, 10 * r, 10 * r};
+  SphereWorld w = s.make(mat);
+  Integration in = sphere_test::set_undamped(w, 0.0, 1e18);
+  in.dt = 1e-6;
+  w.set_integration(in);
+  // Load: sphere 1 slides along `load` for a few steps (|Ft| ≈ 0.25–0.3 Fn).
+  w.set_velocity(1, load, Vector3d::Zero());
+  w.step(5);
+  w.set_velocity(0, Vector3d::Zero(), Vector3d::Zero());
+  w.set_velocity(1, Vector3d::Zero(), Vector3d::Zero());
+  w.step(1);
+  const auto c0 = w.contacts();
+  const Vector3d f0 = c0.at(0).tangential;
+  const Vector3d centre = 0.5 * (sphere_test::position(w, 0) + sphere_test::position(w, 1));
+  const double d = (sphere_test::position(w, 1) - sphere_test::position(w, 0)).norm();
+
+  // A zero `axis` means the branch itself (the loading tilted it a little).
+  const Vector3d e =
+      axis.isZero()
+          ? Vector3d(sphere_test::position(w, 1) - sphere_test::position(w, 0)).normalized()
+          : axis.normalized();
+  const int steps = 100000;
+  const double theta = 0.5 * std::numbers::pi, wdt = theta / steps;
+  const Vector3d Omega = e * wdt / in.dt;
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(wdt, e).toRotationMatrix();
+  for (int k = 0; k < steps; ++k) {
+    for (int i = 0; i < 2; ++i)
+      w.set_velocity(
+          i, (R - Eigen::Matrix3d::Identity()) * (sphere_test::position(w, i) - centre) / in.dt,
+          Omega);
+    w.step(1);
+  }
+  const Eigen::Matrix3d Rt = Eigen::AngleAxisd(theta, e).toRotationMatrix();
+  TurnResult out;
+  out.expected = Rt * f0;
+  out.got = w.contacts().at(0).tangential;
+  out.force = f0.norm();
+  const double kt = mat.particle.kt;
+  out.tolerance = kt * d * theta * wdt * wdt / 6.0 +
+                  steps * kt * 7.0 * in.dt * in.dt * out.force / w.mass()[0] + 1e-9 * out.force;
+  if (general_axis) out.tolerance += 2.0 * theta * wdt * out.force + kt * d * theta * wdt / 4.0;
+  return out;
+}
+
+TEST(SphereContact, TangentialForceTurnsWithRigidlyRotatingPair) {
+  // Tilt (axis normal to the branch, force in the tilt plane), twist (axis
+  // along the branch), and both with a force in no special direction.
+  struct Case {
+    Vector3d axis, load;
+    bool general;
+  };
+  for (const Case& c : {Case{{0, 0, 1}, {0, 1, 0}, false}, Case{{0, 0, 0}, {0, 1, 0.5}, false},
+                        Case{{1, 1, 1}, {0, 1, 0.5}, true}}) {
+    SCOPED_TRACE(c.axis.transpose());
+    const TurnResult t = turn_loaded_pair(c.axis, c.load, c.general);
+    EXPECT_GT(t.force, 100.0);
+    EXPECT_NEAR((t.got - t.expected).norm(), 0.0, t.tolerance);
+    EXPECT_NEAR(t.got.norm(), t.force, t.tolerance);
+  }
+}
+
+}  // namespace
+}  // namespace demcal
+
+namespace demcal {
+namespace {
+
+// A heavy sphere pressed onto the bottom wall (wall friction μ_w) slides
+// horizontally at constant speed V along u. The wall's incremental spring
+// gives F_t = kt_w·V·t_elapsed against the motion while below μ_w·Fn, then
+// exactly μ_w·Fn; the torque about the centre is (−dist·g) × F_t, dist =
+// r − δ; the wall feels the opposite of the force on the sphere. Mass
+// scaling 1e15: the forces change the velocity by < 1e-6 relative.
+TEST(SphereContact, WallFrictionSticksThenSlidesWithTorque) {
+  const double mu_w = 0.4, r = kR, delta = 1e-6, V = 1e-3;
+  const SphereMaterial mat = test_material(0.3, mu_w);
+  sphere_test::Scene s;
+  s.add(Vector3d(0.0, 0.0, r - delta), r);
+  s.lo = {-20 * r, -20 * r, 0.0};
+  s.hi = {20 * r, 20 * r, 10 * r};
+  SphereWorld w = s.make(mat);
+  Integration in = sphere_test::set_undamped(w, 0.0, 1e15);
+  in.dt = 1e-6;
+  w.set_integration(in);
+  const Vector3d u = Vector3d(1.0, 2.0, 0.0).normalized(), g(0.0, 0.0, 1.0);
+  w.set_velocity(0, V * u, Vector3d::Zero());
+  const double fn = mat.wall.kn * delta, ktw = mat.wall.kt;
+  int stuck = 0, slid = 0;
+  for (int k = 1; k <= 1500; ++k) {
+    ASSERT_TRUE(w.step(1));
+    const Vector3d f = sphere_test::force(w, 0);
+    EXPECT_NEAR(f.dot(g), fn, 1e-6 * fn);  // the sphere stays at its height
+    const Vector3d ft = f - f.dot(g) * g;
+    EXPECT_NEAR(ft.normalized().dot(-u), 1.0, 1e-12);
+    const double stick = ktw * V * in.dt * k, tol = 1e-6 * stick;
+    if (stick < mu_w * fn - tol) {
+      EXPECT_NEAR(ft.norm(), stick, tol);
+      ++stuck;
+    } else if (stick > mu_w * fn + tol) {
+      EXPECT_NEAR(ft.norm(), mu_w * f.dot(g), 1e-13 * fn);
+      ++slid;
+    }
+    const double dist = w.z()[0];
+    EXPECT_NEAR((sphere_test::torque(w, 0) - (-dist * g).cross(ft)).norm(), 0.0, 1e-13 * fn * r);
+    EXPECT_NEAR((w.wall(kZMin).force + f).norm(), 0.0, 1e-13 * fn);
+    EXPECT_EQ(w.wall(kZMin).contacts, 1);
+  }
+  EXPECT_GT(stuck, 700);  // μ_w·Fn/(kt_w·V·Δt) = 800 steps
+  EXPECT_GT(slid, 600);
+}
+
+}  // namespace
+}  // namespace demcal
