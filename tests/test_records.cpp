@@ -241,8 +241,12 @@ TEST(Records, EvidenceBlockMeasuresPeakErrorsAgainstTheReference) {
   best.score.criteria.peak_stress_yy = -6.3e5;  // 5 % stronger: a positive error
   const json b = evidence_block(e, best);
   EXPECT_NEAR(b.at("reference").at("calibrated_peak_error").get<double>(), 0.05, 1e-12);
+  EXPECT_NEAR(*peak_error(best, e.reference_peak), 0.05, 1e-12);
   best.score.diverged = true;
   EXPECT_TRUE(peak_error_json(best, e.reference_peak).is_null());
+  best.score.diverged = false;
+  best.score.complete = false;  // stopped early: its peak is not the run's
+  EXPECT_FALSE(peak_error(best, e.reference_peak));
   const std::string lines = evidence_lines(e);  // the two reference runs, no baseline
   EXPECT_EQ(std::count(lines.begin(), lines.end(), '\n'), 2);
 }

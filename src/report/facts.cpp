@@ -72,9 +72,7 @@ Point point_of(const ReportInput& in, bool have_best, const TrialRecord& t,
   p.seconds = t.wall_time_s;
   if (!t.score.complete && t.steps_run > 0 && t.params.steps > t.steps_run)
     p.seconds *= static_cast<double>(t.params.steps) / static_cast<double>(t.steps_run);
-  const Score& s = t.score;
-  if (in.reference && s.complete && !s.diverged && s.criteria.peak_stress_yy < 0.0)
-    p.peak_error = (in.reference->peak - s.criteria.peak_stress_yy) / std::abs(in.reference->peak);
+  if (in.reference) p.peak_error = peak_error(t, in.reference->peak);
   p.best = have_best && t.phase == S.best_trial.phase && t.id == S.best_trial.id &&
            t.params.steps == S.best_trial.params.steps;
   return p;

@@ -64,14 +64,12 @@ std::vector<double> fourth_differences(const std::vector<double>& x) {
 // The fourth difference of white noise of variance s² has variance 70 s².
 constexpr double kHighPassGain = 8.366600265340756;  // sqrt(70)
 
-// Relative error of a (negative) peak against a reference: positive when
-// the strength is over-predicted.
+}  // namespace
+
 std::optional<double> peak_error_of(double peak, std::optional<double> reference) {
   if (!reference || *reference == 0.0) return std::nullopt;
   return (*reference - peak) / std::abs(*reference);
 }
-
-}  // namespace
 
 double robust_noise(const std::vector<double>& x) {
   std::vector<double> hp = fourth_differences(x);

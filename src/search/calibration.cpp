@@ -172,6 +172,12 @@ TrialRecord trial_record(const AlgorithmSpec& params, const Score& score,
       .params = params, .score = score, .steps_run = run.steps_run, .wall_time_s = run.wall_time_s};
 }
 
+std::optional<double> peak_error(const TrialRecord& t, double reference_peak) {
+  const Score& s = t.score;
+  if (!s.complete || s.diverged || s.criteria.peak_stress_yy >= 0.0) return std::nullopt;
+  return peak_error_of(s.criteria.peak_stress_yy, reference_peak);
+}
+
 // trials.jsonl: one line per trial. The keys are those of every earlier
 // version (the peak repeated beside the criteria), so old files resume.
 nlohmann::json to_json(const TrialRecord& r) {

@@ -44,9 +44,8 @@ nlohmann::json params_file(const SceneConfig& config, const ConsolidatedState& s
 }
 
 nlohmann::json peak_error_json(const TrialRecord& t, double reference_peak) {
-  const Criteria& c = t.score.criteria;
-  if (!t.score.complete || t.score.diverged || c.peak_stress_yy >= 0.0) return nullptr;
-  return (reference_peak - c.peak_stress_yy) / std::abs(reference_peak);
+  const std::optional<double> error = peak_error(t, reference_peak);
+  return error ? nlohmann::json(*error) : nlohmann::json(nullptr);
 }
 
 nlohmann::json evidence_block(const CalibrationEvidence& e, const TrialRecord& best) {

@@ -148,6 +148,10 @@ Criteria compute_criteria(const std::vector<MonitorPoint>& series, double latera
                           std::optional<double> reference_peak = std::nullopt);
 Score score_run(const LoadingResult& run, double lateral_stress, const Tolerances& tolerances,
                 std::optional<double> reference_peak = std::nullopt);
+/// Relative error of a (negative) peak b_yy against a reference,
+/// (reference − peak)/|reference|: positive when the strength is
+/// over-predicted; nothing without a (non-zero) reference.
+std::optional<double> peak_error_of(double peak, std::optional<double> reference);
 /// The parameter most likely out of bounds, from the pattern of measures
 /// (DESIGN.md §3 as our kernel shows it; reports/signature-atlas.md).
 ///

@@ -122,6 +122,9 @@ nlohmann::json to_json(const TrialRecord& record);
 TrialRecord trial_from_json(const nlohmann::json& j, const std::string& source);
 /// A trial (id 0, phase search) from its parameters, score and run.
 TrialRecord trial_record(const AlgorithmSpec& params, const Score& score, const LoadingResult& run);
+/// A trial's peak error against a reference peak (peak_error_of()), or
+/// nothing for a run without a valid peak (stopped early, diverged).
+std::optional<double> peak_error(const TrialRecord& trial, double reference_peak);
 
 struct Certificate {
   int64_t steps = 0;
