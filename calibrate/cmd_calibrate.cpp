@@ -162,8 +162,7 @@ int cmd_calibrate(const CalibrateOptions& o) {
       reference = run_refined_reference(config, state, summary.best, options.tolerances, 1);
     };
     run_parallel({run_baseline, run_reference}, jobs);
-    const CalibrationEvidence evidence{reference->coarse, reference->fine, reference->peak,
-                                       *baseline, kStartStepsPerParticle * n_rev};
+    const CalibrationEvidence evidence{*reference, *baseline, kStartStepsPerParticle * n_rev};
     evidence_lines = demcal::evidence_lines(evidence);
     params["evidence"] = evidence_block(evidence, summary.best_trial);
   }

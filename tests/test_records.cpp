@@ -235,18 +235,18 @@ TEST(Records, ParamsFileCarriesTheCalibratedBlocks) {
 
 TEST(Records, EvidenceBlockMeasuresPeakErrorsAgainstTheReference) {
   CalibrationEvidence e;
-  e.coarse = e.fine = sample_trial();
-  e.reference_peak = -6.0e5;
+  e.reference.coarse = e.reference.fine = sample_trial();
+  e.reference.peak = -6.0e5;
   TrialRecord best = sample_trial();
   best.score.criteria.peak_stress_yy = -6.3e5;  // 5 % stronger: a positive error
   const json b = evidence_block(e, best);
   EXPECT_NEAR(b.at("reference").at("calibrated_peak_error").get<double>(), 0.05, 1e-12);
-  EXPECT_NEAR(*peak_error(best, e.reference_peak), 0.05, 1e-12);
+  EXPECT_NEAR(*peak_error(best, e.reference.peak), 0.05, 1e-12);
   best.score.diverged = true;
-  EXPECT_TRUE(peak_error_json(best, e.reference_peak).is_null());
+  EXPECT_TRUE(peak_error_json(best, e.reference.peak).is_null());
   best.score.diverged = false;
   best.score.complete = false;  // stopped early: its peak is not the run's
-  EXPECT_FALSE(peak_error(best, e.reference_peak));
+  EXPECT_FALSE(peak_error(best, e.reference.peak));
   const std::string lines = evidence_lines(e);  // the two reference runs, no baseline
   EXPECT_EQ(std::count(lines.begin(), lines.end(), '\n'), 2);
 }

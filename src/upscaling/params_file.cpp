@@ -59,16 +59,16 @@ nlohmann::json evidence_block(const CalibrationEvidence& e, const TrialRecord& b
     b["steps"] = baseline.params.steps;
     b["particle_steps"] = last.score.particle_steps;
     b["peak_stress_yy"] = last.score.criteria.peak_stress_yy;
-    b["peak_error"] = peak_error_json(last, e.reference_peak);
+    b["peak_error"] = peak_error_json(last, e.reference.peak);
   }
   return {{"reference",
            {{"law", "Richardson, error proportional to 1/Nstep: 2 P(16 Nstep) - P(8 Nstep)"},
-            {"steps_8x", e.coarse.params.steps},
-            {"peak_stress_yy_8x", e.coarse.score.criteria.peak_stress_yy},
-            {"steps_16x", e.fine.params.steps},
-            {"peak_stress_yy_16x", e.fine.score.criteria.peak_stress_yy},
-            {"peak_stress_yy", e.reference_peak},
-            {"calibrated_peak_error", peak_error_json(best, e.reference_peak)}}},
+            {"steps_8x", e.reference.coarse.params.steps},
+            {"peak_stress_yy_8x", e.reference.coarse.score.criteria.peak_stress_yy},
+            {"steps_16x", e.reference.fine.params.steps},
+            {"peak_stress_yy_16x", e.reference.fine.score.criteria.peak_stress_yy},
+            {"peak_stress_yy", e.reference.peak},
+            {"calibrated_peak_error", peak_error_json(best, e.reference.peak)}}},
           {"baseline", b}};
 }
 
@@ -76,11 +76,11 @@ std::string evidence_lines(const CalibrationEvidence& e) {
   std::string lines;
   auto add = [&](const TrialRecord& t) {
     nlohmann::json j = to_json(t);
-    j["peak_error"] = peak_error_json(t, e.reference_peak);
+    j["peak_error"] = peak_error_json(t, e.reference.peak);
     lines += j.dump() + "\n";
   };
-  add(e.coarse);
-  add(e.fine);
+  add(e.reference.coarse);
+  add(e.reference.fine);
   for (const auto& t : e.baseline.trials) add(t);
   return lines;
 }
