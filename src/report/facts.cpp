@@ -43,23 +43,6 @@ std::string verdict(const TrialRecord& t) {
   return t.score.passed ? "pass" : "FAIL";
 }
 
-double Ratios::worst() const {
-  return std::max({force_balance, moment_balance, servo, oscillation});
-}
-
-std::string Ratios::worst_name() const {
-  const double w = worst();
-  if (w == force_balance) return "force balance";
-  if (w == moment_balance) return "moment balance";
-  if (w == servo) return "servo";
-  return "oscillation";
-}
-
-Ratios ratios(const Criteria& c, const Tolerances& t) {
-  return {c.force_balance / t.force_balance, c.moment_balance / t.moment_balance, c.servo / t.servo,
-          c.oscillation / t.oscillation};
-}
-
 namespace {
 
 Point point_of(const ReportInput& in, bool have_best, const TrialRecord& t,

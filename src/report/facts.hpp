@@ -26,14 +26,6 @@ std::string params_gp(const AlgorithmSpec& p);
 /// "diverged", "stopped early", "pass" or "FAIL".
 std::string verdict(const TrialRecord& t);
 
-/// Each criterion divided by its tolerance (≤ 1 passes).
-struct Ratios {
-  double force_balance, moment_balance, servo, oscillation;
-  double worst() const;
-  std::string worst_name() const;
-};
-Ratios ratios(const Criteria& c, const Tolerances& t);
-
 /// One trial in the history and the speed-vs-accuracy chart.
 struct Point {
   std::string label;                   ///< "12", "b3", "r8"

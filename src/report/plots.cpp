@@ -219,7 +219,7 @@ std::vector<std::string> add_history_files(PlotPlan& plot, const ReportFacts& f,
   int64_t best_so_far = 0;
   for (const auto& t : f.in->summary.trials) {
     const Score& s = t.score;
-    const Ratios r = ratios(s.criteria, tol);
+    const Excesses r = excesses(s.criteria, tol);
     const double rv[4] = {r.force_balance, r.moment_balance, r.servo, r.oscillation};
     h << t.id << ' ' << t.params.steps;
     for (int k = 0; k < 4; ++k) {

@@ -54,8 +54,8 @@ void write_at_a_glance(Doc& d, const ReportFacts& f) {
   std::vector<std::string> glance;
   if (f.have_best) {
     glance.push_back(use_line(in));
-    const Ratios r =
-        ratios(in.best ? in.best->score.criteria : S.best_trial.score.criteria, in.tolerances);
+    const Excesses r =
+        excesses(in.best ? in.best->score.criteria : S.best_trial.score.criteria, in.tolerances);
     glance.push_back("Every criterion within tolerance: worst " + r.worst_name() + " at " +
                      fixed(100.0 * r.worst(), 0) + " % of its tolerance.");
   }

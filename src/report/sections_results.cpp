@@ -149,7 +149,7 @@ void write_rejected_neighbours(Doc& d, const ReportFacts& f, int near_failures) 
       "failed.");
   std::vector<std::vector<std::string>> rows;
   for (const auto& [dd, t] : failed) {
-    const Ratios r = ratios(t->score.criteria, in.tolerances);
+    const Excesses r = excesses(t->score.criteria, in.tolerances);
     rows.push_back(
         {std::to_string(t->id), differs_from(t->params, S.best), verdict(*t),
          t->score.diverged ? "diverged" : r.worst_name() + " " + fixed(r.worst(), 2) + "×",
@@ -168,7 +168,7 @@ void write_diagnosis(Doc& d, const ReportFacts& f, int near_failures) {
   d.heading(2, "Diagnosis in words", "diagnosis");
   if (in.start) {
     const auto& s = in.start->score;
-    const Ratios r = ratios(s.criteria, in.tolerances);
+    const Excesses r = excesses(s.criteria, in.tolerances);
     std::string text = "Start point (" + params_text(in.start->params) + "): " +
                        (s.passed ? "passes every criterion. "
                                  : "does not pass (worst: " + r.worst_name() + " at " +
@@ -331,7 +331,7 @@ void write_all_trials(Doc& d, const ReportFacts& f) {
   std::vector<std::vector<std::string>> rows;
   for (const auto& p : f.points) {
     const auto& t = *p.trial;
-    const Ratios r = ratios(t.score.criteria, tol);
+    const Excesses r = excesses(t.score.criteria, tol);
     auto ratio = [&](double v) { return t.score.diverged ? std::string("-") : fixed(v, 2); };
     rows.push_back({p.label + (p.best ? "*" : ""), to_string(t.phase), num(t.params.dt_ratio, 4),
                     grouped(t.params.steps), num(t.params.damping_ratio_translation, 3),
