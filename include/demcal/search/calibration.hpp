@@ -108,9 +108,9 @@ struct TrialRecord {
   int id = 0;
   TrialPhase phase = TrialPhase::search;
   AlgorithmSpec params;
-  /// Read back from trials.jsonl, the score lacks what the file does not
-  /// keep: the four per-criterion excesses and the diagnosis beyond its
-  /// message (constraint_values() and objective() need neither).
+  /// Read back from trials.jsonl, the score lacks only what the file does
+  /// not keep: the diagnosis beyond its message (the search and the report
+  /// need no more).
   Score score;
   int64_t steps_run = 0;  ///< fewer than params.steps when the run stopped early
   double wall_time_s = 0.0;
