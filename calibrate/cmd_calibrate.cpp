@@ -139,7 +139,7 @@ int cmd_calibrate(const CalibrateOptions& o) {
   const int64_t n_proto = config.prototype.particles > 0 ? config.prototype.particles : n_rev;
   nlohmann::json params = params_file(config, state, options, summary);
 
-  const bool have_best = summary.best_trial.particle_steps > 0.0;
+  const bool have_best = summary.best_trial.score.particle_steps > 0.0;
   const int jobs = resolve_jobs(o.jobs);
   auto say = [&](const std::string& line) {
     if (!o.quiet) std::cerr << "demcal: " << line << "\n";
@@ -162,8 +162,7 @@ int cmd_calibrate(const CalibrateOptions& o) {
       reference = run_refined_reference(config, state, summary.best, options.tolerances, 1);
     };
     run_parallel({run_baseline, run_reference}, jobs);
-    const CalibrationEvidence evidence{reference->coarse, reference->fine, reference->peak,
-                                       *baseline, kStartStepsPerParticle * n_rev};
+    const CalibrationEvidence evidence{*reference, *baseline, kStartStepsPerParticle * n_rev};
     evidence_lines = demcal::evidence_lines(evidence);
     params["evidence"] = evidence_block(evidence, summary.best_trial);
   }

@@ -216,15 +216,15 @@ int cmd_verify(const VerifyOptions& o) {
       {"rev", {{"particles", rev.particles}, {"steps", rev.params.steps}}},
       {"upscaling", upscaling_block(rev.particles, n, law)},
       {"params", param_block(up, scales)},
-      {"passed", trial.passed},
-      {"criteria", to_json(trial.criteria)},
+      {"passed", trial.score.passed},
+      {"criteria", to_json(trial.score.criteria)},
       {"tolerances", to_json(tolerances)},
       {"diagnosis", to_json(score.diagnosis)},
       {"peak",
-       {{"stress_yy", trial.criteria.peak_stress_yy},
-        {"strain_yy", trial.criteria.peak_strain_yy},
-        {"ratio", -trial.criteria.peak_stress_yy / config.test.lateral_stress}}},
-      {"diverged", trial.diverged},
+       {{"stress_yy", trial.score.criteria.peak_stress_yy},
+        {"strain_yy", trial.score.criteria.peak_strain_yy},
+        {"ratio", -trial.score.criteria.peak_stress_yy / config.test.lateral_stress}}},
+      {"diverged", trial.score.diverged},
       {"consolidation", {{"steps", state.steps}, {"wall_time_s", state.wall_time_s}}},
       {"loading",
        {{"steps", up.steps},
@@ -237,8 +237,8 @@ int cmd_verify(const VerifyOptions& o) {
   write_file_atomic(dir + "/verify.json", out.dump(2) + "\n");
   write_file_atomic(dir + "/series.csv", series_csv(run.series));
 
-  const auto& c = trial.criteria;
-  std::cout << (trial.passed ? "PASS" : "FAIL") << ": prototype of " << n << " particles, "
+  const auto& c = trial.score.criteria;
+  std::cout << (trial.score.passed ? "PASS" : "FAIL") << ": prototype of " << n << " particles, "
             << up.steps << " steps (alpha " << up.dt_ratio << ", zeta_t "
             << up.damping_ratio_translation << ", zeta_r " << up.damping_ratio_rotation << ")\n"
             << "  force balance " << c.force_balance << " (tol " << tolerances.force_balance
@@ -252,7 +252,7 @@ int cmd_verify(const VerifyOptions& o) {
             << " s (" << (trial.wall_time_s > 0 ? particle_steps / trial.wall_time_s : 0.0)
             << " particle-steps/s), total " << total_s << " s\n"
             << "  wrote " << dir << "/verify.json, series.csv, prototype.csv\n";
-  return trial.passed ? 0 : 1;
+  return trial.score.passed ? 0 : 1;
 }
 
 }  // namespace demcal::cli

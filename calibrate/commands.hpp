@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "demcal/scene/config.hpp"
+#include "demcal/search/calibration.hpp"
 
 namespace CLI {
 class App;
@@ -38,7 +39,7 @@ struct CalibrateOptions {
   int jobs = 0;           ///< 0: one per core
   int max_trials = 0;     ///< 0: the config's calibration.max_trials
   double accuracy = 0.0;  ///< 0: the config's calibration.accuracy
-  std::string strategy = "model";
+  std::string strategy = to_string(CalibrationOptions{}.strategy);
   bool resume = false;
   bool quiet = false;
   /// Also run the paper-recipe baseline and a converged reference (8× and

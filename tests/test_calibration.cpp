@@ -16,11 +16,11 @@
 #include <string>
 #include <thread>
 
-#include "demcal/scene/biaxial.hpp"
-#include "demcal/search/calibration.hpp"
 #include "demcal/io/files.hpp"
-#include "demcal/scene/run_output.hpp"
+#include "demcal/scene/biaxial.hpp"
 #include "demcal/scene/packing.hpp"
+#include "demcal/scene/run_output.hpp"
+#include "demcal/search/calibration.hpp"
 #include "stop_signal.hpp"
 
 namespace fs = std::filesystem;
@@ -116,8 +116,8 @@ TEST(Calibration, DivergedTrialIsScoredNotFatal) {
   p.damping_ratio_rotation = 0.0;
   p.steps = 20000;
   const TrialRecord r = run_trial(config, state, p, Tolerances{});
-  EXPECT_TRUE(r.diverged);
-  EXPECT_FALSE(r.passed);
+  EXPECT_TRUE(r.score.diverged);
+  EXPECT_FALSE(r.score.passed);
   EXPECT_LT(r.steps_run, p.steps);
 }
 
@@ -267,14 +267,14 @@ TEST(Calibration, EarlyStopNeverStopsATrialThatWouldPass) {
     SCOPED_TRACE(testing::Message()
                  << "alpha " << p.dt_ratio << " steps " << p.steps << " zeta_t "
                  << p.damping_ratio_translation << " zeta_r " << p.damping_ratio_rotation);
-    if (full.passed) {
+    if (full.score.passed) {
       ++passed;
-      EXPECT_TRUE(early.complete);
-      EXPECT_TRUE(early.passed);
+      EXPECT_TRUE(early.score.complete);
+      EXPECT_TRUE(early.score.passed);
     }
-    if (!early.complete) {
+    if (!early.score.complete) {
       ++stopped;
-      EXPECT_FALSE(full.passed);
+      EXPECT_FALSE(full.score.passed);
       EXPECT_LT(early.steps_run, full.steps_run);
     }
   }

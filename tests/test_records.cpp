@@ -49,23 +49,25 @@ AlgorithmSpec sample_params() {
 TrialRecord sample_trial() {
   TrialRecord t;
   t.id = 7;
-  t.phase = to_string(TrialPhase::search_tightened);
+  t.phase = TrialPhase::search_tightened;
   t.params = sample_params();
-  t.criteria.force_balance = 0.0031;
-  t.criteria.moment_balance = 2.5e-6;
-  t.criteria.servo = 0.0012;
-  t.criteria.oscillation = 4e-4;
-  t.criteria.zigzag = 0.02;
-  t.criteria.peak_stress_yy = -6.1e5;
-  t.criteria.peak_strain_yy = -0.004;
-  t.criteria.points = 199;
-  t.criteria.peak_error = 0.013;
-  t.passed = true;
-  t.worst_excess = 0.4;
   t.steps_run = 12345;
-  t.particle_steps = 25.0 * 12345;
   t.wall_time_s = 0.25;
-  t.diagnosis = "quasi-static";
+  Score& s = t.score;
+  s.criteria.force_balance = 0.0031;
+  s.criteria.moment_balance = 2.5e-6;
+  s.criteria.servo = 0.0012;
+  s.criteria.oscillation = 4e-4;
+  s.criteria.zigzag = 0.02;
+  s.criteria.peak_stress_yy = -6.1e5;
+  s.criteria.peak_strain_yy = -0.004;
+  s.criteria.points = 199;
+  s.criteria.peak_error = 0.013;
+  s.passed = true;
+  s.worst_excess = 0.4;
+  s.completed_fraction = 1.0;
+  s.particle_steps = 25.0 * 12345;
+  s.diagnosis.message = "quasi-static";
   return t;
 }
 
@@ -124,12 +126,16 @@ TEST(Records, TrialRecordRoundTripsAndKeepsItsScore) {
   const json j = to_json(t);
   const TrialRecord u = trial_from_json(j, "trials.jsonl: line 1");
   EXPECT_EQ(to_json(u), j);
-  EXPECT_EQ(u.criteria.peak_error, t.criteria.peak_error);
-  EXPECT_EQ(u.criteria.zigzag, t.criteria.zigzag);
-  // The score a record keeps drives the search as the original would.
+  EXPECT_EQ(u.phase, TrialPhase::search_tightened);
+  EXPECT_EQ(u.score.criteria.peak_error, t.score.criteria.peak_error);
+  EXPECT_EQ(u.score.criteria.zigzag, t.score.criteria.zigzag);
+  // The score read back drives the search and ranks the trial as the
+  // original would.
   const Tolerances tol;
-  EXPECT_EQ(constraint_values(score_of(u), tol), constraint_values(score_of(t), tol));
-  EXPECT_DOUBLE_EQ(score_of(u).completed_fraction, 1.0);
+  EXPECT_EQ(constraint_values(u.score, tol), constraint_values(t.score, tol));
+  EXPECT_EQ(objective(u.score, tol), objective(t.score, tol));
+  EXPECT_EQ(u.score.completed_fraction, t.score.completed_fraction);
+  EXPECT_EQ(u.score.diagnosis.message, t.score.diagnosis.message);
 }
 
 TEST(Records, ATrialsJsonlLineOfTheEarlierFormatStillResumes) {
@@ -144,9 +150,9 @@ TEST(Records, ATrialsJsonlLineOfTheEarlierFormatStillResumes) {
     "worst_excess":0.5})");
   const TrialRecord t = trial_from_json(line, "old.jsonl");
   EXPECT_EQ(t.params.steps, 50000);
-  EXPECT_EQ(t.criteria.peak_stress_yy, -612000.0);
-  EXPECT_EQ(t.criteria.zigzag, 0.0);
-  EXPECT_EQ(t.phase, "certificate");
+  EXPECT_EQ(t.score.criteria.peak_stress_yy, -612000.0);
+  EXPECT_EQ(t.score.criteria.zigzag, 0.0);
+  EXPECT_EQ(t.phase, TrialPhase::certificate);
   json bad = line;
   bad["phase"] = "warmup";
   EXPECT_THROW(trial_from_json(bad, "old.jsonl"), InputError);
@@ -211,14 +217,14 @@ TEST(Records, ParamsFileCarriesTheCalibratedBlocks) {
   summary.certificate.steps = summary.best.steps;
   summary.certificate.richardson_error = 0.004;
   summary.certificate.passed = true;
-  summary.strategy = to_string(Strategy::model);
+  summary.strategy = Strategy::model;
   const json p = params_file(config, state, options, summary);
   EXPECT_EQ(p.at("schema"), "demcal.params/1");
   EXPECT_EQ(p.at("rev").at("dt_ratio"), summary.best.dt_ratio);
   EXPECT_EQ(p.at("rev").at("steps"), summary.best.steps);
   EXPECT_EQ(p.at("rev").at("particles"), state.world.size());
   EXPECT_FALSE(p.at("rev").contains("lock_rotation"));
-  EXPECT_EQ(p.at("criteria"), to_json(summary.best_trial.criteria));
+  EXPECT_EQ(p.at("criteria"), to_json(summary.best_trial.score.criteria));
   EXPECT_EQ(p.at("certificate"), to_json(summary.certificate));
   EXPECT_EQ(p.at("strategy"), "model");
   EXPECT_EQ(p.at("trials"), 2);
@@ -229,14 +235,18 @@ TEST(Records, ParamsFileCarriesTheCalibratedBlocks) {
 
 TEST(Records, EvidenceBlockMeasuresPeakErrorsAgainstTheReference) {
   CalibrationEvidence e;
-  e.coarse = e.fine = sample_trial();
-  e.reference_peak = -6.0e5;
+  e.reference.coarse = e.reference.fine = sample_trial();
+  e.reference.peak = -6.0e5;
   TrialRecord best = sample_trial();
-  best.criteria.peak_stress_yy = -6.3e5;  // 5 % stronger: a positive error
+  best.score.criteria.peak_stress_yy = -6.3e5;  // 5 % stronger: a positive error
   const json b = evidence_block(e, best);
   EXPECT_NEAR(b.at("reference").at("calibrated_peak_error").get<double>(), 0.05, 1e-12);
-  best.diverged = true;
-  EXPECT_TRUE(peak_error_json(best, e.reference_peak).is_null());
+  EXPECT_NEAR(*peak_error(best, e.reference.peak), 0.05, 1e-12);
+  best.score.diverged = true;
+  EXPECT_TRUE(peak_error_json(best, e.reference.peak).is_null());
+  best.score.diverged = false;
+  best.score.complete = false;  // stopped early: its peak is not the run's
+  EXPECT_FALSE(peak_error(best, e.reference.peak));
   const std::string lines = evidence_lines(e);  // the two reference runs, no baseline
   EXPECT_EQ(std::count(lines.begin(), lines.end(), '\n'), 2);
 }

@@ -177,8 +177,8 @@ LoadingResult synthetic_run(int64_t steps, double gap, double servo) {
   return r;
 }
 
-TrialRecord trial(int id, const std::string& phase, double alpha, int64_t steps, double fb,
-                  bool passed, bool complete = true, bool diverged = false) {
+TrialRecord trial(int id, TrialPhase phase, double alpha, int64_t steps, double fb, bool passed,
+                  bool complete = true, bool diverged = false) {
   TrialRecord t;
   t.id = id;
   t.phase = phase;
@@ -186,21 +186,22 @@ TrialRecord trial(int id, const std::string& phase, double alpha, int64_t steps,
   t.params.steps = steps;
   t.params.damping_ratio_translation = 0.5;
   t.params.damping_ratio_rotation = 0.0;
-  t.criteria.force_balance = fb;
-  t.criteria.moment_balance = 1e-7;
-  t.criteria.servo = 0.002;
-  t.criteria.oscillation = 1e-6;
-  t.criteria.peak_stress_yy = -6.2e5 * (1.0 + 2e4 / static_cast<double>(steps));
-  t.passed = passed;
-  t.complete = complete;
-  t.diverged = diverged;
-  if (diverged) t.criteria.force_balance = std::numeric_limits<double>::infinity();
   t.steps_run = complete ? steps : steps / 3;
-  t.particle_steps = 100.0 * static_cast<double>(steps);
   t.wall_time_s = 1e-8 * static_cast<double>(t.steps_run) * 100.0;
-  t.diagnosis = passed
-                    ? "quasi-static: every criterion is within tolerance"
-                    : "b and sigma disagree <smoothly> & the loading is too fast | increase steps";
+  Score& s = t.score;
+  s.criteria.force_balance = diverged ? std::numeric_limits<double>::infinity() : fb;
+  s.criteria.moment_balance = 1e-7;
+  s.criteria.servo = 0.002;
+  s.criteria.oscillation = 1e-6;
+  s.criteria.peak_stress_yy = -6.2e5 * (1.0 + 2e4 / static_cast<double>(steps));
+  s.passed = passed;
+  s.complete = complete;
+  s.diverged = diverged;
+  s.completed_fraction = static_cast<double>(t.steps_run) / static_cast<double>(steps);
+  s.particle_steps = 100.0 * static_cast<double>(steps);
+  s.diagnosis.message =
+      passed ? "quasi-static: every criterion is within tolerance"
+             : "b and sigma disagree <smoothly> & the loading is too fast | increase steps";
   return t;
 }
 
@@ -217,14 +218,14 @@ ReportInput synthetic_input(bool evidence) {
   auto& S = in.summary;
   S.success = true;
   S.message = "calibrated: every criterion passed";
-  S.strategy = "model";
+  S.strategy = Strategy::model;
   S.dt_ratio_stable = 0.292;
-  S.trials = {trial(0, "search", 0.2, 50000, 0.03, false),
-              trial(1, "search", 0.27, 25060, 0.05, false, false),
-              trial(2, "search", 0.9, 25060, 0.05, false, false, true),
-              trial(3, "verify", 0.277, 89370, 0.0075, true),
-              trial(4, "verify", 0.277, 85000, 0.0085, false),
-              trial(5, "certificate", 0.277, 178740, 0.004, true)};
+  S.trials = {trial(0, TrialPhase::search, 0.2, 50000, 0.03, false),
+              trial(1, TrialPhase::search, 0.27, 25060, 0.05, false, false),
+              trial(2, TrialPhase::search, 0.9, 25060, 0.05, false, false, true),
+              trial(3, TrialPhase::verify, 0.277, 89370, 0.0075, true),
+              trial(4, TrialPhase::verify, 0.277, 85000, 0.0085, false),
+              trial(5, TrialPhase::certificate, 0.277, 178740, 0.004, true)};
   S.best_trial = S.trials[3];
   S.best = S.best_trial.params;
   S.certificate = {89370, -6.255e5, -6.232e5, 0.0037, 0.0074, true};
@@ -282,18 +283,19 @@ ReportInput synthetic_input(bool evidence) {
   in.picture = pic;
   if (evidence) {
     BaselineResult b;
-    b.trials = {trial(0, "baseline", 0.2, 50000, 0.03, false),
-                trial(1, "baseline", 0.2, 100000, 0.015, false),
-                trial(2, "baseline", 0.2, 200000, 0.006, true)};
+    b.trials = {trial(0, TrialPhase::baseline, 0.2, 50000, 0.03, false),
+                trial(1, TrialPhase::baseline, 0.2, 100000, 0.015, false),
+                trial(2, TrialPhase::baseline, 0.2, 200000, 0.006, true)};
     b.passed = true;
     b.params = b.trials.back().params;
     b.particle_steps_total = 3.5e7;
     in.baseline = b;
     ReferenceEvidence ref;
-    ref.coarse = trial(0, "reference", 0.277, 8 * 89370, 0.001, true);
-    ref.fine = trial(1, "reference", 0.277, 16 * 89370, 0.0005, true);
+    ref.coarse = trial(0, TrialPhase::reference, 0.277, 8 * 89370, 0.001, true);
+    ref.fine = trial(1, TrialPhase::reference, 0.277, 16 * 89370, 0.0005, true);
     ref.fine_series = synthetic_run(16 * 89370, 0.0, 0.0).series;
-    ref.peak = 2 * ref.fine.criteria.peak_stress_yy - ref.coarse.criteria.peak_stress_yy;
+    ref.peak = richardson_limit(kReferenceCoarse, ref.coarse.score.criteria.peak_stress_yy,
+                                kReferenceFine, ref.fine.score.criteria.peak_stress_yy);
     in.reference = ref;
   }
   return in;
@@ -503,9 +505,11 @@ TEST(Report, EvidenceRunsReproduceTheTrialsAndExtrapolateThePeak) {
   const ResultRuns runs = rerun_start_and_result(c, state, start, summary, tol, 2);
   ASSERT_TRUE(runs.start && runs.best && runs.picture);
   EXPECT_EQ(runs.best->label, "calibrated");
-  EXPECT_EQ(runs.best->score.criteria.peak_stress_yy, summary.best_trial.criteria.peak_stress_yy);
-  EXPECT_EQ(runs.best->score.criteria.force_balance, summary.best_trial.criteria.force_balance);
-  EXPECT_EQ(runs.start->score.criteria.force_balance, start_trial.criteria.force_balance);
+  EXPECT_EQ(runs.best->score.criteria.peak_stress_yy,
+            summary.best_trial.score.criteria.peak_stress_yy);
+  EXPECT_EQ(runs.best->score.criteria.force_balance,
+            summary.best_trial.score.criteria.force_balance);
+  EXPECT_EQ(runs.start->score.criteria.force_balance, start_trial.score.criteria.force_balance);
   const Peak peak = find_peak(runs.best->run.series);
   EXPECT_EQ(runs.picture->step, runs.best->run.series[peak.index].step);
   EXPECT_EQ(runs.picture->stress_yy, peak.stress_yy);
@@ -515,10 +519,12 @@ TEST(Report, EvidenceRunsReproduceTheTrialsAndExtrapolateThePeak) {
   const ReferenceEvidence ref = run_refined_reference(c, state, best, tol, 2);
   EXPECT_EQ(ref.coarse.params.steps, 8 * best.steps);
   EXPECT_EQ(ref.fine.params.steps, 16 * best.steps);
-  EXPECT_EQ(ref.coarse.phase, "reference");
-  EXPECT_EQ(ref.fine.phase, "reference");
-  EXPECT_DOUBLE_EQ(ref.peak,
-                   2.0 * ref.fine.criteria.peak_stress_yy - ref.coarse.criteria.peak_stress_yy);
+  EXPECT_EQ(ref.coarse.phase, TrialPhase::reference);
+  EXPECT_EQ(ref.fine.phase, TrialPhase::reference);
+  // Richardson with Nstep ratios that are powers of two: exactly the
+  // 2·P(16N) − P(8N) that params.json's evidence block has always held.
+  EXPECT_EQ(ref.peak, 2.0 * ref.fine.score.criteria.peak_stress_yy -
+                          ref.coarse.score.criteria.peak_stress_yy);
   ASSERT_FALSE(ref.fine_series.empty());
   EXPECT_EQ(ref.fine_series.back().step, ref.fine.params.steps);
 }

@@ -192,13 +192,13 @@ TEST(StepSearch, FindsTheSmallestPassingNstepAtFixedMultipliers) {
   p.steps = 10000;  // too fast for 25 particles
   const StepSearch s = smallest_passing_steps(c, state, p);
   ASSERT_TRUE(s.found);
-  EXPECT_TRUE(s.best.passed);
+  EXPECT_TRUE(s.best.score.passed);
   EXPECT_GT(s.best.params.steps, 10000);
   EXPECT_LE(s.trials.size(), 8u);
   EXPECT_EQ(s.best.params.dt_ratio, 0.2);
   // Every failing run was shorter than the answer.
   for (const auto& t : s.trials)
-    if (!t.passed) {
+    if (!t.score.passed) {
       EXPECT_LT(t.params.steps, s.best.params.steps);
     }
 }

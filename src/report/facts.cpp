@@ -38,39 +38,9 @@ std::string params_gp(const AlgorithmSpec& p) {
 }
 
 std::string verdict(const TrialRecord& t) {
-  if (t.diverged) return "diverged";
-  if (!t.complete) return "stopped early";
-  return t.passed ? "pass" : "FAIL";
-}
-
-double Ratios::worst() const {
-  return std::max({force_balance, moment_balance, servo, oscillation});
-}
-
-std::string Ratios::worst_name() const {
-  const double w = worst();
-  if (w == force_balance) return "force balance";
-  if (w == moment_balance) return "moment balance";
-  if (w == servo) return "servo";
-  return "oscillation";
-}
-
-Ratios ratios(const Criteria& c, const Tolerances& t) {
-  return {c.force_balance / t.force_balance, c.moment_balance / t.moment_balance, c.servo / t.servo,
-          c.oscillation / t.oscillation};
-}
-
-double objective_of(const TrialRecord& t, const Tolerances& tol) {
-  Score s;
-  s.criteria = t.criteria;
-  s.diverged = t.diverged;
-  s.complete = t.complete;
-  s.passed = t.passed;
-  s.completed_fraction =
-      t.params.steps > 0 ? static_cast<double>(t.steps_run) / static_cast<double>(t.params.steps)
-                         : 0.0;
-  s.particle_steps = t.particle_steps;
-  return objective(s, tol);
+  if (t.score.diverged) return "diverged";
+  if (!t.score.complete) return "stopped early";
+  return t.score.passed ? "pass" : "FAIL";
 }
 
 namespace {
@@ -80,14 +50,12 @@ Point point_of(const ReportInput& in, bool have_best, const TrialRecord& t,
   const auto& S = in.summary;
   Point p;
   p.label = label;
-  p.phase = t.phase;
   p.trial = &t;
-  p.cost = t.particle_steps;
+  p.cost = t.score.particle_steps;
   p.seconds = t.wall_time_s;
-  if (!t.complete && t.steps_run > 0 && t.params.steps > t.steps_run)
+  if (!t.score.complete && t.steps_run > 0 && t.params.steps > t.steps_run)
     p.seconds *= static_cast<double>(t.params.steps) / static_cast<double>(t.steps_run);
-  if (in.reference && t.complete && !t.diverged && t.criteria.peak_stress_yy < 0.0)
-    p.peak_error = (in.reference->peak - t.criteria.peak_stress_yy) / std::abs(in.reference->peak);
+  if (in.reference) p.peak_error = peak_error(t, in.reference->peak);
   p.best = have_best && t.phase == S.best_trial.phase && t.id == S.best_trial.id &&
            t.params.steps == S.best_trial.params.steps;
   return p;
@@ -112,7 +80,7 @@ ReportFacts gather_facts(const ReportInput& in) {
   ReportFacts f;
   f.in = &in;
   const auto& S = in.summary;
-  f.have_best = S.best_trial.particle_steps > 0.0;  // default-constructed: none
+  f.have_best = S.best_trial.score.particle_steps > 0.0;  // default-constructed: none
   auto add = [&](const TrialRecord& t, const std::string& label) {
     f.points.push_back(point_of(in, f.have_best, t, label));
   };
@@ -131,7 +99,8 @@ ReportFacts gather_facts(const ReportInput& in) {
   for (size_t k = 0; k < f.points.size(); ++k) {
     const Point& p = f.points[k];
     if (p.best) f.best_peak_error = p.peak_error;
-    if (p.phase == "baseline" && p.trial->passed) f.baseline_index = static_cast<int>(k);
+    if (p.trial->phase == TrialPhase::baseline && p.trial->score.passed)
+      f.baseline_index = static_cast<int>(k);
   }
   if (in.start) f.runs.push_back(&*in.start);
   if (in.best) f.runs.push_back(&*in.best);

@@ -26,23 +26,11 @@ std::string params_gp(const AlgorithmSpec& p);
 /// "diverged", "stopped early", "pass" or "FAIL".
 std::string verdict(const TrialRecord& t);
 
-/// Each criterion divided by its tolerance (≤ 1 passes).
-struct Ratios {
-  double force_balance, moment_balance, servo, oscillation;
-  double worst() const;
-  std::string worst_name() const;
-};
-Ratios ratios(const Criteria& c, const Tolerances& t);
-
-/// The search's objective of a recorded trial.
-double objective_of(const TrialRecord& t, const Tolerances& tol);
-
 /// One trial in the history and the speed-vs-accuracy chart.
 struct Point {
-  std::string label;  ///< "12", "b3", "r8"
-  std::string phase;
-  const TrialRecord* trial = nullptr;
-  double cost = 0.0;     ///< particle-steps planned
+  std::string label;                   ///< "12", "b3", "r8"
+  const TrialRecord* trial = nullptr;  ///< its phase, parameters and score
+  double cost = 0.0;                   ///< particle-steps planned
   double seconds = 0.0;  ///< wall time (extrapolated to the full run when stopped early)
   std::optional<double> peak_error;
   bool best = false;

@@ -218,18 +218,19 @@ std::vector<std::string> add_history_files(PlotPlan& plot, const ReportFacts& f,
   std::ostringstream h, hp, hf, he, hd, hb;
   int64_t best_so_far = 0;
   for (const auto& t : f.in->summary.trials) {
-    const Ratios r = ratios(t.criteria, tol);
+    const Score& s = t.score;
+    const Excesses r = excesses(s.criteria, tol);
     const double rv[4] = {r.force_balance, r.moment_balance, r.servo, r.oscillation};
     h << t.id << ' ' << t.params.steps;
     for (int k = 0; k < 4; ++k) {
-      const bool ok = !t.diverged && std::isfinite(rv[k]) && rv[k] > 0;
+      const bool ok = !s.diverged && std::isfinite(rv[k]) && rv[k] > 0;
       any_ratio[k] = any_ratio[k] || ok;
       h << ' ' << (ok ? dat(rv[k]) : "?");
     }
-    h << ' ' << dat(objective_of(t, tol)) << '\n';
-    std::ostringstream& o = t.diverged ? hd : !t.complete ? he : t.passed ? hp : hf;
+    h << ' ' << dat(objective(s, tol)) << '\n';
+    std::ostringstream& o = s.diverged ? hd : !s.complete ? he : s.passed ? hp : hf;
     o << t.id << ' ' << t.params.steps << '\n';
-    if (t.passed && t.complete && (best_so_far == 0 || t.params.steps < best_so_far))
+    if (s.passed && s.complete && (best_so_far == 0 || t.params.steps < best_so_far))
       best_so_far = t.params.steps;
     if (best_so_far > 0) hb << t.id << ' ' << best_so_far << '\n';
   }
@@ -302,7 +303,9 @@ void add_history_figure(PlotPlan& plot, const ReportFacts& f) {
 // Speed against accuracy: cost (particle-steps, seconds) against error
 // (force balance; with --evidence also the peak error), Pareto front marked.
 
-bool finished(const Point& p) { return p.trial->complete && !p.trial->diverged; }
+bool finished(const Point& p) { return p.trial->score.complete && !p.trial->score.diverged; }
+bool passed(const Point& p) { return p.trial->score.passed; }
+bool in_phase(const Point& p, TrialPhase phase) { return p.trial->phase == phase; }
 
 /// A class of points drawn with one style, in its own data file.
 struct SpeedCategory {
@@ -311,25 +314,27 @@ struct SpeedCategory {
 };
 
 std::vector<SpeedCategory> speed_categories() {
-  auto search = [](const Point& p) { return p.phase != "baseline" && p.phase != "reference"; };
+  auto search = [](const Point& p) {
+    return !in_phase(p, TrialPhase::baseline) && !in_phase(p, TrialPhase::reference);
+  };
   return {{"sp_fail.dat", "w p pt 6 ps 0.9 lc rgb '#d62728' t 'search trial, fail'",
-           [=](const Point& p) { return finished(p) && !p.trial->passed && search(p); }},
+           [=](const Point& p) { return finished(p) && !passed(p) && search(p); }},
           {"sp_early.dat", "w p pt 4 ps 0.7 lc rgb '#ff7f0e' t 'stopped early (error so far)'",
-           [](const Point& p) { return !p.trial->complete && !p.trial->diverged; }},
+           [](const Point& p) { return !p.trial->score.complete && !p.trial->score.diverged; }},
           {"sp_pass.dat", "w p pt 7 ps 0.9 lc rgb '#2ca02c' t 'search trial, pass'",
-           [=](const Point& p) { return finished(p) && p.trial->passed && search(p); }},
+           [=](const Point& p) { return finished(p) && passed(p) && search(p); }},
           {"sp_base.dat",
            "w lp pt 9 ps 1.3 lw 1 dt 2 lc rgb '#e6550d' t 'paper recipe (Nstep doubled)'",
-           [](const Point& p) { return finished(p) && p.phase == "baseline"; }},
+           [](const Point& p) { return finished(p) && in_phase(p, TrialPhase::baseline); }},
           {"sp_ref.dat", "w p pt 11 ps 1.3 lc rgb '#555555' t 'reference runs (8N, 16N)'",
-           [](const Point& p) { return finished(p) && p.phase == "reference"; }},
+           [](const Point& p) { return finished(p) && in_phase(p, TrialPhase::reference); }},
           {"sp_best.dat", "w p pt 3 ps 3 lw 2.5 lc rgb '#08519c' t 'chosen (calibrated)'",
            [](const Point& p) { return p.best; }}};
 }
 
 /// y: 0 force-balance error, 1 |peak error|; NaN when there is none.
 double speed_y(const Point& p, int which) {
-  if (which == 0) return p.trial->diverged ? NAN : p.trial->criteria.force_balance;
+  if (which == 0) return p.trial->score.diverged ? NAN : p.trial->score.criteria.force_balance;
   return p.peak_error ? std::abs(*p.peak_error) : NAN;
 }
 /// x: 0 particle-steps, 1 seconds.

@@ -22,8 +22,9 @@ void write_title(Doc& d, const ReportFacts& f) {
   const std::string line =
       "Scene " + in.scene + ", " + grouped(in.particles) + " particles (REV); " +
       std::to_string(S.trials.size()) + " trials (" + std::to_string(S.trials_run) + " run, " +
-      std::to_string(S.trials_reused) + " reused from an earlier run), strategy " + S.strategy +
-      ", " + num(S.wall_time_s, 3) + " s in this invocation. σ3 = " + kpa(in.lateral_stress) + ".";
+      std::to_string(S.trials_reused) + " reused from an earlier run), strategy " +
+      to_string(S.strategy) + ", " + num(S.wall_time_s, 3) +
+      " s in this invocation. σ3 = " + kpa(in.lateral_stress) + ".";
   d.para(line, "small");
 }
 
@@ -53,8 +54,8 @@ void write_at_a_glance(Doc& d, const ReportFacts& f) {
   std::vector<std::string> glance;
   if (f.have_best) {
     glance.push_back(use_line(in));
-    const Ratios r =
-        ratios(in.best ? in.best->score.criteria : S.best_trial.criteria, in.tolerances);
+    const Excesses r =
+        excesses(in.best ? in.best->score.criteria : S.best_trial.score.criteria, in.tolerances);
     glance.push_back("Every criterion within tolerance: worst " + r.worst_name() + " at " +
                      fixed(100.0 * r.worst(), 0) + " % of its tolerance.");
   }
@@ -71,7 +72,7 @@ void write_at_a_glance(Doc& d, const ReportFacts& f) {
   if (base && f.have_best)
     glance.push_back(
         "The paper's recipe (α 0.2, ζ 1, Nstep doubled until it passes) costs " +
-        num(base->cost / std::max(1.0, S.best_trial.particle_steps), 3) +
+        num(base->cost / std::max(1.0, S.best_trial.score.particle_steps), 3) +
         "× as many particle-steps per run" +
         (base->peak_error ? " (peak error " + signed_pct(*base->peak_error, 2) + ")." : "."));
   if (!glance.empty()) d.bullets(glance);
@@ -156,7 +157,7 @@ void write_criteria(Doc& d, const ReportFacts& f) {
   }
   // The rerun's criteria (every field; a trial reloaded by --resume
   // carries only those trials.jsonl keeps). Same run, same numbers.
-  const auto& c = in.best ? in.best->score.criteria : S.best_trial.criteria;
+  const auto& c = in.best ? in.best->score.criteria : S.best_trial.score.criteria;
   auto row = [&](const std::string& name, const std::string& meaning, double v, double t) {
     return std::vector<std::string>{
         name, meaning, num(v, 3), num(t, 3), fixed(v / t, 2) + "×", v <= t ? "pass" : "FAIL"};
@@ -190,7 +191,7 @@ int64_t doubled_steps(const CalibrationSummary& S) {
   const auto& C = S.certificate;
   int64_t steps = 2 * C.steps;
   for (const auto& t : S.trials)
-    if (t.phase == "certificate" && t.params.dt_ratio == S.best.dt_ratio &&
+    if (t.phase == TrialPhase::certificate && t.params.dt_ratio == S.best.dt_ratio &&
         t.params.damping_ratio_translation == S.best.damping_ratio_translation &&
         t.params.damping_ratio_rotation == S.best.damping_ratio_rotation &&
         std::abs(static_cast<double>(t.params.steps) / static_cast<double>(2 * C.steps) - 1.0) <
@@ -224,9 +225,9 @@ void write_reference_evidence(Doc& d, const ReportFacts& f) {
   const auto& e = f.best_peak_error;
   std::vector<std::vector<std::string>> rows{
       {"peak b_yy at 8·Nstep = " + grouped(R.coarse.params.steps),
-       kpa(R.coarse.criteria.peak_stress_yy)},
+       kpa(R.coarse.score.criteria.peak_stress_yy)},
       {"peak b_yy at 16·Nstep = " + grouped(R.fine.params.steps),
-       kpa(R.fine.criteria.peak_stress_yy)},
+       kpa(R.fine.score.criteria.peak_stress_yy)},
       {"converged reference 2·P(16N) − P(8N)", kpa(R.peak)},
       {"calibrated peak error against the reference", e ? signed_pct(*e, 2) : std::string("n/a")},
       {"within the accuracy target",
@@ -249,9 +250,9 @@ void write_baseline_evidence(Doc& d, const ReportFacts& f) {
     text = "The paper's recipe done mechanically (α = 0.2, ζ_t = ζ_r = 1, Nstep doubled from " +
            grouped(B.trials.front().params.steps) +
            " until every criterion passes) passes at Nstep = " + grouped(B.params.steps) + ": " +
-           sci(base->cost) + " particle-steps per run against " + sci(S.best_trial.particle_steps) +
-           " calibrated (" + num(base->cost / std::max(1.0, S.best_trial.particle_steps), 3) +
-           "× the cost)";
+           sci(base->cost) + " particle-steps per run against " +
+           sci(S.best_trial.score.particle_steps) + " calibrated (" +
+           num(base->cost / std::max(1.0, S.best_trial.score.particle_steps), 3) + "× the cost)";
     if (base->peak_error)
       text += ", peak error " + signed_pct(*base->peak_error, 2) + " against the reference";
     text += "; the recipe's search itself cost " + sci(B.particle_steps_total) +

@@ -48,7 +48,8 @@ void write_panel_numbers(Doc& d, const ReportFacts& f) {
   for (const auto* r : f.runs)
     fs.push_back(series_numbers(r->run.series, r->score.criteria, r->run.diverged));
   if (f.have_ref_series)
-    fs.push_back(series_numbers(in.reference->fine_series, in.reference->fine.criteria, false));
+    fs.push_back(
+        series_numbers(in.reference->fine_series, in.reference->fine.score.criteria, false));
   std::vector<std::vector<std::string>> rows;
   auto row = [&](const std::string& name,
                  const std::function<std::string(const SeriesNumbers&)>& cell) {
@@ -134,7 +135,7 @@ void write_rejected_neighbours(Doc& d, const ReportFacts& f, int near_failures) 
   const double a_span = std::max(0.05, in.dt_ratio_max > 0 ? in.dt_ratio_max : 0.3);
   std::vector<std::pair<double, const TrialRecord*>> failed;
   for (const auto& t : S.trials)
-    if (!t.passed) failed.push_back({search_distance(t.params, S.best, a_span), &t});
+    if (!t.score.passed) failed.push_back({search_distance(t.params, S.best, a_span), &t});
   std::stable_sort(failed.begin(), failed.end(),
                    [](const auto& a, const auto& b) { return a.first < b.first; });
   if (failed.size() > static_cast<size_t>(near_failures)) failed.resize(near_failures);
@@ -148,10 +149,12 @@ void write_rejected_neighbours(Doc& d, const ReportFacts& f, int near_failures) 
       "failed.");
   std::vector<std::vector<std::string>> rows;
   for (const auto& [dd, t] : failed) {
-    const Ratios r = ratios(t->criteria, in.tolerances);
-    rows.push_back({std::to_string(t->id), differs_from(t->params, S.best), verdict(*t),
-                    t->diverged ? "diverged" : r.worst_name() + " " + fixed(r.worst(), 2) + "×",
-                    t->diagnosis.empty() ? "(no diagnosis recorded)" : sentence(t->diagnosis)});
+    const Excesses r = excesses(t->score.criteria, in.tolerances);
+    rows.push_back(
+        {std::to_string(t->id), differs_from(t->params, S.best), verdict(*t),
+         t->score.diverged ? "diverged" : r.worst_name() + " " + fixed(r.worst(), 2) + "×",
+         t->score.diagnosis.message.empty() ? "(no diagnosis recorded)"
+                                            : sentence(t->score.diagnosis.message)});
   }
   d.table({"trial", "differs from the result in", "verdict", "worst criterion / tolerance",
            "diagnosis"},
@@ -165,7 +168,7 @@ void write_diagnosis(Doc& d, const ReportFacts& f, int near_failures) {
   d.heading(2, "Diagnosis in words", "diagnosis");
   if (in.start) {
     const auto& s = in.start->score;
-    const Ratios r = ratios(s.criteria, in.tolerances);
+    const Excesses r = excesses(s.criteria, in.tolerances);
     std::string text = "Start point (" + params_text(in.start->params) + "): " +
                        (s.passed ? "passes every criterion. "
                                  : "does not pass (worst: " + r.worst_name() + " at " +
@@ -193,11 +196,11 @@ void write_history(Doc& d, const ReportFacts& f, const Figures& figures) {
   }
   int pass = 0, fail = 0, early = 0, div = 0;
   for (const auto& t : trials) {
-    if (t.diverged)
+    if (t.score.diverged)
       ++div;
-    else if (!t.complete)
+    else if (!t.score.complete)
       ++early;
-    else if (t.passed)
+    else if (t.score.passed)
       ++pass;
     else
       ++fail;
@@ -220,20 +223,21 @@ std::string peak_error_cell(const Point& p, const char* none) {
 void write_pareto_front(Doc& d, const ReportFacts& f) {
   std::vector<const Point*> fin;
   for (const auto& p : f.points)
-    if (p.trial->complete && !p.trial->diverged && p.trial->criteria.force_balance > 0)
+    if (p.trial->score.complete && !p.trial->score.diverged &&
+        p.trial->score.criteria.force_balance > 0)
       fin.push_back(&p);
   std::stable_sort(fin.begin(), fin.end(), [](const Point* a, const Point* b) {
-    return a->cost < b->cost || (a->cost == b->cost && a->trial->criteria.force_balance <
-                                                           b->trial->criteria.force_balance);
+    return a->cost < b->cost || (a->cost == b->cost && a->trial->score.criteria.force_balance <
+                                                           b->trial->score.criteria.force_balance);
   });
   std::vector<std::vector<std::string>> rows;
   double ymin = std::numeric_limits<double>::infinity();
   for (const Point* p : fin) {
-    if (p->trial->criteria.force_balance >= ymin) continue;
-    ymin = p->trial->criteria.force_balance;
-    rows.push_back({p->label + (p->best ? " (chosen)" : ""), p->phase,
+    if (p->trial->score.criteria.force_balance >= ymin) continue;
+    ymin = p->trial->score.criteria.force_balance;
+    rows.push_back({p->label + (p->best ? " (chosen)" : ""), to_string(p->trial->phase),
                     params_text(p->trial->params), sci(p->cost), num(p->seconds, 3),
-                    num(p->trial->criteria.force_balance, 3), verdict(*p->trial),
+                    num(p->trial->score.criteria.force_balance, 3), verdict(*p->trial),
                     peak_error_cell(*p, "n/a")});
   }
   d.heading(3, "Pareto front (force-balance error against particle-steps)");
@@ -262,7 +266,7 @@ void write_speed(Doc& d, const ReportFacts& f, const Figures& figures) {
     if (p.best || &p == base)
       marks.push_back({p.best ? "chosen (calibrated)" : "paper recipe", p.label,
                        params_text(p.trial->params), sci(p.cost), num(p.seconds, 3),
-                       num(p.trial->criteria.force_balance, 3), peak_error_cell(p, "n/a")});
+                       num(p.trial->score.criteria.force_balance, 3), peak_error_cell(p, "n/a")});
   if (!marks.empty()) {
     d.heading(3, "Highlighted points");
     d.table({"point", "trial", "parameters", "particle-steps", "seconds", "force balance",
@@ -327,15 +331,17 @@ void write_all_trials(Doc& d, const ReportFacts& f) {
   std::vector<std::vector<std::string>> rows;
   for (const auto& p : f.points) {
     const auto& t = *p.trial;
-    const Ratios r = ratios(t.criteria, tol);
-    auto ratio = [&](double v) { return t.diverged ? std::string("-") : fixed(v, 2); };
-    rows.push_back({p.label + (p.best ? "*" : ""), t.phase, num(t.params.dt_ratio, 4),
+    const Excesses r = excesses(t.score.criteria, tol);
+    auto ratio = [&](double v) { return t.score.diverged ? std::string("-") : fixed(v, 2); };
+    rows.push_back({p.label + (p.best ? "*" : ""), to_string(t.phase), num(t.params.dt_ratio, 4),
                     grouped(t.params.steps), num(t.params.damping_ratio_translation, 3),
                     num(t.params.damping_ratio_rotation, 3), verdict(t), ratio(r.force_balance),
                     ratio(r.moment_balance), ratio(r.servo), ratio(r.oscillation),
-                    t.complete && !t.diverged ? num(t.criteria.peak_stress_yy / 1e3, 4) : "-",
+                    t.score.complete && !t.score.diverged
+                        ? num(t.score.criteria.peak_stress_yy / 1e3, 4)
+                        : "-",
                     peak_error_cell(p, "-"), sci(p.cost), num(t.wall_time_s, 3),
-                    num(objective_of(t, tol), 4), sentence(t.diagnosis)});
+                    num(objective(t.score, tol), 4), sentence(t.score.diagnosis.message)});
   }
   d.para(
       "Criteria are divided by their tolerances (≤ 1 passes). * marks the chosen trial; b: "

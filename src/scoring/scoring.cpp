@@ -64,14 +64,29 @@ std::vector<double> fourth_differences(const std::vector<double>& x) {
 // The fourth difference of white noise of variance s² has variance 70 s².
 constexpr double kHighPassGain = 8.366600265340756;  // sqrt(70)
 
-// Relative error of a (negative) peak against a reference: positive when
-// the strength is over-predicted.
+}  // namespace
+
+Excesses excesses(const Criteria& c, const Tolerances& t) {
+  return {c.force_balance / t.force_balance, c.moment_balance / t.moment_balance, c.servo / t.servo,
+          c.oscillation / t.oscillation};
+}
+
+double Excesses::worst() const {
+  return std::max({force_balance, moment_balance, servo, oscillation});
+}
+
+std::string Excesses::worst_name() const {
+  const double w = worst();
+  if (w == force_balance) return "force balance";
+  if (w == moment_balance) return "moment balance";
+  if (w == servo) return "servo";
+  return "oscillation";
+}
+
 std::optional<double> peak_error_of(double peak, std::optional<double> reference) {
   if (!reference || *reference == 0.0) return std::nullopt;
   return (*reference - peak) / std::abs(*reference);
 }
-
-}  // namespace
 
 double robust_noise(const std::vector<double>& x) {
   std::vector<double> hp = fourth_differences(x);
@@ -479,12 +494,7 @@ Score score_run(const LoadingResult& run, double s3, const Tolerances& t,
                                                      static_cast<double>(run.steps_planned)
                                                : 0.0;
   s.particle_steps = static_cast<double>(run.particles) * static_cast<double>(run.steps_planned);
-  s.force_balance_excess = s.criteria.force_balance / t.force_balance;
-  s.moment_balance_excess = s.criteria.moment_balance / t.moment_balance;
-  s.servo_excess = s.criteria.servo / t.servo;
-  s.oscillation_excess = s.criteria.oscillation / t.oscillation;
-  s.worst_excess = std::max(
-      {s.force_balance_excess, s.moment_balance_excess, s.servo_excess, s.oscillation_excess});
+  s.worst_excess = excesses(s.criteria, t).worst();
   s.passed = !s.diverged && s.complete && s.worst_excess <= 1.0;
   s.diagnosis = diagnose(s.criteria, t, s.diverged, run_parameters(run));
   return s;

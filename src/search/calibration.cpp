@@ -168,72 +168,59 @@ TrialRecord run_trial(const SceneConfig& config, const ConsolidatedState& state,
 
 TrialRecord trial_record(const AlgorithmSpec& params, const Score& score,
                          const LoadingResult& run) {
-  TrialRecord r;
-  r.params = params;
-  r.criteria = score.criteria;
-  r.passed = score.passed;
-  r.diverged = score.diverged;
-  r.complete = score.complete;
-  r.worst_excess = score.worst_excess;
-  r.steps_run = run.steps_run;
-  r.particle_steps = score.particle_steps;
-  r.wall_time_s = run.wall_time_s;
-  r.diagnosis = score.diagnosis.message;
-  return r;
+  return {
+      .params = params, .score = score, .steps_run = run.steps_run, .wall_time_s = run.wall_time_s};
 }
 
-Score score_of(const TrialRecord& r) {
-  Score score;
-  score.criteria = r.criteria;
-  score.diverged = r.diverged;
-  score.complete = r.complete;
-  score.passed = r.passed;
-  score.worst_excess = r.worst_excess;
-  score.particle_steps = r.particle_steps;
-  score.completed_fraction =
-      r.params.steps > 0 ? static_cast<double>(r.steps_run) / static_cast<double>(r.params.steps)
-                         : 0.0;
-  score.diagnosis.message = r.diagnosis;
-  return score;
+std::optional<double> peak_error(const TrialRecord& t, double reference_peak) {
+  const Score& s = t.score;
+  if (!s.complete || s.diverged || s.criteria.peak_stress_yy >= 0.0) return std::nullopt;
+  return peak_error_of(s.criteria.peak_stress_yy, reference_peak);
 }
 
 // trials.jsonl: one line per trial. The keys are those of every earlier
 // version (the peak repeated beside the criteria), so old files resume.
 nlohmann::json to_json(const TrialRecord& r) {
+  const Score& s = r.score;
   return {{"id", r.id},
-          {"phase", r.phase},
+          {"phase", to_string(r.phase)},
           {"params", to_json(r.params)},
-          {"criteria", to_json(r.criteria)},
-          {"peak_stress_yy", r.criteria.peak_stress_yy},
-          {"peak_strain_yy", r.criteria.peak_strain_yy},
-          {"passed", r.passed},
-          {"diverged", r.diverged},
-          {"complete", r.complete},
-          {"worst_excess", r.worst_excess},
+          {"criteria", to_json(s.criteria)},
+          {"peak_stress_yy", s.criteria.peak_stress_yy},
+          {"peak_strain_yy", s.criteria.peak_strain_yy},
+          {"passed", s.passed},
+          {"diverged", s.diverged},
+          {"complete", s.complete},
+          {"worst_excess", s.worst_excess},
           {"steps_run", r.steps_run},
-          {"particle_steps", r.particle_steps},
+          {"particle_steps", s.particle_steps},
           {"wall_time_s", r.wall_time_s},
-          {"diagnosis", r.diagnosis}};
+          {"diagnosis", s.diagnosis.message}};
 }
 
 TrialRecord trial_from_json(const nlohmann::json& j, const std::string& source) {
   try {
     TrialRecord r;
     r.id = j.at("id").get<int>();
-    r.phase = to_string(parse_trial_phase(j.at("phase").get<std::string>(), source));
+    r.phase = parse_trial_phase(j.at("phase").get<std::string>(), source);
     r.params = algorithm_from_json(j.at("params"), source, "params");
-    r.criteria = criteria_from_json(j.at("criteria"));
-    // Records older than the peak inside the criteria carry it beside them.
-    r.criteria.peak_stress_yy = j.at("peak_stress_yy").get<double>();
-    r.criteria.peak_strain_yy = j.at("peak_strain_yy").get<double>();
-    r.passed = j.at("passed").get<bool>();
-    r.diverged = j.at("diverged").get<bool>();
-    r.complete = j.at("complete").get<bool>();
-    r.worst_excess = j.at("worst_excess").get<double>();
     r.steps_run = j.at("steps_run").get<int64_t>();
-    r.particle_steps = j.at("particle_steps").get<double>();
     r.wall_time_s = j.at("wall_time_s").get<double>();
-    r.diagnosis = j.at("diagnosis").get<std::string>();
+    Score& s = r.score;
+    s.criteria = criteria_from_json(j.at("criteria"));
+    // Records older than the peak inside the criteria carry it beside them.
+    s.criteria.peak_stress_yy = j.at("peak_stress_yy").get<double>();
+    s.criteria.peak_strain_yy = j.at("peak_strain_yy").get<double>();
+    s.passed = j.at("passed").get<bool>();
+    s.diverged = j.at("diverged").get<bool>();
+    s.complete = j.at("complete").get<bool>();
+    s.worst_excess = j.at("worst_excess").get<double>();
+    s.particle_steps = j.at("particle_steps").get<double>();
+    // As score_run() computes it (the steps planned are params.steps).
+    s.completed_fraction =
+        r.params.steps > 0 ? static_cast<double>(r.steps_run) / static_cast<double>(r.params.steps)
+                           : 0.0;
+    s.diagnosis.message = j.at("diagnosis").get<std::string>();
     return r;
   } catch (const nlohmann::json::exception& e) {
     throw InputError(source, "", std::string("not a demcal trial record: ") + e.what());
@@ -294,8 +281,8 @@ class Evaluator {
       promise.set_exception(std::current_exception());
       throw;
     }
-    r.phase = to_string(phase);
-    if (!r.complete && stopped()) {
+    r.phase = phase;
+    if (!r.score.complete && stopped()) {
       // Possibly cut by the stop: not a finished trial. --resume reruns it.
       r = interrupted_record(params, phase);
       std::lock_guard<std::mutex> lock(mutex_);
@@ -317,12 +304,12 @@ class Evaluator {
           << "): alpha " << params.dt_ratio << ", steps " << params.steps << ", zeta_t "
           << params.damping_ratio_translation << ", zeta_r " << params.damping_ratio_rotation
           << " -> "
-          << (r.diverged ? "diverged"
-              : r.passed ? "pass"
-                         : "fail")
-          << " (worst " << r.worst_excess << "x tol)";
-        if (best_steps_ > 0 || r.passed) {
-          if (r.passed && (best_steps_ == 0 || params.steps < best_steps_))
+          << (r.score.diverged ? "diverged"
+              : r.score.passed ? "pass"
+                               : "fail")
+          << " (worst " << r.score.worst_excess << "x tol)";
+        if (best_steps_ > 0 || r.score.passed) {
+          if (r.score.passed && (best_steps_ == 0 || params.steps < best_steps_))
             best_steps_ = params.steps;
           s << "; best so far " << best_steps_ << " steps";
         }
@@ -351,10 +338,10 @@ class Evaluator {
   static TrialRecord interrupted_record(const AlgorithmSpec& params, TrialPhase phase) {
     TrialRecord r;
     r.params = params;
-    r.phase = to_string(phase);
-    r.complete = false;
-    r.worst_excess = std::numeric_limits<double>::infinity();
-    r.diagnosis = "interrupted";
+    r.phase = phase;
+    r.score.complete = false;
+    r.score.worst_excess = std::numeric_limits<double>::infinity();
+    r.score.diagnosis.message = "interrupted";
     return r;
   }
 
@@ -387,12 +374,6 @@ AlgorithmSpec params_at(const SearchSpace& space, const double* x) {
   return p;
 }
 
-constexpr int kConstraints = 4;
-
-std::array<double, kConstraints> constraint_values(const TrialRecord& r, const Tolerances& t) {
-  return demcal::constraint_values(score_of(r), t);
-}
-
 struct SearchContext {
   Evaluator* evaluator;
   const SearchSpace* space;
@@ -411,13 +392,13 @@ TrialRecord eval_at(SearchContext& c, const double* x) {
 double objective(unsigned, const double* x, double*, void* data) {
   auto& c = *static_cast<SearchContext*>(data);
   const TrialRecord r = eval_at(c, x);
-  return search_objective(params_at(*c.space, x).steps, score_of(r), c.tolerances, c.penalty);
+  return search_objective(params_at(*c.space, x).steps, r.score, c.tolerances, c.penalty);
 }
 
 template <int K>
 double constraint(unsigned, const double* x, double*, void* data) {
   auto& c = *static_cast<SearchContext*>(data);
-  return constraint_values(eval_at(c, x), c.tolerances)[K];
+  return constraint_values(eval_at(c, x).score, c.tolerances)[K];
 }
 
 /// One local search from `start`; returns nothing, the trials are in the
@@ -509,10 +490,11 @@ double model_objective(unsigned, const double* x, double*, void* data) {
     nlopt_force_stop(m.opt);
     return HUGE_VAL;
   }
-  if (r.diverged) return std::log10(m.n_guess) + 3.0;
+  if (r.score.diverged) return std::log10(m.n_guess) + 3.0;
   const double predicted =
-      m.n_guess * std::max(rate_excess(r.criteria, m.tolerances), 1e-3) * kModelMargin;
-  const double osc = std::log(std::max(r.criteria.oscillation, 1e-12) / m.tolerances.oscillation);
+      m.n_guess * std::max(rate_excess(r.score.criteria, m.tolerances), 1e-3) * kModelMargin;
+  const double osc =
+      std::log(std::max(r.score.criteria.oscillation, 1e-12) / m.tolerances.oscillation);
   const double penalty = 10.0 * std::max(0.0, osc);
   if (penalty == 0.0 && (m.best_prediction == 0.0 || predicted < m.best_prediction)) {
     m.best_prediction = predicted;
@@ -561,13 +543,14 @@ std::optional<TrialRecord> model_search(Evaluator& evaluator, const SearchSpace&
   for (int k = 0; k < verify_budget; ++k) {
     const double full[4] = {m.best_x[0], std::log10(n), m.best_x[1], m.best_x[2]};
     const TrialRecord r = evaluator.evaluate(params_at(space, full), TrialPhase::verify);
-    if (r.diverged || evaluator.stopped()) break;
-    const double excess = rate_excess(r.criteria, tolerances);
-    if (r.passed && r.complete) {
+    if (r.score.diverged || evaluator.stopped()) break;
+    const double excess = rate_excess(r.score.criteria, tolerances);
+    if (r.score.passed && r.score.complete) {
       if (!best || r.params.steps < best->params.steps) best = r;
       if (excess > 0.9) break;  // close enough to the boundary
     }
-    n = static_cast<double>(r.params.steps) * std::max(excess, 0.5) * (r.passed ? 1.02 : 1.05);
+    n = static_cast<double>(r.params.steps) * std::max(excess, 0.5) *
+        (r.score.passed ? 1.02 : 1.05);
   }
   return best;
 }
@@ -580,9 +563,9 @@ std::optional<TrialRecord> cheapest_passing(const std::vector<TrialRecord>& tria
                                             const Tolerances* judged_by = nullptr) {
   std::optional<TrialRecord> best;
   for (const auto& t : trials) {
-    if (!t.passed || !t.complete) continue;
+    if (!t.score.passed || !t.score.complete) continue;
     if (judged_by) {
-      const auto g = constraint_values(t, *judged_by);
+      const auto g = constraint_values(t.score, *judged_by);
       if (*std::max_element(g.begin(), g.end()) > 0.0) continue;
     }
     if (!best || t.params.steps < best->params.steps ||
@@ -601,12 +584,12 @@ Certificate certify(Evaluator& evaluator, const TrialRecord& best, double accura
                jobs);
   Certificate c;
   c.steps = best.params.steps;
-  c.peak = a.criteria.peak_stress_yy;
-  c.peak_doubled = b.criteria.peak_stress_yy;
+  c.peak = a.score.criteria.peak_stress_yy;
+  c.peak_doubled = b.score.criteria.peak_stress_yy;
   c.steps_doubled_peak_change =
       c.peak_doubled != 0.0 ? std::abs(c.peak - c.peak_doubled) / std::abs(c.peak_doubled) : 1.0;
   c.richardson_error = richardson_error(c.steps_doubled_peak_change, 2.0);
-  c.passed = !b.diverged && b.complete && c.richardson_error <= accuracy;
+  c.passed = !b.score.diverged && b.score.complete && c.richardson_error <= accuracy;
   return c;
 }
 
@@ -641,7 +624,7 @@ CalibrationSummary calibrate(const SceneConfig& config, const ConsolidatedState&
                              const CalibrationOptions& options) {
   const auto t0 = std::chrono::steady_clock::now();
   CalibrationSummary out;
-  out.strategy = to_string(options.strategy);
+  out.strategy = options.strategy;
   const int jobs = resolve_jobs(options.jobs);
   const int n = state.world.size();
 
@@ -786,11 +769,11 @@ BaselineResult paper_recipe_baseline(const SceneConfig& config, const Consolidat
   p.steps = start_steps;
   for (int k = 0; k <= max_doublings; ++k) {
     TrialRecord r = run_trial(config, state, p, tolerances);
-    r.phase = to_string(TrialPhase::baseline);
+    r.phase = TrialPhase::baseline;
     r.id = k;
     out.trials.push_back(r);
-    out.particle_steps_total += r.particle_steps;
-    if (r.passed) {
+    out.particle_steps_total += r.score.particle_steps;
+    if (r.score.passed) {
       out.passed = true;
       out.params = p;
       return out;
@@ -804,7 +787,7 @@ std::string CalibrationSummary::BriefReport() const {
   std::ostringstream s;
   s.precision(4);
   s << (success ? "SUCCESS" : interrupted ? "INTERRUPTED" : "FAILURE") << ": " << message << "\n";
-  if (best_trial.particle_steps > 0)
+  if (best_trial.score.particle_steps > 0)
     s << "  dt_ratio " << best.dt_ratio << ", steps " << best.steps
       << ", damping_ratio_translation " << best.damping_ratio_translation
       << ", damping_ratio_rotation " << best.damping_ratio_rotation << "\n";
@@ -817,9 +800,9 @@ std::string CalibrationSummary::FullReport() const {
   std::ostringstream s;
   s.precision(4);
   s << BriefReport();
-  s << "  strategy " << strategy << ", stable dt_ratio " << dt_ratio_stable << "\n";
-  if (best_trial.particle_steps > 0) {
-    const auto& c = best_trial.criteria;
+  s << "  strategy " << to_string(strategy) << ", stable dt_ratio " << dt_ratio_stable << "\n";
+  if (best_trial.score.particle_steps > 0) {
+    const auto& c = best_trial.score.criteria;
     s << "  criteria: force balance " << c.force_balance << ", moment balance " << c.moment_balance
       << ", servo " << c.servo << ", oscillation " << c.oscillation << "\n"
       << "  certificate: peak " << certificate.peak << " Pa, Nstep doubled "
@@ -828,13 +811,13 @@ std::string CalibrationSummary::FullReport() const {
   }
   s << "  trials:\n";
   for (const auto& t : trials)
-    s << "    #" << t.id << " " << t.phase << " alpha " << t.params.dt_ratio << " steps "
+    s << "    #" << t.id << " " << to_string(t.phase) << " alpha " << t.params.dt_ratio << " steps "
       << t.params.steps << " zt " << t.params.damping_ratio_translation << " zr "
       << t.params.damping_ratio_rotation
-      << (t.diverged ? " diverged"
-          : t.passed ? " pass"
-                     : " fail")
-      << " worst " << t.worst_excess << " peak " << t.criteria.peak_stress_yy << "\n";
+      << (t.score.diverged ? " diverged"
+          : t.score.passed ? " pass"
+                           : " fail")
+      << " worst " << t.score.worst_excess << " peak " << t.score.criteria.peak_stress_yy << "\n";
   return s.str();
 }
 

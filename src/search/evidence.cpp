@@ -74,7 +74,7 @@ ResultRuns rerun_start_and_result(const SceneConfig& config, const ConsolidatedS
     return r;
   };
   ResultRuns out;
-  const bool have_best = summary.best_trial.particle_steps > 0.0;  // a trial ran
+  const bool have_best = summary.best_trial.score.particle_steps > 0.0;  // a trial ran
   run_parallel({[&] { out.start = one("start point", start); },
                 [&] {
                   if (have_best)
@@ -90,19 +90,21 @@ ReferenceEvidence run_refined_reference(const SceneConfig& config, const Consoli
                                         int jobs) {
   ReferenceEvidence out;
   AlgorithmSpec coarse = best, fine = best;
-  coarse.steps = 8 * best.steps;
-  fine.steps = 16 * best.steps;
+  coarse.steps = kReferenceCoarse * best.steps;
+  fine.steps = kReferenceFine * best.steps;
   LoadingResult fine_run;
   run_parallel(
       {[&] { out.fine = run_trial(config, state, fine, tolerances, false, 3.0, &fine_run); },
        [&] { out.coarse = run_trial(config, state, coarse, tolerances); }},
       jobs);
-  out.coarse.phase = out.fine.phase = "reference";
+  out.coarse.phase = out.fine.phase = TrialPhase::reference;
   out.coarse.id = 0;
   out.fine.id = 1;
   out.fine_series = std::move(fine_run.series);
-  // Peak error ∝ 1/Nstep: P(∞) ≈ P(16N) + (P(16N) − P(8N)).
-  out.peak = 2.0 * out.fine.criteria.peak_stress_yy - out.coarse.criteria.peak_stress_yy;
+  // Nstep in units of the result's: only the ratio matters, and with
+  // powers of two the limit is exactly 2·P(16N) − P(8N).
+  out.peak = richardson_limit(kReferenceCoarse, out.coarse.score.criteria.peak_stress_yy,
+                              kReferenceFine, out.fine.score.criteria.peak_stress_yy);
   return out;
 }
 

@@ -28,12 +28,12 @@ nlohmann::json params_file(const SceneConfig& config, const ConsolidatedState& s
       {"prototype", prototype_block(config, summary.best, n_rev)},
       {"upscaling", upscaling_block(n_rev, n_proto)},
       {"config", to_json(config)},
-      {"criteria", to_json(summary.best_trial.criteria)},
+      {"criteria", to_json(summary.best_trial.score.criteria)},
       {"tolerances", to_json(options.tolerances)},
       {"accuracy", options.accuracy},
       {"certificate", to_json(summary.certificate)},
       {"dt_ratio_stable", summary.dt_ratio_stable},
-      {"strategy", summary.strategy},
+      {"strategy", to_string(summary.strategy)},
       {"trials", static_cast<int>(summary.trials.size())},
       {"particle_steps_run", particle_steps_run(summary.trials, n_rev)},
       {"seed", config.calibration.seed},
@@ -44,8 +44,8 @@ nlohmann::json params_file(const SceneConfig& config, const ConsolidatedState& s
 }
 
 nlohmann::json peak_error_json(const TrialRecord& t, double reference_peak) {
-  if (!t.complete || t.diverged || t.criteria.peak_stress_yy >= 0.0) return nullptr;
-  return (reference_peak - t.criteria.peak_stress_yy) / std::abs(reference_peak);
+  const std::optional<double> error = peak_error(t, reference_peak);
+  return error ? nlohmann::json(*error) : nlohmann::json(nullptr);
 }
 
 nlohmann::json evidence_block(const CalibrationEvidence& e, const TrialRecord& best) {
@@ -57,18 +57,18 @@ nlohmann::json evidence_block(const CalibrationEvidence& e, const TrialRecord& b
   if (baseline.passed) {
     const TrialRecord& last = baseline.trials.back();
     b["steps"] = baseline.params.steps;
-    b["particle_steps"] = last.particle_steps;
-    b["peak_stress_yy"] = last.criteria.peak_stress_yy;
-    b["peak_error"] = peak_error_json(last, e.reference_peak);
+    b["particle_steps"] = last.score.particle_steps;
+    b["peak_stress_yy"] = last.score.criteria.peak_stress_yy;
+    b["peak_error"] = peak_error_json(last, e.reference.peak);
   }
   return {{"reference",
            {{"law", "Richardson, error proportional to 1/Nstep: 2 P(16 Nstep) - P(8 Nstep)"},
-            {"steps_8x", e.coarse.params.steps},
-            {"peak_stress_yy_8x", e.coarse.criteria.peak_stress_yy},
-            {"steps_16x", e.fine.params.steps},
-            {"peak_stress_yy_16x", e.fine.criteria.peak_stress_yy},
-            {"peak_stress_yy", e.reference_peak},
-            {"calibrated_peak_error", peak_error_json(best, e.reference_peak)}}},
+            {"steps_8x", e.reference.coarse.params.steps},
+            {"peak_stress_yy_8x", e.reference.coarse.score.criteria.peak_stress_yy},
+            {"steps_16x", e.reference.fine.params.steps},
+            {"peak_stress_yy_16x", e.reference.fine.score.criteria.peak_stress_yy},
+            {"peak_stress_yy", e.reference.peak},
+            {"calibrated_peak_error", peak_error_json(best, e.reference.peak)}}},
           {"baseline", b}};
 }
 
@@ -76,11 +76,11 @@ std::string evidence_lines(const CalibrationEvidence& e) {
   std::string lines;
   auto add = [&](const TrialRecord& t) {
     nlohmann::json j = to_json(t);
-    j["peak_error"] = peak_error_json(t, e.reference_peak);
+    j["peak_error"] = peak_error_json(t, e.reference.peak);
     lines += j.dump() + "\n";
   };
-  add(e.coarse);
-  add(e.fine);
+  add(e.reference.coarse);
+  add(e.reference.fine);
   for (const auto& t : e.baseline.trials) add(t);
   return lines;
 }

@@ -236,8 +236,9 @@ void fixed_multipliers(Family& family, const ScalingStudyOptions& o, const Scali
   r.fixed.wall_time_s = seconds_since(t0);
   write_file_atomic(fixed_path, to_json(r).dump(2) + "\n");
   for (const auto& t : search.trials)
-    family.log("  " + std::to_string(t.params.steps) + " steps: " + (t.passed ? "pass" : "fail") +
-               " (worst " + num(t.worst_excess, 3) + "x tol), " + num(t.wall_time_s, 3) + " s");
+    family.log("  " + std::to_string(t.params.steps) +
+               " steps: " + (t.score.passed ? "pass" : "fail") + " (worst " +
+               num(t.score.worst_excess, 3) + "x tol), " + num(t.wall_time_s, 3) + " s");
 }
 
 /// Step 3: the fits and the law they measure.
@@ -296,14 +297,14 @@ void forward_check(Family& family, const ScalingStudyOptions& o, ScalingStudy& s
                std::to_string(ref_params.steps) + " steps");
     st.reference = run_trial(family.scene(st.forward_size), family.state(st.forward_size),
                              ref_params, st.tolerances);
-    st.reference.phase = to_string(TrialPhase::reference);
+    st.reference.phase = TrialPhase::reference;
     write_file_atomic(ref_path, to_json(st.reference).dump(2) + "\n");
   }
-  const double ref_peak = st.reference.criteria.peak_stress_yy;
+  const double ref_peak = st.reference.score.criteria.peak_stress_yy;
   st.linear_peak_error =
-      ref_peak != 0.0
-          ? (std::abs(linear_run.criteria.peak_stress_yy) - std::abs(ref_peak)) / std::abs(ref_peak)
-          : 0.0;
+      ref_peak != 0.0 ? (std::abs(linear_run.score.criteria.peak_stress_yy) - std::abs(ref_peak)) /
+                            std::abs(ref_peak)
+                      : 0.0;
 }
 
 }  // namespace
@@ -372,8 +373,8 @@ ScalingStudy run_scaling_study(const SceneConfig& config, const ScalingStudyOpti
   const ScalingSize& fwd = st.results[st.forward_size];
   if (st.forward_size > o.calibrate_max && !fwd.fixed.trials.empty())
     forward_check(family, o, st, fwd.fixed.trials.front());
-  st.forward_ok =
-      st.have_forward && st.linear_run.passed && std::abs(st.linear_peak_error) <= st.accuracy;
+  st.forward_ok = st.have_forward && st.linear_run.score.passed &&
+                  std::abs(st.linear_peak_error) <= st.accuracy;
   // The law upscaling uses: linear while the forward check confirms it (a
   // smaller measured exponent would save steps, but it was fitted on the
   // forward size itself and has no independent check here); the measured

@@ -287,13 +287,13 @@ StepSearch smallest_passing_steps(const SceneConfig& config, const ConsolidatedS
   for (int k = 0; k < max_runs; ++k) {
     TrialRecord r = run_trial(config, state, p, tol);
     r.id = k;
-    r.phase = to_string(TrialPhase::steps_search);
+    r.phase = TrialPhase::steps_search;
     out.trials.push_back(r);
-    out.particle_steps += r.particle_steps;
-    if (r.diverged) break;
-    const double excess = rate_excess(r.criteria, tol);
+    out.particle_steps += r.score.particle_steps;
+    if (r.score.diverged) break;
+    const double excess = rate_excess(r.score.criteria, tol);
     double next;
-    if (r.passed) {
+    if (r.score.passed) {
       if (!out.found || p.steps < out.best.params.steps) out.best = r;
       out.found = true;
       if (excess > 0.93) break;  // within 7 % of the boundary

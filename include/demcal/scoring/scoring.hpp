@@ -127,15 +127,22 @@ struct Diagnosis {
   std::string signature;    ///< the pattern seen, short (DESIGN.md §3 wording)
 };
 
+/// Each criterion divided by its tolerance (≤ 1 passes).
+struct Excesses {
+  double force_balance = 0.0, moment_balance = 0.0, servo = 0.0, oscillation = 0.0;
+  double worst() const;
+  /// "force balance", "moment balance", "servo" or "oscillation": the worst.
+  std::string worst_name() const;
+};
+Excesses excesses(const Criteria& criteria, const Tolerances& tolerances);
+
 struct Score {
   Criteria criteria;
   bool diverged = false;
   bool complete = true;  ///< false when the run stopped early
   bool passed = false;   ///< every criterion within tolerance, not diverged
-  /// Per criterion: value/tolerance (≤ 1 passes).
-  double force_balance_excess = 0.0, moment_balance_excess = 0.0, servo_excess = 0.0,
-         oscillation_excess = 0.0;
-  double worst_excess = 0.0;        ///< the largest of the four
+  /// excesses(criteria, tolerances).worst(): the largest value/tolerance
+  double worst_excess = 0.0;
   double completed_fraction = 1.0;  ///< steps_run / steps_planned
   double particle_steps = 0.0;      ///< cost of the run as planned
   Diagnosis diagnosis;
@@ -148,6 +155,10 @@ Criteria compute_criteria(const std::vector<MonitorPoint>& series, double latera
                           std::optional<double> reference_peak = std::nullopt);
 Score score_run(const LoadingResult& run, double lateral_stress, const Tolerances& tolerances,
                 std::optional<double> reference_peak = std::nullopt);
+/// Relative error of a (negative) peak b_yy against a reference,
+/// (reference − peak)/|reference|: positive when the strength is
+/// over-predicted; nothing without a (non-zero) reference.
+std::optional<double> peak_error_of(double peak, std::optional<double> reference);
 /// The parameter most likely out of bounds, from the pattern of measures
 /// (DESIGN.md §3 as our kernel shows it; reports/signature-atlas.md).
 ///

@@ -102,32 +102,29 @@ struct CalibrationOptions {
   static CalibrationOptions from(const CalibrationSpec& spec);
 };
 
-/// One finished trial, as stored in trials.jsonl.
+/// One finished trial, as stored in trials.jsonl: which trial, why it ran,
+/// what it ran and how it scored, plus what the run took.
 struct TrialRecord {
   int id = 0;
-  /// to_string(TrialPhase): a name, checked by parse_trial_phase() on read.
-  /// (A string still because the report compares names.)
-  std::string phase;
+  TrialPhase phase = TrialPhase::search;
   AlgorithmSpec params;
-  Criteria criteria;
-  bool passed = false, diverged = false, complete = true;
-  double worst_excess = 0.0;
-  int64_t steps_run = 0;
-  double particle_steps = 0.0;  ///< cost
+  /// Read back from trials.jsonl, the score lacks only what the file does
+  /// not keep: the diagnosis beyond its message (the search and the report
+  /// need no more).
+  Score score;
+  int64_t steps_run = 0;  ///< fewer than params.steps when the run stopped early
   double wall_time_s = 0.0;
-  std::string diagnosis;
 };
 /// The one JSON form of a trial (a line of trials.jsonl, the evidence and
-/// scaling files) and its inverse; errors name `source`.
+/// scaling files) and its inverse; errors name `source`. The keys are those
+/// of every earlier version, so old files resume.
 nlohmann::json to_json(const TrialRecord& record);
 TrialRecord trial_from_json(const nlohmann::json& j, const std::string& source);
-/// A trial from its score and run: the one place a TrialRecord is filled
-/// from a Score.
+/// A trial (id 0, phase search) from its parameters, score and run.
 TrialRecord trial_record(const AlgorithmSpec& params, const Score& score, const LoadingResult& run);
-/// The Score a record keeps (criteria, verdicts, worst excess, cost,
-/// completed fraction, the diagnosis message): what constraint_values()
-/// and objective() need. The per-criterion excesses are not kept.
-Score score_of(const TrialRecord& record);
+/// A trial's peak error against a reference peak (peak_error_of()), or
+/// nothing for a run without a valid peak (stopped early, diverged).
+std::optional<double> peak_error(const TrialRecord& trial, double reference_peak);
 
 struct Certificate {
   int64_t steps = 0;
@@ -150,7 +147,7 @@ struct CalibrationSummary {
   std::vector<TrialRecord> trials;  ///< every trial, in id order
   int trials_run = 0, trials_reused = 0;
   double wall_time_s = 0.0;
-  std::string strategy;  ///< to_string(options.strategy), as the reports print it
+  Strategy strategy = CalibrationOptions{}.strategy;  ///< options.strategy
 
   std::string BriefReport() const;
   std::string FullReport() const;

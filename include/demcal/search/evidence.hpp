@@ -60,8 +60,9 @@ ResultRuns rerun_start_and_result(const SceneConfig& config, const ConsolidatedS
                                   const Tolerances& tolerances, int jobs);
 
 /// The --evidence reference: the result's multipliers at 8× and 16× Nstep,
-/// and the peak extrapolated to infinite Nstep, P_ref = 2·P(16N) − P(8N)
-/// (Richardson, peak error ∝ 1/Nstep).
+/// and the peak extrapolated to infinite Nstep by richardson_limit(),
+/// P_ref = 2·P(16N) − P(8N) (peak error ∝ 1/Nstep).
+inline constexpr int kReferenceCoarse = 8, kReferenceFine = 16;  ///< × the result's Nstep
 struct ReferenceEvidence {
   TrialRecord coarse, fine;  ///< 8×Nstep and 16×Nstep
   std::vector<MonitorPoint> fine_series;

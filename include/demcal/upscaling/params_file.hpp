@@ -13,6 +13,7 @@
 #include "demcal/scene/biaxial.hpp"
 #include "demcal/scene/config.hpp"
 #include "demcal/search/calibration.hpp"
+#include "demcal/search/evidence.hpp"
 
 namespace demcal {
 
@@ -30,8 +31,7 @@ nlohmann::json params_file(const SceneConfig& config, const ConsolidatedState& s
 /// The accuracy evidence of `demcal calibrate --evidence`: the converged
 /// reference (Nstep ×8 and ×16, Richardson) and the paper-recipe baseline.
 struct CalibrationEvidence {
-  TrialRecord coarse, fine;     ///< the reference runs, 8× and 16× Nstep
-  double reference_peak = 0.0;  ///< Richardson-extrapolated peak b_yy (negative)
+  ReferenceEvidence reference;
   BaselineResult baseline;
   int64_t baseline_start_steps = 0;
 };
