@@ -253,7 +253,9 @@ class Evaluator {
   /// Run (or look up) one trial. Once stopped(), no new trial starts, and a
   /// trial cut short by the stop is neither cached nor written: it returns
   /// marked incomplete and failed, and the searches wind down.
-  TrialRecord evaluate(AlgorithmSpec params, TrialPhase phase) {
+  /// `early_stop` false runs the trial to the end even when it has certainly
+  /// failed: the model strategy extrapolates from the whole run.
+  TrialRecord evaluate(AlgorithmSpec params, TrialPhase phase, bool early_stop = true) {
     params = rounded_params(params);
     if (stopped()) return interrupted_record(params, phase);
     const Key key = key_of(params);
@@ -275,7 +277,7 @@ class Evaluator {
     if (!mine) return future.get();
     TrialRecord r;
     try {
-      r = run_trial(config_, state_, params, options_.tolerances, options_.early_stop,
+      r = run_trial(config_, state_, params, options_.tolerances, options_.early_stop && early_stop,
                     options_.early_stop_factor, nullptr, options_.stop);
     } catch (...) {
       promise.set_exception(std::current_exception());
@@ -468,6 +470,13 @@ void global_phase(SearchContext context, int max_evals) {
 // NLopt searches the smooth 3-D function log10 N*(α, ζ_t, ζ_r) (plus a
 // penalty on oscillation, which more steps do not cure), re-centred once on
 // its own prediction; then N* is verified and refined by a few trials.
+//
+// Multi-fidelity: the search's trials run at 1/kFidelity of the Nstep they
+// aim at, so each costs an eighth of a final run; only the verification
+// runs at full length. The 1/Nstep law holds that far down: at the
+// calibrated multipliers, N·(force balance) and N·(servo error) stay within
+// 7 % of their final values from N*/16 to N* on hex_10x10 and random_400
+// (reports/calibration-cost.md).
 struct ModelSearch {
   Evaluator* evaluator;
   const SearchSpace* space;
@@ -480,19 +489,24 @@ struct ModelSearch {
 };
 
 constexpr double kModelMargin = 1.1;  // aim a little below the tolerances
+constexpr double kFidelity = 8.0;     // search trials at N*/8
+constexpr int kVerifyBudget = 4;
 
 double model_objective(unsigned, const double* x, double*, void* data) {
   auto& m = *static_cast<ModelSearch*>(data);
   ++m.evaluations;
   const double full[4] = {x[0], std::log10(m.n_guess), x[1], x[2]};
-  const TrialRecord r = m.evaluator->evaluate(params_at(*m.space, full), TrialPhase::search);
+  // The whole run: an early-stopped trial's criteria would under-predict N*.
+  const TrialRecord r =
+      m.evaluator->evaluate(params_at(*m.space, full), TrialPhase::search, /*early_stop=*/false);
   if (m.evaluator->stopped()) {
     nlopt_force_stop(m.opt);
     return HUGE_VAL;
   }
   if (r.score.diverged) return std::log10(m.n_guess) + 3.0;
-  const double predicted =
-      m.n_guess * std::max(rate_excess(r.score.criteria, m.tolerances), 1e-3) * kModelMargin;
+  const double predicted = static_cast<double>(r.params.steps) *
+                           std::max(rate_excess(r.score.criteria, m.tolerances), 1e-3) *
+                           kModelMargin;
   const double osc =
       std::log(std::max(r.score.criteria.oscillation, 1e-12) / m.tolerances.oscillation);
   const double penalty = 10.0 * std::max(0.0, osc);
@@ -503,18 +517,30 @@ double model_objective(unsigned, const double* x, double*, void* data) {
   return std::log10(predicted) + penalty;
 }
 
-/// Returns the verified cheapest passing trial of this search, if any.
-std::optional<TrialRecord> model_search(Evaluator& evaluator, const SearchSpace& space,
-                                        const Tolerances& tolerances, const double* start,
-                                        int max_evals) {
+/// The multipliers with the smallest predicted passing Nstep, and that Nstep.
+struct ModelPrediction {
+  double x[3] = {0, 0, 0};  ///< α, ζ_t, ζ_r
+  double steps = 0.0;       ///< predicted N*
+};
+
+/// The search fidelity for a target Nstep: N*/kFidelity, within the bounds.
+double fidelity_steps(const SearchSpace& space, double target) {
+  return std::clamp(target / kFidelity, std::pow(10.0, space.lower[1]),
+                    std::pow(10.0, space.upper[1]));
+}
+
+/// BOBYQA over (α, ζ_t, ζ_r) on the 1/Nstep model, from `start` (α, log10
+/// of the Nstep aimed at, ζ_t, ζ_r); at most `max_evals` low-fidelity trials.
+std::optional<ModelPrediction> model_predict(Evaluator& evaluator, const SearchSpace& space,
+                                             const Tolerances& tolerances, const double* start,
+                                             int max_evals) {
   ModelSearch m{&evaluator, &space, tolerances};
-  m.n_guess = std::pow(10.0, start[1]);
+  m.n_guess = fidelity_steps(space, std::pow(10.0, start[1]));
   double x[3] = {start[0], start[2], start[3]};
   const double lower[3] = {space.lower[0], space.lower[2], space.lower[3]};
   const double upper[3] = {space.upper[0], space.upper[2], space.upper[3]};
   for (int k = 0; k < 3; ++k) x[k] = std::clamp(x[k], lower[k], upper[k]);
-  const int verify_budget = 4;
-  const int per_round = std::max(4, (max_evals - verify_budget) / 2);
+  const int per_round = std::max(4, max_evals / 2);
   for (int round = 0; round < 2; ++round) {
     nlopt_opt opt = nlopt_create(NLOPT_LN_BOBYQA, 3);
     m.opt = opt;
@@ -530,18 +556,28 @@ std::optional<TrialRecord> model_search(Evaluator& evaluator, const SearchSpace&
     nlopt_destroy(opt);
     m.opt = nullptr;
     if (evaluator.stopped() || m.best_prediction == 0.0) return std::nullopt;
-    // Re-centre the 1/N model on its own prediction.
-    if (std::abs(std::log10(m.best_prediction / m.n_guess)) < 0.05) break;
-    m.n_guess = m.best_prediction;
+    // Re-centre the fidelity on the model's own prediction.
+    const double next = fidelity_steps(space, m.best_prediction);
+    if (round == 1 || std::abs(std::log10(next / m.n_guess)) < 0.05) break;
+    m.n_guess = next;
     std::copy(m.best_x, m.best_x + 3, x);
     m.best_prediction = 0.0;
   }
-  if (m.best_prediction == 0.0) return std::nullopt;
-  // Verify at the prediction and walk to the smallest passing Nstep.
+  ModelPrediction p;
+  std::copy(m.best_x, m.best_x + 3, p.x);
+  p.steps = m.best_prediction;
+  return p;
+}
+
+/// Verify a prediction at full length and walk to the smallest passing
+/// Nstep: the cheapest passing trial found, if any.
+std::optional<TrialRecord> verify_prediction(Evaluator& evaluator, const SearchSpace& space,
+                                             const Tolerances& tolerances,
+                                             const ModelPrediction& p) {
   std::optional<TrialRecord> best;
-  double n = m.best_prediction;
-  for (int k = 0; k < verify_budget; ++k) {
-    const double full[4] = {m.best_x[0], std::log10(n), m.best_x[1], m.best_x[2]};
+  double n = p.steps;
+  for (int k = 0; k < kVerifyBudget; ++k) {
+    const double full[4] = {p.x[0], std::log10(n), p.x[1], p.x[2]};
     const TrialRecord r = evaluator.evaluate(params_at(space, full), TrialPhase::verify);
     if (r.score.diverged || evaluator.stopped()) break;
     const double excess = rate_excess(r.score.criteria, tolerances);
@@ -553,6 +589,25 @@ std::optional<TrialRecord> model_search(Evaluator& evaluator, const SearchSpace&
         (r.score.passed ? 1.02 : 1.05);
   }
   return best;
+}
+
+/// Two model searches (in parallel when jobs > 1), then the verification of
+/// the cheaper prediction, and of the other only when that one fails: the
+/// same trials whatever `jobs` is.
+std::optional<TrialRecord> model_search(Evaluator& evaluator, const SearchSpace& space,
+                                        const Tolerances& tolerances, const double* a,
+                                        const double* b, int max_evals, int jobs) {
+  const int evals = std::max(8, max_evals - kVerifyBudget);
+  std::optional<ModelPrediction> pa, pb;
+  run_parallel({[&] { pa = model_predict(evaluator, space, tolerances, a, evals / 2); },
+                [&] { pb = model_predict(evaluator, space, tolerances, b, evals - evals / 2); }},
+               jobs);
+  if (pa && pb && pb->steps < pa->steps) std::swap(pa, pb);
+  for (const auto& p : {pa, pb}) {
+    if (!p || evaluator.stopped()) continue;
+    if (auto best = verify_prediction(evaluator, space, tolerances, *p)) return best;
+  }
+  return std::nullopt;
 }
 
 /// The cheapest passing trial (ties: the smaller key of the parameters, so
@@ -664,9 +719,7 @@ CalibrationSummary calibrate(const SceneConfig& config, const ConsolidatedState&
   auto search_round = [&](const double* a, const double* b, int evals, TrialPhase phase) {
     SearchContext context{&evaluator, &space, tolerances, phase};
     if (options.strategy == Strategy::model) {
-      run_parallel({[&] { model_search(evaluator, space, tolerances, a, evals / 2); },
-                    [&] { model_search(evaluator, space, tolerances, b, evals - evals / 2); }},
-                   jobs);
+      model_search(evaluator, space, tolerances, a, b, evals, jobs);
       return;
     }
     if (options.strategy == Strategy::direct) {
@@ -722,7 +775,7 @@ CalibrationSummary calibrate(const SceneConfig& config, const ConsolidatedState&
                            best->params.damping_ratio_translation,
                            best->params.damping_ratio_rotation};
       if (options.strategy == Strategy::model) {
-        model_search(evaluator, space, tolerances, x, std::max(8, budget / 4));
+        model_search(evaluator, space, tolerances, x, x, std::max(8, budget / 4), jobs);
       } else {
         SearchContext context{&evaluator, &space, tolerances, TrialPhase::search_tightened};
         local_search(options.strategy == Strategy::direct ? Strategy::cobyla : options.strategy,
