@@ -310,6 +310,18 @@ TEST(EngineLammps, VerifyInLammpsAgreesWithDemcal) {
   nlohmann::json params = nlohmann::json::parse(std::ifstream(dir / "cal" / "params.json"));
   params["rev"]["damping_ratio_rotation"] = 0.0;
   params["rev"]["damping_rotation"] = 0.0;
+  // LAMMPS applies fix viscous explicitly in velocity Verlet, which shrinks
+  // its stable step by f = sqrt(1 + zeta^2) - zeta (a damped oscillator
+  // under an explicit dashpot); demcal's semi-implicit damping does not.
+  // With the calibrated zeta_t near 1, the calibrated alpha chatters in
+  // LAMMPS (measured at 0.286 and 0.257, zeta_t 1.107). The engines are
+  // compared at alpha*f with Nstep/f: the same loading time and rate. (The
+  // export does not yet make this change itself: reports/engines.md.)
+  const double zeta = params["rev"]["damping_ratio_translation"].get<double>();
+  const double f = std::sqrt(1.0 + zeta * zeta) - zeta;
+  params["rev"]["dt_ratio"] = f * params["rev"]["dt_ratio"].get<double>();
+  params["rev"]["dt"] = f * params["rev"]["dt"].get<double>();
+  params["rev"]["steps"] = std::llround(params["rev"]["steps"].get<double>() / f);
   std::ofstream(dir / "p0.json") << params.dump(1);
   const int ours =
       std::system((cd + "verify p0.json --particles 25 -o vd >/dev/null 2>&1").c_str());
