@@ -29,7 +29,23 @@ for scene in "${scenes[@]}"; do
   cfg="$root/configs/$scene.json"
   dir="$out/$scene"
   rm -rf "$dir"
-  "$build/demcal" calibrate "$cfg" -o "$dir" -q --jobs 2 > /dev/null
+  status=0
+  "$build/demcal" calibrate "$cfg" -o "$dir" -q --jobs 2 > "$dir.log" 2>&1 || status=$?
+  if [ ! -f "$dir/params.json" ]; then
+    echo "| $scene | | | | | | | | failed (exit $status): $(tail -n 1 "$dir.log" | cut -c1-120) |"
+    continue
+  fi
+  if [ "$status" -ne 0 ]; then
+    python3 - "$dir" "$scene" <<'EOF'
+import json, sys
+d, scene = sys.argv[1:]
+p = json.load(open(d + "/params.json"))
+run = json.load(open(d + "/run.json"))
+print(f"| {scene} | {p['rev']['particles']} | {p['trials']} | no certified answer | | "
+      f"{run['wall_time_s']:.1f} | {run['kernel_simd']} | | |")
+EOF
+    continue
+  fi
   read -r n trials ratio steps alpha zt zr peak < <(python3 - "$dir" <<'EOF'
 import json, sys
 d = sys.argv[1]
