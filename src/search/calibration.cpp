@@ -593,27 +593,39 @@ Certificate certify(Evaluator& evaluator, const TrialRecord& best, double accura
   return c;
 }
 
-/// --resume: every whole line of trials.jsonl into the evaluator's cache.
+/// --resume: every line of trials.jsonl into the evaluator's cache. Only an
+/// unterminated last line is the normal trace of a kill in mid-append: it is
+/// dropped (the file rewritten without it) so new trials start on a fresh
+/// line. Any other line that does not read is damage: an InputError naming
+/// the line (exit 2), the file untouched, since rerunning everything after
+/// it would silently replace the user's trials.
 void preload_trials(Evaluator& evaluator, const std::string& path) {
-  std::ifstream in(path);
-  std::string line, kept;
+  const std::string text = read_text_file(path);  // a folder, a loop: one clear error
+  size_t begin = 0, kept_end = 0;
   int line_no = 0;
-  while (std::getline(in, line)) {
+  while (begin < text.size()) {
     ++line_no;
-    if (line.empty()) continue;
-    nlohmann::json j;
-    try {
-      j = nlohmann::json::parse(line);
-    } catch (const nlohmann::json::parse_error&) {
-      // A line cut by a kill in mid-write: everything before it is whole.
-      break;
+    const size_t newline = text.find('\n', begin);
+    const bool terminated = newline != std::string::npos;
+    const size_t end = terminated ? newline : text.size();
+    const std::string_view line(text.data() + begin, end - begin);
+    const std::string where = "line " + std::to_string(line_no);
+    if (!line.empty()) {
+      nlohmann::json j;
+      try {
+        j = nlohmann::json::parse(line);
+      } catch (const nlohmann::json::parse_error&) {
+        if (!terminated) break;  // cut by a kill: everything before it is whole
+        throw InputError(path, where,
+                         "not a trial record (the file is damaged; only a cut last line is "
+                         "repaired). Fix or remove the line, or calibrate afresh without --resume");
+      }
+      evaluator.preload(trial_from_json(j, path + ": " + where));
     }
-    evaluator.preload(trial_from_json(j, path + ": line " + std::to_string(line_no)));
-    kept += line + "\n";
+    kept_end = terminated ? end + 1 : end;
+    begin = end + 1;
   }
-  in.close();
-  // Drop a cut last line so that new trials do not append to it.
-  write_file_atomic(path, kept);
+  if (kept_end < text.size()) write_file_atomic(path, text.substr(0, kept_end));
 }
 
 }  // namespace
