@@ -166,7 +166,11 @@ int cmd_calibrate(const CalibrateOptions& o) {
   // Held to the end: a second calibration into this folder stops here,
   // before it changes anything.
   const FolderLock lock(dir);
-  if (o.resume) require_same_run(dir, key);  // unchanged since the check above?
+  if (o.resume) {
+    require_same_run(dir, key);  // unchanged since the check above?
+    // A damaged trials.jsonl stops the run before anything is removed.
+    read_trials_text(read_text_file(trials_path), trials_path);
+  }
   remove_stale_temporaries(dir);
   if (!o.resume) {
     require_regular_file_target(trials_path);

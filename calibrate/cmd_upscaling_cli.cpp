@@ -57,9 +57,11 @@ std::function<int()> add_upscaling_commands(CLI::App& app) {
   scaling->add_option("config", sc->config, "scene config (JSON); default: the embedded one");
   scaling->add_option("--set", sc->sets, "override a key: section.key=value (repeatable)");
   scaling->add_option("--sizes", sc->sizes, "particle counts (default 25,100,400,1600)");
-  scaling->add_option("--calibrate-max", sc->calibrate_max,
-                      "calibrate sizes up to this count; larger ones are checked forward only "
-                      "(default 400)");
+  scaling
+      ->add_option("--calibrate-max", sc->calibrate_max,
+                   "calibrate sizes up to this count; larger ones are checked forward only "
+                   "(default 400)")
+      ->check(whole_number(1, kMaxParticles));
   scaling->add_option("-o,--output", sc->out_dir, "report folder (default reports)");
   scaling->add_option("--work", sc->work_dir, "per-size work folder (default demcal-scaling-NAME)");
   scaling->add_option("-j,--jobs", sc->jobs, "trials in parallel (default: cores)")
