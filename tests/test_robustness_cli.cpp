@@ -232,3 +232,17 @@ TEST_F(RobustCli, ParamsFileIsValidated) {
 }
 
 }  // namespace
+
+namespace {
+
+// A rev that fails after its checks (a REV larger than the prototype)
+// leaves no empty output folder behind.
+TEST_F(RobustCli, FailedRevLeavesNoFolder) {
+  const Result r = demcal(
+      {"rev", kHex5, "--set", "prototype.particles=100", "--particles", "1000", "-o", "out"});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("prototype has only 100"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(work() / "out"));
+}
+
+}  // namespace

@@ -10,6 +10,7 @@ namespace demcal {
 nlohmann::json read_params_file(const std::string& path) {
   const nlohmann::json params = read_json_file(path);
   if (!params.is_object()) throw InputError(path, "", "must be a JSON object (a params.json)");
+  rev_params_from_json(params, path);  // the values used first: their key named first
   const auto schema = params.find("schema");
   if (schema == params.end() || !schema->is_string() || *schema != kParamsSchema)
     throw InputError(
@@ -29,7 +30,6 @@ nlohmann::json read_params_file(const std::string& path) {
       throw InputError(path, "version",
                        "must be a demcal version string, got " + quoted_value(version->dump()));
   }
-  rev_params_from_json(params, path);  // throws on any bad rev value
   if (params.contains("prototype") && params["prototype"].is_object() &&
       params["prototype"].contains("particles")) {
     const auto& n = params["prototype"]["particles"];
