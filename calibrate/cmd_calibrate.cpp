@@ -83,6 +83,52 @@ nlohmann::json run_record(double wall_time_s, const CalibrationSummary& summary,
           {"version", DEMCAL_VERSION}};
 }
 
+/// DIR/resume.json: what the trials of DIR/trials.jsonl were run with.
+/// Written when a calibration starts afresh; --resume reuses the trials only
+/// when everything that changes a trial's outcome or the search is the same
+/// (the config as given with its --set, --accuracy, --strategy, demcal's
+/// version). --max-trials, --jobs and --evidence do not change a trial.
+nlohmann::json resume_key(const SceneConfig& config, const Strategy strategy) {
+  return {{"schema", "demcal.resume/1"},
+          {"config_sha256", sha256_hex(config.text)},
+          {"accuracy", config.calibration.accuracy},
+          {"strategy", to_string(strategy)},
+          {"version", DEMCAL_VERSION}};
+}
+
+/// --resume into `dir`: the trials there must come from the same settings,
+/// or the result would be another calibration's (one error, exit 2,
+/// nothing changed).
+void require_same_run(const std::string& dir, const nlohmann::json& key) {
+  const std::string path = dir + "/resume.json";
+  const char* fresh = "calibrate afresh without --resume (or into another -o)";
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec))
+    throw InputError(path, "",
+                     std::string("missing: the trials in this folder cannot be matched to their "
+                                 "settings (an older demcal or not a calibration); ") +
+                         fresh);
+  nlohmann::json stored;
+  try {
+    stored = parse_config_json(read_text_file(path), path);
+  } catch (const InputError& e) {
+    throw InputError(path, "", std::string(e.what()) + "; " + fresh);
+  }
+  const auto shown = [](const nlohmann::json& v) {
+    return v.is_string() ? quoted_value(v.get<std::string>()) : quoted_value(v.dump());
+  };
+  for (const auto& [name, value] : key.items())
+    if (!stored.is_object() || !stored.contains(name) || stored[name] != value)
+      throw InputError(path, name,
+                       "the trials in " + dir + "/trials.jsonl were run with " +
+                           (stored.is_object() && stored.contains(name) ? shown(stored[name])
+                                                                        : std::string("nothing")) +
+                           ", this run has " + shown(value) +
+                           "; --resume reuses only trials of the same config, --set, --accuracy, "
+                           "--strategy and demcal version: " +
+                           fresh);
+}
+
 }  // namespace
 
 int cmd_calibrate(const CalibrateOptions& o) {
@@ -98,6 +144,11 @@ int cmd_calibrate(const CalibrateOptions& o) {
   OutputFolder::check(dir);  // an unwritable -o fails now, not after the search
   if (o.resume && !std::filesystem::exists(trials_path))
     throw InputError(trials_path, "", "--resume needs the trials.jsonl of an earlier run");
+  const nlohmann::json key = resume_key(config, strategy);
+  if (o.resume) {
+    require_readable_file(trials_path);  // a folder named trials.jsonl: one line
+    require_same_run(dir, key);          // before the consolidation's seconds
+  }
 
   Assembly assembly = make_assembly(config);
   if (!o.quiet)
@@ -112,8 +163,20 @@ int cmd_calibrate(const CalibrateOptions& o) {
   // the default action is fine before).
   const StopOnSignal stop;
   make_output_dir(dir);
+  // Held to the end: a second calibration into this folder stops here,
+  // before it changes anything.
+  const FolderLock lock(dir);
+  if (o.resume) {
+    require_same_run(dir, key);  // unchanged since the check above?
+    // A damaged trials.jsonl stops the run before anything is removed.
+    read_trials_text(read_text_file(trials_path), trials_path);
+  }
   remove_stale_temporaries(dir);
-  if (!o.resume) std::filesystem::remove(trials_path);
+  if (!o.resume) {
+    require_regular_file_target(trials_path);
+    std::filesystem::remove(trials_path);
+    write_file_atomic(dir + "/resume.json", key.dump(2) + "\n");
+  }
   // Results of an earlier run in this folder would not match the trials
   // from here on; they are rewritten at the end.
   for (const char* name : {"params.json", "run.json", "report.html", "report.md", "evidence.jsonl"})

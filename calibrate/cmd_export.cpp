@@ -5,10 +5,11 @@
 #include <iostream>
 
 #include "commands.hpp"
-#include "demcal/scene/biaxial.hpp"
-#include "demcal/upscaling/export.hpp"
 #include "demcal/io/files.hpp"
+#include "demcal/scene/biaxial.hpp"
 #include "demcal/scene/run_output.hpp"
+#include "demcal/upscaling/export.hpp"
+#include "demcal/upscaling/params_file.hpp"
 #include "demcal/upscaling/rev.hpp"
 #include "demcal/upscaling/upscaling.hpp"
 #include "upscaling_cli.hpp"
@@ -17,7 +18,7 @@ namespace demcal::cli {
 
 int cmd_export(const ExportCmdOptions& o) {
   namespace fs = std::filesystem;
-  const nlohmann::json params = read_json_file(o.params);
+  const nlohmann::json params = read_params_file(o.params);
   const RevParams rev = rev_params_from_json(params, o.params);
   if (o.format != "lammps" && o.format != "liggghts")
     throw InputError("--format", "", "must be lammps or liggghts, got \"" + o.format + "\"");

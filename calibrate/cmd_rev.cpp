@@ -9,11 +9,12 @@
 #include <iostream>
 
 #include "commands.hpp"
-#include "demcal/scene/biaxial.hpp"
 #include "demcal/io/files.hpp"
+#include "demcal/scene/biaxial.hpp"
 #include "demcal/scene/run_output.hpp"
 #include "demcal/upscaling/rev.hpp"
 #include "demcal/upscaling/upscaling.hpp"
+#include "output_folder.hpp"
 #include "upscaling_cli.hpp"
 
 namespace demcal::cli {
@@ -33,7 +34,7 @@ int cmd_rev(const RevCmdOptions& o) {
                      "names no prototype: give prototype.file or prototype.particles, or "
                      "--prototype FILE");
   const std::string dir = o.out_dir.empty() ? "demcal-rev-" + config.name : o.out_dir;
-  make_output_dir(dir);
+  OutputFolder::check(dir);  // a bad -o fails now, and leaves no folder
   if (!proto.dense) {
     // A generated gas is no packing to cut from or compare with.
     std::cerr << "demcal rev: consolidating the prototype first (" << source.description
@@ -49,7 +50,9 @@ int cmd_rev(const RevCmdOptions& o) {
             << ", consolidating it to sigma3\n";
   const RevResult r = make_rev(config, proto, ro);
 
-  write_file_atomic(dir + "/rev.csv", particle_csv(r.assembly));
+  // The three files together or none (a failure leaves no folder it made).
+  OutputFolder out(dir);
+  out.write("rev.csv", particle_csv(r.assembly));
   nlohmann::json report{
       {"schema", "demcal.rev/1"},
       {"scene", config.name},
@@ -58,7 +61,7 @@ int cmd_rev(const RevCmdOptions& o) {
       {"particles", r.assembly.size()},
       {"consolidation", {{"steps", r.state.steps}, {"wall_time_s", r.state.wall_time_s}}},
       {"representativeness", to_json(r.representativeness)}};
-  write_file_atomic(dir + "/rev.json", report.dump(2) + "\n");
+  out.write("rev.json", report.dump(2) + "\n");
   // A config that calibrates on the REV and upscales to the prototype.
   nlohmann::json c = to_json(config);
   c["name"] = config.name + "-rev" + std::to_string(r.assembly.size());
@@ -67,7 +70,8 @@ int cmd_rev(const RevCmdOptions& o) {
     c["prototype"] = {{"particles", 0}, {"file", fs::absolute(source.file).string()}};
   else
     c["prototype"] = {{"particles", source.particles}};
-  write_file_atomic(dir + "/rev-config.json", c.dump(2) + "\n");
+  out.write("rev-config.json", c.dump(2) + "\n");
+  out.commit();
 
   const auto& rep = r.representativeness;
   std::cout << "REV of " << r.assembly.size() << " particles (" << r.method << ") from "

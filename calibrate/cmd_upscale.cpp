@@ -9,6 +9,7 @@
 #include "commands.hpp"
 #include "demcal/io/files.hpp"
 #include "demcal/scene/run_output.hpp"
+#include "demcal/upscaling/params_file.hpp"
 #include "demcal/upscaling/upscaling.hpp"
 #include "upscaling_cli.hpp"
 
@@ -81,7 +82,7 @@ ScalingLaw resolve_law(const nlohmann::json& params, const std::string& params_p
 }
 
 int cmd_upscale(const UpscaleOptions& o) {
-  const nlohmann::json params = read_json_file(o.params);
+  const nlohmann::json params = read_params_file(o.params);
   const RevParams rev = rev_params_from_json(params, o.params);
   if (o.particles < 0) throw InputError("--particles", "", "must be positive");
   if (o.particles == 0 && o.prototype.empty())

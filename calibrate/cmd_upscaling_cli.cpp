@@ -4,6 +4,8 @@
 #include <memory>
 
 #include "commands.hpp"
+#include "demcal/scene/config.hpp"
+#include "option_checks.hpp"
 #include "upscaling_cli.hpp"
 
 namespace demcal::cli {
@@ -13,12 +15,14 @@ std::function<int()> add_upscaling_commands(CLI::App& app) {
   auto* upscale = app.add_subcommand(
       "upscale", "the calibrated parameters for a prototype of N particles (or a particle file)");
   upscale->add_option("params", up->params, "params.json of a calibration")->required();
-  upscale->add_option("--particles", up->particles, "the prototype's particle count");
+  upscale->add_option("--particles", up->particles, "the prototype's particle count")
+      ->check(whole_number(1, kMaxParticles));
   upscale->add_option("--prototype", up->prototype, "the prototype's particle file (CSV x,y,r)");
   upscale->add_option("--config", up->config, "scene config, if params.json carries none");
   upscale->add_option("--set", up->sets, "override a config key: section.key=value");
   upscale->add_option("--law", up->law, "scaling.json of demcal scaling: use its measured law");
-  upscale->add_option("--exponent", up->exponent, "Nstep ~ N^exponent (default 1, linear)");
+  upscale->add_option("--exponent", up->exponent, "Nstep ~ N^exponent (default 1, linear)")
+      ->check(real_above(0.0, kMaxExponent));
   upscale->add_option("-o,--output", up->output, "write params.json here (default stdout)");
 
   auto ve = std::make_shared<VerifyOptions>();
@@ -26,14 +30,18 @@ std::function<int()> add_upscaling_commands(CLI::App& app) {
       app.add_subcommand("verify", "run the prototype with the upscaled parameters and score it");
   verify->add_option("params", ve->params, "params.json of a calibration")->required();
   verify->add_option("--prototype", ve->prototype, "the prototype's particle file (CSV x,y,r)");
-  verify->add_option("--particles", ve->particles, "a generated prototype of N particles");
+  verify->add_option("--particles", ve->particles, "a generated prototype of N particles")
+      ->check(whole_number(1, kMaxParticles));
   verify->add_option("--config", ve->config, "scene config, if params.json carries none");
   verify->add_option("--set", ve->sets, "override a config key: section.key=value");
   verify->add_option("--law", ve->law, "scaling.json of demcal scaling: use its measured law");
-  verify->add_option("--exponent", ve->exponent, "Nstep ~ N^exponent (default 1, linear)");
+  verify->add_option("--exponent", ve->exponent, "Nstep ~ N^exponent (default 1, linear)")
+      ->check(real_above(0.0, kMaxExponent));
   verify->add_option("-o,--output", ve->out_dir, "output folder (default demcal-verify-NAME)");
-  verify->add_option("--max-minutes", ve->max_minutes,
-                     "refuse a loading run estimated longer than this (default 8)");
+  verify
+      ->add_option("--max-minutes", ve->max_minutes,
+                   "refuse a loading run estimated longer than this (default 8)")
+      ->check(real_above(0.0, kMaxMinutes));
   verify->add_flag("--consolidate-only", ve->consolidate_only,
                    "consolidate the prototype, write DIR/prototype.csv, and stop");
   verify->add_option("--tile", ve->tile,
@@ -49,13 +57,17 @@ std::function<int()> add_upscaling_commands(CLI::App& app) {
   scaling->add_option("config", sc->config, "scene config (JSON); default: the embedded one");
   scaling->add_option("--set", sc->sets, "override a key: section.key=value (repeatable)");
   scaling->add_option("--sizes", sc->sizes, "particle counts (default 25,100,400,1600)");
-  scaling->add_option("--calibrate-max", sc->calibrate_max,
-                      "calibrate sizes up to this count; larger ones are checked forward only "
-                      "(default 400)");
+  scaling
+      ->add_option("--calibrate-max", sc->calibrate_max,
+                   "calibrate sizes up to this count; larger ones are checked forward only "
+                   "(default 400)")
+      ->check(whole_number(1, kMaxParticles));
   scaling->add_option("-o,--output", sc->out_dir, "report folder (default reports)");
   scaling->add_option("--work", sc->work_dir, "per-size work folder (default demcal-scaling-NAME)");
-  scaling->add_option("-j,--jobs", sc->jobs, "trials in parallel (default: cores)");
-  scaling->add_option("--max-trials", sc->max_trials, "search trials per size (default: config)");
+  scaling->add_option("-j,--jobs", sc->jobs, "trials in parallel (default: cores)")
+      ->check(whole_number(1, kMaxJobs));
+  scaling->add_option("--max-trials", sc->max_trials, "search trials per size (default: config)")
+      ->check(whole_number(1, kMaxTrials));
   scaling->add_flag("--resume", sc->resume, "reuse the sizes already done in the work folder");
   scaling->add_flag("-q,--quiet", sc->quiet, "no progress lines on stderr");
 
@@ -66,11 +78,13 @@ std::function<int()> add_upscaling_commands(CLI::App& app) {
   exp->add_option("--format", ex->format, "lammps (default) or liggghts");
   exp->add_option("-o,--output", ex->output, "the deck (default demcal-NAME.FORMAT)");
   exp->add_option("--prototype", ex->prototype, "the prototype's particle file (CSV x,y,r)");
-  exp->add_option("--particles", ex->particles, "a generated prototype of N particles");
+  exp->add_option("--particles", ex->particles, "a generated prototype of N particles")
+      ->check(whole_number(1, kMaxParticles));
   exp->add_option("--config", ex->config, "scene config, if params.json carries none");
   exp->add_option("--set", ex->sets, "override a config key: section.key=value");
   exp->add_option("--law", ex->law, "scaling.json of demcal scaling: use its measured law");
-  exp->add_option("--exponent", ex->exponent, "Nstep ~ N^exponent (default 1, linear)");
+  exp->add_option("--exponent", ex->exponent, "Nstep ~ N^exponent (default 1, linear)")
+      ->check(real_above(0.0, kMaxExponent));
   exp->add_flag("--no-consolidate", ex->no_consolidate,
                 "write the prototype as read (it is already consolidated to sigma3)");
 
@@ -80,7 +94,8 @@ std::function<int()> add_upscaling_commands(CLI::App& app) {
   rev->add_option("config", rv->config, "scene config (JSON); default: the embedded one");
   rev->add_option("--set", rv->sets, "override a key: section.key=value (repeatable)");
   rev->add_option("--prototype", rv->prototype, "the prototype's particle file (CSV x,y,r)");
-  rev->add_option("--particles", rv->particles, "particles in the REV (default 400)");
+  rev->add_option("--particles", rv->particles, "particles in the REV (default 400)")
+      ->check(whole_number(1, kMaxParticles));
   rev->add_option("--method", rv->method, "cut (a window of the prototype) or generate");
   rev->add_option("-o,--output", rv->out_dir, "output folder (default demcal-rev-NAME)");
 

@@ -23,6 +23,7 @@
 #include "demcal/scoring/trial.hpp"
 #include "demcal/search/calibration.hpp"
 #include "demcal/upscaling/export.hpp"
+#include "demcal/upscaling/params_file.hpp"
 #include "demcal/upscaling/rev.hpp"
 #include "demcal/upscaling/upscaling.hpp"
 #include "upscaling_cli.hpp"
@@ -116,7 +117,7 @@ int verify_in_lammps(const VerifyOptions& o, const SceneConfig& config,
 }  // namespace
 
 int cmd_verify(const VerifyOptions& o) {
-  const nlohmann::json params = read_json_file(o.params);
+  const nlohmann::json params = read_params_file(o.params);
   const RevParams rev = rev_params_from_json(params, o.params);
   const SceneConfig config = required_scene(params, o.params, o.config, o.sets);
   const ScalingLaw law = resolve_law(params, o.params, o.law, o.exponent);

@@ -4,8 +4,10 @@
 #include <iostream>
 
 #include "commands.hpp"
+#include "demcal/kernel/world.hpp"
 #include "demcal/scene/config.hpp"
 #include "demcal/search/calibration.hpp"
+#include "option_checks.hpp"
 
 int main(int argc, char** argv) {
   using namespace demcal::cli;
@@ -38,16 +40,20 @@ int main(int argc, char** argv) {
   sweep->add_option("--set", sweep_options.sets, "override a key: section.key=value (repeatable)");
   sweep->add_option("-o,--output", sweep_options.out_dir,
                     "output folder (default demcal-sweep-NAME)");
-  sweep->add_option("-j,--jobs", sweep_options.jobs, "trials in parallel (default: cores)");
+  sweep->add_option("-j,--jobs", sweep_options.jobs, "trials in parallel (default: cores)")
+      ->check(whole_number(1, kMaxJobs));
 
   CalibrateOptions cal;
   auto* calibrate = app.add_subcommand("calibrate", "calibrate dt, steps and damping on the REV");
   calibrate->add_option("config", cal.config, "scene config (JSON); default: the embedded one");
   calibrate->add_option("--set", cal.sets, "override a key: section.key=value (repeatable)");
   calibrate->add_option("-o,--output", cal.out_dir, "output folder (default demcal-NAME)");
-  calibrate->add_option("-j,--jobs", cal.jobs, "trials in parallel (default: cores)");
-  calibrate->add_option("--max-trials", cal.max_trials, "search trials (default: config, 80)");
-  calibrate->add_option("--accuracy", cal.accuracy, "peak accuracy target (default 0.02)");
+  calibrate->add_option("-j,--jobs", cal.jobs, "trials in parallel (default: cores)")
+      ->check(whole_number(1, kMaxJobs));
+  calibrate->add_option("--max-trials", cal.max_trials, "search trials (default: config, 80)")
+      ->check(whole_number(1, kMaxTrials));
+  calibrate->add_option("--accuracy", cal.accuracy, "peak accuracy target (default 0.02)")
+      ->check(real_between(0.0, 1.0));
   std::string strategies;
   for (demcal::Strategy s : demcal::kStrategies)
     strategies += (strategies.empty() ? "" : ", ") + demcal::to_string(s);
@@ -65,30 +71,61 @@ int main(int argc, char** argv) {
   stability->add_option("--set", stab.sets, "override a key: section.key=value (repeatable)");
   stability->add_option("-o,--output", stab.out_dir,
                         "output folder (default demcal-stability-NAME)");
-  stability->add_option("-j,--jobs", stab.jobs, "trials in parallel (default: cores)");
+  stability->add_option("-j,--jobs", stab.jobs, "trials in parallel (default: cores)")
+      ->check(whole_number(1, kMaxJobs));
   stability->add_option("--from", stab.from, "first rung, x the estimated stable dt_ratio (0.5)")
-      ->check(CLI::PositiveNumber);
+      ->check(real_above(0.0, 100.0));
   stability->add_option("--to", stab.to, "last rung, x the estimated stable dt_ratio (2)")
-      ->check(CLI::PositiveNumber);
+      ->check(real_above(0.0, 100.0));
   stability->add_option("--points", stab.points, "rungs of the ladder (16)")
       ->check(CLI::Range(2, 1000));
+  // Fewer steps than this cannot show a divergence: the energy ledger is
+  // sampled every energy_check_interval steps, and a step past the stable
+  // one needs a few thousand steps to create energy beyond the threshold
+  // (KernelOptions in demcal/kernel/world.hpp); 100 steps called 2x the
+  // stable step "stable".
+  constexpr int64_t kMinStabilitySteps = 16LL * demcal::KernelOptions{}.energy_check_interval;
   stability->add_option("--steps", stab.steps, "loading steps per trial (20000)")
-      ->check(CLI::PositiveNumber);
+      ->check(whole_number(kMinStabilitySteps, 1'000'000'000,
+                           "fewer steps cannot show a divergence: the energy ledger is sampled "
+                           "every " +
+                               std::to_string(demcal::KernelOptions{}.energy_check_interval) +
+                               " steps"));
 
   ScoreOptions score_options;
   auto* score = app.add_subcommand(
       "score", "criteria, verdict and diagnosis of another engine's monitoring series (CSV)");
   score->add_option("file", score_options.file, "series file (e.g. the LAMMPS deck's series.csv)")
       ->required();
-  score->add_option("--lateral-stress", score_options.lateral_stress,
-                    "sigma3 in Pa, if the file has no '# lateral_stress = ' line");
-  score->add_option("--reference-peak", score_options.reference_peak,
-                    "a reference peak |sigma_yy| in Pa to report the peak error against");
+  score
+      ->add_option("--lateral-stress", score_options.lateral_stress,
+                   "sigma3 in Pa, if the file has no '# lateral_stress = ' line")
+      ->check(real_above(0.0, 1e12));
+  score
+      ->add_option("--reference-peak", score_options.reference_peak,
+                   "a reference peak |sigma_yy| in Pa to report the peak error against")
+      ->check(real_above(0.0, 1e15));
   score->add_option("-o,--output", score_options.out_dir,
                     "output folder (default demcal-score-STEM)");
 
   const auto run_upscaling = add_upscaling_commands(app);  // upscale, verify, scaling, export, rev
 
+  // A first word that is neither an option nor a command: name it (CLI11
+  // says only that a subcommand is required).
+  if (argc > 1 && argv[1][0] != '-') {
+    const std::string word = argv[1];
+    std::string names;
+    bool known = false;
+    for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) {
+      known |= sub->get_name() == word;
+      names += (names.empty() ? "" : ", ") + sub->get_name();
+    }
+    if (!known) {
+      std::cerr << "demcal: error: unknown command " << demcal::quoted_value(word)
+                << "; the commands are " << names << " (see --help)\n";
+      return kBadInput;
+    }
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

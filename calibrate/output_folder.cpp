@@ -1,5 +1,12 @@
 #include "output_folder.hpp"
 
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+
 #include "demcal/io/input_error.hpp"
 
 namespace demcal::cli {
@@ -72,6 +79,28 @@ void OutputFolder::fail(const std::string& what) {
   remove_created();
   committed_ = true;
   throw InputError(name_, "", "output folder unusable: " + what);
+}
+
+FolderLock::FolderLock(const std::string& dir) {
+  fd_ = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd_ < 0)
+    throw InputError(dir, "",
+                     std::string("cannot open the output folder (") + std::strerror(errno) + ")");
+  if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+    const int saved = errno;
+    ::close(fd_);
+    fd_ = -1;
+    if (saved == EWOULDBLOCK)
+      throw InputError(dir, "",
+                       "another demcal command is writing into this folder; wait for it to end "
+                       "or give another -o");
+    throw InputError(dir, "",
+                     std::string("cannot lock the output folder (") + std::strerror(saved) + ")");
+  }
+}
+
+FolderLock::~FolderLock() {
+  if (fd_ >= 0) ::close(fd_);  // closing drops the lock
 }
 
 }  // namespace demcal::cli

@@ -46,4 +46,20 @@ class OutputFolder {
   bool committed_ = false;
 };
 
+/// An exclusive lock on an existing output folder (flock on the folder
+/// itself), held until destruction: two commands writing into one folder
+/// (two calibrations interleaving their trials.jsonl) cannot run at once.
+/// A folder already locked: InputError naming it (exit 2). The kernel drops
+/// the lock when the process dies, so a killed run leaves none behind.
+class FolderLock {
+ public:
+  explicit FolderLock(const std::string& dir);
+  FolderLock(const FolderLock&) = delete;
+  FolderLock& operator=(const FolderLock&) = delete;
+  ~FolderLock();
+
+ private:
+  int fd_ = -1;
+};
+
 }  // namespace demcal::cli

@@ -161,7 +161,7 @@ TEST_F(CliEndToEnd, UsageErrorsExitTwo) {
   expect_bad_input({"calibrate", kHex5, "--strategy", "bogus", "-o", out}, {"--strategy", "bogus"});
   expect_bad_input({"stability", kHex5, "--points", "1", "-o", out}, {"--points"});
   expect_bad_input({"stability", kHex5, "--from", "2", "--to", "1", "-o", out}, {"--to"});
-  expect_bad_input({"frobnicate"}, {"subcommand"});
+  expect_bad_input({"frobnicate"}, {"unknown command \"frobnicate\""});
   const Result help = demcal({"--help"});
   EXPECT_EQ(help.status, 0);
   EXPECT_NE(help.out.find("stability"), std::string::npos);

@@ -648,32 +648,50 @@ Certificate certify(Evaluator& evaluator, const TrialRecord& best, double accura
   return c;
 }
 
-/// --resume: every whole line of trials.jsonl into the evaluator's cache.
+/// --resume: every trial of trials.jsonl (read_trials_text) into the
+/// evaluator's cache; a cut last line is dropped from the file so that new
+/// trials start on a fresh line.
 void preload_trials(Evaluator& evaluator, const std::string& path) {
-  std::ifstream in(path);
-  std::string line, kept;
-  int line_no = 0;
-  while (std::getline(in, line)) {
-    ++line_no;
-    if (line.empty()) continue;
-    nlohmann::json j;
-    try {
-      j = nlohmann::json::parse(line);
-    } catch (const nlohmann::json::parse_error&) {
-      // A line cut by a kill in mid-write: everything before it is whole.
-      break;
-    }
-    evaluator.preload(trial_from_json(j, path + ": line " + std::to_string(line_no)));
-    kept += line + "\n";
-  }
-  in.close();
-  // Drop a cut last line so that new trials do not append to it.
-  write_file_atomic(path, kept);
+  const std::string text = read_text_file(path);  // a folder, a loop: one clear error
+  size_t whole = 0;
+  for (TrialRecord& t : read_trials_text(text, path, &whole)) evaluator.preload(std::move(t));
+  if (whole < text.size()) write_file_atomic(path, text.substr(0, whole));
 }
 
 }  // namespace
 
 // ---------------------------------------------------------------------------
+
+std::vector<TrialRecord> read_trials_text(std::string_view text, const std::string& path,
+                                          size_t* whole_bytes) {
+  std::vector<TrialRecord> out;
+  size_t begin = 0, kept_end = 0;
+  int line_no = 0;
+  while (begin < text.size()) {
+    ++line_no;
+    const size_t newline = text.find('\n', begin);
+    const bool terminated = newline != std::string_view::npos;
+    const size_t end = terminated ? newline : text.size();
+    const std::string_view line = text.substr(begin, end - begin);
+    const std::string where = "line " + std::to_string(line_no);
+    if (!line.empty()) {
+      nlohmann::json j;
+      try {
+        j = nlohmann::json::parse(line);
+      } catch (const nlohmann::json::exception&) {
+        if (!terminated) break;  // cut by a kill: everything before it is whole
+        throw InputError(path, where,
+                         "not a trial record (the file is damaged; only a cut last line is "
+                         "repaired). Fix or remove the line, or calibrate afresh without --resume");
+      }
+      out.push_back(trial_from_json(j, path + ": " + where));
+    }
+    kept_end = terminated ? end + 1 : end;
+    begin = end + 1;
+  }
+  if (whole_bytes) *whole_bytes = kept_end;
+  return out;
+}
 
 CalibrationSummary calibrate(const SceneConfig& config, const ConsolidatedState& state,
                              const CalibrationOptions& options) {

@@ -7,6 +7,40 @@
 
 namespace demcal {
 
+nlohmann::json read_params_file(const std::string& path) {
+  const nlohmann::json params = read_json_file(path);
+  if (!params.is_object()) throw InputError(path, "", "must be a JSON object (a params.json)");
+  rev_params_from_json(params, path);  // the values used first: their key named first
+  const auto schema = params.find("schema");
+  if (schema == params.end() || !schema->is_string() || *schema != kParamsSchema)
+    throw InputError(
+        path, "schema",
+        std::string("must be \"") + kParamsSchema + "\" (a demcal params.json), got " +
+            (schema == params.end() ? "nothing"
+                                    : quoted_value(schema->is_string() ? schema->get<std::string>()
+                                                                       : schema->dump())));
+  const auto version = params.find("version");
+  if (version != params.end()) {
+    const bool plain = version->is_string() && !version->get<std::string>().empty() &&
+                       version->get<std::string>().size() <= 40 &&
+                       version->get<std::string>().find_first_not_of(
+                           "0123456789.+-abcdefghijklm"
+                           "nopqrstuvwxyz") == std::string::npos;
+    if (!plain)
+      throw InputError(path, "version",
+                       "must be a demcal version string, got " + quoted_value(version->dump()));
+  }
+  if (params.contains("prototype") && params["prototype"].is_object() &&
+      params["prototype"].contains("particles")) {
+    const auto& n = params["prototype"]["particles"];
+    if (!n.is_number_integer() || n.get<int64_t>() < 1 || n.get<int64_t>() > kMaxParticles)
+      throw InputError(path, "prototype.particles",
+                       std::string("must be a whole number from 1 to ") + kMaxParticlesWhy +
+                           ", got " + quoted_value(n.dump()));
+  }
+  return params;
+}
+
 double particle_steps_run(const std::vector<TrialRecord>& trials, int64_t particles) {
   double sum = 0.0;
   for (const auto& t : trials) sum += static_cast<double>(t.steps_run);

@@ -7,6 +7,7 @@
 #include <numeric>
 #include <sstream>
 
+#include "demcal/io/files.hpp"
 #include "demcal/upscaling/rev.hpp"
 
 namespace demcal {
@@ -181,8 +182,12 @@ double number_at(const nlohmann::json& block, const std::string& key, const std:
   if (!block.contains(key))
     throw InputError(source, where + "." + key, "missing (not a demcal params.json?)");
   if (!block[key].is_number())
-    throw InputError(source, where + "." + key, "must be a number, got " + block[key].dump());
-  return block[key].get<double>();
+    throw InputError(source, where + "." + key,
+                     "must be a number, got " + quoted_value(block[key].dump()));
+  const double v = block[key].get<double>();
+  if (!std::isfinite(v))
+    throw InputError(source, where + "." + key, "must be finite, got " + block[key].dump());
+  return v;
 }
 
 }  // namespace
@@ -203,8 +208,10 @@ RevParams rev_params_from_json(const nlohmann::json& params, const std::string& 
     throw InputError(source, "rev.dt_ratio", "must be in (0, 2), got " + b["dt_ratio"].dump());
   if (!(steps >= 1.0 && steps < 9e18))
     throw InputError(source, "rev.steps", "must be a positive integer, got " + b["steps"].dump());
-  if (!(particles >= 1.0))
-    throw InputError(source, "rev.particles", "must be positive, got " + b["particles"].dump());
+  if (!(particles >= 1.0 && particles <= static_cast<double>(kMaxParticles)))
+    throw InputError(source, "rev.particles",
+                     std::string("must be a count from 1 to ") + kMaxParticlesWhy + ", got " +
+                         b["particles"].dump());
   if (p.damping_ratio_translation < 0.0 || p.damping_ratio_rotation < 0.0)
     throw InputError(source, "rev.damping_ratio_translation", "damping ratios must be >= 0");
   if (!(p.mass_scaling > 0.0)) throw InputError(source, "rev.mass_scaling", "must be > 0");
@@ -213,6 +220,9 @@ RevParams rev_params_from_json(const nlohmann::json& params, const std::string& 
   auto& s = out.scales;
   s.particles = out.particles;
   s.dt_crit = number_at(b, "dt_crit", source, "rev");
+  if (!(s.dt_crit > 0.0))
+    throw InputError(source, "rev.dt_crit",
+                     "must be > 0 (a time step), got " + b["dt_crit"].dump());
   auto crit = [&](const char* abs_key, const char* crit_key, double ratio) {
     if (b.contains(crit_key)) return number_at(b, crit_key, source, "rev");
     if (ratio > 0.0 && b.contains(abs_key)) return number_at(b, abs_key, source, "rev") / ratio;
@@ -224,8 +234,12 @@ RevParams rev_params_from_json(const nlohmann::json& params, const std::string& 
       crit("damping_rotation", "damping_rotation_crit", p.damping_ratio_rotation);
   s.damping_translation_crit_mean = s.damping_translation_crit;
   s.damping_rotation_crit_mean = s.damping_rotation_crit;
+  if (s.damping_translation_crit < 0.0 || s.damping_rotation_crit < 0.0)
+    throw InputError(source, "rev.damping_translation_crit", "critical dampings must be >= 0");
   if (b.contains("radius_min")) s.radius_min = number_at(b, "radius_min", source, "rev");
   if (b.contains("mass_min")) s.mass_min = number_at(b, "mass_min", source, "rev");
+  if (s.radius_min < 0.0 || s.mass_min < 0.0)
+    throw InputError(source, s.radius_min < 0.0 ? "rev.radius_min" : "rev.mass_min", "must be > 0");
   s.mass_mean = s.mass_min;
   return out;
 }
@@ -329,16 +343,10 @@ StepSearch smallest_passing_steps(const SceneConfig& config, const ConsolidatedS
 namespace demcal {
 
 nlohmann::json read_json_file(const std::string& path) {
-  if (std::filesystem::is_directory(path)) throw InputError(path, "", "is a folder, not a file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path, "", "cannot open file");
-  std::ostringstream s;
-  s << in.rdbuf();
-  try {
-    return nlohmann::json::parse(s.str());
-  } catch (const nlohmann::json::parse_error& e) {
-    throw InputError(path, "byte " + std::to_string(e.byte), "not valid JSON");
-  }
+  // The config's reader: a folder or a loop named, every nlohmann error
+  // (1e999 is out_of_range, not a parse error) an InputError with its line,
+  // duplicate keys refused.
+  return parse_config_json(read_text_file(path), path);
 }
 
 }  // namespace demcal

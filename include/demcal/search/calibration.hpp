@@ -153,6 +153,15 @@ struct CalibrationSummary {
   std::string FullReport() const;
 };
 
+/// The trials of a trials.jsonl text (`path` names it in errors). Only an
+/// unterminated last line is the normal trace of a kill in mid-append: it is
+/// skipped, and `whole_bytes` (if given) is the length of the text without
+/// it. Any other line that does not read is damage: an InputError naming
+/// the line (exit 2), since rerunning the trials after it would silently
+/// replace the user's.
+std::vector<TrialRecord> read_trials_text(std::string_view text, const std::string& path,
+                                          size_t* whole_bytes = nullptr);
+
 /// Calibrate on a consolidated REV. Deterministic for a given config,
 /// options and seed, whatever `jobs` is.
 CalibrationSummary calibrate(const SceneConfig& config, const ConsolidatedState& state,

@@ -27,6 +27,14 @@ double particle_steps_run(const std::vector<TrialRecord>& trials, int64_t partic
 /// certificate, and what reproduces it (config, seed, hash, version).
 nlohmann::json params_file(const SceneConfig& config, const ConsolidatedState& state,
                            const CalibrationOptions& options, const CalibrationSummary& summary);
+/// The schema params_file() writes and read_params_file() accepts.
+inline constexpr const char* kParamsSchema = "demcal.params/1";
+/// A params.json read back and checked like a config: valid JSON without
+/// duplicate keys, this schema, a version string, and a `rev` block whose
+/// numbers are finite and in range (rev_params_from_json), a prototype
+/// particle count that fits. Every fault is an InputError naming the file
+/// and the key (exit 2).
+nlohmann::json read_params_file(const std::string& path);
 
 /// The accuracy evidence of `demcal calibrate --evidence`: the converged
 /// reference (Nstep ×8 and ×16, Richardson) and the paper-recipe baseline.

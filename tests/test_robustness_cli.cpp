@@ -1,0 +1,248 @@
+// The command line against hostile-but-realistic input (issue 14, round
+// two): every numeric option of every subcommand at 0, -1, nan and values
+// that do not fit; --resume with other settings; two calibrations into one
+// folder; a damaged trials.jsonl; a params.json that lies. Each must end
+// with exit status 2, one line naming the option, file, key or line, and
+// nothing written or changed.
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <sys/file.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kBinary = DEMCAL_BINARY;
+const std::string kSource = DEMCAL_SOURCE_DIR;
+const std::string kHex5 = kSource + "/configs/hex_5x5.json";
+
+std::string read(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::string quote(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+struct Result {
+  int status = -1;
+  std::string out, err;
+};
+
+/// Path → content of every file under `dir` (folders as "<dir>").
+std::map<std::string, std::string> snapshot(const fs::path& dir) {
+  std::map<std::string, std::string> out;
+  for (const auto& e : fs::recursive_directory_iterator(dir))
+    out[fs::relative(e.path(), dir).string()] =
+        e.is_regular_file() ? std::to_string(std::hash<std::string>{}(read(e.path())))
+                            : std::string("<dir>");
+  return out;
+}
+
+class RobustCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = fs::temp_directory_path() /
+           ("demcal_test_robust_cli_" + std::to_string(::getpid()) + "_" + info->name());
+    fs::remove_all(dir_);
+    fs::create_directories(work());
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  fs::path work() const { return dir_ / "work"; }
+
+  Result demcal(const std::vector<std::string>& args) {
+    std::string cmd = "cd " + quote(work().string()) + " && " + quote(kBinary);
+    for (const auto& a : args) cmd += " " + quote(a);
+    cmd += " >" + quote((dir_ / "stdout").string()) + " 2>" + quote((dir_ / "stderr").string());
+    const int raw = std::system(cmd.c_str());
+    Result r;
+    r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+    r.out = read(dir_ / "stdout");
+    r.err = read(dir_ / "stderr");
+    return r;
+  }
+
+  /// Exit 2, one line on stderr naming `mention`, the work folder unchanged.
+  void expect_refused(const std::vector<std::string>& args, const std::string& mention) {
+    std::string trace = "demcal";
+    for (const auto& a : args) trace += " " + a;
+    SCOPED_TRACE(trace);
+    const auto before = snapshot(work());
+    const Result r = demcal(args);
+    EXPECT_EQ(r.status, 2) << r.err;
+    EXPECT_NE(r.err.find(mention), std::string::npos) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_EQ(snapshot(work()), before);
+  }
+
+  /// A small finished calibration in work()/A (under a second).
+  void calibrate_a() {
+    const Result r = demcal({"calibrate", kHex5, "-o", "A", "-q", "-j", "1", "--max-trials", "8"});
+    ASSERT_EQ(r.status, 0) << r.err;
+    ASSERT_TRUE(fs::exists(work() / "A" / "resume.json"));
+  }
+
+  fs::path dir_;
+};
+
+// Every numeric option of every subcommand, at values that are never
+// meant: each names the option, exit 2, nothing written.
+TEST_F(RobustCli, EveryNumericOptionOutOfRangeIsRefused) {
+  std::ofstream(work() / "series.csv") << "# not read: the options fail first\n";
+  const std::vector<std::pair<std::vector<std::string>, std::vector<std::string>>> commands = {
+      {{"sweep", kHex5}, {"--jobs"}},
+      {{"calibrate", kHex5}, {"--jobs", "--max-trials", "--accuracy"}},
+      {{"stability", kHex5}, {"--jobs", "--from", "--to", "--points", "--steps"}},
+      {{"score", "series.csv"}, {"--lateral-stress", "--reference-peak"}},
+      {{"upscale", "params.json"}, {"--particles", "--exponent"}},
+      {{"verify", "params.json"}, {"--particles", "--exponent", "--max-minutes", "--np"}},
+      {{"scaling", kHex5}, {"--jobs", "--max-trials", "--calibrate-max"}},
+      {{"export", "params.json"}, {"--particles", "--exponent"}},
+      {{"rev", kHex5}, {"--particles"}},
+  };
+  const std::vector<std::string> values = {
+      "0", "-1", "-5", "nan", "inf", "1e999", "1e300", "1e9", "99999999999999999999"};
+  for (const auto& [head, options] : commands)
+    for (const auto& option : options)
+      for (const auto& value : values) {
+        // Values that are in range for this option (1e9 steps, a 1e9 Pa
+        // reference peak) are not the point here.
+        if (value == "1e9" && option != "--particles" && option != "--calibrate-max") continue;
+        std::vector<std::string> args = head;
+        args.insert(args.end(), {option, value, "-o", "out"});
+        expect_refused(args, option);
+      }
+}
+
+TEST_F(RobustCli, StabilityRefusesTooFewStepsToSeeADivergence) {
+  expect_refused({"stability", kHex5, "--steps", "100", "-o", "out"}, "energy ledger");
+}
+
+TEST_F(RobustCli, UnknownCommandIsNamed) { expect_refused({"frobnicate"}, "\"frobnicate\""); }
+
+TEST_F(RobustCli, ResumeWithOtherSettingsIsRefusedAndChangesNothing) {
+  calibrate_a();
+  expect_refused({"calibrate", kHex5, "--set", "material.friction=0.5", "-o", "A", "-q", "-j", "1",
+                  "--resume"},
+                 "config_sha256");
+  expect_refused({"calibrate", kHex5, "--accuracy", "0.05", "-o", "A", "-q", "-j", "1", "--resume"},
+                 "accuracy");
+  expect_refused(
+      {"calibrate", kHex5, "--strategy", "cobyla", "-o", "A", "-q", "-j", "1", "--resume"},
+      "strategy");
+  // Without the record of its settings a folder's trials cannot be reused.
+  fs::remove(work() / "A" / "resume.json");
+  expect_refused({"calibrate", kHex5, "-o", "A", "-q", "-j", "1", "--resume"}, "resume.json");
+}
+
+TEST_F(RobustCli, ResumeWithTheSameSettingsReusesEveryTrial) {
+  calibrate_a();
+  const Result r =
+      demcal({"calibrate", kHex5, "-o", "A", "-q", "-j", "1", "--max-trials", "8", "--resume"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto run = nlohmann::json::parse(read(work() / "A" / "run.json"));
+  EXPECT_EQ(run["trials_run"].get<int>(), 0);
+  EXPECT_GT(run["trials_reused"].get<int>(), 0);
+}
+
+TEST_F(RobustCli, SecondCalibrationIntoALockedFolderIsRefused) {
+  calibrate_a();
+  // This process holds the lock a running calibration would hold.
+  const int fd = ::open((work() / "A").c_str(), O_RDONLY | O_DIRECTORY);
+  ASSERT_GE(fd, 0);
+  ASSERT_EQ(::flock(fd, LOCK_EX | LOCK_NB), 0);
+  expect_refused({"calibrate", kHex5, "-o", "A", "-q", "-j", "1"}, "another demcal command");
+  ::close(fd);
+}
+
+TEST_F(RobustCli, DamagedTrialLineIsRefusedWithItsNumber) {
+  calibrate_a();
+  const fs::path trials = work() / "A" / "trials.jsonl";
+  std::string text = read(trials);
+  const size_t second = text.find('\n') + 1;
+  text.replace(second, text.find('\n', second) - second, "{\"garbage");
+  std::ofstream(trials, std::ios::binary) << text;
+  expect_refused({"calibrate", kHex5, "-o", "A", "-q", "-j", "1", "--resume"}, "line 2");
+}
+
+TEST_F(RobustCli, CutLastTrialLineIsRepaired) {
+  calibrate_a();
+  const fs::path trials = work() / "A" / "trials.jsonl";
+  const std::string whole = read(trials);
+  std::ofstream(trials, std::ios::binary | std::ios::app) << "{\"id\": 9";
+  const Result r =
+      demcal({"calibrate", kHex5, "-o", "A", "-q", "-j", "1", "--max-trials", "8", "--resume"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(read(trials), whole);  // the cut line gone, no trial rerun
+}
+
+TEST_F(RobustCli, TrialsFileThatIsAFolderIsOneLine) {
+  calibrate_a();
+  fs::remove(work() / "A" / "trials.jsonl");
+  fs::create_directory(work() / "A" / "trials.jsonl");
+  expect_refused({"calibrate", kHex5, "-o", "A", "-q", "-j", "1", "--resume"}, "is a folder");
+}
+
+// params.json is checked like a config: file and key named, exit 2.
+TEST_F(RobustCli, ParamsFileIsValidated) {
+  calibrate_a();
+  const auto good = nlohmann::json::parse(read(work() / "A" / "params.json"));
+  auto write_params = [&](const std::string& text) {
+    std::ofstream(dir_ / "bad.json", std::ios::binary) << text;
+    return (dir_ / "bad.json").string();
+  };
+  auto with = [&](const nlohmann::json::json_pointer& at, const nlohmann::json& v) {
+    nlohmann::json j = good;
+    j[at] = v;
+    return write_params(j.dump());
+  };
+  using ptr = nlohmann::json::json_pointer;
+  for (const std::string cmd : {"upscale", "export"}) {
+    expect_refused({cmd, with(ptr("/rev/dt_crit"), -1e-6), "--particles", "100"}, "rev.dt_crit");
+    expect_refused({cmd, with(ptr("/rev/particles"), 1e300), "--particles", "100"},
+                   "rev.particles");
+    expect_refused({cmd, with(ptr("/schema"), "other.tool/7"), "--particles", "100"}, "schema");
+    expect_refused({cmd, with(ptr("/version"), nlohmann::json::array()), "--particles", "100"},
+                   "version");
+    std::string text = good.dump();
+    text.insert(1, "\"huge\": 1e999, ");
+    expect_refused({cmd, write_params(text), "--particles", "100"}, "bad.json");
+  }
+  // The good file passes the same reader.
+  const Result r =
+      demcal({"upscale", (work() / "A" / "params.json").string(), "--particles", "100"});
+  EXPECT_EQ(r.status, 0) << r.err;
+}
+
+}  // namespace
+
+namespace {
+
+// A rev that fails after its checks (a REV larger than the prototype)
+// leaves no empty output folder behind.
+TEST_F(RobustCli, FailedRevLeavesNoFolder) {
+  const Result r = demcal(
+      {"rev", kHex5, "--set", "prototype.particles=100", "--particles", "1000", "-o", "out"});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("prototype has only 100"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(work() / "out"));
+}
+
+}  // namespace
