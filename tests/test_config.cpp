@@ -72,7 +72,7 @@ void expect_rejected(const std::string& text, const std::string& field) {
 
 // --- defaults -----------------------------------------------------------
 
-// The documented defaults (config.hpp, DESIGN.md §5), written out once more
+// The documented defaults (scene/config.hpp, README.md "Config keys"), written out once more
 // so that a silent change of a default is caught here.
 TEST(ConfigDefaults, EmptyObjectGivesEveryDocumentedDefault) {
   // The material's density, kn, kt and friction have no default any more

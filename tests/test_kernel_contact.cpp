@@ -1,4 +1,4 @@
-// Contact law of the kernel against closed-form results (DESIGN.md §2):
+// Contact law of the kernel against closed-form results (README.md "Physics in one paragraph"):
 // normal force kn·δ, contact duration and restitution of a head-on collision,
 // incremental tangential spring with the Coulomb cap, torques.
 #include <gtest/gtest.h>
@@ -294,7 +294,8 @@ TEST(KernelContact, TangentialHistoryCarriesOverRebuilds) {
   }
 }
 
-// Locked rotation (the diagnostic switch of DESIGN.md §2) means ω ≡ 0: a
+// Locked rotation (algorithm.lock_rotation, the diagnostic switch under which
+// the hexagonal packing fails by the analytical sliding mechanism) means ω ≡ 0: a
 // spin left over from before the lock, or set afterwards, must neither turn
 // the disk nor load the tangential springs through the contact-point
 // velocity.

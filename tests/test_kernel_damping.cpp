@@ -1,4 +1,5 @@
-// Global damping (DESIGN.md §2) against the damped linear oscillator.
+// Global damping (D = ζ·2·sqrt(k·m), src/kernel/solver.cpp) against the damped
+// linear oscillator.
 //
 // A wall contact is one-sided, so a disk released against a single wall
 // leaves it and never oscillates about an equilibrium. Here the disk is

@@ -1,4 +1,5 @@
-// Energy conservation of the undamped kernel (DESIGN.md §2 integration).
+// Energy conservation of the undamped kernel (central-difference integration,
+// src/kernel/solver.cpp).
 //
 // Scene: a 10×10 hexagonal packing pre-compressed by the four walls
 // (overlap 1e-6 m = 2rε, ε = 1e-3, at every contact), first relaxed to

@@ -2,8 +2,8 @@
 //
 // The undamped central-difference scheme is stable iff ω_max·Δt < 2, ω²_max
 // the largest eigenvalue of A = M^-½·K·M^-½ (K: stiffness of the contact
-// network, translations and rotations coupled); with the damping of
-// DESIGN.md §2 the boundary is the same (the characteristic polynomial at
+// network, translations and rotations coupled); with the global damping of
+// src/kernel/solver.cpp the boundary is the same (the characteristic polynomial at
 // z = −1 is 4 − ω²Δt², independent of the damping). In units of
 // Δt_crit = 2·sqrt(m/kn): α_stable = 1/sqrt(λ), λ = ω²_max·m/kn.
 #include <gtest/gtest.h>

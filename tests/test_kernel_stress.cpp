@@ -1,4 +1,5 @@
-// Stress measures (DESIGN.md §2), tension positive, origin at the box centre:
+// Stress measures (README.md "Physics in one paragraph"), tension positive,
+// origin at the box centre:
 //   b_ij = (1/V) Σ_{wall contacts} x^c_i f^c_j,
 //   σ_ij = (1/V) Σ_p Σ_{c∈p} (x^c − x^p)_i f^c_j.
 // Exact identities, for any state (pair contacts cancel in Σ x^c ⊗ f^c):
