@@ -10,18 +10,14 @@
 #include "demcal/scene/biaxial.hpp"
 #include "demcal/scene/config.hpp"
 #include "demcal/scene/packing.hpp"
+#include "support/scenes.hpp"
 
 namespace demcal {
 namespace {
 
 /// `json` with the material keys a config must give added where absent.
 SceneConfig scene(const std::string& json) {
-  nlohmann::json j = nlohmann::json::parse(json);
-  const nlohmann::json required = {
-      {"density", 2650}, {"kn", 1e8}, {"kt", 5e7}, {"friction", 0.3}};
-  for (const auto& [key, value] : required.items())
-    if (!j["material"].contains(key)) j["material"][key] = value;
-  return parse_config_text(j.dump(), "test");
+  return parse_config_text(test::with_required_material(json), "test");
 }
 
 double peak_ratio(const LoadingResult& run, const TestSpec& test) {

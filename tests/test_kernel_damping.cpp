@@ -34,7 +34,7 @@ namespace {
 
 using kernel_test::kEps;
 using kernel_test::kR;
-using kernel_test::test_material;
+using kernel_test::reference_material;
 
 struct DiscreteOscillator {
   double rho, theta;
@@ -67,7 +67,7 @@ struct SqueezedDisk {
     h = std::sqrt(world.material().particle.kn / world.mass()[0]) * in.dt;  // = 2α
   }
   static Material material() {
-    Material m = test_material(0.3, 0.0);
+    Material m = reference_material(0.3, 0.0);
     m.wall.kn = 0.5 * m.particle.kn;  // two walls in parallel: k = kn
     return m;
   }
@@ -153,7 +153,7 @@ struct SpunDisk {
     h = std::sqrt(world.material().particle.kt * r * r / inertia) * in.dt;
   }
   static Material material() {
-    Material m = test_material(0.3, 10.0);  // wall friction never reached
+    Material m = reference_material(0.3, 10.0);  // wall friction never reached
     const double dist = r - delta0;
     m.wall.kt = m.particle.kt * r * r / (2.0 * dist * dist);
     return m;

@@ -44,7 +44,7 @@ struct EnergyRun {
 
 EnergyRun run_vibrating_hex(double mu, double alpha, uint32_t seed) {
   auto scene = kernel_test::hex_scene(10, 10);
-  World w = scene.make(kernel_test::test_material(mu, 0.0));
+  World w = scene.make(kernel_test::reference_material(mu, 0.0));
   // Relax to rest (the shifted rows are not balanced at the side walls),
   // frictionless, so that no tangential force is locked in at rest. (A
   // locked-in Ft makes the rotating incremental spring non-conservative: the

@@ -101,7 +101,7 @@ void expect_boundary_stress_is_wall_stress(const World& w, const Measures& m, do
 
 TEST(KernelStress, StaticFrictionalPackingHasBoundaryEqualHomogenizedAndSymmetricStress) {
   auto scene = kernel_test::random_loose_scene(8, 8, 3);
-  World w = scene.make(kernel_test::test_material(0.3));
+  World w = scene.make(kernel_test::reference_material(0.3));
   kernel_test::compact(w, 0.84, 0.3, 0);
   // Relax with the walls fixed and critical damping until static.
   w.step(20000);
@@ -138,7 +138,7 @@ TEST(KernelStress, StaticFrictionalPackingHasBoundaryEqualHomogenizedAndSymmetri
 
 TEST(KernelStress, NetForceMomentIdentityHoldsToRoundOffDuringDynamicRun) {
   auto scene = kernel_test::random_loose_scene(10, 10, 5);
-  World w = scene.make(kernel_test::test_material(0.3));
+  World w = scene.make(kernel_test::reference_material(0.3));
   kernel_test::compact(w, 0.84, 0.3, 2000);
   // Fast, lightly damped shear: top wall down, side walls out, 1e-3 r per step.
   Integration in = w.integration();
