@@ -8,9 +8,10 @@
 // and each of the four frictionless walls overlaps the outermost disks by the
 // same amount. Bottom, left and right walls are fixed; the top wall moves
 // down at the speed that gives 1 % vertical strain over 1e5 steps.
-// Material: ρ = 2650 kg/m³, t = 1 m, kn = 1e8 N/m, kt = 5e7 N/m, μ = 0.3;
-// walls kn = 1e8, kt = 5e7, μ = 0. Integration: α = Δt/Δt_crit = 0.2 with
-// Δt_crit from World::reference_scales(), ζ_t = ζ_r = 1.
+// Material (reference_material in tests/support/scenes.hpp): ρ = 2650 kg/m³,
+// t = 1 m, kn = 1e8 N/m, kt = 5e7 N/m, μ = 0.3; walls kn = 1e8, kt = 5e7,
+// μ = 0. Integration: α = Δt/Δt_crit = 0.2 with Δt_crit from
+// World::reference_scales(), ζ_t = ζ_r = 1.
 //
 // Random scene: n polydisperse disks, radii uniform in [0.8, 1.2]·5e-4 m,
 // placed on a loose square grid (spacing 2.1·r_max) with random jitter
@@ -29,8 +30,9 @@
 #include <string>
 #include <vector>
 
-#include "demcal/scene/packing.hpp"
 #include "demcal/kernel/world.hpp"
+#include "demcal/scene/packing.hpp"
+#include "support/scenes.hpp"
 
 namespace demcal_bench {
 
@@ -47,15 +49,8 @@ inline constexpr double kAlpha = 0.2;        // Δt / Δt_crit
 inline constexpr double kStrain = 0.01;      // top-wall strain ...
 inline constexpr double kStrainSteps = 1e5;  // ... over this many steps
 
-inline demcal::Material bench_material() {
-  demcal::Material m;
-  m.density = 2650.0;
-  m.thickness = 1.0;
-  m.particle = {1e8, 5e7, 0.3};
-  m.wall = {1e8, 5e7, 0.0};
-  m.contact_damping_ratio = 0.0;
-  return m;
-}
+/// The default scene's material (tests/support/scenes.hpp), as the tests use.
+inline demcal::Material bench_material() { return demcal::test::reference_material(); }
 
 /// nx columns × ny rows hexagonal packing, pre-compressed, walls touching.
 inline Scene hex_scene(int nx, int ny) {

@@ -1,5 +1,5 @@
 // `demcal sweep CONFIG [--jobs N] [-o DIR]`: the signature atlas
-// (DESIGN.md §3, demcal/sweep.hpp). The config's algorithm block is the
+// (demcal/search/sweep.hpp; reports/signature-atlas.md). The config's algorithm block is the
 // benchmark; every other case changes one parameter.
 #include <iomanip>
 #include <iostream>

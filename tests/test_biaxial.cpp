@@ -10,18 +10,14 @@
 #include "demcal/scene/biaxial.hpp"
 #include "demcal/scene/config.hpp"
 #include "demcal/scene/packing.hpp"
+#include "support/scenes.hpp"
 
 namespace demcal {
 namespace {
 
 /// `json` with the material keys a config must give added where absent.
 SceneConfig scene(const std::string& json) {
-  nlohmann::json j = nlohmann::json::parse(json);
-  const nlohmann::json required = {
-      {"density", 2650}, {"kn", 1e8}, {"kt", 5e7}, {"friction", 0.3}};
-  for (const auto& [key, value] : required.items())
-    if (!j["material"].contains(key)) j["material"][key] = value;
-  return parse_config_text(j.dump(), "test");
+  return parse_config_text(test::with_required_material(json), "test");
 }
 
 double peak_ratio(const LoadingResult& run, const TestSpec& test) {
@@ -42,8 +38,8 @@ double peak_ratio(const LoadingResult& run, const TestSpec& test) {
 // P(200k) 7.767, P(400k) 7.744, differences halving), so the Richardson
 // estimate 2·P(2N) − P(N) removes it to first order; what is left is the
 // O(1/N²) term (≪ the 0.3 % P(N) − P(2N)) and the tilt (≈ 0.05 %). The
-// product's bar (DESIGN.md §7) is 2 %; the error budget supports 0.5 %, which
-// is asserted too so that a real regression of the kernel is not hidden by
+// product's bar for kernel accuracy is 2 %; the error budget supports 0.5 %,
+// which is asserted too so that a real regression of the kernel is not hidden by
 // the bar's margin. Measured at writing: 7.721, −0.05 %.
 TEST(BiaxialAnalyticalPeak, StiffHex5x5RotationLockedMatchesWalledSlidingPeak) {
   const SceneConfig c = scene(R"({
@@ -74,7 +70,8 @@ TEST(BiaxialAnalyticalPeak, StiffHex5x5RotationLockedMatchesWalledSlidingPeak) {
 }
 
 // With free rotation the boundary disks roll and the sample is weaker than
-// the rotation-locked mechanism (DESIGN.md §2), at default stiffness.
+// the rotation-locked sliding mechanism σ1/σ3 = tan 60°·tan(60° + φμ),
+// tan φμ = μ, at default stiffness.
 TEST(BiaxialAnalyticalPeak, FreeRotationIsWeakerThanLocked) {
   SceneConfig c = scene(R"({"assembly": {"columns": 5, "rows": 5},
                             "test": {"vertical_strain": 0.01, "monitor_points": 50}})");

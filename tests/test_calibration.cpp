@@ -22,47 +22,25 @@
 #include "demcal/scene/run_output.hpp"
 #include "demcal/search/calibration.hpp"
 #include "stop_signal.hpp"
+#include "support/files.hpp"
+#include "support/process.hpp"
 
 namespace fs = std::filesystem;
 using namespace demcal;
 
 namespace {
 
-fs::path fresh_dir(const std::string& name) {
-  fs::path dir =
-      fs::temp_directory_path() / ("demcal_test_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  return dir;
-}
+using test::read_json;
+using test::wait_exit;
 
 /// Start `demcal calibrate` on a config ("" = the embedded default, a
 /// 10x10 hexagonal REV); returns the pid.
 pid_t spawn_calibrate(const fs::path& out, bool resume, const std::string& jobs = "2",
-                      const std::string& config = DEMCAL_SOURCE_DIR "/configs/hex_5x5.json") {
-  const pid_t pid = fork();
-  if (pid == 0) {
-    std::vector<std::string> args{DEMCAL_BINARY, "calibrate", "-q", "-o",
-                                  out.string(),  "--jobs",    jobs};
-    if (!config.empty()) args.push_back(config);
-    if (resume) args.push_back("--resume");
-    std::vector<char*> argv;
-    for (auto& a : args) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    execv(DEMCAL_BINARY, argv.data());
-    _exit(127);
-  }
-  return pid;
-}
-
-int wait_exit(pid_t pid) {
-  int status = 0;
-  waitpid(pid, &status, 0);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
-nlohmann::json read_json(const fs::path& p) {
-  std::ifstream in(p);
-  return nlohmann::json::parse(in);
+                      const std::string& config = test::shipped_config("hex_5x5")) {
+  std::vector<std::string> args{"calibrate", "-q", "-o", out.string(), "--jobs", jobs};
+  if (!config.empty()) args.push_back(config);
+  if (resume) args.push_back("--resume");
+  return test::spawn_demcal(args);
 }
 
 std::vector<nlohmann::json> read_trials(const fs::path& p) {
@@ -122,7 +100,7 @@ TEST(Calibration, DivergedTrialIsScoredNotFatal) {
 }
 
 TEST(Calibration, DefaultSceneCalibratesAndIsCertified) {
-  const fs::path out = fresh_dir("cal_plain");
+  const fs::path out = test::fresh_path("cal_plain");
   ASSERT_EQ(wait_exit(spawn_calibrate(out, false, "2", "")), 0);
   const auto params = read_json(out / "params.json");
   EXPECT_TRUE(params["success"].get<bool>());
@@ -139,7 +117,7 @@ TEST(Calibration, DefaultSceneCalibratesAndIsCertified) {
 }
 
 TEST(Calibration, SameResultWithAnyJobs) {
-  const fs::path a = fresh_dir("cal_j1"), b = fresh_dir("cal_j2");
+  const fs::path a = test::fresh_path("cal_j1"), b = test::fresh_path("cal_j2");
   ASSERT_EQ(wait_exit(spawn_calibrate(a, false, "1")), 0);
   ASSERT_EQ(wait_exit(spawn_calibrate(b, false, "2")), 0);
   // Byte for byte: params.json holds nothing that depends on the machine or
@@ -154,7 +132,7 @@ TEST(Calibration, SameResultWithAnyJobs) {
 // Kill a calibration with SIGKILL at random moments, resume each time: no
 // finished trial is rerun, and the result equals an uninterrupted run's.
 TEST(Calibration, ResumeAfterSigkillEqualsUninterrupted) {
-  const fs::path reference = fresh_dir("cal_ref"), killed = fresh_dir("cal_killed");
+  const fs::path reference = test::fresh_path("cal_ref"), killed = test::fresh_path("cal_killed");
   ASSERT_EQ(wait_exit(spawn_calibrate(reference, false)), 0);
   std::mt19937 rng(7);
   std::uniform_int_distribution<int> delay_ms(200, 1200);
@@ -189,7 +167,7 @@ TEST(Calibration, SigintAndSigtermStopCleanlyAndResumeContinues) {
   // The default 10x10 scene on one job: some 50 trials, seconds of work,
   // so the signals arrive mid-search.
   const std::string config = "";
-  const fs::path reference = fresh_dir("cal_sig_ref"), stopped = fresh_dir("cal_sig");
+  const fs::path reference = test::fresh_path("cal_sig_ref"), stopped = test::fresh_path("cal_sig");
   ASSERT_EQ(wait_exit(spawn_calibrate(reference, false, "1", config)), 0);
 
   std::vector<nlohmann::json> kept;
@@ -227,12 +205,9 @@ TEST(Calibration, SigintAndSigtermStopCleanlyAndResumeContinues) {
 // folder removes those of processes that are gone, and only those (a user's
 // NAME.tmp.PID is not demcal's: tests/test_robustness_io.cpp).
 TEST(Output, StaleTemporariesOfDeadProcessesAreRemoved) {
-  const fs::path dir = fresh_dir("stale_tmp");
+  const fs::path dir = test::fresh_path("stale_tmp");
   fs::create_directories(dir);
-  // A child that exits at once gives a PID that is certainly not running.
-  const pid_t dead = fork();
-  if (dead == 0) _exit(0);
-  wait_exit(dead);
+  const pid_t dead = test::dead_pid();
   const fs::path stale = dir / temporary_name("params.json", dead);
   const fs::path live = dir / temporary_name("report.html", ::getppid());
   const fs::path user = dir / "notes.tmp.txt";

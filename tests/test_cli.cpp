@@ -15,27 +15,20 @@
 #include <string>
 #include <vector>
 
+#include "support/files.hpp"
+#include "support/process.hpp"
+#include "support/scenes.hpp"
+
 namespace {
 
 namespace fs = std::filesystem;
+namespace test = demcal::test;
 
-const std::string kBinary = DEMCAL_BINARY;
-const std::string kSource = DEMCAL_SOURCE_DIR;
-const std::string kHex5 = kSource + "/configs/hex_5x5.json";
+using test::lines_of;
+using test::read_text;
+using Result = test::RunResult;
 
-std::string read(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-std::vector<std::string> lines_of(const std::string& text) {
-  std::vector<std::string> lines;
-  std::stringstream s(text);
-  for (std::string line; std::getline(s, line);) lines.push_back(line);
-  return lines;
-}
+const std::string kHex5 = test::shipped_config("hex_5x5");
 
 std::vector<std::string> split(const std::string& line, char sep) {
   std::vector<std::string> out;
@@ -44,46 +37,18 @@ std::vector<std::string> split(const std::string& line, char sep) {
   return out;
 }
 
-std::string quote(const std::string& s) {
-  std::string q = "'";
-  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
-
-struct Result {
-  int status = -1;
-  std::string out, err;
-};
-
 /// A fresh folder per test (the working directory of the runs), removed
 /// afterwards.
 class CliEndToEnd : public ::testing::Test {
  protected:
-  void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() /
-           ("demcal_test_cli_" + std::to_string(::getpid()) + "_" + info->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_ / "work");
-  }
-  void TearDown() override { fs::remove_all(dir_); }
+  void SetUp() override { fs::create_directories(dir_ / "work"); }
 
   /// Run `demcal ARGS` in dir_/work with stdout and stderr captured.
   Result demcal(const std::vector<std::string>& args) {
-    std::string cmd = "cd " + quote((dir_ / "work").string()) + " && " + quote(kBinary);
-    for (const auto& a : args) cmd += " " + quote(a);
-    cmd += " >" + quote((dir_ / "stdout").string()) + " 2>" + quote((dir_ / "stderr").string());
-    const int raw = std::system(cmd.c_str());
-    Result r;
-    r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-    r.out = read(dir_ / "stdout");
-    r.err = read(dir_ / "stderr");
-    return r;
+    return test::run_demcal(args, dir_ / "work");
   }
   std::string write(const std::string& name, const std::string& content) {
-    const fs::path path = dir_ / name;
-    std::ofstream(path, std::ios::binary) << content;
-    return path.string();
+    return test::write_text(dir_ / name, content);
   }
   /// Everything under dir_/work (the runs' working directory).
   std::set<std::string> work_contents() {
@@ -110,7 +75,8 @@ class CliEndToEnd : public ::testing::Test {
     EXPECT_TRUE(work_contents().empty()) << "left output behind: " << *work_contents().begin();
   }
 
-  fs::path dir_;
+  test::TempDir tmp_{"cli"};
+  const fs::path dir_ = tmp_.path();
 };
 
 // --- bad input ------------------------------------------------------------
@@ -173,19 +139,19 @@ TEST_F(CliEndToEnd, StabilityScanWritesItsReport) {
   const Result r = demcal({"stability", kHex5, "--steps", "5000", "-o", out.string()});
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.out.find("x the estimate"), std::string::npos) << r.out;
-  const auto j = nlohmann::json::parse(read(out / "stability.json"));
+  const auto j = nlohmann::json::parse(read_text(out / "stability.json"));
   EXPECT_NEAR(j["measured_over_estimate"].get<double>(), 1.0, 0.03);
   for (const auto& t : j["trials"])
     if (t["diverged"].get<bool>()) EXPECT_GT(t["divergence_step"].get<int>(), 0);
-  EXPECT_NE(read(out / "stability.md").find("| alpha |"), std::string::npos);
+  EXPECT_NE(read_text(out / "stability.md").find("| alpha |"), std::string::npos);
 }
 
 TEST_F(CliEndToEnd, BadParticleFileNamesFileAndLine) {
   const std::string out = (dir_ / "work" / "out").string();
   const std::string csv = write("p.csv", "x,y,r\n0,0,5e-4\n1e-3,0,-5e-4\n");
-  const std::string config = write(
-      "file.json",
-      R"({"material": {"density": 2650, "kn": 1e8, "kt": 5e7, "friction": 0.3}, "assembly": {"type": "file", "file": "p.csv"}})");
+  const std::string config =
+      write("file.json",
+            "{" + test::kMaterialMember + R"(, "assembly": {"type": "file", "file": "p.csv"}})");
   expect_bad_input({"run", config, "-o", out}, {csv, "line 3", "radius"});
   const std::string overlap = write("o.csv", "# two\n0,0,5e-4\n5e-4,0,5e-4\n");
   expect_bad_input({"run", config, "--set", "assembly.file=" + overlap, "-o", out},
@@ -214,7 +180,7 @@ TEST_F(CliEndToEnd, UnwritableOutputExitsTwoBeforeRunning) {
     EXPECT_NE(r.err.find(out), std::string::npos) << r.err;
     EXPECT_EQ(r.out, "");  // nothing ran
     EXPECT_EQ(work_contents(), before);
-    EXPECT_EQ(read(file), "not a folder\n");
+    EXPECT_EQ(read_text(file), "not a folder\n");
   }
   // A folder the kernel refuses (as root too).
   const Result r = demcal({"run", kHex5, "-o", "/proc/demcal-forbidden/out"});
@@ -263,9 +229,9 @@ TEST_F(CliEndToEnd, CheckAcceptsAParticleFile) {
       csv += line.str();
     }
   write("hex.csv", csv);
-  const std::string config = write(
-      "file.json",
-      R"({"material": {"density": 2650, "kn": 1e8, "kt": 5e7, "friction": 0.3}, "assembly": {"type": "file", "file": "hex.csv"}})");
+  const std::string config =
+      write("file.json",
+            "{" + test::kMaterialMember + R"(, "assembly": {"type": "file", "file": "hex.csv"}})");
   const Result res = demcal({"check", config});
   EXPECT_EQ(res.status, 0) << res.err;
   EXPECT_NE(res.out.find("12 particles"), std::string::npos) << res.out;
@@ -368,7 +334,7 @@ TEST_F(CliEndToEnd, RunWritesSummarySeriesAndVtk) {
   for (const auto& e : fs::directory_iterator(out)) files.insert(e.path().filename().string());
   EXPECT_EQ(files, (std::set<std::string>{"summary.json", "series.csv", "final.vtk"}));
 
-  const auto s = nlohmann::json::parse(read(out / "summary.json"));
+  const auto s = nlohmann::json::parse(read_text(out / "summary.json"));
   EXPECT_EQ(s.at("particles"), 25);
   const auto& p = s.at("params");
   for (const char* key :
@@ -391,7 +357,7 @@ TEST_F(CliEndToEnd, RunWritesSummarySeriesAndVtk) {
   EXPECT_GT(s.at("wall_time_s").get<double>(), 0.0);
   EXPECT_GT(s.at("particle_steps_per_s").get<double>(), 0.0);
 
-  const auto rows = lines_of(read(out / "series.csv"));
+  const auto rows = lines_of(read_text(out / "series.csv"));
   ASSERT_EQ(rows.size(), 202u);  // header + monitor_points + 1
   const std::vector<std::string> expected = {"step",
                                              "strain_yy",
@@ -421,7 +387,7 @@ TEST_F(CliEndToEnd, RunWritesSummarySeriesAndVtk) {
   EXPECT_EQ(split(rows[1], ',')[0], "0");
   EXPECT_EQ(split(rows.back(), ',')[0], "2000");
 
-  expect_valid_vtk(read(out / "final.vtk"), 25);
+  expect_valid_vtk(read_text(out / "final.vtk"), 25);
 }
 
 TEST_F(CliEndToEnd, RunIntoAnExistingFolderAndWithoutVtk) {
@@ -445,7 +411,8 @@ TEST_F(CliEndToEnd, RunIntoAnExistingFolderAndWithoutVtk) {
 TEST_F(CliEndToEnd, FailedConsolidationExitsOneAndWritesNothing) {
   const std::string config = write(
       "gas.json",
-      R"({"material": {"density": 2650, "kn": 1e8, "kt": 5e7, "friction": 0.3}, "assembly": {"type": "random", "count": 60}, "test": {"consolidation_max_steps": 1000}})");
+      "{" + test::kMaterialMember +
+          R"(, "assembly": {"type": "random", "count": 60}, "test": {"consolidation_max_steps": 1000}})");
   const Result r = demcal({"run", config, "-o", (dir_ / "work" / "out").string()});
   EXPECT_EQ(r.status, 1) << r.err;
   EXPECT_EQ(lines_of(r.err).size(), 1u) << r.err;
@@ -471,11 +438,11 @@ TEST_F(CliEndToEnd, DivergedRunIsReportedNotFatal) {
                            "algorithm.damping_ratio_rotation=0", "--set", "algorithm.steps=20000",
                            "-o", out.string()});
   ASSERT_EQ(r.status, 0) << r.err;
-  const auto s = nlohmann::json::parse(read(out / "summary.json"));
+  const auto s = nlohmann::json::parse(read_text(out / "summary.json"));
   EXPECT_EQ(s.at("diverged"), true);
   EXPECT_TRUE(s.at("divergence").at("reason").is_string());
   EXPECT_LT(s.at("steps_run").get<int>(), 20000);
-  expect_valid_vtk(read(out / "final.vtk"), 25, false);  // finite, counts consistent
+  expect_valid_vtk(read_text(out / "final.vtk"), 25, false);  // finite, counts consistent
 }
 
 }  // namespace

@@ -12,6 +12,8 @@
 #include <string>
 
 #include "demcal/scene/config.hpp"
+#include "support/input_errors.hpp"
+#include "support/scenes.hpp"
 
 namespace demcal {
 namespace {
@@ -20,40 +22,14 @@ constexpr const char* kFile = "scene.json";
 
 /// `text` with the keys a config must give (the material's density, kn, kt
 /// and friction: ConfigRequired.MaterialAndItsKeys) added where absent, so
-/// that the tests below see only the key they are about. Text that is not a
-/// JSON object, or whose material is not one, is passed as it is.
-std::string with_material(const std::string& text) {
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::exception&) {
-    return text;
-  }
-  if (!j.is_object()) return text;
-  nlohmann::json& m = j["material"];
-  if (m.is_null()) m = nlohmann::json::object();
-  if (!m.is_object()) return text;
-  const nlohmann::json required = {{"density", 2650}, {"kn", 1e8}, {"kt", 5e7}, {"friction", 0.3}};
-  for (const auto& [key, value] : required.items())
-    if (!m.contains(key)) m[key] = value;
-  return j.dump();
+/// that the tests below see only the key they are about.
+using test::with_required_material;
+
+SceneConfig parse(const std::string& text) {
+  return parse_config_text(with_required_material(text), kFile);
 }
 
-SceneConfig parse(const std::string& text) { return parse_config_text(with_material(text), kFile); }
-
-/// The InputError `f` throws, or nothing (then the test fails).
-std::optional<InputError> input_error(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e;
-  } catch (const std::exception& e) {
-    ADD_FAILURE() << "expected InputError, got another exception: " << e.what();
-    return std::nullopt;
-  }
-  ADD_FAILURE() << "expected InputError, nothing thrown";
-  return std::nullopt;
-}
+using test::input_error;
 
 /// Parsing `text` fails with an InputError naming kFile and `field`, and the
 /// message (what the user sees) contains both.
@@ -72,11 +48,11 @@ void expect_rejected(const std::string& text, const std::string& field) {
 
 // --- defaults -----------------------------------------------------------
 
-// The documented defaults (config.hpp, DESIGN.md §5), written out once more
+// The documented defaults (scene/config.hpp, README.md "Config keys"), written out once more
 // so that a silent change of a default is caught here.
 TEST(ConfigDefaults, EmptyObjectGivesEveryDocumentedDefault) {
   // The material's density, kn, kt and friction have no default any more
-  // (with_material gives them): thickness still has one.
+  // (with_required_material gives them): thickness still has one.
   const SceneConfig c = parse("{}");
   EXPECT_EQ(c.name, "scene");
   EXPECT_EQ(c.material.thickness, 1.0);
@@ -190,10 +166,12 @@ TEST(ConfigDefaults, WholeNumbersInExponentFormAreIntegers) {
 
 TEST(ConfigDefaults, FileRelativeToTheConfigFolder) {
   const SceneConfig c = parse_config_text(
-      with_material(R"({"assembly": {"type": "file", "file": "p.csv"}})"), "dir/sub/scene.json");
+      with_required_material(R"({"assembly": {"type": "file", "file": "p.csv"}})"),
+      "dir/sub/scene.json");
   EXPECT_EQ(std::filesystem::path(c.assembly.file), std::filesystem::path("dir/sub/p.csv"));
   const SceneConfig abs = parse_config_text(
-      with_material(R"({"assembly": {"type": "file", "file": "/x/p.csv"}})"), "dir/s.json");
+      with_required_material(R"({"assembly": {"type": "file", "file": "/x/p.csv"}})"),
+      "dir/s.json");
   EXPECT_EQ(abs.assembly.file, "/x/p.csv");
 }
 
@@ -355,7 +333,7 @@ TEST(ConfigErrors, MissingFileAndFolder) {
 // --- --set overrides --------------------------------------------------------
 
 SceneConfig with_sets(const std::string& text, const std::vector<std::string>& sets) {
-  nlohmann::json j = nlohmann::json::parse(with_material(text));
+  nlohmann::json j = nlohmann::json::parse(with_required_material(text));
   apply_overrides(j, sets, kFile);
   return parse_config(j, kFile);
 }

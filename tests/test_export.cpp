@@ -16,6 +16,8 @@
 #include "demcal/scene/packing.hpp"
 #include "demcal/upscaling/export.hpp"
 #include "demcal/upscaling/rev.hpp"
+#include "support/files.hpp"
+#include "support/process.hpp"
 
 namespace demcal {
 namespace {
@@ -121,21 +123,10 @@ TEST(Export, LiggghtsDeckHasMeshesAndServo) {
   EXPECT_EQ(r.files.count("proto-left.stl"), 1u);
 }
 
-/// The first `lmp` on PATH, or "".
-std::string find_lammps() {
-  const char* path = std::getenv("PATH");
-  std::stringstream s(path ? path : "");
-  for (std::string dir; std::getline(s, dir, ':');) {
-    const fs::path p = fs::path(dir) / "lmp";
-    if (fs::exists(p) && ::access(p.c_str(), X_OK) == 0) return p.string();
-  }
-  return "";
-}
-
 class LammpsRun : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(LammpsRun, TheDeckStartsWithOurTimestepAndSigma3OnTheWalls) {
-  const std::string lmp = find_lammps();
+  const std::string lmp = test::find_on_path("lmp");
   if (lmp.empty()) GTEST_SKIP() << "LAMMPS (lmp) is not installed: the exported deck is not run";
   SceneConfig c = default_config();
   if (std::string(GetParam()) == "hexagonal") {
@@ -150,21 +141,11 @@ TEST_P(LammpsRun, TheDeckStartsWithOurTimestepAndSigma3OnTheWalls) {
   o.data_name = "hex5.data";
   const ExportResult r = export_deck(c, params(), a, o);
 
-  const fs::path dir =
-      fs::temp_directory_path() / ("demcal_test_lammps_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  std::ofstream(dir / "in.hex5") << r.deck;
-  for (const auto& [name, content] : r.files) std::ofstream(dir / name) << content;
-  const std::string cmd = "cd '" + dir.string() + "' && '" + lmp +
-                          "' -var run_steps 300 -in in.hex5 -log log.lammps -screen none "
-                          ">/dev/null 2>&1";
-  const int raw = std::system(cmd.c_str());
-  std::stringstream log;
-  log << std::ifstream(dir / "log.lammps").rdbuf();
-  fs::remove_all(dir);
-  ASSERT_TRUE(WIFEXITED(raw) && WEXITSTATUS(raw) == 0) << log.str();
-  const std::string text = log.str();
+  const test::TempDir dir("lammps");
+  const test::DeckRun lammps = test::run_deck(lmp, dir.path(), r.deck, r.files,
+                                              {"-var", "run_steps", "300", "-screen", "none"});
+  ASSERT_EQ(lammps.status, 0) << lammps.log;
+  const std::string& text = lammps.log;
   ASSERT_NE(text.find("Loop time"), std::string::npos) << text;
   // Thermo rows: step dt time epsyy p_top p_left p_right W H ke.
   std::stringstream lines(text.substr(text.find("Step Dt Time")));
@@ -215,7 +196,7 @@ TEST(Export, LammpsReproducesDemcalsPeak) {
   // The whole loading of the 25-particle sample in both codes (ζ_r = 0:
   // this LAMMPS has no rotational damping, so both run the same model):
   // the axial peak agrees within 1 %. ~1·10⁶ particle-steps each.
-  const std::string lmp = find_lammps();
+  const std::string lmp = test::find_on_path("lmp");
   if (lmp.empty()) GTEST_SKIP() << "LAMMPS (lmp) is not installed: the exported deck is not run";
   SceneConfig c = default_config();
   c.assembly.columns = c.assembly.rows = 5;
@@ -227,20 +208,10 @@ TEST(Export, LammpsReproducesDemcalsPeak) {
   ExportOptions o;
   o.data_name = "hex5.data";
   const ExportResult r = export_deck(c, p, assembly_of(state.world), o);
-  const fs::path dir =
-      fs::temp_directory_path() / ("demcal_test_lammps_peak_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  std::ofstream(dir / "in.hex5") << r.deck;
-  for (const auto& [name, content] : r.files) std::ofstream(dir / name) << content;
-  const std::string cmd = "cd '" + dir.string() + "' && '" + lmp +
-                          "' -in in.hex5 -log log.lammps -screen none >/dev/null 2>&1";
-  const int raw = std::system(cmd.c_str());
-  std::stringstream log;
-  log << std::ifstream(dir / "log.lammps").rdbuf();
-  fs::remove_all(dir);
-  ASSERT_TRUE(WIFEXITED(raw) && WEXITSTATUS(raw) == 0) << log.str();
-  const auto rows = thermo_rows(log.str());
+  const test::TempDir dir("lammps_peak");
+  const test::DeckRun lammps = test::run_deck(lmp, dir.path(), r.deck, r.files);
+  ASSERT_EQ(lammps.status, 0) << lammps.log;
+  const auto rows = thermo_rows(lammps.log);
   ASSERT_GT(rows.size(), 100u);
   EXPECT_EQ(rows.back()[0], p.steps);
   double lammps_peak = 0.0;

@@ -1,4 +1,4 @@
-// Contact law of the kernel against closed-form results (DESIGN.md §2):
+// Contact law of the kernel against closed-form results (README.md "Physics in one paragraph"):
 // normal force kn·δ, contact duration and restitution of a head-on collision,
 // incremental tangential spring with the Coulomb cap, torques.
 #include <gtest/gtest.h>
@@ -16,7 +16,7 @@ namespace {
 
 using kernel_test::kEps;
 using kernel_test::kR;
-using kernel_test::test_material;
+using kernel_test::reference_material;
 
 // Two equal disks approach head-on at ±v0, undamped, and separate again.
 // Analytical (linear spring, reduced mass m_eff = m/2, ω = sqrt(kn/m_eff)):
@@ -24,7 +24,7 @@ using kernel_test::test_material;
 //   contact duration T = π·sqrt(m_eff/kn), restitution e = 1,
 //   largest overlap δ_max = v_rel/ω.
 TEST(KernelContact, HeadOnCollisionForceDurationAndRestitution) {
-  const Material mat = test_material(0.3);
+  const Material mat = reference_material(0.3);
   const double r = kR, v0 = 0.05;  // v_rel = 0.1 m/s → δ_max ≈ 4.6e-7 m ≈ 1e-3 r
   const std::vector<double> x{0.0, 2.0 * r + 2e-3 * r}, y{0.0, 0.0}, rad{r, r};  // gap 1e-6 m
   World w(mat, x, y, rad, -10 * r, 12 * r, -10 * r, 10 * r);
@@ -132,7 +132,7 @@ TEST(KernelContact, HeadOnCollisionForceDurationAndRestitution) {
 // nevertheless computed from the disk's actual state, not from V.
 TEST(KernelContact, WallFrictionSticksThenSlidesAtCoulombLimitWithTorque) {
   const double mu_w = 0.4;
-  const Material mat = test_material(0.3, mu_w);
+  const Material mat = reference_material(0.3, mu_w);
   const double r = kR, delta = 1e-6;  // Fn = kn·δ = 100 N
   const std::vector<double> x{0.0}, y{r - delta}, rad{r};
   World w(mat, x, y, rad, -20 * r, 20 * r, 0.0, 10 * r);
@@ -194,7 +194,7 @@ TEST(KernelContact, WallFrictionSticksThenSlidesAtCoulombLimitWithTorque) {
 // pair rolls like two gears), Newton's third law.
 TEST(KernelContact, ParticleFrictionSticksThenSlidesWithGearTorques) {
   const double mu = 0.3;
-  const Material mat = test_material(mu);
+  const Material mat = reference_material(mu);
   const double r = kR, delta = 1e-6;
   const std::vector<double> x{0.0, 0.0}, y{0.0, 2.0 * r - delta}, rad{r, r};
   World w(mat, x, y, rad, -20 * r, 20 * r, -10 * r, 10 * r);
@@ -261,7 +261,7 @@ TEST(KernelContact, ParticleFrictionSticksThenSlidesWithGearTorques) {
 // re-evaluating the forces without a time increment leaves every contact
 // force and every wall force bit-identical.
 TEST(KernelContact, TangentialHistoryCarriesOverRebuilds) {
-  const Material mat = test_material(0.3, 0.2);
+  const Material mat = reference_material(0.3, 0.2);
   auto scene = kernel_test::random_loose_scene(6, 6, 11);
   World w = scene.make(mat);
   kernel_test::compact(w, 0.84, 0.3, 0);
@@ -294,12 +294,13 @@ TEST(KernelContact, TangentialHistoryCarriesOverRebuilds) {
   }
 }
 
-// Locked rotation (the diagnostic switch of DESIGN.md §2) means ω ≡ 0: a
+// Locked rotation (algorithm.lock_rotation, the diagnostic switch under which
+// the hexagonal packing fails by the analytical sliding mechanism) means ω ≡ 0: a
 // spin left over from before the lock, or set afterwards, must neither turn
 // the disk nor load the tangential springs through the contact-point
 // velocity.
 TEST(KernelContact, LockedRotationMeansNoSpinAndNoSpinDrivenFriction) {
-  const Material mat = test_material(0.3, 0.5);
+  const Material mat = reference_material(0.3, 0.5);
   const double r = kR;
   const std::vector<double> x{0.0}, y{r - 1e-6}, rad{r};
   World w(mat, x, y, rad, -20 * r, 20 * r, 0.0, 10 * r);

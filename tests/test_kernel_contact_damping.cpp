@@ -22,7 +22,7 @@ namespace demcal {
 namespace {
 
 using kernel_test::kR;
-using kernel_test::test_material;
+using kernel_test::reference_material;
 
 double clamped_restitution(double zeta) {
   const double s = std::sqrt(1.0 - zeta * zeta);
@@ -38,7 +38,7 @@ struct Collision {
 };
 
 Collision collide(double zeta, double alpha) {
-  Material mat = test_material(0.3);
+  Material mat = reference_material(0.3);
   mat.contact_damping_ratio = zeta;
   const double r = kR, v0 = 0.05;
   const std::vector<double> x{0.0, 2.0 * r + 2e-3 * r}, y{0.0, 0.0}, rad{r, r};

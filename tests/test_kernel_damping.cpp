@@ -1,4 +1,5 @@
-// Global damping (DESIGN.md §2) against the damped linear oscillator.
+// Global damping (D = ζ·2·sqrt(k·m), src/kernel/solver.cpp) against the damped
+// linear oscillator.
 //
 // A wall contact is one-sided, so a disk released against a single wall
 // leaves it and never oscillates about an equilibrium. Here the disk is
@@ -33,7 +34,7 @@ namespace {
 
 using kernel_test::kEps;
 using kernel_test::kR;
-using kernel_test::test_material;
+using kernel_test::reference_material;
 
 struct DiscreteOscillator {
   double rho, theta;
@@ -66,7 +67,7 @@ struct SqueezedDisk {
     h = std::sqrt(world.material().particle.kn / world.mass()[0]) * in.dt;  // = 2α
   }
   static Material material() {
-    Material m = test_material(0.3, 0.0);
+    Material m = reference_material(0.3, 0.0);
     m.wall.kn = 0.5 * m.particle.kn;  // two walls in parallel: k = kn
     return m;
   }
@@ -152,7 +153,7 @@ struct SpunDisk {
     h = std::sqrt(world.material().particle.kt * r * r / inertia) * in.dt;
   }
   static Material material() {
-    Material m = test_material(0.3, 10.0);  // wall friction never reached
+    Material m = reference_material(0.3, 10.0);  // wall friction never reached
     const double dist = r - delta0;
     m.wall.kt = m.particle.kt * r * r / (2.0 * dist * dist);
     return m;

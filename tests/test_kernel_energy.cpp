@@ -1,4 +1,5 @@
-// Energy conservation of the undamped kernel (DESIGN.md §2 integration).
+// Energy conservation of the undamped kernel (central-difference integration,
+// src/kernel/solver.cpp).
 //
 // Scene: a 10×10 hexagonal packing pre-compressed by the four walls
 // (overlap 1e-6 m = 2rε, ε = 1e-3, at every contact), first relaxed to
@@ -43,7 +44,7 @@ struct EnergyRun {
 
 EnergyRun run_vibrating_hex(double mu, double alpha, uint32_t seed) {
   auto scene = kernel_test::hex_scene(10, 10);
-  World w = scene.make(kernel_test::test_material(mu, 0.0));
+  World w = scene.make(kernel_test::reference_material(mu, 0.0));
   // Relax to rest (the shifted rows are not balanced at the side walls),
   // frictionless, so that no tangential force is locked in at rest. (A
   // locked-in Ft makes the rotating incremental spring non-conservative: the

@@ -1,7 +1,8 @@
 // Shared scenes and helpers for the kernel physics tests (test_kernel_*.cpp).
 //
-// Units follow the product's default scene: r ≈ 5e-4 m, ρ = 2650 kg/m³,
-// t = 1 m, kn = 1e8 N/m, kt = kn/2, so m ≈ 2.08e-3 kg, ω0 = sqrt(kn/m) ≈
+// Units follow the product's default scene (reference_material,
+// tests/support/scenes.hpp): r ≈ 5e-4 m, ρ = 2650 kg/m³, t = 1 m,
+// kn = 1e8 N/m, kt = kn/2, so m ≈ 2.08e-3 kg, ω0 = sqrt(kn/m) ≈
 // 2.2e5 rad/s and an overlap of 1e-6 m carries 100 N (≈ 100 kPa).
 #pragma once
 
@@ -12,23 +13,16 @@
 #include <random>
 #include <vector>
 
-#include "demcal/scene/packing.hpp"
 #include "demcal/kernel/world.hpp"
+#include "demcal/scene/packing.hpp"
+#include "support/scenes.hpp"
 
 namespace demcal::kernel_test {
 
 inline constexpr double kEps = std::numeric_limits<double>::epsilon();
 inline constexpr double kR = 5e-4;  // reference radius [m]
 
-inline Material test_material(double mu = 0.3, double wall_mu = 0.0) {
-  Material m;
-  m.density = 2650.0;
-  m.thickness = 1.0;
-  m.particle = {1e8, 5e7, mu};
-  m.wall = {1e8, 5e7, wall_mu};
-  m.contact_damping_ratio = 0.0;
-  return m;
-}
+using test::reference_material;
 
 struct Scene {
   std::vector<double> x, y, r;

@@ -25,7 +25,7 @@ namespace {
 // to within the leapfrog bound at every step.
 TEST(KernelLedger, BalancesWallWorkAgainstDampingWithinTheLeapfrogBound) {
   const auto scene = kernel_test::hex_scene(10, 10);
-  Material material = kernel_test::test_material(0.0);
+  Material material = kernel_test::reference_material(0.0);
   material.contact_damping_ratio = 0.2;
   KernelOptions options;
   options.energy_check_interval = 1;
@@ -60,7 +60,7 @@ TEST(KernelLedger, BalancesWallWorkAgainstDampingWithinTheLeapfrogBound) {
 // counted), and the check never fires on a stable run.
 TEST(KernelLedger, FrictionOnlyLowersTheReading) {
   const auto scene = kernel_test::hex_scene(10, 10);
-  World w = scene.make(kernel_test::test_material(0.3));
+  World w = scene.make(kernel_test::reference_material(0.3));
   Integration in;
   in.dt = 0.2 * w.reference_scales().dt_crit;
   in.damping_ratio_translation = 0.05;
@@ -83,7 +83,7 @@ TEST(KernelLedger, BeyondTheStableStepIsDivergedWhenDamped) {
   const auto scene = kernel_test::hex_scene(10, 10);
   const std::pair<double, double> dampings[] = {{0.2, 0.0}, {1.0, 0.0}, {0.0, 1.0}, {1.0, 1.0}};
   for (const auto& [zeta_t, zeta_r] : dampings) {
-    World w = scene.make(kernel_test::test_material(0.3));
+    World w = scene.make(kernel_test::reference_material(0.3));
     w.update_forces();
     const double alpha_stable = w.stability_estimate().dt_ratio_stable;
     Integration in;
@@ -106,7 +106,7 @@ TEST(KernelLedger, BeyondTheStableStepIsDivergedWhenDamped) {
     EXPECT_LE(w.divergence_step(), 2000);
 
     // The same at 0.95·α_stable runs to the end.
-    World stable = scene.make(kernel_test::test_material(0.3));
+    World stable = scene.make(kernel_test::reference_material(0.3));
     in.dt = 0.95 * alpha_stable * stable.reference_scales().dt_crit;
     stable.set_integration(in);
     for (int i = 0; i < stable.size(); ++i)

@@ -105,7 +105,7 @@ void expect_contacts_match_brute_force(const World& w, Check& check, int step) {
 // close all the time. Undamped, frictional particles and walls.
 TEST(KernelNeighbours, ContactSetEqualsBruteForceAcrossRebuildsInShakenPacking) {
   auto scene = kernel_test::random_loose_scene(15, 15, 17, 0.5);
-  World w = scene.make(kernel_test::test_material(0.3, 0.2));
+  World w = scene.make(kernel_test::reference_material(0.3, 0.2));
   kernel_test::compact(w, 0.84, 0.3, 0);
   Integration in = w.integration();
   in.damping_ratio_translation = 0.0;
@@ -161,7 +161,7 @@ TEST(KernelNeighbours, ContactSetEqualsBruteForceInSparseGas) {
   scene.right = 100.0 * r0;
   scene.bottom = 0.0;
   scene.top = 100.0 * r0;
-  World w = scene.make(kernel_test::test_material(0.3, 0.0));
+  World w = scene.make(kernel_test::reference_material(0.3, 0.0));
   Integration in;
   in.dt = 0.2 * w.reference_scales().dt_crit;
   in.damping_ratio_translation = 0.0;

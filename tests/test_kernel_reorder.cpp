@@ -20,7 +20,7 @@ namespace {
 // A sheared, frictional polydisperse packing with contact histories.
 World loaded_world() {
   auto scene = kernel_test::random_loose_scene(12, 12, 5);
-  World w = scene.make(kernel_test::test_material(0.3));
+  World w = scene.make(kernel_test::reference_material(0.3));
   kernel_test::compact(w, 0.82, 0.3, 4000);
   Integration in = w.integration();
   in.dt = 0.2 * w.reference_scales().dt_crit;

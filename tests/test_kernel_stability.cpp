@@ -2,8 +2,8 @@
 //
 // The undamped central-difference scheme is stable iff ω_max·Δt < 2, ω²_max
 // the largest eigenvalue of A = M^-½·K·M^-½ (K: stiffness of the contact
-// network, translations and rotations coupled); with the damping of
-// DESIGN.md §2 the boundary is the same (the characteristic polynomial at
+// network, translations and rotations coupled); with the global damping of
+// src/kernel/solver.cpp the boundary is the same (the characteristic polynomial at
 // z = −1 is 4 − ω²Δt², independent of the damping). In units of
 // Δt_crit = 2·sqrt(m/kn): α_stable = 1/sqrt(λ), λ = ω²_max·m/kn.
 #include <gtest/gtest.h>
@@ -97,7 +97,7 @@ Eigen::MatrixXd dense_dynamical_matrix(const World& w, bool rotation) {
 
 World jammed_packing(int nx, int ny, uint32_t seed, double mu, double wall_mu) {
   auto scene = kernel_test::random_loose_scene(nx, ny, seed);
-  World w = scene.make(kernel_test::test_material(mu, wall_mu));
+  World w = scene.make(kernel_test::reference_material(mu, wall_mu));
   kernel_test::compact(w, 0.84, mu, 2000);
   return w;
 }
@@ -150,7 +150,7 @@ TEST(KernelStability, HexPackingRotationLimitConvergesToOneOverSqrt12) {
   const double alpha_inf = 1.0 / (std::sqrt(12.0) * (1.0 - eps));
   auto estimate = [&](int n, int iterations) {
     auto scene = kernel_test::hex_scene(n, n, eps);
-    World w = scene.make(kernel_test::test_material(0.3));
+    World w = scene.make(kernel_test::reference_material(0.3));
     Integration in;
     in.dt = 0.1 * w.reference_scales().dt_crit;
     w.set_integration(in);

@@ -1,4 +1,5 @@
-// Stress measures (DESIGN.md §2), tension positive, origin at the box centre:
+// Stress measures (README.md "Physics in one paragraph"), tension positive,
+// origin at the box centre:
 //   b_ij = (1/V) Σ_{wall contacts} x^c_i f^c_j,
 //   σ_ij = (1/V) Σ_p Σ_{c∈p} (x^c − x^p)_i f^c_j.
 // Exact identities, for any state (pair contacts cancel in Σ x^c ⊗ f^c):
@@ -100,7 +101,7 @@ void expect_boundary_stress_is_wall_stress(const World& w, const Measures& m, do
 
 TEST(KernelStress, StaticFrictionalPackingHasBoundaryEqualHomogenizedAndSymmetricStress) {
   auto scene = kernel_test::random_loose_scene(8, 8, 3);
-  World w = scene.make(kernel_test::test_material(0.3));
+  World w = scene.make(kernel_test::reference_material(0.3));
   kernel_test::compact(w, 0.84, 0.3, 0);
   // Relax with the walls fixed and critical damping until static.
   w.step(20000);
@@ -137,7 +138,7 @@ TEST(KernelStress, StaticFrictionalPackingHasBoundaryEqualHomogenizedAndSymmetri
 
 TEST(KernelStress, NetForceMomentIdentityHoldsToRoundOffDuringDynamicRun) {
   auto scene = kernel_test::random_loose_scene(10, 10, 5);
-  World w = scene.make(kernel_test::test_material(0.3));
+  World w = scene.make(kernel_test::reference_material(0.3));
   kernel_test::compact(w, 0.84, 0.3, 2000);
   // Fast, lightly damped shear: top wall down, side walls out, 1e-3 r per step.
   Integration in = w.integration();

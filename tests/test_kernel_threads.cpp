@@ -61,7 +61,7 @@ void expect_identical(const World& a, const World& b) {
 // on one thread).
 const World& jammed(double contact_damping) {
   auto make = [](double damping) {
-    Material mat = kernel_test::test_material(0.3, 0.2);
+    Material mat = kernel_test::reference_material(0.3, 0.2);
     mat.contact_damping_ratio = damping;
     auto scene = kernel_test::random_loose_scene(30, 30, 7);
     World w = scene.make(mat);

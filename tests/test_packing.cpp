@@ -13,6 +13,8 @@
 #include <string>
 
 #include "demcal/scene/packing.hpp"
+#include "support/files.hpp"
+#include "support/scenes.hpp"
 
 namespace demcal {
 namespace {
@@ -22,18 +24,8 @@ namespace fs = std::filesystem;
 /// A fresh folder per test, removed afterwards.
 class PackingFile : public ::testing::Test {
  protected:
-  void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() /
-           ("demcal_test_packing_" + std::to_string(::getpid()) + "_" + info->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
   std::string write(const std::string& content, const std::string& name = "p.csv") {
-    const std::string path = (dir_ / name).string();
-    std::ofstream(path, std::ios::binary) << content;
-    return path;
+    return test::write_text(dir_ / name, content);
   }
   /// Reading `content` fails naming the file and `field`.
   void expect_rejected(const std::string& content, const std::string& field,
@@ -52,7 +44,8 @@ class PackingFile : public ::testing::Test {
       }
     }
   }
-  fs::path dir_;
+  test::TempDir tmp_{"packing"};
+  const fs::path dir_ = tmp_.path();
 };
 
 TEST_F(PackingFile, HeaderIsOptional) {
@@ -161,8 +154,7 @@ TEST_F(PackingFile, MissingFileAndConfigDispatch) {
   // make_assembly reads the config's file, resolved against the config.
   write("0,0,1e-3\n2e-3,0,1e-3\n4e-3,0,1e-3\n");
   const SceneConfig c = parse_config_text(
-      R"({"material": {"density": 2650, "kn": 1e8, "kt": 5e7, "friction": 0.3},
-          "assembly": {"type": "file", "file": "p.csv"}})",
+      "{" + test::kMaterialMember + R"(, "assembly": {"type": "file", "file": "p.csv"}})",
       (dir_ / "scene.json").string());
   EXPECT_EQ(make_assembly(c).size(), 3);
 }

@@ -18,6 +18,8 @@
 #include "demcal/report/report.hpp"
 #include "demcal/scene/packing.hpp"
 #include "demcal/search/evidence.hpp"
+#include "support/files.hpp"
+#include "support/process.hpp"
 
 namespace fs = std::filesystem;
 using namespace demcal;
@@ -530,28 +532,13 @@ TEST(Report, EvidenceRunsReproduceTheTrialsAndExtrapolateThePeak) {
 }
 
 TEST(Report, CalibrateWritesBothFiles) {
-  const fs::path dir =
-      fs::temp_directory_path() / ("demcal_test_report_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  const pid_t pid = fork();
-  if (pid == 0) {
-    const std::string out = dir.string();
-    freopen("/dev/null", "w", stdout);
-    execl(DEMCAL_BINARY, DEMCAL_BINARY, "calibrate", "-q", "--jobs", "2", "-o", out.c_str(),
-          DEMCAL_SOURCE_DIR "/configs/hex_5x5.json", static_cast<char*>(nullptr));
-    _exit(127);
-  }
-  int status = 0;
-  waitpid(pid, &status, 0);
+  const fs::path dir = test::fresh_path("report");
+  const int status = test::wait_exit(test::spawn_demcal(
+      {"calibrate", "-q", "--jobs", "2", "-o", dir.string(), test::shipped_config("hex_5x5")}));
   // 0: calibrated, 1: the calibration failed; the report is written either way.
-  ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) <= 1);
-  auto read = [](const fs::path& p) {
-    std::ifstream f(p);
-    std::stringstream s;
-    s << f.rdbuf();
-    return s.str();
-  };
-  const std::string html = read(dir / "report.html"), md = read(dir / "report.md");
+  ASSERT_TRUE(status == 0 || status == 1) << status;
+  const std::string html = test::read_text(dir / "report.html"),
+                    md = test::read_text(dir / "report.md");
   EXPECT_EQ(html_problem(html), "");
   EXPECT_EQ(external_references(html), std::vector<std::string>{});
   for (const char* section :

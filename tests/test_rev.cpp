@@ -13,6 +13,7 @@
 #include "demcal/scene/biaxial.hpp"
 #include "demcal/scene/packing.hpp"
 #include "demcal/upscaling/rev.hpp"
+#include "support/files.hpp"
 
 namespace demcal {
 namespace {
@@ -152,11 +153,9 @@ TEST(Rev, MirrorTilingMakesSeamsTouch) {
 
 TEST(Rev, ParticleCsvRoundTrips) {
   const Assembly a = hexagonal_packing(4, 3, 1e-3);
-  const auto path =
-      std::filesystem::temp_directory_path() / ("demcal_rev_" + std::to_string(getpid()) + ".csv");
-  std::ofstream(path) << particle_csv(a);
-  const Assembly b = read_particle_file(path.string());
-  std::filesystem::remove(path);
+  const test::TempDir dir("rev");
+  const std::string path = test::write_text(dir / "particles.csv", particle_csv(a));
+  const Assembly b = read_particle_file(path);
   ASSERT_EQ(b.size(), a.size());
   for (int i = 0; i < a.size(); ++i) {
     EXPECT_EQ(b.x[i], a.x[i]);

@@ -17,52 +17,25 @@
 #include <vector>
 
 #include "demcal/io/files.hpp"
+#include "support/files.hpp"
+#include "support/process.hpp"
+#include "support/scenes.hpp"
 
 namespace demcal {
 namespace {
 
 namespace fs = std::filesystem;
 
-std::string read(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using test::names_in;
+using test::read_text;
 
-std::set<std::string> names_in(const fs::path& dir) {
-  std::set<std::string> out;
-  for (const auto& e : fs::directory_iterator(dir)) out.insert(e.path().filename().string());
-  return out;
-}
-
-/// A PID that is certainly not running: a child that has exited and been reaped.
-pid_t dead_pid() {
-  const pid_t pid = fork();
-  if (pid == 0) _exit(0);
-  int status = 0;
-  waitpid(pid, &status, 0);
-  return pid;
-}
+using test::dead_pid;
 
 class RobustIo : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("demcal_robust_io_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(dir_, ec);
-  }
-  void put(const fs::path& p, const std::string& content) {
-    fs::create_directories(p.parent_path());
-    std::ofstream(p, std::ios::binary) << content;
-  }
-  fs::path dir_;
+  void put(const fs::path& p, const std::string& content) { test::write_text(p, content); }
+  test::TempDir tmp_{"robust_io"};
+  const fs::path dir_ = tmp_.path();
 };
 
 // A user's thesis.tmp.4242 was deleted as a "stale temporary".
@@ -85,14 +58,14 @@ TEST_F(RobustIo, OnlyDemcalTemporariesOfDeadProcessesAreRemoved) {
   EXPECT_FALSE(fs::exists(stale));
   EXPECT_FALSE(fs::exists(stale_stage));
   EXPECT_TRUE(fs::exists(live));
-  for (const auto& p : users) EXPECT_EQ(read(p), "mine") << p;
+  for (const auto& p : users) EXPECT_EQ(read_text(p), "mine") << p;
 }
 
 // An atomic write leaves nothing but the file (its temporary is renamed).
 TEST_F(RobustIo, AtomicWriteLeavesOnlyTheFile) {
   write_file_atomic((dir_ / "a.json").string(), "{}\n");
   write_file_atomic((dir_ / "a.json").string(), "{\"b\": 1}\n");
-  EXPECT_EQ(read(dir_ / "a.json"), "{\"b\": 1}\n");
+  EXPECT_EQ(read_text(dir_ / "a.json"), "{\"b\": 1}\n");
   EXPECT_EQ(names_in(dir_), (std::set<std::string>{"a.json"}));
 }
 
@@ -156,8 +129,8 @@ TEST_F(RobustIo, UncommittedTransactionChangesNothing) {
     t.add("series/a.csv", "new series");
   }
   EXPECT_EQ(names_in(out), before);
-  EXPECT_EQ(read(out / "summary.json"), "old summary");
-  EXPECT_EQ(read(out / "series.csv"), "old series");
+  EXPECT_EQ(read_text(out / "summary.json"), "old summary");
+  EXPECT_EQ(read_text(out / "series.csv"), "old series");
 }
 
 // A commit replaces every file at once; retired files of the earlier run go.
@@ -173,9 +146,9 @@ TEST_F(RobustIo, CommittedTransactionReplacesTogether) {
   t.commit();
   EXPECT_EQ(names_in(out),
             (std::set<std::string>{"summary.json", "series.csv", "series", "keep.txt"}));
-  EXPECT_EQ(read(out / "summary.json"), "new summary");
-  EXPECT_EQ(read(out / "series/a.csv"), "a");
-  EXPECT_EQ(read(out / "keep.txt"), "mine");
+  EXPECT_EQ(read_text(out / "summary.json"), "new summary");
+  EXPECT_EQ(read_text(out / "series/a.csv"), "a");
+  EXPECT_EQ(read_text(out / "keep.txt"), "mine");
 }
 
 /// A tmpfs of `kb` kilobytes at `at` (root only): false when it cannot be
@@ -218,8 +191,8 @@ TEST_F(RobustIo, FullDiskChangesNothingAndSaysSo) {
   EXPECT_NE(message.find("No space left on device"), std::string::npos) << message;
   EXPECT_NE(message.find("summary.json"), std::string::npos) << message;
   EXPECT_EQ(names_in(out), before);
-  EXPECT_EQ(read(out / "summary.json"), "old summary");
-  EXPECT_EQ(read(out / "series.csv"), "old series");
+  EXPECT_EQ(read_text(out / "summary.json"), "old summary");
+  EXPECT_EQ(read_text(out / "series.csv"), "old series");
   // The single-file write: the same, the old file kept.
   message.clear();
   try {
@@ -228,39 +201,24 @@ TEST_F(RobustIo, FullDiskChangesNothingAndSaysSo) {
     message = e.what();
   }
   EXPECT_NE(message.find("No space left on device"), std::string::npos) << message;
-  EXPECT_EQ(read(out / "series.csv"), "old series");
+  EXPECT_EQ(read_text(out / "series.csv"), "old series");
   EXPECT_EQ(names_in(out), before);
   ::umount(disk.c_str());
 }
 
 // --- the demcal binary: the output folder every command shares ----------------
 
-struct Result {
-  int status = -1;
-  std::string err;
-};
+using Result = test::RunResult;
+using test::run_demcal;
 
-Result demcal(const std::vector<std::string>& args, const fs::path& cwd) {
-  std::string cmd = "cd '" + cwd.string() + "' && '" DEMCAL_BINARY "'";
-  for (const auto& a : args) cmd += " '" + a + "'";
-  const fs::path err = cwd / "stderr.txt";
-  cmd += " >/dev/null 2>'" + err.string() + "'";
-  const int raw = std::system(cmd.c_str());
-  Result r;
-  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-  r.err = read(err);
-  fs::remove(err);
-  return r;
-}
-
-const std::string kHex5 = std::string(DEMCAL_SOURCE_DIR) + "/configs/hex_5x5.json";
+const std::string kHex5 = test::shipped_config("hex_5x5");
 
 // -o naming a device node or a fifo: exit 2, the node untouched.
 TEST_F(RobustIo, CliRefusesANonRegularOutput) {
   const fs::path fifo = dir_ / "nullnode";
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0644), 0);
   const Result r =
-      demcal({"run", kHex5, "--set", "algorithm.steps=200", "-o", fifo.string()}, dir_);
+      run_demcal({"run", kHex5, "--set", "algorithm.steps=200", "-o", fifo.string()}, dir_);
   EXPECT_EQ(r.status, 2) << r.err;
   EXPECT_NE(r.err.find("nullnode"), std::string::npos) << r.err;
   EXPECT_EQ(fs::status(fifo).type(), fs::file_type::fifo);
@@ -269,12 +227,11 @@ TEST_F(RobustIo, CliRefusesANonRegularOutput) {
 // A command that fails leaves no output folder it made (here consolidation
 // runs out of steps: exit 1, after the folder was checked).
 TEST_F(RobustIo, FailedCommandLeavesNoFolderItMade) {
-  std::ofstream(dir_ / "gas.json")
-      << R"({"material": {"density": 2650, "kn": 1e8, "kt": 5e7, "friction": 0.3},
+  test::write_text(dir_ / "gas.json", "{" + test::kMaterialMember + R"(,
              "assembly": {"type": "random", "count": 60},
-             "test": {"consolidation_max_steps": 1000}})";
+             "test": {"consolidation_max_steps": 1000}})");
   const fs::path out = dir_ / "new" / "deeper";
-  const Result r = demcal({"run", "gas.json", "-o", out.string()}, dir_);
+  const Result r = run_demcal({"run", "gas.json", "-o", out.string()}, dir_);
   EXPECT_EQ(r.status, 1) << r.err;
   EXPECT_FALSE(fs::exists(dir_ / "new")) << r.err;
 }
@@ -289,11 +246,12 @@ TEST_F(RobustIo, CliRunReplacesAnEarlierRunAndKeepsUserFiles) {
   // A killed earlier run's staging folder is cleared.
   fs::create_directories(out / temporary_name("stage1", dead));
   std::ofstream(out / temporary_name("stage1", dead) / "summary.json") << "half";
-  const Result r = demcal({"run", kHex5, "--set", "algorithm.steps=400", "-o", out.string()}, dir_);
+  const Result r =
+      run_demcal({"run", kHex5, "--set", "algorithm.steps=400", "-o", out.string()}, dir_);
   ASSERT_EQ(r.status, 0) << r.err;
-  EXPECT_NE(read(out / "summary.json"), "old summary");
-  EXPECT_NE(read(out / "final.vtk"), "old vtk");
-  EXPECT_EQ(read(out / "keep.txt"), "mine");
+  EXPECT_NE(read_text(out / "summary.json"), "old summary");
+  EXPECT_NE(read_text(out / "final.vtk"), "old vtk");
+  EXPECT_EQ(read_text(out / "keep.txt"), "mine");
   for (const auto& name : names_in(out))
     EXPECT_EQ(name.find(".demcal-tmp-"), std::string::npos) << name;
   EXPECT_EQ(names_in(out).size(), 5u);
@@ -306,12 +264,13 @@ TEST_F(RobustIo, CliRunOnAFullDiskKeepsTheEarlierRun) {
   const fs::path out = disk / "out";
   put_old_run(out);
   fill_disk(disk);
-  const Result r = demcal({"run", kHex5, "--set", "algorithm.steps=400", "-o", out.string()}, dir_);
+  const Result r =
+      run_demcal({"run", kHex5, "--set", "algorithm.steps=400", "-o", out.string()}, dir_);
   EXPECT_NE(r.status, 0);
   EXPECT_NE(r.err.find("No space left on device"), std::string::npos) << r.err;
-  EXPECT_EQ(read(out / "summary.json"), "old summary");
-  EXPECT_EQ(read(out / "series.csv"), "old series");
-  EXPECT_EQ(read(out / "final.vtk"), "old vtk");
+  EXPECT_EQ(read_text(out / "summary.json"), "old summary");
+  EXPECT_EQ(read_text(out / "series.csv"), "old series");
+  EXPECT_EQ(read_text(out / "final.vtk"), "old vtk");
   EXPECT_EQ(names_in(out).size(), 4u);
   ::umount(disk.c_str());
 }

@@ -17,6 +17,9 @@
 #include "demcal/scene/biaxial.hpp"
 #include "demcal/scene/config.hpp"
 #include "demcal/scene/packing.hpp"
+#include "support/files.hpp"
+#include "support/input_errors.hpp"
+#include "support/scenes.hpp"
 
 namespace demcal {
 namespace {
@@ -24,26 +27,13 @@ namespace {
 namespace fs = std::filesystem;
 
 constexpr const char* kFile = "scene.json";
-// The keys a config must give; the tests add what they are about.
-constexpr const char* kMaterial =
-    R"("material": {"density": 2650, "kn": 1e8, "kt": 5e7, "friction": 0.3})";
-
+/// The keys a config must give, then `rest` (JSON members written out, so
+/// that duplicate keys reach the parser).
 std::string with_material(const std::string& rest) {
-  return std::string("{") + kMaterial + (rest.empty() ? "" : ", " + rest) + "}";
+  return "{" + test::kMaterialMember + (rest.empty() ? "" : ", " + rest) + "}";
 }
 
-std::optional<InputError> input_error(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e;
-  } catch (const std::exception& e) {
-    ADD_FAILURE() << "expected InputError, got: " << e.what();
-    return std::nullopt;
-  }
-  ADD_FAILURE() << "expected InputError, nothing thrown";
-  return std::nullopt;
-}
+using test::input_error;
 
 /// Parsing fails naming kFile and `field`; the message holds `words`.
 void expect_rejected(const std::string& text, const std::string& field,
@@ -245,10 +235,8 @@ TEST(RobustScene, MaterialAndItsPhysicalKeysAreRequired) {
 
 // A symlink loop, a folder, a device as the config: one line naming it.
 TEST(RobustScene, UnreadableConfigPathsAreOneLine) {
-  const fs::path dir =
-      fs::temp_directory_path() / ("demcal_robust_cfg_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const test::TempDir tmp("robust_cfg");
+  const fs::path& dir = tmp.path();
   fs::create_symlink(dir / "b.json", dir / "a.json");
   fs::create_symlink(dir / "a.json", dir / "b.json");
   for (const std::string& path : {(dir / "a.json").string(), dir.string(), std::string("/dev/zero"),
@@ -264,25 +252,23 @@ TEST(RobustScene, UnreadableConfigPathsAreOneLine) {
   }
   const auto loop = input_error([&] { load_config((dir / "a.json").string(), {}); });
   EXPECT_NE(std::string(loop->what()).find("symbolic links"), std::string::npos) << loop->what();
-  fs::remove_all(dir);
 }
 
 // load_config(path, sets) is what the commands use: the file's duplicates
 // are caught there too, and the overrides apply.
 TEST(RobustScene, LoadConfigWithOverrides) {
-  const fs::path path =
-      fs::temp_directory_path() / ("demcal_robust_" + std::to_string(::getpid()) + ".json");
-  std::ofstream(path) << with_material(R"("name": "x", "name": "y")");
+  const test::TempDir dir("robust");
+  const fs::path path = dir / "scene.json";
+  test::write_text(path, with_material(R"("name": "x", "name": "y")"));
   const auto e = input_error([&] { load_config(path.string(), {}); });
   ASSERT_TRUE(e);
   EXPECT_EQ(e->field(), "name");
-  std::ofstream(path) << with_material(R"("name": "x")");
+  test::write_text(path, with_material(R"("name": "x")"));
   const SceneConfig c = load_config(path.string(), {"algorithm.steps=5000"});
   EXPECT_EQ(c.algorithm.steps, 5000);
   EXPECT_NE(c.text.find("5000"), std::string::npos);  // the hash covers the override
   EXPECT_EQ(load_config(path.string(), {}).text, with_material(R"("name": "x")"));
   EXPECT_EQ(load_config("", {}).name, "hex_10x10");  // the embedded default
-  fs::remove(path);
 }
 
 // §2: the name becomes the default output folder "demcal-run-NAME".

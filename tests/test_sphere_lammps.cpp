@@ -40,6 +40,8 @@
 #include <vector>
 
 #include "demcal/scene/sphere_packing.hpp"
+#include "support/files.hpp"
+#include "support/process.hpp"
 #include "test_sphere_helpers.hpp"
 
 namespace demcal {
@@ -47,16 +49,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using sphere_test::kR;
-
-std::string find_lmp() {
-  const char* path = std::getenv("PATH");
-  std::stringstream s(path ? path : "");
-  for (std::string dir; std::getline(s, dir, ':');) {
-    const fs::path p = fs::path(dir) / "lmp";
-    if (fs::exists(p) && ::access(p.c_str(), X_OK) == 0) return p.string();
-  }
-  return "";
-}
 
 /// One sample of a run: step, particle contacts, diagonal of b.
 struct Sample {
@@ -96,10 +88,8 @@ std::string num(double v) {
 /// log goes to `log`).
 std::vector<Sample> run_lammps(const std::string& lmp, const SphereWorld& w, const Protocol& p,
                                std::string& log) {
-  const fs::path dir =
-      fs::temp_directory_path() / ("demcal_sphere_lammps_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const test::TempDir tmp("sphere_lammps");
+  const fs::path& dir = tmp.path();
   const SphereMaterial& mat = w.material();
   // One atom type per distinct mass (a few for a polydisperse sample).
   std::map<double, int> type_of;
@@ -166,15 +156,12 @@ std::vector<Sample> run_lammps(const std::string& lmp, const SphereWorld& w, con
   in << "thermo_style custom step v_contacts c_fxlo c_fxhi c_fylo c_fyhi c_fzlo c_fzhi\n"
      << "thermo_modify norm no\nthermo " << p.every << "\nrun " << p.steps << "\n";
   in.close();
-  const std::string cmd = "cd '" + dir.string() + "' && '" + lmp +
-                          "' -in in.spheres -log log.lammps -screen none >/dev/null 2>&1";
-  const int raw = std::system(cmd.c_str());
-  std::stringstream text;
-  text << std::ifstream(dir / "log.lammps").rdbuf();
-  log = text.str();
-  fs::remove_all(dir);
+  const int status =
+      test::run_program(lmp, {"-in", "in.spheres", "-log", "log.lammps", "-screen", "none"}, dir)
+          .status;
+  log = test::read_text(dir / "log.lammps");
   std::vector<Sample> out;
-  if (!(WIFEXITED(raw) && WEXITSTATUS(raw) == 0)) return out;
+  if (status != 0) return out;
   const auto at = log.find("Step v_contacts");
   if (at == std::string::npos) return out;
   std::stringstream lines(log.substr(at));
@@ -217,7 +204,7 @@ Comparison compare(const std::vector<Sample>& d, const std::vector<Sample>& l) {
 }
 
 void check_against_lammps(const char* name, const SphereWorld& w, const Protocol& p) {
-  const std::string lmp = find_lmp();
+  const std::string lmp = test::find_on_path("lmp");
   if (lmp.empty()) GTEST_SKIP() << "LAMMPS (lmp) is not installed: the cross-check is not run";
   const std::vector<Sample> d = run_demcal(w, p);
   std::string log;

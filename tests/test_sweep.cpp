@@ -22,6 +22,8 @@
 #include "demcal/scene/packing.hpp"
 #include "demcal/scoring/scoring.hpp"
 #include "demcal/search/sweep.hpp"
+#include "support/files.hpp"
+#include "support/process.hpp"
 
 namespace demcal {
 namespace {
@@ -271,15 +273,14 @@ TEST(Sweep, RunsInParallelAndScoresAgainstTheLadder) {
 
 TEST(Sweep, CommandWritesTheAtlas) {
   // hex_5x5 at a benchmark of 2000 steps: the whole atlas in about a second.
-  const fs::path dir =
-      fs::temp_directory_path() / ("demcal-sweep-test-" + std::to_string(getpid()));
-  fs::remove_all(dir);
-  const std::string cmd = std::string(DEMCAL_BINARY) + " sweep " + DEMCAL_SOURCE_DIR +
-                          "/configs/hex_5x5.json --set algorithm.steps=2000 --jobs 2 -o " +
-                          dir.string() + " > " + dir.string() + ".out 2> " + dir.string() + ".err";
-  const int status = std::system(cmd.c_str());
-  ASSERT_TRUE(WIFEXITED(status));
-  EXPECT_EQ(WEXITSTATUS(status), 0);
+  const test::TempDir tmp("sweep");
+  const fs::path dir = tmp / "atlas";
+  const test::RunResult r =
+      test::run_demcal({"sweep", test::shipped_config("hex_5x5"), "--set", "algorithm.steps=2000",
+                        "--jobs", "2", "-o", dir.string()},
+                       tmp.path());
+  ASSERT_NE(r.status, -1);
+  EXPECT_EQ(r.status, 0) << r.err;
   for (const char* f : {"atlas.md", "atlas.json", "evidence.csv", "series/benchmark.csv",
                         "series/steps_x33.csv", "series/mass_1e8_undamped.csv"})
     EXPECT_TRUE(fs::exists(dir / f)) << f;
@@ -288,9 +289,6 @@ TEST(Sweep, CommandWritesTheAtlas) {
   EXPECT_EQ(j["scene"], "hex_5x5");
   EXPECT_GT(j["cases"].size(), 60u);
   EXPECT_EQ(j["benchmark"]["steps"], 2000);
-  fs::remove_all(dir);
-  fs::remove(dir.string() + ".out");
-  fs::remove(dir.string() + ".err");
 }
 
 }  // namespace

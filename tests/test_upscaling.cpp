@@ -14,6 +14,8 @@
 #include "demcal/scene/packing.hpp"
 #include "demcal/upscaling/rev.hpp"
 #include "demcal/upscaling/upscaling.hpp"
+#include "support/files.hpp"
+#include "support/process.hpp"
 
 namespace demcal {
 namespace {
@@ -100,14 +102,11 @@ TEST(Upscale, PrototypeBlockRecomputesDtAndDampingFromThePrototypesParticles) {
 
   // A prototype file with a smaller smallest particle: Δt_crit ∝ r_min
   // (m ∝ r²), D_t^crit ∝ r_min, D_r^crit ∝ r_min³.
-  const fs::path dir = fs::temp_directory_path() / ("demcal_test_up_" + std::to_string(getpid()));
-  fs::create_directories(dir);
+  const test::TempDir dir("up");
   Assembly p = hexagonal_packing(20, 20, 5e-4);
   p.r[7] = 2.5e-4;  // one half-size disk
-  const std::string file = (dir / "proto.csv").string();
-  std::ofstream(file) << particle_csv(p);
+  const std::string file = test::write_text(dir / "proto.csv", particle_csv(p));
   const nlohmann::json b = prototype_block(c, rev, 100, {}, 0, file);
-  fs::remove_all(dir);
   EXPECT_EQ(b["particles"].get<int64_t>(), 400);
   EXPECT_EQ(b["steps"].get<int64_t>(), 360000);
   EXPECT_NEAR(b["dt_crit"].get<double>() / rev_scales.dt_crit, 0.5, 1e-12);
@@ -205,33 +204,16 @@ TEST(StepSearch, FindsTheSmallestPassingNstepAtFixedMultipliers) {
 
 // --- `demcal upscale` end to end ---------------------------------------------
 
-struct Cli {
-  int status = -1;
-  std::string out, err;
-};
+using Cli = test::RunResult;
 
 class UpscaleCli : public ::testing::Test {
  protected:
-  void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() /
-           ("demcal_test_upscale_" + std::to_string(::getpid()) + "_" + info->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
+  /// `demcal ARGS` in dir_ (ARGS split at spaces).
   Cli run(const std::string& args) {
-    const std::string cmd = "cd '" + dir_.string() + "' && '" + std::string(DEMCAL_BINARY) + "' " +
-                            args + " >out.txt 2>err.txt";
-    const int raw = std::system(cmd.c_str());
-    Cli r;
-    r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-    std::stringstream o, e;
-    o << std::ifstream(dir_ / "out.txt").rdbuf();
-    e << std::ifstream(dir_ / "err.txt").rdbuf();
-    r.out = o.str();
-    r.err = e.str();
-    return r;
+    std::vector<std::string> words;
+    std::stringstream s(args);
+    for (std::string w; s >> w;) words.push_back(w);
+    return test::run_demcal(words, dir_);
   }
   /// A params.json as `demcal calibrate` writes it, for the default scene.
   void write_params(bool with_config) {
@@ -246,7 +228,8 @@ class UpscaleCli : public ::testing::Test {
     if (with_config) j["config"] = to_json(c);
     std::ofstream(dir_ / "params.json") << j.dump(2);
   }
-  fs::path dir_;
+  test::TempDir tmp_{"upscale"};
+  const fs::path dir_ = tmp_.path();
 };
 
 TEST_F(UpscaleCli, UpscalesToACountAndWritesParams) {

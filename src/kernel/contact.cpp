@@ -1,4 +1,4 @@
-// Contact law (DESIGN.md §2): linear normal spring kn·δ; incremental
+// Contact law (README.md "Physics in one paragraph"): linear normal spring kn·δ; incremental
 // tangential spring kt capped by Coulomb μ·Fn. The tangential force is kept
 // as a scalar along the contact tangent t = (−n_y, n_x), so it turns with the
 // contact as the pair rolls around itself.

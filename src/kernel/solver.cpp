@@ -1,5 +1,5 @@
-// Central-difference integration with global (mass-proportional) damping,
-// DESIGN.md §2:
+// Central-difference integration with global (mass-proportional) damping
+// (README.md "Physics in one paragraph"):
 //   v(n+½) = [(1 − D·Δt/2m)·v(n−½) + F·Δt/m] / (1 + D·Δt/2m)
 // with D = ζ_t·2·sqrt(kn·m) per particle (and ζ_r·2·sqrt(kt·r²·I) for ω),
 // so every particle has the same damping ratio.

@@ -1,4 +1,4 @@
-// Stress and equilibrium measures (DESIGN.md §2), tension positive:
+// Stress and equilibrium measures (README.md "Physics in one paragraph"), tension positive:
 //   b_ij = (1/V) Σ_{wall contacts} x^c_i f^c_j      (origin at the box centre)
 //   σ_ij = (1/V) Σ_p Σ_{c∈p} (x^c − x^p)_i f^c_j   (wall contacts included)
 // For a particle pair the two particles' terms add up to (x^j − x^i) ⊗ f_i,

@@ -1,4 +1,4 @@
-// The biaxial test (DESIGN.md §2): consolidation to isotropic σ3 with four
+// The biaxial test (README.md "Physics in one paragraph"): consolidation to isotropic σ3 with four
 // servo walls, then loading: bottom fixed, top wall strain-controlled to a
 // total vertical strain ε over Nstep steps, left and right walls servoed at
 // σ3. Monitored at M points.

@@ -68,7 +68,8 @@ struct TestSpec {
   int64_t consolidation_max_steps = 2000000;
 };
 
-/// The algorithmic parameters of one run (DESIGN.md §5 `algorithm`).
+/// The algorithmic parameters of one run (the config's `algorithm` block;
+/// its keys are also read by the report and by other tools).
 struct AlgorithmSpec {
   double dt_ratio = 0.2;                   ///< α = Δt/Δt_crit
   int64_t steps = 100000;                  ///< Nstep (loading)

@@ -1,7 +1,10 @@
 // Scoring: from a loading run's monitored series, how far it was from
 // quasi-static, and which algorithmic parameter is to blame. Knows nothing
-// of the search that uses it (DESIGN.md §2.1, §3; evidence and the choice
-// of the default tolerances: reports/signature-atlas.md).
+// of the search that uses it. Every component of b − σ is measured against a
+// scale that makes it sensitive (the lateral ones against σ3), and oscillation
+// and servo error are criteria of their own: the paper's single vertical
+// measure passes runs whose peak is ~30 % off. Evidence and the choice of the
+// default tolerances: reports/signature-atlas.md.
 //
 // Every measure is a relative number (0 = perfect), computed at the
 // monitoring points after the first (the consolidated start is static by
@@ -124,7 +127,7 @@ struct Diagnosis {
   std::string direction;    ///< "increase", "decrease" or ""
   double confidence = 0.0;  ///< 0..1
   std::string message;      ///< one sentence for a user
-  std::string signature;    ///< the pattern seen, short (DESIGN.md §3 wording)
+  std::string signature;    ///< the pattern seen, short (wording of reports/signature-atlas.md §5)
 };
 
 /// Each criterion divided by its tolerance (≤ 1 passes).
@@ -160,7 +163,8 @@ Score score_run(const LoadingResult& run, double lateral_stress, const Tolerance
 /// over-predicted; nothing without a (non-zero) reference.
 std::optional<double> peak_error_of(double peak, std::optional<double> reference);
 /// The parameter most likely out of bounds, from the pattern of measures
-/// (DESIGN.md §3 as our kernel shows it; reports/signature-atlas.md).
+/// (the paper's signatures as our kernel shows them: reports/signature-atlas.md
+/// §5 and §7).
 ///
 /// The pattern names the class of fault (divergence, rotational chatter,
 /// dynamic run, noise, loading too fast for the walls, rotational drag,

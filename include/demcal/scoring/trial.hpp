@@ -20,7 +20,7 @@ std::optional<double> analytical_peak_stress(const SceneConfig& config);
 nlohmann::json params_json(const AlgorithmSpec& algorithm, const Integration& integration,
                            const ReferenceScales& scales);
 
-/// summary.json of a run (DESIGN.md §5 / issue: `demcal run`).
+/// summary.json of a run (`demcal run`, README.md "Commands").
 nlohmann::json run_summary(const SceneConfig& config, const LoadingResult& run, const Score& score);
 
 }  // namespace demcal

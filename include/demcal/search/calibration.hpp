@@ -1,4 +1,4 @@
-// Automatic calibration (DESIGN.md §4–§7): NLopt searches the algorithmic
+// Automatic calibration (README.md "Commands", ARCHITECTURE.md): NLopt searches the algorithmic
 // parameters for the cheapest run (fewest steps) that passes every
 // criterion of the scoring module; a convergence certificate (Nstep
 // doubled) confirms the answer stopped moving.

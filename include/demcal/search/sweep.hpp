@@ -1,4 +1,4 @@
-// The signature atlas (DESIGN.md §3): around a benchmark parameter set, one
+// The signature atlas (reports/signature-atlas.md): around a benchmark parameter set, one
 // algorithmic parameter out of bounds at a time, every trial scored and
 // diagnosed, against the converged quasi-static peak of the same scene.
 //
@@ -23,7 +23,7 @@ struct SweepCase {
   std::string name;      ///< file-safe id: "steps_x1_6", "alpha_0.30", ...
   std::string group;     ///< benchmark | atlas | alpha_scan | convergence | grid
   std::string change;    ///< what differs from the benchmark, for people
-  std::string expected;  ///< the paper's signature (DESIGN.md §3), "" if none
+  std::string expected;  ///< the paper's signature (reports/signature-atlas.md §5), "" if none
   AlgorithmSpec algorithm;
 };
 

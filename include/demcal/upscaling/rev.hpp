@@ -1,5 +1,6 @@
 // The representative elementary volume (REV): a small sample of the user's
-// prototype that the calibration runs on (DESIGN.md §4, issue #6 §1).
+// prototype that the calibration runs on (issue #6 §1): as small as still
+// representative, so that every trial of the search is cheap.
 //
 // Two ways to get one from a prototype assembly (a particle file):
 //   cut      — a rectangular window around the prototype's centre holding

@@ -1,5 +1,6 @@
-// Upscaling (DESIGN.md §4 "Upscaling"): from the parameters calibrated on a
-// small REV to the user's prototype.
+// Upscaling (README.md "Upscaling, verification and export"; evidence in
+// reports/scaling.md): from the parameters calibrated on a small REV to the
+// user's prototype.
 //
 // The dimensionless multipliers α = Δt/Δt_crit, ζ_t = D_t/D_t^crit,
 // ζ_r = D_r/D_r^crit and the mass scaling carry over unchanged; Nstep grows

@@ -1,0 +1,61 @@
+// Test support: starting the demcal program (or another one, such as LAMMPS)
+// the two ways the tests need: run to completion with the output captured,
+// or start in the background and keep the pid (to signal or kill it).
+#pragma once
+
+#include <sys/types.h>
+
+#include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace demcal::test {
+
+/// The demcal program built with the tests, and the source tree (configs/).
+extern const std::string kDemcalBinary;
+extern const std::string kSourceDir;
+/// A shipped scene config, e.g. shipped_config("hex_5x5").
+std::string shipped_config(const std::string& name);
+
+/// The first executable `name` on PATH (lmp, liggghts), or "" when there is
+/// none: the tests that need another engine skip without it.
+std::string find_on_path(const std::string& name);
+
+/// `s` single-quoted for /bin/sh.
+std::string shell_quote(const std::string& s);
+
+struct RunResult {
+  int status = -1;  ///< exit status; -1 when the program did not exit normally
+  std::string out, err;
+};
+
+/// Run `program ARGS` in `cwd` to completion, stdout and stderr captured.
+/// The capture files live in the temporary directory and are removed
+/// afterwards, so `cwd` holds only what the program itself wrote.
+RunResult run_program(const std::string& program, const std::vector<std::string>& args,
+                      const std::filesystem::path& cwd);
+/// run_program for demcal.
+RunResult run_demcal(const std::vector<std::string>& args, const std::filesystem::path& cwd);
+
+/// An input deck run by another engine (LAMMPS, LIGGGHTS).
+struct DeckRun {
+  int status = -1;  ///< the engine's exit status
+  std::string log;  ///< its log file
+};
+/// Write `deck` as `dir`/in.deck and `files` beside it, then run
+/// `program OPTIONS -in in.deck -log log.txt` in `dir`.
+DeckRun run_deck(const std::string& program, const std::filesystem::path& dir,
+                 const std::string& deck, const std::map<std::string, std::string>& files,
+                 const std::vector<std::string>& options = {"-screen", "none"});
+
+/// Start `demcal ARGS` in the background, stdout to /dev/null; returns the pid.
+pid_t spawn_demcal(const std::vector<std::string>& args);
+/// Wait for `pid`; its exit status, -1 when it was killed by a signal.
+int wait_exit(pid_t pid);
+
+/// A pid that is certainly not running: a child that has exited and been
+/// reaped (for code that must tell a live process from a gone one).
+pid_t dead_pid();
+
+}  // namespace demcal::test
