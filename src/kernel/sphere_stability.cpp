@@ -21,6 +21,7 @@
 #include <limits>
 
 #include "demcal/kernel/sphere_world.hpp"
+#include "tridiagonal.hpp"
 
 namespace demcal {
 
@@ -87,42 +88,6 @@ void apply(const std::vector<LinearContact>& contacts, const std::vector<double>
   }
 }
 
-// Largest eigenvalue of a symmetric tridiagonal matrix by Sturm bisection
-// (the 2D kernel's stability.cpp explains why not Eigen's QR).
-double tridiagonal_max_eigenvalue(const std::vector<double>& d, const std::vector<double>& e) {
-  const size_t m = d.size();
-  if (m == 0) return 0.0;
-  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-  for (size_t k = 0; k < m; ++k) {
-    const double off = (k > 0 ? std::abs(e[k - 1]) : 0.0) + (k + 1 < m ? std::abs(e[k]) : 0.0);
-    lo = std::min(lo, d[k] - off);
-    hi = std::max(hi, d[k] + off);
-  }
-  auto count_below = [&](double x) {
-    size_t count = 0;
-    double q = 1.0;
-    const double tiny = std::numeric_limits<double>::min() / std::numeric_limits<double>::epsilon();
-    for (size_t k = 0; k < m; ++k) {
-      q = d[k] - x - (k > 0 ? e[k - 1] * e[k - 1] / q : 0.0);
-      if (q == 0.0) q = -tiny;
-      if (q < 0.0) ++count;
-    }
-    return count;
-  };
-  const double scale = std::max(std::abs(lo), std::abs(hi));
-  hi += 4.0 * std::numeric_limits<double>::epsilon() * scale + std::numeric_limits<double>::min();
-  for (int it = 0; it < 200 && hi - lo > 2.0 * std::numeric_limits<double>::epsilon() * scale;
-       ++it) {
-    const double mid = 0.5 * (lo + hi);
-    if (mid <= lo || mid >= hi) break;
-    if (count_below(mid) >= m)
-      hi = mid;
-    else
-      lo = mid;
-  }
-  return 0.5 * (lo + hi);
-}
-
 double lanczos_max(const std::vector<LinearContact>& contacts, const std::vector<double>& ism,
                    const std::vector<double>& isi, bool rotation, int iterations) {
   const int n = static_cast<int>(ism.size());
@@ -152,7 +117,7 @@ double lanczos_max(const std::vector<LinearContact>& contacts, const std::vector
     v_prev = v;
     v = w / b;
   }
-  return tridiagonal_max_eigenvalue(alpha, beta);
+  return detail::tridiagonal_max_eigenvalue(alpha, beta);
 }
 
 // Gershgorin: row sums of |A|, bounded contact by contact. With an
