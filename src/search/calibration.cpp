@@ -364,7 +364,8 @@ class Evaluator {
 
 struct SearchSpace {
   double lower[4], upper[4];
-  AlgorithmSpec base;  // mass scaling, lock_rotation
+  AlgorithmSpec base;         // mass scaling, lock_rotation
+  double fidelity_min = 0.0;  // the smallest Nstep of a model-search trial
 };
 
 AlgorithmSpec params_at(const SearchSpace& space, const double* x) {
@@ -496,11 +497,12 @@ double model_objective(unsigned, const double* x, double*, void* data) {
   auto& m = *static_cast<ModelSearch*>(data);
   ++m.evaluations;
   const double full[4] = {x[0], std::log10(m.n_guess), x[1], x[2]};
+  AlgorithmSpec p = params_at(*m.space, full);
+  p.steps = std::llround(m.n_guess);  // may lie below the search space: a probe
   // The whole run: an early-stopped trial's criteria would under-predict N*.
-  const TrialRecord r =
-      m.evaluator->evaluate(params_at(*m.space, full), TrialPhase::search, /*early_stop=*/false);
+  const TrialRecord r = m.evaluator->evaluate(p, TrialPhase::search, /*early_stop=*/false);
   if (m.evaluator->stopped()) {
-    nlopt_force_stop(m.opt);
+    if (m.opt) nlopt_force_stop(m.opt);
     return HUGE_VAL;
   }
   if (r.score.diverged) return std::log10(m.n_guess) + 3.0;
@@ -525,8 +527,7 @@ struct ModelPrediction {
 
 /// The search fidelity for a target Nstep: N*/kFidelity, within the bounds.
 double fidelity_steps(const SearchSpace& space, double target) {
-  return std::clamp(target / kFidelity, std::pow(10.0, space.lower[1]),
-                    std::pow(10.0, space.upper[1]));
+  return std::clamp(target / kFidelity, space.fidelity_min, std::pow(10.0, space.upper[1]));
 }
 
 /// BOBYQA over (α, ζ_t, ζ_r) on the 1/Nstep model, from `start` (α, log10
@@ -720,6 +721,12 @@ CalibrationSummary calibrate(const SceneConfig& config, const ConsolidatedState&
   space.upper[2] = options.damping_max;
   space.lower[3] = 0.0;
   space.upper[3] = options.damping_max;
+  // Search-fidelity trials may run below steps_min, down to 16 steps per
+  // particle: the 1/Nstep law was measured to hold there (random_400,
+  // reports/calibration-cost.md), and a REV whose N* is small would
+  // otherwise be searched at N*/4 instead of N*/8.
+  space.fidelity_min = static_cast<double>(
+      options.steps_min > 0 ? steps_min : std::min<int64_t>(16LL * n, steps_min));
 
   // Starts: the paper's recommendation with a size-based Nstep (500 per
   // particle: the model strategy extrapolates from there, so it need not
