@@ -129,6 +129,50 @@ void require_same_run(const std::string& dir, const nlohmann::json& key) {
                            fresh);
 }
 
+/// The report: the start point and the result rerun with their series, the
+/// picture at the peak, then plots and text. Returns the files written, for
+/// the closing line ("" when the report failed: a warning, not a failure).
+std::string write_report(const CalibrateOptions& o, const SceneConfig& config,
+                         const ConsolidatedState& state, const std::string& dir,
+                         const nlohmann::json& params, const CalibrationSummary& summary,
+                         const CalibrationOptions& options, std::optional<BaselineResult> baseline,
+                         std::optional<ReferenceEvidence> reference, int jobs) {
+  const int64_t n_rev = state.world.size();
+  try {
+    const auto t0 = std::chrono::steady_clock::now();
+    ReportInput in;
+    in.scene = config.name;
+    in.command = reproduce_command(o, config, dir);
+    in.params = params;
+    in.summary = summary;
+    in.tolerances = options.tolerances;
+    in.accuracy = options.accuracy;
+    in.lateral_stress = config.test.lateral_stress;
+    in.dt_ratio_max = dt_ratio_max(options, summary.dt_ratio_stable);
+    in.particles = n_rev;
+    in.prototype_particles = config.prototype.particles > 0 ? config.prototype.particles : n_rev;
+    in.analytical_peak = analytical_peak_stress(config);
+    in.baseline = std::move(baseline);
+    in.reference = std::move(reference);
+    // The search's first start, as it ran.
+    const AlgorithmSpec start =
+        rounded_params(search_start(config.algorithm, n_rev, in.dt_ratio_max));
+    // A stop now: finish, the runs are done.
+    attach_runs(in, rerun_start_and_result(config, state, start, summary, in.tolerances, jobs));
+    const auto t1 = std::chrono::steady_clock::now();
+    const Report report = make_report(in);
+    write_file_atomic(dir + "/report.html", report.html);
+    write_file_atomic(dir + "/report.md", report.markdown);
+    if (!o.quiet)
+      std::cerr << "demcal: report: reruns " << std::chrono::duration<double>(t1 - t0).count()
+                << " s, writing " << seconds_since(t1) << " s; " << report.plot_status << "\n";
+    return ", " + dir + "/report.html, " + dir + "/report.md";
+  } catch (const std::exception& e) {
+    std::cerr << "demcal: warning: the report was not written: " << e.what() << "\n";
+    return "";
+  }
+}
+
 }  // namespace
 
 int cmd_calibrate(const CalibrateOptions& o) {
@@ -199,7 +243,6 @@ int cmd_calibrate(const CalibrateOptions& o) {
   if (summary.interrupted) return interrupted("");
 
   const int64_t n_rev = state.world.size();
-  const int64_t n_proto = config.prototype.particles > 0 ? config.prototype.particles : n_rev;
   nlohmann::json params = params_file(config, state, options, summary);
 
   const bool have_best = summary.best_trial.score.particle_steps > 0.0;
@@ -247,42 +290,8 @@ int cmd_calibrate(const CalibrateOptions& o) {
         " before the report (params.json and run.json are written; --resume reuses every trial "
         "and writes the report)");
 
-  // The report: the start point and the result rerun with their series,
-  // the picture at the peak, then plots and text.
-  std::string report_note;
-  try {
-    const auto t0 = std::chrono::steady_clock::now();
-    ReportInput in;
-    in.scene = config.name;
-    in.command = reproduce_command(o, config, dir);
-    in.params = params;
-    in.summary = summary;
-    in.tolerances = options.tolerances;
-    in.accuracy = options.accuracy;
-    in.lateral_stress = config.test.lateral_stress;
-    in.dt_ratio_max = dt_ratio_max(options, summary.dt_ratio_stable);
-    in.particles = n_rev;
-    in.prototype_particles = n_proto;
-    in.analytical_peak = analytical_peak_stress(config);
-    in.baseline = std::move(baseline);
-    in.reference = std::move(reference);
-    // The search's first start, as it ran.
-    const AlgorithmSpec start =
-        rounded_params(search_start(config.algorithm, n_rev, in.dt_ratio_max));
-    // A stop now: finish, the runs are done.
-    attach_runs(in, rerun_start_and_result(config, state, start, summary, in.tolerances, jobs));
-    const auto t1 = std::chrono::steady_clock::now();
-    const Report report = make_report(in);
-    write_file_atomic(dir + "/report.html", report.html);
-    write_file_atomic(dir + "/report.md", report.markdown);
-    const auto t2 = std::chrono::steady_clock::now();
-    auto secs = [](auto a, auto b) { return std::chrono::duration<double>(b - a).count(); };
-    say("report: reruns " + std::to_string(secs(t0, t1)) + " s, writing " +
-        std::to_string(secs(t1, t2)) + " s; " + report.plot_status);
-    report_note = ", " + dir + "/report.html, " + dir + "/report.md";
-  } catch (const std::exception& e) {
-    std::cerr << "demcal: warning: the report was not written: " << e.what() << "\n";
-  }
+  const std::string report_note = write_report(o, config, state, dir, params, summary, options,
+                                               std::move(baseline), std::move(reference), jobs);
 
   write_run_json();
   std::cout << summary.BriefReport() << "  wrote " << dir << "/params.json, " << dir
