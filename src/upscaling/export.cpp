@@ -241,33 +241,113 @@ std::string lammps_series_block(const SceneConfig& c, const AlgorithmSpec& p, co
   return s.str();
 }
 
+// The walls, the servo and the measured wall stresses of the LAMMPS deck:
+// text only, every number comes from the deck's parameters block.
+constexpr const char kLammpsWalls[] =
+    "# --- walls -------------------------------------------------------------------\n"
+    "# top: a plane moving down at vtop; left/right: planes moved by the servo.\n"
+    "# The fix order matters: the walls, then fix store/force (contact forces\n"
+    "# only), then the damping.\n"
+    "variable dytop  equal -v_vtop*step*dt\n"
+    "variable dxl    equal f_servol*(step-v_step0)\n"
+    "variable dxr    equal f_servor*(step-v_step0)\n"
+    "region          rtop   plane 0 ${yt0} 0  0 -1 0 side in move NULL v_dytop NULL units box\n"
+    "region          rleft  plane ${xl_now} 0 0  1 0 0  side in move v_dxl NULL NULL units box\n"
+    "region          rright plane ${xr_now} 0 0  -1 0 0 side in move v_dxr NULL NULL units box\n"
+    "# Each moving wall acts on the particles that can reach it (a wall fix loops\n"
+    "# over its group every step): those within band_v of the top, band_h of a\n"
+    "# lateral wall at the start. fix halt stops the run with an error should a\n"
+    "# particle outside a band ever touch that wall (then widen the bands).\n"
+    "region          bandtop block INF INF $(v_yt0-v_band_v) INF INF INF units box\n"
+    "region          bandleft block INF $(v_xl0+v_band_h) INF INF INF INF units box\n"
+    "region          bandright block $(v_xr0-v_band_h) INF INF INF INF INF units box\n"
+    "group           gtop region bandtop\n"
+    "group           gleft region bandleft\n"
+    "group           gright region bandright\n"
+    "group           ntop subtract all gtop\n"
+    "group           nleft subtract all gleft\n"
+    "group           nright subtract all gright\n"
+    "fix             wbottom all wall/gran hooke/history ${kn_wall} ${kt_wall} 0 0 ${mu_wall} 0 "
+    "yplane ${yb0} NULL contacts\n"
+    "fix             wtop gtop wall/gran/region hooke/history ${kn_wall} ${kt_wall} 0 0 "
+    "${mu_wall} 0 region rtop contacts\n"
+    "fix             wleft gleft wall/gran/region hooke/history ${kn_wall} ${kt_wall} 0 0 "
+    "${mu_wall} 0 region rleft contacts\n"
+    "fix             wright gright wall/gran/region hooke/history ${kn_wall} ${kt_wall} 0 0 "
+    "${mu_wall} 0 region rright contacts\n"
+    "# contact force on every particle (pairs and walls), before the damping\n"
+    "fix             fcon all store/force\n"
+    "# wall contact arrays: [1] contacts, [2] [3] force on the particle, [5] [6]\n"
+    "# contact point\n"
+    "compute         cl gleft reduce sum f_wleft[1] f_wleft[2]\n"
+    "compute         cr gright reduce sum f_wright[1] f_wright[2]\n"
+    "compute         ct gtop reduce sum f_wtop[1] f_wtop[3]\n"
+    "compute         cb all reduce sum f_wbottom[1] f_wbottom[3]\n"
+    "variable        xl equal v_xl_now+v_dxl\n"
+    "variable        xr equal v_xr_now+v_dxr\n"
+    "variable        yt equal v_yt0+v_dytop\n"
+    "variable        H  equal v_yt-v_yb0\n"
+    "variable        W  equal v_xr-v_xl\n"
+    "variable        pl equal c_cl[2]/(v_H*v_thick)\n"
+    "variable        pr equal -c_cr[2]/(v_H*v_thick)\n"
+    "variable        pt equal -c_ct[2]/(v_W*v_thick)\n"
+    "variable        pb equal c_cb[2]/(v_W*v_thick)\n"
+    "# clearance of the particles outside each band from its wall (> 0)\n"
+    "compute         rad all property/atom radius\n"
+    "variable        gap_top atom v_yt-y-c_rad\n"
+    "variable        gap_left atom x-c_rad-v_xl\n"
+    "variable        gap_right atom v_xr-x-c_rad\n"
+    "compute         clear_top ntop reduce min v_gap_top\n"
+    "compute         clear_left nleft reduce min v_gap_left\n"
+    "compute         clear_right nright reduce min v_gap_right\n"
+    "variable        clear_top equal c_clear_top\n"
+    "variable        clear_left equal c_clear_left\n"
+    "variable        clear_right equal c_clear_right\n"
+    "# demcal's servo, one move per step toward the sample when p < sigma3:\n"
+    "#   move = gain*(sigma3*H*t - F)/(kn_wall*max(1, n)), clamped to +-cap,\n"
+    "# F the wall force, n its contacts. One flat formula per wall, the numbers\n"
+    "# substituted now: a chain of variables re-parsed every step cost more than\n"
+    "# the granular step itself (this release has no min/max of two numbers:\n"
+    "# max(1, n) = (1+n+abs(1-n))/2, clamp(x) = (abs(x+cap)-abs(x-cap))/2).\n"
+    "variable        rawl  equal ${gain}*(${sigma3}*(${H0}-${vtop}*step*dt)*${thick}-c_cl[2])/"
+    "(${kn_wall}*(1+c_cl[1]+abs(1-c_cl[1]))/2)\n"
+    "variable        rawr  equal ${gain}*(${sigma3}*(${H0}-${vtop}*step*dt)*${thick}+c_cr[2])/"
+    "(${kn_wall}*(1+c_cr[1]+abs(1-c_cr[1]))/2)\n"
+    "variable        movel equal (abs(v_rawl+${cap})-abs(v_rawl-${cap}))/2\n"
+    "variable        mover equal -(abs(v_rawr+${cap})-abs(v_rawr-${cap}))/2\n"
+    "fix             servol all ave/time 1 1 1 v_movel ave running\n"
+    "fix             servor all ave/time 1 1 1 v_mover ave running\n\n";
+
+// Data file: atom_style sphere rows "id type diameter density x y z"; the
+// density column is overwritten by set density/disc below.
+std::string lammps_data_file(const SceneConfig& c, const Assembly& a, const Plan& plan) {
+  const auto& m = c.material;
+  std::ostringstream d;
+  const double mx = 0.5 * plan.width0, my = 0.1 * plan.height0;
+  d << "LAMMPS data file written by demcal " << DEMCAL_VERSION << " (scene " << c.name
+    << ", consolidated to sigma3)\n\n"
+    << plan.n << " atoms\n"
+    << plan.types << " atom types\n\n"
+    << num(a.left - mx) << " " << num(a.right + mx) << " xlo xhi\n"
+    << num(a.bottom - my) << " " << num(a.top + my) << " ylo yhi\n"
+    << num(-0.5 * m.thickness) << " " << num(0.5 * m.thickness) << " zlo zhi\n\n"
+    << "Atoms # sphere\n\n";
+  char line[160];
+  for (int i = 0; i < plan.n; ++i) {
+    std::snprintf(line, sizeof line, "%d %d %.17g %.10g %.17g %.17g 0\n", i + 1, plan.type[i],
+                  2.0 * a.r[i], plan.areal_density, a.x[i], a.y[i]);
+    d << line;
+  }
+  return d.str();
+}
+
 ExportResult lammps(const SceneConfig& c, const AlgorithmSpec& p, const Assembly& a,
                     const ExportOptions& o) {
   const Plan plan = make_plan(c, p, a, o.max_types);
   const auto& m = c.material;
   ExportResult out = result_of(plan);
 
-  // Data file: atom_style sphere rows "id type diameter density x y z"; the
-  // density column is overwritten by set density/disc below.
-  {
-    std::ostringstream d;
-    const double mx = 0.5 * plan.width0, my = 0.1 * plan.height0;
-    d << "LAMMPS data file written by demcal " << DEMCAL_VERSION << " (scene " << c.name
-      << ", consolidated to sigma3)\n\n"
-      << plan.n << " atoms\n"
-      << plan.types << " atom types\n\n"
-      << num(a.left - mx) << " " << num(a.right + mx) << " xlo xhi\n"
-      << num(a.bottom - my) << " " << num(a.top + my) << " ylo yhi\n"
-      << num(-0.5 * m.thickness) << " " << num(0.5 * m.thickness) << " zlo zhi\n\n"
-      << "Atoms # sphere\n\n";
-    char line[160];
-    for (int i = 0; i < plan.n; ++i) {
-      std::snprintf(line, sizeof line, "%d %d %.17g %.10g %.17g %.17g 0\n", i + 1, plan.type[i],
-                    2.0 * a.r[i], plan.areal_density, a.x[i], a.y[i]);
-      d << line;
-    }
-    out.files[o.data_name] = d.str();
-  }
+  out.files[o.data_name] = lammps_data_file(c, a, plan);
 
   std::ostringstream s;
   s << mapping_header(c, p, plan, o, "LAMMPS");
@@ -379,79 +459,7 @@ ExportResult lammps(const SceneConfig& c, const AlgorithmSpec& p, const Assembly
     << "timestep        ${dt}\n\n"
     << "fix             integrate all nve/sphere disc\n\n";
 
-  s << "# --- walls -------------------------------------------------------------------\n"
-    << "# top: a plane moving down at vtop; left/right: planes moved by the servo.\n"
-    << "# The fix order matters: the walls, then fix store/force (contact forces\n"
-    << "# only), then the damping.\n"
-    << "variable dytop  equal -v_vtop*step*dt\n"
-    << "variable dxl    equal f_servol*(step-v_step0)\n"
-    << "variable dxr    equal f_servor*(step-v_step0)\n"
-    << "region          rtop   plane 0 ${yt0} 0  0 -1 0 side in move NULL v_dytop NULL units box\n"
-    << "region          rleft  plane ${xl_now} 0 0  1 0 0  side in move v_dxl NULL NULL units box\n"
-    << "region          rright plane ${xr_now} 0 0  -1 0 0 side in move v_dxr NULL NULL units box\n"
-    << "# Each moving wall acts on the particles that can reach it (a wall fix loops\n"
-    << "# over its group every step): those within band_v of the top, band_h of a\n"
-    << "# lateral wall at the start. fix halt stops the run with an error should a\n"
-    << "# particle outside a band ever touch that wall (then widen the bands).\n"
-    << "region          bandtop block INF INF $(v_yt0-v_band_v) INF INF INF units box\n"
-    << "region          bandleft block INF $(v_xl0+v_band_h) INF INF INF INF units box\n"
-    << "region          bandright block $(v_xr0-v_band_h) INF INF INF INF INF units box\n"
-    << "group           gtop region bandtop\n"
-    << "group           gleft region bandleft\n"
-    << "group           gright region bandright\n"
-    << "group           ntop subtract all gtop\n"
-    << "group           nleft subtract all gleft\n"
-    << "group           nright subtract all gright\n"
-    << "fix             wbottom all wall/gran hooke/history ${kn_wall} ${kt_wall} 0 0 ${mu_wall} 0 "
-       "yplane ${yb0} NULL contacts\n"
-    << "fix             wtop gtop wall/gran/region hooke/history ${kn_wall} ${kt_wall} 0 0 "
-       "${mu_wall} 0 region rtop contacts\n"
-    << "fix             wleft gleft wall/gran/region hooke/history ${kn_wall} ${kt_wall} 0 0 "
-       "${mu_wall} 0 region rleft contacts\n"
-    << "fix             wright gright wall/gran/region hooke/history ${kn_wall} ${kt_wall} 0 0 "
-       "${mu_wall} 0 region rright contacts\n"
-    << "# contact force on every particle (pairs and walls), before the damping\n"
-    << "fix             fcon all store/force\n"
-    << "# wall contact arrays: [1] contacts, [2] [3] force on the particle, [5] [6]\n"
-    << "# contact point\n"
-    << "compute         cl gleft reduce sum f_wleft[1] f_wleft[2]\n"
-    << "compute         cr gright reduce sum f_wright[1] f_wright[2]\n"
-    << "compute         ct gtop reduce sum f_wtop[1] f_wtop[3]\n"
-    << "compute         cb all reduce sum f_wbottom[1] f_wbottom[3]\n"
-    << "variable        xl equal v_xl_now+v_dxl\n"
-    << "variable        xr equal v_xr_now+v_dxr\n"
-    << "variable        yt equal v_yt0+v_dytop\n"
-    << "variable        H  equal v_yt-v_yb0\n"
-    << "variable        W  equal v_xr-v_xl\n"
-    << "variable        pl equal c_cl[2]/(v_H*v_thick)\n"
-    << "variable        pr equal -c_cr[2]/(v_H*v_thick)\n"
-    << "variable        pt equal -c_ct[2]/(v_W*v_thick)\n"
-    << "variable        pb equal c_cb[2]/(v_W*v_thick)\n"
-    << "# clearance of the particles outside each band from its wall (> 0)\n"
-    << "compute         rad all property/atom radius\n"
-    << "variable        gap_top atom v_yt-y-c_rad\n"
-    << "variable        gap_left atom x-c_rad-v_xl\n"
-    << "variable        gap_right atom v_xr-x-c_rad\n"
-    << "compute         clear_top ntop reduce min v_gap_top\n"
-    << "compute         clear_left nleft reduce min v_gap_left\n"
-    << "compute         clear_right nright reduce min v_gap_right\n"
-    << "variable        clear_top equal c_clear_top\n"
-    << "variable        clear_left equal c_clear_left\n"
-    << "variable        clear_right equal c_clear_right\n"
-    << "# demcal's servo, one move per step toward the sample when p < sigma3:\n"
-    << "#   move = gain*(sigma3*H*t - F)/(kn_wall*max(1, n)), clamped to +-cap,\n"
-    << "# F the wall force, n its contacts. One flat formula per wall, the numbers\n"
-    << "# substituted now: a chain of variables re-parsed every step cost more than\n"
-    << "# the granular step itself (this release has no min/max of two numbers:\n"
-    << "# max(1, n) = (1+n+abs(1-n))/2, clamp(x) = (abs(x+cap)-abs(x-cap))/2).\n"
-    << "variable        rawl  equal ${gain}*(${sigma3}*(${H0}-${vtop}*step*dt)*${thick}-c_cl[2])/"
-       "(${kn_wall}*(1+c_cl[1]+abs(1-c_cl[1]))/2)\n"
-    << "variable        rawr  equal ${gain}*(${sigma3}*(${H0}-${vtop}*step*dt)*${thick}+c_cr[2])/"
-       "(${kn_wall}*(1+c_cr[1]+abs(1-c_cr[1]))/2)\n"
-    << "variable        movel equal (abs(v_rawl+${cap})-abs(v_rawl-${cap}))/2\n"
-    << "variable        mover equal -(abs(v_rawr+${cap})-abs(v_rawr-${cap}))/2\n"
-    << "fix             servol all ave/time 1 1 1 v_movel ave running\n"
-    << "fix             servor all ave/time 1 1 1 v_mover ave running\n\n";
+  s << kLammpsWalls;
 
   s << "# --- global damping ----------------------------------------------------------\n";
   if (p.damping_ratio_translation > 0.0) {
