@@ -12,11 +12,11 @@
 
 namespace demcal::test {
 
-const std::string kDemcalBinary = DEMCAL_BINARY;
-const std::string kSourceDir = DEMCAL_SOURCE_DIR;
+const char* const kDemcalBinary = DEMCAL_BINARY;
+const char* const kSourceDir = DEMCAL_SOURCE_DIR;
 
 std::string shipped_config(const std::string& name) {
-  return kSourceDir + "/configs/" + name + ".json";
+  return std::string(kSourceDir) + "/configs/" + name + ".json";
 }
 
 std::string find_on_path(const std::string& name) {
@@ -93,7 +93,7 @@ pid_t spawn_demcal(const std::vector<std::string>& args) {
   if (pid == 0) {
     const int null = ::open("/dev/null", O_WRONLY);
     if (null >= 0) ::dup2(null, STDOUT_FILENO);
-    ::execv(kDemcalBinary.c_str(), argv.data());
+    ::execv(kDemcalBinary, argv.data());
     ::_exit(127);
   }
   return pid;

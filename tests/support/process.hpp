@@ -13,8 +13,12 @@
 namespace demcal::test {
 
 /// The demcal program built with the tests, and the source tree (configs/).
-extern const std::string kDemcalBinary;
-extern const std::string kSourceDir;
+/// Plain character constants, not std::string: other translation units use
+/// them while initialising their own globals (`const std::string kHex5 =
+/// shipped_config("hex_5x5")`), and a std::string global of another file may
+/// not be constructed yet then (the order follows the link order).
+extern const char* const kDemcalBinary;
+extern const char* const kSourceDir;
 /// A shipped scene config, e.g. shipped_config("hex_5x5").
 std::string shipped_config(const std::string& name);
 
