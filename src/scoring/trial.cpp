@@ -60,7 +60,7 @@ nlohmann::json run_summary(const SceneConfig& config, const LoadingResult& run,
         {"stress_yy", *analytical},
         {"ratio", -*analytical / config.test.lateral_stress},
         {"ratio_periodic", hexagonal_peak_ratio(config.material.particle.friction)},
-        {"note", "walled-box value; rotation-locked sliding mechanism (DESIGN.md §2)"}};
+        {"note", "walled-box value; rotation-locked sliding mechanism (reports/hexagonal-peaks.md)"}};
   }
   return j;
 }
