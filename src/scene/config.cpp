@@ -290,10 +290,14 @@ SceneConfig parse_config(const nlohmann::json& root_json, const std::string& sou
   Reader root(root_json, source, "");
   c.name = root.string("name", c.name);
   check_scene_name(root, c.name);
+  c.dimension = static_cast<int>(root.integer("dimension", c.dimension, 2, 3));
+  const bool three_d = c.dimension == 3;
 
   {
     Reader m = root.child("material");
     c.material.density = m.positive("density", c.material.density);
+    if (c.dimension == 3 && m.has("thickness"))
+      m.fail("thickness", "has no meaning in 3D (spheres of mass rho*(4/3)*pi*r^3); remove it");
     c.material.thickness = m.positive("thickness", c.material.thickness);
     c.material.particle = read_contact(m, c.material.particle);
     check_tangential_stiffness(m, c.material.particle);
@@ -307,8 +311,27 @@ SceneConfig parse_config(const nlohmann::json& root_json, const std::string& sou
   {
     Reader a = root.child("assembly");
     auto& s = c.assembly;
-    s.type = a.string("type", s.type, {"hexagonal", "square", "random", "file"});
-    if (s.type == "hexagonal" || s.type == "square") {
+    s.type = a.string("type", three_d ? kDefaultAssembly3D : s.type,
+                      {"hexagonal", "square", "fcc", "random", "file"});
+    if (three_d && (s.type == "hexagonal" || s.type == "square"))
+      a.fail("type", "\"" + s.type +
+                         "\" is a 2D (disk) assembly; with \"dimension\": 3 use fcc, random or "
+                         "file");
+    if (!three_d && s.type == "fcc")
+      a.fail("type",
+             "\"fcc\" is a 3D (sphere) assembly: set \"dimension\": 3, or use hexagonal, "
+             "square, random or file");
+    if (s.type == "fcc") {
+      constexpr int64_t kIntMax = std::numeric_limits<int>::max();
+      s.cells_x = static_cast<int>(a.integer("cells_x", s.cells_x, 1, kIntMax));
+      s.cells_y = static_cast<int>(a.integer("cells_y", s.cells_y, 1, kIntMax));
+      s.cells_z = static_cast<int>(a.integer("cells_z", s.cells_z, 1, kIntMax));
+      const double spheres = 4.0 * s.cells_x * static_cast<double>(s.cells_y) * s.cells_z;
+      if (spheres > static_cast<double>(kMaxParticles))
+        a.fail("cells_x", "4 x cells_x x cells_y x cells_z = " + std::to_string(spheres) +
+                              " particles, more than the limit " + kMaxParticlesWhy);
+      s.radius = a.positive("radius", s.radius);
+    } else if (s.type == "hexagonal" || s.type == "square") {
       constexpr int64_t kIntMax = std::numeric_limits<int>::max();
       s.columns = static_cast<int>(a.integer("columns", s.columns, 1, kIntMax));
       s.rows = static_cast<int>(a.integer("rows", s.rows, 1, kIntMax));
@@ -345,7 +368,12 @@ SceneConfig parse_config(const nlohmann::json& root_json, const std::string& sou
   {
     Reader t = root.child("test");
     auto& s = c.test;
-    s.type = t.string("type", s.type, {"biaxial"});
+    s.type = t.string("type", three_d ? kDefaultTest3D : s.type, {"biaxial", "triaxial"});
+    if (three_d && s.type != "triaxial")
+      t.fail("type", "\"" + s.type + "\" is a 2D test; with \"dimension\": 3 use triaxial");
+    if (!three_d && s.type != "biaxial")
+      t.fail("type",
+             "\"" + s.type + "\" is the 3D test: set \"dimension\": 3 (spheres), or use biaxial");
     s.lateral_stress = t.positive("lateral_stress", s.lateral_stress);
     s.vertical_strain = t.positive("vertical_strain", s.vertical_strain);
     if (s.vertical_strain >= 0.5) t.fail("vertical_strain", "must be < 0.5");
@@ -358,7 +386,9 @@ SceneConfig parse_config(const nlohmann::json& root_json, const std::string& sou
     s.consolidation_unbalanced = t.positive("consolidation_unbalanced", s.consolidation_unbalanced);
     s.consolidation_max_steps =
         t.integer("consolidation_max_steps", s.consolidation_max_steps, 1000, 1000000000);
-    check_lateral_stress(t, c.material, s.lateral_stress);
+    // 3D: the overlap at sigma3 depends on the radii, checked with the
+    // assembly (check_sphere_overlap in triaxial.cpp).
+    if (!three_d) check_lateral_stress(t, c.material, s.lateral_stress);
     check_servo_gain(t, s);
     t.reject_unknown();
   }
@@ -535,12 +565,17 @@ nlohmann::json to_json(const SceneConfig& c) {
   };
   json material = law(c.material.particle);
   material["density"] = c.material.density;
-  material["thickness"] = c.material.thickness;
+  if (c.dimension == 2) material["thickness"] = c.material.thickness;
   material["contact_damping_ratio"] = c.material.contact_damping_ratio;
   material["wall"] = law(c.material.wall);
   const auto& a = c.assembly;
   json assembly{{"type", a.type}};
-  if (a.type == "hexagonal" || a.type == "square") {
+  if (a.type == "fcc") {
+    assembly.update({{"cells_x", a.cells_x},
+                     {"cells_y", a.cells_y},
+                     {"cells_z", a.cells_z},
+                     {"radius", a.radius}});
+  } else if (a.type == "hexagonal" || a.type == "square") {
     assembly.update({{"columns", a.columns}, {"rows", a.rows}, {"radius", a.radius}});
   } else if (a.type == "random") {
     assembly.update({{"count", a.count},
@@ -557,25 +592,28 @@ nlohmann::json to_json(const SceneConfig& c) {
   const auto& t = c.test;
   json prototype{{"particles", c.prototype.particles}};
   if (!c.prototype.file.empty()) prototype["file"] = c.prototype.file;
-  return json{{"name", c.name},
-              {"material", material},
-              {"assembly", assembly},
-              {"test",
-               {{"type", t.type},
-                {"lateral_stress", t.lateral_stress},
-                {"vertical_strain", t.vertical_strain},
-                {"monitor_points", t.monitor_points},
-                {"servo_gain", t.servo_gain},
-                {"consolidation_tolerance", t.consolidation_tolerance},
-                {"consolidation_unbalanced", t.consolidation_unbalanced},
-                {"consolidation_max_steps", t.consolidation_max_steps}}},
-              {"algorithm", to_json(c.algorithm)},
-              {"calibration",
-               {{"accuracy", c.calibration.accuracy},
-                {"max_trials", c.calibration.max_trials},
-                {"seed", c.calibration.seed}}},
-              {"prototype", prototype},
-              {"output", {{"vtk", c.output.vtk}}}};
+  json out{{"name", c.name},
+           {"material", material},
+           {"assembly", assembly},
+           {"test",
+            {{"type", t.type},
+             {"lateral_stress", t.lateral_stress},
+             {"vertical_strain", t.vertical_strain},
+             {"monitor_points", t.monitor_points},
+             {"servo_gain", t.servo_gain},
+             {"consolidation_tolerance", t.consolidation_tolerance},
+             {"consolidation_unbalanced", t.consolidation_unbalanced},
+             {"consolidation_max_steps", t.consolidation_max_steps}}},
+           {"algorithm", to_json(c.algorithm)},
+           {"calibration",
+            {{"accuracy", c.calibration.accuracy},
+             {"max_trials", c.calibration.max_trials},
+             {"seed", c.calibration.seed}}},
+           {"prototype", prototype},
+           {"output", {{"vtk", c.output.vtk}}}};
+  // 2D configs read back as they always have (no key they never had).
+  if (c.dimension != 2) out["dimension"] = c.dimension;
+  return out;
 }
 
 std::string sha256_hex(std::string_view data) {

@@ -31,11 +31,20 @@ inline constexpr const char* kMaxParticlesWhy =
 /// for (test.lateral_stress): see check_lateral_stress in config.cpp.
 inline constexpr double kMaxOverlapAtSigma3 = 0.05;
 
+/// The defaults of `assembly.type` and `test.type` in a 3D config
+/// (`"dimension": 3`): the 2D defaults (hexagonal, biaxial) have no 3D
+/// meaning.
+inline constexpr const char* kDefaultAssembly3D = "fcc";
+inline constexpr const char* kDefaultTest3D = "triaxial";
+
 struct AssemblySpec {
-  std::string type = "hexagonal";        ///< hexagonal | square | random | file
-  int columns = 10;                      ///< hexagonal/square
-  int rows = 10;                         ///< hexagonal/square
-  double radius = 5e-4;                  ///< hexagonal/square [m]
+  /// 2D: hexagonal | square | random | file; 3D: fcc | random | file.
+  std::string type = "hexagonal";
+  int columns = 10;      ///< hexagonal/square
+  int rows = 10;         ///< hexagonal/square
+  double radius = 5e-4;  ///< hexagonal/square/fcc [m]
+  /// fcc: unit cells along x, y, z (4 spheres each, cube axes along the box).
+  int cells_x = 4, cells_y = 4, cells_z = 4;
   int count = 400;                       ///< random
   std::string distribution = "uniform";  ///< random: uniform | lognormal
   double radius_min = 3.75e-4;           ///< random uniform [m]
@@ -44,14 +53,16 @@ struct AssemblySpec {
   double radius_std = 1e-4;              ///< random lognormal: standard deviation [m]
   double aspect = 1.0;                   ///< random: width/height of the initial box
   uint64_t seed = 1;                     ///< random
-  std::string file;                      ///< file: CSV x,y,r (relative to the config)
+  /// file: CSV x,y,r (2D) or x,y,z,r (3D), relative to the config
+  std::string file;
 };
 
 struct TestSpec {
-  std::string type = "biaxial";
-  double lateral_stress = 1e5;    ///< σ3, compressive magnitude [Pa]
-  double vertical_strain = 0.01;  ///< total compressive strain ε of the top wall
-  int monitor_points = 200;       ///< M
+  std::string type = "biaxial";  ///< 2D: biaxial; 3D: triaxial (kDefaultTest3D)
+  double lateral_stress = 1e5;   ///< σ3, compressive magnitude [Pa] (3D: σ2 = σ3)
+  /// Total compressive strain ε of the top wall (the axial strain along z in 3D).
+  double vertical_strain = 0.01;
+  int monitor_points = 200;  ///< M
   /// Servo: each step a lateral wall moves by gain·(σ3 − p)·L·t/(kn_wall·n_c),
   /// the fraction `gain` of the move that would cancel the stress error if
   /// only its n_c wall contacts deformed (the true stiffness is lower, so
@@ -109,6 +120,8 @@ struct OutputSpec {
 
 struct SceneConfig {
   std::string name = "scene";
+  /// 2: disks, biaxial test (plane strain); 3: spheres, triaxial test.
+  int dimension = 2;
   Material material;
   AssemblySpec assembly;
   TestSpec test;

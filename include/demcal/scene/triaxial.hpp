@@ -1,0 +1,133 @@
+// The triaxial test (DESIGN.md §8), the 3D counterpart of biaxial.hpp:
+// spheres in a box of six rigid frictionless walls. Consolidation to
+// isotropic σ3 with all six walls servo-controlled, once per sample
+// (frictionless, then friction on), then loading: bottom wall (z min) fixed,
+// top wall (z max) down at constant velocity to the axial strain ε over
+// Nstep steps, the four lateral walls servo-controlled at σ3 (σ2 = σ3).
+// Monitored at M points. Stresses tension positive; z is the axial axis.
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <vector>
+
+#include "demcal/kernel/sphere_world.hpp"
+#include "demcal/scene/config.hpp"
+#include "demcal/scene/sphere_packing.hpp"
+
+namespace demcal {
+
+/// One monitoring point of a triaxial loading run.
+struct TriaxialPoint {
+  int64_t step = 0;
+  double strain_zz = 0.0;                           ///< (H − H0)/H0, negative in compression
+  Eigen::Matrix3d b = Eigen::Matrix3d::Zero();      ///< boundary stress
+  Eigen::Matrix3d sigma = Eigen::Matrix3d::Zero();  ///< homogenized stress
+  double kinetic_energy = 0.0;                      ///< translation + rotation
+  double kinetic_energy_rotation = 0.0;
+  double elastic_energy = 0.0;
+  double unbalanced_force_ratio = 0.0;
+  double inertial_number = 0.0;
+  double coordination_number = 0.0;
+  /// (p − σ3)/σ3, signed, of the lateral walls x min, x max, y min, y max.
+  std::array<double, 4> servo_error{};
+  /// (mean pressure of the four lateral walls − σ3)/σ3.
+  double lateral_stress_error = 0.0;
+  std::array<double, 6> walls{};  ///< positions, SphereWallSide order
+};
+
+/// The consolidated sample, made once and copied by every run.
+struct TriaxialState {
+  SphereWorld world;
+  std::array<double, 3> extent0{};  ///< box edges after consolidation
+  int64_t steps = 0;                ///< consolidation steps taken
+  double wall_time_s = 0.0;
+  bool converged = false;
+  double stress_error = 0.0;      ///< max |p − σ3|/σ3 over the six walls at the end
+  double unbalanced_ratio = 0.0;  ///< at the end
+};
+
+/// The sphere material of a config's material block (thickness unused).
+SphereMaterial sphere_material(const Material& material);
+/// Build the sphere assembly a 3D config asks for (fcc, random gas, file)
+/// and check that the overlap at σ3 is resolvable: InputError naming
+/// test.lateral_stress otherwise.
+SphereAssembly make_sphere_assembly(const SceneConfig& config);
+
+/// Compressive pressure on a wall from the spheres [Pa].
+double wall_pressure(const SphereWorld& world, SphereWallSide side);
+/// Servo: move the wall by gain·(σ3 − p)·A/(kn_wall·n_c) toward the sample
+/// this step (A the wall's area, n_c its contacts; at most 2 % of the
+/// smallest radius per step), as the 2D servo_velocity. Returns the wall
+/// velocity along its axis.
+double servo_velocity(const SphereWorld& world, SphereWallSide side, double target_stress,
+                      double gain);
+
+/// Absolute integration parameters for an algorithm spec: Δt = α·Δt_crit
+/// with Δt_crit from the kernel's masses at the spec's mass scaling
+/// (SphereWorld::reference_scales(), the one home of m = ρ(4/3)πr³).
+Integration integration_for(const SphereWorld& world, const AlgorithmSpec& algorithm);
+
+/// Progress of a consolidation, every few hundred steps.
+struct ConsolidationProgress {
+  int phase = 0;  ///< 0 frictionless, 1 friction on
+  int64_t steps = 0, max_steps = 0;
+  double stress_error = 0.0;      ///< max |p − σ3|/σ3 over the six walls
+  double unbalanced_ratio = 0.0;  ///< unbalanced-force ratio
+};
+using ConsolidationCallback = std::function<void(const ConsolidationProgress&)>;
+
+/// Consolidate: all six walls servo to σ3, frictionless until static, then
+/// friction on and static again; light global damping (ζ = 0.02) with the
+/// 2D fallback to critical damping after a quarter of the budget. Static:
+/// every wall stress within test.consolidation_tolerance of σ3 and the
+/// unbalanced-force ratio below test.consolidation_unbalanced. Throws
+/// std::runtime_error saying what was reached if it cannot.
+TriaxialState consolidate_triaxial(const SceneConfig& config, const SphereAssembly& assembly,
+                                   const ConsolidationCallback& progress = {});
+
+/// The stable α of the consolidated contact network (6 DOF per sphere).
+double estimated_stable_dt_ratio(const TriaxialState& state, const AlgorithmSpec& algorithm);
+
+struct TriaxialResult {
+  std::vector<TriaxialPoint> series;
+  int particles = 0;
+  Integration integration;  ///< what was run (absolute Δt)
+  ReferenceScales scales;
+  int64_t steps_planned = 0;
+  int64_t steps_run = 0;
+  bool diverged = false;
+  Divergence divergence = Divergence::kNone;
+  int64_t divergence_step = -1;
+  bool stopped_early = false;
+  double wall_time_s = 0.0;
+  double strain_rate = 0.0;  ///< ε/(Nstep·Δt) [1/s]
+  /// Tracked every step: the most compressive axial wall stress
+  /// −(p_top + p_bottom)/2 (= b_zz for frictionless walls) and its strain.
+  double peak_stress_zz = 0.0;
+  double peak_strain_zz = 0.0;
+  /// The largest σ1/σ3 with the lateral stress the walls actually carry,
+  /// (p_top + p_bottom)/(p_xmin + p_xmax + p_ymin + p_ymax)·2, every step.
+  double peak_ratio = 0.0;
+  double peak_ratio_strain = 0.0;
+};
+
+/// Called at each monitoring point; return false to stop early.
+using TriaxialMonitor = std::function<bool(const TriaxialPoint&)>;
+
+/// Load a copy of the consolidated state; `final_state` receives the world
+/// at the end.
+TriaxialResult run_triaxial_loading(const TriaxialState& start, const TestSpec& test,
+                                    const AlgorithmSpec& algorithm,
+                                    const TriaxialMonitor& monitor = {},
+                                    SphereWorld* final_state = nullptr);
+
+/// σ1/σ3 at failure for the config's assembly when theory gives it: the
+/// walled FCC lattice (fcc_peak_ratio_walled, Thornton 1979, rotation
+/// absent). Nothing for other assemblies.
+std::optional<double> analytical_peak_ratio_3d(const SceneConfig& config);
+
+}  // namespace demcal

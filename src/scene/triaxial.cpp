@@ -1,0 +1,331 @@
+// The triaxial test (triaxial.hpp): the biaxial protocol (biaxial.cpp) with
+// six walls. The servo law, the consolidation damping and its fallback, the
+// static criteria and the divergence handling are the 2D ones; the reasons
+// given there hold here and are not repeated.
+#include "demcal/scene/triaxial.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+#include "demcal/io/format.hpp"
+#include "demcal/io/input_error.hpp"
+
+namespace demcal {
+
+namespace {
+
+// +1 when the wall's inward direction is +axis (min walls).
+double inward(SphereWallSide side) { return side % 2 == 0 ? 1.0 : -1.0; }
+
+double wall_area(const SphereWorld& world, SphereWallSide side) {
+  const int axis = side / 2;
+  return world.extent((axis + 1) % 3) * world.extent((axis + 2) % 3);
+}
+
+constexpr SphereWallSide kLateral[4] = {kXMin, kXMax, kYMin, kYMax};
+
+// Overlap at σ3: a sphere of radius r carries about σ3·(2r)² per contact
+// (the wall area of its cube), so δ/r = 4·σ3·r/kn. As in 2D
+// (check_lateral_stress in config.cpp, check_resolvable in packing.cpp):
+// δ/r at most kMaxOverlapAtSigma3 for the largest sphere (the peak is
+// several times σ3 and the kernel stops at 0.5), and δ of the smallest
+// resolved by the positions' round-off to a tenth of the consolidation
+// tolerance.
+void check_sphere_overlap(const SceneConfig& config, const SphereAssembly& a) {
+  if (a.size() == 0) return;
+  const Material& m = config.material;
+  const double sigma3 = config.test.lateral_stress;
+  const double r_min = *std::min_element(a.r.begin(), a.r.end());
+  const double r_max = *std::max_element(a.r.begin(), a.r.end());
+  const double kn_soft = std::min(m.particle.kn, m.wall.kn);
+  const double limit = kMaxOverlapAtSigma3 * kn_soft / (4.0 * r_max);
+  std::ostringstream msg;
+  if (sigma3 > limit) {
+    msg << "must be at most " << limit << " Pa for kn " << kn_soft << " N/m and the largest radius "
+        << r_max << " m: the overlap at sigma3, 4*sigma3*r/kn = " << 4.0 * sigma3 * r_max / kn_soft
+        << " of the radius, must stay below " << kMaxOverlapAtSigma3 << "; got " << sigma3;
+    throw InputError(config.source, "test.lateral_stress", msg.str());
+  }
+  double coordinate = 0.0;
+  for (int axis = 0; axis < 3; ++axis)
+    coordinate = std::max({coordinate, std::abs(a.lo[axis]), std::abs(a.hi[axis])});
+  const double kn = std::max(m.particle.kn, m.wall.kn);
+  const double delta = 4.0 * sigma3 * r_min * r_min / kn;
+  const double roundoff = 0.5 * std::numeric_limits<double>::epsilon() * coordinate;
+  const double wanted = 0.1 * config.test.consolidation_tolerance;
+  if (roundoff <= wanted * delta) return;
+  msg << "must be at least " << roundoff / wanted * kn / (4.0 * r_min * r_min)
+      << " Pa for this assembly: the overlap at sigma3, 4*sigma3*r_min^2/kn = " << delta
+      << " m, is not resolved by positions up to " << coordinate << " m (round-off " << roundoff
+      << " m must stay below a tenth of consolidation_tolerance of it); got " << sigma3;
+  throw InputError(config.source, "test.lateral_stress", msg.str());
+}
+
+std::string percent(double v) {
+  std::ostringstream s;
+  s.precision(3);
+  s << 100.0 * v << " %";
+  return s.str();
+}
+
+}  // namespace
+
+SphereMaterial sphere_material(const Material& material) {
+  SphereMaterial m;
+  m.density = material.density;
+  m.particle = material.particle;
+  m.wall = material.wall;
+  m.contact_damping_ratio = material.contact_damping_ratio;
+  return m;
+}
+
+SphereAssembly make_sphere_assembly(const SceneConfig& config) {
+  if (config.dimension != 3)
+    throw InputError(config.source, "dimension", "a sphere assembly needs \"dimension\": 3");
+  const AssemblySpec& s = config.assembly;
+  SphereAssembly a;
+  if (s.type == "fcc")
+    a = fcc_packing(s.cells_x, s.cells_y, s.cells_z, s.radius);
+  else if (s.type == "random")
+    a = random_sphere_gas(s);
+  else if (s.type == "file")
+    a = read_sphere_file(s.file);
+  else
+    throw InputError(config.source, "assembly.type",
+                     "\"" + s.type + "\" is not a 3D assembly (fcc, random or file)");
+  check_sphere_overlap(config, a);
+  return a;
+}
+
+double wall_pressure(const SphereWorld& world, SphereWallSide side) {
+  // The spheres push the wall outward: −inward·F is the compressive force.
+  return -inward(side) * world.wall(side).force[side / 2] / wall_area(world, side);
+}
+
+double servo_velocity(const SphereWorld& world, SphereWallSide side, double target_stress,
+                      double gain) {
+  const double dt = world.integration().dt;
+  const int contacts = std::max(1, world.wall(side).contacts);
+  const double error = target_stress - wall_pressure(world, side);
+  double move = gain * error * wall_area(world, side) / (world.material().wall.kn * contacts);
+  const double r_min = world.min_radius();
+  move = std::clamp(move, -0.02 * r_min, 0.02 * r_min);
+  return inward(side) * move / dt;
+}
+
+Integration integration_for(const SphereWorld& world, const AlgorithmSpec& algorithm) {
+  // Δt_crit = 2·sqrt(m_min/kn) from the kernel's masses at this mass
+  // scaling: a probe with the spec's f_ms (masses are set by set_integration).
+  Integration in;
+  in.mass_scaling = algorithm.mass_scaling;
+  in.damping_ratio_translation = algorithm.damping_ratio_translation;
+  in.damping_ratio_rotation = algorithm.damping_ratio_rotation;
+  in.lock_rotation = algorithm.lock_rotation;
+  double dt_crit = world.reference_scales().dt_crit;
+  if (world.integration().mass_scaling != algorithm.mass_scaling) {
+    const std::span<const double> r = world.radius();
+    const int i = static_cast<int>(std::min_element(r.begin(), r.end()) - r.begin());
+    const std::array<double, 3> lo{-2.0 * r[i], -2.0 * r[i], -2.0 * r[i]};
+    const std::array<double, 3> hi{2.0 * r[i], 2.0 * r[i], 2.0 * r[i]};
+    const double zero = 0.0;
+    SphereWorld probe(world.material(), {&zero, 1}, {&zero, 1}, {&zero, 1}, r.subspan(i, 1), lo,
+                      hi);
+    Integration p;
+    p.mass_scaling = algorithm.mass_scaling;
+    probe.set_integration(p);
+    dt_crit = probe.reference_scales().dt_crit;
+  }
+  in.dt = algorithm.dt_ratio * dt_crit;
+  return in;
+}
+
+TriaxialState consolidate_triaxial(const SceneConfig& config, const SphereAssembly& assembly,
+                                   const ConsolidationCallback& progress) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const TestSpec& test = config.test;
+  TriaxialState state{SphereWorld(sphere_material(config.material), assembly.x, assembly.y,
+                                  assembly.z, assembly.r, assembly.lo, assembly.hi)};
+  SphereWorld& world = state.world;
+  const double mu = config.material.particle.friction;
+  // Light damping for the fastest relaxation of the slow collective modes
+  // (biaxial.cpp, consolidate(): measured there).
+  constexpr double kConsolidationDamping = 0.02;
+  AlgorithmSpec settle;  // α = 0.2, the paper's start step
+  settle.damping_ratio_translation = kConsolidationDamping;
+  settle.damping_ratio_rotation = kConsolidationDamping;
+  settle.lock_rotation = config.algorithm.lock_rotation;
+  world.set_integration(integration_for(world, settle));
+  // Only the blow-up checks stay on while the walls work on the sample
+  // (biaxial.cpp says why the energy checks cannot).
+  const KernelOptions kernel_options = world.options();
+  KernelOptions no_ledger = kernel_options;
+  no_ledger.max_energy_created = std::numeric_limits<double>::infinity();
+  no_ledger.max_energy_ratio = std::numeric_limits<double>::infinity();
+  world.set_options(no_ledger);
+
+  const double sigma3 = test.lateral_stress;
+  constexpr int kCheckEvery = 200;
+  int64_t steps = 0;
+  const int64_t max_steps = test.consolidation_max_steps;
+  bool critical = false;
+  int phase = 0;
+  for (; phase < 2; ++phase) {
+    world.set_particle_friction(phase == 0 ? 0.0 : mu);
+    bool done = false;
+    while (!done) {
+      for (int k = 0; k < kCheckEvery; ++k) {
+        for (int s = 0; s < 6; ++s) {
+          const auto side = static_cast<SphereWallSide>(s);
+          world.wall(side).velocity = servo_velocity(world, side, sigma3, test.servo_gain);
+        }
+        if (!world.step(1))
+          throw std::runtime_error(std::string("consolidation diverged: ") +
+                                   to_string(world.divergence()));
+      }
+      steps += kCheckEvery;
+      // The 2D fallback: critical damping for the last three quarters.
+      if (!critical && steps >= max_steps / 4) {
+        critical = true;
+        settle.damping_ratio_translation = settle.damping_ratio_rotation = 1.0;
+        world.set_integration(integration_for(world, settle));
+      }
+      double err = 0.0;
+      for (int s = 0; s < 6; ++s)
+        err = std::max(
+            err, std::abs(wall_pressure(world, static_cast<SphereWallSide>(s)) - sigma3) / sigma3);
+      const double ufr = world.measure().unbalanced_force_ratio;
+      state.stress_error = err;
+      state.unbalanced_ratio = ufr;
+      if (progress) progress({phase, steps, max_steps, err, ufr});
+      done = err < test.consolidation_tolerance && ufr < test.consolidation_unbalanced;
+      if (steps >= max_steps) break;
+    }
+    if (!done) break;
+    state.converged = phase == 1;
+  }
+  world.set_options(kernel_options);
+  for (int s = 0; s < 6; ++s) world.wall(static_cast<SphereWallSide>(s)).velocity = 0.0;
+  for (int i = 0; i < world.size(); ++i)
+    world.set_velocity(i, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
+  world.update_forces();
+  for (int axis = 0; axis < 3; ++axis) state.extent0[axis] = world.extent(axis);
+  state.steps = steps;
+  state.wall_time_s = seconds_since(t0);
+  if (!state.converged)
+    throw std::runtime_error("consolidation did not reach a static state in " +
+                             std::to_string(max_steps) + " steps (" +
+                             (phase == 0 ? "frictionless phase" : "friction phase") +
+                             ", largest wall stress error " + percent(state.stress_error) +
+                             " of sigma3, tolerance " + percent(test.consolidation_tolerance) +
+                             "; unbalanced-force ratio " + std::to_string(state.unbalanced_ratio) +
+                             ", tolerance " + std::to_string(test.consolidation_unbalanced) +
+                             "); raise test.consolidation_max_steps or loosen the tolerances");
+  return state;
+}
+
+double estimated_stable_dt_ratio(const TriaxialState& state, const AlgorithmSpec& algorithm) {
+  SphereWorld probe = state.world;
+  AlgorithmSpec a = algorithm;
+  a.dt_ratio = std::min(a.dt_ratio, 0.1);  // any valid step: the estimate does not use it
+  probe.set_integration(integration_for(probe, a));
+  probe.update_forces();
+  return probe.stability_estimate().dt_ratio_stable;
+}
+
+TriaxialResult run_triaxial_loading(const TriaxialState& start, const TestSpec& test,
+                                    const AlgorithmSpec& algorithm, const TriaxialMonitor& monitor,
+                                    SphereWorld* final_state) {
+  const auto t0 = std::chrono::steady_clock::now();
+  SphereWorld world = start.world;
+  TriaxialResult out;
+  out.particles = world.size();
+  out.integration = integration_for(world, algorithm);
+  world.set_integration(out.integration);
+  out.scales = world.reference_scales();
+  const double dt = out.integration.dt;
+  const int64_t nstep = algorithm.steps;
+  out.steps_planned = nstep;
+  const double sigma3 = test.lateral_stress;
+  const double h0 = start.extent0[2];
+  out.strain_rate = test.vertical_strain / (static_cast<double>(nstep) * dt);
+  world.wall(kZMin).velocity = 0.0;
+  world.wall(kZMax).velocity = -test.vertical_strain * h0 / (static_cast<double>(nstep) * dt);
+
+  const int m = test.monitor_points;
+  out.series.reserve(m + 1);
+  auto record = [&](int64_t step) {
+    const SphereMeasures ms = world.measure(out.strain_rate);
+    TriaxialPoint p;
+    p.step = step;
+    p.strain_zz = (world.extent(2) - h0) / h0;
+    p.b = ms.boundary_stress;
+    p.sigma = ms.homogenized_stress;
+    p.kinetic_energy = ms.kinetic_energy_translation + ms.kinetic_energy_rotation;
+    p.kinetic_energy_rotation = ms.kinetic_energy_rotation;
+    p.elastic_energy = ms.elastic_energy;
+    p.unbalanced_force_ratio = ms.unbalanced_force_ratio;
+    p.inertial_number = ms.inertial_number;
+    p.coordination_number = ms.coordination_number;
+    double lateral = 0.0;
+    for (int k = 0; k < 4; ++k) {
+      const double pk = wall_pressure(world, kLateral[k]);
+      p.servo_error[k] = (pk - sigma3) / sigma3;
+      lateral += 0.25 * pk;
+    }
+    p.lateral_stress_error = (lateral - sigma3) / sigma3;
+    for (int s = 0; s < 6; ++s) p.walls[s] = world.wall(static_cast<SphereWallSide>(s)).position;
+    out.series.push_back(p);
+    return !monitor || monitor(p);
+  };
+
+  bool keep_going = record(0);
+  int64_t done = 0;
+  for (int k = 1; k <= m && keep_going; ++k) {
+    const int64_t target = nstep * k / m;
+    while (done < target) {
+      for (SphereWallSide side : kLateral)
+        world.wall(side).velocity = servo_velocity(world, side, sigma3, test.servo_gain);
+      if (!world.step(1)) break;
+      ++done;
+      const double axial = 0.5 * (wall_pressure(world, kZMin) + wall_pressure(world, kZMax));
+      double lateral = 0.0;
+      for (SphereWallSide side : kLateral) lateral += 0.25 * wall_pressure(world, side);
+      const double strain = (world.extent(2) - h0) / h0;
+      if (-axial < out.peak_stress_zz) {
+        out.peak_stress_zz = -axial;
+        out.peak_strain_zz = strain;
+      }
+      if (lateral > 0.0 && axial / lateral > out.peak_ratio) {
+        out.peak_ratio = axial / lateral;
+        out.peak_ratio_strain = strain;
+      }
+    }
+    if (world.divergence() != Divergence::kNone) {
+      out.diverged = true;
+      out.divergence = world.divergence();
+      out.divergence_step = world.divergence_step() - start.world.steps_taken();
+      break;
+    }
+    keep_going = record(done);
+  }
+  out.stopped_early = !out.diverged && !keep_going && done < nstep;
+  out.steps_run = done;
+  out.wall_time_s = seconds_since(t0);
+  if (final_state) *final_state = std::move(world);
+  return out;
+}
+
+std::optional<double> analytical_peak_ratio_3d(const SceneConfig& config) {
+  if (config.dimension != 3 || config.assembly.type != "fcc") return std::nullopt;
+  const double ratio =
+      fcc_peak_ratio_walled(config.material.particle.friction, config.assembly.cells_x,
+                            config.assembly.cells_y, config.assembly.cells_z);
+  if (!std::isfinite(ratio)) return std::nullopt;
+  return ratio;
+}
+
+}  // namespace demcal

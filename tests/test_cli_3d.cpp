@@ -1,0 +1,256 @@
+// `demcal run` and `demcal check` on 3D configs (issue #17): the three
+// files of a run (summary.json, series.csv with the nine components of b
+// and σ, final.vtk with spheres and the contact network), the derived
+// scales, and 3D mismatches as bad input (exit 2, file and key named).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <numbers>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "support/files.hpp"
+#include "support/process.hpp"
+#include "support/scenes.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+namespace test = demcal::test;
+
+using test::lines_of;
+using test::read_text;
+
+std::vector<std::string> split(const std::string& line, char sep) {
+  std::vector<std::string> out;
+  std::stringstream s(line);
+  for (std::string f; std::getline(s, f, sep);) out.push_back(f);
+  return out;
+}
+
+// FCC 2×2×2 (32 spheres), r = 5e-4 m, rotation free.
+std::string fcc_config(const std::string& extra_test = "") {
+  return "{" + test::kMaterialMember + R"(, "name": "fcc2", "dimension": 3,
+    "assembly": {"type": "fcc", "cells_x": 2, "cells_y": 2, "cells_z": 2, "radius": 5e-4},
+    "test": {"type": "triaxial", "lateral_stress": 1e7, "vertical_strain": 5e-4,
+             "monitor_points": 50)" +
+         extra_test + R"(},
+    "algorithm": {"steps": 4000}})";
+}
+
+class Cli3D : public ::testing::Test {
+ protected:
+  void SetUp() override { fs::create_directories(dir_ / "work"); }
+  test::RunResult demcal(const std::vector<std::string>& args) {
+    return test::run_demcal(args, dir_ / "work");
+  }
+  std::string write(const std::string& name, const std::string& content) {
+    return test::write_text(dir_ / name, content);
+  }
+  bool work_empty() const { return fs::is_empty(dir_ / "work"); }
+
+  test::TempDir tmp_{"cli3d"};
+  const fs::path dir_ = tmp_.path();
+};
+
+/// Legacy VTK polydata: every count checked against the data that follows;
+/// returns the names of the data arrays.
+std::set<std::string> parse_vtk(const std::string& text, long particles) {
+  std::set<std::string> names;
+  std::stringstream s(text);
+  std::string line, word, type;
+  std::getline(s, line);
+  EXPECT_EQ(line, "# vtk DataFile Version 3.0");
+  std::getline(s, line);  // title
+  std::getline(s, line);
+  EXPECT_EQ(line, "ASCII");
+  std::getline(s, line);
+  EXPECT_EQ(line, "DATASET POLYDATA");
+  long n = -1, count = -1, size = -1, lines = -1;
+  s >> word >> n >> type;
+  EXPECT_EQ(word, "POINTS");
+  EXPECT_EQ(n, particles);
+  for (long i = 0; i < 3 * n; ++i) {
+    double v;
+    if (!(s >> v) || !std::isfinite(v)) {
+      ADD_FAILURE() << "point " << i / 3;
+      return names;
+    }
+  }
+  s >> word >> count >> size;
+  EXPECT_EQ(word, "VERTICES");
+  EXPECT_EQ(count, n);
+  EXPECT_EQ(size, 2 * n);
+  for (long i = 0; i < count; ++i) {
+    long one, index;
+    s >> one >> index;
+    EXPECT_EQ(one, 1);
+    EXPECT_EQ(index, i);
+  }
+  s >> word >> lines >> size;
+  EXPECT_EQ(word, "LINES");
+  EXPECT_GT(lines, 0);  // a loaded packing has contacts
+  EXPECT_EQ(size, 3 * lines);
+  for (long i = 0; i < lines; ++i) {
+    long two, a, b;
+    s >> two >> a >> b;
+    EXPECT_EQ(two, 2);
+    EXPECT_TRUE(a >= 0 && a < n && b >= 0 && b < n && a != b) << a << " " << b;
+  }
+  long data = -1;
+  s >> word >> data;
+  EXPECT_EQ(word, "POINT_DATA");
+  EXPECT_EQ(data, n);
+  bool cell_data = false;
+  while (s >> word) {
+    if (word == "CELL_DATA") {
+      s >> data;
+      EXPECT_EQ(data, n + lines);
+      cell_data = true;
+      continue;
+    }
+    std::string name, vtype, lut, table;
+    s >> name >> vtype;
+    names.insert(name);
+    int components = 3;
+    if (word == "SCALARS") {
+      s >> components >> lut >> table;
+      EXPECT_EQ(lut, "LOOKUP_TABLE");
+    } else {
+      EXPECT_EQ(word, "VECTORS");
+    }
+    for (long i = 0; i < data * components; ++i) {
+      double v;
+      if (!(s >> v)) {
+        ADD_FAILURE() << name << " value " << i;
+        return names;
+      }
+    }
+  }
+  EXPECT_TRUE(cell_data);
+  return names;
+}
+
+TEST_F(Cli3D, RunWritesSummaryNineComponentSeriesAndSphereVtk) {
+  const std::string config = write("fcc2.json", fcc_config());
+  const fs::path out = dir_ / "work" / "out";
+  const test::RunResult r = demcal({"run", config, "-o", out.string()});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("32 spheres"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("peak sigma_zz"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("moment balance"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("issue #18"), std::string::npos) << r.out;
+  std::set<std::string> files;
+  for (const auto& e : fs::directory_iterator(out)) files.insert(e.path().filename().string());
+  EXPECT_EQ(files, (std::set<std::string>{"summary.json", "series.csv", "final.vtk"}));
+
+  const auto s = nlohmann::json::parse(read_text(out / "summary.json"));
+  EXPECT_EQ(s.at("dimension"), 3);
+  EXPECT_EQ(s.at("particles"), 32);
+  // Δt = 0.2·2·sqrt(m/kn), m = ρ(4/3)πr³ of a sphere.
+  const double m = 2650.0 * 4.0 / 3.0 * std::numbers::pi * std::pow(5e-4, 3);
+  EXPECT_NEAR(s.at("params").at("dt").get<double>(), 0.2 * 2.0 * std::sqrt(m / 1e8), 1e-15);
+  EXPECT_EQ(s.at("params").at("steps"), 4000);
+  for (const char* plane : {"xz", "yz", "xy"})
+    EXPECT_TRUE(s.at("criteria_planes").contains(plane)) << plane;
+  EXPECT_TRUE(s.at("criteria").at("force_balance").is_number());
+  EXPECT_TRUE(s.at("verdict").at("within_2d_tolerances").is_boolean());
+  EXPECT_LT(s.at("peak").at("stress_zz").get<double>(), -1e7);  // beyond σ3, compressive
+  EXPECT_NEAR(s.at("analytical_peak").at("ratio").get<double>(), 2.0 * 1.3 / 0.7, 1e-9);
+  EXPECT_EQ(s.at("diverged"), false);
+
+  const auto rows = lines_of(read_text(out / "series.csv"));
+  ASSERT_EQ(rows.size(), 52u);  // header + monitor_points + 1
+  const auto header = split(rows[0], ',');
+  std::vector<std::string> stresses;
+  for (const char* t : {"b_", "s_"})
+    for (const char* ij : {"xx", "xy", "xz", "yx", "yy", "yz", "zx", "zy", "zz"})
+      stresses.push_back(std::string(t) + ij);
+  ASSERT_GE(header.size(), 20u);
+  EXPECT_EQ(header[0], "step");
+  EXPECT_EQ(header[1], "strain_zz");
+  EXPECT_EQ(std::vector<std::string>(header.begin() + 2, header.begin() + 20), stresses);
+  for (const char* extra : {"kinetic_energy", "unbalanced_force_ratio", "inertial_number",
+                            "servo_error_xmin", "servo_error_ymax", "wall_zmax"})
+    EXPECT_NE(std::find(header.begin(), header.end(), extra), header.end()) << extra;
+  for (size_t k = 1; k < rows.size(); ++k) {
+    const auto fields = split(rows[k], ',');
+    ASSERT_EQ(fields.size(), header.size()) << "row " << k;
+    for (const auto& f : fields) {
+      char* end = nullptr;
+      std::strtod(f.c_str(), &end);
+      ASSERT_TRUE(end != f.c_str() && *end == '\0') << "row " << k << ": " << f;
+    }
+  }
+  EXPECT_EQ(split(rows.back(), ',')[0], "4000");
+  // The axial stress at the end: compressive, beyond σ3 (b_zz column).
+  EXPECT_LT(std::stod(split(rows.back(), ',')[10]), -1e7);
+
+  const auto names = parse_vtk(read_text(out / "final.vtk"), 32);
+  for (const char* field :
+       {"radius", "diameter", "velocity", "angular_velocity", "normal_force", "tangential_force"})
+    EXPECT_TRUE(names.count(field)) << field;
+}
+
+TEST_F(Cli3D, CheckPrintsTheSphereScales) {
+  const std::string config = write("fcc2.json", fcc_config());
+  const test::RunResult r = demcal({"check", config});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("valid"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("32 spheres"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("rho (4/3) pi r^3"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("stable dt_ratio"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("3.714"), std::string::npos) << r.out;  // Thornton, μ = 0.3
+  EXPECT_TRUE(work_empty());
+}
+
+TEST_F(Cli3D, MismatchesAndUnsupportedCommandsAreBadInput) {
+  struct Case {
+    std::vector<std::string> args;
+    std::string mention;
+  };
+  const std::string triaxial_2d =
+      write("t2.json", "{" + test::kMaterialMember + R"(, "test": {"type": "triaxial"}})");
+  const std::string hex_3d =
+      write("h3.json", "{" + test::kMaterialMember +
+                           R"(, "dimension": 3, "assembly": {"type": "hexagonal"}})");
+  const std::string fcc = write("fcc2.json", fcc_config());
+  const Case cases[] = {
+      {{"run", triaxial_2d}, "test.type"},
+      {{"check", hex_3d}, "assembly.type"},
+      {{"calibrate", fcc, "-o", (dir_ / "work" / "c").string()}, "dimension"},
+      {{"sweep", fcc}, "dimension"},
+  };
+  for (const Case& k : cases) {
+    SCOPED_TRACE(k.args[0] + " " + k.args[1]);
+    const test::RunResult r = demcal(k.args);
+    EXPECT_EQ(r.status, 2) << r.err;
+    EXPECT_EQ(lines_of(r.err).size(), 1u) << r.err;
+    EXPECT_NE(r.err.find(k.args[1]), std::string::npos) << r.err;  // the file
+    EXPECT_NE(r.err.find(k.mention), std::string::npos) << r.err;  // the key
+    EXPECT_TRUE(work_empty());
+  }
+}
+
+TEST_F(Cli3D, RunAcceptsASphereFile) {
+  // A 2×2×2 simple-cubic block of touching spheres, written as CSV x,y,z,r.
+  std::string csv = "x,y,z,r\n";
+  for (int k = 0; k < 2; ++k)
+    for (int j = 0; j < 2; ++j)
+      for (int i = 0; i < 2; ++i)
+        csv += std::to_string(5e-4 + 1e-3 * i) + "," + std::to_string(5e-4 + 1e-3 * j) + "," +
+               std::to_string(5e-4 + 1e-3 * k) + ",5e-4\n";
+  write("cube.csv", csv);
+  const std::string config = write(
+      "file.json", "{" + test::kMaterialMember +
+                       R"(, "dimension": 3, "assembly": {"type": "file", "file": "cube.csv"}})");
+  const test::RunResult r = demcal({"check", config});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("8 spheres"), std::string::npos) << r.out;
+}
+
+}  // namespace

@@ -1,0 +1,196 @@
+// The 3D scene layer: "dimension": 3 configs (parsing, defaults, mismatches
+// as bad input) and the triaxial protocol of triaxial.hpp (consolidation to
+// σ3 on all six walls; Thornton's FCC peak with rotation locked).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include "demcal/scene/config.hpp"
+#include "demcal/scene/sphere_packing.hpp"
+#include "demcal/scene/triaxial.hpp"
+#include "support/input_errors.hpp"
+#include "support/scenes.hpp"
+
+namespace demcal {
+namespace {
+
+using test::input_error;
+
+SceneConfig parse(const std::string& text) {
+  return parse_config_text(test::with_required_material(text), "scene3d.json");
+}
+
+// A small FCC config; `extra` is spliced into the test block.
+std::string fcc_text(int n, double sigma3, double strain, int64_t steps, bool lock,
+                     const std::string& extra = "") {
+  char buf[1024];
+  std::snprintf(buf, sizeof buf,
+                R"({"name": "fcc", "dimension": 3,
+      "assembly": {"type": "fcc", "cells_x": %d, "cells_y": %d, "cells_z": %d, "radius": 5e-4},
+      "test": {"type": "triaxial", "lateral_stress": %g, "vertical_strain": %g,
+               "monitor_points": 50%s},
+      "algorithm": {"steps": %lld, "lock_rotation": %s}})",
+                n, n, n, sigma3, strain, extra.c_str(), static_cast<long long>(steps),
+                lock ? "true" : "false");
+  return buf;
+}
+
+TEST(Config3D, ReadsTheTriaxialKeys) {
+  const SceneConfig c = parse(fcc_text(3, 2e5, 0.002, 20000, true));
+  EXPECT_EQ(c.dimension, 3);
+  EXPECT_EQ(c.assembly.type, "fcc");
+  EXPECT_EQ(c.assembly.cells_x, 3);
+  EXPECT_EQ(c.assembly.cells_z, 3);
+  EXPECT_EQ(c.test.type, "triaxial");
+  EXPECT_EQ(c.test.lateral_stress, 2e5);
+  EXPECT_EQ(c.test.vertical_strain, 0.002);
+  EXPECT_TRUE(c.algorithm.lock_rotation);
+  // Written back: the dimension and the FCC keys, no disk thickness.
+  const nlohmann::json j = to_json(c);
+  EXPECT_EQ(j.at("dimension"), 3);
+  EXPECT_EQ(j.at("assembly").at("cells_y"), 3);
+  EXPECT_FALSE(j.at("material").contains("thickness"));
+  EXPECT_EQ(parse(j.dump()).assembly.cells_y, 3);
+}
+
+TEST(Config3D, DefaultsAreThe3DOnes) {
+  const SceneConfig c = parse(R"({"dimension": 3})");
+  EXPECT_EQ(c.assembly.type, kDefaultAssembly3D);
+  EXPECT_EQ(c.test.type, kDefaultTest3D);
+  EXPECT_EQ(c.assembly.cells_x, AssemblySpec{}.cells_x);
+  // Random and file assemblies keep their 2D keys and meaning.
+  const SceneConfig r = parse(
+      R"({"dimension": 3, "assembly": {"type": "random", "count": 50, "distribution": "lognormal",
+          "radius_mean": 5e-4, "radius_std": 1e-4, "seed": 3}})");
+  EXPECT_EQ(r.assembly.count, 50);
+  EXPECT_EQ(r.assembly.distribution, "lognormal");
+}
+
+TEST(Config3D, TwoDConfigsAreUnchanged) {
+  const SceneConfig c = parse(R"({"assembly": {"type": "hexagonal", "columns": 4, "rows": 4}})");
+  EXPECT_EQ(c.dimension, 2);
+  EXPECT_EQ(c.test.type, "biaxial");
+  const nlohmann::json j = to_json(c);
+  EXPECT_FALSE(j.contains("dimension"));
+  EXPECT_TRUE(j.at("material").contains("thickness"));
+}
+
+TEST(Config3D, MismatchesAreInputErrorsNamingFileAndKey) {
+  struct Case {
+    const char* text;
+    const char* field;
+  };
+  const Case cases[] = {
+      {R"({"test": {"type": "triaxial"}})", "test.type"},
+      {R"({"dimension": 2, "assembly": {"type": "fcc"}})", "assembly.type"},
+      {R"({"dimension": 3, "assembly": {"type": "hexagonal"}})", "assembly.type"},
+      {R"({"dimension": 3, "assembly": {"type": "square"}})", "assembly.type"},
+      {R"({"dimension": 3, "test": {"type": "biaxial"}})", "test.type"},
+      {R"({"dimension": 3, "material": {"thickness": 1.0}})", "material.thickness"},
+      {R"({"dimension": 4})", "dimension"},
+      {R"({"dimension": "3"})", "dimension"},
+      {R"({"dimension": 3, "assembly": {"type": "fcc", "cells_x": 0}})", "assembly.cells_x"},
+      {R"({"dimension": 3, "assembly": {"type": "fcc", "columns": 3}})", "assembly.columns"},
+      {R"({"dimension": 3, "assembly": {"type": "fcc", "radius": -1}})", "assembly.radius"},
+  };
+  for (const Case& k : cases) {
+    SCOPED_TRACE(k.text);
+    const auto e = input_error([&] { parse(k.text); });
+    ASSERT_TRUE(e);
+    EXPECT_EQ(e->file(), "scene3d.json");
+    EXPECT_EQ(e->field(), k.field) << e->what();
+  }
+}
+
+TEST(Config3D, OverlapAtSigma3IsCheckedWithTheRadii) {
+  // δ/r = 4·σ3·r/kn: 0.05 at σ3 = 2.5e9 Pa for r = 5e-4 m, kn = 1e8 N/m.
+  const SceneConfig ok = parse(fcc_text(2, 2.4e9, 0.001, 1000, true));
+  EXPECT_NO_THROW(make_sphere_assembly(ok));
+  const SceneConfig bad = parse(fcc_text(2, 2.6e9, 0.001, 1000, true));
+  const auto e = input_error([&] { make_sphere_assembly(bad); });
+  ASSERT_TRUE(e);
+  EXPECT_EQ(e->field(), "test.lateral_stress");
+}
+
+double max_wall_error(const SphereWorld& w, double sigma3) {
+  double err = 0.0;
+  for (int s = 0; s < 6; ++s)
+    err =
+        std::max(err, std::abs(wall_pressure(w, static_cast<SphereWallSide>(s)) - sigma3) / sigma3);
+  return err;
+}
+
+// A loose random gas is compressed until every one of the six walls carries
+// σ3 within the consolidation tolerance and the sample is static. σ3 = 1e7
+// Pa: kn/(σ3·d) = 1e4, the stiffness level of configs/random_500_3d.json.
+TEST(TriaxialScene, ConsolidationReachesSigma3OnAllSixWalls) {
+  const SceneConfig c = parse(
+      R"({"dimension": 3, "assembly": {"type": "random", "count": 60, "radius_min": 4e-4,
+          "radius_max": 6e-4, "seed": 2}, "test": {"lateral_stress": 1e7}})");
+  const SphereAssembly a = make_sphere_assembly(c);
+  int calls = 0;
+  const TriaxialState s =
+      consolidate_triaxial(c, a, [&](const ConsolidationProgress&) { ++calls; });
+  std::printf("60 spheres consolidated in %lld steps, wall error %.2e, unbalanced %.2e\n",
+              static_cast<long long>(s.steps), s.stress_error, s.unbalanced_ratio);
+  EXPECT_TRUE(s.converged);
+  EXPECT_GT(calls, 0);
+  EXPECT_LT(max_wall_error(s.world, c.test.lateral_stress), c.test.consolidation_tolerance);
+  EXPECT_LT(s.world.measure().unbalanced_force_ratio, c.test.consolidation_unbalanced);
+  for (int axis = 0; axis < 3; ++axis) EXPECT_EQ(s.extent0[axis], s.world.extent(axis));
+  // Friction is on for the loading.
+  EXPECT_EQ(s.world.material().particle.friction, c.material.particle.friction);
+}
+
+TEST(TriaxialScene, ConsolidationThatCannotFinishSaysWhatItReached) {
+  SceneConfig c = parse(fcc_text(2, 1e7, 5e-4, 1000, true));
+  c.test.consolidation_max_steps = 1000;
+  c.test.consolidation_unbalanced = 1e-30;  // unreachable
+  try {
+    consolidate_triaxial(c, make_sphere_assembly(c));
+    FAIL() << "no error";
+  } catch (const std::runtime_error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("did not reach a static state in 1000 steps"), std::string::npos) << what;
+    EXPECT_NE(what.find("unbalanced-force ratio"), std::string::npos) << what;
+  }
+}
+
+// The scene protocol on the walled FCC cube, rotation locked: the peak
+// σ1/σ3 within 2 % of Thornton's value 2(1 + μ)/(1 − μ) for the walled
+// sample (fcc_peak_ratio_walled; 3.714 at μ = 0.3). σ3 = 1e7 Pa keeps the
+// overlaps near 2e-4·r (the elastic tilt of the inclined contacts is of
+// that order); the peak comes near an axial strain of 2e-4.
+TEST(TriaxialScene, FccPeakWithRotationLockedMatchesThornton) {
+  const int n = 3;
+  const SceneConfig c = parse(fcc_text(n, 1e7, 5e-4, 20000, true));
+  const double analytical = fcc_peak_ratio_walled(0.3, n, n, n);
+  ASSERT_EQ(analytical_peak_ratio_3d(c), analytical);
+  const TriaxialState s = consolidate_triaxial(c, make_sphere_assembly(c));
+  ASSERT_TRUE(s.converged);
+  const TriaxialResult r = run_triaxial_loading(s, c.test, c.algorithm);
+  ASSERT_FALSE(r.diverged);
+  EXPECT_EQ(r.steps_run, c.algorithm.steps);
+  ASSERT_EQ(r.series.size(), static_cast<size_t>(c.test.monitor_points + 1));
+  const double ratio = -r.peak_stress_zz / c.test.lateral_stress;
+  std::printf(
+      "FCC %dx%dx%d scene protocol, rotation locked: consolidated in %lld steps; peak "
+      "sigma1/sigma3 %.4f (against the lateral walls %.4f), analytical %.4f (%+.2f %%) at strain "
+      "%.2e\n",
+      n, n, n, static_cast<long long>(s.steps), ratio, r.peak_ratio, analytical,
+      100.0 * (ratio / analytical - 1.0), r.peak_strain_zz);
+  EXPECT_NEAR(ratio, analytical, 0.02 * analytical);
+  EXPECT_NEAR(r.peak_ratio, analytical, 0.02 * analytical);
+  // Monitoring: the last point is the end of the loading; b is 3×3 with the
+  // axial component the largest; the servo holds the four lateral walls.
+  const TriaxialPoint& last = r.series.back();
+  EXPECT_EQ(last.step, c.algorithm.steps);
+  EXPECT_NEAR(last.strain_zz, -c.test.vertical_strain, 1e-3 * c.test.vertical_strain);
+  EXPECT_LT(last.b(2, 2), last.b(0, 0));
+  for (double e : last.servo_error) EXPECT_LT(std::abs(e), 0.05);
+}
+
+}  // namespace
+}  // namespace demcal
