@@ -140,7 +140,11 @@ std::string mapping_header(const SceneConfig& c, const AlgorithmSpec& p, const P
     << "#   stresses: tension positive in demcal; the thermo columns below give the\n"
     << "#     compressive wall pressures (positive) instead\n"
     << "# The particle file holds the state demcal consolidated to sigma3 (walls at its\n"
-    << "# box); the run starts loading from it. Contact histories start at zero.\n"
+    << "# box); the run starts loading from it. Not carried over: the tangential\n"
+    << "# contact forces (the tangential springs' histories, particle-particle and\n"
+    << "# particle-wall) start at zero here, where demcal's consolidated state had\n"
+    << "# them; the normal forces (overlaps) are in the positions. The first steps of\n"
+    << "# the loading mobilise them again (small at a static, isotropic start).\n"
     << "# ===========================================================================\n";
   return s.str();
 }
@@ -151,6 +155,9 @@ ExportResult result_of(const Plan& plan) {
   out.dt = plan.dt;
   out.steps = plan.steps;
   out.step_factor = plan.step_factor;
+  out.notes.push_back(
+      "tangential contact forces are not carried over: the deck's contacts start with zero "
+      "tangential springs (normal forces are in the positions)");
   if (plan.step_factor < 1.0)
     out.notes.push_back(
         "timestep alpha*f and Nstep/f (f = sqrt(1 + zeta_t^2) - zeta_t = " + num(plan.step_factor) +
@@ -287,6 +294,7 @@ constexpr const char kLammpsWalls[] =
     "group           gtop region bandtop\n"
     "group           gleft region bandleft\n"
     "group           gright region bandright\n"
+    "group           gside union gleft gright\n"
     "group           ntop subtract all gtop\n"
     "group           nleft subtract all gleft\n"
     "group           nright subtract all gright\n"
@@ -302,8 +310,9 @@ constexpr const char kLammpsWalls[] =
     "fix             fcon all store/force\n"
     "# wall contact arrays: [1] contacts, [2] [3] force on the particle, [5] [6]\n"
     "# contact point\n"
-    "compute         cl gleft reduce sum f_wleft[1] f_wleft[2]\n"
-    "compute         cr gright reduce sum f_wright[1] f_wright[2]\n"
+    "# the servo's input, both lateral walls in one reduction (one global sum per\n"
+    "# step under MPI): [1] [2] left contacts and force, [3] [4] right\n"
+    "compute         cs gside reduce sum f_wleft[1] f_wleft[2] f_wright[1] f_wright[2]\n"
     "compute         ct gtop reduce sum f_wtop[1] f_wtop[3]\n"
     "compute         cb all reduce sum f_wbottom[1] f_wbottom[3]\n"
     "variable        xl equal v_xl_now+v_dxl\n"
@@ -311,8 +320,8 @@ constexpr const char kLammpsWalls[] =
     "variable        yt equal v_yt0+v_dytop\n"
     "variable        H  equal v_yt-v_yb0\n"
     "variable        W  equal v_xr-v_xl\n"
-    "variable        pl equal c_cl[2]/(v_H*v_thick)\n"
-    "variable        pr equal -c_cr[2]/(v_H*v_thick)\n"
+    "variable        pl equal c_cs[2]/(v_H*v_thick)\n"
+    "variable        pr equal -c_cs[4]/(v_H*v_thick)\n"
     "variable        pt equal -c_ct[2]/(v_W*v_thick)\n"
     "variable        pb equal c_cb[2]/(v_W*v_thick)\n"
     "# clearance of the particles outside each band from its wall (> 0)\n"
@@ -332,10 +341,10 @@ constexpr const char kLammpsWalls[] =
     "# substituted now: a chain of variables re-parsed every step cost more than\n"
     "# the granular step itself (this release has no min/max of two numbers:\n"
     "# max(1, n) = (1+n+abs(1-n))/2, clamp(x) = (abs(x+cap)-abs(x-cap))/2).\n"
-    "variable        rawl  equal ${gain}*(${sigma3}*(${H0}-${vtop}*step*dt)*${thick}-c_cl[2])/"
-    "(${kn_wall}*(1+c_cl[1]+abs(1-c_cl[1]))/2)\n"
-    "variable        rawr  equal ${gain}*(${sigma3}*(${H0}-${vtop}*step*dt)*${thick}+c_cr[2])/"
-    "(${kn_wall}*(1+c_cr[1]+abs(1-c_cr[1]))/2)\n"
+    "variable        rawl  equal ${gain}*(${sigma3}*(${H0}-${vtop}*step*dt)*${thick}-c_cs[2])/"
+    "(${kn_wall}*(1+c_cs[1]+abs(1-c_cs[1]))/2)\n"
+    "variable        rawr  equal ${gain}*(${sigma3}*(${H0}-${vtop}*step*dt)*${thick}+c_cs[4])/"
+    "(${kn_wall}*(1+c_cs[3]+abs(1-c_cs[3]))/2)\n"
     "variable        movel equal (abs(v_rawl+${cap})-abs(v_rawl-${cap}))/2\n"
     "variable        mover equal -(abs(v_rawr+${cap})-abs(v_rawr-${cap}))/2\n"
     "fix             servol all ave/time 1 1 1 v_movel ave running\n"
