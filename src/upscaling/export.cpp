@@ -278,9 +278,11 @@ constexpr const char kLammpsWalls[] =
     "# top: a plane moving down at vtop; left/right: planes moved by the servo.\n"
     "# The fix order matters: the walls, then fix store/force (contact forces\n"
     "# only), then the damping.\n"
-    "variable dytop  equal -v_vtop*step*dt\n"
-    "variable dxl    equal f_servol*(step-v_step0)\n"
-    "variable dxr    equal f_servor*(step-v_step0)\n"
+    "# (evaluated every step: the constants substituted now, ${...}; in this\n"
+    "# release a v_ reference formats the other variable to text and back)\n"
+    "variable dytop  equal -${vtop}*step*dt\n"
+    "variable dxl    equal f_servo[1]*(step-${step0})\n"
+    "variable dxr    equal f_servo[2]*(step-${step0})\n"
     "region          rtop   plane 0 ${yt0} 0  0 -1 0 side in move NULL v_dytop NULL units box\n"
     "region          rleft  plane ${xl_now} 0 0  1 0 0  side in move v_dxl NULL NULL units box\n"
     "region          rright plane ${xr_now} 0 0  -1 0 0 side in move v_dxr NULL NULL units box\n"
@@ -334,21 +336,36 @@ constexpr const char kLammpsWalls[] =
     "compute         clear_right nright reduce min v_gap_right\n"
     "variable        clear_top equal c_clear_top\n"
     "variable        clear_left equal c_clear_left\n"
-    "variable        clear_right equal c_clear_right\n"
-    "# demcal's servo, one move per step toward the sample when p < sigma3:\n"
-    "#   move = gain*(sigma3*H*t - F)/(kn_wall*max(1, n)), clamped to +-cap,\n"
-    "# F the wall force, n its contacts. One flat formula per wall, the numbers\n"
-    "# substituted now: a chain of variables re-parsed every step cost more than\n"
-    "# the granular step itself (this release has no min/max of two numbers:\n"
-    "# max(1, n) = (1+n+abs(1-n))/2, clamp(x) = (abs(x+cap)-abs(x-cap))/2).\n"
-    "variable        rawl  equal ${gain}*(${sigma3}*(${H0}-${vtop}*step*dt)*${thick}-c_cs[2])/"
-    "(${kn_wall}*(1+c_cs[1]+abs(1-c_cs[1]))/2)\n"
-    "variable        rawr  equal ${gain}*(${sigma3}*(${H0}-${vtop}*step*dt)*${thick}+c_cs[4])/"
-    "(${kn_wall}*(1+c_cs[3]+abs(1-c_cs[3]))/2)\n"
-    "variable        movel equal (abs(v_rawl+${cap})-abs(v_rawl-${cap}))/2\n"
-    "variable        mover equal -(abs(v_rawr+${cap})-abs(v_rawr-${cap}))/2\n"
-    "fix             servol all ave/time 1 1 1 v_movel ave running\n"
-    "fix             servor all ave/time 1 1 1 v_mover ave running\n\n";
+    "variable        clear_right equal c_clear_right\n";
+
+/// demcal's servo law (scene/biaxial.cpp, servo_velocity) in the deck: one
+/// flat formula per lateral wall, evaluated every step by one fix ave/time.
+std::string lammps_servo() {
+  // gain*(sigma3*H*t - F)/(kn_wall*max(1, n)); F, n from compute cs: the
+  // left wall's force on the particles is +x (columns 1, 2), the right
+  // wall's -x (columns 3, 4: F = -c_cs[4]).
+  auto raw = [](const char* force_sign, int count, int force) {
+    return std::string("${gain}*(${sigma3}*(${H0}-${vtop}*step*dt)*${thick}") + force_sign +
+           "c_cs[" + std::to_string(force) + "])/(${kn_wall}*(1+c_cs[" + std::to_string(count) +
+           "]+abs(1-c_cs[" + std::to_string(count) + "]))/2)";
+  };
+  auto clamp = [](const std::string& x) {
+    return "(abs(" + x + "+${cap})-abs(" + x + "-${cap}))/2";
+  };
+  std::ostringstream s;
+  s << "# demcal's servo, one move per step toward the sample when p < sigma3:\n"
+    << "#   move = gain*(sigma3*H*t - F)/(kn_wall*max(1, n)), clamped to +-cap,\n"
+    << "# F the wall force, n its contacts; the wall's displacement is the sum of\n"
+    << "# the moves (running mean times the steps of this run, dxl and dxr above).\n"
+    << "# One flat formula per wall with the numbers substituted now (each v_\n"
+    << "# reference, and each level of parsing, is paid every step); this\n"
+    << "# release has no min/max of two numbers: max(1, n) = (1+n+abs(1-n))/2,\n"
+    << "# clamp(x) = (abs(x+cap)-abs(x-cap))/2.\n"
+    << "variable        movel equal " << clamp(raw("-", 1, 2)) << "\n"
+    << "variable        mover equal -" << clamp(raw("+", 3, 4)) << "\n"
+    << "fix             servo all ave/time 1 1 1 v_movel v_mover ave running\n\n";
+  return s.str();
+}
 
 // Data file: atom_style sphere rows "id type diameter density x y z"; the
 // density column is overwritten by set density/disc below.
@@ -492,7 +509,7 @@ ExportResult lammps(const SceneConfig& c, const AlgorithmSpec& p, const Assembly
     << "timestep        ${dt}\n\n"
     << "fix             integrate all nve/sphere disc\n\n";
 
-  s << kLammpsWalls;
+  s << kLammpsWalls << lammps_servo();
 
   s << "# --- global damping ----------------------------------------------------------\n";
   if (p.damping_ratio_translation > 0.0) {
