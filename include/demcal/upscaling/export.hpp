@@ -20,6 +20,8 @@
 //              mesh/surface/stress/servo, gain from demcal's servo law) on
 //              the lateral walls.
 //
+// Both formats run at α·f·Δt_crit for Nstep/f steps, f =
+// explicit_damping_step_factor(ζ_t) (below): their fix viscous is explicit.
 // Every mapping, and every place where the other code cannot do exactly
 // what demcal does, is written as comments into the deck itself.
 #pragma once
