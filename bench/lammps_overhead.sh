@@ -10,7 +10,12 @@
 # times and shares, and rerun on a quiet machine).
 #
 #   bench/lammps_overhead.sh PARAMS.json [BUILD_DIR]
-# Environment: SIZES="400 20000" STEPS=5000 NP="1 2" KEEP=dir
+# Environment: SIZES="400 20000" STEPS=5000 NP="1 2" REPEAT=1 KEEP=dir
+#   REPEAT=3 alternates serial and MPI runs three times (on a shared machine
+#   the load changes between runs: compare runs taken side by side)
+#   MPI_FLAGS="--mca mpi_yield_when_idle 1 --bind-to none" on a machine shared
+#   with other jobs (OpenMPI's ranks otherwise busy-wait pinned to a core
+#   another process holds: 5x slower than serial at load 8 on 2 cores)
 #   EXPORT_FLAGS="--no-consolidate" (the generated packing as it is: no
 #   minutes of consolidation before a timing)
 # Installs nothing; needs lmp (and mpirun for NP > 1).
@@ -38,9 +43,10 @@ for n in $SIZES; do
       -e "s/@KW@/$(get kn_wall)/; s/@KTW@/$(get kt_wall)/; s/@XL@/$(get xl0)/; s/@XR@/$(get xr0)/; s/@YB@/$(get yb0)/" \
       -e "s/@YT@/$(get yt0)/; s/@GAMMA@/${gamma:-0}/; s/@DENS@/$dens/; s/@SKIN@/$skin/" \
       "$here/lammps/in.bare" > "$d/bare.lammps"
+  for rep in $(seq "${REPEAT:-1}"); do
   for np in $NP; do
     for kind in bare deck; do
-      launch=(lmp); [[ "$np" -gt 1 ]] && launch=(mpirun --allow-run-as-root --oversubscribe -np "$np" lmp)
+      launch=(lmp); [[ "$np" -gt 1 ]] && launch=(mpirun --allow-run-as-root --oversubscribe ${MPI_FLAGS:-} -np "$np" lmp)
       load=$(cut -d' ' -f1 /proc/loadavg)
       cpu=$( { cd "$d" && /usr/bin/time -f "%U %S" "${launch[@]}" -in "$kind.lammps" \
                -var run_steps "$STEPS" -log "log.$kind.$np" -screen none >/dev/null; } 2>&1 | tail -1)
@@ -51,4 +57,6 @@ for n in $SIZES; do
       echo "N=$n np=$np $kind: loop ${loop} s, cpu(user sys) ${cpu} s, Pair ${pair} %, Modify ${modify} %, load ${load}"
     done
   done
+  done
+  echo "# $(uptime)"
 done

@@ -60,7 +60,8 @@ int cmd_export(const ExportCmdOptions& o) {
             << " radius class(es))";
   for (const auto& [name, content] : r.files) std::cout << ", " << (dir / name).string();
   std::cout << "\n";
-  for (const auto& note : r.notes) std::cout << "  note: " << note << "\n";
+  // What could not be carried over exactly: on stderr (diagnostics), once.
+  for (const auto& note : r.notes) std::cerr << "demcal export: note: " << note << "\n";
   std::cout << "  run it in its folder: cd " << dir.string() << " && "
             << (o.format == "lammps" ? "lmp" : "liggghts") << " -in " << deck_fs.filename().string()
             << "\n";

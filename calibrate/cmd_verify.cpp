@@ -91,6 +91,9 @@ int verify_in_lammps(const VerifyOptions& o, const SceneConfig& config,
                    {"np", o.np},
                    {"deck", (work / "deck.lammps").string()},
                    {"wall_time_s", engine_s},
+                   {"steps", deck.steps},
+                   {"dt", deck.dt},
+                   {"step_factor", deck.step_factor},
                    {"notes", deck.notes}};
   const nlohmann::json summary = external_summary(series, scored, tolerances);
   for (const char* key : {"passed", "criteria", "tolerances", "diagnosis", "peak", "diverged",
@@ -100,8 +103,10 @@ int verify_in_lammps(const VerifyOptions& o, const SceneConfig& config,
   const auto& c = score.criteria;
   std::cout << (score.passed ? "PASS" : "FAIL") << " in LAMMPS (" << o.np
             << (o.np > 1 ? " ranks" : " rank") << "): prototype of " << state.world.size()
-            << " particles, " << up.steps << " steps (alpha " << up.dt_ratio << ", zeta_t "
-            << up.damping_ratio_translation << "; zeta_r not applied by this LAMMPS)\n"
+            << " particles, " << deck.steps << " steps (alpha " << up.dt_ratio * deck.step_factor
+            << " = " << up.dt_ratio << " * f, f " << deck.step_factor
+            << " for the explicit fix viscous; zeta_t " << up.damping_ratio_translation
+            << "; zeta_r not applied by this LAMMPS)\n"
             << "  force balance " << c.force_balance << " (tol " << tolerances.force_balance
             << "), moment balance " << c.moment_balance << " (tol " << tolerances.moment_balance
             << ", lever-arm floor RMS " << scored.lever_arm_floor_rms << " not counted), servo "

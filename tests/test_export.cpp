@@ -59,15 +59,22 @@ TEST(Export, LammpsDeckMapsEveryParameter) {
   o.data_name = "proto.data";
   const ExportResult r = export_deck(c, params(), a, o);
   const ParticleScales s = particle_scales(a.r, c.material);
-  EXPECT_NEAR(r.dt, 0.22 * s.dt_crit, 1e-18);
-  EXPECT_EQ(r.steps, 44390);
+  // The engine's explicit fix viscous: alpha*f, Nstep/f, f(0.7) = 0.520656.
+  const double f = explicit_damping_step_factor(0.7);
+  EXPECT_NEAR(f, std::sqrt(1.49) - 0.7, 1e-15);
+  EXPECT_EQ(r.step_factor, f);
+  EXPECT_NEAR(r.dt, 0.22 * f * s.dt_crit, 1e-18);
+  EXPECT_EQ(r.steps, std::llround(44390 / f));
+  // The loading time, hence the rate and the strain, is demcal's.
+  EXPECT_NEAR(r.steps * r.dt / (44390 * 0.22 * s.dt_crit), 1.0, 0.5 / r.steps);
   EXPECT_EQ(r.types, 1);
   for (const char* needle :
        {"units           si", "dimension       2", "density/disc 2650", "nve/sphere disc",
         "pair_style      gran/hooke/history ${kn} ${kt} 0 0.0 ${mu} 0",
         "fix             twod all enforce2d", "wall/gran/region hooke/history",
         "fix             dampt all viscous", "#fix            dampr all viscous/sphere",
-        "variable nstep     equal 44390", "variable run_steps index ${nstep}",
+        "variable nstep     equal 85258", "variable run_steps index ${nstep}",
+        "f = sqrt(1 + zeta_t^2) - zeta_t = 0.5206555616 (zeta_t = 0.7)",
         "fix             fcon all store/force", "fix             series all print ${monitor_every}",
         "variable vtop      equal $(v_strain*v_H0/(v_nstep*v_dt))", "then \"read_data proto.data\"",
         "variable kn        equal 100000000"})
@@ -87,6 +94,34 @@ TEST(Export, LammpsDeckMapsEveryParameter) {
         export_deck(c, params(), a, bad);
       }(),
       InputError);
+}
+
+TEST(Export, ExplicitDampingStepFactorIsTheDampedOscillatorsStabilityLimit) {
+  // A mass on a spring integrated as LAMMPS does with fix viscous
+  // (velocity Verlet, the drag -gamma*v from the half-step velocity): the
+  // step Omega = omega*dt at which it turns unstable is 2f, f =
+  // sqrt(1 + zeta^2) - zeta. 1 % below, the motion decays; 1 % above,
+  // it grows (the root z = -1 of the characteristic equation).
+  auto amplitude = [](double zeta, double omega_dt) {
+    const double w = 1.0, dt = omega_dt / w, c = 2.0 * zeta * w;  // k/m = w^2, gamma/m = c
+    double x = 1.0, v = 0.0, a = -w * w * x;
+    double peak = 0.0;
+    for (int n = 0; n < 2000; ++n) {
+      const double vh = v + 0.5 * dt * a;  // first half kick
+      x += dt * vh;
+      a = -w * w * x - c * vh;  // forces, then the post-force drag on vh
+      v = vh + 0.5 * dt * a;
+      if (n >= 1900) peak = std::max(peak, std::abs(x));
+    }
+    return peak;
+  };
+  for (const double zeta : {0.0, 0.2, 0.7, 1.107, 3.0}) {
+    const double f = explicit_damping_step_factor(zeta);
+    EXPECT_NEAR(f, std::sqrt(1.0 + zeta * zeta) - zeta, 1e-14);
+    EXPECT_LT(amplitude(zeta, 2.0 * f * (1.0 - 1e-2)), 1.0 + 1e-9) << "zeta " << zeta;
+    EXPECT_GT(amplitude(zeta, 2.0 * f * (1.0 + 1e-2)), 1e3) << "zeta " << zeta;
+  }
+  EXPECT_EQ(explicit_damping_step_factor(0.0), 1.0);
 }
 
 TEST(Export, PolydisperseDampingPerClass) {
@@ -213,7 +248,7 @@ TEST(Export, LammpsReproducesDemcalsPeak) {
   ASSERT_EQ(lammps.status, 0) << lammps.log;
   const auto rows = thermo_rows(lammps.log);
   ASSERT_GT(rows.size(), 100u);
-  EXPECT_EQ(rows.back()[0], p.steps);
+  EXPECT_EQ(rows.back()[0], r.steps);
   double lammps_peak = 0.0;
   for (const auto& row : rows) lammps_peak = std::max(lammps_peak, row[4]);
   const double demcal_peak = -run.peak_stress_yy;

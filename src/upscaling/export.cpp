@@ -30,6 +30,7 @@ struct Plan {
   std::vector<int> type;           // per particle, 1-based
   std::vector<double> r_lo, r_hi;  // per class (index type−1)
   double dt = 0.0, dt_crit = 0.0;
+  double step_factor = 1.0;  // f = sqrt(1 + zeta_t^2) - zeta_t: explicit fix viscous
   int64_t steps = 0;
   double areal_density = 0.0;  // f_ms·ρ·t [kg/m²]
   double width0 = 0.0, height0 = 0.0;
@@ -56,12 +57,18 @@ Plan make_plan(const SceneConfig& c, const AlgorithmSpec& p, const Assembly& a, 
   plan.r_min = plan.scales.radius_min;
   plan.r_max = plan.scales.radius_max;
   plan.dt_crit = plan.scales.dt_crit;
-  plan.dt = p.dt_ratio * plan.dt_crit;
-  plan.steps = p.steps;
+  // Both engines apply fix viscous explicitly (the force from the half-step
+  // velocity), which shrinks the stable step by f; demcal's damping is
+  // semi-implicit. The deck runs at alpha*f for Nstep/f steps: the same
+  // loading time, rate and strain, and the same stability margin as demcal.
+  plan.step_factor = explicit_damping_step_factor(p.damping_ratio_translation);
+  plan.dt = p.dt_ratio * plan.step_factor * plan.dt_crit;
+  plan.steps = std::max<int64_t>(1, std::llround(static_cast<double>(p.steps) / plan.step_factor));
   plan.areal_density = p.mass_scaling * c.material.density * c.material.thickness;
   plan.width0 = a.right - a.left;
   plan.height0 = a.top - a.bottom;
-  plan.top_speed = c.test.vertical_strain * plan.height0 / (static_cast<double>(p.steps) * plan.dt);
+  plan.top_speed =
+      c.test.vertical_strain * plan.height0 / (static_cast<double>(plan.steps) * plan.dt);
   // D_t = ζ_t·2·sqrt(kn·m) ∝ r and D_r = ζ_r·2·sqrt(kt·r²·I) ∝ r³ for discs
   // of one density: each class gets the value of its mid radius, which
   // bounds the error by (r_hi − r_lo)/(r_hi + r_lo) for D_t.
@@ -76,7 +83,7 @@ Plan make_plan(const SceneConfig& c, const AlgorithmSpec& p, const Assembly& a, 
         std::max(plan.class_error, (plan.r_hi[k] - plan.r_lo[k]) / (plan.r_hi[k] + plan.r_lo[k]));
   }
   plan.thermo_every =
-      static_cast<int>(std::max<int64_t>(1, p.steps / std::max(1, c.test.monitor_points)));
+      static_cast<int>(std::max<int64_t>(1, plan.steps / std::max(1, c.test.monitor_points)));
   return plan;
 }
 
@@ -90,12 +97,22 @@ std::string mapping_header(const SceneConfig& c, const AlgorithmSpec& p, const P
   if (!o.provenance.empty()) s << "# parameters: " << o.provenance << "\n";
   s << "#\n"
     << "# How demcal's parameters map (demcal -> " << code << "):\n"
-    << "#   dt = alpha * dt_crit = " << num(p.dt_ratio) << " * " << num(plan.dt_crit)
-    << " s = " << num(plan.dt) << " s -> timestep\n"
+    << "#   dt = alpha * f * dt_crit = " << num(p.dt_ratio) << " * " << num(plan.step_factor)
+    << " * " << num(plan.dt_crit) << " s = " << num(plan.dt) << " s -> timestep\n"
     << "#     dt_crit = 2 sqrt(m_min/kn) of the smallest disc (r = " << num(plan.r_min) << " m)\n"
-    << "#   Nstep = " << p.steps << " loading steps (upscaled) -> run length; the top wall moves\n"
+    << "#     f = sqrt(1 + zeta_t^2) - zeta_t = " << num(plan.step_factor)
+    << " (zeta_t = " << num(p.damping_ratio_translation) << "): " << code
+    << "'s fix viscous is explicit\n"
+    << "#       (the drag -gamma*v uses the half-step velocity), which shrinks a damped\n"
+    << "#       oscillator's stable step from 2/omega to f*2/omega; demcal damps\n"
+    << "#       semi-implicitly (f = 1). At demcal's alpha a well-damped calibration\n"
+    << "#       chatters here (measured: alpha 0.286, zeta_t 1.107, force balance 0.195\n"
+    << "#       FAIL in LAMMPS); alpha*f keeps demcal's margin to the stable step.\n"
+    << "#   Nstep = " << p.steps << " / f = " << plan.steps
+    << " loading steps (upscaled, then / f: the same loading\n"
+    << "#     time Nstep*dt, so the same rate and strain) -> run length; the top wall moves\n"
     << "#     eps * H0 / (Nstep * dt) = " << num(c.test.vertical_strain) << " * "
-    << num(plan.height0) << " / (" << p.steps << " * " << num(plan.dt)
+    << num(plan.height0) << " / (" << plan.steps << " * " << num(plan.dt)
     << ") = " << num(plan.top_speed) << " m/s\n"
     << "#   kn = " << num(m.particle.kn) << " N/m, kt = " << num(m.particle.kt)
     << " N/m, mu = " << num(m.particle.friction)
@@ -123,7 +140,11 @@ std::string mapping_header(const SceneConfig& c, const AlgorithmSpec& p, const P
     << "#   stresses: tension positive in demcal; the thermo columns below give the\n"
     << "#     compressive wall pressures (positive) instead\n"
     << "# The particle file holds the state demcal consolidated to sigma3 (walls at its\n"
-    << "# box); the run starts loading from it. Contact histories start at zero.\n"
+    << "# box); the run starts loading from it. Not carried over: the tangential\n"
+    << "# contact forces (the tangential springs' histories, particle-particle and\n"
+    << "# particle-wall) start at zero here, where demcal's consolidated state had\n"
+    << "# them; the normal forces (overlaps) are in the positions. The first steps of\n"
+    << "# the loading mobilise them again (small at a static, isotropic start).\n"
     << "# ===========================================================================\n";
   return s.str();
 }
@@ -133,6 +154,15 @@ ExportResult result_of(const Plan& plan) {
   ExportResult out;
   out.dt = plan.dt;
   out.steps = plan.steps;
+  out.step_factor = plan.step_factor;
+  out.notes.push_back(
+      "tangential contact forces are not carried over: the deck's contacts start with zero "
+      "tangential springs (normal forces are in the positions)");
+  if (plan.step_factor < 1.0)
+    out.notes.push_back(
+        "timestep alpha*f and Nstep/f (f = sqrt(1 + zeta_t^2) - zeta_t = " + num(plan.step_factor) +
+        "): this engine's fix viscous is explicit and shrinks the stable step "
+        "by f; the loading time, rate and strain are demcal's");
   out.types = plan.types;
   out.damping_class_error = plan.class_error;
   return out;
@@ -248,9 +278,11 @@ constexpr const char kLammpsWalls[] =
     "# top: a plane moving down at vtop; left/right: planes moved by the servo.\n"
     "# The fix order matters: the walls, then fix store/force (contact forces\n"
     "# only), then the damping.\n"
-    "variable dytop  equal -v_vtop*step*dt\n"
-    "variable dxl    equal f_servol*(step-v_step0)\n"
-    "variable dxr    equal f_servor*(step-v_step0)\n"
+    "# (evaluated every step: the constants substituted now, ${...}; in this\n"
+    "# release a v_ reference formats the other variable to text and back)\n"
+    "variable dytop  equal -${vtop}*step*dt\n"
+    "variable dxl    equal f_servo[1]*(step-${step0})\n"
+    "variable dxr    equal f_servo[2]*(step-${step0})\n"
     "region          rtop   plane 0 ${yt0} 0  0 -1 0 side in move NULL v_dytop NULL units box\n"
     "region          rleft  plane ${xl_now} 0 0  1 0 0  side in move v_dxl NULL NULL units box\n"
     "region          rright plane ${xr_now} 0 0  -1 0 0 side in move v_dxr NULL NULL units box\n"
@@ -264,6 +296,7 @@ constexpr const char kLammpsWalls[] =
     "group           gtop region bandtop\n"
     "group           gleft region bandleft\n"
     "group           gright region bandright\n"
+    "group           gside union gleft gright\n"
     "group           ntop subtract all gtop\n"
     "group           nleft subtract all gleft\n"
     "group           nright subtract all gright\n"
@@ -279,8 +312,9 @@ constexpr const char kLammpsWalls[] =
     "fix             fcon all store/force\n"
     "# wall contact arrays: [1] contacts, [2] [3] force on the particle, [5] [6]\n"
     "# contact point\n"
-    "compute         cl gleft reduce sum f_wleft[1] f_wleft[2]\n"
-    "compute         cr gright reduce sum f_wright[1] f_wright[2]\n"
+    "# the servo's input, both lateral walls in one reduction (one global sum per\n"
+    "# step under MPI): [1] [2] left contacts and force, [3] [4] right\n"
+    "compute         cs gside reduce sum f_wleft[1] f_wleft[2] f_wright[1] f_wright[2]\n"
     "compute         ct gtop reduce sum f_wtop[1] f_wtop[3]\n"
     "compute         cb all reduce sum f_wbottom[1] f_wbottom[3]\n"
     "variable        xl equal v_xl_now+v_dxl\n"
@@ -288,8 +322,8 @@ constexpr const char kLammpsWalls[] =
     "variable        yt equal v_yt0+v_dytop\n"
     "variable        H  equal v_yt-v_yb0\n"
     "variable        W  equal v_xr-v_xl\n"
-    "variable        pl equal c_cl[2]/(v_H*v_thick)\n"
-    "variable        pr equal -c_cr[2]/(v_H*v_thick)\n"
+    "variable        pl equal c_cs[2]/(v_H*v_thick)\n"
+    "variable        pr equal -c_cs[4]/(v_H*v_thick)\n"
     "variable        pt equal -c_ct[2]/(v_W*v_thick)\n"
     "variable        pb equal c_cb[2]/(v_W*v_thick)\n"
     "# clearance of the particles outside each band from its wall (> 0)\n"
@@ -302,21 +336,36 @@ constexpr const char kLammpsWalls[] =
     "compute         clear_right nright reduce min v_gap_right\n"
     "variable        clear_top equal c_clear_top\n"
     "variable        clear_left equal c_clear_left\n"
-    "variable        clear_right equal c_clear_right\n"
-    "# demcal's servo, one move per step toward the sample when p < sigma3:\n"
-    "#   move = gain*(sigma3*H*t - F)/(kn_wall*max(1, n)), clamped to +-cap,\n"
-    "# F the wall force, n its contacts. One flat formula per wall, the numbers\n"
-    "# substituted now: a chain of variables re-parsed every step cost more than\n"
-    "# the granular step itself (this release has no min/max of two numbers:\n"
-    "# max(1, n) = (1+n+abs(1-n))/2, clamp(x) = (abs(x+cap)-abs(x-cap))/2).\n"
-    "variable        rawl  equal ${gain}*(${sigma3}*(${H0}-${vtop}*step*dt)*${thick}-c_cl[2])/"
-    "(${kn_wall}*(1+c_cl[1]+abs(1-c_cl[1]))/2)\n"
-    "variable        rawr  equal ${gain}*(${sigma3}*(${H0}-${vtop}*step*dt)*${thick}+c_cr[2])/"
-    "(${kn_wall}*(1+c_cr[1]+abs(1-c_cr[1]))/2)\n"
-    "variable        movel equal (abs(v_rawl+${cap})-abs(v_rawl-${cap}))/2\n"
-    "variable        mover equal -(abs(v_rawr+${cap})-abs(v_rawr-${cap}))/2\n"
-    "fix             servol all ave/time 1 1 1 v_movel ave running\n"
-    "fix             servor all ave/time 1 1 1 v_mover ave running\n\n";
+    "variable        clear_right equal c_clear_right\n";
+
+/// demcal's servo law (scene/biaxial.cpp, servo_velocity) in the deck: one
+/// flat formula per lateral wall, evaluated every step by one fix ave/time.
+std::string lammps_servo() {
+  // gain*(sigma3*H*t - F)/(kn_wall*max(1, n)); F, n from compute cs: the
+  // left wall's force on the particles is +x (columns 1, 2), the right
+  // wall's -x (columns 3, 4: F = -c_cs[4]).
+  auto raw = [](const char* force_sign, int count, int force) {
+    return std::string("${gain}*(${sigma3}*(${H0}-${vtop}*step*dt)*${thick}") + force_sign +
+           "c_cs[" + std::to_string(force) + "])/(${kn_wall}*(1+c_cs[" + std::to_string(count) +
+           "]+abs(1-c_cs[" + std::to_string(count) + "]))/2)";
+  };
+  auto clamp = [](const std::string& x) {
+    return "(abs(" + x + "+${cap})-abs(" + x + "-${cap}))/2";
+  };
+  std::ostringstream s;
+  s << "# demcal's servo, one move per step toward the sample when p < sigma3:\n"
+    << "#   move = gain*(sigma3*H*t - F)/(kn_wall*max(1, n)), clamped to +-cap,\n"
+    << "# F the wall force, n its contacts; the wall's displacement is the sum of\n"
+    << "# the moves (running mean times the steps of this run, dxl and dxr above).\n"
+    << "# One flat formula per wall with the numbers substituted now (each v_\n"
+    << "# reference, and each level of parsing, is paid every step); this\n"
+    << "# release has no min/max of two numbers: max(1, n) = (1+n+abs(1-n))/2,\n"
+    << "# clamp(x) = (abs(x+cap)-abs(x-cap))/2.\n"
+    << "variable        movel equal " << clamp(raw("-", 1, 2)) << "\n"
+    << "variable        mover equal -" << clamp(raw("+", 3, 4)) << "\n"
+    << "fix             servo all ave/time 1 1 1 v_movel v_mover ave running\n\n";
+  return s.str();
+}
 
 // Data file: atom_style sphere rows "id type diameter density x y z"; the
 // density column is overwritten by set density/disc below.
@@ -365,8 +414,9 @@ ExportResult lammps(const SceneConfig& c, const AlgorithmSpec& p, const Assembly
     s << "#    not needed here, the calibrated zeta_r is 0.\n";
   }
   s << "#  - damping is applied explicitly by fix viscous (force -gamma*v from the\n"
-    << "#    velocity-Verlet velocity), semi-implicitly by demcal's central difference;\n"
-    << "#    same continuous equation, discretisations differ at order zeta*alpha.\n"
+    << "#    velocity-Verlet half-step velocity), semi-implicitly by demcal's central\n"
+    << "#    difference: same continuous equation; the timestep carries the factor f\n"
+    << "#    above so that the explicit drag does not cost the stability margin.\n"
     << "#  - servo walls are not native: the lateral walls are fix wall/gran/region\n"
     << "#    planes whose displacement is the running sum of demcal's per-step servo\n"
     << "#    move gain*(sigma3 - p)*H*t/(kn_wall*n_contacts), capped at 2 % of r_min,\n"
@@ -459,7 +509,7 @@ ExportResult lammps(const SceneConfig& c, const AlgorithmSpec& p, const Assembly
     << "timestep        ${dt}\n\n"
     << "fix             integrate all nve/sphere disc\n\n";
 
-  s << kLammpsWalls;
+  s << kLammpsWalls << lammps_servo();
 
   s << "# --- global damping ----------------------------------------------------------\n";
   if (p.damping_ratio_translation > 0.0) {
