@@ -11,6 +11,8 @@
 #   run (machine-independent); consolidation steps; wall time and SIMD path
 #   (machine-dependent); the calibrated peak against the 8x run.
 # Not a test: wall times depend on the machine and its load (printed).
+# The consolidation cache is a fresh folder in OUT_DIR: each calibration
+# consolidates afresh (its wall time includes it), the 8x run reads it back.
 set -euo pipefail
 build=$1
 out=${2:-$(mktemp -d)}
@@ -20,6 +22,8 @@ scenes=("$@")
   scenes=(hex_5x5 hex_10x10 hex_20x20 random_400 poly_uniform_400 poly_lognormal_500)
 root=$(cd "$(dirname "$0")/.." && pwd)
 mkdir -p "$out"
+export DEMCAL_CACHE_DIR="$out/consolidation-cache"
+rm -rf "$DEMCAL_CACHE_DIR"
 echo "machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs)," \
   "load $(cut -d' ' -f1-3 /proc/loadavg); DEMCAL_SIMD=${DEMCAL_SIMD:-auto}"
 echo
@@ -70,4 +74,25 @@ dev = "%+.2f %%" % (100 * (float(peak) - p8) / abs(p8))
 print(f"| {scene} | {n} | {trials} | {ratio}x | {s8['consolidation']['steps']} | "
       f"{run['wall_time_s']:.1f} | {run['kernel_simd']} | {steps} | {dev} |")
 EOF
+done
+# Where the particle-steps went: trials.jsonl grouped by phase (search trials
+# also by the Nstep they ran at), in final runs (particles x calibrated Nstep).
+echo
+echo "phases (particle-steps / one final run; search@S: search trials at S steps):"
+for scene in "${scenes[@]}"; do
+  [ -f "$out/$scene/params.json" ] || continue
+  python3 - "$out/$scene" "$scene" <<'EOF2'
+import collections, json, sys
+d, scene = sys.argv[1:]
+p = json.load(open(d + "/params.json"))
+final = p["rev"]["particles"] * p["rev"]["steps"]
+phases = collections.OrderedDict()
+for line in open(d + "/trials.jsonl"):
+    t = json.loads(line)
+    key = t["phase"] + ("@%d" % t["params"]["steps"] if t["phase"] == "search" else "")
+    c = phases.setdefault(key, [0, 0.0])
+    c[0] += 1
+    c[1] += t["particle_steps"] / final
+print(f"- {scene}: " + "; ".join(f"{k} x{n}: {v:.2f}" for k, (n, v) in phases.items()))
+EOF2
 done

@@ -108,6 +108,11 @@ TEST(Calibration, DefaultSceneCalibratesAndIsCertified) {
   EXPECT_LE(params["certificate"]["richardson_error"].get<double>(), 0.02);
   // Never beyond the stable step estimated from the stiffnesses.
   EXPECT_LE(params["rev"]["dt_ratio"].get<double>(), params["dt_ratio_stable"].get<double>());
+  // Issue #15's bar, in particle-steps (machine-independent): the whole
+  // calibration costs at most 10 runs at the parameters it finds (6.8 when
+  // this was written; reports/calibration-cost.md).
+  EXPECT_LE(params["particle_steps_run"].get<double>(),
+            10.0 * params["rev"]["particles"].get<double>() * params["rev"]["steps"].get<double>());
   // Every finished trial is in trials.jsonl, once.
   const auto trials = read_trials(out / "trials.jsonl");
   EXPECT_EQ(static_cast<int>(trials.size()), params["trials"].get<int>());

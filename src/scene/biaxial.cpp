@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "demcal/io/format.hpp"
+#include "demcal/scene/consolidation_cache.hpp"
 
 namespace demcal {
 
@@ -55,7 +56,9 @@ Integration integration_for(const World& world, const AlgorithmSpec& algorithm) 
   return in;
 }
 
-ConsolidatedState consolidate(const SceneConfig& config, const Assembly& assembly) {
+namespace {
+
+ConsolidatedState consolidate_fresh(const SceneConfig& config, const Assembly& assembly) {
   const auto t0 = std::chrono::steady_clock::now();
   const TestSpec& test = config.test;
   ConsolidatedState state{World(config.material, assembly.x, assembly.y, assembly.r, assembly.left,
@@ -154,6 +157,26 @@ ConsolidatedState consolidate(const SceneConfig& config, const Assembly& assembl
                              std::to_string(state.unbalanced_ratio) +
                              "); raise test.consolidation_max_steps or loosen the tolerances");
   return state;
+}
+
+}  // namespace
+
+ConsolidatedState consolidate(const SceneConfig& config, const Assembly& assembly,
+                              const std::string& cache_dir) {
+  if (cache_dir.empty()) return consolidate_fresh(config, assembly);
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::string key = consolidation_key(config, assembly);
+  if (auto cached = load_consolidated(cache_dir, key)) {
+    cached->wall_time_s = seconds_since(t0);
+    return std::move(*cached);
+  }
+  ConsolidatedState state = consolidate_fresh(config, assembly);  // a failure is not stored
+  store_consolidated(cache_dir, key, state);
+  return state;
+}
+
+ConsolidatedState consolidate(const SceneConfig& config, const Assembly& assembly) {
+  return consolidate(config, assembly, consolidation_cache_dir());
 }
 
 double estimated_stable_dt_ratio(const ConsolidatedState& state, const AlgorithmSpec& algorithm) {

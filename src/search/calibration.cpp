@@ -530,13 +530,15 @@ double fidelity_steps(const SearchSpace& space, double target) {
   return std::clamp(target / kFidelity, space.fidelity_min, std::pow(10.0, space.upper[1]));
 }
 
-/// BOBYQA over (α, ζ_t, ζ_r) on the 1/Nstep model, from `start` (α, log10
-/// of the Nstep aimed at, ζ_t, ζ_r); at most `max_evals` low-fidelity trials.
+/// BOBYQA over (α, ζ_t, ζ_r) on the 1/Nstep model, from `start` (α, ζ_t,
+/// ζ_r at 0, 2, 3); the first round's trials run at the fidelity of the
+/// Nstep `log_target` (log10), the second at that of the first round's own
+/// prediction. At most `max_evals` low-fidelity trials.
 std::optional<ModelPrediction> model_predict(Evaluator& evaluator, const SearchSpace& space,
                                              const Tolerances& tolerances, const double* start,
-                                             int max_evals) {
+                                             double log_target, int max_evals) {
   ModelSearch m{&evaluator, &space, tolerances};
-  m.n_guess = fidelity_steps(space, std::pow(10.0, start[1]));
+  m.n_guess = fidelity_steps(space, std::pow(10.0, log_target));
   double x[3] = {start[0], start[2], start[3]};
   const double lower[3] = {space.lower[0], space.lower[2], space.lower[3]};
   const double upper[3] = {space.upper[0], space.upper[2], space.upper[3]};
@@ -595,14 +597,24 @@ std::optional<TrialRecord> verify_prediction(Evaluator& evaluator, const SearchS
 /// Two model searches (in parallel when jobs > 1), then the verification of
 /// the cheaper prediction, and of the other only when that one fails: the
 /// same trials whatever `jobs` is.
+///
+/// Both first rounds run at the fidelity of the lower of the two starts'
+/// Nstep. A start's Nstep is a prior (the paper's recipe, 500 per particle),
+/// not N*, and the trials need only lie in the 1/Nstep regime, which holds
+/// from N*/16 (reports/calibration-cost.md): at the higher start's fidelity,
+/// random_400's first round ran at N*/3.7 and cost 4.9 final runs of its
+/// 10.4; at the lower one, N*/7.4 and 3.4 of 6.4 in all. The second round
+/// re-centres on the first round's prediction.
 std::optional<TrialRecord> model_search(Evaluator& evaluator, const SearchSpace& space,
                                         const Tolerances& tolerances, const double* a,
                                         const double* b, int max_evals, int jobs) {
   const int evals = std::max(8, max_evals - kVerifyBudget);
+  const double first = std::min(a[1], b[1]);
   std::optional<ModelPrediction> pa, pb;
-  run_parallel({[&] { pa = model_predict(evaluator, space, tolerances, a, evals / 2); },
-                [&] { pb = model_predict(evaluator, space, tolerances, b, evals - evals / 2); }},
-               jobs);
+  run_parallel(
+      {[&] { pa = model_predict(evaluator, space, tolerances, a, first, evals / 2); },
+       [&] { pb = model_predict(evaluator, space, tolerances, b, first, evals - evals / 2); }},
+      jobs);
   if (pa && pb && pb->steps < pa->steps) std::swap(pa, pb);
   for (const auto& p : {pa, pb}) {
     if (!p || evaluator.stopped()) continue;

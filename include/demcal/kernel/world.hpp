@@ -50,6 +50,7 @@
 #include <new>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "demcal/kernel/material.hpp"
@@ -297,7 +298,19 @@ class World {
   /// set-up or edits, so that measure() sees consistent forces).
   void update_forces();
 
+  // --- the whole state as bytes (world_state.cpp) ------------------------
+  /// Every member of the state, bit for bit (this build's layout and byte
+  /// order; the threads are not state): the World load_state() reads back
+  /// steps exactly as this one, as a copy does. For the consolidation cache.
+  std::string save_state() const;
+  /// The World of save_state()'s bytes. Bytes that do not read as one (cut,
+  /// sizes that do not fit together) throw std::runtime_error.
+  static World load_state(std::string_view bytes);
+
  private:
+  World() = default;  // load_state()
+  template <class Self, class Visitor>
+  static void visit_state(Self& self, Visitor& visit);  // every member (world_state.cpp)
   using Array = detail::AlignedVector<double>;
   std::span<const double> view(const Array& a) const { return {a.data(), static_cast<size_t>(n_)}; }
 

@@ -8,11 +8,12 @@
 #include <cstdint>
 #include <functional>
 #include <optional>
+#include <string>
 #include <vector>
 
+#include "demcal/kernel/world.hpp"
 #include "demcal/scene/config.hpp"
 #include "demcal/scene/packing.hpp"
-#include "demcal/kernel/world.hpp"
 
 namespace demcal {
 
@@ -44,6 +45,9 @@ struct ConsolidatedState {
   bool converged = false;
   double stress_error = 0.0;      ///< max |p − σ3|/σ3 over the walls at the end
   double unbalanced_ratio = 0.0;  ///< at the end
+  /// Read from the consolidation cache (consolidation_cache.hpp): `steps`
+  /// are those the consolidation took, wall_time_s the reading's.
+  bool from_cache = false;
 };
 
 /// Servo: each step move the wall by gain·(σ3 − p)·L·t/(kn_wall·n_c) toward
@@ -54,7 +58,12 @@ double wall_pressure(const World& world, WallSide side);
 
 /// Consolidate: frictionless servo compression to σ3 until static, then
 /// friction on and static again. Throws std::runtime_error if it cannot.
+/// Through the consolidation cache in consolidation_cache_dir() (the
+/// environment's; consolidation_cache.hpp): the same state, bit for bit.
 ConsolidatedState consolidate(const SceneConfig& config, const Assembly& assembly);
+/// The same through the cache in `cache_dir`; "" consolidates afresh.
+ConsolidatedState consolidate(const SceneConfig& config, const Assembly& assembly,
+                              const std::string& cache_dir);
 
 struct LoadingResult {
   std::vector<MonitorPoint> series;

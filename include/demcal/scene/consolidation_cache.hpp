@@ -1,0 +1,54 @@
+// The on-disk cache of consolidated samples (issue #15): consolidation is
+// the same for every check, run, calibrate, sweep and verify of a scene, so
+// consolidate() keeps its result in a folder, keyed by everything that
+// determines it, and later commands read it back instead of consolidating
+// again. Bit-exact: the state read back is the state consolidate() made
+// (World::save_state), so every result is byte-identical with and without
+// the cache.
+//
+// The folder: $DEMCAL_CACHE_DIR if set ("off" or "" disables the cache),
+// else $XDG_CACHE_HOME/demcal, else $HOME/.cache/demcal. One file per key,
+// consolidated-<SHA-256 of the key>.bin, holding the key itself, the state
+// and a SHA-256 of both: an entry that does not read back whole (cut,
+// damaged, another key under the same name) is ignored and rebuilt, never
+// trusted. Entries are written to a temporary and renamed into place, so
+// concurrent readers and writers (two commands on the same scene) never see
+// half a file; two writers of one key write the same bytes.
+#pragma once
+
+#include <optional>
+#include <string>
+
+#include "demcal/scene/biaxial.hpp"
+#include "demcal/scene/config.hpp"
+#include "demcal/scene/packing.hpp"
+
+namespace demcal {
+
+/// The cache folder from the environment (see the file comment); "" when
+/// the cache is off or there is no home folder.
+std::string consolidation_cache_dir();
+
+/// Everything that determines consolidate()'s result, as text: the
+/// assembly it starts from (a SHA-256 of its disks and box, so the
+/// assembly spec, seed and particle file's content all enter through what
+/// they produce), the material, σ3 and the servo and consolidation
+/// settings, the rotation lock, the kernel options and SIMD path, and the
+/// program (demcal version and a SHA-256 of the running executable, so that
+/// a rebuilt consolidation never reads another build's entries).
+std::string consolidation_key(const SceneConfig& config, const Assembly& assembly);
+
+/// The entry file of `key` in `dir`.
+std::string consolidation_cache_path(const std::string& dir, const std::string& key);
+
+/// The state stored for `key`, or nothing: no entry, or one that does not
+/// read back whole. Never throws.
+std::optional<ConsolidatedState> load_consolidated(const std::string& dir, const std::string& key);
+
+/// Store `state` for `key` (the folder is created). Best effort: a folder
+/// that cannot be written leaves no entry, and is not an error. Returns
+/// whether the entry was written.
+bool store_consolidated(const std::string& dir, const std::string& key,
+                        const ConsolidatedState& state);
+
+}  // namespace demcal

@@ -1,0 +1,196 @@
+// The whole state of a World as bytes, and back (World::save_state,
+// World::load_state): what the consolidation cache stores.
+//
+// Every member is written, the neighbour list and its scratch included, so
+// that a World read back is a copy of the one saved: it rebuilds its list,
+// sums its forces and steps exactly as the original would (a state rebuilt
+// from positions alone would differ in the tangential histories and in when
+// the list is next rebuilt). Numbers are stored as their bytes (native byte
+// order): exact, and readable only by the same build, which is what the
+// cache's key demands anyway. The threads are not state: a World read back
+// starts its own on first use, as a copy does.
+#include <cstring>
+#include <stdexcept>
+#include <type_traits>
+
+#include "demcal/kernel/world.hpp"
+
+namespace demcal {
+
+namespace {
+
+constexpr char kMagic[8] = {'d', 'e', 'm', 'W', 'o', 'r', 'l', 'd'};
+
+template <class T>
+constexpr bool kScalar = std::is_arithmetic_v<T> || std::is_enum_v<T>;
+
+class Writer {
+ public:
+  std::string out;
+
+  template <class T>
+  requires kScalar<T>
+  void operator()(const T& v) { out.append(reinterpret_cast<const char*>(&v), sizeof(T)); }
+  template <class T, class A>
+  requires kScalar<T>
+  void operator()(const std::vector<T, A>& v) {
+    (*this)(static_cast<uint64_t>(v.size()));
+    out.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
+  }
+};
+
+class Reader {
+ public:
+  explicit Reader(std::string_view bytes) : in_(bytes) {}
+
+  template <class T>
+  requires kScalar<T>
+  void operator()(T& v) { take(&v, sizeof(T)); }
+  template <class T, class A>
+  requires kScalar<T>
+  void operator()(std::vector<T, A>& v) {
+    uint64_t n = 0;
+    (*this)(n);
+    if (n > (in_.size() - at_) / sizeof(T)) fail();
+    v.resize(n);
+    take(v.data(), n * sizeof(T));
+  }
+  bool done() const { return at_ == in_.size(); }
+  [[noreturn]] static void fail() {
+    throw std::runtime_error("World::load_state: not the bytes of a saved World");
+  }
+
+ private:
+  void take(void* to, size_t n) {
+    if (n > in_.size() - at_) fail();
+    if (n) std::memcpy(to, in_.data() + at_, n);
+    at_ += n;
+  }
+  std::string_view in_;
+  size_t at_ = 0;
+};
+
+// A new member of these structs must be visited below: the sizes catch one
+// that is not (x86-64 layouts).
+static_assert(sizeof(Material) == 9 * sizeof(double));
+static_assert(sizeof(KernelOptions) == 4 * sizeof(double) + 4 * sizeof(int));
+static_assert(sizeof(Integration) == 5 * sizeof(double));
+static_assert(sizeof(Wall) == 48);  // 4 doubles and an int, 16-byte aligned
+
+}  // namespace
+
+template <class Self, class Visitor>
+void World::visit_state(Self& w, Visitor& v) {
+  for (auto* law : {&w.material_.particle, &w.material_.wall}) {
+    v(law->kn);
+    v(law->kt);
+    v(law->friction);
+  }
+  v(w.material_.density);
+  v(w.material_.thickness);
+  v(w.material_.contact_damping_ratio);
+  auto& o = w.options_;
+  v(o.skin_ratio);
+  v(o.max_overlap_ratio);
+  v(o.check_interval);
+  v(o.max_energy_ratio);
+  v(o.max_energy_created);
+  v(o.energy_check_interval);
+  v(o.threads);
+  auto& in = w.integration_;
+  v(in.dt);
+  v(in.damping_ratio_translation);
+  v(in.damping_ratio_rotation);
+  v(in.mass_scaling);
+  v(in.lock_rotation);
+  v(w.threads_);
+  v(w.n_);
+  v(w.nblocks_);
+  v(w.ghost_);
+  for (auto* a :
+       {&w.x_,       &w.y_,           &w.vx_,          &w.vy_,         &w.theta_,   &w.omega_,
+        &w.r_,       &w.inv_r_,       &w.m_,           &w.inertia_,    &w.fx_,      &w.fy_,
+        &w.tq_,      &w.block_power_, &w.ca_t_,        &w.cb_t_,       &w.ca_r_,    &w.cb_r_,
+        &w.slot_ft_, &w.slot_r_,      &w.new_slot_ft_, &w.new_slot_r_, &w.x_built_, &w.y_built_})
+    v(*a);
+  v(w.wall_dashpot_power_);
+  for (int s = 0; s < 4; ++s) {
+    v(w.wall_ft_[s]);
+    v(w.wall_fn_[s]);
+    v(w.wall_candidates_[s]);
+    v(w.wall_built_[s]);
+    auto& wall = w.walls_[s];
+    v(wall.position);
+    v(wall.velocity);
+    v(wall.force.x());
+    v(wall.force.y());
+    v(wall.contacts);
+  }
+  for (auto* a :
+       {&w.block_slot_, &w.pair_i_, &w.pair_j_, &w.pair_slot_, &w.pair_bounds_, &w.particle_bounds_,
+        &w.nbr_start_, &w.nbr_list_, &w.cell_start_, &w.cell_next_, &w.new_block_slot_})
+    v(*a);
+  v(w.slot_j_);
+  v(w.new_slot_j_);
+  v(w.skin_);
+  v(w.r_max_);
+  v(w.r_min_);
+  v(w.list_valid_);
+  v(w.rebuilds_);
+  v(w.max_overlap_ratio_seen_);
+  v(w.initial_energy_);
+  v(w.energy_scale_);
+  auto& l = w.ledger_;
+  v(l.started);
+  v(l.step);
+  v(l.energy0);
+  v(l.work);
+  v(l.lost);
+  v(l.power_in);
+  v(l.power_lost);
+  v(l.dashpot);
+  v(l.created);
+  v(w.divergence_);
+  v(w.divergence_step_);
+  v(w.steps_);
+  v(w.time_);
+}
+
+std::string World::save_state() const {
+  Writer writer;
+  writer.out.append(kMagic, sizeof kMagic);
+  visit_state(*this, writer);
+  return std::move(writer.out);
+}
+
+World World::load_state(std::string_view bytes) {
+  if (bytes.size() < sizeof kMagic || bytes.substr(0, sizeof kMagic) != std::string_view(kMagic, 8))
+    Reader::fail();
+  Reader reader(bytes.substr(sizeof kMagic));
+  World w;
+  visit_state(w, reader);
+  if (!reader.done()) Reader::fail();
+  // The arrays the passes index by particle, block and slot must fit the
+  // sizes read (a checksum guards the cache's bytes; this guards the reader).
+  const size_t cap = static_cast<size_t>(w.ghost_) + 8;
+  const bool fits =
+      w.n_ >= 0 && w.nblocks_ == (w.n_ + 7) / 8 && w.ghost_ == 8 * w.nblocks_ &&
+      w.x_.size() == cap && w.y_.size() == cap && w.vx_.size() == cap && w.vy_.size() == cap &&
+      w.theta_.size() == cap && w.omega_.size() == cap && w.r_.size() == cap &&
+      w.inv_r_.size() == cap && w.m_.size() == cap && w.inertia_.size() == cap &&
+      w.fx_.size() == cap && w.fy_.size() == cap && w.tq_.size() == cap && w.ca_t_.size() == cap &&
+      w.cb_t_.size() == cap && w.ca_r_.size() == cap && w.cb_r_.size() == cap &&
+      w.block_slot_.size() == static_cast<size_t>(w.nblocks_) + 1 &&
+      w.slot_j_.size() == w.slot_ft_.size() && w.slot_r_.size() == w.slot_ft_.size() &&
+      static_cast<size_t>(w.block_slot_.back()) <= w.slot_j_.size();
+  for (int s = 0; s < 4; ++s)
+    if (w.wall_ft_[s].size() != static_cast<size_t>(w.n_) ||
+        w.wall_fn_[s].size() != static_cast<size_t>(w.n_))
+      Reader::fail();
+  if (!fits) Reader::fail();
+  for (int j : w.slot_j_)
+    if (j < 0 || j > w.ghost_) Reader::fail();
+  return w;
+}
+
+}  // namespace demcal

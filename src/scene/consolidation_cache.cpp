@@ -1,0 +1,207 @@
+#include "demcal/scene/consolidation_cache.hpp"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <sstream>
+
+#include "demcal/io/files.hpp"
+
+namespace demcal {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// The entry's first bytes; the number is the layout of what follows.
+constexpr std::string_view kMagic = "demcal consolidated state 1\n";
+constexpr size_t kDigestHex = 64;  // SHA-256 in hex
+
+std::string hex_float(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%a", v);
+  return buf;
+}
+
+/// SHA-256 of the running program (the build), once per process; "" when it
+/// cannot be read (then the version alone stands for the build).
+const std::string& program_digest() {
+  static const std::string digest = [] {
+    std::ifstream in("/proc/self/exe", std::ios::binary);
+    if (!in) return std::string();
+    const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    return in.bad() ? std::string() : sha256_hex(bytes);
+  }();
+  return digest;
+}
+
+template <class T>
+void put(std::string& out, const T& v) {
+  out.append(reinterpret_cast<const char*>(&v), sizeof(T));
+}
+
+/// Reads what put() wrote; false once the bytes run out.
+class Cursor {
+ public:
+  explicit Cursor(std::string_view bytes) : in_(bytes) {}
+  template <class T>
+  bool get(T& v) {
+    if (sizeof(T) > in_.size() - at_) return false;
+    std::memcpy(&v, in_.data() + at_, sizeof(T));
+    at_ += sizeof(T);
+    return true;
+  }
+  bool get(std::string_view& v, size_t n) {
+    if (n > in_.size() - at_) return false;
+    v = in_.substr(at_, n);
+    at_ += n;
+    return true;
+  }
+  size_t at() const { return at_; }
+
+ private:
+  std::string_view in_;
+  size_t at_ = 0;
+};
+
+std::string encode(const std::string& key, const ConsolidatedState& s) {
+  std::string payload;
+  put(payload, s.steps);
+  put(payload, s.width0);
+  put(payload, s.height0);
+  put(payload, s.stress_error);
+  put(payload, s.unbalanced_ratio);
+  put(payload, s.converged);
+  payload += s.world.save_state();
+  std::string out(kMagic);
+  put(out, static_cast<uint64_t>(key.size()));
+  out += key;
+  put(out, static_cast<uint64_t>(payload.size()));
+  out += payload;
+  out += sha256_hex(out);
+  return out;
+}
+
+std::optional<ConsolidatedState> decode(std::string_view bytes, const std::string& key) {
+  if (bytes.size() < kMagic.size() + kDigestHex || bytes.substr(0, kMagic.size()) != kMagic)
+    return std::nullopt;
+  const std::string_view body = bytes.substr(0, bytes.size() - kDigestHex);
+  if (sha256_hex(body) != bytes.substr(body.size())) return std::nullopt;
+  Cursor c(body.substr(kMagic.size()));
+  uint64_t key_size = 0, payload_size = 0;
+  std::string_view stored_key, payload;
+  if (!c.get(key_size) || !c.get(stored_key, key_size) || stored_key != key ||
+      !c.get(payload_size) || !c.get(payload, payload_size) ||
+      c.at() != body.size() - kMagic.size())
+    return std::nullopt;
+  Cursor p(payload);
+  int64_t steps = 0;
+  double width0 = 0, height0 = 0, stress_error = 0, unbalanced_ratio = 0;
+  bool converged = false;
+  if (!p.get(steps) || !p.get(width0) || !p.get(height0) || !p.get(stress_error) ||
+      !p.get(unbalanced_ratio) || !p.get(converged))
+    return std::nullopt;
+  ConsolidatedState s{World::load_state(payload.substr(p.at()))};  // throws when it does not read
+  s.steps = steps;
+  s.width0 = width0;
+  s.height0 = height0;
+  s.stress_error = stress_error;
+  s.unbalanced_ratio = unbalanced_ratio;
+  s.converged = converged;
+  return s;
+}
+
+}  // namespace
+
+std::string consolidation_cache_dir() {
+  if (const char* d = std::getenv("DEMCAL_CACHE_DIR"))
+    return std::string(d) == "off" ? std::string() : std::string(d);
+  if (const char* x = std::getenv("XDG_CACHE_HOME"); x && *x)
+    return (fs::path(x) / "demcal").string();
+  if (const char* h = std::getenv("HOME"); h && *h)
+    return (fs::path(h) / ".cache" / "demcal").string();
+  return {};
+}
+
+std::string consolidation_key(const SceneConfig& config, const Assembly& a) {
+  std::ostringstream k;
+  k << "demcal " << DEMCAL_VERSION << " consolidation\n"
+    << "program " << program_digest() << "\n"
+    << "simd " << kernel_simd() << "\n";
+  std::string disks;
+  for (const auto* v : {&a.x, &a.y, &a.r})
+    for (double d : *v) put(disks, d);
+  for (double d : {a.left, a.right, a.bottom, a.top}) put(disks, d);
+  k << "assembly " << a.size() << " disks " << sha256_hex(disks) << "\n";
+  const Material& m = config.material;
+  k << "material";
+  for (double d : {m.density, m.thickness, m.particle.kn, m.particle.kt, m.particle.friction,
+                   m.wall.kn, m.wall.kt, m.wall.friction, m.contact_damping_ratio})
+    k << " " << hex_float(d);
+  const TestSpec& t = config.test;
+  k << "\ntest " << hex_float(t.lateral_stress) << " " << hex_float(t.servo_gain) << " "
+    << hex_float(t.consolidation_tolerance) << " " << hex_float(t.consolidation_unbalanced) << " "
+    << t.consolidation_max_steps << "\nlock_rotation " << config.algorithm.lock_rotation;
+  const KernelOptions o;
+  k << "\nkernel " << hex_float(o.skin_ratio) << " " << hex_float(o.max_overlap_ratio) << " "
+    << o.check_interval << " " << hex_float(o.max_energy_ratio) << " "
+    << hex_float(o.max_energy_created) << " " << o.energy_check_interval << " " << o.threads
+    << "\n";
+  return k.str();
+}
+
+std::string consolidation_cache_path(const std::string& dir, const std::string& key) {
+  return (fs::path(dir) / ("consolidated-" + sha256_hex(key) + ".bin")).string();
+}
+
+std::optional<ConsolidatedState> load_consolidated(const std::string& dir, const std::string& key) {
+  try {
+    std::ifstream in(consolidation_cache_path(dir, key), std::ios::binary);
+    if (!in) return std::nullopt;
+    const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (in.bad()) return std::nullopt;
+    auto state = decode(bytes, key);
+    if (state) state->from_cache = true;
+    return state;
+  } catch (const std::exception&) {
+    return std::nullopt;  // bytes that do not read as a state: rebuilt
+  }
+}
+
+bool store_consolidated(const std::string& dir, const std::string& key,
+                        const ConsolidatedState& state) {
+  static std::atomic<int> counter{0};
+  const std::string path = consolidation_cache_path(dir, key);
+  // A name of this process and write of its own (two threads of one process
+  // may store the same key at once).
+  const std::string tmp = (fs::path(dir) / temporary_name(std::to_string(counter++) + "-" +
+                                                          fs::path(path).filename().string()))
+                              .string();
+  try {
+    fs::create_directories(dir);
+    const std::string bytes = encode(key, state);
+    const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+    if (fd < 0) return false;
+    size_t done = 0;
+    while (done < bytes.size()) {
+      const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+      if (n <= 0) break;
+      done += static_cast<size_t>(n);
+    }
+    const bool written = ::close(fd) == 0 && done == bytes.size();
+    if (written && std::rename(tmp.c_str(), path.c_str()) == 0) return true;
+    ::unlink(tmp.c_str());
+  } catch (const std::exception&) {
+    ::unlink(tmp.c_str());
+  }
+  return false;
+}
+
+}  // namespace demcal
