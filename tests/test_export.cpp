@@ -158,6 +158,44 @@ TEST(Export, LiggghtsDeckHasMeshesAndServo) {
   EXPECT_EQ(r.files.count("proto-left.stl"), 1u);
 }
 
+TEST(Export, AConsolidatedStateReadBackGivesTheSameDeck) {
+  // `demcal verify` writes the consolidated prototype (particle_csv); read
+  // back (`export --prototype FILE --no-consolidate`) it carries its walls,
+  // so the deck starts at sigma3 as the one exported from the state does.
+  SceneConfig c = default_config();
+  c.assembly.columns = c.assembly.rows = 5;
+  const ConsolidatedState state = consolidate(c, make_assembly(c));
+  const Assembly a = assembly_of(state.world);
+  std::istringstream csv(particle_csv(a));
+  const Assembly b = read_particles(csv, "prototype.csv");
+  ASSERT_EQ(b.size(), a.size());
+  EXPECT_EQ(b.left, a.left);
+  EXPECT_EQ(b.right, a.right);
+  EXPECT_EQ(b.bottom, a.bottom);
+  EXPECT_EQ(b.top, a.top);
+  // The walls press into the particles (sigma3 on them): not the bounding box.
+  double extent_left = a.x[0] - a.r[0];
+  for (int i = 0; i < a.size(); ++i) extent_left = std::min(extent_left, a.x[i] - a.r[i]);
+  EXPECT_GT(b.left, extent_left);
+  ExportOptions o;
+  o.data_name = "p.data";
+  const ExportResult from_state = export_deck(c, params(), a, o);
+  const ExportResult read_back = export_deck(c, params(), b, o);
+  EXPECT_EQ(read_back.deck, from_state.deck);
+  EXPECT_EQ(read_back.files, from_state.files);
+  // A walls line that presses further than a contact can is an error naming
+  // the file and the line.
+  std::istringstream bad(
+      std::string(kParticleFileWalls) +
+      " 0.0002 0.01 0 0.01\nx,y,r\n0.0005,0.0005,0.0005\n0.0015,0.0005,0.0005\n");
+  try {
+    read_particles(bad, "bad.csv");
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("bad.csv: line 1"), std::string::npos) << e.what();
+  }
+}
+
 class LammpsRun : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(LammpsRun, TheDeckStartsWithOurTimestepAndSigma3OnTheWalls) {

@@ -5,9 +5,11 @@
 #include <array>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <limits>
 #include <numbers>
+#include <optional>
 #include <random>
 #include <sstream>
 
@@ -197,7 +199,9 @@ Assembly read_particles(std::istream& in, const std::string& path) {
   std::vector<int> lines;  // line of each particle, for the overlap error
   std::string line;
   int line_no = 0;
-  bool seen_content = false;  // a header or a particle
+  bool seen_content = false;                   // a header or a particle
+  std::optional<std::array<double, 4>> walls;  // from a kParticleFileWalls line
+  int walls_line = 0;
   auto where = [&]() { return "line " + std::to_string(line_no); };
   while (std::getline(in, line)) {
     ++line_no;
@@ -209,6 +213,21 @@ Assembly read_particles(std::istream& in, const std::string& path) {
           path, where(),
           "holds a NUL byte at column " + std::to_string(nul + 1) + " (not a text line)");
     const auto first = line.find_first_not_of(" \t");
+    if (first != std::string::npos &&
+        line.compare(first, std::strlen(kParticleFileWalls), kParticleFileWalls) == 0) {
+      std::istringstream w(line.substr(first + std::strlen(kParticleFileWalls)));
+      std::array<double, 4> v{};
+      std::string rest;
+      if (!(w >> v[0] >> v[1] >> v[2] >> v[3]) || (w >> rest) ||
+          !std::all_of(v.begin(), v.end(), [](double x) { return std::isfinite(x); }) ||
+          !(v[0] < v[1] && v[2] < v[3]))
+        throw InputError(path, where(),
+                         "walls: expected four finite numbers left < right, bottom < top, got " +
+                             quoted_value(line));
+      walls = v;
+      walls_line = line_no;
+      continue;
+    }
     if (first == std::string::npos || line[first] == '#') continue;
     std::vector<std::string> fields;
     std::stringstream ss(line);
@@ -259,6 +278,25 @@ Assembly read_particles(std::istream& in, const std::string& path) {
     a.right = std::max(a.right, a.x[i] + a.r[i]);
     a.bottom = std::min(a.bottom, a.y[i] - a.r[i]);
     a.top = std::max(a.top, a.y[i] + a.r[i]);
+  }
+  if (walls) {
+    // A wall may press into the particles as a contact does (a consolidated
+    // state), never further; it may stand off them (a gas in its box).
+    const double r_min = *std::min_element(a.r.begin(), a.r.end());
+    const double slack = 0.05 * r_min;
+    const auto [l, r, b, t] = *walls;
+    const bool ok =
+        l <= a.left + slack && r >= a.right - slack && b <= a.bottom + slack && t >= a.top - slack;
+    if (!ok)
+      throw InputError(path, "line " + std::to_string(walls_line),
+                       "walls press into the particles by more than 5 % of the smallest radius "
+                       "(their extent is [" +
+                           std::to_string(a.left) + ", " + std::to_string(a.right) + "] x [" +
+                           std::to_string(a.bottom) + ", " + std::to_string(a.top) + "])");
+    a.left = l;
+    a.right = r;
+    a.bottom = b;
+    a.top = t;
   }
   return a;
 }

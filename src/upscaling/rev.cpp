@@ -413,7 +413,13 @@ RevResult make_rev(const SceneConfig& config, const Assembly& prototype, const R
 }
 
 std::string particle_csv(const Assembly& a) {
-  std::string s = "x,y,r\n";
+  // The walls first, as a comment (readers of plain x,y,r skip it;
+  // read_particles takes it): a consolidated state read back starts at its
+  // walls, not at its bounding box with zero wall stress.
+  char walls[160];
+  std::snprintf(walls, sizeof walls, "%s %.17g %.17g %.17g %.17g\n", kParticleFileWalls, a.left,
+                a.right, a.bottom, a.top);
+  std::string s = std::string(walls) + "x,y,r\n";
   char line[96];
   for (int i = 0; i < a.size(); ++i) {
     std::snprintf(line, sizeof line, "%.17g,%.17g,%.17g\n", a.x[i], a.y[i], a.r[i]);

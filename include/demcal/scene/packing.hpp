@@ -31,7 +31,12 @@ Assembly square_packing(int columns, int rows, double radius);
 /// grid; consolidation makes it dense (frictionless compression, then
 /// friction on). Deterministic for a seed on every platform.
 Assembly random_gas(const AssemblySpec& spec);
-/// CSV x,y,r (header optional, '#' comments); walls at the bounding box.
+/// The comment line that gives a particle file's walls:
+/// "# walls left right bottom top: L R B T" (written by particle_csv).
+inline constexpr const char kParticleFileWalls[] = "# walls left right bottom top:";
+/// CSV x,y,r (header optional, '#' comments); walls at the bounding box, or
+/// where a kParticleFileWalls line puts them (none pressing more than 5 %
+/// of the smallest radius into the particles' extent, like an overlap).
 /// Errors name the file and the line.
 Assembly read_particle_file(const std::string& path);
 /// The same from a stream; `source` names it in errors.
