@@ -14,11 +14,16 @@
 #                      THREADS threads; medians over the rounds are printed
 #   PATHS="default avx2"  demcal SIMD paths (DEMCAL_SIMD; default = the widest)
 #   THREADS=2          threads of the extra demcal run (pinned to cores 0..T-1;
-#                      1: no such run)
+#                      1: no such run), only from THREADS_MIN spheres on
+#   THREADS_MIN=50000  (small samples run single-threaded: a calibration
+#                      runs trials in parallel instead)
 #   CORE=0             the core the one-core runs are pinned to (taskset)
 #   KEEP=dir           keep the raw outputs there
 # Timing excludes set-up in both: demcal times SphereWorld::step(nsteps),
-# LAMMPS reports "Loop time" of the second `run`. Both print the particle
+# LAMMPS reports "Loop time" of the second `run`. The one-core rates are CPU
+# time (demcal: clock(); LAMMPS: Loop time × its "% CPU use"), so that a
+# busy machine (other processes on the pinned core) slows neither engine's
+# figure; the thread speed-up is wall time (2 threads against 1, same round). Both print the particle
 # contacts at the end: they must agree, or the comparison is not of the same
 # computation. The machine may be shared: the load average is printed at
 # the start and the end, and every raw line is kept (KEEP).
@@ -30,6 +35,7 @@ PS_TARGET="${PS_TARGET:-2e7}"
 REPS="${REPS:-3}"
 PATHS="${PATHS:-default avx2}"
 THREADS="${THREADS:-2}"
+THREADS_MIN="${THREADS_MIN:-50000}"
 CORE="${CORE:-0}"
 if ! command -v lmp >/dev/null 2>&1; then
   echo "lmp (LAMMPS) not found: nothing compared."
@@ -50,6 +56,8 @@ field() { sed -n "s/.* $1=\([^ ]*\).*/\1/p" <<<"$2"; }
 header="spheres steps"
 for p in $PATHS; do header+=" demcal_${p}_ps/s ratio_${p}"; done
 header+=" lammps_ps/s contacts"
+# the thread columns: wall-clock rate of the THREADS run and its speed-up
+# over the one-thread wall-clock rate of the first path, same rounds
 [[ "$THREADS" -gt 1 ]] && header+=" demcal_${THREADS}thr_ps/s speedup_${THREADS}thr"
 echo "# medians over $REPS alternating rounds; ratio = demcal/LAMMPS per particle-step"
 echo "$header"
@@ -59,22 +67,25 @@ for n in $CELLS; do
   pre=$((steps / 10))
   "$driver" --cells "$n" --write-lammps "$work/fcc$n" --no-run
   declare -A rates=()
-  lrates="" trates="" dcon="" lcon=""
+  lrates="" trates="" wall1="" dcon="" lcon=""
   for rep in $(seq "$REPS"); do
     for p in $PATHS; do
       if [[ "$p" == default ]]; then env=(env -u DEMCAL_SIMD); else env=(env DEMCAL_SIMD="$p"); fi
       d=$("${env[@]}" "${pin[@]}" "$driver" --cells "$n" --steps "$steps" --preload "$pre")
       echo "$d" >>"$work/raw.txt"
-      rates[$p]+=" $(field particle_steps_per_s "$d")"
+      rates[$p]+=" $(python3 -c "print($spheres * $steps / $(field cpu_seconds "$d"))")"
+      [[ "$p" == "${PATHS%% *}" ]] && wall1+=" $(field particle_steps_per_s "$d")"
       dcon=$(field contacts "$d")
     done
     (cd "$work" && "${pin[@]}" lmp -in "$here/lammps/in.sphere_compress" -var prefix "fcc$n" \
         -var npre "$pre" -var nsteps "$steps" -log "log$n.$rep" -screen none >/dev/null)
     loop=$(sed -n 's/^Loop time of \([^ ]*\).*/\1/p' "$work/log$n.$rep" | tail -1)
+    pct=$(sed -n 's/^\([0-9.]*\)% CPU use.*/\1/p' "$work/log$n.$rep" | tail -1)
+    loop=$(python3 -c "print($loop * ${pct:-100} / 100)")
     lcon=$(awk '/^ *Step/{h=1;next} h&&NF==4&&$1~/^[0-9]+$/{c=$3} /^Loop time/{h=0} END{print c}' "$work/log$n.$rep")
     echo "engine=lammps particles=$spheres steps=$steps loop_seconds=$loop contacts=$lcon" >>"$work/raw.txt"
     lrates+=" $(python3 -c "print($spheres * $steps / $loop)")"
-    if [[ "$THREADS" -gt 1 ]]; then
+    if [[ "$THREADS" -gt 1 && "$spheres" -ge "$THREADS_MIN" ]]; then
       d=$(taskset -c "0-$((THREADS - 1))" "$driver" --cells "$n" --steps "$steps" --preload "$pre" \
           --threads "$THREADS")
       echo "$d" >>"$work/raw.txt"
@@ -88,9 +99,9 @@ for n in $CELLS; do
     line+=" $m $(python3 -c "print('%.2f' % ($m / $lmed))")"
   done
   line+=" $lmed $dcon/$lcon"
-  if [[ "$THREADS" -gt 1 ]]; then
+  if [[ -n "$trates" ]]; then
     t=$(median $trates)
-    line+=" $t $(python3 -c "print('%.2f' % ($t / $(median ${rates[default]:-${rates[${PATHS%% *}]}})))")"
+    line+=" $t $(python3 -c "print('%.2f' % ($t / $(median $wall1)))")"
   fi
   echo "$line"
   unset rates
