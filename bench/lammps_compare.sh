@@ -9,6 +9,8 @@
 #   REPS=5            repetitions per engine and size (alternating demcal, LAMMPS)
 #   SIZES="100 400 10000 100000"   hexagonal sizes (side = round(sqrt(N)))
 #   RANDOM400=1       also the random polydisperse 400-disk scene (0: skip)
+#   SPHERES=0         1: then the 3D side by side too (lammps_compare_sphere.sh,
+#                     same BUILD_DIR; it needs bench_sphere_side_by_side)
 #   CORE=0            the core both engines are pinned to (taskset)
 #   PS_TARGET=4e7     particle-steps per timed run (sets the step count; at most
 #                     2e5 steps, i.e. 2 % strain of the top wall)
@@ -142,3 +144,8 @@ for kind, n in cases:
           f"| {d['wyy']:.5g} / {l['wyy']:.5g} |")
 print(f"\n(reps per cell: {summary(*cases[0], 'demcal', 5)['reps']}; spread = min and max over the reps)")
 PY
+if [[ "${SPHERES:-0}" == 1 ]]; then
+  echo
+  echo "# 3D: spheres (bench/lammps_compare_sphere.sh)"
+  "$here/lammps_compare_sphere.sh" "$build"
+fi

@@ -7,18 +7,35 @@
 # BUILD_DIR (default: build/) must hold bench_sphere_side_by_side
 # (cmake -DDEMCAL_BUILD_BENCH=ON, target bench_sphere_side_by_side).
 # Environment knobs:
-#   CELLS="4 10 19"   FCC cells per side (4n³ spheres: 256, 4000, 27436)
-#   PS_TARGET=2e7     particle-steps per timed run
-#   CORE=0            the core both engines are pinned to (taskset)
+#   CELLS="4 10 29"    FCC cells per side (4n³ spheres: 256, 4000, 97556)
+#   PS_TARGET=2e7      particle-steps per timed run
+#   REPS=3             rounds; each round runs, alternately, demcal on every
+#                      path of PATHS, LAMMPS, and (if THREADS > 1) demcal on
+#                      THREADS threads; medians over the rounds are printed
+#   PATHS="default avx2"  demcal SIMD paths (DEMCAL_SIMD; default = the widest)
+#   THREADS=2          threads of the extra demcal run (pinned to cores 0..T-1;
+#                      1: no such run), only from THREADS_MIN spheres on
+#   THREADS_MIN=50000  (small samples run single-threaded: a calibration
+#                      runs trials in parallel instead)
+#   CORE=0             the core the one-core runs are pinned to (taskset)
+#   KEEP=dir           keep the raw outputs there
 # Timing excludes set-up in both: demcal times SphereWorld::step(nsteps),
-# LAMMPS reports "Loop time" of the second `run`. Both print the particle
+# LAMMPS reports "Loop time" of the second `run`. The one-core rates are CPU
+# time (demcal: clock(); LAMMPS: Loop time × its "% CPU use"), so that a
+# busy machine (other processes on the pinned core) slows neither engine's
+# figure; the thread speed-up is wall time (2 threads against 1, same round). Both print the particle
 # contacts at the end: they must agree, or the comparison is not of the same
-# computation. One run each: on a loaded machine say the load (printed).
+# computation. The machine may be shared: the load average is printed at
+# the start and the end, and every raw line is kept (KEEP).
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 build="${1:-$here/../build}"
-CELLS="${CELLS:-4 10 19}"
+CELLS="${CELLS:-4 10 29}"
 PS_TARGET="${PS_TARGET:-2e7}"
+REPS="${REPS:-3}"
+PATHS="${PATHS:-default avx2}"
+THREADS="${THREADS:-2}"
+THREADS_MIN="${THREADS_MIN:-50000}"
 CORE="${CORE:-0}"
 if ! command -v lmp >/dev/null 2>&1; then
   echo "lmp (LAMMPS) not found: nothing compared."
@@ -26,27 +43,67 @@ if ! command -v lmp >/dev/null 2>&1; then
 fi
 driver="$build/bench_sphere_side_by_side"
 [[ -x "$driver" ]] || { echo "error: $driver not found" >&2; exit 1; }
-work="$(mktemp -d)"; trap 'rm -rf "$work"' EXIT
+work="${KEEP:-$(mktemp -d)}"
+mkdir -p "$work"
+[[ -n "${KEEP:-}" ]] || trap 'rm -rf "$work"' EXIT
 export OMP_NUM_THREADS=1
 pin=(taskset -c "$CORE")
 echo "# machine: $(lscpu | sed -n 's/^Model name: *//p' | head -1), $(nproc) cores; pinned to core $CORE"
 echo "# $(lmp -h | grep -m1 'Large-scale' | sed 's/^ *//')"
 echo "# start $(date -u +%FT%TZ), load average $(cut -d' ' -f1-3 /proc/loadavg)"
-printf "%8s %10s %14s %14s %8s %10s\n" spheres steps demcal_ps/s lammps_ps/s ratio contacts
+median() { python3 -c "import statistics,sys; print('%.4g' % statistics.median(float(v) for v in sys.argv[1:]))" "$@"; }
+field() { sed -n "s/.* $1=\([^ ]*\).*/\1/p" <<<"$2"; }
+header="spheres steps"
+for p in $PATHS; do header+=" demcal_${p}_ps/s ratio_${p}"; done
+header+=" lammps_ps/s contacts"
+# the thread columns: wall-clock rate of the THREADS run and its speed-up
+# over the one-thread wall-clock rate of the first path, same rounds
+[[ "$THREADS" -gt 1 ]] && header+=" demcal_${THREADS}thr_ps/s speedup_${THREADS}thr"
+echo "# medians over $REPS alternating rounds; ratio = demcal/LAMMPS per particle-step"
+echo "$header"
 for n in $CELLS; do
   spheres=$((4 * n * n * n))
-  steps=$(python3 -c "print(max(200, int(float('$PS_TARGET') / $spheres)))")
+  steps=$(python3 -c "print(max(100, int(float('$PS_TARGET') / $spheres)))")
   pre=$((steps / 10))
   "$driver" --cells "$n" --write-lammps "$work/fcc$n" --no-run
-  d=$("${pin[@]}" "$driver" --cells "$n" --steps "$steps" --preload "$pre")
-  dps=$(sed -n 's/.*particle_steps_per_s=\([^ ]*\).*/\1/p' <<<"$d")
-  dcon=$(sed -n 's/.*contacts=\([^ ]*\).*/\1/p' <<<"$d")
-  (cd "$work" && "${pin[@]}" lmp -in "$here/lammps/in.sphere_compress" -var prefix "fcc$n" \
-      -var npre "$pre" -var nsteps "$steps" -log "log$n" -screen none >/dev/null)
-  loop=$(sed -n 's/^Loop time of \([^ ]*\).*/\1/p' "$work/log$n" | tail -1)
-  lcon=$(awk '/^ *Step/{h=1;next} h&&NF==4&&$1~/^[0-9]+$/{c=$3} /^Loop time/{h=0} END{print c}' "$work/log$n")
-  lps=$(python3 -c "print('%.3g' % ($spheres * $steps / $loop))")
-  ratio=$(python3 -c "print('%.2f' % ($dps / ($spheres * $steps / $loop)))")
-  printf "%8d %10d %14.3g %14s %8s %10s\n" "$spheres" "$steps" "$dps" "$lps" "$ratio" "$dcon/$lcon"
+  declare -A rates=()
+  lrates="" trates="" wall1="" dcon="" lcon=""
+  for rep in $(seq "$REPS"); do
+    for p in $PATHS; do
+      if [[ "$p" == default ]]; then env=(env -u DEMCAL_SIMD); else env=(env DEMCAL_SIMD="$p"); fi
+      d=$("${env[@]}" "${pin[@]}" "$driver" --cells "$n" --steps "$steps" --preload "$pre")
+      echo "$d" >>"$work/raw.txt"
+      rates[$p]+=" $(python3 -c "print($spheres * $steps / $(field cpu_seconds "$d"))")"
+      [[ "$p" == "${PATHS%% *}" ]] && wall1+=" $(field particle_steps_per_s "$d")"
+      dcon=$(field contacts "$d")
+    done
+    (cd "$work" && "${pin[@]}" lmp -in "$here/lammps/in.sphere_compress" -var prefix "fcc$n" \
+        -var npre "$pre" -var nsteps "$steps" -log "log$n.$rep" -screen none >/dev/null)
+    loop=$(sed -n 's/^Loop time of \([^ ]*\).*/\1/p' "$work/log$n.$rep" | tail -1)
+    pct=$(sed -n 's/^\([0-9.]*\)% CPU use.*/\1/p' "$work/log$n.$rep" | tail -1)
+    loop=$(python3 -c "print($loop * ${pct:-100} / 100)")
+    lcon=$(awk '/^ *Step/{h=1;next} h&&NF==4&&$1~/^[0-9]+$/{c=$3} /^Loop time/{h=0} END{print c}' "$work/log$n.$rep")
+    echo "engine=lammps particles=$spheres steps=$steps loop_seconds=$loop contacts=$lcon" >>"$work/raw.txt"
+    lrates+=" $(python3 -c "print($spheres * $steps / $loop)")"
+    if [[ "$THREADS" -gt 1 && "$spheres" -ge "$THREADS_MIN" ]]; then
+      d=$(taskset -c "0-$((THREADS - 1))" "$driver" --cells "$n" --steps "$steps" --preload "$pre" \
+          --threads "$THREADS")
+      echo "$d" >>"$work/raw.txt"
+      trates+=" $(field particle_steps_per_s "$d")"
+    fi
+  done
+  lmed=$(median $lrates)
+  line="$spheres $steps"
+  for p in $PATHS; do
+    m=$(median ${rates[$p]})
+    line+=" $m $(python3 -c "print('%.2f' % ($m / $lmed))")"
+  done
+  line+=" $lmed $dcon/$lcon"
+  if [[ -n "$trates" ]]; then
+    t=$(median $trates)
+    line+=" $t $(python3 -c "print('%.2f' % ($t / $(median $wall1)))")"
+  fi
+  echo "$line"
+  unset rates
 done
 echo "# end $(date -u +%FT%TZ), load average $(cut -d' ' -f1-3 /proc/loadavg)"

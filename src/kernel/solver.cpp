@@ -105,6 +105,12 @@ TeamHandle& TeamHandle::operator=(const TeamHandle&) noexcept {
 TeamHandle& TeamHandle::operator=(TeamHandle&&) noexcept = default;
 TeamHandle::~TeamHandle() = default;
 
+void team_run(TeamHandle& handle, int size, void (*fn)(void*, int), void* ctx) {
+  if (handle.team && handle.team->size() != size) handle.team.reset();
+  if (!handle.team) handle.team = std::make_unique<KernelTeam>(size);
+  handle.team->run(fn, ctx);
+}
+
 }  // namespace detail
 
 namespace {

@@ -1,15 +1,30 @@
 // Broad phase of the sphere kernel: cell grid + Verlet skin, as the 2D
-// kernel's (broad_phase.cpp). The list holds every pair i < j closer than
-// r_i + r_j + skin, row by row sorted by j; it is rebuilt only when some
-// particle (or a wall) has moved far enough that a pair outside it could
-// touch (the displacement scan is fused into the integration,
-// sphere_world.cpp). A pair's tangential history carries over a rebuild.
+// kernel's (broad_phase.cpp). The list holds every pair closer than
+// r_i + r_j + skin, from both sides, in sliced ELLPACK blocks of 8
+// (sphere_world.hpp), each particle's neighbours in increasing index; the
+// half list (i < j) beside it points to i's copy of each pair. It is
+// rebuilt only when some particle (or a wall) has moved far enough that a
+// pair outside it could touch (the displacement scan is fused into the
+// integration pass). A pair's tangential history carries over a rebuild in
+// both copies.
 #include <algorithm>
 #include <cmath>
 
 #include "demcal/kernel/sphere_world.hpp"
 
 namespace demcal {
+
+namespace {
+constexpr int kBlock = 8;
+}
+
+double SphereWorld::neighbour_slot_fill() const {
+  const int slots = block_slot_[nblocks_];
+  if (slots == 0) return 1.0;
+  int real = 0;
+  for (int s = 0; s < slots; ++s) real += slot_j_[s] != ghost_;
+  return static_cast<double>(real) / slots;
+}
 
 bool SphereWorld::needs_rebuild() const {
   if (!list_valid_) return true;
@@ -61,16 +76,14 @@ void SphereWorld::rebuild_neighbours() {
     cell_start_[k] = i;
   }
 
-  // Half list (j > i), each row sorted; histories merged from the old list.
-  new_start_.assign(static_cast<size_t>(n) + 1, 0);
-  new_j_.clear();
-  new_hx_.clear();
-  new_hy_.clear();
-  new_hz_.clear();
+  // Full lists (CSR), each sorted by index. The cut-off test is symmetric
+  // in i and j bit for bit, so j is i's neighbour iff i is j's.
+  full_start_.assign(static_cast<size_t>(n) + 1, 0);
+  full_j_.clear();
   for (int i = 0; i < n; ++i) {
     std::array<int, 3> c;
     cell_of(i, c);
-    const size_t first = new_j_.size();
+    const size_t first = full_j_.size();
     for (int dz = -1; dz <= 1; ++dz)
       for (int dy = -1; dy <= 1; ++dy)
         for (int dx = -1; dx <= 1; ++dx) {
@@ -78,30 +91,65 @@ void SphereWorld::rebuild_neighbours() {
           if (o[0] < 0 || o[0] >= nc[0] || o[1] < 0 || o[1] >= nc[1] || o[2] < 0 || o[2] >= nc[2])
             continue;
           for (int j = cell_start_[index(o)]; j >= 0; j = cell_next_[j]) {
-            if (j <= i) continue;
+            if (j == i) continue;
             const double ddx = x_[j] - x_[i], ddy = y_[j] - y_[i], ddz = z_[j] - z_[i];
             const double cut = r_[i] + r_[j] + skin_;
-            if (ddx * ddx + ddy * ddy + ddz * ddz < cut * cut) new_j_.push_back(j);
+            if (ddx * ddx + ddy * ddy + ddz * ddz < cut * cut) full_j_.push_back(j);
           }
         }
-    std::sort(new_j_.begin() + static_cast<std::ptrdiff_t>(first), new_j_.end());
-    new_start_[i + 1] = static_cast<int>(new_j_.size());
-    // Carry the histories over by a merge of the two sorted rows.
-    int o = nbr_start_[i];
-    const int old_end = nbr_start_[i + 1];
-    for (size_t k = first; k < new_j_.size(); ++k) {
-      while (o < old_end && nbr_j_[o] < new_j_[k]) ++o;
-      const bool kept = o < old_end && nbr_j_[o] == new_j_[k];
-      new_hx_.push_back(kept ? hx_[o] : 0.0);
-      new_hy_.push_back(kept ? hy_[o] : 0.0);
-      new_hz_.push_back(kept ? hz_[o] : 0.0);
-    }
+    std::sort(full_j_.begin() + static_cast<std::ptrdiff_t>(first), full_j_.end());
+    full_start_[i + 1] = static_cast<int>(full_j_.size());
   }
-  nbr_start_.swap(new_start_);
-  nbr_j_.swap(new_j_);
+
+  // Sliced ELLPACK: block b gets as many rows as its longest list.
+  new_block_slot_.assign(static_cast<size_t>(nblocks_) + 1, 0);
+  for (int b = 0; b < nblocks_; ++b) {
+    int rows = 0;
+    for (int i = kBlock * b; i < std::min(n, kBlock * (b + 1)); ++i)
+      rows = std::max(rows, full_start_[i + 1] - full_start_[i]);
+    new_block_slot_[b + 1] = new_block_slot_[b] + kBlock * rows;
+  }
+  const size_t ns = static_cast<size_t>(new_block_slot_[nblocks_]);
+  new_slot_j_.assign(ns, ghost_);
+  new_slot_r_.assign(ns, 0.0);
+  new_hx_.assign(ns, 0.0);
+  new_hy_.assign(ns, 0.0);
+  new_hz_.assign(ns, 0.0);
+  nbr_start_.assign(static_cast<size_t>(n) + 1, 0);
+  nbr_j_.clear();
+  pair_slot_.clear();
+  for (int i = 0; i < n; ++i) {
+    const int b = i / kBlock, lane = i % kBlock;
+    const int nb = new_block_slot_[b] + lane;
+    // Carry the histories over by a merge with the old slots of i (in
+    // increasing j, then ghosts).
+    int o = block_slot_[b] + lane;
+    const int old_end = block_slot_[b + 1];
+    for (int k = full_start_[i]; k < full_start_[i + 1]; ++k) {
+      const int j = full_j_[k];
+      const int s = nb + kBlock * (k - full_start_[i]);
+      new_slot_j_[s] = j;
+      new_slot_r_[s] = r_[j];
+      while (o < old_end && slot_j_[o] < j) o += kBlock;
+      if (o < old_end && slot_j_[o] == j) {
+        new_hx_[s] = hx_[o];
+        new_hy_[s] = hy_[o];
+        new_hz_[s] = hz_[o];
+      }
+      if (j > i) {
+        nbr_j_.push_back(j);
+        pair_slot_.push_back(s);
+      }
+    }
+    nbr_start_[i + 1] = static_cast<int>(nbr_j_.size());
+  }
+  block_slot_.swap(new_block_slot_);
+  slot_j_.swap(new_slot_j_);
+  slot_r_.swap(new_slot_r_);
   hx_.swap(new_hx_);
   hy_.swap(new_hy_);
   hz_.swap(new_hz_);
+  update_thread_bounds();
 
   // Wall candidates: particles within skin of a wall.
   for (int s = 0; s < 6; ++s) {
@@ -116,9 +164,9 @@ void SphereWorld::rebuild_neighbours() {
     }
   }
 
-  x_built_ = x_;
-  y_built_ = y_;
-  z_built_ = z_;
+  std::copy(x_.begin(), x_.begin() + n, x_built_.begin());
+  std::copy(y_.begin(), y_.begin() + n, y_built_.begin());
+  std::copy(z_.begin(), z_.begin() + n, z_built_.begin());
   for (int s = 0; s < 6; ++s) wall_built_[s] = walls_[s].position;
   list_valid_ = true;
 }

@@ -40,122 +40,426 @@
 // step just past the stable one rattles contacts open and shut, and the
 // ledger without them reads strongly negative.
 //
+// The pair pass (pair_blocks) runs over the full neighbour list in blocks
+// of 8 particles, W lanes at a time on the SIMD path of this machine (the
+// 2D kernel's, simd.hpp): each particle's force and torque are a plain sum
+// over its own slots, so every pair is evaluated twice, once from either
+// side, by the same instructions with i and j swapped. Every quantity the
+// history depends on is then invariant or exactly negated under the swap,
+// also under FMA contraction: n, v_rel, h and the twist are negated, δ,
+// the lever arms' sums and |h| are invariant, and the lever-arm term
+// a_i·ω_i + a_j·ω_j is written ½[(ω_i + ω_j)(a_i + a_j) + (ω_i − ω_j)(a_i −
+// a_j)] (the plain form is not symmetric once one product is fused). So
+// the two copies of a pair's history stay exact opposites and so do the
+// forces on i and j; the torques a_i·n × h and a_j·n × h come out of the
+// same n × h. The twist is applied even when it is 0 (the identity then).
+//
 // Walls: the inward normal g is fixed and the wall does not rotate, so a
 // wall history stays in the wall plane with no turning; the contact point is
 // the foot of the centre on the plane (lever arm −dist·g).
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 #include "demcal/kernel/sphere_world.hpp"
+#include "simd.hpp"
 
 namespace demcal {
 
 namespace {
 using V3 = Eigen::Vector3d;
 
-/// Turn a tangential history h onto the plane normal to the unit vector n
-/// (projection rescaled to the former length), then about n by `twist`.
-V3 turn_history(const V3& h, const V3& n, double twist) {
-  const double mag2 = h.squaredNorm();
-  if (mag2 == 0.0) return h;
-  V3 p = h - h.dot(n) * n;
-  const double p2 = p.squaredNorm();
-  if (p2 == 0.0) return V3::Zero();  // h along the new normal: no direction left
-  p *= std::sqrt(mag2 / p2);
-  if (twist != 0.0) {
-    // Rotation about n by 2·atan(twist/2) (Cayley form: exactly a rotation,
-    // length kept, the angle off by twist³/12 — far below the O(ΩΔt)² per
-    // step of the scheme — and no trigonometric call per contact).
-    const double c = 0.5 * twist, q = 1.0 / (1.0 + c * c);
-    p = p * ((1.0 - c * c) * q) + n.cross(p) * (2.0 * c * q);
-  }
-  return p;
+constexpr int kBlock = 8;
+
+struct PairArgs {
+  const int *__restrict block_slot;
+  const int *__restrict slot_j;
+  double *__restrict hx, *__restrict hy, *__restrict hz;
+  const double *__restrict slot_r;
+  const double *__restrict x, *__restrict y, *__restrict z;
+  const double *__restrict vx, *__restrict vy, *__restrict vz;
+  const double *__restrict wx, *__restrict wy, *__restrict wz;
+  const double *__restrict r, *__restrict inv_r, *__restrict m;
+  double *__restrict fx, *__restrict fy, *__restrict fz;
+  double *__restrict tx, *__restrict ty, *__restrict tz;
+  double *__restrict block_released, *__restrict block_slid;
+  double kn, kdt, half_dt, mu, beta2;  // beta2 = 2·contact damping ratio
+};
+
+// v itself, rounded: the compiler cannot fuse it into an FMA with what
+// follows (an empty asm the value must pass through).
+template <int W>
+DEMCAL_INLINE typename Simd<W>::D rounded(typename Simd<W>::D v) {
+#ifdef DEMCAL_X86_64
+  if constexpr (W == 8)
+    asm("" : "+v"(v));
+  else
+    asm("" : "+x"(v));
+#endif
+  return v;
 }
+
+// Normal geometry and force of a pair: unit normal, overlap, normal force
+// (0 when apart), contact flag. One home for the pair pass and the scalar
+// re-evaluation (SphereWorld::pair_geometry, through one_pair below on the
+// same SIMD path), so that both round alike, FMA contractions included.
+template <int W>
+struct Normal {
+  typename Simd<W>::D nx, ny, nz, ov, fn;
+  typename Simd<W>::M touch;
+};
+template <int W, bool kDamped>
+DEMCAL_INLINE Normal<W> normal_part(typename Simd<W>::D dx, typename Simd<W>::D dy,
+                                    typename Simd<W>::D dz, typename Simd<W>::D ri,
+                                    typename Simd<W>::D rj, typename Simd<W>::D dvx,
+                                    typename Simd<W>::D dvy, typename Simd<W>::D dvz,
+                                    typename Simd<W>::D mi, typename Simd<W>::D mj, double kn,
+                                    double beta2) {
+  using D = typename Simd<W>::D;
+  const D zero{};
+  Normal<W> g;
+  // The squared distance without FMA contraction (rounded products, as
+  // the scalar |d|² of the tests and the old scalar kernel): the overlap
+  // rs − d cancels most of d, so its last bits are the overlap's.
+  const D d2 = rounded<W>(dx * dx) + rounded<W>(dy * dy) + rounded<W>(dz * dz);
+  const D rs = ri + rj;
+  g.touch = d2 < rs * rs;
+  const D d = vsqrt(d2);
+  const D inv = 1.0 / d;
+  g.nx = dx * inv;
+  g.ny = dy * inv;
+  g.nz = dz * inv;
+  g.ov = rs - d;
+  D fn = kn * g.ov;
+  if constexpr (kDamped) {
+    const D meff = mi * mj / (mi + mj);
+    const D vn = dvx * g.nx + dvy * g.ny + dvz * g.nz;  // > 0 when separating
+    fn = fn - beta2 * vsqrt(kn * meff) * vn;
+    fn = fn > zero ? fn : zero;
+  }
+  g.fn = select<W>(g.touch, fn, zero);
+  return g;
+}
+
+template <int W>
+DEMCAL_INLINE typename Simd<W>::D lane0(double v) {
+  typename Simd<W>::D r{};
+  r[0] = v;
+  return r;
+}
+
+// One pair through normal_part on lane 0: in = {dx, dy, dz, r_i, r_j, dvx,
+// dvy, dvz, m_i, m_j, kn, 2ζ}, out = {nx, ny, nz, overlap, fn, touching}.
+template <int W>
+DEMCAL_INLINE void one_pair(const double *in, double *out) {
+  const Normal<W> g =
+      in[11] > 0.0
+          ? normal_part<W, true>(lane0<W>(in[0]), lane0<W>(in[1]), lane0<W>(in[2]), lane0<W>(in[3]),
+                                 lane0<W>(in[4]), lane0<W>(in[5]), lane0<W>(in[6]), lane0<W>(in[7]),
+                                 lane0<W>(in[8]), lane0<W>(in[9]), in[10], in[11])
+          : normal_part<W, false>(lane0<W>(in[0]), lane0<W>(in[1]), lane0<W>(in[2]),
+                                  lane0<W>(in[3]), lane0<W>(in[4]), lane0<W>(in[5]),
+                                  lane0<W>(in[6]), lane0<W>(in[7]), lane0<W>(in[8]),
+                                  lane0<W>(in[9]), in[10], in[11]);
+  out[0] = g.nx[0];
+  out[1] = g.ny[0];
+  out[2] = g.nz[0];
+  out[3] = g.ov[0];
+  out[4] = g.fn[0];
+  out[5] = g.touch[0] ? 1.0 : 0.0;
+}
+
+template <int W>
+DEMCAL_INLINE double hsum(typename Simd<W>::D v) {
+  double s = v[0];
+  for (int l = 1; l < W; ++l) s += v[l];
+  return s;
+}
+
+// Forces and torques of blocks [b0, b1): each particle's sum over its own
+// slots, written (not added). Returns the largest overlap/r_own (over both
+// copies of a pair: overlap/min(r_i, r_j)).
+template <int W, bool kDamped>
+DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
+  using D = typename Simd<W>::D;
+  using M = typename Simd<W>::M;
+  const D zero{}, one = zero + 1.0;
+  D mo = zero;
+  const double kn = a.kn, kdt = a.kdt, half_dt = a.half_dt, mu = a.mu;
+  for (int b = b0; b < b1; ++b) {
+    const int s0 = a.block_slot[b], s1 = a.block_slot[b + 1];
+    D released = zero, slid = zero;
+    for (int sub = 0; sub < kBlock; sub += W) {
+      const int i0 = kBlock * b + sub;
+      const D xi = load<W>(a.x + i0), yi = load<W>(a.y + i0), zi = load<W>(a.z + i0);
+      const D vxi = load<W>(a.vx + i0), vyi = load<W>(a.vy + i0), vzi = load<W>(a.vz + i0);
+      const D wxi = load<W>(a.wx + i0), wyi = load<W>(a.wy + i0), wzi = load<W>(a.wz + i0);
+      const D ri = load<W>(a.r + i0), iri = load<W>(a.inv_r + i0);
+      D mi = zero;
+      if constexpr (kDamped) mi = load<W>(a.m + i0);
+      D fx = zero, fy = zero, fz = zero, tx = zero, ty = zero, tz = zero;
+      for (int s = s0 + sub; s < s1; s += kBlock) {
+        const int *J = a.slot_j + s;
+        const D rj = load<W>(a.slot_r + s);
+        const D dx = gather<W>(a.x, J) - xi, dy = gather<W>(a.y, J) - yi,
+                dz = gather<W>(a.z, J) - zi;
+        const D dvx = gather<W>(a.vx, J) - vxi, dvy = gather<W>(a.vy, J) - vyi,
+                dvz = gather<W>(a.vz, J) - vzi;
+        D mj = zero;
+        if constexpr (kDamped) mj = gather<W>(a.m, J);
+        const Normal<W> g =
+            normal_part<W, kDamped>(dx, dy, dz, ri, rj, dvx, dvy, dvz, mi, mj, kn, a.beta2);
+        const M touch = g.touch;
+        const D nx = g.nx, ny = g.ny, nz = g.nz, ov = g.ov, fn = g.fn;
+        const D ai = ri - 0.5 * ov, aj = rj - 0.5 * ov;
+        const D wxj = gather<W>(a.wx, J), wyj = gather<W>(a.wy, J), wzj = gather<W>(a.wz, J);
+        // a_i·ω_i + a_j·ω_j in the swap-symmetric form (file comment).
+        const D as = ai + aj, ad = ai - aj;
+        const D sx = wxi + wxj, sy = wyi + wyj, sz = wzi + wzj;
+        const D rx = 0.5 * (sx * as + (wxi - wxj) * ad);
+        const D ry = 0.5 * (sy * as + (wyi - wyj) * ad);
+        const D rz = 0.5 * (sz * as + (wzi - wzj) * ad);
+        // v_rel = v_j − v_i − (a_i ω_i + a_j ω_j) × n; v_t its tangential part.
+        const D ux = dvx - (ry * nz - rz * ny);
+        const D uy = dvy - (rz * nx - rx * nz);
+        const D uz = dvz - (rx * ny - ry * nx);
+        const D un = ux * nx + uy * ny + uz * nz;
+        const D vtx = ux - un * nx, vty = uy - un * ny, vtz = uz - un * nz;
+        // Turn the history: projection onto the contact plane rescaled to
+        // its former length, then the twist about n (Cayley form).
+        const D hx0 = load<W>(a.hx + s), hy0 = load<W>(a.hy + s), hz0 = load<W>(a.hz + s);
+        const D mag2 = hx0 * hx0 + hy0 * hy0 + hz0 * hz0;
+        const D hn = hx0 * nx + hy0 * ny + hz0 * nz;
+        D px = hx0 - hn * nx, py = hy0 - hn * ny, pz = hz0 - hn * nz;
+        const D p2 = px * px + py * py + pz * pz;
+        const M turnable = p2 > zero;
+        const D scale =
+            select<W>(turnable, vsqrt(mag2 / select<W>(turnable, p2, mag2 + 1.0)), zero);
+        px *= scale;
+        py *= scale;
+        pz *= scale;
+        const D c = half_dt * 0.5 * (nx * sx + ny * sy + nz * sz);
+        const D q = 1.0 / (1.0 + c * c);
+        const D ca = (1.0 - c * c) * q, cb = 2.0 * c * q;
+        D hx = px * ca + (ny * pz - nz * py) * cb + kdt * vtx;
+        D hy = py * ca + (nz * px - nx * pz) * cb + kdt * vty;
+        D hz = pz * ca + (nx * py - ny * px) * cb + kdt * vtz;
+        // Coulomb: |h| ≤ μ·fn.
+        const D cap = mu * fn, h2 = hx * hx + hy * hy + hz * hz;
+        const M sliding = h2 > cap * cap;
+        const D mag = vsqrt(h2);
+        const D cut = select<W>(sliding, cap / select<W>(sliding, mag, one), one);
+        slid += select<W>(touch & sliding, cap * (mag - cap), zero);
+        released += select<W>(touch, zero, mag2);
+        hx = select<W>(touch, hx * cut, zero);
+        hy = select<W>(touch, hy * cut, zero);
+        hz = select<W>(touch, hz * cut, zero);
+        store<W>(a.hx + s, hx);
+        store<W>(a.hy + s, hy);
+        store<W>(a.hz + s, hz);
+        // Force on i: −fn·n + h; torque a_i·n × h.
+        fx += hx - fn * nx;
+        fy += hy - fn * ny;
+        fz += hz - fn * nz;
+        tx += ai * (ny * hz - nz * hy);
+        ty += ai * (nz * hx - nx * hz);
+        tz += ai * (nx * hy - ny * hx);
+        const D ovr = select<W>(touch, ov * iri, zero);
+        mo = mo > ovr ? mo : ovr;
+      }
+      store<W>(a.fx + i0, fx);
+      store<W>(a.fy + i0, fy);
+      store<W>(a.fz + i0, fz);
+      store<W>(a.tx + i0, tx);
+      store<W>(a.ty + i0, ty);
+      store<W>(a.tz + i0, tz);
+    }
+    a.block_released[b] = hsum<W>(released);
+    a.block_slid[b] = hsum<W>(slid);
+  }
+  return hmax<W>(mo);
+}
+
+struct IntegrateArgs {
+  double *__restrict x, *__restrict y, *__restrict z;
+  double *__restrict vx, *__restrict vy, *__restrict vz;
+  double *__restrict wx, *__restrict wy, *__restrict wz;
+  const double *__restrict fx, *__restrict fy, *__restrict fz;
+  const double *__restrict tx, *__restrict ty, *__restrict tz;
+  const double *__restrict ca_t, *__restrict cb_t, *__restrict ca_r, *__restrict cb_r;
+  const double *__restrict d_t, *__restrict d_r;
+  const double *__restrict x_built, *__restrict y_built, *__restrict z_built;
+  double *__restrict block_lost;
+  double dt;
+};
+
+// Central difference with global damping for blocks [b0, b1); writes each
+// block's damping loss Σ D·|v̄|²/4 and returns the largest squared
+// displacement since the last neighbour-list build.
+template <int W, bool kRotation>
+DEMCAL_INLINE double integrate_blocks(const IntegrateArgs &a, int b0, int b1) {
+  using D = typename Simd<W>::D;
+  D md = D{};
+  const double dt = a.dt;
+  for (int b = b0; b < b1; ++b) {
+    D lost = D{};
+    for (int i = kBlock * b; i < kBlock * (b + 1); i += W) {
+      const D cat = load<W>(a.ca_t + i), cbt = load<W>(a.cb_t + i);
+      const D ux = load<W>(a.vx + i), uy = load<W>(a.vy + i), uz = load<W>(a.vz + i);
+      const D vx = cat * ux + cbt * load<W>(a.fx + i);
+      const D vy = cat * uy + cbt * load<W>(a.fy + i);
+      const D vz = cat * uz + cbt * load<W>(a.fz + i);
+      const D bx = ux + vx, by = uy + vy, bz = uz + vz;
+      lost += 0.25 * load<W>(a.d_t + i) * (bx * bx + by * by + bz * bz);
+      const D x = load<W>(a.x + i) + vx * dt, y = load<W>(a.y + i) + vy * dt,
+              z = load<W>(a.z + i) + vz * dt;
+      store<W>(a.vx + i, vx);
+      store<W>(a.vy + i, vy);
+      store<W>(a.vz + i, vz);
+      store<W>(a.x + i, x);
+      store<W>(a.y + i, y);
+      store<W>(a.z + i, z);
+      if constexpr (kRotation) {
+        const D car = load<W>(a.ca_r + i), cbr = load<W>(a.cb_r + i);
+        const D oxu = load<W>(a.wx + i), oyu = load<W>(a.wy + i), ozu = load<W>(a.wz + i);
+        const D ox = car * oxu + cbr * load<W>(a.tx + i);
+        const D oy = car * oyu + cbr * load<W>(a.ty + i);
+        const D oz = car * ozu + cbr * load<W>(a.tz + i);
+        const D ex = oxu + ox, ey = oyu + oy, ez = ozu + oz;
+        lost += 0.25 * load<W>(a.d_r + i) * (ex * ex + ey * ey + ez * ez);
+        store<W>(a.wx + i, ox);
+        store<W>(a.wy + i, oy);
+        store<W>(a.wz + i, oz);
+      }
+      const D dx = x - load<W>(a.x_built + i), dy = y - load<W>(a.y_built + i),
+              dz = z - load<W>(a.z_built + i);
+      const D d2 = dx * dx + dy * dy + dz * dz;
+      md = d2 > md ? d2 : md;
+    }
+    a.block_lost[b] = hsum<W>(lost);
+  }
+  return hmax<W>(md);
+}
+
+// ---------------------------------------------------------------- dispatch
+
+using PairFn = double (*)(const PairArgs &, int, int);
+using IntegrateFn = double (*)(const IntegrateArgs &, int, int);
+
+struct Kernels {
+  PairFn pairs, pairs_damped;
+  IntegrateFn integrate, integrate_locked;
+  void (*one_pair)(const double *, double *);
+};
+
+#define DEMCAL_SPHERE_KERNELS(SUFFIX, TARGET, W)                                                 \
+  TARGET double pairs_##SUFFIX(const PairArgs &a, int b0, int b1) {                              \
+    return pair_blocks<W, false>(a, b0, b1);                                                     \
+  }                                                                                              \
+  TARGET double pairs_damped_##SUFFIX(const PairArgs &a, int b0, int b1) {                       \
+    return pair_blocks<W, true>(a, b0, b1);                                                      \
+  }                                                                                              \
+  TARGET double integrate_##SUFFIX(const IntegrateArgs &a, int b0, int b1) {                     \
+    return integrate_blocks<W, true>(a, b0, b1);                                                 \
+  }                                                                                              \
+  TARGET double integrate_locked_##SUFFIX(const IntegrateArgs &a, int b0, int b1) {              \
+    return integrate_blocks<W, false>(a, b0, b1);                                                \
+  }                                                                                              \
+  TARGET void one_pair_##SUFFIX(const double *in, double *out) { one_pair<W>(in, out); }         \
+  constexpr Kernels kKernels_##SUFFIX{pairs_##SUFFIX, pairs_damped_##SUFFIX, integrate_##SUFFIX, \
+                                      integrate_locked_##SUFFIX, one_pair_##SUFFIX};
+
+#define DEMCAL_NO_TARGET
+DEMCAL_SPHERE_KERNELS(sse2, DEMCAL_NO_TARGET, 2)
+#ifdef DEMCAL_X86_64
+DEMCAL_SPHERE_KERNELS(avx2, __attribute__((target("arch=x86-64-v3"))), 4)
+DEMCAL_SPHERE_KERNELS(avx512, __attribute__((target("arch=x86-64-v4"))), 8)
+#endif
+
+// The path the 2D kernel chose (kernel_simd(): CPU and DEMCAL_SIMD).
+const Kernels &kernels() {
+  static const Kernels chosen = [] {
+#ifdef DEMCAL_X86_64
+    const char *name = kernel_simd();
+    if (std::strcmp(name, "avx512") == 0) return kKernels_avx512;
+    if (std::strcmp(name, "avx2") == 0) return kKernels_avx2;
+#endif
+    return kKernels_sse2;
+  }();
+  return chosen;
+}
+
 }  // namespace
 
+double SphereWorld::pair_pass(int b0, int b1) {
+  const PairArgs a{block_slot_.data(),
+                   slot_j_.data(),
+                   hx_.data(),
+                   hy_.data(),
+                   hz_.data(),
+                   slot_r_.data(),
+                   x_.data(),
+                   y_.data(),
+                   z_.data(),
+                   vx_.data(),
+                   vy_.data(),
+                   vz_.data(),
+                   wx_.data(),
+                   wy_.data(),
+                   wz_.data(),
+                   r_.data(),
+                   inv_r_.data(),
+                   m_.data(),
+                   fx_.data(),
+                   fy_.data(),
+                   fz_.data(),
+                   tx_.data(),
+                   ty_.data(),
+                   tz_.data(),
+                   block_released_.data(),
+                   block_slid_.data(),
+                   material_.particle.kn,
+                   material_.particle.kt * integration_.dt,
+                   0.5 * integration_.dt,
+                   material_.particle.friction,
+                   2.0 * material_.contact_damping_ratio};
+  const Kernels &k = kernels();
+  return material_.contact_damping_ratio > 0.0 ? k.pairs_damped(a, b0, b1) : k.pairs(a, b0, b1);
+}
+
+double SphereWorld::integrate_pass(int b0, int b1) {
+  const IntegrateArgs a{x_.data(),          y_.data(),       z_.data(),       vx_.data(),
+                        vy_.data(),         vz_.data(),      wx_.data(),      wy_.data(),
+                        wz_.data(),         fx_.data(),      fy_.data(),      fz_.data(),
+                        tx_.data(),         ty_.data(),      tz_.data(),      ca_t_.data(),
+                        cb_t_.data(),       ca_r_.data(),    cb_r_.data(),    d_t_.data(),
+                        d_r_.data(),        x_built_.data(), y_built_.data(), z_built_.data(),
+                        block_lost_.data(), integration_.dt};
+  const Kernels &k = kernels();
+  return integration_.lock_rotation ? k.integrate_locked(a, b0, b1) : k.integrate(a, b0, b1);
+}
+
 double SphereWorld::wall_distance(int s, int i) const {
-  const double* pos[3] = {x_.data(), y_.data(), z_.data()};
+  const double *pos[3] = {x_.data(), y_.data(), z_.data()};
   const double sign = (s % 2 == 0) ? 1.0 : -1.0;
   return (pos[s / 2][i] - walls_[s].position) * sign;
 }
 
 SphereWorld::PairGeometry SphereWorld::pair_geometry(int i, int j) const {
+  // The pair pass's normal_part, one lane on the same SIMD path.
+  const double in[12] = {
+      x_[j] - x_[i], y_[j] - y_[i],   z_[j] - z_[i],         r_[i],
+      r_[j],         vx_[j] - vx_[i], vy_[j] - vy_[i],       vz_[j] - vz_[i],
+      m_[i],         m_[j],           material_.particle.kn, 2.0 * material_.contact_damping_ratio};
+  double out[6];
+  kernels().one_pair(in, out);
   PairGeometry p{};
-  const V3 d(x_[j] - x_[i], y_[j] - y_[i], z_[j] - z_[i]);
-  const double d2 = d.squaredNorm();
-  const double rs = r_[i] + r_[j];
-  p.touching = d2 < rs * rs;
+  p.touching = out[5] != 0.0;
   if (!p.touching) return p;
-  const double dist = std::sqrt(d2);
-  p.n = d / dist;
-  p.overlap = rs - dist;
-  const double kn = material_.particle.kn;
-  double fn = kn * p.overlap;
-  const double beta2 = 2.0 * material_.contact_damping_ratio;
-  if (beta2 > 0.0) {
-    const double meff = m_[i] * m_[j] / (m_[i] + m_[j]);
-    const V3 dv(vx_[j] - vx_[i], vy_[j] - vy_[i], vz_[j] - vz_[i]);
-    fn = std::max(0.0, fn - beta2 * std::sqrt(kn * meff) * dv.dot(p.n));
-  }
-  p.fn = fn;
+  p.n = V3(out[0], out[1], out[2]);
+  p.overlap = out[3];
+  p.fn = out[4];
   return p;
-}
-
-// flatten: pair_geometry (shared with the energy ledger) inlined here, the
-// hot loop (it was a call per neighbour, a sixth of the step).
-[[gnu::flatten]] void SphereWorld::pair_forces() {
-  const double dt = integration_.dt;
-  const double kt = material_.particle.kt, kdt = kt * dt, mu = material_.particle.friction;
-  const double compliance = kt > 0.0 ? 1.0 / kt : 0.0, half_compliance = 0.5 * compliance;
-  double max_overlap = 0.0, released = 0.0, slid = 0.0;
-  for (int i = 0; i < n_; ++i) {
-    const V3 vi(vx_[i], vy_[i], vz_[i]), wi(wx_[i], wy_[i], wz_[i]);
-    V3 fi(fx_[i], fy_[i], fz_[i]), ti(tx_[i], ty_[i], tz_[i]);
-    for (int k = nbr_start_[i]; k < nbr_start_[i + 1]; ++k) {
-      const int j = nbr_j_[k];
-      const PairGeometry g = pair_geometry(i, j);
-      if (!g.touching) {
-        released += hx_[k] * hx_[k] + hy_[k] * hy_[k] + hz_[k] * hz_[k];
-        hx_[k] = hy_[k] = hz_[k] = 0.0;
-        continue;
-      }
-      const V3& n = g.n;
-      const double ai = r_[i] - 0.5 * g.overlap, aj = r_[j] - 0.5 * g.overlap;
-      const V3 wj(wx_[j], wy_[j], wz_[j]);
-      const V3 vrel = V3(vx_[j], vy_[j], vz_[j]) - vi - (ai * wi + aj * wj).cross(n);
-      const V3 vt = vrel - vrel.dot(n) * n;
-      V3 h = turn_history(V3(hx_[k], hy_[k], hz_[k]), n, 0.5 * dt * n.dot(wi + wj));
-      h += kdt * vt;
-      const double cap = mu * g.fn, h2 = h.squaredNorm();
-      if (h2 > cap * cap) {
-        const double mag = std::sqrt(h2);
-        slid += cap * (mag - cap);
-        h *= cap / mag;
-      }
-      hx_[k] = h.x();
-      hy_[k] = h.y();
-      hz_[k] = h.z();
-      const V3 f = -g.fn * n + h;  // on i
-      const V3 nxh = n.cross(h);
-      fi += f;
-      ti += ai * nxh;
-      fx_[j] -= f.x();
-      fy_[j] -= f.y();
-      fz_[j] -= f.z();
-      tx_[j] += aj * nxh.x();
-      ty_[j] += aj * nxh.y();
-      tz_[j] += aj * nxh.z();
-      max_overlap = std::max(max_overlap, g.overlap / std::min(r_[i], r_[j]));
-    }
-    fx_[i] = fi.x();
-    fy_[i] = fi.y();
-    fz_[i] = fi.z();
-    tx_[i] = ti.x();
-    ty_[i] = ti.y();
-    tz_[i] = ti.z();
-  }
-  max_overlap_ratio_seen_ = max_overlap;
-  friction_dissipated_ += released * half_compliance + slid * compliance;
 }
 
 void SphereWorld::wall_forces() {
@@ -167,7 +471,7 @@ void SphereWorld::wall_forces() {
   const double half_compliance = 0.5 * compliance;
   double max_overlap = 0.0, released = 0.0, slid = 0.0;
   for (int s = 0; s < 6; ++s) {
-    SphereWall& wall = walls_[s];
+    SphereWall &wall = walls_[s];
     const int axis = s / 2;
     V3 g = V3::Zero();
     g[axis] = (s % 2 == 0) ? 1.0 : -1.0;  // inward normal
@@ -223,8 +527,18 @@ void SphereWorld::wall_forces() {
 }
 
 void SphereWorld::compute_forces() {
-  for (auto* a : {&fx_, &fy_, &fz_, &tx_, &ty_, &tz_}) std::fill(a->begin(), a->end(), 0.0);
-  pair_forces();
+  max_overlap_ratio_seen_ = run_pass(&SphereWorld::pair_pass, pair_bounds_);
+  // Friction's losses, block by block in a fixed order (every pair was
+  // counted from both sides).
+  const double kt = material_.particle.kt;
+  if (kt > 0.0) {
+    double released = 0.0, slid = 0.0;
+    for (int b = 0; b < nblocks_; ++b) {
+      released += block_released_[b];
+      slid += block_slid_[b];
+    }
+    friction_dissipated_ += 0.5 * (released * (0.5 / kt) + slid / kt);
+  }
   wall_forces();
 }
 

@@ -43,7 +43,7 @@ SphereWorld::EnergySample SphereWorld::energy_sample() const {
       const double fn_elastic = kn * g.overlap;
       const double vn = (vx_[j] - vx_[i]) * g.n.x() + (vy_[j] - vy_[i]) * g.n.y() +
                         (vz_[j] - vz_[i]) * g.n.z();  // > 0 when separating
-      const double h2 = hx_[k] * hx_[k] + hy_[k] * hy_[k] + hz_[k] * hz_[k];
+      const double h2 = pair_history(k).squaredNorm();
       e.elastic += 0.5 * fn_elastic * g.overlap + (kt > 0.0 ? 0.5 * h2 / kt : 0.0);
       e.power_lost += (fn_elastic - g.fn) * vn;
     }

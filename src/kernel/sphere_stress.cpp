@@ -31,7 +31,7 @@ SphereMeasures SphereWorld::measure(double strain_rate) const {
   for (int i = 0; i < n_; ++i)
     for (int k = nbr_start_[i]; k < nbr_start_[i + 1]; ++k) {
       const int j = nbr_j_[k];
-      const V3 h(hx_[k], hy_[k], hz_[k]);
+      const V3 h = pair_history(k);
       const PairGeometry g = pair_geometry(i, j);
       const double fn = g.touching ? g.fn : 0.0;
       if (fn <= 0.0 && h.squaredNorm() == 0.0) continue;
@@ -99,7 +99,7 @@ std::vector<SphereWorld::ContactView> SphereWorld::contacts() const {
   for (int i = 0; i < n_; ++i)
     for (int k = nbr_start_[i]; k < nbr_start_[i + 1]; ++k) {
       const int j = nbr_j_[k];
-      const V3 h(hx_[k], hy_[k], hz_[k]);
+      const V3 h = pair_history(k);
       const PairGeometry g = pair_geometry(i, j);
       const double fn = g.touching ? g.fn : 0.0;
       if (fn <= 0.0 && h.squaredNorm() == 0.0) continue;

@@ -11,8 +11,14 @@
 #include <numbers>
 #include <optional>
 #include <stdexcept>
+#include <thread>
 
 namespace demcal {
+
+namespace {
+constexpr int kBlock = 8;
+constexpr double kFar = 1e100;  // padding lanes at +kFar, the ghost at −kFar
+}  // namespace
 
 SphereWorld::SphereWorld(const SphereMaterial& material, std::span<const double> x,
                          std::span<const double> y, std::span<const double> z,
@@ -30,13 +36,30 @@ SphereWorld::SphereWorld(const SphereMaterial& material, std::span<const double>
     if (!(r > 0.0) || !std::isfinite(r))
       throw std::invalid_argument("SphereWorld: radius must be > 0");
   n_ = static_cast<int>(n);
-  x_.assign(x.begin(), x.end());
-  y_.assign(y.begin(), y.end());
-  z_.assign(z.begin(), z.end());
-  r_.assign(radius.begin(), radius.end());
+  nblocks_ = (n_ + kBlock - 1) / kBlock;
+  ghost_ = kBlock * nblocks_;
+  const size_t cap = static_cast<size_t>(ghost_) + kBlock;  // padding, ghost, one spare block
+  // Padding lanes far away at +kFar, the ghost at −kFar, both of radius 0.
+  for (auto* a : {&x_, &y_, &z_}) {
+    a->assign(cap, kFar);
+    (*a)[ghost_] = -kFar;
+  }
+  std::copy(x.begin(), x.end(), x_.begin());
+  std::copy(y.begin(), y.end(), y_.begin());
+  std::copy(z.begin(), z.end(), z_.begin());
+  r_.assign(cap, 0.0);
+  std::copy(radius.begin(), radius.end(), r_.begin());
+  inv_r_.assign(cap, 0.0);
+  for (int i = 0; i < n_; ++i) inv_r_[i] = 1.0 / r_[i];
   for (auto* a : {&vx_, &vy_, &vz_, &wx_, &wy_,   &wz_,   &m_,    &inertia_, &fx_,  &fy_,
                   &fz_, &tx_, &ty_, &tz_, &ca_t_, &cb_t_, &ca_r_, &cb_r_,    &d_t_, &d_r_})
-    a->assign(n, 0.0);
+    a->assign(cap, 0.0);
+  x_built_ = x_;
+  y_built_ = y_;
+  z_built_ = z_;
+  for (auto* a : {&block_lost_, &block_released_, &block_slid_})
+    a->assign(static_cast<size_t>(nblocks_) + 1, 0.0);
+  block_slot_.assign(static_cast<size_t>(nblocks_) + 1, 0);
   for (int s = 0; s < 6; ++s) {
     for (auto* h : {&wall_hx_[s], &wall_hy_[s], &wall_hz_[s], &wall_fn_[s]}) h->assign(n, 0.0);
     walls_[s].position = (s % 2 == 0) ? lo[s / 2] : hi[s / 2];
@@ -45,8 +68,61 @@ SphereWorld::SphereWorld(const SphereMaterial& material, std::span<const double>
   r_min_ = n ? *std::min_element(radius.begin(), radius.end()) : 1.0;
   r_max_ = n ? *std::max_element(radius.begin(), radius.end()) : 1.0;
   skin_ = options_.skin_ratio * r_min_;
+  set_threads(options_.threads);
   set_integration(integration_);
   update_forces();
+}
+
+void SphereWorld::set_threads(int threads) {
+  if (threads < 0) throw std::invalid_argument("SphereWorld: threads must be >= 0");
+  if (threads == 0) threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  options_.threads = threads;
+  threads_ = threads;
+  update_thread_bounds();
+}
+
+int SphereWorld::active_threads() const {
+  // At least 8 blocks (64 spheres) per thread, or the hand-over costs more
+  // than it saves.
+  return std::max(1, std::min({threads_, nblocks_ / 8, 64}));
+}
+
+void SphereWorld::update_thread_bounds() {
+  const int t = active_threads();
+  particle_bounds_.assign(static_cast<size_t>(t) + 1, 0);
+  pair_bounds_.assign(static_cast<size_t>(t) + 1, 0);
+  for (int k = 0; k <= t; ++k)
+    particle_bounds_[k] = static_cast<int>(static_cast<int64_t>(nblocks_) * k / t);
+  // Pair pass: equal shares of slots (block_slot_ is non-decreasing).
+  const int64_t total = block_slot_.back();
+  int b = 0;
+  for (int k = 1; k < t; ++k) {
+    const int64_t target = total * k / t;
+    while (b < nblocks_ && block_slot_[b] < target) ++b;
+    pair_bounds_[k] = b;
+  }
+  pair_bounds_[t] = nblocks_;
+}
+
+double SphereWorld::run_pass(double (SphereWorld::*pass)(int, int),
+                             const std::vector<int>& bounds) {
+  const int t = active_threads();
+  if (t <= 1) return (this->*pass)(0, nblocks_);
+  struct Ctx {
+    SphereWorld* w;
+    double (SphereWorld::*pass)(int, int);
+    const std::vector<int>* bounds;
+    double out[64];
+  } ctx{this, pass, &bounds, {}};
+  detail::team_run(
+      team_, t,
+      [](void* p, int k) {
+        auto* c = static_cast<Ctx*>(p);
+        c->out[k] = (c->w->*c->pass)((*c->bounds)[k], (*c->bounds)[k + 1]);
+      },
+      &ctx);
+  // Maxima are exact whatever the split: the result does not depend on t.
+  return *std::max_element(ctx.out, ctx.out + t);
 }
 
 void SphereWorld::set_options(const KernelOptions& options) {
@@ -54,6 +130,7 @@ void SphereWorld::set_options(const KernelOptions& options) {
   ledger_ = {};
   skin_ = options_.skin_ratio * r_min_;
   list_valid_ = false;
+  set_threads(options.threads);
 }
 
 void SphereWorld::set_integration(const Integration& integration) {
@@ -141,35 +218,15 @@ void SphereWorld::book_wall_work() {
 }
 
 void SphereWorld::integrate() {
-  const double dt = integration_.dt;
-  double max_d2 = 0.0;
   // The scheme is m·(v⁺ − v⁻)/Δt = F − D·v̄, v̄ = (v⁺ + v⁻)/2, so the
   // damping removes exactly D·|v̄|²·Δt of (half-step) kinetic energy per
-  // step: summed here for the energy ledger, exact however fast the decay.
+  // step: summed for the energy ledger (each block's share by the pass, the
+  // blocks here in order), exact however fast the decay. The pass also
+  // scans the displacements since the last list build.
+  const double dt = integration_.dt;
+  const double max_d2 = run_pass(&SphereWorld::integrate_pass, particle_bounds_);
   double lost = 0.0;
-  for (int i = 0; i < n_; ++i) {
-    const double ux = vx_[i], uy = vy_[i], uz = vz_[i];
-    vx_[i] = ca_t_[i] * vx_[i] + cb_t_[i] * fx_[i];
-    vy_[i] = ca_t_[i] * vy_[i] + cb_t_[i] * fy_[i];
-    vz_[i] = ca_t_[i] * vz_[i] + cb_t_[i] * fz_[i];
-    const double bx = ux + vx_[i], by = uy + vy_[i], bz = uz + vz_[i];
-    lost += 0.25 * d_t_[i] * (bx * bx + by * by + bz * bz);
-    x_[i] += vx_[i] * dt;
-    y_[i] += vy_[i] * dt;
-    z_[i] += vz_[i] * dt;
-    const double dx = x_[i] - x_built_[i], dy = y_[i] - y_built_[i], dz = z_[i] - z_built_[i];
-    max_d2 = std::max(max_d2, dx * dx + dy * dy + dz * dz);
-  }
-  if (!integration_.lock_rotation) {
-    for (int i = 0; i < n_; ++i) {
-      const double ux = wx_[i], uy = wy_[i], uz = wz_[i];
-      wx_[i] = ca_r_[i] * wx_[i] + cb_r_[i] * tx_[i];
-      wy_[i] = ca_r_[i] * wy_[i] + cb_r_[i] * ty_[i];
-      wz_[i] = ca_r_[i] * wz_[i] + cb_r_[i] * tz_[i];
-      const double bx = ux + wx_[i], by = uy + wy_[i], bz = uz + wz_[i];
-      lost += 0.25 * d_r_[i] * (bx * bx + by * by + bz * bz);
-    }
-  }
+  for (int b = 0; b < nblocks_; ++b) lost += block_lost_[b];
   damping_dissipated_ += lost * dt;
   for (int s = 0; s < 6; ++s) {
     wall_move_[s] = walls_[s].velocity * dt;

@@ -10,8 +10,16 @@
 //   sphere_energy_balance.cpp  the energy ledger of the divergence check
 // The contact, integration, damping and option types are the 2D kernel's
 // (one definition each): ContactLaw, Integration (thickness unused),
-// ReferenceScales, StabilityEstimate, Divergence, KernelOptions (threads
-// unused: this kernel is scalar and single-threaded for now).
+// ReferenceScales, StabilityEstimate, Divergence, KernelOptions.
+//
+// Layout for speed (reports/performance.md, "3D"): the 2D kernel's. State
+// in 64-byte aligned flat arrays padded to blocks of 8 particles; a full
+// neighbour list in sliced ELLPACK (each pair evaluated from both sides, a
+// particle's force a plain sum over its own slots: no scatter); the pair
+// and particle passes SIMD over 8, 4 or 2 lanes chosen at run time
+// (kernel_simd(), DEMCAL_SIMD); threads share the blocks, results
+// bit-identical for any thread count; no allocation in a step without a
+// list rebuild.
 //
 // Physics (SI, tension positive):
 //  - m = ρ·(4/3)·π·r³·f_ms, I = (2/5)·m·r²;
@@ -124,26 +132,26 @@ class SphereWorld {
 
   // --- state access (flat arrays) ----------------------------------------
   int size() const { return n_; }
-  std::span<const double> x() const { return x_; }
-  std::span<const double> y() const { return y_; }
-  std::span<const double> z() const { return z_; }
-  std::span<const double> vx() const { return vx_; }
-  std::span<const double> vy() const { return vy_; }
-  std::span<const double> vz() const { return vz_; }
-  std::span<const double> omega_x() const { return wx_; }
-  std::span<const double> omega_y() const { return wy_; }
-  std::span<const double> omega_z() const { return wz_; }
-  std::span<const double> radius() const { return r_; }
+  std::span<const double> x() const { return view(x_); }
+  std::span<const double> y() const { return view(y_); }
+  std::span<const double> z() const { return view(z_); }
+  std::span<const double> vx() const { return view(vx_); }
+  std::span<const double> vy() const { return view(vy_); }
+  std::span<const double> vz() const { return view(vz_); }
+  std::span<const double> omega_x() const { return view(wx_); }
+  std::span<const double> omega_y() const { return view(wy_); }
+  std::span<const double> omega_z() const { return view(wz_); }
+  std::span<const double> radius() const { return view(r_); }
   double min_radius() const { return r_min_; }
   double max_radius() const { return r_max_; }
-  std::span<const double> mass() const { return m_; }           ///< scaled masses
-  std::span<const double> inertia() const { return inertia_; }  ///< scaled moments
-  std::span<const double> fx() const { return fx_; }            ///< net contact force
-  std::span<const double> fy() const { return fy_; }
-  std::span<const double> fz() const { return fz_; }
-  std::span<const double> torque_x() const { return tx_; }
-  std::span<const double> torque_y() const { return ty_; }
-  std::span<const double> torque_z() const { return tz_; }
+  std::span<const double> mass() const { return view(m_); }           ///< scaled masses
+  std::span<const double> inertia() const { return view(inertia_); }  ///< scaled moments
+  std::span<const double> fx() const { return view(fx_); }            ///< net contact force
+  std::span<const double> fy() const { return view(fy_); }
+  std::span<const double> fz() const { return view(fz_); }
+  std::span<const double> torque_x() const { return view(tx_); }
+  std::span<const double> torque_y() const { return view(ty_); }
+  std::span<const double> torque_z() const { return view(tz_); }
 
   /// Direct state edits for tests and scene set-up. With rotation locked the
   /// spin is ignored (kept 0).
@@ -169,12 +177,23 @@ class SphereWorld {
   };
   std::vector<ContactView> contacts() const;
   int64_t rebuilds() const { return rebuilds_; }
+  /// Share of the neighbour slots the pair pass evaluates that hold a real
+  /// neighbour (the rest pad each block's rows to its longest list).
+  double neighbour_slot_fill() const;
+
+  /// Threads for stepping this world (KernelOptions::threads: 0 = all
+  /// cores). Results are bit-identical for any thread count.
+  void set_threads(int threads);
+  int threads() const { return threads_; }
 
   /// Recompute forces for the current state without moving anything and
   /// without a tangential increment.
   void update_forces();
 
  private:
+  using Array = detail::AlignedVector<double>;
+  std::span<const double> view(const Array& a) const { return {a.data(), static_cast<size_t>(n_)}; }
+
   // sphere_broad_phase.cpp
   void rebuild_neighbours();
   bool needs_rebuild() const;
@@ -185,7 +204,21 @@ class SphereWorld {
     bool touching;
   };
   PairGeometry pair_geometry(int i, int j) const;
-  void pair_forces();
+  /// Tangential force on i of the k-th pair of the half list (i < j).
+  Eigen::Vector3d pair_history(int k) const {
+    const int s = pair_slot_[k];
+    return {hx_[s], hy_[s], hz_[s]};
+  }
+  // The SIMD passes over particle blocks [b0, b1) (sphere_contact.cpp):
+  // pair forces (returns the largest overlap/r) and integration (returns
+  // the largest squared displacement since the last build).
+  double pair_pass(int b0, int b1);
+  double integrate_pass(int b0, int b1);
+  // Run a pass over all blocks, shared among the threads by `bounds`;
+  // returns the largest value it returned (sphere_world.cpp).
+  double run_pass(double (SphereWorld::*pass)(int, int), const std::vector<int>& bounds);
+  int active_threads() const;
+  void update_thread_bounds();
   void wall_forces();
   void compute_forces();
   /// Signed distance from wall s to the centre of i, along the inward normal.
@@ -207,13 +240,23 @@ class SphereWorld {
   SphereMaterial material_;
   KernelOptions options_;
   Integration integration_;
+  int threads_ = 1;
 
-  int n_ = 0;
-  std::vector<double> x_, y_, z_, vx_, vy_, vz_, wx_, wy_, wz_, r_;
-  std::vector<double> m_, inertia_;
-  std::vector<double> fx_, fy_, fz_, tx_, ty_, tz_;
-  std::vector<double> ca_t_, cb_t_, ca_r_, cb_r_;  // v ← a·v + b·F per particle
-  std::vector<double> d_t_, d_r_;                  // damping coefficients D_t, D_r
+  // Particle state (structure of arrays, 64-byte aligned), padded to whole
+  // blocks of 8: index n_ .. 8·nblocks_ − 1 are inert padding lanes, index
+  // ghost_ = 8·nblocks_ the ghost particle empty slots point to (far away,
+  // radius 0: never in contact).
+  int n_ = 0, nblocks_ = 0, ghost_ = 0;
+  Array x_, y_, z_, vx_, vy_, vz_, wx_, wy_, wz_, r_, inv_r_;
+  Array m_, inertia_;
+  Array fx_, fy_, fz_, tx_, ty_, tz_;
+  Array ca_t_, cb_t_, ca_r_, cb_r_;  // v ← a·v + b·F per particle (0 for padding)
+  Array d_t_, d_r_;                  // damping coefficients D_t, D_r
+  // Per block, written by the passes and summed in block order (the same
+  // sums for any thread count): global damping loss of the step (Σ D·|v̄|²/4)
+  // and, over the block's slots, Σ|h|² of contacts that opened and
+  // Σ μFn·(|h_trial| − μFn) of sliding ones (every pair counted twice).
+  Array block_lost_, block_released_, block_slid_;
   // Energy taken by global damping since the energy ledger started [J] (a
   // running total from the start, not a difference of two totals: that
   // would cancel catastrophically once most of the energy is gone).
@@ -234,18 +277,30 @@ class SphereWorld {
   double wall_work_abs_ = 0.0;
   std::array<double, 6> wall_push_{}, wall_move_{};
 
-  // Verlet half list (pairs i < j) in CSR form, each row sorted by j; the
-  // tangential force on i of each pair (3 components), kept across rebuilds.
-  std::vector<int> nbr_start_, nbr_j_;
-  std::vector<double> hx_, hy_, hz_;
+  // Verlet neighbour list, full (each pair from both sides) in sliced
+  // ELLPACK blocks of 8 as the 2D kernel's (world.hpp): block b's slots are
+  // [block_slot_[b], block_slot_[b + 1]), rows of 8, slot (row, lane) the
+  // row-th neighbour (increasing index) of particle 8b + lane, then ghosts.
+  // hx_, hy_, hz_: each slot's tangential force on its own particle (the
+  // two copies of a pair are exact opposites), kept across rebuilds; slot_r_
+  // the neighbour's radius.
+  std::vector<int> block_slot_;
+  detail::AlignedVector<int> slot_j_;
+  Array hx_, hy_, hz_, slot_r_;
+  // The half list (pairs i < j) in CSR form, each row sorted by j, and the
+  // slot of i's copy of each pair (for measures, views and the ledger).
+  std::vector<int> nbr_start_, nbr_j_, pair_slot_;
+  // Block ranges of the threads: pair pass (balanced by slots), particle pass.
+  std::vector<int> pair_bounds_, particle_bounds_;
   // Wall contacts: candidates within skin, tangential force history and
   // last normal force per wall and particle.
   std::array<std::vector<int>, 6> wall_candidates_;
   std::array<std::vector<double>, 6> wall_hx_, wall_hy_, wall_hz_, wall_fn_;
   // Scratch for rebuilds (kept to avoid allocation).
-  std::vector<int> new_start_, new_j_, cell_start_, cell_next_;
-  std::vector<double> new_hx_, new_hy_, new_hz_;
-  std::vector<double> x_built_, y_built_, z_built_;
+  std::vector<int> full_start_, full_j_, cell_start_, cell_next_, new_block_slot_;
+  detail::AlignedVector<int> new_slot_j_;
+  Array new_hx_, new_hy_, new_hz_, new_slot_r_;
+  Array x_built_, y_built_, z_built_;
   std::array<double, 6> wall_built_{};
   double skin_ = 0.0, r_min_ = 0.0, r_max_ = 0.0;
   bool list_valid_ = false;
@@ -266,6 +321,7 @@ class SphereWorld {
   int64_t divergence_step_ = -1;
   int64_t steps_ = 0;
   double time_ = 0.0;
+  detail::TeamHandle team_;
 };
 
 }  // namespace demcal

@@ -185,6 +185,11 @@ struct TeamHandle {
   TeamHandle& operator=(TeamHandle&&) noexcept;
   ~TeamHandle();
 };
+/// Run fn(ctx, t) for t = 0 .. size − 1 on `handle`'s team of `size`
+/// threads (started on first use, restarted if its size differs; t = 0 runs
+/// on the calling thread) and return when all are done. For the sphere
+/// kernel, which shares the 2D kernel's team.
+void team_run(TeamHandle& handle, int size, void (*fn)(void*, int), void* ctx);
 }  // namespace detail
 
 /// A 2D assembly of disks in a rectangular box of four walls.

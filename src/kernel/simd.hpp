@@ -1,0 +1,92 @@
+// SIMD helpers of the kernels' pair and particle passes (private to the
+// kernel): GCC vector types of W doubles, unaligned loads and stores,
+// emulated gathers, correctly rounded square roots, selects, maxima. Used
+// by the 2D passes (contact.cpp) and the sphere passes (sphere_contact.cpp);
+// the code path (W) is chosen once per process (kernel_simd()).
+#pragma once
+
+#include <cmath>
+#include <cstring>
+
+#if defined(__x86_64__) && defined(__GNUC__)
+#include <emmintrin.h>
+#define DEMCAL_X86_64 1
+#endif
+
+namespace demcal {
+namespace {
+
+// ---------------------------------------------------------------- SIMD
+
+// The vector helpers are always inlined: no vector crosses a call boundary,
+// so the ABI note about passing AVX vectors does not apply.
+#pragma GCC diagnostic ignored "-Wpsabi"
+
+template <int W>
+struct Simd {
+  typedef double D __attribute__((vector_size(8 * W)));
+  typedef long long M __attribute__((vector_size(8 * W)));  // lane masks (0 or −1)
+};
+
+#define DEMCAL_INLINE inline __attribute__((always_inline))
+
+template <int W>
+DEMCAL_INLINE typename Simd<W>::D load(const double *p) {
+  typename Simd<W>::D v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+template <int W>
+DEMCAL_INLINE void store(double *p, typename Simd<W>::D v) {
+  std::memcpy(p, &v, sizeof v);
+}
+template <int W>
+DEMCAL_INLINE typename Simd<W>::D gather(const double *__restrict b, const int *__restrict j) {
+  if constexpr (W == 8)
+    return
+        typename Simd<W>::D{b[j[0]], b[j[1]], b[j[2]], b[j[3]], b[j[4]], b[j[5]], b[j[6]], b[j[7]]};
+  else if constexpr (W == 4)
+    return typename Simd<W>::D{b[j[0]], b[j[1]], b[j[2]], b[j[3]]};
+  else
+    return typename Simd<W>::D{b[j[0]], b[j[1]]};
+}
+
+// Correctly rounded square roots. The 256- and 512-bit forms are inline
+// assembly because the template bodies are compiled for the baseline target
+// and only inlined into the AVX2 / AVX-512 entry points below (an intrinsic
+// there would not inline); the assembler takes the instruction as it is.
+DEMCAL_INLINE Simd<2>::D vsqrt(Simd<2>::D a) {
+#ifdef DEMCAL_X86_64
+  return reinterpret_cast<Simd<2>::D>(_mm_sqrt_pd(reinterpret_cast<__m128d>(a)));
+#else
+  return Simd<2>::D{std::sqrt(a[0]), std::sqrt(a[1])};
+#endif
+}
+#ifdef DEMCAL_X86_64
+DEMCAL_INLINE Simd<4>::D vsqrt(Simd<4>::D a) {
+  Simd<4>::D r;
+  asm("vsqrtpd %1, %0" : "=x"(r) : "x"(a));
+  return r;
+}
+DEMCAL_INLINE Simd<8>::D vsqrt(Simd<8>::D a) {
+  Simd<8>::D r;
+  asm("vsqrtpd %1, %0" : "=v"(r) : "v"(a));
+  return r;
+}
+#endif
+
+template <int W>
+DEMCAL_INLINE typename Simd<W>::D select(typename Simd<W>::M m, typename Simd<W>::D a,
+                                         typename Simd<W>::D b) {
+  return m ? a : b;
+}
+
+template <int W>
+DEMCAL_INLINE double hmax(typename Simd<W>::D v) {
+  double m = v[0];
+  for (int l = 1; l < W; ++l) m = v[l] > m ? v[l] : m;
+  return m;
+}
+
+}  // namespace
+}  // namespace demcal
