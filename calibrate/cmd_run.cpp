@@ -52,16 +52,16 @@ void print_scales(const SceneConfig& config, const World& world) {
 
 namespace {
 
-/// A prescribed Δt beyond the stable step of the consolidated REV is bad
-/// input (the run would diverge or rattle), unless asked for.
-void require_stable_step(const SceneConfig& config, const ConsolidatedState& state,
-                         bool allow_unstable) {
-  const double stable = estimated_stable_dt_ratio(state, config.algorithm);
+/// A prescribed Δt beyond `stable` (the dt_ratio estimated from the
+/// consolidated contact network, 2D or 3D) is bad input: the run would
+/// diverge or rattle, unless asked for.
+void require_stable_step(const SceneConfig& config, double stable, bool allow_unstable) {
   if (allow_unstable || config.algorithm.dt_ratio <= stable) return;
   std::ostringstream s;
   s << std::setprecision(4) << config.algorithm.dt_ratio
     << " is beyond the stable step estimated from the consolidated contact network, " << stable
-    << " (use a smaller value; `demcal stability` measures the limit, "
+    << " (use a smaller value; "
+    << (config.dimension == 2 ? "`demcal stability` measures the limit, " : "")
     << "`demcal run --allow-unstable` runs it anyway)";
   throw InputError(config.source, "algorithm.dt_ratio", s.str());
 }
@@ -93,17 +93,6 @@ TriaxialState consolidate_3d(const SceneConfig& config) {
   return consolidate_triaxial(config, assembly, consolidation_progress());
 }
 
-void require_stable_step(const SceneConfig& config, const TriaxialState& state,
-                         bool allow_unstable) {
-  const double stable = estimated_stable_dt_ratio(state, config.algorithm);
-  if (allow_unstable || config.algorithm.dt_ratio <= stable) return;
-  std::ostringstream s;
-  s << std::setprecision(4) << config.algorithm.dt_ratio
-    << " is beyond the stable step estimated from the consolidated contact network, " << stable
-    << " (use a smaller value; `demcal run --allow-unstable` runs it anyway)";
-  throw InputError(config.source, "algorithm.dt_ratio", s.str());
-}
-
 void print_scales_3d(const SceneConfig& config, const SphereWorld& world) {
   const ReferenceScales s = world.reference_scales();
   std::cout << "scene " << config.name << " (3D, triaxial): " << world.size() << " spheres\n"
@@ -117,7 +106,7 @@ void print_scales_3d(const SceneConfig& config, const SphereWorld& world) {
 
 int check_3d(const SceneConfig& config) {
   const TriaxialState state = consolidate_3d(config);
-  require_stable_step(config, state, false);
+  require_stable_step(config, estimated_stable_dt_ratio(state, config.algorithm), false);
   std::cout << "config " << config.source << ": valid\n";
   // The scales at the config's mass scaling, from the kernel's masses.
   SphereWorld probe = state.world;
@@ -147,7 +136,7 @@ int run_3d(const SceneConfig& config, const std::string& out_dir, bool allow_uns
   const std::string dir = out_dir.empty() ? "demcal-run-" + config.name : out_dir;
   OutputFolder::check(dir);  // an unwritable -o fails now, not after the run
   const TriaxialState state = consolidate_triaxial(config, assembly, consolidation_progress());
-  require_stable_step(config, state, allow_unstable);
+  require_stable_step(config, estimated_stable_dt_ratio(state, config.algorithm), allow_unstable);
   SphereWorld final_state = state.world;
   const TriaxialResult run =
       run_triaxial_loading(state, config.test, config.algorithm, {}, &final_state);
@@ -208,7 +197,7 @@ int cmd_check(const std::string& path, const std::vector<std::string>& sets) {
   if (config.dimension == 3) return check_3d(config);
   Assembly assembly = make_assembly(config);
   const ConsolidatedState state = consolidate(config, assembly);
-  require_stable_step(config, state, false);
+  require_stable_step(config, estimated_stable_dt_ratio(state, config.algorithm), false);
   std::cout << "config " << config.source << ": valid\n";
   print_scales(config, state.world);
   const StabilityEstimate est = state.world.stability_estimate();
@@ -236,7 +225,7 @@ int cmd_run(const std::string& path, const std::vector<std::string>& sets,
   const std::string dir = out_dir.empty() ? "demcal-run-" + config.name : out_dir;
   OutputFolder::check(dir);  // an unwritable -o fails now, not after the run
   const ConsolidatedState state = consolidate(config, assembly);
-  require_stable_step(config, state, allow_unstable);
+  require_stable_step(config, estimated_stable_dt_ratio(state, config.algorithm), allow_unstable);
   World final_state = state.world;
   const LoadingResult run = run_loading(state, config.test, config.algorithm, {}, &final_state);
   const Tolerances tolerances;

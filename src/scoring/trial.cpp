@@ -47,10 +47,9 @@ nlohmann::json run_summary(const SceneConfig& config, const LoadingResult& run,
          {"diverged", run.diverged},
          {"steps_run", run.steps_run},
          {"wall_time_s", run.wall_time_s},
-         {"particle_steps_per_s", run.wall_time_s > 0
-                                      ? static_cast<double>(run.particles) *
-                                            static_cast<double>(run.steps_run) / run.wall_time_s
-                                      : 0.0},
+         {"particle_steps_per_s",
+          particle_steps_per_second(run.particles, static_cast<double>(run.steps_run),
+                                    run.wall_time_s)},
          {"strain_rate", run.strain_rate}};
   if (run.diverged) {
     j["divergence"] = {{"reason", to_string(run.divergence)}, {"step", run.divergence_step}};
@@ -60,7 +59,8 @@ nlohmann::json run_summary(const SceneConfig& config, const LoadingResult& run,
         {"stress_yy", *analytical},
         {"ratio", -*analytical / config.test.lateral_stress},
         {"ratio_periodic", hexagonal_peak_ratio(config.material.particle.friction)},
-        {"note", "walled-box value; rotation-locked sliding mechanism (reports/hexagonal-peaks.md)"}};
+        {"note",
+         "walled-box value; rotation-locked sliding mechanism (reports/hexagonal-peaks.md)"}};
   }
   return j;
 }

@@ -127,10 +127,9 @@ nlohmann::json triaxial_run_summary(const SceneConfig& config, const TriaxialSta
          {"diverged", run.diverged},
          {"steps_run", run.steps_run},
          {"wall_time_s", run.wall_time_s},
-         {"particle_steps_per_s", run.wall_time_s > 0
-                                      ? static_cast<double>(run.particles) *
-                                            static_cast<double>(run.steps_run) / run.wall_time_s
-                                      : 0.0},
+         {"particle_steps_per_s",
+          particle_steps_per_second(run.particles, static_cast<double>(run.steps_run),
+                                    run.wall_time_s)},
          {"strain_rate", run.strain_rate},
          {"consolidation",
           {{"steps", state.steps},

@@ -20,6 +20,12 @@ std::optional<double> analytical_peak_stress(const SceneConfig& config);
 nlohmann::json params_json(const AlgorithmSpec& algorithm, const Integration& integration,
                            const ReferenceScales& scales);
 
+/// Particle-steps per wall-clock second, the cost rate every summary
+/// reports (0 when no time was measured).
+inline double particle_steps_per_second(double particles, double steps, double wall_time_s) {
+  return wall_time_s > 0 ? particles * steps / wall_time_s : 0.0;
+}
+
 /// summary.json of a run (`demcal run`, README.md "Commands").
 nlohmann::json run_summary(const SceneConfig& config, const LoadingResult& run, const Score& score);
 
