@@ -209,7 +209,7 @@ StabilityEstimate World::stability_estimate(int iterations) const {
     const double omega = std::sqrt(w2);
     if (gamma == 0.0) return 2.0 / omega;
     const double zeta = 0.5 * gamma * omega;
-    return 2.0 / omega * (std::sqrt(1.0 + zeta * zeta) - zeta);
+    return 2.0 / omega * dashpot_step_factor(zeta);
   };
   est.dt_stable = step_for(est.omega2_max);
   est.dt_stable_gershgorin = step_for(est.omega2_gershgorin);

@@ -33,8 +33,20 @@ double servo_velocity(const World& world, WallSide side, double target_stress, d
   const double dt = world.integration().dt;
   const int contacts = std::max(1, world.wall(side).contacts);
   const double error = target_stress - wall_pressure(world, side);
-  double move =
-      gain * error * length * world.material().thickness / (world.material().wall.kn * contacts);
+  // The wall's contacts resist a move by kw per unit length, and their
+  // dashpots by c/Δt more within the step (c = 2ζ_c·sqrt(kw·m), the heaviest
+  // particle's: the most damping). Leaving the dashpots out makes the servo
+  // overshoot by gain·c/(Δt·kw) = gain·ζ_c/α each step, and beyond 1 the
+  // wall velocity flips and grows: the loop, not the integrator, creates
+  // energy (issue 14: contact damping 0.2 "diverged" in consolidation).
+  const Material& mat = world.material();
+  double resistance = mat.wall.kn;
+  if (mat.contact_damping_ratio > 0.0) {
+    const double m_max =
+        disk_mass(disk_areal_density(mat, world.integration().mass_scaling), world.max_radius());
+    resistance += 2.0 * mat.contact_damping_ratio * std::sqrt(mat.wall.kn * m_max) / dt;
+  }
+  double move = gain * error * length * mat.thickness / (resistance * contacts);
   // Never more than 2 % of the smallest radius per step (a gas far from the
   // walls is approached at this speed; a packing never gets near it).
   const double r_min = world.min_radius();
@@ -79,6 +91,20 @@ ConsolidatedState consolidate_fresh(const SceneConfig& config, const Assembly& a
   settle.damping_ratio_translation = kConsolidationDamping;
   settle.damping_ratio_rotation = kConsolidationDamping;
   settle.lock_rotation = config.algorithm.lock_rotation;
+  // Contact dashpots lower the stable step: 2/ω·f(ζ), f = sqrt(1 + ζ²) − ζ,
+  // ζ = ½·γ·ω, γ = 2·ζ_c·sqrt(m_eff/k) (stability.cpp). 2/ω·f(½·γ·ω)
+  // decreases with ω, so if α = 0.2 is stable without them (ω_max·Δt₀ ≤ 2),
+  // Δt₀·f(γ_max/Δt₀) is stable with them (γ_max: the heaviest particle on
+  // the softer of particle and wall springs).
+  if (const double zeta_c = config.material.contact_damping_ratio; zeta_c > 0.0) {
+    const Material& mat = config.material;
+    const double density = disk_areal_density(mat, settle.mass_scaling);
+    const double gamma_max =
+        2.0 * zeta_c *
+        std::sqrt(disk_mass(density, world.max_radius()) / std::min(mat.particle.kn, mat.wall.kn));
+    const double dt0 = integration_for(world, settle).dt;
+    settle.dt_ratio *= dashpot_step_factor(gamma_max / dt0);
+  }
   world.set_integration(integration_for(world, settle));
   // Only the blow-up checks (non-finite state, overlap beyond the limit) stay
   // on during consolidation. With light damping, the energy checks read the

@@ -44,6 +44,10 @@ inline double critical_damping_rotation(double kt, double radius, double inertia
   return 2.0 * std::sqrt(kt * radius * radius * inertia);
 }
 
+/// The explicit contact dashpot's factor on the stable step of a mode damped
+/// at ratio ζ by it: ω·Δt < 2·(sqrt(1 + ζ²) − ζ) (stability.cpp).
+inline double dashpot_step_factor(double zeta) { return std::sqrt(1.0 + zeta * zeta) - zeta; }
+
 /// D_r^crit of a disk of mass m, with the inertia m·r²/2 written out:
 /// 2·sqrt(kt·r²·(m/2)·r²). The same value as critical_damping_rotation(kt,
 /// r, disk_inertia(m, r)) up to the last bit; this order is the one the
