@@ -60,7 +60,7 @@ TEST(Export, LammpsDeckMapsEveryParameter) {
   const ExportResult r = export_deck(c, params(), a, o);
   const ParticleScales s = particle_scales(a.r, c.material);
   // The engine's explicit fix viscous: alpha*f, Nstep/f, f(0.7) = 0.520656.
-  const double f = explicit_damping_step_factor(0.7);
+  const double f = dashpot_step_factor(0.7);
   EXPECT_NEAR(f, std::sqrt(1.49) - 0.7, 1e-15);
   EXPECT_EQ(r.step_factor, f);
   EXPECT_NEAR(r.dt, 0.22 * f * s.dt_crit, 1e-18);
@@ -116,12 +116,12 @@ TEST(Export, ExplicitDampingStepFactorIsTheDampedOscillatorsStabilityLimit) {
     return peak;
   };
   for (const double zeta : {0.0, 0.2, 0.7, 1.107, 3.0}) {
-    const double f = explicit_damping_step_factor(zeta);
+    const double f = dashpot_step_factor(zeta);
     EXPECT_NEAR(f, std::sqrt(1.0 + zeta * zeta) - zeta, 1e-14);
     EXPECT_LT(amplitude(zeta, 2.0 * f * (1.0 - 1e-2)), 1.0 + 1e-9) << "zeta " << zeta;
     EXPECT_GT(amplitude(zeta, 2.0 * f * (1.0 + 1e-2)), 1e3) << "zeta " << zeta;
   }
-  EXPECT_EQ(explicit_damping_step_factor(0.0), 1.0);
+  EXPECT_EQ(dashpot_step_factor(0.0), 1.0);
 }
 
 TEST(Export, PolydisperseDampingPerClass) {

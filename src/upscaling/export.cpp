@@ -61,7 +61,7 @@ Plan make_plan(const SceneConfig& c, const AlgorithmSpec& p, const Assembly& a, 
   // velocity), which shrinks the stable step by f; demcal's damping is
   // semi-implicit. The deck runs at alpha*f for Nstep/f steps: the same
   // loading time, rate and strain, and the same stability margin as demcal.
-  plan.step_factor = explicit_damping_step_factor(p.damping_ratio_translation);
+  plan.step_factor = dashpot_step_factor(p.damping_ratio_translation);
   plan.dt = p.dt_ratio * plan.step_factor * plan.dt_crit;
   plan.steps = std::max<int64_t>(1, std::llround(static_cast<double>(p.steps) / plan.step_factor));
   plan.areal_density = p.mass_scaling * c.material.density * c.material.thickness;

@@ -44,9 +44,19 @@ inline double critical_damping_rotation(double kt, double radius, double inertia
   return 2.0 * std::sqrt(kt * radius * radius * inertia);
 }
 
-/// The explicit contact dashpot's factor on the stable step of a mode damped
-/// at ratio ζ by it: ω·Δt < 2·(sqrt(1 + ζ²) − ζ) (stability.cpp).
-inline double dashpot_step_factor(double zeta) { return std::sqrt(1.0 + zeta * zeta) - zeta; }
+/// f = sqrt(1 + ζ²) − ζ: the factor by which an explicit dashpot of ratio ζ
+/// (of the critical value) shrinks the stable step of a mass on a spring,
+/// ω·Δt < 2f. Explicit: the drag comes from the lagging velocity, i.e.
+/// x_{n+1} − 2x_n + x_{n−1} = −Ω²x_n − 2ζΩ(x_n − x_{n−1}), Ω = ω·Δt, whose
+/// characteristic z² + (Ω² + 2ζΩ − 2)z + 1 − 2ζΩ = 0 has its root z = −1 at
+/// Ω = 2f. Two users: the kernel's contact dashpots (stability.cpp, the
+/// consolidation step in biaxial.cpp), and LAMMPS' and LIGGGHTS' fix viscous,
+/// which the export runs at α·f for Nstep/f steps (demcal's global damping
+/// is semi-implicit, f = 1). Written as 1/(sqrt(1 + ζ²) + ζ), which loses no
+/// digits at large ζ.
+inline double dashpot_step_factor(double zeta) {
+  return 1.0 / (std::sqrt(1.0 + zeta * zeta) + zeta);
+}
 
 /// D_r^crit of a disk of mass m, with the inertia m·r²/2 written out:
 /// 2·sqrt(kt·r²·(m/2)·r²). The same value as critical_damping_rotation(kt,

@@ -21,7 +21,7 @@
 //              the lateral walls.
 //
 // Both formats run at α·f·Δt_crit for Nstep/f steps, f =
-// explicit_damping_step_factor(ζ_t) (below): their fix viscous is explicit.
+// dashpot_step_factor(ζ_t) (kernel/particle_scales.hpp): their fix viscous is explicit.
 // Every mapping, and every place where the other code cannot do exactly
 // what demcal does, is written as comments into the deck itself.
 #pragma once
@@ -31,6 +31,7 @@
 #include <string>
 #include <vector>
 
+#include "demcal/kernel/particle_scales.hpp"
 #include "demcal/scene/config.hpp"
 #include "demcal/scene/packing.hpp"
 #include "demcal/upscaling/upscaling.hpp"
@@ -52,7 +53,7 @@ struct ExportResult {
   /// Other files the deck reads, by name (the data file, meshes).
   std::map<std::string, std::string> files;
   /// The timestep written into the deck [s]: α·f·Δt_crit, f =
-  /// explicit_damping_step_factor(ζ_t) (the engines' fix viscous is
+  /// dashpot_step_factor(ζ_t) (the engines' fix viscous is
   /// explicit; demcal's damping is not).
   double dt = 0.0;
   int64_t steps = 0;         ///< the run length written into the deck: Nstep/f (same loading time)
@@ -63,19 +64,6 @@ struct ExportResult {
   double damping_class_error = 0.0;
   std::vector<std::string> notes;  ///< what could not be mapped exactly
 };
-
-/// f = sqrt(1 + ζ²) − ζ: the factor by which an explicit dashpot of ratio ζ
-/// (of the critical value) shrinks the stable step of a mass on a spring,
-/// Δt ≤ f·Δt_crit. LAMMPS' and LIGGGHTS' fix viscous take the drag from the
-/// half-step velocity of velocity Verlet, i.e. central differences with a
-/// lagging velocity: x_{n+1} − 2x_n + x_{n−1} = −Ω²x_n − 2ζΩ(x_n − x_{n−1}),
-/// Ω = ω·Δt, characteristic z² + (Ω² + 2ζΩ − 2)z + 1 − 2ζΩ = 0, whose root
-/// z = −1 sits at Ω = 2f. demcal's damping is semi-implicit (f = 1), so the
-/// export runs the engines at α·f for Nstep/f steps. Written as
-/// 1/(sqrt(1 + ζ²) + ζ), which loses no digits at large ζ.
-inline double explicit_damping_step_factor(double damping_ratio) {
-  return 1.0 / (std::sqrt(1.0 + damping_ratio * damping_ratio) + damping_ratio);
-}
 
 /// The deck for running `params` (the prototype's: Nstep upscaled) on
 /// `assembly` (best a consolidated state: its walls are the starting wall
