@@ -161,8 +161,10 @@ std::string write_report(const CalibrateOptions& o, const SceneConfig& config,
     attach_runs(in, rerun_start_and_result(config, state, start, summary, in.tolerances, jobs));
     const auto t1 = std::chrono::steady_clock::now();
     const Report report = make_report(in);
-    write_file_atomic(dir + "/report.html", report.html);
-    write_file_atomic(dir + "/report.md", report.markdown);
+    OutputFolder out(dir);  // the two renderings of one report, together
+    out.write("report.html", report.html);
+    out.write("report.md", report.markdown);
+    out.commit();
     if (!o.quiet)
       std::cerr << "demcal: report: reruns " << std::chrono::duration<double>(t1 - t0).count()
                 << " s, writing " << seconds_since(t1) << " s; " << report.plot_status << "\n";
@@ -275,16 +277,25 @@ int cmd_calibrate(const CalibrateOptions& o) {
   // The evidence and report runs do not poll the flag (seconds on a REV):
   // a stop asked for during them takes effect here.
   if (stop.stopped()) return interrupted(" during the evidence runs (nothing written)");
-  if (!evidence_lines.empty()) write_file_atomic(dir + "/evidence.jsonl", evidence_lines);
-  write_file_atomic(dir + "/params.json", params.dump(2) + "\n");
-  // What varies between invocations stays out of params.json. Written now
-  // and again after the report, so params.json never stands without it.
-  const auto write_run_json = [&] {
-    const double wall_time_s = seconds_since(t_start);
-    write_file_atomic(dir + "/run.json",
-                      run_record(wall_time_s, summary, state, jobs, o.resume).dump(2) + "\n");
+  // What varies between invocations stays out of params.json (run.json).
+  // Written with params.json, and again after the report with the total.
+  const auto run_json = [&] {
+    return run_record(seconds_since(t_start), summary, state, jobs, o.resume).dump(2) + "\n";
   };
-  write_run_json();
+  {
+    // params.json, run.json and evidence.jsonl of one calibration replace
+    // those of an earlier one together (an evidence.jsonl of an earlier
+    // --evidence run that this one does not redo goes with them).
+    OutputFolder out(dir);
+    if (!evidence_lines.empty())
+      out.write("evidence.jsonl", evidence_lines);
+    else
+      out.retire("evidence.jsonl");
+    out.write("params.json", params.dump(2) + "\n");
+    out.write("run.json", run_json());
+    out.commit();
+  }
+  const auto write_run_json = [&] { write_file_atomic(dir + "/run.json", run_json()); };
   if (stop.stopped())
     return interrupted(
         " before the report (params.json and run.json are written; --resume reuses every trial "

@@ -12,6 +12,7 @@
 #include "demcal/upscaling/params_file.hpp"
 #include "demcal/upscaling/rev.hpp"
 #include "demcal/upscaling/upscaling.hpp"
+#include "output_folder.hpp"
 #include "upscaling_cli.hpp"
 
 namespace demcal::cli {
@@ -33,6 +34,8 @@ int cmd_export(const ExportCmdOptions& o) {
       o.output.empty() ? "demcal-" + config.name + "." + o.format : o.output;
   const fs::path deck_fs(deck_path);
   if (fs::is_directory(deck_fs)) throw InputError(deck_path, "", "is a folder; give a file name");
+  // An unwritable destination fails now, not after the consolidation.
+  OutputFolder::check(deck_fs.has_parent_path() ? deck_fs.parent_path().string() : ".");
   ExportOptions eo;
   eo.format = o.format;
   const std::string ext = deck_fs.extension().string();
@@ -52,9 +55,14 @@ int cmd_export(const ExportCmdOptions& o) {
   }
   const ExportResult r = export_deck(config, up, proto, eo);
   const fs::path dir = deck_fs.has_parent_path() ? deck_fs.parent_path() : fs::path(".");
-  if (!dir.empty() && dir != ".") make_output_dir(dir.string());
-  for (const auto& [name, content] : r.files) write_file_atomic((dir / name).string(), content);
-  write_file_atomic(deck_path, r.deck);
+  {
+    // The deck and the files it reads (data file, meshes) replace those of
+    // an earlier export together: never a new deck beside an old data file.
+    OutputFolder out(dir.string());
+    for (const auto& [name, content] : r.files) out.write(name, content);
+    out.write(deck_fs.filename().string(), r.deck);
+    out.commit();
+  }
   std::cout << "wrote " << deck_path << " (" << o.format << ", " << proto.size()
             << " particles, timestep " << r.dt << " s, " << r.steps << " steps, " << r.types
             << " radius class(es))";

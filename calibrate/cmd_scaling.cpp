@@ -7,6 +7,7 @@
 #include "demcal/io/files.hpp"
 #include "demcal/io/format.hpp"
 #include "demcal/upscaling/scaling_study.hpp"
+#include "output_folder.hpp"
 #include "upscaling_cli.hpp"
 
 namespace demcal::cli {
@@ -25,11 +26,15 @@ int cmd_scaling(const ScalingOptions& o) {
     so.log = [](const std::string& line) { std::cerr << "demcal scaling: " << line << "\n"; };
   check_scaling_sizes(so);  // bad sizes fail before any folder is made
   const std::string out_dir = o.out_dir.empty() ? "reports" : o.out_dir;
-  make_output_dir(out_dir);
+  OutputFolder::check(out_dir);  // an unwritable -o fails now, not after the study
 
   const ScalingStudy st = run_scaling_study(config, so);
-  write_file_atomic(out_dir + "/scaling.json", to_json(st, config).dump(2) + "\n");
-  write_file_atomic(out_dir + "/scaling.md", scaling_markdown(st, config));
+  {
+    OutputFolder out(out_dir);  // both files replaced together, or neither
+    out.write("scaling.json", to_json(st, config).dump(2) + "\n");
+    out.write("scaling.md", scaling_markdown(st, config));
+    out.commit();
+  }
   std::cout << "calibrated fit: slope " << num(st.lin_cal.slope, 5) << ", intercept "
             << num(st.lin_cal.intercept, 5) << ", R2 " << num(st.lin_cal.r2, 4)
             << "; fixed multipliers from the REV up: exponent " << num(st.measured.exponent, 3)

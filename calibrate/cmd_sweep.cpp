@@ -6,10 +6,10 @@
 #include <sstream>
 
 #include "commands.hpp"
-#include "demcal/scene/biaxial.hpp"
 #include "demcal/io/files.hpp"
-#include "demcal/scene/run_output.hpp"
+#include "demcal/scene/biaxial.hpp"
 #include "demcal/scene/packing.hpp"
+#include "demcal/scene/run_output.hpp"
 #include "demcal/search/sweep.hpp"
 #include "output_folder.hpp"
 
@@ -37,16 +37,18 @@ int cmd_sweep(const SweepOptions& options) {
             << ", alpha_stable " << std::setprecision(3) << alpha_stable << "\n";
   const SweepResult result = run_sweep(config, state, cases, settings);
 
-  make_output_dir(dir);
-  make_output_dir(dir + "/series");
-  for (const auto& r : result.cases)
-    write_file_atomic(dir + "/series/" + r.spec.name + ".csv", series_csv(r.run.series));
-  write_file_atomic(dir + "/evidence.csv", evidence_csv(result));
-  nlohmann::json j = to_json(result);
-  j["config_sha256"] = sha256_hex(config.text);
-  j["version"] = DEMCAL_VERSION;
-  write_file_atomic(dir + "/atlas.json", j.dump(2) + "\n");
-  write_file_atomic(dir + "/atlas.md", atlas_markdown(result));
+  {
+    OutputFolder out(dir);  // all files replaced together, or none
+    for (const auto& r : result.cases)
+      out.write("series/" + r.spec.name + ".csv", series_csv(r.run.series));
+    out.write("evidence.csv", evidence_csv(result));
+    nlohmann::json j = to_json(result);
+    j["config_sha256"] = sha256_hex(config.text);
+    j["version"] = DEMCAL_VERSION;
+    out.write("atlas.json", j.dump(2) + "\n");
+    out.write("atlas.md", atlas_markdown(result));
+    out.commit();
+  }
 
   const double s3 = config.test.lateral_stress;
   std::cout << std::setprecision(4) << "sweep " << config.name << ": " << result.cases.size()

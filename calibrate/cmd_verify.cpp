@@ -26,6 +26,7 @@
 #include "demcal/upscaling/params_file.hpp"
 #include "demcal/upscaling/rev.hpp"
 #include "demcal/upscaling/upscaling.hpp"
+#include "output_folder.hpp"
 #include "upscaling_cli.hpp"
 
 namespace demcal::cli {
@@ -240,8 +241,12 @@ int cmd_verify(const VerifyOptions& o) {
          trial.wall_time_s > 0 ? particle_steps / trial.wall_time_s : 0.0}}},
       {"wall_time_s", total_s},
       {"version", DEMCAL_VERSION}};
-  write_file_atomic(dir + "/verify.json", out.dump(2) + "\n");
-  write_file_atomic(dir + "/series.csv", series_csv(run.series));
+  {
+    OutputFolder files(dir);  // verify.json and series.csv of one run, replaced together
+    files.write("verify.json", out.dump(2) + "\n");
+    files.write("series.csv", series_csv(run.series));
+    files.commit();
+  }
 
   const auto& c = trial.score.criteria;
   std::cout << (trial.score.passed ? "PASS" : "FAIL") << ": prototype of " << n << " particles, "

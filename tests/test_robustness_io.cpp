@@ -275,5 +275,42 @@ TEST_F(RobustIo, CliRunOnAFullDiskKeepsTheEarlierRun) {
   ::umount(disk.c_str());
 }
 
+// The other commands write through the same output folder: an export on a
+// nearly full disk keeps the earlier deck and its data file (never a new
+// data file beside an old deck), and a later export replaces both together.
+TEST_F(RobustIo, ExportReplacesDeckAndDataTogetherOrNotAtAll) {
+  const Result cal = run_demcal({"calibrate", kHex5, "-o", "cal", "-q"}, dir_);
+  ASSERT_EQ(cal.status, 0) << cal.err;
+  const fs::path params = dir_ / "cal" / "params.json";
+  const fs::path disk = dir_ / "disk";
+  if (!mount_small_disk(disk, 512)) GTEST_SKIP() << "cannot mount a tmpfs here (needs root)";
+  const fs::path out = disk / "out";
+  fs::create_directories(out);
+  std::ofstream(out / "deck.lammps") << "old deck";
+  std::ofstream(out / "deck.data") << "old data";
+  std::ofstream(out / "keep.txt") << "mine";
+  fill_disk(disk);
+  // Room for the data file (6 kB) but not the deck (17 kB) as well: written
+  // one by one, the new data file landed beside the old deck.
+  fs::resize_file(disk / "filler", fs::file_size(disk / "filler") - 3 * 4096);
+  const std::vector<std::string> args{
+      "export", params.string(), "--particles", "100", "-o", (out / "deck.lammps").string()};
+  const Result full = run_demcal(args, dir_);
+  EXPECT_NE(full.status, 0);
+  EXPECT_NE(full.err.find("No space left on device"), std::string::npos) << full.err;
+  EXPECT_EQ(read_text(out / "deck.lammps"), "old deck");
+  EXPECT_EQ(read_text(out / "deck.data"), "old data");
+  EXPECT_EQ(names_in(out).size(), 3u);
+
+  fs::remove(disk / "filler");
+  const Result r = run_demcal(args, dir_);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(read_text(out / "deck.lammps").find("read_data"), std::string::npos);
+  EXPECT_NE(read_text(out / "deck.data"), "old data");
+  EXPECT_EQ(read_text(out / "keep.txt"), "mine");
+  EXPECT_EQ(names_in(out).size(), 3u);
+  ::umount(disk.c_str());
+}
+
 }  // namespace
 }  // namespace demcal
