@@ -33,13 +33,13 @@ ReferenceScales SphereWorld::reference_scales() const {
     if (m_[i] < m_[imin]) imin = i;
   const double kn = material_.particle.kn, kt = material_.particle.kt;
   s.mass_min = m_[imin];
-  s.dt_crit = 2.0 * std::sqrt(m_[imin] / kn);
-  s.damping_translation_crit = 2.0 * std::sqrt(kn * m_[imin]);
-  s.damping_rotation_crit = 2.0 * std::sqrt(kt * r_[imin] * r_[imin] * inertia_[imin]);
+  s.dt_crit = critical_time_step(m_[imin], kn);
+  s.damping_translation_crit = critical_damping_translation(kn, m_[imin]);
+  s.damping_rotation_crit = critical_damping_rotation(kt, r_[imin], inertia_[imin]);
   double dt_sum = 0.0, dr_sum = 0.0;
   for (int i = 0; i < n_; ++i) {
-    dt_sum += 2.0 * std::sqrt(kn * m_[i]);
-    dr_sum += 2.0 * std::sqrt(kt * r_[i] * r_[i] * inertia_[i]);
+    dt_sum += critical_damping_translation(kn, m_[i]);
+    dr_sum += critical_damping_rotation(kt, r_[i], inertia_[i]);
   }
   s.damping_translation_crit_mean = dt_sum / n_;
   s.damping_rotation_crit_mean = dr_sum / n_;

@@ -13,6 +13,8 @@
 #include <stdexcept>
 #include <thread>
 
+#include "demcal/kernel/particle_scales.hpp"
+
 namespace demcal {
 
 namespace {
@@ -146,8 +148,8 @@ void SphereWorld::set_integration(const Integration& integration) {
     for (auto* w : {&wx_, &wy_, &wz_}) std::fill(w->begin(), w->end(), 0.0);
   const double rho = material_.density * integration_.mass_scaling;
   for (int i = 0; i < n_; ++i) {
-    m_[i] = rho * 4.0 / 3.0 * std::numbers::pi * r_[i] * r_[i] * r_[i];
-    inertia_[i] = 0.4 * m_[i] * r_[i] * r_[i];
+    m_[i] = sphere_mass(rho, r_[i]);
+    inertia_[i] = sphere_inertia(m_[i], r_[i]);
   }
   update_damping_coefficients();
 }
@@ -156,13 +158,15 @@ void SphereWorld::update_damping_coefficients() {
   const double dt = integration_.dt;
   const double kn = material_.particle.kn, kt = material_.particle.kt;
   for (int i = 0; i < n_; ++i) {
-    const double dtc = integration_.damping_ratio_translation * 2.0 * std::sqrt(kn * m_[i]);
+    // ζ·(2·sqrt(kn·m)) equals (ζ·2)·sqrt(kn·m) to the bit: ×2 is exact.
+    const double dtc =
+        integration_.damping_ratio_translation * critical_damping_translation(kn, m_[i]);
     d_t_[i] = dtc;
     const double c = dtc * dt / (2.0 * m_[i]);
     ca_t_[i] = (1.0 - c) / (1.0 + c);
     cb_t_[i] = dt / m_[i] / (1.0 + c);
     const double drc =
-        integration_.damping_ratio_rotation * 2.0 * std::sqrt(kt * r_[i] * r_[i] * inertia_[i]);
+        integration_.damping_ratio_rotation * critical_damping_rotation(kt, r_[i], inertia_[i]);
     d_r_[i] = drc;
     const double cr = drc * dt / (2.0 * inertia_[i]);
     ca_r_[i] = (1.0 - cr) / (1.0 + cr);

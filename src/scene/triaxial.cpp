@@ -118,27 +118,16 @@ double servo_velocity(const SphereWorld& world, SphereWallSide side, double targ
 }
 
 Integration integration_for(const SphereWorld& world, const AlgorithmSpec& algorithm) {
-  // Δt_crit = 2·sqrt(m_min/kn) from the kernel's masses at this mass
-  // scaling: a probe with the spec's f_ms (masses are set by set_integration).
   Integration in;
   in.mass_scaling = algorithm.mass_scaling;
   in.damping_ratio_translation = algorithm.damping_ratio_translation;
   in.damping_ratio_rotation = algorithm.damping_ratio_rotation;
   in.lock_rotation = algorithm.lock_rotation;
-  double dt_crit = world.reference_scales().dt_crit;
-  if (world.integration().mass_scaling != algorithm.mass_scaling) {
-    const std::span<const double> r = world.radius();
-    const int i = static_cast<int>(std::min_element(r.begin(), r.end()) - r.begin());
-    const std::array<double, 3> lo{-2.0 * r[i], -2.0 * r[i], -2.0 * r[i]};
-    const std::array<double, 3> hi{2.0 * r[i], 2.0 * r[i], 2.0 * r[i]};
-    const double zero = 0.0;
-    SphereWorld probe(world.material(), {&zero, 1}, {&zero, 1}, {&zero, 1}, r.subspan(i, 1), lo,
-                      hi);
-    Integration p;
-    p.mass_scaling = algorithm.mass_scaling;
-    probe.set_integration(p);
-    dt_crit = probe.reference_scales().dt_crit;
-  }
+  // Δt_crit = 2·sqrt(m_min/kn) at this run's mass scaling (the smallest
+  // sphere is the lightest: one density).
+  const double m_min =
+      sphere_mass(world.material().density * algorithm.mass_scaling, world.min_radius());
+  const double dt_crit = critical_time_step(m_min, world.material().particle.kn);
   in.dt = algorithm.dt_ratio * dt_crit;
   return in;
 }

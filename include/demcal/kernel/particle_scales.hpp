@@ -5,6 +5,7 @@
 //
 //   disk mass          m = f_ms·ρ·t·π·r²   (a cylinder of thickness t)
 //   inertia            I = m·r²/2
+//   sphere mass        m = f_ms·ρ·(4/3)·π·r³,  I = (2/5)·m·r²
 //   critical step      Δt_crit = 2·sqrt(m_min/kn)
 //   critical damping   D_t^crit = 2·sqrt(kn·m),  D_r^crit = 2·sqrt(kt·r²·I)
 //
@@ -32,6 +33,12 @@ inline double disk_mass(double areal_density, double radius) {
 }
 /// I = m·r²/2 [kg·m²] of a uniform disk.
 inline double disk_inertia(double mass, double radius) { return 0.5 * mass * radius * radius; }
+/// m = (f_ms·ρ)·(4/3)·π·r³ [kg] of a sphere, `density` = f_ms·ρ.
+inline double sphere_mass(double density, double radius) {
+  return density * 4.0 / 3.0 * std::numbers::pi * radius * radius * radius;
+}
+/// I = (2/5)·m·r² [kg·m²] of a uniform sphere.
+inline double sphere_inertia(double mass, double radius) { return 0.4 * mass * radius * radius; }
 /// Δt_crit = 2·sqrt(m/kn) [s]: twice the inverse angular frequency of a
 /// mass on one spring.
 inline double critical_time_step(double mass, double kn) { return 2.0 * std::sqrt(mass / kn); }
