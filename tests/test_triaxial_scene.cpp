@@ -124,7 +124,7 @@ double max_wall_error(const SphereWorld& w, double sigma3) {
 
 // A loose random gas is compressed until every one of the six walls carries
 // σ3 within the consolidation tolerance and the sample is static. σ3 = 1e7
-// Pa: kn/(σ3·d) = 1e4, the stiffness level of configs/random_500_3d.json.
+// Pa: kn/(σ3·d) = 1e4, the stiffness level of configs/random_500_3d.json (kn 1e6 at 100 kPa there).
 TEST(TriaxialScene, ConsolidationReachesSigma3OnAllSixWalls) {
   const SceneConfig c = parse(
       R"({"dimension": 3, "assembly": {"type": "random", "count": 60, "radius_min": 4e-4,
