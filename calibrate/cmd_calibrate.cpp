@@ -75,6 +75,7 @@ nlohmann::json run_record(double wall_time_s, const CalibrationSummary& summary,
           {"wall_time_s", wall_time_s},
           {"calibration_wall_time_s", summary.wall_time_s},
           {"consolidation_wall_time_s", state.wall_time_s},
+          {"consolidation_from_cache", state.from_cache},
           {"jobs", jobs},
           {"resumed", resumed},
           {"trials_run", summary.trials_run},
@@ -202,8 +203,10 @@ int cmd_calibrate(const CalibrateOptions& o) {
               << " to sigma3 = " << config.test.lateral_stress << " Pa\n";
   const ConsolidatedState state = consolidate(config, assembly);
   if (!o.quiet)
-    std::cerr << "demcal: consolidated in " << state.steps << " steps (" << state.wall_time_s
-              << " s)\n";
+    std::cerr << "demcal: consolidated in " << state.steps << " steps ("
+              << (state.from_cache ? "read from the consolidation cache"
+                                   : std::to_string(state.wall_time_s) + " s")
+              << ")\n";
 
   // From here on a signal stops cleanly (consolidation writes nothing, so
   // the default action is fine before).

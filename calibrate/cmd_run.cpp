@@ -202,7 +202,8 @@ int cmd_check(const std::string& path, const std::vector<std::string>& sets) {
   print_scales(config, state.world);
   const StabilityEstimate est = state.world.stability_estimate();
   std::cout << "  consolidated in " << state.steps << " steps (" << std::setprecision(3)
-            << state.wall_time_s << " s), box " << state.width0 << " x " << state.height0 << " m\n"
+            << state.wall_time_s << " s" << (state.from_cache ? ", from the cache" : "")
+            << "), box " << state.width0 << " x " << state.height0 << " m\n"
             << std::setprecision(6) << "  stable dt_ratio (Lanczos, rotation coupled) "
             << est.dt_ratio_stable << "\n"
             << "  stable dt_ratio (Gershgorin bound)         " << est.dt_ratio_stable_gershgorin
@@ -233,7 +234,8 @@ int cmd_run(const std::string& path, const std::vector<std::string>& sets,
       score_run(run, config.test.lateral_stress, tolerances, analytical_peak_stress(config));
   nlohmann::json summary = run_summary(config, run, score);
   summary["tolerances"] = to_json(tolerances);
-  summary["consolidation"] = {{"steps", state.steps}, {"wall_time_s", state.wall_time_s}};
+  summary["consolidation"] = {
+      {"steps", state.steps}, {"wall_time_s", state.wall_time_s}, {"from_cache", state.from_cache}};
   summary["config_sha256"] = sha256_hex(config.text);
   summary["version"] = DEMCAL_VERSION;
 
