@@ -60,10 +60,10 @@ void write_lammps(const demcal_bench::Scene& s, const demcal::World& w, const st
   double gamma = 0.0, mass_sum = 0.0;
   const double areal_density = disk_areal_density(s.material, w.integration().mass_scaling);
   for (size_t i = 0; i < s.x.size(); ++i) {
-    const double m = disk_mass(areal_density, s.r[i]);
+    const double m = demcal::disk_mass(areal_density, s.r[i]);
     mass_sum += m;
     gamma += w.integration().damping_ratio_translation *
-             critical_damping_translation(s.material.particle.kn, m);
+             demcal::critical_damping_translation(s.material.particle.kn, m);
   }
   gamma /= static_cast<double>(s.x.size());
   std::ofstream v(prefix + ".vars");
