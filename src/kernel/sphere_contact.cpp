@@ -54,6 +54,19 @@
 // forces on i and j; the torques a_i·n × h and a_j·n × h come out of the
 // same n × h. The twist is applied even when it is 0 (the identity then).
 //
+// Cost per slot: the rescale and the twist share one factor, h' = A·[(1 −
+// c²)·p + 2c·n × p] with A = sqrt(|h|²/(|p|²·(1 + c²)²)) (the rescale
+// sqrt(|h|²/|p|²) times the Cayley 1/(1 + c²)): one division, and the
+// root by a Taylor polynomial where A is within 1e-4 of 1, as it is unless
+// the contact turned a lot in one step (root_near_one). The Coulomb cap
+// compares squares; its root and division run only for a vector with a
+// touching lane that slides, and a vector with no touching lane only
+// releases its histories. So the common slot takes one root (|d|) and two
+// divisions (1/|d|, A²), where it took three roots and four divisions; the
+// skipped branches give the same bits as the full evaluation (cut = 1, h
+// = 0 there), and each lane's polynomial-or-root choice depends on its own
+// A² alone, invariant under the swap, so both copies still round alike.
+//
 // Walls: the inward normal g is fixed and the wall does not rotate, so a
 // wall history stays in the wall plane with no turning; the contact point is
 // the foot of the centre on the plane (lever arm −dist·g).
@@ -169,6 +182,48 @@ DEMCAL_INLINE void one_pair(const double *in, double *out) {
   out[5] = g.touch[0] ? 1.0 : 0.0;
 }
 
+// Whether any lane of m is set. The mask goes through a select into
+// doubles (−1 or 0) and one test instruction: read lane by lane, GCC
+// rebuilds the comparison behind m with one scalar compare per lane.
+template <int W>
+DEMCAL_INLINE bool any(typename Simd<W>::M m) {
+  using D = typename Simd<W>::D;
+  const D zero{};
+  const D v = select<W>(m, zero - 1.0, zero);
+#ifdef DEMCAL_X86_64
+  if constexpr (W == 8) {
+    unsigned char k;
+    asm("vptestmq %1, %1, %0" : "=k"(k) : "v"(v));
+    return k != 0;
+  } else if constexpr (W == 4) {
+    int bits;
+    asm("vmovmskpd %1, %0" : "=r"(bits) : "x"(v));
+    return bits != 0;
+  } else {
+    return _mm_movemask_pd(reinterpret_cast<__m128d>(v)) != 0;
+  }
+#else
+  bool r = false;
+  for (int l = 0; l < W; ++l) r = r || v[l] != 0.0;
+  return r;
+#endif
+}
+
+// sqrt(z) for z ≥ 0. Near 1 (|z − 1| < 1e-4, the rescale-and-twist factor
+// of a history that turned little in a step: the usual case) the Taylor
+// polynomial 1 + e/2 − e²/8 + e³/16 of sqrt(1 + e), whose truncation error
+// 5e⁴/128 < 4e-18 is below half an ulp of 1; the correctly rounded root
+// only where a lane needs it. Lane by lane, the value depends on z alone.
+template <int W>
+DEMCAL_INLINE typename Simd<W>::D root_near_one(typename Simd<W>::D z) {
+  using D = typename Simd<W>::D;
+  const D e = z - 1.0;
+  const D series = 1.0 + e * (0.5 + e * (-0.125 + e * 0.0625));
+  const typename Simd<W>::M far = e * e >= 1e-8;
+  if (!any<W>(far)) return series;
+  return select<W>(far, vsqrt(z), series);
+}
+
 template <int W>
 DEMCAL_INLINE double hsum(typename Simd<W>::D v) {
   double s = v[0];
@@ -210,6 +265,15 @@ DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
         const Normal<W> g =
             normal_part<W, kDamped>(dx, dy, dz, ri, rj, dvx, dvy, dvz, mi, mj, kn, a.beta2);
         const M touch = g.touch;
+        const D hx0 = load<W>(a.hx + s), hy0 = load<W>(a.hy + s), hz0 = load<W>(a.hz + s);
+        const D mag2 = hx0 * hx0 + hy0 * hy0 + hz0 * hz0;
+        if (!any<W>(touch)) {  // no lane touches: histories released, no force
+          released += mag2;
+          store<W>(a.hx + s, zero);
+          store<W>(a.hy + s, zero);
+          store<W>(a.hz + s, zero);
+          continue;
+        }
         const D nx = g.nx, ny = g.ny, nz = g.nz, ov = g.ov, fn = g.fn;
         const D ai = ri - 0.5 * ov, aj = rj - 0.5 * ov;
         const D wxj = gather<W>(a.wx, J), wyj = gather<W>(a.wy, J), wzj = gather<W>(a.wz, J);
@@ -226,34 +290,36 @@ DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
         const D un = ux * nx + uy * ny + uz * nz;
         const D vtx = ux - un * nx, vty = uy - un * ny, vtz = uz - un * nz;
         // Turn the history: projection onto the contact plane rescaled to
-        // its former length, then the twist about n (Cayley form).
-        const D hx0 = load<W>(a.hx + s), hy0 = load<W>(a.hy + s), hz0 = load<W>(a.hz + s);
-        const D mag2 = hx0 * hx0 + hy0 * hy0 + hz0 * hz0;
+        // its former length, then the twist about n (Cayley form), one
+        // scale A = sqrt(|h|²/|p|²)/(1 + c²) for both (file comment).
         const D hn = hx0 * nx + hy0 * ny + hz0 * nz;
-        D px = hx0 - hn * nx, py = hy0 - hn * ny, pz = hz0 - hn * nz;
+        const D px = hx0 - hn * nx, py = hy0 - hn * ny, pz = hz0 - hn * nz;
         const D p2 = px * px + py * py + pz * pz;
         const M turnable = p2 > zero;
-        const D scale =
-            select<W>(turnable, vsqrt(mag2 / select<W>(turnable, p2, mag2 + 1.0)), zero);
-        px *= scale;
-        py *= scale;
-        pz *= scale;
         const D c = half_dt * 0.5 * (nx * sx + ny * sy + nz * sz);
-        const D q = 1.0 / (1.0 + c * c);
-        const D ca = (1.0 - c * c) * q, cb = 2.0 * c * q;
+        const D t = 1.0 + c * c;
+        const D z = mag2 / select<W>(turnable, p2 * t * t, one);
+        const D A = select<W>(turnable, root_near_one<W>(z), zero);
+        const D ca = A * (1.0 - c * c), cb = (2.0 * c) * A;
         D hx = px * ca + (ny * pz - nz * py) * cb + kdt * vtx;
         D hy = py * ca + (nz * px - nx * pz) * cb + kdt * vty;
         D hz = pz * ca + (nx * py - ny * px) * cb + kdt * vtz;
-        // Coulomb: |h| ≤ μ·fn.
+        // Coulomb: |h| ≤ μ·fn. The root and the division only when a
+        // touching lane slides (else cut = 1 in every lane that counts).
         const D cap = mu * fn, h2 = hx * hx + hy * hy + hz * hz;
-        const M sliding = h2 > cap * cap;
-        const D mag = vsqrt(h2);
-        const D cut = select<W>(sliding, cap / select<W>(sliding, mag, one), one);
-        slid += select<W>(touch & sliding, cap * (mag - cap), zero);
+        const M sliding = select<W>(touch, h2, zero) > cap * cap;  // touching and sliding
+        if (any<W>(sliding)) {
+          const D mag = vsqrt(h2);
+          const D cut = select<W>(sliding, cap / select<W>(sliding, mag, one), one);
+          slid += select<W>(sliding, cap * (mag - cap), zero);
+          hx *= cut;
+          hy *= cut;
+          hz *= cut;
+        }
         released += select<W>(touch, zero, mag2);
-        hx = select<W>(touch, hx * cut, zero);
-        hy = select<W>(touch, hy * cut, zero);
-        hz = select<W>(touch, hz * cut, zero);
+        hx = select<W>(touch, hx, zero);
+        hy = select<W>(touch, hy, zero);
+        hz = select<W>(touch, hz, zero);
         store<W>(a.hx + s, hx);
         store<W>(a.hy + s, hy);
         store<W>(a.hz + s, hz);
