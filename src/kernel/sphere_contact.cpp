@@ -298,7 +298,7 @@ DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
         const M turnable = p2 > zero;
         const D c = half_dt * 0.5 * (nx * sx + ny * sy + nz * sz);
         const D t = 1.0 + c * c;
-        const D z = mag2 / select<W>(turnable, p2 * t * t, one);
+        const D z = select<W>(turnable, mag2, one) / select<W>(turnable, p2 * t * t, one);
         const D A = select<W>(turnable, root_near_one<W>(z), zero);
         const D ca = A * (1.0 - c * c), cb = (2.0 * c) * A;
         D hx = px * ca + (ny * pz - nz * py) * cb + kdt * vtx;
