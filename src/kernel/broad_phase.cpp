@@ -9,7 +9,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "demcal/kernel/world.hpp"
+#include "world_impl.hpp"
 
 namespace demcal {
 
@@ -17,7 +17,7 @@ namespace {
 constexpr int kBlock = 8;
 }
 
-void World::layout_blocks(const std::vector<int>& start, std::vector<int>& block_slot) const {
+void WorldImpl::layout_blocks(const std::vector<int>& start, std::vector<int>& block_slot) const {
   // Sliced ELLPACK: block b gets as many rows as its longest list.
   block_slot.assign(static_cast<size_t>(nblocks_) + 1, 0);
   for (int b = 0; b < nblocks_; ++b) {
@@ -28,7 +28,7 @@ void World::layout_blocks(const std::vector<int>& start, std::vector<int>& block
   }
 }
 
-bool World::needs_rebuild() const {
+bool WorldImpl::needs_rebuild() const {
   if (!list_valid_) return true;
   double max_d2 = 0.0;
   for (int i = 0; i < n_; ++i) {
@@ -43,7 +43,7 @@ bool World::needs_rebuild() const {
   return 2.0 * max_disp >= skin_ || max_disp + max_wall >= skin_;
 }
 
-void World::rebuild_neighbours() {
+void WorldImpl::rebuild_neighbours() {
   const int n = n_;
   ++rebuilds_;
   // Grid over the box (particles that left it are clamped to the edge cells).

@@ -26,7 +26,7 @@
 #include <string_view>
 
 #include "contact_law.hpp"
-#include "demcal/kernel/world.hpp"
+#include "world_impl.hpp"
 #include "simd.hpp"
 
 namespace demcal {
@@ -220,7 +220,7 @@ const char *kernel_simd() {
 #endif
 }
 
-double World::pair_pass(int b0, int b1) {
+double WorldImpl::pair_pass(int b0, int b1) {
   const PairArgs a{block_slot_.data(),
                    slot_j_.data(),
                    slot_ft_.data(),
@@ -245,7 +245,7 @@ double World::pair_pass(int b0, int b1) {
   return material_.contact_damping_ratio > 0.0 ? k.pairs_damped(a, b0, b1) : k.pairs(a, b0, b1);
 }
 
-double World::integrate_pass(int b0, int b1) {
+double WorldImpl::integrate_pass(int b0, int b1) {
   const IntegrateArgs a{x_.data(),     y_.data(),       vx_.data(),      vy_.data(),
                         theta_.data(), omega_.data(),   fx_.data(),      fy_.data(),
                         tq_.data(),    ca_t_.data(),    cb_t_.data(),    ca_r_.data(),
@@ -254,7 +254,7 @@ double World::integrate_pass(int b0, int b1) {
   return integration_.lock_rotation ? k.integrate_locked(a, b0, b1) : k.integrate(a, b0, b1);
 }
 
-World::PairState World::pair_state(int i, int j) const {
+WorldImpl::PairState WorldImpl::pair_state(int i, int j) const {
   // The same operations as pair_blocks, one lane.
   PairState p{};
   const double dx = x_[j] - x_[i], dy = y_[j] - y_[i];
@@ -278,7 +278,7 @@ World::PairState World::pair_state(int i, int j) const {
   return p;
 }
 
-void World::wall_pass() {
+void WorldImpl::wall_pass() {
   // Walls. Contact point on the wall line; lever arm = distance to the wall.
   // Added to the pair forces, after them, wall by wall.
   const double dt = integration_.dt;
@@ -337,12 +337,12 @@ void World::wall_pass() {
   wall_dashpot_power_ = power;
 }
 
-void World::compute_forces() {
+void WorldImpl::compute_forces() {
   max_overlap_ratio_seen_ = run_pair_pass();
   wall_pass();
 }
 
-double World::dashpot_power() const {
+double WorldImpl::dashpot_power() const {
   if (!(material_.contact_damping_ratio > 0.0)) return 0.0;
   // Block by block in a fixed order: the same sum for any thread count.
   double pairs = 0.0;

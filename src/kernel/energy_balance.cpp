@@ -18,18 +18,18 @@
 // the global damping are sampled every KernelOptions::energy_check_interval
 // steps and integrated with the trapezoidal rule; the contact dashpots'
 // dissipation lives in contact vibrations a few steps long, which such
-// samples would alias, so it is summed every step (World::dashpot_power). Measured readings of
+// samples would alias, so it is summed every step (WorldImpl::dashpot_power). Measured readings of
 // stable runs (hex 5×5, 10×10, 20×20, random 400; ζ from 0 to 4; 10³ to 10⁵ steps) stay below
 // 0.012; rattles pass 0.1 within a few hundred to a few thousand steps.
 #include <algorithm>
 #include <cmath>
 
 #include "contact_law.hpp"
-#include "demcal/kernel/world.hpp"
+#include "world_impl.hpp"
 
 namespace demcal {
 
-World::EnergySample World::energy_sample() const {
+WorldImpl::EnergySample WorldImpl::energy_sample() const {
   EnergySample e;
   const int n = size();
   const double kn = material_.particle.kn, kt = material_.particle.kt;
@@ -75,7 +75,7 @@ World::EnergySample World::energy_sample() const {
   e.energy += e.elastic;
   return e;
 }
-double World::wall_power() const {
+double WorldImpl::wall_power() const {
   double power = 0.0;
   for (int s = 0; s < 4; ++s) {
     const Wall& wall = walls_[s];
@@ -86,11 +86,11 @@ double World::wall_power() const {
   return power;
 }
 
-bool World::ledger_due() const {
+bool WorldImpl::ledger_due() const {
   return !ledger_.started || steps_ - ledger_.step >= std::max(1, options_.energy_check_interval);
 }
 
-bool World::ledger_record(const EnergySample& e) {
+bool WorldImpl::ledger_record(const EnergySample& e) {
   Ledger& l = ledger_;
   if (!l.started) {
     l = {};

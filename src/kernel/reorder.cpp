@@ -1,11 +1,11 @@
-// Renumbering the particles (World::reorder) and the order that fills the
-// SIMD blocks (World::block_friendly_order). See world.hpp.
+// Renumbering the particles (WorldImpl::reorder) and the order that fills the
+// SIMD blocks (WorldImpl::block_friendly_order). See world.hpp.
 #include <algorithm>
 #include <stdexcept>
 #include <tuple>
 #include <vector>
 
-#include "demcal/kernel/world.hpp"
+#include "world_impl.hpp"
 
 namespace demcal {
 
@@ -14,7 +14,7 @@ constexpr int kBlock = 8;
 constexpr int kWindow = 64;  // particles sorted together: 8 blocks
 }  // namespace
 
-double World::neighbour_slot_fill() const {
+double WorldImpl::neighbour_slot_fill() const {
   const int slots = block_slot_[nblocks_];
   if (slots == 0) return 1.0;
   int real = 0;
@@ -22,7 +22,7 @@ double World::neighbour_slot_fill() const {
   return static_cast<double>(real) / slots;
 }
 
-std::vector<int> World::block_friendly_order() const {
+std::vector<int> WorldImpl::block_friendly_order() const {
   const int n = n_;
   std::vector<int> count(n, 0);
   for (int i = 0; i < n; ++i) {
@@ -39,15 +39,15 @@ std::vector<int> World::block_friendly_order() const {
   return order;
 }
 
-void World::reorder(std::span<const int> order) {
+void WorldImpl::reorder(std::span<const int> order) {
   const int n = n_;
   if (static_cast<int>(order.size()) != n)
-    throw std::invalid_argument("World::reorder: order must list every particle once");
+    throw std::invalid_argument("WorldImpl::reorder: order must list every particle once");
   std::vector<int> new_index(n, -1);
   for (int k = 0; k < n; ++k) {
     const int i = order[k];
     if (i < 0 || i >= n || new_index[i] >= 0)
-      throw std::invalid_argument("World::reorder: order is not a permutation");
+      throw std::invalid_argument("WorldImpl::reorder: order is not a permutation");
     new_index[i] = k;
   }
 

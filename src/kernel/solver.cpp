@@ -17,7 +17,7 @@
 #include <stdexcept>
 #include <thread>
 
-#include "demcal/kernel/world.hpp"
+#include "world_impl.hpp"
 
 #if defined(__x86_64__) || defined(__i386__)
 #include <immintrin.h>
@@ -134,9 +134,9 @@ const char* to_string(Divergence d) {
   return "unknown";
 }
 
-World::World(const Material& material, std::span<const double> x, std::span<const double> y,
-             std::span<const double> radius, double left, double right, double bottom, double top,
-             KernelOptions options)
+WorldImpl::WorldImpl(const Material& material, std::span<const double> x, std::span<const double> y,
+                     std::span<const double> radius, double left, double right, double bottom,
+                     double top, KernelOptions options)
     : material_(material), options_(options) {
   const size_t n = x.size();
   if (y.size() != n || radius.size() != n)
@@ -181,7 +181,7 @@ World::World(const Material& material, std::span<const double> x, std::span<cons
   update_forces();
 }
 
-void World::set_threads(int threads) {
+void WorldImpl::set_threads(int threads) {
   if (threads < 0) throw std::invalid_argument("World: threads must be >= 0");
   if (threads == 0) threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   options_.threads = threads;
@@ -190,7 +190,7 @@ void World::set_threads(int threads) {
   update_thread_bounds();
 }
 
-void World::set_options(const KernelOptions& options) {
+void WorldImpl::set_options(const KernelOptions& options) {
   options_ = options;
   ledger_ = {};
   skin_ = options_.skin_ratio * r_min_;
@@ -198,13 +198,13 @@ void World::set_options(const KernelOptions& options) {
   set_threads(options.threads);
 }
 
-int World::active_threads() const {
+int WorldImpl::active_threads() const {
   // At least 8 blocks (64 particles) per thread, or the hand-over costs
   // more than it saves.
   return std::max(1, std::min({threads_, nblocks_ / 8, 64}));
 }
 
-void World::update_thread_bounds() {
+void WorldImpl::update_thread_bounds() {
   const int t = active_threads();
   particle_bounds_.assign(static_cast<size_t>(t) + 1, 0);
   pair_bounds_.assign(static_cast<size_t>(t) + 1, 0);
@@ -221,13 +221,13 @@ void World::update_thread_bounds() {
   pair_bounds_[t] = nblocks_;
 }
 
-double World::run_pass(double (World::*pass)(int, int), const std::vector<int>& bounds) {
+double WorldImpl::run_pass(double (WorldImpl::*pass)(int, int), const std::vector<int>& bounds) {
   const int t = active_threads();
   if (t <= 1) return (this->*pass)(0, nblocks_);
   if (!team_.team) team_.team = std::make_unique<detail::KernelTeam>(t);
   struct Ctx {
-    World* w;
-    double (World::*pass)(int, int);
+    WorldImpl* w;
+    double (WorldImpl::*pass)(int, int);
     const std::vector<int>* bounds;
     double out[64];
   } ctx{this, pass, &bounds, {}};
@@ -241,11 +241,13 @@ double World::run_pass(double (World::*pass)(int, int), const std::vector<int>& 
   return *std::max_element(ctx.out, ctx.out + t);
 }
 
-double World::run_pair_pass() { return run_pass(&World::pair_pass, pair_bounds_); }
+double WorldImpl::run_pair_pass() { return run_pass(&WorldImpl::pair_pass, pair_bounds_); }
 
-double World::run_integrate_pass() { return run_pass(&World::integrate_pass, particle_bounds_); }
+double WorldImpl::run_integrate_pass() {
+  return run_pass(&WorldImpl::integrate_pass, particle_bounds_);
+}
 
-void World::set_integration(const Integration& integration) {
+void WorldImpl::set_integration(const Integration& integration) {
   if (!(integration.dt >= 0.0) || !std::isfinite(integration.dt))
     throw std::invalid_argument("World: dt must be finite and >= 0");
   if (!(integration.mass_scaling > 0.0))
@@ -264,7 +266,7 @@ void World::set_integration(const Integration& integration) {
   update_damping_coefficients();
 }
 
-void World::update_damping_coefficients() {
+void WorldImpl::update_damping_coefficients() {
   const double dt = integration_.dt;
   const double kn = material_.particle.kn, kt = material_.particle.kt;
   for (int i = 0; i < size(); ++i) {
@@ -281,21 +283,21 @@ void World::update_damping_coefficients() {
   }
 }
 
-void World::set_velocity(int i, double vx, double vy, double omega) {
+void WorldImpl::set_velocity(int i, double vx, double vy, double omega) {
   ledger_ = {};
   vx_[i] = vx;
   vy_[i] = vy;
   omega_[i] = integration_.lock_rotation ? 0.0 : omega;
 }
 
-void World::set_position(int i, double x, double y) {
+void WorldImpl::set_position(int i, double x, double y) {
   ledger_ = {};
   x_[i] = x;
   y_[i] = y;
   list_valid_ = false;
 }
 
-void World::update_forces() {
+void WorldImpl::update_forces() {
   if (needs_rebuild()) rebuild_neighbours();
   const double dt = integration_.dt;
   // Re-evaluating forces in place must not add a tangential increment twice.
@@ -304,7 +306,7 @@ void World::update_forces() {
   integration_.dt = dt;
 }
 
-void World::integrate() {
+void WorldImpl::integrate() {
   // Fused with the displacement scan of the neighbour-list check.
   const double max_d2 = run_integrate_pass();
   for (auto& w : walls_) w.position += w.velocity * integration_.dt;
@@ -318,7 +320,7 @@ void World::integrate() {
   if (2.0 * max_disp >= skin_ || max_disp + max_wall >= skin_) list_valid_ = false;
 }
 
-bool World::check_divergence() {
+bool WorldImpl::check_divergence() {
   const int n = size();
   double ke = 0.0;
   bool finite = true;
@@ -353,7 +355,7 @@ bool World::check_divergence() {
   return sample && ledger_record(*sample);
 }
 
-bool World::step(int64_t count) {
+bool WorldImpl::step(int64_t count) {
   if (divergence_ != Divergence::kNone) return false;
   if (initial_energy_ < 0.0) {
     const Measures m = measure();

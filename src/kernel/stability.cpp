@@ -29,12 +29,12 @@
 #include <limits>
 
 #include "contact_law.hpp"
-#include "demcal/kernel/world.hpp"
+#include "world_impl.hpp"
 #include "tridiagonal.hpp"
 
 namespace demcal {
 
-ReferenceScales World::reference_scales() const {
+ReferenceScales WorldImpl::reference_scales() const {
   return particle_scales(radius(), material_, integration_.mass_scaling);
 }
 
@@ -126,7 +126,7 @@ double lanczos_max(const std::vector<LinearContact>& contacts,
 
 }  // namespace
 
-StabilityEstimate World::stability_estimate(int iterations) const {
+StabilityEstimate WorldImpl::stability_estimate(int iterations) const {
   StabilityEstimate est;
   const int n = size();
   const bool rotation = !integration_.lock_rotation;

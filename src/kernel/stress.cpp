@@ -5,21 +5,21 @@
 // independent of where the contact point sits; f_i is the force on i.
 // Pair normals and normal forces are not stored by the force pass; they are
 // re-evaluated here from the positions by the contact law's own formulas
-// (World::pair_state), the tangential forces read from the list.
+// (WorldImpl::pair_state), the tangential forces read from the list.
 #include <cmath>
 #include <numbers>
 
 #include "contact_law.hpp"
-#include "demcal/kernel/world.hpp"
+#include "world_impl.hpp"
 
 namespace demcal {
 
-Eigen::Vector2d World::centre() const {
+Eigen::Vector2d WorldImpl::centre() const {
   return {0.5 * (walls_[kLeft].position + walls_[kRight].position),
           0.5 * (walls_[kBottom].position + walls_[kTop].position)};
 }
 
-Measures World::measure(double strain_rate) const {
+Measures WorldImpl::measure(double strain_rate) const {
   Measures out;
   const int n = size();
   const double volume = this->volume();
@@ -99,7 +99,7 @@ Measures World::measure(double strain_rate) const {
   return out;
 }
 
-Eigen::Matrix2d World::net_force_moment() const {
+Eigen::Matrix2d WorldImpl::net_force_moment() const {
   const Eigen::Vector2d c = centre();
   Eigen::Matrix2d m = Eigen::Matrix2d::Zero();
   for (int i = 0; i < size(); ++i)
@@ -108,8 +108,8 @@ Eigen::Matrix2d World::net_force_moment() const {
   return m / volume();
 }
 
-std::vector<World::ContactView> World::contacts() const {
-  std::vector<ContactView> out;
+std::vector<World::ContactView> WorldImpl::contacts() const {
+  std::vector<World::ContactView> out;
   for (size_t k = 0; k < pair_i_.size(); ++k) {
     const int i = pair_i_[k], j = pair_j_[k];
     const double ft = slot_ft_[pair_slot_[k]];

@@ -1,5 +1,5 @@
-// The whole state of a World as bytes, and back (World::save_state,
-// World::load_state): what the consolidation cache stores.
+// The whole state of a World as bytes, and back (WorldImpl::save_state,
+// WorldImpl::load_state): what the consolidation cache stores.
 //
 // Every member is written, the neighbour list and its scratch included, so
 // that a World read back is a copy of the one saved: it rebuilds its list,
@@ -13,7 +13,7 @@
 #include <stdexcept>
 #include <type_traits>
 
-#include "demcal/kernel/world.hpp"
+#include "world_impl.hpp"
 
 namespace demcal {
 
@@ -57,7 +57,7 @@ class Reader {
   }
   bool done() const { return at_ == in_.size(); }
   [[noreturn]] static void fail() {
-    throw std::runtime_error("World::load_state: not the bytes of a saved World");
+    throw std::runtime_error("WorldImpl::load_state: not the bytes of a saved World");
   }
 
  private:
@@ -80,7 +80,7 @@ static_assert(sizeof(Wall) == 48);  // 4 doubles and an int, 16-byte aligned
 }  // namespace
 
 template <class Self, class Visitor>
-void World::visit_state(Self& w, Visitor& v) {
+void WorldImpl::visit_state(Self& w, Visitor& v) {
   for (auto* law : {&w.material_.particle, &w.material_.wall}) {
     v(law->kn);
     v(law->kt);
@@ -156,18 +156,18 @@ void World::visit_state(Self& w, Visitor& v) {
   v(w.time_);
 }
 
-std::string World::save_state() const {
+std::string WorldImpl::save_state() const {
   Writer writer;
   writer.out.append(kMagic, sizeof kMagic);
   visit_state(*this, writer);
   return std::move(writer.out);
 }
 
-World World::load_state(std::string_view bytes) {
+WorldImpl WorldImpl::load_state(std::string_view bytes) {
   if (bytes.size() < sizeof kMagic || bytes.substr(0, sizeof kMagic) != std::string_view(kMagic, 8))
     Reader::fail();
   Reader reader(bytes.substr(sizeof kMagic));
-  World w;
+  WorldImpl w;
   visit_state(w, reader);
   if (!reader.done()) Reader::fail();
   // The arrays the passes index by particle, block and slot must fit the
