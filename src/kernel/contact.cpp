@@ -26,8 +26,8 @@
 #include <string_view>
 
 #include "contact_law.hpp"
-#include "world_impl.hpp"
 #include "simd.hpp"
+#include "world_impl.hpp"
 
 namespace demcal {
 

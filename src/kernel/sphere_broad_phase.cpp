@@ -10,7 +10,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "demcal/kernel/sphere_world.hpp"
+#include "sphere_world_impl.hpp"
 
 namespace demcal {
 
@@ -18,7 +18,7 @@ namespace {
 constexpr int kBlock = 8;
 }
 
-double SphereWorld::neighbour_slot_fill() const {
+double SphereWorldImpl::neighbour_slot_fill() const {
   const int slots = block_slot_[nblocks_];
   if (slots == 0) return 1.0;
   int real = 0;
@@ -26,7 +26,7 @@ double SphereWorld::neighbour_slot_fill() const {
   return static_cast<double>(real) / slots;
 }
 
-bool SphereWorld::needs_rebuild() const {
+bool SphereWorldImpl::needs_rebuild() const {
   if (!list_valid_) return true;
   double max_d2 = 0.0;
   for (int i = 0; i < n_; ++i) {
@@ -40,7 +40,7 @@ bool SphereWorld::needs_rebuild() const {
   return 2.0 * max_disp >= skin_ || max_disp + max_wall >= skin_;
 }
 
-void SphereWorld::rebuild_neighbours() {
+void SphereWorldImpl::rebuild_neighbours() {
   const int n = n_;
   ++rebuilds_;
   // Grid over the box (particles outside it are clamped to the edge cells).

@@ -74,8 +74,8 @@
 #include <cmath>
 #include <cstring>
 
-#include "demcal/kernel/sphere_world.hpp"
 #include "simd.hpp"
+#include "sphere_world_impl.hpp"
 
 namespace demcal {
 
@@ -114,7 +114,7 @@ DEMCAL_INLINE typename Simd<W>::D rounded(typename Simd<W>::D v) {
 
 // Normal geometry and force of a pair: unit normal, overlap, normal force
 // (0 when apart), contact flag. One home for the pair pass and the scalar
-// re-evaluation (SphereWorld::pair_geometry, through one_pair below on the
+// re-evaluation (SphereWorldImpl::pair_geometry, through one_pair below on the
 // same SIMD path), so that both round alike, FMA contractions included.
 template <int W>
 struct Normal {
@@ -457,7 +457,7 @@ const Kernels &kernels() {
 
 }  // namespace
 
-double SphereWorld::pair_pass(int b0, int b1) {
+double SphereWorldImpl::pair_pass(int b0, int b1) {
   const PairArgs a{block_slot_.data(),
                    slot_j_.data(),
                    hx_.data(),
@@ -493,7 +493,7 @@ double SphereWorld::pair_pass(int b0, int b1) {
   return material_.contact_damping_ratio > 0.0 ? k.pairs_damped(a, b0, b1) : k.pairs(a, b0, b1);
 }
 
-double SphereWorld::integrate_pass(int b0, int b1) {
+double SphereWorldImpl::integrate_pass(int b0, int b1) {
   const IntegrateArgs a{x_.data(),          y_.data(),       z_.data(),       vx_.data(),
                         vy_.data(),         vz_.data(),      wx_.data(),      wy_.data(),
                         wz_.data(),         fx_.data(),      fy_.data(),      fz_.data(),
@@ -505,13 +505,13 @@ double SphereWorld::integrate_pass(int b0, int b1) {
   return integration_.lock_rotation ? k.integrate_locked(a, b0, b1) : k.integrate(a, b0, b1);
 }
 
-double SphereWorld::wall_distance(int s, int i) const {
+double SphereWorldImpl::wall_distance(int s, int i) const {
   const double *pos[3] = {x_.data(), y_.data(), z_.data()};
   const double sign = (s % 2 == 0) ? 1.0 : -1.0;
   return (pos[s / 2][i] - walls_[s].position) * sign;
 }
 
-SphereWorld::PairGeometry SphereWorld::pair_geometry(int i, int j) const {
+SphereWorldImpl::PairGeometry SphereWorldImpl::pair_geometry(int i, int j) const {
   // The pair pass's normal_part, one lane on the same SIMD path.
   const double in[12] = {
       x_[j] - x_[i], y_[j] - y_[i],   z_[j] - z_[i],         r_[i],
@@ -528,7 +528,7 @@ SphereWorld::PairGeometry SphereWorld::pair_geometry(int i, int j) const {
   return p;
 }
 
-void SphereWorld::wall_forces() {
+void SphereWorldImpl::wall_forces() {
   const double dt = integration_.dt;
   const double beta = material_.contact_damping_ratio;
   const double kw = material_.wall.kn, ktw_dt = material_.wall.kt * dt;
@@ -592,8 +592,8 @@ void SphereWorld::wall_forces() {
   friction_dissipated_ += released * half_compliance + slid * compliance;
 }
 
-void SphereWorld::compute_forces() {
-  max_overlap_ratio_seen_ = run_pass(&SphereWorld::pair_pass, pair_bounds_);
+void SphereWorldImpl::compute_forces() {
+  max_overlap_ratio_seen_ = run_pass(&SphereWorldImpl::pair_pass, pair_bounds_);
   // Friction's losses, block by block in a fixed order (every pair was
   // counted from both sides).
   const double kt = material_.particle.kt;

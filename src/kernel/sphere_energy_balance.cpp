@@ -8,8 +8,8 @@
 // Coulomb cap or at opening, summed every step (sphere_contact.cpp); left
 // out (as the 2D ledger does), it reads as a deficit that hides created
 // energy. The global damping's loss is summed every step, exactly
-// (SphereWorld::integrate), and so is the work of the moving walls
-// (SphereWorld::book_wall_work: sampled, it missed collisions shorter than
+// (SphereWorldImpl::integrate), and so is the work of the moving walls
+// (SphereWorldImpl::book_wall_work: sampled, it missed collisions shorter than
 // the interval, and a wall throwing a resting sphere read as energy
 // created); the contact damping is sampled every energy_check_interval
 // steps and integrated with the trapezoidal rule. (Sampling the global damping too, as the 2D
@@ -18,11 +18,11 @@
 #include <algorithm>
 #include <cmath>
 
-#include "demcal/kernel/sphere_world.hpp"
+#include "sphere_world_impl.hpp"
 
 namespace demcal {
 
-SphereWorld::EnergySample SphereWorld::energy_sample() const {
+SphereWorldImpl::EnergySample SphereWorldImpl::energy_sample() const {
   EnergySample e;
   const double kn = material_.particle.kn, kt = material_.particle.kt;
   const bool rotation = !integration_.lock_rotation;
@@ -71,11 +71,11 @@ SphereWorld::EnergySample SphereWorld::energy_sample() const {
   return e;
 }
 
-bool SphereWorld::ledger_due() const {
+bool SphereWorldImpl::ledger_due() const {
   return !ledger_.started || steps_ - ledger_.step >= std::max(1, options_.energy_check_interval);
 }
 
-bool SphereWorld::ledger_record(const EnergySample& e) {
+bool SphereWorldImpl::ledger_record(const EnergySample& e) {
   Ledger& l = ledger_;
   if (!l.started) {
     l = {};

@@ -20,12 +20,12 @@
 #include <cstdint>
 #include <limits>
 
-#include "demcal/kernel/sphere_world.hpp"
+#include "sphere_world_impl.hpp"
 #include "tridiagonal.hpp"
 
 namespace demcal {
 
-ReferenceScales SphereWorld::reference_scales() const {
+ReferenceScales SphereWorldImpl::reference_scales() const {
   ReferenceScales s;
   if (n_ == 0) return s;
   int imin = 0;
@@ -166,7 +166,7 @@ double gershgorin_bound(const std::vector<LinearContact>& contacts, const std::v
 
 }  // namespace
 
-StabilityEstimate SphereWorld::stability_estimate(int iterations) const {
+StabilityEstimate SphereWorldImpl::stability_estimate(int iterations) const {
   StabilityEstimate est;
   const bool rotation = !integration_.lock_rotation;
   std::vector<LinearContact> contacts;

@@ -10,7 +10,7 @@
 // are the stored histories, i.e. the forces the last evaluation applied.
 #include <cmath>
 
-#include "demcal/kernel/sphere_world.hpp"
+#include "sphere_world_impl.hpp"
 
 namespace demcal {
 
@@ -18,7 +18,7 @@ namespace {
 using V3 = Eigen::Vector3d;
 }
 
-SphereMeasures SphereWorld::measure(double strain_rate) const {
+SphereMeasures SphereWorldImpl::measure(double strain_rate) const {
   SphereMeasures out;
   const double volume = this->volume();
   out.volume = volume;
@@ -86,7 +86,7 @@ SphereMeasures SphereWorld::measure(double strain_rate) const {
   return out;
 }
 
-Eigen::Matrix3d SphereWorld::net_force_moment() const {
+Eigen::Matrix3d SphereWorldImpl::net_force_moment() const {
   const V3 c = centre();
   Eigen::Matrix3d m = Eigen::Matrix3d::Zero();
   for (int i = 0; i < n_; ++i)
@@ -94,8 +94,8 @@ Eigen::Matrix3d SphereWorld::net_force_moment() const {
   return m / volume();
 }
 
-std::vector<SphereWorld::ContactView> SphereWorld::contacts() const {
-  std::vector<ContactView> out;
+std::vector<SphereWorld::ContactView> SphereWorldImpl::contacts() const {
+  std::vector<SphereWorld::ContactView> out;
   for (int i = 0; i < n_; ++i)
     for (int k = nbr_start_[i]; k < nbr_start_[i + 1]; ++k) {
       const int j = nbr_j_[k];

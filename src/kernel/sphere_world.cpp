@@ -4,8 +4,6 @@
 //   v(n+½) = [(1 − D·Δt/2m)·v(n−½) + F·Δt/m] / (1 + D·Δt/2m)
 // with D = ζ_t·2·sqrt(kn·m) per particle (ζ_r·2·sqrt(kt·r²·I) for ω, with
 // I in place of m), so every sphere has the same damping ratio.
-#include "demcal/kernel/sphere_world.hpp"
-
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -14,6 +12,7 @@
 #include <thread>
 
 #include "demcal/kernel/particle_scales.hpp"
+#include "sphere_world_impl.hpp"
 
 namespace demcal {
 
@@ -22,10 +21,10 @@ constexpr int kBlock = 8;
 constexpr double kFar = 1e100;  // padding lanes at +kFar, the ghost at −kFar
 }  // namespace
 
-SphereWorld::SphereWorld(const SphereMaterial& material, std::span<const double> x,
-                         std::span<const double> y, std::span<const double> z,
-                         std::span<const double> radius, const std::array<double, 3>& lo,
-                         const std::array<double, 3>& hi, KernelOptions options)
+SphereWorldImpl::SphereWorldImpl(const SphereMaterial& material, std::span<const double> x,
+                                 std::span<const double> y, std::span<const double> z,
+                                 std::span<const double> radius, const std::array<double, 3>& lo,
+                                 const std::array<double, 3>& hi, KernelOptions options)
     : material_(material), options_(options) {
   const size_t n = x.size();
   if (y.size() != n || z.size() != n || radius.size() != n)
@@ -75,7 +74,7 @@ SphereWorld::SphereWorld(const SphereMaterial& material, std::span<const double>
   update_forces();
 }
 
-void SphereWorld::set_threads(int threads) {
+void SphereWorldImpl::set_threads(int threads) {
   if (threads < 0) throw std::invalid_argument("SphereWorld: threads must be >= 0");
   if (threads == 0) threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   options_.threads = threads;
@@ -83,13 +82,13 @@ void SphereWorld::set_threads(int threads) {
   update_thread_bounds();
 }
 
-int SphereWorld::active_threads() const {
+int SphereWorldImpl::active_threads() const {
   // At least 8 blocks (64 spheres) per thread, or the hand-over costs more
   // than it saves.
   return std::max(1, std::min({threads_, nblocks_ / 8, 64}));
 }
 
-void SphereWorld::update_thread_bounds() {
+void SphereWorldImpl::update_thread_bounds() {
   const int t = active_threads();
   particle_bounds_.assign(static_cast<size_t>(t) + 1, 0);
   pair_bounds_.assign(static_cast<size_t>(t) + 1, 0);
@@ -106,13 +105,13 @@ void SphereWorld::update_thread_bounds() {
   pair_bounds_[t] = nblocks_;
 }
 
-double SphereWorld::run_pass(double (SphereWorld::*pass)(int, int),
-                             const std::vector<int>& bounds) {
+double SphereWorldImpl::run_pass(double (SphereWorldImpl::*pass)(int, int),
+                                 const std::vector<int>& bounds) {
   const int t = active_threads();
   if (t <= 1) return (this->*pass)(0, nblocks_);
   struct Ctx {
-    SphereWorld* w;
-    double (SphereWorld::*pass)(int, int);
+    SphereWorldImpl* w;
+    double (SphereWorldImpl::*pass)(int, int);
     const std::vector<int>* bounds;
     double out[64];
   } ctx{this, pass, &bounds, {}};
@@ -127,7 +126,7 @@ double SphereWorld::run_pass(double (SphereWorld::*pass)(int, int),
   return *std::max_element(ctx.out, ctx.out + t);
 }
 
-void SphereWorld::set_options(const KernelOptions& options) {
+void SphereWorldImpl::set_options(const KernelOptions& options) {
   options_ = options;
   ledger_ = {};
   skin_ = options_.skin_ratio * r_min_;
@@ -135,7 +134,7 @@ void SphereWorld::set_options(const KernelOptions& options) {
   set_threads(options.threads);
 }
 
-void SphereWorld::set_integration(const Integration& integration) {
+void SphereWorldImpl::set_integration(const Integration& integration) {
   if (!(integration.dt >= 0.0) || !std::isfinite(integration.dt))
     throw std::invalid_argument("SphereWorld: dt must be finite and >= 0");
   if (!(integration.mass_scaling > 0.0))
@@ -154,7 +153,7 @@ void SphereWorld::set_integration(const Integration& integration) {
   update_damping_coefficients();
 }
 
-void SphereWorld::update_damping_coefficients() {
+void SphereWorldImpl::update_damping_coefficients() {
   const double dt = integration_.dt;
   const double kn = material_.particle.kn, kt = material_.particle.kt;
   for (int i = 0; i < n_; ++i) {
@@ -174,7 +173,7 @@ void SphereWorld::update_damping_coefficients() {
   }
 }
 
-void SphereWorld::set_velocity(int i, const Eigen::Vector3d& v, const Eigen::Vector3d& omega) {
+void SphereWorldImpl::set_velocity(int i, const Eigen::Vector3d& v, const Eigen::Vector3d& omega) {
   ledger_ = {};
   vx_[i] = v.x();
   vy_[i] = v.y();
@@ -185,7 +184,7 @@ void SphereWorld::set_velocity(int i, const Eigen::Vector3d& v, const Eigen::Vec
   wz_[i] = lock ? 0.0 : omega.z();
 }
 
-void SphereWorld::set_position(int i, const Eigen::Vector3d& p) {
+void SphereWorldImpl::set_position(int i, const Eigen::Vector3d& p) {
   ledger_ = {};
   x_[i] = p.x();
   y_[i] = p.y();
@@ -193,13 +192,13 @@ void SphereWorld::set_position(int i, const Eigen::Vector3d& p) {
   list_valid_ = false;
 }
 
-Eigen::Vector3d SphereWorld::centre() const {
+Eigen::Vector3d SphereWorldImpl::centre() const {
   return {0.5 * (walls_[kXMin].position + walls_[kXMax].position),
           0.5 * (walls_[kYMin].position + walls_[kYMax].position),
           0.5 * (walls_[kZMin].position + walls_[kZMax].position)};
 }
 
-void SphereWorld::update_forces() {
+void SphereWorldImpl::update_forces() {
   if (needs_rebuild()) rebuild_neighbours();
   const double dt = integration_.dt;
   // Re-evaluating forces in place must not add a tangential increment (nor
@@ -210,7 +209,7 @@ void SphereWorld::update_forces() {
   for (int s = 0; s < 6; ++s) wall_push_[s] = -walls_[s].force[s / 2];
 }
 
-void SphereWorld::book_wall_work() {
+void SphereWorldImpl::book_wall_work() {
   for (int s = 0; s < 6; ++s) {
     // wall.force is the spheres' force on the wall; the wall's on them is −force.
     const double push = -walls_[s].force[s / 2];
@@ -221,14 +220,14 @@ void SphereWorld::book_wall_work() {
   }
 }
 
-void SphereWorld::integrate() {
+void SphereWorldImpl::integrate() {
   // The scheme is m·(v⁺ − v⁻)/Δt = F − D·v̄, v̄ = (v⁺ + v⁻)/2, so the
   // damping removes exactly D·|v̄|²·Δt of (half-step) kinetic energy per
   // step: summed for the energy ledger (each block's share by the pass, the
   // blocks here in order), exact however fast the decay. The pass also
   // scans the displacements since the last list build.
   const double dt = integration_.dt;
-  const double max_d2 = run_pass(&SphereWorld::integrate_pass, particle_bounds_);
+  const double max_d2 = run_pass(&SphereWorldImpl::integrate_pass, particle_bounds_);
   double lost = 0.0;
   for (int b = 0; b < nblocks_; ++b) lost += block_lost_[b];
   damping_dissipated_ += lost * dt;
@@ -246,7 +245,7 @@ void SphereWorld::integrate() {
   if (2.0 * max_disp >= skin_ || max_disp + max_wall >= skin_) list_valid_ = false;
 }
 
-bool SphereWorld::check_divergence() {
+bool SphereWorldImpl::check_divergence() {
   double ke = 0.0;
   bool finite = true;
   for (int i = 0; i < n_; ++i) {
@@ -281,7 +280,7 @@ bool SphereWorld::check_divergence() {
   return sample && ledger_record(*sample);
 }
 
-bool SphereWorld::step(int64_t count) {
+bool SphereWorldImpl::step(int64_t count) {
   if (divergence_ != Divergence::kNone) return false;
   if (initial_energy_ < 0.0) {
     const SphereMeasures m = measure();

@@ -29,8 +29,8 @@
 #include <limits>
 
 #include "contact_law.hpp"
-#include "world_impl.hpp"
 #include "tridiagonal.hpp"
+#include "world_impl.hpp"
 
 namespace demcal {
 

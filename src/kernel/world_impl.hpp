@@ -7,6 +7,7 @@
 #pragma once
 
 #include "demcal/kernel/world.hpp"
+#include "kernel_detail.hpp"
 
 namespace demcal {
 

@@ -39,12 +39,15 @@
 #include <Eigen/Geometry>
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <vector>
 
 #include "demcal/kernel/world.hpp"
 
 namespace demcal {
+
+class SphereWorldImpl;
 
 /// Material of the spheres and the walls.
 struct SphereMaterial {
@@ -97,30 +100,32 @@ class SphereWorld {
               std::span<const double> z, std::span<const double> radius,
               const std::array<double, 3>& lo, const std::array<double, 3>& hi,
               KernelOptions options = {});
+  SphereWorld(const SphereWorld& other);
+  SphereWorld(SphereWorld&& other) noexcept;
+  SphereWorld& operator=(const SphereWorld& other);
+  SphereWorld& operator=(SphereWorld&& other) noexcept;
+  ~SphereWorld();
 
   // --- setup -----------------------------------------------------------
   void set_integration(const Integration& integration);
-  const Integration& integration() const { return integration_; }
-  const SphereMaterial& material() const { return material_; }
-  const KernelOptions& options() const { return options_; }
+  const Integration& integration() const;
+  const SphereMaterial& material() const;
+  const KernelOptions& options() const;
   /// Replace the kernel options; the energy ledger restarts.
   void set_options(const KernelOptions& options);
   /// Friction of particle–particle contacts (frictionless consolidation,
   /// then friction on).
-  void set_particle_friction(double mu) {
-    material_.particle.friction = mu;
-    ledger_ = {};
-  }
+  void set_particle_friction(double mu);
 
   // --- stepping --------------------------------------------------------
   /// Advance `n` steps; false as soon as the run diverged (see divergence()).
   bool step(int64_t n = 1);
-  Divergence divergence() const { return divergence_; }
+  Divergence divergence() const;
   /// The energy ledger's last reading (World::energy_created has the meaning).
-  double energy_created() const { return ledger_.created; }
-  int64_t divergence_step() const { return divergence_step_; }
-  int64_t steps_taken() const { return steps_; }
-  double time() const { return time_; }
+  double energy_created() const;
+  int64_t divergence_step() const;
+  int64_t steps_taken() const;
+  double time() const;
 
   // --- measures --------------------------------------------------------
   SphereMeasures measure(double strain_rate = 0.0) const;
@@ -131,40 +136,38 @@ class SphereWorld {
   Eigen::Matrix3d net_force_moment() const;
 
   // --- state access (flat arrays) ----------------------------------------
-  int size() const { return n_; }
-  std::span<const double> x() const { return view(x_); }
-  std::span<const double> y() const { return view(y_); }
-  std::span<const double> z() const { return view(z_); }
-  std::span<const double> vx() const { return view(vx_); }
-  std::span<const double> vy() const { return view(vy_); }
-  std::span<const double> vz() const { return view(vz_); }
-  std::span<const double> omega_x() const { return view(wx_); }
-  std::span<const double> omega_y() const { return view(wy_); }
-  std::span<const double> omega_z() const { return view(wz_); }
-  std::span<const double> radius() const { return view(r_); }
-  double min_radius() const { return r_min_; }
-  double max_radius() const { return r_max_; }
-  std::span<const double> mass() const { return view(m_); }           ///< scaled masses
-  std::span<const double> inertia() const { return view(inertia_); }  ///< scaled moments
-  std::span<const double> fx() const { return view(fx_); }            ///< net contact force
-  std::span<const double> fy() const { return view(fy_); }
-  std::span<const double> fz() const { return view(fz_); }
-  std::span<const double> torque_x() const { return view(tx_); }
-  std::span<const double> torque_y() const { return view(ty_); }
-  std::span<const double> torque_z() const { return view(tz_); }
+  int size() const;
+  std::span<const double> x() const;
+  std::span<const double> y() const;
+  std::span<const double> z() const;
+  std::span<const double> vx() const;
+  std::span<const double> vy() const;
+  std::span<const double> vz() const;
+  std::span<const double> omega_x() const;
+  std::span<const double> omega_y() const;
+  std::span<const double> omega_z() const;
+  std::span<const double> radius() const;
+  double min_radius() const;
+  double max_radius() const;
+  std::span<const double> mass() const;     ///< scaled masses
+  std::span<const double> inertia() const;  ///< scaled moments
+  std::span<const double> fx() const;       ///< net contact force
+  std::span<const double> fy() const;
+  std::span<const double> fz() const;
+  std::span<const double> torque_x() const;
+  std::span<const double> torque_y() const;
+  std::span<const double> torque_z() const;
 
   /// Direct state edits for tests and scene set-up. With rotation locked the
   /// spin is ignored (kept 0).
   void set_velocity(int i, const Eigen::Vector3d& v, const Eigen::Vector3d& omega);
   void set_position(int i, const Eigen::Vector3d& p);
 
-  SphereWall& wall(SphereWallSide side) { return walls_[side]; }
-  const SphereWall& wall(SphereWallSide side) const { return walls_[side]; }
+  SphereWall& wall(SphereWallSide side);
+  const SphereWall& wall(SphereWallSide side) const;
   /// Box edge along axis a (0 = x, 1 = y, 2 = z).
-  double extent(int axis) const {
-    return walls_[2 * axis + 1].position - walls_[2 * axis].position;
-  }
-  double volume() const { return extent(0) * extent(1) * extent(2); }
+  double extent(int axis) const;
+  double volume() const;
   Eigen::Vector3d centre() const;
 
   /// Active particle–particle contacts (after the last force evaluation).
@@ -176,7 +179,7 @@ class SphereWorld {
     double overlap;
   };
   std::vector<ContactView> contacts() const;
-  int64_t rebuilds() const { return rebuilds_; }
+  int64_t rebuilds() const;
   /// Share of the neighbour slots the pair pass evaluates that hold a real
   /// neighbour (the rest pad each block's rows to its longest list).
   double neighbour_slot_fill() const;
@@ -184,144 +187,16 @@ class SphereWorld {
   /// Threads for stepping this world (KernelOptions::threads: 0 = all
   /// cores). Results are bit-identical for any thread count.
   void set_threads(int threads);
-  int threads() const { return threads_; }
+  int threads() const;
 
   /// Recompute forces for the current state without moving anything and
   /// without a tangential increment.
   void update_forces();
 
  private:
-  using Array = detail::AlignedVector<double>;
-  std::span<const double> view(const Array& a) const { return {a.data(), static_cast<size_t>(n_)}; }
-
-  // sphere_broad_phase.cpp
-  void rebuild_neighbours();
-  bool needs_rebuild() const;
-  // sphere_contact.cpp
-  struct PairGeometry {
-    Eigen::Vector3d n;  // unit, i to j
-    double overlap, fn;
-    bool touching;
-  };
-  PairGeometry pair_geometry(int i, int j) const;
-  /// Tangential force on i of the k-th pair of the half list (i < j).
-  Eigen::Vector3d pair_history(int k) const {
-    const int s = pair_slot_[k];
-    return {hx_[s], hy_[s], hz_[s]};
-  }
-  // The SIMD passes over particle blocks [b0, b1) (sphere_contact.cpp):
-  // pair forces (returns the largest overlap/r) and integration (returns
-  // the largest squared displacement since the last build).
-  double pair_pass(int b0, int b1);
-  double integrate_pass(int b0, int b1);
-  // Run a pass over all blocks, shared among the threads by `bounds`;
-  // returns the largest value it returned (sphere_world.cpp).
-  double run_pass(double (SphereWorld::*pass)(int, int), const std::vector<int>& bounds);
-  int active_threads() const;
-  void update_thread_bounds();
-  void wall_forces();
-  void compute_forces();
-  /// Signed distance from wall s to the centre of i, along the inward normal.
-  double wall_distance(int s, int i) const;
-  // sphere_energy_balance.cpp
-  struct EnergySample {
-    double energy = 0.0, elastic = 0.0;
-    double power_lost = 0.0;  // contact damping [W] (global damping is summed each step)
-  };
-  EnergySample energy_sample() const;
-  bool ledger_due() const;
-  bool ledger_record(const EnergySample& sample);
-  // sphere_world.cpp
-  void integrate();
-  void book_wall_work();
-  void update_damping_coefficients();
-  bool check_divergence();
-
-  SphereMaterial material_;
-  KernelOptions options_;
-  Integration integration_;
-  int threads_ = 1;
-
-  // Particle state (structure of arrays, 64-byte aligned), padded to whole
-  // blocks of 8: index n_ .. 8·nblocks_ − 1 are inert padding lanes, index
-  // ghost_ = 8·nblocks_ the ghost particle empty slots point to (far away,
-  // radius 0: never in contact).
-  int n_ = 0, nblocks_ = 0, ghost_ = 0;
-  Array x_, y_, z_, vx_, vy_, vz_, wx_, wy_, wz_, r_, inv_r_;
-  Array m_, inertia_;
-  Array fx_, fy_, fz_, tx_, ty_, tz_;
-  Array ca_t_, cb_t_, ca_r_, cb_r_;  // v ← a·v + b·F per particle (0 for padding)
-  Array d_t_, d_r_;                  // damping coefficients D_t, D_r
-  // Per block, written by the passes and summed in block order (the same
-  // sums for any thread count): global damping loss of the step (Σ D·|v̄|²/4)
-  // and, over the block's slots, Σ|h|² of contacts that opened and
-  // Σ μFn·(|h_trial| − μFn) of sliding ones (every pair counted twice).
-  Array block_lost_, block_released_, block_slid_;
-  // Energy taken by global damping since the energy ledger started [J] (a
-  // running total from the start, not a difference of two totals: that
-  // would cancel catastrophically once most of the energy is gone).
-  double damping_dissipated_ = 0.0;
-  // Energy taken by Coulomb friction since the ledger started [J]: the
-  // tangential spring energy a contact gives up when its force is capped
-  // (sliding) or when it opens (sphere_contact.cpp explains why that is
-  // dissipated, not created).
-  double friction_dissipated_ = 0.0;
-  // Work of the moving walls on the spheres since the ledger started [J],
-  // summed every step by the trapezoidal rule over each wall's move: the
-  // wall's push along its axis before and after the move (wall_push_) times
-  // the move (wall_move_). (Sampled every energy_check_interval steps it
-  // missed a collision shorter than the interval.)
-  double wall_work_ = 0.0;
-  // Σ|work| of the walls since construction (never reset): energy the
-  // walls may have put into motion directly, a scale of the kEnergy check.
-  double wall_work_abs_ = 0.0;
-  std::array<double, 6> wall_push_{}, wall_move_{};
-
-  // Verlet neighbour list, full (each pair from both sides) in sliced
-  // ELLPACK blocks of 8 as the 2D kernel's (world.hpp): block b's slots are
-  // [block_slot_[b], block_slot_[b + 1]), rows of 8, slot (row, lane) the
-  // row-th neighbour (increasing index) of particle 8b + lane, then ghosts.
-  // hx_, hy_, hz_: each slot's tangential force on its own particle (the
-  // two copies of a pair are exact opposites), kept across rebuilds; slot_r_
-  // the neighbour's radius.
-  std::vector<int> block_slot_;
-  detail::AlignedVector<int> slot_j_;
-  Array hx_, hy_, hz_, slot_r_;
-  // The half list (pairs i < j) in CSR form, each row sorted by j, and the
-  // slot of i's copy of each pair (for measures, views and the ledger).
-  std::vector<int> nbr_start_, nbr_j_, pair_slot_;
-  // Block ranges of the threads: pair pass (balanced by slots), particle pass.
-  std::vector<int> pair_bounds_, particle_bounds_;
-  // Wall contacts: candidates within skin, tangential force history and
-  // last normal force per wall and particle.
-  std::array<std::vector<int>, 6> wall_candidates_;
-  std::array<std::vector<double>, 6> wall_hx_, wall_hy_, wall_hz_, wall_fn_;
-  // Scratch for rebuilds (kept to avoid allocation).
-  std::vector<int> full_start_, full_j_, cell_start_, cell_next_, new_block_slot_;
-  detail::AlignedVector<int> new_slot_j_;
-  Array new_hx_, new_hy_, new_hz_, new_slot_r_;
-  Array x_built_, y_built_, z_built_;
-  std::array<double, 6> wall_built_{};
-  double skin_ = 0.0, r_min_ = 0.0, r_max_ = 0.0;
-  bool list_valid_ = false;
-  int64_t rebuilds_ = 0;
-
-  std::array<SphereWall, 6> walls_;
-  double max_overlap_ratio_seen_ = 0.0;
-  double initial_energy_ = -1.0;
-  double energy_scale_ = 0.0;
-  struct Ledger {
-    bool started = false;
-    int64_t step = 0;
-    double energy0 = 0.0, lost = 0.0, power_lost = 0.0;
-    double created = 0.0;
-  } ledger_;
-
-  Divergence divergence_ = Divergence::kNone;
-  int64_t divergence_step_ = -1;
-  int64_t steps_ = 0;
-  double time_ = 0.0;
-  detail::TeamHandle team_;
+  // The state and passes (src/kernel/sphere_world_impl.hpp, private to the
+  // kernel).
+  std::unique_ptr<SphereWorldImpl> impl_;
 };
 
 }  // namespace demcal

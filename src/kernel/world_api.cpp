@@ -1,10 +1,9 @@
 // World, the 2D kernel's public face: each call forwards to the WorldImpl
 // it owns (world_impl.hpp). The step and the passes run inside WorldImpl,
 // so the forwarding costs one call per step(n), not per particle.
-#include "demcal/kernel/world.hpp"
-
 #include <utility>
 
+#include "demcal/kernel/world.hpp"
 #include "world_impl.hpp"
 
 namespace demcal {
