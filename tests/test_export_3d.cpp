@@ -312,3 +312,52 @@ TEST(Export3dLiggghts, PeakAgainstDemcal) {
 
 }  // namespace
 }  // namespace demcal
+
+namespace demcal {
+namespace {
+
+// A measurement, not part of the suite (~5 min on a shared 2-core machine):
+// the servo deck on the polydisperse random_500_3d (8 radius classes, the
+// export default, then one per sphere) against demcal, 40 000 steps, ζ_t = 0.4, ζ_r = 0. Run with
+//   build/demcal_tests --gtest_also_run_disabled_tests \
+//     --gtest_filter='Export3dLammps.DISABLED_Random500'
+// (reports/engines-3d.md has the figures).
+TEST(Export3dLammps, DISABLED_Random500) {
+  const std::string lmp = test::find_on_path("lmp");
+  if (lmp.empty()) GTEST_SKIP() << "LAMMPS (lmp) is not installed: the 3D deck is not run";
+  const SceneConfig c = load_config(test::shipped_config("random_500_3d"));
+  auto t0 = std::chrono::steady_clock::now();
+  const TriaxialState state = consolidate_triaxial(c, make_sphere_assembly(c));
+  const double consolidation =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const AlgorithmSpec p = fixed_params(40000);
+  SphereWorld end = state.world;
+  t0 = std::chrono::steady_clock::now();
+  const TriaxialResult d = run_triaxial_loading(state, c.test, p, {}, &end);
+  const double demcal_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  // The export default (8 radius classes), then one class per sphere.
+  for (int max_types : {8, c.assembly.count}) {
+    Export3dOptions o;
+    o.data_name = "r500.data";
+    o.max_types = max_types;
+    const ExportResult r = export_3d_decks(c, p, state, o);
+    const EngineRun l = run_engine(lmp, {"-screen", "none"}, r, "lammps3d_r500");
+    ASSERT_EQ(l.status, 0) << l.log;
+    ASSERT_FALSE(l.rows.empty());
+    std::printf(
+        "random_500_3d (%d classes, damping class error %.2f %%), %lld steps (LAMMPS %lld): peak "
+        "axial stress demcal %.6g / LAMMPS %.6g Pa (%+.3f %%), peak sigma1/sigma3 %.5f / %.5f "
+        "(%+.3f %%); contacts at the end %d / %.0f; consolidation %.1f s, demcal %.2f s, LAMMPS "
+        "%.2f s\n",
+        r.types, 100 * r.damping_class_error, static_cast<long long>(p.steps),
+        static_cast<long long>(r.steps), -d.peak_stress_zz, l.peak_axial,
+        100 * (l.peak_axial / -d.peak_stress_zz - 1), d.peak_ratio, l.peak_ratio,
+        100 * (l.peak_ratio / d.peak_ratio - 1), end.measure().particle_contacts,
+        l.rows.back().back(), consolidation, demcal_s, l.seconds);
+    EXPECT_NEAR(l.peak_axial / -d.peak_stress_zz, 1.0, 0.01);
+  }
+}
+
+}  // namespace
+}  // namespace demcal
