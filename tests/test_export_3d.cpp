@@ -137,8 +137,8 @@ TEST(Export3d, LiggghtsDeckHasSixWallsAndTheServo) {
   for (const char* name :
        {"fcc.data", "fcc-xmin.stl", "fcc-xmax.stl", "fcc-ymin.stl", "fcc-ymax.stl", "fcc-top.stl"})
     EXPECT_EQ(r.files.count(name), 1u) << name;
-  for (const char* line : {"primitive type 2 zplane", "mesh/surface/stress/servo", "n_meshes 5",
-                           "move/mesh mesh mtop linear 0 0 -"})
+  for (const char* line : {"fix mbottom all mesh/surface/stress", "mesh/surface/stress/servo",
+                           "n_meshes 6", "move/mesh mesh mtop linear 0 0 -"})
     EXPECT_NE(r.deck.find(line), std::string::npos) << line;
   EXPECT_EQ(r.deck.find("dimension 2"), std::string::npos);
 }
@@ -265,6 +265,10 @@ TEST(Export3dLammps, PeakMatchesDemcalSerially) { check_lammps(1, 20000); }
 // several times a step, which a shared machine makes slow (reports/engines-3d.md).
 TEST(Export3dLammps, PeakMatchesDemcalUnderMpirunNp2) { check_lammps(2, 5000); }
 
+// The LIGGGHTS deck over the whole loading against demcal's run of the same
+// parameters (ζ_r = 0). Its axial stress is the mean of the top and bottom
+// meshes, as demcal's: the top wall alone reads 0.32 % higher at the peak
+// (the damping drag on the spheres moving with it; reports/engines-3d.md).
 TEST(Export3dLiggghts, PeakAgainstDemcal) {
   const std::string liggghts = test::find_on_path("liggghts");
   if (liggghts.empty())
@@ -280,8 +284,8 @@ TEST(Export3dLiggghts, PeakAgainstDemcal) {
   const EngineRun g = run_engine(liggghts, {"-var", "thermo_every", "1"}, r, "liggghts3d");
   ASSERT_EQ(g.status, 0) << g.log;
   ASSERT_EQ(g.log.find("ERROR"), std::string::npos) << g.log;
-  // Thermo rows: step time ke strain_zz p_top p_lat Wx Wy.
-  const auto at = g.log.find("v_p_top");
+  // Thermo rows: step time ke strain_zz p_axial p_lat p_top p_bottom Wx Wy.
+  const auto at = g.log.find("v_p_axial");
   ASSERT_NE(at, std::string::npos) << g.log;
   std::stringstream lines(g.log.substr(g.log.find('\n', g.log.find("Step", at)) + 1));
   double peak_axial = 0.0, peak_ratio = 0.0, last_lateral = 0.0;
@@ -291,7 +295,7 @@ TEST(Export3dLiggghts, PeakAgainstDemcal) {
     std::stringstream f(line);
     std::vector<double> v;
     for (double x; f >> x;) v.push_back(x);
-    if (v.size() != 8) continue;
+    if (v.size() != 10) continue;
     ++rows;
     peak_axial = std::max(peak_axial, v[4]);
     if (v[5] > 0.0) peak_ratio = std::max(peak_ratio, v[4] / v[5]);

@@ -579,9 +579,9 @@ std::string liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p, const Pl
   const double mz = 0.1 * ext[2] + 2 * plan.r_max;
   using V3 = Eigen::Vector3d;
   const V3 lo(plan.lo[0], plan.lo[1], plan.lo[2]), hi(plan.hi[0], plan.hi[1], plan.hi[2]);
-  std::array<std::string, 5> mesh_file;
-  const char* mesh_name[5] = {"xmin", "xmax", "ymin", "ymax", "top"};
-  for (int k = 0; k < 5; ++k) mesh_file[k] = stem + "-" + mesh_name[k] + ".stl";
+  std::array<std::string, 6> mesh_file;
+  const char* mesh_name[6] = {"xmin", "xmax", "ymin", "ymax", "top", "bottom"};
+  for (int k = 0; k < 6; ++k) mesh_file[k] = stem + "-" + mesh_name[k] + ".stl";
   const double z0 = lo.z() - mz, zh = ext[2] + 2 * mz;
   out.files[mesh_file[0]] =
       stl_rectangle("xmin", V3(lo.x(), lo.y() - my, z0), V3(0, ext[1] + 2 * my, 0), V3(0, 0, zh));
@@ -591,6 +591,8 @@ std::string liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p, const Pl
       stl_rectangle("ymin", V3(lo.x() - mx, lo.y(), z0), V3(0, 0, zh), V3(ext[0] + 2 * mx, 0, 0));
   out.files[mesh_file[3]] =
       stl_rectangle("ymax", V3(lo.x() - mx, hi.y(), z0), V3(ext[0] + 2 * mx, 0, 0), V3(0, 0, zh));
+  out.files[mesh_file[5]] = stl_rectangle("bottom", V3(lo.x() - mx, lo.y() - my, lo.z()),
+                                          V3(ext[0] + 2 * mx, 0, 0), V3(0, ext[1] + 2 * my, 0));
   out.files[mesh_file[4]] = stl_rectangle("top", V3(lo.x() - mx, lo.y() - my, hi.z()),
                                           V3(0, ext[1] + 2 * my, 0), V3(ext[0] + 2 * mx, 0, 0));
 
@@ -618,11 +620,13 @@ std::string liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p, const Pl
     << "#    is the force on the mesh along +axis: positive on a min wall.\n"
     << "#  - translational damping per radius class via fix viscous ... scale.\n"
     << "# Run it with a screen (liggghts 3.8 crashes reading meshes with -screen none).\n"
-    << "#  - the axial stress is the top wall's (LIGGGHTS gives no force on a\n"
-    << "#    primitive wall); demcal's is the mean of top and bottom.\n"
-    << "# Thermo: p_top (axial, Pa), p_lat (mean lateral, Pa, on the current areas),\n"
-    << "# sigma1/sigma3 = p_top/p_lat (no column: both are 0 at the start, when\n"
-    << "# LIGGGHTS has not yet computed the mesh forces).\n";
+    << "#  - the bottom is a fixed mesh (not a primitive plane) so that its force is\n"
+    << "#    known: the axial stress is the mean of top and bottom, as demcal's (the\n"
+    << "#    top alone reads 0.3 % higher at the peak on fcc_4x4x4: the damping drag\n"
+    << "#    on the spheres that move with it).\n"
+    << "# Thermo: p_axial = (p_top + p_bottom)/2, p_lat (mean of the four lateral\n"
+    << "# walls), Pa, on the current areas; sigma1/sigma3 = p_axial/p_lat (no\n"
+    << "# column: both are 0 at the start, before LIGGGHTS computes mesh forces).\n";
   out.notes.push_back(
       "LIGGGHTS deck: each lateral force held at sigma3*A0 (the area at the start), servo gain "
       "from the wall contacts at the start; no rotational damping");
@@ -652,9 +656,7 @@ std::string liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p, const Pl
        "tangential_damping off\n"
     << "pair_coeff * *\n"
     << "timestep " << exact(plan.dt) << "\n\n"
-    << "fix bottom all wall/gran model hooke/stiffness tangential history primitive type "
-    << wall_type << " zplane " << exact(plan.lo[2])
-    << " absolute_damping on tangential_damping off\n"
+    << "fix mbottom all mesh/surface/stress file " << mesh_file[5] << " type " << wall_type << "\n"
     << "fix mtop all mesh/surface/stress file " << mesh_file[4] << " type " << wall_type << "\n";
   const V3 centre = 0.5 * (lo + hi);
   for (int sd = 0; sd < 4; ++sd) {
@@ -676,8 +678,8 @@ std::string liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p, const Pl
         << wall_type << "\n";
     }
   }
-  s << "fix walls all wall/gran model hooke/stiffness tangential history mesh n_meshes 5 meshes "
-       "mtop mxmin mxmax mymin mymax absolute_damping on tangential_damping off\n"
+  s << "fix walls all wall/gran model hooke/stiffness tangential history mesh n_meshes 6 meshes "
+       "mbottom mtop mxmin mxmax mymin mymax absolute_damping on tangential_damping off\n"
     << "fix movetop all move/mesh mesh mtop linear 0 0 " << exact(-plan.top_speed) << "\n\n"
     << "fix integrate all nve/sphere\n";
   if (p.damping_ratio_translation > 0.0) {
@@ -698,13 +700,16 @@ std::string liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p, const Pl
     << "variable Wx equal " << wall_pos(1) << "-(" << wall_pos(0) << ")\n"
     << "variable Wy equal " << wall_pos(3) << "-(" << wall_pos(2) << ")\n"
     << "variable p_top equal f_mtop[3]/(v_Wx*v_Wy)\n"
+    << "variable p_bottom equal -f_mbottom[3]/(v_Wx*v_Wy)\n"
+    << "variable p_axial equal (v_p_top+v_p_bottom)/2\n"
     << "variable p_lat equal (-f_mxmin[1]+f_mxmax[1])/(4*v_Wy*v_H)+(-f_mymin[2]+f_mymax[2])/"
        "(4*v_Wx*v_H)\n"
     << "variable strain_zz equal (v_H-" << exact(ext[2]) << ")/" << exact(ext[2]) << "\n"
-    << "# LIGGGHTS 3.8 has no fix vector: the peaks are the largest p_top and ratio\n"
+    << "# LIGGGHTS 3.8 has no fix vector: the peaks are the largest p_axial and ratio\n"
     << "# over the thermo rows; -var thermo_every 1 for every step.\n"
     << "variable thermo_every index " << monitor_every << "\n"
-    << "thermo_style custom step time ke v_strain_zz v_p_top v_p_lat v_Wx v_Wy\n"
+    << "thermo_style custom step time ke v_strain_zz v_p_axial v_p_lat v_p_top v_p_bottom v_Wx "
+       "v_Wy\n"
     << "thermo ${thermo_every}\n"
     << "variable run_steps index " << plan.steps << "\n"
     << "run ${run_steps}\n";

@@ -18,10 +18,12 @@
 //              positions, servo errors, contacts) and, at the end, the peak
 //              axial stress and the peak σ1/σ3 over every step.
 //   liggghts — LIGGGHTS-PUBLIC 3.8: gran model hooke/stiffness, per-type-pair
-//              kn/kt/μ, bottom a primitive plane, top and lateral walls STL
-//              meshes (top moved by move/mesh, lateral ones by fix
-//              mesh/surface/stress/servo holding the force σ3·A0 with the
-//              gain of demcal's servo law).
+//              kn/kt/μ, the six walls STL meshes (bottom fixed, top moved
+//              by move/mesh, lateral ones by fix mesh/surface/stress/servo
+//              holding the force σ3·A0 with the gain of demcal's servo law);
+//              thermo rows with the axial stress (mean of top and bottom, as
+//              demcal's) and the mean lateral stress, every
+//              `thermo_every` steps (-var thermo_every 1: every step).
 //
 // Both run at α·f·Δt_crit for Nstep/f steps, f = dashpot_step_factor(ζ_t)
 // (their fix viscous is explicit; demcal's damping is semi-implicit), with
