@@ -1,0 +1,747 @@
+// The 3D decks (export_3d.hpp). The mapping rules are the 2D decks'
+// (export.cpp); the reasons given there (explicit damping and the step
+// factor, the servo as a running sum, the fix order) hold here and are
+// only recalled in the decks' headers.
+#include "demcal/upscaling/export_3d.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <sstream>
+
+#include "demcal/io/input_error.hpp"
+#include "demcal/kernel/particle_scales.hpp"
+
+namespace demcal {
+
+namespace {
+
+std::string num(double v) {
+  char b[40];
+  std::snprintf(b, sizeof b, "%.10g", v);
+  return b;
+}
+std::string exact(double v) {
+  char b[40];
+  std::snprintf(b, sizeof b, "%.17g", v);
+  return b;
+}
+std::string fmt3(double v) {
+  char b[40];
+  std::snprintf(b, sizeof b, "%.3g", v);
+  return b;
+}
+
+constexpr const char* kAxis = "xyz";
+constexpr const char* kWall[6] = {"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"};
+
+/// Everything both decks need, computed once.
+struct Plan3 {
+  int n = 0, types = 0;
+  std::vector<int> type;  // per particle, 1-based
+  std::vector<double> r_lo, r_hi;
+  double density = 0.0;  // f_ms·ρ [kg/m³]
+  double r_min = 0.0, r_max = 0.0, m_mean = 0.0;
+  double dt_crit = 0.0, step_factor = 1.0, dt = 0.0;
+  int64_t steps = 0;
+  std::array<double, 3> lo{}, hi{};
+  double top_speed = 0.0;  // [m/s], downward
+  std::vector<double> gamma_t, gamma_r;
+  double class_error = 0.0;
+  std::array<int, 6> wall_contacts{};  // at the start
+};
+
+Plan3 make_plan(const SceneConfig& c, const AlgorithmSpec& p, const SphereWorld& w, int max_types) {
+  Plan3 plan;
+  plan.n = w.size();
+  const std::vector<double> radii(w.radius().begin(), w.radius().end());
+  plan.type = radius_classes(radii, std::max(1, max_types), &plan.types);
+  plan.r_lo.assign(plan.types, std::numeric_limits<double>::infinity());
+  plan.r_hi.assign(plan.types, 0.0);
+  for (int i = 0; i < plan.n; ++i) {
+    const int k = plan.type[i] - 1;
+    plan.r_lo[k] = std::min(plan.r_lo[k], radii[i]);
+    plan.r_hi[k] = std::max(plan.r_hi[k], radii[i]);
+  }
+  plan.density = c.material.density * p.mass_scaling;
+  plan.r_min = w.min_radius();
+  plan.r_max = w.max_radius();
+  double m_sum = 0.0;
+  for (double r : radii) m_sum += sphere_mass(plan.density, r);
+  plan.m_mean = m_sum / plan.n;
+  const double kn = c.material.particle.kn, kt = c.material.particle.kt;
+  // Δt_crit of the lightest sphere, as integration_for (triaxial.cpp).
+  plan.dt_crit = critical_time_step(sphere_mass(plan.density, plan.r_min), kn);
+  // The engines' fix viscous is explicit: α·f for Nstep/f steps (export.hpp).
+  plan.step_factor = dashpot_step_factor(p.damping_ratio_translation);
+  plan.dt = p.dt_ratio * plan.step_factor * plan.dt_crit;
+  plan.steps = std::max<int64_t>(1, std::llround(static_cast<double>(p.steps) / plan.step_factor));
+  for (int a = 0; a < 3; ++a) {
+    plan.lo[a] = w.wall(static_cast<SphereWallSide>(2 * a)).position;
+    plan.hi[a] = w.wall(static_cast<SphereWallSide>(2 * a + 1)).position;
+  }
+  plan.top_speed = c.test.vertical_strain * (plan.hi[2] - plan.lo[2]) /
+                   (static_cast<double>(plan.steps) * plan.dt);
+  // D_t = ζ_t·2·sqrt(kn·m) ∝ r^(3/2), D_r = ζ_r·2·sqrt(kt·r²·I) ∝ r^(7/2): each
+  // class gets the value of its mid radius; the error bound is that of D_t.
+  for (int k = 0; k < plan.types; ++k) {
+    const double r = 0.5 * (plan.r_lo[k] + plan.r_hi[k]);
+    const double m = sphere_mass(plan.density, r);
+    plan.gamma_t.push_back(p.damping_ratio_translation * critical_damping_translation(kn, m));
+    plan.gamma_r.push_back(p.damping_ratio_rotation *
+                           critical_damping_rotation(kt, r, sphere_inertia(m, r)));
+    const double lo = std::pow(plan.r_lo[k] / r, 1.5), hi = std::pow(plan.r_hi[k] / r, 1.5);
+    plan.class_error = std::max({plan.class_error, 1.0 - lo, hi - 1.0});
+  }
+  for (int s = 0; s < 6; ++s)
+    plan.wall_contacts[s] = w.wall(static_cast<SphereWallSide>(s)).contacts;
+  return plan;
+}
+
+ExportResult result_of(const Plan3& plan) {
+  ExportResult out;
+  out.dt = plan.dt;
+  out.steps = plan.steps;
+  out.step_factor = plan.step_factor;
+  out.types = plan.types;
+  out.damping_class_error = plan.class_error;
+  out.notes.push_back(
+      "tangential contact forces are not carried over: the deck's contacts start with zero "
+      "tangential springs (normal forces are in the positions)");
+  if (plan.step_factor < 1.0)
+    out.notes.push_back(
+        "timestep alpha*f and Nstep/f (f = sqrt(1 + zeta_t^2) - zeta_t = " + num(plan.step_factor) +
+        "): this engine's fix viscous is explicit and shrinks the stable step "
+        "by f; the loading time, rate and strain are demcal's");
+  return out;
+}
+
+std::string mapping_header(const SceneConfig& c, const AlgorithmSpec& p, const Plan3& plan,
+                           const Export3dOptions& o, const std::string& code) {
+  std::ostringstream s;
+  const auto& m = c.material;
+  const double h0 = plan.hi[2] - plan.lo[2];
+  s << "# ===========================================================================\n"
+    << "# demcal " << DEMCAL_VERSION << " export: " << code << " input deck, 3D triaxial test\n"
+    << "# scene " << c.name << "; " << plan.n << " spheres (" << o.data_name << ")\n";
+  if (!o.provenance.empty()) s << "# parameters: " << o.provenance << "\n";
+  s << "#\n"
+    << "# How demcal's parameters map (demcal -> " << code << "):\n"
+    << "#   dt = alpha * f * dt_crit = " << num(p.dt_ratio) << " * " << num(plan.step_factor)
+    << " * " << num(plan.dt_crit) << " s = " << num(plan.dt) << " s -> timestep\n"
+    << "#     dt_crit = 2 sqrt(m_min/kn) of the smallest sphere (r = " << num(plan.r_min)
+    << " m, m = f_ms rho 4/3 pi r^3)\n"
+    << "#     f = sqrt(1 + zeta_t^2) - zeta_t = " << num(plan.step_factor)
+    << " (zeta_t = " << num(p.damping_ratio_translation) << "): " << code
+    << "'s fix viscous is explicit\n"
+    << "#       (drag from the half-step velocity), which shrinks a damped oscillator's\n"
+    << "#       stable step by f; demcal damps semi-implicitly (f = 1)\n"
+    << "#   Nstep = " << p.steps << " / f = " << plan.steps
+    << " loading steps (the same loading time Nstep*dt: the same rate\n"
+    << "#     and strain); the top wall moves eps * H0 / (Nstep * dt) = "
+    << num(c.test.vertical_strain) << " * " << num(h0) << " / (" << plan.steps << " * "
+    << num(plan.dt) << ") = " << num(plan.top_speed) << " m/s\n"
+    << "#   kn = " << num(m.particle.kn) << " N/m, kt = " << num(m.particle.kt)
+    << " N/m, mu = " << num(m.particle.friction)
+    << " -> linear normal spring, incremental tangential spring, Coulomb cap\n"
+    << "#   contact (local) damping: "
+    << (m.contact_damping_ratio > 0 ? num(m.contact_damping_ratio) + " of critical" : "none")
+    << "\n"
+    << "#   zeta_t = " << num(p.damping_ratio_translation)
+    << ": D_t = zeta_t * 2 sqrt(kn m_i) per sphere -> fix viscous per radius class\n"
+    << "#     (atom type): " << plan.types
+    << " class(es), gamma of the class's mid radius, largest error against the\n"
+    << "#     per-sphere value " << fmt3(100 * plan.class_error) << " %\n"
+    << "#   zeta_r = " << num(p.damping_ratio_rotation)
+    << ": D_r = zeta_r * 2 sqrt(kt r^2 I), I = 2/5 m r^2: NOT APPLIED (this release\n"
+    << "#     has no rotational viscous fix); the run is demcal's with zeta_r = 0\n"
+    << "#   mass scaling f_ms = " << num(p.mass_scaling)
+    << " -> density f_ms*rho = " << num(plan.density) << " kg/m^3 in the data file\n"
+    << "#   walls: kn = " << num(m.wall.kn) << " N/m, kt = " << num(m.wall.kt)
+    << " N/m, mu = " << num(m.wall.friction) << "; bottom (z min) fixed, top (z max) down\n"
+    << "#     at constant speed, the four lateral walls "
+    << (o.lateral_servo ? "servo-controlled to sigma3 = " + num(c.test.lateral_stress) +
+                              " Pa (gain " + num(c.test.servo_gain) + ")"
+                        : "held fixed (no servo)")
+    << "\n"
+    << "#   stresses: tension positive in b and s; wall pressures compressive positive\n"
+    << "# The particle file holds demcal's consolidated state (walls at its box); the\n"
+    << "# run starts loading from it. Not carried over: the tangential contact forces\n"
+    << "# (springs start at zero here), the velocities (zero).\n"
+    << "# ===========================================================================\n";
+  return s.str();
+}
+
+// ---------------------------------------------------------------------------
+// LAMMPS (29 Sep 2021)
+
+std::string lammps_data_file(const SceneConfig& c, const Plan3& plan, const SphereWorld& w) {
+  std::ostringstream d;
+  d << "LAMMPS data file written by demcal " << DEMCAL_VERSION << " (scene " << c.name
+    << ", 3D)\n\n"
+    << plan.n << " atoms\n"
+    << plan.types << " atom types\n\n";
+  // Room around the walls: the top moves in, the lateral walls breathe.
+  for (int a = 0; a < 3; ++a) {
+    const double pad = 0.5 * (plan.hi[a] - plan.lo[a]) + 4.0 * plan.r_max;
+    d << exact(plan.lo[a] - pad) << " " << exact(plan.hi[a] + pad) << " " << kAxis[a] << "lo "
+      << kAxis[a] << "hi\n";
+  }
+  d << "\nAtoms # sphere\n\n";
+  char line[200];
+  for (int i = 0; i < plan.n; ++i) {
+    std::snprintf(line, sizeof line, "%d %d %.17g %.17g %.17g %.17g %.17g\n", i + 1, plan.type[i],
+                  2.0 * w.radius()[i], plan.density, w.x()[i], w.y()[i], w.z()[i]);
+    d << line;
+  }
+  return d.str();
+}
+
+/// Sum over the six walls of f_W[a] (times f_W[b] when b > 0).
+std::string wall_sum(int a, int b) {
+  std::string out;
+  for (const char* w : kWall) {
+    if (!out.empty()) out += "+";
+    out += std::string("f_w") + w + "[" + std::to_string(a) + "]";
+    if (b > 0) out += std::string("*f_w") + w + "[" + std::to_string(b) + "]";
+  }
+  return out;
+}
+
+std::string lammps_deck(const SceneConfig& c, const AlgorithmSpec& p, const Plan3& plan,
+                        const Export3dOptions& o, ExportResult& out) {
+  const auto& m = c.material;
+  std::ostringstream s;
+  s << mapping_header(c, p, plan, o, "LAMMPS");
+  s << "#\n# What this LAMMPS cannot do as demcal does, and what the deck does instead:\n"
+    << "#  - rotational damping: no rotational viscous fix in 29 Sep 2021 (zeta_r = 0\n"
+    << "#    here); releases from 2022 on have fix viscous/sphere: the line is below,\n"
+    << "#    commented out.\n"
+    << "#  - damping explicit (fix viscous) vs demcal's semi-implicit: the factor f.\n"
+    << "#  - servo walls are not native: each lateral wall is a wall/gran/region plane\n"
+    << "#    whose displacement is the running sum of demcal's per-step servo move\n"
+    << "#    gain*(sigma3*A - F)/(kn_wall*max(1, n)), capped at 2 % of r_min (A the\n"
+    << "#    wall's current area, F its force, n its contacts), kept by fix ave/time\n"
+    << "#    (running mean times the step); one run command only (no restart split).\n"
+    << "#  - LAMMPS takes a contact's torque at the lever arm r_i (demcal r_i - delta/2):\n"
+    << "#    the antisymmetric part of s carries a small static term.\n"
+    << "#  - a sphere's velocities and the tangential springs start at zero.\n"
+    << "# Outputs: ${series} (columns below) and, at the end, peak_axial_stress and\n"
+    << "# peak_ratio over every step (print; also appended to ${series} as comments).\n";
+  if (p.damping_ratio_rotation > 0.0)
+    out.notes.push_back("rotational damping zeta_r = " + num(p.damping_ratio_rotation) +
+                        " not applied: LAMMPS 29 Sep 2021 has no rotational viscous fix "
+                        "(fix viscous/sphere is in later releases; the deck has the line, "
+                        "commented out)");
+  if (plan.types > 1)
+    out.notes.push_back("translational damping per radius class (" + std::to_string(plan.types) +
+                        " atom types), at most " + fmt3(100 * plan.class_error) +
+                        " % off demcal's per-sphere value");
+
+  s << "\n# --- parameters (edit here) -------------------------------------------------\n"
+    << "# Everything below is derived from this block: editing dt or nstep keeps the\n"
+    << "# strain, the servo cap and the monitoring points right.\n"
+    << "variable dt        equal " << exact(plan.dt) << "      # s\n"
+    << "variable nstep     equal " << plan.steps << "      # loading steps\n"
+    << "variable strain    equal " << exact(c.test.vertical_strain)
+    << "      # axial (z) strain over nstep, compression\n"
+    << "variable monitor_points equal " << c.test.monitor_points << "      # rows of ${series}\n"
+    << "variable kn        equal " << exact(m.particle.kn) << "\n"
+    << "variable kt        equal " << exact(m.particle.kt) << "\n"
+    << "variable mu        equal " << exact(m.particle.friction) << "\n"
+    << "variable kn_wall   equal " << exact(m.wall.kn) << "\n"
+    << "variable kt_wall   equal " << exact(m.wall.kt) << "\n"
+    << "variable mu_wall   equal " << exact(m.wall.friction) << "\n"
+    << "variable sigma3    equal " << exact(c.test.lateral_stress) << "      # Pa\n"
+    << "variable gain      equal " << exact(o.lateral_servo ? c.test.servo_gain : 0.0)
+    << "      # servo gain (0: lateral walls fixed)\n"
+    << "variable r_min     equal " << exact(plan.r_min) << "      # m\n";
+  for (int sd = 0; sd < 6; ++sd)
+    s << "variable " << kWall[sd] << "0    equal "
+      << exact(sd % 2 == 0 ? plan.lo[sd / 2] : plan.hi[sd / 2]) << "      # wall at the start, m\n";
+  s << "variable series    index series.csv\n"
+    << "variable run_steps index ${nstep}      # -var run_steps 300 for a check\n"
+    << "\n# --- derived (do not edit) ---------------------------------------------------\n"
+    << "variable H0        equal $(v_zmax0-v_zmin0)\n"
+    << "variable Wx0       equal $(v_xmax0-v_xmin0)\n"
+    << "variable Wy0       equal $(v_ymax0-v_ymin0)\n"
+    << "variable vtop      equal $(v_strain*v_H0/(v_nstep*v_dt))      # m/s, top wall, down\n"
+    << "variable cap       equal $(0.02*v_r_min)      # m per step, servo move cap\n"
+    << "variable monitor_every equal "
+       "$(floor((1+v_nstep/v_monitor_points+abs(1-v_nstep/v_monitor_points))/2))\n"
+    << "variable peak_every equal $(ceil(v_nstep/1000000))      # fix vector length <= 1e6\n";
+
+  double gamma_n = 0.0;
+  if (m.contact_damping_ratio > 0.0) {
+    // demcal: ratio·2·sqrt(kn·m_eff); LAMMPS: m_eff·gamma_n, at the mean mass.
+    gamma_n = m.contact_damping_ratio * 2.0 * std::sqrt(m.particle.kn / (0.5 * plan.m_mean));
+    out.notes.push_back("contact damping mapped at the mean sphere mass");
+  }
+  s << "\n# --- system ------------------------------------------------------------------\n"
+    << "units           si\n"
+    << "dimension       3\n"
+    << "boundary        f f f\n"
+    << "atom_style      sphere\n"
+    << "atom_modify     map array\n"
+    << "comm_modify     vel yes\n"
+    << "newton          off\n"
+    << "read_data       " << o.data_name << "\n"
+    << "# sphere masses f_ms*rho*4/3*pi*r^3 (density column), inertia 2/5 m r^2\n"
+    << "pair_style      gran/hooke/history ${kn} ${kt} " << num(gamma_n) << " 0.0 ${mu} 0\n"
+    << "pair_coeff      * *\n"
+    << "neighbor        " << num(0.3 * plan.r_min) << " bin\n"
+    << "neigh_modify    delay 0 every 1 check yes\n"
+    << "timestep        ${dt}\n\n"
+    << "fix             integrate all nve/sphere\n\n";
+
+  // The servo moves, one flat formula each (numbers substituted now): wall
+  // k's move toward the sample, gain*(sigma3*A - F)/(kn_wall*max(1, n))
+  // clamped to ±cap; its displacement along +axis is f_servo[k]*step.
+  // Columns of compute cs: contacts and normal force on the particles of
+  // each lateral wall, in kWall order.
+  auto pos = [](int sd) {
+    return std::string("(${") + kWall[sd] + "0}+f_servo[" + std::to_string(sd + 1) + "]*step)";
+  };
+  const std::string h = "(${H0}-${vtop}*step*dt)";
+  const std::string area_x = "(" + pos(3) + "-" + pos(2) + ")*" + h;
+  const std::string area_y = "(" + pos(1) + "-" + pos(0) + ")*" + h;
+  auto move = [&](int sd) {
+    const std::string area = sd < 2 ? area_x : area_y;
+    // The force on the particles along +axis: +P on a min wall, −P on a max wall.
+    const std::string pressure_force =
+        std::string(sd % 2 == 0 ? "" : "-") + "c_cs[" + std::to_string(2 * sd + 2) + "]";
+    const std::string count = "c_cs[" + std::to_string(2 * sd + 1) + "]";
+    const std::string raw = "${gain}*(${sigma3}*" + area + "-(" + pressure_force +
+                            "))/(${kn_wall}*(1+" + count + "+abs(1-" + count + "))/2)";
+    const std::string clamped = "(abs(" + raw + "+${cap})-abs(" + raw + "-${cap}))/2";
+    return std::string(sd % 2 == 0 ? "" : "-") + clamped;
+  };
+
+  s << "# --- walls -------------------------------------------------------------------\n"
+    << "# bottom: fixed plane; top: plane moving down at vtop; lateral: planes moved\n"
+    << "# by the servo. Order: the walls, then fix store/force (contact forces only),\n"
+    << "# then the damping. Wall contact arrays: [1] contact, [2-4] force on the\n"
+    << "# sphere, [5-7] contact point.\n"
+    << "variable        dzmax equal -${vtop}*step*dt\n";
+  for (int sd = 0; sd < 4; ++sd)
+    s << "variable        d" << kWall[sd] << " equal f_servo[" << sd + 1 << "]*step\n";
+  s << "region          rxmin plane ${xmin0} 0 0  1 0 0 side in move v_dxmin NULL NULL units box\n"
+    << "region          rxmax plane ${xmax0} 0 0 -1 0 0 side in move v_dxmax NULL NULL units box\n"
+    << "region          rymin plane 0 ${ymin0} 0 0  1 0 side in move NULL v_dymin NULL units box\n"
+    << "region          rymax plane 0 ${ymax0} 0 0 -1 0 side in move NULL v_dymax NULL units box\n"
+    << "region          rzmax plane 0 0 ${zmax0} 0 0 -1 side in move NULL NULL v_dzmax units box\n"
+    << "fix             wzmin all wall/gran hooke/history ${kn_wall} ${kt_wall} 0 0 ${mu_wall} 0 "
+       "zplane ${zmin0} NULL contacts\n";
+  for (int sd : {5, 0, 1, 2, 3})
+    s << "fix             w" << kWall[sd]
+      << " all wall/gran/region hooke/history ${kn_wall} ${kt_wall} 0 0 ${mu_wall} 0 region r"
+      << kWall[sd] << " contacts\n";
+  s << "# contact force on every sphere (pairs and walls), before the damping\n"
+    << "fix             fcon all store/force\n\n";
+
+  s << "# --- global damping ----------------------------------------------------------\n";
+  if (p.damping_ratio_translation > 0.0) {
+    s << "# gamma per class, N*s/m:";
+    for (int k = 0; k < plan.types; ++k) s << " " << num(plan.gamma_t[k]);
+    s << "\nfix             dampt all viscous " << exact(plan.gamma_t[0]);
+    for (int k = 1; k < plan.types; ++k)
+      s << " scale " << k + 1 << " " << exact(plan.gamma_t[k] / plan.gamma_t[0]);
+    s << "\n";
+  } else {
+    s << "# zeta_t = 0: no translational damping\n";
+  }
+  s << "# LAMMPS >= 2022 only (absent in 29 Sep 2021): rotational damping D_r per class,\n"
+    << "# N*m*s (zeta_r = " << num(p.damping_ratio_rotation) << ")\n";
+  if (p.damping_ratio_rotation > 0.0) {
+    s << "#fix            dampr all viscous/sphere " << exact(plan.gamma_r[0]);
+    for (int k = 1; k < plan.types; ++k)
+      s << " scale " << k + 1 << " " << exact(plan.gamma_r[k] / plan.gamma_r[0]);
+    s << "\n\n";
+  } else {
+    s << "#   (zeta_r = 0: nothing to apply)\n\n";
+  }
+
+  // Measures: wall forces for the servo and the pressures, one reduction.
+  s << "# --- measures ----------------------------------------------------------------\n"
+    << "# the servo's input, the four lateral walls in one reduction (one global sum per\n"
+    << "# step under MPI): contacts and force along the wall's axis, xmin xmax ymin ymax\n"
+    << "compute         cs all reduce sum f_wxmin[1] f_wxmin[2] f_wxmax[1] f_wxmax[2] &\n"
+    << "                f_wymin[1] f_wymin[3] f_wymax[1] f_wymax[3] f_wzmin[1] f_wzmin[4] &\n"
+    << "                f_wzmax[1] f_wzmax[4]\n";
+  // Wall positions and pressures (flat: positions from f_servo directly).
+  for (int sd = 0; sd < 4; ++sd)
+    s << "variable        wall_" << kWall[sd] << " equal " << pos(sd) << "\n";
+  s << "variable        wall_zmin equal ${zmin0}\n"
+    << "variable        wall_zmax equal ${zmax0}-${vtop}*step*dt\n"
+    << "variable        H equal " << h << "\n"
+    << "variable        Ax equal " << area_x << "\n"
+    << "variable        Ay equal " << area_y << "\n"
+    << "variable        Az equal (" << pos(1) << "-" << pos(0) << ")*(" << pos(3) << "-" << pos(2)
+    << ")\n"
+    << "variable        p_xmin equal c_cs[2]/v_Ax\n"
+    << "variable        p_xmax equal -c_cs[4]/v_Ax\n"
+    << "variable        p_ymin equal c_cs[6]/v_Ay\n"
+    << "variable        p_ymax equal -c_cs[8]/v_Ay\n"
+    << "variable        p_zmin equal c_cs[10]/v_Az\n"
+    << "variable        p_zmax equal -c_cs[12]/v_Az\n"
+    << "variable        axial equal (v_p_zmin+v_p_zmax)/2\n"
+    << "variable        lateral equal (v_p_xmin+v_p_xmax+v_p_ymin+v_p_ymax)/4\n"
+    << "variable        ratio equal v_axial/v_lateral\n";
+
+  // The monitoring series: b and σ over the walls' contact arrays.
+  s << "# b_ij = (1/V) sum_walls (x_i - c_i) f_j (contact point x, force f on the\n"
+    << "# sphere, c the box centre); s_ij = b_ij - (1/V) sum_p (x_i - c_i) F_j, F the\n"
+    << "# contact force of fix store/force (V (b - sigma) = sum_p x_p (x) F_p)\n";
+  std::string reduce;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      s << "variable        bw" << kAxis[i] << kAxis[j] << " atom " << wall_sum(5 + i, 2 + j)
+        << "\n"
+        << "variable        mp" << kAxis[i] << kAxis[j] << " atom " << kAxis[i] << "*f_fcon["
+        << j + 1 << "]\n";
+      reduce += std::string(" v_bw") + kAxis[i] + kAxis[j] + " v_mp" + kAxis[i] + kAxis[j];
+    }
+  for (int j = 0; j < 3; ++j)
+    s << "variable        fw" << kAxis[j] << " atom " << wall_sum(2 + j, 0) << "\n";
+  s << "compute         cn all contact/atom\n"
+    << "compute         meas all reduce sum" << reduce
+    << " v_fwx v_fwy v_fwz f_fcon[1] f_fcon[2] f_fcon[3] c_cn\n"
+    << "compute         ket all ke\n"
+    << "compute         ker all erotate/sphere\n"
+    << "variable        cx equal (v_wall_xmin+v_wall_xmax)/2\n"
+    << "variable        cy equal (v_wall_ymin+v_wall_ymax)/2\n"
+    << "variable        cz equal (v_wall_zmin+v_wall_zmax)/2\n"
+    << "variable        V equal v_Ax*(v_wall_xmax-v_wall_xmin)\n";
+  // c_meas layout: [1..18] bw/mp pairs, [19..21] fw, [22..24] fcon, [25] cn.
+  std::string row = "${stepn},${strain_zz}";
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      const int k = 2 * (3 * i + j) + 1;
+      const std::string ij = std::string(1, kAxis[i]) + kAxis[j];
+      s << "variable        b_" << ij << " equal (c_meas[" << k << "]-v_c" << kAxis[i] << "*c_meas["
+        << 19 + j << "])/v_V\n"
+        << "variable        s_" << ij << " equal v_b_" << ij << "-(c_meas[" << k + 1 << "]-v_c"
+        << kAxis[i] << "*c_meas[" << 22 + j << "])/v_V\n";
+    }
+  for (const char* t : {"b_", "s_"})
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) row += std::string(",${") + t + kAxis[i] + kAxis[j] + "}";
+  s << "variable        strain_zz equal (v_H-v_H0)/v_H0\n"
+    << "variable        ke equal c_ket+c_ker\n"
+    << "variable        ke_rot equal c_ker\n"
+    << "variable        lat_err equal (v_lateral-v_sigma3)/v_sigma3\n";
+  for (int sd = 0; sd < 4; ++sd)
+    s << "variable        err_" << kWall[sd] << " equal (v_p_" << kWall[sd]
+      << "-v_sigma3)/v_sigma3\n";
+  s << "variable        contacts equal c_meas[25]/2\n"
+    << "variable        stepn equal step\n";
+  row += ",${ke},${ke_rot},${lat_err}";
+  std::string columns = "step,strain_zz";
+  for (const char* t : {"b_", "s_"})
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) columns += std::string(",") + t + kAxis[i] + kAxis[j];
+  columns += ",kinetic_energy,kinetic_energy_rotation,lateral_stress_error";
+  for (int sd = 0; sd < 4; ++sd) {
+    row += std::string(",${err_") + kWall[sd] + "}";
+    columns += std::string(",servo_error_") + kWall[sd];
+  }
+  for (int sd = 0; sd < 6; ++sd) {
+    row += std::string(",${wall_") + kWall[sd] + "}";
+    columns += std::string(",wall_") + kWall[sd];
+  }
+  for (int sd = 0; sd < 6; ++sd) {
+    row += std::string(",${p_") + kWall[sd] + "}";
+    columns += std::string(",p_") + kWall[sd];
+  }
+  row += ",${contacts}";
+  columns += ",contacts";
+
+  s << "\n# --- monitoring series -------------------------------------------------------\n"
+    << "# ${series}: every monitor_every steps and at the start; tension positive, SI,\n"
+    << "# origin at the box centre. Columns:\n"
+    << "#   step, strain_zz (H - H0)/H0\n"
+    << "#   b_xx .. b_zz   boundary stress, row by row, from the six walls' contact arrays\n"
+    << "#   s_xx .. s_zz   homogenized stress (V (b - sigma) = sum_p x_p (x) F_p)\n"
+    << "#   kinetic_energy (translation + rotation, I = 2/5 m r^2), kinetic_energy_rotation [J]\n"
+    << "#   lateral_stress_error  (mean of the four lateral pressures - sigma3)/sigma3\n"
+    << "#   servo_error_xmin .. ymax  (p - sigma3)/sigma3 of each lateral wall\n"
+    << "#   wall_xmin .. wall_zmax    wall positions [m]\n"
+    << "#   p_xmin .. p_zmax          compressive wall pressures [Pa]\n"
+    << "#   contacts                  sphere-sphere contacts\n"
+    << "# the columns up to wall_zmax are those of demcal's series.csv (run_output.hpp)\n"
+    << "# where LAMMPS measures them. The series and the peaks are fixes defined\n"
+    << "# before the servo's fix ave/time, so that at each step they see the walls\n"
+    << "# where the forces were computed (the servo's running mean updates after).\n"
+    << "print           \"# demcal.series/1: LAMMPS 3D deck written by demcal " << DEMCAL_VERSION
+    << ", scene " << c.name << "\" file ${series} screen no\n"
+    << "print           \"# particles = " << plan.n << "\" append ${series} screen no\n"
+    << "print           \"# lateral_stress = ${sigma3}\" append ${series} screen no\n"
+    << "print           \"# steps = ${nstep}\" append ${series} screen no\n"
+    << "print           \"# dt = ${dt}\" append ${series} screen no\n"
+    << "print           \"# damping_ratio_translation = " << num(p.damping_ratio_translation)
+    << "\" append ${series} screen no\n"
+    << "print           \"# damping_ratio_rotation = 0\" append ${series} screen no\n"
+    << "print           \"# moment_lever_arm = radius\" append ${series} screen no\n"
+    << "fix             series all print ${monitor_every} \"" << row
+    << "\" append ${series} screen no title \"" << columns << "\"\n"
+    << "# the peaks over every peak_every steps: axial pressure and sigma1/sigma3\n"
+    << "fix             peaks all vector ${peak_every} v_axial v_ratio\n\n";
+
+  s << "# --- servo -------------------------------------------------------------------\n"
+    << "# demcal's servo, one move per step and wall toward the sample when p < sigma3:\n"
+    << "#   move = gain*(sigma3*A - F)/(kn_wall*max(1, n)), clamped to +-cap,\n"
+    << "# A = the wall's current area, F its force, n its contacts (compute cs). One\n"
+    << "# flat formula per wall with the numbers substituted now; this release has no\n"
+    << "# min/max of two numbers: max(1, n) = (1+n+abs(1-n))/2, clamp(x) =\n"
+    << "# (abs(x+cap)-abs(x-cap))/2. f_servo[k]: the running mean of the moves along\n"
+    << "# +axis (xmin xmax ymin ymax), times the step = the wall's displacement.\n";
+  for (int sd = 0; sd < 4; ++sd)
+    s << "variable        m" << kWall[sd] << " equal " << move(sd) << "\n";
+  s << "fix             servo all ave/time 1 1 1 v_mxmin v_mxmax v_mymin v_mymax ave running\n\n";
+
+  s << "# --- output and run ----------------------------------------------------------\n"
+    << "thermo_style    custom step time v_strain_zz v_axial v_lateral v_ratio ke\n"
+    << "thermo_modify   norm no\n"
+    << "thermo          ${monitor_every}\n"
+    << "run             ${run_steps}\n"
+    << "variable        peak_axial equal max(f_peaks[1])\n"
+    << "variable        peak_ratio equal max(f_peaks[2])\n"
+    << "print           \"peak_axial_stress = ${peak_axial}\"\n"
+    << "print           \"peak_ratio = ${peak_ratio}\"\n"
+    << "print           \"# peak_axial_stress = ${peak_axial}\" append ${series} screen no\n"
+    << "print           \"# peak_ratio = ${peak_ratio}\" append ${series} screen no\n";
+  return s.str();
+}
+
+// ---------------------------------------------------------------------------
+// LIGGGHTS-PUBLIC 3.8
+
+/// A rectangle p0, p0 + u, p0 + u + v, p0 + v as two facets (normal u × v).
+std::string stl_rectangle(const std::string& name, const Eigen::Vector3d& p0,
+                          const Eigen::Vector3d& u, const Eigen::Vector3d& v) {
+  std::ostringstream s;
+  const Eigen::Vector3d n = u.cross(v).normalized();
+  auto vertex = [&](const Eigen::Vector3d& q) {
+    s << "      vertex " << exact(q.x()) << " " << exact(q.y()) << " " << exact(q.z()) << "\n";
+  };
+  s << "solid " << name << "\n";
+  for (int f = 0; f < 2; ++f) {
+    s << "  facet normal " << num(n.x()) << " " << num(n.y()) << " " << num(n.z())
+      << "\n    outer loop\n";
+    vertex(p0);
+    if (f == 0) {
+      vertex(p0 + u);
+      vertex(p0 + u + v);
+    } else {
+      vertex(p0 + u + v);
+      vertex(p0 + v);
+    }
+    s << "    endloop\n  endfacet\n";
+  }
+  s << "endsolid " << name << "\n";
+  return s.str();
+}
+
+std::string liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p, const Plan3& plan,
+                          const Export3dOptions& o, const SphereWorld& w, ExportResult& out) {
+  const auto& m = c.material;
+  const int wall_type = plan.types + 1, ntypes = plan.types + 1;
+  const std::array<double, 3> ext{plan.hi[0] - plan.lo[0], plan.hi[1] - plan.lo[1],
+                                  plan.hi[2] - plan.lo[2]};
+  // Data file: atom_style granular rows "id type diameter density x y z"
+  // (LIGGGHTS in 3D: m = density·(4/3)πr³).
+  {
+    std::ostringstream d;
+    d << "LIGGGHTS data file written by demcal " << DEMCAL_VERSION << " (scene " << c.name
+      << ", 3D)\n\n"
+      << plan.n << " atoms\n"
+      << ntypes << " atom types\n\n";
+    for (int a = 0; a < 3; ++a) {
+      const double pad = 0.5 * ext[a] + 4.0 * plan.r_max;
+      d << exact(plan.lo[a] - pad) << " " << exact(plan.hi[a] + pad) << " " << kAxis[a] << "lo "
+        << kAxis[a] << "hi\n";
+    }
+    d << "\nAtoms\n\n";
+    char line[200];
+    for (int i = 0; i < plan.n; ++i) {
+      std::snprintf(line, sizeof line, "%d %d %.17g %.17g %.17g %.17g %.17g\n", i + 1, plan.type[i],
+                    2.0 * w.radius()[i], plan.density, w.x()[i], w.y()[i], w.z()[i]);
+      d << line;
+    }
+    out.files[o.data_name] = d.str();
+  }
+  // Meshes: the top (normal −z) a little wider than the box; the lateral
+  // walls from below the bottom to above the top, a little wider than the
+  // box (the meshes cross at the edges; they do not touch each other).
+  const std::string stem = o.data_name.substr(0, o.data_name.rfind('.'));
+  const double mx = 0.1 * ext[0] + 2 * plan.r_max, my = 0.1 * ext[1] + 2 * plan.r_max;
+  const double mz = 0.1 * ext[2] + 2 * plan.r_max;
+  using V3 = Eigen::Vector3d;
+  const V3 lo(plan.lo[0], plan.lo[1], plan.lo[2]), hi(plan.hi[0], plan.hi[1], plan.hi[2]);
+  std::array<std::string, 6> mesh_file;
+  const char* mesh_name[6] = {"xmin", "xmax", "ymin", "ymax", "top", "bottom"};
+  for (int k = 0; k < 6; ++k) mesh_file[k] = stem + "-" + mesh_name[k] + ".stl";
+  const double z0 = lo.z() - mz, zh = ext[2] + 2 * mz;
+  out.files[mesh_file[0]] =
+      stl_rectangle("xmin", V3(lo.x(), lo.y() - my, z0), V3(0, ext[1] + 2 * my, 0), V3(0, 0, zh));
+  out.files[mesh_file[1]] =
+      stl_rectangle("xmax", V3(hi.x(), lo.y() - my, z0), V3(0, 0, zh), V3(0, ext[1] + 2 * my, 0));
+  out.files[mesh_file[2]] =
+      stl_rectangle("ymin", V3(lo.x() - mx, lo.y(), z0), V3(0, 0, zh), V3(ext[0] + 2 * mx, 0, 0));
+  out.files[mesh_file[3]] =
+      stl_rectangle("ymax", V3(lo.x() - mx, hi.y(), z0), V3(ext[0] + 2 * mx, 0, 0), V3(0, 0, zh));
+  out.files[mesh_file[5]] = stl_rectangle("bottom", V3(lo.x() - mx, lo.y() - my, lo.z()),
+                                          V3(ext[0] + 2 * mx, 0, 0), V3(0, ext[1] + 2 * my, 0));
+  out.files[mesh_file[4]] = stl_rectangle("top", V3(lo.x() - mx, lo.y() - my, hi.z()),
+                                          V3(0, ext[1] + 2 * my, 0), V3(ext[0] + 2 * mx, 0, 0));
+
+  auto pair_matrix = [&](double pp, double pw) {
+    std::ostringstream s;
+    for (int i = 1; i <= ntypes; ++i)
+      for (int j = 1; j <= ntypes; ++j)
+        s << " " << exact((i == wall_type || j == wall_type) ? pw : pp);
+    return s.str();
+  };
+  // Servo: LIGGGHTS moves a servo mesh at vel_max·kp·(F_target − F)/|F_target|
+  // per unit time; vel_max = cap/dt and kp = gain·F_target/(kn_wall·n_c·cap)
+  // give demcal's per-step move gain·(F_target − F)/(kn_wall·n_c), n_c the
+  // wall's contacts at the start (demcal: the current count).
+  const double cap = 0.02 * plan.r_min;
+  std::ostringstream s;
+  s << mapping_header(c, p, plan, o, "LIGGGHTS");
+  s << "#\n# Checked with LIGGGHTS 3.8 (Debian). Differences from demcal:\n"
+    << "#  - rotational damping: no fix here (zeta_r not applied).\n"
+    << "#  - lateral walls: fix mesh/surface/stress/servo holds the wall FORCE at\n"
+    << "#    sigma3*A0 (A0 the wall's area at the start), not the stress on the current\n"
+    << "#    area; its gain kp = gain*F_target/(kn_wall*n_c*cap) with vel_max = cap/dt\n"
+    << "#    gives demcal's per-step move gain*(F_target - F)/(kn_wall*n_c), n_c the\n"
+    << "#    wall's contacts at the start (demcal uses the current count); the target\n"
+    << "#    is the force on the mesh along +axis: positive on a min wall.\n"
+    << "#  - translational damping per radius class via fix viscous ... scale.\n"
+    << "# Run it with a screen (liggghts 3.8 crashes reading meshes with -screen none).\n"
+    << "#  - the bottom is a fixed mesh (not a primitive plane) so that its force is\n"
+    << "#    known: the axial stress is the mean of top and bottom, as demcal's (the\n"
+    << "#    top alone reads 0.3 % higher at the peak on fcc_4x4x4: the damping drag\n"
+    << "#    on the spheres that move with it).\n"
+    << "# Thermo: p_axial = (p_top + p_bottom)/2, p_lat (mean of the four lateral\n"
+    << "# walls), Pa, on the current areas; sigma1/sigma3 = p_axial/p_lat (no\n"
+    << "# column: both are 0 at the start, before LIGGGHTS computes mesh forces).\n";
+  out.notes.push_back(
+      "LIGGGHTS deck: each lateral force held at sigma3*A0 (the area at the start), servo gain "
+      "from the wall contacts at the start; no rotational damping");
+  if (!o.lateral_servo)
+    out.notes.push_back("LIGGGHTS deck: lateral walls fixed (lateral_servo off)");
+  s << "\natom_style      granular\n"
+    << "atom_modify     map array\n"
+    << "boundary        f f f\n"
+    << "newton          off\n"
+    << "communicate     single vel yes\n"
+    << "units           si\n"
+    << "read_data       " << o.data_name << "\n"
+    << "neighbor        " << num(0.3 * plan.r_min) << " bin\n"
+    << "neigh_modify    delay 0\n\n"
+    << "# type " << wall_type << " is the walls' material\n"
+    << "fix m1 all property/global kn peratomtypepair " << ntypes
+    << pair_matrix(m.particle.kn, m.wall.kn) << "\n"
+    << "fix m2 all property/global kt peratomtypepair " << ntypes
+    << pair_matrix(m.particle.kt, m.wall.kt) << "\n"
+    << "fix m3 all property/global gamman_abs peratomtypepair " << ntypes << pair_matrix(0, 0)
+    << "\n"
+    << "fix m4 all property/global gammat_abs peratomtypepair " << ntypes << pair_matrix(0, 0)
+    << "\n"
+    << "fix m5 all property/global coefficientFriction peratomtypepair " << ntypes
+    << pair_matrix(m.particle.friction, m.wall.friction) << "\n\n"
+    << "pair_style gran model hooke/stiffness tangential history absolute_damping on "
+       "tangential_damping off\n"
+    << "pair_coeff * *\n"
+    << "timestep " << exact(plan.dt) << "\n\n"
+    << "fix mbottom all mesh/surface/stress file " << mesh_file[5] << " type " << wall_type << "\n"
+    << "fix mtop all mesh/surface/stress file " << mesh_file[4] << " type " << wall_type << "\n";
+  const V3 centre = 0.5 * (lo + hi);
+  for (int sd = 0; sd < 4; ++sd) {
+    const int a = sd / 2;
+    const double area = ext[(a + 1) % 3] * ext[(a + 2) % 3];
+    const double target = c.test.lateral_stress * area;
+    const int n_c = std::max(1, plan.wall_contacts[sd]);
+    const double kp = o.lateral_servo ? c.test.servo_gain * target / (m.wall.kn * n_c * cap) : 0.0;
+    V3 com = centre;
+    com[a] = sd % 2 == 0 ? plan.lo[a] : plan.hi[a];
+    if (o.lateral_servo) {
+      s << "fix m" << kWall[sd] << " all mesh/surface/stress/servo file " << mesh_file[sd]
+        << " type " << wall_type << " com " << exact(com.x()) << " " << exact(com.y()) << " "
+        << exact(com.z()) << " ctrlPV force axis " << (a == 0 ? "1 0 0" : "0 1 0") << " target_val "
+        << exact(sd % 2 == 0 ? target : -target) << " vel_max " << exact(cap / plan.dt) << " kp "
+        << exact(kp) << "\n";
+    } else {
+      s << "fix m" << kWall[sd] << " all mesh/surface/stress file " << mesh_file[sd] << " type "
+        << wall_type << "\n";
+    }
+  }
+  s << "fix walls all wall/gran model hooke/stiffness tangential history mesh n_meshes 6 meshes "
+       "mbottom mtop mxmin mxmax mymin mymax absolute_damping on tangential_damping off\n"
+    << "fix movetop all move/mesh mesh mtop linear 0 0 " << exact(-plan.top_speed) << "\n\n"
+    << "fix integrate all nve/sphere\n";
+  if (p.damping_ratio_translation > 0.0) {
+    s << "fix dampt all viscous " << exact(plan.gamma_t[0]);
+    for (int k = 1; k < plan.types; ++k)
+      s << " scale " << k + 1 << " " << exact(plan.gamma_t[k] / plan.gamma_t[0]);
+    s << "\n";
+  }
+  // Wall positions: the servo meshes report theirs ([7..9]); the top moves
+  // at the loading speed.
+  auto wall_pos = [&](int sd) {
+    if (!o.lateral_servo) return exact(sd % 2 == 0 ? plan.lo[sd / 2] : plan.hi[sd / 2]);
+    return std::string("f_m") + kWall[sd] + "[" + std::to_string(7 + sd / 2) + "]";
+  };
+  const int monitor_every =
+      static_cast<int>(std::max<int64_t>(1, plan.steps / std::max(1, c.test.monitor_points)));
+  s << "\nvariable H equal " << exact(ext[2]) << "-" << exact(plan.top_speed) << "*step*dt\n"
+    << "variable Wx equal " << wall_pos(1) << "-(" << wall_pos(0) << ")\n"
+    << "variable Wy equal " << wall_pos(3) << "-(" << wall_pos(2) << ")\n"
+    << "variable p_top equal f_mtop[3]/(v_Wx*v_Wy)\n"
+    << "variable p_bottom equal -f_mbottom[3]/(v_Wx*v_Wy)\n"
+    << "variable p_axial equal (v_p_top+v_p_bottom)/2\n"
+    << "variable p_lat equal (-f_mxmin[1]+f_mxmax[1])/(4*v_Wy*v_H)+(-f_mymin[2]+f_mymax[2])/"
+       "(4*v_Wx*v_H)\n"
+    << "variable strain_zz equal (v_H-" << exact(ext[2]) << ")/" << exact(ext[2]) << "\n"
+    << "# LIGGGHTS 3.8 has no fix vector: the peaks are the largest p_axial and ratio\n"
+    << "# over the thermo rows; -var thermo_every 1 for every step.\n"
+    << "variable thermo_every index " << monitor_every << "\n"
+    << "thermo_style custom step time ke v_strain_zz v_p_axial v_p_lat v_p_top v_p_bottom v_Wx "
+       "v_Wy\n"
+    << "thermo ${thermo_every}\n"
+    << "variable run_steps index " << plan.steps << "\n"
+    << "run ${run_steps}\n";
+  return s.str();
+}
+
+}  // namespace
+
+ExportResult export_3d_decks(const SceneConfig& config, const AlgorithmSpec& params,
+                             const SphereWorld& world, const Export3dOptions& options) {
+  if (config.dimension != 3)
+    throw InputError(config.source, "dimension", "a 3D deck needs \"dimension\": 3");
+  if (world.size() == 0) throw InputError("export", "prototype", "no particles");
+  if (options.format != "lammps" && options.format != "liggghts")
+    throw InputError("--format", "", "must be lammps or liggghts, got \"" + options.format + "\"");
+  const Plan3 plan = make_plan(config, params, world, options.max_types);
+  ExportResult out = result_of(plan);
+  if (options.format == "lammps") {
+    out.files[options.data_name] = lammps_data_file(config, plan, world);
+    out.deck = lammps_deck(config, params, plan, options, out);
+    out.notes.push_back(
+        "lateral servo walls emulated with variables (running sum of demcal's per-step servo "
+        "move): one run command only");
+  } else {
+    out.deck = liggghts_deck(config, params, plan, options, world, out);
+  }
+  return out;
+}
+
+ExportResult export_3d_decks(const SceneConfig& config, const AlgorithmSpec& params,
+                             const TriaxialState& state, const Export3dOptions& options) {
+  return export_3d_decks(config, params, state.world, options);
+}
+
+}  // namespace demcal
