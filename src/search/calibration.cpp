@@ -628,12 +628,14 @@ std::optional<TrialRecord> model_search(Evaluator& evaluator, const SearchSpace&
 /// The cheapest passing trial (ties: the smaller key of the parameters, so
 /// the choice never depends on which thread finished first). With
 /// `judged_by`, a trial must also meet those (possibly tightened)
-/// tolerances.
+/// tolerances. Trials below `steps_floor` are not considered (the
+/// certificate's fallback has moved past them).
 std::optional<TrialRecord> cheapest_passing(const std::vector<TrialRecord>& trials,
-                                            const Tolerances* judged_by = nullptr) {
+                                            const Tolerances* judged_by = nullptr,
+                                            int64_t steps_floor = 0) {
   std::optional<TrialRecord> best;
   for (const auto& t : trials) {
-    if (!t.score.passed || !t.score.complete) continue;
+    if (!t.score.passed || !t.score.complete || t.params.steps < steps_floor) continue;
     if (judged_by) {
       const auto g = constraint_values(t.score, *judged_by);
       if (*std::max_element(g.begin(), g.end()) > 0.0) continue;
@@ -805,9 +807,10 @@ CalibrationSummary calibrate(const TrialRunner& runner, const AlgorithmSpec& bas
   // Certificate; when it fails, tighten the tolerances and search again
   // from the best point, then fall back to doubling Nstep.
   std::optional<TrialRecord> best;
+  int64_t steps_floor = 0;  // raised by the fallback, so that it moves on
   for (int round = 0; round < 6; ++round) {
     // Judged against the current (possibly tightened) tolerances.
-    best = cheapest_passing(evaluator.all(), &tolerances);
+    best = cheapest_passing(evaluator.all(), &tolerances, steps_floor);
     if (!best) break;
     out.certificate = certify(evaluator, *best, options.accuracy, jobs);
     if (evaluator.stopped()) return finish_interrupted();
@@ -836,6 +839,9 @@ CalibrationSummary calibrate(const TrialRunner& runner, const AlgorithmSpec& bas
       p.steps *= 2;
       evaluator.evaluate(p, TrialPhase::certificate);
       tolerances = options.tolerances;  // the doubled run is judged as any other
+      // Without the floor the next round would pick the same failed best
+      // again (it is still the cheapest passing trial) and never move on.
+      steps_floor = rounded_params(p).steps;
     }
   }
 
