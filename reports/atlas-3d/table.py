@@ -2,12 +2,19 @@
 """Markdown table of an atlas3d.py result: each finished run's criteria
 (over the 2D default tolerances) against its peak error.
 
-  reports/atlas-3d/table.py ATLAS.jsonl [--target 0.02]
+  reports/atlas-3d/table.py ATLAS.jsonl [--target 0.02] [--tighten F]
+
+--tighten F: force balance and servo tolerances multiplied by F (a 3D
+tolerance candidate derived from the table).
 """
 import json, sys
 
 TOL = {"force_balance": 0.008, "moment_balance": 1e-5, "servo": 0.0025, "oscillation": 1e-3}
 path = sys.argv[1]
+if "--tighten" in sys.argv:
+    f = float(sys.argv[sys.argv.index("--tighten") + 1])
+    TOL["force_balance"] *= f
+    TOL["servo"] *= f
 target = float(sys.argv[sys.argv.index("--target") + 1]) if "--target" in sys.argv else 0.02
 lines = [json.loads(l) for l in open(path)]
 head, runs = lines[0], lines[1:]
@@ -29,8 +36,8 @@ n_pass = sum(1 for x in rows if x[2])
 bad_pass = [x for x in rows if x[2] and abs(x[3]) > target]
 max_pass = max((abs(x[3]) for x in rows if x[2]), default=float("nan"))
 inacc = [x for x in rows if abs(x[3]) > target]
-print(f"reference peak (Richardson, 2 P(16N) - P(8N)): {ref:.6g} Pa "
-      f"(P(8N) {head['p8']:.6g}, P(16N) {head['p16']:.6g}); calibrated point "
+print(f"reference peak (Richardson, {head['law']}): {ref:.6g} Pa "
+      f"(coarse {head['p_coarse']:.6g}, fine {head['p_fine']:.6g}); calibrated point N = Nstep, "
       f"alpha {head['calibrated'][0]}, zeta_t {head['calibrated'][1]}, zeta_r "
       f"{head['calibrated'][2]}, Nstep {head['calibrated'][3]}\n")
 print(f"{len(rows)} finished runs, {n_pass} pass every criterion; largest |peak error| of a passing "
