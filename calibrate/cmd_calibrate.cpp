@@ -25,6 +25,7 @@
 #include "demcal/scene/biaxial.hpp"
 #include "demcal/scene/packing.hpp"
 #include "demcal/scene/run_output.hpp"
+#include "demcal/scene/triaxial.hpp"
 #include "demcal/scoring/trial.hpp"
 #include "demcal/search/calibration.hpp"
 #include "demcal/search/parallel.hpp"
@@ -70,12 +71,13 @@ std::string reproduce_command(const CalibrateOptions& o, const SceneConfig& conf
 
 /// run.json: what varies between invocations (kept out of params.json).
 nlohmann::json run_record(double wall_time_s, const CalibrationSummary& summary,
-                          const ConsolidatedState& state, int jobs, bool resumed) {
+                          double consolidation_wall_time_s, bool consolidation_from_cache, int jobs,
+                          bool resumed) {
   return {{"schema", "demcal.run/1"},
           {"wall_time_s", wall_time_s},
           {"calibration_wall_time_s", summary.wall_time_s},
-          {"consolidation_wall_time_s", state.wall_time_s},
-          {"consolidation_from_cache", state.from_cache},
+          {"consolidation_wall_time_s", consolidation_wall_time_s},
+          {"consolidation_from_cache", consolidation_from_cache},
           {"jobs", jobs},
           {"resumed", resumed},
           {"trials_run", summary.trials_run},
@@ -180,7 +182,9 @@ std::string write_report(const CalibrateOptions& o, const SceneConfig& config,
 
 int cmd_calibrate(const CalibrateOptions& o) {
   const auto t_start = std::chrono::steady_clock::now();
-  SceneConfig config = load_scene(o.config, o.sets);
+  // 2D scenes as every command loads them; 3D (spheres, triaxial test) too.
+  SceneConfig config = load_config(o.config, o.sets);
+  const bool three_d = config.dimension == 3;
   if (o.max_trials > 0) config.calibration.max_trials = o.max_trials;
   if (o.accuracy > 0) config.calibration.accuracy = o.accuracy;
   if (o.accuracy < 0 || o.accuracy >= 1)
@@ -197,15 +201,37 @@ int cmd_calibrate(const CalibrateOptions& o) {
     require_same_run(dir, key);          // before the consolidation's seconds
   }
 
-  Assembly assembly = make_assembly(config);
+  // The consolidated REV: disks (biaxial, cached) or spheres (triaxial).
+  std::optional<ConsolidatedState> state2;
+  std::optional<TriaxialState> state3;
+  int64_t n_rev = 0;
+  int64_t consolidation_steps = 0;
+  double consolidation_wall_time_s = 0.0;
+  bool from_cache = false;
+  if (three_d) {
+    const SphereAssembly assembly = make_sphere_assembly(config);
+    if (!o.quiet)
+      std::cerr << "demcal: consolidating " << assembly.size() << " spheres of " << config.name
+                << " to sigma3 = " << config.test.lateral_stress << " Pa (3D, triaxial)\n";
+    state3.emplace(consolidate_triaxial(config, assembly));
+    n_rev = state3->world.size();
+    consolidation_steps = state3->steps;
+    consolidation_wall_time_s = state3->wall_time_s;
+  } else {
+    Assembly assembly = make_assembly(config);
+    if (!o.quiet)
+      std::cerr << "demcal: consolidating " << assembly.size() << " particles of " << config.name
+                << " to sigma3 = " << config.test.lateral_stress << " Pa\n";
+    state2.emplace(consolidate(config, assembly));
+    n_rev = state2->world.size();
+    consolidation_steps = state2->steps;
+    consolidation_wall_time_s = state2->wall_time_s;
+    from_cache = state2->from_cache;
+  }
   if (!o.quiet)
-    std::cerr << "demcal: consolidating " << assembly.size() << " particles of " << config.name
-              << " to sigma3 = " << config.test.lateral_stress << " Pa\n";
-  const ConsolidatedState state = consolidate(config, assembly);
-  if (!o.quiet)
-    std::cerr << "demcal: consolidated in " << state.steps << " steps ("
-              << (state.from_cache ? "read from the consolidation cache"
-                                   : std::to_string(state.wall_time_s) + " s")
+    std::cerr << "demcal: consolidated in " << consolidation_steps << " steps ("
+              << (from_cache ? "read from the consolidation cache"
+                             : std::to_string(consolidation_wall_time_s) + " s")
               << ")\n";
 
   // From here on a signal stops cleanly (consolidation writes nothing, so
@@ -238,7 +264,8 @@ int cmd_calibrate(const CalibrateOptions& o) {
   options.resume = o.resume;
   if (!o.quiet) options.progress = [](const std::string& line) { std::cerr << line << "\n"; };
   options.stop = &stop.flag();
-  const CalibrationSummary summary = calibrate(config, state, options);
+  const CalibrationSummary summary =
+      three_d ? calibrate(config, *state3, options) : calibrate(config, *state2, options);
   const auto interrupted = [&](const std::string& what) {
     std::cerr << "demcal: interrupted" << what << "; " << summary.trials.size()
               << " finished trials are in " << trials_path << ". Continue with:\n  "
@@ -247,8 +274,8 @@ int cmd_calibrate(const CalibrateOptions& o) {
   };
   if (summary.interrupted) return interrupted("");
 
-  const int64_t n_rev = state.world.size();
-  nlohmann::json params = params_file(config, state, options, summary);
+  nlohmann::json params = three_d ? params_file(config, *state3, options, summary)
+                                  : params_file(config, *state2, options, summary);
 
   const bool have_best = summary.best_trial.score.particle_steps > 0.0;
   const int jobs = resolve_jobs(o.jobs);
@@ -262,15 +289,18 @@ int cmd_calibrate(const CalibrateOptions& o) {
   std::optional<BaselineResult> baseline;
   std::optional<ReferenceEvidence> reference;
   std::string evidence_lines;  // evidence.jsonl, written with params.json
-  if (o.evidence && have_best) {
+  if (o.evidence && have_best && three_d)
+    say("--evidence: the paper-recipe baseline and the converged reference are 2D only for now "
+        "(issue #18); skipped for this 3D scene");
+  if (o.evidence && have_best && !three_d) {
     say("evidence: paper-recipe baseline and converged reference (8x, 16x Nstep = " +
         std::to_string(16 * summary.best.steps) + ")");
     auto run_baseline = [&] {
-      baseline =
-          paper_recipe_baseline(config, state, options.tolerances, kStartStepsPerParticle * n_rev);
+      baseline = paper_recipe_baseline(config, *state2, options.tolerances,
+                                       kStartStepsPerParticle * n_rev);
     };
     auto run_reference = [&] {
-      reference = run_refined_reference(config, state, summary.best, options.tolerances, 1);
+      reference = run_refined_reference(config, *state2, summary.best, options.tolerances, 1);
     };
     run_parallel({run_baseline, run_reference}, jobs);
     const CalibrationEvidence evidence{*reference, *baseline, kStartStepsPerParticle * n_rev};
@@ -283,7 +313,10 @@ int cmd_calibrate(const CalibrateOptions& o) {
   // What varies between invocations stays out of params.json (run.json).
   // Written with params.json, and again after the report with the total.
   const auto run_json = [&] {
-    return run_record(seconds_since(t_start), summary, state, jobs, o.resume).dump(2) + "\n";
+    return run_record(seconds_since(t_start), summary, consolidation_wall_time_s, from_cache, jobs,
+                      o.resume)
+               .dump(2) +
+           "\n";
   };
   {
     // params.json, run.json and evidence.jsonl of one calibration replace
@@ -304,13 +337,20 @@ int cmd_calibrate(const CalibrateOptions& o) {
         " before the report (params.json and run.json are written; --resume reuses every trial "
         "and writes the report)");
 
-  const std::string report_note = write_report(o, config, state, dir, params, summary, options,
-                                               std::move(baseline), std::move(reference), jobs);
+  std::string report_note;
+  if (three_d) {
+    // The 3D report (panels, picture) is not written yet: said, not crashed.
+    std::cerr << "demcal: note: no report for 3D scenes yet (issue #18, report part); params.json "
+                 "and trials.jsonl hold the result\n";
+  } else {
+    report_note = write_report(o, config, *state2, dir, params, summary, options,
+                               std::move(baseline), std::move(reference), jobs);
+  }
 
   write_run_json();
   std::cout << summary.BriefReport() << "  wrote " << dir << "/params.json, " << dir
             << "/run.json, " << dir << "/trials.jsonl" << report_note
-            << (o.evidence && have_best ? ", " + dir + "/evidence.jsonl" : "") << "\n";
+            << (o.evidence && have_best && !three_d ? ", " + dir + "/evidence.jsonl" : "") << "\n";
   if (stop.stopped()) {
     std::cerr << "demcal: interrupted after the last run; every output was written\n";
     return stop.exit_status();

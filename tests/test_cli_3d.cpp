@@ -222,7 +222,6 @@ TEST_F(Cli3D, MismatchesAndUnsupportedCommandsAreBadInput) {
   const Case cases[] = {
       {{"run", triaxial_2d}, "test.type"},
       {{"check", hex_3d}, "assembly.type"},
-      {{"calibrate", fcc, "-o", (dir_ / "work" / "c").string()}, "dimension"},
       {{"sweep", fcc}, "dimension"},
   };
   for (const Case& k : cases) {

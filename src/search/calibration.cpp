@@ -235,9 +235,8 @@ namespace {
 
 class Evaluator {
  public:
-  Evaluator(const SceneConfig& config, const ConsolidatedState& state,
-            const CalibrationOptions& options)
-      : config_(config), state_(state), options_(options), t0_(std::chrono::steady_clock::now()) {}
+  Evaluator(const TrialRunner& runner, const CalibrationOptions& options)
+      : runner_(runner), options_(options), t0_(std::chrono::steady_clock::now()) {}
 
   void preload(const TrialRecord& r) {
     std::promise<TrialRecord> p;
@@ -277,8 +276,12 @@ class Evaluator {
     if (!mine) return future.get();
     TrialRecord r;
     try {
-      r = run_trial(config_, state_, params, options_.tolerances, options_.early_stop && early_stop,
-                    options_.early_stop_factor, nullptr, options_.stop);
+      TrialRun run = runner_.run(params, options_.tolerances, options_.early_stop && early_stop,
+                                 options_.early_stop_factor, options_.stop);
+      r.params = params;
+      r.score = std::move(run.score);
+      r.steps_run = run.steps_run;
+      r.wall_time_s = run.wall_time_s;
     } catch (...) {
       promise.set_exception(std::current_exception());
       throw;
@@ -347,8 +350,7 @@ class Evaluator {
     return r;
   }
 
-  const SceneConfig& config_;
-  const ConsolidatedState& state_;
+  const TrialRunner& runner_;
   const CalibrationOptions& options_;
   std::chrono::steady_clock::time_point t0_;
   std::mutex mutex_;
@@ -626,12 +628,14 @@ std::optional<TrialRecord> model_search(Evaluator& evaluator, const SearchSpace&
 /// The cheapest passing trial (ties: the smaller key of the parameters, so
 /// the choice never depends on which thread finished first). With
 /// `judged_by`, a trial must also meet those (possibly tightened)
-/// tolerances.
+/// tolerances. Trials below `steps_floor` are not considered (the
+/// certificate's fallback has moved past them).
 std::optional<TrialRecord> cheapest_passing(const std::vector<TrialRecord>& trials,
-                                            const Tolerances* judged_by = nullptr) {
+                                            const Tolerances* judged_by = nullptr,
+                                            int64_t steps_floor = 0) {
   std::optional<TrialRecord> best;
   for (const auto& t : trials) {
-    if (!t.score.passed || !t.score.complete) continue;
+    if (!t.score.passed || !t.score.complete || t.params.steps < steps_floor) continue;
     if (judged_by) {
       const auto g = constraint_values(t.score, *judged_by);
       if (*std::max_element(g.begin(), g.end()) > 0.0) continue;
@@ -708,19 +712,29 @@ std::vector<TrialRecord> read_trials_text(std::string_view text, const std::stri
 
 CalibrationSummary calibrate(const SceneConfig& config, const ConsolidatedState& state,
                              const CalibrationOptions& options) {
+  return calibrate(BiaxialRunner(config, state), config.algorithm, options);
+}
+
+CalibrationSummary calibrate(const SceneConfig& config, const TriaxialState& state,
+                             const CalibrationOptions& options) {
+  return calibrate(TriaxialRunner(config, state), config.algorithm, options);
+}
+
+CalibrationSummary calibrate(const TrialRunner& runner, const AlgorithmSpec& base,
+                             const CalibrationOptions& options) {
   const auto t0 = std::chrono::steady_clock::now();
   CalibrationSummary out;
   out.strategy = options.strategy;
+  out.dimension = runner.dimension();
   const int jobs = resolve_jobs(options.jobs);
-  const int n = state.world.size();
+  const int64_t n = runner.particles();
 
-  Evaluator evaluator(config, state, options);
+  Evaluator evaluator(runner, options);
   if (options.resume && !options.trials_path.empty())
     preload_trials(evaluator, options.trials_path);
 
   // Bounds. The stable step comes from the consolidated contact network.
-  AlgorithmSpec base = config.algorithm;
-  out.dt_ratio_stable = estimated_stable_dt_ratio(state, base);
+  out.dt_ratio_stable = runner.stable_dt_ratio(base);
   SearchSpace space;
   space.base = base;
   const int64_t steps_min = options.steps_min > 0 ? options.steps_min : 50LL * n;
@@ -793,9 +807,10 @@ CalibrationSummary calibrate(const SceneConfig& config, const ConsolidatedState&
   // Certificate; when it fails, tighten the tolerances and search again
   // from the best point, then fall back to doubling Nstep.
   std::optional<TrialRecord> best;
+  int64_t steps_floor = 0;  // raised by the fallback, so that it moves on
   for (int round = 0; round < 6; ++round) {
     // Judged against the current (possibly tightened) tolerances.
-    best = cheapest_passing(evaluator.all(), &tolerances);
+    best = cheapest_passing(evaluator.all(), &tolerances, steps_floor);
     if (!best) break;
     out.certificate = certify(evaluator, *best, options.accuracy, jobs);
     if (evaluator.stopped()) return finish_interrupted();
@@ -824,6 +839,9 @@ CalibrationSummary calibrate(const SceneConfig& config, const ConsolidatedState&
       p.steps *= 2;
       evaluator.evaluate(p, TrialPhase::certificate);
       tolerances = options.tolerances;  // the doubled run is judged as any other
+      // Without the floor the next round would pick the same failed best
+      // again (it is still the cheapest passing trial) and never move on.
+      steps_floor = rounded_params(p).steps;
     }
   }
 

@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "demcal/scene/triaxial.hpp"
 #include "demcal/scoring/trial.hpp"
 #include "demcal/upscaling/upscaling.hpp"
 
@@ -74,6 +75,66 @@ nlohmann::json params_file(const SceneConfig& config, const ConsolidatedState& s
       {"config_sha256", sha256_hex(config.text)},
       {"version", DEMCAL_VERSION}};
   if (auto a = analytical_peak_stress(config)) params["analytical_peak_stress_yy"] = *a;
+  return params;
+}
+
+nlohmann::json params_file(const SceneConfig& config, const TriaxialState& state,
+                           const CalibrationOptions& options, const CalibrationSummary& summary) {
+  const int64_t n_rev = state.world.size();
+  // The sphere scales at the calibrated mass scaling, from the kernel's
+  // masses (m = ρ(4/3)πr³, I = (2/5)mr²); the radius and mean-mass entries
+  // that SphereWorld::reference_scales() leaves out are filled here.
+  SphereWorld world = state.world;
+  world.set_integration(integration_for(world, summary.best));
+  ParticleScales scales = world.reference_scales();
+  scales.particles = n_rev;
+  const auto radii = world.radius();
+  double sum_r = 0.0, sum_m = 0.0;
+  scales.radius_min = radii.empty() ? 0.0 : radii[0];
+  for (double r : radii) {
+    sum_r += r;
+    sum_m += sphere_mass(config.material.density * summary.best.mass_scaling, r);
+    scales.radius_min = std::min(scales.radius_min, r);
+    scales.radius_max = std::max(scales.radius_max, r);
+  }
+  if (n_rev > 0) {
+    scales.radius_mean = sum_r / static_cast<double>(n_rev);
+    scales.mass_mean = sum_m / static_cast<double>(n_rev);
+  }
+  nlohmann::json rev = param_block(summary.best, scales);
+  // No 3D prototype yet (`demcal upscale` on spheres is issue #18's
+  // upscaling part): the prototype block is the REV's own.
+  nlohmann::json prototype = rev;
+  prototype["source"] = {{"kind", "rev"},
+                         {"description", "the REV itself (" + std::to_string(n_rev) +
+                                             " spheres); 3D prototypes are not upscaled yet"}};
+  const Tolerances& t = options.tolerances;
+  nlohmann::json params{{"schema", kParamsSchema},
+                        {"scene", config.name},
+                        {"dimension", 3},
+                        {"test", "triaxial"},
+                        {"success", summary.success},
+                        {"message", summary.message},
+                        {"rev", rev},
+                        {"prototype", prototype},
+                        {"upscaling", upscaling_block(n_rev, n_rev)},
+                        {"config", to_json(config)},
+                        {"criteria", to_json(summary.best_trial.score.criteria)},
+                        {"tolerances", to_json(t)},
+                        {"accuracy", options.accuracy},
+                        {"certificate", to_json(summary.certificate)},
+                        {"dt_ratio_stable", summary.dt_ratio_stable},
+                        {"strategy", to_string(summary.strategy)},
+                        {"trials", static_cast<int>(summary.trials.size())},
+                        {"particle_steps_run", particle_steps_run(summary.trials, n_rev)},
+                        {"seed", config.calibration.seed},
+                        {"config_sha256", sha256_hex(config.text)},
+                        {"version", DEMCAL_VERSION}};
+  params["axial_component"] =
+      "criteria.peak_stress_yy and certificate.peak_stress_yy* hold the axial b_zz (the triaxial "
+      "test's axis is z)";
+  if (auto a = analytical_peak_ratio_3d(config))
+    params["analytical_peak_stress_yy"] = -*a * config.test.lateral_stress;
   return params;
 }
 

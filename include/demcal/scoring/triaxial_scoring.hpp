@@ -1,8 +1,10 @@
-// Scoring a triaxial (3D) run: the criteria of the three coordinate planes
-// and summary.json. The tolerances are the 2D ones until issue #18
-// validates 3D tolerances; the verdict says so (kTriaxialVerdictNote).
+// Scoring a triaxial (3D) run: the criteria of the three coordinate planes,
+// the Score the calibration works on, its early stop, and summary.json.
+// The tolerances are the 2D ones; reports/atlas-3d.md measures whether they
+// hold in 3D.
 #pragma once
 
+#include <array>
 #include <nlohmann/json.hpp>
 #include <vector>
 
@@ -17,13 +19,43 @@ namespace demcal {
 /// biaxial measure: axial component against its own scale, lateral against
 /// σ3), and for the horizontal pair the symmetric xy shear gap (up to the
 /// axial peak, as every gap), its noise, and the xy moment balance.
-/// `combined` holds the largest of each, for the 2D tolerances.
+/// The servo error is measured on each of the four lateral walls on its own
+/// (servo_walls, x min, x max, y min, y max: the 2D measure, max |trend| of
+/// (p − σ3)/σ3, per wall); the planes' own servo is that of the mean of
+/// their two walls. `combined` holds the largest of each (servo: of the four
+/// walls), for the tolerances.
 struct TriaxialCriteria {
   Criteria xz, yz, xy;
+  std::array<double, 4> servo_walls{};
   Criteria combined;
 };
 
+/// The criteria of a monitored series; the peak is the monitored one.
 TriaxialCriteria compute_triaxial_criteria(const std::vector<TriaxialPoint>& series, double s3);
+/// The same with the peak tracked at every step (run.peak_stress_zz, as the
+/// 2D compute_criteria(LoadingResult) takes run.peak_stress_yy), when the
+/// run has one.
+TriaxialCriteria compute_triaxial_criteria(const TriaxialResult& run, double s3);
+
+/// A triaxial run scored as score_run() scores a biaxial one: the combined
+/// criteria (peak_stress_yy holds the axial peak b_zz), the verdict against
+/// `tolerances`, completeness, cost and the diagnosis.
+Score score_triaxial_run(const TriaxialResult& run, double s3, const Tolerances& tolerances);
+/// The algorithmic parameters a triaxial run was made with.
+AlgorithmSpec run_parameters(const TriaxialResult& run);
+
+/// The early stop of a triaxial trial: EarlyFailure (scoring.hpp) on each
+/// of the three planes, fed the same points compute_triaxial_criteria()
+/// scores; failed once any plane has certainly failed (the combined
+/// criteria are the planes' maxima).
+class TriaxialEarlyFailure {
+ public:
+  TriaxialEarlyFailure(const Tolerances& tolerances, double factor, int monitor_points, double s3);
+  bool add(const TriaxialPoint& point);
+
+ private:
+  std::array<EarlyFailure, 3> planes_;
+};
 
 /// What `demcal run` says of a 3D verdict: measured against the 2D tolerances.
 extern const char* const kTriaxialVerdictNote;

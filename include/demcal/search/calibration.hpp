@@ -19,6 +19,7 @@
 #include "demcal/scene/biaxial.hpp"
 #include "demcal/scene/config.hpp"
 #include "demcal/scoring/scoring.hpp"
+#include "demcal/search/trial_runner.hpp"
 
 namespace demcal {
 
@@ -148,6 +149,7 @@ struct CalibrationSummary {
   int trials_run = 0, trials_reused = 0;
   double wall_time_s = 0.0;
   Strategy strategy = CalibrationOptions{}.strategy;  ///< options.strategy
+  int dimension = 2;  ///< of the scene calibrated (TrialRunner::dimension())
 
   std::string BriefReport() const;
   std::string FullReport() const;
@@ -163,8 +165,17 @@ std::vector<TrialRecord> read_trials_text(std::string_view text, const std::stri
                                           size_t* whole_bytes = nullptr);
 
 /// Calibrate on a consolidated REV. Deterministic for a given config,
-/// options and seed, whatever `jobs` is.
+/// options and seed, whatever `jobs` is. The search sees the scene only
+/// through `runner` (trial_runner.hpp); `base` gives what is not searched
+/// (mass scaling, lock_rotation).
+CalibrationSummary calibrate(const TrialRunner& runner, const AlgorithmSpec& base,
+                             const CalibrationOptions& options);
+/// The biaxial (2D) REV: calibrate(BiaxialRunner(config, state), config.algorithm, options).
 CalibrationSummary calibrate(const SceneConfig& config, const ConsolidatedState& state,
+                             const CalibrationOptions& options);
+/// The triaxial (3D) REV: the same search and certificate on spheres; the
+/// certificate's peak is the axial b_zz.
+CalibrationSummary calibrate(const SceneConfig& config, const TriaxialState& state,
                              const CalibrationOptions& options);
 
 /// Nstep per particle of the search's first start and of the paper-recipe

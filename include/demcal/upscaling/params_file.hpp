@@ -12,6 +12,7 @@
 
 #include "demcal/scene/biaxial.hpp"
 #include "demcal/scene/config.hpp"
+#include "demcal/scene/triaxial.hpp"
 #include "demcal/search/calibration.hpp"
 #include "demcal/search/evidence.hpp"
 
@@ -26,6 +27,11 @@ double particle_steps_run(const std::vector<TrialRecord>& trials, int64_t partic
 /// block and the upscaling law, the criteria of the best trial, the
 /// certificate, and what reproduces it (config, seed, hash, version).
 nlohmann::json params_file(const SceneConfig& config, const ConsolidatedState& state,
+                           const CalibrationOptions& options, const CalibrationSummary& summary);
+/// The same for a triaxial (3D) calibration on the consolidated spheres
+/// `state`: "dimension": 3, the REV block from the sphere scales; the
+/// prototype block is the REV's own until 3D upscaling exists.
+nlohmann::json params_file(const SceneConfig& config, const TriaxialState& state,
                            const CalibrationOptions& options, const CalibrationSummary& summary);
 /// The schema params_file() writes and read_params_file() accepts.
 inline constexpr const char* kParamsSchema = "demcal.params/1";

@@ -1,0 +1,95 @@
+// Calibration in 3D (issue #18): the search and its certificate on a
+// triaxial (sphere) REV through the TrialRunner interface; the calibrated
+// peak checked against a run 8x longer; `demcal calibrate` on a 3D config
+// and its --resume.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "demcal/scene/config.hpp"
+#include "demcal/scene/triaxial.hpp"
+#include "demcal/search/calibration.hpp"
+#include "demcal/search/trial_runner.hpp"
+#include "support/files.hpp"
+#include "support/process.hpp"
+
+namespace fs = std::filesystem;
+using namespace demcal;
+
+namespace {
+
+// FCC 2×2×2 (32 spheres), the material and test of configs/fcc_4x4x4.json.
+const char* const kFcc2 = R"({
+  "name": "fcc_2x2x2", "dimension": 3,
+  "material": {"density": 2650, "kn": 1e8, "kt": 5e7, "friction": 0.3,
+               "wall": {"kn": 1e8, "kt": 5e7, "friction": 0.0}},
+  "assembly": {"type": "fcc", "cells_x": 2, "cells_y": 2, "cells_z": 2, "radius": 5e-4},
+  "test": {"type": "triaxial", "lateral_stress": 1e5, "vertical_strain": 1e-5,
+           "monitor_points": 200},
+  "calibration": {"accuracy": 0.02, "max_trials": 40, "seed": 1}})";
+
+double relative(double a, double b) { return std::abs(a - b) / std::abs(b); }
+
+}  // namespace
+
+TEST(Calibration3D, SmallFccIsCertifiedAndMatchesARunEightTimesLonger) {
+  const SceneConfig config = parse_config_text(kFcc2, "fcc_2x2x2");
+  const TriaxialState state = consolidate_triaxial(config, make_sphere_assembly(config));
+  CalibrationOptions options = CalibrationOptions::from(config.calibration);
+  options.jobs = 2;
+  const CalibrationSummary s = calibrate(config, state, options);
+  ASSERT_TRUE(s.success) << s.FullReport();
+  EXPECT_EQ(s.dimension, 3);
+  // The search never proposed a step beyond the 3D stable-step estimate.
+  const TriaxialRunner runner(config, state);
+  EXPECT_DOUBLE_EQ(s.dt_ratio_stable, runner.stable_dt_ratio(config.algorithm));
+  for (const TrialRecord& t : s.trials) EXPECT_LE(t.params.dt_ratio, s.dt_ratio_stable);
+  EXPECT_TRUE(s.best_trial.score.passed);
+  EXPECT_LE(s.certificate.richardson_error, options.accuracy);
+  EXPECT_EQ(s.certificate.peak, s.best_trial.score.criteria.peak_stress_yy);
+  EXPECT_LT(s.certificate.peak, -config.test.lateral_stress);  // compressive, above σ3
+
+  // The claim the certificate makes: the calibrated peak is within the
+  // accuracy target of the converged one. Against Nstep ×8 (1/Nstep decay:
+  // P(8N) is 7/8 of the way from P(N) to the limit).
+  AlgorithmSpec longer = s.best;
+  longer.steps *= 8;
+  const TrialRun fine = runner.run(longer, options.tolerances, false, 3.0, nullptr);
+  ASSERT_TRUE(fine.score.complete);
+  EXPECT_LE(
+      relative(s.best_trial.score.criteria.peak_stress_yy, fine.score.criteria.peak_stress_yy),
+      options.accuracy)
+      << s.FullReport();
+}
+
+TEST(Calibration3D, CommandWritesParamsWithTheDimensionAndResumeReusesEveryTrial) {
+  test::TempDir dir("calib3d");
+  const std::string config = test::write_text(dir / "fcc_2x2x2.json", kFcc2);
+  const fs::path out = dir / "out";
+  const test::RunResult first =
+      test::run_demcal({"calibrate", config, "-q", "-o", out.string(), "--jobs", "2"}, dir.path());
+  ASSERT_EQ(first.status, 0) << first.err;
+  EXPECT_NE(first.err.find("no report for 3D"), std::string::npos) << first.err;
+  const nlohmann::json params = test::read_json(out / "params.json");
+  EXPECT_EQ(params.at("dimension"), 3);
+  EXPECT_EQ(params.at("schema"), "demcal.params/1");
+  EXPECT_TRUE(params.at("success").get<bool>());
+  EXPECT_TRUE(params.at("certificate").at("passed").get<bool>());
+  EXPECT_GT(params.at("rev").at("dt").get<double>(), 0.0);
+  EXPECT_EQ(params.at("rev").at("particles"), 32);
+  EXPECT_FALSE(fs::exists(out / "report.html"));
+  const std::string bytes = test::read_text(out / "params.json");
+  const size_t trials = test::lines_of(test::read_text(out / "trials.jsonl")).size();
+  ASSERT_GT(trials, 0u);
+
+  const test::RunResult again = test::run_demcal(
+      {"calibrate", config, "-o", out.string(), "--jobs", "1", "--resume"}, dir.path());
+  ASSERT_EQ(again.status, 0) << again.err;
+  EXPECT_NE(again.out.find("0 trials run, " + std::to_string(trials) + " reused"),
+            std::string::npos)
+      << again.out;
+  EXPECT_EQ(test::read_text(out / "params.json"), bytes);  // --jobs and --resume change nothing
+}
