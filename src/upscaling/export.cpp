@@ -390,16 +390,10 @@ std::string lammps_data_file(const SceneConfig& c, const Assembly& a, const Plan
   return d.str();
 }
 
-ExportResult lammps(const SceneConfig& c, const AlgorithmSpec& p, const Assembly& a,
-                    const ExportOptions& o) {
-  const Plan plan = make_plan(c, p, a, o.max_types);
-  const auto& m = c.material;
-  ExportResult out = result_of(plan);
-
-  out.files[o.data_name] = lammps_data_file(c, a, plan);
-
+/// What this LAMMPS cannot do as demcal does, in the deck's header; the
+/// same facts go to `out.notes` (stderr at export).
+std::string lammps_limitations(const AlgorithmSpec& p, const Plan& plan, ExportResult& out) {
   std::ostringstream s;
-  s << mapping_header(c, p, plan, o, "LAMMPS");
   s << "#\n# What this LAMMPS cannot do as demcal does, and what the deck does instead:\n"
     << "#  - rotational damping: this release (29 Sep 2021) has no rotational viscous fix;\n";
   if (p.damping_ratio_rotation > 0.0) {
@@ -434,7 +428,13 @@ ExportResult lammps(const SceneConfig& c, const AlgorithmSpec& p, const Assembly
   out.notes.push_back(
       "lateral servo walls emulated with variables (running sum of demcal's per-step servo "
       "move): one run command only");
+  return s.str();
+}
 
+/// The block a user edits; every other number of the deck derives from it.
+std::string lammps_parameters(const SceneConfig& c, const Assembly& a, const Plan& plan) {
+  const auto& m = c.material;
+  std::ostringstream s;
   s << "\n# --- parameters (edit here) -------------------------------------------------\n"
     << "# Everything below the block is derived from it: editing dt or nstep keeps the\n"
     << "# strain, the loading rate per step count, the servo cap and the monitoring\n"
@@ -480,7 +480,13 @@ ExportResult lammps(const SceneConfig& c, const AlgorithmSpec& p, const Assembly
        "$(floor((1+v_nstep/v_monitor_points+abs(1-v_nstep/v_monitor_points))/2))\n"
     << "variable band_v    equal $(v_strain*v_H0+6*v_r_max)      # m, see the walls\n"
     << "variable band_h    equal $(2*v_strain*(v_xr0-v_xl0)+6*v_r_max)\n";
+  return s.str();
+}
 
+/// Units, particles (data file or restart), masses, contact law, integrator.
+std::string lammps_system(const SceneConfig& c, const Plan& plan, const ExportOptions& o,
+                          ExportResult& out) {
+  const auto& m = c.material;
   double gamma_n = 0.0;
   if (m.contact_damping_ratio > 0.0) {
     // demcal: ratio·2·sqrt(kn·m_eff); LAMMPS: m_eff·gamma_n → gamma_n =
@@ -489,6 +495,7 @@ ExportResult lammps(const SceneConfig& c, const AlgorithmSpec& p, const Assembly
         m.contact_damping_ratio * 2.0 * std::sqrt(m.particle.kn / (0.5 * plan.scales.mass_mean));
     out.notes.push_back("contact damping mapped at the mean particle mass");
   }
+  std::ostringstream s;
   s << "\n# --- system ------------------------------------------------------------------\n"
     << "units           si\n"
     << "dimension       2\n"
@@ -508,9 +515,12 @@ ExportResult lammps(const SceneConfig& c, const AlgorithmSpec& p, const Assembly
     << "neigh_modify    delay 0 every 1 check yes\n"
     << "timestep        ${dt}\n\n"
     << "fix             integrate all nve/sphere disc\n\n";
+  return s.str();
+}
 
-  s << kLammpsWalls << lammps_servo();
-
+/// Global damping per radius class (fix viscous ... scale), then enforce2d.
+std::string lammps_damping(const AlgorithmSpec& p, const Plan& plan) {
+  std::ostringstream s;
   s << "# --- global damping ----------------------------------------------------------\n";
   if (p.damping_ratio_translation > 0.0) {
     s << "# gamma per class, N*s/m:";
@@ -531,18 +541,32 @@ ExportResult lammps(const SceneConfig& c, const AlgorithmSpec& p, const Assembly
     s << "\n";
   }
   s << "fix             twod all enforce2d\n\n";
-  s << lammps_series_block(c, p, plan);
-  s << "# --- output and run ----------------------------------------------------------\n"
-    << "# p_left, p_right: lateral wall pressures (servo target sigma3); p_top: axial\n"
-    << "variable        epsyy equal (v_H-v_H0)/v_H0\n"
-    << "thermo_style    custom step dt time v_epsyy v_pt v_pl v_pr v_W v_H ke\n"
-    << "thermo_modify   norm no\n"
-    << "thermo          ${monitor_every}\n"
-    << "run             ${run_steps} upto\n"
-    << "write_restart   ${restart_out}\n"
-    << "print           \"-var continued 1 -var restart_from ${restart_out} -var xl_now ${xl} -var "
-       "xr_now ${xr}\" "
-       "file ${restart_out}.args screen no\n";
+  return s.str();
+}
+
+/// Thermo, the run up to run_steps, and the restart a split run continues.
+constexpr const char kLammpsRun[] =
+    "# --- output and run ----------------------------------------------------------\n"
+    "# p_left, p_right: lateral wall pressures (servo target sigma3); p_top: axial\n"
+    "variable        epsyy equal (v_H-v_H0)/v_H0\n"
+    "thermo_style    custom step dt time v_epsyy v_pt v_pl v_pr v_W v_H ke\n"
+    "thermo_modify   norm no\n"
+    "thermo          ${monitor_every}\n"
+    "run             ${run_steps} upto\n"
+    "write_restart   ${restart_out}\n"
+    "print           \"-var continued 1 -var restart_from ${restart_out} -var xl_now ${xl} -var "
+    "xr_now ${xr}\" "
+    "file ${restart_out}.args screen no\n";
+
+ExportResult lammps(const SceneConfig& c, const AlgorithmSpec& p, const Assembly& a,
+                    const ExportOptions& o) {
+  const Plan plan = make_plan(c, p, a, o.max_types);
+  ExportResult out = result_of(plan);
+  out.files[o.data_name] = lammps_data_file(c, a, plan);
+  std::ostringstream s;
+  s << mapping_header(c, p, plan, o, "LAMMPS") << lammps_limitations(p, plan, out)
+    << lammps_parameters(c, a, plan) << lammps_system(c, plan, o, out) << kLammpsWalls
+    << lammps_servo() << lammps_damping(p, plan) << lammps_series_block(c, p, plan) << kLammpsRun;
   out.deck = s.str();
   return out;
 }
