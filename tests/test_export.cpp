@@ -14,6 +14,7 @@
 
 #include "demcal/scene/biaxial.hpp"
 #include "demcal/scene/packing.hpp"
+#include "demcal/scoring/external_series.hpp"
 #include "demcal/upscaling/export.hpp"
 #include "demcal/upscaling/rev.hpp"
 #include "support/files.hpp"
@@ -294,6 +295,70 @@ TEST(Export, LammpsReproducesDemcalsPeak) {
       << "LAMMPS " << lammps_peak << " Pa, demcal " << demcal_peak << " Pa";
   // The servo held σ3 in LAMMPS too.
   EXPECT_NEAR(rows.back()[5] / c.test.lateral_stress, 1.0, 0.01);
+}
+
+/// The peak σ_yy of a deck's series.csv (tension positive: the most negative).
+double series_peak(const fs::path& dir, const SceneConfig& c) {
+  const ExternalSeries s = parse_external_series(test::read_text(dir / "series.csv"), "series.csv",
+                                                 c.test.lateral_stress);
+  double peak = 0.0;
+  for (const auto& p : s.run.series) peak = std::min(peak, p.sigma(1, 1));
+  return peak;
+}
+
+TEST(Export, LammpsDeckConsolidatesItselfToDemcalsPeak) {
+  // --consolidate-in deck: the deck takes the generated hex 5x5 lattice to
+  // isotropic sigma3 itself (stage 1), then loads it. A hexagonal lattice
+  // has one consolidated packing (the lattice compressed isotropically) and
+  // its peak is proportional to sigma3 (failure at a fixed sigma1/sigma3),
+  // and each consolidation leaves every wall within consolidation_tolerance
+  // of sigma3: the peak after the deck's consolidation is that after
+  // demcal's within 2 * consolidation_tolerance (both loaded in LAMMPS, so
+  // the engines' differences cancel). Under mpirun -np 2 the same run: the
+  // peak within 1e-9 (the order of the MPI sums).
+  const std::string lmp = test::find_on_path("lmp");
+  if (lmp.empty()) GTEST_SKIP() << "LAMMPS (lmp) is not installed: the exported deck is not run";
+  SceneConfig c = default_config();
+  c.assembly.columns = c.assembly.rows = 5;
+  AlgorithmSpec p = params();
+  p.damping_ratio_rotation = 0.0;
+  p.steps = 8000;  // a faster loading, the same in both decks: seconds per run
+  const Assembly generated = make_assembly(c);
+  ExportOptions o;
+  o.data_name = "hex5.data";
+  const ExportResult by_demcal =
+      export_deck(c, p, assembly_of(consolidate(c, generated, "").world), o);
+  o.consolidate_in_deck = true;
+  const ExportResult in_deck = export_deck(c, p, generated, o);
+  EXPECT_NE(in_deck.deck.find("stage 1: consolidation"), std::string::npos);
+  EXPECT_EQ(by_demcal.deck.find("stage 1: consolidation"), std::string::npos);
+
+  const test::TempDir d1("lammps_cons_demcal"), d2("lammps_cons_deck"), d3("lammps_cons_np2");
+  const test::DeckRun r1 = test::run_deck(lmp, d1.path(), by_demcal.deck, by_demcal.files);
+  ASSERT_EQ(r1.status, 0) << r1.log;
+  const test::DeckRun r2 = test::run_deck(lmp, d2.path(), in_deck.deck, in_deck.files);
+  ASSERT_EQ(r2.status, 0) << r2.log;
+  ASSERT_NE(r2.log.find("demcal deck: consolidated in"), std::string::npos) << r2.log;
+  // The loading starts at sigma3 on all four walls (series row 0).
+  const ExternalSeries s2 = parse_external_series(test::read_text(d2.path() / "series.csv"),
+                                                  "series.csv", c.test.lateral_stress);
+  ASSERT_FALSE(s2.run.series.empty());
+  const double tol = c.test.consolidation_tolerance;
+  const auto& first = s2.run.series.front();
+  EXPECT_NEAR(-first.sigma(0, 0) / c.test.lateral_stress, 1.0, 2 * tol);
+  EXPECT_NEAR(-first.sigma(1, 1) / c.test.lateral_stress, 1.0, 2 * tol);
+  const double peak_demcal = series_peak(d1.path(), c), peak_deck = series_peak(d2.path(), c);
+  EXPECT_NEAR(peak_deck / peak_demcal, 1.0, 2 * tol)
+      << "deck-consolidated " << peak_deck << " Pa, demcal-consolidated " << peak_demcal << " Pa";
+
+  const std::string mpirun = test::find_on_path("mpirun");
+  if (mpirun.empty()) GTEST_SKIP() << "mpirun is not installed: the deck is not run under MPI";
+  setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 0);
+  setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1", 0);
+  const test::DeckRun r3 = test::run_deck(mpirun, d3.path(), in_deck.deck, in_deck.files,
+                                          {"-np", "2", lmp, "-screen", "none"});
+  ASSERT_EQ(r3.status, 0) << r3.log;
+  EXPECT_NEAR(series_peak(d3.path(), c) / peak_deck, 1.0, 1e-9);
 }
 
 }  // namespace
