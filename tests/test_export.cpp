@@ -361,5 +361,39 @@ TEST(Export, LammpsDeckConsolidatesItselfToDemcalsPeak) {
   EXPECT_NEAR(series_peak(d3.path(), c) / peak_deck, 1.0, 1e-9);
 }
 
+TEST(ExportCli, ConsolidateInChoosesWhereAndRejectsBadCombinations) {
+  // auto: demcal's kernel up to 2 000 particles, the deck's stage 1 above
+  // (said on stderr); bad values and combinations exit 2 writing nothing.
+  const test::TempDir dir("export_cli");
+  const std::string params =
+      (fs::path(test::shipped_config("hex_5x5")).parent_path().parent_path() / "reports" /
+       "example-hex_10x10" / "params.json")
+          .string();
+  auto run = [&](std::vector<std::string> args) {
+    args.insert(args.begin(), {"export", params});
+    return test::run_demcal(args, dir.path());
+  };
+  const auto small = run({"--particles", "25", "-o", "a/deck.lammps"});
+  const auto large = run({"--particles", "2500", "-o", "b/deck.lammps"});
+  ASSERT_EQ(small.status, 0) << small.err;
+  ASSERT_EQ(large.status, 0) << large.err;
+  EXPECT_NE(small.err.find("with demcal's kernel"), std::string::npos) << small.err;
+  EXPECT_NE(large.err.find("the deck consolidates the prototype"), std::string::npos) << large.err;
+  const std::string deck_a = test::read_text(dir.path() / "a" / "deck.lammps");
+  const std::string deck_b = test::read_text(dir.path() / "b" / "deck.lammps");
+  EXPECT_EQ(deck_a.find("stage 1: consolidation"), std::string::npos);
+  EXPECT_NE(deck_b.find("stage 1: consolidation"), std::string::npos);
+  EXPECT_EQ(run({"--particles", "25", "--consolidate-in", "gpu", "-o", "c/d.lammps"}).status, 2);
+  EXPECT_EQ(run({"--particles", "25", "--consolidate-in", "deck", "--format", "liggghts", "-o",
+                 "c/d.liggghts"})
+                .status,
+            2);
+  EXPECT_EQ(
+      run({"--particles", "25", "--consolidate-in", "deck", "--no-consolidate", "-o", "c/d.lammps"})
+          .status,
+      2);
+  EXPECT_FALSE(fs::exists(dir.path() / "c"));
+}
+
 }  // namespace
 }  // namespace demcal
