@@ -6,6 +6,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -350,6 +351,24 @@ TEST(Export, LammpsDeckConsolidatesItselfToDemcalsPeak) {
   const double peak_demcal = series_peak(d1.path(), c), peak_deck = series_peak(d2.path(), c);
   EXPECT_NEAR(peak_deck / peak_demcal, 1.0, 2 * tol)
       << "deck-consolidated " << peak_deck << " Pa, demcal-consolidated " << peak_demcal << " Pa";
+
+  // A split run: the continuation skips stage 1 and takes its start walls
+  // from the restart args; the same peak (the servo's sum restarts: 1e-6).
+  const test::TempDir d4("lammps_cons_split");
+  const int half = static_cast<int>(in_deck.steps / 2);
+  const test::DeckRun first_part =
+      test::run_deck(lmp, d4.path(), in_deck.deck, in_deck.files,
+                     {"-var", "run_steps", std::to_string(half), "-screen", "none"});
+  ASSERT_EQ(first_part.status, 0) << first_part.log;
+  std::vector<std::string> args;
+  std::stringstream words(test::read_text(d4.path() / "final.restart.args"));
+  for (std::string w; words >> w;) args.push_back(w);
+  ASSERT_NE(std::find(args.begin(), args.end(), "yt0"), args.end());
+  args.insert(args.end(), {"-screen", "none"});
+  const test::DeckRun second_part = test::run_deck(lmp, d4.path(), in_deck.deck, {}, args);
+  ASSERT_EQ(second_part.status, 0) << second_part.log;
+  EXPECT_EQ(second_part.log.find("demcal deck: consolidated in"), std::string::npos);
+  EXPECT_NEAR(series_peak(d4.path(), c) / peak_deck, 1.0, 1e-6);
 
   const std::string mpirun = test::find_on_path("mpirun");
   if (mpirun.empty()) GTEST_SKIP() << "mpirun is not installed: the deck is not run under MPI";

@@ -447,6 +447,7 @@ std::string lammps_limitations(const AlgorithmSpec& p, const Plan& plan, ExportR
 std::string lammps_parameters(const SceneConfig& c, const Assembly& a, const Plan& plan,
                               const ExportOptions& o) {
   const auto& m = c.material;
+  const char* wall_style = o.consolidate_in_deck ? "index " : "equal ";
   std::ostringstream s;
   s << "\n# --- parameters (edit here) -------------------------------------------------\n"
     << "# Everything below the block is derived from it: editing dt or nstep keeps the\n"
@@ -468,11 +469,14 @@ std::string lammps_parameters(const SceneConfig& c, const Assembly& a, const Pla
     << "variable sigma3    equal " << num(c.test.lateral_stress) << "      # Pa\n"
     << "variable gain      equal " << num(c.test.servo_gain) << "\n"
     << "variable r_min     equal " << num(plan.r_min) << "      # m, smallest radius\n"
-    << "variable r_max     equal " << num(plan.r_max) << "      # m, largest radius\n"
-    << "variable xl0       equal " << num(a.left) << "      # walls at the start, m\n"
-    << "variable xr0       equal " << num(a.right) << "\n"
-    << "variable yb0       equal " << num(a.bottom) << "\n"
-    << "variable yt0       equal " << num(a.top) << "\n"
+    << "variable r_max     equal " << num(plan.r_max)
+    << "      # m, largest radius\n"
+    // With stage 1 the start walls are those it ends with, kept as index
+    // variables: a continued run gets them on its command line (restart args).
+    << "variable xl0       " << wall_style << num(a.left) << "      # walls at the start, m\n"
+    << "variable xr0       " << wall_style << num(a.right) << "\n"
+    << "variable yb0       " << wall_style << num(a.bottom) << "\n"
+    << "variable yt0       " << wall_style << num(a.top) << "\n"
     << "variable series    index series.csv      # the monitoring series (demcal score)\n"
     << "# A split run: the first part writes ${restart_out} and ${restart_out}.args at its\n"
     << "# end; continue it with  lmp $(cat final.restart.args) -in THIS_DECK\n"
@@ -752,10 +756,14 @@ std::string lammps_consolidation(const SceneConfig& c, const Plan& plan, double 
     << "# the loading starts from here: walls, step 0, particles at rest. Each wall\n"
     << "# where its contacts put it (F = kn_wall * sum of overlaps, exact for these\n"
     << "# undamped walls), so the loading starts from the forces of the static state.\n"
-    << "variable        xl0 equal $((c_cons_w[2]/v_kn_wall-c_cons_pos[1])/c_cons_w[1])\n"
-    << "variable        xr0 equal $((c_cons_pos[2]+c_cons_w[4]/v_kn_wall)/c_cons_w[3])\n"
-    << "variable        yb0 equal $((c_cons_w[6]/v_kn_wall-c_cons_pos[3])/c_cons_w[5])\n"
-    << "variable        yt0 equal $((c_cons_pos[4]+c_cons_w[8]/v_kn_wall)/c_cons_w[7])\n"
+    << "variable        xl0 delete\n"
+    << "variable        xr0 delete\n"
+    << "variable        yb0 delete\n"
+    << "variable        yt0 delete\n"
+    << "variable        xl0 index $((c_cons_w[2]/v_kn_wall-c_cons_pos[1])/c_cons_w[1])\n"
+    << "variable        xr0 index $((c_cons_pos[2]+c_cons_w[4]/v_kn_wall)/c_cons_w[3])\n"
+    << "variable        yb0 index $((c_cons_w[6]/v_kn_wall-c_cons_pos[3])/c_cons_w[5])\n"
+    << "variable        yt0 index $((c_cons_pos[4]+c_cons_w[8]/v_kn_wall)/c_cons_w[7])\n"
     << "variable        xl_now delete\n"
     << "variable        xr_now delete\n"
     << "variable        xl_now index ${xl0}\n"
@@ -783,19 +791,25 @@ std::string lammps_consolidation(const SceneConfig& c, const Plan& plan, double 
   return s.str();
 }
 
-/// Thermo, the run up to run_steps, and the restart a split run continues.
-constexpr const char kLammpsRun[] =
-    "# --- output and run ----------------------------------------------------------\n"
-    "# p_left, p_right: lateral wall pressures (servo target sigma3); p_top: axial\n"
-    "variable        epsyy equal (v_H-v_H0)/v_H0\n"
-    "thermo_style    custom step dt time v_epsyy v_pt v_pl v_pr v_W v_H ke\n"
-    "thermo_modify   norm no\n"
-    "thermo          ${monitor_every}\n"
-    "run             ${run_steps} upto\n"
-    "write_restart   ${restart_out}\n"
-    "print           \"-var continued 1 -var restart_from ${restart_out} -var xl_now ${xl} -var "
-    "xr_now ${xr}\" "
-    "file ${restart_out}.args screen no\n";
+/// Thermo, the run up to run_steps, and the restart a split run continues
+/// (with stage 1, the args also carry the start walls it found).
+std::string lammps_run(bool consolidate_in_deck) {
+  std::ostringstream s;
+  s << "# --- output and run ----------------------------------------------------------\n"
+    << "# p_left, p_right: lateral wall pressures (servo target sigma3); p_top: axial\n"
+    << "variable        epsyy equal (v_H-v_H0)/v_H0\n"
+    << "thermo_style    custom step dt time v_epsyy v_pt v_pl v_pr v_W v_H ke\n"
+    << "thermo_modify   norm no\n"
+    << "thermo          ${monitor_every}\n"
+    << "run             ${run_steps} upto\n"
+    << "write_restart   ${restart_out}\n"
+    << "print           \"-var continued 1 -var restart_from ${restart_out} -var xl_now ${xl} -var "
+       "xr_now ${xr}"
+    << (consolidate_in_deck ? " -var xl0 ${xl0} -var xr0 ${xr0} -var yb0 ${yb0} -var yt0 ${yt0}"
+                            : "")
+    << "\" file ${restart_out}.args screen no\n";
+  return s.str();
+}
 
 ExportResult lammps(const SceneConfig& c, const AlgorithmSpec& p, const Assembly& a,
                     const ExportOptions& o) {
@@ -811,7 +825,7 @@ ExportResult lammps(const SceneConfig& c, const AlgorithmSpec& p, const Assembly
   else
     s << lammps_derived() << lammps_system(c, plan, o, out);
   s << kLammpsWalls << lammps_servo() << lammps_damping(p, plan) << lammps_series_block(c, p, plan)
-    << kLammpsRun;
+    << lammps_run(o.consolidate_in_deck);
   out.deck = s.str();
   return out;
 }
