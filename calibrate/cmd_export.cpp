@@ -17,6 +17,11 @@
 
 namespace demcal::cli {
 
+/// Above this many particles `--consolidate-in auto` leaves the consolidation
+/// to the LAMMPS deck: demcal's kernel consolidates single-threaded, and
+/// beyond a few thousand particles that takes minutes (reports/engines.md §8).
+constexpr int kDeckConsolidationAbove = 2000;
+
 int cmd_export(const ExportCmdOptions& o) {
   namespace fs = std::filesystem;
   const nlohmann::json params = read_params_file(o.params);
@@ -45,9 +50,29 @@ int cmd_export(const ExportCmdOptions& o) {
                   std::to_string(rev.params.steps) + " steps; " + law.name() + " law, exponent " +
                   std::to_string(law.exponent) + ")";
 
-  if (!o.no_consolidate) {
+  if (o.consolidate_in != "auto" && o.consolidate_in != "demcal" && o.consolidate_in != "deck")
+    throw InputError("--consolidate-in", "",
+                     "must be demcal, deck or auto, got \"" + o.consolidate_in + "\"");
+  if (o.consolidate_in == "deck" && o.format != "lammps")
+    throw InputError("--consolidate-in", "", "deck: only the LAMMPS deck consolidates itself");
+  if (o.consolidate_in != "auto" && o.no_consolidate)
+    throw InputError("--consolidate-in", "",
+                     "the prototype is not consolidated with --no-consolidate");
+  eo.consolidate_in_deck =
+      !o.no_consolidate &&
+      (o.consolidate_in == "deck" || (o.consolidate_in == "auto" && o.format == "lammps" &&
+                                      proto.size() > kDeckConsolidationAbove));
+  if (eo.consolidate_in_deck) {
+    std::cerr << "demcal export: " << proto.size() << " particles"
+              << (o.consolidate_in == "auto"
+                      ? " (more than " + std::to_string(kDeckConsolidationAbove) + ")"
+                      : std::string())
+              << ": the deck consolidates the prototype to sigma3 itself (stage 1, under MPI; "
+                 "--consolidate-in demcal does it here instead)\n";
+  } else if (!o.no_consolidate) {
     std::cerr << "demcal export: consolidating the prototype (" << source.description
-              << ") to sigma3 with demcal's kernel\n";
+              << ") to sigma3 with demcal's kernel, single-threaded (--consolidate-in deck "
+                 "leaves it to the LAMMPS deck, under MPI)\n";
     const ConsolidatedState state = consolidate(config, proto);
     std::cerr << "demcal export: consolidated in " << state.steps << " steps, " << state.wall_time_s
               << " s\n";

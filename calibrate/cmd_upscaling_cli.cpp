@@ -87,6 +87,9 @@ std::function<int()> add_upscaling_commands(CLI::App& app) {
       ->check(real_above(0.0, kMaxExponent));
   exp->add_flag("--no-consolidate", ex->no_consolidate,
                 "write the prototype as read (it is already consolidated to sigma3)");
+  exp->add_option("--consolidate-in", ex->consolidate_in,
+                  "demcal, deck (LAMMPS: the deck's first stage, under MPI) or auto (default: "
+                  "the deck above 2000 particles)");
 
   auto rv = std::make_shared<RevCmdOptions>();
   auto* rev = app.add_subcommand(

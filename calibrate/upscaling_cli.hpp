@@ -74,6 +74,10 @@ struct ExportCmdOptions {
   std::string law;
   double exponent = 0.0;
   bool no_consolidate = false;
+  /// Where the prototype is consolidated: demcal (its kernel, before
+  /// writing), deck (a first stage of the LAMMPS deck) or auto (the deck
+  /// above kDeckConsolidationAbove particles).
+  std::string consolidate_in = "auto";
 };
 int cmd_export(const ExportCmdOptions& options);
 

@@ -6,6 +6,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -14,6 +15,7 @@
 
 #include "demcal/scene/biaxial.hpp"
 #include "demcal/scene/packing.hpp"
+#include "demcal/scoring/external_series.hpp"
 #include "demcal/upscaling/export.hpp"
 #include "demcal/upscaling/rev.hpp"
 #include "support/files.hpp"
@@ -294,6 +296,122 @@ TEST(Export, LammpsReproducesDemcalsPeak) {
       << "LAMMPS " << lammps_peak << " Pa, demcal " << demcal_peak << " Pa";
   // The servo held σ3 in LAMMPS too.
   EXPECT_NEAR(rows.back()[5] / c.test.lateral_stress, 1.0, 0.01);
+}
+
+/// The peak σ_yy of a deck's series.csv (tension positive: the most negative).
+double series_peak(const fs::path& dir, const SceneConfig& c) {
+  const ExternalSeries s = parse_external_series(test::read_text(dir / "series.csv"), "series.csv",
+                                                 c.test.lateral_stress);
+  double peak = 0.0;
+  for (const auto& p : s.run.series) peak = std::min(peak, p.sigma(1, 1));
+  return peak;
+}
+
+TEST(Export, LammpsDeckConsolidatesItselfToDemcalsPeak) {
+  // --consolidate-in deck: the deck takes the generated hex 5x5 lattice to
+  // isotropic sigma3 itself (stage 1), then loads it. A hexagonal lattice
+  // has one consolidated packing (the lattice compressed isotropically) and
+  // its peak is proportional to sigma3 (failure at a fixed sigma1/sigma3),
+  // and each consolidation leaves every wall within consolidation_tolerance
+  // of sigma3: the peak after the deck's consolidation is that after
+  // demcal's within 2 * consolidation_tolerance (both loaded in LAMMPS, so
+  // the engines' differences cancel). Under mpirun -np 2 the same run: the
+  // peak within 1e-9 (the order of the MPI sums).
+  const std::string lmp = test::find_on_path("lmp");
+  if (lmp.empty()) GTEST_SKIP() << "LAMMPS (lmp) is not installed: the exported deck is not run";
+  SceneConfig c = default_config();
+  c.assembly.columns = c.assembly.rows = 5;
+  AlgorithmSpec p = params();
+  p.damping_ratio_rotation = 0.0;
+  p.steps = 8000;  // a faster loading, the same in both decks: seconds per run
+  const Assembly generated = make_assembly(c);
+  ExportOptions o;
+  o.data_name = "hex5.data";
+  const ExportResult by_demcal =
+      export_deck(c, p, assembly_of(consolidate(c, generated, "").world), o);
+  o.consolidate_in_deck = true;
+  const ExportResult in_deck = export_deck(c, p, generated, o);
+  EXPECT_NE(in_deck.deck.find("stage 1: consolidation"), std::string::npos);
+  EXPECT_EQ(by_demcal.deck.find("stage 1: consolidation"), std::string::npos);
+
+  const test::TempDir d1("lammps_cons_demcal"), d2("lammps_cons_deck"), d3("lammps_cons_np2");
+  const test::DeckRun r1 = test::run_deck(lmp, d1.path(), by_demcal.deck, by_demcal.files);
+  ASSERT_EQ(r1.status, 0) << r1.log;
+  const test::DeckRun r2 = test::run_deck(lmp, d2.path(), in_deck.deck, in_deck.files);
+  ASSERT_EQ(r2.status, 0) << r2.log;
+  ASSERT_NE(r2.log.find("demcal deck: consolidated in"), std::string::npos) << r2.log;
+  // The loading starts at sigma3 on all four walls (series row 0).
+  const ExternalSeries s2 = parse_external_series(test::read_text(d2.path() / "series.csv"),
+                                                  "series.csv", c.test.lateral_stress);
+  ASSERT_FALSE(s2.run.series.empty());
+  const double tol = c.test.consolidation_tolerance;
+  const auto& first = s2.run.series.front();
+  EXPECT_NEAR(-first.sigma(0, 0) / c.test.lateral_stress, 1.0, 2 * tol);
+  EXPECT_NEAR(-first.sigma(1, 1) / c.test.lateral_stress, 1.0, 2 * tol);
+  const double peak_demcal = series_peak(d1.path(), c), peak_deck = series_peak(d2.path(), c);
+  EXPECT_NEAR(peak_deck / peak_demcal, 1.0, 2 * tol)
+      << "deck-consolidated " << peak_deck << " Pa, demcal-consolidated " << peak_demcal << " Pa";
+
+  // A split run: the continuation skips stage 1 and takes its start walls
+  // from the restart args; the same peak (the servo's sum restarts: 1e-6).
+  const test::TempDir d4("lammps_cons_split");
+  const int half = static_cast<int>(in_deck.steps / 2);
+  const test::DeckRun first_part =
+      test::run_deck(lmp, d4.path(), in_deck.deck, in_deck.files,
+                     {"-var", "run_steps", std::to_string(half), "-screen", "none"});
+  ASSERT_EQ(first_part.status, 0) << first_part.log;
+  std::vector<std::string> args;
+  std::stringstream words(test::read_text(d4.path() / "final.restart.args"));
+  for (std::string w; words >> w;) args.push_back(w);
+  ASSERT_NE(std::find(args.begin(), args.end(), "yt0"), args.end());
+  args.insert(args.end(), {"-screen", "none"});
+  const test::DeckRun second_part = test::run_deck(lmp, d4.path(), in_deck.deck, {}, args);
+  ASSERT_EQ(second_part.status, 0) << second_part.log;
+  EXPECT_EQ(second_part.log.find("demcal deck: consolidated in"), std::string::npos);
+  EXPECT_NEAR(series_peak(d4.path(), c) / peak_deck, 1.0, 1e-6);
+
+  const std::string mpirun = test::find_on_path("mpirun");
+  if (mpirun.empty()) GTEST_SKIP() << "mpirun is not installed: the deck is not run under MPI";
+  setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 0);
+  setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1", 0);
+  const test::DeckRun r3 = test::run_deck(mpirun, d3.path(), in_deck.deck, in_deck.files,
+                                          {"-np", "2", lmp, "-screen", "none"});
+  ASSERT_EQ(r3.status, 0) << r3.log;
+  EXPECT_NEAR(series_peak(d3.path(), c) / peak_deck, 1.0, 1e-9);
+}
+
+TEST(ExportCli, ConsolidateInChoosesWhereAndRejectsBadCombinations) {
+  // auto: demcal's kernel up to 2 000 particles, the deck's stage 1 above
+  // (said on stderr); bad values and combinations exit 2 writing nothing.
+  const test::TempDir dir("export_cli");
+  const std::string params =
+      (fs::path(test::shipped_config("hex_5x5")).parent_path().parent_path() / "reports" /
+       "example-hex_10x10" / "params.json")
+          .string();
+  auto run = [&](std::vector<std::string> args) {
+    args.insert(args.begin(), {"export", params});
+    return test::run_demcal(args, dir.path());
+  };
+  const auto small = run({"--particles", "25", "-o", "a/deck.lammps"});
+  const auto large = run({"--particles", "2500", "-o", "b/deck.lammps"});
+  ASSERT_EQ(small.status, 0) << small.err;
+  ASSERT_EQ(large.status, 0) << large.err;
+  EXPECT_NE(small.err.find("with demcal's kernel"), std::string::npos) << small.err;
+  EXPECT_NE(large.err.find("the deck consolidates the prototype"), std::string::npos) << large.err;
+  const std::string deck_a = test::read_text(dir.path() / "a" / "deck.lammps");
+  const std::string deck_b = test::read_text(dir.path() / "b" / "deck.lammps");
+  EXPECT_EQ(deck_a.find("stage 1: consolidation"), std::string::npos);
+  EXPECT_NE(deck_b.find("stage 1: consolidation"), std::string::npos);
+  EXPECT_EQ(run({"--particles", "25", "--consolidate-in", "gpu", "-o", "c/d.lammps"}).status, 2);
+  EXPECT_EQ(run({"--particles", "25", "--consolidate-in", "deck", "--format", "liggghts", "-o",
+                 "c/d.liggghts"})
+                .status,
+            2);
+  EXPECT_EQ(
+      run({"--particles", "25", "--consolidate-in", "deck", "--no-consolidate", "-o", "c/d.lammps"})
+          .status,
+      2);
+  EXPECT_FALSE(fs::exists(dir.path() / "c"));
 }
 
 }  // namespace

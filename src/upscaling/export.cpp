@@ -7,6 +7,8 @@
 #include <numeric>
 #include <sstream>
 
+#include "demcal/scene/biaxial.hpp"
+
 namespace demcal {
 
 namespace {
@@ -138,8 +140,16 @@ std::string mapping_header(const SceneConfig& c, const AlgorithmSpec& p, const P
     << "#     left/right servo-controlled to sigma3 = " << num(c.test.lateral_stress)
     << " Pa (gain " << num(c.test.servo_gain) << ")\n"
     << "#   stresses: tension positive in demcal; the thermo columns below give the\n"
-    << "#     compressive wall pressures (positive) instead\n"
-    << "# The particle file holds the state demcal consolidated to sigma3 (walls at its\n"
+    << "#     compressive wall pressures (positive) instead\n";
+  if (o.consolidate_in_deck) {
+    s << "# The particle file holds the prototype as generated (walls at its box): stage 1\n"
+      << "# of this deck consolidates it to isotropic sigma3 as demcal does (see there),\n"
+      << "# under MPI, before the loading. Run it with -in (the stage skips itself with\n"
+      << "# jump SELF), e.g. mpirun -np 4 lmp -in THIS_DECK.\n"
+      << "# ===========================================================================\n";
+    return s.str();
+  }
+  s << "# The particle file holds the state demcal consolidated to sigma3 (walls at its\n"
     << "# box); the run starts loading from it. Not carried over: the tangential\n"
     << "# contact forces (the tangential springs' histories, particle-particle and\n"
     << "# particle-wall) start at zero here, where demcal's consolidated state had\n"
@@ -369,12 +379,14 @@ std::string lammps_servo() {
 
 // Data file: atom_style sphere rows "id type diameter density x y z"; the
 // density column is overwritten by set density/disc below.
-std::string lammps_data_file(const SceneConfig& c, const Assembly& a, const Plan& plan) {
+std::string lammps_data_file(const SceneConfig& c, const Assembly& a, const Plan& plan,
+                             bool consolidated) {
   const auto& m = c.material;
   std::ostringstream d;
   const double mx = 0.5 * plan.width0, my = 0.1 * plan.height0;
   d << "LAMMPS data file written by demcal " << DEMCAL_VERSION << " (scene " << c.name
-    << ", consolidated to sigma3)\n\n"
+    << (consolidated ? ", consolidated to sigma3)\n\n"
+                     : ", as generated: the deck consolidates it)\n\n")
     << plan.n << " atoms\n"
     << plan.types << " atom types\n\n"
     << num(a.left - mx) << " " << num(a.right + mx) << " xlo xhi\n"
@@ -390,16 +402,10 @@ std::string lammps_data_file(const SceneConfig& c, const Assembly& a, const Plan
   return d.str();
 }
 
-ExportResult lammps(const SceneConfig& c, const AlgorithmSpec& p, const Assembly& a,
-                    const ExportOptions& o) {
-  const Plan plan = make_plan(c, p, a, o.max_types);
-  const auto& m = c.material;
-  ExportResult out = result_of(plan);
-
-  out.files[o.data_name] = lammps_data_file(c, a, plan);
-
+/// What this LAMMPS cannot do as demcal does, in the deck's header; the
+/// same facts go to `out.notes` (stderr at export).
+std::string lammps_limitations(const AlgorithmSpec& p, const Plan& plan, ExportResult& out) {
   std::ostringstream s;
-  s << mapping_header(c, p, plan, o, "LAMMPS");
   s << "#\n# What this LAMMPS cannot do as demcal does, and what the deck does instead:\n"
     << "#  - rotational damping: this release (29 Sep 2021) has no rotational viscous fix;\n";
   if (p.damping_ratio_rotation > 0.0) {
@@ -434,7 +440,15 @@ ExportResult lammps(const SceneConfig& c, const AlgorithmSpec& p, const Assembly
   out.notes.push_back(
       "lateral servo walls emulated with variables (running sum of demcal's per-step servo "
       "move): one run command only");
+  return s.str();
+}
 
+/// The block a user edits; every other number of the deck derives from it.
+std::string lammps_parameters(const SceneConfig& c, const Assembly& a, const Plan& plan,
+                              const ExportOptions& o) {
+  const auto& m = c.material;
+  const char* wall_style = o.consolidate_in_deck ? "index " : "equal ";
+  std::ostringstream s;
   s << "\n# --- parameters (edit here) -------------------------------------------------\n"
     << "# Everything below the block is derived from it: editing dt or nstep keeps the\n"
     << "# strain, the loading rate per step count, the servo cap and the monitoring\n"
@@ -455,11 +469,14 @@ ExportResult lammps(const SceneConfig& c, const AlgorithmSpec& p, const Assembly
     << "variable sigma3    equal " << num(c.test.lateral_stress) << "      # Pa\n"
     << "variable gain      equal " << num(c.test.servo_gain) << "\n"
     << "variable r_min     equal " << num(plan.r_min) << "      # m, smallest radius\n"
-    << "variable r_max     equal " << num(plan.r_max) << "      # m, largest radius\n"
-    << "variable xl0       equal " << num(a.left) << "      # walls at the start, m\n"
-    << "variable xr0       equal " << num(a.right) << "\n"
-    << "variable yb0       equal " << num(a.bottom) << "\n"
-    << "variable yt0       equal " << num(a.top) << "\n"
+    << "variable r_max     equal " << num(plan.r_max)
+    << "      # m, largest radius\n"
+    // With stage 1 the start walls are those it ends with, kept as index
+    // variables: a continued run gets them on its command line (restart args).
+    << "variable xl0       " << wall_style << num(a.left) << "      # walls at the start, m\n"
+    << "variable xr0       " << wall_style << num(a.right) << "\n"
+    << "variable yb0       " << wall_style << num(a.bottom) << "\n"
+    << "variable yt0       " << wall_style << num(a.top) << "\n"
     << "variable series    index series.csv      # the monitoring series (demcal score)\n"
     << "# A split run: the first part writes ${restart_out} and ${restart_out}.args at its\n"
     << "# end; continue it with  lmp $(cat final.restart.args) -in THIS_DECK\n"
@@ -471,8 +488,23 @@ ExportResult lammps(const SceneConfig& c, const AlgorithmSpec& p, const Assembly
     << "variable xl_now    index ${xl0}      # lateral walls where this run starts\n"
     << "variable xr_now    index ${xr0}\n"
     << "variable run_steps index ${nstep}      # run up to this step; -var run_steps 300 for a "
-       "check\n"
-    << "\n# --- derived (do not edit) ---------------------------------------------------\n"
+       "check\n";
+  if (o.consolidate_in_deck)
+    s << "# stage 1, the consolidation (demcal's test.consolidation_* values):\n"
+      << "variable consolidate index 1      # 0: skip it (the particles are at sigma3)\n"
+      << "variable cons_tol  equal " << num(c.test.consolidation_tolerance)
+      << "      # largest wall stress error / sigma3\n"
+      << "variable cons_unbalanced equal " << num(c.test.consolidation_unbalanced)
+      << "      # mean|F_p| / mean|f_c|\n"
+      << "variable cons_max_steps equal " << c.test.consolidation_max_steps << "\n"
+      << "variable cons_check equal 200      # steps between checks\n";
+  return s.str();
+}
+
+/// Quantities LAMMPS derives from the parameters block (and the start walls).
+std::string lammps_derived() {
+  std::ostringstream s;
+  s << "\n# --- derived (do not edit) ---------------------------------------------------\n"
     << "variable H0        equal $(v_yt0-v_yb0)\n"
     << "variable vtop      equal $(v_strain*v_H0/(v_nstep*v_dt))      # m/s, top wall, down\n"
     << "variable cap       equal $(0.02*v_r_min)      # m per step, servo move cap\n"
@@ -480,15 +512,24 @@ ExportResult lammps(const SceneConfig& c, const AlgorithmSpec& p, const Assembly
        "$(floor((1+v_nstep/v_monitor_points+abs(1-v_nstep/v_monitor_points))/2))\n"
     << "variable band_v    equal $(v_strain*v_H0+6*v_r_max)      # m, see the walls\n"
     << "variable band_h    equal $(2*v_strain*(v_xr0-v_xl0)+6*v_r_max)\n";
+  return s.str();
+}
 
-  double gamma_n = 0.0;
-  if (m.contact_damping_ratio > 0.0) {
-    // demcal: ratio·2·sqrt(kn·m_eff); LAMMPS: m_eff·gamma_n → gamma_n =
-    // ratio·2·sqrt(kn/m_eff), taken at the mean mass (m_eff = m/2).
-    gamma_n =
-        m.contact_damping_ratio * 2.0 * std::sqrt(m.particle.kn / (0.5 * plan.scales.mass_mean));
-    out.notes.push_back("contact damping mapped at the mean particle mass");
-  }
+/// The pair style's gamma_n for demcal's contact damping: demcal
+/// ratio·2·sqrt(kn·m_eff), LAMMPS m_eff·gamma_n, so gamma_n =
+/// ratio·2·sqrt(kn/m_eff), taken at the mean mass (m_eff = m/2); 0 without.
+double contact_gamma_n(const SceneConfig& c, const Plan& plan) {
+  const auto& m = c.material;
+  if (m.contact_damping_ratio <= 0.0) return 0.0;
+  return m.contact_damping_ratio * 2.0 * std::sqrt(m.particle.kn / (0.5 * plan.scales.mass_mean));
+}
+
+/// Units, particles (data file or restart), masses, contact law, integrator.
+std::string lammps_system(const SceneConfig& c, const Plan& plan, const ExportOptions& o,
+                          ExportResult& out) {
+  const double gamma_n = contact_gamma_n(c, plan);
+  if (gamma_n > 0.0) out.notes.push_back("contact damping mapped at the mean particle mass");
+  std::ostringstream s;
   s << "\n# --- system ------------------------------------------------------------------\n"
     << "units           si\n"
     << "dimension       2\n"
@@ -508,9 +549,12 @@ ExportResult lammps(const SceneConfig& c, const AlgorithmSpec& p, const Assembly
     << "neigh_modify    delay 0 every 1 check yes\n"
     << "timestep        ${dt}\n\n"
     << "fix             integrate all nve/sphere disc\n\n";
+  return s.str();
+}
 
-  s << kLammpsWalls << lammps_servo();
-
+/// Global damping per radius class (fix viscous ... scale), then enforce2d.
+std::string lammps_damping(const AlgorithmSpec& p, const Plan& plan) {
+  std::ostringstream s;
   s << "# --- global damping ----------------------------------------------------------\n";
   if (p.damping_ratio_translation > 0.0) {
     s << "# gamma per class, N*s/m:";
@@ -531,7 +575,271 @@ ExportResult lammps(const SceneConfig& c, const AlgorithmSpec& p, const Assembly
     s << "\n";
   }
   s << "fix             twod all enforce2d\n\n";
-  s << lammps_series_block(c, p, plan);
+  return s.str();
+}
+
+/// Stage 1's step and servo resistance: demcal's consolidation (alpha 0.2,
+/// shrunk for contact dashpots, scene/biaxial.cpp) times the explicit
+/// damper's factor f(zeta) (Plan), at the light and at critical damping.
+struct ConsolidationSteps {
+  double alpha = 0.0, dt_light = 0.0, dt_damped = 0.0;
+  std::string resist;  ///< the servo's R: kn_wall (+ the wall dashpots' c/dt)
+};
+
+ConsolidationSteps consolidation_steps(const SceneConfig& c, const Plan& plan) {
+  const auto& m = c.material;
+  ConsolidationSteps st;
+  st.alpha = AlgorithmSpec{}.dt_ratio;
+  double resist_dash = 0.0;  // the wall dashpots' c [N*s/m]
+  const double m_max = plan.areal_density * std::numbers::pi * plan.r_max * plan.r_max;
+  if (m.contact_damping_ratio > 0.0) {
+    const double gamma_max =
+        2.0 * m.contact_damping_ratio * std::sqrt(m_max / std::min(m.particle.kn, m.wall.kn));
+    st.alpha *= dashpot_step_factor(gamma_max / (st.alpha * plan.dt_crit));
+    resist_dash = 2.0 * m.contact_damping_ratio * std::sqrt(m.wall.kn * m_max);
+  }
+  st.dt_light = st.alpha * dashpot_step_factor(kConsolidationDampingRatio) * plan.dt_crit;
+  st.dt_damped = st.alpha * dashpot_step_factor(1.0) * plan.dt_crit;
+  st.resist = resist_dash > 0.0 ? "(${kn_wall}+" + num(resist_dash) + "/dt)" : "${kn_wall}";
+  return st;
+}
+
+/// Stage 1's fix viscous at damping ratio z, per radius class.
+std::string consolidation_viscous(const SceneConfig& c, const Plan& plan, double z) {
+  auto g = [&](int k) {
+    const double r = 0.5 * (plan.r_lo[k] + plan.r_hi[k]);
+    return z * 2.0 *
+           std::sqrt(c.material.particle.kn * plan.areal_density * std::numbers::pi * r * r);
+  };
+  std::string out = "fix cons_damp all viscous " + num(g(0));
+  for (int k = 1; k < plan.types; ++k)
+    out += " scale " + std::to_string(k + 1) + " " + num(g(k) / g(0));
+  return out;
+}
+
+/// Stage 1's walls and servo: four planes moved by demcal's per-step law.
+std::string lammps_consolidation_walls(const SceneConfig& c, const Plan& plan,
+                                       const ConsolidationSteps& st) {
+  const double zeta = kConsolidationDampingRatio;
+  const std::string& resist = st.resist;
+  const double alpha = st.alpha, dt_light = st.dt_light;
+  // move = gain*(sigma3*L*t - F)/(R*max(1, n)), clamped to +-cap; F, n of
+  // compute cons_w: [1] [2] left n, F_x; [3] [4] right; [5] [6] bottom n, F_y;
+  // [7] [8] top; the force on the particles, inward for left and bottom
+  auto move = [&](const char* length, const char* sign, int n) {
+    const std::string raw = "${gain}*(${sigma3}*" + std::string(length) + "*${thick}" + sign +
+                            "c_cons_w[" + std::to_string(n + 1) + "])/(" + resist +
+                            "*(1+c_cons_w[" + std::to_string(n) + "]+abs(1-c_cons_w[" +
+                            std::to_string(n) + "]))/2)";
+    return "(abs(" + raw + "+${cap})-abs(" + raw + "-${cap}))/2";
+  };
+  std::ostringstream s;
+  s << "# --- stage 1: consolidation to isotropic sigma3 -------------------------------\n"
+    << "# demcal's consolidation (demcal export --consolidate-in deck), run here so\n"
+    << "# that it scales under MPI: all four walls servoed with the loading's law\n"
+    << "# (each wall: move = gain*(sigma3*L*t - F)/(kn_wall*max(1, n)) per step, cap\n"
+    << "# 2 % of r_min), global damping zeta " << num(zeta)
+    << " on translation (demcal also damps\n"
+    << "# rotation; this LAMMPS cannot), particle friction 0 until static, then\n"
+    << "# mu until static again; critical damping (zeta 1, timestep * f(1)/f(" << num(zeta)
+    << "))\n"
+    << "# once a quarter of cons_max_steps has passed without. Static: every wall\n"
+    << "# within cons_tol of sigma3 and the unbalanced-force ratio mean|F_p| / mean\n"
+    << "# |f_c| below cons_unbalanced (demcal's test.consolidation_* values), checked\n"
+    << "# every cons_check steps by fix halt; |f_c| of a particle contact is its normal\n"
+    << "# force (compute pair/local; the tangential part left out: a stricter ratio).\n"
+    << "# The end state's walls become xl0 xr0 yb0 yt0 of the loading, whose step\n"
+    << "# count starts at 0; the pair contacts keep their tangential springs, the\n"
+    << "# walls' start at zero. Progress: the thermo lines (cons_err, cons_ufr).\n"
+    << "if              \"${consolidate} == 0 || ${continued} != 0\" then \"jump SELF "
+       "loading\"\n"
+    << "variable        cap equal $(0.02*v_r_min)\n"
+    << "timestep        " << num(dt_light) << "      # alpha*f(zeta)*dt_crit, alpha " << num(alpha)
+    << "\n"
+    << "variable        cons_s0 equal $(step)\n"
+    << "# runs end on check steps, where the criterion's computes are current\n"
+    << "variable        cons_quarter equal $(v_cons_check*floor(v_cons_max_steps/4/v_cons_check))\n"
+    << "variable        cons_last equal $(v_cons_check*floor(v_cons_max_steps/v_cons_check))\n"
+    << "variable        cons_dxl equal f_cons_servo[1]*(step-${cons_s0})\n"
+    << "variable        cons_dxr equal f_cons_servo[2]*(step-${cons_s0})\n"
+    << "variable        cons_dyb equal f_cons_servo[3]*(step-${cons_s0})\n"
+    << "variable        cons_dyt equal f_cons_servo[4]*(step-${cons_s0})\n"
+    << "region          cons_rl plane ${xl0} 0 0  1 0 0 side in move v_cons_dxl NULL NULL "
+       "units box\n"
+    << "region          cons_rr plane ${xr0} 0 0 -1 0 0 side in move v_cons_dxr NULL NULL "
+       "units box\n"
+    << "region          cons_rb plane 0 ${yb0} 0 0  1 0 side in move NULL v_cons_dyb NULL "
+       "units box\n"
+    << "region          cons_rt plane 0 ${yt0} 0 0 -1 0 side in move NULL v_cons_dyt NULL "
+       "units box\n";
+  const char* w[] = {"l", "r", "b", "t"};
+  for (const char* x : w)
+    s << "fix             cons_w" << x << " all wall/gran/region hooke/history ${kn_wall} "
+      << "${kt_wall} 0 0 ${mu_wall} 0 region cons_r" << x << " contacts\n";
+  s << "fix             cons_fcon all store/force\n"
+    << consolidation_viscous(c, plan, zeta) << "\n"
+    << "fix             cons_twod all enforce2d\n"
+    << "compute         cons_w all reduce sum f_cons_wl[1] f_cons_wl[2] f_cons_wr[1] "
+       "f_cons_wr[2] &\n"
+    << "                f_cons_wb[1] f_cons_wb[3] f_cons_wt[1] f_cons_wt[3]\n"
+    << "variable        cons_xl equal v_xl0+v_cons_dxl\n"
+    << "variable        cons_xr equal v_xr0+v_cons_dxr\n"
+    << "variable        cons_yb equal v_yb0+v_cons_dyb\n"
+    << "variable        cons_yt equal v_yt0+v_cons_dyt\n"
+    << "variable        cons_H equal v_cons_yt-v_cons_yb\n"
+    << "variable        cons_W equal v_cons_xr-v_cons_xl\n"
+    << "variable        cons_ml equal " << move("v_cons_H", "-", 1) << "\n"
+    << "variable        cons_mr equal -" << move("v_cons_H", "+", 3) << "\n"
+    << "variable        cons_mb equal " << move("v_cons_W", "-", 5) << "\n"
+    << "variable        cons_mt equal -" << move("v_cons_W", "+", 7) << "\n"
+    << "fix             cons_servo all ave/time 1 1 1 v_cons_ml v_cons_mr v_cons_mb "
+       "v_cons_mt ave running\n";
+  return s.str();
+}
+
+/// Stage 1's static criterion (demcal's), checked by fix halt.
+constexpr const char kLammpsConsolidationCriterion[] =
+    "# the static criterion\n"
+    "variable        cons_pl equal c_cons_w[2]/(v_cons_H*v_thick)\n"
+    "variable        cons_pr equal -c_cons_w[4]/(v_cons_H*v_thick)\n"
+    "variable        cons_pb equal c_cons_w[6]/(v_cons_W*v_thick)\n"
+    "variable        cons_pt equal -c_cons_w[8]/(v_cons_W*v_thick)\n"
+    "variable        cons_fnet atom sqrt(f_cons_fcon[1]^2+f_cons_fcon[2]^2)\n"
+    "variable        cons_fw atom \"sqrt(f_cons_wl[2]^2+f_cons_wl[3]^2)+sqrt(f_cons_wr[2]^2+"
+    "f_cons_wr[3]^2)+&\n"
+    "                sqrt(f_cons_wb[2]^2+f_cons_wb[3]^2)+sqrt(f_cons_wt[2]^2+f_cons_wt[3]^2)\"\n"
+    "compute         cons_pair all pair/local force cutoff radius\n"
+    "compute         cons_nc all contact/atom\n"
+    "compute         cons_fp all reduce sum c_cons_pair\n"
+    "compute         cons_at all reduce sum v_cons_fnet v_cons_fw c_cons_nc\n"
+    "# (x==0) is 1 for x = 0: no contacts yet (a gas) gives ratio 0, as in demcal\n"
+    "variable        cons_nct equal c_cons_at[3]/2+c_cons_w[1]+c_cons_w[3]+c_cons_w[5]+"
+    "c_cons_w[7]\n"
+    "variable        cons_fct equal c_cons_fp+c_cons_at[2]\n"
+    "variable        cons_ufr equal (c_cons_at[1]/atoms)*(v_cons_nct+(v_cons_nct==0))/"
+    "(v_cons_fct+(v_cons_fct==0))\n"
+    "# largest wall stress error: max(a, b) = (a+b+abs(a-b))/2 (no max() of two\n"
+    "# numbers in this release)\n"
+    "variable        cons_el equal abs(v_cons_pl-v_sigma3)\n"
+    "variable        cons_er equal abs(v_cons_pr-v_sigma3)\n"
+    "variable        cons_eb equal abs(v_cons_pb-v_sigma3)\n"
+    "variable        cons_et equal abs(v_cons_pt-v_sigma3)\n"
+    "variable        cons_eh equal (v_cons_el+v_cons_er+abs(v_cons_el-v_cons_er))/2\n"
+    "variable        cons_ev equal (v_cons_eb+v_cons_et+abs(v_cons_eb-v_cons_et))/2\n"
+    "variable        cons_err equal (v_cons_eh+v_cons_ev+abs(v_cons_eh-v_cons_ev))/2/v_sigma3\n"
+    "# sums over each wall's contacts for its position at the end (r -+ x, r -+ y)\n"
+    "compute         cons_rad all property/atom radius\n"
+    "variable        cons_rxn atom (c_cons_rad-x)*f_cons_wl[1]\n"
+    "variable        cons_rxp atom (c_cons_rad+x)*f_cons_wr[1]\n"
+    "variable        cons_ryn atom (c_cons_rad-y)*f_cons_wb[1]\n"
+    "variable        cons_ryp atom (c_cons_rad+y)*f_cons_wt[1]\n"
+    "compute         cons_pos all reduce sum v_cons_rxn v_cons_rxp v_cons_ryn v_cons_ryp\n"
+    "# (the last term only computes cons_pos on the check steps: current at a halt)\n"
+    "variable        cons_static equal (v_cons_err<v_cons_tol)&&(v_cons_ufr<v_cons_unbalanced)"
+    "&&(c_cons_pos[1]==c_cons_pos[1])\n"
+    "fix             cons_halt all halt ${cons_check} v_cons_static > 0.5 error continue "
+    "message no\n"
+    "thermo_style    custom step dt v_cons_err v_cons_ufr v_cons_pl v_cons_pr v_cons_pb "
+    "v_cons_pt ke\n"
+    "thermo_modify   norm no\n"
+    "thermo          $(10*v_cons_check)\n";
+
+/// Stage 1's runs: frictionless, then friction on; critical damping once a
+/// quarter of the budget has passed; quit 2 when the budget is spent.
+std::string lammps_consolidation_runs(const SceneConfig& c, const Plan& plan, double gamma_n,
+                                      const ConsolidationSteps& st) {
+  const std::string critical = consolidation_viscous(c, plan, 1.0);
+  const double dt_crit_damped = st.dt_damped;
+  std::ostringstream s;
+  s << "# phase 0: frictionless\n"
+    << "pair_style      gran/hooke/history ${kn} ${kt} " << num(gamma_n) << " 0.0 0 0\n"
+    << "variable        cons_critical equal 0\n"
+    << "run             ${cons_quarter} upto\n"
+    << "if              \"${cons_static} == 0\" then \"" << critical << "\" &\n"
+    << "                \"timestep " << num(dt_crit_damped)
+    << "\" \"variable cons_critical equal 1\" "
+    << "\"run ${cons_last} upto\"\n"
+    << "if              \"${cons_static} == 0\" then \"print 'demcal deck: consolidation "
+       "(frictionless) did not reach a static state in ${cons_max_steps} steps: raise "
+       "cons_max_steps'\" \"quit 2\"\n"
+    << "# phase 1: friction on (at least one check interval)\n"
+    << "pair_style      gran/hooke/history ${kn} ${kt} " << num(gamma_n) << " 0.0 ${mu} 0\n"
+    << "if              \"${cons_critical} == 0 && $(step+v_cons_check) <= ${cons_quarter}\" "
+       "then \"run ${cons_quarter} upto\" else \"run ${cons_check}\"\n"
+    << "if              \"${cons_static} == 0 && ${cons_critical} == 0\" then \"" << critical
+    << "\" &\n"
+    << "                \"timestep " << num(dt_crit_damped)
+    << "\" \"variable cons_critical equal 1\"\n"
+    << "if              \"${cons_static} == 0\" then \"run ${cons_last} upto\"\n"
+    << "if              \"${cons_static} == 0\" then \"print 'demcal deck: consolidation did "
+       "not reach a static state in ${cons_max_steps} steps: raise cons_max_steps'\" \"quit 2\"\n"
+    << "print           \"demcal deck: consolidated in $(step-v_cons_s0) steps (wall stress "
+       "error ${cons_err}, unbalanced-force ratio ${cons_ufr})\"\n";
+  return s.str();
+}
+
+/// Stage 1's end: the loading's start walls, particles at rest, step 0.
+constexpr const char kLammpsConsolidationEnd[] =
+    "# the loading starts from here: walls, step 0, particles at rest. Each wall\n"
+    "# where its contacts put it (F = kn_wall * sum of overlaps, exact for these\n"
+    "# undamped walls), so the loading starts from the forces of the static state.\n"
+    "variable        xl0 delete\n"
+    "variable        xr0 delete\n"
+    "variable        yb0 delete\n"
+    "variable        yt0 delete\n"
+    "variable        xl0 index $((c_cons_w[2]/v_kn_wall-c_cons_pos[1])/c_cons_w[1])\n"
+    "variable        xr0 index $((c_cons_pos[2]+c_cons_w[4]/v_kn_wall)/c_cons_w[3])\n"
+    "variable        yb0 index $((c_cons_w[6]/v_kn_wall-c_cons_pos[3])/c_cons_w[5])\n"
+    "variable        yt0 index $((c_cons_pos[4]+c_cons_w[8]/v_kn_wall)/c_cons_w[7])\n"
+    "variable        xl_now delete\n"
+    "variable        xr_now delete\n"
+    "variable        xl_now index ${xl0}\n"
+    "variable        xr_now index ${xr0}\n"
+    "velocity        all set 0 0 0\n"
+    "set             group all omega 0 0 0\n"
+    "unfix           cons_halt\n"
+    "uncompute       cons_at\n"
+    "uncompute       cons_pos\n"
+    "uncompute       cons_rad\n"
+    "uncompute       cons_fp\n"
+    "uncompute       cons_nc\n"
+    "uncompute       cons_pair\n"
+    "uncompute       cons_w\n"
+    "unfix           cons_servo\n"
+    "unfix           cons_twod\n"
+    "unfix           cons_damp\n"
+    "unfix           cons_fcon\n"
+    "unfix           cons_wl\n"
+    "unfix           cons_wr\n"
+    "unfix           cons_wb\n"
+    "unfix           cons_wt\n"
+    "region          cons_rl delete\n"
+    "region          cons_rr delete\n"
+    "region          cons_rb delete\n"
+    "region          cons_rt delete\n"
+    "variable        cap delete\n"
+    "reset_timestep  0\n"
+    "timestep        ${dt}\n"
+    "label           loading\n\n";
+
+/// Stage 1 of a deck that consolidates itself (ExportOptions::
+/// consolidate_in_deck): demcal's consolidation (scene/biaxial.cpp) in
+/// LAMMPS, under MPI. Four walls servoed to sigma3 with demcal's per-step law,
+/// frictionless until static, then with friction until static again; light
+/// global damping, critical after a quarter of the budget; static = every
+/// wall within cons_tol of sigma3 and the unbalanced-force ratio below
+/// cons_unbalanced, checked every cons_check steps (fix halt). At the end the
+/// walls' positions become the loading's start walls and the step count 0.
+std::string lammps_consolidation(const SceneConfig& c, const Plan& plan, double gamma_n) {
+  const ConsolidationSteps st = consolidation_steps(c, plan);
+  return lammps_consolidation_walls(c, plan, st) + kLammpsConsolidationCriterion +
+         lammps_consolidation_runs(c, plan, gamma_n, st) + kLammpsConsolidationEnd;
+}
+
+/// Thermo, the run up to run_steps, and the restart a split run continues
+/// (with stage 1, the args also carry the start walls it found).
+std::string lammps_run(bool consolidate_in_deck) {
+  std::ostringstream s;
   s << "# --- output and run ----------------------------------------------------------\n"
     << "# p_left, p_right: lateral wall pressures (servo target sigma3); p_top: axial\n"
     << "variable        epsyy equal (v_H-v_H0)/v_H0\n"
@@ -541,8 +849,28 @@ ExportResult lammps(const SceneConfig& c, const AlgorithmSpec& p, const Assembly
     << "run             ${run_steps} upto\n"
     << "write_restart   ${restart_out}\n"
     << "print           \"-var continued 1 -var restart_from ${restart_out} -var xl_now ${xl} -var "
-       "xr_now ${xr}\" "
-       "file ${restart_out}.args screen no\n";
+       "xr_now ${xr}"
+    << (consolidate_in_deck ? " -var xl0 ${xl0} -var xr0 ${xr0} -var yb0 ${yb0} -var yt0 ${yt0}"
+                            : "")
+    << "\" file ${restart_out}.args screen no\n";
+  return s.str();
+}
+
+ExportResult lammps(const SceneConfig& c, const AlgorithmSpec& p, const Assembly& a,
+                    const ExportOptions& o) {
+  const Plan plan = make_plan(c, p, a, o.max_types);
+  ExportResult out = result_of(plan);
+  out.files[o.data_name] = lammps_data_file(c, a, plan, !o.consolidate_in_deck);
+  std::ostringstream s;
+  s << mapping_header(c, p, plan, o, "LAMMPS") << lammps_limitations(p, plan, out)
+    << lammps_parameters(c, a, plan, o);
+  if (o.consolidate_in_deck)
+    s << lammps_system(c, plan, o, out) << lammps_consolidation(c, plan, contact_gamma_n(c, plan))
+      << lammps_derived();
+  else
+    s << lammps_derived() << lammps_system(c, plan, o, out);
+  s << kLammpsWalls << lammps_servo() << lammps_damping(p, plan) << lammps_series_block(c, p, plan)
+    << lammps_run(o.consolidate_in_deck);
   out.deck = s.str();
   return out;
 }

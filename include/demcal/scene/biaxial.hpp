@@ -56,6 +56,11 @@ double servo_velocity(const World& world, WallSide side, double target_stress, d
 /// Compressive pressure on a wall from the particles [Pa].
 double wall_pressure(const World& world, WallSide side);
 
+/// The global damping ratio (translation and rotation) consolidation
+/// settles with: light, so the packing's slow collective modes relax at their
+/// own speed (biaxial.cpp; the exported decks' consolidation stage uses it).
+inline constexpr double kConsolidationDampingRatio = 0.02;
+
 /// Consolidate: frictionless servo compression to σ3 until static, then
 /// friction on and static again. Throws std::runtime_error if it cannot.
 /// Through the consolidation cache in consolidation_cache_dir() (the

@@ -46,6 +46,11 @@ struct ExportOptions {
   /// a monodisperse assembly gets one.
   int max_types = 8;
   std::string provenance;  ///< one line: where the parameters came from
+  /// LAMMPS only: the deck consolidates the prototype itself (a first stage
+  /// bringing it to isotropic sigma3 with demcal's servo, damping, friction
+  /// phases and static criterion; scene/biaxial.cpp), then loads it. The
+  /// assembly is then the prototype as generated.
+  bool consolidate_in_deck = false;
 };
 
 struct ExportResult {
