@@ -1,6 +1,7 @@
 // `demcal export PARAMS.json --format lammps|liggghts [-o FILE]`: an input
 // deck for the prototype run in another code, with the particle file it
-// reads (demcal's consolidated state of the prototype) next to it.
+// reads (demcal's consolidated state of the prototype) next to it. A 3D
+// params.json (spheres, triaxial test) gives the 3D deck of its REV.
 #include <filesystem>
 #include <iostream>
 
@@ -8,7 +9,9 @@
 #include "demcal/io/files.hpp"
 #include "demcal/scene/biaxial.hpp"
 #include "demcal/scene/run_output.hpp"
+#include "demcal/scene/triaxial.hpp"
 #include "demcal/upscaling/export.hpp"
+#include "demcal/upscaling/export_3d.hpp"
 #include "demcal/upscaling/params_file.hpp"
 #include "demcal/upscaling/rev.hpp"
 #include "demcal/upscaling/upscaling.hpp"
@@ -22,34 +25,99 @@ namespace demcal::cli {
 /// beyond a few thousand particles that takes minutes (reports/engines.md §8).
 constexpr int kDeckConsolidationAbove = 2000;
 
-int cmd_export(const ExportCmdOptions& o) {
-  namespace fs = std::filesystem;
-  const nlohmann::json params = read_params_file(o.params);
-  const RevParams rev = rev_params_from_json(params, o.params);
+namespace {
+
+namespace fs = std::filesystem;
+
+/// Where the deck goes: -o FILE or demcal-NAME.FORMAT, checked writable now
+/// (not after a consolidation); the data file is named after the deck.
+fs::path deck_destination(const ExportCmdOptions& o, const SceneConfig& config, ExportOptions& eo) {
   if (o.format != "lammps" && o.format != "liggghts")
     throw InputError("--format", "", "must be lammps or liggghts, got \"" + o.format + "\"");
+  const fs::path deck_fs(o.output.empty() ? "demcal-" + config.name + "." + o.format : o.output);
+  if (fs::is_directory(deck_fs))
+    throw InputError(deck_fs.string(), "", "is a folder; give a file name");
+  OutputFolder::check(deck_fs.has_parent_path() ? deck_fs.parent_path().string() : ".");
+  eo.format = o.format;
+  const std::string ext = deck_fs.extension().string();
+  const bool known = ext == ".lammps" || ext == ".liggghts" || ext == ".in" || ext == ".lmp";
+  eo.data_name = (known ? deck_fs.stem() : deck_fs.filename()).string() + ".data";
+  return deck_fs;
+}
+
+/// Writes the deck and the files it reads together (never a new deck beside
+/// an old data file) and says what was written and how to run it.
+void write_deck(const fs::path& deck_fs, const ExportCmdOptions& o, const ExportResult& r,
+                int particles, const char* what) {
+  const fs::path dir = deck_fs.has_parent_path() ? deck_fs.parent_path() : fs::path(".");
+  {
+    OutputFolder out(dir.string());
+    for (const auto& [name, content] : r.files) out.write(name, content);
+    out.write(deck_fs.filename().string(), r.deck);
+    out.commit();
+  }
+  std::cout << "wrote " << deck_fs.string() << " (" << o.format << ", " << particles << " " << what
+            << ", timestep " << r.dt << " s, " << r.steps << " steps, " << r.types
+            << " radius class(es))";
+  for (const auto& [name, content] : r.files) std::cout << ", " << (dir / name).string();
+  std::cout << "\n";
+  // What could not be carried over exactly: on stderr (diagnostics), once.
+  for (const auto& note : r.notes) std::cerr << "demcal export: note: " << note << "\n";
+  std::cout << "  run it in its folder: cd " << dir.string() << " && "
+            << (o.format == "lammps" ? "lmp" : "liggghts") << " -in " << deck_fs.filename().string()
+            << "\n";
+}
+
+/// A 3D params.json: the deck of the calibrated REV itself, consolidated by
+/// demcal's sphere kernel. Nstep is not scaled to another size: how it grows
+/// with N in 3D is not measured yet (`demcal scaling` is 2D), so a prototype
+/// size, file or law is refused rather than guessed.
+int export_3d(const ExportCmdOptions& o, const RevParams& rev, const SceneConfig& config) {
+  if (!o.prototype.empty() || (o.particles != 0 && o.particles != rev.particles) ||
+      !o.law.empty() || o.exponent > 0.0)
+    throw InputError(o.params, "dimension",
+                     "3D (spheres): the deck is the calibrated REV's own (" +
+                         std::to_string(rev.particles) +
+                         " spheres); --prototype, --particles, --law and --exponent need the 3D "
+                         "scaling law, which is not measured yet");
+  if (o.no_consolidate || o.consolidate_in == "deck")
+    throw InputError(o.no_consolidate ? "--no-consolidate" : "--consolidate-in", "",
+                     "3D: demcal consolidates the REV (the 3D deck has no consolidation stage)");
+  if (o.consolidate_in != "auto" && o.consolidate_in != "demcal")
+    throw InputError("--consolidate-in", "",
+                     "must be demcal, deck or auto, got \"" + o.consolidate_in + "\"");
+  Export3dOptions eo;
+  const fs::path deck_fs = deck_destination(o, config, eo);
+  eo.provenance = o.params + " (REV " + std::to_string(rev.particles) + " spheres, " +
+                  std::to_string(rev.params.steps) + " steps)";
+  const SphereAssembly assembly = make_sphere_assembly(config);
+  std::cerr << "demcal export: consolidating the " << assembly.size()
+            << " spheres of the REV to sigma3 with demcal's kernel\n";
+  const TriaxialState state = consolidate_triaxial(config, assembly);
+  std::cerr << "demcal export: consolidated in " << state.steps << " steps, " << state.wall_time_s
+            << " s\n";
+  const ExportResult r = export_3d_decks(config, rev.params, state, eo);
+  write_deck(deck_fs, o, r, state.world.size(), "spheres");
+  return 0;
+}
+
+}  // namespace
+
+int cmd_export(const ExportCmdOptions& o) {
+  const nlohmann::json params = read_params_file(o.params);
+  const RevParams rev = rev_params_from_json(params, o.params);
   const SceneConfig config = required_scene(params, o.params, o.config, o.sets);
+  if (config.dimension == 3) return export_3d(o, rev, config);
+  ExportOptions eo;
+  const fs::path deck_fs = deck_destination(o, config, eo);
   const ScalingLaw law = resolve_law(params, o.params, o.law, o.exponent);
   auto [file, particles] = named_prototype(params, o.prototype, o.particles);
   PrototypeSource source;
   Assembly proto = prototype_assembly(config, particles, file, &source);
   const AlgorithmSpec up = upscale(rev.params, rev.particles, proto.size(), law);
-
-  const std::string deck_path =
-      o.output.empty() ? "demcal-" + config.name + "." + o.format : o.output;
-  const fs::path deck_fs(deck_path);
-  if (fs::is_directory(deck_fs)) throw InputError(deck_path, "", "is a folder; give a file name");
-  // An unwritable destination fails now, not after the consolidation.
-  OutputFolder::check(deck_fs.has_parent_path() ? deck_fs.parent_path().string() : ".");
-  ExportOptions eo;
-  eo.format = o.format;
-  const std::string ext = deck_fs.extension().string();
-  const bool known = ext == ".lammps" || ext == ".liggghts" || ext == ".in" || ext == ".lmp";
-  eo.data_name = (known ? deck_fs.stem() : deck_fs.filename()).string() + ".data";
   eo.provenance = o.params + " (REV " + std::to_string(rev.particles) + " particles, " +
                   std::to_string(rev.params.steps) + " steps; " + law.name() + " law, exponent " +
                   std::to_string(law.exponent) + ")";
-
   if (o.consolidate_in != "auto" && o.consolidate_in != "demcal" && o.consolidate_in != "deck")
     throw InputError("--consolidate-in", "",
                      "must be demcal, deck or auto, got \"" + o.consolidate_in + "\"");
@@ -79,25 +147,7 @@ int cmd_export(const ExportCmdOptions& o) {
     proto = assembly_of(state.world);
   }
   const ExportResult r = export_deck(config, up, proto, eo);
-  const fs::path dir = deck_fs.has_parent_path() ? deck_fs.parent_path() : fs::path(".");
-  {
-    // The deck and the files it reads (data file, meshes) replace those of
-    // an earlier export together: never a new deck beside an old data file.
-    OutputFolder out(dir.string());
-    for (const auto& [name, content] : r.files) out.write(name, content);
-    out.write(deck_fs.filename().string(), r.deck);
-    out.commit();
-  }
-  std::cout << "wrote " << deck_path << " (" << o.format << ", " << proto.size()
-            << " particles, timestep " << r.dt << " s, " << r.steps << " steps, " << r.types
-            << " radius class(es))";
-  for (const auto& [name, content] : r.files) std::cout << ", " << (dir / name).string();
-  std::cout << "\n";
-  // What could not be carried over exactly: on stderr (diagnostics), once.
-  for (const auto& note : r.notes) std::cerr << "demcal export: note: " << note << "\n";
-  std::cout << "  run it in its folder: cd " << dir.string() << " && "
-            << (o.format == "lammps" ? "lmp" : "liggghts") << " -in " << deck_fs.filename().string()
-            << "\n";
+  write_deck(deck_fs, o, r, proto.size(), "particles");
   return 0;
 }
 

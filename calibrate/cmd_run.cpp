@@ -23,15 +23,15 @@
 
 namespace demcal::cli {
 
-// Every command but run, check and calibrate works on 2D scenes only for
-// now: the sweep, upscaling and export of 3D scenes are issue #18.
+// Every command but run, check, calibrate and export works on 2D scenes only
+// for now: the sweep, REV, upscaling and verify of 3D scenes are issue #18.
 SceneConfig load_scene(const std::string& path, const std::vector<std::string>& sets) {
   SceneConfig config = load_config(path, sets);
   if (config.dimension != 2)
     throw InputError(config.source, "dimension",
                      "3D scenes (\"dimension\": 3) are accepted by `demcal run`, `demcal "
-                     "check` and `demcal calibrate` only for now; the other commands are issue "
-                     "#18");
+                     "check`, `demcal calibrate` and `demcal export` only for now; the other "
+                     "commands are issue #18");
   return config;
 }
 

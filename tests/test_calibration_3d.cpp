@@ -93,3 +93,67 @@ TEST(Calibration3D, CommandWritesParamsWithTheDimensionAndResumeReusesEveryTrial
       << again.out;
   EXPECT_EQ(test::read_text(out / "params.json"), bytes);  // --jobs and --resume change nothing
 }
+
+// `demcal export` on a 3D params.json: the deck of the calibrated REV with
+// params.json's α, Nstep and ζ_t (the library's deck against demcal is
+// tests/test_export_3d.cpp; this checks the command carries the calibrated
+// parameters through). A size to scale to is refused: the 3D Nstep law is
+// not measured yet.
+TEST(Calibration3D, ExportWritesTheCalibratedRevsDeckAndRefusesToScaleIt) {
+  test::TempDir dir("export3d");
+  const std::string config = test::write_text(dir / "fcc_2x2x2.json", kFcc2);
+  const fs::path out = dir / "out";
+  const test::RunResult cal =
+      test::run_demcal({"calibrate", config, "-q", "-o", out.string(), "--jobs", "2"}, dir.path());
+  ASSERT_EQ(cal.status, 0) << cal.err;
+  const std::string params = (out / "params.json").string();
+
+  const test::RunResult refused = test::run_demcal(
+      {"export", params, "--particles", "1000", "-o", (dir / "big" / "fcc.lammps").string()},
+      dir.path());
+  EXPECT_EQ(refused.status, 2) << refused.err;
+  EXPECT_NE(refused.err.find("3D scaling law"), std::string::npos) << refused.err;
+  EXPECT_FALSE(fs::exists(dir / "big"));
+
+  const fs::path deck = dir / "deck" / "fcc.lammps";
+  const test::RunResult exported =
+      test::run_demcal({"export", params, "-o", deck.string()}, dir.path());
+  ASSERT_EQ(exported.status, 0) << exported.err;
+  ASSERT_TRUE(fs::exists(deck));
+  ASSERT_TRUE(fs::exists(dir / "deck" / "fcc.data"));
+  EXPECT_NE(exported.out.find("32 spheres"), std::string::npos) << exported.out;
+
+  const std::string lmp = test::find_on_path("lmp");
+  if (lmp.empty()) GTEST_SKIP() << "lmp (Debian package lammps) is not installed: deck not run";
+  const test::RunResult ran =
+      test::run_program(lmp, {"-in", "fcc.lammps", "-screen", "none"}, dir / "deck");
+  ASSERT_EQ(ran.status, 0) << ran.err;
+  // The deck appends "# peak_axial_stress = P" to its series at the end.
+  const std::string series = test::read_text(dir / "deck" / "series.csv");
+  const std::string tag = "# peak_axial_stress = ";
+  const size_t at = series.rfind(tag);
+  ASSERT_NE(at, std::string::npos) << "no peak in the deck's series.csv";
+  const double lammps_peak = std::stod(series.substr(at + tag.size()));
+
+  // demcal with the same parameters and ζ_r = 0 (LAMMPS 2021 has no
+  // rotational viscous fix; the deck says so).
+  const nlohmann::json rev = test::read_json(out / "params.json").at("rev");
+  const auto set = [&](const char* key, const nlohmann::json& v) {
+    return std::string("algorithm.") + key + "=" + v.dump();
+  };
+  const test::RunResult run = test::run_demcal(
+      {"run", config, "-o", (dir / "run").string(), "--set", set("dt_ratio", rev.at("dt_ratio")),
+       "--set", set("steps", rev.at("steps")), "--set",
+       set("damping_ratio_translation", rev.at("damping_ratio_translation")), "--set",
+       "algorithm.damping_ratio_rotation=0"},
+      dir.path());
+  ASSERT_EQ(run.status == 0 || run.status == 1, true) << run.err;
+  const double demcal_peak =
+      -test::read_json(dir / "run" / "summary.json").at("peak").at("stress_zz").get<double>();
+  // Same sample, same law, same loading time: the two integrators differ in
+  // the damping scheme (explicit in LAMMPS, at α·f for Nstep/f steps), which
+  // moves the peak by well under the 1 % the issue asks (−0.09 % on
+  // fcc_4x4x4, reports/engines-3d.md).
+  EXPECT_LT(relative(lammps_peak, demcal_peak), 0.01)
+      << "LAMMPS " << lammps_peak << " Pa, demcal " << demcal_peak << " Pa";
+}
