@@ -13,6 +13,7 @@
 
 #include "demcal/io/format.hpp"
 #include "demcal/io/input_error.hpp"
+#include "demcal/scene/biaxial.hpp"
 
 namespace demcal {
 
@@ -142,10 +143,9 @@ TriaxialState consolidate_triaxial(const SceneConfig& config, const SphereAssemb
   const double mu = config.material.particle.friction;
   // Light damping for the fastest relaxation of the slow collective modes
   // (biaxial.cpp, consolidate(): measured there).
-  constexpr double kConsolidationDamping = 0.02;
   AlgorithmSpec settle;  // α = 0.2, the paper's start step
-  settle.damping_ratio_translation = kConsolidationDamping;
-  settle.damping_ratio_rotation = kConsolidationDamping;
+  settle.damping_ratio_translation = kConsolidationDampingRatio;
+  settle.damping_ratio_rotation = kConsolidationDampingRatio;
   settle.lock_rotation = config.algorithm.lock_rotation;
   world.set_integration(integration_for(world, settle));
   // Only the blow-up checks stay on while the walls work on the sample
