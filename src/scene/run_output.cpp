@@ -22,35 +22,81 @@ std::string series_csv(const std::vector<MonitorPoint>& series) {
   return s.str();
 }
 
-std::string world_vtk(const World& world, const std::string& title) {
-  const int n = world.size();
-  const auto contacts = world.contacts();
+namespace {
+
+// The legacy-VTK polydata both dimensions write: particles as vertices,
+// contacts as lines, then per-particle and per-cell fields (a vertex cell
+// per particle, then a line per contact; particles carry 0 in the contact
+// fields).
+template <class Contacts, class Point>
+void vtk_geometry(std::ostream& s, const std::string& title, int n, const Contacts& contacts,
+                  Point point) {
   const size_t nc = contacts.size();
-  std::ostringstream s;
-  s << std::setprecision(10);
   s << "# vtk DataFile Version 3.0\n" << title << "\nASCII\nDATASET POLYDATA\n";
   s << "POINTS " << n << " double\n";
-  for (int i = 0; i < n; ++i) s << world.x()[i] << ' ' << world.y()[i] << " 0\n";
+  for (int i = 0; i < n; ++i) s << point(i) << '\n';
   s << "VERTICES " << n << ' ' << 2 * n << '\n';
   for (int i = 0; i < n; ++i) s << "1 " << i << '\n';
   s << "LINES " << nc << ' ' << 3 * nc << '\n';
   for (const auto& c : contacts) s << "2 " << c.i << ' ' << c.j << '\n';
   s << "POINT_DATA " << n << '\n';
-  s << "SCALARS radius double 1\nLOOKUP_TABLE default\n";
-  for (int i = 0; i < n; ++i) s << world.radius()[i] << '\n';
-  s << "SCALARS rotation double 1\nLOOKUP_TABLE default\n";
-  for (int i = 0; i < n; ++i) s << world.rotation()[i] << '\n';
-  s << "SCALARS angular_velocity double 1\nLOOKUP_TABLE default\n";
-  for (int i = 0; i < n; ++i) s << world.omega()[i] << '\n';
-  s << "VECTORS velocity double\n";
-  for (int i = 0; i < n; ++i) s << world.vx()[i] << ' ' << world.vy()[i] << " 0\n";
-  s << "CELL_DATA " << n + nc << '\n';
+}
+
+template <class Value>
+void vtk_point_scalar(std::ostream& s, const char* name, int n, Value value) {
+  s << "SCALARS " << name << " double 1\nLOOKUP_TABLE default\n";
+  for (int i = 0; i < n; ++i) s << value(i) << '\n';
+}
+
+template <class Value>
+void vtk_point_vector(std::ostream& s, const char* name, int n, Value value) {
+  s << "VECTORS " << name << " double\n";
+  for (int i = 0; i < n; ++i) s << value(i) << '\n';
+}
+
+// The contacts' normal and tangential force magnitudes as cell fields.
+template <class Contacts, class Tangential>
+void vtk_contact_forces(std::ostream& s, int n, const Contacts& contacts, Tangential ft) {
+  s << "CELL_DATA " << n + contacts.size() << '\n';
   s << "SCALARS normal_force double 1\nLOOKUP_TABLE default\n";
   for (int i = 0; i < n; ++i) s << "0\n";
   for (const auto& c : contacts) s << c.fn << '\n';
   s << "SCALARS tangential_force double 1\nLOOKUP_TABLE default\n";
   for (int i = 0; i < n; ++i) s << "0\n";
-  for (const auto& c : contacts) s << c.ft << '\n';
+  for (const auto& c : contacts) s << ft(c) << '\n';
+}
+
+// "x y z" of a point or vector, at the stream's precision.
+struct Triple {
+  double x, y, z;
+};
+std::ostream& operator<<(std::ostream& s, const Triple& t) {
+  return s << t.x << ' ' << t.y << ' ' << t.z;
+}
+// A 2D point or vector in 3D: z written as the integer 0, as ever (the
+// files compare byte for byte).
+struct Planar {
+  double x, y;
+};
+std::ostream& operator<<(std::ostream& s, const Planar& p) {
+  return s << p.x << ' ' << p.y << " 0";
+}
+
+}  // namespace
+
+std::string world_vtk(const World& world, const std::string& title) {
+  const int n = world.size();
+  const auto contacts = world.contacts();
+  const auto x = world.x(), y = world.y(), r = world.radius();
+  const auto vx = world.vx(), vy = world.vy(), rot = world.rotation(), w = world.omega();
+  std::ostringstream s;
+  s << std::setprecision(10);
+  vtk_geometry(s, title, n, contacts, [&](int i) { return Planar{x[i], y[i]}; });
+  vtk_point_scalar(s, "radius", n, [&](int i) { return r[i]; });
+  vtk_point_scalar(s, "rotation", n, [&](int i) { return rot[i]; });
+  vtk_point_scalar(s, "angular_velocity", n, [&](int i) { return w[i]; });
+  vtk_point_vector(s, "velocity", n, [&](int i) { return Planar{vx[i], vy[i]}; });
+  vtk_contact_forces(s, n, contacts, [](const auto& c) { return c.ft; });
   return s.str();
 }
 
@@ -84,35 +130,17 @@ std::string series_csv(const std::vector<TriaxialPoint>& series) {
 std::string world_vtk(const SphereWorld& world, const std::string& title) {
   const int n = world.size();
   const auto contacts = world.contacts();
-  const size_t nc = contacts.size();
+  const auto x = world.x(), y = world.y(), z = world.z(), r = world.radius();
+  const auto vx = world.vx(), vy = world.vy(), vz = world.vz();
+  const auto wx = world.omega_x(), wy = world.omega_y(), wz = world.omega_z();
   std::ostringstream s;
   s << std::setprecision(10);
-  s << "# vtk DataFile Version 3.0\n" << title << "\nASCII\nDATASET POLYDATA\n";
-  s << "POINTS " << n << " double\n";
-  for (int i = 0; i < n; ++i)
-    s << world.x()[i] << ' ' << world.y()[i] << ' ' << world.z()[i] << '\n';
-  s << "VERTICES " << n << ' ' << 2 * n << '\n';
-  for (int i = 0; i < n; ++i) s << "1 " << i << '\n';
-  s << "LINES " << nc << ' ' << 3 * nc << '\n';
-  for (const auto& c : contacts) s << "2 " << c.i << ' ' << c.j << '\n';
-  s << "POINT_DATA " << n << '\n';
-  s << "SCALARS radius double 1\nLOOKUP_TABLE default\n";
-  for (int i = 0; i < n; ++i) s << world.radius()[i] << '\n';
-  s << "SCALARS diameter double 1\nLOOKUP_TABLE default\n";
-  for (int i = 0; i < n; ++i) s << 2.0 * world.radius()[i] << '\n';
-  s << "VECTORS velocity double\n";
-  for (int i = 0; i < n; ++i)
-    s << world.vx()[i] << ' ' << world.vy()[i] << ' ' << world.vz()[i] << '\n';
-  s << "VECTORS angular_velocity double\n";
-  for (int i = 0; i < n; ++i)
-    s << world.omega_x()[i] << ' ' << world.omega_y()[i] << ' ' << world.omega_z()[i] << '\n';
-  s << "CELL_DATA " << n + nc << '\n';
-  s << "SCALARS normal_force double 1\nLOOKUP_TABLE default\n";
-  for (int i = 0; i < n; ++i) s << "0\n";
-  for (const auto& c : contacts) s << c.fn << '\n';
-  s << "SCALARS tangential_force double 1\nLOOKUP_TABLE default\n";
-  for (int i = 0; i < n; ++i) s << "0\n";
-  for (const auto& c : contacts) s << c.tangential.norm() << '\n';
+  vtk_geometry(s, title, n, contacts, [&](int i) { return Triple{x[i], y[i], z[i]}; });
+  vtk_point_scalar(s, "radius", n, [&](int i) { return r[i]; });
+  vtk_point_scalar(s, "diameter", n, [&](int i) { return 2.0 * r[i]; });
+  vtk_point_vector(s, "velocity", n, [&](int i) { return Triple{vx[i], vy[i], vz[i]}; });
+  vtk_point_vector(s, "angular_velocity", n, [&](int i) { return Triple{wx[i], wy[i], wz[i]}; });
+  vtk_contact_forces(s, n, contacts, [](const auto& c) { return c.tangential.norm(); });
   return s.str();
 }
 
