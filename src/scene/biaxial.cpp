@@ -6,6 +6,7 @@
 #include <limits>
 #include <stdexcept>
 
+#include "consolidation_loop.hpp"
 #include "demcal/io/format.hpp"
 #include "demcal/scene/consolidation_cache.hpp"
 
@@ -104,68 +105,13 @@ ConsolidatedState consolidate_fresh(const SceneConfig& config, const Assembly& a
     const double dt0 = integration_for(world, settle).dt;
     settle.dt_ratio *= dashpot_step_factor(gamma_max / dt0);
   }
-  world.set_integration(integration_for(world, settle));
-  // Only the blow-up checks (non-finite state, overlap beyond the limit) stay
-  // on during consolidation. With light damping, the energy checks read the
-  // walls' work as energy made by the integrator: the kinetic energy a
-  // servo wall pumps into a gas exceeds anything the springs have stored,
-  // and the ledger's sampled damping and wall powers alias when velocities
-  // oscillate at the contact frequency (a false "energy created" on the
-  // hexagonal REVs). They guard against runs that look plausible while
-  // being dynamic; consolidation must reach the static state demanded
-  // below, which no rattling or growing run does.
-  const KernelOptions kernel_options = world.options();
-  KernelOptions no_ledger = kernel_options;
-  no_ledger.max_energy_created = std::numeric_limits<double>::infinity();
-  no_ledger.max_energy_ratio = std::numeric_limits<double>::infinity();
-  world.set_options(no_ledger);
-
-  const double sigma3 = test.lateral_stress;
-  constexpr int kCheckEvery = 200;
-  int64_t steps = 0;
-  const int64_t max_steps = test.consolidation_max_steps;
-  // Phase 0: frictionless compression (a dense packing without friction
-  // finds its densest state); phase 1: friction on, static again.
-  bool critical = false;
-  for (int phase = 0; phase < 2; ++phase) {
-    world.set_particle_friction(phase == 0 ? 0.0 : mu);
-    bool done = false;
-    while (!done) {
-      for (int k = 0; k < kCheckEvery; ++k) {
-        for (int s = 0; s < 4; ++s)
-          world.wall(static_cast<WallSide>(s)).velocity =
-              servo_velocity(world, static_cast<WallSide>(s), sigma3, test.servo_gain);
-        if (!world.step(1))
-          throw std::runtime_error(std::string("consolidation diverged: ") +
-                                   to_string(world.divergence()));
-      }
-      steps += kCheckEvery;
-      // Light damping relaxes slow collective modes fast, but where the
-      // residual is noise rather than slow modes (a very low sigma3, where
-      // round-off forces are a sizeable share of the contact forces) it
-      // leaves that noise undamped. If a quarter of the budget has not
-      // brought the sample to rest, finish with critical damping (the
-      // paper's start point), which did before.
-      if (!critical && steps >= max_steps / 4) {
-        critical = true;
-        settle.damping_ratio_translation = settle.damping_ratio_rotation = 1.0;
-        world.set_integration(integration_for(world, settle));
-      }
-      double err = 0.0;
-      for (int s = 0; s < 4; ++s)
-        err = std::max(err,
-                       std::abs(wall_pressure(world, static_cast<WallSide>(s)) - sigma3) / sigma3);
-      const double ufr = world.measure().unbalanced_force_ratio;
-      state.stress_error = err;
-      state.unbalanced_ratio = ufr;
-      done = err < test.consolidation_tolerance && ufr < test.consolidation_unbalanced;
-      if (steps >= max_steps) break;
-    }
-    if (!done) break;
-    state.converged = phase == 1;
-  }
-  world.set_options(kernel_options);
-  for (int s = 0; s < 4; ++s) world.wall(static_cast<WallSide>(s)).velocity = 0.0;
+  const detail::ConsolidationOutcome o = detail::run_consolidation<WallSide, 4>(
+      world, test, mu, settle,
+      [](const World& w, const AlgorithmSpec& a) { return integration_for(w, a); },
+      [](const detail::ConsolidationOutcome&) {});
+  state.converged = o.converged;
+  state.stress_error = o.stress_error;
+  state.unbalanced_ratio = o.unbalanced_ratio;
   for (int i = 0; i < world.size(); ++i) world.set_velocity(i, 0.0, 0.0, 0.0);
   world.update_forces();
   // Every trial starts from this state: number the particles so that the
@@ -173,14 +119,9 @@ ConsolidatedState consolidate_fresh(const SceneConfig& config, const Assembly& a
   world.reorder(world.block_friendly_order());
   state.width0 = world.width();
   state.height0 = world.height();
-  state.steps = steps;
+  state.steps = o.steps;
   state.wall_time_s = seconds_since(t0);
-  if (!state.converged)
-    throw std::runtime_error("consolidation did not reach a static state in " +
-                             std::to_string(max_steps) + " steps (wall stress error " +
-                             std::to_string(state.stress_error) + ", unbalanced-force ratio " +
-                             std::to_string(state.unbalanced_ratio) +
-                             "); raise test.consolidation_max_steps or loosen the tolerances");
+  if (!state.converged) throw std::runtime_error(detail::consolidation_failure(o, test));
   return state;
 }
 

@@ -11,6 +11,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "consolidation_loop.hpp"
 #include "demcal/io/format.hpp"
 #include "demcal/io/input_error.hpp"
 #include "demcal/scene/biaxial.hpp"
@@ -64,13 +65,6 @@ void check_sphere_overlap(const SceneConfig& config, const SphereAssembly& a) {
       << " m, is not resolved by positions up to " << coordinate << " m (round-off " << roundoff
       << " m must stay below a tenth of consolidation_tolerance of it); got " << sigma3;
   throw InputError(config.source, "test.lateral_stress", msg.str());
-}
-
-std::string percent(double v) {
-  std::ostringstream s;
-  s.precision(3);
-  s << 100.0 * v << " %";
-  return s.str();
 }
 
 }  // namespace
@@ -147,72 +141,24 @@ TriaxialState consolidate_triaxial(const SceneConfig& config, const SphereAssemb
   settle.damping_ratio_translation = kConsolidationDampingRatio;
   settle.damping_ratio_rotation = kConsolidationDampingRatio;
   settle.lock_rotation = config.algorithm.lock_rotation;
-  world.set_integration(integration_for(world, settle));
-  // Only the blow-up checks stay on while the walls work on the sample
-  // (biaxial.cpp says why the energy checks cannot).
-  const KernelOptions kernel_options = world.options();
-  KernelOptions no_ledger = kernel_options;
-  no_ledger.max_energy_created = std::numeric_limits<double>::infinity();
-  no_ledger.max_energy_ratio = std::numeric_limits<double>::infinity();
-  world.set_options(no_ledger);
-
-  const double sigma3 = test.lateral_stress;
-  constexpr int kCheckEvery = 200;
-  int64_t steps = 0;
-  const int64_t max_steps = test.consolidation_max_steps;
-  bool critical = false;
-  int phase = 0;
-  for (; phase < 2; ++phase) {
-    world.set_particle_friction(phase == 0 ? 0.0 : mu);
-    bool done = false;
-    while (!done) {
-      for (int k = 0; k < kCheckEvery; ++k) {
-        for (int s = 0; s < 6; ++s) {
-          const auto side = static_cast<SphereWallSide>(s);
-          world.wall(side).velocity = servo_velocity(world, side, sigma3, test.servo_gain);
-        }
-        if (!world.step(1))
-          throw std::runtime_error(std::string("consolidation diverged: ") +
-                                   to_string(world.divergence()));
-      }
-      steps += kCheckEvery;
-      // The 2D fallback: critical damping for the last three quarters.
-      if (!critical && steps >= max_steps / 4) {
-        critical = true;
-        settle.damping_ratio_translation = settle.damping_ratio_rotation = 1.0;
-        world.set_integration(integration_for(world, settle));
-      }
-      double err = 0.0;
-      for (int s = 0; s < 6; ++s)
-        err = std::max(
-            err, std::abs(wall_pressure(world, static_cast<SphereWallSide>(s)) - sigma3) / sigma3);
-      const double ufr = world.measure().unbalanced_force_ratio;
-      state.stress_error = err;
-      state.unbalanced_ratio = ufr;
-      if (progress) progress({phase, steps, max_steps, err, ufr});
-      done = err < test.consolidation_tolerance && ufr < test.consolidation_unbalanced;
-      if (steps >= max_steps) break;
-    }
-    if (!done) break;
-    state.converged = phase == 1;
-  }
-  world.set_options(kernel_options);
-  for (int s = 0; s < 6; ++s) world.wall(static_cast<SphereWallSide>(s)).velocity = 0.0;
+  const detail::ConsolidationOutcome o = detail::run_consolidation<SphereWallSide, 6>(
+      world, test, mu, settle,
+      [](const SphereWorld& w, const AlgorithmSpec& a) { return integration_for(w, a); },
+      [&](const detail::ConsolidationOutcome& c) {
+        if (progress)
+          progress(
+              {c.phase, c.steps, test.consolidation_max_steps, c.stress_error, c.unbalanced_ratio});
+      });
+  state.converged = o.converged;
+  state.stress_error = o.stress_error;
+  state.unbalanced_ratio = o.unbalanced_ratio;
   for (int i = 0; i < world.size(); ++i)
     world.set_velocity(i, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
   world.update_forces();
   for (int axis = 0; axis < 3; ++axis) state.extent0[axis] = world.extent(axis);
-  state.steps = steps;
+  state.steps = o.steps;
   state.wall_time_s = seconds_since(t0);
-  if (!state.converged)
-    throw std::runtime_error("consolidation did not reach a static state in " +
-                             std::to_string(max_steps) + " steps (" +
-                             (phase == 0 ? "frictionless phase" : "friction phase") +
-                             ", largest wall stress error " + percent(state.stress_error) +
-                             " of sigma3, tolerance " + percent(test.consolidation_tolerance) +
-                             "; unbalanced-force ratio " + std::to_string(state.unbalanced_ratio) +
-                             ", tolerance " + std::to_string(test.consolidation_unbalanced) +
-                             "); raise test.consolidation_max_steps or loosen the tolerances");
+  if (!state.converged) throw std::runtime_error(detail::consolidation_failure(o, test));
   return state;
 }
 

@@ -1,0 +1,114 @@
+// The consolidation both protocols run (biaxial.cpp for disks, triaxial.cpp
+// for spheres), written once: every wall servoed at σ3; phase 0
+// frictionless (a packing without friction finds its densest state), phase
+// 1 friction on, each until static — every wall stress within
+// test.consolidation_tolerance of σ3 and the unbalanced-force ratio below
+// test.consolidation_unbalanced, checked every kCheckEvery steps. Light
+// damping relaxes slow collective modes fast, but where the residual is
+// noise rather than slow modes (a very low σ3, where round-off forces are a
+// sizeable share of the contact forces) it leaves that noise undamped: if a
+// quarter of the budget has not brought the sample to rest, the rest runs
+// at critical damping (the paper's start point). Private to src/scene.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+#include "demcal/io/format.hpp"
+#include "demcal/kernel/world.hpp"
+#include "demcal/scene/config.hpp"
+
+namespace demcal::detail {
+
+struct ConsolidationOutcome {
+  int64_t steps = 0;
+  int phase = 0;  ///< the phase it ended in (0 frictionless, 1 friction on)
+  bool converged = false;
+  double stress_error = 0.0;      ///< max |p − σ3|/σ3 over the walls, last check
+  double unbalanced_ratio = 0.0;  ///< unbalanced-force ratio, last check
+};
+
+/// Runs the consolidation on `world` (its integration set from `settle`
+/// by `integration_for`, which the critical-damping fallback calls again),
+/// with `walls` walls of type `Side`, and calls on_check(outcome) after
+/// every check. Only the blow-up checks (non-finite state, overlap beyond
+/// the limit) stay on meanwhile: with light damping the energy checks read
+/// the walls' work as energy made by the integrator — the kinetic energy a
+/// servo wall pumps into a gas exceeds anything the springs have stored,
+/// and the ledger's sampled damping and wall powers alias when velocities
+/// oscillate at the contact frequency (a false "energy created" on the
+/// hexagonal REVs). Consolidation must reach the static state demanded,
+/// which no rattling or growing run does. Throws std::runtime_error when
+/// the kernel diverges; the caller decides what non-convergence means.
+template <class Side, int walls, class Sample, class IntegrationFor, class OnCheck>
+ConsolidationOutcome run_consolidation(Sample& world, const TestSpec& test, double friction,
+                                       AlgorithmSpec settle, IntegrationFor integration_for,
+                                       OnCheck on_check) {
+  world.set_integration(integration_for(world, settle));
+  const KernelOptions kernel_options = world.options();
+  KernelOptions no_ledger = kernel_options;
+  no_ledger.max_energy_created = std::numeric_limits<double>::infinity();
+  no_ledger.max_energy_ratio = std::numeric_limits<double>::infinity();
+  world.set_options(no_ledger);
+
+  const double sigma3 = test.lateral_stress;
+  constexpr int kCheckEvery = 200;
+  const int64_t max_steps = test.consolidation_max_steps;
+  ConsolidationOutcome out;
+  bool critical = false;
+  for (out.phase = 0; out.phase < 2; ++out.phase) {
+    world.set_particle_friction(out.phase == 0 ? 0.0 : friction);
+    bool done = false;
+    while (!done) {
+      for (int k = 0; k < kCheckEvery; ++k) {
+        for (int s = 0; s < walls; ++s) {
+          const auto side = static_cast<Side>(s);
+          world.wall(side).velocity = servo_velocity(world, side, sigma3, test.servo_gain);
+        }
+        if (!world.step(1))
+          throw std::runtime_error(std::string("consolidation diverged: ") +
+                                   to_string(world.divergence()));
+      }
+      out.steps += kCheckEvery;
+      if (!critical && out.steps >= max_steps / 4) {
+        critical = true;
+        settle.damping_ratio_translation = settle.damping_ratio_rotation = 1.0;
+        world.set_integration(integration_for(world, settle));
+      }
+      double err = 0.0;
+      for (int s = 0; s < walls; ++s)
+        err = std::max(err, std::abs(wall_pressure(world, static_cast<Side>(s)) - sigma3) / sigma3);
+      out.stress_error = err;
+      out.unbalanced_ratio = world.measure().unbalanced_force_ratio;
+      on_check(out);
+      done = err < test.consolidation_tolerance &&
+             out.unbalanced_ratio < test.consolidation_unbalanced;
+      if (out.steps >= max_steps) break;
+    }
+    if (!done) break;
+    out.converged = out.phase == 1;
+  }
+  if (out.phase > 1) out.phase = 1;
+  world.set_options(kernel_options);
+  for (int s = 0; s < walls; ++s) world.wall(static_cast<Side>(s)).velocity = 0.0;
+  return out;
+}
+
+/// What a consolidation that did not converge reached, for its error.
+inline std::string consolidation_failure(const ConsolidationOutcome& o, const TestSpec& test) {
+  const auto percent = [](double v) { return num(100.0 * v, 3) + " %"; };
+  return "consolidation did not reach a static state in " +
+         std::to_string(test.consolidation_max_steps) + " steps (" +
+         (o.phase == 0 ? "frictionless phase" : "friction phase") + ", largest wall stress error " +
+         percent(o.stress_error) + " of sigma3, tolerance " +
+         percent(test.consolidation_tolerance) + "; unbalanced-force ratio " +
+         std::to_string(o.unbalanced_ratio) + ", tolerance " +
+         std::to_string(test.consolidation_unbalanced) +
+         "); raise test.consolidation_max_steps or loosen the tolerances";
+}
+
+}  // namespace demcal::detail
