@@ -6,9 +6,9 @@
 #include <limits>
 #include <stdexcept>
 
-#include "consolidation_loop.hpp"
 #include "demcal/io/format.hpp"
 #include "demcal/scene/consolidation_cache.hpp"
+#include "protocol_steps.hpp"
 
 namespace demcal {
 
@@ -146,12 +146,7 @@ ConsolidatedState consolidate(const SceneConfig& config, const Assembly& assembl
 }
 
 double estimated_stable_dt_ratio(const ConsolidatedState& state, const AlgorithmSpec& algorithm) {
-  World probe = state.world;
-  AlgorithmSpec a = algorithm;
-  a.dt_ratio = std::min(a.dt_ratio, 0.1);  // any valid step: the estimate does not use it
-  probe.set_integration(integration_for(probe, a));
-  probe.update_forces();
-  return probe.stability_estimate().dt_ratio_stable;
+  return detail::stable_dt_ratio_of<World>(state.world, algorithm, integration_for);
 }
 
 LoadingResult run_loading(const ConsolidatedState& start, const TestSpec& test,
@@ -160,17 +155,11 @@ LoadingResult run_loading(const ConsolidatedState& start, const TestSpec& test,
   const auto t0 = std::chrono::steady_clock::now();
   World world = start.world;
   LoadingResult out;
-  out.particles = world.size();
-  out.integration = integration_for(world, algorithm);
-  world.set_integration(out.integration);
-  out.scales = world.reference_scales();
-  const double dt = out.integration.dt;
-  const int64_t nstep = algorithm.steps;
-  out.steps_planned = nstep;
-  const double sigma3 = test.lateral_stress;
   const double h0 = start.height0;
-  const double top_velocity = -test.vertical_strain * h0 / (static_cast<double>(nstep) * dt);
-  out.strain_rate = test.vertical_strain / (static_cast<double>(nstep) * dt);
+  const double top_velocity =
+      detail::start_loading(world, out, algorithm, test, h0, integration_for);
+  const int64_t nstep = algorithm.steps;
+  const double sigma3 = test.lateral_stress;
   world.wall(kBottom).velocity = 0.0;
   world.wall(kTop).velocity = top_velocity;
 
@@ -181,14 +170,7 @@ LoadingResult run_loading(const ConsolidatedState& start, const TestSpec& test,
     MonitorPoint p;
     p.step = step;
     p.strain_yy = (world.height() - h0) / h0;
-    p.b = ms.boundary_stress;
-    p.sigma = ms.homogenized_stress;
-    p.kinetic_energy = ms.kinetic_energy_translation + ms.kinetic_energy_rotation;
-    p.kinetic_energy_rotation = ms.kinetic_energy_rotation;
-    p.elastic_energy = ms.elastic_energy;
-    p.unbalanced_force_ratio = ms.unbalanced_force_ratio;
-    p.inertial_number = ms.inertial_number;
-    p.coordination_number = ms.coordination_number;
+    detail::copy_measures(p, ms);
     const double lateral = 0.5 * (wall_pressure(world, kLeft) + wall_pressure(world, kRight));
     p.lateral_stress_error = (lateral - sigma3) / sigma3;
     p.left = world.wall(kLeft).position;

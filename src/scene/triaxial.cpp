@@ -11,10 +11,10 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "consolidation_loop.hpp"
 #include "demcal/io/format.hpp"
 #include "demcal/io/input_error.hpp"
 #include "demcal/scene/biaxial.hpp"
+#include "protocol_steps.hpp"
 
 namespace demcal {
 
@@ -163,12 +163,7 @@ TriaxialState consolidate_triaxial(const SceneConfig& config, const SphereAssemb
 }
 
 double estimated_stable_dt_ratio(const TriaxialState& state, const AlgorithmSpec& algorithm) {
-  SphereWorld probe = state.world;
-  AlgorithmSpec a = algorithm;
-  a.dt_ratio = std::min(a.dt_ratio, 0.1);  // any valid step: the estimate does not use it
-  probe.set_integration(integration_for(probe, a));
-  probe.update_forces();
-  return probe.stability_estimate().dt_ratio_stable;
+  return detail::stable_dt_ratio_of<SphereWorld>(state.world, algorithm, integration_for);
 }
 
 TriaxialResult run_triaxial_loading(const TriaxialState& start, const TestSpec& test,
@@ -177,18 +172,13 @@ TriaxialResult run_triaxial_loading(const TriaxialState& start, const TestSpec& 
   const auto t0 = std::chrono::steady_clock::now();
   SphereWorld world = start.world;
   TriaxialResult out;
-  out.particles = world.size();
-  out.integration = integration_for(world, algorithm);
-  world.set_integration(out.integration);
-  out.scales = world.reference_scales();
-  const double dt = out.integration.dt;
-  const int64_t nstep = algorithm.steps;
-  out.steps_planned = nstep;
-  const double sigma3 = test.lateral_stress;
   const double h0 = start.extent0[2];
-  out.strain_rate = test.vertical_strain / (static_cast<double>(nstep) * dt);
+  const double top_velocity =
+      detail::start_loading(world, out, algorithm, test, h0, integration_for);
+  const int64_t nstep = algorithm.steps;
+  const double sigma3 = test.lateral_stress;
   world.wall(kZMin).velocity = 0.0;
-  world.wall(kZMax).velocity = -test.vertical_strain * h0 / (static_cast<double>(nstep) * dt);
+  world.wall(kZMax).velocity = top_velocity;
 
   const int m = test.monitor_points;
   out.series.reserve(m + 1);
@@ -197,14 +187,7 @@ TriaxialResult run_triaxial_loading(const TriaxialState& start, const TestSpec& 
     TriaxialPoint p;
     p.step = step;
     p.strain_zz = (world.extent(2) - h0) / h0;
-    p.b = ms.boundary_stress;
-    p.sigma = ms.homogenized_stress;
-    p.kinetic_energy = ms.kinetic_energy_translation + ms.kinetic_energy_rotation;
-    p.kinetic_energy_rotation = ms.kinetic_energy_rotation;
-    p.elastic_energy = ms.elastic_energy;
-    p.unbalanced_force_ratio = ms.unbalanced_force_ratio;
-    p.inertial_number = ms.inertial_number;
-    p.coordination_number = ms.coordination_number;
+    detail::copy_measures(p, ms);
     double lateral = 0.0;
     for (int k = 0; k < 4; ++k) {
       const double pk = wall_pressure(world, kLateral[k]);

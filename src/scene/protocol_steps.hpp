@@ -1,5 +1,7 @@
-// The consolidation both protocols run (biaxial.cpp for disks, triaxial.cpp
-// for spheres), written once: every wall servoed at σ3; phase 0
+// The steps the biaxial (disks, biaxial.cpp) and triaxial (spheres,
+// triaxial.cpp) protocols share, written once. Private to src/scene.
+//
+// Consolidation: every wall servoed at σ3; phase 0
 // frictionless (a packing without friction finds its densest state), phase
 // 1 friction on, each until static — every wall stress within
 // test.consolidation_tolerance of σ3 and the unbalanced-force ratio below
@@ -8,7 +10,7 @@
 // noise rather than slow modes (a very low σ3, where round-off forces are a
 // sizeable share of the contact forces) it leaves that noise undamped: if a
 // quarter of the budget has not brought the sample to rest, the rest runs
-// at critical damping (the paper's start point). Private to src/scene.
+// at critical damping (the paper's start point).
 #pragma once
 
 #include <algorithm>
@@ -109,6 +111,52 @@ inline std::string consolidation_failure(const ConsolidationOutcome& o, const Te
          std::to_string(o.unbalanced_ratio) + ", tolerance " +
          std::to_string(test.consolidation_unbalanced) +
          "); raise test.consolidation_max_steps or loosen the tolerances";
+}
+
+/// The stable α of a consolidated sample (a probe copy; its stable-step
+/// estimate of the contact network, which does not depend on Δt: any
+/// valid step will do).
+template <class Sample>
+double stable_dt_ratio_of(Sample probe, const AlgorithmSpec& algorithm,
+                          Integration (*integration_for)(const Sample&, const AlgorithmSpec&)) {
+  AlgorithmSpec a = algorithm;
+  a.dt_ratio = std::min(a.dt_ratio, 0.1);
+  probe.set_integration(integration_for(probe, a));
+  probe.update_forces();
+  return probe.stability_estimate().dt_ratio_stable;
+}
+
+/// The loading's start, the same in 2D and 3D: the spec's integration on
+/// `world`, the run's scales, planned steps and strain rate in `out`.
+/// Returns the platen speed (negative: compressing) that reaches
+/// test.vertical_strain of `h0` in Nstep steps.
+template <class Sample, class Result>
+double start_loading(Sample& world, Result& out, const AlgorithmSpec& algorithm,
+                     const TestSpec& test, double h0,
+                     Integration (*integration_for)(const Sample&, const AlgorithmSpec&)) {
+  out.particles = world.size();
+  out.integration = integration_for(world, algorithm);
+  world.set_integration(out.integration);
+  out.scales = world.reference_scales();
+  const double dt = out.integration.dt;
+  const int64_t nstep = algorithm.steps;
+  out.steps_planned = nstep;
+  out.strain_rate = test.vertical_strain / (static_cast<double>(nstep) * dt);
+  return -test.vertical_strain * h0 / (static_cast<double>(nstep) * dt);
+}
+
+/// A monitoring point's stresses, energies and ratios from the kernel's
+/// measures (the fields MonitorPoint and TriaxialPoint share).
+template <class Point, class Measures>
+void copy_measures(Point& p, const Measures& ms) {
+  p.b = ms.boundary_stress;
+  p.sigma = ms.homogenized_stress;
+  p.kinetic_energy = ms.kinetic_energy_translation + ms.kinetic_energy_rotation;
+  p.kinetic_energy_rotation = ms.kinetic_energy_rotation;
+  p.elastic_energy = ms.elastic_energy;
+  p.unbalanced_force_ratio = ms.unbalanced_force_ratio;
+  p.inertial_number = ms.inertial_number;
+  p.coordination_number = ms.coordination_number;
 }
 
 }  // namespace demcal::detail
