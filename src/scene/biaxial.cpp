@@ -87,10 +87,7 @@ ConsolidatedState consolidate_fresh(const SceneConfig& config, const Assembly& a
   // to 12 600 steps and a 500-disk lognormal REV from 1 536 200 to 61 200;
   // a 400-disk REV with radius ratio 3 did not converge in 2·10⁶ steps at
   // ζ = 1 and needs 60 600 at 0.02; hexagonal REVs need 1 400 at most.
-  AlgorithmSpec settle;  // α = 0.2, the paper's start step
-  settle.damping_ratio_translation = kConsolidationDampingRatio;
-  settle.damping_ratio_rotation = kConsolidationDampingRatio;
-  settle.lock_rotation = config.algorithm.lock_rotation;
+  AlgorithmSpec settle = detail::consolidation_settings(config, kConsolidationDampingRatio);
   // Contact dashpots lower the stable step: 2/ω·f(ζ), f = sqrt(1 + ζ²) − ζ,
   // ζ = ½·γ·ω, γ = 2·ζ_c·sqrt(m_eff/k) (stability.cpp). 2/ω·f(½·γ·ω)
   // decreases with ω, so if α = 0.2 is stable without them (ω_max·Δt₀ ≤ 2),

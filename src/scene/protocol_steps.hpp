@@ -26,6 +26,17 @@
 
 namespace demcal::detail {
 
+/// The step and damping consolidation settles with: α = 0.2 (the paper's
+/// start step), light damping kConsolidationDampingRatio on translation and
+/// rotation (biaxial.cpp says why), the config's rotation lock.
+inline AlgorithmSpec consolidation_settings(const SceneConfig& config, double damping_ratio) {
+  AlgorithmSpec settle;
+  settle.damping_ratio_translation = damping_ratio;
+  settle.damping_ratio_rotation = damping_ratio;
+  settle.lock_rotation = config.algorithm.lock_rotation;
+  return settle;
+}
+
 struct ConsolidationOutcome {
   int64_t steps = 0;
   int phase = 0;  ///< the phase it ended in (0 frictionless, 1 friction on)

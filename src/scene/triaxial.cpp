@@ -137,10 +137,7 @@ TriaxialState consolidate_triaxial(const SceneConfig& config, const SphereAssemb
   const double mu = config.material.particle.friction;
   // Light damping for the fastest relaxation of the slow collective modes
   // (biaxial.cpp, consolidate(): measured there).
-  AlgorithmSpec settle;  // α = 0.2, the paper's start step
-  settle.damping_ratio_translation = kConsolidationDampingRatio;
-  settle.damping_ratio_rotation = kConsolidationDampingRatio;
-  settle.lock_rotation = config.algorithm.lock_rotation;
+  const AlgorithmSpec settle = detail::consolidation_settings(config, kConsolidationDampingRatio);
   const detail::ConsolidationOutcome o = detail::run_consolidation<SphereWallSide, 6>(
       world, test, mu, settle,
       [](const SphereWorld& w, const AlgorithmSpec& a) { return integration_for(w, a); },
