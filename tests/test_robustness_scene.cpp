@@ -125,9 +125,9 @@ void expect_spheres_rejected(const std::string& content, const std::string& fiel
 
 // The sphere reader (3D) had neither check: "3\0x" was read as 3.
 TEST(RobustScene, NulByteInASphereLineNamesTheLine) {
-  expect_spheres_rejected(std::string("0,0,0,1\n3\0x,0,0,1\n9,9,9,1\n", 28), "line 2",
-                          "NUL byte at column 2");
-  expect_spheres_rejected(std::string("x,y,z,r\n0,0,0,1\n3,0,0,1\0\n", 26), "line 3", "NUL byte");
+  using namespace std::string_literals;  // "…\0…"s keeps the NUL and what follows
+  expect_spheres_rejected("0,0,0,1\n3\0x,0,0,1\n9,9,9,1\n"s, "line 2", "NUL byte at column 2");
+  expect_spheres_rejected("x,y,z,r\n0,0,0,1\n3,0,0,1\0\n"s, "line 3", "NUL byte");
   expect_spheres_rejected("0,0,0,1\n" + std::string(100000, 'x') + "\n", "line 2", "characters)");
   // What the shared line preparation keeps: a BOM on line 1 and CRLF endings.
   std::istringstream in("\xEF\xBB\xBFx,y,z,r\r\n0,0,0,1\r\n3,0,0,1\r\n");
