@@ -17,6 +17,7 @@
 #include "demcal/scene/biaxial.hpp"
 #include "demcal/scene/config.hpp"
 #include "demcal/scene/packing.hpp"
+#include "demcal/scene/sphere_packing.hpp"
 #include "support/files.hpp"
 #include "support/input_errors.hpp"
 #include "support/scenes.hpp"
@@ -109,6 +110,48 @@ TEST(RobustScene, NulByteInAParticleLineNamesTheLine) {
 
 TEST(RobustScene, LongBrokenParticleLineIsQuotedShort) {
   expect_particles_rejected("0,0,1\n" + std::string(100000, 'x') + "\n", "line 2", "characters)");
+}
+
+/// The sphere reader fails on `content` naming "s.csv" and `field`.
+void expect_spheres_rejected(const std::string& content, const std::string& field,
+                             const std::string& words) {
+  std::istringstream in(content);
+  const auto e = input_error([&] { read_spheres(in, "s.csv"); });
+  ASSERT_TRUE(e);
+  EXPECT_EQ(e->file(), "s.csv");
+  EXPECT_EQ(e->field(), field) << e->what();
+  EXPECT_NE(std::string(e->what()).find(words), std::string::npos) << e->what();
+}
+
+// The sphere reader (3D) had neither check: "3\0x" was read as 3.
+TEST(RobustScene, NulByteInASphereLineNamesTheLine) {
+  using namespace std::string_literals;  // "…\0…"s keeps the NUL and what follows
+  expect_spheres_rejected("0,0,0,1\n3\0x,0,0,1\n9,9,9,1\n"s, "line 2", "NUL byte at column 2");
+  expect_spheres_rejected("x,y,z,r\n0,0,0,1\n3,0,0,1\0\n"s, "line 3", "NUL byte");
+  expect_spheres_rejected("0,0,0,1\n" + std::string(100000, 'x') + "\n", "line 2", "characters)");
+  // What the shared line preparation keeps: a BOM on line 1 and CRLF endings.
+  std::istringstream in("\xEF\xBB\xBFx,y,z,r\r\n0,0,0,1\r\n3,0,0,1\r\n");
+  EXPECT_EQ(read_spheres(in, "s.csv").size(), 2);
+}
+
+// A symlink loop, a folder, a device as the sphere file: one line naming
+// it (a folder used to read as "needs at least two spheres, found 0").
+TEST(RobustScene, UnreadableSphereFilePathsAreOneLine) {
+  const test::TempDir tmp("robust_spheres");
+  const fs::path& dir = tmp.path();
+  fs::create_symlink(dir / "b.csv", dir / "a.csv");
+  fs::create_symlink(dir / "a.csv", dir / "b.csv");
+  for (const std::string& path : {(dir / "a.csv").string(), dir.string(), std::string("/dev/zero"),
+                                  (dir / "missing.csv").string()}) {
+    SCOPED_TRACE(path);
+    const auto e = input_error([&] { read_sphere_file(path); });
+    ASSERT_TRUE(e);
+    EXPECT_EQ(e->file(), path);
+    EXPECT_EQ(std::string(e->what()).find('\n'), std::string::npos);
+    EXPECT_EQ(std::string(e->what()).find("two spheres"), std::string::npos) << e->what();
+  }
+  const auto loop = input_error([&] { read_sphere_file((dir / "a.csv").string()); });
+  EXPECT_NE(std::string(loop->what()).find("symbolic links"), std::string::npos) << loop->what();
 }
 
 /// The brute-force answer: does any pair overlap beyond 5 % of the smaller?

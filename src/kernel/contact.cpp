@@ -194,8 +194,18 @@ const Kernels &kernels() {
   static const Kernels chosen = [] {
 #ifdef DEMCAL_X86_64
     __builtin_cpu_init();
+#ifdef __clang__
+    // Clang 14 knows no "x86-64-vN" level names: the levels' features one
+    // by one (x86-64-v3's F16C, LZCNT, MOVBE and XSAVE it cannot query;
+    // every CPU with AVX2, FMA and BMI2 has them).
+    const bool v3 = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") &&
+                    __builtin_cpu_supports("bmi") && __builtin_cpu_supports("bmi2");
+    const bool v4 = v3 && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") &&
+                    __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512vl");
+#else
     const bool v4 = __builtin_cpu_supports("x86-64-v4") != 0;
     const bool v3 = __builtin_cpu_supports("x86-64-v3") != 0;
+#endif
     if (const char *env = std::getenv("DEMCAL_SIMD")) {
       const std::string_view want(env);
       if (want == "sse2") return kKernels_sse2;

@@ -51,10 +51,14 @@ DEMCAL_INLINE typename Simd<W>::D gather(const double *__restrict b, const int *
     return typename Simd<W>::D{b[j[0]], b[j[1]]};
 }
 
-// Correctly rounded square roots. The 256- and 512-bit forms are inline
-// assembly because the template bodies are compiled for the baseline target
-// and only inlined into the AVX2 / AVX-512 entry points below (an intrinsic
-// there would not inline); the assembler takes the instruction as it is.
+// Correctly rounded square roots. The template bodies are compiled for the
+// baseline target and only inlined into the AVX2 / AVX-512 entry points
+// (contact.cpp), so an AVX intrinsic would not inline there. GCC: the 256-
+// and 512-bit forms are inline assembly, which the assembler takes as it
+// is. Clang checks an asm operand's size against the baseline target and
+// rejects them; it gets the 128-bit SSE2 form on each half instead (in the
+// AVX entry points the VEX encoding of the same instruction). Every form is
+// IEEE sqrt, correctly rounded: the results are the same bits.
 DEMCAL_INLINE Simd<2>::D vsqrt(Simd<2>::D a) {
 #ifdef DEMCAL_X86_64
   return reinterpret_cast<Simd<2>::D>(_mm_sqrt_pd(reinterpret_cast<__m128d>(a)));
@@ -63,6 +67,18 @@ DEMCAL_INLINE Simd<2>::D vsqrt(Simd<2>::D a) {
 #endif
 }
 #ifdef DEMCAL_X86_64
+#ifdef __clang__
+DEMCAL_INLINE Simd<4>::D vsqrt(Simd<4>::D a) {
+  const Simd<2>::D lo = vsqrt(Simd<2>::D(__builtin_shufflevector(a, a, 0, 1)));
+  const Simd<2>::D hi = vsqrt(Simd<2>::D(__builtin_shufflevector(a, a, 2, 3)));
+  return __builtin_shufflevector(lo, hi, 0, 1, 2, 3);
+}
+DEMCAL_INLINE Simd<8>::D vsqrt(Simd<8>::D a) {
+  const Simd<4>::D lo = vsqrt(Simd<4>::D(__builtin_shufflevector(a, a, 0, 1, 2, 3)));
+  const Simd<4>::D hi = vsqrt(Simd<4>::D(__builtin_shufflevector(a, a, 4, 5, 6, 7)));
+  return __builtin_shufflevector(lo, hi, 0, 1, 2, 3, 4, 5, 6, 7);
+}
+#else
 DEMCAL_INLINE Simd<4>::D vsqrt(Simd<4>::D a) {
   Simd<4>::D r;
   asm("vsqrtpd %1, %0" : "=x"(r) : "x"(a));
@@ -74,6 +90,38 @@ DEMCAL_INLINE Simd<8>::D vsqrt(Simd<8>::D a) {
   return r;
 }
 #endif
+#endif
+
+// Makes v opaque to the optimiser (an empty asm the value must pass
+// through): it is used as rounded, never fused into an FMA with what
+// follows. Clang rejects a 256- or 512-bit asm operand in the baseline
+// target (see vsqrt): it passes the 128-bit halves.
+template <int W>
+DEMCAL_INLINE void opaque(typename Simd<W>::D &v) {
+#ifdef DEMCAL_X86_64
+#ifdef __clang__
+  if constexpr (W == 2) {
+    asm("" : "+x"(v));
+  } else {
+    using H = typename Simd<W / 2>::D;
+    H lo, hi;
+    std::memcpy(&lo, &v, sizeof lo);
+    std::memcpy(&hi, reinterpret_cast<const char *>(&v) + sizeof lo, sizeof hi);
+    opaque<W / 2>(lo);
+    opaque<W / 2>(hi);
+    std::memcpy(&v, &lo, sizeof lo);
+    std::memcpy(reinterpret_cast<char *>(&v) + sizeof lo, &hi, sizeof hi);
+  }
+#else
+  if constexpr (W == 8)
+    asm("" : "+v"(v));
+  else
+    asm("" : "+x"(v));
+#endif
+#else
+  (void)v;
+#endif
+}
 
 template <int W>
 DEMCAL_INLINE typename Simd<W>::D select(typename Simd<W>::M m, typename Simd<W>::D a,

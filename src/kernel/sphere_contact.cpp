@@ -103,12 +103,7 @@ struct PairArgs {
 // follows (an empty asm the value must pass through).
 template <int W>
 DEMCAL_INLINE typename Simd<W>::D rounded(typename Simd<W>::D v) {
-#ifdef DEMCAL_X86_64
-  if constexpr (W == 8)
-    asm("" : "+v"(v));
-  else
-    asm("" : "+x"(v));
-#endif
+  opaque<W>(v);
   return v;
 }
 

@@ -79,10 +79,7 @@ Assembly random_gas(const AssemblySpec& spec) {
   return a;
 }
 
-namespace {
-
-/// The whole of `field` (blanks around it allowed) as a number.
-bool parse_number(const std::string& field, double& value) {
+bool parse_particle_number(const std::string& field, double& value) {
   const char* s = field.c_str();
   char* end = nullptr;
   value = std::strtod(s, &end);
@@ -91,7 +88,15 @@ bool parse_number(const std::string& field, double& value) {
   return *end == '\0';
 }
 
-}  // namespace
+void prepare_particle_line(std::string& line, int line_no, const std::string& path) {
+  if (line_no == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);  // UTF-8 BOM
+  if (!line.empty() && line.back() == '\r') line.pop_back();
+  // strtod would stop at a NUL and take "1.5\0garbage" for 1.5.
+  if (const auto nul = line.find('\0'); nul != std::string::npos)
+    throw InputError(
+        path, "line " + std::to_string(line_no),
+        "holds a NUL byte at column " + std::to_string(nul + 1) + " (not a text line)");
+}
 
 Assembly read_particle_file(const std::string& path) {
   require_readable_file(path);  // a folder, a device, a symlink loop: one line, exit 2
@@ -205,13 +210,7 @@ Assembly read_particles(std::istream& in, const std::string& path) {
   auto where = [&]() { return "line " + std::to_string(line_no); };
   while (std::getline(in, line)) {
     ++line_no;
-    if (line_no == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);  // UTF-8 BOM
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    // strtod would stop at a NUL and take "1.5\0garbage" for 1.5.
-    if (const auto nul = line.find('\0'); nul != std::string::npos)
-      throw InputError(
-          path, where(),
-          "holds a NUL byte at column " + std::to_string(nul + 1) + " (not a text line)");
+    prepare_particle_line(line, line_no, path);
     const auto first = line.find_first_not_of(" \t");
     if (first != std::string::npos &&
         line.compare(first, std::strlen(kParticleFileWalls), kParticleFileWalls) == 0) {
@@ -235,7 +234,8 @@ Assembly read_particles(std::istream& in, const std::string& path) {
     while (std::getline(ss, f, ',')) fields.push_back(f);
     double v[3];
     int numbers = 0;
-    for (size_t k = 0; k < fields.size() && k < 3; ++k) numbers += parse_number(fields[k], v[k]);
+    for (size_t k = 0; k < fields.size() && k < 3; ++k)
+      numbers += parse_particle_number(fields[k], v[k]);
     if (fields.size() != 3 || numbers != 3) {
       // A header is the first line that is not blank or a comment, and has
       // three fields none of which is a number ("x,y,r"); a line with some

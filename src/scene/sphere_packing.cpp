@@ -9,7 +9,9 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "demcal/io/files.hpp"
 #include "demcal/io/input_error.hpp"
+#include "demcal/scene/packing.hpp"
 #include "demcal/scene/random_radii.hpp"
 
 namespace demcal {
@@ -65,21 +67,8 @@ SphereAssembly random_sphere_gas(const AssemblySpec& spec) {
   return a;
 }
 
-namespace {
-
-/// The whole of `field` (blanks around it allowed) as a number.
-bool parse_number(const std::string& field, double& value) {
-  const char* s = field.c_str();
-  char* end = nullptr;
-  value = std::strtod(s, &end);
-  if (end == s) return false;
-  while (*end == ' ' || *end == '\t') ++end;
-  return *end == '\0';
-}
-
-}  // namespace
-
 SphereAssembly read_sphere_file(const std::string& path) {
+  require_readable_file(path);  // a folder, a device, a symlink loop: one line, exit 2
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path, "", "cannot open particle file");
   return read_spheres(in, path);
@@ -94,8 +83,7 @@ SphereAssembly read_spheres(std::istream& in, const std::string& path) {
   auto where = [&]() { return "line " + std::to_string(line_no); };
   while (std::getline(in, line)) {
     ++line_no;
-    if (line_no == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);  // UTF-8 BOM
-    if (!line.empty() && line.back() == '\r') line.pop_back();
+    prepare_particle_line(line, line_no, path);  // the 2D reader's: BOM, CR, NUL
     const auto first = line.find_first_not_of(" \t");
     if (first == std::string::npos || line[first] == '#') continue;
     std::vector<std::string> fields;
@@ -104,7 +92,8 @@ SphereAssembly read_spheres(std::istream& in, const std::string& path) {
     while (std::getline(ss, f, ',')) fields.push_back(f);
     double v[4];
     int numbers = 0;
-    for (size_t k = 0; k < fields.size() && k < 4; ++k) numbers += parse_number(fields[k], v[k]);
+    for (size_t k = 0; k < fields.size() && k < 4; ++k)
+      numbers += parse_particle_number(fields[k], v[k]);
     if (fields.size() != 4 || numbers != 4) {
       // The header is the first content line with four fields, none a
       // number ("x,y,z,r"); a line with some numbers is a broken sphere
@@ -113,13 +102,14 @@ SphereAssembly read_spheres(std::istream& in, const std::string& path) {
         seen_content = true;
         continue;
       }
-      throw InputError(path, where(), "expected four numbers x,y,z,r, got \"" + line + "\"");
+      throw InputError(path, where(), "expected four numbers x,y,z,r, got " + quoted_value(line));
     }
     seen_content = true;
     if (!std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2]) ||
         !std::isfinite(v[3]))
-      throw InputError(path, where(), "values must be finite, got \"" + line + "\"");
-    if (!(v[3] > 0.0)) throw InputError(path, where(), "radius must be > 0, got \"" + line + "\"");
+      throw InputError(path, where(), "values must be finite, got " + quoted_value(line));
+    if (!(v[3] > 0.0))
+      throw InputError(path, where(), "radius must be > 0, got " + quoted_value(line));
     a.x.push_back(v[0]);
     a.y.push_back(v[1]);
     a.z.push_back(v[2]);

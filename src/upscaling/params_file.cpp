@@ -1,7 +1,9 @@
 #include "demcal/upscaling/params_file.hpp"
 
 #include <cmath>
+#include <string_view>
 
+#include "demcal/io/files.hpp"
 #include "demcal/scene/triaxial.hpp"
 #include "demcal/scoring/trial.hpp"
 #include "demcal/upscaling/upscaling.hpp"
@@ -9,7 +11,13 @@
 namespace demcal {
 
 nlohmann::json read_params_file(const std::string& path) {
-  const nlohmann::json params = read_json_file(path);
+  return parse_params_text(read_text_file(path), path);  // a folder, a loop: one clear error
+}
+
+nlohmann::json parse_params_text(std::string_view text, const std::string& path) {
+  // The config's JSON reader: every nlohmann error (1e999 is out_of_range,
+  // not a parse error) an InputError with its line, duplicate keys refused.
+  const nlohmann::json params = parse_config_json(text, path);
   if (!params.is_object()) throw InputError(path, "", "must be a JSON object (a params.json)");
   rev_params_from_json(params, path);  // the values used first: their key named first
   const auto schema = params.find("schema");

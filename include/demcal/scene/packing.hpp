@@ -41,6 +41,13 @@ inline constexpr const char kParticleFileWalls[] = "# walls left right bottom to
 Assembly read_particle_file(const std::string& path);
 /// The same from a stream; `source` names it in errors.
 Assembly read_particles(std::istream& in, const std::string& source);
+/// A particle-file line made ready to split, for the 2D and the sphere
+/// readers: the UTF-8 BOM of line 1 and a trailing CR dropped. A NUL byte
+/// (strtod would stop at it and take "1.5\0garbage" for 1.5) is an
+/// InputError naming `path` and the line.
+void prepare_particle_line(std::string& line, int line_no, const std::string& path);
+/// The whole of `field` (blanks around it allowed) as a number.
+bool parse_particle_number(const std::string& field, double& value);
 /// Build the assembly a config asks for.
 Assembly make_assembly(const SceneConfig& config);
 

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "demcal/scene/biaxial.hpp"
@@ -41,6 +42,9 @@ inline constexpr const char* kParamsSchema = "demcal.params/1";
 /// particle count that fits. Every fault is an InputError naming the file
 /// and the key (exit 2).
 nlohmann::json read_params_file(const std::string& path);
+/// The same checks on a params.json's text (`path` names it in errors);
+/// read_params_file reads the file and calls this.
+nlohmann::json parse_params_text(std::string_view text, const std::string& path);
 
 /// The accuracy evidence of `demcal calibrate --evidence`: the converged
 /// reference (Nstep ×8 and ×16, Richardson) and the paper-recipe baseline.
