@@ -225,6 +225,29 @@ TEST(RobustScene, OneHugeDiskAmongManySmallOnesIsChecked) {
                             "overlaps the one on line 160001");
 }
 
+// The same in 3D: the sphere reader sized its cells by the largest sphere,
+// so one sphere 100x the others made the check quadratic. It shares the
+// 2D reader's levelled grids now; finishes, and finds the overlaps.
+TEST(RobustScene, OneHugeSphereAmongManySmallOnesIsChecked) {
+  std::string lattice;
+  lattice.reserve(64000 * 20);
+  for (int i = 0; i < 40; ++i)
+    for (int j = 0; j < 40; ++j)
+      for (int k = 0; k < 40; ++k)
+        lattice += std::to_string(2 * i) + "," + std::to_string(2 * j) + "," +
+                   std::to_string(2 * k) + ",1\n";
+  // The big sphere just clear of the lattice's face x = 78 + 1.
+  {
+    std::istringstream in(lattice + "180,40,40,100\n");
+    EXPECT_EQ(read_spheres(in, "s.csv").size(), 64001);
+  }
+  // Moved 10 towards the lattice it covers spheres: named with its line.
+  expect_spheres_rejected(lattice + "170,40,40,100\n", "line 64001", "overlaps the one on line");
+  // A small sphere overlapping the big one (checked from the small one's side).
+  expect_spheres_rejected(lattice + "180,40,40,100\n281,40,40,1.5\n", "line 64002",
+                          "overlaps the one on line 64001");
+}
+
 // --- §3 limits ------------------------------------------------------------------
 
 // columns = rows = 1e5 asked for 1e10 particles and died in bad_alloc.

@@ -15,6 +15,7 @@
 
 #include "demcal/io/files.hpp"
 #include "demcal/scene/random_radii.hpp"
+#include "overlap_check.hpp"
 
 namespace demcal {
 
@@ -105,100 +106,6 @@ Assembly read_particle_file(const std::string& path) {
   return read_particles(in, path);
 }
 
-namespace {
-
-/// Throws naming both lines when two particles overlap by more than 5 % of
-/// the smaller radius (beyond that a file is not a packing but an error).
-///
-/// O(N) for any radius distribution: particles are grouped in levels by
-/// radius (level = binary exponent of r, so radii within a level differ by
-/// less than 2x), each level on its own grid of cells 2·r_max(level) wide.
-/// A pair is tested once, from its smaller particle: that one looks at the
-/// at most 3 x 3 cells of each level at or above its own that can hold a
-/// partner. Cells of one level hold O(1) particles that do not overlap, so
-/// the work is N·9·O(1) per occupied level (a single grid sized by the
-/// largest disk degenerates to O(N^2) when one disk is 100x the others).
-void check_overlaps(const Assembly& a, const std::vector<int>& lines, const std::string& path) {
-  const int n = a.size();
-  double x0 = a.x[0], y0 = a.y[0], x1 = a.x[0], y1 = a.y[0];
-  for (int i = 0; i < n; ++i) {
-    x0 = std::min(x0, a.x[i]);
-    y0 = std::min(y0, a.y[i]);
-    x1 = std::max(x1, a.x[i]);
-    y1 = std::max(y1, a.y[i]);
-  }
-  const double extent = std::max(x1 - x0, y1 - y0);
-  if (!std::isfinite(extent))
-    throw InputError(path, "", "coordinates span more than a double can hold");
-
-  struct Level {
-    int exponent = 0;
-    double r_max = 0.0, cell = 0.0;
-    std::vector<std::array<int64_t, 3>> cells;  // (cy, cx, particle), sorted
-  };
-  std::vector<Level> levels;  // by increasing exponent
-  std::vector<int> level_of(n);
-  {
-    std::vector<int> exponents(n);
-    for (int i = 0; i < n; ++i) exponents[i] = std::ilogb(a.r[i]);
-    std::vector<int> distinct = exponents;
-    std::sort(distinct.begin(), distinct.end());
-    distinct.erase(std::unique(distinct.begin(), distinct.end()), distinct.end());
-    levels.resize(distinct.size());
-    for (size_t k = 0; k < distinct.size(); ++k) levels[k].exponent = distinct[k];
-    for (int i = 0; i < n; ++i) {
-      level_of[i] = static_cast<int>(
-          std::lower_bound(distinct.begin(), distinct.end(), exponents[i]) - distinct.begin());
-      levels[level_of[i]].r_max = std::max(levels[level_of[i]].r_max, a.r[i]);
-    }
-  }
-  // Cells never more than 2^40 a side (a sparse, huge domain would overflow
-  // the integer cell keys): larger cells only cost time, never a missed pair.
-  constexpr double kMaxCellsPerSide = 1099511627776.0;  // 2^40
-  for (auto& level : levels) level.cell = std::max(2.0 * level.r_max, extent / kMaxCellsPerSide);
-  // Clamped: a coordinate plus a radius may pass the last cell (even
-  // overflow to inf near the largest double); no particle lies beyond it.
-  auto cell_index = [&](double v, double origin, double cell) {
-    return static_cast<int64_t>(std::clamp(std::floor((v - origin) / cell), -0x1p62, 0x1p62));
-  };
-  for (int i = 0; i < n; ++i) {
-    Level& level = levels[level_of[i]];
-    level.cells.push_back(
-        {cell_index(a.y[i], y0, level.cell), cell_index(a.x[i], x0, level.cell), i});
-  }
-  for (auto& level : levels) std::sort(level.cells.begin(), level.cells.end());
-
-  for (int i = 0; i < n; ++i) {
-    for (size_t b = level_of[i]; b < levels.size(); ++b) {
-      const Level& level = levels[b];
-      const double reach = a.r[i] + level.r_max;  // centres closer than this may overlap
-      const int64_t cx0 = cell_index(a.x[i] - reach, x0, level.cell);
-      const int64_t cx1 = cell_index(a.x[i] + reach, x0, level.cell);
-      const int64_t cy0 = cell_index(a.y[i] - reach, y0, level.cell);
-      const int64_t cy1 = cell_index(a.y[i] + reach, y0, level.cell);
-      for (int64_t cy = cy0; cy <= cy1; ++cy) {
-        auto it = std::lower_bound(level.cells.begin(), level.cells.end(),
-                                   std::array<int64_t, 3>{cy, cx0, -1});
-        for (; it != level.cells.end() && (*it)[0] == cy && (*it)[1] <= cx1; ++it) {
-          const int j = static_cast<int>((*it)[2]);
-          if (static_cast<int>(b) == level_of[i] && j <= i) continue;  // once per pair
-          const double d = std::hypot(a.x[j] - a.x[i], a.y[j] - a.y[i]);
-          const double overlap = a.r[i] + a.r[j] - d;
-          const double smaller = std::min(a.r[i], a.r[j]);
-          if (overlap > 0.05 * smaller)
-            throw InputError(path, "line " + std::to_string(lines[std::max(i, j)]),
-                             "particle overlaps the one on line " +
-                                 std::to_string(lines[std::min(i, j)]) + " by " +
-                                 std::to_string(100.0 * overlap / smaller) +
-                                 " % of the smaller radius (limit 5 %)");
-        }
-      }
-    }
-  }
-}
-
-}  // namespace
-
 Assembly read_particles(std::istream& in, const std::string& path) {
   Assembly a;
   std::vector<int> lines;  // line of each particle, for the overlap error
@@ -267,7 +174,8 @@ Assembly read_particles(std::istream& in, const std::string& path) {
   if (in.bad()) throw InputError(path, "", "cannot read particle file");
   if (a.size() < 2)
     throw InputError(path, "", "needs at least two particles, found " + std::to_string(a.size()));
-  check_overlaps(a, lines, path);
+  detail::check_overlaps<2>({std::span<const double>(a.x), std::span<const double>(a.y)}, a.r,
+                            lines, path, "particle");
   const int n = a.size();
   a.left = a.x[0] - a.r[0];
   a.right = a.x[0] + a.r[0];

@@ -13,6 +13,7 @@
 #include "demcal/io/input_error.hpp"
 #include "demcal/scene/packing.hpp"
 #include "demcal/scene/random_radii.hpp"
+#include "overlap_check.hpp"
 
 namespace demcal {
 
@@ -129,45 +130,9 @@ SphereAssembly read_spheres(std::istream& in, const std::string& path) {
       a.hi[axis] = std::max(a.hi[axis], (*pos[axis])[i] + a.r[i]);
     }
   }
-  // Overlaps beyond 5 % of the smaller radius are not a packing but an
-  // error. A cell grid (cells of at least 2·r_max, at most 2^20 a side so
-  // the keys cannot overflow; larger cells only cost time) keeps it O(N).
-  const double r_max = *std::max_element(a.r.begin(), a.r.end());
-  double extent = 0.0;
-  for (int axis = 0; axis < 3; ++axis) extent = std::max(extent, a.hi[axis] - a.lo[axis]);
-  const double cell = std::max(2.0 * r_max, extent / static_cast<double>(1 << 20));
-  if (!std::isfinite(extent) || !std::isfinite(cell) || !(cell > 0.0))
-    throw InputError(path, "", "coordinates span more than a double can hold");
-  auto key_of = [&](int i, int dx, int dy, int dz) {
-    const int64_t c[3] = {static_cast<int64_t>((a.x[i] - a.lo[0]) / cell) + dx,
-                          static_cast<int64_t>((a.y[i] - a.lo[1]) / cell) + dy,
-                          static_cast<int64_t>((a.z[i] - a.lo[2]) / cell) + dz};
-    constexpr int64_t kStride = int64_t{1} << 21;
-    return (c[2] * kStride + c[1]) * kStride + c[0];
-  };
-  std::vector<std::pair<int64_t, int>> keyed(n);
-  for (int i = 0; i < n; ++i) keyed[i] = {key_of(i, 0, 0, 0), i};
-  std::sort(keyed.begin(), keyed.end());
-  for (int i = 0; i < n; ++i)
-    for (int dz = -1; dz <= 1; ++dz)
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx) {
-          const int64_t key = key_of(i, dx, dy, dz);
-          auto it = std::lower_bound(keyed.begin(), keyed.end(), std::pair<int64_t, int>(key, -1));
-          for (; it != keyed.end() && it->first == key; ++it) {
-            const int j = it->second;
-            if (j <= i) continue;
-            const double d = std::sqrt(std::pow(a.x[j] - a.x[i], 2) + std::pow(a.y[j] - a.y[i], 2) +
-                                       std::pow(a.z[j] - a.z[i], 2));
-            const double overlap = a.r[i] + a.r[j] - d;
-            const double smaller = std::min(a.r[i], a.r[j]);
-            if (overlap > 0.05 * smaller)
-              throw InputError(path, "line " + std::to_string(lines[j]),
-                               "sphere overlaps the one on line " + std::to_string(lines[i]) +
-                                   " by " + std::to_string(100.0 * overlap / smaller) +
-                                   " % of the smaller radius (limit 5 %)");
-          }
-        }
+  detail::check_overlaps<3>(
+      {std::span<const double>(a.x), std::span<const double>(a.y), std::span<const double>(a.z)},
+      a.r, lines, path, "sphere");
   return a;
 }
 
