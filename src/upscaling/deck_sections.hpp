@@ -1,0 +1,78 @@
+// Pieces of text the 2D deck writer (export.cpp) and the 3D deck writer
+// (export_3d.cpp) share: one home each, so that a change to a number's
+// format, the contact law's mapping or a block of a deck is made once.
+// Private to the upscaling layer. Where the two decks differ in a detail
+// (the dimension, the boundary, the number format), it is a parameter.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "demcal/kernel/material.hpp"
+#include "demcal/upscaling/export.hpp"
+
+namespace demcal::deck {
+
+/// A number in a deck: 10 significant digits (num), 17 (exact: round-trips
+/// a double), 3 (fmt3: for prose).
+std::string num(double v);
+std::string exact(double v);
+std::string fmt3(double v);
+
+/// How a writer formats the numbers of a block: num or exact.
+using NumberFormat = std::string (*)(double);
+
+/// The figures every export reports (the files and deck are added after),
+/// with the notes both writers give: the tangential springs start at zero,
+/// and the step factor f when the explicit damping shrinks the step.
+ExportResult plan_result(double dt, int64_t steps, double step_factor, int types,
+                         double class_error);
+
+/// The pair style's gamma_n for demcal's contact damping: demcal
+/// ratio·2·sqrt(kn·m_eff), LAMMPS m_eff·gamma_n, so gamma_n =
+/// ratio·2·sqrt(kn/m_eff), taken at the mean mass (m_eff = m/2); 0 without.
+double contact_gamma_n(const Material& m, double mass_mean);
+
+/// The note when zeta_r > 0: LAMMPS 29 Sep 2021 has no rotational viscous fix.
+std::string lammps_rotational_damping_note(double zeta_r);
+
+/// The note when the damping goes per radius class (atom type); `what` is
+/// the particle's kind in "demcal's per-WHAT value" (particle, sphere).
+std::string lammps_class_damping_note(int types, double class_error, const std::string& what);
+
+/// LAMMPS parameters block: the particles' and the walls' contact laws
+/// (variables kn kt mu kn_wall kt_wall mu_wall).
+std::string lammps_material_variables(const Material& m, NumberFormat f);
+
+/// LAMMPS derived block: the top wall's speed, the servo's cap and the
+/// monitoring interval (from the parameters block).
+std::string lammps_loading_derived();
+
+/// LAMMPS system block, head: units, dimension, boundary, atom style.
+std::string lammps_system_head(int dimension, const std::string& boundary);
+
+/// LAMMPS system block, tail: the contact law (gamma_n of contact_gamma_n),
+/// the neighbour list, the timestep and the integrator (fix nve/sphere
+/// with `integrate_args`, e.g. "disc").
+std::string lammps_contact_law(double gamma_n, double r_min, const std::string& integrate_args);
+
+/// LAMMPS global damping block, translational part: fix viscous per radius
+/// class (gamma_t[k] for type k+1), or a comment when zeta_t = 0.
+std::string lammps_translational_damping(double zeta_t, const std::vector<double>& gamma_t,
+                                         NumberFormat f);
+
+/// LIGGGHTS: atom style, boundary, communication, units (and dimension 2
+/// for `dimension` 2), the data file and the neighbour list.
+std::string liggghts_preamble(int dimension, const std::string& boundary,
+                              const std::string& data_name, double r_min);
+
+/// LIGGGHTS: the materials (type ntypes is the walls'), the granular pair
+/// style without damping (absolute_damping with gamma 0) and the timestep.
+std::string liggghts_materials(const Material& m, int ntypes, double dt, NumberFormat f);
+
+/// LIGGGHTS: fix viscous per radius class (nothing when zeta_t = 0).
+std::string liggghts_translational_damping(double zeta_t, const std::vector<double>& gamma_t,
+                                           NumberFormat f);
+
+}  // namespace demcal::deck
