@@ -1,8 +1,12 @@
 #include "deck_sections.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <sstream>
+
+#include "demcal/kernel/particle_scales.hpp"
 
 namespace demcal::deck {
 
@@ -17,6 +21,31 @@ std::string printed(const char* format, double v) {
 std::string num(double v) { return printed("%.10g", v); }
 std::string exact(double v) { return printed("%.17g", v); }
 std::string fmt3(double v) { return printed("%.3g", v); }
+
+RadiusClasses radius_class_bounds(const std::vector<double>& radii, int max_types) {
+  RadiusClasses out;
+  out.type = radius_classes(radii, std::max(1, max_types), &out.types);
+  out.r_lo.assign(out.types, std::numeric_limits<double>::infinity());
+  out.r_hi.assign(out.types, 0.0);
+  for (size_t i = 0; i < radii.size(); ++i) {
+    const int k = out.type[i] - 1;
+    out.r_lo[k] = std::min(out.r_lo[k], radii[i]);
+    out.r_hi[k] = std::max(out.r_hi[k], radii[i]);
+  }
+  return out;
+}
+
+DeckTiming deck_timing(double dt_ratio, int64_t steps, double zeta_t, double dt_crit) {
+  DeckTiming out;
+  out.step_factor = dashpot_step_factor(zeta_t);
+  out.dt = dt_ratio * out.step_factor * dt_crit;
+  out.steps = std::max<int64_t>(1, std::llround(static_cast<double>(steps) / out.step_factor));
+  return out;
+}
+
+int monitor_interval(int64_t steps, int monitor_points) {
+  return static_cast<int>(std::max<int64_t>(1, steps / std::max(1, monitor_points)));
+}
 
 ExportResult plan_result(double dt, int64_t steps, double step_factor, int types,
                          double class_error) {

@@ -23,6 +23,29 @@ std::string fmt3(double v);
 /// How a writer formats the numbers of a block: num or exact.
 using NumberFormat = std::string (*)(double);
 
+/// The radius classes of a deck (one atom type each, radius_classes) and
+/// each class's smallest and largest radius (index type−1).
+struct RadiusClasses {
+  int types = 0;
+  std::vector<int> type;  // per particle, 1-based
+  std::vector<double> r_lo, r_hi;
+};
+RadiusClasses radius_class_bounds(const std::vector<double>& radii, int max_types);
+
+/// The deck's step and run length: both engines apply fix viscous
+/// explicitly (the force from the half-step velocity), which shrinks the
+/// stable step by f = dashpot_step_factor(zeta_t); demcal's damping is
+/// semi-implicit. The deck runs at alpha·f·dt_crit for Nstep/f steps: the
+/// same loading time, rate and strain, the same stability margin as demcal.
+struct DeckTiming {
+  double step_factor = 1.0, dt = 0.0;
+  int64_t steps = 0;
+};
+DeckTiming deck_timing(double dt_ratio, int64_t steps, double zeta_t, double dt_crit);
+
+/// Steps between two monitoring rows: Nstep / monitor_points, at least 1.
+int monitor_interval(int64_t steps, int monitor_points);
+
 /// The figures every export reports (the files and deck are added after),
 /// with the notes both writers give: the tangential springs start at zero,
 /// and the step factor f when the explicit damping shrinks the step.

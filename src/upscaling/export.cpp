@@ -39,25 +39,21 @@ struct Plan {
 Plan make_plan(const SceneConfig& c, const AlgorithmSpec& p, const Assembly& a, int max_types) {
   Plan plan;
   plan.n = a.size();
-  plan.type = radius_classes(a.r, std::max(1, max_types), &plan.types);
-  plan.r_lo.assign(plan.types, std::numeric_limits<double>::infinity());
-  plan.r_hi.assign(plan.types, 0.0);
-  for (int i = 0; i < plan.n; ++i) {
-    const int k = plan.type[i] - 1;
-    plan.r_lo[k] = std::min(plan.r_lo[k], a.r[i]);
-    plan.r_hi[k] = std::max(plan.r_hi[k], a.r[i]);
-  }
+  deck::RadiusClasses classes = deck::radius_class_bounds(a.r, max_types);
+  plan.types = classes.types;
+  plan.type = std::move(classes.type);
+  plan.r_lo = std::move(classes.r_lo);
+  plan.r_hi = std::move(classes.r_hi);
   plan.scales = particle_scales(a.r, c.material, p.mass_scaling);
   plan.r_min = plan.scales.radius_min;
   plan.r_max = plan.scales.radius_max;
   plan.dt_crit = plan.scales.dt_crit;
-  // Both engines apply fix viscous explicitly (the force from the half-step
-  // velocity), which shrinks the stable step by f; demcal's damping is
-  // semi-implicit. The deck runs at alpha*f for Nstep/f steps: the same
-  // loading time, rate and strain, and the same stability margin as demcal.
-  plan.step_factor = dashpot_step_factor(p.damping_ratio_translation);
-  plan.dt = p.dt_ratio * plan.step_factor * plan.dt_crit;
-  plan.steps = std::max<int64_t>(1, std::llround(static_cast<double>(p.steps) / plan.step_factor));
+  // alpha*f for Nstep/f steps: the engines' fix viscous is explicit.
+  const deck::DeckTiming timing =
+      deck::deck_timing(p.dt_ratio, p.steps, p.damping_ratio_translation, plan.dt_crit);
+  plan.step_factor = timing.step_factor;
+  plan.dt = timing.dt;
+  plan.steps = timing.steps;
   plan.areal_density = p.mass_scaling * c.material.density * c.material.thickness;
   plan.width0 = a.right - a.left;
   plan.height0 = a.top - a.bottom;
@@ -76,8 +72,7 @@ Plan make_plan(const SceneConfig& c, const AlgorithmSpec& p, const Assembly& a, 
     plan.class_error =
         std::max(plan.class_error, (plan.r_hi[k] - plan.r_lo[k]) / (plan.r_hi[k] + plan.r_lo[k]));
   }
-  plan.thermo_every =
-      static_cast<int>(std::max<int64_t>(1, plan.steps / std::max(1, c.test.monitor_points)));
+  plan.thermo_every = deck::monitor_interval(plan.steps, c.test.monitor_points);
   return plan;
 }
 

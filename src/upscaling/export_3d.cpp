@@ -45,14 +45,11 @@ Plan3 make_plan(const SceneConfig& c, const AlgorithmSpec& p, const SphereWorld&
   Plan3 plan;
   plan.n = w.size();
   const std::vector<double> radii(w.radius().begin(), w.radius().end());
-  plan.type = radius_classes(radii, std::max(1, max_types), &plan.types);
-  plan.r_lo.assign(plan.types, std::numeric_limits<double>::infinity());
-  plan.r_hi.assign(plan.types, 0.0);
-  for (int i = 0; i < plan.n; ++i) {
-    const int k = plan.type[i] - 1;
-    plan.r_lo[k] = std::min(plan.r_lo[k], radii[i]);
-    plan.r_hi[k] = std::max(plan.r_hi[k], radii[i]);
-  }
+  deck::RadiusClasses classes = deck::radius_class_bounds(radii, max_types);
+  plan.types = classes.types;
+  plan.type = std::move(classes.type);
+  plan.r_lo = std::move(classes.r_lo);
+  plan.r_hi = std::move(classes.r_hi);
   plan.density = c.material.density * p.mass_scaling;
   plan.r_min = w.min_radius();
   plan.r_max = w.max_radius();
@@ -63,9 +60,11 @@ Plan3 make_plan(const SceneConfig& c, const AlgorithmSpec& p, const SphereWorld&
   // Δt_crit of the lightest sphere, as integration_for (triaxial.cpp).
   plan.dt_crit = critical_time_step(sphere_mass(plan.density, plan.r_min), kn);
   // The engines' fix viscous is explicit: α·f for Nstep/f steps (export.hpp).
-  plan.step_factor = dashpot_step_factor(p.damping_ratio_translation);
-  plan.dt = p.dt_ratio * plan.step_factor * plan.dt_crit;
-  plan.steps = std::max<int64_t>(1, std::llround(static_cast<double>(p.steps) / plan.step_factor));
+  const deck::DeckTiming timing =
+      deck::deck_timing(p.dt_ratio, p.steps, p.damping_ratio_translation, plan.dt_crit);
+  plan.step_factor = timing.step_factor;
+  plan.dt = timing.dt;
+  plan.steps = timing.steps;
   for (int a = 0; a < 3; ++a) {
     plan.lo[a] = w.wall(static_cast<SphereWallSide>(2 * a)).position;
     plan.hi[a] = w.wall(static_cast<SphereWallSide>(2 * a + 1)).position;
@@ -579,8 +578,7 @@ std::string liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p, const Pl
     if (!o.lateral_servo) return exact(sd % 2 == 0 ? plan.lo[sd / 2] : plan.hi[sd / 2]);
     return std::string("f_m") + kWall[sd] + "[" + std::to_string(7 + sd / 2) + "]";
   };
-  const int monitor_every =
-      static_cast<int>(std::max<int64_t>(1, plan.steps / std::max(1, c.test.monitor_points)));
+  const int monitor_every = deck::monitor_interval(plan.steps, c.test.monitor_points);
   s << "\nvariable H equal " << exact(ext[2]) << "-" << exact(plan.top_speed) << "*step*dt\n"
     << "variable Wx equal " << wall_pos(1) << "-(" << wall_pos(0) << ")\n"
     << "variable Wy equal " << wall_pos(3) << "-(" << wall_pos(2) << ")\n"
