@@ -47,6 +47,39 @@ int monitor_interval(int64_t steps, int monitor_points) {
   return static_cast<int>(std::max<int64_t>(1, steps / std::max(1, monitor_points)));
 }
 
+std::string header_opening(const std::string& code, const std::string& test,
+                           const std::string& sample, const std::string& provenance,
+                           double dt_ratio, double step_factor, double dt_crit, double dt) {
+  std::ostringstream s;
+  s << "# ===========================================================================\n"
+    << "# demcal " << DEMCAL_VERSION << " export: " << code << " input deck, " << test << "\n"
+    << "# " << sample << "\n";
+  if (!provenance.empty()) s << "# parameters: " << provenance << "\n";
+  s << "#\n"
+    << "# How demcal's parameters map (demcal -> " << code << "):\n"
+    << "#   dt = alpha * f * dt_crit = " << num(dt_ratio) << " * " << num(step_factor) << " * "
+    << num(dt_crit) << " s = " << num(dt) << " s -> timestep\n";
+  return s.str();
+}
+
+std::string header_step_factor(const std::string& code, double step_factor, double zeta_t) {
+  return "#     f = sqrt(1 + zeta_t^2) - zeta_t = " + num(step_factor) +
+         " (zeta_t = " + num(zeta_t) + "): " + code + "'s fix viscous is explicit\n";
+}
+
+std::string header_contact_law(const Material& m) {
+  return "#   kn = " + num(m.particle.kn) + " N/m, kt = " + num(m.particle.kt) +
+         " N/m, mu = " + num(m.particle.friction) +
+         " -> linear normal spring, incremental tangential spring, Coulomb cap\n"
+         "#   contact (local) damping: " +
+         (m.contact_damping_ratio > 0 ? num(m.contact_damping_ratio) + " of critical" : "none");
+}
+
+std::string header_wall_law(const Material& m) {
+  return "#   walls: kn = " + num(m.wall.kn) + " N/m, kt = " + num(m.wall.kt) +
+         " N/m, mu = " + num(m.wall.friction);
+}
+
 ExportResult plan_result(double dt, int64_t steps, double step_factor, int types,
                          double class_error) {
   ExportResult out;

@@ -46,6 +46,25 @@ DeckTiming deck_timing(double dt_ratio, int64_t steps, double zeta_t, double dt_
 /// Steps between two monitoring rows: Nstep / monitor_points, at least 1.
 int monitor_interval(int64_t steps, int monitor_points);
 
+/// The mapping header's opening: the banner naming the engine (`code`),
+/// the test (`test`, e.g. "2D biaxial test") and the sample (`sample`, one
+/// line without "# "), the parameters' provenance, and the step line
+/// dt = alpha·f·dt_crit.
+std::string header_opening(const std::string& code, const std::string& test,
+                           const std::string& sample, const std::string& provenance,
+                           double dt_ratio, double step_factor, double dt_crit, double dt);
+
+/// The mapping header's line on the step factor f (the engine's explicit
+/// fix viscous).
+std::string header_step_factor(const std::string& code, double step_factor, double zeta_t);
+
+/// The mapping header's lines on the particles' contact law and the
+/// contact damping (the last line left open for the writer's detail).
+std::string header_contact_law(const Material& m);
+
+/// The mapping header's walls' contact law (the line left open).
+std::string header_wall_law(const Material& m);
+
 /// The figures every export reports (the files and deck are added after),
 /// with the notes both writers give: the tangential springs start at zero,
 /// and the step factor f when the explicit damping shrinks the step.

@@ -80,18 +80,12 @@ std::string mapping_header(const SceneConfig& c, const AlgorithmSpec& p, const P
                            const ExportOptions& o, const std::string& code) {
   std::ostringstream s;
   const auto& m = c.material;
-  s << "# ===========================================================================\n"
-    << "# demcal " << DEMCAL_VERSION << " export: " << code << " input deck, 2D biaxial test\n"
-    << "# scene " << c.name << "; prototype " << plan.n << " particles (" << o.data_name << ")\n";
-  if (!o.provenance.empty()) s << "# parameters: " << o.provenance << "\n";
-  s << "#\n"
-    << "# How demcal's parameters map (demcal -> " << code << "):\n"
-    << "#   dt = alpha * f * dt_crit = " << num(p.dt_ratio) << " * " << num(plan.step_factor)
-    << " * " << num(plan.dt_crit) << " s = " << num(plan.dt) << " s -> timestep\n"
+  s << deck::header_opening(code, "2D biaxial test",
+                            "scene " + c.name + "; prototype " + std::to_string(plan.n) +
+                                " particles (" + o.data_name + ")",
+                            o.provenance, p.dt_ratio, plan.step_factor, plan.dt_crit, plan.dt)
     << "#     dt_crit = 2 sqrt(m_min/kn) of the smallest disc (r = " << num(plan.r_min) << " m)\n"
-    << "#     f = sqrt(1 + zeta_t^2) - zeta_t = " << num(plan.step_factor)
-    << " (zeta_t = " << num(p.damping_ratio_translation) << "): " << code
-    << "'s fix viscous is explicit\n"
+    << deck::header_step_factor(code, plan.step_factor, p.damping_ratio_translation)
     << "#       (the drag -gamma*v uses the half-step velocity), which shrinks a damped\n"
     << "#       oscillator's stable step from 2/omega to f*2/omega; demcal damps\n"
     << "#       semi-implicitly (f = 1). At demcal's alpha a well-damped calibration\n"
@@ -103,12 +97,7 @@ std::string mapping_header(const SceneConfig& c, const AlgorithmSpec& p, const P
     << "#     eps * H0 / (Nstep * dt) = " << num(c.test.vertical_strain) << " * "
     << num(plan.height0) << " / (" << plan.steps << " * " << num(plan.dt)
     << ") = " << num(plan.top_speed) << " m/s\n"
-    << "#   kn = " << num(m.particle.kn) << " N/m, kt = " << num(m.particle.kt)
-    << " N/m, mu = " << num(m.particle.friction)
-    << " -> linear normal spring, incremental tangential spring, Coulomb cap\n"
-    << "#   contact (local) damping: "
-    << (m.contact_damping_ratio > 0 ? num(m.contact_damping_ratio) + " of critical" : "none")
-    << " -> gamma_n"
+    << deck::header_contact_law(m) << " -> gamma_n"
     << (m.contact_damping_ratio > 0 ? " (per pair in demcal; mean mass here)" : " = gamma_t = 0")
     << "\n"
     << "#   zeta_t = " << num(p.damping_ratio_translation)
@@ -122,8 +111,7 @@ std::string mapping_header(const SceneConfig& c, const AlgorithmSpec& p, const P
     << "#   mass scaling f_ms = " << num(p.mass_scaling)
     << " -> areal density f_ms*rho*t = " << num(plan.areal_density)
     << " kg/m^2 (rho = " << num(m.density) << " kg/m^3, t = " << num(m.thickness) << " m)\n"
-    << "#   walls: kn = " << num(m.wall.kn) << " N/m, kt = " << num(m.wall.kt)
-    << " N/m, mu = " << num(m.wall.friction) << "; bottom fixed, top at constant speed,\n"
+    << deck::header_wall_law(m) << "; bottom fixed, top at constant speed,\n"
     << "#     left/right servo-controlled to sigma3 = " << num(c.test.lateral_stress)
     << " Pa (gain " << num(c.test.servo_gain) << ")\n"
     << "#   stresses: tension positive in demcal; the thermo columns below give the\n"

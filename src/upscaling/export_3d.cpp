@@ -96,19 +96,13 @@ std::string mapping_header(const SceneConfig& c, const AlgorithmSpec& p, const P
   std::ostringstream s;
   const auto& m = c.material;
   const double h0 = plan.hi[2] - plan.lo[2];
-  s << "# ===========================================================================\n"
-    << "# demcal " << DEMCAL_VERSION << " export: " << code << " input deck, 3D triaxial test\n"
-    << "# scene " << c.name << "; " << plan.n << " spheres (" << o.data_name << ")\n";
-  if (!o.provenance.empty()) s << "# parameters: " << o.provenance << "\n";
-  s << "#\n"
-    << "# How demcal's parameters map (demcal -> " << code << "):\n"
-    << "#   dt = alpha * f * dt_crit = " << num(p.dt_ratio) << " * " << num(plan.step_factor)
-    << " * " << num(plan.dt_crit) << " s = " << num(plan.dt) << " s -> timestep\n"
+  s << deck::header_opening(
+           code, "3D triaxial test",
+           "scene " + c.name + "; " + std::to_string(plan.n) + " spheres (" + o.data_name + ")",
+           o.provenance, p.dt_ratio, plan.step_factor, plan.dt_crit, plan.dt)
     << "#     dt_crit = 2 sqrt(m_min/kn) of the smallest sphere (r = " << num(plan.r_min)
     << " m, m = f_ms rho 4/3 pi r^3)\n"
-    << "#     f = sqrt(1 + zeta_t^2) - zeta_t = " << num(plan.step_factor)
-    << " (zeta_t = " << num(p.damping_ratio_translation) << "): " << code
-    << "'s fix viscous is explicit\n"
+    << deck::header_step_factor(code, plan.step_factor, p.damping_ratio_translation)
     << "#       (drag from the half-step velocity), which shrinks a damped oscillator's\n"
     << "#       stable step by f; demcal damps semi-implicitly (f = 1)\n"
     << "#   Nstep = " << p.steps << " / f = " << plan.steps
@@ -116,12 +110,7 @@ std::string mapping_header(const SceneConfig& c, const AlgorithmSpec& p, const P
     << "#     and strain); the top wall moves eps * H0 / (Nstep * dt) = "
     << num(c.test.vertical_strain) << " * " << num(h0) << " / (" << plan.steps << " * "
     << num(plan.dt) << ") = " << num(plan.top_speed) << " m/s\n"
-    << "#   kn = " << num(m.particle.kn) << " N/m, kt = " << num(m.particle.kt)
-    << " N/m, mu = " << num(m.particle.friction)
-    << " -> linear normal spring, incremental tangential spring, Coulomb cap\n"
-    << "#   contact (local) damping: "
-    << (m.contact_damping_ratio > 0 ? num(m.contact_damping_ratio) + " of critical" : "none")
-    << "\n"
+    << deck::header_contact_law(m) << "\n"
     << "#   zeta_t = " << num(p.damping_ratio_translation)
     << ": D_t = zeta_t * 2 sqrt(kn m_i) per sphere -> fix viscous per radius class\n"
     << "#     (atom type): " << plan.types
@@ -132,8 +121,7 @@ std::string mapping_header(const SceneConfig& c, const AlgorithmSpec& p, const P
     << "#     has no rotational viscous fix); the run is demcal's with zeta_r = 0\n"
     << "#   mass scaling f_ms = " << num(p.mass_scaling)
     << " -> density f_ms*rho = " << num(plan.density) << " kg/m^3 in the data file\n"
-    << "#   walls: kn = " << num(m.wall.kn) << " N/m, kt = " << num(m.wall.kt)
-    << " N/m, mu = " << num(m.wall.friction) << "; bottom (z min) fixed, top (z max) down\n"
+    << deck::header_wall_law(m) << "; bottom (z min) fixed, top (z max) down\n"
     << "#     at constant speed, the four lateral walls "
     << (o.lateral_servo ? "servo-controlled to sigma3 = " + num(c.test.lateral_stress) +
                               " Pa (gain " + num(c.test.servo_gain) + ")"
