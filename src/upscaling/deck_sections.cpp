@@ -178,6 +178,24 @@ std::string lammps_translational_damping(double zeta_t, const std::vector<double
   return s.str();
 }
 
+std::string lammps_series_header(const std::string& deck, const std::string& scene, int particles,
+                                 double zeta_t, std::optional<double> dt_crit,
+                                 std::optional<double> mass_scaling) {
+  auto line = [](const std::string& key, const std::string& value) {
+    return "print           \"# " + key + " = " + value + "\" append ${series} screen no\n";
+  };
+  std::ostringstream s;
+  s << "print           \"# demcal.series/1: " << deck << " written by demcal " << DEMCAL_VERSION
+    << ", scene " << scene << "\" file ${series} screen no\n"
+    << line("particles", std::to_string(particles)) << line("lateral_stress", "${sigma3}")
+    << line("steps", "${nstep}") << line("dt", "${dt}");
+  if (dt_crit) s << line("dt_crit", num(*dt_crit));
+  s << line("damping_ratio_translation", num(zeta_t)) << line("damping_ratio_rotation", "0");
+  if (mass_scaling) s << line("mass_scaling", num(*mass_scaling));
+  s << line("moment_lever_arm", "radius");
+  return s.str();
+}
+
 std::string liggghts_preamble(int dimension, const std::string& boundary,
                               const std::string& data_name, double r_min) {
   std::ostringstream s;

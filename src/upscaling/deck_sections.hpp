@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -103,6 +104,14 @@ std::string lammps_contact_law(double gamma_n, double r_min, const std::string& 
 /// class (gamma_t[k] for type k+1), or a comment when zeta_t = 0.
 std::string lammps_translational_damping(double zeta_t, const std::vector<double>& gamma_t,
                                          NumberFormat f);
+
+/// LAMMPS: the series file's header (print lines), what `demcal score`
+/// reads about the run: the deck (`deck`, e.g. "LAMMPS 3D deck"), scene,
+/// particles, sigma3, Nstep, dt, dt_crit (when given), the damping ratios
+/// applied (zeta_r 0: no rotational fix), f_ms (when given), the lever arm.
+std::string lammps_series_header(const std::string& deck, const std::string& scene, int particles,
+                                 double zeta_t, std::optional<double> dt_crit,
+                                 std::optional<double> mass_scaling);
 
 /// LIGGGHTS: atom style, boundary, communication, units (and dimension 2
 /// for `dimension` 2), the data file and the neighbour list.

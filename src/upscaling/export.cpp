@@ -220,19 +220,8 @@ std::string lammps_series_block(const SceneConfig& c, const AlgorithmSpec& p, co
   s << "# the header: what demcal score needs to know about the run (not repeated by\n"
     << "# the continuation of a split run, which appends its rows)\n"
     << "if              \"${continued} != 0\" then \"jump SELF series_rows\"\n"
-    << "print           \"# demcal.series/1: LAMMPS deck written by demcal " << DEMCAL_VERSION
-    << ", scene " << c.name << "\" file ${series} screen no\n"
-    << "print           \"# particles = " << plan.n << "\" append ${series} screen no\n"
-    << "print           \"# lateral_stress = ${sigma3}\" append ${series} screen no\n"
-    << "print           \"# steps = ${nstep}\" append ${series} screen no\n"
-    << "print           \"# dt = ${dt}\" append ${series} screen no\n"
-    << "print           \"# dt_crit = " << num(plan.dt_crit) << "\" append ${series} screen no\n"
-    << "print           \"# damping_ratio_translation = " << num(p.damping_ratio_translation)
-    << "\" append ${series} screen no\n"
-    << "print           \"# damping_ratio_rotation = 0\" append ${series} screen no\n"
-    << "print           \"# mass_scaling = " << num(p.mass_scaling)
-    << "\" append ${series} screen no\n"
-    << "print           \"# moment_lever_arm = radius\" append ${series} screen no\n"
+    << deck::lammps_series_header("LAMMPS deck", c.name, plan.n, p.damping_ratio_translation,
+                                  plan.dt_crit, p.mass_scaling)
     << "label           series_rows\n"
     << "fix             halt_top all halt ${monitor_every} v_clear_top < 0.0 error hard\n"
     << "fix             halt_left all halt ${monitor_every} v_clear_left < 0.0 error hard\n"

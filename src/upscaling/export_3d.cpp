@@ -400,16 +400,8 @@ std::string lammps_deck(const SceneConfig& c, const AlgorithmSpec& p, const Plan
     << "# where LAMMPS measures them. The series and the peaks are fixes defined\n"
     << "# before the servo's fix ave/time, so that at each step they see the walls\n"
     << "# where the forces were computed (the servo's running mean updates after).\n"
-    << "print           \"# demcal.series/1: LAMMPS 3D deck written by demcal " << DEMCAL_VERSION
-    << ", scene " << c.name << "\" file ${series} screen no\n"
-    << "print           \"# particles = " << plan.n << "\" append ${series} screen no\n"
-    << "print           \"# lateral_stress = ${sigma3}\" append ${series} screen no\n"
-    << "print           \"# steps = ${nstep}\" append ${series} screen no\n"
-    << "print           \"# dt = ${dt}\" append ${series} screen no\n"
-    << "print           \"# damping_ratio_translation = " << num(p.damping_ratio_translation)
-    << "\" append ${series} screen no\n"
-    << "print           \"# damping_ratio_rotation = 0\" append ${series} screen no\n"
-    << "print           \"# moment_lever_arm = radius\" append ${series} screen no\n"
+    << deck::lammps_series_header("LAMMPS 3D deck", c.name, plan.n, p.damping_ratio_translation,
+                                  std::nullopt, std::nullopt)
     << "fix             series all print ${monitor_every} \"" << row
     << "\" append ${series} screen no title \"" << columns << "\"\n"
     << "# the peaks over every peak_every steps: axial pressure and sigma1/sigma3\n"
