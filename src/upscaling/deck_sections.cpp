@@ -178,6 +178,23 @@ std::string lammps_translational_damping(double zeta_t, const std::vector<double
   return s.str();
 }
 
+std::string lammps_wall_sum(const std::vector<std::string>& fixes, int a, int b) {
+  std::string out;
+  for (const std::string& w : fixes) {
+    if (!out.empty()) out += "+";
+    out += "f_" + w + "[" + std::to_string(a) + "]";
+    if (b > 0) out += "*f_" + w + "[" + std::to_string(b) + "]";
+  }
+  return out;
+}
+
+std::string lammps_servo_move(const std::string& area, const std::string& minus_force,
+                              const std::string& count) {
+  const std::string raw = "${gain}*(${sigma3}*" + area + minus_force + ")/(${kn_wall}*(1+" + count +
+                          "+abs(1-" + count + "))/2)";
+  return "(abs(" + raw + "+${cap})-abs(" + raw + "-${cap}))/2";
+}
+
 std::string lammps_series_header(const std::string& deck, const std::string& scene, int particles,
                                  double zeta_t, std::optional<double> dt_crit,
                                  std::optional<double> mass_scaling) {

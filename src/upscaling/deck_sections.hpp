@@ -105,6 +105,19 @@ std::string lammps_contact_law(double gamma_n, double r_min, const std::string& 
 std::string lammps_translational_damping(double zeta_t, const std::vector<double>& gamma_t,
                                          NumberFormat f);
 
+/// LAMMPS: the sum over the wall fixes `fixes` (e.g. "wleft") of
+/// f_FIX[a], times f_FIX[b] when b > 0: an atom-style variable's formula.
+std::string lammps_wall_sum(const std::vector<std::string>& fixes, int a, int b);
+
+/// LAMMPS: demcal's servo move of one wall in one step, toward the sample
+/// when its pressure is below sigma3: gain*(sigma3*A - F)/(kn_wall*max(1,
+/// n)), clamped to ±cap, as one flat formula of the deck's variables.
+/// `area` is A, `minus_force` the term that subtracts F (e.g. "-c_cs[2]"),
+/// `count` n. This release has no min/max of two numbers: max(1, n) =
+/// (1+n+abs(1-n))/2 and clamp(x) = (abs(x+cap)-abs(x-cap))/2.
+std::string lammps_servo_move(const std::string& area, const std::string& minus_force,
+                              const std::string& count);
+
 /// LAMMPS: the series file's header (print lines), what `demcal score`
 /// reads about the run: the deck (`deck`, e.g. "LAMMPS 3D deck"), scene,
 /// particles, sigma3, Nstep, dt, dt_crit (when given), the damping ratios

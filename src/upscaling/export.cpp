@@ -176,15 +176,8 @@ std::string lammps_series_block(const SceneConfig& c, const AlgorithmSpec& p, co
     << "variable        cx equal (v_xl+v_xr)/2\n"
     << "variable        cy equal (v_yb0+v_yt)/2\n"
     << "variable        V  equal v_W*v_H*v_thick\n";
-  const char* walls[] = {"wleft", "wright", "wtop", "wbottom"};
-  auto wall_sum = [&](int a, int b) {
-    std::string out;
-    for (const char* w : walls) {
-      if (!out.empty()) out += "+";
-      out += std::string("f_") + w + "[" + std::to_string(a) + "]";
-      if (b > 0) out += std::string("*f_") + w + "[" + std::to_string(b) + "]";
-    }
-    return out;
+  auto wall_sum = [](int a, int b) {
+    return deck::lammps_wall_sum({"wleft", "wright", "wtop", "wbottom"}, a, b);
   };
   s << "variable        bxx_a atom " << wall_sum(5, 2) << "\n"
     << "variable        bxy_a atom " << wall_sum(5, 3) << "\n"
@@ -304,13 +297,10 @@ std::string lammps_servo() {
   // gain*(sigma3*H*t - F)/(kn_wall*max(1, n)); F, n from compute cs: the
   // left wall's force on the particles is +x (columns 1, 2), the right
   // wall's -x (columns 3, 4: F = -c_cs[4]).
-  auto raw = [](const char* force_sign, int count, int force) {
-    return std::string("${gain}*(${sigma3}*(${H0}-${vtop}*step*dt)*${thick}") + force_sign +
-           "c_cs[" + std::to_string(force) + "])/(${kn_wall}*(1+c_cs[" + std::to_string(count) +
-           "]+abs(1-c_cs[" + std::to_string(count) + "]))/2)";
-  };
-  auto clamp = [](const std::string& x) {
-    return "(abs(" + x + "+${cap})-abs(" + x + "-${cap}))/2";
+  auto move = [](const char* force_sign, int count, int force) {
+    return deck::lammps_servo_move("(${H0}-${vtop}*step*dt)*${thick}",
+                                   force_sign + ("c_cs[" + std::to_string(force) + "]"),
+                                   "c_cs[" + std::to_string(count) + "]");
   };
   std::ostringstream s;
   s << "# demcal's servo, one move per step toward the sample when p < sigma3:\n"
@@ -321,8 +311,8 @@ std::string lammps_servo() {
     << "# reference, and each level of parsing, is paid every step); this\n"
     << "# release has no min/max of two numbers: max(1, n) = (1+n+abs(1-n))/2,\n"
     << "# clamp(x) = (abs(x+cap)-abs(x-cap))/2.\n"
-    << "variable        movel equal " << clamp(raw("-", 1, 2)) << "\n"
-    << "variable        mover equal -" << clamp(raw("+", 3, 4)) << "\n"
+    << "variable        movel equal " << move("-", 1, 2) << "\n"
+    << "variable        mover equal -" << move("+", 3, 4) << "\n"
     << "fix             servo all ave/time 1 1 1 v_movel v_mover ave running\n\n";
   return s.str();
 }

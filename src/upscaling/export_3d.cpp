@@ -166,13 +166,7 @@ std::string data_file(const std::string& code, const SceneConfig& c, const Plan3
 
 /// Sum over the six walls of f_W[a] (times f_W[b] when b > 0).
 std::string wall_sum(int a, int b) {
-  std::string out;
-  for (const char* w : kWall) {
-    if (!out.empty()) out += "+";
-    out += std::string("f_w") + w + "[" + std::to_string(a) + "]";
-    if (b > 0) out += std::string("*f_w") + w + "[" + std::to_string(b) + "]";
-  }
-  return out;
+  return deck::lammps_wall_sum({"wxmin", "wxmax", "wymin", "wymax", "wzmin", "wzmax"}, a, b);
 }
 
 std::string lammps_deck(const SceneConfig& c, const AlgorithmSpec& p, const Plan3& plan,
@@ -249,10 +243,8 @@ std::string lammps_deck(const SceneConfig& c, const AlgorithmSpec& p, const Plan
     const std::string pressure_force =
         std::string(sd % 2 == 0 ? "" : "-") + "c_cs[" + std::to_string(2 * sd + 2) + "]";
     const std::string count = "c_cs[" + std::to_string(2 * sd + 1) + "]";
-    const std::string raw = "${gain}*(${sigma3}*" + area + "-(" + pressure_force +
-                            "))/(${kn_wall}*(1+" + count + "+abs(1-" + count + "))/2)";
-    const std::string clamped = "(abs(" + raw + "+${cap})-abs(" + raw + "-${cap}))/2";
-    return std::string(sd % 2 == 0 ? "" : "-") + clamped;
+    return std::string(sd % 2 == 0 ? "" : "-") +
+           deck::lammps_servo_move(area, "-(" + pressure_force + ")", count);
   };
 
   s << "# --- walls -------------------------------------------------------------------\n"
