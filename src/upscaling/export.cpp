@@ -7,23 +7,15 @@
 #include <numeric>
 #include <sstream>
 
+#include "deck_sections.hpp"
 #include "demcal/scene/biaxial.hpp"
 
 namespace demcal {
 
 namespace {
 
-std::string fmt3(double v) {
-  char b[40];
-  std::snprintf(b, sizeof b, "%.3g", v);
-  return b;
-}
-
-std::string num(double v) {
-  char b[40];
-  std::snprintf(b, sizeof b, "%.10g", v);
-  return b;
-}
+using deck::fmt3;
+using deck::num;
 
 /// Everything both decks need, computed once.
 struct Plan {
@@ -47,25 +39,21 @@ struct Plan {
 Plan make_plan(const SceneConfig& c, const AlgorithmSpec& p, const Assembly& a, int max_types) {
   Plan plan;
   plan.n = a.size();
-  plan.type = radius_classes(a.r, std::max(1, max_types), &plan.types);
-  plan.r_lo.assign(plan.types, std::numeric_limits<double>::infinity());
-  plan.r_hi.assign(plan.types, 0.0);
-  for (int i = 0; i < plan.n; ++i) {
-    const int k = plan.type[i] - 1;
-    plan.r_lo[k] = std::min(plan.r_lo[k], a.r[i]);
-    plan.r_hi[k] = std::max(plan.r_hi[k], a.r[i]);
-  }
+  deck::RadiusClasses classes = deck::radius_class_bounds(a.r, max_types);
+  plan.types = classes.types;
+  plan.type = std::move(classes.type);
+  plan.r_lo = std::move(classes.r_lo);
+  plan.r_hi = std::move(classes.r_hi);
   plan.scales = particle_scales(a.r, c.material, p.mass_scaling);
   plan.r_min = plan.scales.radius_min;
   plan.r_max = plan.scales.radius_max;
   plan.dt_crit = plan.scales.dt_crit;
-  // Both engines apply fix viscous explicitly (the force from the half-step
-  // velocity), which shrinks the stable step by f; demcal's damping is
-  // semi-implicit. The deck runs at alpha*f for Nstep/f steps: the same
-  // loading time, rate and strain, and the same stability margin as demcal.
-  plan.step_factor = dashpot_step_factor(p.damping_ratio_translation);
-  plan.dt = p.dt_ratio * plan.step_factor * plan.dt_crit;
-  plan.steps = std::max<int64_t>(1, std::llround(static_cast<double>(p.steps) / plan.step_factor));
+  // alpha*f for Nstep/f steps: the engines' fix viscous is explicit.
+  const deck::DeckTiming timing =
+      deck::deck_timing(p.dt_ratio, p.steps, p.damping_ratio_translation, plan.dt_crit);
+  plan.step_factor = timing.step_factor;
+  plan.dt = timing.dt;
+  plan.steps = timing.steps;
   plan.areal_density = p.mass_scaling * c.material.density * c.material.thickness;
   plan.width0 = a.right - a.left;
   plan.height0 = a.top - a.bottom;
@@ -84,8 +72,7 @@ Plan make_plan(const SceneConfig& c, const AlgorithmSpec& p, const Assembly& a, 
     plan.class_error =
         std::max(plan.class_error, (plan.r_hi[k] - plan.r_lo[k]) / (plan.r_hi[k] + plan.r_lo[k]));
   }
-  plan.thermo_every =
-      static_cast<int>(std::max<int64_t>(1, plan.steps / std::max(1, c.test.monitor_points)));
+  plan.thermo_every = deck::monitor_interval(plan.steps, c.test.monitor_points);
   return plan;
 }
 
@@ -93,18 +80,12 @@ std::string mapping_header(const SceneConfig& c, const AlgorithmSpec& p, const P
                            const ExportOptions& o, const std::string& code) {
   std::ostringstream s;
   const auto& m = c.material;
-  s << "# ===========================================================================\n"
-    << "# demcal " << DEMCAL_VERSION << " export: " << code << " input deck, 2D biaxial test\n"
-    << "# scene " << c.name << "; prototype " << plan.n << " particles (" << o.data_name << ")\n";
-  if (!o.provenance.empty()) s << "# parameters: " << o.provenance << "\n";
-  s << "#\n"
-    << "# How demcal's parameters map (demcal -> " << code << "):\n"
-    << "#   dt = alpha * f * dt_crit = " << num(p.dt_ratio) << " * " << num(plan.step_factor)
-    << " * " << num(plan.dt_crit) << " s = " << num(plan.dt) << " s -> timestep\n"
+  s << deck::header_opening(code, "2D biaxial test",
+                            "scene " + c.name + "; prototype " + std::to_string(plan.n) +
+                                " particles (" + o.data_name + ")",
+                            o.provenance, p.dt_ratio, plan.step_factor, plan.dt_crit, plan.dt)
     << "#     dt_crit = 2 sqrt(m_min/kn) of the smallest disc (r = " << num(plan.r_min) << " m)\n"
-    << "#     f = sqrt(1 + zeta_t^2) - zeta_t = " << num(plan.step_factor)
-    << " (zeta_t = " << num(p.damping_ratio_translation) << "): " << code
-    << "'s fix viscous is explicit\n"
+    << deck::header_step_factor(code, plan.step_factor, p.damping_ratio_translation)
     << "#       (the drag -gamma*v uses the half-step velocity), which shrinks a damped\n"
     << "#       oscillator's stable step from 2/omega to f*2/omega; demcal damps\n"
     << "#       semi-implicitly (f = 1). At demcal's alpha a well-damped calibration\n"
@@ -116,12 +97,7 @@ std::string mapping_header(const SceneConfig& c, const AlgorithmSpec& p, const P
     << "#     eps * H0 / (Nstep * dt) = " << num(c.test.vertical_strain) << " * "
     << num(plan.height0) << " / (" << plan.steps << " * " << num(plan.dt)
     << ") = " << num(plan.top_speed) << " m/s\n"
-    << "#   kn = " << num(m.particle.kn) << " N/m, kt = " << num(m.particle.kt)
-    << " N/m, mu = " << num(m.particle.friction)
-    << " -> linear normal spring, incremental tangential spring, Coulomb cap\n"
-    << "#   contact (local) damping: "
-    << (m.contact_damping_ratio > 0 ? num(m.contact_damping_ratio) + " of critical" : "none")
-    << " -> gamma_n"
+    << deck::header_contact_law(m) << " -> gamma_n"
     << (m.contact_damping_ratio > 0 ? " (per pair in demcal; mean mass here)" : " = gamma_t = 0")
     << "\n"
     << "#   zeta_t = " << num(p.damping_ratio_translation)
@@ -135,8 +111,7 @@ std::string mapping_header(const SceneConfig& c, const AlgorithmSpec& p, const P
     << "#   mass scaling f_ms = " << num(p.mass_scaling)
     << " -> areal density f_ms*rho*t = " << num(plan.areal_density)
     << " kg/m^2 (rho = " << num(m.density) << " kg/m^3, t = " << num(m.thickness) << " m)\n"
-    << "#   walls: kn = " << num(m.wall.kn) << " N/m, kt = " << num(m.wall.kt)
-    << " N/m, mu = " << num(m.wall.friction) << "; bottom fixed, top at constant speed,\n"
+    << deck::header_wall_law(m) << "; bottom fixed, top at constant speed,\n"
     << "#     left/right servo-controlled to sigma3 = " << num(c.test.lateral_stress)
     << " Pa (gain " << num(c.test.servo_gain) << ")\n"
     << "#   stresses: tension positive in demcal; the thermo columns below give the\n"
@@ -161,21 +136,7 @@ std::string mapping_header(const SceneConfig& c, const AlgorithmSpec& p, const P
 
 /// The figures of a plan every export reports (the files are added after).
 ExportResult result_of(const Plan& plan) {
-  ExportResult out;
-  out.dt = plan.dt;
-  out.steps = plan.steps;
-  out.step_factor = plan.step_factor;
-  out.notes.push_back(
-      "tangential contact forces are not carried over: the deck's contacts start with zero "
-      "tangential springs (normal forces are in the positions)");
-  if (plan.step_factor < 1.0)
-    out.notes.push_back(
-        "timestep alpha*f and Nstep/f (f = sqrt(1 + zeta_t^2) - zeta_t = " + num(plan.step_factor) +
-        "): this engine's fix viscous is explicit and shrinks the stable step "
-        "by f; the loading time, rate and strain are demcal's");
-  out.types = plan.types;
-  out.damping_class_error = plan.class_error;
-  return out;
+  return deck::plan_result(plan.dt, plan.steps, plan.step_factor, plan.types, plan.class_error);
 }
 
 // ---------------------------------------------------------------------------
@@ -215,15 +176,8 @@ std::string lammps_series_block(const SceneConfig& c, const AlgorithmSpec& p, co
     << "variable        cx equal (v_xl+v_xr)/2\n"
     << "variable        cy equal (v_yb0+v_yt)/2\n"
     << "variable        V  equal v_W*v_H*v_thick\n";
-  const char* walls[] = {"wleft", "wright", "wtop", "wbottom"};
-  auto wall_sum = [&](int a, int b) {
-    std::string out;
-    for (const char* w : walls) {
-      if (!out.empty()) out += "+";
-      out += std::string("f_") + w + "[" + std::to_string(a) + "]";
-      if (b > 0) out += std::string("*f_") + w + "[" + std::to_string(b) + "]";
-    }
-    return out;
+  auto wall_sum = [](int a, int b) {
+    return deck::lammps_wall_sum({"wleft", "wright", "wtop", "wbottom"}, a, b);
   };
   s << "variable        bxx_a atom " << wall_sum(5, 2) << "\n"
     << "variable        bxy_a atom " << wall_sum(5, 3) << "\n"
@@ -259,19 +213,8 @@ std::string lammps_series_block(const SceneConfig& c, const AlgorithmSpec& p, co
   s << "# the header: what demcal score needs to know about the run (not repeated by\n"
     << "# the continuation of a split run, which appends its rows)\n"
     << "if              \"${continued} != 0\" then \"jump SELF series_rows\"\n"
-    << "print           \"# demcal.series/1: LAMMPS deck written by demcal " << DEMCAL_VERSION
-    << ", scene " << c.name << "\" file ${series} screen no\n"
-    << "print           \"# particles = " << plan.n << "\" append ${series} screen no\n"
-    << "print           \"# lateral_stress = ${sigma3}\" append ${series} screen no\n"
-    << "print           \"# steps = ${nstep}\" append ${series} screen no\n"
-    << "print           \"# dt = ${dt}\" append ${series} screen no\n"
-    << "print           \"# dt_crit = " << num(plan.dt_crit) << "\" append ${series} screen no\n"
-    << "print           \"# damping_ratio_translation = " << num(p.damping_ratio_translation)
-    << "\" append ${series} screen no\n"
-    << "print           \"# damping_ratio_rotation = 0\" append ${series} screen no\n"
-    << "print           \"# mass_scaling = " << num(p.mass_scaling)
-    << "\" append ${series} screen no\n"
-    << "print           \"# moment_lever_arm = radius\" append ${series} screen no\n"
+    << deck::lammps_series_header("LAMMPS deck", c.name, plan.n, p.damping_ratio_translation,
+                                  plan.dt_crit, p.mass_scaling)
     << "label           series_rows\n"
     << "fix             halt_top all halt ${monitor_every} v_clear_top < 0.0 error hard\n"
     << "fix             halt_left all halt ${monitor_every} v_clear_left < 0.0 error hard\n"
@@ -354,13 +297,10 @@ std::string lammps_servo() {
   // gain*(sigma3*H*t - F)/(kn_wall*max(1, n)); F, n from compute cs: the
   // left wall's force on the particles is +x (columns 1, 2), the right
   // wall's -x (columns 3, 4: F = -c_cs[4]).
-  auto raw = [](const char* force_sign, int count, int force) {
-    return std::string("${gain}*(${sigma3}*(${H0}-${vtop}*step*dt)*${thick}") + force_sign +
-           "c_cs[" + std::to_string(force) + "])/(${kn_wall}*(1+c_cs[" + std::to_string(count) +
-           "]+abs(1-c_cs[" + std::to_string(count) + "]))/2)";
-  };
-  auto clamp = [](const std::string& x) {
-    return "(abs(" + x + "+${cap})-abs(" + x + "-${cap}))/2";
+  auto move = [](const char* force_sign, int count, int force) {
+    return deck::lammps_servo_move("(${H0}-${vtop}*step*dt)*${thick}",
+                                   force_sign + ("c_cs[" + std::to_string(force) + "]"),
+                                   "c_cs[" + std::to_string(count) + "]");
   };
   std::ostringstream s;
   s << "# demcal's servo, one move per step toward the sample when p < sigma3:\n"
@@ -371,8 +311,8 @@ std::string lammps_servo() {
     << "# reference, and each level of parsing, is paid every step); this\n"
     << "# release has no min/max of two numbers: max(1, n) = (1+n+abs(1-n))/2,\n"
     << "# clamp(x) = (abs(x+cap)-abs(x-cap))/2.\n"
-    << "variable        movel equal " << clamp(raw("-", 1, 2)) << "\n"
-    << "variable        mover equal -" << clamp(raw("+", 3, 4)) << "\n"
+    << "variable        movel equal " << move("-", 1, 2) << "\n"
+    << "variable        mover equal -" << move("+", 3, 4) << "\n"
     << "fix             servo all ave/time 1 1 1 v_movel v_mover ave running\n\n";
   return s.str();
 }
@@ -412,10 +352,7 @@ std::string lammps_limitations(const AlgorithmSpec& p, const Plan& plan, ExportR
     s << "#    zeta_r = " << num(p.damping_ratio_rotation)
       << " is NOT applied. LAMMPS releases from 2022 on have fix viscous/sphere:\n"
       << "#    uncomment the line marked viscous/sphere below there.\n";
-    out.notes.push_back("rotational damping zeta_r = " + num(p.damping_ratio_rotation) +
-                        " not applied: LAMMPS 29 Sep 2021 has no rotational viscous fix "
-                        "(fix viscous/sphere is in later releases; the deck has the line, "
-                        "commented out)");
+    out.notes.push_back(deck::lammps_rotational_damping_note(p.damping_ratio_rotation));
   } else {
     s << "#    not needed here, the calibrated zeta_r is 0.\n";
   }
@@ -433,9 +370,7 @@ std::string lammps_limitations(const AlgorithmSpec& p, const Plan& plan, ExportR
     s << "#  - per-particle damping D_t ~ sqrt(m): fix viscous has one gamma per atom type,\n"
       << "#    so the particles are grouped in " << plan.types << " radius classes (types 1.."
       << plan.types << ").\n";
-    out.notes.push_back("translational damping per radius class (" + std::to_string(plan.types) +
-                        " atom types), at most " + fmt3(100 * plan.class_error) +
-                        " % off demcal's per-particle value");
+    out.notes.push_back(deck::lammps_class_damping_note(plan.types, plan.class_error, "particle"));
   }
   out.notes.push_back(
       "lateral servo walls emulated with variables (running sum of demcal's per-step servo "
@@ -459,13 +394,8 @@ std::string lammps_parameters(const SceneConfig& c, const Assembly& a, const Pla
     << "      # total vertical strain over nstep\n"
     << "variable monitor_points equal " << c.test.monitor_points
     << "      # rows of the series file\n"
-    << "variable kn        equal " << num(m.particle.kn) << "\n"
-    << "variable kt        equal " << num(m.particle.kt) << "\n"
-    << "variable mu        equal " << num(m.particle.friction) << "\n"
-    << "variable kn_wall   equal " << num(m.wall.kn) << "\n"
-    << "variable kt_wall   equal " << num(m.wall.kt) << "\n"
-    << "variable mu_wall   equal " << num(m.wall.friction) << "\n"
-    << "variable thick     equal " << num(m.thickness) << "      # disc thickness t, m\n"
+    << deck::lammps_material_variables(m, num) << "variable thick     equal " << num(m.thickness)
+    << "      # disc thickness t, m\n"
     << "variable sigma3    equal " << num(c.test.lateral_stress) << "      # Pa\n"
     << "variable gain      equal " << num(c.test.servo_gain) << "\n"
     << "variable r_min     equal " << num(plan.r_min) << "      # m, smallest radius\n"
@@ -506,10 +436,7 @@ std::string lammps_derived() {
   std::ostringstream s;
   s << "\n# --- derived (do not edit) ---------------------------------------------------\n"
     << "variable H0        equal $(v_yt0-v_yb0)\n"
-    << "variable vtop      equal $(v_strain*v_H0/(v_nstep*v_dt))      # m/s, top wall, down\n"
-    << "variable cap       equal $(0.02*v_r_min)      # m per step, servo move cap\n"
-    << "variable monitor_every equal "
-       "$(floor((1+v_nstep/v_monitor_points+abs(1-v_nstep/v_monitor_points))/2))\n"
+    << deck::lammps_loading_derived()
     << "variable band_v    equal $(v_strain*v_H0+6*v_r_max)      # m, see the walls\n"
     << "variable band_h    equal $(2*v_strain*(v_xr0-v_xl0)+6*v_r_max)\n";
   return s.str();
@@ -519,9 +446,7 @@ std::string lammps_derived() {
 /// ratio·2·sqrt(kn·m_eff), LAMMPS m_eff·gamma_n, so gamma_n =
 /// ratio·2·sqrt(kn/m_eff), taken at the mean mass (m_eff = m/2); 0 without.
 double contact_gamma_n(const SceneConfig& c, const Plan& plan) {
-  const auto& m = c.material;
-  if (m.contact_damping_ratio <= 0.0) return 0.0;
-  return m.contact_damping_ratio * 2.0 * std::sqrt(m.particle.kn / (0.5 * plan.scales.mass_mean));
+  return deck::contact_gamma_n(c.material, plan.scales.mass_mean);
 }
 
 /// Units, particles (data file or restart), masses, contact law, integrator.
@@ -530,43 +455,21 @@ std::string lammps_system(const SceneConfig& c, const Plan& plan, const ExportOp
   const double gamma_n = contact_gamma_n(c, plan);
   if (gamma_n > 0.0) out.notes.push_back("contact damping mapped at the mean particle mass");
   std::ostringstream s;
-  s << "\n# --- system ------------------------------------------------------------------\n"
-    << "units           si\n"
-    << "dimension       2\n"
-    << "boundary        f f p\n"
-    << "atom_style      sphere\n"
-    << "atom_modify     map array\n"
-    << "comm_modify     vel yes\n"
+  s << deck::lammps_system_head(2, "f f p")
     << "if              \"${continued} == 0\" then \"read_data " << o.data_name
     << "\" else \"read_restart ${restart_from}\"\n"
     << "variable        step0 equal $(step)\n"
     << "# disc masses m = f_ms*rho*t*pi*r^2 and inertia m*r^2/2 (fix nve/sphere disc)\n"
     << "set             type 1*" << plan.types << " density/disc " << num(plan.areal_density)
     << "\n\n"
-    << "pair_style      gran/hooke/history ${kn} ${kt} " << num(gamma_n) << " 0.0 ${mu} 0\n"
-    << "pair_coeff      * *\n"
-    << "neighbor        " << num(0.3 * plan.r_min) << " bin\n"
-    << "neigh_modify    delay 0 every 1 check yes\n"
-    << "timestep        ${dt}\n\n"
-    << "fix             integrate all nve/sphere disc\n\n";
+    << deck::lammps_contact_law(gamma_n, plan.r_min, "disc");
   return s.str();
 }
 
 /// Global damping per radius class (fix viscous ... scale), then enforce2d.
 std::string lammps_damping(const AlgorithmSpec& p, const Plan& plan) {
   std::ostringstream s;
-  s << "# --- global damping ----------------------------------------------------------\n";
-  if (p.damping_ratio_translation > 0.0) {
-    s << "# gamma per class, N*s/m:";
-    for (int k = 0; k < plan.types; ++k) s << " " << num(plan.gamma_t[k]);
-    s << "\nfix             dampt all viscous " << num(plan.gamma_t[0]);
-    // one "scale type ratio" keyword per type
-    for (int k = 1; k < plan.types; ++k)
-      s << " scale " << k + 1 << " " << num(plan.gamma_t[k] / plan.gamma_t[0]);
-    s << "\n";
-  } else {
-    s << "# zeta_t = 0: no translational damping\n";
-  }
+  s << deck::lammps_translational_damping(p.damping_ratio_translation, plan.gamma_t, num);
   if (p.damping_ratio_rotation > 0.0) {
     s << "# LAMMPS >= 2022 only (absent in 29 Sep 2021): rotational damping, N*m*s\n"
       << "#fix            dampr all viscous/sphere " << num(plan.gamma_r[0]);
@@ -951,14 +854,6 @@ ExportResult liggghts(const SceneConfig& c, const AlgorithmSpec& p, const Assemb
   out.files[left] = stl_rectangle("left", a.left, ylo, a.left, yhi, z0, z1);
   out.files[right] = stl_rectangle("right", a.right, yhi, a.right, ylo, z0, z1);
 
-  auto pair_matrix = [&](double pp, double pw) {
-    std::ostringstream s;
-    for (int i = 1; i <= ntypes; ++i)
-      for (int j = 1; j <= ntypes; ++j)
-        s << " " << num((i == wall_type || j == wall_type) ? pw : pp);
-    return s.str();
-  };
-
   std::ostringstream s;
   s << mapping_header(c, p, plan, o, "LIGGGHTS");
   s << "#\n# Checked with LIGGGHTS 3.8 (Debian): on a 25-disc sample its peak is within\n"
@@ -981,31 +876,8 @@ ExportResult liggghts(const SceneConfig& c, const AlgorithmSpec& p, const Assemb
   out.notes.push_back(
       "LIGGGHTS deck: lateral force held at sigma3*H0*t (not on the current height); discs "
       "rotate as spheres");
-  s << "\natom_style      granular\n"
-    << "atom_modify     map array\n"
-    << "boundary        f f p\n"
-    << "newton          off\n"
-    << "communicate     single vel yes\n"
-    << "units           si\n"
-    << "dimension       2\n"
-    << "read_data       " << o.data_name << "\n"
-    << "neighbor        " << num(0.3 * plan.r_min) << " bin\n"
-    << "neigh_modify    delay 0\n\n"
-    << "# type " << wall_type << " is the walls' material\n"
-    << "fix m1 all property/global kn peratomtypepair " << ntypes
-    << pair_matrix(m.particle.kn, m.wall.kn) << "\n"
-    << "fix m2 all property/global kt peratomtypepair " << ntypes
-    << pair_matrix(m.particle.kt, m.wall.kt) << "\n"
-    << "fix m3 all property/global gamman_abs peratomtypepair " << ntypes << pair_matrix(0, 0)
-    << "\n"
-    << "fix m4 all property/global gammat_abs peratomtypepair " << ntypes << pair_matrix(0, 0)
-    << "\n"
-    << "fix m5 all property/global coefficientFriction peratomtypepair " << ntypes
-    << pair_matrix(m.particle.friction, m.wall.friction) << "\n\n"
-    << "pair_style gran model hooke/stiffness tangential history absolute_damping on "
-       "tangential_damping off\n"
-    << "pair_coeff * *\n"
-    << "timestep " << num(plan.dt) << "\n\n"
+  s << deck::liggghts_preamble(2, "f f p", o.data_name, plan.r_min)
+    << deck::liggghts_materials(m, ntypes, plan.dt, num)
     << "fix bottom all wall/gran model hooke/stiffness tangential history primitive type "
     << wall_type << " yplane " << num(a.bottom) << " absolute_damping on tangential_damping off\n"
     << "fix mtop all mesh/surface/stress file " << top << " type " << wall_type << "\n"
@@ -1023,13 +895,8 @@ ExportResult liggghts(const SceneConfig& c, const AlgorithmSpec& p, const Assemb
        "mtop mleft mright absolute_damping on tangential_damping off\n"
     << "fix movetop all move/mesh mesh mtop linear 0 " << num(-plan.top_speed) << " 0\n\n"
     << "fix integrate all nve/sphere\n";
-  if (p.damping_ratio_translation > 0.0) {
-    s << "fix dampt all viscous " << num(plan.gamma_t[0]);
-    for (int k = 1; k < plan.types; ++k)
-      s << " scale " << k + 1 << " " << num(plan.gamma_t[k] / plan.gamma_t[0]);
-    s << "\n";
-  }
-  s << "fix twod all enforce2d\n\n"
+  s << deck::liggghts_translational_damping(p.damping_ratio_translation, plan.gamma_t, num)
+    << "fix twod all enforce2d\n\n"
     << "# p_top: axial stress on the top wall; p_left, p_right: lateral (Pa)\n"
     << "variable xl equal f_mleft[7]\n"
     << "variable xr equal f_mright[7]\n"

@@ -10,6 +10,7 @@
 #include <limits>
 #include <sstream>
 
+#include "deck_sections.hpp"
 #include "demcal/io/input_error.hpp"
 #include "demcal/kernel/particle_scales.hpp"
 
@@ -17,21 +18,9 @@ namespace demcal {
 
 namespace {
 
-std::string num(double v) {
-  char b[40];
-  std::snprintf(b, sizeof b, "%.10g", v);
-  return b;
-}
-std::string exact(double v) {
-  char b[40];
-  std::snprintf(b, sizeof b, "%.17g", v);
-  return b;
-}
-std::string fmt3(double v) {
-  char b[40];
-  std::snprintf(b, sizeof b, "%.3g", v);
-  return b;
-}
+using deck::exact;
+using deck::fmt3;
+using deck::num;
 
 constexpr const char* kAxis = "xyz";
 constexpr const char* kWall[6] = {"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"};
@@ -56,14 +45,11 @@ Plan3 make_plan(const SceneConfig& c, const AlgorithmSpec& p, const SphereWorld&
   Plan3 plan;
   plan.n = w.size();
   const std::vector<double> radii(w.radius().begin(), w.radius().end());
-  plan.type = radius_classes(radii, std::max(1, max_types), &plan.types);
-  plan.r_lo.assign(plan.types, std::numeric_limits<double>::infinity());
-  plan.r_hi.assign(plan.types, 0.0);
-  for (int i = 0; i < plan.n; ++i) {
-    const int k = plan.type[i] - 1;
-    plan.r_lo[k] = std::min(plan.r_lo[k], radii[i]);
-    plan.r_hi[k] = std::max(plan.r_hi[k], radii[i]);
-  }
+  deck::RadiusClasses classes = deck::radius_class_bounds(radii, max_types);
+  plan.types = classes.types;
+  plan.type = std::move(classes.type);
+  plan.r_lo = std::move(classes.r_lo);
+  plan.r_hi = std::move(classes.r_hi);
   plan.density = c.material.density * p.mass_scaling;
   plan.r_min = w.min_radius();
   plan.r_max = w.max_radius();
@@ -74,9 +60,11 @@ Plan3 make_plan(const SceneConfig& c, const AlgorithmSpec& p, const SphereWorld&
   // Δt_crit of the lightest sphere, as integration_for (triaxial.cpp).
   plan.dt_crit = critical_time_step(sphere_mass(plan.density, plan.r_min), kn);
   // The engines' fix viscous is explicit: α·f for Nstep/f steps (export.hpp).
-  plan.step_factor = dashpot_step_factor(p.damping_ratio_translation);
-  plan.dt = p.dt_ratio * plan.step_factor * plan.dt_crit;
-  plan.steps = std::max<int64_t>(1, std::llround(static_cast<double>(p.steps) / plan.step_factor));
+  const deck::DeckTiming timing =
+      deck::deck_timing(p.dt_ratio, p.steps, p.damping_ratio_translation, plan.dt_crit);
+  plan.step_factor = timing.step_factor;
+  plan.dt = timing.dt;
+  plan.steps = timing.steps;
   for (int a = 0; a < 3; ++a) {
     plan.lo[a] = w.wall(static_cast<SphereWallSide>(2 * a)).position;
     plan.hi[a] = w.wall(static_cast<SphereWallSide>(2 * a + 1)).position;
@@ -100,21 +88,7 @@ Plan3 make_plan(const SceneConfig& c, const AlgorithmSpec& p, const SphereWorld&
 }
 
 ExportResult result_of(const Plan3& plan) {
-  ExportResult out;
-  out.dt = plan.dt;
-  out.steps = plan.steps;
-  out.step_factor = plan.step_factor;
-  out.types = plan.types;
-  out.damping_class_error = plan.class_error;
-  out.notes.push_back(
-      "tangential contact forces are not carried over: the deck's contacts start with zero "
-      "tangential springs (normal forces are in the positions)");
-  if (plan.step_factor < 1.0)
-    out.notes.push_back(
-        "timestep alpha*f and Nstep/f (f = sqrt(1 + zeta_t^2) - zeta_t = " + num(plan.step_factor) +
-        "): this engine's fix viscous is explicit and shrinks the stable step "
-        "by f; the loading time, rate and strain are demcal's");
-  return out;
+  return deck::plan_result(plan.dt, plan.steps, plan.step_factor, plan.types, plan.class_error);
 }
 
 std::string mapping_header(const SceneConfig& c, const AlgorithmSpec& p, const Plan3& plan,
@@ -122,19 +96,13 @@ std::string mapping_header(const SceneConfig& c, const AlgorithmSpec& p, const P
   std::ostringstream s;
   const auto& m = c.material;
   const double h0 = plan.hi[2] - plan.lo[2];
-  s << "# ===========================================================================\n"
-    << "# demcal " << DEMCAL_VERSION << " export: " << code << " input deck, 3D triaxial test\n"
-    << "# scene " << c.name << "; " << plan.n << " spheres (" << o.data_name << ")\n";
-  if (!o.provenance.empty()) s << "# parameters: " << o.provenance << "\n";
-  s << "#\n"
-    << "# How demcal's parameters map (demcal -> " << code << "):\n"
-    << "#   dt = alpha * f * dt_crit = " << num(p.dt_ratio) << " * " << num(plan.step_factor)
-    << " * " << num(plan.dt_crit) << " s = " << num(plan.dt) << " s -> timestep\n"
+  s << deck::header_opening(
+           code, "3D triaxial test",
+           "scene " + c.name + "; " + std::to_string(plan.n) + " spheres (" + o.data_name + ")",
+           o.provenance, p.dt_ratio, plan.step_factor, plan.dt_crit, plan.dt)
     << "#     dt_crit = 2 sqrt(m_min/kn) of the smallest sphere (r = " << num(plan.r_min)
     << " m, m = f_ms rho 4/3 pi r^3)\n"
-    << "#     f = sqrt(1 + zeta_t^2) - zeta_t = " << num(plan.step_factor)
-    << " (zeta_t = " << num(p.damping_ratio_translation) << "): " << code
-    << "'s fix viscous is explicit\n"
+    << deck::header_step_factor(code, plan.step_factor, p.damping_ratio_translation)
     << "#       (drag from the half-step velocity), which shrinks a damped oscillator's\n"
     << "#       stable step by f; demcal damps semi-implicitly (f = 1)\n"
     << "#   Nstep = " << p.steps << " / f = " << plan.steps
@@ -142,12 +110,7 @@ std::string mapping_header(const SceneConfig& c, const AlgorithmSpec& p, const P
     << "#     and strain); the top wall moves eps * H0 / (Nstep * dt) = "
     << num(c.test.vertical_strain) << " * " << num(h0) << " / (" << plan.steps << " * "
     << num(plan.dt) << ") = " << num(plan.top_speed) << " m/s\n"
-    << "#   kn = " << num(m.particle.kn) << " N/m, kt = " << num(m.particle.kt)
-    << " N/m, mu = " << num(m.particle.friction)
-    << " -> linear normal spring, incremental tangential spring, Coulomb cap\n"
-    << "#   contact (local) damping: "
-    << (m.contact_damping_ratio > 0 ? num(m.contact_damping_ratio) + " of critical" : "none")
-    << "\n"
+    << deck::header_contact_law(m) << "\n"
     << "#   zeta_t = " << num(p.damping_ratio_translation)
     << ": D_t = zeta_t * 2 sqrt(kn m_i) per sphere -> fix viscous per radius class\n"
     << "#     (atom type): " << plan.types
@@ -158,8 +121,7 @@ std::string mapping_header(const SceneConfig& c, const AlgorithmSpec& p, const P
     << "#     has no rotational viscous fix); the run is demcal's with zeta_r = 0\n"
     << "#   mass scaling f_ms = " << num(p.mass_scaling)
     << " -> density f_ms*rho = " << num(plan.density) << " kg/m^3 in the data file\n"
-    << "#   walls: kn = " << num(m.wall.kn) << " N/m, kt = " << num(m.wall.kt)
-    << " N/m, mu = " << num(m.wall.friction) << "; bottom (z min) fixed, top (z max) down\n"
+    << deck::header_wall_law(m) << "; bottom (z min) fixed, top (z max) down\n"
     << "#     at constant speed, the four lateral walls "
     << (o.lateral_servo ? "servo-controlled to sigma3 = " + num(c.test.lateral_stress) +
                               " Pa (gain " + num(c.test.servo_gain) + ")"
@@ -176,19 +138,23 @@ std::string mapping_header(const SceneConfig& c, const AlgorithmSpec& p, const P
 // ---------------------------------------------------------------------------
 // LAMMPS (29 Sep 2021)
 
-std::string lammps_data_file(const SceneConfig& c, const Plan3& plan, const SphereWorld& w) {
+/// The particle file of either engine: rows "id type diameter density x y
+/// z" (LAMMPS atom_style sphere, LIGGGHTS granular: m = density·(4/3)πr³);
+/// `ntypes` the atom types (LIGGGHTS adds the walls'), `atoms` the section.
+std::string data_file(const std::string& code, const SceneConfig& c, const Plan3& plan,
+                      const SphereWorld& w, int ntypes, const std::string& atoms) {
   std::ostringstream d;
-  d << "LAMMPS data file written by demcal " << DEMCAL_VERSION << " (scene " << c.name
+  d << code << " data file written by demcal " << DEMCAL_VERSION << " (scene " << c.name
     << ", 3D)\n\n"
     << plan.n << " atoms\n"
-    << plan.types << " atom types\n\n";
+    << ntypes << " atom types\n\n";
   // Room around the walls: the top moves in, the lateral walls breathe.
   for (int a = 0; a < 3; ++a) {
     const double pad = 0.5 * (plan.hi[a] - plan.lo[a]) + 4.0 * plan.r_max;
     d << exact(plan.lo[a] - pad) << " " << exact(plan.hi[a] + pad) << " " << kAxis[a] << "lo "
       << kAxis[a] << "hi\n";
   }
-  d << "\nAtoms # sphere\n\n";
+  d << "\n" << atoms << "\n\n";
   char line[200];
   for (int i = 0; i < plan.n; ++i) {
     std::snprintf(line, sizeof line, "%d %d %.17g %.17g %.17g %.17g %.17g\n", i + 1, plan.type[i],
@@ -200,13 +166,7 @@ std::string lammps_data_file(const SceneConfig& c, const Plan3& plan, const Sphe
 
 /// Sum over the six walls of f_W[a] (times f_W[b] when b > 0).
 std::string wall_sum(int a, int b) {
-  std::string out;
-  for (const char* w : kWall) {
-    if (!out.empty()) out += "+";
-    out += std::string("f_w") + w + "[" + std::to_string(a) + "]";
-    if (b > 0) out += std::string("*f_w") + w + "[" + std::to_string(b) + "]";
-  }
-  return out;
+  return deck::lammps_wall_sum({"wxmin", "wxmax", "wymin", "wymax", "wzmin", "wzmax"}, a, b);
 }
 
 std::string lammps_deck(const SceneConfig& c, const AlgorithmSpec& p, const Plan3& plan,
@@ -230,14 +190,9 @@ std::string lammps_deck(const SceneConfig& c, const AlgorithmSpec& p, const Plan
     << "# Outputs: ${series} (columns below) and, at the end, peak_axial_stress and\n"
     << "# peak_ratio over every step (print; also appended to ${series} as comments).\n";
   if (p.damping_ratio_rotation > 0.0)
-    out.notes.push_back("rotational damping zeta_r = " + num(p.damping_ratio_rotation) +
-                        " not applied: LAMMPS 29 Sep 2021 has no rotational viscous fix "
-                        "(fix viscous/sphere is in later releases; the deck has the line, "
-                        "commented out)");
+    out.notes.push_back(deck::lammps_rotational_damping_note(p.damping_ratio_rotation));
   if (plan.types > 1)
-    out.notes.push_back("translational damping per radius class (" + std::to_string(plan.types) +
-                        " atom types), at most " + fmt3(100 * plan.class_error) +
-                        " % off demcal's per-sphere value");
+    out.notes.push_back(deck::lammps_class_damping_note(plan.types, plan.class_error, "sphere"));
 
   s << "\n# --- parameters (edit here) -------------------------------------------------\n"
     << "# Everything below is derived from this block: editing dt or nstep keeps the\n"
@@ -247,13 +202,8 @@ std::string lammps_deck(const SceneConfig& c, const AlgorithmSpec& p, const Plan
     << "variable strain    equal " << exact(c.test.vertical_strain)
     << "      # axial (z) strain over nstep, compression\n"
     << "variable monitor_points equal " << c.test.monitor_points << "      # rows of ${series}\n"
-    << "variable kn        equal " << exact(m.particle.kn) << "\n"
-    << "variable kt        equal " << exact(m.particle.kt) << "\n"
-    << "variable mu        equal " << exact(m.particle.friction) << "\n"
-    << "variable kn_wall   equal " << exact(m.wall.kn) << "\n"
-    << "variable kt_wall   equal " << exact(m.wall.kt) << "\n"
-    << "variable mu_wall   equal " << exact(m.wall.friction) << "\n"
-    << "variable sigma3    equal " << exact(c.test.lateral_stress) << "      # Pa\n"
+    << deck::lammps_material_variables(m, exact) << "variable sigma3    equal "
+    << exact(c.test.lateral_stress) << "      # Pa\n"
     << "variable gain      equal " << exact(o.lateral_servo ? c.test.servo_gain : 0.0)
     << "      # servo gain (0: lateral walls fixed)\n"
     << "variable r_min     equal " << exact(plan.r_min) << "      # m\n";
@@ -266,34 +216,15 @@ std::string lammps_deck(const SceneConfig& c, const AlgorithmSpec& p, const Plan
     << "variable H0        equal $(v_zmax0-v_zmin0)\n"
     << "variable Wx0       equal $(v_xmax0-v_xmin0)\n"
     << "variable Wy0       equal $(v_ymax0-v_ymin0)\n"
-    << "variable vtop      equal $(v_strain*v_H0/(v_nstep*v_dt))      # m/s, top wall, down\n"
-    << "variable cap       equal $(0.02*v_r_min)      # m per step, servo move cap\n"
-    << "variable monitor_every equal "
-       "$(floor((1+v_nstep/v_monitor_points+abs(1-v_nstep/v_monitor_points))/2))\n"
+    << deck::lammps_loading_derived()
     << "variable peak_every equal $(ceil(v_nstep/1000000))      # fix vector length <= 1e6\n";
 
-  double gamma_n = 0.0;
-  if (m.contact_damping_ratio > 0.0) {
-    // demcal: ratio·2·sqrt(kn·m_eff); LAMMPS: m_eff·gamma_n, at the mean mass.
-    gamma_n = m.contact_damping_ratio * 2.0 * std::sqrt(m.particle.kn / (0.5 * plan.m_mean));
-    out.notes.push_back("contact damping mapped at the mean sphere mass");
-  }
-  s << "\n# --- system ------------------------------------------------------------------\n"
-    << "units           si\n"
-    << "dimension       3\n"
-    << "boundary        f f f\n"
-    << "atom_style      sphere\n"
-    << "atom_modify     map array\n"
-    << "comm_modify     vel yes\n"
-    << "newton          off\n"
+  const double gamma_n = deck::contact_gamma_n(m, plan.m_mean);
+  if (gamma_n > 0.0) out.notes.push_back("contact damping mapped at the mean sphere mass");
+  s << deck::lammps_system_head(3, "f f f") << "newton          off\n"
     << "read_data       " << o.data_name << "\n"
     << "# sphere masses f_ms*rho*4/3*pi*r^3 (density column), inertia 2/5 m r^2\n"
-    << "pair_style      gran/hooke/history ${kn} ${kt} " << num(gamma_n) << " 0.0 ${mu} 0\n"
-    << "pair_coeff      * *\n"
-    << "neighbor        " << num(0.3 * plan.r_min) << " bin\n"
-    << "neigh_modify    delay 0 every 1 check yes\n"
-    << "timestep        ${dt}\n\n"
-    << "fix             integrate all nve/sphere\n\n";
+    << deck::lammps_contact_law(gamma_n, plan.r_min, "");
 
   // The servo moves, one flat formula each (numbers substituted now): wall
   // k's move toward the sample, gain*(sigma3*A - F)/(kn_wall*max(1, n))
@@ -312,10 +243,8 @@ std::string lammps_deck(const SceneConfig& c, const AlgorithmSpec& p, const Plan
     const std::string pressure_force =
         std::string(sd % 2 == 0 ? "" : "-") + "c_cs[" + std::to_string(2 * sd + 2) + "]";
     const std::string count = "c_cs[" + std::to_string(2 * sd + 1) + "]";
-    const std::string raw = "${gain}*(${sigma3}*" + area + "-(" + pressure_force +
-                            "))/(${kn_wall}*(1+" + count + "+abs(1-" + count + "))/2)";
-    const std::string clamped = "(abs(" + raw + "+${cap})-abs(" + raw + "-${cap}))/2";
-    return std::string(sd % 2 == 0 ? "" : "-") + clamped;
+    return std::string(sd % 2 == 0 ? "" : "-") +
+           deck::lammps_servo_move(area, "-(" + pressure_force + ")", count);
   };
 
   s << "# --- walls -------------------------------------------------------------------\n"
@@ -340,17 +269,7 @@ std::string lammps_deck(const SceneConfig& c, const AlgorithmSpec& p, const Plan
   s << "# contact force on every sphere (pairs and walls), before the damping\n"
     << "fix             fcon all store/force\n\n";
 
-  s << "# --- global damping ----------------------------------------------------------\n";
-  if (p.damping_ratio_translation > 0.0) {
-    s << "# gamma per class, N*s/m:";
-    for (int k = 0; k < plan.types; ++k) s << " " << num(plan.gamma_t[k]);
-    s << "\nfix             dampt all viscous " << exact(plan.gamma_t[0]);
-    for (int k = 1; k < plan.types; ++k)
-      s << " scale " << k + 1 << " " << exact(plan.gamma_t[k] / plan.gamma_t[0]);
-    s << "\n";
-  } else {
-    s << "# zeta_t = 0: no translational damping\n";
-  }
+  s << deck::lammps_translational_damping(p.damping_ratio_translation, plan.gamma_t, exact);
   s << "# LAMMPS >= 2022 only (absent in 29 Sep 2021): rotational damping D_r per class,\n"
     << "# N*m*s (zeta_r = " << num(p.damping_ratio_rotation) << ")\n";
   if (p.damping_ratio_rotation > 0.0) {
@@ -473,16 +392,8 @@ std::string lammps_deck(const SceneConfig& c, const AlgorithmSpec& p, const Plan
     << "# where LAMMPS measures them. The series and the peaks are fixes defined\n"
     << "# before the servo's fix ave/time, so that at each step they see the walls\n"
     << "# where the forces were computed (the servo's running mean updates after).\n"
-    << "print           \"# demcal.series/1: LAMMPS 3D deck written by demcal " << DEMCAL_VERSION
-    << ", scene " << c.name << "\" file ${series} screen no\n"
-    << "print           \"# particles = " << plan.n << "\" append ${series} screen no\n"
-    << "print           \"# lateral_stress = ${sigma3}\" append ${series} screen no\n"
-    << "print           \"# steps = ${nstep}\" append ${series} screen no\n"
-    << "print           \"# dt = ${dt}\" append ${series} screen no\n"
-    << "print           \"# damping_ratio_translation = " << num(p.damping_ratio_translation)
-    << "\" append ${series} screen no\n"
-    << "print           \"# damping_ratio_rotation = 0\" append ${series} screen no\n"
-    << "print           \"# moment_lever_arm = radius\" append ${series} screen no\n"
+    << deck::lammps_series_header("LAMMPS 3D deck", c.name, plan.n, p.damping_ratio_translation,
+                                  std::nullopt, std::nullopt)
     << "fix             series all print ${monitor_every} \"" << row
     << "\" append ${series} screen no title \"" << columns << "\"\n"
     << "# the peaks over every peak_every steps: axial pressure and sigma1/sigma3\n"
@@ -549,28 +460,7 @@ std::string liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p, const Pl
   const int wall_type = plan.types + 1, ntypes = plan.types + 1;
   const std::array<double, 3> ext{plan.hi[0] - plan.lo[0], plan.hi[1] - plan.lo[1],
                                   plan.hi[2] - plan.lo[2]};
-  // Data file: atom_style granular rows "id type diameter density x y z"
-  // (LIGGGHTS in 3D: m = density·(4/3)πr³).
-  {
-    std::ostringstream d;
-    d << "LIGGGHTS data file written by demcal " << DEMCAL_VERSION << " (scene " << c.name
-      << ", 3D)\n\n"
-      << plan.n << " atoms\n"
-      << ntypes << " atom types\n\n";
-    for (int a = 0; a < 3; ++a) {
-      const double pad = 0.5 * ext[a] + 4.0 * plan.r_max;
-      d << exact(plan.lo[a] - pad) << " " << exact(plan.hi[a] + pad) << " " << kAxis[a] << "lo "
-        << kAxis[a] << "hi\n";
-    }
-    d << "\nAtoms\n\n";
-    char line[200];
-    for (int i = 0; i < plan.n; ++i) {
-      std::snprintf(line, sizeof line, "%d %d %.17g %.17g %.17g %.17g %.17g\n", i + 1, plan.type[i],
-                    2.0 * w.radius()[i], plan.density, w.x()[i], w.y()[i], w.z()[i]);
-      d << line;
-    }
-    out.files[o.data_name] = d.str();
-  }
+  out.files[o.data_name] = data_file("LIGGGHTS", c, plan, w, ntypes, "Atoms");
   // Meshes: the top (normal −z) a little wider than the box; the lateral
   // walls from below the bottom to above the top, a little wider than the
   // box (the meshes cross at the edges; they do not touch each other).
@@ -596,13 +486,6 @@ std::string liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p, const Pl
   out.files[mesh_file[4]] = stl_rectangle("top", V3(lo.x() - mx, lo.y() - my, hi.z()),
                                           V3(0, ext[1] + 2 * my, 0), V3(ext[0] + 2 * mx, 0, 0));
 
-  auto pair_matrix = [&](double pp, double pw) {
-    std::ostringstream s;
-    for (int i = 1; i <= ntypes; ++i)
-      for (int j = 1; j <= ntypes; ++j)
-        s << " " << exact((i == wall_type || j == wall_type) ? pw : pp);
-    return s.str();
-  };
   // Servo: LIGGGHTS moves a servo mesh at vel_max·kp·(F_target − F)/|F_target|
   // per unit time; vel_max = cap/dt and kp = gain·F_target/(kn_wall·n_c·cap)
   // give demcal's per-step move gain·(F_target − F)/(kn_wall·n_c), n_c the
@@ -632,30 +515,8 @@ std::string liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p, const Pl
       "from the wall contacts at the start; no rotational damping");
   if (!o.lateral_servo)
     out.notes.push_back("LIGGGHTS deck: lateral walls fixed (lateral_servo off)");
-  s << "\natom_style      granular\n"
-    << "atom_modify     map array\n"
-    << "boundary        f f f\n"
-    << "newton          off\n"
-    << "communicate     single vel yes\n"
-    << "units           si\n"
-    << "read_data       " << o.data_name << "\n"
-    << "neighbor        " << num(0.3 * plan.r_min) << " bin\n"
-    << "neigh_modify    delay 0\n\n"
-    << "# type " << wall_type << " is the walls' material\n"
-    << "fix m1 all property/global kn peratomtypepair " << ntypes
-    << pair_matrix(m.particle.kn, m.wall.kn) << "\n"
-    << "fix m2 all property/global kt peratomtypepair " << ntypes
-    << pair_matrix(m.particle.kt, m.wall.kt) << "\n"
-    << "fix m3 all property/global gamman_abs peratomtypepair " << ntypes << pair_matrix(0, 0)
-    << "\n"
-    << "fix m4 all property/global gammat_abs peratomtypepair " << ntypes << pair_matrix(0, 0)
-    << "\n"
-    << "fix m5 all property/global coefficientFriction peratomtypepair " << ntypes
-    << pair_matrix(m.particle.friction, m.wall.friction) << "\n\n"
-    << "pair_style gran model hooke/stiffness tangential history absolute_damping on "
-       "tangential_damping off\n"
-    << "pair_coeff * *\n"
-    << "timestep " << exact(plan.dt) << "\n\n"
+  s << deck::liggghts_preamble(3, "f f f", o.data_name, plan.r_min)
+    << deck::liggghts_materials(m, ntypes, plan.dt, exact)
     << "fix mbottom all mesh/surface/stress file " << mesh_file[5] << " type " << wall_type << "\n"
     << "fix mtop all mesh/surface/stress file " << mesh_file[4] << " type " << wall_type << "\n";
   const V3 centre = 0.5 * (lo + hi);
@@ -681,21 +542,15 @@ std::string liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p, const Pl
   s << "fix walls all wall/gran model hooke/stiffness tangential history mesh n_meshes 6 meshes "
        "mbottom mtop mxmin mxmax mymin mymax absolute_damping on tangential_damping off\n"
     << "fix movetop all move/mesh mesh mtop linear 0 0 " << exact(-plan.top_speed) << "\n\n"
-    << "fix integrate all nve/sphere\n";
-  if (p.damping_ratio_translation > 0.0) {
-    s << "fix dampt all viscous " << exact(plan.gamma_t[0]);
-    for (int k = 1; k < plan.types; ++k)
-      s << " scale " << k + 1 << " " << exact(plan.gamma_t[k] / plan.gamma_t[0]);
-    s << "\n";
-  }
+    << "fix integrate all nve/sphere\n"
+    << deck::liggghts_translational_damping(p.damping_ratio_translation, plan.gamma_t, exact);
   // Wall positions: the servo meshes report theirs ([7..9]); the top moves
   // at the loading speed.
   auto wall_pos = [&](int sd) {
     if (!o.lateral_servo) return exact(sd % 2 == 0 ? plan.lo[sd / 2] : plan.hi[sd / 2]);
     return std::string("f_m") + kWall[sd] + "[" + std::to_string(7 + sd / 2) + "]";
   };
-  const int monitor_every =
-      static_cast<int>(std::max<int64_t>(1, plan.steps / std::max(1, c.test.monitor_points)));
+  const int monitor_every = deck::monitor_interval(plan.steps, c.test.monitor_points);
   s << "\nvariable H equal " << exact(ext[2]) << "-" << exact(plan.top_speed) << "*step*dt\n"
     << "variable Wx equal " << wall_pos(1) << "-(" << wall_pos(0) << ")\n"
     << "variable Wy equal " << wall_pos(3) << "-(" << wall_pos(2) << ")\n"
@@ -728,7 +583,8 @@ ExportResult export_3d_decks(const SceneConfig& config, const AlgorithmSpec& par
   const Plan3 plan = make_plan(config, params, world, options.max_types);
   ExportResult out = result_of(plan);
   if (options.format == "lammps") {
-    out.files[options.data_name] = lammps_data_file(config, plan, world);
+    out.files[options.data_name] =
+        data_file("LAMMPS", config, plan, world, plan.types, "Atoms # sphere");
     out.deck = lammps_deck(config, params, plan, options, out);
     out.notes.push_back(
         "lateral servo walls emulated with variables (running sum of demcal's per-step servo "

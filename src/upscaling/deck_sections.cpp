@@ -1,0 +1,270 @@
+#include "deck_sections.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <sstream>
+
+#include "demcal/kernel/particle_scales.hpp"
+
+namespace demcal::deck {
+
+namespace {
+std::string printed(const char* format, double v) {
+  char b[40];
+  std::snprintf(b, sizeof b, format, v);
+  return b;
+}
+}  // namespace
+
+std::string num(double v) { return printed("%.10g", v); }
+std::string exact(double v) { return printed("%.17g", v); }
+std::string fmt3(double v) { return printed("%.3g", v); }
+
+RadiusClasses radius_class_bounds(const std::vector<double>& radii, int max_types) {
+  RadiusClasses out;
+  out.type = radius_classes(radii, std::max(1, max_types), &out.types);
+  out.r_lo.assign(out.types, std::numeric_limits<double>::infinity());
+  out.r_hi.assign(out.types, 0.0);
+  for (size_t i = 0; i < radii.size(); ++i) {
+    const int k = out.type[i] - 1;
+    out.r_lo[k] = std::min(out.r_lo[k], radii[i]);
+    out.r_hi[k] = std::max(out.r_hi[k], radii[i]);
+  }
+  return out;
+}
+
+DeckTiming deck_timing(double dt_ratio, int64_t steps, double zeta_t, double dt_crit) {
+  DeckTiming out;
+  out.step_factor = dashpot_step_factor(zeta_t);
+  out.dt = dt_ratio * out.step_factor * dt_crit;
+  out.steps = std::max<int64_t>(1, std::llround(static_cast<double>(steps) / out.step_factor));
+  return out;
+}
+
+int monitor_interval(int64_t steps, int monitor_points) {
+  return static_cast<int>(std::max<int64_t>(1, steps / std::max(1, monitor_points)));
+}
+
+std::string header_opening(const std::string& code, const std::string& test,
+                           const std::string& sample, const std::string& provenance,
+                           double dt_ratio, double step_factor, double dt_crit, double dt) {
+  std::ostringstream s;
+  s << "# ===========================================================================\n"
+    << "# demcal " << DEMCAL_VERSION << " export: " << code << " input deck, " << test << "\n"
+    << "# " << sample << "\n";
+  if (!provenance.empty()) s << "# parameters: " << provenance << "\n";
+  s << "#\n"
+    << "# How demcal's parameters map (demcal -> " << code << "):\n"
+    << "#   dt = alpha * f * dt_crit = " << num(dt_ratio) << " * " << num(step_factor) << " * "
+    << num(dt_crit) << " s = " << num(dt) << " s -> timestep\n";
+  return s.str();
+}
+
+std::string header_step_factor(const std::string& code, double step_factor, double zeta_t) {
+  return "#     f = sqrt(1 + zeta_t^2) - zeta_t = " + num(step_factor) +
+         " (zeta_t = " + num(zeta_t) + "): " + code + "'s fix viscous is explicit\n";
+}
+
+std::string header_contact_law(const Material& m) {
+  return "#   kn = " + num(m.particle.kn) + " N/m, kt = " + num(m.particle.kt) +
+         " N/m, mu = " + num(m.particle.friction) +
+         " -> linear normal spring, incremental tangential spring, Coulomb cap\n"
+         "#   contact (local) damping: " +
+         (m.contact_damping_ratio > 0 ? num(m.contact_damping_ratio) + " of critical" : "none");
+}
+
+std::string header_wall_law(const Material& m) {
+  return "#   walls: kn = " + num(m.wall.kn) + " N/m, kt = " + num(m.wall.kt) +
+         " N/m, mu = " + num(m.wall.friction);
+}
+
+ExportResult plan_result(double dt, int64_t steps, double step_factor, int types,
+                         double class_error) {
+  ExportResult out;
+  out.dt = dt;
+  out.steps = steps;
+  out.step_factor = step_factor;
+  out.types = types;
+  out.damping_class_error = class_error;
+  out.notes.push_back(
+      "tangential contact forces are not carried over: the deck's contacts start with zero "
+      "tangential springs (normal forces are in the positions)");
+  if (step_factor < 1.0)
+    out.notes.push_back(
+        "timestep alpha*f and Nstep/f (f = sqrt(1 + zeta_t^2) - zeta_t = " + num(step_factor) +
+        "): this engine's fix viscous is explicit and shrinks the stable step "
+        "by f; the loading time, rate and strain are demcal's");
+  return out;
+}
+
+double contact_gamma_n(const Material& m, double mass_mean) {
+  if (m.contact_damping_ratio <= 0.0) return 0.0;
+  return m.contact_damping_ratio * 2.0 * std::sqrt(m.particle.kn / (0.5 * mass_mean));
+}
+
+std::string lammps_rotational_damping_note(double zeta_r) {
+  return "rotational damping zeta_r = " + num(zeta_r) +
+         " not applied: LAMMPS 29 Sep 2021 has no rotational viscous fix "
+         "(fix viscous/sphere is in later releases; the deck has the line, "
+         "commented out)";
+}
+
+std::string lammps_class_damping_note(int types, double class_error, const std::string& what) {
+  return "translational damping per radius class (" + std::to_string(types) +
+         " atom types), at most " + fmt3(100 * class_error) + " % off demcal's per-" + what +
+         " value";
+}
+
+std::string lammps_material_variables(const Material& m, NumberFormat f) {
+  std::ostringstream s;
+  s << "variable kn        equal " << f(m.particle.kn) << "\n"
+    << "variable kt        equal " << f(m.particle.kt) << "\n"
+    << "variable mu        equal " << f(m.particle.friction) << "\n"
+    << "variable kn_wall   equal " << f(m.wall.kn) << "\n"
+    << "variable kt_wall   equal " << f(m.wall.kt) << "\n"
+    << "variable mu_wall   equal " << f(m.wall.friction) << "\n";
+  return s.str();
+}
+
+std::string lammps_loading_derived() {
+  return "variable vtop      equal $(v_strain*v_H0/(v_nstep*v_dt))      # m/s, top wall, down\n"
+         "variable cap       equal $(0.02*v_r_min)      # m per step, servo move cap\n"
+         "variable monitor_every equal "
+         "$(floor((1+v_nstep/v_monitor_points+abs(1-v_nstep/v_monitor_points))/2))\n";
+}
+
+std::string lammps_system_head(int dimension, const std::string& boundary) {
+  std::ostringstream s;
+  s << "\n# --- system ------------------------------------------------------------------\n"
+    << "units           si\n"
+    << "dimension       " << dimension << "\n"
+    << "boundary        " << boundary << "\n"
+    << "atom_style      sphere\n"
+    << "atom_modify     map array\n"
+    << "comm_modify     vel yes\n";
+  return s.str();
+}
+
+std::string lammps_contact_law(double gamma_n, double r_min, const std::string& integrate_args) {
+  std::ostringstream s;
+  s << "pair_style      gran/hooke/history ${kn} ${kt} " << num(gamma_n) << " 0.0 ${mu} 0\n"
+    << "pair_coeff      * *\n"
+    << "neighbor        " << num(0.3 * r_min) << " bin\n"
+    << "neigh_modify    delay 0 every 1 check yes\n"
+    << "timestep        ${dt}\n\n"
+    << "fix             integrate all nve/sphere";
+  if (!integrate_args.empty()) s << " " << integrate_args;
+  s << "\n\n";
+  return s.str();
+}
+
+std::string lammps_translational_damping(double zeta_t, const std::vector<double>& gamma_t,
+                                         NumberFormat f) {
+  std::ostringstream s;
+  s << "# --- global damping ----------------------------------------------------------\n";
+  if (zeta_t > 0.0) {
+    s << "# gamma per class, N*s/m:";
+    for (double g : gamma_t) s << " " << num(g);
+    // one "scale type ratio" keyword per type after the first
+    s << "\nfix             dampt all viscous " << f(gamma_t[0]);
+    for (size_t k = 1; k < gamma_t.size(); ++k)
+      s << " scale " << k + 1 << " " << f(gamma_t[k] / gamma_t[0]);
+    s << "\n";
+  } else {
+    s << "# zeta_t = 0: no translational damping\n";
+  }
+  return s.str();
+}
+
+std::string lammps_wall_sum(const std::vector<std::string>& fixes, int a, int b) {
+  std::string out;
+  for (const std::string& w : fixes) {
+    if (!out.empty()) out += "+";
+    out += "f_" + w + "[" + std::to_string(a) + "]";
+    if (b > 0) out += "*f_" + w + "[" + std::to_string(b) + "]";
+  }
+  return out;
+}
+
+std::string lammps_servo_move(const std::string& area, const std::string& minus_force,
+                              const std::string& count) {
+  const std::string raw = "${gain}*(${sigma3}*" + area + minus_force + ")/(${kn_wall}*(1+" + count +
+                          "+abs(1-" + count + "))/2)";
+  return "(abs(" + raw + "+${cap})-abs(" + raw + "-${cap}))/2";
+}
+
+std::string lammps_series_header(const std::string& deck, const std::string& scene, int particles,
+                                 double zeta_t, std::optional<double> dt_crit,
+                                 std::optional<double> mass_scaling) {
+  auto line = [](const std::string& key, const std::string& value) {
+    return "print           \"# " + key + " = " + value + "\" append ${series} screen no\n";
+  };
+  std::ostringstream s;
+  s << "print           \"# demcal.series/1: " << deck << " written by demcal " << DEMCAL_VERSION
+    << ", scene " << scene << "\" file ${series} screen no\n"
+    << line("particles", std::to_string(particles)) << line("lateral_stress", "${sigma3}")
+    << line("steps", "${nstep}") << line("dt", "${dt}");
+  if (dt_crit) s << line("dt_crit", num(*dt_crit));
+  s << line("damping_ratio_translation", num(zeta_t)) << line("damping_ratio_rotation", "0");
+  if (mass_scaling) s << line("mass_scaling", num(*mass_scaling));
+  s << line("moment_lever_arm", "radius");
+  return s.str();
+}
+
+std::string liggghts_preamble(int dimension, const std::string& boundary,
+                              const std::string& data_name, double r_min) {
+  std::ostringstream s;
+  s << "\natom_style      granular\n"
+    << "atom_modify     map array\n"
+    << "boundary        " << boundary << "\n"
+    << "newton          off\n"
+    << "communicate     single vel yes\n"
+    << "units           si\n";
+  if (dimension == 2) s << "dimension       2\n";
+  s << "read_data       " << data_name << "\n"
+    << "neighbor        " << num(0.3 * r_min) << " bin\n"
+    << "neigh_modify    delay 0\n\n";
+  return s.str();
+}
+
+std::string liggghts_materials(const Material& m, int ntypes, double dt, NumberFormat f) {
+  const int wall_type = ntypes;
+  auto pair_matrix = [&](double pp, double pw) {
+    std::ostringstream s;
+    for (int i = 1; i <= ntypes; ++i)
+      for (int j = 1; j <= ntypes; ++j) s << " " << f((i == wall_type || j == wall_type) ? pw : pp);
+    return s.str();
+  };
+  std::ostringstream s;
+  s << "# type " << wall_type << " is the walls' material\n"
+    << "fix m1 all property/global kn peratomtypepair " << ntypes
+    << pair_matrix(m.particle.kn, m.wall.kn) << "\n"
+    << "fix m2 all property/global kt peratomtypepair " << ntypes
+    << pair_matrix(m.particle.kt, m.wall.kt) << "\n"
+    << "fix m3 all property/global gamman_abs peratomtypepair " << ntypes << pair_matrix(0, 0)
+    << "\n"
+    << "fix m4 all property/global gammat_abs peratomtypepair " << ntypes << pair_matrix(0, 0)
+    << "\n"
+    << "fix m5 all property/global coefficientFriction peratomtypepair " << ntypes
+    << pair_matrix(m.particle.friction, m.wall.friction) << "\n\n"
+    << "pair_style gran model hooke/stiffness tangential history absolute_damping on "
+       "tangential_damping off\n"
+    << "pair_coeff * *\n"
+    << "timestep " << f(dt) << "\n\n";
+  return s.str();
+}
+
+std::string liggghts_translational_damping(double zeta_t, const std::vector<double>& gamma_t,
+                                           NumberFormat f) {
+  if (zeta_t <= 0.0) return "";
+  std::ostringstream s;
+  s << "fix dampt all viscous " << f(gamma_t[0]);
+  for (size_t k = 1; k < gamma_t.size(); ++k)
+    s << " scale " << k + 1 << " " << f(gamma_t[k] / gamma_t[0]);
+  s << "\n";
+  return s.str();
+}
+
+}  // namespace demcal::deck

@@ -1,0 +1,142 @@
+// Pieces of text the 2D deck writer (export.cpp) and the 3D deck writer
+// (export_3d.cpp) share: one home each, so that a change to a number's
+// format, the contact law's mapping or a block of a deck is made once.
+// Private to the upscaling layer. Where the two decks differ in a detail
+// (the dimension, the boundary, the number format), it is a parameter.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "demcal/kernel/material.hpp"
+#include "demcal/upscaling/export.hpp"
+
+namespace demcal::deck {
+
+/// A number in a deck: 10 significant digits (num), 17 (exact: round-trips
+/// a double), 3 (fmt3: for prose).
+std::string num(double v);
+std::string exact(double v);
+std::string fmt3(double v);
+
+/// How a writer formats the numbers of a block: num or exact.
+using NumberFormat = std::string (*)(double);
+
+/// The radius classes of a deck (one atom type each, radius_classes) and
+/// each class's smallest and largest radius (index type−1).
+struct RadiusClasses {
+  int types = 0;
+  std::vector<int> type;  // per particle, 1-based
+  std::vector<double> r_lo, r_hi;
+};
+RadiusClasses radius_class_bounds(const std::vector<double>& radii, int max_types);
+
+/// The deck's step and run length: both engines apply fix viscous
+/// explicitly (the force from the half-step velocity), which shrinks the
+/// stable step by f = dashpot_step_factor(zeta_t); demcal's damping is
+/// semi-implicit. The deck runs at alpha·f·dt_crit for Nstep/f steps: the
+/// same loading time, rate and strain, the same stability margin as demcal.
+struct DeckTiming {
+  double step_factor = 1.0, dt = 0.0;
+  int64_t steps = 0;
+};
+DeckTiming deck_timing(double dt_ratio, int64_t steps, double zeta_t, double dt_crit);
+
+/// Steps between two monitoring rows: Nstep / monitor_points, at least 1.
+int monitor_interval(int64_t steps, int monitor_points);
+
+/// The mapping header's opening: the banner naming the engine (`code`),
+/// the test (`test`, e.g. "2D biaxial test") and the sample (`sample`, one
+/// line without "# "), the parameters' provenance, and the step line
+/// dt = alpha·f·dt_crit.
+std::string header_opening(const std::string& code, const std::string& test,
+                           const std::string& sample, const std::string& provenance,
+                           double dt_ratio, double step_factor, double dt_crit, double dt);
+
+/// The mapping header's line on the step factor f (the engine's explicit
+/// fix viscous).
+std::string header_step_factor(const std::string& code, double step_factor, double zeta_t);
+
+/// The mapping header's lines on the particles' contact law and the
+/// contact damping (the last line left open for the writer's detail).
+std::string header_contact_law(const Material& m);
+
+/// The mapping header's walls' contact law (the line left open).
+std::string header_wall_law(const Material& m);
+
+/// The figures every export reports (the files and deck are added after),
+/// with the notes both writers give: the tangential springs start at zero,
+/// and the step factor f when the explicit damping shrinks the step.
+ExportResult plan_result(double dt, int64_t steps, double step_factor, int types,
+                         double class_error);
+
+/// The pair style's gamma_n for demcal's contact damping: demcal
+/// ratio·2·sqrt(kn·m_eff), LAMMPS m_eff·gamma_n, so gamma_n =
+/// ratio·2·sqrt(kn/m_eff), taken at the mean mass (m_eff = m/2); 0 without.
+double contact_gamma_n(const Material& m, double mass_mean);
+
+/// The note when zeta_r > 0: LAMMPS 29 Sep 2021 has no rotational viscous fix.
+std::string lammps_rotational_damping_note(double zeta_r);
+
+/// The note when the damping goes per radius class (atom type); `what` is
+/// the particle's kind in "demcal's per-WHAT value" (particle, sphere).
+std::string lammps_class_damping_note(int types, double class_error, const std::string& what);
+
+/// LAMMPS parameters block: the particles' and the walls' contact laws
+/// (variables kn kt mu kn_wall kt_wall mu_wall).
+std::string lammps_material_variables(const Material& m, NumberFormat f);
+
+/// LAMMPS derived block: the top wall's speed, the servo's cap and the
+/// monitoring interval (from the parameters block).
+std::string lammps_loading_derived();
+
+/// LAMMPS system block, head: units, dimension, boundary, atom style.
+std::string lammps_system_head(int dimension, const std::string& boundary);
+
+/// LAMMPS system block, tail: the contact law (gamma_n of contact_gamma_n),
+/// the neighbour list, the timestep and the integrator (fix nve/sphere
+/// with `integrate_args`, e.g. "disc").
+std::string lammps_contact_law(double gamma_n, double r_min, const std::string& integrate_args);
+
+/// LAMMPS global damping block, translational part: fix viscous per radius
+/// class (gamma_t[k] for type k+1), or a comment when zeta_t = 0.
+std::string lammps_translational_damping(double zeta_t, const std::vector<double>& gamma_t,
+                                         NumberFormat f);
+
+/// LAMMPS: the sum over the wall fixes `fixes` (e.g. "wleft") of
+/// f_FIX[a], times f_FIX[b] when b > 0: an atom-style variable's formula.
+std::string lammps_wall_sum(const std::vector<std::string>& fixes, int a, int b);
+
+/// LAMMPS: demcal's servo move of one wall in one step, toward the sample
+/// when its pressure is below sigma3: gain*(sigma3*A - F)/(kn_wall*max(1,
+/// n)), clamped to ±cap, as one flat formula of the deck's variables.
+/// `area` is A, `minus_force` the term that subtracts F (e.g. "-c_cs[2]"),
+/// `count` n. This release has no min/max of two numbers: max(1, n) =
+/// (1+n+abs(1-n))/2 and clamp(x) = (abs(x+cap)-abs(x-cap))/2.
+std::string lammps_servo_move(const std::string& area, const std::string& minus_force,
+                              const std::string& count);
+
+/// LAMMPS: the series file's header (print lines), what `demcal score`
+/// reads about the run: the deck (`deck`, e.g. "LAMMPS 3D deck"), scene,
+/// particles, sigma3, Nstep, dt, dt_crit (when given), the damping ratios
+/// applied (zeta_r 0: no rotational fix), f_ms (when given), the lever arm.
+std::string lammps_series_header(const std::string& deck, const std::string& scene, int particles,
+                                 double zeta_t, std::optional<double> dt_crit,
+                                 std::optional<double> mass_scaling);
+
+/// LIGGGHTS: atom style, boundary, communication, units (and dimension 2
+/// for `dimension` 2), the data file and the neighbour list.
+std::string liggghts_preamble(int dimension, const std::string& boundary,
+                              const std::string& data_name, double r_min);
+
+/// LIGGGHTS: the materials (type ntypes is the walls'), the granular pair
+/// style without damping (absolute_damping with gamma 0) and the timestep.
+std::string liggghts_materials(const Material& m, int ntypes, double dt, NumberFormat f);
+
+/// LIGGGHTS: fix viscous per radius class (nothing when zeta_t = 0).
+std::string liggghts_translational_damping(double zeta_t, const std::vector<double>& gamma_t,
+                                           NumberFormat f);
+
+}  // namespace demcal::deck
