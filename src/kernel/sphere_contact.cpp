@@ -185,7 +185,16 @@ DEMCAL_INLINE bool any(typename Simd<W>::M m) {
   using D = typename Simd<W>::D;
   const D zero{};
   const D v = select<W>(m, zero - 1.0, zero);
-#ifdef DEMCAL_X86_64
+#if defined(DEMCAL_X86_64) && defined(__clang__)
+  // Clang rejects a 256- or 512-bit asm operand in the baseline target
+  // (simd.hpp, vsqrt): test the 128-bit halves.
+  bool set = false;
+  for (int k = 0; k < W; k += 2) {
+    const Simd<2>::D half{v[k], v[k + 1]};
+    set = set || _mm_movemask_pd(reinterpret_cast<__m128d>(half)) != 0;
+  }
+  return set;
+#elif defined(DEMCAL_X86_64)
   if constexpr (W == 8) {
     unsigned char k;
     asm("vptestmq %1, %1, %0" : "=k"(k) : "v"(v));

@@ -304,15 +304,20 @@ Criteria compute_criteria(const std::vector<MonitorPoint>& series, double s3,
   return c;
 }
 
-AlgorithmSpec run_parameters(const LoadingResult& run) {
+AlgorithmSpec run_parameters(const Integration& integration, double dt_crit,
+                             int64_t steps_planned) {
   AlgorithmSpec a;
-  a.dt_ratio = run.scales.dt_crit > 0.0 ? run.integration.dt / run.scales.dt_crit : 0.0;
-  a.steps = run.steps_planned;
-  a.damping_ratio_translation = run.integration.damping_ratio_translation;
-  a.damping_ratio_rotation = run.integration.damping_ratio_rotation;
-  a.mass_scaling = run.integration.mass_scaling;
-  a.lock_rotation = run.integration.lock_rotation;
+  a.dt_ratio = dt_crit > 0.0 ? integration.dt / dt_crit : 0.0;
+  a.steps = steps_planned;
+  a.damping_ratio_translation = integration.damping_ratio_translation;
+  a.damping_ratio_rotation = integration.damping_ratio_rotation;
+  a.mass_scaling = integration.mass_scaling;
+  a.lock_rotation = integration.lock_rotation;
   return a;
+}
+
+AlgorithmSpec run_parameters(const LoadingResult& run) {
+  return run_parameters(run.integration, run.scales.dt_crit, run.steps_planned);
 }
 
 namespace {

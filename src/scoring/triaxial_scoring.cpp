@@ -112,14 +112,7 @@ TriaxialCriteria compute_triaxial_criteria(const TriaxialResult& run, double s3)
 }
 
 AlgorithmSpec run_parameters(const TriaxialResult& run) {
-  AlgorithmSpec a;
-  a.dt_ratio = run.scales.dt_crit > 0.0 ? run.integration.dt / run.scales.dt_crit : 0.0;
-  a.steps = run.steps_planned;
-  a.damping_ratio_translation = run.integration.damping_ratio_translation;
-  a.damping_ratio_rotation = run.integration.damping_ratio_rotation;
-  a.mass_scaling = run.integration.mass_scaling;
-  a.lock_rotation = run.integration.lock_rotation;
-  return a;
+  return run_parameters(run.integration, run.scales.dt_crit, run.steps_planned);
 }
 
 Score score_triaxial_run(const TriaxialResult& run, double s3, const Tolerances& t) {

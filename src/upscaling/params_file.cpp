@@ -56,32 +56,44 @@ double particle_steps_run(const std::vector<TrialRecord>& trials, int64_t partic
   return sum * static_cast<double>(particles);
 }
 
+namespace {
+
+// What params.json holds in 2D and 3D alike: the scene, the outcome, the
+// criteria and certificate of the calibrated run, the search's figures and
+// provenance. (nlohmann::json sorts the keys: the order here is free.)
+nlohmann::json calibration_record(const SceneConfig& config, int64_t n_rev,
+                                  const CalibrationOptions& options,
+                                  const CalibrationSummary& summary) {
+  return {{"scene", config.name},
+          {"success", summary.success},
+          {"message", summary.message},
+          {"config", to_json(config)},
+          {"criteria", to_json(summary.best_trial.score.criteria)},
+          {"tolerances", to_json(options.tolerances)},
+          {"accuracy", options.accuracy},
+          {"certificate", to_json(summary.certificate)},
+          {"dt_ratio_stable", summary.dt_ratio_stable},
+          {"strategy", to_string(summary.strategy)},
+          {"trials", static_cast<int>(summary.trials.size())},
+          {"particle_steps_run", particle_steps_run(summary.trials, n_rev)},
+          {"seed", config.calibration.seed},
+          {"config_sha256", sha256_hex(config.text)},
+          {"version", DEMCAL_VERSION}};
+}
+
+}  // namespace
+
 nlohmann::json params_file(const SceneConfig& config, const ConsolidatedState& state,
                            const CalibrationOptions& options, const CalibrationSummary& summary) {
   const int64_t n_rev = state.world.size();
   const int64_t n_proto = config.prototype.particles > 0 ? config.prototype.particles : n_rev;
-  nlohmann::json params{
-      {"schema", "demcal.params/1"},
-      {"scene", config.name},
-      {"success", summary.success},
-      {"message", summary.message},
-      {"rev", param_block(summary.best, particle_scales(state.world.radius(), config.material,
-                                                        summary.best.mass_scaling))},
-      // Δt and damping recomputed from the prototype's own particles.
-      {"prototype", prototype_block(config, summary.best, n_rev)},
-      {"upscaling", upscaling_block(n_rev, n_proto)},
-      {"config", to_json(config)},
-      {"criteria", to_json(summary.best_trial.score.criteria)},
-      {"tolerances", to_json(options.tolerances)},
-      {"accuracy", options.accuracy},
-      {"certificate", to_json(summary.certificate)},
-      {"dt_ratio_stable", summary.dt_ratio_stable},
-      {"strategy", to_string(summary.strategy)},
-      {"trials", static_cast<int>(summary.trials.size())},
-      {"particle_steps_run", particle_steps_run(summary.trials, n_rev)},
-      {"seed", config.calibration.seed},
-      {"config_sha256", sha256_hex(config.text)},
-      {"version", DEMCAL_VERSION}};
+  nlohmann::json params = calibration_record(config, n_rev, options, summary);
+  params["schema"] = kParamsSchema;
+  params["rev"] = param_block(summary.best, particle_scales(state.world.radius(), config.material,
+                                                            summary.best.mass_scaling));
+  // Δt and damping recomputed from the prototype's own particles.
+  params["prototype"] = prototype_block(config, summary.best, n_rev);
+  params["upscaling"] = upscaling_block(n_rev, n_proto);
   if (auto a = analytical_peak_stress(config)) params["analytical_peak_stress_yy"] = *a;
   return params;
 }
@@ -116,28 +128,13 @@ nlohmann::json params_file(const SceneConfig& config, const TriaxialState& state
   prototype["source"] = {{"kind", "rev"},
                          {"description", "the REV itself (" + std::to_string(n_rev) +
                                              " spheres); 3D prototypes are not upscaled yet"}};
-  const Tolerances& t = options.tolerances;
-  nlohmann::json params{{"schema", kParamsSchema},
-                        {"scene", config.name},
-                        {"dimension", 3},
-                        {"test", "triaxial"},
-                        {"success", summary.success},
-                        {"message", summary.message},
-                        {"rev", rev},
-                        {"prototype", prototype},
-                        {"upscaling", upscaling_block(n_rev, n_rev)},
-                        {"config", to_json(config)},
-                        {"criteria", to_json(summary.best_trial.score.criteria)},
-                        {"tolerances", to_json(t)},
-                        {"accuracy", options.accuracy},
-                        {"certificate", to_json(summary.certificate)},
-                        {"dt_ratio_stable", summary.dt_ratio_stable},
-                        {"strategy", to_string(summary.strategy)},
-                        {"trials", static_cast<int>(summary.trials.size())},
-                        {"particle_steps_run", particle_steps_run(summary.trials, n_rev)},
-                        {"seed", config.calibration.seed},
-                        {"config_sha256", sha256_hex(config.text)},
-                        {"version", DEMCAL_VERSION}};
+  nlohmann::json params = calibration_record(config, n_rev, options, summary);
+  params["schema"] = kParamsSchema;
+  params["dimension"] = 3;
+  params["test"] = "triaxial";
+  params["rev"] = rev;
+  params["prototype"] = prototype;
+  params["upscaling"] = upscaling_block(n_rev, n_rev);
   params["axial_component"] =
       "criteria.peak_stress_yy and certificate.peak_stress_yy* hold the axial b_zz (the triaxial "
       "test's axis is z)";

@@ -175,6 +175,9 @@ Diagnosis diagnose(const Criteria& criteria, const Tolerances& tolerances, bool 
                    const std::optional<AlgorithmSpec>& parameters = std::nullopt);
 /// The algorithmic parameters a run was made with (α from Δt/Δt_crit).
 AlgorithmSpec run_parameters(const LoadingResult& run);
+/// The same from a run's integration, Δt_crit and planned steps (2D and 3D
+/// runs alike).
+AlgorithmSpec run_parameters(const Integration& integration, double dt_crit, int64_t steps_planned);
 
 /// The force-balance measures (g_xx, g_yy, g_s) and the moment-balance
 /// measure a of one monitoring point, as compute_criteria() takes them.
