@@ -489,10 +489,9 @@ Diagnosis diagnose(const Criteria& c, const Tolerances& t, bool diverged,
   return {"steps", "increase", 0.5, "a criterion is out of tolerance; increase steps", "other"};
 }
 
-Score score_run(const LoadingResult& run, double s3, const Tolerances& t,
-                std::optional<double> reference_peak) {
+Score score_of(const Criteria& criteria, const RunOutcome& run, const Tolerances& t) {
   Score s;
-  s.criteria = compute_criteria(run, s3, reference_peak);
+  s.criteria = criteria;
   s.diverged = run.diverged;
   s.complete = !run.diverged && !run.stopped_early && run.steps_run == run.steps_planned;
   s.completed_fraction = run.steps_planned > 0 ? static_cast<double>(run.steps_run) /
@@ -501,8 +500,16 @@ Score score_run(const LoadingResult& run, double s3, const Tolerances& t,
   s.particle_steps = static_cast<double>(run.particles) * static_cast<double>(run.steps_planned);
   s.worst_excess = excesses(s.criteria, t).worst();
   s.passed = !s.diverged && s.complete && s.worst_excess <= 1.0;
-  s.diagnosis = diagnose(s.criteria, t, s.diverged, run_parameters(run));
+  s.diagnosis = diagnose(s.criteria, t, s.diverged, run.parameters);
   return s;
+}
+
+Score score_run(const LoadingResult& run, double s3, const Tolerances& t,
+                std::optional<double> reference_peak) {
+  return score_of(compute_criteria(run, s3, reference_peak),
+                  {run.diverged, run.stopped_early, run.steps_run, run.steps_planned, run.particles,
+                   run_parameters(run)},
+                  t);
 }
 
 std::array<double, 4> constraint_values(const Score& s, const Tolerances& t) {

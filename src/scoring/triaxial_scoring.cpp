@@ -116,18 +116,10 @@ AlgorithmSpec run_parameters(const TriaxialResult& run) {
 }
 
 Score score_triaxial_run(const TriaxialResult& run, double s3, const Tolerances& t) {
-  Score s;
-  s.criteria = compute_triaxial_criteria(run, s3).combined;
-  s.diverged = run.diverged;
-  s.complete = !run.diverged && !run.stopped_early && run.steps_run == run.steps_planned;
-  s.completed_fraction = run.steps_planned > 0 ? static_cast<double>(run.steps_run) /
-                                                     static_cast<double>(run.steps_planned)
-                                               : 0.0;
-  s.particle_steps = static_cast<double>(run.particles) * static_cast<double>(run.steps_planned);
-  s.worst_excess = excesses(s.criteria, t).worst();
-  s.passed = !s.diverged && s.complete && s.worst_excess <= 1.0;
-  s.diagnosis = diagnose(s.criteria, t, s.diverged, run_parameters(run));
-  return s;
+  return score_of(compute_triaxial_criteria(run, s3).combined,
+                  {run.diverged, run.stopped_early, run.steps_run, run.steps_planned, run.particles,
+                   run_parameters(run)},
+                  t);
 }
 
 TriaxialEarlyFailure::TriaxialEarlyFailure(const Tolerances& tolerances, double factor,

@@ -169,10 +169,30 @@ std::string wall_sum(int a, int b) {
   return deck::lammps_wall_sum({"wxmin", "wxmax", "wymin", "wymax", "wzmin", "wzmax"}, a, b);
 }
 
-std::string lammps_deck(const SceneConfig& c, const AlgorithmSpec& p, const Plan3& plan,
-                        const Export3dOptions& o, ExportResult& out) {
-  const auto& m = c.material;
-  std::ostringstream s;
+// The servo moves, one flat formula each (numbers substituted now): wall
+// k's move toward the sample, gain*(sigma3*A - F)/(kn_wall*max(1, n))
+// clamped to ±cap; its displacement along +axis is f_servo[k]*step.
+// Columns of compute cs: contacts and normal force on the particles of
+// each lateral wall, in kWall order.
+std::string wall_pos(int sd) {
+  return std::string("(${") + kWall[sd] + "0}+f_servo[" + std::to_string(sd + 1) + "]*step)";
+}
+const char* const kHeight = "(${H0}-${vtop}*step*dt)";
+std::string area_x() { return "(" + wall_pos(3) + "-" + wall_pos(2) + ")*" + kHeight; }
+std::string area_y() { return "(" + wall_pos(1) + "-" + wall_pos(0) + ")*" + kHeight; }
+std::string servo_move(int sd) {
+  const std::string area = sd < 2 ? area_x() : area_y();
+  // The force on the particles along +axis: +P on a min wall, −P on a max wall.
+  const std::string pressure_force =
+      std::string(sd % 2 == 0 ? "" : "-") + "c_cs[" + std::to_string(2 * sd + 2) + "]";
+  const std::string count = "c_cs[" + std::to_string(2 * sd + 1) + "]";
+  return std::string(sd % 2 == 0 ? "" : "-") +
+         deck::lammps_servo_move(area, "-(" + pressure_force + ")", count);
+}
+
+// Header: the mapping and what this LAMMPS cannot do as demcal does.
+void lammps_3d_limitations(std::ostream& s, const SceneConfig& c, const AlgorithmSpec& p,
+                           const Plan3& plan, const Export3dOptions& o, ExportResult& out) {
   s << mapping_header(c, p, plan, o, "LAMMPS");
   s << "#\n# What this LAMMPS cannot do as demcal does, and what the deck does instead:\n"
     << "#  - rotational damping: no rotational viscous fix in 29 Sep 2021 (zeta_r = 0\n"
@@ -193,7 +213,12 @@ std::string lammps_deck(const SceneConfig& c, const AlgorithmSpec& p, const Plan
     out.notes.push_back(deck::lammps_rotational_damping_note(p.damping_ratio_rotation));
   if (plan.types > 1)
     out.notes.push_back(deck::lammps_class_damping_note(plan.types, plan.class_error, "sphere"));
+}
 
+// The parameters block a user edits, and what is derived from it.
+void lammps_3d_parameters(std::ostream& s, const SceneConfig& c, const Plan3& plan,
+                          const Export3dOptions& o) {
+  const auto& m = c.material;
   s << "\n# --- parameters (edit here) -------------------------------------------------\n"
     << "# Everything below is derived from this block: editing dt or nstep keeps the\n"
     << "# strain, the servo cap and the monitoring points right.\n"
@@ -218,35 +243,22 @@ std::string lammps_deck(const SceneConfig& c, const AlgorithmSpec& p, const Plan
     << "variable Wy0       equal $(v_ymax0-v_ymin0)\n"
     << deck::lammps_loading_derived()
     << "variable peak_every equal $(ceil(v_nstep/1000000))      # fix vector length <= 1e6\n";
+}
 
+// Units, box, data file, contact law.
+void lammps_3d_system(std::ostream& s, const SceneConfig& c, const Plan3& plan,
+                      const Export3dOptions& o, ExportResult& out) {
+  const auto& m = c.material;
   const double gamma_n = deck::contact_gamma_n(m, plan.m_mean);
   if (gamma_n > 0.0) out.notes.push_back("contact damping mapped at the mean sphere mass");
   s << deck::lammps_system_head(3, "f f f") << "newton          off\n"
     << "read_data       " << o.data_name << "\n"
     << "# sphere masses f_ms*rho*4/3*pi*r^3 (density column), inertia 2/5 m r^2\n"
     << deck::lammps_contact_law(gamma_n, plan.r_min, "");
+}
 
-  // The servo moves, one flat formula each (numbers substituted now): wall
-  // k's move toward the sample, gain*(sigma3*A - F)/(kn_wall*max(1, n))
-  // clamped to ±cap; its displacement along +axis is f_servo[k]*step.
-  // Columns of compute cs: contacts and normal force on the particles of
-  // each lateral wall, in kWall order.
-  auto pos = [](int sd) {
-    return std::string("(${") + kWall[sd] + "0}+f_servo[" + std::to_string(sd + 1) + "]*step)";
-  };
-  const std::string h = "(${H0}-${vtop}*step*dt)";
-  const std::string area_x = "(" + pos(3) + "-" + pos(2) + ")*" + h;
-  const std::string area_y = "(" + pos(1) + "-" + pos(0) + ")*" + h;
-  auto move = [&](int sd) {
-    const std::string area = sd < 2 ? area_x : area_y;
-    // The force on the particles along +axis: +P on a min wall, −P on a max wall.
-    const std::string pressure_force =
-        std::string(sd % 2 == 0 ? "" : "-") + "c_cs[" + std::to_string(2 * sd + 2) + "]";
-    const std::string count = "c_cs[" + std::to_string(2 * sd + 1) + "]";
-    return std::string(sd % 2 == 0 ? "" : "-") +
-           deck::lammps_servo_move(area, "-(" + pressure_force + ")", count);
-  };
-
+// The six walls, the contact-force store and the damping.
+void lammps_3d_walls(std::ostream& s, const AlgorithmSpec& p, const Plan3& plan) {
   s << "# --- walls -------------------------------------------------------------------\n"
     << "# bottom: fixed plane; top: plane moving down at vtop; lateral: planes moved\n"
     << "# by the servo. Order: the walls, then fix store/force (contact forces only),\n"
@@ -280,7 +292,10 @@ std::string lammps_deck(const SceneConfig& c, const AlgorithmSpec& p, const Plan
   } else {
     s << "#   (zeta_r = 0: nothing to apply)\n\n";
   }
+}
 
+// The servo's input, wall positions and pressures, b and sigma reductions.
+void lammps_3d_measures(std::ostream& s) {
   // Measures: wall forces for the servo and the pressures, one reduction.
   s << "# --- measures ----------------------------------------------------------------\n"
     << "# the servo's input, the four lateral walls in one reduction (one global sum per\n"
@@ -290,14 +305,14 @@ std::string lammps_deck(const SceneConfig& c, const AlgorithmSpec& p, const Plan
     << "                f_wzmax[1] f_wzmax[4]\n";
   // Wall positions and pressures (flat: positions from f_servo directly).
   for (int sd = 0; sd < 4; ++sd)
-    s << "variable        wall_" << kWall[sd] << " equal " << pos(sd) << "\n";
+    s << "variable        wall_" << kWall[sd] << " equal " << wall_pos(sd) << "\n";
   s << "variable        wall_zmin equal ${zmin0}\n"
     << "variable        wall_zmax equal ${zmax0}-${vtop}*step*dt\n"
-    << "variable        H equal " << h << "\n"
-    << "variable        Ax equal " << area_x << "\n"
-    << "variable        Ay equal " << area_y << "\n"
-    << "variable        Az equal (" << pos(1) << "-" << pos(0) << ")*(" << pos(3) << "-" << pos(2)
-    << ")\n"
+    << "variable        H equal " << kHeight << "\n"
+    << "variable        Ax equal " << area_x() << "\n"
+    << "variable        Ay equal " << area_y() << "\n"
+    << "variable        Az equal (" << wall_pos(1) << "-" << wall_pos(0) << ")*(" << wall_pos(3)
+    << "-" << wall_pos(2) << ")\n"
     << "variable        p_xmin equal c_cs[2]/v_Ax\n"
     << "variable        p_xmax equal -c_cs[4]/v_Ax\n"
     << "variable        p_ymin equal c_cs[6]/v_Ay\n"
@@ -332,6 +347,11 @@ std::string lammps_deck(const SceneConfig& c, const AlgorithmSpec& p, const Plan
     << "variable        cy equal (v_wall_ymin+v_wall_ymax)/2\n"
     << "variable        cz equal (v_wall_zmin+v_wall_zmax)/2\n"
     << "variable        V equal v_Ax*(v_wall_xmax-v_wall_xmin)\n";
+}
+
+// b and sigma per component, the monitoring series and the peaks.
+void lammps_3d_series(std::ostream& s, const SceneConfig& c, const AlgorithmSpec& p,
+                      const Plan3& plan) {
   // c_meas layout: [1..18] bw/mp pairs, [19..21] fw, [22..24] fcon, [25] cn.
   std::string row = "${stepn},${strain_zz}";
   for (int i = 0; i < 3; ++i)
@@ -398,7 +418,10 @@ std::string lammps_deck(const SceneConfig& c, const AlgorithmSpec& p, const Plan
     << "\" append ${series} screen no title \"" << columns << "\"\n"
     << "# the peaks over every peak_every steps: axial pressure and sigma1/sigma3\n"
     << "fix             peaks all vector ${peak_every} v_axial v_ratio\n\n";
+}
 
+// The servo's per-step moves, then the run and the peaks printed.
+void lammps_3d_servo_and_run(std::ostream& s) {
   s << "# --- servo -------------------------------------------------------------------\n"
     << "# demcal's servo, one move per step and wall toward the sample when p < sigma3:\n"
     << "#   move = gain*(sigma3*A - F)/(kn_wall*max(1, n)), clamped to +-cap,\n"
@@ -408,7 +431,7 @@ std::string lammps_deck(const SceneConfig& c, const AlgorithmSpec& p, const Plan
     << "# (abs(x+cap)-abs(x-cap))/2. f_servo[k]: the running mean of the moves along\n"
     << "# +axis (xmin xmax ymin ymax), times the step = the wall's displacement.\n";
   for (int sd = 0; sd < 4; ++sd)
-    s << "variable        m" << kWall[sd] << " equal " << move(sd) << "\n";
+    s << "variable        m" << kWall[sd] << " equal " << servo_move(sd) << "\n";
   s << "fix             servo all ave/time 1 1 1 v_mxmin v_mxmax v_mymin v_mymax ave running\n\n";
 
   s << "# --- output and run ----------------------------------------------------------\n"
@@ -422,6 +445,18 @@ std::string lammps_deck(const SceneConfig& c, const AlgorithmSpec& p, const Plan
     << "print           \"peak_ratio = ${peak_ratio}\"\n"
     << "print           \"# peak_axial_stress = ${peak_axial}\" append ${series} screen no\n"
     << "print           \"# peak_ratio = ${peak_ratio}\" append ${series} screen no\n";
+}
+
+std::string lammps_deck(const SceneConfig& c, const AlgorithmSpec& p, const Plan3& plan,
+                        const Export3dOptions& o, ExportResult& out) {
+  std::ostringstream s;
+  lammps_3d_limitations(s, c, p, plan, o, out);
+  lammps_3d_parameters(s, c, plan, o);
+  lammps_3d_system(s, c, plan, o, out);
+  lammps_3d_walls(s, p, plan);
+  lammps_3d_measures(s);
+  lammps_3d_series(s, c, p, plan);
+  lammps_3d_servo_and_run(s);
   return s.str();
 }
 

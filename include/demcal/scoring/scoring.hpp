@@ -156,6 +156,16 @@ Criteria compute_criteria(const LoadingResult& run, double lateral_stress,
                           std::optional<double> reference_peak = std::nullopt);
 Criteria compute_criteria(const std::vector<MonitorPoint>& series, double lateral_stress,
                           std::optional<double> reference_peak = std::nullopt);
+/// How a run ended, whatever its dimension: what a Score needs besides the
+/// criteria.
+struct RunOutcome {
+  bool diverged = false, stopped_early = false;
+  int64_t steps_run = 0, steps_planned = 0;
+  int64_t particles = 0;
+  AlgorithmSpec parameters;
+};
+/// The Score of a run's criteria (score_run and score_triaxial_run call it).
+Score score_of(const Criteria& criteria, const RunOutcome& run, const Tolerances& tolerances);
 Score score_run(const LoadingResult& run, double lateral_stress, const Tolerances& tolerances,
                 std::optional<double> reference_peak = std::nullopt);
 /// Relative error of a (negative) peak b_yy against a reference,
