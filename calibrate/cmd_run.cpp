@@ -20,6 +20,7 @@
 #include "demcal/scoring/trial.hpp"
 #include "demcal/scoring/triaxial_scoring.hpp"
 #include "output_folder.hpp"
+#include "print_criteria.hpp"
 
 namespace demcal::cli {
 
@@ -167,14 +168,8 @@ int run_3d(const SceneConfig& config, const std::string& out_dir, bool allow_uns
   if (auto a = analytical_peak_ratio_3d(config))
     std::cout << "  analytical (walled FCC, Thornton, rotation locked) sigma1/sigma3 " << *a
               << "\n";
-  std::cout << "  force balance " << m.force_balance << " (axial " << m.force_balance_yy
-            << ", lateral x " << c.xz.force_balance_xx << ", lateral y " << c.yz.force_balance_xx
-            << ", shear xz " << c.xz.force_balance_shear << ", yz " << c.yz.force_balance_shear
-            << ", xy " << c.xy.force_balance_shear << ")\n"
-            << "  moment balance " << m.moment_balance << " (xz " << c.xz.moment_balance << ", yz "
-            << c.yz.moment_balance << ", xy " << c.xy.moment_balance << "), servo " << m.servo
-            << ", oscillation " << m.oscillation << "\n"
-            << "  kinetic/elastic energy max " << m.kinetic_energy_ratio_max
+  print_triaxial_criteria(std::cout, c);
+  std::cout << "  kinetic/elastic energy max " << m.kinetic_energy_ratio_max
             << ", unbalanced-force ratio mean " << m.unbalanced_force_ratio_mean
             << ", inertial number max " << m.inertial_number_max << "\n"
             << "  " << (within ? "WITHIN" : "OUTSIDE") << " the 2D default tolerances"

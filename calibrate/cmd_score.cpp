@@ -1,7 +1,8 @@
 // `demcal score FILE [--lateral-stress PA] [-o DIR]`: the criteria, verdict
 // and diagnosis of a monitoring series written by another engine (the
-// exported LAMMPS deck's series.csv, or any code writing the documented
-// CSV), as `demcal run` prints them for its own runs; DIR/summary.json.
+// exported LAMMPS deck's series.csv, 2D or 3D, or any code writing the
+// documented CSV), as `demcal run` prints them for its own runs;
+// DIR/summary.json.
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -11,6 +12,7 @@
 #include "commands.hpp"
 #include "demcal/scoring/external_series.hpp"
 #include "output_folder.hpp"
+#include "print_criteria.hpp"
 
 namespace demcal::cli {
 
@@ -39,26 +41,33 @@ int cmd_score(const ScoreOptions& o) {
   const Score& score = scored.score;
   const auto& c = score.criteria;
   const double sigma3 = series.lateral_stress;
-  std::cout << std::setprecision(4) << "series " << o.file << ": " << series.run.series.size()
-            << " monitoring points, " << series.run.steps_run << " steps"
-            << (score.complete ? "" : " (incomplete)") << "\n"
-            << "  peak sigma_yy " << c.peak_stress_yy << " Pa at strain " << c.peak_strain_yy
-            << " (sigma1/sigma3 " << -c.peak_stress_yy / sigma3 << ")\n"
-            << "  force balance " << c.force_balance << " (tol " << tolerances.force_balance
-            << "; paper form " << c.force_balance_paper << "), moment balance " << c.moment_balance
-            << " (tol " << tolerances.moment_balance << "), servo " << c.servo << " (tol "
-            << tolerances.servo << "), oscillation " << c.oscillation << " (tol "
-            << tolerances.oscillation << ")\n";
-  if (series.torque_column)
-    std::cout << "  moment balance measured on the engine's net torques; lever-arm floor of "
-                 "s_xy - s_yx (not counted): RMS "
-              << scored.lever_arm_floor_rms << ", max " << scored.lever_arm_floor_max << "\n";
+  const bool is_3d = series.dimension == 3;
+  const size_t points = is_3d ? series.triaxial.series.size() : series.run.series.size();
+  const int64_t steps = is_3d ? series.triaxial.steps_run : series.run.steps_run;
+  std::cout << std::setprecision(4) << "series " << o.file << ": "
+            << (is_3d ? "3D (triaxial), " : "") << points << " monitoring points, " << steps
+            << " steps" << (score.complete ? "" : " (incomplete)") << "\n"
+            << "  peak sigma_" << (is_3d ? "zz " : "yy ") << c.peak_stress_yy << " Pa at strain "
+            << c.peak_strain_yy << " (sigma1/sigma3 " << -c.peak_stress_yy / sigma3 << ")\n";
+  if (scored.planes) {
+    print_triaxial_criteria(std::cout, *scored.planes);
+    std::cout << "  tolerances: force balance " << tolerances.force_balance << ", moment balance "
+              << tolerances.moment_balance << ", servo " << tolerances.servo << ", oscillation "
+              << tolerances.oscillation << " (the 2D defaults; " << kTriaxialVerdictNote << ")\n";
+  } else {
+    std::cout << "  force balance " << c.force_balance << " (tol " << tolerances.force_balance
+              << "; paper form " << c.force_balance_paper << "), moment balance "
+              << c.moment_balance << " (tol " << tolerances.moment_balance << "), servo " << c.servo
+              << " (tol " << tolerances.servo << "), oscillation " << c.oscillation << " (tol "
+              << tolerances.oscillation << ")\n";
+  }
   if (c.peak_error)
     std::cout << "  peak error against " << -std::abs(o.reference_peak)
               << " Pa: " << 100.0 * *c.peak_error << " %\n";
   std::cout << "  " << (score.passed ? "PASS" : "FAIL") << ": " << score.diagnosis.message << "\n";
-  if (series.run.diverged)
-    std::cout << "  DIVERGED: non-finite values from step " << series.run.divergence_step << "\n";
+  if (is_3d ? series.triaxial.diverged : series.run.diverged)
+    std::cout << "  DIVERGED: non-finite values from step "
+              << (is_3d ? series.triaxial.divergence_step : series.run.divergence_step) << "\n";
   std::cout << "  wrote " << dir << "/summary.json\n";
   return score.passed ? 0 : 1;
 }

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "demcal/io/input_error.hpp"
+#include "demcal/scoring/triaxial_scoring.hpp"
 
 namespace demcal {
 
@@ -42,19 +43,27 @@ std::optional<double> meta_number(const ExternalSeries& s, const std::string& ke
   return parse_number(it->second, s.source, "# " + key);
 }
 
-}  // namespace
-
-ExternalSeries parse_external_series(const std::string& text, const std::string& source,
-                                     std::optional<double> lateral_stress) {
-  ExternalSeries out;
-  out.source = source;
+/// The file as read: its columns by name and its rows up to the first
+/// non-finite one (a diverged engine run: what came before is scored).
+struct Table {
   std::vector<std::string> columns;
   std::map<std::string, size_t> col;
   std::vector<std::vector<double>> rows;
-  std::stringstream lines(text);
-  int line_no = 0;
   bool diverged = false;
   int64_t diverged_step = -1;
+
+  bool has(const char* name) const { return col.count(name) > 0; }
+  double value(const std::vector<double>& row, const std::string& name, double fallback) const {
+    const auto it = col.find(name);
+    return it == col.end() ? fallback : row[it->second];
+  }
+};
+
+Table read_table(const std::string& text, ExternalSeries& out) {
+  const std::string& source = out.source;
+  Table t;
+  std::stringstream lines(text);
+  int line_no = 0;
   for (std::string raw; std::getline(lines, raw);) {
     ++line_no;
     const std::string line = trim(raw);
@@ -66,39 +75,176 @@ ExternalSeries parse_external_series(const std::string& text, const std::string&
       continue;
     }
     const std::string where = "line " + std::to_string(line_no);
-    if (columns.empty()) {
-      columns = split_commas(line);
-      for (size_t k = 0; k < columns.size(); ++k) {
-        if (columns[k].empty()) throw InputError(source, where, "an empty column name");
-        if (!col.emplace(columns[k], k).second)
-          throw InputError(source, where, "column \"" + columns[k] + "\" appears twice");
+    if (t.columns.empty()) {
+      t.columns = split_commas(line);
+      for (size_t k = 0; k < t.columns.size(); ++k) {
+        if (t.columns[k].empty()) throw InputError(source, where, "an empty column name");
+        if (!t.col.emplace(t.columns[k], k).second)
+          throw InputError(source, where, "column \"" + t.columns[k] + "\" appears twice");
       }
       continue;
     }
     // The continuation of a split run repeats the header and the row of the
     // step it restarted from: both are skipped.
-    if (split_commas(line) == columns) continue;
     const auto fields = split_commas(line);
-    if (fields.size() != columns.size())
+    if (fields == t.columns) continue;
+    if (fields.size() != t.columns.size())
       throw InputError(source, where,
                        std::to_string(fields.size()) + " values for " +
-                           std::to_string(columns.size()) + " columns");
+                           std::to_string(t.columns.size()) + " columns");
     std::vector<double> row;
     for (const auto& f : fields) row.push_back(parse_number(f, source, where));
-    if (!diverged &&
+    if (!t.diverged &&
         std::any_of(row.begin(), row.end(), [](double v) { return !std::isfinite(v); })) {
-      diverged = true;  // the engine's run blew up here: score what came before
-      diverged_step = static_cast<int64_t>(std::isfinite(row[0]) ? row[0] : -1);
+      t.diverged = true;  // the engine's run blew up here: score what came before
+      t.diverged_step = static_cast<int64_t>(std::isfinite(row[0]) ? row[0] : -1);
     }
-    if (!diverged && !rows.empty() && row[0] == rows.back()[0]) continue;
-    if (!diverged) rows.push_back(std::move(row));
+    if (!t.diverged && !t.rows.empty() && row[0] == t.rows.back()[0]) continue;
+    if (!t.diverged) t.rows.push_back(std::move(row));
   }
-  if (columns.empty()) throw InputError(source, "", "no column header (and no data)");
-  for (const char* need :
-       {"step", "strain_yy", "b_xx", "b_xy", "b_yx", "b_yy", "s_xx", "s_xy", "s_yx", "s_yy"})
-    if (!col.count(need))
-      throw InputError(source, "columns", std::string("no column \"") + need + "\"");
-  if (rows.size() < 2 && !diverged)
+  if (t.columns.empty()) throw InputError(source, "", "no column header (and no data)");
+  return t;
+}
+
+void require_columns(const Table& t, const std::string& source,
+                     std::initializer_list<std::string> names) {
+  for (const std::string& need : names)
+    if (!t.col.count(need)) throw InputError(source, "columns", "no column \"" + need + "\"");
+}
+
+const char* const kAxis = "xyz";
+
+std::string component(const char* prefix, int i, int j) {
+  return std::string(prefix) + kAxis[i] + kAxis[j];
+}
+
+/// The biaxial rows (2D): disks, b and σ 2×2.
+void read_biaxial_rows(const Table& t, ExternalSeries& out) {
+  const double s3 = out.lateral_stress;
+  const bool has_error = t.has("lateral_stress_error");
+  const bool has_pressures = t.has("p_left") && t.has("p_right");
+  out.torque_column = t.has("torque_stress");
+  for (const auto& row : t.rows) {
+    MonitorPoint p;
+    p.step = static_cast<int64_t>(t.value(row, "step", 0));
+    p.strain_yy = t.value(row, "strain_yy", 0);
+    for (int i = 0; i < 2; ++i)
+      for (int j = 0; j < 2; ++j) {
+        p.b(i, j) = t.value(row, component("b_", i, j), 0);
+        p.sigma(i, j) = t.value(row, component("s_", i, j), 0);
+      }
+    if (out.torque_column) {
+      // Moment balance on the engine's own rotational disequilibrium (see the
+      // header); the symmetric part, all force balance uses, is unchanged.
+      const double tau = t.value(row, "torque_stress", 0);
+      const double asym = p.sigma(0, 1) - p.sigma(1, 0);
+      out.lever_arm_floor.push_back((asym - tau) / s3);
+      const double sym = 0.5 * (p.sigma(0, 1) + p.sigma(1, 0));
+      p.sigma(0, 1) = sym + 0.5 * tau;
+      p.sigma(1, 0) = sym - 0.5 * tau;
+    }
+    p.kinetic_energy = t.value(row, "kinetic_energy", 0);
+    p.kinetic_energy_rotation = t.value(row, "kinetic_energy_rotation", 0);
+    p.elastic_energy = t.value(row, "elastic_energy", 0);
+    p.unbalanced_force_ratio = t.value(row, "unbalanced_force_ratio", 0);
+    p.inertial_number = t.value(row, "inertial_number", 0);
+    p.coordination_number = t.value(row, "coordination_number", 0);
+    if (has_error)
+      p.lateral_stress_error = t.value(row, "lateral_stress_error", 0);
+    else if (has_pressures)
+      p.lateral_stress_error =
+          (0.5 * (t.value(row, "p_left", 0) + t.value(row, "p_right", 0)) - s3) / s3;
+    p.left = t.value(row, "wall_left", 0);
+    p.right = t.value(row, "wall_right", 0);
+    p.bottom = t.value(row, "wall_bottom", 0);
+    p.top = t.value(row, "wall_top", 0);
+    out.run.series.push_back(p);
+  }
+}
+
+/// The triaxial rows (3D): spheres, b and σ 3×3, the four lateral walls'
+/// servo errors (from servo_error_* or else from the pressures p_*).
+void read_triaxial_rows(const Table& t, ExternalSeries& out) {
+  static const char* const kWall[6] = {"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"};
+  const double s3 = out.lateral_stress;
+  for (const auto& row : t.rows) {
+    TriaxialPoint p;
+    p.step = static_cast<int64_t>(t.value(row, "step", 0));
+    p.strain_zz = t.value(row, "strain_zz", 0);
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) {
+        p.b(i, j) = t.value(row, component("b_", i, j), 0);
+        p.sigma(i, j) = t.value(row, component("s_", i, j), 0);
+      }
+    p.kinetic_energy = t.value(row, "kinetic_energy", 0);
+    p.kinetic_energy_rotation = t.value(row, "kinetic_energy_rotation", 0);
+    p.elastic_energy = t.value(row, "elastic_energy", 0);
+    p.unbalanced_force_ratio = t.value(row, "unbalanced_force_ratio", 0);
+    p.inertial_number = t.value(row, "inertial_number", 0);
+    p.coordination_number = t.value(row, "coordination_number", 0);
+    double mean_error = 0.0;
+    for (int w = 0; w < 4; ++w) {
+      const std::string pressure = std::string("p_") + kWall[w];
+      const double from_pressure =
+          t.has(pressure.c_str()) ? (t.value(row, pressure, 0) - s3) / s3 : 0.0;
+      p.servo_error[w] = t.value(row, std::string("servo_error_") + kWall[w], from_pressure);
+      mean_error += 0.25 * p.servo_error[w];
+    }
+    p.lateral_stress_error = t.value(row, "lateral_stress_error", mean_error);
+    for (int w = 0; w < 6; ++w) p.walls[w] = t.value(row, std::string("wall_") + kWall[w], 0);
+    out.triaxial.series.push_back(p);
+  }
+}
+
+/// What the metadata and the rows say of the run (LoadingResult and
+/// TriaxialResult name these fields alike). Its last monitoring point may
+/// fall short of the last step by less than one interval (Nstep not a
+/// multiple of M).
+template <class Run>
+void read_run_facts(const Table& t, const ExternalSeries& out, Run& run) {
+  const auto& series = run.series;
+  const int64_t last = series.empty() ? 0 : series.back().step;
+  const int64_t interval = series.size() >= 2 ? last - series[series.size() - 2].step : 0;
+  const auto steps = meta_number(out, "steps");
+  run.steps_planned = steps ? static_cast<int64_t>(*steps) : last;
+  run.steps_run =
+      (!t.diverged && steps && last < run.steps_planned && run.steps_planned - last < interval)
+          ? run.steps_planned
+          : last;
+  run.diverged = t.diverged;
+  if (t.diverged) {
+    run.divergence = Divergence::kNotFinite;
+    run.divergence_step = t.diverged_step;
+  }
+  run.particles = static_cast<int>(meta_number(out, "particles").value_or(0));
+  run.integration.dt = meta_number(out, "dt").value_or(0);
+  run.scales.dt_crit = meta_number(out, "dt_crit").value_or(0);
+  run.integration.damping_ratio_translation =
+      meta_number(out, "damping_ratio_translation").value_or(0);
+  run.integration.damping_ratio_rotation = meta_number(out, "damping_ratio_rotation").value_or(0);
+  run.integration.mass_scaling = meta_number(out, "mass_scaling").value_or(1);
+}
+
+}  // namespace
+
+ExternalSeries parse_external_series(const std::string& text, const std::string& source,
+                                     std::optional<double> lateral_stress) {
+  ExternalSeries out;
+  out.source = source;
+  const Table t = read_table(text, out);
+  // A triaxial series names the axial strain strain_zz (and has b_zz).
+  out.dimension = t.has("strain_zz") || t.has("b_zz") ? 3 : 2;
+  if (out.dimension == 2) {
+    require_columns(
+        t, source,
+        {"step", "strain_yy", "b_xx", "b_xy", "b_yx", "b_yy", "s_xx", "s_xy", "s_yx", "s_yy"});
+  } else {
+    require_columns(t, source, {"step", "strain_zz"});
+    for (const char* prefix : {"b_", "s_"})
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) require_columns(t, source, {component(prefix, i, j)});
+  }
+  if (t.rows.size() < 2 && !t.diverged)
     throw InputError(source, "", "fewer than two monitoring points");
 
   if (lateral_stress) {
@@ -112,80 +258,32 @@ ExternalSeries parse_external_series(const std::string& text, const std::string&
   if (!(out.lateral_stress > 0.0))
     throw InputError(source, "lateral_stress", "must be positive (sigma3, Pa)");
 
-  auto value = [&](const std::vector<double>& row, const char* name, double fallback) {
-    const auto it = col.find(name);
-    return it == col.end() ? fallback : row[it->second];
-  };
-  const double s3 = out.lateral_stress;
-  const bool has_error = col.count("lateral_stress_error") > 0;
-  const bool has_pressures = col.count("p_left") && col.count("p_right");
-  out.torque_column = col.count("torque_stress") > 0;
-  LoadingResult& run = out.run;
-  for (const auto& row : rows) {
-    MonitorPoint p;
-    p.step = static_cast<int64_t>(value(row, "step", 0));
-    p.strain_yy = value(row, "strain_yy", 0);
-    p.b << value(row, "b_xx", 0), value(row, "b_xy", 0), value(row, "b_yx", 0),
-        value(row, "b_yy", 0);
-    p.sigma << value(row, "s_xx", 0), value(row, "s_xy", 0), value(row, "s_yx", 0),
-        value(row, "s_yy", 0);
-    if (out.torque_column) {
-      // Moment balance on the engine's own rotational disequilibrium (see the
-      // header); the symmetric part, all force balance uses, is unchanged.
-      const double tau = value(row, "torque_stress", 0);
-      const double asym = p.sigma(0, 1) - p.sigma(1, 0);
-      out.lever_arm_floor.push_back((asym - tau) / s3);
-      const double sym = 0.5 * (p.sigma(0, 1) + p.sigma(1, 0));
-      p.sigma(0, 1) = sym + 0.5 * tau;
-      p.sigma(1, 0) = sym - 0.5 * tau;
-    }
-    p.kinetic_energy = value(row, "kinetic_energy", 0);
-    p.kinetic_energy_rotation = value(row, "kinetic_energy_rotation", 0);
-    p.elastic_energy = value(row, "elastic_energy", 0);
-    p.unbalanced_force_ratio = value(row, "unbalanced_force_ratio", 0);
-    p.inertial_number = value(row, "inertial_number", 0);
-    p.coordination_number = value(row, "coordination_number", 0);
-    if (has_error)
-      p.lateral_stress_error = value(row, "lateral_stress_error", 0);
-    else if (has_pressures)
-      p.lateral_stress_error =
-          (0.5 * (value(row, "p_left", 0) + value(row, "p_right", 0)) - s3) / s3;
-    p.left = value(row, "wall_left", 0);
-    p.right = value(row, "wall_right", 0);
-    p.bottom = value(row, "wall_bottom", 0);
-    p.top = value(row, "wall_top", 0);
-    run.series.push_back(p);
+  if (out.dimension == 2) {
+    read_biaxial_rows(t, out);
+    read_run_facts(t, out, out.run);
+  } else {
+    read_triaxial_rows(t, out);
+    read_run_facts(t, out, out.triaxial);
   }
-
-  // What is known of the run. Its last monitoring point may fall short of
-  // the last step by less than one interval (Nstep not a multiple of M).
-  const int64_t last = run.series.empty() ? 0 : run.series.back().step;
-  const int64_t interval =
-      run.series.size() >= 2 ? last - run.series[run.series.size() - 2].step : 0;
-  const auto steps = meta_number(out, "steps");
-  run.steps_planned = steps ? static_cast<int64_t>(*steps) : last;
-  run.steps_run =
-      (!diverged && steps && last < run.steps_planned && run.steps_planned - last < interval)
-          ? run.steps_planned
-          : last;
-  run.diverged = diverged;
-  if (diverged) {
-    run.divergence = Divergence::kNotFinite;
-    run.divergence_step = diverged_step;
-  }
-  run.particles = static_cast<int>(meta_number(out, "particles").value_or(0));
-  run.integration.dt = meta_number(out, "dt").value_or(0);
-  run.scales.dt_crit = meta_number(out, "dt_crit").value_or(0);
-  run.integration.damping_ratio_translation =
-      meta_number(out, "damping_ratio_translation").value_or(0);
-  run.integration.damping_ratio_rotation = meta_number(out, "damping_ratio_rotation").value_or(0);
-  run.integration.mass_scaling = meta_number(out, "mass_scaling").value_or(1);
   return out;
 }
 
 ExternalScore score_external(const ExternalSeries& series, const Tolerances& tolerances,
                              std::optional<double> reference_peak) {
   ExternalScore out;
+  if (series.dimension == 3) {
+    // The criteria of the three planes, as `demcal run` scores its own 3D
+    // runs; the peak is the monitored one (as in 2D).
+    const TriaxialResult& run = series.triaxial;
+    TriaxialCriteria c = compute_triaxial_criteria(run.series, series.lateral_stress);
+    c.combined.peak_error = peak_error_of(c.combined.peak_stress_yy, reference_peak);
+    out.score = score_of(c.combined,
+                         {run.diverged, run.stopped_early, run.steps_run, run.steps_planned,
+                          run.particles, run_parameters(run)},
+                         tolerances);
+    out.planes = c;
+    return out;
+  }
   out.score = score_run(series.run, series.lateral_stress, tolerances, reference_peak);
   // As the criteria, the start point (static by construction) is left out.
   double sum = 0.0;
@@ -202,24 +300,32 @@ ExternalScore score_external(const ExternalSeries& series, const Tolerances& tol
 nlohmann::json external_summary(const ExternalSeries& series, const ExternalScore& score,
                                 const Tolerances& tolerances) {
   const Score& s = score.score;
-  const LoadingResult& run = series.run;
-  nlohmann::json j{{"schema", "demcal.score/1"},
-                   {"source", series.source},
-                   {"metadata", series.meta},
-                   {"points", run.series.size()},
-                   {"steps_planned", run.steps_planned},
-                   {"steps_run", run.steps_run},
-                   {"lateral_stress", series.lateral_stress},
-                   {"criteria", to_json(s.criteria)},
-                   {"tolerances", to_json(tolerances)},
-                   {"passed", s.passed},
-                   {"complete", s.complete},
-                   {"diagnosis", to_json(s.diagnosis)},
-                   {"peak",
-                    {{"stress_yy", s.criteria.peak_stress_yy},
-                     {"strain_yy", s.criteria.peak_strain_yy},
-                     {"ratio", -s.criteria.peak_stress_yy / series.lateral_stress}}},
-                   {"diverged", run.diverged}};
+  const bool is_3d = series.dimension == 3;
+  const size_t points = is_3d ? series.triaxial.series.size() : series.run.series.size();
+  const bool diverged = is_3d ? series.triaxial.diverged : series.run.diverged;
+  const int64_t divergence_step =
+      is_3d ? series.triaxial.divergence_step : series.run.divergence_step;
+  const std::string axial = is_3d ? "zz" : "yy";  // the loaded axis
+  nlohmann::json j{
+      {"schema", "demcal.score/1"},
+      {"source", series.source},
+      {"dimension", series.dimension},
+      {"metadata", series.meta},
+      {"points", points},
+      {"steps_planned", is_3d ? series.triaxial.steps_planned : series.run.steps_planned},
+      {"steps_run", is_3d ? series.triaxial.steps_run : series.run.steps_run},
+      {"lateral_stress", series.lateral_stress},
+      {"criteria", to_json(s.criteria)},
+      {"tolerances", to_json(tolerances)},
+      {"passed", s.passed},
+      {"complete", s.complete},
+      {"diagnosis", to_json(s.diagnosis)},
+      {"peak",
+       {{"stress_" + axial, s.criteria.peak_stress_yy},
+        {"strain_" + axial, s.criteria.peak_strain_yy},
+        {"ratio", -s.criteria.peak_stress_yy / series.lateral_stress}}},
+      {"diverged", diverged}};
+  if (score.planes) j["criteria_planes"] = to_json(*score.planes);
   j["moment_balance_source"] = series.torque_column
                                    ? "torque_stress (the engine's net contact torques / V)"
                                    : "s_xy - s_yx as written";
@@ -231,7 +337,7 @@ nlohmann::json external_summary(const ExternalSeries& series, const ExternalScor
          "((s_xy - s_yx) - torque_stress)/sigma3: the static moment term of an engine that "
          "applies tangential forces at r_i instead of r_i - delta/2; not counted in moment "
          "balance"}};
-  if (run.diverged) j["divergence"] = {{"step", run.divergence_step}};
+  if (diverged) j["divergence"] = {{"step", divergence_step}};
   return j;
 }
 

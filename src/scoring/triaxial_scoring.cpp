@@ -111,6 +111,17 @@ TriaxialCriteria compute_triaxial_criteria(const TriaxialResult& run, double s3)
   return c;
 }
 
+nlohmann::json to_json(const TriaxialCriteria& c) {
+  return {{"xz", to_json(c.xz)},
+          {"yz", to_json(c.yz)},
+          {"xy",
+           {{"force_balance_shear", c.xy.force_balance_shear},
+            {"oscillation_shear", c.xy.oscillation_shear},
+            {"moment_balance", c.xy.moment_balance},
+            {"moment_noise", c.xy.moment_noise}}},
+          {"servo_walls", c.servo_walls}};
+}
+
 AlgorithmSpec run_parameters(const TriaxialResult& run) {
   return run_parameters(run.integration, run.scales.dt_crit, run.steps_planned);
 }
@@ -154,15 +165,7 @@ nlohmann::json triaxial_run_summary(const SceneConfig& config, const TriaxialSta
          {"particles", run.particles},
          {"params", params_json(config.algorithm, run.integration, run.scales)},
          {"criteria", to_json(c.combined)},
-         {"criteria_planes",
-          {{"xz", to_json(c.xz)},
-           {"yz", to_json(c.yz)},
-           {"xy",
-            {{"force_balance_shear", c.xy.force_balance_shear},
-             {"oscillation_shear", c.xy.oscillation_shear},
-             {"moment_balance", c.xy.moment_balance},
-             {"moment_noise", c.xy.moment_noise}}},
-           {"servo_walls", c.servo_walls}}},
+         {"criteria_planes", to_json(c)},
          {"tolerances", to_json(t)},
          {"verdict",
           {{"within_2d_tolerances", within},

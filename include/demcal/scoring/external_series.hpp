@@ -15,6 +15,15 @@
 // wall_left, wall_right, wall_bottom, wall_top, torque_stress. demcal's own
 // series.csv is such a file.
 //
+// A triaxial (3D) series is recognised by its axial strain column
+// strain_zz: required step, strain_zz and the nine components of b
+// (b_xx .. b_zz) and of σ (s_xx .. s_zz); optional the energies and ratios
+// above, servo_error_xmin, _xmax, _ymin, _ymax (else from the pressures
+// p_xmin .. p_ymax, else 0), lateral_stress_error (else their mean),
+// wall_xmin .. wall_zmax. demcal's 3D series.csv and the exported 3D
+// LAMMPS deck's are such files; they are scored as `demcal run` scores a
+// triaxial run (triaxial_scoring.hpp).
+//
 // Moment balance. In demcal V(σxy − σyx) = Σ_p T_p, the particles' net
 // contact torques, exactly. An engine that applies a contact's tangential
 // force at the lever arm r_i instead of r_i − δ/2 (LAMMPS) adds a static
@@ -32,15 +41,19 @@
 #include <string>
 
 #include "demcal/scoring/scoring.hpp"
+#include "demcal/scoring/triaxial_scoring.hpp"
 
 namespace demcal {
 
 struct ExternalSeries {
   std::string source;                       ///< the file, for messages
   std::map<std::string, std::string> meta;  ///< "# key = value" lines
-  LoadingResult run;                        ///< series and what is known of the run
-  double lateral_stress = 0.0;              ///< σ3 [Pa]
-  bool torque_column = false;               ///< torque_stress was given
+  /// 3 for a triaxial (sphere) series: it names the axial strain strain_zz.
+  int dimension = 2;
+  LoadingResult run;            ///< 2D: series and what is known of the run
+  TriaxialResult triaxial;      ///< 3D: the same
+  double lateral_stress = 0.0;  ///< σ3 [Pa]
+  bool torque_column = false;   ///< torque_stress was given
   /// Per monitoring point: ((σxy − σyx) − torque_stress)/σ3 (empty without
   /// torque_stress).
   std::vector<double> lever_arm_floor;
@@ -55,6 +68,8 @@ struct ExternalScore {
   Score score;
   double lever_arm_floor_rms = 0.0;  ///< RMS of ExternalSeries::lever_arm_floor
   double lever_arm_floor_max = 0.0;  ///< largest |value|
+  /// 3D: the criteria of each plane (Score holds their combination).
+  std::optional<TriaxialCriteria> planes;
 };
 
 /// The criteria, verdict and diagnosis of the series (score_run()).

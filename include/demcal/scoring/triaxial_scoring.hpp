@@ -37,6 +37,10 @@ TriaxialCriteria compute_triaxial_criteria(const std::vector<TriaxialPoint>& ser
 /// run has one.
 TriaxialCriteria compute_triaxial_criteria(const TriaxialResult& run, double s3);
 
+/// The planes' criteria as summary.json holds them ("criteria_planes": xz,
+/// yz, the xy shear and moment terms, the four walls' servo errors).
+nlohmann::json to_json(const TriaxialCriteria& c);
+
 /// A triaxial run scored as score_run() scores a biaxial one: the combined
 /// criteria (peak_stress_yy holds the axial peak b_zz), the verdict against
 /// `tolerances`, completeness, cost and the diagnosis.

@@ -1,0 +1,14 @@
+// The criteria of a run as the commands print them: one home for the lines
+// `demcal run` and `demcal score` share.
+#pragma once
+
+#include <ostream>
+
+#include "demcal/scoring/triaxial_scoring.hpp"
+
+namespace demcal::cli {
+
+/// The 3D criteria, combined and per plane, two indented lines.
+void print_triaxial_criteria(std::ostream& out, const TriaxialCriteria& c);
+
+}  // namespace demcal::cli

@@ -1,0 +1,141 @@
+// Scoring a triaxial (3D) series from another engine: demcal's own 3D
+// series.csv read back scores as the run itself; the servo error of each
+// lateral wall comes from its pressure when the file has no servo column;
+// a 3D file missing a component is one clear InputError; `demcal score`
+// on a 3D file writes its summary with the planes' criteria. (The exported
+// LAMMPS 3D deck's own series is scored in test_export_3d.cpp.)
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "demcal/io/input_error.hpp"
+#include "demcal/scene/run_output.hpp"
+#include "demcal/scene/triaxial.hpp"
+#include "demcal/scoring/external_series.hpp"
+#include "demcal/scoring/triaxial_scoring.hpp"
+#include "support/files.hpp"
+#include "support/process.hpp"
+
+namespace demcal {
+namespace {
+
+namespace fs = std::filesystem;
+
+SceneConfig fcc3() {
+  SceneConfig c = load_config(test::shipped_config("fcc_4x4x4"));
+  c.assembly.cells_x = c.assembly.cells_y = c.assembly.cells_z = 3;
+  c.test.monitor_points = 50;
+  return c;
+}
+
+AlgorithmSpec params(int64_t steps) {
+  AlgorithmSpec p;
+  p.dt_ratio = 0.2;
+  p.steps = steps;
+  p.damping_ratio_translation = 0.4;
+  p.damping_ratio_rotation = 0.4;
+  return p;
+}
+
+TriaxialResult fcc3_run(int64_t steps) {
+  const SceneConfig c = fcc3();
+  const TriaxialState state = consolidate_triaxial(c, make_sphere_assembly(c));
+  return run_triaxial_loading(state, c.test, params(steps));
+}
+
+TEST(ExternalSeries3d, DemcalsOwnSeriesScoresAsTheRun) {
+  const SceneConfig c = fcc3();
+  const double s3 = c.test.lateral_stress;
+  // Fast and slow loading: one fails, one passes, each read back the same.
+  for (int64_t steps : {2000, 20000}) {
+    const TriaxialResult run = fcc3_run(steps);
+    const TriaxialCriteria direct = compute_triaxial_criteria(run.series, s3);
+    const ExternalSeries read = parse_external_series(series_csv(run.series), "series.csv", s3);
+    ASSERT_EQ(read.dimension, 3);
+    ASSERT_EQ(read.triaxial.series.size(), run.series.size());
+    const ExternalScore back = score_external(read, Tolerances{});
+    ASSERT_TRUE(back.planes.has_value());
+    const Criteria& b = back.score.criteria;
+    const Criteria& d = direct.combined;
+    // series.csv carries 10 significant digits: the criteria agree to that
+    // (relative to each criterion's own scale, σ3 or the peak).
+    EXPECT_NEAR(b.force_balance, d.force_balance, 1e-7) << steps;
+    EXPECT_NEAR(b.moment_balance, d.moment_balance, 1e-7) << steps;
+    EXPECT_NEAR(b.servo, d.servo, 1e-7) << steps;
+    EXPECT_NEAR(b.oscillation, d.oscillation, 1e-7) << steps;
+    for (int w = 0; w < 4; ++w)
+      EXPECT_NEAR(back.planes->servo_walls[w], direct.servo_walls[w], 1e-7) << steps << " " << w;
+    EXPECT_NEAR(b.peak_stress_yy / d.peak_stress_yy, 1.0, 1e-9) << steps;
+    EXPECT_EQ(b.points, d.points);
+    // The verdict of the criteria against the same tolerances; the file
+    // has no "# steps", so the run counts as complete at its last row.
+    EXPECT_EQ(back.score.passed, excesses(d, Tolerances{}).worst() <= 1.0 && !run.diverged)
+        << steps;
+  }
+}
+
+TEST(ExternalSeries3d, ServoErrorsComeFromThePressuresWhenNotGiven) {
+  std::string csv = "# lateral_stress = 100000\n# steps = 10\nstep,strain_zz";
+  for (const char* t : {"b_", "s_"})
+    for (const char* ij : {"xx", "xy", "xz", "yx", "yy", "yz", "zx", "zy", "zz"})
+      csv += std::string(",") + t + ij;
+  csv += ",p_xmin,p_xmax,p_ymin,p_ymax\n";
+  for (int row = 0; row < 2; ++row) {
+    csv += std::to_string(10 * row) + ",-0.001";
+    for (int k = 0; k < 18; ++k) csv += k % 4 == 0 ? ",-100000" : ",0";
+    csv += ",101000,99000,100000,102000\n";
+  }
+  const ExternalSeries s = parse_external_series(csv, "t.csv");
+  ASSERT_EQ(s.dimension, 3);
+  ASSERT_EQ(s.triaxial.series.size(), 2u);
+  const TriaxialPoint& p = s.triaxial.series.back();
+  EXPECT_DOUBLE_EQ(p.servo_error[0], 0.01);
+  EXPECT_DOUBLE_EQ(p.servo_error[1], -0.01);
+  EXPECT_DOUBLE_EQ(p.servo_error[2], 0.0);
+  EXPECT_DOUBLE_EQ(p.servo_error[3], 0.02);
+  EXPECT_DOUBLE_EQ(p.lateral_stress_error, 0.005);  // their mean
+  EXPECT_EQ(p.b(2, 2), -100000);
+  EXPECT_EQ(s.triaxial.steps_planned, 10);
+}
+
+TEST(ExternalSeries3d, AMissingComponentIsOneClearError) {
+  std::string csv = "# lateral_stress = 100000\nstep,strain_zz";
+  for (const char* t : {"b_", "s_"})
+    for (const char* ij : {"xx", "xy", "xz", "yx", "yy", "yz", "zx", "zy"})  // no zz
+      csv += std::string(",") + t + ij;
+  csv += "\n";
+  for (int row = 0; row < 2; ++row) {
+    csv += std::to_string(row) + ",0";
+    for (int k = 0; k < 16; ++k) csv += ",0";
+    csv += "\n";
+  }
+  try {
+    parse_external_series(csv, "t.csv");
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("t.csv"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("b_zz"), std::string::npos) << e.what();
+  }
+}
+
+TEST(ScoreCli3d, ScoresATriaxialSeries) {
+  const test::TempDir dir("score_cli_3d");
+  const SceneConfig c = fcc3();
+  test::write_text(dir / "series.csv", series_csv(fcc3_run(20000).series));
+  const auto r = test::run_demcal(
+      {"score", "series.csv", "--lateral-stress", std::to_string(c.test.lateral_stress), "-o", "s"},
+      dir.path());
+  ASSERT_TRUE(r.status == 0 || r.status == 1) << r.out;  // a verdict, not an error
+  EXPECT_NE(r.out.find("3D (triaxial)"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("peak sigma_zz"), std::string::npos) << r.out;
+  const nlohmann::json j = nlohmann::json::parse(test::read_text(dir / "s" / "summary.json"));
+  EXPECT_EQ(j.at("dimension"), 3);
+  EXPECT_TRUE(j.at("criteria_planes").contains("servo_walls"));
+  EXPECT_LT(j.at("peak").at("stress_zz").get<double>(), 0.0);
+  EXPECT_EQ(j.at("passed").get<bool>(), r.status == 0);
+}
+
+}  // namespace
+}  // namespace demcal
