@@ -1,14 +1,15 @@
 // `demcal stability [CONFIG] [--from F --to T --points P --steps S] [-o DIR]`:
-// the stability scan (demcal/stability_scan.hpp). Writes DIR/stability.json
+// the stability scan (demcal/stability_scan.hpp), 2D or 3D. Writes DIR/stability.json
 // and DIR/stability.md; prints the measured limit against the estimate.
 #include <iomanip>
 #include <iostream>
 
 #include "commands.hpp"
-#include "demcal/scene/biaxial.hpp"
 #include "demcal/io/files.hpp"
-#include "demcal/scene/run_output.hpp"
+#include "demcal/scene/biaxial.hpp"
 #include "demcal/scene/packing.hpp"
+#include "demcal/scene/run_output.hpp"
+#include "demcal/scene/triaxial.hpp"
 #include "demcal/search/stability_scan.hpp"
 #include "output_folder.hpp"
 
@@ -16,13 +17,10 @@ namespace demcal::cli {
 
 int cmd_stability(const StabilityOptions& o) {
   if (!(o.to > o.from)) throw InputError("--to", "", "must be larger than --from");
-  SceneConfig config = load_scene(o.config, o.sets);
+  // 2D (disks, biaxial test) and 3D (spheres, triaxial test) alike.
+  SceneConfig config = load_config(o.config, o.sets);
   const std::string dir = o.out_dir.empty() ? "demcal-stability-" + config.name : o.out_dir;
   OutputFolder::check(dir);  // an unwritable -o fails now, not after the scan
-  Assembly assembly = make_assembly(config);
-  std::cerr << "stability " << config.name << ": consolidating " << assembly.size()
-            << " particles\n";
-  const ConsolidatedState state = consolidate(config, assembly);
 
   StabilityScanOptions options;
   options.from = o.from;
@@ -30,7 +28,18 @@ int cmd_stability(const StabilityOptions& o) {
   options.points = o.points;
   options.steps = o.steps;
   options.jobs = o.jobs;
-  const StabilityScanResult r = stability_scan(config, state, options);
+  StabilityScanResult r;
+  if (config.dimension == 3) {
+    const SphereAssembly assembly = make_sphere_assembly(config);
+    std::cerr << "stability " << config.name << ": consolidating " << assembly.size()
+              << " spheres (3D, triaxial)\n";
+    r = stability_scan(config, consolidate_triaxial(config, assembly), options);
+  } else {
+    Assembly assembly = make_assembly(config);
+    std::cerr << "stability " << config.name << ": consolidating " << assembly.size()
+              << " particles\n";
+    r = stability_scan(config, consolidate(config, assembly), options);
+  }
 
   nlohmann::json j = to_json(r);
   j["scene"] = config.name;
@@ -46,7 +55,7 @@ int cmd_stability(const StabilityOptions& o) {
   int diverged = 0;
   for (const auto& t : r.trials) diverged += t.diverged ? 1 : 0;
   std::cout << std::setprecision(4) << "stability " << config.name << ": estimate alpha "
-            << r.dt_ratio_estimate;
+            << r.dt_ratio_estimate << " (Gershgorin " << r.dt_ratio_gershgorin << ")";
   if (r.ratio() > 0.0)
     std::cout << ", measured: stable at " << r.dt_ratio_last_stable << ", diverged at "
               << r.dt_ratio_first_diverged << " (" << r.ratio() << " x the estimate)";

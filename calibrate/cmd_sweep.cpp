@@ -1,6 +1,6 @@
 // `demcal sweep CONFIG [--jobs N] [-o DIR]`: the signature atlas
-// (demcal/search/sweep.hpp; reports/signature-atlas.md). The config's algorithm block is the
-// benchmark; every other case changes one parameter.
+// (demcal/search/sweep.hpp; reports/signature-atlas.md), on a 2D or a 3D scene. The config's
+// algorithm block is the benchmark; every other case changes one parameter.
 #include <iomanip>
 #include <iostream>
 #include <sstream>
@@ -10,21 +10,18 @@
 #include "demcal/scene/biaxial.hpp"
 #include "demcal/scene/packing.hpp"
 #include "demcal/scene/run_output.hpp"
+#include "demcal/scene/triaxial.hpp"
 #include "demcal/search/sweep.hpp"
 #include "output_folder.hpp"
 
 namespace demcal::cli {
 
 int cmd_sweep(const SweepOptions& options) {
-  SceneConfig config = load_scene(options.config, options.sets);
-  Assembly assembly = make_assembly(config);
+  // 2D (disks, biaxial test) and 3D (spheres, triaxial test): one sweep.
+  SceneConfig config = load_config(options.config, options.sets);
+  const bool three_d = config.dimension == 3;
   const std::string dir = options.out_dir.empty() ? "demcal-sweep-" + config.name : options.out_dir;
   OutputFolder::check(dir);  // an unwritable -o fails now, not after the sweep
-  std::cerr << "sweep " << config.name << ": consolidating " << assembly.r.size()
-            << " particles (once)\n";
-  const ConsolidatedState state = consolidate(config, assembly);
-  const double alpha_stable = state.world.stability_estimate().dt_ratio_stable;
-  const std::vector<SweepCase> cases = atlas_cases(config.algorithm, alpha_stable);
 
   SweepSettings settings;
   settings.jobs = options.jobs;
@@ -33,14 +30,32 @@ int cmd_sweep(const SweepOptions& options) {
     std::cerr << "  [" << k << "/" << n << "] " << name << " (" << std::fixed
               << std::setprecision(1) << seconds << " s)\n";
   };
-  std::cerr << "  " << cases.size() << " trials, benchmark Nstep " << config.algorithm.steps
-            << ", alpha_stable " << std::setprecision(3) << alpha_stable << "\n";
-  const SweepResult result = run_sweep(config, state, cases, settings);
+  // The consolidated state, once; the cases around the config's algorithm block.
+  auto sweep = [&](const auto& state, double alpha_stable) {
+    const std::vector<SweepCase> cases = atlas_cases(config.algorithm, alpha_stable);
+    std::cerr << "  " << cases.size() << " trials, benchmark Nstep " << config.algorithm.steps
+              << ", alpha_stable " << std::setprecision(3) << alpha_stable << "\n";
+    return run_sweep(config, state, cases, settings);
+  };
+  SweepResult result;
+  if (three_d) {
+    const SphereAssembly assembly = make_sphere_assembly(config);
+    std::cerr << "sweep " << config.name << ": consolidating " << assembly.size()
+              << " spheres (once; 3D, triaxial)\n";
+    const TriaxialState state = consolidate_triaxial(config, assembly);
+    result = sweep(state, estimated_stable_dt_ratio(state, config.algorithm));
+  } else {
+    Assembly assembly = make_assembly(config);
+    std::cerr << "sweep " << config.name << ": consolidating " << assembly.r.size()
+              << " particles (once)\n";
+    const ConsolidatedState state = consolidate(config, assembly);
+    result = sweep(state, state.world.stability_estimate().dt_ratio_stable);
+  }
 
   {
     OutputFolder out(dir);  // all files replaced together, or none
     for (const auto& r : result.cases)
-      out.write("series/" + r.spec.name + ".csv", series_csv(r.run.series));
+      out.write("series/" + r.spec.name + ".csv", r.run.series_csv);
     out.write("evidence.csv", evidence_csv(result));
     nlohmann::json j = to_json(result);
     j["config_sha256"] = sha256_hex(config.text);

@@ -218,11 +218,9 @@ TEST_F(Cli3D, MismatchesAndUnsupportedCommandsAreBadInput) {
   const std::string hex_3d =
       write("h3.json", "{" + test::kMaterialMember +
                            R"(, "dimension": 3, "assembly": {"type": "hexagonal"}})");
-  const std::string fcc = write("fcc2.json", fcc_config());
   const Case cases[] = {
       {{"run", triaxial_2d}, "test.type"},
       {{"check", hex_3d}, "assembly.type"},
-      {{"sweep", fcc}, "dimension"},
   };
   for (const Case& k : cases) {
     SCOPED_TRACE(k.args[0] + " " + k.args[1]);

@@ -258,7 +258,9 @@ TEST(Sweep, RunsInParallelAndScoresAgainstTheLadder) {
   EXPECT_EQ(r.cases[4].score.diagnosis.parameter, "dt");
   EXPECT_GT(objective(r.cases[4].score, r.tolerances), 2.0);
   for (const auto& c : r.cases)
-    if (!c.run.diverged) EXPECT_LT(c.identity_residual, 1e-9) << c.spec.name;
+    if (!c.run.diverged) {
+      EXPECT_LT(c.identity_residual, 1e-9) << c.spec.name;
+    }
   EXPECT_EQ(r.evidence.size(), 15u);
 
   const nlohmann::json j = to_json(r);

@@ -6,6 +6,7 @@
 #include <cstdio>
 
 #include "demcal/io/format.hpp"
+#include "demcal/kernel/sphere_world.hpp"
 
 namespace demcal {
 
@@ -139,12 +140,18 @@ std::vector<double> moving_trend(const std::vector<double>& x, int h) {
 
 Eigen::Matrix2d force_balance_gap(const World& world) { return world.net_force_moment(); }
 
-double gap_identity_residual(const World& world) {
-  const Measures m = world.measure();
-  const Eigen::Matrix2d gap = m.boundary_stress - m.homogenized_stress;
+namespace {
+template <class W>
+double identity_residual(const W& world) {
+  const auto m = world.measure();
+  const auto gap = (m.boundary_stress - m.homogenized_stress).eval();
   const double scale = std::max(m.boundary_stress.norm(), 1e-300);
   return (gap - world.net_force_moment()).norm() / scale;
 }
+}  // namespace
+
+double gap_identity_residual(const World& world) { return identity_residual(world); }
+double gap_identity_residual(const SphereWorld& world) { return identity_residual(world); }
 
 Criteria compute_criteria(const LoadingResult& run, double s3,
                           std::optional<double> reference_peak) {

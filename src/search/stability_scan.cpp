@@ -13,14 +13,17 @@ namespace demcal {
 
 namespace {
 
-StabilityTrial run_one(const SceneConfig& config, const ConsolidatedState& state, double alpha,
-                       int64_t steps) {
+/// The loading of one rung: `steps` steps at α, the config's damping and
+/// mass scaling; only divergence matters, so few monitoring points.
+template <class State, class Load>
+StabilityTrial run_one(const SceneConfig& config, const State& state, double alpha, int64_t steps,
+                       Load load) {
   AlgorithmSpec a = config.algorithm;
   a.dt_ratio = alpha;
   a.steps = steps;
   TestSpec test = config.test;
   test.monitor_points = std::min<int>(test.monitor_points, 20);  // only divergence matters
-  const LoadingResult run = run_loading(state, test, a);
+  const auto run = load(state, test, a);
   StabilityTrial t;
   t.dt_ratio = alpha;
   t.diverged = run.diverged;
@@ -30,31 +33,22 @@ StabilityTrial run_one(const SceneConfig& config, const ConsolidatedState& state
   return t;
 }
 
-}  // namespace
-
-double StabilityScanResult::ratio() const {
-  if (dt_ratio_estimate <= 0.0 || dt_ratio_first_diverged <= 0.0 || dt_ratio_last_stable <= 0.0)
-    return 0.0;
-  return 0.5 * (dt_ratio_last_stable + dt_ratio_first_diverged) / dt_ratio_estimate;
-}
-
-StabilityScanResult stability_scan(const SceneConfig& config, const ConsolidatedState& state,
-                                   const StabilityScanOptions& options) {
+/// The scan, whatever the dimension: `out` holds the estimates, `trial(α)`
+/// runs one rung.
+template <class Trial>
+StabilityScanResult scan(StabilityScanResult out, const StabilityScanOptions& options,
+                         const Trial& trial) {
   if (!(options.from > 0.0) || !(options.to > options.from) || options.points < 2 ||
       options.steps < 1 || options.bisections < 0)
     throw std::invalid_argument("stability_scan: need 0 < from < to, points >= 2, steps >= 1");
   const auto t0 = std::chrono::steady_clock::now();
   const int jobs = resolve_jobs(options.jobs);
-  StabilityScanResult out;
   out.steps = options.steps;
-  out.damping_ratio_translation = config.algorithm.damping_ratio_translation;
-  out.damping_ratio_rotation = config.algorithm.damping_ratio_rotation;
-  out.dt_ratio_estimate = estimated_stable_dt_ratio(state, config.algorithm);
 
   std::vector<StabilityTrial> ladder(options.points);
   for_each_parallel(options.points, jobs, [&](int k) {
     const double f = options.from + (options.to - options.from) * k / (options.points - 1);
-    ladder[k] = run_one(config, state, f * out.dt_ratio_estimate, options.steps);
+    ladder[k] = trial(f * out.dt_ratio_estimate);
   });
   out.trials = ladder;
 
@@ -63,7 +57,7 @@ StabilityScanResult stability_scan(const SceneConfig& config, const Consolidated
   if (first_diverged != ladder.end() && first_diverged != ladder.begin()) {
     double lo = std::prev(first_diverged)->dt_ratio, hi = first_diverged->dt_ratio;
     for (int b = 0; b < options.bisections; ++b) {
-      StabilityTrial t = run_one(config, state, 0.5 * (lo + hi), options.steps);
+      StabilityTrial t = trial(0.5 * (lo + hi));
       t.bisection = true;
       (t.diverged ? hi : lo) = t.dt_ratio;
       out.trials.push_back(t);
@@ -81,6 +75,48 @@ StabilityScanResult stability_scan(const SceneConfig& config, const Consolidated
   return out;
 }
 
+/// What every scan reports besides its trials.
+template <class State>
+StabilityScanResult estimates(const SceneConfig& config, const State& state, int dimension) {
+  StabilityScanResult out;
+  out.dimension = dimension;
+  out.damping_ratio_translation = config.algorithm.damping_ratio_translation;
+  out.damping_ratio_rotation = config.algorithm.damping_ratio_rotation;
+  out.dt_ratio_estimate = estimated_stable_dt_ratio(state, config.algorithm);
+  const StabilityEstimate e = state.world.stability_estimate();
+  out.dt_ratio_gershgorin = e.dt_ratio_stable_gershgorin;
+  out.dt_ratio_translation = e.dt_ratio_stable_translation;
+  return out;
+}
+
+}  // namespace
+
+double StabilityScanResult::ratio() const {
+  if (dt_ratio_estimate <= 0.0 || dt_ratio_first_diverged <= 0.0 || dt_ratio_last_stable <= 0.0)
+    return 0.0;
+  return 0.5 * (dt_ratio_last_stable + dt_ratio_first_diverged) / dt_ratio_estimate;
+}
+
+StabilityScanResult stability_scan(const SceneConfig& config, const ConsolidatedState& state,
+                                   const StabilityScanOptions& options) {
+  return scan(estimates(config, state, 2), options, [&](double alpha) {
+    return run_one(config, state, alpha, options.steps,
+                   [](const ConsolidatedState& s, const TestSpec& t, const AlgorithmSpec& a) {
+                     return run_loading(s, t, a);
+                   });
+  });
+}
+
+StabilityScanResult stability_scan(const SceneConfig& config, const TriaxialState& state,
+                                   const StabilityScanOptions& options) {
+  return scan(estimates(config, state, 3), options, [&](double alpha) {
+    return run_one(config, state, alpha, options.steps,
+                   [](const TriaxialState& s, const TestSpec& t, const AlgorithmSpec& a) {
+                     return run_triaxial_loading(s, t, a);
+                   });
+  });
+}
+
 nlohmann::json to_json(const StabilityScanResult& r) {
   nlohmann::json trials = nlohmann::json::array();
   for (const auto& t : r.trials) {
@@ -95,7 +131,10 @@ nlohmann::json to_json(const StabilityScanResult& r) {
     trials.push_back(j);
   }
   nlohmann::json j{{"schema", "demcal.stability/1"},
+                   {"dimension", r.dimension},
                    {"dt_ratio_estimate", r.dt_ratio_estimate},
+                   {"dt_ratio_gershgorin", r.dt_ratio_gershgorin},
+                   {"dt_ratio_translation", r.dt_ratio_translation},
                    {"dt_ratio_last_stable", r.dt_ratio_last_stable},
                    {"dt_ratio_first_diverged", r.dt_ratio_first_diverged},
                    {"measured_over_estimate", r.ratio()},
@@ -112,8 +151,10 @@ std::string stability_markdown(const StabilityScanResult& r, const std::string& 
   s.precision(4);
   s << "# Stability scan: " << scene << "\n\n"
     << "Estimated stable alpha = dt/dt_crit from the stiffnesses (Lanczos on the consolidated "
-       "contact network): **"
-    << r.dt_ratio_estimate << "**.\n\n";
+       "contact network, "
+    << (r.dimension == 3 ? "spheres, 6" : "disks, 3") << " DOF each): **" << r.dt_ratio_estimate
+    << "**. Gershgorin bound " << r.dt_ratio_gershgorin << ", translation only (rotation locked) "
+    << r.dt_ratio_translation << " (of the consolidated network).\n\n";
   if (r.ratio() > 0.0)
     s << "Measured: stable at alpha = " << r.dt_ratio_last_stable << ", diverged at "
       << r.dt_ratio_first_diverged << ", so the limit is " << r.ratio() << " x the estimate.\n\n";

@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "demcal/io/format.hpp"
+#include "demcal/scene/run_output.hpp"
 #include "demcal/scoring/trial.hpp"
 #include "demcal/search/parallel.hpp"
 
@@ -284,19 +285,19 @@ void compute_evidence(SweepResult& res) {
 
 }  // namespace
 
-SweepResult run_sweep(const SceneConfig& config, const ConsolidatedState& state,
-                      const std::vector<SweepCase>& cases, const SweepSettings& settings) {
+namespace {
+
+/// Runs one case of a scene: fills r.run, r.score (against no reference:
+/// the peak error is added once the reference is known), r.planes (3D) and
+/// r.identity_residual. Thread-safe.
+using CaseRunner = std::function<void(SweepCaseResult& r)>;
+
+/// The sweep, whatever the dimension: `res` holds the scene's description.
+SweepResult sweep_cases(SweepResult res, const std::vector<SweepCase>& cases,
+                        const SweepSettings& settings, const CaseRunner& run_case) {
   const auto t0 = std::chrono::steady_clock::now();
-  SweepResult res;
-  res.scene = config.name;
-  res.particles = state.world.size();
-  res.benchmark = config.algorithm;
-  res.lateral_stress = config.test.lateral_stress;
   res.accuracy = settings.accuracy;
   res.tolerances = settings.tolerances;
-  res.consolidation_time_s = state.wall_time_s;
-  res.analytical_peak = analytical_peak_stress(config);
-  res.alpha_stable = state.world.stability_estimate().dt_ratio_stable;
   res.cases.resize(cases.size());
   for (size_t i = 0; i < cases.size(); ++i) res.cases[i].spec = cases[i];
 
@@ -313,10 +314,7 @@ SweepResult run_sweep(const SceneConfig& config, const ConsolidatedState& state,
   std::mutex progress_mutex;
   for_each_parallel(static_cast<int>(order.size()), jobs, [&](int k) {
     SweepCaseResult& r = res.cases[order[k]];
-    const ConsolidatedState local = state;  // each trial its own copy
-    World final_state = local.world;
-    r.run = run_loading(local, config.test, r.spec.algorithm, {}, &final_state);
-    r.identity_residual = gap_identity_residual(final_state);
+    run_case(r);
     const int finished = ++done;
     if (settings.progress) {
       std::lock_guard<std::mutex> lock(progress_mutex);
@@ -330,23 +328,76 @@ SweepResult run_sweep(const SceneConfig& config, const ConsolidatedState& state,
     const bool ladder =
         r.spec.group == "benchmark" || r.spec.group == "convergence" || r.spec.name == "steps_x33";
     if (!ladder || r.run.diverged || r.run.steps_run != r.run.steps_planned) continue;
-    const Criteria c = compute_criteria(r.run, res.lateral_stress);
-    peaks.emplace_back(r.spec.algorithm.steps, c.peak_stress_yy);
+    peaks.emplace_back(r.spec.algorithm.steps, r.score.criteria.peak_stress_yy);
   }
   res.reference = converged_reference(peaks);
   const std::optional<double> ref =
       peaks.empty() ? std::nullopt : std::optional<double>(res.reference.peak_stress_yy);
   for (auto& r : res.cases) {
-    r.score = score_run(r.run, res.lateral_stress, settings.tolerances, ref);
-    if (res.analytical_peak && r.score.criteria.peak_stress_yy < 0.0)
+    Criteria& c = r.score.criteria;
+    // As compute_criteria() sets it: for every run that has a (compressive) peak.
+    if (c.peak_stress_yy < 0.0) c.peak_error = peak_error_of(c.peak_stress_yy, ref);
+    if (res.analytical_peak && c.peak_stress_yy < 0.0)
       r.peak_error_analytical =
-          (*res.analytical_peak - r.score.criteria.peak_stress_yy) / std::abs(*res.analytical_peak);
-    r.accurate =
-        r.score.criteria.peak_error && std::abs(*r.score.criteria.peak_error) <= settings.accuracy;
+          (*res.analytical_peak - c.peak_stress_yy) / std::abs(*res.analytical_peak);
+    r.accurate = c.peak_error && std::abs(*c.peak_error) <= settings.accuracy;
   }
   compute_evidence(res);
   res.wall_time_s = seconds_since(t0);
   return res;
+}
+
+template <class Run>
+SweepRun sweep_run(const Run& run, std::string series) {
+  return {run.diverged,      run.divergence,     run.divergence_step, run.steps_run,
+          run.steps_planned, run.integration.dt, run.wall_time_s,     std::move(series)};
+}
+
+}  // namespace
+
+SweepResult run_sweep(const SceneConfig& config, const ConsolidatedState& state,
+                      const std::vector<SweepCase>& cases, const SweepSettings& settings) {
+  SweepResult res;
+  res.scene = config.name;
+  res.dimension = 2;
+  res.particles = state.world.size();
+  res.benchmark = config.algorithm;
+  res.lateral_stress = config.test.lateral_stress;
+  res.consolidation_time_s = state.wall_time_s;
+  res.analytical_peak = analytical_peak_stress(config);
+  res.alpha_stable = state.world.stability_estimate().dt_ratio_stable;
+  const double s3 = config.test.lateral_stress;
+  return sweep_cases(std::move(res), cases, settings, [&](SweepCaseResult& r) {
+    const ConsolidatedState local = state;  // each trial its own copy
+    World final_state = local.world;
+    const LoadingResult run = run_loading(local, config.test, r.spec.algorithm, {}, &final_state);
+    r.score = score_run(run, s3, settings.tolerances);
+    r.identity_residual = gap_identity_residual(final_state);
+    r.run = sweep_run(run, series_csv(run.series));
+  });
+}
+
+SweepResult run_sweep(const SceneConfig& config, const TriaxialState& state,
+                      const std::vector<SweepCase>& cases, const SweepSettings& settings) {
+  SweepResult res;
+  res.scene = config.name;
+  res.dimension = 3;
+  res.particles = state.world.size();
+  res.benchmark = config.algorithm;
+  res.lateral_stress = config.test.lateral_stress;
+  res.consolidation_time_s = state.wall_time_s;
+  const double s3 = config.test.lateral_stress;
+  if (const auto ratio = analytical_peak_ratio_3d(config)) res.analytical_peak = -*ratio * s3;
+  res.alpha_stable = estimated_stable_dt_ratio(state, config.algorithm);
+  return sweep_cases(std::move(res), cases, settings, [&](SweepCaseResult& r) {
+    SphereWorld final_state = state.world;
+    const TriaxialResult run =
+        run_triaxial_loading(state, config.test, r.spec.algorithm, {}, &final_state);
+    r.score = score_triaxial_run(run, s3, settings.tolerances);
+    r.planes = compute_triaxial_criteria(run, s3);
+    r.identity_residual = gap_identity_residual(final_state);
+    r.run = sweep_run(run, series_csv(run.series));
+  });
 }
 
 namespace {
@@ -366,7 +417,7 @@ nlohmann::json to_json(const SweepResult& res) {
            {"group", r.spec.group},
            {"change", r.spec.change},
            {"expected", r.spec.expected},
-           {"params", params_with_dt(r.spec.algorithm, r.run.integration.dt)},
+           {"params", params_with_dt(r.spec.algorithm, r.run.dt)},
            {"criteria", to_json(r.score.criteria)},
            {"peak_ratio", -r.score.criteria.peak_stress_yy / res.lateral_stress},
            {"passed", r.score.passed},
@@ -380,6 +431,11 @@ nlohmann::json to_json(const SweepResult& res) {
            {"series", "series/" + r.spec.name + ".csv"}};
     if (r.run.diverged) c["divergence"] = to_string(r.run.divergence);
     if (r.peak_error_analytical) c["peak_error_analytical"] = *r.peak_error_analytical;
+    if (r.planes)
+      c["planes"] = {{"xz", to_json(r.planes->xz)},
+                     {"yz", to_json(r.planes->yz)},
+                     {"xy", to_json(r.planes->xy)},
+                     {"servo_walls", r.planes->servo_walls}};
     cases.push_back(c);
   }
   json ladder = json::array();
@@ -400,6 +456,7 @@ nlohmann::json to_json(const SweepResult& res) {
   }
   json j{{"schema", "demcal.sweep/1"},
          {"scene", res.scene},
+         {"dimension", res.dimension},
          {"particles", res.particles},
          {"benchmark", to_json(res.benchmark)},
          {"alpha_stable", res.alpha_stable},
@@ -443,9 +500,11 @@ std::string compact(double v) {
 std::string atlas_markdown(const SweepResult& res) {
   std::ostringstream md;
   const double s3 = res.lateral_stress;
+  const bool three_d = res.dimension == 3;
   md << "# Signature atlas: " << res.scene << "\n\n"
-     << res.particles << " particles. Benchmark: alpha " << res.benchmark.dt_ratio << ", Nstep "
-     << res.benchmark.steps << ", zeta_t " << res.benchmark.damping_ratio_translation << ", zeta_r "
+     << res.particles << (three_d ? " spheres, triaxial test (z axial)" : " particles")
+     << ". Benchmark: alpha " << res.benchmark.dt_ratio << ", Nstep " << res.benchmark.steps
+     << ", zeta_t " << res.benchmark.damping_ratio_translation << ", zeta_r "
      << res.benchmark.damping_ratio_rotation << ", mass scaling " << res.benchmark.mass_scaling
      << ". Stable alpha (rotation coupled) " << fixed(res.alpha_stable, 3) << ".\n\n";
   md << "Converged quasi-static peak sigma1/sigma3 = "
@@ -453,7 +512,9 @@ std::string atlas_markdown(const SweepResult& res) {
      << "doubling changed the peak by " << fixed(100.0 * res.reference.last_change, 2) << " %, "
      << (res.reference.converged ? "converged" : "NOT converged") << ")";
   if (res.analytical_peak)
-    md << "; analytical (walled box, rotation locked) " << fixed(-*res.analytical_peak / s3, 4);
+    md << (three_d ? "; analytical (walled FCC, Thornton 1979, rotation locked) "
+                   : "; analytical (walled box, rotation locked) ")
+       << fixed(-*res.analytical_peak / s3, 4);
   md << ".\n\n| Nstep | peak sigma1/sigma3 | Richardson with previous |\n|---:|---:|---:|\n";
   for (const auto& r : res.reference.ladder)
     md << "| " << r.steps << " | " << fixed(-r.peak_stress_yy / s3, 4) << " | "
@@ -466,6 +527,12 @@ std::string atlas_markdown(const SweepResult& res) {
         "RMS(b_yy−σ_yy)/RMS(b_yy), MB = moment balance RMS(σxy−σyx)/σ3, servo = max |trend| of "
         "the lateral wall stress error, osc = noise of b−σ, zig = noise b_yy and σ_yy share, "
         "soft = post-peak softening. Values above tolerance in **bold**.\n\n";
+  if (three_d)
+    md << "3D: FB, MB, servo and osc are the combined criteria (scoring/triaxial_scoring.hpp: "
+          "each the largest over the xz, yz and xy planes, servo over the four lateral walls "
+          "too); FB x, FB y = lateral gaps (b−σ)/σ3 on x and y, FB z = axial gap on |b_zz|, "
+          "FB sh = largest symmetric shear gap of the three planes, MB xz/yz/xy = moment balance "
+          "per plane, rot = median KE_rot/KE. paper and zig are those of b_zz, σ_zz.\n\n";
   auto bold = [](double v, double tol) { return v > tol ? "**" + compact(v) + "**" : compact(v); };
   const std::vector<std::string> groups = {"benchmark", "atlas", "convergence", "alpha_scan",
                                            "grid"};
@@ -473,10 +540,17 @@ std::string atlas_markdown(const SweepResult& res) {
     bool any = false;
     for (const auto& r : res.cases) any = any || r.spec.group == g;
     if (!any) continue;
-    md << "\n## " << g << "\n\n"
-       << "| case | change | peak s1/s3 | err vs ref | FB | FB xx | FB yy | FB sh | paper | MB | "
-          "servo | osc | zig | soft | pass | diagnosis | signature |\n"
-       << "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---|---|\n";
+    md << "\n## " << g << "\n\n";
+    if (three_d)
+      md << "| case | change | peak s1/s3 | err vs ref | FB | FB x | FB y | FB z | FB sh | paper | "
+            "MB | MB xz | MB yz | MB xy | servo | osc | zig | soft | rot | pass | diagnosis | "
+            "signature |\n"
+         << "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+            "---:|---:|---|---|---|\n";
+    else
+      md << "| case | change | peak s1/s3 | err vs ref | FB | FB xx | FB yy | FB sh | paper | MB | "
+            "servo | osc | zig | soft | pass | diagnosis | signature |\n"
+         << "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---|---|\n";
     for (const auto& r : res.cases) {
       if (r.spec.group != g) continue;
       const Criteria& c = r.score.criteria;
@@ -484,18 +558,30 @@ std::string atlas_markdown(const SweepResult& res) {
       md << "| " << r.spec.name << " | " << r.spec.change << " | ";
       if (r.run.diverged) {
         md << "diverged (" << to_string(r.run.divergence) << ", step " << r.run.divergence_step
-           << ") | – | – | – | – | – | – | – | – | – | – | – | – | fail | "
-           << r.score.diagnosis.parameter << " " << r.score.diagnosis.direction << " | "
-           << r.score.diagnosis.signature << " |\n";
+           << ") |";
+        for (int k = 0; k < (three_d ? 16 : 11); ++k) md << " – |";
+        md << " fail | " << r.score.diagnosis.parameter << " " << r.score.diagnosis.direction
+           << " | " << r.score.diagnosis.signature << " |\n";
         continue;
       }
       md << fixed(-c.peak_stress_yy / s3, 3) << " | " << pct(c.peak_error) << " | "
-         << bold(c.force_balance, t.force_balance) << " | " << compact(c.force_balance_xx) << " | "
-         << compact(c.force_balance_yy) << " | " << compact(c.force_balance_shear) << " | "
-         << compact(c.force_balance_paper) << " | " << bold(c.moment_balance, t.moment_balance)
-         << " | " << bold(c.servo, t.servo) << " | " << bold(c.oscillation, t.oscillation) << " | "
-         << compact(c.zigzag) << " | " << compact(c.post_peak_softening) << " | "
-         << (r.score.passed ? "pass" : "fail") << (r.accurate ? "" : " (inacc.)") << " | "
+         << bold(c.force_balance, t.force_balance) << " | ";
+      if (three_d && r.planes) {
+        const TriaxialCriteria& p = *r.planes;
+        md << compact(p.xz.force_balance_xx) << " | " << compact(p.yz.force_balance_xx) << " | "
+           << compact(c.force_balance_yy) << " | " << compact(c.force_balance_shear) << " | "
+           << compact(c.force_balance_paper) << " | " << bold(c.moment_balance, t.moment_balance)
+           << " | " << compact(p.xz.moment_balance) << " | " << compact(p.yz.moment_balance)
+           << " | " << compact(p.xy.moment_balance) << " | ";
+      } else {
+        md << compact(c.force_balance_xx) << " | " << compact(c.force_balance_yy) << " | "
+           << compact(c.force_balance_shear) << " | " << compact(c.force_balance_paper) << " | "
+           << bold(c.moment_balance, t.moment_balance) << " | ";
+      }
+      md << bold(c.servo, t.servo) << " | " << bold(c.oscillation, t.oscillation) << " | "
+         << compact(c.zigzag) << " | " << compact(c.post_peak_softening) << " | ";
+      if (three_d) md << fixed(c.rotational_energy_share, 2) << " | ";
+      md << (r.score.passed ? "pass" : "fail") << (r.accurate ? "" : " (inacc.)") << " | "
          << r.score.diagnosis.parameter << " " << r.score.diagnosis.direction << " ("
          << fixed(r.score.diagnosis.confidence, 2) << ") | " << r.score.diagnosis.signature
          << " |\n";
@@ -569,7 +655,13 @@ std::string evidence_csv(const SweepResult& res) {
        "force_balance_shear,force_balance_xx_rms,force_balance_whole,moment_balance,moment_balance_"
        "trend,"
        "moment_noise,servo,servo_rms,interior_lateral,oscillation,zigzag,post_peak_softening,"
-       "plateau_spread,unbalanced_force_ratio_max,kinetic_energy_ratio_max,diagnosis\n";
+       "plateau_spread,unbalanced_force_ratio_max,kinetic_energy_ratio_max,diagnosis";
+  if (res.dimension == 3)
+    s << ",force_balance_x,force_balance_y,force_balance_z_xz,force_balance_z_yz,"
+         "force_balance_shear_xz,force_balance_shear_yz,force_balance_shear_xy,moment_balance_xz,"
+         "moment_balance_yz,moment_balance_xy,servo_xmin,servo_xmax,servo_ymin,servo_ymax,"
+         "rotational_energy_share";
+  s << '\n';
   for (const auto& r : res.cases) {
     const Criteria& c = r.score.criteria;
     const AlgorithmSpec& a = r.spec.algorithm;
@@ -584,7 +676,17 @@ std::string evidence_csv(const SweepResult& res) {
       << ',' << c.interior_lateral << ',' << c.oscillation << ',' << c.zigzag << ','
       << c.post_peak_softening << ',' << c.plateau_spread << ',' << c.unbalanced_force_ratio_max
       << ',' << c.kinetic_energy_ratio_max << ',' << r.score.diagnosis.parameter << '_'
-      << r.score.diagnosis.direction << '\n';
+      << r.score.diagnosis.direction;
+    if (r.planes) {
+      const TriaxialCriteria& p = *r.planes;
+      s << ',' << p.xz.force_balance_xx << ',' << p.yz.force_balance_xx << ','
+        << p.xz.force_balance_yy << ',' << p.yz.force_balance_yy << ',' << p.xz.force_balance_shear
+        << ',' << p.yz.force_balance_shear << ',' << p.xy.force_balance_shear << ','
+        << p.xz.moment_balance << ',' << p.yz.moment_balance << ',' << p.xy.moment_balance;
+      for (double w : p.servo_walls) s << ',' << w;
+      s << ',' << c.rotational_energy_share;
+    }
+    s << '\n';
   }
   return s.str();
 }

@@ -291,7 +291,10 @@ std::vector<double> moving_trend(const std::vector<double>& series, int half_wid
 Eigen::Matrix2d force_balance_gap(const World& world);
 /// Consistency of a world state with that identity: ‖(b − σ) −
 /// net_force_moment()‖ / max(‖b‖, tiny). ~1e-12 for a consistent kernel.
+/// Disks (2D) and spheres (3D, SphereWorld::net_force_moment()) alike.
 double gap_identity_residual(const World& world);
+class SphereWorld;
+double gap_identity_residual(const SphereWorld& world);
 
 /// Every field of Criteria (peak included) by its name.
 nlohmann::json to_json(const Criteria& criteria);

@@ -1,4 +1,5 @@
-// The stability scan (issue #9 §3): load the consolidated REV at a ladder of
+// The stability scan (issue #9 §3; 3D: issue #18): load the consolidated REV
+// (disks, biaxial test; or spheres, triaxial test) at a ladder of
 // time steps α = Δt/Δt_crit around the estimate from the stiffnesses,
 // find the smallest α at which the run diverges (bisection between the
 // last stable and the first diverged rung), and compare it with the
@@ -13,6 +14,7 @@
 
 #include "demcal/scene/biaxial.hpp"
 #include "demcal/scene/config.hpp"
+#include "demcal/scene/triaxial.hpp"
 
 namespace demcal {
 
@@ -37,7 +39,11 @@ struct StabilityTrial {
 };
 
 struct StabilityScanResult {
-  double dt_ratio_estimate = 0.0;  ///< World::stability_estimate() of the consolidated REV
+  int dimension = 2;               ///< 2: disks (3 DOF each); 3: spheres (6 DOF each)
+  double dt_ratio_estimate = 0.0;  ///< estimated_stable_dt_ratio() of the consolidated REV
+  /// The Gershgorin bound's α (a safe lower bound on the limit) and the
+  /// translation-only α, of the same probe.
+  double dt_ratio_gershgorin = 0.0, dt_ratio_translation = 0.0;
   /// The measured limit: largest α that ran to the end below the smallest α
   /// that diverged (0 when no rung diverged / every rung did).
   double dt_ratio_last_stable = 0.0, dt_ratio_first_diverged = 0.0;
@@ -52,6 +58,8 @@ struct StabilityScanResult {
 };
 
 StabilityScanResult stability_scan(const SceneConfig& config, const ConsolidatedState& state,
+                                   const StabilityScanOptions& options = {});
+StabilityScanResult stability_scan(const SceneConfig& config, const TriaxialState& state,
                                    const StabilityScanOptions& options = {});
 
 nlohmann::json to_json(const StabilityScanResult& result);

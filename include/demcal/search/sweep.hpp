@@ -1,6 +1,9 @@
 // The signature atlas (reports/signature-atlas.md): around a benchmark parameter set, one
 // algorithmic parameter out of bounds at a time, every trial scored and
 // diagnosed, against the converged quasi-static peak of the same scene.
+// One code path for both dimensions: the biaxial test on disks (2D) or the
+// triaxial test on spheres (3D, scored by triaxial_scoring.hpp, whose
+// combined criteria fill the 2D columns and whose planes add the 3D ones).
 //
 // The consolidated state is computed once by the caller; every trial copies
 // it. Trials run on a std::thread pool, longest first.
@@ -14,7 +17,9 @@
 
 #include "demcal/scene/biaxial.hpp"
 #include "demcal/scene/config.hpp"
+#include "demcal/scene/triaxial.hpp"
 #include "demcal/scoring/scoring.hpp"
+#include "demcal/scoring/triaxial_scoring.hpp"
 
 namespace demcal {
 
@@ -54,12 +59,25 @@ struct ConvergedReference {
   std::vector<Rung> ladder;
 };
 
+/// How one trial ran, whatever the dimension.
+struct SweepRun {
+  bool diverged = false;
+  Divergence divergence = Divergence::kNone;
+  int64_t divergence_step = -1;
+  int64_t steps_run = 0, steps_planned = 0;
+  double dt = 0.0;  ///< absolute Δt run [s]
+  double wall_time_s = 0.0;
+  std::string series_csv;  ///< the monitored series (scene/run_output.hpp's series_csv)
+};
+
 struct SweepCaseResult {
   SweepCase spec;
-  LoadingResult run;  ///< with its series
-  Score score;        ///< peak_error against the converged reference
+  SweepRun run;
+  Score score;  ///< peak_error against the converged reference (3D: the combined criteria)
+  /// 3D only: the criteria of the three coordinate planes and of each lateral wall.
+  std::optional<TriaxialCriteria> planes;
   std::optional<double> peak_error_analytical;
-  double identity_residual = 0.0;  ///< gap_identity_residual() of the final state
+  double identity_residual = 0.0;  ///< gap_identity_residual() of the final state (2D and 3D)
   bool accurate = false;           ///< |peak_error| within the accuracy target
 };
 
@@ -87,13 +105,15 @@ struct CriterionEvidence {
 
 struct SweepResult {
   std::string scene;
+  int dimension = 2;  ///< 2: disks, biaxial test; 3: spheres, triaxial test (z axial)
   int particles = 0;
   AlgorithmSpec benchmark;
   double alpha_stable = 0.0;
   double lateral_stress = 0.0;
   ConvergedReference reference;
-  std::optional<double> analytical_peak;  ///< hexagonal scenes, rotation locked
-  std::vector<SweepCaseResult> cases;     ///< in atlas_cases() order
+  /// Hexagonal (2D) and FCC (3D) scenes, rotation locked; axial stress (negative).
+  std::optional<double> analytical_peak;
+  std::vector<SweepCaseResult> cases;  ///< in atlas_cases() order
   std::vector<CriterionEvidence> evidence;
   int false_passes = 0;             ///< passed every criterion, peak off by more than accuracy
   double worst_passed_error = 0.0;  ///< largest |peak error| among passed trials
@@ -111,8 +131,11 @@ struct SweepResult {
 
 /// Run `cases` on copies of `state` (in parallel), compute the converged
 /// reference from the "convergence" group (and the benchmark, and
-/// "steps_x33"), score every case against it.
+/// "steps_x33"), score every case against it. The biaxial test on a disk
+/// sample, or the triaxial test on a sphere sample (peak: the axial b_zz).
 SweepResult run_sweep(const SceneConfig& config, const ConsolidatedState& state,
+                      const std::vector<SweepCase>& cases, const SweepSettings& settings);
+SweepResult run_sweep(const SceneConfig& config, const TriaxialState& state,
                       const std::vector<SweepCase>& cases, const SweepSettings& settings);
 
 /// The reference from (Nstep, peak) pairs sorted by Nstep (see
@@ -122,9 +145,11 @@ ConvergedReference converged_reference(std::vector<std::pair<int64_t, double>> p
 
 nlohmann::json to_json(const SweepResult& result);
 /// atlas.md: the table (case, measures, peak vs reference, diagnosis), the
-/// reference ladder and the tolerance evidence.
+/// reference ladder and the tolerance evidence; in 3D with the per-plane
+/// columns (force balance x, y, z; moment balance xz, yz, xy; servo per wall).
 std::string atlas_markdown(const SweepResult& result);
-/// One row per finished case, every measure and the peak error (for plots).
+/// One row per finished case, every measure and the peak error (for plots);
+/// in 3D the per-plane measures follow.
 std::string evidence_csv(const SweepResult& result);
 
 }  // namespace demcal
