@@ -13,7 +13,8 @@
 namespace demcal::cli {
 
 int cmd_scaling(const ScalingOptions& o) {
-  SceneConfig config = load_scene(o.config, o.sets);
+  // 2D (disks, biaxial) and 3D (spheres, triaxial) families alike.
+  SceneConfig config = load_config(o.config, o.sets);
   if (o.max_trials > 0) config.calibration.max_trials = o.max_trials;
   ScalingStudyOptions so;
   so.sizes = parse_sizes(o.sizes, "--sizes");
@@ -35,13 +36,13 @@ int cmd_scaling(const ScalingOptions& o) {
     out.write("scaling.md", scaling_markdown(st, config));
     out.commit();
   }
-  std::cout << "calibrated fit: slope " << num(st.lin_cal.slope, 5) << ", intercept "
-            << num(st.lin_cal.intercept, 5) << ", R2 " << num(st.lin_cal.r2, 4)
-            << "; fixed multipliers from the REV up: exponent " << num(st.measured.exponent, 3)
-            << " (law " << st.chosen.name() << "); forward check of the linear law at "
-            << st.results.at(st.forward_size).particles << ": "
-            << (st.forward_ok ? "passed" : "FAILED") << "\n  wrote " << out_dir << "/scaling.md, "
-            << out_dir << "/scaling.json\n";
+  std::cout << (st.dimension == 3 ? "3D (spheres): " : "") << "calibrated fit: slope "
+            << num(st.lin_cal.slope, 5) << ", intercept " << num(st.lin_cal.intercept, 5) << ", R2 "
+            << num(st.lin_cal.r2, 4) << "; fixed multipliers from the REV up: exponent "
+            << num(st.measured.exponent, 3) << " (law " << st.chosen.name()
+            << "); forward check of the linear law at " << st.results.at(st.forward_size).particles
+            << ": " << (st.forward_ok ? "passed" : "FAILED") << "\n  wrote " << out_dir
+            << "/scaling.md, " << out_dir << "/scaling.json\n";
   return st.forward_ok ? 0 : 1;
 }
 

@@ -15,11 +15,32 @@
 
 namespace demcal::cli {
 
+namespace {
+
+/// A params.json and the config it is applied to are of one dimension:
+/// 3D parameters (spheres, triaxial) on a 2D scene or the reverse would be
+/// upscaled with the wrong particle scales.
+SceneConfig same_dimension(SceneConfig config, const nlohmann::json& params,
+                           const std::string& path) {
+  const int d = params_dimension(params);
+  if (config.dimension != d)
+    throw InputError(path, "dimension",
+                     "is " + std::to_string(d) + (d == 3 ? " (spheres)" : " (disks)") +
+                         ", but the config " + config.source + " is " +
+                         std::to_string(config.dimension) +
+                         "D: give the config the parameters were calibrated on");
+  return config;
+}
+
+}  // namespace
+
 std::optional<SceneConfig> params_scene(const nlohmann::json& params, const std::string& path,
                                         const std::string& config_path,
                                         const std::vector<std::string>& sets) {
-  if (!config_path.empty()) return load_scene(config_path, sets);
+  // 2D and 3D configs alike (the commands dispatch on config.dimension).
+  if (!config_path.empty()) return same_dimension(load_config(config_path, sets), params, path);
   if (auto c = config_from_params(params, path)) {
+    if (c->dimension != params_dimension(params)) same_dimension(*c, params, path);
     if (sets.empty()) return c;
     nlohmann::json j = to_json(*c);
     apply_overrides(j, sets, path + ": config");
@@ -71,6 +92,15 @@ ScalingLaw resolve_law(const nlohmann::json& params, const std::string& params_p
   if (!law_path.empty()) {
     const nlohmann::json j = read_json_file(law_path);
     if (!j.contains("law")) throw InputError(law_path, "law", "missing (not a scaling.json?)");
+    // A law measured on disks is not one for spheres, nor the reverse.
+    const int law_dim = j.contains("dimension") && j["dimension"].is_number_integer()
+                            ? j["dimension"].get<int>()
+                            : 2;
+    if (law_dim != params_dimension(params))
+      throw InputError(law_path, "dimension",
+                       "a law measured in " + std::to_string(law_dim) + "D, but " + params_path +
+                           " is " + std::to_string(params_dimension(params)) +
+                           "D: pass the scaling.json of a study in its dimension");
     ScalingLaw law = scaling_law_from_json(j["law"], law_path);
     law.source = law_path + ": " + law.source;
     return law;
@@ -78,7 +108,7 @@ ScalingLaw resolve_law(const nlohmann::json& params, const std::string& params_p
   if (params.contains("upscaling") && params["upscaling"].is_object() &&
       params["upscaling"].contains("exponent"))
     return scaling_law_from_json(params["upscaling"], params_path + ": upscaling");
-  return ScalingLaw{};
+  return default_law(params_dimension(params));
 }
 
 int cmd_upscale(const UpscaleOptions& o) {
@@ -118,12 +148,17 @@ int cmd_upscale(const UpscaleOptions& o) {
   out["prototype"] = block;
   out["upscaling"] = upscaling_block(rev.particles, n_proto, law);
   const std::string text = out.dump(2) + "\n";
+  // Which law scaled Nstep, on stderr whatever the output (in 3D without
+  // --law it is the 2D default, and the user must know it).
+  std::cerr << "demcal upscale: Nstep by the " << law.name() << " law (exponent " << law.exponent
+            << "; " << law.source << ")\n";
   if (o.output.empty() || o.output == "-") {
     std::cout << text;
   } else {
     write_file_atomic(o.output, text);
-    std::cerr << "demcal upscale: " << n_proto << " particles, " << block["steps"] << " steps, dt "
-              << block["dt"] << " s; wrote " << o.output << "\n";
+    std::cerr << "demcal upscale: " << n_proto
+              << (params_dimension(params) == 3 ? " spheres, " : " particles, ") << block["steps"]
+              << " steps, dt " << block["dt"] << " s; wrote " << o.output << "\n";
   }
   return 0;
 }

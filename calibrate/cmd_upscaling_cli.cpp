@@ -17,7 +17,8 @@ std::function<int()> add_upscaling_commands(CLI::App& app) {
   upscale->add_option("params", up->params, "params.json of a calibration")->required();
   upscale->add_option("--particles", up->particles, "the prototype's particle count")
       ->check(whole_number(1, kMaxParticles));
-  upscale->add_option("--prototype", up->prototype, "the prototype's particle file (CSV x,y,r)");
+  upscale->add_option("--prototype", up->prototype,
+                      "the prototype's particle file (CSV x,y,r; 3D: x,y,z,r)");
   upscale->add_option("--config", up->config, "scene config, if params.json carries none");
   upscale->add_option("--set", up->sets, "override a config key: section.key=value");
   upscale->add_option("--law", up->law, "scaling.json of demcal scaling: use its measured law");
@@ -29,7 +30,8 @@ std::function<int()> add_upscaling_commands(CLI::App& app) {
   auto* verify =
       app.add_subcommand("verify", "run the prototype with the upscaled parameters and score it");
   verify->add_option("params", ve->params, "params.json of a calibration")->required();
-  verify->add_option("--prototype", ve->prototype, "the prototype's particle file (CSV x,y,r)");
+  verify->add_option("--prototype", ve->prototype,
+                     "the prototype's particle file (CSV x,y,r; 3D: x,y,z,r)");
   verify->add_option("--particles", ve->particles, "a generated prototype of N particles")
       ->check(whole_number(1, kMaxParticles));
   verify->add_option("--config", ve->config, "scene config, if params.json carries none");
@@ -50,6 +52,12 @@ std::function<int()> add_upscaling_commands(CLI::App& app) {
                      "demcal (default) or lammps: run the exported deck with lmp and score it");
   verify->add_option("--np", ve->np, "MPI ranks for --engine lammps (mpirun -np N; default 1)")
       ->check(CLI::Range(1, 4096));
+  verify
+      ->add_option(
+          "--threads", ve->threads,
+          "3D: threads for the prototype's loading run (default 0: the faster of 1 and all "
+          "cores, measured on the prototype)")
+      ->check(CLI::Range(0, 4096));
 
   auto sc = std::make_shared<ScalingOptions>();
   auto* scaling = app.add_subcommand(

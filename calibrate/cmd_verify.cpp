@@ -5,6 +5,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -12,16 +13,21 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <optional>
 #include <sstream>
+#include <thread>
 
 #include "commands.hpp"
 #include "demcal/io/files.hpp"
+#include "demcal/io/format.hpp"
 #include "demcal/scene/biaxial.hpp"
 #include "demcal/scene/run_output.hpp"
+#include "demcal/scene/triaxial.hpp"
 #include "demcal/scoring/external_series.hpp"
 #include "demcal/scoring/scoring.hpp"
 #include "demcal/scoring/trial.hpp"
 #include "demcal/search/calibration.hpp"
+#include "demcal/search/trial_runner.hpp"
 #include "demcal/upscaling/export.hpp"
 #include "demcal/upscaling/params_file.hpp"
 #include "demcal/upscaling/rev.hpp"
@@ -120,6 +126,166 @@ int verify_in_lammps(const VerifyOptions& o, const SceneConfig& config,
             << work.string() << "/ (deck, series.csv, log.lammps)\n";
   return score.passed ? 0 : 1;
 }
+
+/// The loading rate of `world` with `params` on this machine now, from a
+/// short timed run of a copy (particle-steps/s): the 3D estimate printed
+/// before anything long runs.
+double probe_rate(const SphereWorld& world, const AlgorithmSpec& params, int threads) {
+  SphereWorld probe = world;
+  probe.set_threads(threads);
+  probe.set_integration(integration_for(probe, params));
+  probe.step(5);  // neighbour lists built, threads started
+  const int64_t steps = std::clamp<int64_t>(2000000 / std::max(1, probe.size()), 5, 200);
+  const auto t0 = std::chrono::steady_clock::now();
+  probe.step(steps);
+  const double s = seconds_since(t0);
+  return s > 0.0 ? static_cast<double>(steps) * probe.size() / s : 0.0;
+}
+
+/// The peak of the REV's calibrated run as params.json records it.
+std::optional<double> rev_peak(const nlohmann::json& params) {
+  const auto c = params.find("criteria");
+  if (c == params.end() || !c->is_object() || !c->contains("peak_stress_yy") ||
+      !(*c)["peak_stress_yy"].is_number())
+    return std::nullopt;
+  return (*c)["peak_stress_yy"].get<double>();
+}
+
+/// `demcal verify` on 3D params: the spheres of the prototype consolidated
+/// by the sphere kernel, loaded with the upscaled parameters on `threads`
+/// threads, scored with the triaxial criteria, the peak against the REV's.
+int verify_3d(const VerifyOptions& o, const nlohmann::json& params, const RevParams& rev,
+              const SceneConfig& config, const ScalingLaw& law) {
+  if (o.engine != "demcal")
+    throw InputError("--engine", "",
+                     "3D: verify runs demcal's sphere kernel (the LAMMPS 3D deck is `demcal "
+                     "export`'s)");
+  if (!o.tile.empty()) throw InputError("--tile", "", "tiles 2D prototype files only");
+  if (o.consolidate_only)
+    throw InputError("--consolidate-only", "", "2D only (3D prototypes are consolidated per run)");
+  auto [file, particles] = named_prototype(params, o.prototype, o.particles);
+  PrototypeSource source;
+  const SphereAssembly proto = prototype_spheres(config, particles, file, &source);
+  const int64_t n = proto.size();
+  const AlgorithmSpec up = upscale(rev.params, rev.particles, n, law);
+  const double particle_steps = static_cast<double>(n) * static_cast<double>(up.steps);
+  const SphereWorld world(sphere_material(config.material), proto.x, proto.y, proto.z, proto.r,
+                          proto.lo, proto.hi);
+  // --threads, else the faster of one thread and all cores, measured now:
+  // on a loaded machine, or for a small prototype, the threads' barriers
+  // can cost more than they share.
+  int threads = o.threads;
+  double rate = 0.0;
+  if (threads > 0) {
+    rate = probe_rate(world, up, threads);
+  } else {
+    const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+    threads = 1;
+    rate = probe_rate(world, up, 1);
+    if (cores > 1) {
+      const double rate_all = probe_rate(world, up, cores);
+      std::cerr << "demcal verify: probe: " << rate << " particle-steps/s on 1 thread, " << rate_all
+                << " on " << cores << "\n";
+      if (rate_all > rate) threads = cores, rate = rate_all;
+    }
+  }
+  const double estimate_s = rate > 0.0 ? particle_steps / rate : 0.0;
+  std::cerr << "demcal verify: prototype " << source.description << "; " << up.steps
+            << " steps upscaled (" << law.name() << " law, exponent " << law.exponent << ": "
+            << law.source << ") from " << rev.particles << " spheres / " << rev.params.steps
+            << " steps\n"
+            << "demcal verify: loading = " << particle_steps << " particle-steps, estimated "
+            << estimate_s / 60.0 << " min at " << rate
+            << " particle-steps/s (measured now on the prototype, " << threads
+            << " thread(s); plus a single-thread consolidation"
+            << (source.kind == "generated" && config.assembly.type == "random"
+                    ? ", long for a loose gas)"
+                    : ")")
+            << "\n";
+  if (estimate_s > 60.0 * o.max_minutes)
+    throw InputError("--max-minutes", "",
+                     "the loading of " + std::to_string(n) + " spheres over " +
+                         std::to_string(up.steps) + " steps is estimated at " +
+                         std::to_string(estimate_s / 60.0) + " min, beyond the budget of " +
+                         std::to_string(o.max_minutes) + " min; raise --max-minutes to run it");
+  const std::string dir = o.out_dir.empty() ? "demcal-verify-" + config.name : o.out_dir;
+  OutputFolder::check(dir);
+
+  const auto t0 = std::chrono::steady_clock::now();
+  TriaxialState state = consolidate_triaxial(config, proto);
+  std::cerr << "demcal verify: consolidated in " << state.steps << " steps, " << state.wall_time_s
+            << " s; loading now\n";
+  state.world.set_threads(threads);
+  const Tolerances tolerances;
+  TriaxialResult run;
+  const TriaxialRunner runner(config, state);
+  const TrialRun trial = runner.run(up, tolerances, false, 3.0, nullptr, &run);
+  const Score& score = trial.score;
+  const double total_s = seconds_since(t0);
+  const auto& c = score.criteria;
+  const std::optional<double> peak_rev = rev_peak(params);
+  const double s3 = config.test.lateral_stress;
+  nlohmann::json peak{{"stress_zz", c.peak_stress_yy},
+                      {"strain_zz", c.peak_strain_yy},
+                      {"ratio", -c.peak_stress_yy / s3}};
+  if (peak_rev) {
+    peak["rev_stress_zz"] = *peak_rev;
+    peak["relative_to_rev"] = (c.peak_stress_yy - *peak_rev) / std::abs(*peak_rev);
+  }
+  const double rate_run = trial.wall_time_s > 0 ? particle_steps / trial.wall_time_s : 0.0;
+  nlohmann::json out{
+      {"schema", "demcal.verify/1"},
+      {"dimension", 3},
+      {"scene", config.name},
+      {"params_file", o.params},
+      {"prototype",
+       {{"particles", n}, {"source", source.kind}, {"description", source.description}}},
+      {"rev", {{"particles", rev.particles}, {"steps", rev.params.steps}}},
+      {"upscaling", upscaling_block(rev.particles, n, law)},
+      {"params", param_block(up, sphere_scales(state.world, config.material, up))},
+      {"passed", score.passed},
+      {"criteria", to_json(c)},
+      {"tolerances", to_json(tolerances)},
+      {"diagnosis", to_json(score.diagnosis)},
+      {"peak", peak},
+      {"diverged", score.diverged},
+      {"axial_component", "criteria.peak_stress_yy holds the axial b_zz (the axis is z)"},
+      {"consolidation", {{"steps", state.steps}, {"wall_time_s", state.wall_time_s}}},
+      {"loading",
+       {{"steps", up.steps},
+        {"particle_steps", particle_steps},
+        {"threads", state.world.threads()},
+        {"estimated_s", estimate_s},
+        {"wall_time_s", trial.wall_time_s},
+        {"particle_steps_per_s", rate_run}}},
+      {"wall_time_s", total_s},
+      {"version", DEMCAL_VERSION}};
+  {
+    OutputFolder files(dir);  // verify.json and series.csv of one run, replaced together
+    files.write("verify.json", out.dump(2) + "\n");
+    files.write("series.csv", series_csv(run.series));
+    files.commit();
+  }
+  std::cout << (score.passed ? "PASS" : "FAIL") << ": 3D prototype of " << n << " spheres, "
+            << up.steps << " steps (alpha " << up.dt_ratio << ", zeta_t "
+            << up.damping_ratio_translation << ", zeta_r " << up.damping_ratio_rotation << ")\n"
+            << "  force balance " << c.force_balance << " (tol " << tolerances.force_balance
+            << "), moment balance " << c.moment_balance << " (tol " << tolerances.moment_balance
+            << "), servo " << c.servo << " (tol " << tolerances.servo << "), oscillation "
+            << c.oscillation << " (tol " << tolerances.oscillation << ")\n"
+            << "  peak axial b_zz " << c.peak_stress_yy << " Pa (sigma1/sigma3 "
+            << -c.peak_stress_yy / s3 << ")";
+  if (peak_rev)
+    std::cout << "; the REV's " << *peak_rev << " Pa ("
+              << num(100.0 * (c.peak_stress_yy - *peak_rev) / std::abs(*peak_rev), 3) << " %)";
+  std::cout << "\n"
+            << "  " << score.diagnosis.message << "\n"
+            << "  consolidation " << state.wall_time_s << " s, loading " << trial.wall_time_s
+            << " s (" << rate_run << " particle-steps/s on " << state.world.threads()
+            << " thread(s), estimated " << estimate_s << " s), total " << total_s << " s\n"
+            << "  wrote " << dir << "/verify.json, series.csv\n";
+  return score.passed ? 0 : 1;
+}
 }  // namespace
 
 int cmd_verify(const VerifyOptions& o) {
@@ -127,6 +293,7 @@ int cmd_verify(const VerifyOptions& o) {
   const RevParams rev = rev_params_from_json(params, o.params);
   const SceneConfig config = required_scene(params, o.params, o.config, o.sets);
   const ScalingLaw law = resolve_law(params, o.params, o.law, o.exponent);
+  if (config.dimension == 3) return verify_3d(o, params, rev, config, law);
   const bool in_lammps = o.engine == "lammps";
   if (!in_lammps && o.engine != "demcal")
     throw InputError("--engine", "", "must be demcal or lammps, got \"" + o.engine + "\"");

@@ -39,6 +39,9 @@ nlohmann::json parse_params_text(std::string_view text, const std::string& path)
       throw InputError(path, "version",
                        "must be a demcal version string, got " + quoted_value(version->dump()));
   }
+  if (const auto d = params.find("dimension"); d != params.end())
+    if (!d->is_number_integer() || (d->get<int64_t>() != 2 && d->get<int64_t>() != 3))
+      throw InputError(path, "dimension", "must be 2 or 3, got " + quoted_value(d->dump()));
   if (params.contains("prototype") && params["prototype"].is_object() &&
       params["prototype"].contains("particles")) {
     const auto& n = params["prototype"]["particles"];
@@ -48,6 +51,11 @@ nlohmann::json parse_params_text(std::string_view text, const std::string& path)
                            ", got " + quoted_value(n.dump()));
   }
   return params;
+}
+
+int params_dimension(const nlohmann::json& params) {
+  const auto d = params.find("dimension");
+  return d != params.end() && d->is_number_integer() ? static_cast<int>(d->get<int64_t>()) : 2;
 }
 
 double particle_steps_run(const std::vector<TrialRecord>& trials, int64_t particles) {
@@ -101,40 +109,21 @@ nlohmann::json params_file(const SceneConfig& config, const ConsolidatedState& s
 nlohmann::json params_file(const SceneConfig& config, const TriaxialState& state,
                            const CalibrationOptions& options, const CalibrationSummary& summary) {
   const int64_t n_rev = state.world.size();
-  // The sphere scales at the calibrated mass scaling, from the kernel's
-  // masses (m = ρ(4/3)πr³, I = (2/5)mr²); the radius and mean-mass entries
-  // that SphereWorld::reference_scales() leaves out are filled here.
-  SphereWorld world = state.world;
-  world.set_integration(integration_for(world, summary.best));
-  ParticleScales scales = world.reference_scales();
-  scales.particles = n_rev;
-  const auto radii = world.radius();
-  double sum_r = 0.0, sum_m = 0.0;
-  scales.radius_min = radii.empty() ? 0.0 : radii[0];
-  for (double r : radii) {
-    sum_r += r;
-    sum_m += sphere_mass(config.material.density * summary.best.mass_scaling, r);
-    scales.radius_min = std::min(scales.radius_min, r);
-    scales.radius_max = std::max(scales.radius_max, r);
-  }
-  if (n_rev > 0) {
-    scales.radius_mean = sum_r / static_cast<double>(n_rev);
-    scales.mass_mean = sum_m / static_cast<double>(n_rev);
-  }
-  nlohmann::json rev = param_block(summary.best, scales);
-  // No 3D prototype yet (`demcal upscale` on spheres is issue #18's
-  // upscaling part): the prototype block is the REV's own.
-  nlohmann::json prototype = rev;
-  prototype["source"] = {{"kind", "rev"},
-                         {"description", "the REV itself (" + std::to_string(n_rev) +
-                                             " spheres); 3D prototypes are not upscaled yet"}};
+  nlohmann::json rev =
+      param_block(summary.best, sphere_scales(state.world, config.material, summary.best));
+  // Δt and damping recomputed from the prototype's own spheres; Nstep by
+  // the default law (linear; its source says it is the 2D one: `demcal
+  // upscale --law` applies a law measured on spheres).
+  const ScalingLaw law = default_law(3);
+  nlohmann::json prototype = prototype_block(config, summary.best, n_rev, law);
+  const int64_t n_proto = prototype.at("particles").get<int64_t>();
   nlohmann::json params = calibration_record(config, n_rev, options, summary);
   params["schema"] = kParamsSchema;
   params["dimension"] = 3;
   params["test"] = "triaxial";
   params["rev"] = rev;
   params["prototype"] = prototype;
-  params["upscaling"] = upscaling_block(n_rev, n_rev);
+  params["upscaling"] = upscaling_block(n_rev, n_proto, law);
   params["axial_component"] =
       "criteria.peak_stress_yy and certificate.peak_stress_yy* hold the axial b_zz (the triaxial "
       "test's axis is z)";

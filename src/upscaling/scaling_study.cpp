@@ -5,12 +5,16 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <memory>
+#include <optional>
 #include <sstream>
 
 #include "demcal/io/files.hpp"
 #include "demcal/io/format.hpp"
 #include "demcal/scene/packing.hpp"
 #include "demcal/scene/run_output.hpp"
+#include "demcal/scene/triaxial.hpp"
+#include "demcal/search/trial_runner.hpp"
 #include "demcal/upscaling/rev.hpp"
 
 namespace demcal {
@@ -115,15 +119,32 @@ json read_json(const std::string& path) {
   }
 }
 
-/// The family of scenes and their consolidated states. A size that is not
-/// calibrated keeps its consolidated packing in the work folder, so that a
-/// resumed study re-settles a dense file in a few thousand steps instead of
-/// compressing a gas again.
+/// One size's consolidated sample, disks or spheres, and the runner the
+/// search and the step search see it through (addresses stable: held by
+/// pointer).
+struct SizeState {
+  SceneConfig scene;
+  std::optional<ConsolidatedState> disks;
+  std::optional<TriaxialState> spheres;
+  std::unique_ptr<TrialRunner> runner;
+  int64_t particles = 0, steps = 0;
+  double wall_time_s = 0.0;
+};
+
+/// The family of scenes and their consolidated states, 2D or 3D. A 2D size
+/// that is not calibrated keeps its consolidated packing in the work
+/// folder, so that a resumed study re-settles a dense file in a few
+/// thousand steps instead of compressing a gas again (3D sizes are
+/// generated and re-consolidated).
 class Family {
  public:
   Family(const SceneConfig& config, const ScalingStudyOptions& o) : config_(config), o_(o) {
     from_file_ = config.assembly.type == "file";
     if (!from_file_) return;
+    if (config.dimension == 3)
+      throw InputError(config.source, "assembly.type",
+                       "a 3D scaling study needs a generated family (fcc or random): REVs cut "
+                       "from a sphere file are `demcal rev`'s");
     file_prototype_ = read_particle_file(config.prototype.file.empty() ? config.assembly.file
                                                                        : config.prototype.file);
     if (file_prototype_.size() < o.sizes.back())
@@ -135,24 +156,45 @@ class Family {
   int64_t file_particles() const { return file_prototype_.size(); }
   SceneConfig scene(int64_t n) const { return from_file_ ? config_ : scene_of_size(config_, n); }
 
-  const ConsolidatedState& state(int64_t n) {
+  const SizeState& state(int64_t n) {
     auto it = states_.find(n);
-    if (it != states_.end()) return it->second;
-    const std::string cache = dir(n) + "/consolidated.csv";
-    const bool cached = o_.resume && n > o_.calibrate_max && fs::exists(cache);
-    const Assembly a = cached       ? read_particle_file(cache)
-                       : from_file_ ? cut_rev(file_prototype_, n)
-                                    : make_assembly(scene_of_size(config_, n));
-    log("consolidating " + std::to_string(a.size()) + " particles (size " + std::to_string(n) +
-        (cached ? ", from " + cache : std::string()) + ")");
-    auto [pos, _] = states_.emplace(n, consolidate(scene(n), a));
-    log("  consolidated in " + std::to_string(pos->second.steps) + " steps, " +
-        num(pos->second.wall_time_s, 3) + " s");
-    if (n > o_.calibrate_max && !cached) {
-      make_output_dir(dir(n));
-      write_file_atomic(cache, particle_csv(assembly_of(pos->second.world)));
+    if (it != states_.end()) return *it->second;
+    auto st = std::make_unique<SizeState>();
+    st->scene = scene(n);
+    if (config_.dimension == 3) {
+      const SphereAssembly a = make_sphere_assembly(st->scene);
+      log("consolidating " + std::to_string(a.size()) + " spheres (size " + std::to_string(n) +
+          ")");
+      st->spheres.emplace(consolidate_triaxial(st->scene, a));
+      st->runner = std::make_unique<TriaxialRunner>(st->scene, *st->spheres);
+      st->steps = st->spheres->steps;
+      st->wall_time_s = st->spheres->wall_time_s;
+    } else {
+      const std::string cache = dir(n) + "/consolidated.csv";
+      const bool cached = o_.resume && n > o_.calibrate_max && fs::exists(cache);
+      const Assembly a = cached       ? read_particle_file(cache)
+                         : from_file_ ? cut_rev(file_prototype_, n)
+                                      : make_assembly(st->scene);
+      log("consolidating " + std::to_string(a.size()) + " particles (size " + std::to_string(n) +
+          (cached ? ", from " + cache : std::string()) + ")");
+      st->disks.emplace(consolidate(st->scene, a));
+      st->runner = std::make_unique<BiaxialRunner>(st->scene, *st->disks);
+      st->steps = st->disks->steps;
+      st->wall_time_s = st->disks->wall_time_s;
+      if (n > o_.calibrate_max && !cached) {
+        make_output_dir(dir(n));
+        write_file_atomic(cache, particle_csv(assembly_of(st->disks->world)));
+      }
     }
-    return pos->second;
+    st->particles = st->runner->particles();
+    log("  consolidated in " + std::to_string(st->steps) + " steps, " + num(st->wall_time_s, 3) +
+        " s");
+    return *states_.emplace(n, std::move(st)).first->second;
+  }
+  /// Calibrate size n with the search of its dimension.
+  CalibrationSummary calibrate_size(int64_t n, const CalibrationOptions& co) {
+    const SizeState& st = state(n);
+    return st.spheres ? calibrate(st.scene, *st.spheres, co) : calibrate(st.scene, *st.disks, co);
   }
   std::string dir(int64_t n) const { return o_.work_dir + "/size-" + std::to_string(n); }
   void log(const std::string& line) const {
@@ -164,7 +206,7 @@ class Family {
   const ScalingStudyOptions& o_;
   bool from_file_ = false;
   Assembly file_prototype_;
-  std::map<int64_t, ConsolidatedState> states_;
+  std::map<int64_t, std::unique_ptr<SizeState>> states_;
 };
 
 /// Step 1: calibrate a size (or reuse its result.json).
@@ -177,10 +219,10 @@ ScalingSize calibrate_size(Family& family, const SceneConfig& config, const Scal
     return r;
   }
   make_output_dir(family.dir(n));
-  const ConsolidatedState& state = family.state(n);
+  const SizeState& state = family.state(n);
   ScalingSize r;
   r.requested = n;
-  r.particles = state.world.size();
+  r.particles = state.particles;
   r.consolidation_steps = state.steps;
   r.consolidation_s = state.wall_time_s;
   CalibrationOptions co = CalibrationOptions::from(config.calibration);
@@ -191,7 +233,7 @@ ScalingSize calibrate_size(Family& family, const SceneConfig& config, const Scal
     co.progress = [n, &o](const std::string& line) {
       o.log("size " + std::to_string(n) + ": " + line);
     };
-  const CalibrationSummary s = calibrate(family.scene(n), state, co);
+  const CalibrationSummary s = family.calibrate_size(n, co);
   r.calibrated = true;
   r.success = s.success;
   r.best = s.best;
@@ -220,15 +262,15 @@ void fixed_multipliers(Family& family, const ScalingStudyOptions& o, const Scali
     return;
   }
   make_output_dir(family.dir(n));
-  const ConsolidatedState& state = family.state(n);
-  r.particles = state.world.size();
+  const SizeState& state = family.state(n);
+  r.particles = state.particles;
   const AlgorithmSpec start = upscale(ref.best, ref.particles, r.particles);
   family.log("size " + std::to_string(r.particles) +
              ": smallest passing Nstep at the REV's multipliers, from the linear prediction " +
              std::to_string(start.steps) + " (" +
              num(static_cast<double>(start.steps) * r.particles, 3) + " particle-steps)");
   const auto t0 = std::chrono::steady_clock::now();
-  const StepSearch search = smallest_passing_steps(family.scene(n), state, start, tolerances);
+  const StepSearch search = smallest_passing_steps(*state.runner, start, tolerances);
   r.fixed.found = search.found;
   r.fixed.steps = search.found ? search.best.params.steps : 0;
   r.fixed.best = search.best;
@@ -295,8 +337,7 @@ void forward_check(Family& family, const ScalingStudyOptions& o, ScalingStudy& s
   } else {
     family.log("forward reference at " + std::to_string(st.forward_size) + ": " +
                std::to_string(ref_params.steps) + " steps");
-    st.reference = run_trial(family.scene(st.forward_size), family.state(st.forward_size),
-                             ref_params, st.tolerances);
+    st.reference = run_record(*family.state(st.forward_size).runner, ref_params, st.tolerances);
     st.reference.phase = TrialPhase::reference;
     write_file_atomic(ref_path, to_json(st.reference).dump(2) + "\n");
   }
@@ -325,6 +366,7 @@ ScalingStudy run_scaling_study(const SceneConfig& config, const ScalingStudyOpti
   const auto t_start = std::chrono::steady_clock::now();
   ScalingStudy st;
   st.scene = config.name;
+  st.dimension = config.dimension;
   st.sizes = o.sizes;
   st.sizes_text = o.sizes_text;
   st.calibrate_max = o.calibrate_max;
@@ -380,6 +422,11 @@ ScalingStudy run_scaling_study(const SceneConfig& config, const ScalingStudyOpti
   // forward size itself and has no independent check here); the measured
   // exponent when the linear law falls short.
   st.chosen = st.forward_ok || st.measured.exponent <= 1.0 ? ScalingLaw{} : st.measured;
+  if (st.dimension == 3 && st.chosen.name() == "linear")
+    st.chosen.source = "Tu & Andrade (2008): Nstep proportional to N, on spheres: demcal scaling " +
+                       st.scene +
+                       (st.forward_ok ? ", checked forward at " : ", forward check FAILED at ") +
+                       std::to_string(st.results[st.forward_size].particles) + " spheres";
   st.wall_time_s = seconds_since(t_start);
   return st;
 }
@@ -413,6 +460,8 @@ json to_json(const ScalingStudy& st, const SceneConfig& config) {
             {"damping_ratio_translation", spread_json(st.zeta_t)},
             {"damping_ratio_rotation", spread_json(st.zeta_r)}}},
           {"measured_law", to_json(st.measured)},
+          {"dimension", st.dimension},
+          {"exponent_linear_size", st.dimension * st.measured.exponent},
           {"law", to_json(st.chosen)},
           {"linear_holds", st.linear_holds},
           {"forward",

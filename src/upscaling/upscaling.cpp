@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "demcal/io/files.hpp"
+#include "demcal/scene/triaxial.hpp"
 #include "demcal/upscaling/rev.hpp"
 
 namespace demcal {
@@ -34,6 +35,15 @@ ScalingLaw scaling_law_from_json(const nlohmann::json& j, const std::string& sou
     law.source = j["source"].get<std::string>();
   else
     law.source = source;
+  return law;
+}
+
+ScalingLaw default_law(int dimension) {
+  ScalingLaw law;
+  if (dimension == 3)
+    law.source =
+        "Tu & Andrade (2008): Nstep proportional to N; the 2D default law, not measured on "
+        "spheres (demcal scaling on a 3D config measures it: pass its scaling.json with --law)";
   return law;
 }
 
@@ -93,6 +103,17 @@ SceneConfig scene_of_size(const SceneConfig& config, int64_t particles) {
         std::max(1, static_cast<int>(std::lround(static_cast<double>(particles) / columns)));
     a.columns = columns;
     a.rows = rows;
+  } else if (a.type == "fcc") {
+    // The cell aspect kept: every edge scaled by the same factor s, with
+    // 4·(s·cx)(s·cy)(s·cz) = particles.
+    const double cells = static_cast<double>(a.cells_x) * a.cells_y * a.cells_z;
+    const double s = std::cbrt(static_cast<double>(particles) / (4.0 * cells));
+    auto edge = [s](int n) { return std::max(1, static_cast<int>(std::lround(n * s))); };
+    const int nx = edge(a.cells_x), ny = edge(a.cells_y), nz = edge(a.cells_z);
+    if (4.0 * nx * ny * nz > static_cast<double>(kMaxParticles))
+      throw InputError(config.source, "prototype.particles",
+                       std::string("at most ") + kMaxParticlesWhy + " spheres");
+    a.cells_x = nx, a.cells_y = ny, a.cells_z = nz;
   } else if (a.type == "random") {
     if (particles > 10000000)
       throw InputError(config.source, "assembly.count", "at most 10,000,000 particles");
@@ -149,6 +170,75 @@ Assembly prototype_assembly(const SceneConfig& config, int64_t particles, const 
   return a;
 }
 
+SphereAssembly prototype_spheres(const SceneConfig& config, int64_t particles,
+                                 const std::string& file, PrototypeSource* source) {
+  PrototypeSource src;
+  SphereAssembly a;
+  auto read = [&](const std::string& path) {
+    a = read_sphere_file(path);
+    src.kind = "file";
+    src.file = path;
+    src.description = std::to_string(a.size()) + " spheres read from " + path;
+  };
+  auto generated = [&](int64_t n, const std::string& key) {
+    if (config.assembly.type == "file")
+      throw InputError(config.source, key,
+                       "a 3D REV read from a file has no generator to resize: give the "
+                       "prototype's spheres as a file (prototype.file, CSV x,y,z,r)");
+    const SceneConfig c = scene_of_size(config, n);
+    a = make_sphere_assembly(c);
+    src.kind = "generated";
+    const auto& s = c.assembly;
+    src.description =
+        std::to_string(a.size()) + " spheres from the " + s.type + " generator of " + config.name +
+        (s.type == "fcc" ? " (" + std::to_string(s.cells_x) + "x" + std::to_string(s.cells_y) +
+                               "x" + std::to_string(s.cells_z) + " cells)"
+                         : std::string());
+  };
+  if (!file.empty()) {
+    read(file);
+  } else if (particles > 0) {
+    generated(particles, "--particles");
+  } else if (!config.prototype.file.empty()) {
+    read(config.prototype.file);
+  } else if (config.prototype.particles > 0) {
+    generated(config.prototype.particles, "prototype.particles");
+  } else {
+    a = make_sphere_assembly(config);
+    src.kind = "rev";
+    src.description = "the REV itself (" + std::to_string(a.size()) + " spheres)";
+  }
+  src.particles = a.size();
+  if (source) *source = src;
+  return a;
+}
+
+ParticleScales sphere_scales(const SphereWorld& w, const Material& material,
+                             const AlgorithmSpec& params) {
+  // The sphere scales at the run's mass scaling, from the kernel's masses
+  // (m = ρ(4/3)πr³, I = (2/5)mr²); the radius and mean-mass entries that
+  // SphereWorld::reference_scales() leaves out are filled here.
+  SphereWorld world = w;
+  world.set_integration(integration_for(world, params));
+  ParticleScales scales = world.reference_scales();
+  const int64_t n = world.size();
+  scales.particles = n;
+  const auto radii = world.radius();
+  double sum_r = 0.0, sum_m = 0.0;
+  scales.radius_min = radii.empty() ? 0.0 : radii[0];
+  for (double r : radii) {
+    sum_r += r;
+    sum_m += sphere_mass(material.density * params.mass_scaling, r);
+    scales.radius_min = std::min(scales.radius_min, r);
+    scales.radius_max = std::max(scales.radius_max, r);
+  }
+  if (n > 0) {
+    scales.radius_mean = sum_r / static_cast<double>(n);
+    scales.mass_mean = sum_m / static_cast<double>(n);
+  }
+  return scales;
+}
+
 nlohmann::json upscaling_block(int64_t n_rev, int64_t n_proto, const ScalingLaw& law) {
   const double ratio =
       static_cast<double>(n_proto) / static_cast<double>(std::max<int64_t>(1, n_rev));
@@ -167,9 +257,18 @@ nlohmann::json upscaling_block(int64_t n_rev, int64_t n_proto, const ScalingLaw&
 nlohmann::json prototype_block(const SceneConfig& config, const AlgorithmSpec& rev, int64_t n_rev,
                                const ScalingLaw& law, int64_t particles, const std::string& file) {
   PrototypeSource src;
-  const Assembly proto = prototype_assembly(config, particles, file, &src);
-  const ParticleScales scales = particle_scales(proto.r, config.material, rev.mass_scaling);
-  nlohmann::json block = param_block(upscale(rev, n_rev, proto.size(), law), scales);
+  nlohmann::json block;
+  if (config.dimension == 3) {
+    const SphereAssembly proto = prototype_spheres(config, particles, file, &src);
+    const SphereWorld world(sphere_material(config.material), proto.x, proto.y, proto.z, proto.r,
+                            proto.lo, proto.hi);
+    const AlgorithmSpec up = upscale(rev, n_rev, proto.size(), law);
+    block = param_block(up, sphere_scales(world, config.material, up));
+  } else {
+    const Assembly proto = prototype_assembly(config, particles, file, &src);
+    const ParticleScales scales = particle_scales(proto.r, config.material, rev.mass_scaling);
+    block = param_block(upscale(rev, n_rev, proto.size(), law), scales);
+  }
   block["source"] = {{"kind", src.kind}, {"description", src.description}};
   if (!src.file.empty()) block["source"]["file"] = src.file;
   return block;
@@ -292,14 +391,28 @@ LinearFit fit_power(std::span<const double> x, std::span<const double> y) {
 
 namespace demcal {
 
+TrialRecord run_record(const TrialRunner& runner, const AlgorithmSpec& params,
+                       const Tolerances& tol) {
+  const TrialRun run = runner.run(params, tol, false, 3.0, nullptr);
+  return {.params = params,
+          .score = run.score,
+          .steps_run = run.steps_run,
+          .wall_time_s = run.wall_time_s};
+}
+
 StepSearch smallest_passing_steps(const SceneConfig& config, const ConsolidatedState& state,
                                   const AlgorithmSpec& start, const Tolerances& tol, int max_runs) {
+  return smallest_passing_steps(BiaxialRunner(config, state), start, tol, max_runs);
+}
+
+StepSearch smallest_passing_steps(const TrialRunner& runner, const AlgorithmSpec& start,
+                                  const Tolerances& tol, int max_runs) {
   StepSearch out;
   AlgorithmSpec p = start;
   p.steps = round_steps(static_cast<double>(start.steps));
   int64_t largest_failing = 0;
   for (int k = 0; k < max_runs; ++k) {
-    TrialRecord r = run_trial(config, state, p, tol);
+    TrialRecord r = run_record(runner, p, tol);
     r.id = k;
     r.phase = TrialPhase::steps_search;
     out.trials.push_back(r);

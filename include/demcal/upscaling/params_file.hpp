@@ -30,8 +30,9 @@ double particle_steps_run(const std::vector<TrialRecord>& trials, int64_t partic
 nlohmann::json params_file(const SceneConfig& config, const ConsolidatedState& state,
                            const CalibrationOptions& options, const CalibrationSummary& summary);
 /// The same for a triaxial (3D) calibration on the consolidated spheres
-/// `state`: "dimension": 3, the REV block from the sphere scales; the
-/// prototype block is the REV's own until 3D upscaling exists.
+/// `state`: "dimension": 3, the REV block from the sphere scales, the
+/// prototype block for the spheres the config's "prototype" names (the REV
+/// itself without one), Nstep by default_law(3).
 nlohmann::json params_file(const SceneConfig& config, const TriaxialState& state,
                            const CalibrationOptions& options, const CalibrationSummary& summary);
 /// The schema params_file() writes and read_params_file() accepts.
@@ -39,12 +40,16 @@ inline constexpr const char* kParamsSchema = "demcal.params/1";
 /// A params.json read back and checked like a config: valid JSON without
 /// duplicate keys, this schema, a version string, and a `rev` block whose
 /// numbers are finite and in range (rev_params_from_json), a prototype
-/// particle count that fits. Every fault is an InputError naming the file
+/// particle count that fits, a "dimension" of 2 or 3 when present (absent:
+/// 2). Every fault is an InputError naming the file
 /// and the key (exit 2).
 nlohmann::json read_params_file(const std::string& path);
 /// The same checks on a params.json's text (`path` names it in errors);
 /// read_params_file reads the file and calls this.
 nlohmann::json parse_params_text(std::string_view text, const std::string& path);
+/// The dimension a params.json was calibrated in: its "dimension" (2 when
+/// absent, as 2D params.json files have always been written).
+int params_dimension(const nlohmann::json& params);
 
 /// The accuracy evidence of `demcal calibrate --evidence`: the converged
 /// reference (Nstep ×8 and ×16, Richardson) and the paper-recipe baseline.

@@ -73,6 +73,9 @@ Spread spread_of(const std::vector<double>& values);
 
 struct ScalingStudy {
   std::string scene, family;  ///< family: one line, e.g. "hexagonal generator"
+  /// 2 (disks, biaxial) or 3 (spheres, triaxial): the sample's linear size
+  /// grows as N^(1/dimension), so Nstep ∝ N^p is Nstep ∝ L^(dimension·p).
+  int dimension = 2;
   bool from_file = false;
   std::vector<int64_t> sizes, calibrated_sizes;
   std::string sizes_text;
@@ -101,10 +104,12 @@ struct ScalingStudy {
 void check_scaling_sizes(const ScalingStudyOptions& options);
 
 /// Run the study on the family of `config` (resized generators, or REVs cut
-/// from the prototype file for a file assembly).
+/// from the prototype file for a 2D file assembly); 2D and 3D configs run
+/// the same code (the search, step search and runs through TrialRunner).
 ScalingStudy run_scaling_study(const SceneConfig& config, const ScalingStudyOptions& options);
 
-/// scaling.json (schema demcal.scaling/1).
+/// scaling.json (schema demcal.scaling/1; "dimension" says which: a law is
+/// only applied to params.json of its dimension).
 nlohmann::json to_json(const ScalingStudy& study, const SceneConfig& config);
 /// scaling.md.
 std::string scaling_markdown(const ScalingStudy& study, const SceneConfig& config);

@@ -19,12 +19,15 @@
 #include <string>
 #include <vector>
 
+#include "demcal/kernel/particle_scales.hpp"
+#include "demcal/kernel/sphere_world.hpp"
+#include "demcal/kernel/world.hpp"
 #include "demcal/scene/biaxial.hpp"
-#include "demcal/search/calibration.hpp"
 #include "demcal/scene/config.hpp"
 #include "demcal/scene/packing.hpp"
-#include "demcal/kernel/particle_scales.hpp"
-#include "demcal/kernel/world.hpp"
+#include "demcal/scene/sphere_packing.hpp"
+#include "demcal/search/calibration.hpp"
+#include "demcal/search/trial_runner.hpp"
 
 namespace demcal {
 
@@ -44,6 +47,13 @@ struct ScalingLaw {
 /// "exponent" reads as linear; errors name `source`.
 nlohmann::json to_json(const ScalingLaw& law);
 ScalingLaw scaling_law_from_json(const nlohmann::json& j, const std::string& source);
+
+/// The law upscaling uses when no study is named (--law, --exponent, a
+/// params.json's "upscaling" block): Tu & Andrade's linear law in both
+/// dimensions. In 3D its source says that it is the 2D default, not a law
+/// measured on spheres (reports/scaling-3d.md measures one: pass its
+/// scaling.json with --law).
+ScalingLaw default_law(int dimension);
 
 /// Nstep for `n_proto` particles from a calibration on `n_rev` particles.
 int64_t upscale_steps(int64_t steps_rev, int64_t n_rev, int64_t n_proto,
@@ -71,9 +81,10 @@ struct PrototypeSource {
 
 /// The config's assembly resized to about `particles` particles: the same
 /// generator with the same distribution and seed (hexagonal/square: the
-/// column:row ratio kept; random: count). A family of scenes that differ
-/// only in size. Throws InputError for a file assembly (cut a REV instead,
-/// rev.hpp).
+/// column:row ratio kept; fcc: the cells_x:cells_y:cells_z ratio kept, 4
+/// spheres a cell, each edge rounded to the nearest whole cell; random, 2D
+/// or 3D: count). A family of scenes that differ only in size. Throws
+/// InputError for a file assembly (cut a REV instead, rev.hpp).
 SceneConfig scene_of_size(const SceneConfig& config, int64_t particles);
 
 /// The prototype the config names (prototype.file, else prototype.particles
@@ -83,10 +94,27 @@ SceneConfig scene_of_size(const SceneConfig& config, int64_t particles);
 Assembly prototype_assembly(const SceneConfig& config, int64_t particles = 0,
                             const std::string& file = "", PrototypeSource* source = nullptr);
 
+/// The 3D prototype the config names, as prototype_assembly() for disks:
+/// prototype.file (CSV x,y,z,r), else prototype.particles spheres from the
+/// config's generator (scene_of_size: an FCC block with the REV's cell
+/// aspect, or a random gas with the REV's radius distribution and seed),
+/// else the REV itself. A 3D file REV has no generator to resize: a
+/// particle count then is an InputError (give prototype.file).
+SphereAssembly prototype_spheres(const SceneConfig& config, int64_t particles = 0,
+                                 const std::string& file = "", PrototypeSource* source = nullptr);
+
+/// The reference scales of spheres (the kernel's own masses m = ρ(4/3)πr³
+/// at `params`' mass scaling, via SphereWorld::reference_scales()) with the
+/// radius and mean-mass entries filled in: the 3D REV block and the 3D
+/// prototype block of params.json both come from here.
+ParticleScales sphere_scales(const SphereWorld& world, const Material& material,
+                             const AlgorithmSpec& params);
+
 /// The `prototype` block of params.json for a calibration: the REV's
 /// parameters `rev` (calibrated on `n_rev` particles) upscaled to the
 /// prototype the config names, with Δt and damping recomputed from the
-/// prototype's particles. Meant to be called by `demcal calibrate`:
+/// prototype's particles (disks, or spheres for a 3D config). Meant to be called by `demcal
+/// calibrate`:
 ///   params["prototype"] = prototype_block(config, summary.best, n_rev);
 ///   params["upscaling"] = upscaling_block(config, n_rev);
 nlohmann::json prototype_block(const SceneConfig& config, const AlgorithmSpec& rev, int64_t n_rev,
@@ -123,9 +151,15 @@ struct StepSearch {
   std::vector<TrialRecord> trials;  ///< every run, in order
   double particle_steps = 0.0;      ///< total cost
 };
+StepSearch smallest_passing_steps(const TrialRunner& runner, const AlgorithmSpec& params,
+                                  const Tolerances& tolerances = {}, int max_runs = 8);
+/// The same on a consolidated disk REV (BiaxialRunner).
 StepSearch smallest_passing_steps(const SceneConfig& config, const ConsolidatedState& state,
                                   const AlgorithmSpec& params, const Tolerances& tolerances = {},
                                   int max_runs = 8);
+/// One full run (no early stop) of `runner` as a TrialRecord.
+TrialRecord run_record(const TrialRunner& runner, const AlgorithmSpec& params,
+                       const Tolerances& tolerances = {});
 
 /// Least-squares fits of Nstep against N (scaling.md).
 struct LinearFit {

@@ -1,0 +1,81 @@
+// `demcal verify` on 3D params (issue #18): a small FCC prototype (256
+// spheres, 4 cells an edge) run with the parameters of a 32-sphere REV
+// upscaled by the law, on the faster of one thread and all cores (measured
+// by verify's probe); the estimate is printed before the
+// run, and verify.json reports the criteria, the peak against the REV's and
+// the particle-steps that the law's Nstep gives.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "demcal/scene/triaxial.hpp"
+#include "demcal/upscaling/params_file.hpp"
+#include "support/files.hpp"
+#include "support/process.hpp"
+#include "support/scenes.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+namespace test = demcal::test;
+
+TEST(Verify3D, SmallFccPrototypeRunsAndReports) {
+  test::TempDir dir("verify3d");
+  const demcal::SceneConfig config =
+      demcal::parse_config_text("{" + test::kMaterialMember + R"(, "name": "fcc2", "dimension": 3,
+        "assembly": {"type": "fcc", "cells_x": 2, "cells_y": 2, "cells_z": 2, "radius": 5e-4},
+        "test": {"type": "triaxial", "lateral_stress": 1e5, "vertical_strain": 1e-5,
+                 "monitor_points": 50},
+        "algorithm": {"steps": 2000}, "prototype": {"particles": 256}})",
+                                "fcc2.json");
+  const demcal::TriaxialState state =
+      demcal::consolidate_triaxial(config, demcal::make_sphere_assembly(config));
+  demcal::CalibrationSummary summary;
+  summary.success = true;
+  summary.best.dt_ratio = 0.15;
+  summary.best.steps = 2000;
+  summary.best.damping_ratio_translation = 0.7;
+  summary.best.damping_ratio_rotation = 0.5;
+  summary.best_trial.params = summary.best;
+  summary.best_trial.score.criteria.peak_stress_yy = -3.3e5;  // the REV's peak, as recorded
+  summary.dimension = 3;
+  const std::string params = test::write_text(
+      dir / "params.json",
+      demcal::params_file(config, state, demcal::CalibrationOptions::from(config.calibration),
+                          summary)
+              .dump(2) +
+          "\n");
+
+  const test::RunResult r = test::run_demcal({"verify", params, "-o", "v"}, dir.path());
+  ASSERT_TRUE(r.status == 0 || r.status == 1) << r.err;  // PASS or FAIL, both reported
+  // The estimate comes first, before the consolidation.
+  const auto estimate = r.err.find("estimated");
+  ASSERT_NE(estimate, std::string::npos) << r.err;
+  EXPECT_LT(estimate, r.err.find("consolidated in")) << r.err;
+  EXPECT_NE(r.err.find("2D default"), std::string::npos) << r.err;  // which law
+  EXPECT_NE(r.out.find("256 spheres"), std::string::npos) << r.out;
+
+  const nlohmann::json v = nlohmann::json::parse(test::read_text(dir / "v" / "verify.json"));
+  EXPECT_EQ(v.at("dimension"), 3);
+  EXPECT_EQ(v.at("prototype").at("particles"), 256);
+  const int64_t steps = std::llround(2000.0 * 256.0 / 32.0);  // the linear law
+  EXPECT_EQ(v.at("loading").at("steps").get<int64_t>(), steps);
+  EXPECT_DOUBLE_EQ(v.at("loading").at("particle_steps").get<double>(), 256.0 * steps);
+  EXPECT_GE(v.at("loading").at("threads").get<int>(), 1);  // the faster, measured
+  EXPECT_GT(v.at("loading").at("estimated_s").get<double>(), 0.0);
+  EXPECT_EQ(v.at("passed").get<bool>(), r.status == 0);
+  for (const char* k : {"force_balance", "moment_balance", "servo", "oscillation"})
+    EXPECT_TRUE(v.at("criteria").contains(k)) << k;
+  // The peak: compressive, and against the REV's as params.json records it.
+  const double peak = v.at("peak").at("stress_zz").get<double>();
+  EXPECT_LT(peak, 0.0);
+  EXPECT_DOUBLE_EQ(v.at("peak").at("rev_stress_zz").get<double>(), -3.3e5);
+  EXPECT_NEAR(v.at("peak").at("relative_to_rev").get<double>(), (peak + 3.3e5) / 3.3e5, 1e-12);
+  // series.csv: a header and the monitored points.
+  EXPECT_GE(test::lines_of(test::read_text(dir / "v" / "series.csv")).size(), 50u);
+}
+
+}  // namespace
