@@ -2,8 +2,9 @@
 // the same config and seed give the same bytes, whatever --jobs or
 // --resume), DIR/run.json (this invocation: wall time, jobs, trials run and
 // reused), DIR/trials.jsonl (appended per trial, so --resume loses nothing)
-// and the report, DIR/report.html and DIR/report.md; with --evidence also
-// DIR/evidence.jsonl (the paper-recipe baseline and the reference runs).
+// and the report, DIR/report.html and DIR/report.md (3D: and DIR/final.vtk,
+// the calibrated run at its peak, when output.vtk); with --evidence (2D)
+// also DIR/evidence.jsonl (the paper-recipe baseline and the reference runs).
 // SIGINT/SIGTERM stop it cleanly after consolidation, exit status 128 +
 // signal: finished trials stay in trials.jsonl; during the search or the
 // evidence runs nothing else is written; once params.json (and run.json)
