@@ -767,3 +767,58 @@ TEST(Report3D, CalibrateWritesThe3DReportAndTheVtk) {
   EXPECT_NE(vtk.find("POINTS 32 "), std::string::npos);
   fs::remove_all(dir);
 }
+
+// A 3D calibration with no result still reports its start point; without a
+// prototype block in params.json the report says the prototype is the REV,
+// and with one it shows that block.
+TEST(Report3D, NoResultAndThePrototypeBlock) {
+  const TriaxialState& state = small_fcc();
+  const SceneConfig c = parse_config_text(R"({"dimension": 3,
+      "material": {"density": 2650, "kn": 1e8, "kt": 5e7, "friction": 0.3},
+      "assembly": {"type": "fcc", "cells_x": 2, "cells_y": 2, "cells_z": 2, "radius": 5e-4},
+      "test": {"type": "triaxial", "lateral_stress": 1e5, "vertical_strain": 1e-5,
+               "monitor_points": 40}})",
+                                          "fcc2.json");
+  ReportInput in;
+  in.scene = "fcc2";
+  in.command = "demcal calibrate fcc2.json";
+  in.lateral_stress = 1e5;
+  in.particles = in.prototype_particles = state.world.size();
+  in.summary.success = false;
+  in.summary.message = "no trial passed every criterion within 1 trials";
+  AlgorithmSpec start = c.algorithm;
+  start.steps = 1500;
+  attach_runs(in, rerun_start_and_result(c, state, start, in.summary, in.tolerances, 1));
+  ASSERT_EQ(in.dimension, 3);
+  ASSERT_TRUE(in.start3);
+  EXPECT_FALSE(in.best3 || in.sphere_picture);
+  ReportOptions options;
+  options.gnuplot = "";
+  const Report failed = make_report(in, options);
+  EXPECT_EQ(html_problem(failed.html), "");
+  EXPECT_NE(failed.markdown.find("The answer: no parameter set passed"), std::string::npos);
+  EXPECT_NE(failed.markdown.find("Start point (α 0.2, Nstep 1,500"), std::string::npos);
+  EXPECT_NE(failed.markdown.find("No picture: there is no calibrated run."), std::string::npos);
+  EXPECT_EQ(sphere_svg_of(failed.html), "");
+
+  // A result and params.json's blocks.
+  in.summary.success = true;
+  in.summary.best = start;
+  in.summary.best_trial.params = start;
+  in.summary.best_trial.score = in.start3->score;
+  in.summary.best_trial.score.particle_steps = 1.0;
+  in.params = {{"rev", {{"particles", 32}, {"steps", 1500}}}};
+  attach_runs(in, rerun_start_and_result(c, state, start, in.summary, in.tolerances, 1));
+  const Report rev = make_report(in, options);
+  EXPECT_NE(rev.markdown.find("params.json has no prototype block: the prototype is the REV"),
+            std::string::npos);
+  EXPECT_EQ(count(sphere_svg_of(rev.html), "<circle "), 32);
+  in.params["prototype"] = {{"particles", 20000},
+                            {"steps", 2000000},
+                            {"source", {{"kind", "scaled"}, {"description", "a test block"}}}};
+  const Report proto = make_report(in, options);
+  EXPECT_NE(proto.markdown.find("The prototype is not the REV (params.json's prototype block: a "
+                                "test block; kind scaled)"),
+            std::string::npos);
+  EXPECT_NE(proto.markdown.find("| steps | 2,000,000 |"), std::string::npos);
+}
