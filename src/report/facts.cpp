@@ -18,6 +18,10 @@ std::string grouped(int64_t v) {
 
 std::string kpa(double pa) { return num(pa / 1e3, 4) + " kPa"; }
 
+std::string strain_pct(double fraction, int dimension) {
+  return dimension == 3 ? num(100.0 * fraction, 3) + " %" : pct(fraction, 3);
+}
+
 std::string sentence(std::string s) {
   while (!s.empty() && s.back() == ' ') s.pop_back();
   if (s.empty()) return s;

@@ -17,6 +17,9 @@ namespace demcal::report {
 std::string grouped(int64_t v);
 /// A stress in Pa as "12.5 kPa".
 std::string kpa(double pa);
+/// A strain (a fraction) in %: three decimals in 2D, three significant
+/// digits in 3D (the triaxial scenes load to strains of 1e-5).
+std::string strain_pct(double fraction, int dimension);
 /// A diagnosis message as a sentence: capital first letter, final period.
 std::string sentence(std::string s);
 /// "α 0.277, Nstep 89,370, ζ_t 0.5, ζ_r 0".

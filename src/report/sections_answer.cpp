@@ -198,8 +198,8 @@ void write_criteria(Doc& d, const ReportFacts& f) {
             num(c.unbalanced_force_ratio_mean, 3) + " / " + num(c.unbalanced_force_ratio_max, 3)},
            {"inertial number, max", num(c.inertial_number_max, 3)},
            {"peak " + f.axial, kpa(c.peak_stress_yy) + " at ε_" + f.axial.substr(2) + " = " +
-                                   pct(c.peak_strain_yy, 3)},
-           {d3 ? "analytical peak (walled FCC lattice, Thornton 1979)"
+                                   strain_pct(c.peak_strain_yy, f.dimension)},
+           {d3 ? "analytical peak (walled FCC lattice, rotation locked; Thornton 1979)"
                : "analytical peak (rotation locked, walled box)",
             in.analytical_peak ? kpa(*in.analytical_peak) : std::string("n/a")}});
 }

@@ -76,7 +76,8 @@ void write_panel_numbers(Doc& d, const ReportFacts& f) {
   using R = const PanelRun&;
   row("peak " + f.axial + " (monitoring points)",
       [](R x) { return kpa(-1e3 * monitored_peak(x).first); });
-  row("strain at the peak", [](R x) { return pct(-monitored_peak(x).second / 100.0, 3); });
+  row("strain at the peak",
+      [&](R x) { return strain_pct(-monitored_peak(x).second / 100.0, f.dimension); });
   for (const auto& g : gap_rows(f.dimension))
     row(g.name, [&](R x) {
       const double v = max_gap(x, g);
@@ -379,7 +380,7 @@ void write_sphere_assembly(Doc& d, const ReportFacts& f) {
   const SphereColourScale cs = colour_scale(p);
   const std::string caption =
       "Calibrated run at its peak (step " + grouped(p.step) + " of " + grouped(p.steps) +
-      ", ε_zz = " + pct(p.strain_zz, 3) + ", b_zz = " + kpa(p.stress_zz) +
+      ", ε_zz = " + strain_pct(p.strain_zz, 3) + ", b_zz = " + kpa(p.stress_zz) +
       "): " + std::to_string(p.x.size()) +
       " spheres seen from the front right and above (z up; the box of walls dashed behind, "
       "faint in front), "
