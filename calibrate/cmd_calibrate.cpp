@@ -2,8 +2,9 @@
 // the same config and seed give the same bytes, whatever --jobs or
 // --resume), DIR/run.json (this invocation: wall time, jobs, trials run and
 // reused), DIR/trials.jsonl (appended per trial, so --resume loses nothing)
-// and the report, DIR/report.html and DIR/report.md; with --evidence also
-// DIR/evidence.jsonl (the paper-recipe baseline and the reference runs).
+// and the report, DIR/report.html and DIR/report.md (3D: and DIR/final.vtk,
+// the calibrated run at its peak, when output.vtk); with --evidence (2D)
+// also DIR/evidence.jsonl (the paper-recipe baseline and the reference runs).
 // SIGINT/SIGTERM stop it cleanly after consolidation, exit status 128 +
 // signal: finished trials stay in trials.jsonl; during the search or the
 // evidence runs nothing else is written; once params.json (and run.json)
@@ -132,107 +133,246 @@ void require_same_run(const std::string& dir, const nlohmann::json& key) {
                            fresh);
 }
 
-/// The report: the start point and the result rerun with their series, the
-/// picture at the peak, then plots and text. Returns the files written, for
-/// the closing line ("" when the report failed: a warning, not a failure).
-std::string write_report(const CalibrateOptions& o, const SceneConfig& config,
-                         const ConsolidatedState& state, const std::string& dir,
-                         const nlohmann::json& params, const CalibrationSummary& summary,
-                         const CalibrationOptions& options, std::optional<BaselineResult> baseline,
-                         std::optional<ReferenceEvidence> reference, int jobs) {
+/// The consolidated REV of either dimension, made once.
+struct Consolidated {
+  std::optional<ConsolidatedState> disks;  ///< 2D: biaxial, cached
+  std::optional<TriaxialState> spheres;    ///< 3D: triaxial
+  int64_t particles = 0, steps = 0;
+  double wall_time_s = 0.0;
+  bool from_cache = false;
+};
+
+/// What one invocation works on: the config with the flags applied, where
+/// it writes, and the key of its trials.
+struct Invocation {
+  SceneConfig config;
+  bool three_d = false;
+  Strategy strategy{};
+  std::string dir, trials_path;
+  nlohmann::json key;  ///< resume_key()
+};
+
+/// The config and flags checked before anything runs: bad input fails here
+/// (exit 2), before the consolidation's seconds.
+Invocation prepare(const CalibrateOptions& o) {
+  Invocation v;
+  // 2D scenes as every command loads them; 3D (spheres, triaxial test) too.
+  v.config = load_config(o.config, o.sets);
+  SceneConfig& config = v.config;
+  v.three_d = config.dimension == 3;
+  if (o.max_trials > 0) config.calibration.max_trials = o.max_trials;
+  if (o.accuracy > 0) config.calibration.accuracy = o.accuracy;
+  if (o.accuracy < 0 || o.accuracy >= 1)
+    throw InputError("--accuracy", "", "must be a fraction in (0, 1), e.g. 0.02");
+  v.strategy = parse_strategy(o.strategy, "--strategy");
+  v.dir = o.out_dir.empty() ? "demcal-" + config.name : o.out_dir;
+  v.trials_path = v.dir + "/trials.jsonl";
+  OutputFolder::check(v.dir);  // an unwritable -o fails now, not after the search
+  if (o.resume && !std::filesystem::exists(v.trials_path))
+    throw InputError(v.trials_path, "", "--resume needs the trials.jsonl of an earlier run");
+  v.key = resume_key(config, v.strategy);
+  if (o.resume) {
+    require_readable_file(v.trials_path);  // a folder named trials.jsonl: one line
+    require_same_run(v.dir, v.key);        // before the consolidation's seconds
+  }
+  return v;
+}
+
+/// The consolidated REV: disks (biaxial, cached) or spheres (triaxial).
+Consolidated consolidate_rev(const CalibrateOptions& o, const SceneConfig& config, bool three_d) {
+  Consolidated c;
+  if (three_d) {
+    const SphereAssembly assembly = make_sphere_assembly(config);
+    if (!o.quiet)
+      std::cerr << "demcal: consolidating " << assembly.size() << " spheres of " << config.name
+                << " to sigma3 = " << config.test.lateral_stress << " Pa (3D, triaxial)\n";
+    c.spheres.emplace(consolidate_triaxial(config, assembly));
+    c.particles = c.spheres->world.size();
+    c.steps = c.spheres->steps;
+    c.wall_time_s = c.spheres->wall_time_s;
+  } else {
+    Assembly assembly = make_assembly(config);
+    if (!o.quiet)
+      std::cerr << "demcal: consolidating " << assembly.size() << " particles of " << config.name
+                << " to sigma3 = " << config.test.lateral_stress << " Pa\n";
+    c.disks.emplace(consolidate(config, assembly));
+    c.particles = c.disks->world.size();
+    c.steps = c.disks->steps;
+    c.wall_time_s = c.disks->wall_time_s;
+    c.from_cache = c.disks->from_cache;
+  }
+  if (!o.quiet)
+    std::cerr << "demcal: consolidated in " << c.steps << " steps ("
+              << (c.from_cache ? "read from the consolidation cache"
+                               : std::to_string(c.wall_time_s) + " s")
+              << ")\n";
+  return c;
+}
+
+/// The output folder made ready under its lock: a --resume checked once
+/// more, a fresh start's trials and key replaced, earlier results removed.
+void ready_output_folder(const CalibrateOptions& o, const Invocation& v) {
+  const std::string& dir = v.dir;
+  if (o.resume) {
+    require_same_run(dir, v.key);  // unchanged since the check in prepare()?
+    // A damaged trials.jsonl stops the run before anything is removed.
+    read_trials_text(read_text_file(v.trials_path), v.trials_path);
+  }
+  remove_stale_temporaries(dir);
+  if (!o.resume) {
+    require_regular_file_target(v.trials_path);
+    std::filesystem::remove(v.trials_path);
+    write_file_atomic(dir + "/resume.json", v.key.dump(2) + "\n");
+  }
+  // Results of an earlier run in this folder would not match the trials
+  // from here on; they are rewritten at the end.
+  for (const char* name : {"params.json", "run.json", "report.html", "report.md", "evidence.jsonl"})
+    std::filesystem::remove(dir + "/" + name);
+  if (v.three_d) std::filesystem::remove(dir + "/final.vtk");  // the 3D report's
+}
+
+/// The --evidence runs (2D): the paper's recipe done mechanically (α = 0.2,
+/// ζ = 1, Nstep doubled from the search's size-based start until it passes)
+/// and a converged reference from the calibrated multipliers.
+struct Evidence {
+  std::optional<BaselineResult> baseline;
+  std::optional<ReferenceEvidence> reference;
+  std::string lines;     ///< evidence.jsonl, written with params.json
+  nlohmann::json block;  ///< params.json's "evidence"
+};
+
+Evidence run_evidence(const SceneConfig& config, const ConsolidatedState& state,
+                      const CalibrationSummary& summary, const CalibrationOptions& options,
+                      int jobs) {
+  Evidence e;
   const int64_t n_rev = state.world.size();
-  try {
-    const auto t0 = std::chrono::steady_clock::now();
-    ReportInput in;
-    in.scene = config.name;
-    in.command = reproduce_command(o, config, dir);
-    in.params = params;
-    in.summary = summary;
-    in.tolerances = options.tolerances;
-    in.accuracy = options.accuracy;
-    in.lateral_stress = config.test.lateral_stress;
-    in.dt_ratio_max = dt_ratio_max(options, summary.dt_ratio_stable);
-    in.particles = n_rev;
+  auto run_baseline = [&] {
+    e.baseline =
+        paper_recipe_baseline(config, state, options.tolerances, kStartStepsPerParticle * n_rev);
+  };
+  auto run_reference = [&] {
+    e.reference = run_refined_reference(config, state, summary.best, options.tolerances, 1);
+  };
+  run_parallel({run_baseline, run_reference}, jobs);
+  const CalibrationEvidence evidence{*e.reference, *e.baseline, kStartStepsPerParticle * n_rev};
+  e.lines = demcal::evidence_lines(evidence);
+  e.block = evidence_block(evidence, summary.best_trial);
+  return e;
+}
+
+/// The report's input from the calibration, before the reruns.
+ReportInput report_input(const CalibrateOptions& o, const Invocation& v, int64_t n_rev,
+                         const nlohmann::json& params, const CalibrationSummary& summary,
+                         const CalibrationOptions& options) {
+  const SceneConfig& config = v.config;
+  ReportInput in;
+  in.scene = config.name;
+  in.command = reproduce_command(o, config, v.dir);
+  in.params = params;
+  in.summary = summary;
+  in.tolerances = options.tolerances;
+  in.accuracy = options.accuracy;
+  in.lateral_stress = config.test.lateral_stress;
+  in.dt_ratio_max = dt_ratio_max(options, summary.dt_ratio_stable);
+  in.particles = n_rev;
+  if (v.three_d) {
+    // 3D: the prototype is what params.json's prototype block says (the
+    // report shows it); the analytical peak is params.json's.
+    in.prototype_particles = n_rev;
+    if (params.contains("analytical_peak_stress_yy"))
+      in.analytical_peak = params["analytical_peak_stress_yy"].get<double>();
+  } else {
     in.prototype_particles = config.prototype.particles > 0 ? config.prototype.particles : n_rev;
     in.analytical_peak = analytical_peak_stress(config);
-    in.baseline = std::move(baseline);
-    in.reference = std::move(reference);
+  }
+  return in;
+}
+
+/// The report: the start point and the result rerun with their series, the
+/// picture at the peak (3D: and final.vtk of that state, when output.vtk),
+/// then plots and text. Returns the files written, for the closing line
+/// ("" when the report failed: a warning, not a failure).
+std::string write_report(const CalibrateOptions& o, const Invocation& v, const Consolidated& rev,
+                         const nlohmann::json& params, const CalibrationSummary& summary,
+                         const CalibrationOptions& options, Evidence evidence, int jobs) {
+  const SceneConfig& config = v.config;
+  const std::string& dir = v.dir;
+  try {
+    const auto t0 = std::chrono::steady_clock::now();
+    ReportInput in = report_input(o, v, rev.particles, params, summary, options);
+    in.baseline = std::move(evidence.baseline);
+    in.reference = std::move(evidence.reference);
     // The search's first start, as it ran.
     const AlgorithmSpec start =
-        rounded_params(search_start(config.algorithm, n_rev, in.dt_ratio_max));
+        rounded_params(search_start(config.algorithm, rev.particles, in.dt_ratio_max));
     // A stop now: finish, the runs are done.
-    attach_runs(in, rerun_start_and_result(config, state, start, summary, in.tolerances, jobs));
+    std::string vtk;
+    if (v.three_d) {
+      ResultRuns3D runs =
+          rerun_start_and_result(config, *rev.spheres, start, summary, in.tolerances, jobs);
+      if (runs.world && config.output.vtk) {
+        vtk = world_vtk(*runs.world, "demcal " + config.name + " calibrated, at the peak");
+        in.vtk_file = "final.vtk";
+      }
+      attach_runs(in, std::move(runs));
+    } else {
+      attach_runs(in,
+                  rerun_start_and_result(config, *rev.disks, start, summary, in.tolerances, jobs));
+    }
     const auto t1 = std::chrono::steady_clock::now();
     const Report report = make_report(in);
-    OutputFolder out(dir);  // the two renderings of one report, together
+    OutputFolder out(dir);  // the renderings of one report, together
     out.write("report.html", report.html);
     out.write("report.md", report.markdown);
+    if (!vtk.empty()) out.write("final.vtk", vtk);
     out.commit();
     if (!o.quiet)
       std::cerr << "demcal: report: reruns " << std::chrono::duration<double>(t1 - t0).count()
                 << " s, writing " << seconds_since(t1) << " s; " << report.plot_status << "\n";
-    return ", " + dir + "/report.html, " + dir + "/report.md";
+    return ", " + dir + "/report.html, " + dir + "/report.md" +
+           (vtk.empty() ? "" : ", " + dir + "/final.vtk");
   } catch (const std::exception& e) {
     std::cerr << "demcal: warning: the report was not written: " << e.what() << "\n";
     return "";
   }
 }
 
+/// params.json, run.json and evidence.jsonl of one calibration replace
+/// those of an earlier one together (an evidence.jsonl of an earlier
+/// --evidence run that this one does not redo goes with them).
+void write_results(const std::string& dir, const nlohmann::json& params,
+                   const std::string& evidence_lines, const std::string& run_json) {
+  OutputFolder out(dir);
+  if (!evidence_lines.empty())
+    out.write("evidence.jsonl", evidence_lines);
+  else
+    out.retire("evidence.jsonl");
+  out.write("params.json", params.dump(2) + "\n");
+  out.write("run.json", run_json);
+  out.commit();
+}
+
+/// The search's options from the config and the flags.
+CalibrationOptions search_options(const CalibrateOptions& o, const Invocation& v,
+                                  const StopOnSignal& stop) {
+  CalibrationOptions options = CalibrationOptions::from(v.config.calibration);
+  options.strategy = v.strategy;
+  options.jobs = o.jobs;
+  options.trials_path = v.trials_path;
+  options.resume = o.resume;
+  if (!o.quiet) options.progress = [](const std::string& line) { std::cerr << line << "\n"; };
+  options.stop = &stop.flag();
+  return options;
+}
+
 }  // namespace
 
 int cmd_calibrate(const CalibrateOptions& o) {
   const auto t_start = std::chrono::steady_clock::now();
-  // 2D scenes as every command loads them; 3D (spheres, triaxial test) too.
-  SceneConfig config = load_config(o.config, o.sets);
-  const bool three_d = config.dimension == 3;
-  if (o.max_trials > 0) config.calibration.max_trials = o.max_trials;
-  if (o.accuracy > 0) config.calibration.accuracy = o.accuracy;
-  if (o.accuracy < 0 || o.accuracy >= 1)
-    throw InputError("--accuracy", "", "must be a fraction in (0, 1), e.g. 0.02");
-  const Strategy strategy = parse_strategy(o.strategy, "--strategy");
-  const std::string dir = o.out_dir.empty() ? "demcal-" + config.name : o.out_dir;
-  const std::string trials_path = dir + "/trials.jsonl";
-  OutputFolder::check(dir);  // an unwritable -o fails now, not after the search
-  if (o.resume && !std::filesystem::exists(trials_path))
-    throw InputError(trials_path, "", "--resume needs the trials.jsonl of an earlier run");
-  const nlohmann::json key = resume_key(config, strategy);
-  if (o.resume) {
-    require_readable_file(trials_path);  // a folder named trials.jsonl: one line
-    require_same_run(dir, key);          // before the consolidation's seconds
-  }
-
-  // The consolidated REV: disks (biaxial, cached) or spheres (triaxial).
-  std::optional<ConsolidatedState> state2;
-  std::optional<TriaxialState> state3;
-  int64_t n_rev = 0;
-  int64_t consolidation_steps = 0;
-  double consolidation_wall_time_s = 0.0;
-  bool from_cache = false;
-  if (three_d) {
-    const SphereAssembly assembly = make_sphere_assembly(config);
-    if (!o.quiet)
-      std::cerr << "demcal: consolidating " << assembly.size() << " spheres of " << config.name
-                << " to sigma3 = " << config.test.lateral_stress << " Pa (3D, triaxial)\n";
-    state3.emplace(consolidate_triaxial(config, assembly));
-    n_rev = state3->world.size();
-    consolidation_steps = state3->steps;
-    consolidation_wall_time_s = state3->wall_time_s;
-  } else {
-    Assembly assembly = make_assembly(config);
-    if (!o.quiet)
-      std::cerr << "demcal: consolidating " << assembly.size() << " particles of " << config.name
-                << " to sigma3 = " << config.test.lateral_stress << " Pa\n";
-    state2.emplace(consolidate(config, assembly));
-    n_rev = state2->world.size();
-    consolidation_steps = state2->steps;
-    consolidation_wall_time_s = state2->wall_time_s;
-    from_cache = state2->from_cache;
-  }
-  if (!o.quiet)
-    std::cerr << "demcal: consolidated in " << consolidation_steps << " steps ("
-              << (from_cache ? "read from the consolidation cache"
-                             : std::to_string(consolidation_wall_time_s) + " s")
-              << ")\n";
+  const Invocation v = prepare(o);
+  const SceneConfig& config = v.config;
+  const std::string& dir = v.dir;
+  const Consolidated rev = consolidate_rev(o, config, v.three_d);
 
   // From here on a signal stops cleanly (consolidation writes nothing, so
   // the default action is fine before).
@@ -241,71 +381,36 @@ int cmd_calibrate(const CalibrateOptions& o) {
   // Held to the end: a second calibration into this folder stops here,
   // before it changes anything.
   const FolderLock lock(dir);
-  if (o.resume) {
-    require_same_run(dir, key);  // unchanged since the check above?
-    // A damaged trials.jsonl stops the run before anything is removed.
-    read_trials_text(read_text_file(trials_path), trials_path);
-  }
-  remove_stale_temporaries(dir);
-  if (!o.resume) {
-    require_regular_file_target(trials_path);
-    std::filesystem::remove(trials_path);
-    write_file_atomic(dir + "/resume.json", key.dump(2) + "\n");
-  }
-  // Results of an earlier run in this folder would not match the trials
-  // from here on; they are rewritten at the end.
-  for (const char* name : {"params.json", "run.json", "report.html", "report.md", "evidence.jsonl"})
-    std::filesystem::remove(dir + "/" + name);
+  ready_output_folder(o, v);
 
-  CalibrationOptions options = CalibrationOptions::from(config.calibration);
-  options.strategy = strategy;
-  options.jobs = o.jobs;
-  options.trials_path = trials_path;
-  options.resume = o.resume;
-  if (!o.quiet) options.progress = [](const std::string& line) { std::cerr << line << "\n"; };
-  options.stop = &stop.flag();
+  const CalibrationOptions options = search_options(o, v, stop);
   const CalibrationSummary summary =
-      three_d ? calibrate(config, *state3, options) : calibrate(config, *state2, options);
+      v.three_d ? calibrate(config, *rev.spheres, options) : calibrate(config, *rev.disks, options);
   const auto interrupted = [&](const std::string& what) {
     std::cerr << "demcal: interrupted" << what << "; " << summary.trials.size()
-              << " finished trials are in " << trials_path << ". Continue with:\n  "
+              << " finished trials are in " << v.trials_path << ". Continue with:\n  "
               << reproduce_command(o, config, dir) << " --resume\n";
     return stop.exit_status();
   };
   if (summary.interrupted) return interrupted("");
 
-  nlohmann::json params = three_d ? params_file(config, *state3, options, summary)
-                                  : params_file(config, *state2, options, summary);
-
+  nlohmann::json params = v.three_d ? params_file(config, *rev.spheres, options, summary)
+                                    : params_file(config, *rev.disks, options, summary);
   const bool have_best = summary.best_trial.score.particle_steps > 0.0;
   const int jobs = resolve_jobs(o.jobs);
   auto say = [&](const std::string& line) {
     if (!o.quiet) std::cerr << "demcal: " << line << "\n";
   };
-
-  // --evidence: the paper's recipe done mechanically (α = 0.2, ζ = 1,
-  // Nstep doubled from the search's size-based start until it passes) and a
-  // converged reference from the calibrated multipliers.
-  std::optional<BaselineResult> baseline;
-  std::optional<ReferenceEvidence> reference;
-  std::string evidence_lines;  // evidence.jsonl, written with params.json
-  if (o.evidence && have_best && three_d)
+  const bool evidence_runs = o.evidence && have_best && !v.three_d;
+  Evidence evidence;
+  if (o.evidence && have_best && v.three_d)
     say("--evidence: the paper-recipe baseline and the converged reference are 2D only for now "
         "(issue #18); skipped for this 3D scene");
-  if (o.evidence && have_best && !three_d) {
+  if (evidence_runs) {
     say("evidence: paper-recipe baseline and converged reference (8x, 16x Nstep = " +
         std::to_string(16 * summary.best.steps) + ")");
-    auto run_baseline = [&] {
-      baseline = paper_recipe_baseline(config, *state2, options.tolerances,
-                                       kStartStepsPerParticle * n_rev);
-    };
-    auto run_reference = [&] {
-      reference = run_refined_reference(config, *state2, summary.best, options.tolerances, 1);
-    };
-    run_parallel({run_baseline, run_reference}, jobs);
-    const CalibrationEvidence evidence{*reference, *baseline, kStartStepsPerParticle * n_rev};
-    evidence_lines = demcal::evidence_lines(evidence);
-    params["evidence"] = evidence_block(evidence, summary.best_trial);
+    evidence = run_evidence(config, *rev.disks, summary, options, jobs);
+    params["evidence"] = evidence.block;
   }
   // The evidence and report runs do not poll the flag (seconds on a REV):
   // a stop asked for during them takes effect here.
@@ -313,44 +418,23 @@ int cmd_calibrate(const CalibrateOptions& o) {
   // What varies between invocations stays out of params.json (run.json).
   // Written with params.json, and again after the report with the total.
   const auto run_json = [&] {
-    return run_record(seconds_since(t_start), summary, consolidation_wall_time_s, from_cache, jobs,
+    return run_record(seconds_since(t_start), summary, rev.wall_time_s, rev.from_cache, jobs,
                       o.resume)
                .dump(2) +
            "\n";
   };
-  {
-    // params.json, run.json and evidence.jsonl of one calibration replace
-    // those of an earlier one together (an evidence.jsonl of an earlier
-    // --evidence run that this one does not redo goes with them).
-    OutputFolder out(dir);
-    if (!evidence_lines.empty())
-      out.write("evidence.jsonl", evidence_lines);
-    else
-      out.retire("evidence.jsonl");
-    out.write("params.json", params.dump(2) + "\n");
-    out.write("run.json", run_json());
-    out.commit();
-  }
-  const auto write_run_json = [&] { write_file_atomic(dir + "/run.json", run_json()); };
+  write_results(dir, params, evidence.lines, run_json());
   if (stop.stopped())
     return interrupted(
         " before the report (params.json and run.json are written; --resume reuses every trial "
         "and writes the report)");
 
-  std::string report_note;
-  if (three_d) {
-    // The 3D report (panels, picture) is not written yet: said, not crashed.
-    std::cerr << "demcal: note: no report for 3D scenes yet (issue #18, report part); params.json "
-                 "and trials.jsonl hold the result\n";
-  } else {
-    report_note = write_report(o, config, *state2, dir, params, summary, options,
-                               std::move(baseline), std::move(reference), jobs);
-  }
-
-  write_run_json();
+  const std::string report_note =
+      write_report(o, v, rev, params, summary, options, std::move(evidence), jobs);
+  write_file_atomic(dir + "/run.json", run_json());
   std::cout << summary.BriefReport() << "  wrote " << dir << "/params.json, " << dir
             << "/run.json, " << dir << "/trials.jsonl" << report_note
-            << (o.evidence && have_best && !three_d ? ", " + dir + "/evidence.jsonl" : "") << "\n";
+            << (evidence_runs ? ", " + dir + "/evidence.jsonl" : "") << "\n";
   if (stop.stopped()) {
     std::cerr << "demcal: interrupted after the last run; every output was written\n";
     return stop.exit_status();

@@ -11,12 +11,16 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <numbers>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "demcal/report/report.hpp"
+#include "demcal/report/sphere_svg.hpp"
 #include "demcal/scene/packing.hpp"
+#include "demcal/scene/triaxial.hpp"
+#include "demcal/scoring/triaxial_scoring.hpp"
 #include "demcal/search/evidence.hpp"
 #include "support/files.hpp"
 #include "support/process.hpp"
@@ -555,4 +559,266 @@ TEST(Report, CalibrateWritesBothFiles) {
   for (const auto& e : fs::directory_iterator(dir))
     EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos) << e.path();
   fs::remove_all(dir);
+}
+
+// ---------------------------------------------------------------------------
+// 3D: the sphere picture and the report of a triaxial calibration.
+
+namespace {
+
+/// The attribute `name` of every element `tag` of `svg`, in document order.
+std::vector<std::string> attributes(const std::string& svg, const std::string& tag,
+                                    const std::string& name) {
+  std::vector<std::string> out;
+  const std::string open = "<" + tag + " ";
+  for (size_t k = 0; (k = svg.find(open, k)) != std::string::npos; k += open.size()) {
+    const size_t end = svg.find('>', k);
+    const size_t a = svg.find(" " + name + "=\"", k);
+    if (a == std::string::npos || a > end) {
+      out.push_back("");
+      continue;
+    }
+    const size_t v = a + name.size() + 3;
+    out.push_back(svg.substr(v, svg.find('"', v) - v));
+  }
+  return out;
+}
+
+/// The sphere assembly's <svg> element in a report page.
+std::string sphere_svg_of(const std::string& html) {
+  const size_t a = html.find("<svg class=\"assembly\"");
+  if (a == std::string::npos) return "";
+  return html.substr(a, html.find("</svg>", a) + 6 - a);
+}
+
+/// A consolidated walled FCC sample of 2×2×2 cells (32 spheres).
+const TriaxialState& small_fcc() {
+  static const TriaxialState state = [] {
+    const SceneConfig c = parse_config_text(R"({"name": "fcc2", "dimension": 3,
+      "material": {"density": 2650, "kn": 1e8, "kt": 5e7, "friction": 0.3},
+      "assembly": {"type": "fcc", "cells_x": 2, "cells_y": 2, "cells_z": 2, "radius": 5e-4},
+      "test": {"type": "triaxial", "lateral_stress": 1e5, "vertical_strain": 1e-5,
+               "monitor_points": 40}})",
+                                            "fcc2.json");
+    return consolidate_triaxial(c, make_sphere_assembly(c));
+  }();
+  return state;
+}
+
+}  // namespace
+
+// Painter's order: whatever the order of the spheres in the picture, the one
+// nearer the viewer is drawn after the one behind it, and a sphere moved
+// along the line of sight lands on the same spot of the screen.
+TEST(Report3D, TheSphereInFrontIsDrawnAfterTheOneBehind) {
+  for (const SphereView view : {SphereView{}, SphereView{30.0, 20.0}, SphereView{-120.0, 60.0}}) {
+    const double a = view.azimuth_deg * std::numbers::pi / 180.0,
+                 e = view.elevation_deg * std::numbers::pi / 180.0;
+    const double w[3] = {std::cos(e) * std::cos(a), std::cos(e) * std::sin(a), std::sin(e)};
+    SpherePicture p;
+    // Sphere 0 in front of sphere 1 (3 mm nearer the viewer), listed first.
+    p.x = {1e-3 + 3e-3 * w[0], 1e-3};
+    p.y = {2e-3 + 3e-3 * w[1], 2e-3};
+    p.z = {0.5e-3 + 3e-3 * w[2], 0.5e-3};
+    p.r = {0.7e-3, 0.3e-3};
+    p.force = {2.0, 1.0};
+    p.lo = {-1e-3, -1e-3, -1e-3};
+    p.hi = {6e-3, 6e-3, 6e-3};
+    const auto drawn = project_spheres(p, view);
+    ASSERT_EQ(drawn.size(), 2u);
+    EXPECT_EQ(drawn[0].index, 1) << view.azimuth_deg;
+    EXPECT_EQ(drawn[1].index, 0) << view.azimuth_deg;
+    EXPECT_NEAR(drawn[1].depth - drawn[0].depth, 3e-3, 1e-12);
+    EXPECT_NEAR(drawn[0].u, drawn[1].u, 1e-12);
+    EXPECT_NEAR(drawn[0].v, drawn[1].v, 1e-12);
+    // In the SVG: the small (back) circle first, the large one over it.
+    const auto radii = attributes(sphere_svg(p, view), "circle", "r");
+    ASSERT_EQ(radii.size(), 2u);
+    EXPECT_LT(std::stod(radii[0]), std::stod(radii[1]));
+  }
+  // z is up on the screen, whatever the azimuth.
+  SpherePicture p;
+  p.x = {0, 0};
+  p.y = {0, 0};
+  p.z = {0, 1e-3};
+  p.r = {1e-4, 1e-4};
+  p.force = {0, 0};
+  const auto d = project_spheres(p);
+  const auto& low = d[0].index == 0 ? d[0] : d[1];
+  const auto& high = d[0].index == 0 ? d[1] : d[0];
+  EXPECT_GT(high.v, low.v);
+}
+
+// The picture of a consolidated sample: every sphere drawn once, coloured by
+// the sum of the normal contact forces on it; the legend spans exactly the
+// smallest to the largest of those sums. The sums are the kernel's: over
+// all spheres they count each sphere contact twice and each wall contact
+// once, and the wall contacts add up to the force the walls feel.
+TEST(Report3D, EverySphereDrawnOnceColouredByItsContactForce) {
+  const TriaxialState& state = small_fcc();
+  const SphereWorld& w = state.world;
+  const SpherePicture p = picture_of(w);
+  ASSERT_EQ(p.force.size(), static_cast<size_t>(w.size()));
+  double total = 0.0, contacts = 0.0, walls = 0.0;
+  for (double f : p.force) total += f;
+  for (const auto& c : w.contacts()) contacts += std::max(0.0, c.fn);
+  for (int side = 0; side < 6; ++side)
+    walls += std::abs(w.wall(static_cast<SphereWallSide>(side)).force[side / 2]);
+  ASSERT_GT(walls, 0.0);
+  EXPECT_NEAR(total, 2.0 * contacts + walls, 1e-9 * total);
+
+  const std::string svg = sphere_svg(p);
+  const auto fills = attributes(svg, "circle", "fill");
+  ASSERT_EQ(fills.size(), p.x.size());
+  const auto order = project_spheres(p);
+  const SphereColourScale scale = colour_scale(p);
+  for (size_t k = 0; k < order.size(); ++k)
+    EXPECT_EQ(fills[k], "url(#sph-" + std::to_string(scale.bin(p.force[order[k].index])) + ")")
+        << k;
+  const auto [lo, hi] = std::minmax_element(p.force.begin(), p.force.end());
+  ASSERT_LT(*lo, *hi);
+  const auto legend_lo = attributes(svg, "g", "data-lo"),
+             legend_hi = attributes(svg, "g", "data-hi");
+  std::string lo_text, hi_text;
+  for (size_t k = 0; k < legend_lo.size(); ++k)
+    if (!legend_lo[k].empty()) {
+      lo_text = legend_lo[k];
+      hi_text = legend_hi[k];
+    }
+  ASSERT_FALSE(lo_text.empty());
+  EXPECT_NEAR(std::stod(lo_text), *lo, 1e-8 * *hi);
+  EXPECT_NEAR(std::stod(hi_text), *hi, 1e-8 * *hi);
+  EXPECT_EQ(scale.bin(*lo), 0);
+  EXPECT_EQ(scale.bin(*hi), kSphereColourBins - 1);
+  EXPECT_EQ(html_problem("<html>" + svg + "</html>"), "");
+}
+
+// The 3D reruns reproduce the search's trials and the picture is the
+// result at the monitoring point of its most compressive b_zz.
+TEST(Report3D, RerunsReproduceTheTrialsAndPictureThePeak) {
+  const TriaxialState& state = small_fcc();
+  const SceneConfig c = parse_config_text(R"({"dimension": 3,
+      "material": {"density": 2650, "kn": 1e8, "kt": 5e7, "friction": 0.3},
+      "assembly": {"type": "fcc", "cells_x": 2, "cells_y": 2, "cells_z": 2, "radius": 5e-4},
+      "test": {"type": "triaxial", "lateral_stress": 1e5, "vertical_strain": 1e-5,
+               "monitor_points": 40}})",
+                                          "fcc2.json");
+  const Tolerances tol;
+  AlgorithmSpec best = c.algorithm, start = c.algorithm;
+  best.steps = 3000;
+  start.steps = 1500;
+  CalibrationSummary summary;
+  summary.success = true;
+  summary.best = best;
+  summary.best_trial.params = best;
+  const TriaxialResult run = run_triaxial_loading(state, c.test, best);
+  summary.best_trial.score = score_triaxial_run(run, 1e5, tol);
+  const ResultRuns3D runs = rerun_start_and_result(c, state, start, summary, tol, 2);
+  ASSERT_TRUE(runs.start && runs.best && runs.picture && runs.world);
+  EXPECT_EQ(runs.best->score.criteria.force_balance,
+            summary.best_trial.score.criteria.force_balance);
+  EXPECT_EQ(runs.start->params.steps, start.steps);
+  const auto& series = runs.best->run.series;
+  size_t peak = 0;
+  for (size_t k = 1; k < series.size(); ++k)
+    if (series[k].b(2, 2) < series[peak].b(2, 2)) peak = k;
+  EXPECT_EQ(runs.picture->step, series[peak].step);
+  EXPECT_EQ(runs.picture->stress_zz, series[peak].b(2, 2));
+  EXPECT_GT(runs.picture->step, 0);
+  EXPECT_EQ(runs.picture->hi[2], runs.world->wall(kZMax).position);
+  EXPECT_EQ(runs.picture->x.size(), static_cast<size_t>(state.world.size()));
+}
+
+// `demcal calibrate` on the shipped 3D scene cut to 2×2×2 cells (32 spheres,
+// about a second), a few trials: report.html has
+// every 3D panel, the sphere picture with a circle per sphere, the
+// prototype said to be what params.json says, and final.vtk beside it.
+TEST(Report3D, CalibrateWritesThe3DReportAndTheVtk) {
+  const fs::path dir = test::fresh_path("report3d");
+  const int status = test::wait_exit(
+      test::spawn_demcal({"calibrate", "-q", "--jobs", "2", "--max-trials", "6", "-o", dir.string(),
+                          test::shipped_config("fcc_4x4x4"), "--set", "assembly.cells_x=2", "--set",
+                          "assembly.cells_y=2", "--set", "assembly.cells_z=2"}));
+  ASSERT_TRUE(status == 0 || status == 1) << status;
+  const std::string html = test::read_text(dir / "report.html"),
+                    md = test::read_text(dir / "report.md");
+  EXPECT_EQ(html_problem(html), "");
+  EXPECT_EQ(external_references(html), std::vector<std::string>{});
+  for (const char* fact :
+       {"spheres (REV, triaxial test)", "(a) Axial boundary stress b_zz", "Lateral component xx",
+        "Lateral component yy", "Shear pair σ_xy and σ_yx", "Shear pair σ_xz and σ_zx",
+        "Shear pair σ_yz and σ_zy", "each of the four lateral walls", "max |σ_yz − σ_zy|",
+        "max |servo error|, wall y max", "peak b_zz at Nstep", "Diagnosis in words",
+        "Search history", "Speed against accuracy", "Upscaling to the prototype",
+        "The assembly at the peak", "final.vtk"}) {
+    EXPECT_NE(html.find(fact), std::string::npos) << "HTML lacks " << fact;
+    std::string in_md;  // the Markdown tables escape '|'
+    for (char ch : std::string(fact)) in_md += ch == '|' ? std::string("\\|") : std::string(1, ch);
+    EXPECT_NE(md.find(in_md), std::string::npos) << "Markdown lacks " << in_md;
+  }
+  const std::string svg = sphere_svg_of(html);
+  EXPECT_EQ(count(svg, "<circle "), 32);  // 2×2×2 FCC cells
+  if (!find_program("gnuplot").empty()) {
+    // Axial, two lateral, three shear, servo; history; speed.
+    EXPECT_EQ(count(html, "class=\"plot"), 9);
+  }
+  const std::string vtk = test::read_text(dir / "final.vtk");
+  EXPECT_EQ(vtk.rfind("# vtk DataFile", 0), 0u);
+  EXPECT_NE(vtk.find("POINTS 32 "), std::string::npos);
+  fs::remove_all(dir);
+}
+
+// A 3D calibration with no result still reports its start point; without a
+// prototype block in params.json the report says the prototype is the REV,
+// and with one it shows that block.
+TEST(Report3D, NoResultAndThePrototypeBlock) {
+  const TriaxialState& state = small_fcc();
+  const SceneConfig c = parse_config_text(R"({"dimension": 3,
+      "material": {"density": 2650, "kn": 1e8, "kt": 5e7, "friction": 0.3},
+      "assembly": {"type": "fcc", "cells_x": 2, "cells_y": 2, "cells_z": 2, "radius": 5e-4},
+      "test": {"type": "triaxial", "lateral_stress": 1e5, "vertical_strain": 1e-5,
+               "monitor_points": 40}})",
+                                          "fcc2.json");
+  ReportInput in;
+  in.scene = "fcc2";
+  in.command = "demcal calibrate fcc2.json";
+  in.lateral_stress = 1e5;
+  in.particles = in.prototype_particles = state.world.size();
+  in.summary.success = false;
+  in.summary.message = "no trial passed every criterion within 1 trials";
+  AlgorithmSpec start = c.algorithm;
+  start.steps = 1500;
+  attach_runs(in, rerun_start_and_result(c, state, start, in.summary, in.tolerances, 1));
+  ASSERT_EQ(in.dimension, 3);
+  ASSERT_TRUE(in.start3);
+  EXPECT_FALSE(in.best3 || in.sphere_picture);
+  ReportOptions options;
+  options.gnuplot = "";
+  const Report failed = make_report(in, options);
+  EXPECT_EQ(html_problem(failed.html), "");
+  EXPECT_NE(failed.markdown.find("The answer: no parameter set passed"), std::string::npos);
+  EXPECT_NE(failed.markdown.find("Start point (α 0.2, Nstep 1,500"), std::string::npos);
+  EXPECT_NE(failed.markdown.find("No picture: there is no calibrated run."), std::string::npos);
+  EXPECT_EQ(sphere_svg_of(failed.html), "");
+
+  // A result and params.json's blocks.
+  in.summary.success = true;
+  in.summary.best = start;
+  in.summary.best_trial.params = start;
+  in.summary.best_trial.score = in.start3->score;
+  in.summary.best_trial.score.particle_steps = 1.0;
+  in.params = {{"rev", {{"particles", 32}, {"steps", 1500}}}};
+  attach_runs(in, rerun_start_and_result(c, state, start, in.summary, in.tolerances, 1));
+  const Report rev = make_report(in, options);
+  EXPECT_NE(rev.markdown.find("params.json has no prototype block: the prototype is the REV"),
+            std::string::npos);
+  EXPECT_EQ(count(sphere_svg_of(rev.html), "<circle "), 32);
+  in.params["prototype"] = {{"particles", 20000},
+                            {"steps", 2000000},
+                            {"source", {{"kind", "scaled"}, {"description", "a test block"}}}};
+  const Report proto = make_report(in, options);
+  EXPECT_NE(proto.markdown.find("The prototype is not the REV (params.json's prototype block: a "
+                                "test block; kind scaled)"),
+            std::string::npos);
+  EXPECT_NE(proto.markdown.find("| steps | 2,000,000 |"), std::string::npos);
 }

@@ -18,6 +18,10 @@ std::string grouped(int64_t v) {
 
 std::string kpa(double pa) { return num(pa / 1e3, 4) + " kPa"; }
 
+std::string strain_pct(double fraction, int dimension) {
+  return dimension == 3 ? num(100.0 * fraction, 3) + " %" : pct(fraction, 3);
+}
+
 std::string sentence(std::string s) {
   while (!s.empty() && s.back() == ' ') s.pop_back();
   if (s.empty()) return s;
@@ -76,9 +80,70 @@ int64_t prototype_steps(const ReportInput& in) {
 
 }  // namespace
 
-ReportFacts gather_facts(const ReportInput& in) {
-  ReportFacts f;
+std::vector<std::vector<double>> panel_rows(const std::vector<MonitorPoint>& series) {
+  std::vector<std::vector<double>> rows;
+  rows.reserve(series.size());
+  for (const auto& p : series)
+    rows.push_back({-100.0 * p.strain_yy, -p.b(1, 1) / 1e3, -p.sigma(1, 1) / 1e3,
+                    p.sigma(0, 1) / 1e3, p.sigma(1, 0) / 1e3, -p.b(0, 0) / 1e3,
+                    -p.sigma(0, 0) / 1e3, 100.0 * p.lateral_stress_error});
+  return rows;
+}
+
+std::vector<std::vector<double>> panel_rows(const std::vector<TriaxialPoint>& series) {
+  std::vector<std::vector<double>> rows;
+  rows.reserve(series.size());
+  for (const auto& p : series) {
+    const auto& b = p.b;
+    const auto& s = p.sigma;
+    rows.push_back({-100.0 * p.strain_zz, -b(2, 2) / 1e3, -s(2, 2) / 1e3, -b(0, 0) / 1e3,
+                    -s(0, 0) / 1e3, -b(1, 1) / 1e3, -s(1, 1) / 1e3, s(0, 1) / 1e3, s(1, 0) / 1e3,
+                    s(0, 2) / 1e3, s(2, 0) / 1e3, s(1, 2) / 1e3, s(2, 1) / 1e3,
+                    100.0 * p.servo_error[0], 100.0 * p.servo_error[1], 100.0 * p.servo_error[2],
+                    100.0 * p.servo_error[3]});
+  }
+  return rows;
+}
+
+namespace {
+
+template <class Run>
+PanelRun panel_run(const Run& r, bool result) {
+  PanelRun p;
+  p.label = r.label;
+  p.params = &r.params;
+  p.score = &r.score;
+  p.diverged = r.run.diverged;
+  p.result = result;
+  p.rows = panel_rows(r.run.series);
+  return p;
+}
+
+void gather_runs(const ReportInput& in, ReportFacts& f) {
+  f.runs.reserve(2);
+  if (in.dimension == 3) {
+    if (in.start3) f.runs.push_back(panel_run(*in.start3, false));
+    if (in.best3) f.runs.push_back(panel_run(*in.best3, true));
+  } else {
+    if (in.start) f.runs.push_back(panel_run(*in.start, false));
+    if (in.best) f.runs.push_back(panel_run(*in.best, true));
+  }
+  for (const auto& r : f.runs) (r.result ? f.result : f.start) = &r;
+  f.have_ref_series = in.dimension != 3 && in.reference && !in.reference->fine_series.empty();
+  if (f.have_ref_series) {
+    f.reference.label = "Nstep ×16";
+    f.reference.params = &in.reference->fine.params;
+    f.reference.score = &in.reference->fine.score;
+    f.reference.rows = panel_rows(in.reference->fine_series);
+  }
+}
+
+}  // namespace
+
+void gather_facts(const ReportInput& in, ReportFacts& f) {
   f.in = &in;
+  f.dimension = in.dimension;
+  f.axial = in.dimension == 3 ? "b_zz" : "b_yy";
   const auto& S = in.summary;
   f.have_best = S.best_trial.score.particle_steps > 0.0;  // default-constructed: none
   auto add = [&](const TrialRecord& t, const std::string& label) {
@@ -102,12 +167,11 @@ ReportFacts gather_facts(const ReportInput& in) {
     if (p.trial->phase == TrialPhase::baseline && p.trial->score.passed)
       f.baseline_index = static_cast<int>(k);
   }
-  if (in.start) f.runs.push_back(&*in.start);
-  if (in.best) f.runs.push_back(&*in.best);
-  f.have_ref_series = in.reference && !in.reference->fine_series.empty();
-  f.upscale = f.have_best && in.prototype_particles > in.particles && in.particles > 0;
+  gather_runs(in, f);
+  // 3D: the prototype block of params.json as it is (no size law assumed).
+  f.upscale =
+      in.dimension != 3 && f.have_best && in.prototype_particles > in.particles && in.particles > 0;
   if (f.have_best && in.particles > 0) f.proto_steps = prototype_steps(in);
-  return f;
 }
 
 }  // namespace demcal::report

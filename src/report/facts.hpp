@@ -17,6 +17,9 @@ namespace demcal::report {
 std::string grouped(int64_t v);
 /// A stress in Pa as "12.5 kPa".
 std::string kpa(double pa);
+/// A strain (a fraction) in %: three decimals in 2D, three significant
+/// digits in 3D (the triaxial scenes load to strains of 1e-5).
+std::string strain_pct(double fraction, int dimension);
 /// A diagnosis message as a sentence: capital first letter, final period.
 std::string sentence(std::string s);
 /// "α 0.277, Nstep 89,370, ζ_t 0.5, ζ_r 0".
@@ -36,21 +39,76 @@ struct Point {
   bool best = false;
 };
 
+/// The columns of a run's panel table (gnuplot's numbering, from 1): the
+/// compressive strain of the loading axis [%], then stresses [kPa] (the
+/// normal components compression positive, shear tension positive) and
+/// servo errors [%]. One layout per dimension.
+namespace col2 {
+enum : int { strain = 1, b_axial, s_axial, s_xy, s_yx, b_xx, s_xx, servo };
+}
+namespace col3 {
+enum : int {
+  strain = 1,
+  b_axial,  // zz
+  s_axial,
+  b_xx,
+  s_xx,
+  b_yy,
+  s_yy,
+  s_xy,
+  s_yx,
+  s_xz,
+  s_zx,
+  s_yz,
+  s_zy,
+  servo_xmin,
+  servo_xmax,
+  servo_ymin,
+  servo_ymax
+};
+}
+
+/// A run of the paper's panels, whatever the dimension: its series as the
+/// panel table (rows of the columns above; rows[k][c − 1] is column c).
+struct PanelRun {
+  std::string label;
+  const AlgorithmSpec* params = nullptr;
+  const Score* score = nullptr;
+  bool diverged = false;
+  bool result = false;  ///< the calibrated run (the reference goes on its panel)
+  std::vector<std::vector<double>> rows;
+  /// The value of column c at row k.
+  double at(size_t k, int c) const { return rows[k][static_cast<size_t>(c - 1)]; }
+};
+/// The panel table of a 2D series (col2) and of a 3D one (col3).
+std::vector<std::vector<double>> panel_rows(const std::vector<MonitorPoint>& series);
+std::vector<std::vector<double>> panel_rows(const std::vector<TriaxialPoint>& series);
+
 struct ReportFacts {
   const ReportInput* in = nullptr;  ///< everything below points into it
-  bool have_best = false;           ///< a trial ran (the summary has a result)
-  std::vector<Point> points;        ///< search trials, then b0…, then r8, r16
+  int dimension = 2;
+  std::string axial;          ///< the loading axis' boundary stress: "b_yy" (2D), "b_zz" (3D)
+  bool have_best = false;     ///< a trial ran (the summary has a result)
+  std::vector<Point> points;  ///< search trials, then b0…, then r8, r16
   std::optional<double> best_peak_error;
-  int baseline_index = -1;             ///< in points: the passing paper-recipe trial
-  std::vector<const ReportRun*> runs;  ///< start point, result (those with series)
-  bool have_ref_series = false;        ///< the 16×Nstep reference kept its series
-  bool upscale = false;                ///< a prototype larger than the REV
-  int64_t proto_steps = 0;             ///< Nstep of the prototype
+  int baseline_index = -1;          ///< in points: the passing paper-recipe trial
+  std::vector<PanelRun> runs;       ///< start point, result (those with series)
+  const PanelRun* start = nullptr;  ///< in runs, when rerun
+  const PanelRun* result = nullptr;
+  bool have_ref_series = false;  ///< the 16×Nstep reference kept its series (2D)
+  PanelRun reference;            ///< its panel table, when it did
+  bool upscale = false;          ///< a prototype larger than the REV
+  int64_t proto_steps = 0;       ///< Nstep of the prototype
+
+  ReportFacts() = default;
+  ReportFacts(const ReportFacts&) = delete;  // start and result point into runs
+  ReportFacts& operator=(const ReportFacts&) = delete;
 
   const Point* baseline() const {
     return baseline_index < 0 ? nullptr : &points[static_cast<size_t>(baseline_index)];
   }
 };
-ReportFacts gather_facts(const ReportInput& in);
+/// Fills `f` (not copyable: it points into itself).
+void gather_facts(const ReportInput& in, ReportFacts& f);
 
 }  // namespace demcal::report

@@ -34,36 +34,14 @@ std::string common() {
          "set datafile missing '?'\n";
 }
 
-/// 6 −b_xx, 7 −σ_xx [kPa], 8 servo error [%].
-std::string series_dat(const std::vector<MonitorPoint>& s) {
+/// A run's panel table as a gnuplot data file.
+std::string series_dat(const PanelRun& r) {
   std::ostringstream o;
-  for (const auto& p : s) {
-    o << dat(-100.0 * p.strain_yy) << ' ' << dat(-p.b(1, 1) / 1e3) << ' '
-      << dat(-p.sigma(1, 1) / 1e3) << ' ' << dat(p.sigma(0, 1) / 1e3) << ' '
-      << dat(p.sigma(1, 0) / 1e3) << ' ' << dat(-p.b(0, 0) / 1e3) << ' '
-      << dat(-p.sigma(0, 0) / 1e3) << ' ' << dat(100.0 * p.lateral_stress_error) << '\n';
+  for (const auto& row : r.rows) {
+    for (size_t c = 0; c < row.size(); ++c) o << (c ? " " : "") << dat(row[c]);
+    o << '\n';
   }
   return o.str();
-}
-
-double column(const MonitorPoint& p, int c) {
-  switch (c) {
-    case 2:
-      return -p.b(1, 1) / 1e3;
-    case 3:
-      return -p.sigma(1, 1) / 1e3;
-    case 4:
-      return p.sigma(0, 1) / 1e3;
-    case 5:
-      return p.sigma(1, 0) / 1e3;
-    case 6:
-      return -p.b(0, 0) / 1e3;
-    case 7:
-      return -p.sigma(0, 0) / 1e3;
-    case 8:
-      return 100.0 * p.lateral_stress_error;
-  }
-  return 0.0;
 }
 
 std::string gp_range(double lo, double hi) {
@@ -91,7 +69,7 @@ struct SeriesFigure {
 /// The y range of a series figure: every curve of every run, except that a
 /// diverged run does not set it (its values explode; it is clipped, and its
 /// panel says it diverged).
-std::pair<double, double> series_range(const std::vector<const ReportRun*>& runs,
+std::pair<double, double> series_range(const std::vector<PanelRun>& runs,
                                        const SeriesFigure& spec) {
   double lo = std::numeric_limits<double>::infinity(), hi = -lo;
   for (double v : spec.include) {
@@ -99,12 +77,12 @@ std::pair<double, double> series_range(const std::vector<const ReportRun*>& runs
     hi = std::max(hi, v);
   }
   bool any_finished = false;
-  for (const auto* r : runs) any_finished = any_finished || !r->run.diverged;
-  for (const auto* r : runs) {
-    if (r->run.diverged && any_finished) continue;
-    for (const auto& p : r->run.series)
+  for (const auto& r : runs) any_finished = any_finished || !r.diverged;
+  for (const auto& r : runs) {
+    if (r.diverged && any_finished) continue;
+    for (size_t k = 0; k < r.rows.size(); ++k)
       for (const auto& [c, t, s] : spec.curves) {
-        const double v = column(p, c);
+        const double v = r.at(k, c);
         if (std::isfinite(v)) {
           lo = std::min(lo, v);
           hi = std::max(hi, v);
@@ -118,20 +96,22 @@ void add_series_figure(PlotPlan& plot, const ReportFacts& f, const SeriesFigure&
   const auto& runs = f.runs;
   if (runs.empty()) return;
   double strain = 0.0;
-  for (const auto* r : runs)
-    for (const auto& p : r->run.series) strain = std::max(strain, -100.0 * p.strain_yy);
+  for (const auto& r : runs)
+    for (size_t k = 0; k < r.rows.size(); ++k) strain = std::max(strain, r.at(k, 1));
   const auto [lo, hi] = series_range(runs, spec);
   std::ostringstream g;
   g << terminal(1060, 370) << "set output '" << spec.name << ".svg'\n"
     << common() << "set multiplot layout 1," << runs.size() << "\n"
-    << "set xlabel 'vertical strain −ε_{yy} [%]'\nset ylabel '" << spec.ylabel << "'\n"
+    << "set xlabel '"
+    << (f.dimension == 3 ? "axial strain −ε_{zz} [%]" : "vertical strain −ε_{yy} [%]")
+    << "'\nset ylabel '" << spec.ylabel << "'\n"
     << "set xrange [0:" << dat(strain > 0 ? strain : 1.0) << "]\nset yrange " << gp_range(lo, hi)
     << "\nset key top right\n"
     << spec.extra;
   for (size_t k = 0; k < runs.size(); ++k) {
     g << "set title '"
-      << (runs[k]->label == "start point" ? std::string("start point: ") : runs[k]->label + ": ")
-      << params_gp(runs[k]->params) << (runs[k]->run.diverged ? "  (DIVERGED)" : "") << "'\n";
+      << (runs[k].label == "start point" ? std::string("start point: ") : runs[k].label + ": ")
+      << params_gp(*runs[k].params) << (runs[k].diverged ? "  (DIVERGED)" : "") << "'\n";
     g << "plot ";
     bool first = true;
     for (const auto& [c, t, s] : spec.curves) {
@@ -139,7 +119,7 @@ void add_series_figure(PlotPlan& plot, const ReportFacts& f, const SeriesFigure&
         << "'";
       first = false;
     }
-    if (spec.with_reference && f.have_ref_series && runs[k] == &*f.in->best)
+    if (spec.with_reference && f.have_ref_series && runs[k].result)
       g << ", 'ref.dat' u 1:2 w l lw 1 dt 3 lc rgb '#333333' t 'N_{step} ×16 (near-converged)'";
     g << "\n";
   }
@@ -147,19 +127,30 @@ void add_series_figure(PlotPlan& plot, const ReportFacts& f, const SeriesFigure&
   plot.figures.push_back({spec.name, g.str(), spec.caption});
 }
 
-void add_series_figures(PlotPlan& plot, const ReportFacts& f) {
+/// σ3 as a dashed line, for the lateral panels.
+std::string sigma3_line(double s3) {
+  return "set arrow 1 from graph 0, first " + dat(s3 / 1e3) + " to graph 1, first " +
+         dat(s3 / 1e3) + " nohead dt 2 lc rgb '#666666'\nset label 1 'σ_3' at graph 0.98, first " +
+         dat(s3 / 1e3) + " right offset 0,-0.8 tc rgb '#666666'\n";
+}
+
+/// ± the servo tolerance [%] as dashed lines.
+std::string servo_lines(double tolerance) {
+  const std::string t = dat(100.0 * tolerance);
+  return "set arrow 1 from graph 0, first " + t + " to graph 1, first " + t +
+         " nohead dt 2 lc rgb '#b3261e'\nset arrow 2 from graph 0, first -" + t +
+         " to graph 1, first -" + t + " nohead dt 2 lc rgb '#b3261e'\n";
+}
+
+void add_series_figures_2d(PlotPlan& plot, const ReportFacts& f) {
   const ReportInput& in = *f.in;
-  for (size_t k = 0; k < f.runs.size(); ++k)
-    plot.files["run" + std::to_string(k) + ".dat"] = series_dat(f.runs[k]->run.series);
-  if (f.have_ref_series) plot.files["ref.dat"] = series_dat(in.reference->fine_series);
   const double s3 = in.lateral_stress;
-  const std::string servo_tol = dat(100.0 * in.tolerances.servo);
   add_series_figure(
       plot, f,
       {"fig_a",
        "compressive stress [kPa]",
-       {{2, "−b_{yy} boundary", "lw 5 lc rgb '#9ecae1'"},
-        {3, "−σ_{yy} homogenized", "lw 1.5 lc rgb '#08306b'"}},
+       {{col2::b_axial, "−b_{yy} boundary", "lw 5 lc rgb '#9ecae1'"},
+        {col2::s_axial, "−σ_{yy} homogenized", "lw 1.5 lc rgb '#08306b'"}},
        "set key bottom right\n",
        true,
        "(a) Vertical boundary stress b_yy and homogenized stress σ_yy against the vertical strain, "
@@ -171,7 +162,8 @@ void add_series_figures(PlotPlan& plot, const ReportFacts& f) {
       plot, f,
       {"fig_b",
        "shear stress [kPa] (tension positive)",
-       {{4, "σ_{xy}", "lw 3 lc rgb '#fdae6b'"}, {5, "σ_{yx}", "lw 1.2 lc rgb '#7f2704'"}},
+       {{col2::s_xy, "σ_{xy}", "lw 3 lc rgb '#fdae6b'"},
+        {col2::s_yx, "σ_{yx}", "lw 1.2 lc rgb '#7f2704'"}},
        "",
        false,
        "(b) Off-diagonal homogenized stresses σ_xy and σ_yx. Moment balance means they coincide; "
@@ -182,11 +174,9 @@ void add_series_figures(PlotPlan& plot, const ReportFacts& f) {
       plot, f,
       {"fig_lat",
        "lateral compressive stress [kPa]",
-       {{6, "−b_{xx} boundary", "lw 5 lc rgb '#a1d99b'"},
-        {7, "−σ_{xx} homogenized", "lw 1.5 lc rgb '#00441b'"}},
-       "set arrow 1 from graph 0, first " + dat(s3 / 1e3) + " to graph 1, first " + dat(s3 / 1e3) +
-           " nohead dt 2 lc rgb '#666666'\nset label 1 'σ_3' at graph 0.98, first " +
-           dat(s3 / 1e3) + " right offset 0,-0.8 tc rgb '#666666'\n",
+       {{col2::b_xx, "−b_{xx} boundary", "lw 5 lc rgb '#a1d99b'"},
+        {col2::s_xx, "−σ_{xx} homogenized", "lw 1.5 lc rgb '#00441b'"}},
+       sigma3_line(s3),
        false,
        "Lateral components: boundary stress b_xx and homogenized σ_xx against σ3 (dashed). Global "
        "damping that drags against the lateral expansion shows up as σ_xx above b_xx: extra "
@@ -196,14 +186,94 @@ void add_series_figures(PlotPlan& plot, const ReportFacts& f) {
       plot, f,
       {"fig_servo",
        "servo error (p_{lateral} − σ_3)/σ_3 [%]",
-       {{8, "servo error", "lw 1.5 lc rgb '#54278f'"}},
-       "set arrow 1 from graph 0, first " + servo_tol + " to graph 1, first " + servo_tol +
-           " nohead dt 2 lc rgb '#b3261e'\nset arrow 2 from graph 0, first -" + servo_tol +
-           " to graph 1, first -" + servo_tol + " nohead dt 2 lc rgb '#b3261e'\n",
+       {{col2::servo, "servo error", "lw 1.5 lc rgb '#54278f'"}},
+       servo_lines(in.tolerances.servo),
        false,
        "Boundary-control (servo) error of the lateral walls: mean lateral wall stress against σ3, "
        "in %. Dashed: ± the servo tolerance (applied to the trend of this curve).",
        {-100.0 * in.tolerances.servo, 100.0 * in.tolerances.servo}});
+}
+
+/// The 3D panels: axial, each lateral component, the three shear pairs,
+/// the four lateral walls' servo errors.
+void add_series_figures_3d(PlotPlan& plot, const ReportFacts& f) {
+  const ReportInput& in = *f.in;
+  const double s3 = in.lateral_stress;
+  add_series_figure(
+      plot, f,
+      {"fig_a",
+       "compressive stress [kPa]",
+       {{col3::b_axial, "−b_{zz} boundary", "lw 5 lc rgb '#9ecae1'"},
+        {col3::s_axial, "−σ_{zz} homogenized", "lw 1.5 lc rgb '#08306b'"}},
+       "set key bottom right\n",
+       false,
+       "(a) Axial boundary stress b_zz and homogenized stress σ_zz against the axial strain, "
+       "compression positive, start point (left) and calibrated run (right), same axes. A static "
+       "run has the two curves on top of each other; a gap means the spheres are not in force "
+       "balance (loading too fast, too much or too little damping).",
+       {}});
+  const char* lateral[2][5] = {
+      {"fig_lat_x", "−b_{xx} boundary", "−σ_{xx} homogenized", "#a1d99b", "#00441b"},
+      {"fig_lat_y", "−b_{yy} boundary", "−σ_{yy} homogenized", "#fdd0a2", "#7f2704"}};
+  for (int a = 0; a < 2; ++a)
+    add_series_figure(
+        plot, f,
+        {lateral[a][0],
+         "lateral compressive stress [kPa]",
+         {{a == 0 ? col3::b_xx : col3::b_yy, lateral[a][1],
+           std::string("lw 5 lc rgb '") + lateral[a][3] + "'"},
+          {a == 0 ? col3::s_xx : col3::s_yy, lateral[a][2],
+           std::string("lw 1.5 lc rgb '") + lateral[a][4] + "'"}},
+         sigma3_line(s3),
+         false,
+         std::string("Lateral component ") + (a == 0 ? "xx" : "yy") + ": boundary stress b_" +
+             (a == 0 ? "xx" : "yy") + " and homogenized σ_" + (a == 0 ? "xx" : "yy") +
+             " against σ3 (dashed). Global damping that drags against the lateral expansion "
+             "shows up as σ above b: extra confinement and an over-predicted peak.",
+         {s3 / 1e3}});
+  const struct {
+    const char *name, *ij, *ji, *light, *dark;
+    int c1, c2;
+  } shear[3] = {{"fig_shear_xy", "xy", "yx", "#fdae6b", "#7f2704", col3::s_xy, col3::s_yx},
+                {"fig_shear_xz", "xz", "zx", "#bcbddc", "#3f007d", col3::s_xz, col3::s_zx},
+                {"fig_shear_yz", "yz", "zy", "#a6dba0", "#00441b", col3::s_yz, col3::s_zy}};
+  for (const auto& p : shear)
+    add_series_figure(
+        plot, f,
+        {p.name,
+         "shear stress [kPa] (tension positive)",
+         {{p.c1, std::string("σ_{") + p.ij + "}", std::string("lw 3 lc rgb '") + p.light + "'"},
+          {p.c2, std::string("σ_{") + p.ji + "}", std::string("lw 1.2 lc rgb '") + p.dark + "'"}},
+         "",
+         false,
+         std::string("(b) Shear pair σ_") + p.ij + " and σ_" + p.ji +
+             " of the homogenized stress. Moment balance means they coincide; "
+             "large and opposite values mean rotational disequilibrium (time step "
+             "too large, or rotational damping too high).",
+         {}});
+  add_series_figure(
+      plot, f,
+      {"fig_servo",
+       "servo error (p_{wall} − σ_3)/σ_3 [%]",
+       {{col3::servo_xmin, "x min", "lw 1.5 lc rgb '#1b9e77'"},
+        {col3::servo_xmax, "x max", "lw 1.5 dt 2 lc rgb '#1b9e77'"},
+        {col3::servo_ymin, "y min", "lw 1.5 lc rgb '#7570b3'"},
+        {col3::servo_ymax, "y max", "lw 1.5 dt 2 lc rgb '#7570b3'"}},
+       servo_lines(in.tolerances.servo),
+       false,
+       "Boundary-control (servo) error of each of the four lateral walls: its stress against σ3, "
+       "in %. Dashed red: ± the servo tolerance (applied to the trend of each curve).",
+       {-100.0 * in.tolerances.servo, 100.0 * in.tolerances.servo}});
+}
+
+void add_series_figures(PlotPlan& plot, const ReportFacts& f) {
+  for (size_t k = 0; k < f.runs.size(); ++k)
+    plot.files["run" + std::to_string(k) + ".dat"] = series_dat(f.runs[k]);
+  if (f.have_ref_series) plot.files["ref.dat"] = series_dat(f.reference);
+  if (f.dimension == 3)
+    add_series_figures_3d(plot, f);
+  else
+    add_series_figures_2d(plot, f);
 }
 
 // ---------------------------------------------------------------------------

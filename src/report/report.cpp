@@ -17,9 +17,17 @@ void attach_runs(ReportInput& input, ResultRuns runs) {
   input.picture = std::move(runs.picture);
 }
 
+void attach_runs(ReportInput& input, ResultRuns3D runs) {
+  input.dimension = 3;
+  input.start3 = std::move(runs.start);
+  input.best3 = std::move(runs.best);
+  input.sphere_picture = std::move(runs.picture);
+}
+
 Report make_report(const ReportInput& in, const ReportOptions& options) {
   using namespace report;
-  const ReportFacts facts = gather_facts(in);
+  ReportFacts facts;
+  gather_facts(in, facts);
   const Figures figures = render_figures(facts, options);
   Doc d;
   write_title(d, facts);

@@ -20,7 +20,8 @@ void write_title(Doc& d, const ReportFacts& f) {
              esc(std::string(S.success ? "SUCCESS" : "FAILURE") + ": " + S.message) + "</div>\n");
   d.md << "**" << (S.success ? "SUCCESS" : "FAILURE") << "**: " << S.message << "\n\n";
   const std::string line =
-      "Scene " + in.scene + ", " + grouped(in.particles) + " particles (REV); " +
+      "Scene " + in.scene + ", " + grouped(in.particles) +
+      (f.dimension == 3 ? " spheres (REV, triaxial test); " : " particles (REV); ") +
       std::to_string(S.trials.size()) + " trials (" + std::to_string(S.trials_run) + " run, " +
       std::to_string(S.trials_reused) + " reused from an earlier run), strategy " +
       to_string(S.strategy) + ", " + num(S.wall_time_s, 3) +
@@ -55,7 +56,7 @@ void write_at_a_glance(Doc& d, const ReportFacts& f) {
   if (f.have_best) {
     glance.push_back(use_line(in));
     const Excesses r =
-        excesses(in.best ? in.best->score.criteria : S.best_trial.score.criteria, in.tolerances);
+        excesses(f.result ? f.result->score->criteria : S.best_trial.score.criteria, in.tolerances);
     glance.push_back("Every criterion within tolerance: worst " + r.worst_name() + " at " +
                      fixed(100.0 * r.worst(), 0) + " % of its tolerance.");
   }
@@ -157,31 +158,49 @@ void write_criteria(Doc& d, const ReportFacts& f) {
   }
   // The rerun's criteria (every field; a trial reloaded by --resume
   // carries only those trials.jsonl keeps). Same run, same numbers.
-  const auto& c = in.best ? in.best->score.criteria : S.best_trial.score.criteria;
+  const auto& c = f.result ? f.result->score->criteria : S.best_trial.score.criteria;
   auto row = [&](const std::string& name, const std::string& meaning, double v, double t) {
     return std::vector<std::string>{
         name, meaning, num(v, 3), num(t, 3), fixed(v / t, 2) + "×", v <= t ? "pass" : "FAIL"};
   };
+  const bool d3 = f.dimension == 3;
   std::vector<std::vector<std::string>> rows{
       row("force balance", "max of the three below: max |trend| of b − σ", c.force_balance,
           tol.force_balance),
-      row("  lateral xx", "(b_xx − σ_xx)/σ3", c.force_balance_xx, tol.force_balance),
-      row("  vertical yy", "(b_yy − σ_yy)/max(|b_yy|, σ3)", c.force_balance_yy, tol.force_balance),
-      row("  shear", "sym(b − σ)_xy/σ3", c.force_balance_shear, tol.force_balance),
-      row("moment balance", "RMS (σ_xy − σ_yx)/σ3", c.moment_balance, tol.moment_balance),
-      row("servo", "max |trend| (lateral wall stress − σ3)/σ3", c.servo, tol.servo),
+      d3 ? row("  lateral xx, yy", "(b_xx − σ_xx)/σ3 and (b_yy − σ_yy)/σ3, the larger",
+               c.force_balance_xx, tol.force_balance)
+         : row("  lateral xx", "(b_xx − σ_xx)/σ3", c.force_balance_xx, tol.force_balance),
+      d3 ? row("  axial zz", "(b_zz − σ_zz)/max(|b_zz|, σ3)", c.force_balance_yy, tol.force_balance)
+         : row("  vertical yy", "(b_yy − σ_yy)/max(|b_yy|, σ3)", c.force_balance_yy,
+               tol.force_balance),
+      d3 ? row("  shear", "sym(b − σ)_ij/σ3, the largest of xy, xz, yz", c.force_balance_shear,
+               tol.force_balance)
+         : row("  shear", "sym(b − σ)_xy/σ3", c.force_balance_shear, tol.force_balance),
+      d3 ? row("moment balance", "RMS (σ_ij − σ_ji)/σ3, the largest of the three pairs",
+               c.moment_balance, tol.moment_balance)
+         : row("moment balance", "RMS (σ_xy − σ_yx)/σ3", c.moment_balance, tol.moment_balance),
+      d3 ? row("servo", "max |trend| (wall stress − σ3)/σ3, the largest of the four lateral walls",
+               c.servo, tol.servo)
+         : row("servo", "max |trend| (lateral wall stress − σ3)/σ3", c.servo, tol.servo),
       row("oscillation", "robust noise of the force-balance gaps", c.oscillation, tol.oscillation)};
   d.table({"criterion", "measure", "value", "tolerance", "value/tolerance", "verdict"}, rows);
   d.table({"for comparison (not criteria)", "value"},
-          {{"paper's force balance RMS(b_yy − σ_yy)/RMS(b_yy)", num(c.force_balance_paper, 3)},
-           {"interior lateral stress error (σ_xx against σ3)", num(c.interior_lateral, 3)},
-           {"zigzag (noise b_yy and σ_yy share)", num(c.zigzag, 3)},
+          {{d3 ? "paper's force balance RMS(b_zz − σ_zz)/RMS(b_zz)"
+               : "paper's force balance RMS(b_yy − σ_yy)/RMS(b_yy)",
+            num(c.force_balance_paper, 3)},
+           {d3 ? "interior lateral stress error (σ_xx and σ_yy against σ3, the larger)"
+               : "interior lateral stress error (σ_xx against σ3)",
+            num(c.interior_lateral, 3)},
+           {d3 ? "zigzag (noise b_zz and σ_zz share)" : "zigzag (noise b_yy and σ_yy share)",
+            num(c.zigzag, 3)},
            {"kinetic / elastic energy, max", num(c.kinetic_energy_ratio_max, 3)},
            {"unbalanced-force ratio, mean / max",
             num(c.unbalanced_force_ratio_mean, 3) + " / " + num(c.unbalanced_force_ratio_max, 3)},
            {"inertial number, max", num(c.inertial_number_max, 3)},
-           {"peak b_yy", kpa(c.peak_stress_yy) + " at ε_yy = " + pct(c.peak_strain_yy, 3)},
-           {"analytical peak (rotation locked, walled box)",
+           {"peak " + f.axial, kpa(c.peak_stress_yy) + " at ε_" + f.axial.substr(2) + " = " +
+                                   strain_pct(c.peak_strain_yy, f.dimension)},
+           {d3 ? "analytical peak (walled FCC lattice, rotation locked; Thornton 1979)"
+               : "analytical peak (rotation locked, walled box)",
             in.analytical_peak ? kpa(*in.analytical_peak) : std::string("n/a")}});
 }
 
@@ -209,8 +228,9 @@ void write_certificate(Doc& d, const ReportFacts& f) {
     return;
   }
   d.table({"check", "value"},
-          {{"peak b_yy at Nstep = " + grouped(C.steps), kpa(C.peak)},
-           {"peak b_yy at 2·Nstep = " + grouped(doubled_steps(in.summary)), kpa(C.peak_doubled)},
+          {{"peak " + f.axial + " at Nstep = " + grouped(C.steps), kpa(C.peak)},
+           {"peak " + f.axial + " at 2·Nstep = " + grouped(doubled_steps(in.summary)),
+            kpa(C.peak_doubled)},
            {"change |P(N) − P(2N)|/|P(2N)|", pct(C.steps_doubled_peak_change, 3)},
            {"Richardson error estimate of P(N), 2 × change (error ∝ 1/Nstep)",
             pct(C.richardson_error, 3)},

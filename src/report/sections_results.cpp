@@ -8,68 +8,87 @@
 
 #include "assembly_svg.hpp"
 #include "demcal/io/format.hpp"
+#include "demcal/report/sphere_svg.hpp"
 #include "sections.hpp"
 
 namespace demcal::report {
 
 namespace {
 
-/// What the panels show of one series, in numbers.
-struct SeriesNumbers {
-  double peak = 0, peak_strain = 0, max_gap_yy = 0, max_gap_xx = 0, max_asym = 0, max_servo = 0;
-  Criteria c;
-  bool diverged = false;
+/// A row of the panel numbers: a run's largest |column a − column b| (b = 0:
+/// its largest |column a|) over the series after the first point.
+struct GapRow {
+  std::string name;
+  int a = 0, b = 0;
+  bool percent = false;  ///< a servo error [%] (else a stress [kPa])
 };
 
-SeriesNumbers series_numbers(const std::vector<MonitorPoint>& s, const Criteria& c, bool diverged) {
-  SeriesNumbers f;
-  f.c = c;
-  f.diverged = diverged;
-  const Peak pk = find_peak(s);
-  f.peak = pk.stress_yy;
-  f.peak_strain = pk.strain_yy;
-  for (size_t k = 1; k < s.size(); ++k) {
-    const auto& p = s[k];
-    f.max_gap_yy = std::max(f.max_gap_yy, std::abs(p.b(1, 1) - p.sigma(1, 1)));
-    f.max_gap_xx = std::max(f.max_gap_xx, std::abs(p.b(0, 0) - p.sigma(0, 0)));
-    f.max_asym = std::max(f.max_asym, std::abs(p.sigma(0, 1) - p.sigma(1, 0)));
-    f.max_servo = std::max(f.max_servo, std::abs(p.lateral_stress_error));
-  }
-  return f;
+std::vector<GapRow> gap_rows(int dimension) {
+  if (dimension == 3)
+    return {{"max |b_zz − σ_zz|", col3::b_axial, col3::s_axial},
+            {"max |b_xx − σ_xx|", col3::b_xx, col3::s_xx},
+            {"max |b_yy − σ_yy|", col3::b_yy, col3::s_yy},
+            {"max |σ_xy − σ_yx|", col3::s_xy, col3::s_yx},
+            {"max |σ_xz − σ_zx|", col3::s_xz, col3::s_zx},
+            {"max |σ_yz − σ_zy|", col3::s_yz, col3::s_zy},
+            {"max |servo error|, wall x min", col3::servo_xmin, 0, true},
+            {"max |servo error|, wall x max", col3::servo_xmax, 0, true},
+            {"max |servo error|, wall y min", col3::servo_ymin, 0, true},
+            {"max |servo error|, wall y max", col3::servo_ymax, 0, true}};
+  return {{"max |b_yy − σ_yy|", col2::b_axial, col2::s_axial},
+          {"max |b_xx − σ_xx|", col2::b_xx, col2::s_xx},
+          {"max |σ_xy − σ_yx|", col2::s_xy, col2::s_yx},
+          {"max |servo error|", col2::servo, 0, true}};
+}
+
+double max_gap(const PanelRun& r, const GapRow& g) {
+  double m = 0.0;
+  for (size_t k = 1; k < r.rows.size(); ++k)
+    m = std::max(m, std::abs(r.at(k, g.a) - (g.b > 0 ? r.at(k, g.b) : 0.0)));
+  return m;
+}
+
+/// The monitored peak of the axial boundary stress (column 2, compression
+/// positive) and its strain (column 1), the first largest.
+std::pair<double, double> monitored_peak(const PanelRun& r) {
+  double peak = r.rows.empty() ? 0.0 : r.at(0, 2), strain = r.rows.empty() ? 0.0 : r.at(0, 1);
+  for (size_t k = 1; k < r.rows.size(); ++k)
+    if (r.at(k, 2) > peak) {
+      peak = r.at(k, 2);
+      strain = r.at(k, 1);
+    }
+  return {peak, strain};
 }
 
 /// The panels' facts as a table: a column per run (and the reference).
 void write_panel_numbers(Doc& d, const ReportFacts& f) {
-  const ReportInput& in = *f.in;
   std::vector<std::string> head{"measure"};
-  for (const auto* r : f.runs) head.push_back(r->label);
-  if (f.have_ref_series) head.push_back("Nstep ×16");
-  std::vector<SeriesNumbers> fs;
-  for (const auto* r : f.runs)
-    fs.push_back(series_numbers(r->run.series, r->score.criteria, r->run.diverged));
-  if (f.have_ref_series)
-    fs.push_back(
-        series_numbers(in.reference->fine_series, in.reference->fine.score.criteria, false));
+  std::vector<const PanelRun*> runs;
+  for (const auto& r : f.runs) runs.push_back(&r);
+  if (f.have_ref_series) runs.push_back(&f.reference);
+  for (const auto* r : runs) head.push_back(r->label);
   std::vector<std::vector<std::string>> rows;
-  auto row = [&](const std::string& name,
-                 const std::function<std::string(const SeriesNumbers&)>& cell) {
+  auto row = [&](const std::string& name, const std::function<std::string(const PanelRun&)>& cell) {
     std::vector<std::string> r{name};
-    for (const auto& x : fs) r.push_back(cell(x));
+    for (const auto* x : runs) r.push_back(cell(*x));
     rows.push_back(r);
   };
-  using N = const SeriesNumbers&;
-  row("peak b_yy (monitoring points)", [](N x) { return kpa(x.peak); });
-  row("strain at the peak", [](N x) { return pct(x.peak_strain, 3); });
-  row("max |b_yy − σ_yy|", [](N x) { return kpa(x.max_gap_yy); });
-  row("max |b_xx − σ_xx|", [](N x) { return kpa(x.max_gap_xx); });
-  row("max |σ_xy − σ_yx|", [](N x) { return kpa(x.max_asym); });
-  row("max |servo error|", [](N x) { return pct(x.max_servo, 3); });
-  row("force balance (criterion)", [](N x) { return num(x.c.force_balance, 3); });
-  row("moment balance (criterion)", [](N x) { return num(x.c.moment_balance, 3); });
-  row("servo (criterion)", [](N x) { return num(x.c.servo, 3); });
-  row("oscillation (criterion)", [](N x) { return num(x.c.oscillation, 3); });
+  using R = const PanelRun&;
+  row("peak " + f.axial + " (monitoring points)",
+      [](R x) { return kpa(-1e3 * monitored_peak(x).first); });
+  row("strain at the peak",
+      [&](R x) { return strain_pct(-monitored_peak(x).second / 100.0, f.dimension); });
+  for (const auto& g : gap_rows(f.dimension))
+    row(g.name, [&](R x) {
+      const double v = max_gap(x, g);
+      return g.percent ? pct(v / 100.0, 3) : kpa(1e3 * v);
+    });
+  row("force balance (criterion)", [](R x) { return num(x.score->criteria.force_balance, 3); });
+  row("moment balance (criterion)", [](R x) { return num(x.score->criteria.moment_balance, 3); });
+  row("servo (criterion)", [](R x) { return num(x.score->criteria.servo, 3); });
+  row("oscillation (criterion)", [](R x) { return num(x.score->criteria.oscillation, 3); });
   // "no" would colour red: say it plainly.
-  row("diverged?", [](N x) { return std::string(x.diverged ? "diverged" : "did not diverge"); });
+  row("diverged?", [](R x) { return std::string(x.diverged ? "diverged" : "did not diverge"); });
   d.table(head, rows);
 }
 
@@ -83,15 +102,24 @@ void write_panels(Doc& d, const ReportFacts& f, const Figures& figures) {
     return;
   }
   std::string intro = "Each run below was rerun with its whole series (" +
-                      std::to_string(f.runs[0]->run.series.size()) + " monitoring points).";
-  if (in.start)
-    intro += " Start point: " + params_text(in.start->params) +
+                      std::to_string(f.runs[0].rows.size()) + " monitoring points).";
+  if (f.start)
+    intro += " Start point: " + params_text(*f.start->params) +
              " (the paper's recommended multipliers with a size-based Nstep of " +
-             grouped(in.particles > 0 ? in.start->params.steps / in.particles : 0) +
+             grouped(in.particles > 0 ? f.start->params->steps / in.particles : 0) +
              " per particle, where the search starts).";
-  if (in.best) intro += " Calibrated: " + params_text(in.best->params) + ".";
+  if (f.result) intro += " Calibrated: " + params_text(*f.result->params) + ".";
+  if (f.dimension == 3)
+    intro +=
+        " Triaxial test: z is the axial axis (top wall pushed down), the four lateral walls "
+        "are servo-controlled at σ3.";
   d.para(intro);
-  for (const char* name : {"fig_a", "fig_b", "fig_lat", "fig_servo"}) figures.put(d, name);
+  if (f.dimension == 3)
+    for (const char* name : {"fig_a", "fig_lat_x", "fig_lat_y", "fig_shear_xy", "fig_shear_xz",
+                             "fig_shear_yz", "fig_servo"})
+      figures.put(d, name);
+  else
+    for (const char* name : {"fig_a", "fig_b", "fig_lat", "fig_servo"}) figures.put(d, name);
   write_panel_numbers(d, f);
 }
 
@@ -166,10 +194,10 @@ void write_rejected_neighbours(Doc& d, const ReportFacts& f, int near_failures) 
 void write_diagnosis(Doc& d, const ReportFacts& f, int near_failures) {
   const ReportInput& in = *f.in;
   d.heading(2, "Diagnosis in words", "diagnosis");
-  if (in.start) {
-    const auto& s = in.start->score;
+  if (f.start) {
+    const auto& s = *f.start->score;
     const Excesses r = excesses(s.criteria, in.tolerances);
-    std::string text = "Start point (" + params_text(in.start->params) + "): " +
+    std::string text = "Start point (" + params_text(*f.start->params) + "): " +
                        (s.passed ? "passes every criterion. "
                                  : "does not pass (worst: " + r.worst_name() + " at " +
                                        fixed(r.worst(), 2) + "× its tolerance). ") +
@@ -178,8 +206,8 @@ void write_diagnosis(Doc& d, const ReportFacts& f, int near_failures) {
       text += " Signature: " + sentence(s.diagnosis.signature);
     d.para(text);
   }
-  if (in.best) {
-    const auto& s = in.best->score;
+  if (f.result) {
+    const auto& s = *f.result->score;
     d.para((in.summary.success ? "Calibrated run: " : "Best run found (not certified): ") +
            std::string(s.passed ? "passes every criterion" : "does not pass") +
            (s.diagnosis.message.empty() ? "." : ". " + sentence(s.diagnosis.message)));
@@ -275,11 +303,56 @@ void write_speed(Doc& d, const ReportFacts& f, const Figures& figures) {
   }
 }
 
+namespace {
+
+/// 3D: what params.json's prototype block says (written by the upscaling
+/// layer), or that the prototype is the REV when there is none.
+void write_upscaling_3d(Doc& d, const ReportFacts& f) {
+  const nlohmann::json& P = f.in->params;
+  if (!P.is_object() || !P.contains("prototype") || !P["prototype"].is_object()) {
+    d.para(
+        "params.json has no prototype block: the prototype is the REV, and the REV parameters "
+        "above are the answer.");
+    return;
+  }
+  const nlohmann::json& B = P["prototype"];
+  auto number = [&](const char* key) {
+    if (!B.contains(key) || !B[key].is_number()) return std::string("n/a");
+    const double v = B[key].get<double>();
+    return key == std::string("particles") || key == std::string("steps")
+               ? grouped(static_cast<int64_t>(std::llround(v)))
+               : num(v, 6);
+  };
+  std::string source;
+  if (B.contains("source") && B["source"].is_object()) {
+    const auto& src = B["source"];
+    if (src.contains("description") && src["description"].is_string())
+      source = src["description"].get<std::string>();
+    if (src.contains("kind") && src["kind"].is_string())
+      source += (source.empty() ? "kind " : "; kind ") + src["kind"].get<std::string>();
+  }
+  const bool is_rev = B.contains("particles") && B["particles"].is_number() &&
+                      B["particles"].get<double>() == static_cast<double>(f.in->particles);
+  d.para(std::string(is_rev ? "The prototype is the REV" : "The prototype is not the REV") +
+         " (params.json's prototype block" + (source.empty() ? "" : ": " + source) +
+         "). In 3D the law Nstep(N) is measured (demcal scaling on a 3D family), not assumed "
+         "linear: the sample's linear size grows as N^(1/3).");
+  std::vector<std::vector<std::string>> rows;
+  for (const char* key : {"particles", "steps", "dt_ratio", "dt", "damping_ratio_translation",
+                          "damping_ratio_rotation", "mass_scaling"})
+    rows.push_back({key, number(key)});
+  d.table({"params.json prototype", "value"}, rows);
+}
+
+}  // namespace
+
 void write_upscaling(Doc& d, const ReportFacts& f, const Figures& figures) {
   const ReportInput& in = *f.in;
   const auto& S = in.summary;
   d.heading(2, "Upscaling to the prototype", "upscaling");
-  if (!f.have_best) {
+  if (f.dimension == 3 && f.have_best) {
+    write_upscaling_3d(d, f);
+  } else if (!f.have_best) {
     d.para("No calibrated Nstep to upscale.");
   } else if (!f.upscale) {
     d.para(
@@ -296,8 +369,44 @@ void write_upscaling(Doc& d, const ReportFacts& f, const Figures& figures) {
   }
 }
 
+namespace {
+
+void write_sphere_assembly(Doc& d, const ReportFacts& f) {
+  if (!f.in->sphere_picture) {
+    d.para("No picture: there is no calibrated run.");
+    return;
+  }
+  const auto& p = *f.in->sphere_picture;
+  const SphereColourScale cs = colour_scale(p);
+  const std::string caption =
+      "Calibrated run at its peak (step " + grouped(p.step) + " of " + grouped(p.steps) +
+      ", ε_zz = " + strain_pct(p.strain_zz, 3) + ", b_zz = " + kpa(p.stress_zz) +
+      "): " + std::to_string(p.x.size()) +
+      " spheres seen from the front right and above (z up; the box of walls dashed behind, "
+      "faint in front), "
+      "each coloured by the sum of the normal contact forces on it from the other spheres and "
+      "the walls, " +
+      num(cs.lo, 3) + " N to " + num(cs.hi, 3) +
+      " N: the bright spheres carry the force chains. Only the spheres on the surface are "
+      "visible; " +
+      (f.in->vtk_file.empty()
+           ? std::string("the whole assembly as VTK is written by demcal run (final.vtk).")
+           : "the whole assembly with its contact network is in " + f.in->vtk_file +
+                 " beside this report (ParaView: Glyph, type Sphere, scale array diameter, "
+                 "factor 1).");
+  d.html << "<figure>\n"
+         << sphere_svg(p) << "\n<figcaption>" << esc(caption) << "</figcaption>\n</figure>\n";
+  d.md << caption << " (picture in report.html)\n\n";
+}
+
+}  // namespace
+
 void write_assembly(Doc& d, const ReportFacts& f) {
   d.heading(2, "The assembly at the peak", "assembly");
+  if (f.dimension == 3) {
+    write_sphere_assembly(d, f);
+    return;
+  }
   if (!f.in->picture) {
     d.para("No picture: there is no calibrated run.");
     return;
@@ -348,10 +457,10 @@ void write_all_trials(Doc& d, const ReportFacts& f) {
       "paper-recipe trials, r8/r16: the reference runs (--evidence). Seconds are as run "
       "(trials stopped early ran only part of the loading).");
   d.details_begin("Show all " + std::to_string(f.points.size()) + " trials");
-  d.table(
-      {"trial", "phase", "α", "Nstep", "ζ_t", "ζ_r", "verdict", "FB/tol", "MB/tol", "servo/tol",
-       "osc/tol", "peak b_yy [kPa]", "peak error", "particle-steps", "s", "objective", "diagnosis"},
-      rows, "trials");
+  d.table({"trial", "phase", "α", "Nstep", "ζ_t", "ζ_r", "verdict", "FB/tol", "MB/tol", "servo/tol",
+           "osc/tol", "peak " + f.axial + " [kPa]", "peak error", "particle-steps", "s",
+           "objective", "diagnosis"},
+          rows, "trials");
   d.details_end();
 }
 

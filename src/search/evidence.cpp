@@ -1,7 +1,9 @@
 #include "demcal/search/evidence.hpp"
 
+#include <algorithm>
 #include <utility>
 
+#include "demcal/scoring/triaxial_scoring.hpp"
 #include "demcal/search/parallel.hpp"
 
 namespace demcal {
@@ -82,6 +84,76 @@ ResultRuns rerun_start_and_result(const SceneConfig& config, const ConsolidatedS
                 }},
                jobs);
   if (out.best) out.picture = picture_at_peak(config, state, *out.best);
+  return out;
+}
+
+SpherePicture picture_of(const SphereWorld& world) {
+  SpherePicture p;
+  const int n = world.size();
+  p.x.assign(world.x().begin(), world.x().end());
+  p.y.assign(world.y().begin(), world.y().end());
+  p.z.assign(world.z().begin(), world.z().end());
+  p.r.assign(world.radius().begin(), world.radius().end());
+  p.force.assign(static_cast<size_t>(n), 0.0);
+  for (int a = 0; a < 3; ++a) {
+    p.lo[a] = world.wall(static_cast<SphereWallSide>(2 * a)).position;
+    p.hi[a] = world.wall(static_cast<SphereWallSide>(2 * a + 1)).position;
+  }
+  for (const auto& c : world.contacts()) {
+    if (c.fn <= 0.0) continue;
+    p.force[c.i] += c.fn;
+    p.force[c.j] += c.fn;
+  }
+  // Wall contacts: kn·overlap, as in the 2D picture_of().
+  const double kn = world.material().wall.kn;
+  for (int i = 0; i < n; ++i) {
+    const double c[3] = {p.x[i], p.y[i], p.z[i]};
+    for (int a = 0; a < 3; ++a)
+      p.force[i] += kn * (std::max(0.0, p.r[i] - (c[a] - p.lo[a])) +
+                          std::max(0.0, p.r[i] - (p.hi[a] - c[a])));
+  }
+  return p;
+}
+
+ResultRuns3D rerun_start_and_result(const SceneConfig& config, const TriaxialState& state,
+                                    const AlgorithmSpec& start, const CalibrationSummary& summary,
+                                    const Tolerances& tolerances, int jobs) {
+  const double s3 = config.test.lateral_stress;
+  auto one = [&](const std::string& label, const AlgorithmSpec& p) {
+    ReportRun3D r;
+    r.label = label;
+    r.params = p;
+    r.run = run_triaxial_loading(state, config.test, p);
+    r.score = score_triaxial_run(r.run, s3, tolerances);
+    return r;
+  };
+  ResultRuns3D out;
+  const bool have_best = summary.best_trial.score.particle_steps > 0.0;  // a trial ran
+  run_parallel({[&] { out.start = one("start point", start); },
+                [&] {
+                  if (have_best)
+                    out.best = one(summary.success ? "calibrated" : "best found", summary.best);
+                }},
+               jobs);
+  if (!out.best || out.best->run.series.empty()) return out;
+  // The result once more, up to the monitoring point of its peak.
+  const auto& series = out.best->run.series;
+  const auto peak =
+      std::min_element(series.begin(), series.end(),
+                       [](const auto& a, const auto& b) { return a.b(2, 2) < b.b(2, 2); });
+  const int64_t peak_step = peak->step;
+  SphereWorld world = state.world;
+  if (peak_step > 0)
+    run_triaxial_loading(
+        state, config.test, out.best->params,
+        [&](const TriaxialPoint& p) { return p.step < peak_step; }, &world);
+  SpherePicture picture = picture_of(world);
+  picture.step = peak_step;
+  picture.steps = out.best->params.steps;
+  picture.strain_zz = peak->strain_zz;
+  picture.stress_zz = peak->b(2, 2);
+  out.picture = std::move(picture);
+  out.world = std::move(world);
   return out;
 }
 

@@ -15,6 +15,13 @@
 // the upscaling line, and the assembly at the peak (disks coloured by
 // rotation, contact forces as lines of width ∝ force).
 //
+// 3D (spheres, triaxial test, dimension = 3): the same report from the same
+// sections; the panels are the axial b_zz and σ_zz, each lateral component
+// (xx, yy), the three shear pairs (σ_xy/σ_yx, σ_xz/σ_zx, σ_yz/σ_zy: moment
+// balance) and the servo error of each of the four lateral walls; the
+// assembly is a shaded isometric view of the spheres coloured by their
+// contact force (sphere_svg.hpp), with final.vtk beside it for ParaView.
+//
 // Plots are rendered by gnuplot (`set terminal svg`) in a private temporary
 // folder, with no shell and no user text in the scripts; without gnuplot the
 // report carries every number and says how to get the plots. The assembly
@@ -59,10 +66,18 @@ struct ReportInput {
   std::optional<AssemblyPicture> picture;  ///< the calibrated run at its peak
   std::optional<BaselineResult> baseline;
   std::optional<ReferenceEvidence> reference;
+
+  // 3D (spheres, triaxial test): the runs in place of start/best/picture.
+  int dimension = 2;
+  std::optional<ReportRun3D> start3, best3;
+  std::optional<SpherePicture> sphere_picture;  ///< the calibrated run at its peak
+  std::string vtk_file;  ///< the picture's world as VTK beside the report ("" none)
 };
 
 /// The runs of rerun_start_and_result() (search/evidence.hpp) into `input`.
 void attach_runs(ReportInput& input, ResultRuns runs);
+/// The same for a 3D scene (sets input.dimension = 3; runs.world is not kept).
+void attach_runs(ReportInput& input, ResultRuns3D runs);
 
 struct ReportOptions {
   /// The gnuplot program (a name looked up on PATH, or a path); "" renders

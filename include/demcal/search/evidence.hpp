@@ -9,6 +9,7 @@
 // trials' numbers exactly.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -16,6 +17,7 @@
 
 #include "demcal/scene/biaxial.hpp"
 #include "demcal/scene/config.hpp"
+#include "demcal/scene/triaxial.hpp"
 #include "demcal/scoring/scoring.hpp"
 #include "demcal/search/calibration.hpp"
 
@@ -58,6 +60,42 @@ struct ResultRuns {
 ResultRuns rerun_start_and_result(const SceneConfig& config, const ConsolidatedState& state,
                                   const AlgorithmSpec& start, const CalibrationSummary& summary,
                                   const Tolerances& tolerances, int jobs);
+
+// --- 3D (spheres, triaxial test) ----------------------------------------
+
+/// A triaxial run shown in the report with its whole monitored series.
+struct ReportRun3D {
+  std::string label;  ///< "start point", "calibrated"
+  AlgorithmSpec params;
+  TriaxialResult run;
+  Score score;  ///< score_triaxial_run()
+};
+
+/// The sphere assembly at one instant: enough to draw it.
+struct SpherePicture {
+  std::vector<double> x, y, z, r;
+  /// Sum of the normal contact forces on each sphere, from the other
+  /// spheres and the walls [N]: what the picture is coloured by.
+  std::vector<double> force;
+  std::array<double, 3> lo{}, hi{};  ///< wall positions (x, y, z)
+  int64_t step = 0, steps = 0;       ///< loading step of the picture, of the run
+  double strain_zz = 0, stress_zz = 0;
+};
+/// The picture of a sphere world (particle contacts from
+/// SphereWorld::contacts(), wall contacts kn·overlap as for 2D picture_of()).
+SpherePicture picture_of(const SphereWorld& world);
+
+/// The 3D ResultRuns, with the world at the result's peak (for final.vtk).
+struct ResultRuns3D {
+  std::optional<ReportRun3D> start, best;
+  std::optional<SpherePicture> picture;
+  std::optional<SphereWorld> world;
+};
+/// rerun_start_and_result() for a triaxial scene: the peak is the
+/// monitoring point of the most compressive b_zz.
+ResultRuns3D rerun_start_and_result(const SceneConfig& config, const TriaxialState& state,
+                                    const AlgorithmSpec& start, const CalibrationSummary& summary,
+                                    const Tolerances& tolerances, int jobs);
 
 /// The --evidence reference: the result's multipliers at 8× and 16× Nstep,
 /// and the peak extrapolated to infinite Nstep by richardson_limit(),
