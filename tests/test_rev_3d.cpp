@@ -227,6 +227,33 @@ TEST(SphereRev, CutFromAnFccFileIsRepresentativeAfterReconsolidation) {
   EXPECT_EQ(j["prototype"]["dimension"].get<int>(), 3);
 }
 
+TEST(SphereRev, GeneratedRevIsADensePackingOfThePrototypesRadii) {
+  // Radii uniform in [0.75, 1.25]·5e-4 m from a loose gas (porosity ≈ 0.8:
+  // one sphere per cell of edge 2.2·r_max). The generated REV, consolidated,
+  // is a dense random packing: porosity between random close packing of
+  // mildly polydisperse spheres (≈ 0.35) and random loose packing (≈ 0.45),
+  // so the verdict against the gas is NOT representative, on porosity.
+  AssemblySpec spec;
+  spec.count = 400;
+  const SphereAssembly proto = random_sphere_gas(spec);
+  RevOptions o;
+  o.particles = 120;
+  o.method = "generate";
+  // The shipped random scene's material (kn = 1e6 N/m: a gas consolidates
+  // in about 1e5 steps).
+  const SceneConfig c = load_config(test::shipped_config("random_500_3d"));
+  const SphereRevResult r = make_rev(c, proto, o);
+  EXPECT_TRUE(r.state.converged);
+  ASSERT_EQ(r.assembly.size(), 120);
+  const auto& rep = r.representativeness;
+  EXPECT_TRUE(rep.size_distribution_ok) << rep.verdict;
+  EXPECT_GT(rep.prototype.porosity, 0.7);
+  EXPECT_GT(rep.rev.porosity_interior, 0.30) << rep.verdict;
+  EXPECT_LT(rep.rev.porosity_interior, 0.45) << rep.verdict;
+  EXPECT_FALSE(rep.porosity_ok) << rep.verdict;
+  EXPECT_FALSE(rep.representative);
+}
+
 TEST(SphereRev, AWrongSizeDistributionIsCaught) {
   // compare is the 2D one: a REV whose radii are not the prototype's fails
   // the KS test, in 3D as in 2D.
