@@ -74,14 +74,14 @@ RevOutcome rev_3d(const SceneConfig& config, const std::string& file, const RevO
                      "asked for a REV of " + std::to_string(ro.particles) +
                          " spheres, the prototype has only " + std::to_string(proto.size()));
   ready();
-  if (source.kind == "generated" && config.assembly.type != "fcc") {
+  if (source.kind == "generated") {
     // A generated gas is no packing to cut from or compare with.
     std::cerr << "demcal rev: consolidating the prototype first (" << source.description
               << "): a loose gas takes long\n";
     proto = sphere_assembly_of(consolidate_triaxial(config, proto).world);
   }
-  std::cerr << "demcal rev: " << (ro.method == "cut" ? "cutting a box" : "generating") << " REV of "
-            << ro.particles << " spheres from " << source.description
+  std::cerr << "demcal rev: " << (ro.method == "cut" ? "cutting a box" : "generating a")
+            << " REV of " << ro.particles << " spheres from " << source.description
             << ", consolidating it to sigma3\n";
   const SphereRevResult r = make_rev(config, proto, ro);
   return {r.method,      sphere_csv(r.assembly), r.assembly.size(),

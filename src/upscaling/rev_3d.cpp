@@ -132,6 +132,11 @@ SphereAssembly prototype_spheres(const SceneConfig& config, const std::string& f
       a = generate_rev(rev, n, config.calibration.seed);
       src.description =
           std::to_string(n) + " spheres with radii drawn from " + config.assembly.file;
+    } else if (config.assembly.type == "fcc") {
+      // A lattice cut from a larger lattice is the smaller lattice.
+      throw InputError(config.source, "prototype.particles",
+                       "an FCC assembly has no larger random prototype to generate; give a "
+                       "prototype file (prototype.file or --prototype, CSV x,y,z,r)");
     } else {
       const SceneConfig c = scene_of_size(config, n);
       a = make_sphere_assembly(c);
