@@ -1,70 +1,132 @@
 // `demcal rev [CONFIG] [--prototype FILE] --particles N [--method cut|generate]`:
 // a REV from the user's prototype, consolidated to σ3, with a report of how
-// representative it is. Writes DIR/rev.csv (the REV's particles),
+// representative it is; disks (x,y,r) for a 2D config, spheres (x,y,z,r, a
+// box window, the triaxial consolidation) for a 3D one (`"dimension": 3`).
+// Writes DIR/rev.csv (the REV's particles),
 // DIR/rev.json (representativeness) and DIR/rev-config.json, a scene config
 // that calibrates on the REV and names the prototype, so that
 //   demcal rev CONFIG --prototype P.csv -o R && demcal calibrate R/rev-config.json
 // is the whole path from a user's assembly to its parameters.
 #include <filesystem>
+#include <functional>
 #include <iostream>
 
 #include "commands.hpp"
 #include "demcal/io/files.hpp"
 #include "demcal/scene/biaxial.hpp"
 #include "demcal/scene/run_output.hpp"
+#include "demcal/scene/sphere_packing.hpp"
+#include "demcal/scene/triaxial.hpp"
 #include "demcal/upscaling/rev.hpp"
+#include "demcal/upscaling/rev_3d.hpp"
 #include "demcal/upscaling/upscaling.hpp"
 #include "output_folder.hpp"
 #include "upscaling_cli.hpp"
 
 namespace demcal::cli {
 
-int cmd_rev(const RevCmdOptions& o) {
-  namespace fs = std::filesystem;
-  SceneConfig config = load_scene(o.config, o.sets);
-  if (o.particles < 2) throw InputError("--particles", "", "needs at least 2 particles");
-  if (o.method != "cut" && o.method != "generate")
-    throw InputError("--method", "", "must be cut or generate, got \"" + o.method + "\"");
-  if (!o.prototype.empty() && !fs::exists(o.prototype))
-    throw InputError(o.prototype, "", "cannot open particle file");
-  PrototypeSource source;
-  Assembly proto = prototype_assembly(config, 0, o.prototype, &source);
+namespace {
+
+// What a REV of either dimension leaves for the files: the REV's particles
+// as CSV, its consolidation and the comparison.
+struct RevOutcome {
+  std::string method;
+  std::string csv;
+  int particles = 0;
+  int64_t steps = 0;
+  double wall_time_s = 0.0;
+  Representativeness representativeness;
+};
+
+// `ready` is called once the prototype is read and checked, before any
+// consolidation (it checks the output folder).
+RevOutcome rev_2d(const SceneConfig& config, const std::string& file, const RevOptions& ro,
+                  PrototypeSource& source, const std::function<void()>& ready) {
+  Assembly proto = prototype_assembly(config, 0, file, &source);
   if (source.kind == "rev")
     throw InputError(config.source, "prototype",
                      "names no prototype: give prototype.file or prototype.particles, or "
                      "--prototype FILE");
-  const std::string dir = o.out_dir.empty() ? "demcal-rev-" + config.name : o.out_dir;
-  OutputFolder::check(dir);  // a bad -o fails now, and leaves no folder
+  ready();
   if (!proto.dense) {
     // A generated gas is no packing to cut from or compare with.
     std::cerr << "demcal rev: consolidating the prototype first (" << source.description
               << "): a loose gas takes long\n";
     proto = assembly_of(consolidate(config, proto).world);
   }
+  std::cerr << "demcal rev: " << (ro.method == "cut" ? "cutting" : "generating") << " a REV of "
+            << ro.particles << " particles from " << source.description
+            << ", consolidating it to sigma3\n";
+  const RevResult r = make_rev(config, proto, ro);
+  return {r.method,      particle_csv(r.assembly), r.assembly.size(),
+          r.state.steps, r.state.wall_time_s,      r.representativeness};
+}
+
+RevOutcome rev_3d(const SceneConfig& config, const std::string& file, const RevOptions& ro,
+                  PrototypeSource& source, const std::function<void()>& ready) {
+  SphereAssembly proto = prototype_spheres(config, file, &source);
+  if (source.kind == "rev")
+    throw InputError(config.source, "prototype",
+                     "names no prototype: give prototype.file or prototype.particles, or "
+                     "--prototype FILE (CSV x,y,z,r)");
+  if (ro.method == "cut" && ro.particles > proto.size())  // before a long consolidation
+    throw InputError(source.kind == "file" ? source.file : config.source, "",
+                     "asked for a REV of " + std::to_string(ro.particles) +
+                         " spheres, the prototype has only " + std::to_string(proto.size()));
+  ready();
+  if (source.kind == "generated") {
+    // A generated gas is no packing to cut from or compare with.
+    std::cerr << "demcal rev: consolidating the prototype first (" << source.description
+              << "): a loose gas takes long\n";
+    proto = sphere_assembly_of(consolidate_triaxial(config, proto).world);
+  }
+  std::cerr << "demcal rev: " << (ro.method == "cut" ? "cutting a box" : "generating a")
+            << " REV of " << ro.particles << " spheres from " << source.description
+            << ", consolidating it to sigma3\n";
+  const SphereRevResult r = make_rev(config, proto, ro);
+  return {r.method,      sphere_csv(r.assembly), r.assembly.size(),
+          r.state.steps, r.state.wall_time_s,    r.representativeness};
+}
+
+}  // namespace
+
+int cmd_rev(const RevCmdOptions& o) {
+  namespace fs = std::filesystem;
+  SceneConfig config = load_config(o.config, o.sets);
+  if (o.particles < 2) throw InputError("--particles", "", "needs at least 2 particles");
+  if (o.method != "cut" && o.method != "generate")
+    throw InputError("--method", "", "must be cut or generate, got \"" + o.method + "\"");
+  if (!o.prototype.empty() && !fs::exists(o.prototype))
+    throw InputError(o.prototype, "", "cannot open particle file");
+  const std::string dir = o.out_dir.empty() ? "demcal-rev-" + config.name : o.out_dir;
   RevOptions ro;
   ro.particles = o.particles;
   ro.method = o.method;
   ro.seed = config.calibration.seed;
-  std::cerr << "demcal rev: " << (o.method == "cut" ? "cutting" : "generating") << " a REV of "
-            << o.particles << " particles from " << source.description
-            << ", consolidating it to sigma3\n";
-  const RevResult r = make_rev(config, proto, ro);
+  PrototypeSource source;
+  // A bad -o fails once the prototype is read, before any consolidation,
+  // and leaves no folder.
+  auto check_folder = [&] { OutputFolder::check(dir); };
+  const RevOutcome r = config.dimension == 3
+                           ? rev_3d(config, o.prototype, ro, source, check_folder)
+                           : rev_2d(config, o.prototype, ro, source, check_folder);
 
   // The three files together or none (a failure leaves no folder it made).
   OutputFolder out(dir);
-  out.write("rev.csv", particle_csv(r.assembly));
+  out.write("rev.csv", r.csv);
   nlohmann::json report{
       {"schema", "demcal.rev/1"},
       {"scene", config.name},
+      {"dimension", config.dimension},
       {"method", r.method},
       {"prototype", {{"source", source.kind}, {"description", source.description}}},
-      {"particles", r.assembly.size()},
-      {"consolidation", {{"steps", r.state.steps}, {"wall_time_s", r.state.wall_time_s}}},
+      {"particles", r.particles},
+      {"consolidation", {{"steps", r.steps}, {"wall_time_s", r.wall_time_s}}},
       {"representativeness", to_json(r.representativeness)}};
   out.write("rev.json", report.dump(2) + "\n");
   // A config that calibrates on the REV and upscales to the prototype.
   nlohmann::json c = to_json(config);
-  c["name"] = config.name + "-rev" + std::to_string(r.assembly.size());
+  c["name"] = config.name + "-rev" + std::to_string(r.particles);
   c["assembly"] = {{"type", "file"}, {"file", "rev.csv"}};
   if (source.kind == "file")
     c["prototype"] = {{"particles", 0}, {"file", fs::absolute(source.file).string()}};
@@ -74,9 +136,9 @@ int cmd_rev(const RevCmdOptions& o) {
   out.commit();
 
   const auto& rep = r.representativeness;
-  std::cout << "REV of " << r.assembly.size() << " particles (" << r.method << ") from "
-            << source.description << "\n  " << rep.verdict << "\n  wrote " << dir
-            << "/rev.csv, rev.json, rev-config.json (demcal calibrate " << dir
+  std::cout << "REV of " << r.particles << (config.dimension == 3 ? " spheres (" : " particles (")
+            << r.method << ") from " << source.description << "\n  " << rep.verdict << "\n  wrote "
+            << dir << "/rev.csv, rev.json, rev-config.json (demcal calibrate " << dir
             << "/rev-config.json)\n";
   return 0;
 }

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <limits>
@@ -45,13 +46,20 @@ SphereAssembly fcc_packing(int nx, int ny, int nz, double radius, double contact
 SphereAssembly random_sphere_gas(const AssemblySpec& spec) {
   if (spec.count < 1) throw std::invalid_argument("random_sphere_gas: count must be >= 1");
   std::mt19937_64 rng(spec.seed);
+  std::vector<double> radii = random_radii::sample(spec, rng);
+  return sphere_gas(std::move(radii), spec.aspect, rng);
+}
+
+SphereAssembly sphere_gas(std::vector<double> radii, double aspect, std::mt19937_64& rng) {
   SphereAssembly a;
-  const int n = spec.count;
-  a.r = random_radii::sample(spec, rng);
+  const int n = static_cast<int>(radii.size());
+  if (n == 0) return a;
+  if (!(aspect > 0.0)) aspect = 1.0;
+  a.r = std::move(radii);
   const double r_max = *std::max_element(a.r.begin(), a.r.end());
   const double spacing = 2.2 * r_max;
   const int across =
-      std::max(1, static_cast<int>(std::ceil(std::cbrt(static_cast<double>(n) * spec.aspect))));
+      std::max(1, static_cast<int>(std::ceil(std::cbrt(static_cast<double>(n) * aspect))));
   const int layers = (n + across * across - 1) / (across * across);
   a.x.resize(n);
   a.y.resize(n);
@@ -66,6 +74,16 @@ SphereAssembly random_sphere_gas(const AssemblySpec& spec) {
   }
   a.hi = {across * spacing, across * spacing, layers * spacing};
   return a;
+}
+
+std::string sphere_csv(const SphereAssembly& a) {
+  std::string s = "x,y,z,r\n";
+  char line[128];
+  for (int i = 0; i < a.size(); ++i) {
+    std::snprintf(line, sizeof line, "%.17g,%.17g,%.17g,%.17g\n", a.x[i], a.y[i], a.z[i], a.r[i]);
+    s += line;
+  }
+  return s;
 }
 
 SphereAssembly read_sphere_file(const std::string& path) {

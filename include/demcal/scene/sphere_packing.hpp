@@ -4,6 +4,7 @@
 
 #include <array>
 #include <istream>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -35,6 +36,10 @@ SphereAssembly fcc_packing(int nx, int ny, int nz, double radius, double contact
 /// (aspect = width/height); walls at the grid's faces. Deterministic for
 /// spec.seed on every platform. Consolidation (compression) makes it dense.
 SphereAssembly random_sphere_gas(const AssemblySpec& spec);
+/// The placement of random_sphere_gas for given radii: one sphere per
+/// jittered cell (jitter drawn from `rng`), no overlaps. random_sphere_gas
+/// is sample() then this, draw for draw.
+SphereAssembly sphere_gas(std::vector<double> radii, double aspect, std::mt19937_64& rng);
 /// CSV x,y,z,r (header optional, '#' comments, blank lines skipped); walls at
 /// the bounding box of the spheres. Bad lines, non-finite values, radii
 /// ≤ 0 and overlaps beyond 5 % of the smaller radius are an InputError
@@ -42,6 +47,9 @@ SphereAssembly random_sphere_gas(const AssemblySpec& spec);
 SphereAssembly read_sphere_file(const std::string& path);
 /// The same from a stream; `source` names it in errors.
 SphereAssembly read_spheres(std::istream& in, const std::string& source);
+/// CSV x,y,z,r with a header, full precision: read_sphere_file reads it
+/// back bit for bit (walls then at the spheres' bounding box).
+std::string sphere_csv(const SphereAssembly& assembly);
 
 /// σ_zz/σ_xx at sliding failure of a periodic FCC array of uniform spheres
 /// (cube axes along the box) under axisymmetric compression along z with

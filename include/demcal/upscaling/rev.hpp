@@ -27,18 +27,23 @@
 
 namespace demcal {
 
-/// Geometry of a packing. Contacts are geometric: centre distance below
-/// (r_i + r_j)·(1 + contact_tolerance), so a file and a simulated state are
-/// judged alike.
+/// Geometry of a packing of disks (2D) or spheres (3D, rev_3d.hpp).
+/// Contacts are geometric: centre distance below (r_i + r_j)·(1 +
+/// contact_tolerance), so a file and a simulated state are judged alike.
 struct PackingStats {
+  int dimension = 2;
   int particles = 0;
   double radius_mean = 0.0, radius_std = 0.0, radius_min = 0.0, radius_max = 0.0;
   double radius_d10 = 0.0, radius_d50 = 0.0, radius_d90 = 0.0;  ///< number quantiles
-  double width = 0.0, height = 0.0;
-  /// 1 − (disk area inside the box)/(box area): what a user measures.
+  /// Box edges: width along x; height along the loading axis (y in 2D, z in
+  /// 3D); depth along y in 3D (0 in 2D).
+  double width = 0.0, height = 0.0, depth = 0.0;
+  /// 1 − (disk area inside the box)/(box area), in 3D 1 − (sphere volume
+  /// inside the box)/(box volume): what a user measures.
   double porosity = 0.0;
   /// The same in the box inset by 2·r_max on every side, away from the wall
-  /// voids (the disks are clipped exactly to that window).
+  /// voids (the particles are clipped to that window: disks exactly,
+  /// spheres by sphere_box_volume).
   double porosity_interior = 0.0;
   /// Mean contacts per particle (particle–particle contacts only), over all
   /// particles and over those centred in the inset window.
@@ -58,8 +63,8 @@ double disk_rectangle_area(double cx, double cy, double r, double x0, double x1,
 /// Two-sample Kolmogorov–Smirnov statistic sup|F_a − F_b|.
 double ks_distance(std::vector<double> a, std::vector<double> b);
 
-/// How a REV compares with its prototype, with the thresholds used for the
-/// verdict (chosen, not derived: see rev.cpp).
+/// How a REV compares with its prototype, 2D or 3D alike, with the
+/// thresholds used for the verdict (chosen, not derived: see rev.cpp).
 struct Representativeness {
   PackingStats rev, prototype;
   double ks = 0.0;                       ///< radius distributions, KS distance

@@ -1,0 +1,156 @@
+// The REV in 3D (rev_3d.hpp): the box cut, the resampled gas, the
+// consolidation and the comparison. The measures, the verdict and the JSON
+// are the 2D ones (rev.cpp).
+#include "demcal/upscaling/rev_3d.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <random>
+
+#include "demcal/io/input_error.hpp"
+
+namespace demcal {
+
+SphereAssembly cut_rev(const SphereAssembly& proto, int64_t count, double aspect) {
+  const int n = proto.size();
+  if (count < 2) throw InputError("REV", "particles", "needs at least 2 particles");
+  if (count > n)
+    throw InputError("REV", "particles",
+                     "asked for " + std::to_string(count) + " spheres, the prototype has only " +
+                         std::to_string(n));
+  // The window's half-edges are s·e[d]/2, centred on the box centre; the
+  // count of centres inside is monotone in s.
+  std::array<double, 3> centre, edge;
+  for (int d = 0; d < 3; ++d) {
+    centre[d] = 0.5 * (proto.lo[d] + proto.hi[d]);
+    edge[d] = proto.hi[d] - proto.lo[d];
+  }
+  if (aspect > 0.0) edge = {aspect, aspect, 1.0};
+  const double scale = std::max({edge[0], edge[1], edge[2]});
+  for (double& e : edge) e /= scale;  // the largest is 1
+  const std::vector<double>* pos[3] = {&proto.x, &proto.y, &proto.z};
+  auto inside = [&](double s, int i) {
+    for (int d = 0; d < 3; ++d)
+      if (!(std::abs((*pos[d])[i] - centre[d]) <= 0.5 * s * edge[d])) return false;
+    return true;
+  };
+  auto count_at = [&](double s) {
+    int64_t c = 0;
+    for (int i = 0; i < n; ++i) c += inside(s, i);
+    return c;
+  };
+  // Every centre is inside at s = 2·(largest edge/smallest relative edge).
+  double lo = 0.0, hi = 1e-12;
+  for (int d = 0; d < 3; ++d)
+    hi = std::max(hi, 2.0 * (proto.hi[d] - proto.lo[d]) / std::max(edge[d], 1e-12));
+  for (int it = 0; it < 200 && hi - lo > 1e-14 * hi; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    (count_at(mid) >= count ? hi : lo) = mid;
+  }
+  const int64_t c_hi = count_at(hi), c_lo = count_at(lo);
+  const double s = (c_lo >= 2 && count - c_lo < c_hi - count) ? lo : hi;
+  SphereAssembly a;
+  for (int i = 0; i < n; ++i) {
+    if (!inside(s, i)) continue;
+    a.x.push_back(proto.x[i]);
+    a.y.push_back(proto.y[i]);
+    a.z.push_back(proto.z[i]);
+    a.r.push_back(proto.r[i]);
+  }
+  std::vector<double>* kept[3] = {&a.x, &a.y, &a.z};
+  for (int d = 0; d < 3; ++d) {
+    a.lo[d] = std::numeric_limits<double>::infinity();
+    a.hi[d] = -std::numeric_limits<double>::infinity();
+    for (int i = 0; i < a.size(); ++i) {
+      a.lo[d] = std::min(a.lo[d], (*kept[d])[i] - a.r[i]);
+      a.hi[d] = std::max(a.hi[d], (*kept[d])[i] + a.r[i]);
+    }
+  }
+  return a;
+}
+
+SphereAssembly generate_rev(const SphereAssembly& proto, int64_t count, uint64_t seed) {
+  if (count < 2) throw InputError("REV", "particles", "needs at least 2 particles");
+  if (count > kMaxParticles)
+    throw InputError("REV", "particles", std::string("at most ") + kMaxParticlesWhy);
+  const double h = proto.hi[2] - proto.lo[2];
+  const double aspect =
+      h > 0.0 ? std::sqrt((proto.hi[0] - proto.lo[0]) * (proto.hi[1] - proto.lo[1])) / h : 1.0;
+  std::mt19937_64 rng(seed);
+  return sphere_gas(resample_radii(proto.r, count, seed), aspect, rng);
+}
+
+SphereAssembly sphere_assembly_of(const SphereWorld& world) {
+  SphereAssembly a;
+  a.x.assign(world.x().begin(), world.x().end());
+  a.y.assign(world.y().begin(), world.y().end());
+  a.z.assign(world.z().begin(), world.z().end());
+  a.r.assign(world.radius().begin(), world.radius().end());
+  for (int d = 0; d < 3; ++d) {
+    a.lo[d] = world.wall(static_cast<SphereWallSide>(2 * d)).position;
+    a.hi[d] = world.wall(static_cast<SphereWallSide>(2 * d + 1)).position;
+  }
+  return a;
+}
+
+SphereRevResult make_rev(const SceneConfig& config, const SphereAssembly& prototype,
+                         const RevOptions& o) {
+  if (o.method != "cut" && o.method != "generate")
+    throw InputError("REV", "method", "must be cut or generate, got \"" + o.method + "\"");
+  const SphereAssembly raw = o.method == "cut" ? cut_rev(prototype, o.particles, o.aspect)
+                                               : generate_rev(prototype, o.particles, o.seed);
+  SphereRevResult out{o.method, {}, consolidate_triaxial(config, raw), {}};
+  out.assembly = sphere_assembly_of(out.state.world);
+  out.representativeness = compare(packing_stats(out.state.world), packing_stats(prototype),
+                                   out.assembly.r, prototype.r);
+  return out;
+}
+
+SphereAssembly prototype_spheres(const SceneConfig& config, const std::string& file,
+                                 PrototypeSource* source) {
+  if (config.dimension != 3)
+    throw InputError(config.source, "dimension", "a sphere prototype needs \"dimension\": 3");
+  PrototypeSource src;
+  SphereAssembly a;
+  auto read = [&](const std::string& path) {
+    a = read_sphere_file(path);
+    src.kind = "file";
+    src.file = path;
+    src.description = std::to_string(a.size()) + " spheres read from " + path;
+  };
+  if (!file.empty()) {
+    read(file);
+  } else if (!config.prototype.file.empty()) {
+    read(config.prototype.file);
+  } else if (config.prototype.particles > 0) {
+    const int64_t n = config.prototype.particles;
+    src.kind = "generated";
+    if (config.assembly.type == "file") {
+      // No generator to resize: draw the radii from the REV's file.
+      const SphereAssembly rev = read_sphere_file(config.assembly.file);
+      a = generate_rev(rev, n, config.calibration.seed);
+      src.description =
+          std::to_string(n) + " spheres with radii drawn from " + config.assembly.file;
+    } else if (config.assembly.type == "fcc") {
+      // A lattice cut from a larger lattice is the smaller lattice.
+      throw InputError(config.source, "prototype.particles",
+                       "an FCC assembly has no larger random prototype to generate; give a "
+                       "prototype file (prototype.file or --prototype, CSV x,y,z,r)");
+    } else {
+      const SceneConfig c = scene_of_size(config, n);
+      a = make_sphere_assembly(c);
+      src.description = std::to_string(a.size()) + " spheres from the " + c.assembly.type +
+                        " generator of " + config.name;
+    }
+  } else {
+    a = make_sphere_assembly(config);
+    src.kind = "rev";
+    src.description = "the REV itself (" + std::to_string(a.size()) + " spheres)";
+  }
+  src.particles = a.size();
+  if (source) *source = src;
+  return a;
+}
+
+}  // namespace demcal
