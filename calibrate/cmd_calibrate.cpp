@@ -257,7 +257,7 @@ int cmd_calibrate(const CalibrateOptions& o) {
   for (const char* name : {"params.json", "run.json", "report.html", "report.md", "evidence.jsonl"})
     std::filesystem::remove(dir + "/" + name);
 
-  CalibrationOptions options = CalibrationOptions::from(config.calibration);
+  CalibrationOptions options = CalibrationOptions::from(config);
   options.strategy = strategy;
   options.jobs = o.jobs;
   options.trials_path = trials_path;
