@@ -1,7 +1,7 @@
 // Scoring a triaxial (3D) run: the criteria of the three coordinate planes,
 // the Score the calibration works on, its early stop, and summary.json.
-// The tolerances are the 2D ones; reports/atlas-3d.md measures whether they
-// hold in 3D.
+// The 3D default tolerances (triaxial_tolerances) and the rotational drag
+// criterion come from reports/atlas-3d.md, which measures that they hold.
 #pragma once
 
 #include <array>
