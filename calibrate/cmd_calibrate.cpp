@@ -355,7 +355,7 @@ void write_results(const std::string& dir, const nlohmann::json& params,
 /// The search's options from the config and the flags.
 CalibrationOptions search_options(const CalibrateOptions& o, const Invocation& v,
                                   const StopOnSignal& stop) {
-  CalibrationOptions options = CalibrationOptions::from(v.config.calibration);
+  CalibrationOptions options = CalibrationOptions::from(v.config);
   options.strategy = v.strategy;
   options.jobs = o.jobs;
   options.trials_path = v.trials_path;

@@ -11,6 +11,7 @@
 
 #include "demcal/scene/config.hpp"
 #include "demcal/scene/triaxial.hpp"
+#include "demcal/scoring/triaxial_scoring.hpp"
 #include "demcal/search/calibration.hpp"
 #include "demcal/search/trial_runner.hpp"
 #include "support/files.hpp"
@@ -38,7 +39,7 @@ double relative(double a, double b) { return std::abs(a - b) / std::abs(b); }
 TEST(Calibration3D, SmallFccIsCertifiedAndMatchesARunEightTimesLonger) {
   const SceneConfig config = parse_config_text(kFcc2, "fcc_2x2x2");
   const TriaxialState state = consolidate_triaxial(config, make_sphere_assembly(config));
-  CalibrationOptions options = CalibrationOptions::from(config.calibration);
+  CalibrationOptions options = CalibrationOptions::from(config);
   options.jobs = 2;
   const CalibrationSummary s = calibrate(config, state, options);
   ASSERT_TRUE(s.success) << s.FullReport();
@@ -49,6 +50,11 @@ TEST(Calibration3D, SmallFccIsCertifiedAndMatchesARunEightTimesLonger) {
   for (const TrialRecord& t : s.trials) EXPECT_LE(t.params.dt_ratio, s.dt_ratio_stable);
   EXPECT_TRUE(s.best_trial.score.passed);
   EXPECT_LE(s.certificate.richardson_error, options.accuracy);
+  // 3D: the certificate's third level (Nstep halved) is in its estimate.
+  ASSERT_TRUE(s.certificate.steps_halved_peak_change.has_value());
+  EXPECT_GE(s.certificate.richardson_error, *s.certificate.steps_halved_peak_change);
+  EXPECT_GE(s.certificate.richardson_error, 2.0 * s.certificate.steps_doubled_peak_change);
+  EXPECT_EQ(options.tolerances.servo, triaxial_tolerances().servo);
   EXPECT_EQ(s.certificate.peak, s.best_trial.score.criteria.peak_stress_yy);
   EXPECT_LT(s.certificate.peak, -config.test.lateral_stress);  // compressive, above σ3
 
@@ -63,6 +69,47 @@ TEST(Calibration3D, SmallFccIsCertifiedAndMatchesARunEightTimesLonger) {
       relative(s.best_trial.score.criteria.peak_stress_yy, fine.score.criteria.peak_stress_yy),
       options.accuracy)
       << s.FullReport();
+}
+
+// Rotational drag (reports/atlas-3d.md): in an FCC crystal the damping
+// torques cancel between symmetric spheres, so moment balance (their sum)
+// does not see ζ_r; the rotational-drag criterion (the damping's share of
+// the axial wall's power) does. The same run with ζ_r = 0 passes every
+// criterion; with ζ_r = 2 it fails on the drag alone, is diagnosed as
+// rotational damping, and its peak is raised by at least the share (energy
+// balance: the power the damping takes must come from the axial wall).
+TEST(Calibration3D, RotationalDragFailsTheDraggedRunAndPassesTheUndampedOne) {
+  const SceneConfig config = parse_config_text(kFcc2, "fcc_2x2x2");
+  const TriaxialState state = consolidate_triaxial(config, make_sphere_assembly(config));
+  const TriaxialRunner runner(config, state);
+  const Tolerances t = triaxial_tolerances();
+  const double s3 = config.test.lateral_stress;
+  AlgorithmSpec p = config.algorithm;
+  p.dt_ratio = 0.17;
+  p.steps = 16000;
+  p.damping_ratio_translation = 0.5;
+  p.damping_ratio_rotation = 0.0;
+  TriaxialResult free_run, dragged_run;
+  const TrialRun free = runner.run(p, t, false, 3.0, nullptr, &free_run);
+  p.damping_ratio_rotation = 2.0;
+  const TrialRun dragged = runner.run(p, t, false, 3.0, nullptr, &dragged_run);
+  const TriaxialCriteria cf = compute_triaxial_criteria(free_run, s3);
+  const TriaxialCriteria cd = compute_triaxial_criteria(dragged_run, s3);
+
+  EXPECT_TRUE(free.score.passed) << free.score.worst_excess;
+  EXPECT_EQ(cf.rotational_drag, 0.0);  // no rotational damping, no drag
+  EXPECT_GT(cd.rotational_drag, kRotationalDragTolerance);
+  EXPECT_FALSE(dragged.score.passed);
+  // Every other criterion passes: moment balance (the torques' sum) alone
+  // would not have seen it.
+  EXPECT_LE(excesses(cd.combined, t).worst(), 1.0);
+  EXPECT_DOUBLE_EQ(dragged.score.criteria.moment_balance,
+                   t.moment_balance * cd.rotational_drag / kRotationalDragTolerance);
+  EXPECT_EQ(dragged.score.diagnosis.parameter, "damping_rotation");
+  EXPECT_EQ(dragged.score.diagnosis.direction, "decrease");
+  const double rise =
+      (free_run.peak_stress_zz - dragged_run.peak_stress_zz) / std::abs(free_run.peak_stress_zz);
+  EXPECT_GT(rise, cd.rotational_drag);
 }
 
 TEST(Calibration3D, CommandWritesParamsWithTheDimensionAndResumeReusesEveryTrial) {

@@ -35,7 +35,10 @@ def run(a, zt, zr, n):
     if p.returncode != 0:
         return {"params": [a, zt, zr, n], "error": p.stderr.strip()[-300:]}
     s = json.load(open(os.path.join(d, "summary.json")))
-    return {"params": [a, zt, zr, n], "criteria": s["criteria"],
+    crit = dict(s["criteria"])
+    for k in ("rotational_drag", "translational_drag"):
+        crit[k] = s["criteria_planes"].get(k)
+    return {"params": [a, zt, zr, n], "criteria": crit,
             "peak": s["peak"]["stress_zz"], "diverged": s["diverged"],
             "steps_run": s["steps_run"], "wall_time_s": s["wall_time_s"]}
 

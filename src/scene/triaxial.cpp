@@ -13,6 +13,7 @@
 
 #include "demcal/io/format.hpp"
 #include "demcal/io/input_error.hpp"
+#include "demcal/kernel/particle_scales.hpp"
 #include "demcal/scene/biaxial.hpp"
 #include "protocol_steps.hpp"
 
@@ -163,6 +164,33 @@ double estimated_stable_dt_ratio(const TriaxialState& state, const AlgorithmSpec
   return detail::stable_dt_ratio_of<SphereWorld>(state.world, algorithm, integration_for);
 }
 
+namespace {
+
+/// The global damping's power at a monitoring point (D as the kernel sets
+/// it: ζ times the critical value of each sphere's scaled mass and inertia)
+/// and the top wall's power.
+void damping_powers(const SphereWorld& world, TriaxialPoint& p) {
+  const Integration& in = world.integration();
+  const double kn = world.material().particle.kn, kt = world.material().particle.kt;
+  const auto m = world.mass();
+  const auto inertia = world.inertia();
+  const auto r = world.radius();
+  const auto vx = world.vx(), vy = world.vy(), vz = world.vz();
+  const auto wx = world.omega_x(), wy = world.omega_y(), wz = world.omega_z();
+  double pt = 0.0, pr = 0.0;
+  for (int i = 0; i < world.size(); ++i) {
+    pt += critical_damping_translation(kn, m[i]) * (vx[i] * vx[i] + vy[i] * vy[i] + vz[i] * vz[i]);
+    pr += critical_damping_rotation(kt, r[i], inertia[i]) *
+          (wx[i] * wx[i] + wy[i] * wy[i] + wz[i] * wz[i]);
+  }
+  p.damping_power_translation = in.damping_ratio_translation * pt;
+  p.damping_power_rotation = in.lock_rotation ? 0.0 : in.damping_ratio_rotation * pr;
+  const SphereWall& top = world.wall(kZMax);
+  p.axial_power = -top.force[2] * top.velocity;
+}
+
+}  // namespace
+
 TriaxialResult run_triaxial_loading(const TriaxialState& start, const TestSpec& test,
                                     const AlgorithmSpec& algorithm, const TriaxialMonitor& monitor,
                                     SphereWorld* final_state) {
@@ -193,6 +221,7 @@ TriaxialResult run_triaxial_loading(const TriaxialState& start, const TestSpec& 
     }
     p.lateral_stress_error = (lateral - sigma3) / sigma3;
     for (int s = 0; s < 6; ++s) p.walls[s] = world.wall(static_cast<SphereWallSide>(s)).position;
+    damping_powers(world, p);
     out.series.push_back(p);
     return !monitor || monitor(p);
   };

@@ -16,6 +16,7 @@
 #include "demcal/io/files.hpp"
 #include "demcal/io/format.hpp"
 #include "demcal/scene/run_output.hpp"
+#include "demcal/scoring/triaxial_scoring.hpp"
 #include "demcal/search/parallel.hpp"
 
 namespace demcal {
@@ -127,12 +128,17 @@ double dt_ratio_max(const CalibrationOptions& options, double dt_ratio_stable) {
 }
 
 nlohmann::json to_json(const Certificate& c) {
-  return {{"steps", c.steps},
-          {"peak_stress_yy", c.peak},
-          {"peak_stress_yy_steps_doubled", c.peak_doubled},
-          {"steps_doubled_peak_change", c.steps_doubled_peak_change},
-          {"richardson_error", c.richardson_error},
-          {"passed", c.passed}};
+  nlohmann::json j{{"steps", c.steps},
+                   {"peak_stress_yy", c.peak},
+                   {"peak_stress_yy_steps_doubled", c.peak_doubled},
+                   {"steps_doubled_peak_change", c.steps_doubled_peak_change},
+                   {"richardson_error", c.richardson_error},
+                   {"passed", c.passed}};
+  if (c.peak_halved) {
+    j["peak_stress_yy_steps_halved"] = *c.peak_halved;
+    j["steps_halved_peak_change"] = *c.steps_halved_peak_change;
+  }
+  return j;
 }
 
 CalibrationOptions CalibrationOptions::from(const CalibrationSpec& spec) {
@@ -140,6 +146,12 @@ CalibrationOptions CalibrationOptions::from(const CalibrationSpec& spec) {
   o.max_trials = spec.max_trials;
   o.accuracy = spec.accuracy;
   o.seed = spec.seed;
+  return o;
+}
+
+CalibrationOptions CalibrationOptions::from(const SceneConfig& config) {
+  CalibrationOptions o = from(config.calibration);
+  o.tolerances = default_tolerances(config);
   return o;
 }
 
@@ -647,13 +659,19 @@ std::optional<TrialRecord> cheapest_passing(const std::vector<TrialRecord>& tria
   return best;
 }
 
-Certificate certify(Evaluator& evaluator, const TrialRecord& best, double accuracy, int jobs) {
-  AlgorithmSpec doubled = best.params;
+Certificate certify(Evaluator& evaluator, const TrialRecord& best, double accuracy, int jobs,
+                    bool three_level) {
+  AlgorithmSpec doubled = best.params, halved = best.params;
   doubled.steps = 2 * best.params.steps;
-  TrialRecord a, b;
-  run_parallel({[&] { a = evaluator.evaluate(best.params, TrialPhase::certificate); },
-                [&] { b = evaluator.evaluate(doubled, TrialPhase::certificate); }},
-               jobs);
+  halved.steps = best.params.steps / 2;
+  TrialRecord a, b, h;
+  std::vector<std::function<void()>> runs{
+      [&] { a = evaluator.evaluate(best.params, TrialPhase::certificate); },
+      [&] { b = evaluator.evaluate(doubled, TrialPhase::certificate); }};
+  // The halved run is judged only by its peak: it runs to its end.
+  if (three_level)
+    runs.push_back([&] { h = evaluator.evaluate(halved, TrialPhase::certificate, false); });
+  run_parallel(runs, jobs);
   Certificate c;
   c.steps = best.params.steps;
   c.peak = a.score.criteria.peak_stress_yy;
@@ -661,7 +679,15 @@ Certificate certify(Evaluator& evaluator, const TrialRecord& best, double accura
   c.steps_doubled_peak_change =
       c.peak_doubled != 0.0 ? std::abs(c.peak - c.peak_doubled) / std::abs(c.peak_doubled) : 1.0;
   c.richardson_error = richardson_error(c.steps_doubled_peak_change, 2.0);
-  c.passed = !b.score.diverged && b.score.complete && c.richardson_error <= accuracy;
+  bool finished = !b.score.diverged && b.score.complete;
+  if (three_level) {
+    c.peak_halved = h.score.criteria.peak_stress_yy;
+    // A halved run that diverged or stopped says nothing: counted as 100 %.
+    const bool ok = !h.score.diverged && h.score.complete && c.peak != 0.0;
+    c.steps_halved_peak_change = ok ? std::abs(*c.peak_halved - c.peak) / std::abs(c.peak) : 1.0;
+    c.richardson_error = std::max(c.richardson_error, *c.steps_halved_peak_change);
+  }
+  c.passed = finished && c.richardson_error <= accuracy;
   return c;
 }
 
@@ -812,7 +838,7 @@ CalibrationSummary calibrate(const TrialRunner& runner, const AlgorithmSpec& bas
     // Judged against the current (possibly tightened) tolerances.
     best = cheapest_passing(evaluator.all(), &tolerances, steps_floor);
     if (!best) break;
-    out.certificate = certify(evaluator, *best, options.accuracy, jobs);
+    out.certificate = certify(evaluator, *best, options.accuracy, jobs, out.dimension == 3);
     if (evaluator.stopped()) return finish_interrupted();
     if (out.certificate.passed) break;
     if (round < 2) {

@@ -37,6 +37,12 @@ struct TriaxialPoint {
   /// (mean pressure of the four lateral walls − σ3)/σ3.
   double lateral_stress_error = 0.0;
   std::array<double, 6> walls{};  ///< positions, SphereWallSide order
+  /// Power the global damping takes from the particles at this step [W]:
+  /// Σ D_t·|v|² and Σ D_r·|ω|² (the rotational drag of the scoring).
+  double damping_power_translation = 0.0;
+  double damping_power_rotation = 0.0;
+  /// Power the moving (top) wall puts into the sample, −F_z·v_z [W].
+  double axial_power = 0.0;
 };
 
 /// The consolidated sample, made once and copied by every run.
