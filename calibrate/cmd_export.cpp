@@ -2,10 +2,13 @@
 // deck for the prototype run in another code, with the particle file it
 // reads (demcal's consolidated state of the prototype) next to it. A 3D
 // params.json (spheres, triaxial test) gives the 3D deck of its REV.
+#include <algorithm>
 #include <filesystem>
 #include <iostream>
+#include <thread>
 
 #include "commands.hpp"
+#include "consolidation_progress.hpp"
 #include "demcal/io/files.hpp"
 #include "demcal/scene/biaxial.hpp"
 #include "demcal/scene/run_output.hpp"
@@ -24,6 +27,11 @@ namespace demcal::cli {
 /// to the LAMMPS deck: demcal's kernel consolidates single-threaded, and
 /// beyond a few thousand particles that takes minutes (reports/engines.md §8).
 constexpr int kDeckConsolidationAbove = 2000;
+
+/// From this many particles demcal's consolidation steps on every core: the
+/// kernel's two threads break even near 10^4 disks (reports/performance.md,
+/// "Threads": 1.78x at 10^4 on an idle machine; a loss on small REVs).
+constexpr int kConsolidationThreadsFrom = 10000;
 
 namespace {
 
@@ -93,7 +101,8 @@ int export_3d(const ExportCmdOptions& o, const RevParams& rev, const SceneConfig
   const SphereAssembly assembly = make_sphere_assembly(config);
   std::cerr << "demcal export: consolidating the " << assembly.size()
             << " spheres of the REV to sigma3 with demcal's kernel\n";
-  const TriaxialState state = consolidate_triaxial(config, assembly);
+  const TriaxialState state =
+      consolidate_triaxial(config, assembly, consolidation_progress(o.progress_every_s));
   std::cerr << "demcal export: consolidated in " << state.steps << " steps, " << state.wall_time_s
             << " s\n";
   const ExportResult r = export_3d_decks(config, rev.params, state, eo);
@@ -138,10 +147,17 @@ int cmd_export(const ExportCmdOptions& o) {
               << ": the deck consolidates the prototype to sigma3 itself (stage 1, under MPI; "
                  "--consolidate-in demcal does it here instead)\n";
   } else if (!o.no_consolidate) {
+    ConsolidationOptions co;
+    co.threads = proto.size() >= kConsolidationThreadsFrom ? 0 : 1;
+    co.progress = consolidation_progress(o.progress_every_s);
     std::cerr << "demcal export: consolidating the prototype (" << source.description
-              << ") to sigma3 with demcal's kernel, single-threaded (--consolidate-in deck "
-                 "leaves it to the LAMMPS deck, under MPI)\n";
-    const ConsolidatedState state = consolidate(config, proto);
+              << ") to sigma3 with demcal's kernel, "
+              << (co.threads == 1
+                      ? std::string("single-threaded")
+                      : "on " + std::to_string(std::max(1u, std::thread::hardware_concurrency())) +
+                            " threads")
+              << " (--consolidate-in deck leaves it to the LAMMPS deck, under MPI)\n";
+    const ConsolidatedState state = consolidate(config, proto, co);
     std::cerr << "demcal export: consolidated in " << state.steps << " steps, " << state.wall_time_s
               << " s\n";
     proto = assembly_of(state.world);

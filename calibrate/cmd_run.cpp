@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "commands.hpp"
+#include "consolidation_progress.hpp"
 #include "demcal/io/files.hpp"
 #include "demcal/scene/biaxial.hpp"
 #include "demcal/scene/packing.hpp"
@@ -73,22 +74,6 @@ void require_stable_step(const SceneConfig& config, double stable, bool allow_un
 namespace {
 
 // ---- 3D: spheres, triaxial test -------------------------------------------
-
-/// Consolidation progress on stderr, at most every two seconds (a random gas
-/// can take a while; never silently).
-ConsolidationCallback consolidation_progress() {
-  auto last =
-      std::make_shared<std::chrono::steady_clock::time_point>(std::chrono::steady_clock::now());
-  return [last](const ConsolidationProgress& p) {
-    const auto now = std::chrono::steady_clock::now();
-    if (now - *last < std::chrono::seconds(2)) return;
-    *last = now;
-    std::cerr << "consolidating (" << (p.phase == 0 ? "frictionless" : "friction on") << "): step "
-              << p.steps << " of at most " << p.max_steps << ", wall stress error "
-              << std::setprecision(3) << 100.0 * p.stress_error << " %, unbalanced-force ratio "
-              << p.unbalanced_ratio << std::endl;
-  };
-}
 
 TriaxialState consolidate_3d(const SceneConfig& config) {
   const SphereAssembly assembly = make_sphere_assembly(config);
@@ -192,7 +177,8 @@ int cmd_check(const std::string& path, const std::vector<std::string>& sets) {
   SceneConfig config = load_config(path, sets);
   if (config.dimension == 3) return check_3d(config);
   Assembly assembly = make_assembly(config);
-  const ConsolidatedState state = consolidate(config, assembly);
+  const ConsolidatedState state =
+      consolidate(config, assembly, ConsolidationOptions{.progress = consolidation_progress()});
   require_stable_step(config, estimated_stable_dt_ratio(state, config.algorithm), false);
   std::cout << "config " << config.source << ": valid\n";
   print_scales(config, state.world);
@@ -221,7 +207,8 @@ int cmd_run(const std::string& path, const std::vector<std::string>& sets,
   Assembly assembly = make_assembly(config);
   const std::string dir = out_dir.empty() ? "demcal-run-" + config.name : out_dir;
   OutputFolder::check(dir);  // an unwritable -o fails now, not after the run
-  const ConsolidatedState state = consolidate(config, assembly);
+  const ConsolidatedState state =
+      consolidate(config, assembly, ConsolidationOptions{.progress = consolidation_progress()});
   require_stable_step(config, estimated_stable_dt_ratio(state, config.algorithm), allow_unstable);
   World final_state = state.world;
   const LoadingResult run = run_loading(state, config.test, config.algorithm, {}, &final_state);

@@ -98,6 +98,10 @@ std::function<int()> add_upscaling_commands(CLI::App& app) {
   exp->add_option("--consolidate-in", ex->consolidate_in,
                   "demcal, deck (LAMMPS: the deck's first stage, under MPI) or auto (default: "
                   "the deck above 2000 particles)");
+  exp->add_option("--progress", ex->progress_every_s,
+                  "seconds between consolidation progress lines on stderr (default 2; 0: every "
+                  "check)")
+      ->check(CLI::Range(0.0, 1e9));
 
   auto rv = std::make_shared<RevCmdOptions>();
   auto* rev = app.add_subcommand(

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "consolidation_progress.hpp"
 #include "demcal/upscaling/upscaling.hpp"
 
 namespace demcal::cli {
@@ -82,6 +83,8 @@ struct ExportCmdOptions {
   /// writing), deck (a first stage of the LAMMPS deck) or auto (the deck
   /// above kDeckConsolidationAbove particles).
   std::string consolidate_in = "auto";
+  /// Seconds between demcal's consolidation progress lines on stderr.
+  double progress_every_s = kProgressEverySeconds;
 };
 int cmd_export(const ExportCmdOptions& options);
 

@@ -71,12 +71,14 @@ Integration integration_for(const World& world, const AlgorithmSpec& algorithm) 
 
 namespace {
 
-ConsolidatedState consolidate_fresh(const SceneConfig& config, const Assembly& assembly) {
+ConsolidatedState consolidate_fresh(const SceneConfig& config, const Assembly& assembly,
+                                    const ConsolidationOptions& options) {
   const auto t0 = std::chrono::steady_clock::now();
   const TestSpec& test = config.test;
   ConsolidatedState state{World(config.material, assembly.x, assembly.y, assembly.r, assembly.left,
                                 assembly.right, assembly.bottom, assembly.top)};
   World& world = state.world;
+  world.set_threads(options.threads);
   const double mu = config.material.particle.friction;
   // Damping for the fastest relaxation, not the loading's. ζ = 1 is critical
   // for one particle on one contact, so it heavily over-damps the packing's
@@ -105,7 +107,10 @@ ConsolidatedState consolidate_fresh(const SceneConfig& config, const Assembly& a
   const detail::ConsolidationOutcome o = detail::run_consolidation<WallSide, 4>(
       world, test, mu, settle,
       [](const World& w, const AlgorithmSpec& a) { return integration_for(w, a); },
-      [](const detail::ConsolidationOutcome&) {});
+      [&](const detail::ConsolidationOutcome& c) {
+        if (options.progress) options.progress(c.progress);
+      });
+  world.set_threads(1);
   state.converged = o.converged;
   state.stress_error = o.stress_error;
   state.unbalanced_ratio = o.unbalanced_ratio;
@@ -125,21 +130,23 @@ ConsolidatedState consolidate_fresh(const SceneConfig& config, const Assembly& a
 }  // namespace
 
 ConsolidatedState consolidate(const SceneConfig& config, const Assembly& assembly,
-                              const std::string& cache_dir) {
-  if (cache_dir.empty()) return consolidate_fresh(config, assembly);
+                              const std::string& cache_dir, const ConsolidationOptions& options) {
+  if (cache_dir.empty()) return consolidate_fresh(config, assembly, options);
   const auto t0 = std::chrono::steady_clock::now();
   const std::string key = consolidation_key(config, assembly);
   if (auto cached = load_consolidated(cache_dir, key)) {
     cached->wall_time_s = seconds_since(t0);
     return std::move(*cached);
   }
-  ConsolidatedState state = consolidate_fresh(config, assembly);  // a failure is not stored
+  ConsolidatedState state =
+      consolidate_fresh(config, assembly, options);  // a failure is not stored
   store_consolidated(cache_dir, key, state);
   return state;
 }
 
-ConsolidatedState consolidate(const SceneConfig& config, const Assembly& assembly) {
-  return consolidate(config, assembly, consolidation_cache_dir());
+ConsolidatedState consolidate(const SceneConfig& config, const Assembly& assembly,
+                              const ConsolidationOptions& options) {
+  return consolidate(config, assembly, consolidation_cache_dir(), options);
 }
 
 double estimated_stable_dt_ratio(const ConsolidatedState& state, const AlgorithmSpec& algorithm) {

@@ -14,15 +14,19 @@
 #pragma once
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <deque>
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "demcal/io/format.hpp"
 #include "demcal/kernel/world.hpp"
 #include "demcal/scene/config.hpp"
+#include "demcal/scene/consolidation_progress.hpp"
 
 namespace demcal::detail {
 
@@ -41,22 +45,75 @@ struct ConsolidationOutcome {
   int64_t steps = 0;
   int phase = 0;  ///< the phase it ended in (0 frictionless, 1 friction on)
   bool converged = false;
-  double stress_error = 0.0;      ///< max |p − σ3|/σ3 over the walls, last check
-  double unbalanced_ratio = 0.0;  ///< unbalanced-force ratio, last check
+  double stress_error = 0.0;       ///< max |p − σ3|/σ3 over the walls, last check
+  double unbalanced_ratio = 0.0;   ///< unbalanced-force ratio, last check
+  ConsolidationProgress progress;  ///< the last check's report (wall-clock fields included)
+};
+
+/// The wall-clock side of ConsolidationProgress: elapsed time, the step
+/// budget's bound and the extrapolated time to a static state
+/// (consolidation_progress.hpp says how). Reads the clock only; the
+/// consolidation does not depend on it.
+class ConsolidationClock {
+ public:
+  explicit ConsolidationClock(const TestSpec& test)
+      : test_(test), start_(std::chrono::steady_clock::now()) {}
+
+  ConsolidationProgress check(int phase, int64_t steps, double stress_error,
+                              double unbalanced_ratio) {
+    ConsolidationProgress p;
+    p.phase = phase;
+    p.steps = steps;
+    p.max_steps = test_.consolidation_max_steps;
+    p.stress_error = stress_error;
+    p.unbalanced_ratio = unbalanced_ratio;
+    p.elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    const double per_step = steps > 0 ? p.elapsed_s / static_cast<double>(steps) : 0.0;
+    p.remaining_max_s = static_cast<double>(std::max<int64_t>(0, p.max_steps - steps)) * per_step;
+    // Distance to static in e-folds of the criterion furthest from its
+    // tolerance (≤ 0: both met).
+    const double d = std::max(std::log(stress_error / test_.consolidation_tolerance),
+                              std::log(unbalanced_ratio / test_.consolidation_unbalanced));
+    if (phase != phase_) window_.clear();
+    phase_ = phase;
+    window_.emplace_back(steps, d);
+    if (window_.size() > kWindow) window_.pop_front();
+    p.remaining_s = p.remaining_max_s;
+    if (!(d > 0.0)) {
+      p.steps_to_go = 0;
+    } else if (window_.size() >= 3) {
+      const auto& [steps0, d0] = window_.front();
+      const double rate = (d0 - d) / static_cast<double>(steps - steps0);  // e-folds per step
+      if (rate > 0.0 && std::isfinite(d0))
+        p.steps_to_go =
+            static_cast<int64_t>(std::ceil(std::min(d / rate, static_cast<double>(p.max_steps))));
+    }
+    if (p.steps_to_go >= 0)
+      p.remaining_s = std::min(p.remaining_max_s, static_cast<double>(p.steps_to_go) * per_step);
+    return p;
+  }
+
+ private:
+  static constexpr size_t kWindow = 10;  ///< checks the trend is taken over
+  const TestSpec& test_;
+  std::chrono::steady_clock::time_point start_;
+  int phase_ = -1;
+  std::deque<std::pair<int64_t, double>> window_;
 };
 
 /// Runs the consolidation on `world` (its integration set from `settle`
 /// by `integration_for`, which the critical-damping fallback calls again),
 /// with `walls` walls of type `Side`, and calls on_check(outcome) after
-/// every check. Only the blow-up checks (non-finite state, overlap beyond
-/// the limit) stay on meanwhile: with light damping the energy checks read
-/// the walls' work as energy made by the integrator — the kinetic energy a
-/// servo wall pumps into a gas exceeds anything the springs have stored,
-/// and the ledger's sampled damping and wall powers alias when velocities
-/// oscillate at the contact frequency (a false "energy created" on the
-/// hexagonal REVs). Consolidation must reach the static state demanded,
-/// which no rattling or growing run does. Throws std::runtime_error when
-/// the kernel diverges; the caller decides what non-convergence means.
+/// every check (outcome.progress: its report, time estimate included).
+/// Only the blow-up checks (non-finite state, overlap beyond the limit)
+/// stay on meanwhile: with light damping the energy checks read the walls'
+/// work as energy made by the integrator — the kinetic energy a servo wall
+/// pumps into a gas exceeds anything the springs have stored, and the
+/// ledger's sampled damping and wall powers alias when velocities oscillate
+/// at the contact frequency (a false "energy created" on the hexagonal
+/// REVs). Consolidation must reach the static state demanded, which no
+/// rattling or growing run does. Throws std::runtime_error when the kernel
+/// diverges; the caller decides what non-convergence means.
 template <class Side, int walls, class Sample, class IntegrationFor, class OnCheck>
 ConsolidationOutcome run_consolidation(Sample& world, const TestSpec& test, double friction,
                                        AlgorithmSpec settle, IntegrationFor integration_for,
@@ -72,6 +129,7 @@ ConsolidationOutcome run_consolidation(Sample& world, const TestSpec& test, doub
   constexpr int kCheckEvery = 200;
   const int64_t max_steps = test.consolidation_max_steps;
   ConsolidationOutcome out;
+  ConsolidationClock clock(test);
   bool critical = false;
   for (out.phase = 0; out.phase < 2; ++out.phase) {
     world.set_particle_friction(out.phase == 0 ? 0.0 : friction);
@@ -97,6 +155,7 @@ ConsolidationOutcome run_consolidation(Sample& world, const TestSpec& test, doub
         err = std::max(err, std::abs(wall_pressure(world, static_cast<Side>(s)) - sigma3) / sigma3);
       out.stress_error = err;
       out.unbalanced_ratio = world.measure().unbalanced_force_ratio;
+      out.progress = clock.check(out.phase, out.steps, out.stress_error, out.unbalanced_ratio);
       on_check(out);
       done = err < test.consolidation_tolerance &&
              out.unbalanced_ratio < test.consolidation_unbalanced;

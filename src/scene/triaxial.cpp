@@ -143,9 +143,7 @@ TriaxialState consolidate_triaxial(const SceneConfig& config, const SphereAssemb
       world, test, mu, settle,
       [](const SphereWorld& w, const AlgorithmSpec& a) { return integration_for(w, a); },
       [&](const detail::ConsolidationOutcome& c) {
-        if (progress)
-          progress(
-              {c.phase, c.steps, test.consolidation_max_steps, c.stress_error, c.unbalanced_ratio});
+        if (progress) progress(c.progress);
       });
   state.converged = o.converged;
   state.stress_error = o.stress_error;

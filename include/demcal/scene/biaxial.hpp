@@ -13,6 +13,7 @@
 
 #include "demcal/kernel/world.hpp"
 #include "demcal/scene/config.hpp"
+#include "demcal/scene/consolidation_progress.hpp"
 #include "demcal/scene/packing.hpp"
 
 namespace demcal {
@@ -61,14 +62,27 @@ double wall_pressure(const World& world, WallSide side);
 /// own speed (biaxial.cpp; the exported decks' consolidation stage uses it).
 inline constexpr double kConsolidationDampingRatio = 0.02;
 
+/// How a consolidation runs; none of it changes the state it reaches.
+struct ConsolidationOptions {
+  /// Kernel threads while consolidating (KernelOptions::threads; 0: every
+  /// core). Results are bit-identical for any count; the state returned
+  /// steps on one thread, as every World starts (its trials run in parallel).
+  int threads = 1;
+  /// Called at every check (every 200 steps) of a fresh consolidation; not
+  /// called for a state read from the cache.
+  ConsolidationCallback progress;
+};
+
 /// Consolidate: frictionless servo compression to σ3 until static, then
 /// friction on and static again. Throws std::runtime_error if it cannot.
 /// Through the consolidation cache in consolidation_cache_dir() (the
 /// environment's; consolidation_cache.hpp): the same state, bit for bit.
-ConsolidatedState consolidate(const SceneConfig& config, const Assembly& assembly);
+ConsolidatedState consolidate(const SceneConfig& config, const Assembly& assembly,
+                              const ConsolidationOptions& options = {});
 /// The same through the cache in `cache_dir`; "" consolidates afresh.
 ConsolidatedState consolidate(const SceneConfig& config, const Assembly& assembly,
-                              const std::string& cache_dir);
+                              const std::string& cache_dir,
+                              const ConsolidationOptions& options = {});
 
 struct LoadingResult {
   std::vector<MonitorPoint> series;

@@ -16,6 +16,7 @@
 
 #include "demcal/kernel/sphere_world.hpp"
 #include "demcal/scene/config.hpp"
+#include "demcal/scene/consolidation_progress.hpp"
 #include "demcal/scene/sphere_packing.hpp"
 
 namespace demcal {
@@ -76,15 +77,6 @@ double servo_velocity(const SphereWorld& world, SphereWallSide side, double targ
 /// with Δt_crit from the kernel's masses at the spec's mass scaling
 /// (SphereWorld::reference_scales(), the one home of m = ρ(4/3)πr³).
 Integration integration_for(const SphereWorld& world, const AlgorithmSpec& algorithm);
-
-/// Progress of a consolidation, every few hundred steps.
-struct ConsolidationProgress {
-  int phase = 0;  ///< 0 frictionless, 1 friction on
-  int64_t steps = 0, max_steps = 0;
-  double stress_error = 0.0;      ///< max |p − σ3|/σ3 over the six walls
-  double unbalanced_ratio = 0.0;  ///< unbalanced-force ratio
-};
-using ConsolidationCallback = std::function<void(const ConsolidationProgress&)>;
 
 /// Consolidate: all six walls servo to σ3, frictionless until static, then
 /// friction on and static again; light global damping (ζ = 0.02) with the

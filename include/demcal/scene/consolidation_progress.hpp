@@ -1,0 +1,35 @@
+// What a consolidation (2D biaxial.hpp, 3D triaxial.hpp) reports while it
+// runs: one record per check (every few hundred steps), for progress lines
+// and a time estimate. Wall-clock fields only; the state never depends on them.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+
+namespace demcal {
+
+/// Progress of a consolidation, at every check (every 200 steps).
+struct ConsolidationProgress {
+  int phase = 0;  ///< 0 frictionless, 1 friction on
+  int64_t steps = 0, max_steps = 0;
+  double stress_error = 0.0;      ///< max |p − σ3|/σ3 over the walls
+  double unbalanced_ratio = 0.0;  ///< unbalanced-force ratio
+  double elapsed_s = 0.0;         ///< wall time since the consolidation started
+  /// Wall time the rest of the step budget would take at the mean rate so
+  /// far: an upper bound (the budget's end is a failure).
+  double remaining_max_s = 0.0;
+  /// Steps until this phase is static, extrapolated: the distance of the
+  /// two criteria to their tolerances, max(ln(err/tol), ln(ufr/ufr_tol)),
+  /// taken as linear in steps over the phase's last ten checks (both decay
+  /// exponentially once the packing has formed). −1 when that distance is
+  /// not shrinking (a gas still being compressed, noise); 0 when both
+  /// criteria are met.
+  int64_t steps_to_go = -1;
+  /// Estimated wall time until this phase is static: steps_to_go at the
+  /// mean rate so far, never above remaining_max_s; remaining_max_s when
+  /// there is no trend (steps_to_go −1).
+  double remaining_s = 0.0;
+};
+using ConsolidationCallback = std::function<void(const ConsolidationProgress&)>;
+
+}  // namespace demcal

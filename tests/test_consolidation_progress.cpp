@@ -1,0 +1,148 @@
+// demcal's 2D consolidation reports progress while it runs (issue #16: it
+// never spends minutes silently) and steps on threads without changing the
+// state it reaches; the CLI prints the reports on stderr.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "demcal/scene/biaxial.hpp"
+#include "demcal/scene/config.hpp"
+#include "demcal/scene/packing.hpp"
+#include "support/files.hpp"
+#include "support/process.hpp"
+#include "support/scenes.hpp"
+
+namespace demcal {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A random gas of 150 disks: compressed by the walls first (no trend while
+// they close in), then settling (the criteria decay), then friction on.
+SceneConfig gas() {
+  return parse_config_text(test::with_required_material(
+                               R"({"assembly": {"type": "random", "count": 150, "radius_min": 4e-4,
+              "radius_max": 6e-4, "seed": 3}})"),
+                           "gas");
+}
+
+TEST(ConsolidationProgress, EveryCheckIsReportedWithAPositiveEstimate) {
+  const SceneConfig c = gas();
+  const Assembly a = make_assembly(c);
+  std::vector<ConsolidationProgress> seen;
+  ConsolidationOptions o;
+  o.progress = [&](const ConsolidationProgress& p) { seen.push_back(p); };
+  const ConsolidatedState s = consolidate(c, a, "", o);
+  ASSERT_TRUE(s.converged);
+  // One report per check (every 200 steps), the last one at the last step.
+  ASSERT_EQ(static_cast<int64_t>(seen.size()) * 200, s.steps);
+  EXPECT_EQ(seen.back().steps, s.steps);
+  EXPECT_EQ(seen.back().phase, 1);
+  EXPECT_EQ(seen.back().stress_error, s.stress_error);
+  EXPECT_EQ(seen.back().unbalanced_ratio, s.unbalanced_ratio);
+  EXPECT_EQ(seen.back().steps_to_go, 0);  // static: nothing to go
+  int trends = 0;
+  for (size_t k = 0; k < seen.size(); ++k) {
+    const ConsolidationProgress& p = seen[k];
+    SCOPED_TRACE("check " + std::to_string(k));
+    EXPECT_EQ(p.steps, 200 * static_cast<int64_t>(k + 1));
+    EXPECT_EQ(p.max_steps, c.test.consolidation_max_steps);
+    if (k > 0) {
+      EXPECT_GE(p.phase, seen[k - 1].phase);
+      EXPECT_GE(p.elapsed_s, seen[k - 1].elapsed_s);
+    }
+    EXPECT_GT(p.elapsed_s, 0.0);
+    EXPECT_GT(p.remaining_max_s, 0.0);  // the budget is far from spent
+    const bool met = p.stress_error < c.test.consolidation_tolerance &&
+                     p.unbalanced_ratio < c.test.consolidation_unbalanced;
+    if (met) {
+      EXPECT_EQ(p.steps_to_go, 0);
+      EXPECT_EQ(p.remaining_s, 0.0);
+    } else {
+      EXPECT_NE(p.steps_to_go, 0);
+      EXPECT_GT(p.remaining_s, 0.0);
+      EXPECT_LE(p.remaining_s, p.remaining_max_s);
+      if (p.steps_to_go < 0) {
+        EXPECT_EQ(p.remaining_s, p.remaining_max_s);
+      }
+      trends += p.steps_to_go > 0;
+    }
+  }
+  // The settling is seen converging (the gas compression is not).
+  EXPECT_GT(trends, 0);
+  EXPECT_EQ(seen.front().steps_to_go, -1);
+  std::printf("150-disk gas: %lld steps, %zu reports, %d with a trend\n",
+              static_cast<long long>(s.steps), seen.size(), trends);
+}
+
+TEST(ConsolidationProgress, ThreadsAndReportsDoNotChangeTheState) {
+  const SceneConfig c = gas();
+  const Assembly a = make_assembly(c);
+  const ConsolidatedState plain = consolidate(c, a, "");
+  ConsolidationOptions o;
+  o.threads = 2;
+  int calls = 0;
+  o.progress = [&](const ConsolidationProgress&) { ++calls; };
+  const ConsolidatedState threaded = consolidate(c, a, "", o);
+  EXPECT_GT(calls, 0);
+  ASSERT_EQ(threaded.steps, plain.steps);
+  ASSERT_EQ(threaded.world.size(), plain.world.size());
+  for (int i = 0; i < plain.world.size(); ++i) {
+    ASSERT_EQ(threaded.world.x()[i], plain.world.x()[i]) << "particle " << i;
+    ASSERT_EQ(threaded.world.y()[i], plain.world.y()[i]) << "particle " << i;
+    ASSERT_EQ(threaded.world.rotation()[i], plain.world.rotation()[i]) << "particle " << i;
+    ASSERT_EQ(threaded.world.fx()[i], plain.world.fx()[i]) << "particle " << i;
+  }
+  EXPECT_EQ(threaded.width0, plain.width0);
+  EXPECT_EQ(threaded.height0, plain.height0);
+  // The state steps on one thread afterwards, as every World starts.
+  EXPECT_EQ(threaded.world.threads(), 1);
+}
+
+std::vector<std::string> progress_lines(const std::string& err) {
+  std::vector<std::string> lines;
+  std::istringstream in(err);
+  for (std::string line; std::getline(in, line);)
+    if (line.rfind("consolidating (", 0) == 0) lines.push_back(line);
+  return lines;
+}
+
+TEST(ConsolidationProgress, ExportPrintsProgressOnStderr) {
+  // --progress 0 prints at every check (the default, 2 s, keeps a short
+  // consolidation quiet): the lines a long one prints, in a fast test.
+  const test::TempDir dir("consolidation_progress");
+  const std::string params =
+      (fs::path(test::kSourceDir) / "reports" / "example-hex_10x10" / "params.json").string();
+  const auto every = test::run_demcal({"export", params, "--particles", "100", "--consolidate-in",
+                                       "demcal", "--progress", "0", "-o", "a/deck.lammps"},
+                                      dir.path());
+  ASSERT_EQ(every.status, 0) << every.err;
+  const std::vector<std::string> lines = progress_lines(every.err);
+  ASSERT_GE(lines.size(), 2u) << every.err;
+  EXPECT_NE(lines.front().find("consolidating (frictionless): step 200 of at most "),
+            std::string::npos)
+      << lines.front();
+  EXPECT_NE(lines.back().find("consolidating (friction on)"), std::string::npos) << lines.back();
+  for (const std::string& l : lines) {
+    EXPECT_NE(l.find(" so far, "), std::string::npos) << l;
+    EXPECT_NE(l.find("(the step budget)"), std::string::npos) << l;
+  }
+  const auto quiet = test::run_demcal(
+      {"export", params, "--particles", "100", "--consolidate-in", "demcal", "-o", "b/deck.lammps"},
+      dir.path());
+  ASSERT_EQ(quiet.status, 0) << quiet.err;
+  EXPECT_TRUE(progress_lines(quiet.err).empty()) << quiet.err;
+  EXPECT_EQ(test::read_text(dir.path() / "a" / "deck.lammps"),
+            test::read_text(dir.path() / "b" / "deck.lammps"));
+  EXPECT_EQ(
+      test::run_demcal({"export", params, "--progress", "-1", "-o", "c/deck.lammps"}, dir.path())
+          .status,
+      2);
+}
+
+}  // namespace
+}  // namespace demcal
