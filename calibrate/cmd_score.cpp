@@ -29,7 +29,7 @@ int cmd_score(const ScoreOptions& o) {
   const std::string dir =
       o.out_dir.empty() ? "demcal-score-" + fs::path(o.file).stem().string() : o.out_dir;
   OutputFolder::check(dir);
-  const Tolerances tolerances;
+  const Tolerances tolerances = series.dimension == 3 ? triaxial_tolerances() : Tolerances{};
   std::optional<double> reference;
   if (o.reference_peak != 0.0) reference = -std::abs(o.reference_peak);
   const ExternalScore scored = score_external(series, tolerances, reference);
@@ -53,7 +53,8 @@ int cmd_score(const ScoreOptions& o) {
     print_triaxial_criteria(std::cout, *scored.planes);
     std::cout << "  tolerances: force balance " << tolerances.force_balance << ", moment balance "
               << tolerances.moment_balance << ", servo " << tolerances.servo << ", oscillation "
-              << tolerances.oscillation << " (the 2D defaults; " << kTriaxialVerdictNote << ")\n";
+              << tolerances.oscillation
+              << " and rotational drag 0.003 folded into moment balance (the 3D defaults)\n";
   } else {
     std::cout << "  force balance " << c.force_balance << " (tol " << tolerances.force_balance
               << "; paper form " << c.force_balance_paper << "), moment balance "

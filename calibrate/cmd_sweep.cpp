@@ -25,6 +25,7 @@ int cmd_sweep(const SweepOptions& options) {
 
   SweepSettings settings;
   settings.jobs = options.jobs;
+  settings.tolerances = default_tolerances(config);  // 3D: the triaxial ones
   settings.accuracy = config.calibration.accuracy;
   settings.progress = [](int k, int n, const std::string& name, double seconds) {
     std::cerr << "  [" << k << "/" << n << "] " << name << " (" << std::fixed

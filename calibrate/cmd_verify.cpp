@@ -91,7 +91,7 @@ int verify_in_lammps(const VerifyOptions& o, const SceneConfig& config,
   text << in.rdbuf();
   const ExternalSeries series =
       parse_external_series(text.str(), (work / "series.csv").string(), std::nullopt);
-  const Tolerances tolerances;
+  const Tolerances tolerances = default_tolerances(config);
   const ExternalScore scored = score_external(series, tolerances);
   const Score& score = scored.score;
   out["engine"] = {{"name", "lammps"},
@@ -216,7 +216,7 @@ int verify_3d(const VerifyOptions& o, const nlohmann::json& params, const RevPar
   std::cerr << "demcal verify: consolidated in " << state.steps << " steps, " << state.wall_time_s
             << " s; loading now\n";
   state.world.set_threads(threads);
-  const Tolerances tolerances;
+  const Tolerances tolerances = default_tolerances(config);
   TriaxialResult run;
   const TriaxialRunner runner(config, state);
   const TrialRun trial = runner.run(up, tolerances, false, 3.0, nullptr, &run);
@@ -371,7 +371,7 @@ int cmd_verify(const VerifyOptions& o) {
     return verify_in_lammps(o, config, state, up, dir, lmp, head);
   }
   LoadingResult run;
-  const Tolerances tolerances;
+  const Tolerances tolerances = default_tolerances(config);
   const TrialRecord trial = run_trial(config, state, up, tolerances, false, 3.0, &run);
   const Score score = score_run(run, config.test.lateral_stress, tolerances);
   const double total_s =

@@ -15,9 +15,6 @@ class App;
 
 namespace demcal::cli {
 
-/// Load CONFIG (or the embedded default when empty) and apply --set.
-SceneConfig load_scene(const std::string& path, const std::vector<std::string>& sets);
-
 int cmd_check(const std::string& path, const std::vector<std::string>& sets);
 /// `allow_unstable`: run a Δt beyond the estimated stable step (otherwise
 /// bad input).

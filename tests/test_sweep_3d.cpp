@@ -117,10 +117,13 @@ TEST(Sweep3D, FasterLoadingOpensTheForceBalanceGapAndOverPredictsThePeak) {
     EXPECT_FALSE(c.run.diverged) << c.spec.name;
     EXPECT_LT(c.identity_residual, 1e-9) << c.spec.name;
     ASSERT_TRUE(c.planes.has_value()) << c.spec.name;
-    // The combined criteria are the planes' largest.
+    // The combined criteria are the planes' largest, with the rotational
+    // drag folded into moment balance (scored_criteria).
+    const double planes_max = std::max(
+        {c.planes->xz.moment_balance, c.planes->yz.moment_balance, c.planes->xy.moment_balance});
+    EXPECT_GE(c.score.criteria.moment_balance, planes_max);
     EXPECT_EQ(c.score.criteria.moment_balance,
-              std::max({c.planes->xz.moment_balance, c.planes->yz.moment_balance,
-                        c.planes->xy.moment_balance}));
+              scored_criteria(*c.planes, r.tolerances).moment_balance);
   }
 }
 

@@ -111,7 +111,7 @@ std::string series_csv(const std::vector<TriaxialPoint>& series) {
   s << ",kinetic_energy,unbalanced_force_ratio,lateral_stress_error,kinetic_energy_rotation,"
        "elastic_energy,inertial_number,coordination_number,servo_error_xmin,servo_error_xmax,"
        "servo_error_ymin,servo_error_ymax,wall_xmin,wall_xmax,wall_ymin,wall_ymax,wall_zmin,"
-       "wall_zmax\n";
+       "wall_zmax,damping_power_translation,damping_power_rotation,axial_power\n";
   for (const auto& p : series) {
     s << p.step << ',' << p.strain_zz;
     for (const Eigen::Matrix3d* m : {&p.b, &p.sigma})
@@ -122,7 +122,8 @@ std::string series_csv(const std::vector<TriaxialPoint>& series) {
       << ',' << p.coordination_number;
     for (double e : p.servo_error) s << ',' << e;
     for (double w : p.walls) s << ',' << w;
-    s << '\n';
+    s << ',' << p.damping_power_translation << ',' << p.damping_power_rotation << ','
+      << p.axial_power << '\n';
   }
   return s.str();
 }

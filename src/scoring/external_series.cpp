@@ -192,6 +192,9 @@ void read_triaxial_rows(const Table& t, ExternalSeries& out) {
     }
     p.lateral_stress_error = t.value(row, "lateral_stress_error", mean_error);
     for (int w = 0; w < 6; ++w) p.walls[w] = t.value(row, std::string("wall_") + kWall[w], 0);
+    p.damping_power_translation = t.value(row, "damping_power_translation", 0);
+    p.damping_power_rotation = t.value(row, "damping_power_rotation", 0);
+    p.axial_power = t.value(row, "axial_power", 0);
     out.triaxial.series.push_back(p);
   }
 }
@@ -273,11 +276,12 @@ ExternalScore score_external(const ExternalSeries& series, const Tolerances& tol
   ExternalScore out;
   if (series.dimension == 3) {
     // The criteria of the three planes, as `demcal run` scores its own 3D
-    // runs; the peak is the monitored one (as in 2D).
+    // runs (the rotational drag folded into moment balance; 0 without the
+    // power columns); the peak is the monitored one (as in 2D).
     const TriaxialResult& run = series.triaxial;
     TriaxialCriteria c = compute_triaxial_criteria(run.series, series.lateral_stress);
     c.combined.peak_error = peak_error_of(c.combined.peak_stress_yy, reference_peak);
-    out.score = score_of(c.combined,
+    out.score = score_of(scored_criteria(c, tolerances),
                          {run.diverged, run.stopped_early, run.steps_run, run.steps_planned,
                           run.particles, run_parameters(run)},
                          tolerances);

@@ -225,7 +225,7 @@ ScalingSize calibrate_size(Family& family, const SceneConfig& config, const Scal
   r.particles = state.particles;
   r.consolidation_steps = state.steps;
   r.consolidation_s = state.wall_time_s;
-  CalibrationOptions co = CalibrationOptions::from(config.calibration);
+  CalibrationOptions co = CalibrationOptions::from(config);
   co.jobs = o.jobs;
   co.trials_path = family.dir(n) + "/trials.jsonl";
   fs::remove(co.trials_path);

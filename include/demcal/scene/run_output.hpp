@@ -27,7 +27,9 @@ std::string world_vtk(const World& world, const std::string& title);
 /// walls), kinetic_energy_rotation, elastic_energy, inertial_number,
 /// coordination_number, servo_error_xmin,servo_error_xmax,servo_error_ymin,
 /// servo_error_ymax ((p − σ3)/σ3 of each lateral wall), then the six wall
-/// positions wall_xmin,wall_xmax,wall_ymin,wall_ymax,wall_zmin,wall_zmax.
+/// positions wall_xmin,wall_xmax,wall_ymin,wall_ymax,wall_zmin,wall_zmax, then
+/// damping_power_translation, damping_power_rotation and axial_power [W]
+/// (the drag criteria of triaxial_scoring.hpp).
 std::string series_csv(const std::vector<TriaxialPoint>& series);
 /// Legacy VTK polydata of a sphere world: the spheres as vertices with
 /// point data radius, diameter, velocity and angular_velocity (vectors), and

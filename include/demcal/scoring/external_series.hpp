@@ -20,9 +20,10 @@
 // (b_xx .. b_zz) and of σ (s_xx .. s_zz); optional the energies and ratios
 // above, servo_error_xmin, _xmax, _ymin, _ymax (else from the pressures
 // p_xmin .. p_ymax, else 0), lateral_stress_error (else their mean),
-// wall_xmin .. wall_zmax. demcal's 3D series.csv and the exported 3D
-// LAMMPS deck's are such files; they are scored as `demcal run` scores a
-// triaxial run (triaxial_scoring.hpp).
+// wall_xmin .. wall_zmax, damping_power_translation, damping_power_rotation
+// and axial_power (the drag criteria; without them the drag reads 0). demcal's 3D series.csv and
+// the exported 3D LAMMPS deck's are such files; they are scored as `demcal run` scores a triaxial
+// run (triaxial_scoring.hpp).
 //
 // Moment balance. In demcal V(σxy − σyx) = Σ_p T_p, the particles' net
 // contact torques, exactly. An engine that applies a contact's tangential

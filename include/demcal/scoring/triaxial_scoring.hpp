@@ -99,7 +99,7 @@ class TriaxialEarlyFailure {
   std::array<EarlyFailure, 3> planes_;
 };
 
-/// What `demcal run` says of a 3D verdict: measured against the 2D tolerances.
+/// What `demcal run` says of a 3D verdict: the 3D tolerances and what they hold.
 extern const char* const kTriaxialVerdictNote;
 
 /// summary.json of a triaxial run (`demcal run` on a 3D config).
