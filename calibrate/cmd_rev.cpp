@@ -64,7 +64,7 @@ RevOutcome rev_2d(const SceneConfig& config, const std::string& file, const RevO
 
 RevOutcome rev_3d(const SceneConfig& config, const std::string& file, const RevOptions& ro,
                   PrototypeSource& source, const std::function<void()>& ready) {
-  SphereAssembly proto = prototype_spheres(config, file, &source);
+  SphereAssembly proto = prototype_spheres(config, 0, file, &source);
   if (source.kind == "rev")
     throw InputError(config.source, "prototype",
                      "names no prototype: give prototype.file or prototype.particles, or "

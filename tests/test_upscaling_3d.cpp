@@ -103,7 +103,8 @@ TEST(Upscaling3D, PrototypeSpheresAsTheConfigNamesThem) {
   const auto rev = demcal::prototype_spheres(fcc_config(R"({})"), 0, "", &src);
   EXPECT_EQ(rev.size(), 32);
   EXPECT_EQ(src.kind, "rev");
-  // A sphere file REV has no generator: a count is refused, naming the key.
+  // A sphere file REV has no generator to resize: a count draws the file's
+  // radii into a gas of that many spheres.
   test::TempDir dir("up3d");
   std::string csv = "x,y,z,r\n";
   for (int i = 0; i < 2; ++i)
@@ -115,12 +116,11 @@ TEST(Upscaling3D, PrototypeSpheresAsTheConfigNamesThem) {
   SceneConfig from_file = fcc_config();
   from_file.assembly.type = "file";
   from_file.assembly.file = file;
-  try {
-    demcal::prototype_spheres(from_file);
-    FAIL() << "a count for a file REV was accepted";
-  } catch (const demcal::InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("prototype.particles"), std::string::npos) << e.what();
-  }
+  ASSERT_GT(from_file.prototype.particles, 8);
+  const auto drawn = demcal::prototype_spheres(from_file, 0, "", &src);
+  EXPECT_EQ(src.kind, "generated");
+  EXPECT_EQ(static_cast<int64_t>(drawn.size()), from_file.prototype.particles);
+  for (double r : drawn.r) EXPECT_EQ(r, 5e-4);  // the file's radii
   // The file itself is a prototype.
   const auto read = demcal::prototype_spheres(from_file, 0, file, &src);
   EXPECT_EQ(read.size(), 8);

@@ -10,6 +10,7 @@
 #include "demcal/io/files.hpp"
 #include "demcal/scene/triaxial.hpp"
 #include "demcal/upscaling/rev.hpp"
+#include "demcal/upscaling/rev_3d.hpp"
 
 namespace demcal {
 
@@ -180,11 +181,15 @@ SphereAssembly prototype_spheres(const SceneConfig& config, int64_t particles,
     src.file = path;
     src.description = std::to_string(a.size()) + " spheres read from " + path;
   };
-  auto generated = [&](int64_t n, const std::string& key) {
-    if (config.assembly.type == "file")
-      throw InputError(config.source, key,
-                       "a 3D REV read from a file has no generator to resize: give the "
-                       "prototype's spheres as a file (prototype.file, CSV x,y,z,r)");
+  auto generated = [&](int64_t n) {
+    if (config.assembly.type == "file") {
+      // No generator to resize: the REV file's radii drawn into a gas of n.
+      a = generate_rev(read_sphere_file(config.assembly.file), n, config.calibration.seed);
+      src.kind = "generated";
+      src.description =
+          std::to_string(a.size()) + " spheres with radii drawn from " + config.assembly.file;
+      return;
+    }
     const SceneConfig c = scene_of_size(config, n);
     a = make_sphere_assembly(c);
     src.kind = "generated";
@@ -198,11 +203,11 @@ SphereAssembly prototype_spheres(const SceneConfig& config, int64_t particles,
   if (!file.empty()) {
     read(file);
   } else if (particles > 0) {
-    generated(particles, "--particles");
+    generated(particles);
   } else if (!config.prototype.file.empty()) {
     read(config.prototype.file);
   } else if (config.prototype.particles > 0) {
-    generated(config.prototype.particles, "prototype.particles");
+    generated(config.prototype.particles);
   } else {
     a = make_sphere_assembly(config);
     src.kind = "rev";

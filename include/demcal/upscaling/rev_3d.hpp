@@ -64,12 +64,4 @@ SphereRevResult make_rev(const SceneConfig& config, const SphereAssembly& protot
 /// A sphere world state as an assembly (positions, radii, walls).
 SphereAssembly sphere_assembly_of(const SphereWorld& world);
 
-/// The prototype a 3D config names, as prototype_assembly does in 2D
-/// (upscaling.hpp): `file`, else prototype.file, else prototype.particles
-/// from the config's generator (an assembly file's radii resampled into a
-/// gas), else the REV itself (kind "rev"). As read or generated, not
-/// consolidated.
-SphereAssembly prototype_spheres(const SceneConfig& config, const std::string& file = "",
-                                 PrototypeSource* source = nullptr);
-
 }  // namespace demcal

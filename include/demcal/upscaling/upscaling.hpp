@@ -99,7 +99,9 @@ Assembly prototype_assembly(const SceneConfig& config, int64_t particles = 0,
 /// config's generator (scene_of_size: an FCC block with the REV's cell
 /// aspect, or a random gas with the REV's radius distribution and seed),
 /// else the REV itself. A 3D file REV has no generator to resize: a
-/// particle count then is an InputError (give prototype.file).
+/// particle count then draws that many radii from the REV's file into a
+/// gas (generate_rev). As read or generated, not consolidated; `rev`,
+/// `upscale`, `verify` and `params.json` all take their prototype here.
 SphereAssembly prototype_spheres(const SceneConfig& config, int64_t particles = 0,
                                  const std::string& file = "", PrototypeSource* source = nullptr);
 
