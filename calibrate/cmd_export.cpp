@@ -1,7 +1,7 @@
 // `demcal export PARAMS.json --format lammps|liggghts [-o FILE]`: an input
 // deck for the prototype run in another code, with the particle file it
 // reads (demcal's consolidated state of the prototype) next to it. A 3D
-// params.json (spheres, triaxial test) gives the 3D deck of its REV.
+// params.json (spheres, triaxial test) gives the 3D deck of its prototype.
 #include <algorithm>
 #include <filesystem>
 #include <iostream>
@@ -76,36 +76,42 @@ void write_deck(const fs::path& deck_fs, const ExportCmdOptions& o, const Export
             << "\n";
 }
 
-/// A 3D params.json: the deck of the calibrated REV itself, consolidated by
-/// demcal's sphere kernel. Nstep is not scaled to another size: how it grows
-/// with N in 3D is not measured yet (`demcal scaling` is 2D), so a prototype
-/// size, file or law is refused rather than guessed.
-int export_3d(const ExportCmdOptions& o, const RevParams& rev, const SceneConfig& config) {
-  if (!o.prototype.empty() || (o.particles != 0 && o.particles != rev.particles) ||
-      !o.law.empty() || o.exponent > 0.0)
-    throw InputError(o.params, "dimension",
-                     "3D (spheres): the deck is the calibrated REV's own (" +
-                         std::to_string(rev.particles) +
-                         " spheres); --prototype, --particles, --law and --exponent need the 3D "
-                         "scaling law, which is not measured yet");
+/// A 3D params.json: the deck of the prototype it names (--prototype FILE
+/// or --particles N override it; without any, the REV itself), Nstep
+/// upscaled by the scaling law (resolve_law: --exponent, --law, else
+/// params.json's, which for spheres is the 2D default linear law until a
+/// 3D study is given), consolidated by demcal's sphere kernel: the 3D deck
+/// has no consolidation stage yet.
+int export_3d(const ExportCmdOptions& o, const nlohmann::json& params, const RevParams& rev,
+              const SceneConfig& config) {
   if (o.no_consolidate || o.consolidate_in == "deck")
     throw InputError(o.no_consolidate ? "--no-consolidate" : "--consolidate-in", "",
-                     "3D: demcal consolidates the REV (the 3D deck has no consolidation stage)");
+                     "3D: demcal consolidates the prototype (the 3D deck has no consolidation "
+                     "stage)");
   if (o.consolidate_in != "auto" && o.consolidate_in != "demcal")
     throw InputError("--consolidate-in", "",
                      "must be demcal, deck or auto, got \"" + o.consolidate_in + "\"");
   Export3dOptions eo;
   const fs::path deck_fs = deck_destination(o, config, eo);
+  const ScalingLaw law = resolve_law(params, o.params, o.law, o.exponent);
+  auto [file, particles] = named_prototype(params, o.prototype, o.particles);
+  PrototypeSource source;
+  const SphereAssembly proto = prototype_spheres(config, particles, file, &source);
+  const AlgorithmSpec up = upscale(rev.params, rev.particles, proto.size(), law);
   eo.provenance = o.params + " (REV " + std::to_string(rev.particles) + " spheres, " +
-                  std::to_string(rev.params.steps) + " steps)";
-  const SphereAssembly assembly = make_sphere_assembly(config);
-  std::cerr << "demcal export: consolidating the " << assembly.size()
-            << " spheres of the REV to sigma3 with demcal's kernel\n";
+                  std::to_string(rev.params.steps) + " steps; " + law.name() + " law, exponent " +
+                  std::to_string(law.exponent) + ")";
+  if (source.kind != "rev")
+    std::cerr << "demcal export: " << up.steps << " steps upscaled from " << rev.particles
+              << " spheres / " << rev.params.steps << " steps (" << law.name() << " law, exponent "
+              << law.exponent << ": " << law.source << ")\n";
+  std::cerr << "demcal export: consolidating the prototype (" << source.description
+            << ") to sigma3 with demcal's sphere kernel\n";
   const TriaxialState state =
-      consolidate_triaxial(config, assembly, consolidation_progress(o.progress_every_s));
+      consolidate_triaxial(config, proto, consolidation_progress(o.progress_every_s));
   std::cerr << "demcal export: consolidated in " << state.steps << " steps, " << state.wall_time_s
             << " s\n";
-  const ExportResult r = export_3d_decks(config, rev.params, state, eo);
+  const ExportResult r = export_3d_decks(config, up, state, eo);
   write_deck(deck_fs, o, r, state.world.size(), "spheres");
   return 0;
 }
@@ -116,7 +122,7 @@ int cmd_export(const ExportCmdOptions& o) {
   const nlohmann::json params = read_params_file(o.params);
   const RevParams rev = rev_params_from_json(params, o.params);
   const SceneConfig config = required_scene(params, o.params, o.config, o.sets);
-  if (config.dimension == 3) return export_3d(o, rev, config);
+  if (config.dimension == 3) return export_3d(o, params, rev, config);
   ExportOptions eo;
   const fs::path deck_fs = deck_destination(o, config, eo);
   const ScalingLaw law = resolve_law(params, o.params, o.law, o.exponent);

@@ -145,7 +145,7 @@ TEST(Calibration3D, CommandWritesParamsWithTheDimensionAndResumeReusesEveryTrial
 // tests/test_export_3d.cpp; this checks the command carries the calibrated
 // parameters through). A size to scale to is refused: the 3D Nstep law is
 // not measured yet.
-TEST(Calibration3D, ExportWritesTheCalibratedRevsDeckAndRefusesToScaleIt) {
+TEST(Calibration3D, ExportWritesTheRevsDeckAndAnUpscaledPrototypesDeck) {
   test::TempDir dir("export3d");
   const std::string config = test::write_text(dir / "fcc_2x2x2.json", kFcc2);
   const fs::path out = dir / "out";
@@ -154,13 +154,6 @@ TEST(Calibration3D, ExportWritesTheCalibratedRevsDeckAndRefusesToScaleIt) {
   ASSERT_EQ(cal.status, 0) << cal.err;
   const std::string params = (out / "params.json").string();
 
-  const test::RunResult refused = test::run_demcal(
-      {"export", params, "--particles", "1000", "-o", (dir / "big" / "fcc.lammps").string()},
-      dir.path());
-  EXPECT_EQ(refused.status, 2) << refused.err;
-  EXPECT_NE(refused.err.find("3D scaling law"), std::string::npos) << refused.err;
-  EXPECT_FALSE(fs::exists(dir / "big"));
-
   const fs::path deck = dir / "deck" / "fcc.lammps";
   const test::RunResult exported =
       test::run_demcal({"export", params, "-o", deck.string()}, dir.path());
@@ -168,6 +161,27 @@ TEST(Calibration3D, ExportWritesTheCalibratedRevsDeckAndRefusesToScaleIt) {
   ASSERT_TRUE(fs::exists(deck));
   ASSERT_TRUE(fs::exists(dir / "deck" / "fcc.data"));
   EXPECT_NE(exported.out.find("32 spheres"), std::string::npos) << exported.out;
+
+  // A larger prototype (FCC 3x3x3, 108 spheres): the lattice resized, Nstep
+  // scaled by the linear law (the default while 3D has no measured one):
+  // the deck's steps 108/32 times the REV deck's (same Δt, same factor f).
+  const test::RunResult big = test::run_demcal(
+      {"export", params, "--particles", "108", "-o", (dir / "big" / "fcc.lammps").string()},
+      dir.path());
+  ASSERT_EQ(big.status, 0) << big.err;
+  EXPECT_NE(big.out.find("108 spheres"), std::string::npos) << big.out;
+  EXPECT_NE(big.err.find("linear law"), std::string::npos) << big.err;
+  const auto steps_of = [](const std::string& out) {
+    const std::string tag = " steps, ";
+    const size_t end = out.find(tag);
+    const size_t begin = out.rfind(", ", end) + 2;
+    return std::stod(out.substr(begin, end - begin));
+  };
+  // Each deck rounds Nstep/f (f ≈ 0.68, the damping factor) after the law
+  // rounded N·108/32: the ratio is exact to (0.5·(1 + 1/f) + 0.5·108/32)
+  // steps over the REV deck's, below 3.
+  EXPECT_NEAR(steps_of(big.out) / steps_of(exported.out), 108.0 / 32.0,
+              3.0 / steps_of(exported.out));
 
   const std::string lmp = test::find_on_path("lmp");
   if (lmp.empty()) GTEST_SKIP() << "lmp (Debian package lammps) is not installed: deck not run";
