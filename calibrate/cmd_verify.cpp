@@ -151,6 +151,15 @@ std::optional<double> rev_peak(const nlohmann::json& params) {
   return (*c)["peak_stress_yy"].get<double>();
 }
 
+/// verify.json and series.csv of one run, replaced together.
+void write_verify_files(const std::string& dir, const nlohmann::json& verify,
+                        const std::string& series) {
+  OutputFolder files(dir);
+  files.write("verify.json", verify.dump(2) + "\n");
+  files.write("series.csv", series);
+  files.commit();
+}
+
 /// `demcal verify` on 3D params: the spheres of the prototype consolidated
 /// by the sphere kernel, loaded with the upscaled parameters on `threads`
 /// threads, scored with the triaxial criteria, the peak against the REV's.
@@ -260,12 +269,7 @@ int verify_3d(const VerifyOptions& o, const nlohmann::json& params, const RevPar
         {"particle_steps_per_s", rate_run}}},
       {"wall_time_s", total_s},
       {"version", DEMCAL_VERSION}};
-  {
-    OutputFolder files(dir);  // verify.json and series.csv of one run, replaced together
-    files.write("verify.json", out.dump(2) + "\n");
-    files.write("series.csv", series_csv(run.series));
-    files.commit();
-  }
+  write_verify_files(dir, out, series_csv(run.series));
   std::cout << (score.passed ? "PASS" : "FAIL") << ": 3D prototype of " << n << " spheres, "
             << up.steps << " steps (alpha " << up.dt_ratio << ", zeta_t "
             << up.damping_ratio_translation << ", zeta_r " << up.damping_ratio_rotation << ")\n"
@@ -408,12 +412,7 @@ int cmd_verify(const VerifyOptions& o) {
          trial.wall_time_s > 0 ? particle_steps / trial.wall_time_s : 0.0}}},
       {"wall_time_s", total_s},
       {"version", DEMCAL_VERSION}};
-  {
-    OutputFolder files(dir);  // verify.json and series.csv of one run, replaced together
-    files.write("verify.json", out.dump(2) + "\n");
-    files.write("series.csv", series_csv(run.series));
-    files.commit();
-  }
+  write_verify_files(dir, out, series_csv(run.series));
 
   const auto& c = trial.score.criteria;
   std::cout << (trial.score.passed ? "PASS" : "FAIL") << ": prototype of " << n << " particles, "

@@ -118,6 +118,17 @@ std::string component(const char* prefix, int i, int j) {
   return std::string(prefix) + kAxis[i] + kAxis[j];
 }
 
+/// The measures MonitorPoint and TriaxialPoint share, by the same names.
+template <class Point>
+void read_measures(const Table& t, const std::vector<double>& row, Point& p) {
+  p.kinetic_energy = t.value(row, "kinetic_energy", 0);
+  p.kinetic_energy_rotation = t.value(row, "kinetic_energy_rotation", 0);
+  p.elastic_energy = t.value(row, "elastic_energy", 0);
+  p.unbalanced_force_ratio = t.value(row, "unbalanced_force_ratio", 0);
+  p.inertial_number = t.value(row, "inertial_number", 0);
+  p.coordination_number = t.value(row, "coordination_number", 0);
+}
+
 /// The biaxial rows (2D): disks, b and σ 2×2.
 void read_biaxial_rows(const Table& t, ExternalSeries& out) {
   const double s3 = out.lateral_stress;
@@ -143,12 +154,7 @@ void read_biaxial_rows(const Table& t, ExternalSeries& out) {
       p.sigma(0, 1) = sym + 0.5 * tau;
       p.sigma(1, 0) = sym - 0.5 * tau;
     }
-    p.kinetic_energy = t.value(row, "kinetic_energy", 0);
-    p.kinetic_energy_rotation = t.value(row, "kinetic_energy_rotation", 0);
-    p.elastic_energy = t.value(row, "elastic_energy", 0);
-    p.unbalanced_force_ratio = t.value(row, "unbalanced_force_ratio", 0);
-    p.inertial_number = t.value(row, "inertial_number", 0);
-    p.coordination_number = t.value(row, "coordination_number", 0);
+    read_measures(t, row, p);
     if (has_error)
       p.lateral_stress_error = t.value(row, "lateral_stress_error", 0);
     else if (has_pressures)
@@ -176,12 +182,7 @@ void read_triaxial_rows(const Table& t, ExternalSeries& out) {
         p.b(i, j) = t.value(row, component("b_", i, j), 0);
         p.sigma(i, j) = t.value(row, component("s_", i, j), 0);
       }
-    p.kinetic_energy = t.value(row, "kinetic_energy", 0);
-    p.kinetic_energy_rotation = t.value(row, "kinetic_energy_rotation", 0);
-    p.elastic_energy = t.value(row, "elastic_energy", 0);
-    p.unbalanced_force_ratio = t.value(row, "unbalanced_force_ratio", 0);
-    p.inertial_number = t.value(row, "inertial_number", 0);
-    p.coordination_number = t.value(row, "coordination_number", 0);
+    read_measures(t, row, p);
     double mean_error = 0.0;
     for (int w = 0; w < 4; ++w) {
       const std::string pressure = std::string("p_") + kWall[w];
