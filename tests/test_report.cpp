@@ -748,9 +748,10 @@ TEST(Report3D, CalibrateWritesThe3DReportAndTheVtk) {
        {"spheres (REV, triaxial test)", "(a) Axial boundary stress b_zz", "Lateral component xx",
         "Lateral component yy", "Shear pair σ_xy and σ_yx", "Shear pair σ_xz and σ_zx",
         "Shear pair σ_yz and σ_zy", "each of the four lateral walls", "max |σ_yz − σ_zy|",
-        "max |servo error|, wall y max", "peak b_zz at Nstep", "Diagnosis in words",
-        "Search history", "Speed against accuracy", "Upscaling to the prototype",
-        "The assembly at the peak", "final.vtk"}) {
+        "max |servo error|, wall y max", "peak b_zz at Nstep",
+        "peak b_zz at Nstep/2 =", "the larger of 2 × |P(N) − P(2N)| and the halved change",
+        "Diagnosis in words", "Search history", "Speed against accuracy",
+        "Upscaling to the prototype", "The assembly at the peak", "final.vtk"}) {
     EXPECT_NE(html.find(fact), std::string::npos) << "HTML lacks " << fact;
     std::string in_md;  // the Markdown tables escape '|'
     for (char ch : std::string(fact)) in_md += ch == '|' ? std::string("\\|") : std::string(1, ch);

@@ -64,8 +64,12 @@ void write_at_a_glance(Doc& d, const ReportFacts& f) {
     glance.push_back(
         "Convergence certificate " + std::string(S.certificate.passed ? "passed" : "FAILED") +
         ": Nstep doubled moves the peak by " + pct(S.certificate.steps_doubled_peak_change, 2) +
-        ", Richardson error estimate " + pct(S.certificate.richardson_error, 2) + " against the " +
-        pct(in.accuracy, 0) + " target.");
+        (S.certificate.steps_halved_peak_change
+             ? ", Nstep halved by " + pct(*S.certificate.steps_halved_peak_change, 2) +
+                   ", error estimate "
+             : std::string(", Richardson error estimate ")) +
+        pct(S.certificate.richardson_error, 2) + " against the " + pct(in.accuracy, 0) +
+        " target.");
   if (in.reference && f.best_peak_error)
     glance.push_back("Against a converged reference (--evidence): peak error " +
                      signed_pct(*f.best_peak_error, 2) + ".");
@@ -227,15 +231,27 @@ void write_certificate(Doc& d, const ReportFacts& f) {
     d.para("No certificate: no passing parameter set to certify.");
     return;
   }
-  d.table({"check", "value"},
-          {{"peak " + f.axial + " at Nstep = " + grouped(C.steps), kpa(C.peak)},
-           {"peak " + f.axial + " at 2·Nstep = " + grouped(doubled_steps(in.summary)),
-            kpa(C.peak_doubled)},
-           {"change |P(N) − P(2N)|/|P(2N)|", pct(C.steps_doubled_peak_change, 3)},
-           {"Richardson error estimate of P(N), 2 × change (error ∝ 1/Nstep)",
-            pct(C.richardson_error, 3)},
-           {"accuracy target", pct(in.accuracy, 2)},
-           {"certificate", C.passed ? "pass" : "FAIL"}});
+  std::vector<std::vector<std::string>> rows{
+      {"peak " + f.axial + " at Nstep = " + grouped(C.steps), kpa(C.peak)},
+      {"peak " + f.axial + " at 2·Nstep = " + grouped(doubled_steps(in.summary)),
+       kpa(C.peak_doubled)},
+      {"change |P(N) − P(2N)|/|P(2N)|", pct(C.steps_doubled_peak_change, 3)}};
+  if (C.peak_halved && C.steps_halved_peak_change) {
+    // 3D: the third level (search/calibration.hpp, Certificate).
+    rows.push_back(
+        {"peak " + f.axial + " at Nstep/2 = " + grouped(C.steps / 2), kpa(*C.peak_halved)});
+    rows.push_back({"change |P(N/2) − P(N)|/|P(N)|", pct(*C.steps_halved_peak_change, 3)});
+    rows.push_back(
+        {"error estimate of P(N): the larger of 2 × |P(N) − P(2N)| and the halved "
+         "change (each equals it when the error ∝ 1/Nstep)",
+         pct(C.richardson_error, 3)});
+  } else {
+    rows.push_back({"Richardson error estimate of P(N), 2 × change (error ∝ 1/Nstep)",
+                    pct(C.richardson_error, 3)});
+  }
+  rows.push_back({"accuracy target", pct(in.accuracy, 2)});
+  rows.push_back({"certificate", C.passed ? "pass" : "FAIL"});
+  d.table({"check", "value"}, rows);
 }
 
 void write_reference_evidence(Doc& d, const ReportFacts& f) {
