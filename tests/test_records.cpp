@@ -158,6 +158,26 @@ TEST(Records, ATrialsJsonlLineOfTheEarlierFormatStillResumes) {
   EXPECT_THROW(trial_from_json(bad, "old.jsonl"), InputError);
 }
 
+TEST(Records, ACountThatIsNoWholeNumberIsBadInputNotAnOverflow) {
+  // The trials.jsonl fuzzer's find: an id of 5.9e110 went through
+  // get<int>(), a float-to-int cast out of range (undefined behaviour).
+  json line = to_json(sample_trial());
+  for (const json& v : {json(5.9e110), json(-1), json(2.5), json("7")}) {
+    json bad = line;
+    bad["id"] = v;
+    EXPECT_THROW(trial_from_json(bad, "t.jsonl"), InputError) << v.dump();
+  }
+  json steps = line;
+  steps["steps_run"] = 1e300;
+  EXPECT_THROW(trial_from_json(steps, "t.jsonl"), InputError);
+  json points = line;
+  points["criteria"]["points"] = -1e20;
+  EXPECT_THROW(trial_from_json(points, "t.jsonl"), InputError);
+  json whole = line;
+  whole["id"] = 12.0;  // a whole number written as a float reads
+  EXPECT_EQ(trial_from_json(whole, "t.jsonl").id, 12);
+}
+
 TEST(Records, RichardsonRecoversAnExactOneOverNLaw) {
   // P(N) = P∞ + c/N exactly: the extrapolation gives P∞, and the error
   // estimate of the coarse run is its true error.

@@ -6,6 +6,7 @@
 #include <cstdio>
 
 #include "demcal/io/format.hpp"
+#include "demcal/io/json_integer.hpp"
 #include "demcal/kernel/sphere_world.hpp"
 
 namespace demcal {
@@ -621,7 +622,8 @@ Criteria criteria_from_json(const nlohmann::json& j) {
   Criteria c;
   for (const auto& f : kCriteriaFields)
     if (j.contains(f.key)) c.*(f.member) = j.at(f.key).get<double>();
-  if (j.contains("points")) c.points = j.at("points").get<int>();
+  if (j.contains("points"))
+    c.points = static_cast<int>(json_integer(j.at("points"), 0, std::numeric_limits<int>::max()));
   if (j.contains("peak_error")) c.peak_error = j.at("peak_error").get<double>();
   return c;
 }

@@ -15,6 +15,7 @@
 
 #include "demcal/io/files.hpp"
 #include "demcal/io/format.hpp"
+#include "demcal/io/json_integer.hpp"
 #include "demcal/scene/run_output.hpp"
 #include "demcal/scoring/triaxial_scoring.hpp"
 #include "demcal/search/parallel.hpp"
@@ -213,10 +214,10 @@ nlohmann::json to_json(const TrialRecord& r) {
 TrialRecord trial_from_json(const nlohmann::json& j, const std::string& source) {
   try {
     TrialRecord r;
-    r.id = j.at("id").get<int>();
+    r.id = static_cast<int>(json_integer(j.at("id"), 0, std::numeric_limits<int>::max()));
     r.phase = parse_trial_phase(j.at("phase").get<std::string>(), source);
     r.params = algorithm_from_json(j.at("params"), source, "params");
-    r.steps_run = j.at("steps_run").get<int64_t>();
+    r.steps_run = json_integer(j.at("steps_run"), 0);
     r.wall_time_s = j.at("wall_time_s").get<double>();
     Score& s = r.score;
     s.criteria = criteria_from_json(j.at("criteria"));
@@ -235,6 +236,8 @@ TrialRecord trial_from_json(const nlohmann::json& j, const std::string& source) 
     s.diagnosis.message = j.at("diagnosis").get<std::string>();
     return r;
   } catch (const nlohmann::json::exception& e) {
+    throw InputError(source, "", std::string("not a demcal trial record: ") + e.what());
+  } catch (const std::logic_error& e) {  // json_integer: a count that is no count
     throw InputError(source, "", std::string("not a demcal trial record: ") + e.what());
   }
 }
