@@ -79,8 +79,8 @@ void write_deck(const fs::path& deck_fs, const ExportCmdOptions& o, const Export
 /// A 3D params.json: the deck of the prototype it names (--prototype FILE
 /// or --particles N override it; without any, the REV itself), Nstep
 /// upscaled by the scaling law (resolve_law: --exponent, --law, else
-/// params.json's, which for spheres is the 2D default linear law until a
-/// 3D study is given), consolidated by demcal's sphere kernel: the 3D deck
+/// params.json's, for spheres by default N^(2/3): default_law(3)),
+/// consolidated by demcal's sphere kernel: the 3D deck
 /// has no consolidation stage yet.
 int export_3d(const ExportCmdOptions& o, const nlohmann::json& params, const RevParams& rev,
               const SceneConfig& config) {

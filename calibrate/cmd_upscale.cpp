@@ -148,8 +148,8 @@ int cmd_upscale(const UpscaleOptions& o) {
   out["prototype"] = block;
   out["upscaling"] = upscaling_block(rev.particles, n_proto, law);
   const std::string text = out.dump(2) + "\n";
-  // Which law scaled Nstep, on stderr whatever the output (in 3D without
-  // --law it is the 2D default, and the user must know it).
+  // Which law scaled Nstep, on stderr whatever the output (the user must
+  // know which law, measured or default, and its source).
   std::cerr << "demcal upscale: Nstep by the " << law.name() << " law (exponent " << law.exponent
             << "; " << law.source << ")\n";
   if (o.output.empty() || o.output == "-") {

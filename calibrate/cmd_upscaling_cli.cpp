@@ -22,7 +22,9 @@ std::function<int()> add_upscaling_commands(CLI::App& app) {
   upscale->add_option("--config", up->config, "scene config, if params.json carries none");
   upscale->add_option("--set", up->sets, "override a config key: section.key=value");
   upscale->add_option("--law", up->law, "scaling.json of demcal scaling: use its measured law");
-  upscale->add_option("--exponent", up->exponent, "Nstep ~ N^exponent (default 1, linear)")
+  upscale
+      ->add_option("--exponent", up->exponent,
+                   "Nstep ~ N^exponent (default: 1 for disks, 2/3 for spheres)")
       ->check(real_above(0.0, kMaxExponent));
   upscale->add_option("-o,--output", up->output, "write params.json here (default stdout)");
 
@@ -37,7 +39,9 @@ std::function<int()> add_upscaling_commands(CLI::App& app) {
   verify->add_option("--config", ve->config, "scene config, if params.json carries none");
   verify->add_option("--set", ve->sets, "override a config key: section.key=value");
   verify->add_option("--law", ve->law, "scaling.json of demcal scaling: use its measured law");
-  verify->add_option("--exponent", ve->exponent, "Nstep ~ N^exponent (default 1, linear)")
+  verify
+      ->add_option("--exponent", ve->exponent,
+                   "Nstep ~ N^exponent (default: 1 for disks, 2/3 for spheres)")
       ->check(real_above(0.0, kMaxExponent));
   verify->add_option("-o,--output", ve->out_dir, "output folder (default demcal-verify-NAME)");
   verify
@@ -91,7 +95,8 @@ std::function<int()> add_upscaling_commands(CLI::App& app) {
   exp->add_option("--config", ex->config, "scene config, if params.json carries none");
   exp->add_option("--set", ex->sets, "override a config key: section.key=value");
   exp->add_option("--law", ex->law, "scaling.json of demcal scaling: use its measured law");
-  exp->add_option("--exponent", ex->exponent, "Nstep ~ N^exponent (default 1, linear)")
+  exp->add_option("--exponent", ex->exponent,
+                  "Nstep ~ N^exponent (default: 1 for disks, 2/3 for spheres)")
       ->check(real_above(0.0, kMaxExponent));
   exp->add_flag("--no-consolidate", ex->no_consolidate,
                 "write the prototype as read (it is already consolidated to sigma3)");

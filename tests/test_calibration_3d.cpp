@@ -163,14 +163,14 @@ TEST(Calibration3D, ExportWritesTheRevsDeckAndAnUpscaledPrototypesDeck) {
   EXPECT_NE(exported.out.find("32 spheres"), std::string::npos) << exported.out;
 
   // A larger prototype (FCC 3x3x3, 108 spheres): the lattice resized, Nstep
-  // scaled by the linear law (the default while 3D has no measured one):
-  // the deck's steps 108/32 times the REV deck's (same Δt, same factor f).
+  // scaled by the default 3D law, ∝ L² = N^(2/3): the deck's steps (3/2)²
+  // times the REV deck's (same Δt, same factor f).
   const test::RunResult big = test::run_demcal(
       {"export", params, "--particles", "108", "-o", (dir / "big" / "fcc.lammps").string()},
       dir.path());
   ASSERT_EQ(big.status, 0) << big.err;
   EXPECT_NE(big.out.find("108 spheres"), std::string::npos) << big.out;
-  EXPECT_NE(big.err.find("linear law"), std::string::npos) << big.err;
+  EXPECT_NE(big.err.find("power law, exponent 0.666"), std::string::npos) << big.err;
   const auto steps_of = [](const std::string& out) {
     const std::string tag = " steps, ";
     const size_t end = out.find(tag);
@@ -178,10 +178,9 @@ TEST(Calibration3D, ExportWritesTheRevsDeckAndAnUpscaledPrototypesDeck) {
     return std::stod(out.substr(begin, end - begin));
   };
   // Each deck rounds Nstep/f (f ≈ 0.68, the damping factor) after the law
-  // rounded N·108/32: the ratio is exact to (0.5·(1 + 1/f) + 0.5·108/32)
+  // rounded N·(3/2)²: the ratio is exact to (0.5·(1 + 1/f) + 0.5·(3/2)²)
   // steps over the REV deck's, below 3.
-  EXPECT_NEAR(steps_of(big.out) / steps_of(exported.out), 108.0 / 32.0,
-              3.0 / steps_of(exported.out));
+  EXPECT_NEAR(steps_of(big.out) / steps_of(exported.out), 2.25, 3.0 / steps_of(exported.out));
 
   const std::string lmp = test::find_on_path("lmp");
   if (lmp.empty()) GTEST_SKIP() << "lmp (Debian package lammps) is not installed: deck not run";

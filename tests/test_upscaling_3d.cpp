@@ -135,8 +135,9 @@ TEST(Upscaling3D, ParamsFileCarriesThePrototypeBlock) {
   EXPECT_EQ(p.at("dimension"), 3);
   EXPECT_EQ(rev.at("particles"), 32);
   EXPECT_EQ(proto.at("particles"), 256);
-  // Nstep by the linear law: 3000·256/32, computed here from the formula.
-  EXPECT_EQ(proto.at("steps").get<int64_t>(), std::llround(3000.0 * 256.0 / 32.0));
+  // Nstep by the default 3D law, ∝ L²: 2 → 4 cells an edge doubles L, so
+  // 4 × 3000 (= 3000·(256/32)^(2/3)).
+  EXPECT_EQ(proto.at("steps").get<int64_t>(), 4 * 3000);
   // Multipliers unchanged; uniform spheres of one radius: the same Δt_crit,
   // Δt and damping as the REV's.
   for (const char* k : {"dt_ratio", "damping_ratio_translation", "damping_ratio_rotation",
@@ -148,9 +149,29 @@ TEST(Upscaling3D, ParamsFileCarriesThePrototypeBlock) {
   EXPECT_EQ(proto.at("source").at("kind"), "generated");
   const auto& up = p.at("upscaling");
   EXPECT_EQ(up.at("particles_prototype"), 256);
-  EXPECT_DOUBLE_EQ(up.at("factor").get<double>(), 8.0);
-  // The law says that it is the 2D default, not measured on spheres.
-  EXPECT_NE(up.at("source").get<std::string>().find("2D default"), std::string::npos);
+  EXPECT_NEAR(up.at("factor").get<double>(), 4.0, 1e-12);  // (256/32)^(2/3): L doubled
+  // The law and where it was measured.
+  EXPECT_EQ(up.at("law"), "power");
+  EXPECT_DOUBLE_EQ(up.at("exponent").get<double>(), 2.0 / 3.0);
+  EXPECT_NE(up.at("source").get<std::string>().find("reports/scaling-3d.md"), std::string::npos);
+}
+
+// The default law is Nstep ∝ L² in both dimensions (reports/scaling-3d.md:
+// the force balance's drag term, ~ ζ·L²/Nstep, is what the steps must
+// beat at large sizes): linear in N for disks (L ∝ N^(1/2), Tu & Andrade),
+// N^(2/3) for spheres (L ∝ N^(1/3)). Checked on FCC blocks, whose edge is
+// known exactly: c → k·c cells an edge multiplies Nstep by k².
+TEST(Upscaling3D, DefaultLawIsNstepProportionalToLSquared) {
+  EXPECT_EQ(demcal::default_law(2).name(), "linear");
+  EXPECT_EQ(demcal::default_law(3).name(), "power");
+  const auto fcc = [](int64_t cells) { return 4 * cells * cells * cells; };
+  for (int64_t c : {2, 3, 4, 5})
+    for (int64_t k : {2, 3, 9}) {
+      const int64_t steps = demcal::upscale_steps(3000, fcc(c), fcc(k * c), demcal::default_law(3));
+      EXPECT_EQ(steps, 3000 * k * k) << c << " cells, edge x" << k;
+    }
+  // Disks: N ∝ L², so the same law is linear in N.
+  EXPECT_EQ(demcal::upscale_steps(3000, 400, 1600, demcal::default_law(2)), 4 * 3000);
 }
 
 class Upscale3DCli : public ::testing::Test {
@@ -181,12 +202,22 @@ TEST_F(Upscale3DCli, NstepByTheMeasuredLawOrTheDefault) {
   EXPECT_DOUBLE_EQ(up.at("upscaling").at("exponent").get<double>(), 0.4);
   EXPECT_NE(r.err.find("a 3D study"), std::string::npos) << r.err;  // which law, said
 
-  // No law given: the 2D default (linear), and the output says so.
+  // No law given: the params.json's, the default 3D law N^(2/3); 500
+  // spheres are FCC 5×5×5 (L 2.5× the REV's): 3000 × 2.5². The output says
+  // which law and where it was measured.
   const auto d = demcal({"upscale", params_, "--particles", "500", "-o", "up2.json"});
   ASSERT_EQ(d.status, 0) << d.err;
   const nlohmann::json up2 = nlohmann::json::parse(test::read_text(dir_ / "work" / "up2.json"));
-  EXPECT_EQ(up2.at("prototype").at("steps").get<int64_t>(), std::llround(3000.0 * 500.0 / 32.0));
-  EXPECT_NE(d.err.find("2D default"), std::string::npos) << d.err;
+  EXPECT_EQ(up2.at("prototype").at("steps").get<int64_t>(), 18750);
+  EXPECT_NE(d.err.find("N^(2/3)"), std::string::npos) << d.err;
+  EXPECT_NE(d.err.find("reports/scaling-3d.md"), std::string::npos) << d.err;
+
+  // Tu & Andrade's linear law on request.
+  const auto l =
+      demcal({"upscale", params_, "--particles", "500", "--exponent", "1", "-o", "up3.json"});
+  ASSERT_EQ(l.status, 0) << l.err;
+  const nlohmann::json up3 = nlohmann::json::parse(test::read_text(dir_ / "work" / "up3.json"));
+  EXPECT_EQ(up3.at("prototype").at("steps").get<int64_t>(), std::llround(3000.0 * 500.0 / 32.0));
 }
 
 TEST_F(Upscale3DCli, DimensionMismatchesAreBadInput) {

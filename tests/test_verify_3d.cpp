@@ -55,13 +55,13 @@ TEST(Verify3D, SmallFccPrototypeRunsAndReports) {
   const auto estimate = r.err.find("estimated");
   ASSERT_NE(estimate, std::string::npos) << r.err;
   EXPECT_LT(estimate, r.err.find("consolidated in")) << r.err;
-  EXPECT_NE(r.err.find("2D default"), std::string::npos) << r.err;  // which law
+  EXPECT_NE(r.err.find("N^(2/3)"), std::string::npos) << r.err;  // which law
   EXPECT_NE(r.out.find("256 spheres"), std::string::npos) << r.out;
 
   const nlohmann::json v = nlohmann::json::parse(test::read_text(dir / "v" / "verify.json"));
   EXPECT_EQ(v.at("dimension"), 3);
   EXPECT_EQ(v.at("prototype").at("particles"), 256);
-  const int64_t steps = std::llround(2000.0 * 256.0 / 32.0);  // the linear law
+  const int64_t steps = 2000 * 4;  // the default 3D law, ∝ L²: 2 → 4 cells an edge
   EXPECT_EQ(v.at("loading").at("steps").get<int64_t>(), steps);
   EXPECT_DOUBLE_EQ(v.at("loading").at("particle_steps").get<double>(), 256.0 * steps);
   EXPECT_GE(v.at("loading").at("threads").get<int>(), 1);  // the faster, measured

@@ -112,8 +112,7 @@ nlohmann::json params_file(const SceneConfig& config, const TriaxialState& state
   nlohmann::json rev =
       param_block(summary.best, sphere_scales(state.world, config.material, summary.best));
   // Δt and damping recomputed from the prototype's own spheres; Nstep by
-  // the default law (linear; its source says it is the 2D one: `demcal
-  // upscale --law` applies a law measured on spheres).
+  // the default 3D law (N^(2/3); `demcal upscale --law` applies another).
   const ScalingLaw law = default_law(3);
   nlohmann::json prototype = prototype_block(config, summary.best, n_rev, law);
   const int64_t n_proto = prototype.at("particles").get<int64_t>();

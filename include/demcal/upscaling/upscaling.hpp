@@ -49,10 +49,10 @@ nlohmann::json to_json(const ScalingLaw& law);
 ScalingLaw scaling_law_from_json(const nlohmann::json& j, const std::string& source);
 
 /// The law upscaling uses when no study is named (--law, --exponent, a
-/// params.json's "upscaling" block): Tu & Andrade's linear law in both
-/// dimensions. In 3D its source says that it is the 2D default, not a law
-/// measured on spheres (reports/scaling-3d.md measures one: pass its
-/// scaling.json with --law).
+/// params.json's "upscaling" block): Nstep ∝ L², L the sample's linear
+/// size, i.e. Tu & Andrade's linear law for disks and N^(2/3) for spheres
+/// (reports/scaling-3d.md: the force balance's drag term grows as L², the
+/// servo error as L; measured at fixed multipliers up to 23 328 spheres).
 ScalingLaw default_law(int dimension);
 
 /// Nstep for `n_proto` particles from a calibration on `n_rev` particles.
