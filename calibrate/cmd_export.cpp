@@ -76,27 +76,72 @@ void write_deck(const fs::path& deck_fs, const ExportCmdOptions& o, const Export
             << "\n";
 }
 
+/// Checks --consolidate-in against the format and --no-consolidate; true
+/// when the deck consolidates the prototype itself (`deck`, or `auto` for
+/// LAMMPS above kDeckConsolidationAbove particles), and says so on stderr.
+bool consolidate_in_deck(const ExportCmdOptions& o, int particles) {
+  if (o.consolidate_in != "auto" && o.consolidate_in != "demcal" && o.consolidate_in != "deck")
+    throw InputError("--consolidate-in", "",
+                     "must be demcal, deck or auto, got \"" + o.consolidate_in + "\"");
+  if (o.consolidate_in == "deck" && o.format != "lammps")
+    throw InputError("--consolidate-in", "", "deck: only the LAMMPS deck consolidates itself");
+  if (o.consolidate_in != "auto" && o.no_consolidate)
+    throw InputError("--consolidate-in", "",
+                     "the prototype is not consolidated with --no-consolidate");
+  const bool in_deck =
+      !o.no_consolidate &&
+      (o.consolidate_in == "deck" ||
+       (o.consolidate_in == "auto" && o.format == "lammps" && particles > kDeckConsolidationAbove));
+  if (in_deck)
+    std::cerr << "demcal export: " << particles << " particles"
+              << (o.consolidate_in == "auto"
+                      ? " (more than " + std::to_string(kDeckConsolidationAbove) + ")"
+                      : std::string())
+              << ": the deck consolidates the prototype to sigma3 itself (stage 1, under MPI; "
+                 "--consolidate-in demcal does it here instead)\n";
+  return in_deck;
+}
+
+/// demcal's consolidation of a prototype: every core from
+/// kConsolidationThreadsFrom particles, progress on stderr.
+ConsolidationOptions export_consolidation(const ExportCmdOptions& o, int particles,
+                                          const std::string& what, const char* kernel) {
+  ConsolidationOptions co;
+  co.threads = particles >= kConsolidationThreadsFrom ? 0 : 1;
+  co.progress = consolidation_progress(o.progress_every_s);
+  std::cerr << "demcal export: consolidating the prototype (" << what
+            << ") to sigma3 with demcal's " << kernel << ", "
+            << (co.threads == 1
+                    ? std::string("single-threaded")
+                    : "on " + std::to_string(std::max(1u, std::thread::hardware_concurrency())) +
+                          " threads")
+            << (o.format == "lammps"
+                    ? " (--consolidate-in deck leaves it to the LAMMPS deck, under "
+                      "MPI)\n"
+                    : "\n");
+  return co;
+}
+
 /// A 3D params.json: the deck of the prototype it names (--prototype FILE
 /// or --particles N override it; without any, the REV itself), Nstep
 /// upscaled by the scaling law (resolve_law: --exponent, --law, else
 /// params.json's, for spheres by default N^(2/3): default_law(3)),
-/// consolidated by demcal's sphere kernel: the 3D deck
-/// has no consolidation stage yet.
+/// consolidated as in 2D: by the LAMMPS deck's stage 1 (--consolidate-in
+/// deck, or auto above kDeckConsolidationAbove spheres) or by demcal's
+/// sphere kernel (threads, progress).
 int export_3d(const ExportCmdOptions& o, const nlohmann::json& params, const RevParams& rev,
               const SceneConfig& config) {
-  if (o.no_consolidate || o.consolidate_in == "deck")
-    throw InputError(o.no_consolidate ? "--no-consolidate" : "--consolidate-in", "",
-                     "3D: demcal consolidates the prototype (the 3D deck has no consolidation "
-                     "stage)");
-  if (o.consolidate_in != "auto" && o.consolidate_in != "demcal")
-    throw InputError("--consolidate-in", "",
-                     "must be demcal, deck or auto, got \"" + o.consolidate_in + "\"");
+  if (o.no_consolidate)
+    throw InputError("--no-consolidate", "",
+                     "3D: the prototype is consolidated, by demcal or by the deck's stage 1 "
+                     "(--consolidate-in)");
   Export3dOptions eo;
   const fs::path deck_fs = deck_destination(o, config, eo);
   const ScalingLaw law = resolve_law(params, o.params, o.law, o.exponent);
   auto [file, particles] = named_prototype(params, o.prototype, o.particles);
   PrototypeSource source;
   const SphereAssembly proto = prototype_spheres(config, particles, file, &source);
+  eo.consolidate_in_deck = consolidate_in_deck(o, proto.size());
   const AlgorithmSpec up = upscale(rev.params, rev.particles, proto.size(), law);
   eo.provenance = o.params + " (REV " + std::to_string(rev.particles) + " spheres, " +
                   std::to_string(rev.params.steps) + " steps; " + law.name() + " law, exponent " +
@@ -105,10 +150,13 @@ int export_3d(const ExportCmdOptions& o, const nlohmann::json& params, const Rev
     std::cerr << "demcal export: " << up.steps << " steps upscaled from " << rev.particles
               << " spheres / " << rev.params.steps << " steps (" << law.name() << " law, exponent "
               << law.exponent << ": " << law.source << ")\n";
-  std::cerr << "demcal export: consolidating the prototype (" << source.description
-            << ") to sigma3 with demcal's sphere kernel\n";
-  const TriaxialState state =
-      consolidate_triaxial(config, proto, consolidation_progress(o.progress_every_s));
+  if (eo.consolidate_in_deck) {
+    const ExportResult r = export_3d_decks(config, up, proto, eo);
+    write_deck(deck_fs, o, r, proto.size(), "spheres");
+    return 0;
+  }
+  const TriaxialState state = consolidate_triaxial(
+      config, proto, export_consolidation(o, proto.size(), source.description, "sphere kernel"));
   std::cerr << "demcal export: consolidated in " << state.steps << " steps, " << state.wall_time_s
             << " s\n";
   const ExportResult r = export_3d_decks(config, up, state, eo);
@@ -133,36 +181,10 @@ int cmd_export(const ExportCmdOptions& o) {
   eo.provenance = o.params + " (REV " + std::to_string(rev.particles) + " particles, " +
                   std::to_string(rev.params.steps) + " steps; " + law.name() + " law, exponent " +
                   std::to_string(law.exponent) + ")";
-  if (o.consolidate_in != "auto" && o.consolidate_in != "demcal" && o.consolidate_in != "deck")
-    throw InputError("--consolidate-in", "",
-                     "must be demcal, deck or auto, got \"" + o.consolidate_in + "\"");
-  if (o.consolidate_in == "deck" && o.format != "lammps")
-    throw InputError("--consolidate-in", "", "deck: only the LAMMPS deck consolidates itself");
-  if (o.consolidate_in != "auto" && o.no_consolidate)
-    throw InputError("--consolidate-in", "",
-                     "the prototype is not consolidated with --no-consolidate");
-  eo.consolidate_in_deck =
-      !o.no_consolidate &&
-      (o.consolidate_in == "deck" || (o.consolidate_in == "auto" && o.format == "lammps" &&
-                                      proto.size() > kDeckConsolidationAbove));
-  if (eo.consolidate_in_deck) {
-    std::cerr << "demcal export: " << proto.size() << " particles"
-              << (o.consolidate_in == "auto"
-                      ? " (more than " + std::to_string(kDeckConsolidationAbove) + ")"
-                      : std::string())
-              << ": the deck consolidates the prototype to sigma3 itself (stage 1, under MPI; "
-                 "--consolidate-in demcal does it here instead)\n";
-  } else if (!o.no_consolidate) {
-    ConsolidationOptions co;
-    co.threads = proto.size() >= kConsolidationThreadsFrom ? 0 : 1;
-    co.progress = consolidation_progress(o.progress_every_s);
-    std::cerr << "demcal export: consolidating the prototype (" << source.description
-              << ") to sigma3 with demcal's kernel, "
-              << (co.threads == 1
-                      ? std::string("single-threaded")
-                      : "on " + std::to_string(std::max(1u, std::thread::hardware_concurrency())) +
-                            " threads")
-              << " (--consolidate-in deck leaves it to the LAMMPS deck, under MPI)\n";
+  eo.consolidate_in_deck = consolidate_in_deck(o, proto.size());
+  if (!eo.consolidate_in_deck && !o.no_consolidate) {
+    const ConsolidationOptions co =
+        export_consolidation(o, proto.size(), source.description, "kernel");
     const ConsolidatedState state = consolidate(config, proto, co);
     std::cerr << "demcal export: consolidated in " << state.steps << " steps, " << state.wall_time_s
               << " s\n";

@@ -1,7 +1,8 @@
 // The 3D decks (upscaling/export_3d.hpp): every parameter mapped as the
 // header says, and, where the engines are installed, the LAMMPS deck's peak
 // against demcal's triaxial run of the same parameters (serially and under
-// mpirun -np 2) and the LIGGGHTS deck's.
+// mpirun -np 2) and the LIGGGHTS deck's; the LAMMPS deck's own
+// consolidation stage (--consolidate-in deck) on a random sample.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -17,6 +18,7 @@
 
 #include "demcal/io/input_error.hpp"
 #include "demcal/kernel/particle_scales.hpp"
+#include "demcal/scene/biaxial.hpp"
 #include "demcal/scene/triaxial.hpp"
 #include "demcal/scoring/external_series.hpp"
 #include "demcal/scoring/triaxial_scoring.hpp"
@@ -295,6 +297,173 @@ TEST(Export3dLammps, PeakMatchesDemcalSerially) { check_lammps(1, 20000); }
 // A quarter of the steps under MPI: two ranks of a 256-sphere deck meet
 // several times a step, which a shared machine makes slow (reports/engines-3d.md).
 TEST(Export3dLammps, PeakMatchesDemcalUnderMpirunNp2) { check_lammps(2, 5000); }
+
+/// configs/random_500_3d.json with `count` spheres (σ3 100 kPa, kn 1e6 N/m,
+/// radii 0.375–0.625 mm, μ 0.3).
+SceneConfig random3d(int count) {
+  SceneConfig c = load_config(test::shipped_config("random_500_3d"));
+  c.assembly.count = count;
+  return c;
+}
+
+// The deck that consolidates itself (--consolidate-in deck): the data file
+// is the assembly as generated, stage 1 servoes all six walls with
+// demcal's law at demcal's consolidation step, then the loading as before.
+TEST(Export3d, LammpsDeckCarriesTheConsolidationStage) {
+  const SceneConfig c = random3d(200);
+  const SphereAssembly a = make_sphere_assembly(c);
+  Export3dOptions o;
+  o.data_name = "r.data";
+  o.consolidate_in_deck = true;
+  const ExportResult r = export_3d_decks(c, fixed_params(), a, o);
+  const std::string& d = r.deck;
+  for (const char* line :
+       {"variable consolidate index 1", "variable cons_check equal 200",
+        "if              \"${consolidate} == 0\" then \"jump SELF loading\"",
+        "fix             cons_servo all ave/time 1 1 1 v_cons_mxmin v_cons_mxmax v_cons_mymin "
+        "v_cons_mymax v_cons_mzmin v_cons_mzmax ave running",
+        "fix             cons_halt all halt ${cons_check} v_cons_static > 0.5",
+        "pair_style      gran/hooke/history ${kn} ${kt} 0 0.0 0 0\n",
+        "variable        zmax0 delete\n", "label           loading\n"})
+    EXPECT_NE(d.find(line), std::string::npos) << line;
+  for (const char* w : {"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"}) {
+    EXPECT_NE(d.find(std::string("fix             cons_w") + w +
+                     " all wall/gran/region hooke/history ${kn_wall} ${kt_wall} 0 0 ${mu_wall} 0 "
+                     "region cons_r" +
+                     w + " contacts"),
+              std::string::npos)
+        << w;
+    EXPECT_NE(d.find(std::string("v_cons_p") + w), std::string::npos) << w;
+  }
+  char line[128];
+  std::snprintf(line, sizeof line, "variable cons_tol  equal %.10g ",
+                c.test.consolidation_tolerance);
+  EXPECT_NE(d.find(line), std::string::npos) << line;
+  // demcal's consolidation step: α 0.2 times the explicit damper's factor
+  // at ζ = 0.02, of the sphere kernel's Δt_crit.
+  const double r_min = *std::min_element(a.r.begin(), a.r.end());
+  const double dt_crit =
+      critical_time_step(sphere_mass(c.material.density, r_min), c.material.particle.kn);
+  std::snprintf(line, sizeof line, "timestep        %.10g      # alpha*f(zeta)*dt_crit",
+                0.2 * dashpot_step_factor(kConsolidationDampingRatio) * dt_crit);
+  EXPECT_NE(d.find(line), std::string::npos) << line;
+  // Stage 1 comes before the loading's derived values (H0 of its walls).
+  EXPECT_LT(d.find("label           loading"), d.find("variable H0"));
+  // The data file: the generated spheres, as they are.
+  std::snprintf(line, sizeof line, " %.17g %.17g %.17g %.17g %.17g\n", 2 * a.r[0],
+                c.material.density, a.x[0], a.y[0], a.z[0]);
+  EXPECT_NE(r.files.at("r.data").find(line), std::string::npos) << line;
+  // Only the LAMMPS deck consolidates itself.
+  o.format = "liggghts";
+  EXPECT_THROW(export_3d_decks(c, fixed_params(), a, o), InputError);
+}
+
+// Stage 1 in LAMMPS on a random gas of 150 spheres: it stops on demcal's
+// criterion (every wall within consolidation_tolerance of σ3, unbalanced-
+// force ratio below consolidation_unbalanced), the loading starts at σ3 on
+// all six walls and loads. Its peak against demcal's on the same generated
+// sample, consolidated by demcal: two consolidations by two integrators
+// give two packings, so the peaks agree only within the sample-to-sample
+// scatter; measured and printed, not asserted (reports/engines.md §10).
+TEST(Export3dLammps, DeckConsolidatesARandomSampleAndLoads) {
+  const std::string lmp = test::find_on_path("lmp");
+  if (lmp.empty()) GTEST_SKIP() << "LAMMPS (lmp) is not installed: the 3D deck is not run";
+  const SceneConfig c = random3d(150);
+  const SphereAssembly a = make_sphere_assembly(c);
+  // A short loading (8 000 steps to ε = 1 %): the test is the consolidation.
+  const AlgorithmSpec p = fixed_params(8000);
+  Export3dOptions o;
+  o.data_name = "r.data";
+  o.consolidate_in_deck = true;
+  const ExportResult r = export_3d_decks(c, p, a, o);
+  const EngineRun l = run_engine(lmp, {"-screen", "none"}, r, "lammps3d_cons");
+  ASSERT_EQ(l.status, 0) << l.log;
+  const std::regex done(
+      "demcal deck: consolidated in ([0-9]+) steps \\(wall stress error ([-+0-9.eE]+), "
+      "unbalanced-force ratio ([-+0-9.eE]+)\\)");
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(l.log, m, done)) << l.log;
+  const long long deck_steps = std::stoll(m[1].str());
+  const double err = std::stod(m[2].str()), ufr = std::stod(m[3].str());
+  EXPECT_LT(err, c.test.consolidation_tolerance);
+  EXPECT_LT(ufr, c.test.consolidation_unbalanced);
+  ASSERT_GT(l.rows.size(), 100u);
+  // The first row: step 0 of the loading, the walls where stage 1 left
+  // them. Its pressures are the static state's forces on the placed walls'
+  // areas, which differ from the servo's by at most a move (the 2D deck's
+  // bound, 2·tol).
+  const auto& first = l.rows.front();
+  ASSERT_EQ(first.size(), kColumns);
+  EXPECT_EQ(first[0], 0);
+  const double sigma3 = c.test.lateral_stress;
+  double worst = 0.0;
+  for (int k = 0; k < 6; ++k) {
+    const double pk = first[kColumns - 7 + k];
+    worst = std::max(worst, std::abs(pk - sigma3) / sigma3);
+    EXPECT_NEAR(pk, sigma3, 2 * c.test.consolidation_tolerance * sigma3) << "wall " << k;
+  }
+  // demcal on the same generated sample.
+  const auto t0 = std::chrono::steady_clock::now();
+  const TriaxialState state = consolidate_triaxial(c, a);
+  const TriaxialResult d = run_triaxial_loading(state, c.test, p);
+  const double demcal_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  ASSERT_FALSE(d.diverged);
+  // It loads: the axial stress rises above σ3 to a peak.
+  EXPECT_GT(l.peak_axial, 1.5 * sigma3);
+  EXPECT_GT(l.peak_ratio, 1.5);
+  std::printf(
+      "random 150 spheres: deck stage 1 %lld steps (wall error %.3g, ufr %.3g; first loading row "
+      "within %.3g of sigma3), demcal %lld steps; peak axial stress deck %.6g / demcal %.6g Pa "
+      "(%+.2f %%), peak sigma1/sigma3 %.5f / %.5f (%+.2f %%); LAMMPS %.1f s, demcal %.1f s\n",
+      deck_steps, err, ufr, worst, static_cast<long long>(state.steps), l.peak_axial,
+      -d.peak_stress_zz, 100 * (l.peak_axial / -d.peak_stress_zz - 1), l.peak_ratio, d.peak_ratio,
+      100 * (l.peak_ratio / d.peak_ratio - 1), l.seconds, demcal_s);
+}
+
+// `demcal export` of a 3D params.json: --consolidate-in as in 2D (deck:
+// stage 1 in the LAMMPS deck; refused for LIGGGHTS; demcal: its threaded
+// sphere kernel with progress on stderr; auto: demcal up to 2 000 spheres).
+TEST(Export3dCli, ConsolidateInChoosesWhereAndPrintsProgress) {
+  const test::TempDir dir("export3d_cli");
+  const std::string params =
+      (fs::path(test::kSourceDir) / "reports" / "example-fcc_4x4x4" / "params.json").string();
+  const std::string config = test::shipped_config("random_500_3d");
+  const std::vector<std::string> base = {"export", params,        "--config",
+                                         config,   "--particles", "150"};
+  auto with = [&](std::vector<std::string> extra) {
+    std::vector<std::string> args = base;
+    args.insert(args.end(), extra.begin(), extra.end());
+    return test::run_demcal(args, dir.path());
+  };
+  const auto deck = with({"--consolidate-in", "deck", "-o", "a/deck.lammps"});
+  ASSERT_EQ(deck.status, 0) << deck.err;
+  EXPECT_NE(deck.err.find("the deck consolidates the prototype to sigma3 itself"),
+            std::string::npos)
+      << deck.err;
+  EXPECT_EQ(deck.err.find("consolidated in"), std::string::npos) << deck.err;
+  EXPECT_NE(test::read_text(dir.path() / "a" / "deck.lammps").find("label           loading"),
+            std::string::npos);
+  const auto demcal =
+      with({"--consolidate-in", "demcal", "--progress", "0", "-o", "b/deck.lammps"});
+  ASSERT_EQ(demcal.status, 0) << demcal.err;
+  EXPECT_NE(demcal.err.find("consolidating (frictionless): step 200 of at most "),
+            std::string::npos)
+      << demcal.err;
+  EXPECT_NE(demcal.err.find("consolidating (friction on)"), std::string::npos) << demcal.err;
+  EXPECT_EQ(test::read_text(dir.path() / "b" / "deck.lammps").find("cons_servo"),
+            std::string::npos);
+  // auto at 150 spheres: demcal consolidates (the same deck as `demcal`).
+  const auto automatic = with({"-o", "c/deck.lammps"});
+  ASSERT_EQ(automatic.status, 0) << automatic.err;
+  EXPECT_EQ(test::read_text(dir.path() / "c" / "deck.lammps"),
+            test::read_text(dir.path() / "b" / "deck.lammps"));
+  EXPECT_EQ(
+      with({"--consolidate-in", "deck", "--format", "liggghts", "-o", "d/deck.liggghts"}).status,
+      2);
+  EXPECT_EQ(with({"--consolidate-in", "elsewhere", "-o", "e/deck.lammps"}).status, 2);
+  EXPECT_FALSE(fs::exists(dir.path() / "d"));
+}
 
 // The LIGGGHTS deck over the whole loading against demcal's run of the same
 // parameters (ζ_r = 0). Its axial stress is the mean of the top and bottom

@@ -130,11 +130,19 @@ Integration integration_for(const SphereWorld& world, const AlgorithmSpec& algor
 
 TriaxialState consolidate_triaxial(const SceneConfig& config, const SphereAssembly& assembly,
                                    const ConsolidationCallback& progress) {
+  ConsolidationOptions options;
+  options.progress = progress;
+  return consolidate_triaxial(config, assembly, options);
+}
+
+TriaxialState consolidate_triaxial(const SceneConfig& config, const SphereAssembly& assembly,
+                                   const ConsolidationOptions& options) {
   const auto t0 = std::chrono::steady_clock::now();
   const TestSpec& test = config.test;
   TriaxialState state{SphereWorld(sphere_material(config.material), assembly.x, assembly.y,
                                   assembly.z, assembly.r, assembly.lo, assembly.hi)};
   SphereWorld& world = state.world;
+  world.set_threads(options.threads);
   const double mu = config.material.particle.friction;
   // Light damping for the fastest relaxation of the slow collective modes
   // (biaxial.cpp, consolidate(): measured there).
@@ -143,8 +151,10 @@ TriaxialState consolidate_triaxial(const SceneConfig& config, const SphereAssemb
       world, test, mu, settle,
       [](const SphereWorld& w, const AlgorithmSpec& a) { return integration_for(w, a); },
       [&](const detail::ConsolidationOutcome& c) {
-        if (progress) progress(c.progress);
+        if (options.progress) options.progress(c.progress);
       });
+  // Its copies are the trials, which a calibration runs in parallel.
+  world.set_threads(1);
   state.converged = o.converged;
   state.stress_error = o.stress_error;
   state.unbalanced_ratio = o.unbalanced_ratio;

@@ -213,6 +213,170 @@ std::string lammps_series_header(const std::string& deck, const std::string& sce
   return s.str();
 }
 
+std::string lammps_consolidation_parameters(const TestSpec& test) {
+  std::ostringstream s;
+  s << "# stage 1, the consolidation (demcal's test.consolidation_* values):\n"
+    << "variable consolidate index 1      # 0: skip it (the particles are at sigma3)\n"
+    << "variable cons_tol  equal " << num(test.consolidation_tolerance)
+    << "      # largest wall stress error / sigma3\n"
+    << "variable cons_unbalanced equal " << num(test.consolidation_unbalanced)
+    << "      # mean|F_p| / mean|f_c|\n"
+    << "variable cons_max_steps equal " << test.consolidation_max_steps << "\n"
+    << "variable cons_check equal 200      # steps between checks\n";
+  return s.str();
+}
+
+double consolidation_dt(double alpha, double zeta, double dt_crit) {
+  return alpha * dashpot_step_factor(zeta) * dt_crit;
+}
+
+std::string lammps_consolidation_viscous(const std::vector<double>& gamma) {
+  std::string out = "fix cons_damp all viscous " + num(gamma[0]);
+  for (size_t k = 1; k < gamma.size(); ++k)
+    out += " scale " + std::to_string(k + 1) + " " + num(gamma[k] / gamma[0]);
+  return out;
+}
+
+namespace {
+/// max(a, b) = (a+b+abs(a-b))/2: no max() of two numbers in this release.
+std::string max_of(const std::string& a, const std::string& b) {
+  return "(" + a + "+" + b + "+abs(" + a + "-" + b + "))/2";
+}
+}  // namespace
+
+std::string lammps_consolidation_criterion(int dimension,
+                                           const std::vector<ConsolidationWall>& walls,
+                                           const std::vector<std::string>& axis_names) {
+  std::ostringstream s;
+  s << "# the static criterion\n";
+  for (const ConsolidationWall& w : walls)
+    s << "variable        cons_p" << w.name << " equal " << w.pressure << "\n";
+  auto components = [&](const std::string& of, int first) {
+    std::string out;
+    for (int d = 0; d < dimension; ++d)
+      out += (d ? "+" : "") + of + "[" + std::to_string(first + d) + "]^2";
+    return "sqrt(" + out + ")";
+  };
+  s << "variable        cons_fnet atom " << components("f_cons_fcon", 1) << "\n"
+    << "variable        cons_fw atom \"";
+  for (size_t k = 0; k < walls.size(); ++k) {
+    if (k > 0) s << (k % 2 == 0 ? "+&\n                " : "+");
+    s << components("f_cons_w" + walls[k].name, 2);
+  }
+  s << "\"\n"
+    << "compute         cons_pair all pair/local force cutoff radius\n"
+    << "compute         cons_nc all contact/atom\n"
+    << "compute         cons_fp all reduce sum c_cons_pair\n"
+    << "compute         cons_at all reduce sum v_cons_fnet v_cons_fw c_cons_nc\n"
+    << "# (x==0) is 1 for x = 0: no contacts yet (a gas) gives ratio 0, as in demcal\n"
+    << "variable        cons_nct equal c_cons_at[3]/2";
+  for (const ConsolidationWall& w : walls) s << "+c_cons_w[" << w.column << "]";
+  s << "\n"
+    << "variable        cons_fct equal c_cons_fp+c_cons_at[2]\n"
+    << "variable        cons_ufr equal (c_cons_at[1]/atoms)*(v_cons_nct+(v_cons_nct==0))/"
+       "(v_cons_fct+(v_cons_fct==0))\n"
+    << "# largest wall stress error: max(a, b) = (a+b+abs(a-b))/2 (no max() of two\n"
+    << "# numbers in this release)\n";
+  for (const ConsolidationWall& w : walls)
+    s << "variable        cons_e" << w.name << " equal abs(v_cons_p" << w.name << "-v_sigma3)\n";
+  for (size_t a = 0; a < axis_names.size(); ++a)
+    s << "variable        cons_e" << axis_names[a] << " equal "
+      << max_of("v_cons_e" + walls[2 * a].name, "v_cons_e" + walls[2 * a + 1].name) << "\n";
+  std::string acc = axis_names[0];
+  for (size_t a = 1; a < axis_names.size(); ++a) {
+    const std::string m = max_of("v_cons_e" + acc, "v_cons_e" + axis_names[a]);
+    if (a + 1 == axis_names.size()) {
+      s << "variable        cons_err equal " << m << "/v_sigma3\n";
+    } else {
+      acc += axis_names[a];
+      s << "variable        cons_e" << acc << " equal " << m << "\n";
+    }
+  }
+  s << "# sums over each wall's contacts for its position at the end (";
+  for (int d = 0; d < dimension; ++d)
+    s << (d ? ", " : "") << "r -+ "
+      << "xyz"[d];
+  s << ")\n"
+    << "compute         cons_rad all property/atom radius\n";
+  std::string pos;
+  for (const ConsolidationWall& w : walls) {
+    const std::string v = std::string("cons_r") + w.axis + (w.min ? "n" : "p");
+    s << "variable        " << v << " atom (c_cons_rad" << (w.min ? "-" : "+") << w.axis
+      << ")*f_cons_w" << w.name << "[1]\n";
+    pos += " v_" + v;
+  }
+  s << "compute         cons_pos all reduce sum" << pos << "\n"
+    << "# (the last term only computes cons_pos on the check steps: current at a halt)\n"
+    << "variable        cons_static equal (v_cons_err<v_cons_tol)&&(v_cons_ufr<v_cons_unbalanced)"
+       "&&(c_cons_pos[1]==c_cons_pos[1])\n"
+    << "fix             cons_halt all halt ${cons_check} v_cons_static > 0.5 error continue "
+       "message no\n"
+    << "thermo_style    custom step dt v_cons_err v_cons_ufr";
+  for (const ConsolidationWall& w : walls) s << " v_cons_p" << w.name;
+  s << " ke\n"
+    << "thermo_modify   norm no\n"
+    << "thermo          $(10*v_cons_check)\n";
+  return s.str();
+}
+
+std::string lammps_consolidation_runs(double gamma_n, double dt_damped,
+                                      const std::string& critical) {
+  std::ostringstream s;
+  s << "# phase 0: frictionless\n"
+    << "pair_style      gran/hooke/history ${kn} ${kt} " << num(gamma_n) << " 0.0 0 0\n"
+    << "variable        cons_critical equal 0\n"
+    << "run             ${cons_quarter} upto\n"
+    << "if              \"${cons_static} == 0\" then \"" << critical << "\" &\n"
+    << "                \"timestep " << num(dt_damped) << "\" \"variable cons_critical equal 1\" "
+    << "\"run ${cons_last} upto\"\n"
+    << "if              \"${cons_static} == 0\" then \"print 'demcal deck: consolidation "
+       "(frictionless) did not reach a static state in ${cons_max_steps} steps: raise "
+       "cons_max_steps'\" \"quit 2\"\n"
+    << "# phase 1: friction on (at least one check interval)\n"
+    << "pair_style      gran/hooke/history ${kn} ${kt} " << num(gamma_n) << " 0.0 ${mu} 0\n"
+    << "if              \"${cons_critical} == 0 && $(step+v_cons_check) <= ${cons_quarter}\" "
+       "then \"run ${cons_quarter} upto\" else \"run ${cons_check}\"\n"
+    << "if              \"${cons_static} == 0 && ${cons_critical} == 0\" then \"" << critical
+    << "\" &\n"
+    << "                \"timestep " << num(dt_damped) << "\" \"variable cons_critical equal 1\"\n"
+    << "if              \"${cons_static} == 0\" then \"run ${cons_last} upto\"\n"
+    << "if              \"${cons_static} == 0\" then \"print 'demcal deck: consolidation did "
+       "not reach a static state in ${cons_max_steps} steps: raise cons_max_steps'\" \"quit 2\"\n"
+    << "print           \"demcal deck: consolidated in $(step-v_cons_s0) steps (wall stress "
+       "error ${cons_err}, unbalanced-force ratio ${cons_ufr})\"\n";
+  return s.str();
+}
+
+std::string lammps_consolidated_wall(const ConsolidationWall& w, int i) {
+  const std::string n = "c_cons_w[" + std::to_string(w.column) + "]";
+  const std::string f = "c_cons_w[" + std::to_string(w.column + 1) + "]";
+  const std::string pos = "c_cons_pos[" + std::to_string(i + 1) + "]";
+  return w.min ? "$((" + f + "/v_kn_wall-" + pos + ")/" + n + ")"
+               : "$((" + pos + "+" + f + "/v_kn_wall)/" + n + ")";
+}
+
+std::string lammps_consolidation_end(const std::vector<ConsolidationWall>& walls,
+                                     const std::vector<std::string>& extra_fixes) {
+  std::ostringstream s;
+  s << "velocity        all set 0 0 0\n"
+    << "set             group all omega 0 0 0\n"
+    << "unfix           cons_halt\n";
+  for (const char* c :
+       {"cons_at", "cons_pos", "cons_rad", "cons_fp", "cons_nc", "cons_pair", "cons_w"})
+    s << "uncompute       " << c << "\n";
+  s << "unfix           cons_servo\n";
+  for (const std::string& f : extra_fixes) s << "unfix           " << f << "\n";
+  s << "unfix           cons_damp\n"
+    << "unfix           cons_fcon\n";
+  for (const ConsolidationWall& w : walls) s << "unfix           cons_w" << w.name << "\n";
+  for (const ConsolidationWall& w : walls) s << "region          cons_r" << w.name << " delete\n";
+  s << "variable        cap delete\n"
+    << "reset_timestep  0\n"
+    << "timestep        ${dt}\n"
+    << "label           loading\n\n";
+  return s.str();
+}
+
 std::string liggghts_preamble(int dimension, const std::string& boundary,
                               const std::string& data_name, double r_min) {
   std::ostringstream s;

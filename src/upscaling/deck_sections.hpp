@@ -126,6 +126,58 @@ std::string lammps_series_header(const std::string& deck, const std::string& sce
                                  double zeta_t, std::optional<double> dt_crit,
                                  std::optional<double> mass_scaling);
 
+/// Stage 1 of a deck that consolidates itself (LAMMPS; export.cpp in 2D,
+/// export_3d.cpp in 3D): demcal's consolidation (scene/protocol_steps.hpp)
+/// with every wall a `fix cons_wNAME wall/gran/region ... contacts` servoed
+/// at sigma3. What the writers share is written here once.
+struct ConsolidationWall {
+  std::string name;      ///< fix cons_w<name>, e.g. "l" (2D left), "xmin"
+  char axis = 'x';       ///< the wall's axis
+  bool min = true;       ///< inward normal +axis (left, bottom, x min ...)
+  int column = 0;        ///< compute cons_w: [column] its contacts, [column+1] its force
+  std::string pressure;  ///< its compressive pressure [Pa], an equal-style formula
+};
+
+/// Stage 1's lines in the parameters block: consolidate (1: run it), the
+/// scene's test.consolidation_* values (cons_tol, cons_unbalanced,
+/// cons_max_steps) and cons_check (demcal's 200 steps between checks).
+std::string lammps_consolidation_parameters(const TestSpec& test);
+
+/// The step of stage 1 at damping ratio zeta: alpha·f(zeta)·dt_crit (the
+/// explicit damper's factor, as the loading's deck_timing).
+double consolidation_dt(double alpha, double zeta, double dt_crit);
+
+/// Stage 1's fix viscous per radius class, gamma[k] for type k+1.
+std::string lammps_consolidation_viscous(const std::vector<double>& gamma);
+
+/// Stage 1's static criterion, demcal's: every wall within cons_tol of
+/// sigma3 and the unbalanced-force ratio mean|F_p|/mean|f_c| below
+/// cons_unbalanced, checked every cons_check steps by fix halt; the per-wall
+/// sums that place each wall at the end (compute cons_pos); the thermo line.
+/// `axis_names`: one name per axis for the largest error of its two walls
+/// (walls are given in pairs, min then max, axis by axis).
+std::string lammps_consolidation_criterion(int dimension,
+                                           const std::vector<ConsolidationWall>& walls,
+                                           const std::vector<std::string>& axis_names);
+
+/// Stage 1's runs: frictionless, then friction on, each until static;
+/// critical damping (`critical`: its fix viscous line, step dt_damped) once a
+/// quarter of the budget has passed; quit 2 when the budget is spent.
+std::string lammps_consolidation_runs(double gamma_n, double dt_damped,
+                                      const std::string& critical);
+
+/// Where stage 1 leaves a wall (i its index in `walls`, cons_pos's column
+/// i+1): placed by its contacts, F = kn_wall·sum of overlaps (exact for
+/// the undamped walls), as an immediate $(...) expression.
+std::string lammps_consolidated_wall(const ConsolidationWall& wall, int i);
+
+/// Stage 1's end after the start walls are set: particles at rest, stage
+/// 1's fixes, computes and regions removed (`extra_fixes` besides the
+/// walls', servo, damping and force store), step 0, the loading's step,
+/// label loading.
+std::string lammps_consolidation_end(const std::vector<ConsolidationWall>& walls,
+                                     const std::vector<std::string>& extra_fixes);
+
 /// LIGGGHTS: atom style, boundary, communication, units (and dimension 2
 /// for `dimension` 2), the data file and the neighbour list.
 std::string liggghts_preamble(int dimension, const std::string& boundary,

@@ -419,15 +419,7 @@ std::string lammps_parameters(const SceneConfig& c, const Assembly& a, const Pla
     << "variable xr_now    index ${xr0}\n"
     << "variable run_steps index ${nstep}      # run up to this step; -var run_steps 300 for a "
        "check\n";
-  if (o.consolidate_in_deck)
-    s << "# stage 1, the consolidation (demcal's test.consolidation_* values):\n"
-      << "variable consolidate index 1      # 0: skip it (the particles are at sigma3)\n"
-      << "variable cons_tol  equal " << num(c.test.consolidation_tolerance)
-      << "      # largest wall stress error / sigma3\n"
-      << "variable cons_unbalanced equal " << num(c.test.consolidation_unbalanced)
-      << "      # mean|F_p| / mean|f_c|\n"
-      << "variable cons_max_steps equal " << c.test.consolidation_max_steps << "\n"
-      << "variable cons_check equal 200      # steps between checks\n";
+  if (o.consolidate_in_deck) s << deck::lammps_consolidation_parameters(c.test);
   return s.str();
 }
 
@@ -501,23 +493,22 @@ ConsolidationSteps consolidation_steps(const SceneConfig& c, const Plan& plan) {
     st.alpha *= dashpot_step_factor(gamma_max / (st.alpha * plan.dt_crit));
     resist_dash = 2.0 * m.contact_damping_ratio * std::sqrt(m.wall.kn * m_max);
   }
-  st.dt_light = st.alpha * dashpot_step_factor(kConsolidationDampingRatio) * plan.dt_crit;
-  st.dt_damped = st.alpha * dashpot_step_factor(1.0) * plan.dt_crit;
+  st.dt_light = deck::consolidation_dt(st.alpha, kConsolidationDampingRatio, plan.dt_crit);
+  st.dt_damped = deck::consolidation_dt(st.alpha, 1.0, plan.dt_crit);
   st.resist = resist_dash > 0.0 ? "(${kn_wall}+" + num(resist_dash) + "/dt)" : "${kn_wall}";
   return st;
 }
 
 /// Stage 1's fix viscous at damping ratio z, per radius class.
 std::string consolidation_viscous(const SceneConfig& c, const Plan& plan, double z) {
-  auto g = [&](int k) {
+  std::vector<double> gamma;
+  for (int k = 0; k < plan.types; ++k) {
     const double r = 0.5 * (plan.r_lo[k] + plan.r_hi[k]);
-    return z * 2.0 *
-           std::sqrt(c.material.particle.kn * plan.areal_density * std::numbers::pi * r * r);
-  };
-  std::string out = "fix cons_damp all viscous " + num(g(0));
-  for (int k = 1; k < plan.types; ++k)
-    out += " scale " + std::to_string(k + 1) + " " + num(g(k) / g(0));
-  return out;
+    gamma.push_back(
+        z * 2.0 *
+        std::sqrt(c.material.particle.kn * plan.areal_density * std::numbers::pi * r * r));
+  }
+  return deck::lammps_consolidation_viscous(gamma);
 }
 
 /// Stage 1's walls and servo: four planes moved by demcal's per-step law.
@@ -600,130 +591,33 @@ std::string lammps_consolidation_walls(const SceneConfig& c, const Plan& plan,
   return s.str();
 }
 
-/// Stage 1's static criterion (demcal's), checked by fix halt.
-constexpr const char kLammpsConsolidationCriterion[] =
-    "# the static criterion\n"
-    "variable        cons_pl equal c_cons_w[2]/(v_cons_H*v_thick)\n"
-    "variable        cons_pr equal -c_cons_w[4]/(v_cons_H*v_thick)\n"
-    "variable        cons_pb equal c_cons_w[6]/(v_cons_W*v_thick)\n"
-    "variable        cons_pt equal -c_cons_w[8]/(v_cons_W*v_thick)\n"
-    "variable        cons_fnet atom sqrt(f_cons_fcon[1]^2+f_cons_fcon[2]^2)\n"
-    "variable        cons_fw atom \"sqrt(f_cons_wl[2]^2+f_cons_wl[3]^2)+sqrt(f_cons_wr[2]^2+"
-    "f_cons_wr[3]^2)+&\n"
-    "                sqrt(f_cons_wb[2]^2+f_cons_wb[3]^2)+sqrt(f_cons_wt[2]^2+f_cons_wt[3]^2)\"\n"
-    "compute         cons_pair all pair/local force cutoff radius\n"
-    "compute         cons_nc all contact/atom\n"
-    "compute         cons_fp all reduce sum c_cons_pair\n"
-    "compute         cons_at all reduce sum v_cons_fnet v_cons_fw c_cons_nc\n"
-    "# (x==0) is 1 for x = 0: no contacts yet (a gas) gives ratio 0, as in demcal\n"
-    "variable        cons_nct equal c_cons_at[3]/2+c_cons_w[1]+c_cons_w[3]+c_cons_w[5]+"
-    "c_cons_w[7]\n"
-    "variable        cons_fct equal c_cons_fp+c_cons_at[2]\n"
-    "variable        cons_ufr equal (c_cons_at[1]/atoms)*(v_cons_nct+(v_cons_nct==0))/"
-    "(v_cons_fct+(v_cons_fct==0))\n"
-    "# largest wall stress error: max(a, b) = (a+b+abs(a-b))/2 (no max() of two\n"
-    "# numbers in this release)\n"
-    "variable        cons_el equal abs(v_cons_pl-v_sigma3)\n"
-    "variable        cons_er equal abs(v_cons_pr-v_sigma3)\n"
-    "variable        cons_eb equal abs(v_cons_pb-v_sigma3)\n"
-    "variable        cons_et equal abs(v_cons_pt-v_sigma3)\n"
-    "variable        cons_eh equal (v_cons_el+v_cons_er+abs(v_cons_el-v_cons_er))/2\n"
-    "variable        cons_ev equal (v_cons_eb+v_cons_et+abs(v_cons_eb-v_cons_et))/2\n"
-    "variable        cons_err equal (v_cons_eh+v_cons_ev+abs(v_cons_eh-v_cons_ev))/2/v_sigma3\n"
-    "# sums over each wall's contacts for its position at the end (r -+ x, r -+ y)\n"
-    "compute         cons_rad all property/atom radius\n"
-    "variable        cons_rxn atom (c_cons_rad-x)*f_cons_wl[1]\n"
-    "variable        cons_rxp atom (c_cons_rad+x)*f_cons_wr[1]\n"
-    "variable        cons_ryn atom (c_cons_rad-y)*f_cons_wb[1]\n"
-    "variable        cons_ryp atom (c_cons_rad+y)*f_cons_wt[1]\n"
-    "compute         cons_pos all reduce sum v_cons_rxn v_cons_rxp v_cons_ryn v_cons_ryp\n"
-    "# (the last term only computes cons_pos on the check steps: current at a halt)\n"
-    "variable        cons_static equal (v_cons_err<v_cons_tol)&&(v_cons_ufr<v_cons_unbalanced)"
-    "&&(c_cons_pos[1]==c_cons_pos[1])\n"
-    "fix             cons_halt all halt ${cons_check} v_cons_static > 0.5 error continue "
-    "message no\n"
-    "thermo_style    custom step dt v_cons_err v_cons_ufr v_cons_pl v_cons_pr v_cons_pb "
-    "v_cons_pt ke\n"
-    "thermo_modify   norm no\n"
-    "thermo          $(10*v_cons_check)\n";
-
-/// Stage 1's runs: frictionless, then friction on; critical damping once a
-/// quarter of the budget has passed; quit 2 when the budget is spent.
-std::string lammps_consolidation_runs(const SceneConfig& c, const Plan& plan, double gamma_n,
-                                      const ConsolidationSteps& st) {
-  const std::string critical = consolidation_viscous(c, plan, 1.0);
-  const double dt_crit_damped = st.dt_damped;
-  std::ostringstream s;
-  s << "# phase 0: frictionless\n"
-    << "pair_style      gran/hooke/history ${kn} ${kt} " << num(gamma_n) << " 0.0 0 0\n"
-    << "variable        cons_critical equal 0\n"
-    << "run             ${cons_quarter} upto\n"
-    << "if              \"${cons_static} == 0\" then \"" << critical << "\" &\n"
-    << "                \"timestep " << num(dt_crit_damped)
-    << "\" \"variable cons_critical equal 1\" "
-    << "\"run ${cons_last} upto\"\n"
-    << "if              \"${cons_static} == 0\" then \"print 'demcal deck: consolidation "
-       "(frictionless) did not reach a static state in ${cons_max_steps} steps: raise "
-       "cons_max_steps'\" \"quit 2\"\n"
-    << "# phase 1: friction on (at least one check interval)\n"
-    << "pair_style      gran/hooke/history ${kn} ${kt} " << num(gamma_n) << " 0.0 ${mu} 0\n"
-    << "if              \"${cons_critical} == 0 && $(step+v_cons_check) <= ${cons_quarter}\" "
-       "then \"run ${cons_quarter} upto\" else \"run ${cons_check}\"\n"
-    << "if              \"${cons_static} == 0 && ${cons_critical} == 0\" then \"" << critical
-    << "\" &\n"
-    << "                \"timestep " << num(dt_crit_damped)
-    << "\" \"variable cons_critical equal 1\"\n"
-    << "if              \"${cons_static} == 0\" then \"run ${cons_last} upto\"\n"
-    << "if              \"${cons_static} == 0\" then \"print 'demcal deck: consolidation did "
-       "not reach a static state in ${cons_max_steps} steps: raise cons_max_steps'\" \"quit 2\"\n"
-    << "print           \"demcal deck: consolidated in $(step-v_cons_s0) steps (wall stress "
-       "error ${cons_err}, unbalanced-force ratio ${cons_ufr})\"\n";
-  return s.str();
+/// Stage 1's walls, in compute cons_w's order.
+std::vector<deck::ConsolidationWall> consolidation_walls() {
+  return {{"l", 'x', true, 1, "c_cons_w[2]/(v_cons_H*v_thick)"},
+          {"r", 'x', false, 3, "-c_cons_w[4]/(v_cons_H*v_thick)"},
+          {"b", 'y', true, 5, "c_cons_w[6]/(v_cons_W*v_thick)"},
+          {"t", 'y', false, 7, "-c_cons_w[8]/(v_cons_W*v_thick)"}};
 }
 
 /// Stage 1's end: the loading's start walls, particles at rest, step 0.
-constexpr const char kLammpsConsolidationEnd[] =
-    "# the loading starts from here: walls, step 0, particles at rest. Each wall\n"
-    "# where its contacts put it (F = kn_wall * sum of overlaps, exact for these\n"
-    "# undamped walls), so the loading starts from the forces of the static state.\n"
-    "variable        xl0 delete\n"
-    "variable        xr0 delete\n"
-    "variable        yb0 delete\n"
-    "variable        yt0 delete\n"
-    "variable        xl0 index $((c_cons_w[2]/v_kn_wall-c_cons_pos[1])/c_cons_w[1])\n"
-    "variable        xr0 index $((c_cons_pos[2]+c_cons_w[4]/v_kn_wall)/c_cons_w[3])\n"
-    "variable        yb0 index $((c_cons_w[6]/v_kn_wall-c_cons_pos[3])/c_cons_w[5])\n"
-    "variable        yt0 index $((c_cons_pos[4]+c_cons_w[8]/v_kn_wall)/c_cons_w[7])\n"
-    "variable        xl_now delete\n"
-    "variable        xr_now delete\n"
-    "variable        xl_now index ${xl0}\n"
-    "variable        xr_now index ${xr0}\n"
-    "velocity        all set 0 0 0\n"
-    "set             group all omega 0 0 0\n"
-    "unfix           cons_halt\n"
-    "uncompute       cons_at\n"
-    "uncompute       cons_pos\n"
-    "uncompute       cons_rad\n"
-    "uncompute       cons_fp\n"
-    "uncompute       cons_nc\n"
-    "uncompute       cons_pair\n"
-    "uncompute       cons_w\n"
-    "unfix           cons_servo\n"
-    "unfix           cons_twod\n"
-    "unfix           cons_damp\n"
-    "unfix           cons_fcon\n"
-    "unfix           cons_wl\n"
-    "unfix           cons_wr\n"
-    "unfix           cons_wb\n"
-    "unfix           cons_wt\n"
-    "region          cons_rl delete\n"
-    "region          cons_rr delete\n"
-    "region          cons_rb delete\n"
-    "region          cons_rt delete\n"
-    "variable        cap delete\n"
-    "reset_timestep  0\n"
-    "timestep        ${dt}\n"
-    "label           loading\n\n";
+std::string lammps_consolidation_end() {
+  const std::vector<deck::ConsolidationWall> walls = consolidation_walls();
+  const char* start[] = {"xl0", "xr0", "yb0", "yt0"};
+  std::ostringstream s;
+  s << "# the loading starts from here: walls, step 0, particles at rest. Each wall\n"
+    << "# where its contacts put it (F = kn_wall * sum of overlaps, exact for these\n"
+    << "# undamped walls), so the loading starts from the forces of the static state.\n";
+  for (const char* v : start) s << "variable        " << v << " delete\n";
+  for (int i = 0; i < 4; ++i)
+    s << "variable        " << start[i] << " index " << deck::lammps_consolidated_wall(walls[i], i)
+      << "\n";
+  s << "variable        xl_now delete\n"
+    << "variable        xr_now delete\n"
+    << "variable        xl_now index ${xl0}\n"
+    << "variable        xr_now index ${xr0}\n"
+    << deck::lammps_consolidation_end(walls, {"cons_twod"});
+  return s.str();
+}
 
 /// Stage 1 of a deck that consolidates itself (ExportOptions::
 /// consolidate_in_deck): demcal's consolidation (scene/biaxial.cpp) in
@@ -735,8 +629,11 @@ constexpr const char kLammpsConsolidationEnd[] =
 /// walls' positions become the loading's start walls and the step count 0.
 std::string lammps_consolidation(const SceneConfig& c, const Plan& plan, double gamma_n) {
   const ConsolidationSteps st = consolidation_steps(c, plan);
-  return lammps_consolidation_walls(c, plan, st) + kLammpsConsolidationCriterion +
-         lammps_consolidation_runs(c, plan, gamma_n, st) + kLammpsConsolidationEnd;
+  return lammps_consolidation_walls(c, plan, st) +
+         deck::lammps_consolidation_criterion(2, consolidation_walls(), {"h", "v"}) +
+         deck::lammps_consolidation_runs(gamma_n, st.dt_damped,
+                                         consolidation_viscous(c, plan, 1.0)) +
+         lammps_consolidation_end();
 }
 
 /// Thermo, the run up to run_steps, and the restart a split run continues

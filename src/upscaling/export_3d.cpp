@@ -13,6 +13,7 @@
 #include "deck_sections.hpp"
 #include "demcal/io/input_error.hpp"
 #include "demcal/kernel/particle_scales.hpp"
+#include "demcal/scene/biaxial.hpp"
 
 namespace demcal {
 
@@ -37,6 +38,7 @@ struct Plan3 {
   std::array<double, 3> lo{}, hi{};
   double top_speed = 0.0;  // [m/s], downward
   std::vector<double> gamma_t, gamma_r;
+  std::vector<double> gamma_critical;  // per class, zeta 1 [N·s/m]: stage 1's damping
   double class_error = 0.0;
   std::array<int, 6> wall_contacts{};  // at the start
 };
@@ -76,7 +78,8 @@ Plan3 make_plan(const SceneConfig& c, const AlgorithmSpec& p, const SphereWorld&
   for (int k = 0; k < plan.types; ++k) {
     const double r = 0.5 * (plan.r_lo[k] + plan.r_hi[k]);
     const double m = sphere_mass(plan.density, r);
-    plan.gamma_t.push_back(p.damping_ratio_translation * critical_damping_translation(kn, m));
+    plan.gamma_critical.push_back(critical_damping_translation(kn, m));
+    plan.gamma_t.push_back(p.damping_ratio_translation * plan.gamma_critical.back());
     plan.gamma_r.push_back(p.damping_ratio_rotation *
                            critical_damping_rotation(kt, r, sphere_inertia(m, r)));
     const double lo = std::pow(plan.r_lo[k] / r, 1.5), hi = std::pow(plan.r_hi[k] / r, 1.5);
@@ -128,9 +131,13 @@ std::string mapping_header(const SceneConfig& c, const AlgorithmSpec& p, const P
                         : "held fixed (no servo)")
     << "\n"
     << "#   stresses: tension positive in b and s; wall pressures compressive positive\n"
-    << "# The particle file holds demcal's consolidated state (walls at its box); the\n"
-    << "# run starts loading from it. Not carried over: the tangential contact forces\n"
-    << "# (springs start at zero here), the velocities (zero).\n"
+    << (o.consolidate_in_deck
+            ? "# The particle file holds the prototype as generated (walls at its box): stage 1\n"
+              "# below consolidates it to isotropic sigma3 (demcal's consolidation), then the\n"
+              "# run loads it from there.\n"
+            : "# The particle file holds demcal's consolidated state (walls at its box); the\n"
+              "# run starts loading from it. Not carried over: the tangential contact forces\n"
+              "# (springs start at zero here), the velocities (zero).\n")
     << "# ===========================================================================\n";
   return s.str();
 }
@@ -234,10 +241,17 @@ void lammps_3d_parameters(std::ostream& s, const SceneConfig& c, const Plan3& pl
     << "variable r_min     equal " << exact(plan.r_min) << "      # m\n";
   for (int sd = 0; sd < 6; ++sd)
     s << "variable " << kWall[sd] << "0    equal "
-      << exact(sd % 2 == 0 ? plan.lo[sd / 2] : plan.hi[sd / 2]) << "      # wall at the start, m\n";
+      << exact(sd % 2 == 0 ? plan.lo[sd / 2] : plan.hi[sd / 2])
+      << (o.consolidate_in_deck ? "      # wall at the start of stage 1, m\n"
+                                : "      # wall at the start, m\n");
   s << "variable series    index series.csv\n"
-    << "variable run_steps index ${nstep}      # -var run_steps 300 for a check\n"
-    << "\n# --- derived (do not edit) ---------------------------------------------------\n"
+    << "variable run_steps index ${nstep}      # -var run_steps 300 for a check\n";
+  if (o.consolidate_in_deck) s << deck::lammps_consolidation_parameters(c.test);
+}
+
+// What is derived from the parameters block (and the start walls).
+void lammps_3d_derived(std::ostream& s) {
+  s << "\n# --- derived (do not edit) ---------------------------------------------------\n"
     << "variable H0        equal $(v_zmax0-v_zmin0)\n"
     << "variable Wx0       equal $(v_xmax0-v_xmin0)\n"
     << "variable Wy0       equal $(v_ymax0-v_ymin0)\n"
@@ -255,6 +269,125 @@ void lammps_3d_system(std::ostream& s, const SceneConfig& c, const Plan3& plan,
     << "read_data       " << o.data_name << "\n"
     << "# sphere masses f_ms*rho*4/3*pi*r^3 (density column), inertia 2/5 m r^2\n"
     << deck::lammps_contact_law(gamma_n, plan.r_min, "");
+}
+
+// ---------------------------------------------------------------------------
+// Stage 1: demcal's consolidation (triaxial.cpp consolidate_triaxial, the
+// shared loop of scene/protocol_steps.hpp) in LAMMPS
+
+/// Stage 1's six walls, in compute cons_w's order (kWall).
+std::vector<deck::ConsolidationWall> consolidation_walls() {
+  const char* area[3] = {"v_cons_Ax", "v_cons_Ay", "v_cons_Az"};
+  std::vector<deck::ConsolidationWall> walls;
+  for (int sd = 0; sd < 6; ++sd) {
+    const int col = 2 * sd + 1;
+    const bool min = sd % 2 == 0;
+    walls.push_back({kWall[sd], kAxis[sd / 2], min, col,
+                     std::string(min ? "" : "-") + "c_cons_w[" + std::to_string(col + 1) + "]/" +
+                         area[sd / 2]});
+  }
+  return walls;
+}
+
+/// The six walls servoed at sigma3 with demcal's per-step law (triaxial.cpp
+/// servo_velocity: gain*(sigma3*A - F)/(kn_wall*max(1, n)), cap 2 % of
+/// r_min, A the wall's current area), light damping, the criterion, the
+/// runs and the start walls of the loading.
+void lammps_3d_consolidation(std::ostream& s, const SceneConfig& c, const Plan3& plan) {
+  const double zeta = kConsolidationDampingRatio;
+  // demcal's consolidation step: alpha of AlgorithmSpec{} (0.2), the
+  // sphere kernel's dt_crit; times the explicit damper's factor.
+  const double alpha = AlgorithmSpec{}.dt_ratio;
+  const double dt_light = deck::consolidation_dt(alpha, zeta, plan.dt_crit);
+  const double dt_damped = deck::consolidation_dt(alpha, 1.0, plan.dt_crit);
+  std::vector<double> light, critical;
+  for (double g : plan.gamma_critical) {
+    light.push_back(zeta * g);
+    critical.push_back(g);
+  }
+  const std::vector<deck::ConsolidationWall> walls = consolidation_walls();
+  s << "\n# --- stage 1: consolidation to isotropic sigma3 -------------------------------\n"
+    << "# demcal's consolidation (demcal export --consolidate-in deck), run here so\n"
+    << "# that it scales under MPI: all six walls servoed with the loading's law (each\n"
+    << "# wall: move = gain*(sigma3*A - F)/(kn_wall*max(1, n)) per step, A its current\n"
+    << "# area, cap 2 % of r_min), global damping zeta " << num(zeta)
+    << " on translation (demcal also\n"
+    << "# damps rotation; this LAMMPS cannot), particle friction 0 until static, then\n"
+    << "# mu until static again; critical damping (zeta 1, timestep * f(1)/f(" << num(zeta)
+    << "))\n"
+    << "# once a quarter of cons_max_steps has passed without. Static: every wall\n"
+    << "# within cons_tol of sigma3 and the unbalanced-force ratio mean|F_p| / mean\n"
+    << "# |f_c| below cons_unbalanced (demcal's test.consolidation_* values), checked\n"
+    << "# every cons_check steps by fix halt; |f_c| of a sphere contact is its normal\n"
+    << "# force (compute pair/local; the tangential part left out: a stricter ratio).\n"
+    << "# The end state's walls become xmin0 .. zmax0 of the loading, whose step\n"
+    << "# count starts at 0; the pair contacts keep their tangential springs, the\n"
+    << "# walls' start at zero. Progress: the thermo lines (cons_err, cons_ufr).\n"
+    << "if              \"${consolidate} == 0\" then \"jump SELF loading\"\n"
+    << "variable        cap equal $(0.02*v_r_min)\n"
+    << "timestep        " << num(dt_light) << "      # alpha*f(zeta)*dt_crit, alpha " << num(alpha)
+    << "\n"
+    << "variable        cons_s0 equal $(step)\n"
+    << "# runs end on check steps, where the criterion's computes are current\n"
+    << "variable        cons_quarter equal $(v_cons_check*floor(v_cons_max_steps/4/v_cons_check))\n"
+    << "variable        cons_last equal $(v_cons_check*floor(v_cons_max_steps/v_cons_check))\n";
+  for (int sd = 0; sd < 6; ++sd)
+    s << "variable        cons_d" << kWall[sd] << " equal f_cons_servo[" << sd + 1
+      << "]*(step-${cons_s0})\n";
+  for (int sd = 0; sd < 6; ++sd) {
+    const int a = sd / 2;
+    std::string point = "0 0 0", normal = "0 0 0", move = "NULL NULL NULL";
+    point.replace(2 * a, 1, std::string("${") + kWall[sd] + "0}");
+    normal.replace(2 * a, 1, sd % 2 == 0 ? " 1" : "-1");
+    move.replace(5 * a, 4, std::string("v_cons_d") + kWall[sd]);
+    s << "region          cons_r" << kWall[sd] << " plane " << point << " " << normal
+      << " side in move " << move << " units box\n";
+  }
+  for (int sd = 0; sd < 6; ++sd)
+    s << "fix             cons_w" << kWall[sd]
+      << " all wall/gran/region hooke/history ${kn_wall} ${kt_wall} 0 0 ${mu_wall} 0 region cons_r"
+      << kWall[sd] << " contacts\n";
+  s << "fix             cons_fcon all store/force\n"
+    << deck::lammps_consolidation_viscous(light) << "\n"
+    << "# contacts and force along the wall's axis, xmin xmax ymin ymax zmin zmax\n"
+    << "compute         cons_w all reduce sum";
+  for (int sd = 0; sd < 6; ++sd) {
+    if (sd == 2 || sd == 4) s << " &\n               ";
+    s << " f_cons_w" << kWall[sd] << "[1] f_cons_w" << kWall[sd] << "[" << 2 + sd / 2 << "]";
+  }
+  s << "\n";
+  for (int sd = 0; sd < 6; ++sd)
+    s << "variable        cons_" << kWall[sd] << " equal v_" << kWall[sd] << "0+v_cons_d"
+      << kWall[sd] << "\n";
+  for (int a = 0; a < 3; ++a)
+    s << "variable        cons_L" << kAxis[a] << " equal v_cons_" << kWall[2 * a + 1] << "-v_cons_"
+      << kWall[2 * a] << "\n";
+  for (int a = 0; a < 3; ++a)
+    s << "variable        cons_A" << kAxis[a] << " equal v_cons_L" << kAxis[(a + 1) % 3]
+      << "*v_cons_L" << kAxis[(a + 2) % 3] << "\n";
+  std::string servo;
+  for (int sd = 0; sd < 6; ++sd) {
+    const std::string col = std::to_string(2 * sd + 2);
+    // F, the compressive force: +c on a min wall, -c on a max wall.
+    const std::string minus_force = std::string(sd % 2 == 0 ? "-" : "+") + "c_cons_w[" + col + "]";
+    s << "variable        cons_m" << kWall[sd] << " equal " << (sd % 2 == 0 ? "" : "-")
+      << deck::lammps_servo_move(std::string("v_cons_A") + kAxis[sd / 2], minus_force,
+                                 "c_cons_w[" + std::to_string(2 * sd + 1) + "]")
+      << "\n";
+    servo += std::string(" v_cons_m") + kWall[sd];
+  }
+  s << "fix             cons_servo all ave/time 1 1 1" << servo << " ave running\n"
+    << deck::lammps_consolidation_criterion(3, walls, {"x", "y", "z"})
+    << deck::lammps_consolidation_runs(deck::contact_gamma_n(c.material, plan.m_mean), dt_damped,
+                                       deck::lammps_consolidation_viscous(critical))
+    << "# the loading starts from here: walls, step 0, spheres at rest. Each wall\n"
+    << "# where its contacts put it (F = kn_wall * sum of overlaps, exact for these\n"
+    << "# undamped walls), so the loading starts from the forces of the static state.\n";
+  for (int sd = 0; sd < 6; ++sd)
+    s << "variable        " << kWall[sd] << "0 delete\n"
+      << "variable        " << kWall[sd] << "0 equal "
+      << deck::lammps_consolidated_wall(walls[sd], sd) << "\n";
+  s << deck::lammps_consolidation_end(walls, {});
 }
 
 // The six walls, the contact-force store and the damping.
@@ -452,7 +585,14 @@ std::string lammps_deck(const SceneConfig& c, const AlgorithmSpec& p, const Plan
   std::ostringstream s;
   lammps_3d_limitations(s, c, p, plan, o, out);
   lammps_3d_parameters(s, c, plan, o);
-  lammps_3d_system(s, c, plan, o, out);
+  if (o.consolidate_in_deck) {
+    lammps_3d_system(s, c, plan, o, out);
+    lammps_3d_consolidation(s, c, plan);
+    lammps_3d_derived(s);
+  } else {
+    lammps_3d_derived(s);
+    lammps_3d_system(s, c, plan, o, out);
+  }
   lammps_3d_walls(s, p, plan);
   lammps_3d_measures(s);
   lammps_3d_series(s, c, p, plan);
@@ -615,6 +755,12 @@ ExportResult export_3d_decks(const SceneConfig& config, const AlgorithmSpec& par
   if (world.size() == 0) throw InputError("export", "prototype", "no particles");
   if (options.format != "lammps" && options.format != "liggghts")
     throw InputError("--format", "", "must be lammps or liggghts, got \"" + options.format + "\"");
+  if (options.consolidate_in_deck && options.format != "lammps")
+    throw InputError("--consolidate-in", "",
+                     "deck: only the LAMMPS deck consolidates itself (LIGGGHTS 3.8 has no fix "
+                     "halt and no servo with demcal's law; reports/engines.md)");
+  if (options.consolidate_in_deck && !options.lateral_servo)
+    throw InputError("export", "lateral_servo", "the deck's consolidation servoes every wall");
   const Plan3 plan = make_plan(config, params, world, options.max_types);
   ExportResult out = result_of(plan);
   if (options.format == "lammps") {
@@ -633,6 +779,14 @@ ExportResult export_3d_decks(const SceneConfig& config, const AlgorithmSpec& par
 ExportResult export_3d_decks(const SceneConfig& config, const AlgorithmSpec& params,
                              const TriaxialState& state, const Export3dOptions& options) {
   return export_3d_decks(config, params, state.world, options);
+}
+
+ExportResult export_3d_decks(const SceneConfig& config, const AlgorithmSpec& params,
+                             const SphereAssembly& assembly, const Export3dOptions& options) {
+  if (assembly.size() == 0) throw InputError("export", "prototype", "no particles");
+  const SphereWorld world(sphere_material(config.material), assembly.x, assembly.y, assembly.z,
+                          assembly.r, assembly.lo, assembly.hi);
+  return export_3d_decks(config, params, world, options);
 }
 
 }  // namespace demcal

@@ -62,17 +62,6 @@ double wall_pressure(const World& world, WallSide side);
 /// own speed (biaxial.cpp; the exported decks' consolidation stage uses it).
 inline constexpr double kConsolidationDampingRatio = 0.02;
 
-/// How a consolidation runs; none of it changes the state it reaches.
-struct ConsolidationOptions {
-  /// Kernel threads while consolidating (KernelOptions::threads; 0: every
-  /// core). Results are bit-identical for any count; the state returned
-  /// steps on one thread, as every World starts (its trials run in parallel).
-  int threads = 1;
-  /// Called at every check (every 200 steps) of a fresh consolidation; not
-  /// called for a state read from the cache.
-  ConsolidationCallback progress;
-};
-
 /// Consolidate: frictionless servo compression to σ3 until static, then
 /// friction on and static again. Throws std::runtime_error if it cannot.
 /// Through the consolidation cache in consolidation_cache_dir() (the

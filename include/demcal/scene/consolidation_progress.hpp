@@ -32,4 +32,16 @@ struct ConsolidationProgress {
 };
 using ConsolidationCallback = std::function<void(const ConsolidationProgress&)>;
 
+/// How a consolidation runs (2D consolidate(), 3D consolidate_triaxial());
+/// none of it changes the state it reaches.
+struct ConsolidationOptions {
+  /// Kernel threads while consolidating (KernelOptions::threads; 0: every
+  /// core). Results are bit-identical for any count; the state returned
+  /// steps on one thread, as every World starts (its trials run in parallel).
+  int threads = 1;
+  /// Called at every check (every 200 steps) of a fresh consolidation; not
+  /// called for a state read from the (2D) consolidation cache.
+  ConsolidationCallback progress;
+};
+
 }  // namespace demcal

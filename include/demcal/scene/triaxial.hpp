@@ -83,9 +83,15 @@ Integration integration_for(const SphereWorld& world, const AlgorithmSpec& algor
 /// 2D fallback to critical damping after a quarter of the budget. Static:
 /// every wall stress within test.consolidation_tolerance of σ3 and the
 /// unbalanced-force ratio below test.consolidation_unbalanced. Throws
-/// std::runtime_error saying what was reached if it cannot.
+/// std::runtime_error saying what was reached if it cannot. options.threads
+/// steps the sphere kernel on that many threads (0: every core; the state
+/// is bit-identical for any count and steps on one thread afterwards);
+/// options.progress is called at every check (every 200 steps).
 TriaxialState consolidate_triaxial(const SceneConfig& config, const SphereAssembly& assembly,
-                                   const ConsolidationCallback& progress = {});
+                                   const ConsolidationOptions& options = {});
+/// The same, single-threaded, with a progress callback.
+TriaxialState consolidate_triaxial(const SceneConfig& config, const SphereAssembly& assembly,
+                                   const ConsolidationCallback& progress);
 
 /// The stable α of the consolidated contact network (6 DOF per sphere).
 double estimated_stable_dt_ratio(const TriaxialState& state, const AlgorithmSpec& algorithm);

@@ -16,7 +16,11 @@
 //              series (b and σ, 3×3, from the walls' contact arrays and the
 //              identity V(b − σ) = Σ x_p ⊗ F_p; energies, wall pressures and
 //              positions, servo errors, contacts) and, at the end, the peak
-//              axial stress and the peak σ1/σ3 over every step.
+//              axial stress and the peak σ1/σ3 over every step. With
+//              consolidate_in_deck a stage 1 first consolidates the
+//              prototype as generated to isotropic σ3 (all six walls
+//              servoed; demcal's law, friction phases, damping and static
+//              criterion; the 2D deck's stage 1 with six walls).
 //   liggghts — LIGGGHTS-PUBLIC 3.8: gran model hooke/stiffness, per-type-pair
 //              kn/kt/μ, the six walls STL meshes (bottom fixed, top moved
 //              by move/mesh, lateral ones by fix mesh/surface/stress/servo
@@ -78,5 +82,11 @@ ExportResult export_3d_decks(const SceneConfig& config, const AlgorithmSpec& par
 /// are; velocities and tangential histories are not carried over).
 ExportResult export_3d_decks(const SceneConfig& config, const AlgorithmSpec& params,
                              const SphereWorld& world, const Export3dOptions& options);
+/// The same from an assembly (walls at its box): with
+/// options.consolidate_in_deck, the prototype as generated, which the
+/// LAMMPS deck's stage 1 consolidates (ExportOptions::consolidate_in_deck:
+/// demcal's consolidation, consolidate_triaxial, with six servo walls).
+ExportResult export_3d_decks(const SceneConfig& config, const AlgorithmSpec& params,
+                             const SphereAssembly& assembly, const Export3dOptions& options);
 
 }  // namespace demcal
