@@ -88,7 +88,9 @@ struct PairArgs {
   const int *__restrict block_slot;
   const int *__restrict slot_j;
   double *__restrict hx, *__restrict hy, *__restrict hz;
-  const double *__restrict slot_r;
+  const double *__restrict slot_r, *__restrict slot_ir;
+  double *__restrict pfx, *__restrict pfy, *__restrict pfz;  // pair force on i, per slot
+  double *__restrict ptx, *__restrict pty, *__restrict ptz;  // torque on j, per slot
   const double *__restrict x, *__restrict y, *__restrict z;
   const double *__restrict vx, *__restrict vy, *__restrict vz;
   const double *__restrict wx, *__restrict wy, *__restrict wz;
@@ -235,9 +237,10 @@ DEMCAL_INLINE double hsum(typename Simd<W>::D v) {
   return s;
 }
 
-// Forces and torques of blocks [b0, b1): each particle's sum over its own
-// slots, written (not added). Returns the largest overlap/r_own (over both
-// copies of a pair: overlap/min(r_i, r_j)).
+// Pairs of blocks [b0, b1) (half list: each pair once, from i < j): each
+// particle's force and torque summed over its own slots, written (not
+// added), and per slot the pair's force on i and torque on j for the sum
+// pass. Returns the largest overlap/min(r_i, r_j).
 template <int W, bool kDamped>
 DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
   using D = typename Simd<W>::D;
@@ -273,9 +276,8 @@ DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
         const D mag2 = hx0 * hx0 + hy0 * hy0 + hz0 * hz0;
         if (!any<W>(touch)) {  // no lane touches: histories released, no force
           released += mag2;
-          store<W>(a.hx + s, zero);
-          store<W>(a.hy + s, zero);
-          store<W>(a.hz + s, zero);
+          for (double *p : {a.hx, a.hy, a.hz, a.pfx, a.pfy, a.pfz, a.ptx, a.pty, a.ptz})
+            store<W>(p + s, zero);
           continue;
         }
         const D nx = g.nx, ny = g.ny, nz = g.nz, ov = g.ov, fn = g.fn;
@@ -327,14 +329,26 @@ DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
         store<W>(a.hx + s, hx);
         store<W>(a.hy + s, hy);
         store<W>(a.hz + s, hz);
-        // Force on i: −fn·n + h; torque a_i·n × h.
-        fx += hx - fn * nx;
-        fy += hy - fn * ny;
-        fz += hz - fn * nz;
-        tx += ai * (ny * hz - nz * hy);
-        ty += ai * (nz * hx - nx * hz);
-        tz += ai * (nx * hy - ny * hx);
-        const D ovr = select<W>(touch, ov * iri, zero);
+        // Force on i: −fn·n + h (on j its opposite); torques a_i·n × h on
+        // i and a_j·n × h on j.
+        const D qx = hx - fn * nx, qy = hy - fn * ny, qz = hz - fn * nz;
+        const D cx = ny * hz - nz * hy, cy = nz * hx - nx * hz, cz = nx * hy - ny * hx;
+        fx += qx;
+        fy += qy;
+        fz += qz;
+        tx += ai * cx;
+        ty += ai * cy;
+        tz += ai * cz;
+        store<W>(a.pfx + s, qx);
+        store<W>(a.pfy + s, qy);
+        store<W>(a.pfz + s, qz);
+        store<W>(a.ptx + s, aj * cx);
+        store<W>(a.pty + s, aj * cy);
+        store<W>(a.ptz + s, aj * cz);
+        // overlap/min(r_i, r_j) (ov ≥ 0 where touching: the product is
+        // monotone, the maximum of the two ratios exactly).
+        const D irj = load<W>(a.slot_ir + s);
+        const D ovr = select<W>(touch, ov * (iri > irj ? iri : irj), zero);
         mo = mo > ovr ? mo : ovr;
       }
       store<W>(a.fx + i0, fx);
@@ -348,6 +362,47 @@ DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
     a.block_slid[b] = hsum<W>(slid);
   }
   return hmax<W>(mo);
+}
+
+struct SumArgs {
+  const int *__restrict mirror_block;
+  const int *__restrict mirror_slot;
+  const double *__restrict pfx, *__restrict pfy, *__restrict pfz;
+  const double *__restrict ptx, *__restrict pty, *__restrict ptz;
+  double *__restrict fx, *__restrict fy, *__restrict fz;
+  double *__restrict tx, *__restrict ty, *__restrict tz;
+};
+
+// Adds to each particle j of blocks [b0, b1) what it receives from its pairs
+// (i, j), i < j, in increasing i: −(force on i) and the torque on j.
+template <int W>
+DEMCAL_INLINE double sum_blocks(const SumArgs &a, int b0, int b1) {
+  using D = typename Simd<W>::D;
+  for (int b = b0; b < b1; ++b) {
+    const int s0 = a.mirror_block[b], s1 = a.mirror_block[b + 1];
+    if (s0 == s1) continue;
+    for (int sub = 0; sub < kBlock; sub += W) {
+      const int i0 = kBlock * b + sub;
+      D fx = load<W>(a.fx + i0), fy = load<W>(a.fy + i0), fz = load<W>(a.fz + i0);
+      D tx = load<W>(a.tx + i0), ty = load<W>(a.ty + i0), tz = load<W>(a.tz + i0);
+      for (int s = s0 + sub; s < s1; s += kBlock) {
+        const int *S = a.mirror_slot + s;
+        fx -= gather<W>(a.pfx, S);
+        fy -= gather<W>(a.pfy, S);
+        fz -= gather<W>(a.pfz, S);
+        tx += gather<W>(a.ptx, S);
+        ty += gather<W>(a.pty, S);
+        tz += gather<W>(a.ptz, S);
+      }
+      store<W>(a.fx + i0, fx);
+      store<W>(a.fy + i0, fy);
+      store<W>(a.fz + i0, fz);
+      store<W>(a.tx + i0, tx);
+      store<W>(a.ty + i0, ty);
+      store<W>(a.tz + i0, tz);
+    }
+  }
+  return 0.0;
 }
 
 struct IntegrateArgs {
@@ -414,30 +469,36 @@ DEMCAL_INLINE double integrate_blocks(const IntegrateArgs &a, int b0, int b1) {
 // ---------------------------------------------------------------- dispatch
 
 using PairFn = double (*)(const PairArgs &, int, int);
+using SumFn = double (*)(const SumArgs &, int, int);
 using IntegrateFn = double (*)(const IntegrateArgs &, int, int);
 
 struct Kernels {
   PairFn pairs, pairs_damped;
+  SumFn sums;
   IntegrateFn integrate, integrate_locked;
   void (*one_pair)(const double *, double *);
 };
 
-#define DEMCAL_SPHERE_KERNELS(SUFFIX, TARGET, W)                                                 \
-  TARGET double pairs_##SUFFIX(const PairArgs &a, int b0, int b1) {                              \
-    return pair_blocks<W, false>(a, b0, b1);                                                     \
-  }                                                                                              \
-  TARGET double pairs_damped_##SUFFIX(const PairArgs &a, int b0, int b1) {                       \
-    return pair_blocks<W, true>(a, b0, b1);                                                      \
-  }                                                                                              \
-  TARGET double integrate_##SUFFIX(const IntegrateArgs &a, int b0, int b1) {                     \
-    return integrate_blocks<W, true>(a, b0, b1);                                                 \
-  }                                                                                              \
-  TARGET double integrate_locked_##SUFFIX(const IntegrateArgs &a, int b0, int b1) {              \
-    return integrate_blocks<W, false>(a, b0, b1);                                                \
-  }                                                                                              \
-  TARGET void one_pair_##SUFFIX(const double *in, double *out) { one_pair<W>(in, out); }         \
-  constexpr Kernels kKernels_##SUFFIX{pairs_##SUFFIX, pairs_damped_##SUFFIX, integrate_##SUFFIX, \
-                                      integrate_locked_##SUFFIX, one_pair_##SUFFIX};
+#define DEMCAL_SPHERE_KERNELS(SUFFIX, TARGET, W)                                         \
+  TARGET double pairs_##SUFFIX(const PairArgs &a, int b0, int b1) {                      \
+    return pair_blocks<W, false>(a, b0, b1);                                             \
+  }                                                                                      \
+  TARGET double pairs_damped_##SUFFIX(const PairArgs &a, int b0, int b1) {               \
+    return pair_blocks<W, true>(a, b0, b1);                                              \
+  }                                                                                      \
+  TARGET double sums_##SUFFIX(const SumArgs &a, int b0, int b1) {                        \
+    return sum_blocks<W>(a, b0, b1);                                                     \
+  }                                                                                      \
+  TARGET double integrate_##SUFFIX(const IntegrateArgs &a, int b0, int b1) {             \
+    return integrate_blocks<W, true>(a, b0, b1);                                         \
+  }                                                                                      \
+  TARGET double integrate_locked_##SUFFIX(const IntegrateArgs &a, int b0, int b1) {      \
+    return integrate_blocks<W, false>(a, b0, b1);                                        \
+  }                                                                                      \
+  TARGET void one_pair_##SUFFIX(const double *in, double *out) { one_pair<W>(in, out); } \
+  constexpr Kernels kKernels_##SUFFIX{                                                   \
+      pairs_##SUFFIX,     pairs_damped_##SUFFIX,     sums_##SUFFIX,                      \
+      integrate_##SUFFIX, integrate_locked_##SUFFIX, one_pair_##SUFFIX};
 
 #define DEMCAL_NO_TARGET
 DEMCAL_SPHERE_KERNELS(sse2, DEMCAL_NO_TARGET, 2)
@@ -468,6 +529,13 @@ double SphereWorldImpl::pair_pass(int b0, int b1) {
                    hy_.data(),
                    hz_.data(),
                    slot_r_.data(),
+                   slot_ir_.data(),
+                   pfx_.data(),
+                   pfy_.data(),
+                   pfz_.data(),
+                   ptx_.data(),
+                   pty_.data(),
+                   ptz_.data(),
                    x_.data(),
                    y_.data(),
                    z_.data(),
@@ -495,6 +563,13 @@ double SphereWorldImpl::pair_pass(int b0, int b1) {
                    2.0 * material_.contact_damping_ratio};
   const Kernels &k = kernels();
   return material_.contact_damping_ratio > 0.0 ? k.pairs_damped(a, b0, b1) : k.pairs(a, b0, b1);
+}
+
+double SphereWorldImpl::sum_pass(int b0, int b1) {
+  const SumArgs a{mirror_block_.data(), mirror_slot_.data(), pfx_.data(), pfy_.data(), pfz_.data(),
+                  ptx_.data(),          pty_.data(),         ptz_.data(), fx_.data(),  fy_.data(),
+                  fz_.data(),           tx_.data(),          ty_.data(),  tz_.data()};
+  return kernels().sums(a, b0, b1);
 }
 
 double SphereWorldImpl::integrate_pass(int b0, int b1) {
@@ -598,8 +673,9 @@ void SphereWorldImpl::wall_forces() {
 
 void SphereWorldImpl::compute_forces() {
   max_overlap_ratio_seen_ = run_pass(&SphereWorldImpl::pair_pass, pair_bounds_);
-  // Friction's losses, block by block in a fixed order (every pair was
-  // counted from both sides).
+  run_pass(&SphereWorldImpl::sum_pass, particle_bounds_);
+  // Friction's losses, block by block in a fixed order (every pair counted
+  // once).
   const double kt = material_.particle.kt;
   if (kt > 0.0) {
     double released = 0.0, slid = 0.0;
@@ -607,7 +683,7 @@ void SphereWorldImpl::compute_forces() {
       released += block_released_[b];
       slid += block_slid_[b];
     }
-    friction_dissipated_ += 0.5 * (released * (0.5 / kt) + slid / kt);
+    friction_dissipated_ += released * (0.5 / kt) + slid / kt;
   }
   wall_forces();
 }
