@@ -18,6 +18,10 @@
 #   THREADS_MIN=50000  (small samples run single-threaded: a calibration
 #                      runs trials in parallel instead)
 #   CORE=0             the core the one-core runs are pinned to (taskset)
+#   BASELINE=binary    another build of bench_sphere_side_by_side (e.g. of an
+#                      older commit), run on every path of PATHS in the same
+#                      rounds, alternating with the current one: adds its
+#                      rate and the current/baseline speed-up per path
 #   KEEP=dir           keep the raw outputs there
 # Timing excludes set-up in both: demcal times SphereWorld::step(nsteps),
 # LAMMPS reports "Loop time" of the second `run`. The one-core rates are CPU
@@ -37,6 +41,7 @@ PATHS="${PATHS:-default avx2}"
 THREADS="${THREADS:-2}"
 THREADS_MIN="${THREADS_MIN:-50000}"
 CORE="${CORE:-0}"
+BASELINE="${BASELINE:-}"
 if ! command -v lmp >/dev/null 2>&1; then
   echo "lmp (LAMMPS) not found: nothing compared."
   exit 0
@@ -55,6 +60,10 @@ median() { python3 -c "import statistics,sys; print('%.4g' % statistics.median(f
 field() { sed -n "s/.* $1=\([^ ]*\).*/\1/p" <<<"$2"; }
 header="spheres steps"
 for p in $PATHS; do header+=" demcal_${p}_ps/s ratio_${p}"; done
+if [[ -n "$BASELINE" ]]; then
+  [[ -x "$BASELINE" ]] || { echo "error: $BASELINE not found" >&2; exit 1; }
+  for p in $PATHS; do header+=" baseline_${p}_ps/s speedup_${p}"; done
+fi
 header+=" lammps_ps/s contacts"
 # the thread columns: wall-clock rate of the THREADS run and its speed-up
 # over the one-thread wall-clock rate of the first path, same rounds
@@ -66,7 +75,7 @@ for n in $CELLS; do
   steps=$(python3 -c "print(max(100, int(float('$PS_TARGET') / $spheres)))")
   pre=$((steps / 10))
   "$driver" --cells "$n" --write-lammps "$work/fcc$n" --no-run
-  declare -A rates=()
+  declare -A rates=() brates=()
   lrates="" trates="" wall1="" dcon="" lcon=""
   for rep in $(seq "$REPS"); do
     for p in $PATHS; do
@@ -76,6 +85,11 @@ for n in $CELLS; do
       rates[$p]+=" $(python3 -c "print($spheres * $steps / $(field cpu_seconds "$d"))")"
       [[ "$p" == "${PATHS%% *}" ]] && wall1+=" $(field particle_steps_per_s "$d")"
       dcon=$(field contacts "$d")
+      if [[ -n "$BASELINE" ]]; then
+        d=$("${env[@]}" "${pin[@]}" "$BASELINE" --cells "$n" --steps "$steps" --preload "$pre")
+        echo "baseline $d" >>"$work/raw.txt"
+        brates[$p]+=" $(python3 -c "print($spheres * $steps / $(field cpu_seconds "$d"))")"
+      fi
     done
     (cd "$work" && "${pin[@]}" lmp -in "$here/lammps/in.sphere_compress" -var prefix "fcc$n" \
         -var npre "$pre" -var nsteps "$steps" -log "log$n.$rep" -screen none >/dev/null)
@@ -98,12 +112,18 @@ for n in $CELLS; do
     m=$(median ${rates[$p]})
     line+=" $m $(python3 -c "print('%.2f' % ($m / $lmed))")"
   done
+  if [[ -n "$BASELINE" ]]; then
+    for p in $PATHS; do
+      b=$(median ${brates[$p]})
+      line+=" $b $(python3 -c "print('%.2f' % ($(median ${rates[$p]}) / $b))")"
+    done
+  fi
   line+=" $lmed $dcon/$lcon"
   if [[ -n "$trates" ]]; then
     t=$(median $trates)
     line+=" $t $(python3 -c "print('%.2f' % ($t / $(median $wall1)))")"
   fi
   echo "$line"
-  unset rates
+  unset rates brates
 done
 echo "# end $(date -u +%FT%TZ), load average $(cut -d' ' -f1-3 /proc/loadavg)"

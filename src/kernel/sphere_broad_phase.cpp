@@ -1,12 +1,12 @@
 // Broad phase of the sphere kernel: cell grid + Verlet skin, as the 2D
 // kernel's (broad_phase.cpp). The list holds every pair closer than
-// r_i + r_j + skin, from both sides, in sliced ELLPACK blocks of 8
-// (sphere_world.hpp), each particle's neighbours in increasing index; the
-// half list (i < j) beside it points to i's copy of each pair. It is
+// r_i + r_j + skin once, from its lower index i < j, in sliced ELLPACK
+// blocks of 8 (sphere_world_impl.hpp), each particle's neighbours in
+// increasing index; the CSR form beside it points to each pair's slot, and
+// the mirror list gives each j the slots of its pairs (i, j). It is
 // rebuilt only when some particle (or a wall) has moved far enough that a
 // pair outside it could touch (the displacement scan is fused into the
-// integration pass). A pair's tangential history carries over a rebuild in
-// both copies.
+// integration pass). A pair's tangential history carries over a rebuild.
 #include <algorithm>
 #include <cmath>
 
@@ -76,14 +76,15 @@ void SphereWorldImpl::rebuild_neighbours() {
     cell_start_[k] = i;
   }
 
-  // Full lists (CSR), each sorted by index. The cut-off test is symmetric
-  // in i and j bit for bit, so j is i's neighbour iff i is j's.
-  full_start_.assign(static_cast<size_t>(n) + 1, 0);
-  full_j_.clear();
+  // Half lists (CSR, pairs i < j), each sorted by index. The cut-off test
+  // is symmetric in i and j bit for bit, so the pair is the same whichever
+  // side finds it.
+  nbr_start_.assign(static_cast<size_t>(n) + 1, 0);
+  nbr_j_.clear();
   for (int i = 0; i < n; ++i) {
     std::array<int, 3> c;
     cell_of(i, c);
-    const size_t first = full_j_.size();
+    const size_t first = nbr_j_.size();
     for (int dz = -1; dz <= 1; ++dz)
       for (int dy = -1; dy <= 1; ++dy)
         for (int dx = -1; dx <= 1; ++dx) {
@@ -91,14 +92,14 @@ void SphereWorldImpl::rebuild_neighbours() {
           if (o[0] < 0 || o[0] >= nc[0] || o[1] < 0 || o[1] >= nc[1] || o[2] < 0 || o[2] >= nc[2])
             continue;
           for (int j = cell_start_[index(o)]; j >= 0; j = cell_next_[j]) {
-            if (j == i) continue;
+            if (j <= i) continue;
             const double ddx = x_[j] - x_[i], ddy = y_[j] - y_[i], ddz = z_[j] - z_[i];
             const double cut = r_[i] + r_[j] + skin_;
-            if (ddx * ddx + ddy * ddy + ddz * ddz < cut * cut) full_j_.push_back(j);
+            if (ddx * ddx + ddy * ddy + ddz * ddz < cut * cut) nbr_j_.push_back(j);
           }
         }
-    std::sort(full_j_.begin() + static_cast<std::ptrdiff_t>(first), full_j_.end());
-    full_start_[i + 1] = static_cast<int>(full_j_.size());
+    std::sort(nbr_j_.begin() + static_cast<std::ptrdiff_t>(first), nbr_j_.end());
+    nbr_start_[i + 1] = static_cast<int>(nbr_j_.size());
   }
 
   // Sliced ELLPACK: block b gets as many rows as its longest list.
@@ -106,18 +107,17 @@ void SphereWorldImpl::rebuild_neighbours() {
   for (int b = 0; b < nblocks_; ++b) {
     int rows = 0;
     for (int i = kBlock * b; i < std::min(n, kBlock * (b + 1)); ++i)
-      rows = std::max(rows, full_start_[i + 1] - full_start_[i]);
+      rows = std::max(rows, nbr_start_[i + 1] - nbr_start_[i]);
     new_block_slot_[b + 1] = new_block_slot_[b] + kBlock * rows;
   }
   const size_t ns = static_cast<size_t>(new_block_slot_[nblocks_]);
   new_slot_j_.assign(ns, ghost_);
   new_slot_r_.assign(ns, 0.0);
+  new_slot_ir_.assign(ns, 0.0);
   new_hx_.assign(ns, 0.0);
   new_hy_.assign(ns, 0.0);
   new_hz_.assign(ns, 0.0);
-  nbr_start_.assign(static_cast<size_t>(n) + 1, 0);
-  nbr_j_.clear();
-  pair_slot_.clear();
+  pair_slot_.resize(nbr_j_.size());
   for (int i = 0; i < n; ++i) {
     const int b = i / kBlock, lane = i % kBlock;
     const int nb = new_block_slot_[b] + lane;
@@ -125,30 +125,48 @@ void SphereWorldImpl::rebuild_neighbours() {
     // increasing j, then ghosts).
     int o = block_slot_[b] + lane;
     const int old_end = block_slot_[b + 1];
-    for (int k = full_start_[i]; k < full_start_[i + 1]; ++k) {
-      const int j = full_j_[k];
-      const int s = nb + kBlock * (k - full_start_[i]);
+    for (int k = nbr_start_[i]; k < nbr_start_[i + 1]; ++k) {
+      const int j = nbr_j_[k];
+      const int s = nb + kBlock * (k - nbr_start_[i]);
       new_slot_j_[s] = j;
       new_slot_r_[s] = r_[j];
+      new_slot_ir_[s] = inv_r_[j];
       while (o < old_end && slot_j_[o] < j) o += kBlock;
       if (o < old_end && slot_j_[o] == j) {
         new_hx_[s] = hx_[o];
         new_hy_[s] = hy_[o];
         new_hz_[s] = hz_[o];
       }
-      if (j > i) {
-        nbr_j_.push_back(j);
-        pair_slot_.push_back(s);
-      }
+      pair_slot_[k] = s;
     }
-    nbr_start_[i + 1] = static_cast<int>(nbr_j_.size());
   }
   block_slot_.swap(new_block_slot_);
   slot_j_.swap(new_slot_j_);
   slot_r_.swap(new_slot_r_);
+  slot_ir_.swap(new_slot_ir_);
   hx_.swap(new_hx_);
   hy_.swap(new_hy_);
   hz_.swap(new_hz_);
+  // The pair terms, and the zero slot at index ns.
+  for (auto* p : {&pfx_, &pfy_, &pfz_, &ptx_, &pty_, &ptz_}) p->assign(ns + 1, 0.0);
+
+  // Mirror list: the slots of the pairs (i, j), i < j, by j, in increasing i.
+  mirror_count_.assign(static_cast<size_t>(kBlock) * nblocks_, 0);
+  for (int k = 0; k < nbr_start_[n]; ++k) ++mirror_count_[nbr_j_[k]];
+  mirror_block_.assign(static_cast<size_t>(nblocks_) + 1, 0);
+  for (int b = 0; b < nblocks_; ++b) {
+    const int rows = *std::max_element(mirror_count_.begin() + kBlock * b,
+                                       mirror_count_.begin() + kBlock * (b + 1));
+    mirror_block_[b + 1] = mirror_block_[b] + kBlock * rows;
+  }
+  mirror_slot_.assign(static_cast<size_t>(mirror_block_[nblocks_]), static_cast<int>(ns));
+  std::fill(mirror_count_.begin(), mirror_count_.end(), 0);
+  for (int i = 0; i < n; ++i)
+    for (int k = nbr_start_[i]; k < nbr_start_[i + 1]; ++k) {
+      const int j = nbr_j_[k];
+      const int row = mirror_count_[j]++;
+      mirror_slot_[mirror_block_[j / kBlock] + j % kBlock + kBlock * row] = pair_slot_[k];
+    }
   update_thread_bounds();
 
   // Wall candidates: particles within skin of a wall.

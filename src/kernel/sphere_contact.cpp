@@ -40,19 +40,23 @@
 // step just past the stable one rattles contacts open and shut, and the
 // ledger without them reads strongly negative.
 //
-// The pair pass (pair_blocks) runs over the full neighbour list in blocks
-// of 8 particles, W lanes at a time on the SIMD path of this machine (the
-// 2D kernel's, simd.hpp): each particle's force and torque are a plain sum
-// over its own slots, so every pair is evaluated twice, once from either
-// side, by the same instructions with i and j swapped. Every quantity the
-// history depends on is then invariant or exactly negated under the swap,
-// also under FMA contraction: n, v_rel, h and the twist are negated, δ,
-// the lever arms' sums and |h| are invariant, and the lever-arm term
-// a_i·ω_i + a_j·ω_j is written ½[(ω_i + ω_j)(a_i + a_j) + (ω_i − ω_j)(a_i −
-// a_j)] (the plain form is not symmetric once one product is fused). So
-// the two copies of a pair's history stay exact opposites and so do the
-// forces on i and j; the torques a_i·n × h and a_j·n × h come out of the
-// same n × h. The twist is applied even when it is 0 (the identity then).
+// The pair pass (pair_blocks) runs over the half neighbour list (pairs i <
+// j, sphere_broad_phase.cpp) in blocks of 8 particles, W lanes at a time on
+// the SIMD path of this machine (the 2D kernel's, simd.hpp), so every pair
+// is evaluated once. Each particle's force and torque are written as the
+// plain sum over its own slots (pairs j > i, increasing j); per slot the
+// pass also writes the pair's force on i and the torque a_j·n × h on j, and
+// the sum pass (sum_blocks) then adds to each particle j, from its mirror
+// list in increasing i, the opposite of that force and that torque. Both
+// sums run in a fixed order whatever the thread split (each pass writes
+// only its own particles' or slots' values), so results are deterministic
+// and bit-identical for any thread count; non-touching slots add exact
+// zeros, so the skin does not change a bit either. (Until 365b7e6 the list
+// was full and each pair was evaluated twice, once from either side, the
+// law written so that both copies came out exact opposites under FMA
+// contraction, e.g. the lever-arm term a_i·ω_i + a_j·ω_j as ½[(ω_i + ω_j)
+// (a_i + a_j) + (ω_i − ω_j)(a_i − a_j)]; evaluated once, it takes the
+// plain form.) The twist is applied even when it is 0 (the identity then).
 //
 // Cost per slot: the rescale and the twist share one factor, h' = A·[(1 −
 // c²)·p + 2c·n × p] with A = sqrt(|h|²/(|p|²·(1 + c²)²)) (the rescale
@@ -65,7 +69,7 @@
 // divisions (1/|d|, A²), where it took three roots and four divisions; the
 // skipped branches give the same bits as the full evaluation (cut = 1, h
 // = 0 there), and each lane's polynomial-or-root choice depends on its own
-// A² alone, invariant under the swap, so both copies still round alike.
+// A² alone.
 //
 // Walls: the inward normal g is fixed and the wall does not rotate, so a
 // wall history stays in the wall plane with no turning; the contact point is
@@ -88,7 +92,9 @@ struct PairArgs {
   const int *__restrict block_slot;
   const int *__restrict slot_j;
   double *__restrict hx, *__restrict hy, *__restrict hz;
-  const double *__restrict slot_r;
+  const double *__restrict slot_r, *__restrict slot_ir;
+  double *__restrict pfx, *__restrict pfy, *__restrict pfz;  // pair force on i, per slot
+  double *__restrict ptx, *__restrict pty, *__restrict ptz;  // torque on j, per slot
   const double *__restrict x, *__restrict y, *__restrict z;
   const double *__restrict vx, *__restrict vy, *__restrict vz;
   const double *__restrict wx, *__restrict wy, *__restrict wz;
@@ -97,6 +103,10 @@ struct PairArgs {
   double *__restrict tx, *__restrict ty, *__restrict tz;
   double *__restrict block_released, *__restrict block_slid;
   double kn, kdt, half_dt, mu, beta2;  // beta2 = 2·contact damping ratio
+  // With fuse_sums, each block's mirrored sums right after its pairs.
+  const int *__restrict mirror_block;
+  const int *__restrict mirror_slot;
+  bool fuse_sums;
 };
 
 // v itself, rounded: the compiler cannot fuse it into an FMA with what
@@ -235,9 +245,55 @@ DEMCAL_INLINE double hsum(typename Simd<W>::D v) {
   return s;
 }
 
-// Forces and torques of blocks [b0, b1): each particle's sum over its own
-// slots, written (not added). Returns the largest overlap/r_own (over both
-// copies of a pair: overlap/min(r_i, r_j)).
+struct SumArgs {
+  const int *__restrict mirror_block;
+  const int *__restrict mirror_slot;
+  const double *__restrict pfx, *__restrict pfy, *__restrict pfz;
+  const double *__restrict ptx, *__restrict pty, *__restrict ptz;
+  double *__restrict fx, *__restrict fy, *__restrict fz;
+  double *__restrict tx, *__restrict ty, *__restrict tz;
+};
+
+// Adds to each particle j of blocks [b0, b1) what it receives from its pairs
+// (i, j), i < j, in increasing i: −(force on i) and the torque on j.
+// (A: SumArgs, or PairArgs when fused into the pair pass, so that the
+// arrays are reached through the same restrict pointers.)
+template <int W, class A>
+DEMCAL_INLINE double sum_blocks(const A &a, int b0, int b1) {
+  using D = typename Simd<W>::D;
+  for (int b = b0; b < b1; ++b) {
+    const int s0 = a.mirror_block[b], s1 = a.mirror_block[b + 1];
+    if (s0 == s1) continue;
+    for (int sub = 0; sub < kBlock; sub += W) {
+      const int i0 = kBlock * b + sub;
+      D fx = load<W>(a.fx + i0), fy = load<W>(a.fy + i0), fz = load<W>(a.fz + i0);
+      D tx = load<W>(a.tx + i0), ty = load<W>(a.ty + i0), tz = load<W>(a.tz + i0);
+      for (int s = s0 + sub; s < s1; s += kBlock) {
+        const int *S = a.mirror_slot + s;
+        fx -= gather<W>(a.pfx, S);
+        fy -= gather<W>(a.pfy, S);
+        fz -= gather<W>(a.pfz, S);
+        tx += gather<W>(a.ptx, S);
+        ty += gather<W>(a.pty, S);
+        tz += gather<W>(a.ptz, S);
+      }
+      store<W>(a.fx + i0, fx);
+      store<W>(a.fy + i0, fy);
+      store<W>(a.fz + i0, fz);
+      store<W>(a.tx + i0, tx);
+      store<W>(a.ty + i0, ty);
+      store<W>(a.tz + i0, tz);
+    }
+  }
+  return 0.0;
+}
+
+// Pairs of blocks [b0, b1) (half list: each pair once, from i < j): each
+// particle's force and torque summed over its own slots, written (not
+// added), and per slot the pair's force on i and torque on j for the sum
+// pass; with fuse_sums, each block's mirrored sums right after its pairs (one
+// thread over all blocks: the same sums in the same order as the separate
+// sum pass). Returns the largest overlap/min(r_i, r_j).
 template <int W, bool kDamped>
 DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
   using D = typename Simd<W>::D;
@@ -273,20 +329,18 @@ DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
         const D mag2 = hx0 * hx0 + hy0 * hy0 + hz0 * hz0;
         if (!any<W>(touch)) {  // no lane touches: histories released, no force
           released += mag2;
-          store<W>(a.hx + s, zero);
-          store<W>(a.hy + s, zero);
-          store<W>(a.hz + s, zero);
+          for (double *p : {a.hx, a.hy, a.hz, a.pfx, a.pfy, a.pfz, a.ptx, a.pty, a.ptz})
+            store<W>(p + s, zero);
           continue;
         }
         const D nx = g.nx, ny = g.ny, nz = g.nz, ov = g.ov, fn = g.fn;
         const D ai = ri - 0.5 * ov, aj = rj - 0.5 * ov;
         const D wxj = gather<W>(a.wx, J), wyj = gather<W>(a.wy, J), wzj = gather<W>(a.wz, J);
-        // a_i·ω_i + a_j·ω_j in the swap-symmetric form (file comment).
-        const D as = ai + aj, ad = ai - aj;
+        // a_i·ω_i + a_j·ω_j, and the spin sum of the twist.
         const D sx = wxi + wxj, sy = wyi + wyj, sz = wzi + wzj;
-        const D rx = 0.5 * (sx * as + (wxi - wxj) * ad);
-        const D ry = 0.5 * (sy * as + (wyi - wyj) * ad);
-        const D rz = 0.5 * (sz * as + (wzi - wzj) * ad);
+        const D rx = ai * wxi + aj * wxj;
+        const D ry = ai * wyi + aj * wyj;
+        const D rz = ai * wzi + aj * wzj;
         // v_rel = v_j − v_i − (a_i ω_i + a_j ω_j) × n; v_t its tangential part.
         const D ux = dvx - (ry * nz - rz * ny);
         const D uy = dvy - (rz * nx - rx * nz);
@@ -327,14 +381,26 @@ DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
         store<W>(a.hx + s, hx);
         store<W>(a.hy + s, hy);
         store<W>(a.hz + s, hz);
-        // Force on i: −fn·n + h; torque a_i·n × h.
-        fx += hx - fn * nx;
-        fy += hy - fn * ny;
-        fz += hz - fn * nz;
-        tx += ai * (ny * hz - nz * hy);
-        ty += ai * (nz * hx - nx * hz);
-        tz += ai * (nx * hy - ny * hx);
-        const D ovr = select<W>(touch, ov * iri, zero);
+        // Force on i: −fn·n + h (on j its opposite); torques a_i·n × h on
+        // i and a_j·n × h on j.
+        const D qx = hx - fn * nx, qy = hy - fn * ny, qz = hz - fn * nz;
+        const D cx = ny * hz - nz * hy, cy = nz * hx - nx * hz, cz = nx * hy - ny * hx;
+        fx += qx;
+        fy += qy;
+        fz += qz;
+        tx += ai * cx;
+        ty += ai * cy;
+        tz += ai * cz;
+        store<W>(a.pfx + s, qx);
+        store<W>(a.pfy + s, qy);
+        store<W>(a.pfz + s, qz);
+        store<W>(a.ptx + s, aj * cx);
+        store<W>(a.pty + s, aj * cy);
+        store<W>(a.ptz + s, aj * cz);
+        // overlap/min(r_i, r_j) (ov ≥ 0 where touching: the product is
+        // monotone, the maximum of the two ratios exactly).
+        const D irj = load<W>(a.slot_ir + s);
+        const D ovr = select<W>(touch, ov * (iri > irj ? iri : irj), zero);
         mo = mo > ovr ? mo : ovr;
       }
       store<W>(a.fx + i0, fx);
@@ -346,6 +412,10 @@ DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
     }
     a.block_released[b] = hsum<W>(released);
     a.block_slid[b] = hsum<W>(slid);
+    // Block b's mirrored slots all belong to blocks ≤ b (i < j): with the
+    // blocks in one pass, its sums are complete now, the pair terms still
+    // in cache.
+    if (a.fuse_sums) sum_blocks<W>(a, b, b + 1);
   }
   return hmax<W>(mo);
 }
@@ -414,30 +484,36 @@ DEMCAL_INLINE double integrate_blocks(const IntegrateArgs &a, int b0, int b1) {
 // ---------------------------------------------------------------- dispatch
 
 using PairFn = double (*)(const PairArgs &, int, int);
+using SumFn = double (*)(const SumArgs &, int, int);
 using IntegrateFn = double (*)(const IntegrateArgs &, int, int);
 
 struct Kernels {
   PairFn pairs, pairs_damped;
+  SumFn sums;
   IntegrateFn integrate, integrate_locked;
   void (*one_pair)(const double *, double *);
 };
 
-#define DEMCAL_SPHERE_KERNELS(SUFFIX, TARGET, W)                                                 \
-  TARGET double pairs_##SUFFIX(const PairArgs &a, int b0, int b1) {                              \
-    return pair_blocks<W, false>(a, b0, b1);                                                     \
-  }                                                                                              \
-  TARGET double pairs_damped_##SUFFIX(const PairArgs &a, int b0, int b1) {                       \
-    return pair_blocks<W, true>(a, b0, b1);                                                      \
-  }                                                                                              \
-  TARGET double integrate_##SUFFIX(const IntegrateArgs &a, int b0, int b1) {                     \
-    return integrate_blocks<W, true>(a, b0, b1);                                                 \
-  }                                                                                              \
-  TARGET double integrate_locked_##SUFFIX(const IntegrateArgs &a, int b0, int b1) {              \
-    return integrate_blocks<W, false>(a, b0, b1);                                                \
-  }                                                                                              \
-  TARGET void one_pair_##SUFFIX(const double *in, double *out) { one_pair<W>(in, out); }         \
-  constexpr Kernels kKernels_##SUFFIX{pairs_##SUFFIX, pairs_damped_##SUFFIX, integrate_##SUFFIX, \
-                                      integrate_locked_##SUFFIX, one_pair_##SUFFIX};
+#define DEMCAL_SPHERE_KERNELS(SUFFIX, TARGET, W)                                         \
+  TARGET double pairs_##SUFFIX(const PairArgs &a, int b0, int b1) {                      \
+    return pair_blocks<W, false>(a, b0, b1);                                             \
+  }                                                                                      \
+  TARGET double pairs_damped_##SUFFIX(const PairArgs &a, int b0, int b1) {               \
+    return pair_blocks<W, true>(a, b0, b1);                                              \
+  }                                                                                      \
+  TARGET double sums_##SUFFIX(const SumArgs &a, int b0, int b1) {                        \
+    return sum_blocks<W, SumArgs>(a, b0, b1);                                            \
+  }                                                                                      \
+  TARGET double integrate_##SUFFIX(const IntegrateArgs &a, int b0, int b1) {             \
+    return integrate_blocks<W, true>(a, b0, b1);                                         \
+  }                                                                                      \
+  TARGET double integrate_locked_##SUFFIX(const IntegrateArgs &a, int b0, int b1) {      \
+    return integrate_blocks<W, false>(a, b0, b1);                                        \
+  }                                                                                      \
+  TARGET void one_pair_##SUFFIX(const double *in, double *out) { one_pair<W>(in, out); } \
+  constexpr Kernels kKernels_##SUFFIX{                                                   \
+      pairs_##SUFFIX,     pairs_damped_##SUFFIX,     sums_##SUFFIX,                      \
+      integrate_##SUFFIX, integrate_locked_##SUFFIX, one_pair_##SUFFIX};
 
 #define DEMCAL_NO_TARGET
 DEMCAL_SPHERE_KERNELS(sse2, DEMCAL_NO_TARGET, 2)
@@ -468,6 +544,13 @@ double SphereWorldImpl::pair_pass(int b0, int b1) {
                    hy_.data(),
                    hz_.data(),
                    slot_r_.data(),
+                   slot_ir_.data(),
+                   pfx_.data(),
+                   pfy_.data(),
+                   pfz_.data(),
+                   ptx_.data(),
+                   pty_.data(),
+                   ptz_.data(),
                    x_.data(),
                    y_.data(),
                    z_.data(),
@@ -492,9 +575,19 @@ double SphereWorldImpl::pair_pass(int b0, int b1) {
                    material_.particle.kt * integration_.dt,
                    0.5 * integration_.dt,
                    material_.particle.friction,
-                   2.0 * material_.contact_damping_ratio};
+                   2.0 * material_.contact_damping_ratio,
+                   mirror_block_.data(),
+                   mirror_slot_.data(),
+                   active_threads() <= 1};
   const Kernels &k = kernels();
   return material_.contact_damping_ratio > 0.0 ? k.pairs_damped(a, b0, b1) : k.pairs(a, b0, b1);
+}
+
+double SphereWorldImpl::sum_pass(int b0, int b1) {
+  const SumArgs a{mirror_block_.data(), mirror_slot_.data(), pfx_.data(), pfy_.data(), pfz_.data(),
+                  ptx_.data(),          pty_.data(),         ptz_.data(), fx_.data(),  fy_.data(),
+                  fz_.data(),           tx_.data(),          ty_.data(),  tz_.data()};
+  return kernels().sums(a, b0, b1);
 }
 
 double SphereWorldImpl::integrate_pass(int b0, int b1) {
@@ -597,9 +690,12 @@ void SphereWorldImpl::wall_forces() {
 }
 
 void SphereWorldImpl::compute_forces() {
+  // One thread: the sums fused into the pair pass, block by block (the
+  // same sums, same order); threads: a second pass once all pairs are done.
   max_overlap_ratio_seen_ = run_pass(&SphereWorldImpl::pair_pass, pair_bounds_);
-  // Friction's losses, block by block in a fixed order (every pair was
-  // counted from both sides).
+  if (active_threads() > 1) run_pass(&SphereWorldImpl::sum_pass, particle_bounds_);
+  // Friction's losses, block by block in a fixed order (every pair counted
+  // once).
   const double kt = material_.particle.kt;
   if (kt > 0.0) {
     double released = 0.0, slid = 0.0;
@@ -607,7 +703,7 @@ void SphereWorldImpl::compute_forces() {
       released += block_released_[b];
       slid += block_slid_[b];
     }
-    friction_dissipated_ += 0.5 * (released * (0.5 / kt) + slid / kt);
+    friction_dissipated_ += released * (0.5 / kt) + slid / kt;
   }
   wall_forces();
 }

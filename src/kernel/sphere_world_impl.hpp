@@ -123,9 +123,11 @@ class SphereWorldImpl {
     return {hx_[s], hy_[s], hz_[s]};
   }
   // The SIMD passes over particle blocks [b0, b1) (sphere_contact.cpp):
-  // pair forces (returns the largest overlap/r) and integration (returns
+  // pair forces (returns the largest overlap/r), the mirrored sums, and integration (returns
   // the largest squared displacement since the last build).
   double pair_pass(int b0, int b1);
+  // Adds what each particle receives from its mirrored slots (returns 0).
+  double sum_pass(int b0, int b1);
   double integrate_pass(int b0, int b1);
   // Run a pass over all blocks, shared among the threads by `bounds`;
   // returns the largest value it returned (sphere_world.cpp).
@@ -168,7 +170,7 @@ class SphereWorldImpl {
   // Per block, written by the passes and summed in block order (the same
   // sums for any thread count): global damping loss of the step (Σ D·|v̄|²/4)
   // and, over the block's slots, Σ|h|² of contacts that opened and
-  // Σ μFn·(|h_trial| − μFn) of sliding ones (every pair counted twice).
+  // Σ μFn·(|h_trial| − μFn) of sliding ones (every pair counted once).
   Array block_lost_, block_released_, block_slid_;
   // Energy taken by global damping since the energy ledger started [J] (a
   // running total from the start, not a difference of two totals: that
@@ -190,29 +192,41 @@ class SphereWorldImpl {
   double wall_work_abs_ = 0.0;
   std::array<double, 6> wall_push_{}, wall_move_{};
 
-  // Verlet neighbour list, full (each pair from both sides) in sliced
-  // ELLPACK blocks of 8 as the 2D kernel's (world.hpp): block b's slots are
-  // [block_slot_[b], block_slot_[b + 1]), rows of 8, slot (row, lane) the
-  // row-th neighbour (increasing index) of particle 8b + lane, then ghosts.
-  // hx_, hy_, hz_: each slot's tangential force on its own particle (the
-  // two copies of a pair are exact opposites), kept across rebuilds; slot_r_
-  // the neighbour's radius.
+  // Verlet neighbour list, half (each pair once, from its lower index i < j)
+  // in sliced ELLPACK blocks of 8 as the 2D kernel's (world.hpp): block b's
+  // slots are [block_slot_[b], block_slot_[b + 1]), rows of 8, slot (row,
+  // lane) the row-th neighbour j > i (increasing index) of particle i = 8b +
+  // lane, then ghosts. hx_, hy_, hz_: each slot's tangential force on i,
+  // kept across rebuilds; slot_r_, slot_ir_ the neighbour's radius and its
+  // inverse. The pair pass writes, per slot, what j receives: the pair's
+  // force on i (pfx_.., j takes its opposite) and the torque on j (ptx_..);
+  // one more slot at the end (index block_slot_[nblocks_]) stays 0, the
+  // padding of the mirror list.
   std::vector<int> block_slot_;
   detail::AlignedVector<int> slot_j_;
-  Array hx_, hy_, hz_, slot_r_;
+  Array hx_, hy_, hz_, slot_r_, slot_ir_;
+  Array pfx_, pfy_, pfz_, ptx_, pty_, ptz_;
+  // Mirror list, sliced ELLPACK blocks of 8 like the half list: block b's
+  // entries are [mirror_block_[b], mirror_block_[b + 1]), entry (row, lane)
+  // the slot of the row-th pair (i, j) with i < j = 8b + lane, in increasing
+  // i, padded with the zero slot. The sum pass adds them, in this fixed
+  // order, to the sums the pair pass wrote over j's own slots.
+  std::vector<int> mirror_block_, mirror_count_;
+  detail::AlignedVector<int> mirror_slot_;
   // The half list (pairs i < j) in CSR form, each row sorted by j, and the
-  // slot of i's copy of each pair (for measures, views and the ledger).
+  // slot of each pair (for measures, views and the ledger).
   std::vector<int> nbr_start_, nbr_j_, pair_slot_;
-  // Block ranges of the threads: pair pass (balanced by slots), particle pass.
+  // Block ranges of the threads: pair pass (balanced by slots), particle
+  // passes (sum and integration).
   std::vector<int> pair_bounds_, particle_bounds_;
   // Wall contacts: candidates within skin, tangential force history and
   // last normal force per wall and particle.
   std::array<std::vector<int>, 6> wall_candidates_;
   std::array<std::vector<double>, 6> wall_hx_, wall_hy_, wall_hz_, wall_fn_;
   // Scratch for rebuilds (kept to avoid allocation).
-  std::vector<int> full_start_, full_j_, cell_start_, cell_next_, new_block_slot_;
+  std::vector<int> cell_start_, cell_next_, new_block_slot_;
   detail::AlignedVector<int> new_slot_j_;
-  Array new_hx_, new_hy_, new_hz_, new_slot_r_;
+  Array new_hx_, new_hy_, new_hz_, new_slot_r_, new_slot_ir_;
   Array x_built_, y_built_, z_built_;
   std::array<double, 6> wall_built_{};
   double skin_ = 0.0, r_min_ = 0.0, r_max_ = 0.0;

@@ -13,9 +13,10 @@
 // ReferenceScales, StabilityEstimate, Divergence, KernelOptions.
 //
 // Layout for speed (reports/performance.md, "3D"): the 2D kernel's. State
-// in 64-byte aligned flat arrays padded to blocks of 8 particles; a full
-// neighbour list in sliced ELLPACK (each pair evaluated from both sides, a
-// particle's force a plain sum over its own slots: no scatter); the pair
+// in 64-byte aligned flat arrays padded to blocks of 8 particles; a half
+// neighbour list in sliced ELLPACK (each pair evaluated once, from its lower
+// index; a particle's force the sum over its own slots, then, in a second
+// pass and a fixed order, over its mirrored ones: no scatter); the pair
 // and particle passes SIMD over 8, 4 or 2 lanes chosen at run time
 // (kernel_simd(), DEMCAL_SIMD); threads share the blocks, results
 // bit-identical for any thread count; no allocation in a step without a
