@@ -3,8 +3,12 @@
 // --resume), DIR/run.json (this invocation: wall time, jobs, trials run and
 // reused), DIR/trials.jsonl (appended per trial, so --resume loses nothing)
 // and the report, DIR/report.html and DIR/report.md (3D: and DIR/final.vtk,
-// the calibrated run at its peak, when output.vtk); with --evidence (2D)
-// also DIR/evidence.jsonl (the paper-recipe baseline and the reference runs).
+// the calibrated run at its peak, when output.vtk); with --evidence also
+// DIR/evidence.jsonl (the paper-recipe baseline and the reference runs).
+// 3D: the report's runs are not rerun after the search: the result's series
+// and world at its peak are kept from the search's own run of it, and the
+// start point runs beside the search when --jobs > 1 (on the core the search
+// leaves idle while it verifies or certifies one run at a time).
 // SIGINT/SIGTERM stop it cleanly after consolidation, exit status 128 +
 // signal: finished trials stay in trials.jsonl; during the search or the
 // evidence runs nothing else is written; once params.json (and run.json)
@@ -15,6 +19,7 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <future>
 #include <iostream>
 #include <optional>
 #include <string_view>
@@ -29,6 +34,7 @@
 #include "demcal/scene/triaxial.hpp"
 #include "demcal/scoring/trial.hpp"
 #include "demcal/search/calibration.hpp"
+#include "demcal/search/evidence.hpp"
 #include "demcal/search/parallel.hpp"
 #include "demcal/upscaling/params_file.hpp"
 #include "demcal/upscaling/upscaling.hpp"
@@ -142,6 +148,43 @@ struct Consolidated {
   bool from_cache = false;
 };
 
+/// The report's start point (3D), run beside the search when there is more
+/// than one job: it depends only on the consolidated REV (the search's
+/// first start, search_start()), and the search leaves a core idle for long
+/// stretches (its verification runs one trial at a time, the certificate's
+/// doubled run outlasts its halved one). Abandoned at its next monitoring
+/// point when the command returns without taking it (a stop, an error).
+class StartPointBeside {
+ public:
+  StartPointBeside(const SceneConfig& config, const TriaxialState& state,
+                   const CalibrationOptions& options) {
+    future_ = std::async(std::launch::async, [&config, &state, options, this] {
+      const AlgorithmSpec start =
+          start_point(config, state.world.size(),
+                      dt_ratio_max(options, estimated_stable_dt_ratio(state, config.algorithm)));
+      return report_run(config, state, "start point", start, options.tolerances, &abandon_);
+    });
+  }
+  StartPointBeside(const StartPointBeside&) = delete;
+  StartPointBeside& operator=(const StartPointBeside&) = delete;
+  ~StartPointBeside() {
+    abandon_ = true;
+    if (future_.valid()) future_.wait();
+  }
+  /// The run, once finished (rethrows its error).
+  ReportRun3D take() { return future_.get(); }
+
+  /// The search's first start as it ran (rounded): the report's start point.
+  static AlgorithmSpec start_point(const SceneConfig& config, int64_t particles,
+                                   double dt_ratio_max) {
+    return rounded_params(search_start(config.algorithm, particles, dt_ratio_max));
+  }
+
+ private:
+  std::atomic<bool> abandon_{false};
+  std::future<ReportRun3D> future_;
+};
+
 /// What one invocation works on: the config with the flags applied, where
 /// it writes, and the key of its trials.
 struct Invocation {
@@ -231,9 +274,11 @@ void ready_output_folder(const CalibrateOptions& o, const Invocation& v) {
   if (v.three_d) std::filesystem::remove(dir + "/final.vtk");  // the 3D report's
 }
 
-/// The --evidence runs (2D): the paper's recipe done mechanically (α = 0.2,
+/// The --evidence runs: the paper's recipe done mechanically (α = 0.2,
 /// ζ = 1, Nstep doubled from the search's size-based start until it passes)
-/// and a converged reference from the calibrated multipliers.
+/// and a converged reference from the calibrated multipliers. 2D and 3D
+/// alike through the scene's trial runner; 2D keeps the reference's fine
+/// series for the report's panels.
 struct Evidence {
   std::optional<BaselineResult> baseline;
   std::optional<ReferenceEvidence> reference;
@@ -241,20 +286,21 @@ struct Evidence {
   nlohmann::json block;  ///< params.json's "evidence"
 };
 
-Evidence run_evidence(const SceneConfig& config, const ConsolidatedState& state,
+Evidence run_evidence(const SceneConfig& config, const Consolidated& rev, const TrialRunner& runner,
                       const CalibrationSummary& summary, const CalibrationOptions& options,
                       int jobs) {
   Evidence e;
-  const int64_t n_rev = state.world.size();
+  const int64_t start_steps = kStartStepsPerParticle * rev.particles;
   auto run_baseline = [&] {
-    e.baseline =
-        paper_recipe_baseline(config, state, options.tolerances, kStartStepsPerParticle * n_rev);
+    e.baseline = paper_recipe_baseline(runner, config.algorithm, options.tolerances, start_steps);
   };
   auto run_reference = [&] {
-    e.reference = run_refined_reference(config, state, summary.best, options.tolerances, 1);
+    e.reference =
+        rev.disks ? run_refined_reference(config, *rev.disks, summary.best, options.tolerances, 1)
+                  : run_refined_reference(runner, summary.best, options.tolerances, 1);
   };
   run_parallel({run_baseline, run_reference}, jobs);
-  const CalibrationEvidence evidence{*e.reference, *e.baseline, kStartStepsPerParticle * n_rev};
+  const CalibrationEvidence evidence{*e.reference, *e.baseline, start_steps};
   e.lines = demcal::evidence_lines(evidence);
   e.block = evidence_block(evidence, summary.best_trial);
   return e;
@@ -294,7 +340,8 @@ ReportInput report_input(const CalibrateOptions& o, const Invocation& v, int64_t
 /// ("" when the report failed: a warning, not a failure).
 std::string write_report(const CalibrateOptions& o, const Invocation& v, const Consolidated& rev,
                          const nlohmann::json& params, const CalibrationSummary& summary,
-                         const CalibrationOptions& options, Evidence evidence, int jobs) {
+                         const CalibrationOptions& options, Evidence evidence, int jobs,
+                         KnownRuns3D known) {
   const SceneConfig& config = v.config;
   const std::string& dir = v.dir;
   try {
@@ -304,12 +351,12 @@ std::string write_report(const CalibrateOptions& o, const Invocation& v, const C
     in.reference = std::move(evidence.reference);
     // The search's first start, as it ran.
     const AlgorithmSpec start =
-        rounded_params(search_start(config.algorithm, rev.particles, in.dt_ratio_max));
+        StartPointBeside::start_point(config, rev.particles, in.dt_ratio_max);
     // A stop now: finish, the runs are done.
     std::string vtk;
     if (v.three_d) {
-      ResultRuns3D runs =
-          rerun_start_and_result(config, *rev.spheres, start, summary, in.tolerances, jobs);
+      ResultRuns3D runs = rerun_start_and_result(config, *rev.spheres, start, summary,
+                                                 in.tolerances, jobs, std::move(known));
       if (runs.world && config.output.vtk) {
         vtk = world_vtk(*runs.world, "demcal " + config.name + " calibrated, at the peak");
         in.vtk_file = "final.vtk";
@@ -384,8 +431,21 @@ int cmd_calibrate(const CalibrateOptions& o) {
   ready_output_folder(o, v);
 
   const CalibrationOptions options = search_options(o, v, stop);
-  const CalibrationSummary summary =
-      v.three_d ? calibrate(config, *rev.spheres, options) : calibrate(config, *rev.disks, options);
+  const int jobs = resolve_jobs(o.jobs);
+  // 3D: the report's runs come from the search (the result's series and its
+  // world at the peak, kept by the runner) and from beside it (the start
+  // point on an idle core), not from reruns after it.
+  std::optional<TriaxialRunner> spheres_runner;
+  std::optional<StartPointBeside> start_beside;
+  if (v.three_d) {
+    spheres_runner.emplace(config, *rev.spheres);
+    spheres_runner->keep_passing_runs(true);
+    if (jobs > 1) start_beside.emplace(config, *rev.spheres, options);
+  }
+  const CalibrationSummary summary = v.three_d
+                                         ? calibrate(*spheres_runner, config.algorithm, options)
+                                         : calibrate(config, *rev.disks, options);
+  if (spheres_runner) spheres_runner->keep_passing_runs(false);  // the result is kept by now
   const auto interrupted = [&](const std::string& what) {
     std::cerr << "demcal: interrupted" << what << "; " << summary.trials.size()
               << " finished trials are in " << v.trials_path << ". Continue with:\n  "
@@ -397,19 +457,19 @@ int cmd_calibrate(const CalibrateOptions& o) {
   nlohmann::json params = v.three_d ? params_file(config, *rev.spheres, options, summary)
                                     : params_file(config, *rev.disks, options, summary);
   const bool have_best = summary.best_trial.score.particle_steps > 0.0;
-  const int jobs = resolve_jobs(o.jobs);
   auto say = [&](const std::string& line) {
     if (!o.quiet) std::cerr << "demcal: " << line << "\n";
   };
-  const bool evidence_runs = o.evidence && have_best && !v.three_d;
+  const bool evidence_runs = o.evidence && have_best;
   Evidence evidence;
-  if (o.evidence && have_best && v.three_d)
-    say("--evidence: the paper-recipe baseline and the converged reference are 2D only for now "
-        "(issue #18); skipped for this 3D scene");
   if (evidence_runs) {
     say("evidence: paper-recipe baseline and converged reference (8x, 16x Nstep = " +
         std::to_string(16 * summary.best.steps) + ")");
-    evidence = run_evidence(config, *rev.disks, summary, options, jobs);
+    std::optional<BiaxialRunner> disks_runner;
+    if (rev.disks) disks_runner.emplace(config, *rev.disks);
+    const TrialRunner& runner = v.three_d ? static_cast<const TrialRunner&>(*spheres_runner)
+                                          : static_cast<const TrialRunner&>(*disks_runner);
+    evidence = run_evidence(config, rev, runner, summary, options, jobs);
     params["evidence"] = evidence.block;
   }
   // The evidence and report runs do not poll the flag (seconds on a REV):
@@ -429,8 +489,16 @@ int cmd_calibrate(const CalibrateOptions& o) {
         " before the report (params.json and run.json are written; --resume reuses every trial "
         "and writes the report)");
 
-  const std::string report_note =
-      write_report(o, v, rev, params, summary, options, std::move(evidence), jobs);
+  KnownRuns3D known;
+  if (start_beside) {
+    try {
+      known.start = start_beside->take();
+    } catch (const std::exception&) {  // the report reruns it (and says so if it fails again)
+    }
+  }
+  if (spheres_runner && have_best) known.best = spheres_runner->kept_run(summary.best);
+  const std::string report_note = write_report(o, v, rev, params, summary, options,
+                                               std::move(evidence), jobs, std::move(known));
   write_file_atomic(dir + "/run.json", run_json());
   std::cout << summary.BriefReport() << "  wrote " << dir << "/params.json, " << dir
             << "/run.json, " << dir << "/trials.jsonl" << report_note

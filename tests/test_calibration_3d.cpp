@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "demcal/scene/config.hpp"
 #include "demcal/scene/triaxial.hpp"
@@ -112,6 +113,72 @@ TEST(Calibration3D, RotationalDragFailsTheDraggedRunAndPassesTheUndampedOne) {
   EXPECT_GT(rise, cd.rotational_drag);
 }
 
+// The early stop's rotational-drag bound (TriaxialEarlyFailure) is a lower
+// bound of the final criterion whatever the rest of the run does: after
+// each point of the dragged run, the run ended there in the way that gives
+// the smallest final drag (b_zz released at once, so the peak is the
+// running one, and no drag afterwards) still has at least the bound. It
+// reaches the final drag once the peak is kTrendHalfWidth points back, and
+// stops a trial once beyond factor × kRotationalDragTolerance.
+TEST(Calibration3D, RotationalDragEarlyStopIsALowerBound) {
+  const SceneConfig config = parse_config_text(kFcc2, "fcc_2x2x2");
+  const TriaxialState state = consolidate_triaxial(config, make_sphere_assembly(config));
+  const TriaxialRunner runner(config, state);
+  const Tolerances t = triaxial_tolerances();
+  const double s3 = config.test.lateral_stress;
+  const int m = config.test.monitor_points;
+  AlgorithmSpec p = config.algorithm;
+  p.dt_ratio = 0.17;
+  p.steps = 16000;
+  p.damping_ratio_translation = 0.5;
+  p.damping_ratio_rotation = 2.0;
+  TriaxialResult run;
+  runner.run(p, t, false, 3.0, nullptr, &run);
+  const std::vector<TriaxialPoint>& series = run.series;
+  const double drag = compute_triaxial_criteria(series, s3).rotational_drag;
+  ASSERT_GT(drag, kRotationalDragTolerance);  // the run of the test above
+
+  // Factor large enough that nothing stops: the bound alone is watched.
+  TriaxialEarlyFailure watch(t, 1e9, m, s3);
+  double previous = 0.0;
+  for (size_t j = 0; j < series.size(); ++j) {
+    EXPECT_FALSE(watch.add(series[j]));
+    const double bound = watch.rotational_drag_bound();
+    EXPECT_GE(bound, previous);
+    previous = bound;
+    std::vector<TriaxialPoint> ended(series.begin(), series.begin() + j + 1);
+    for (int k = 0; k <= 2 * kTrendHalfWidth + 1; ++k) {
+      TriaxialPoint q = series[j];
+      q.step += k + 1;
+      q.b(2, 2) = 0.0;      // released: never more compressive
+      q.axial_power = 0.0;  // no drag share
+      q.damping_power_rotation = 0.0;
+      ended.push_back(q);
+    }
+    EXPECT_LE(bound, compute_triaxial_criteria(ended, s3).rotational_drag) << "point " << j;
+  }
+  EXPECT_LE(previous, drag);
+  size_t peak = 0;
+  for (size_t k = 1; k < series.size(); ++k)
+    if (series[k].b(2, 2) < series[peak].b(2, 2)) peak = k;
+  if (peak + kTrendHalfWidth < series.size() - 1) {
+    EXPECT_EQ(previous, drag);
+  }
+  EXPECT_GT(previous, 0.5 * drag);
+
+  // The stop: a factor that the bound passes stops the trial before its end
+  // (the planes alone do not: every other criterion is within tolerance),
+  // one above the final drag never does.
+  const double reached = previous / kRotationalDragTolerance;
+  ASSERT_GT(reached, 1.0);
+  const TrialRun stopped = runner.run(p, t, true, 0.999 * reached, nullptr);
+  EXPECT_FALSE(stopped.score.complete);
+  EXPECT_LT(stopped.steps_run, p.steps);
+  const TrialRun whole = runner.run(p, t, true, 1.001 * drag / kRotationalDragTolerance, nullptr);
+  EXPECT_TRUE(whole.score.complete);
+  EXPECT_EQ(whole.steps_run, p.steps);
+}
+
 TEST(Calibration3D, CommandWritesParamsWithTheDimensionAndResumeReusesEveryTrial) {
   test::TempDir dir("calib3d");
   const std::string config = test::write_text(dir / "fcc_2x2x2.json", kFcc2);
@@ -138,6 +205,51 @@ TEST(Calibration3D, CommandWritesParamsWithTheDimensionAndResumeReusesEveryTrial
             std::string::npos)
       << again.out;
   EXPECT_EQ(test::read_text(out / "params.json"), bytes);  // --jobs and --resume change nothing
+}
+
+// --evidence on a 3D config: the paper's recipe done mechanically (α 0.2,
+// ζ 1, Nstep doubled from 500 per sphere until it passes) and the converged
+// reference 2·P(16N) − P(8N) of the calibrated multipliers, in params.json,
+// evidence.jsonl and the report, as in 2D; the calibrated peak is within
+// the accuracy target of the reference (what the certificate claims).
+TEST(Calibration3D, EvidenceRunsTheRecipeAndTheReference) {
+  test::TempDir dir("evidence3d");
+  const std::string config = test::write_text(dir / "fcc_2x2x2.json", kFcc2);
+  const fs::path out = dir / "out";
+  const test::RunResult run = test::run_demcal(
+      {"calibrate", config, "-q", "-o", out.string(), "--jobs", "2", "--evidence"}, dir.path());
+  ASSERT_EQ(run.status, 0) << run.err;
+  const nlohmann::json params = test::read_json(out / "params.json");
+  const nlohmann::json& ref = params.at("evidence").at("reference");
+  const int64_t n = params.at("rev").at("steps").get<int64_t>();
+  EXPECT_EQ(ref.at("steps_8x").get<int64_t>(), 8 * n);
+  EXPECT_EQ(ref.at("steps_16x").get<int64_t>(), 16 * n);
+  const double p8 = ref.at("peak_stress_yy_8x").get<double>(),
+               p16 = ref.at("peak_stress_yy_16x").get<double>(),
+               reference = ref.at("peak_stress_yy").get<double>();
+  EXPECT_NEAR(reference, 2.0 * p16 - p8, 1e-9 * std::abs(reference));
+  EXPECT_LT(reference, -1e5);  // the axial peak b_zz, compressive, above σ3
+  EXPECT_LE(std::abs(ref.at("calibrated_peak_error").get<double>()),
+            params.at("accuracy").get<double>());
+
+  const std::vector<std::string> lines = test::lines_of(test::read_text(out / "evidence.jsonl"));
+  const nlohmann::json& baseline = params.at("evidence").at("baseline");
+  const int recipe_trials = baseline.at("trials").get<int>();
+  ASSERT_EQ(lines.size(), static_cast<size_t>(2 + recipe_trials));
+  EXPECT_EQ(baseline.at("start_steps").get<int64_t>(), 500 * 32);
+  for (int k = 0; k < recipe_trials; ++k) {
+    const nlohmann::json t = nlohmann::json::parse(lines[2 + k]);
+    EXPECT_EQ(t.at("phase"), "baseline");
+    EXPECT_EQ(t.at("params").at("dt_ratio").get<double>(), 0.2);
+    EXPECT_EQ(t.at("params").at("damping_ratio_rotation").get<double>(), 1.0);
+    EXPECT_EQ(t.at("params").at("steps").get<int64_t>(), (int64_t{500} * 32) << k);
+    // Doubled until it passes: only the last may pass.
+    EXPECT_EQ(t.at("passed").get<bool>(),
+              baseline.at("passed").get<bool>() && k == recipe_trials - 1);
+  }
+  const std::string md = test::read_text(out / "report.md");
+  EXPECT_NE(md.find("peak b_zz at 8·Nstep"), std::string::npos);
+  EXPECT_NE(md.find("Evidence: the paper's recipe (--evidence)"), std::string::npos);
 }
 
 // `demcal export` on a 3D params.json: the deck of the calibrated REV with

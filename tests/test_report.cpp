@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cctype>
 #include <cmath>
 #include <filesystem>
@@ -19,9 +20,11 @@
 #include "demcal/report/report.hpp"
 #include "demcal/report/sphere_svg.hpp"
 #include "demcal/scene/packing.hpp"
+#include "demcal/scene/run_output.hpp"
 #include "demcal/scene/triaxial.hpp"
 #include "demcal/scoring/triaxial_scoring.hpp"
 #include "demcal/search/evidence.hpp"
+#include "demcal/search/trial_runner.hpp"
 #include "support/files.hpp"
 #include "support/process.hpp"
 
@@ -727,6 +730,94 @@ TEST(Report3D, RerunsReproduceTheTrialsAndPictureThePeak) {
   EXPECT_GT(runs.picture->step, 0);
   EXPECT_EQ(runs.picture->hi[2], runs.world->wall(kZMax).position);
   EXPECT_EQ(runs.picture->x.size(), static_cast<size_t>(state.world.size()));
+}
+
+// What the search kept (TriaxialRunner::keep_passing_runs: the result's
+// series and its world at the peak) and a start point run beforehand
+// (report_run) give the same report runs as the reruns, to the bit: the
+// calibrate command shows them instead of rerunning. A failing trial is not
+// kept; a known run of other parameters, or one cut short, is not used.
+TEST(Report3D, KeptRunsAreTheReruns) {
+  const TriaxialState& state = small_fcc();
+  const SceneConfig c = parse_config_text(R"({"dimension": 3,
+      "material": {"density": 2650, "kn": 1e8, "kt": 5e7, "friction": 0.3},
+      "assembly": {"type": "fcc", "cells_x": 2, "cells_y": 2, "cells_z": 2, "radius": 5e-4},
+      "test": {"type": "triaxial", "lateral_stress": 1e5, "vertical_strain": 1e-5,
+               "monitor_points": 40}})",
+                                          "fcc2.json");
+  // Tolerances loose enough that the run passes: what is kept is at issue
+  // here (ζ_r = 0: the rotational drag's tolerance is not a setting).
+  Tolerances loose;
+  loose.force_balance = loose.moment_balance = loose.servo = loose.oscillation = 1e9;
+  AlgorithmSpec best = c.algorithm, start = c.algorithm;
+  best.steps = 3000;
+  best.damping_ratio_rotation = 0.0;
+  start.steps = 1500;
+  TriaxialRunner runner(c, state);
+  runner.keep_passing_runs(true);
+  const TrialRun trial = runner.run(best, loose, true, 3.0, nullptr);
+  ASSERT_TRUE(trial.score.passed && trial.score.complete);
+  ASSERT_TRUE(runner.kept_run(best));
+  EXPECT_FALSE(runner.kept_run(start));
+  Tolerances tight = loose;
+  tight.force_balance = 1e-12;
+  AlgorithmSpec failing = best;
+  failing.steps = 2000;
+  EXPECT_FALSE(runner.run(failing, tight, false, 3.0, nullptr).score.passed);
+  EXPECT_FALSE(runner.kept_run(failing));  // failed: not kept
+
+  CalibrationSummary summary;
+  summary.success = true;
+  summary.best = best;
+  summary.best_trial.params = best;
+  summary.best_trial.score = trial.score;
+  const ResultRuns3D rerun = rerun_start_and_result(c, state, start, summary, loose, 2);
+  KnownRuns3D known;
+  known.start = report_run(c, state, "start point", start, loose);
+  known.best = runner.kept_run(best);
+  const ResultRuns3D kept = rerun_start_and_result(c, state, start, summary, loose, 2, known);
+  ASSERT_TRUE(rerun.best && rerun.start && rerun.picture && rerun.world);
+  ASSERT_TRUE(kept.best && kept.start && kept.picture && kept.world);
+  const auto same_series = [](const TriaxialResult& a, const TriaxialResult& b) {
+    if (a.series.size() != b.series.size()) return false;
+    for (size_t k = 0; k < a.series.size(); ++k)
+      if (a.series[k].step != b.series[k].step || a.series[k].b != b.series[k].b ||
+          a.series[k].sigma != b.series[k].sigma)
+        return false;
+    return a.peak_stress_zz == b.peak_stress_zz && a.steps_run == b.steps_run;
+  };
+  EXPECT_TRUE(same_series(kept.best->run, rerun.best->run));
+  EXPECT_TRUE(same_series(kept.start->run, rerun.start->run));
+  EXPECT_EQ(kept.best->label, "calibrated");
+  EXPECT_EQ(kept.start->label, "start point");
+  EXPECT_EQ(kept.best->score.criteria.force_balance, rerun.best->score.criteria.force_balance);
+  EXPECT_EQ(kept.best->score.passed, rerun.best->score.passed);
+  const SpherePicture &a = *kept.picture, &b = *rerun.picture;
+  EXPECT_GT(b.step, 0);  // the peak is past the start: the kept world is used
+  EXPECT_EQ(a.step, b.step);
+  EXPECT_EQ(a.stress_zz, b.stress_zz);
+  EXPECT_EQ(a.x, b.x);
+  EXPECT_EQ(a.z, b.z);
+  EXPECT_EQ(a.force, b.force);  // contacts included: the whole state was kept
+  EXPECT_EQ(a.hi, b.hi);
+  EXPECT_EQ(world_vtk(*kept.world, "t"), world_vtk(*rerun.world, "t"));
+
+  // Known runs of other parameters, or cut short, are rerun instead.
+  KnownRuns3D other;
+  other.start = report_run(c, state, "start point", best, loose);  // not the start
+  const std::atomic<bool> stopped{true};
+  other.best = runner.kept_run(best);
+  other.best->params.steps = 2999;
+  const ResultRuns3D fresh = rerun_start_and_result(c, state, start, summary, loose, 1, other);
+  ASSERT_TRUE(fresh.start && fresh.best && fresh.picture);
+  EXPECT_TRUE(same_series(fresh.start->run, rerun.start->run));
+  EXPECT_TRUE(same_series(fresh.best->run, rerun.best->run));
+  EXPECT_EQ(fresh.picture->force, b.force);
+  KnownRuns3D cut;
+  cut.start = report_run(c, state, "start point", start, loose, &stopped);
+  EXPECT_TRUE(cut.start->run.stopped_early);
+  const ResultRuns3D after_cut = rerun_start_and_result(c, state, start, summary, loose, 1, cut);
+  EXPECT_TRUE(same_series(after_cut.start->run, rerun.start->run));
 }
 
 // `demcal calibrate` on the shipped 3D scene cut to 2×2×2 cells (32 spheres,

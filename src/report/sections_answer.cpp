@@ -260,9 +260,9 @@ void write_reference_evidence(Doc& d, const ReportFacts& f) {
   const auto& R = *in.reference;
   const auto& e = f.best_peak_error;
   std::vector<std::vector<std::string>> rows{
-      {"peak b_yy at 8·Nstep = " + grouped(R.coarse.params.steps),
+      {"peak " + f.axial + " at 8·Nstep = " + grouped(R.coarse.params.steps),
        kpa(R.coarse.score.criteria.peak_stress_yy)},
-      {"peak b_yy at 16·Nstep = " + grouped(R.fine.params.steps),
+      {"peak " + f.axial + " at 16·Nstep = " + grouped(R.fine.params.steps),
        kpa(R.fine.score.criteria.peak_stress_yy)},
       {"converged reference 2·P(16N) − P(8N)", kpa(R.peak)},
       {"calibrated peak error against the reference", e ? signed_pct(*e, 2) : std::string("n/a")},

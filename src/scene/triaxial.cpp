@@ -201,7 +201,8 @@ void damping_powers(const SphereWorld& world, TriaxialPoint& p) {
 
 TriaxialResult run_triaxial_loading(const TriaxialState& start, const TestSpec& test,
                                     const AlgorithmSpec& algorithm, const TriaxialMonitor& monitor,
-                                    SphereWorld* final_state) {
+                                    SphereWorld* final_state,
+                                    const TriaxialWorldObserver& observe) {
   const auto t0 = std::chrono::steady_clock::now();
   SphereWorld world = start.world;
   TriaxialResult out;
@@ -231,6 +232,7 @@ TriaxialResult run_triaxial_loading(const TriaxialState& start, const TestSpec& 
     for (int s = 0; s < 6; ++s) p.walls[s] = world.wall(static_cast<SphereWallSide>(s)).position;
     damping_powers(world, p);
     out.series.push_back(p);
+    if (observe) observe(p, world);
     return !monitor || monitor(p);
   };
 

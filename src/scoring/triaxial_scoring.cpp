@@ -57,6 +57,10 @@ MonitorPoint horizontal_plane_point(const TriaxialPoint& t) {
 
 }  // namespace
 
+double rotational_drag_share(const TriaxialPoint& p) {
+  return p.axial_power > 0.0 ? p.damping_power_rotation / p.axial_power : 0.0;
+}
+
 TriaxialCriteria compute_triaxial_criteria(const std::vector<TriaxialPoint>& series, double s3) {
   TriaxialCriteria c;
   std::vector<MonitorPoint> xz, yz, xy;
@@ -88,7 +92,7 @@ TriaxialCriteria compute_triaxial_criteria(const std::vector<TriaxialPoint>& ser
   std::vector<double> rot, tr;
   for (size_t k = 1; k < series.size(); ++k) {
     const double pz = series[k].axial_power;
-    rot.push_back(pz > 0.0 ? series[k].damping_power_rotation / pz : 0.0);
+    rot.push_back(rotational_drag_share(series[k]));
     tr.push_back(pz > 0.0 ? series[k].damping_power_translation / pz : 0.0);
   }
   if (!rot.empty()) {
@@ -178,14 +182,39 @@ TriaxialEarlyFailure::TriaxialEarlyFailure(const Tolerances& tolerances, double 
                                            int monitor_points, double s3)
     : planes_{EarlyFailure(tolerances, factor, monitor_points, s3),
               EarlyFailure(tolerances, factor, monitor_points, s3),
-              EarlyFailure(tolerances, factor, monitor_points, s3)} {}
+              EarlyFailure(tolerances, factor, monitor_points, s3)},
+      drag_limit_(factor * kRotationalDragTolerance) {}
 
 bool TriaxialEarlyFailure::add(const TriaxialPoint& point) {
+  if (failed_) return true;
   // Every plane is fed every point (each keeps its own running bounds).
   const bool xz = planes_[0].add(vertical_plane_point(point, 0));
   const bool yz = planes_[1].add(vertical_plane_point(point, 1));
   const bool xy = planes_[2].add(horizontal_plane_point(point));
-  return xz || yz || xy;
+  if (xz || yz || xy) return failed_ = true;
+  // Rotational drag, as compute_triaxial_criteria() takes it: the
+  // moving_trend() of the shares, max over drag_ index k < max(peak, 1).
+  const int index = points_++;
+  if (peak_index_ < 0 || point.b(2, 2) < peak_) {
+    peak_ = point.b(2, 2);
+    peak_index_ = index;
+  }
+  if (index == 0) return false;  // the start is not scored
+  drag_.push_back(rotational_drag_share(point));
+  const int h = kTrendHalfWidth;
+  const size_t n = drag_.size();
+  const size_t counted = static_cast<size_t>(std::max(peak_index_, 1));  // k < counted
+  // Trend k is final once its window no longer depends on the series'
+  // length: n − 1 − k ≥ kTrendHalfWidth.
+  while (next_trend_ < counted && next_trend_ + h < n) {
+    const int k = static_cast<int>(next_trend_);
+    const int w = std::min(h, k);
+    double sum = 0.0;
+    for (int j = k - w; j <= k + w; ++j) sum += drag_[j];
+    drag_bound_ = std::max(drag_bound_, sum / (2 * w + 1));
+    ++next_trend_;
+  }
+  return failed_ = drag_bound_ > drag_limit_;
 }
 
 const char* const kTriaxialVerdictNote =

@@ -895,17 +895,33 @@ CalibrationSummary calibrate(const TrialRunner& runner, const AlgorithmSpec& bas
   return out;
 }
 
+TrialRecord run_trial(const TrialRunner& runner, const AlgorithmSpec& params,
+                      const Tolerances& tolerances) {
+  const TrialRun run = runner.run(params, tolerances, false, 3.0, nullptr);
+  return {.params = params,
+          .score = run.score,
+          .steps_run = run.steps_run,
+          .wall_time_s = run.wall_time_s};
+}
+
 BaselineResult paper_recipe_baseline(const SceneConfig& config, const ConsolidatedState& state,
                                      const Tolerances& tolerances, int64_t start_steps,
                                      int max_doublings) {
+  return paper_recipe_baseline(BiaxialRunner(config, state), config.algorithm, tolerances,
+                               start_steps, max_doublings);
+}
+
+BaselineResult paper_recipe_baseline(const TrialRunner& runner, const AlgorithmSpec& base,
+                                     const Tolerances& tolerances, int64_t start_steps,
+                                     int max_doublings) {
   BaselineResult out;
-  AlgorithmSpec p = config.algorithm;
+  AlgorithmSpec p = base;
   p.dt_ratio = 0.2;
   p.damping_ratio_translation = 1.0;
   p.damping_ratio_rotation = 1.0;
   p.steps = start_steps;
   for (int k = 0; k <= max_doublings; ++k) {
-    TrialRecord r = run_trial(config, state, p, tolerances);
+    TrialRecord r = run_trial(runner, p, tolerances);
     r.phase = TrialPhase::baseline;
     r.id = k;
     out.trials.push_back(r);

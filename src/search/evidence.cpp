@@ -1,6 +1,7 @@
 #include "demcal/search/evidence.hpp"
 
 #include <algorithm>
+#include <functional>
 #include <utility>
 
 #include "demcal/scoring/triaxial_scoring.hpp"
@@ -115,35 +116,62 @@ SpherePicture picture_of(const SphereWorld& world) {
   return p;
 }
 
+ReportRun3D report_run(const SceneConfig& config, const TriaxialState& state,
+                       const std::string& label, const AlgorithmSpec& params,
+                       const Tolerances& tolerances, const std::atomic<bool>* stop) {
+  ReportRun3D r;
+  r.label = label;
+  r.params = params;
+  TriaxialMonitor monitor;
+  if (stop)
+    monitor = [stop](const TriaxialPoint&) { return !stop->load(std::memory_order_relaxed); };
+  r.run = run_triaxial_loading(state, config.test, params, monitor);
+  r.score = score_triaxial_run(r.run, config.test.lateral_stress, tolerances);
+  return r;
+}
+
 ResultRuns3D rerun_start_and_result(const SceneConfig& config, const TriaxialState& state,
                                     const AlgorithmSpec& start, const CalibrationSummary& summary,
-                                    const Tolerances& tolerances, int jobs) {
-  const double s3 = config.test.lateral_stress;
-  auto one = [&](const std::string& label, const AlgorithmSpec& p) {
-    ReportRun3D r;
-    r.label = label;
-    r.params = p;
-    r.run = run_triaxial_loading(state, config.test, p);
-    r.score = score_triaxial_run(r.run, s3, tolerances);
-    return r;
-  };
+                                    const Tolerances& tolerances, int jobs, KnownRuns3D known) {
   ResultRuns3D out;
   const bool have_best = summary.best_trial.score.particle_steps > 0.0;  // a trial ran
-  run_parallel({[&] { out.start = one("start point", start); },
-                [&] {
-                  if (have_best)
-                    out.best = one(summary.success ? "calibrated" : "best found", summary.best);
-                }},
-               jobs);
+  const std::string best_label = summary.success ? "calibrated" : "best found";
+  // What already ran, when it ran exactly these parameters to the end.
+  const auto whole = [](const TriaxialResult& run) { return !run.stopped_early; };
+  if (known.start && same_params(known.start->params, start) && whole(known.start->run)) {
+    out.start = std::move(known.start);
+    out.start->label = "start point";
+  }
+  if (have_best && known.best && same_params(known.best->params, summary.best) &&
+      whole(known.best->run) && !known.best->run.series.empty() && known.best->peak_world) {
+    ReportRun3D r;
+    r.label = best_label;
+    r.params = summary.best;
+    r.run = std::move(known.best->run);
+    r.score = score_triaxial_run(r.run, config.test.lateral_stress, tolerances);
+    out.best = std::move(r);
+  }
+  std::vector<std::function<void()>> runs;
+  if (!out.start)
+    runs.push_back(
+        [&] { out.start = report_run(config, state, "start point", start, tolerances); });
+  const bool rerun_best = have_best && !out.best;
+  if (rerun_best)
+    runs.push_back(
+        [&] { out.best = report_run(config, state, best_label, summary.best, tolerances); });
+  run_parallel(runs, jobs);
   if (!out.best || out.best->run.series.empty()) return out;
-  // The result once more, up to the monitoring point of its peak.
+  // The world at the monitoring point of the result's peak: kept by the
+  // search, or the result once more, up to that point.
   const auto& series = out.best->run.series;
   const auto peak =
       std::min_element(series.begin(), series.end(),
                        [](const auto& a, const auto& b) { return a.b(2, 2) < b.b(2, 2); });
   const int64_t peak_step = peak->step;
   SphereWorld world = state.world;
-  if (peak_step > 0)
+  if (!rerun_best && peak_step > 0)
+    world = std::move(*known.best->peak_world);
+  else if (peak_step > 0)
     run_triaxial_loading(
         state, config.test, out.best->params,
         [&](const TriaxialPoint& p) { return p.step < peak_step; }, &world);
@@ -157,26 +185,52 @@ ResultRuns3D rerun_start_and_result(const SceneConfig& config, const TriaxialSta
   return out;
 }
 
+namespace {
+
+/// The reference's levels: the result's multipliers at 8× and 16× its Nstep.
+std::pair<AlgorithmSpec, AlgorithmSpec> reference_levels(const AlgorithmSpec& best) {
+  AlgorithmSpec coarse = best, fine = best;
+  coarse.steps = kReferenceCoarse * best.steps;
+  fine.steps = kReferenceFine * best.steps;
+  return {coarse, fine};
+}
+
+/// The two runs made into the reference (phases, ids, Richardson limit).
+void finish_reference(ReferenceEvidence& out) {
+  out.coarse.phase = out.fine.phase = TrialPhase::reference;
+  out.coarse.id = 0;
+  out.fine.id = 1;
+  // Nstep in units of the result's: only the ratio matters, and with
+  // powers of two the limit is exactly 2·P(16N) − P(8N).
+  out.peak = richardson_limit(kReferenceCoarse, out.coarse.score.criteria.peak_stress_yy,
+                              kReferenceFine, out.fine.score.criteria.peak_stress_yy);
+}
+
+}  // namespace
+
 ReferenceEvidence run_refined_reference(const SceneConfig& config, const ConsolidatedState& state,
                                         const AlgorithmSpec& best, const Tolerances& tolerances,
                                         int jobs) {
   ReferenceEvidence out;
-  AlgorithmSpec coarse = best, fine = best;
-  coarse.steps = kReferenceCoarse * best.steps;
-  fine.steps = kReferenceFine * best.steps;
+  const auto [coarse, fine] = reference_levels(best);
   LoadingResult fine_run;
   run_parallel(
       {[&] { out.fine = run_trial(config, state, fine, tolerances, false, 3.0, &fine_run); },
        [&] { out.coarse = run_trial(config, state, coarse, tolerances); }},
       jobs);
-  out.coarse.phase = out.fine.phase = TrialPhase::reference;
-  out.coarse.id = 0;
-  out.fine.id = 1;
   out.fine_series = std::move(fine_run.series);
-  // Nstep in units of the result's: only the ratio matters, and with
-  // powers of two the limit is exactly 2·P(16N) − P(8N).
-  out.peak = richardson_limit(kReferenceCoarse, out.coarse.score.criteria.peak_stress_yy,
-                              kReferenceFine, out.fine.score.criteria.peak_stress_yy);
+  finish_reference(out);
+  return out;
+}
+
+ReferenceEvidence run_refined_reference(const TrialRunner& runner, const AlgorithmSpec& best,
+                                        const Tolerances& tolerances, int jobs) {
+  ReferenceEvidence out;
+  const auto [coarse, fine] = reference_levels(best);
+  run_parallel({[&] { out.fine = run_trial(runner, fine, tolerances); },
+                [&] { out.coarse = run_trial(runner, coarse, tolerances); }},
+               jobs);
+  finish_reference(out);
   return out;
 }
 

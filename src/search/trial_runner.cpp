@@ -43,10 +43,41 @@ TrialRun TriaxialRunner::run(const AlgorithmSpec& params, const Tolerances& tole
       return !(failure && failure->add(p));
     };
   }
-  TriaxialResult run = run_triaxial_loading(state_, config_.test, params, monitor);
+  // Kept runs: the world at the first most compressive b_zz so far, as
+  // rerun_start_and_result() finds the peak.
+  std::optional<SphereWorld> peak_world;
+  double peak = 0.0;
+  TriaxialWorldObserver observe;
+  if (keep_) {
+    observe = [&](const TriaxialPoint& p, const SphereWorld& world) {
+      if (peak_world && !(p.b(2, 2) < peak)) return;
+      peak = p.b(2, 2);
+      peak_world.emplace(world);
+    };
+  }
+  TriaxialResult run =
+      run_triaxial_loading(state_, config_.test, params, monitor, nullptr, observe);
   TrialRun out{score_triaxial_run(run, s3, tolerances), run.steps_run, run.wall_time_s};
+  if (keep_ && out.score.passed && out.score.complete) {
+    const std::lock_guard<std::mutex> lock(kept_mutex_);
+    kept_.push_back({params, run, std::move(peak_world)});
+  }
   if (run_out) *run_out = std::move(run);
   return out;
+}
+
+bool same_params(const AlgorithmSpec& a, const AlgorithmSpec& b) {
+  return a.dt_ratio == b.dt_ratio && a.steps == b.steps &&
+         a.damping_ratio_translation == b.damping_ratio_translation &&
+         a.damping_ratio_rotation == b.damping_ratio_rotation && a.mass_scaling == b.mass_scaling &&
+         a.lock_rotation == b.lock_rotation;
+}
+
+std::optional<KeptTriaxialRun> TriaxialRunner::kept_run(const AlgorithmSpec& params) const {
+  const std::lock_guard<std::mutex> lock(kept_mutex_);
+  for (const auto& k : kept_)
+    if (same_params(k.params, params)) return k;
+  return std::nullopt;
 }
 
 }  // namespace demcal

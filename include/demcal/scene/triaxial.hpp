@@ -122,12 +122,17 @@ struct TriaxialResult {
 /// Called at each monitoring point; return false to stop early.
 using TriaxialMonitor = std::function<bool(const TriaxialPoint&)>;
 
+/// Called at each monitoring point, before the monitor, with the world
+/// there (read only; e.g. to copy the state at the peak).
+using TriaxialWorldObserver = std::function<void(const TriaxialPoint&, const SphereWorld&)>;
+
 /// Load a copy of the consolidated state; `final_state` receives the world
 /// at the end.
 TriaxialResult run_triaxial_loading(const TriaxialState& start, const TestSpec& test,
                                     const AlgorithmSpec& algorithm,
                                     const TriaxialMonitor& monitor = {},
-                                    SphereWorld* final_state = nullptr);
+                                    SphereWorld* final_state = nullptr,
+                                    const TriaxialWorldObserver& observe = {});
 
 /// σ1/σ3 at failure for the config's assembly when theory gives it: the
 /// walled FCC lattice (fcc_peak_ratio_walled, Thornton 1979, rotation

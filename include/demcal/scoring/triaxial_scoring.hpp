@@ -86,17 +86,38 @@ Score score_triaxial_run(const TriaxialResult& run, double s3, const Tolerances&
 /// The algorithmic parameters a triaxial run was made with.
 AlgorithmSpec run_parameters(const TriaxialResult& run);
 
+/// The rotational drag's share at one monitoring point, P_r/P_z (0 while
+/// the axial wall does no work): the series whose trend up to the peak is
+/// TriaxialCriteria::rotational_drag.
+double rotational_drag_share(const TriaxialPoint& point);
+
 /// The early stop of a triaxial trial: EarlyFailure (scoring.hpp) on each
 /// of the three planes, fed the same points compute_triaxial_criteria()
 /// scores; failed once any plane has certainly failed (the combined
-/// criteria are the planes' maxima).
+/// criteria are the planes' maxima), or once the rotational drag has:
+/// its trend at point k is final once kTrendHalfWidth more points are in,
+/// and it counts in the final maximum when k is at or before the running
+/// peak (the first most compressive b_zz so far: the final peak is that one
+/// or a later one, never an earlier one), so the largest such trend is a
+/// lower bound of the final drag. Trends after the running peak are not:
+/// the peak may already be passed, and they would not count.
 class TriaxialEarlyFailure {
  public:
   TriaxialEarlyFailure(const Tolerances& tolerances, double factor, int monitor_points, double s3);
   bool add(const TriaxialPoint& point);
+  /// The lower bound of the final rotational drag so far.
+  double rotational_drag_bound() const { return drag_bound_; }
 
  private:
   std::array<EarlyFailure, 3> planes_;
+  double drag_limit_;  ///< factor × kRotationalDragTolerance
+  int points_ = 0;     ///< added so far, the start included
+  double peak_ = 0.0;
+  int peak_index_ = -1;       ///< of the first most compressive b_zz so far
+  std::vector<double> drag_;  ///< drag_[j] is point j + 1 (the start is not scored)
+  size_t next_trend_ = 0;     ///< next drag_ index whose trend is taken
+  double drag_bound_ = 0.0;
+  bool failed_ = false;
 };
 
 /// What `demcal run` says of a 3D verdict: the 3D tolerances and what they hold.

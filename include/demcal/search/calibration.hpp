@@ -218,6 +218,14 @@ struct BaselineResult {
 BaselineResult paper_recipe_baseline(const SceneConfig& config, const ConsolidatedState& state,
                                      const Tolerances& tolerances, int64_t start_steps,
                                      int max_doublings = 8);
+/// The same on any scene (2D or 3D), through its trial runner; `base` gives
+/// what the recipe does not set (mass scaling, lock_rotation).
+BaselineResult paper_recipe_baseline(const TrialRunner& runner, const AlgorithmSpec& base,
+                                     const Tolerances& tolerances, int64_t start_steps,
+                                     int max_doublings = 8);
+/// One whole trial (no early stop) through a runner, as a record (id 0, phase search).
+TrialRecord run_trial(const TrialRunner& runner, const AlgorithmSpec& params,
+                      const Tolerances& tolerances);
 
 /// Run one trial and score it (no cache, no file).
 /// With `stop` set during the run, the run ends at its next monitoring

@@ -6,10 +6,14 @@
 //
 // The search's trials keep only their criteria (trials.jsonl), not their
 // series, so the report's runs are reruns: deterministic, they reproduce the
-// trials' numbers exactly.
+// trials' numbers exactly. In 3D the calibrate command reruns nothing of the
+// result: the search's runner keeps its series and its world at the peak
+// (TriaxialRunner::keep_passing_runs), and the start point runs beside the
+// search (KnownRuns3D); the report is the same.
 #pragma once
 
 #include <array>
+#include <atomic>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -20,6 +24,7 @@
 #include "demcal/scene/triaxial.hpp"
 #include "demcal/scoring/scoring.hpp"
 #include "demcal/search/calibration.hpp"
+#include "demcal/search/trial_runner.hpp"
 
 namespace demcal {
 
@@ -91,11 +96,29 @@ struct ResultRuns3D {
   std::optional<SpherePicture> picture;
   std::optional<SphereWorld> world;
 };
+
+/// One triaxial run with its series for the report, scored against
+/// `tolerances`. With `stop` set during the run it ends at its next
+/// monitoring point (run.stopped_early: not a run to show).
+ReportRun3D report_run(const SceneConfig& config, const TriaxialState& state,
+                       const std::string& label, const AlgorithmSpec& params,
+                       const Tolerances& tolerances, const std::atomic<bool>* stop = nullptr);
+
+/// What already ran, so that rerun_start_and_result() need not: the start
+/// point (report_run(), e.g. beside the search on an idle core) and the
+/// result as the search ran it (TriaxialRunner::kept_run()). Each is used
+/// only when it ran exactly the parameters asked for and to its end.
+struct KnownRuns3D {
+  std::optional<ReportRun3D> start;
+  std::optional<KeptTriaxialRun> best;
+};
+
 /// rerun_start_and_result() for a triaxial scene: the peak is the
-/// monitoring point of the most compressive b_zz.
+/// monitoring point of the most compressive b_zz. Runs only what `known`
+/// lacks; the result is the same either way (the runs are deterministic).
 ResultRuns3D rerun_start_and_result(const SceneConfig& config, const TriaxialState& state,
                                     const AlgorithmSpec& start, const CalibrationSummary& summary,
-                                    const Tolerances& tolerances, int jobs);
+                                    const Tolerances& tolerances, int jobs, KnownRuns3D known = {});
 
 /// The --evidence reference: the result's multipliers at 8× and 16× Nstep,
 /// and the peak extrapolated to infinite Nstep by richardson_limit(),
@@ -109,5 +132,9 @@ struct ReferenceEvidence {
 ReferenceEvidence run_refined_reference(const SceneConfig& config, const ConsolidatedState& state,
                                         const AlgorithmSpec& best, const Tolerances& tolerances,
                                         int jobs);
+/// The same on any scene through its trial runner (3D: the axial peak
+/// b_zz), without the fine run's series (fine_series stays empty).
+ReferenceEvidence run_refined_reference(const TrialRunner& runner, const AlgorithmSpec& best,
+                                        const Tolerances& tolerances, int jobs);
 
 }  // namespace demcal

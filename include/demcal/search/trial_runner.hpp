@@ -8,6 +8,9 @@
 
 #include <atomic>
 #include <cstdint>
+#include <mutex>
+#include <optional>
+#include <vector>
 
 #include "demcal/scene/biaxial.hpp"
 #include "demcal/scene/config.hpp"
@@ -59,6 +62,18 @@ class BiaxialRunner final : public TrialRunner {
   const ConsolidatedState& state_;
 };
 
+/// The same parameters, exactly (every member): the same run.
+bool same_params(const AlgorithmSpec& a, const AlgorithmSpec& b);
+
+/// A passing trial's run as the search ran it (TriaxialRunner::keep_passing_runs()):
+/// its series and the world at its monitored peak (the first most
+/// compressive b_zz), what the report would otherwise rerun.
+struct KeptTriaxialRun {
+  AlgorithmSpec params;  ///< as run (rounded by the search)
+  TriaxialResult run;
+  std::optional<SphereWorld> peak_world;
+};
+
 /// The triaxial test on a consolidated sphere sample: run_triaxial_loading()
 /// scored by score_triaxial_run(), early stop by TriaxialEarlyFailure.
 class TriaxialRunner final : public TrialRunner {
@@ -75,9 +90,20 @@ class TriaxialRunner final : public TrialRunner {
                double early_stop_factor, const std::atomic<bool>* stop,
                TriaxialResult* run_out) const;
 
+  /// Keep the run of every trial that passes, complete (set before the
+  /// search): the calibration's result is one of them, and kept_run() gives
+  /// it to the report without a rerun. Costs a copy of the world at each new
+  /// running peak of every trial, and the memory of the passing ones.
+  void keep_passing_runs(bool keep) { keep_ = keep; }
+  /// The kept run of a trial run with exactly `params`, if any.
+  std::optional<KeptTriaxialRun> kept_run(const AlgorithmSpec& params) const;
+
  private:
   const SceneConfig& config_;
   const TriaxialState& state_;
+  bool keep_ = false;
+  mutable std::mutex kept_mutex_;
+  mutable std::vector<KeptTriaxialRun> kept_;
 };
 
 }  // namespace demcal
