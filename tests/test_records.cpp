@@ -310,6 +310,46 @@ TEST(ScalingStudy, ASizeRoundTripsThroughItsJson) {
   EXPECT_THROW(scaling_size_from_json(json{{"particles", 3}}, "result.json"), InputError);
 }
 
+// A resumed study reads its sizes back from result.json and fixed.json:
+// a count there that is no whole number in range is the file's error,
+// naming the key (never a float-to-int cast of 5.9e110).
+TEST(ScalingStudy, ACountInAStoredSizeThatIsNoCountIsNamed) {
+  ScalingSize r;
+  r.requested = r.particles = 100;
+  r.calibrated = true;
+  r.best = sample_params();
+  r.trials = 30;
+  r.consolidation_steps = 4000;
+  r.fixed.found = true;
+  r.fixed.steps = 12345;
+  r.fixed.best = sample_trial();
+  r.fixed.trials = {sample_trial()};
+  const json good = to_json(r);
+  ASSERT_NO_THROW(scaling_size_from_json(good, "result.json"));
+  const std::vector<std::pair<std::string, std::string>> counts = {
+      {"/requested", "requested"},
+      {"/particles", "particles"},
+      {"/trials", "trials"},
+      {"/consolidation_steps", "consolidation_steps"},
+      {"/fixed_multipliers/steps", "fixed_multipliers.steps"}};
+  for (const auto& [pointer, field] : counts)
+    for (const json& v : {json(5.9e110), json(-1), json(2.5), json("7")}) {
+      json bad = good;
+      bad[json::json_pointer(pointer)] = v;
+      SCOPED_TRACE(pointer + " = " + v.dump());
+      try {
+        scaling_size_from_json(bad, "result.json");
+        ADD_FAILURE() << "accepted";
+      } catch (const InputError& e) {
+        EXPECT_EQ(e.file(), "result.json");
+        EXPECT_EQ(e.field(), field) << e.what();
+      }
+    }
+  json whole = good;
+  whole["particles"] = 100.0;  // a whole number written as a float reads
+  EXPECT_EQ(scaling_size_from_json(whole, "result.json").particles, 100);
+}
+
 TEST(ScalingStudy, ReportStatesTheVerdictAndTheLaw) {
   // A synthetic study: two calibrated sizes and a forward size where
   // Nstep grows exactly linearly.

@@ -182,6 +182,22 @@ TEST_F(RobustCli, DamagedTrialLineIsRefusedWithItsNumber) {
   expect_refused({"calibrate", kHex5, "-o", "A", "-q", "-j", "1", "--resume"}, "line 2");
 }
 
+// The trials.jsonl fuzzer's find: an id of 5.9e110 was a float-to-int cast
+// out of range; now the line is refused like any damaged one.
+TEST_F(RobustCli, TrialCountThatIsNoWholeNumberIsRefused) {
+  calibrate_a();
+  const fs::path trials = work() / "A" / "trials.jsonl";
+  const std::string text = read(trials);
+  const size_t end = text.find('\n');
+  for (const auto& [key, value] : std::vector<std::pair<std::string, nlohmann::json>>{
+           {"id", 5.9e110}, {"id", -1}, {"steps_run", 2.5}, {"steps_run", "7"}}) {
+    auto line = nlohmann::json::parse(text.substr(0, end));
+    line[key] = value;
+    std::ofstream(trials, std::ios::binary) << line.dump() << text.substr(end);
+    expect_refused({"calibrate", kHex5, "-o", "A", "-q", "-j", "1", "--resume"}, "line 1");
+  }
+}
+
 TEST_F(RobustCli, CutLastTrialLineIsRepaired) {
   calibrate_a();
   const fs::path trials = work() / "A" / "trials.jsonl";
@@ -224,6 +240,24 @@ TEST_F(RobustCli, ParamsFileIsValidated) {
     std::string text = good.dump();
     text.insert(1, "\"huge\": 1e999, ");
     expect_refused({cmd, write_params(text), "--particles", "100"}, "bad.json");
+    // Counts are read as whole numbers: 5.9e110 through get<int64_t>() was a
+    // float-to-int cast out of range (undefined behaviour), 2.5 particles
+    // and a dimension of 2^32 + 2 (read as an int: 2) passed.
+    for (const nlohmann::json& v :
+         {nlohmann::json(5.9e110), nlohmann::json(-3), nlohmann::json(2.5), nlohmann::json("7")})
+      expect_refused({cmd, with(ptr("/prototype/particles"), v), "--particles", "100"},
+                     "bad.json: prototype.particles");
+    for (const nlohmann::json& v : {nlohmann::json(5.9e110), nlohmann::json(4294967298u)})
+      expect_refused({cmd, with(ptr("/dimension"), v), "--particles", "100"},
+                     "bad.json: dimension");
+  }
+  // A scaling.json's dimension is read the same way.
+  const std::string params = (work() / "A" / "params.json").string();
+  for (const char* dimension : {"5.9e110", "4294967298", "2.5"}) {
+    std::ofstream(dir_ / "law.json")
+        << R"({"law": {"exponent": 1.0}, "dimension": )" << dimension << "}";
+    expect_refused({"upscale", params, "--particles", "100", "--law", (dir_ / "law.json").string()},
+                   "law.json: dimension");
   }
   // The good file passes the same reader.
   const Result r =

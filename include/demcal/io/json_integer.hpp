@@ -1,6 +1,8 @@
 // A whole number read from a JSON value without a cast that can overflow:
 // nlohmann's get<int>() on a float converts with static_cast, undefined
 // behaviour for 5e110 (the trials.jsonl fuzzer found it in a record's id).
+// Every count read from a file a user gives (config, params.json,
+// trials.jsonl, a scaling study's results) goes through here.
 #pragma once
 
 #include <cmath>
@@ -10,34 +12,57 @@
 #include <stdexcept>
 #include <string>
 
+#include "demcal/io/input_error.hpp"
+
 namespace demcal {
 
 /// `v` as an integer in [min, max]: a JSON integer, or a float that is a
 /// whole number of at most 2^53 (beyond it a double is not the number
 /// written). Throws std::invalid_argument for a non-number and
-/// std::out_of_range for anything else outside.
+/// std::out_of_range for anything else outside; the message says which
+/// ("must be ..., got VALUE", the value quoted and cut).
 inline int64_t json_integer(const nlohmann::json& v,
                             int64_t min = std::numeric_limits<int64_t>::min(),
                             int64_t max = std::numeric_limits<int64_t>::max()) {
-  if (!v.is_number()) throw std::invalid_argument("not a number: " + v.dump());
+  const auto range = [&] {
+    return std::out_of_range("must be between " + std::to_string(min) + " and " +
+                             std::to_string(max) + ", got " + quoted_value(v.dump()));
+  };
+  if (!v.is_number())
+    throw std::invalid_argument("must be a whole number, got " + std::string(v.type_name()) + " " +
+                                quoted_value(v.dump()));
   if (v.is_number_unsigned()) {
     const uint64_t u = v.get<uint64_t>();
-    if (max >= 0 && u <= static_cast<uint64_t>(max) &&
-        (min <= 0 || u >= static_cast<uint64_t>(min)))
-      return static_cast<int64_t>(u);
-  } else if (v.is_number_integer()) {
-    const int64_t i = v.get<int64_t>();
-    if (i >= min && i <= max) return i;
-  } else {
-    const double d = v.get<double>();
-    constexpr double kExact = 9007199254740992.0;  // 2^53
-    if (std::isfinite(d) && std::floor(d) == d && std::abs(d) <= kExact) {
-      const auto i = static_cast<int64_t>(d);  // exact, no overflow
-      if (i >= min && i <= max) return i;
-    }
+    if (max < 0 || u > static_cast<uint64_t>(max) || (min > 0 && u < static_cast<uint64_t>(min)))
+      throw range();
+    return static_cast<int64_t>(u);
   }
-  throw std::out_of_range("not a whole number between " + std::to_string(min) + " and " +
-                          std::to_string(max) + ": " + v.dump());
+  if (v.is_number_integer()) {
+    const int64_t i = v.get<int64_t>();
+    if (i < min || i > max) throw range();
+    return i;
+  }
+  const double d = v.get<double>();
+  if (!std::isfinite(d) || std::floor(d) != d)
+    throw std::out_of_range("must be a whole number, got " + quoted_value(v.dump()));
+  constexpr double kExact = 9007199254740992.0;  // 2^53
+  if (std::abs(d) > kExact)
+    throw std::out_of_range("must be written as an integer (" + v.dump() +
+                            " in exponent form is beyond 2^53, where a double is not exact)");
+  const auto i = static_cast<int64_t>(d);  // |d| <= 2^53: exact, no overflow
+  if (i < min || i > max) throw range();
+  return i;
+}
+
+/// json_integer for a value read from `file`: a value that is no count in
+/// [min, max] is an InputError naming the file and `field` (exit status 2).
+inline int64_t json_integer(const nlohmann::json& v, int64_t min, int64_t max,
+                            const std::string& file, const std::string& field) {
+  try {
+    return json_integer(v, min, max);
+  } catch (const std::logic_error& e) {  // invalid_argument, out_of_range
+    throw InputError(file, field, e.what());
+  }
 }
 
 }  // namespace demcal
