@@ -336,7 +336,7 @@ TEST(ScalingStudy, ACountInAStoredSizeThatIsNoCountIsNamed) {
     for (const json& v : {json(5.9e110), json(-1), json(2.5), json("7")}) {
       json bad = good;
       bad[json::json_pointer(pointer)] = v;
-      SCOPED_TRACE(pointer + " = " + v.dump());
+      SCOPED_TRACE(::testing::Message() << pointer << " = " << v.dump());
       try {
         scaling_size_from_json(bad, "result.json");
         ADD_FAILURE() << "accepted";

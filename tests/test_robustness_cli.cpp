@@ -198,6 +198,31 @@ TEST_F(RobustCli, TrialCountThatIsNoWholeNumberIsRefused) {
   }
 }
 
+// An engine's series.csv: a step or a count of 1e300 went through
+// static_cast<int64_t> (undefined behaviour); now the file and the column or
+// metadata key are named.
+TEST_F(RobustCli, SeriesCountThatIsNoWholeNumberIsRefused) {
+  const auto series = [&](const std::string& meta, const std::string& second_step,
+                          const std::string& last = "2,-0.02,1,0,0,1,1,0,0,1") {
+    std::ofstream(work() / "series.csv")
+        << "# lateral_stress = 1e5\n"
+        << meta << "step,strain_yy,b_xx,b_xy,b_yx,b_yy,s_xx,s_xy,s_yx,s_yy\n"
+        << "0,0,1,0,0,1,1,0,0,1\n"
+        << second_step << ",-0.01,1,0,0,1,1,0,0,1\n"
+        << last << "\n";
+    return std::vector<std::string>{"score", "series.csv", "-o", "out"};
+  };
+  for (const char* step : {"1e300", "2.5", "-1"})
+    expect_refused(series("", step), "series.csv: step");
+  expect_refused(series("# steps = 1e300\n", "1"), "series.csv: # steps");
+  expect_refused(series("# particles = 1e20\n", "1"), "series.csv: # particles");
+  // The row where the run diverged: its step is read the same way.
+  expect_refused(series("", "1", "1e300,nan,1,0,0,1,1,0,0,1"), "series.csv: line 5: step");
+  // The same file with whole counts is scored.
+  const Result r = demcal(series("# steps = 2\n# particles = 25\n", "1"));
+  EXPECT_EQ(r.status, 0) << r.err;
+}
+
 TEST_F(RobustCli, CutLastTrialLineIsRepaired) {
   calibrate_a();
   const fs::path trials = work() / "A" / "trials.jsonl";
