@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -18,21 +19,18 @@
 #include "demcal/search/calibration.hpp"
 #include "demcal/upscaling/params_file.hpp"
 #include "demcal/upscaling/scaling_study.hpp"
+#include "support/input_errors.hpp"
 
 using namespace demcal;
 using nlohmann::json;
 
 namespace {
 
-/// The message of the InputError `f` throws ("" when it does not throw).
-template <class F>
-std::string input_error_of(F&& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
+/// The message of the InputError `f` throws (the test fails when there is
+/// none, and this is "").
+std::string input_error_of(const std::function<void()>& f) {
+  const auto e = test::input_error(f);
+  return e ? e->what() : "";
 }
 
 AlgorithmSpec sample_params() {
@@ -337,13 +335,10 @@ TEST(ScalingStudy, ACountInAStoredSizeThatIsNoCountIsNamed) {
       json bad = good;
       bad[json::json_pointer(pointer)] = v;
       SCOPED_TRACE(::testing::Message() << pointer << " = " << v.dump());
-      try {
-        scaling_size_from_json(bad, "result.json");
-        ADD_FAILURE() << "accepted";
-      } catch (const InputError& e) {
-        EXPECT_EQ(e.file(), "result.json");
-        EXPECT_EQ(e.field(), field) << e.what();
-      }
+      const auto e = test::input_error([&] { scaling_size_from_json(bad, "result.json"); });
+      ASSERT_TRUE(e);
+      EXPECT_EQ(e->file(), "result.json");
+      EXPECT_EQ(e->field(), field) << e->what();
     }
   json whole = good;
   whole["particles"] = 100.0;  // a whole number written as a float reads

@@ -7,7 +7,6 @@
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <sys/file.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <filesystem>
@@ -15,68 +14,39 @@
 #include <functional>
 #include <map>
 #include <nlohmann/json.hpp>
-#include <sstream>
 #include <string>
 #include <vector>
+
+#include "support/files.hpp"
+#include "support/process.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
 
-const std::string kBinary = DEMCAL_BINARY;
-const std::string kSource = DEMCAL_SOURCE_DIR;
-const std::string kHex5 = kSource + "/configs/hex_5x5.json";
+using Result = demcal::test::RunResult;
+using demcal::test::read_text;
 
-std::string read(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-std::string quote(const std::string& s) {
-  std::string q = "'";
-  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
-
-struct Result {
-  int status = -1;
-  std::string out, err;
-};
+const std::string kHex5 = demcal::test::shipped_config("hex_5x5");
 
 /// Path → content of every file under `dir` (folders as "<dir>").
 std::map<std::string, std::string> snapshot(const fs::path& dir) {
   std::map<std::string, std::string> out;
   for (const auto& e : fs::recursive_directory_iterator(dir))
     out[fs::relative(e.path(), dir).string()] =
-        e.is_regular_file() ? std::to_string(std::hash<std::string>{}(read(e.path())))
+        e.is_regular_file() ? std::to_string(std::hash<std::string>{}(read_text(e.path())))
                             : std::string("<dir>");
   return out;
 }
 
 class RobustCli : public ::testing::Test {
  protected:
-  void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() /
-           ("demcal_test_robust_cli_" + std::to_string(::getpid()) + "_" + info->name());
-    fs::remove_all(dir_);
-    fs::create_directories(work());
-  }
-  void TearDown() override { fs::remove_all(dir_); }
+  void SetUp() override { fs::create_directories(work()); }
   fs::path work() const { return dir_ / "work"; }
 
+  /// demcal ARGS run in work(); its output captured outside it.
   Result demcal(const std::vector<std::string>& args) {
-    std::string cmd = "cd " + quote(work().string()) + " && " + quote(kBinary);
-    for (const auto& a : args) cmd += " " + quote(a);
-    cmd += " >" + quote((dir_ / "stdout").string()) + " 2>" + quote((dir_ / "stderr").string());
-    const int raw = std::system(cmd.c_str());
-    Result r;
-    r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-    r.out = read(dir_ / "stdout");
-    r.err = read(dir_ / "stderr");
-    return r;
+    return ::demcal::test::run_demcal(args, work());
   }
 
   /// Exit 2, one line on stderr naming `mention`, the work folder unchanged.
@@ -99,7 +69,8 @@ class RobustCli : public ::testing::Test {
     ASSERT_TRUE(fs::exists(work() / "A" / "resume.json"));
   }
 
-  fs::path dir_;
+  const demcal::test::TempDir tmp_{"robust_cli"};
+  const fs::path dir_ = tmp_.path();
 };
 
 // Every numeric option of every subcommand, at values that are never
@@ -157,7 +128,7 @@ TEST_F(RobustCli, ResumeWithTheSameSettingsReusesEveryTrial) {
   const Result r =
       demcal({"calibrate", kHex5, "-o", "A", "-q", "-j", "1", "--max-trials", "8", "--resume"});
   ASSERT_EQ(r.status, 0) << r.err;
-  const auto run = nlohmann::json::parse(read(work() / "A" / "run.json"));
+  const auto run = nlohmann::json::parse(read_text(work() / "A" / "run.json"));
   EXPECT_EQ(run["trials_run"].get<int>(), 0);
   EXPECT_GT(run["trials_reused"].get<int>(), 0);
 }
@@ -175,7 +146,7 @@ TEST_F(RobustCli, SecondCalibrationIntoALockedFolderIsRefused) {
 TEST_F(RobustCli, DamagedTrialLineIsRefusedWithItsNumber) {
   calibrate_a();
   const fs::path trials = work() / "A" / "trials.jsonl";
-  std::string text = read(trials);
+  std::string text = read_text(trials);
   const size_t second = text.find('\n') + 1;
   text.replace(second, text.find('\n', second) - second, "{\"garbage");
   std::ofstream(trials, std::ios::binary) << text;
@@ -187,7 +158,7 @@ TEST_F(RobustCli, DamagedTrialLineIsRefusedWithItsNumber) {
 TEST_F(RobustCli, TrialCountThatIsNoWholeNumberIsRefused) {
   calibrate_a();
   const fs::path trials = work() / "A" / "trials.jsonl";
-  const std::string text = read(trials);
+  const std::string text = read_text(trials);
   const size_t end = text.find('\n');
   for (const auto& [key, value] : std::vector<std::pair<std::string, nlohmann::json>>{
            {"id", 5.9e110}, {"id", -1}, {"steps_run", 2.5}, {"steps_run", "7"}}) {
@@ -226,12 +197,12 @@ TEST_F(RobustCli, SeriesCountThatIsNoWholeNumberIsRefused) {
 TEST_F(RobustCli, CutLastTrialLineIsRepaired) {
   calibrate_a();
   const fs::path trials = work() / "A" / "trials.jsonl";
-  const std::string whole = read(trials);
+  const std::string whole = read_text(trials);
   std::ofstream(trials, std::ios::binary | std::ios::app) << "{\"id\": 9";
   const Result r =
       demcal({"calibrate", kHex5, "-o", "A", "-q", "-j", "1", "--max-trials", "8", "--resume"});
   ASSERT_EQ(r.status, 0) << r.err;
-  EXPECT_EQ(read(trials), whole);  // the cut line gone, no trial rerun
+  EXPECT_EQ(read_text(trials), whole);  // the cut line gone, no trial rerun
 }
 
 TEST_F(RobustCli, TrialsFileThatIsAFolderIsOneLine) {
@@ -244,7 +215,7 @@ TEST_F(RobustCli, TrialsFileThatIsAFolderIsOneLine) {
 // params.json is checked like a config: file and key named, exit 2.
 TEST_F(RobustCli, ParamsFileIsValidated) {
   calibrate_a();
-  const auto good = nlohmann::json::parse(read(work() / "A" / "params.json"));
+  const auto good = nlohmann::json::parse(read_text(work() / "A" / "params.json"));
   auto write_params = [&](const std::string& text) {
     std::ofstream(dir_ / "bad.json", std::ios::binary) << text;
     return (dir_ / "bad.json").string();
