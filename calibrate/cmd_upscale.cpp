@@ -8,6 +8,7 @@
 
 #include "commands.hpp"
 #include "demcal/io/files.hpp"
+#include "demcal/io/json_integer.hpp"
 #include "demcal/scene/run_output.hpp"
 #include "demcal/upscaling/params_file.hpp"
 #include "demcal/upscaling/upscaling.hpp"
@@ -75,8 +76,8 @@ std::pair<std::string, int64_t> named_prototype(const nlohmann::json& params,
   const auto& p = params["prototype"];
   if (p.contains("source") && p["source"].contains("file"))
     return {p["source"]["file"].get<std::string>(), 0};
-  if (p.contains("particles") && p["particles"].is_number_integer())
-    return {"", p["particles"].get<int64_t>()};
+  if (p.contains("particles"))  // checked by read_params_file: 1 to kMaxParticles
+    return {"", json_integer(p["particles"], 1, kMaxParticles)};
   return {file, particles};
 }
 
@@ -93,9 +94,10 @@ ScalingLaw resolve_law(const nlohmann::json& params, const std::string& params_p
     const nlohmann::json j = read_json_file(law_path);
     if (!j.contains("law")) throw InputError(law_path, "law", "missing (not a scaling.json?)");
     // A law measured on disks is not one for spheres, nor the reverse.
-    const int law_dim = j.contains("dimension") && j["dimension"].is_number_integer()
-                            ? j["dimension"].get<int>()
-                            : 2;
+    const int law_dim =
+        j.contains("dimension")
+            ? static_cast<int>(json_integer(j["dimension"], 2, 3, law_path, "dimension"))
+            : 2;
     if (law_dim != params_dimension(params))
       throw InputError(law_path, "dimension",
                        "a law measured in " + std::to_string(law_dim) + "D, but " + params_path +
@@ -124,7 +126,7 @@ int cmd_upscale(const UpscaleOptions& o) {
   int64_t n_proto = 0;
   if (config) {
     block = prototype_block(*config, rev.params, rev.particles, law, o.particles, o.prototype);
-    n_proto = block.at("particles").get<int64_t>();
+    n_proto = json_integer(block.at("particles"), 1);
   } else {
     if (!o.prototype.empty())
       throw InputError(o.params, "config",

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -18,21 +19,18 @@
 #include "demcal/search/calibration.hpp"
 #include "demcal/upscaling/params_file.hpp"
 #include "demcal/upscaling/scaling_study.hpp"
+#include "support/input_errors.hpp"
 
 using namespace demcal;
 using nlohmann::json;
 
 namespace {
 
-/// The message of the InputError `f` throws ("" when it does not throw).
-template <class F>
-std::string input_error_of(F&& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
+/// The message of the InputError `f` throws (the test fails when there is
+/// none, and this is "").
+std::string input_error_of(const std::function<void()>& f) {
+  const auto e = test::input_error(f);
+  return e ? e->what() : "";
 }
 
 AlgorithmSpec sample_params() {
@@ -308,6 +306,43 @@ TEST(ScalingStudy, ASizeRoundTripsThroughItsJson) {
   const json j = to_json(r);
   EXPECT_EQ(to_json(scaling_size_from_json(j, "result.json")), j);
   EXPECT_THROW(scaling_size_from_json(json{{"particles", 3}}, "result.json"), InputError);
+}
+
+// A resumed study reads its sizes back from result.json and fixed.json:
+// a count there that is no whole number in range is the file's error,
+// naming the key (never a float-to-int cast of 5.9e110).
+TEST(ScalingStudy, ACountInAStoredSizeThatIsNoCountIsNamed) {
+  ScalingSize r;
+  r.requested = r.particles = 100;
+  r.calibrated = true;
+  r.best = sample_params();
+  r.trials = 30;
+  r.consolidation_steps = 4000;
+  r.fixed.found = true;
+  r.fixed.steps = 12345;
+  r.fixed.best = sample_trial();
+  r.fixed.trials = {sample_trial()};
+  const json good = to_json(r);
+  ASSERT_NO_THROW(scaling_size_from_json(good, "result.json"));
+  const std::vector<std::pair<std::string, std::string>> counts = {
+      {"/requested", "requested"},
+      {"/particles", "particles"},
+      {"/trials", "trials"},
+      {"/consolidation_steps", "consolidation_steps"},
+      {"/fixed_multipliers/steps", "fixed_multipliers.steps"}};
+  for (const auto& [pointer, field] : counts)
+    for (const json& v : {json(5.9e110), json(-1), json(2.5), json("7")}) {
+      json bad = good;
+      bad[json::json_pointer(pointer)] = v;
+      SCOPED_TRACE(::testing::Message() << pointer << " = " << v.dump());
+      const auto e = test::input_error([&] { scaling_size_from_json(bad, "result.json"); });
+      ASSERT_TRUE(e);
+      EXPECT_EQ(e->file(), "result.json");
+      EXPECT_EQ(e->field(), field) << e->what();
+    }
+  json whole = good;
+  whole["particles"] = 100.0;  // a whole number written as a float reads
+  EXPECT_EQ(scaling_size_from_json(whole, "result.json").particles, 100);
 }
 
 TEST(ScalingStudy, ReportStatesTheVerdictAndTheLaw) {

@@ -7,7 +7,6 @@
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <sys/file.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <filesystem>
@@ -15,68 +14,39 @@
 #include <functional>
 #include <map>
 #include <nlohmann/json.hpp>
-#include <sstream>
 #include <string>
 #include <vector>
+
+#include "support/files.hpp"
+#include "support/process.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
 
-const std::string kBinary = DEMCAL_BINARY;
-const std::string kSource = DEMCAL_SOURCE_DIR;
-const std::string kHex5 = kSource + "/configs/hex_5x5.json";
+using Result = demcal::test::RunResult;
+using demcal::test::read_text;
 
-std::string read(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-std::string quote(const std::string& s) {
-  std::string q = "'";
-  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
-
-struct Result {
-  int status = -1;
-  std::string out, err;
-};
+const std::string kHex5 = demcal::test::shipped_config("hex_5x5");
 
 /// Path → content of every file under `dir` (folders as "<dir>").
 std::map<std::string, std::string> snapshot(const fs::path& dir) {
   std::map<std::string, std::string> out;
   for (const auto& e : fs::recursive_directory_iterator(dir))
     out[fs::relative(e.path(), dir).string()] =
-        e.is_regular_file() ? std::to_string(std::hash<std::string>{}(read(e.path())))
+        e.is_regular_file() ? std::to_string(std::hash<std::string>{}(read_text(e.path())))
                             : std::string("<dir>");
   return out;
 }
 
 class RobustCli : public ::testing::Test {
  protected:
-  void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() /
-           ("demcal_test_robust_cli_" + std::to_string(::getpid()) + "_" + info->name());
-    fs::remove_all(dir_);
-    fs::create_directories(work());
-  }
-  void TearDown() override { fs::remove_all(dir_); }
+  void SetUp() override { fs::create_directories(work()); }
   fs::path work() const { return dir_ / "work"; }
 
+  /// demcal ARGS run in work(); its output captured outside it.
   Result demcal(const std::vector<std::string>& args) {
-    std::string cmd = "cd " + quote(work().string()) + " && " + quote(kBinary);
-    for (const auto& a : args) cmd += " " + quote(a);
-    cmd += " >" + quote((dir_ / "stdout").string()) + " 2>" + quote((dir_ / "stderr").string());
-    const int raw = std::system(cmd.c_str());
-    Result r;
-    r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-    r.out = read(dir_ / "stdout");
-    r.err = read(dir_ / "stderr");
-    return r;
+    return ::demcal::test::run_demcal(args, work());
   }
 
   /// Exit 2, one line on stderr naming `mention`, the work folder unchanged.
@@ -99,7 +69,8 @@ class RobustCli : public ::testing::Test {
     ASSERT_TRUE(fs::exists(work() / "A" / "resume.json"));
   }
 
-  fs::path dir_;
+  const demcal::test::TempDir tmp_{"robust_cli"};
+  const fs::path dir_ = tmp_.path();
 };
 
 // Every numeric option of every subcommand, at values that are never
@@ -157,7 +128,7 @@ TEST_F(RobustCli, ResumeWithTheSameSettingsReusesEveryTrial) {
   const Result r =
       demcal({"calibrate", kHex5, "-o", "A", "-q", "-j", "1", "--max-trials", "8", "--resume"});
   ASSERT_EQ(r.status, 0) << r.err;
-  const auto run = nlohmann::json::parse(read(work() / "A" / "run.json"));
+  const auto run = nlohmann::json::parse(read_text(work() / "A" / "run.json"));
   EXPECT_EQ(run["trials_run"].get<int>(), 0);
   EXPECT_GT(run["trials_reused"].get<int>(), 0);
 }
@@ -175,22 +146,63 @@ TEST_F(RobustCli, SecondCalibrationIntoALockedFolderIsRefused) {
 TEST_F(RobustCli, DamagedTrialLineIsRefusedWithItsNumber) {
   calibrate_a();
   const fs::path trials = work() / "A" / "trials.jsonl";
-  std::string text = read(trials);
+  std::string text = read_text(trials);
   const size_t second = text.find('\n') + 1;
   text.replace(second, text.find('\n', second) - second, "{\"garbage");
   std::ofstream(trials, std::ios::binary) << text;
   expect_refused({"calibrate", kHex5, "-o", "A", "-q", "-j", "1", "--resume"}, "line 2");
 }
 
+// The trials.jsonl fuzzer's find: an id of 5.9e110 was a float-to-int cast
+// out of range; now the line is refused like any damaged one.
+TEST_F(RobustCli, TrialCountThatIsNoWholeNumberIsRefused) {
+  calibrate_a();
+  const fs::path trials = work() / "A" / "trials.jsonl";
+  const std::string text = read_text(trials);
+  const size_t end = text.find('\n');
+  for (const auto& [key, value] : std::vector<std::pair<std::string, nlohmann::json>>{
+           {"id", 5.9e110}, {"id", -1}, {"steps_run", 2.5}, {"steps_run", "7"}}) {
+    auto line = nlohmann::json::parse(text.substr(0, end));
+    line[key] = value;
+    std::ofstream(trials, std::ios::binary) << line.dump() << text.substr(end);
+    expect_refused({"calibrate", kHex5, "-o", "A", "-q", "-j", "1", "--resume"}, "line 1");
+  }
+}
+
+// An engine's series.csv: a step or a count of 1e300 went through
+// static_cast<int64_t> (undefined behaviour); now the file and the column or
+// metadata key are named.
+TEST_F(RobustCli, SeriesCountThatIsNoWholeNumberIsRefused) {
+  const auto series = [&](const std::string& meta, const std::string& second_step,
+                          const std::string& last = "2,-0.02,1,0,0,1,1,0,0,1") {
+    std::ofstream(work() / "series.csv")
+        << "# lateral_stress = 1e5\n"
+        << meta << "step,strain_yy,b_xx,b_xy,b_yx,b_yy,s_xx,s_xy,s_yx,s_yy\n"
+        << "0,0,1,0,0,1,1,0,0,1\n"
+        << second_step << ",-0.01,1,0,0,1,1,0,0,1\n"
+        << last << "\n";
+    return std::vector<std::string>{"score", "series.csv", "-o", "out"};
+  };
+  for (const char* step : {"1e300", "2.5", "-1"})
+    expect_refused(series("", step), "series.csv: step");
+  expect_refused(series("# steps = 1e300\n", "1"), "series.csv: # steps");
+  expect_refused(series("# particles = 1e20\n", "1"), "series.csv: # particles");
+  // The row where the run diverged: its step is read the same way.
+  expect_refused(series("", "1", "1e300,nan,1,0,0,1,1,0,0,1"), "series.csv: line 5: step");
+  // The same file with whole counts is scored.
+  const Result r = demcal(series("# steps = 2\n# particles = 25\n", "1"));
+  EXPECT_EQ(r.status, 0) << r.err;
+}
+
 TEST_F(RobustCli, CutLastTrialLineIsRepaired) {
   calibrate_a();
   const fs::path trials = work() / "A" / "trials.jsonl";
-  const std::string whole = read(trials);
+  const std::string whole = read_text(trials);
   std::ofstream(trials, std::ios::binary | std::ios::app) << "{\"id\": 9";
   const Result r =
       demcal({"calibrate", kHex5, "-o", "A", "-q", "-j", "1", "--max-trials", "8", "--resume"});
   ASSERT_EQ(r.status, 0) << r.err;
-  EXPECT_EQ(read(trials), whole);  // the cut line gone, no trial rerun
+  EXPECT_EQ(read_text(trials), whole);  // the cut line gone, no trial rerun
 }
 
 TEST_F(RobustCli, TrialsFileThatIsAFolderIsOneLine) {
@@ -203,7 +215,7 @@ TEST_F(RobustCli, TrialsFileThatIsAFolderIsOneLine) {
 // params.json is checked like a config: file and key named, exit 2.
 TEST_F(RobustCli, ParamsFileIsValidated) {
   calibrate_a();
-  const auto good = nlohmann::json::parse(read(work() / "A" / "params.json"));
+  const auto good = nlohmann::json::parse(read_text(work() / "A" / "params.json"));
   auto write_params = [&](const std::string& text) {
     std::ofstream(dir_ / "bad.json", std::ios::binary) << text;
     return (dir_ / "bad.json").string();
@@ -224,6 +236,24 @@ TEST_F(RobustCli, ParamsFileIsValidated) {
     std::string text = good.dump();
     text.insert(1, "\"huge\": 1e999, ");
     expect_refused({cmd, write_params(text), "--particles", "100"}, "bad.json");
+    // Counts are read as whole numbers: 5.9e110 through get<int64_t>() was a
+    // float-to-int cast out of range (undefined behaviour), 2.5 particles
+    // and a dimension of 2^32 + 2 (read as an int: 2) passed.
+    for (const nlohmann::json& v :
+         {nlohmann::json(5.9e110), nlohmann::json(-3), nlohmann::json(2.5), nlohmann::json("7")})
+      expect_refused({cmd, with(ptr("/prototype/particles"), v), "--particles", "100"},
+                     "bad.json: prototype.particles");
+    for (const nlohmann::json& v : {nlohmann::json(5.9e110), nlohmann::json(4294967298u)})
+      expect_refused({cmd, with(ptr("/dimension"), v), "--particles", "100"},
+                     "bad.json: dimension");
+  }
+  // A scaling.json's dimension is read the same way.
+  const std::string params = (work() / "A" / "params.json").string();
+  for (const char* dimension : {"5.9e110", "4294967298", "2.5"}) {
+    std::ofstream(dir_ / "law.json")
+        << R"({"law": {"exponent": 1.0}, "dimension": )" << dimension << "}";
+    expect_refused({"upscale", params, "--particles", "100", "--law", (dir_ / "law.json").string()},
+                   "law.json: dimension");
   }
   // The good file passes the same reader.
   const Result r =

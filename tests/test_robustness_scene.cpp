@@ -273,6 +273,15 @@ TEST(RobustScene, IntegersAreReadAsIntegers) {
   expect_rejected(with_material(R"("assembly": {"type": "random", "seed": 9223372036854775808})"),
                   "assembly.seed", "between 0 and 9223372036854775807");
   expect_rejected(with_material(R"("calibration": {"seed": 1e300})"), "calibration.seed", "2^53");
+  // Not a whole number, or not a number at all: named as such.
+  expect_rejected(with_material(R"("assembly": {"type": "random", "count": 2.5})"),
+                  "assembly.count", "whole number");
+  expect_rejected(with_material(R"("assembly": {"type": "random", "count": "400"})"),
+                  "assembly.count", "whole number");
+  expect_rejected(with_material(R"("assembly": {"type": "random", "count": -400})"),
+                  "assembly.count", "between 2 and");
+  expect_rejected(with_material(R"("prototype": {"particles": 5.9e110})"), "prototype.particles",
+                  "2^53");
   // Whole numbers in exponent form within 2^53 are still integers.
   const SceneConfig e = parse_config_text(
       with_material(R"("assembly": {"type": "random", "seed": 4e15}, "algorithm": {"steps": 1e5})"),

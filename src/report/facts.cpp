@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "demcal/io/format.hpp"
+#include "demcal/io/json_integer.hpp"
 
 namespace demcal::report {
 
@@ -74,7 +75,7 @@ int64_t prototype_steps(const ReportInput& in) {
                                static_cast<double>(in.particles));
   if (in.params.is_object() && in.params.contains("prototype") &&
       in.params["prototype"].contains("steps"))
-    steps = in.params["prototype"]["steps"].get<int64_t>();
+    steps = json_integer(in.params["prototype"]["steps"], 1);
   return steps;
 }
 

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "demcal/io/files.hpp"
+#include "demcal/io/json_integer.hpp"
 
 namespace demcal {
 
@@ -69,35 +70,11 @@ class Reader {
     return d;
   }
   /// A whole number, read as an integer (never through a double that could
-  /// overflow the cast): 100000, or 1e5 in exponent form when that is exact
-  /// (at most 2^53; beyond it a double is not the number written).
+  /// overflow the cast): 100000, or 1e5 in exponent form when that is exact.
   int64_t integer(const std::string& key, int64_t fallback, int64_t min, int64_t max) {
     used_.insert(key);
     if (!has(key)) return fallback;
-    const json& v = object_.at(key);
-    const std::string range =
-        "must be between " + std::to_string(min) + " and " + std::to_string(max) + ", got ";
-    if (v.is_number_unsigned()) {
-      const uint64_t u = v.get<uint64_t>();
-      if (u > static_cast<uint64_t>(max) || (min > 0 && u < static_cast<uint64_t>(min)))
-        fail(key, range + v.dump());
-      return static_cast<int64_t>(u);
-    }
-    if (v.is_number_integer()) {
-      const int64_t i = v.get<int64_t>();
-      if (i < min || i > max) fail(key, range + v.dump());
-      return i;
-    }
-    if (!v.is_number_float() || std::floor(v.get<double>()) != v.get<double>())
-      fail(key, "must be a whole number, got " + quoted_value(v.dump()));
-    const double d = v.get<double>();
-    constexpr double kExact = 9007199254740992.0;  // 2^53
-    if (std::abs(d) > kExact)
-      fail(key, "must be written as an integer (" + v.dump() +
-                    " in exponent form is beyond 2^53, where a double is not exact)");
-    const auto i = static_cast<int64_t>(d);  // |d| <= 2^53: exact, no overflow
-    if (i < min || i > max) fail(key, range + v.dump());
-    return i;
+    return json_integer(object_.at(key), min, max, file_, field(key));
   }
   bool boolean(const std::string& key, bool fallback) {
     used_.insert(key);

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "demcal/io/input_error.hpp"
+#include "demcal/scene/packing.hpp"
 
 namespace demcal::detail {
 
@@ -105,14 +106,7 @@ void check_overlaps(const std::array<std::span<const double>, D>& x, std::span<c
           if (!same_row) break;
           const int j = static_cast<int>((*it)[D]);
           if (static_cast<int>(b) == level_of[i] && j <= i) continue;  // once per pair
-          double dist;
-          if constexpr (D == 2) {
-            dist = std::hypot(x[0][j] - x[0][i], x[1][j] - x[1][i]);
-          } else {
-            double d2 = 0.0;
-            for (size_t d = 0; d < D; ++d) d2 += (x[d][j] - x[d][i]) * (x[d][j] - x[d][i]);
-            dist = std::sqrt(d2);
-          }
+          const double dist = centre_distance<D>(x, i, j);
           const double overlap = r[i] + r[j] - dist;
           const double smaller = std::min(r[i], r[j]);
           if (overlap > 0.05 * smaller)

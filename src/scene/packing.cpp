@@ -80,6 +80,9 @@ Assembly random_gas(const AssemblySpec& spec) {
   return a;
 }
 
+namespace {
+
+/// The whole of `field` (blanks around it allowed) as a number.
 bool parse_particle_number(const std::string& field, double& value) {
   const char* s = field.c_str();
   char* end = nullptr;
@@ -87,6 +90,35 @@ bool parse_particle_number(const std::string& field, double& value) {
   if (end == s) return false;
   while (*end == ' ' || *end == '\t') ++end;
   return *end == '\0';
+}
+
+}  // namespace
+
+bool parse_particle_fields(const std::string& line, std::span<double> v, bool& seen_content,
+                           const std::string& path, const std::string& where) {
+  const size_t n = v.size();
+  std::vector<std::string> fields;
+  std::stringstream ss(line);
+  for (std::string f; std::getline(ss, f, ',');) fields.push_back(f);
+  size_t numbers = 0;
+  for (size_t k = 0; k < fields.size() && k < n; ++k)
+    numbers += parse_particle_number(fields[k], v[k]);
+  if (fields.size() != n || numbers != n) {
+    if (!seen_content && fields.size() == n && numbers == 0) {
+      seen_content = true;
+      return false;  // the header ("x,y,r")
+    }
+    throw InputError(path, where,
+                     std::string("expected ") +
+                         (n == 3 ? "three numbers x,y,r" : "four numbers x,y,z,r") + ", got " +
+                         quoted_value(line));
+  }
+  seen_content = true;
+  if (!std::all_of(v.begin(), v.end(), [](double x) { return std::isfinite(x); }))
+    throw InputError(path, where, "values must be finite, got " + quoted_value(line));
+  if (!(v[n - 1] > 0.0))
+    throw InputError(path, where, "radius must be > 0, got " + quoted_value(line));
+  return true;
 }
 
 void prepare_particle_line(std::string& line, int line_no, const std::string& path) {
@@ -99,10 +131,15 @@ void prepare_particle_line(std::string& line, int line_no, const std::string& pa
         "holds a NUL byte at column " + std::to_string(nul + 1) + " (not a text line)");
 }
 
-Assembly read_particle_file(const std::string& path) {
+std::ifstream open_particle_file(const std::string& path) {
   require_readable_file(path);  // a folder, a device, a symlink loop: one line, exit 2
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path, "", "cannot open particle file");
+  return in;
+}
+
+Assembly read_particle_file(const std::string& path) {
+  std::ifstream in = open_particle_file(path);
   return read_particles(in, path);
 }
 
@@ -135,29 +172,8 @@ Assembly read_particles(std::istream& in, const std::string& path) {
       continue;
     }
     if (first == std::string::npos || line[first] == '#') continue;
-    std::vector<std::string> fields;
-    std::stringstream ss(line);
-    std::string f;
-    while (std::getline(ss, f, ',')) fields.push_back(f);
     double v[3];
-    int numbers = 0;
-    for (size_t k = 0; k < fields.size() && k < 3; ++k)
-      numbers += parse_particle_number(fields[k], v[k]);
-    if (fields.size() != 3 || numbers != 3) {
-      // A header is the first line that is not blank or a comment, and has
-      // three fields none of which is a number ("x,y,r"); a line with some
-      // numbers is a broken particle line, never silently skipped.
-      if (!seen_content && fields.size() == 3 && numbers == 0) {
-        seen_content = true;
-        continue;
-      }
-      throw InputError(path, where(), "expected three numbers x,y,r, got " + quoted_value(line));
-    }
-    seen_content = true;
-    if (!std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2]))
-      throw InputError(path, where(), "values must be finite, got " + quoted_value(line));
-    if (!(v[2] > 0.0))
-      throw InputError(path, where(), "radius must be > 0, got " + quoted_value(line));
+    if (!parse_particle_fields(line, v, seen_content, path, where())) continue;  // the header
     // The overlap test adds a few radii to a coordinate: that must stay finite.
     if (!std::isfinite(std::abs(v[0]) + 4.0 * v[2]) || !std::isfinite(std::abs(v[1]) + 4.0 * v[2]))
       throw InputError(

@@ -87,9 +87,7 @@ std::string sphere_csv(const SphereAssembly& a) {
 }
 
 SphereAssembly read_sphere_file(const std::string& path) {
-  require_readable_file(path);  // a folder, a device, a symlink loop: one line, exit 2
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path, "", "cannot open particle file");
+  std::ifstream in = open_particle_file(path);
   return read_spheres(in, path);
 }
 
@@ -105,30 +103,8 @@ SphereAssembly read_spheres(std::istream& in, const std::string& path) {
     prepare_particle_line(line, line_no, path);  // the 2D reader's: BOM, CR, NUL
     const auto first = line.find_first_not_of(" \t");
     if (first == std::string::npos || line[first] == '#') continue;
-    std::vector<std::string> fields;
-    std::stringstream ss(line);
-    std::string f;
-    while (std::getline(ss, f, ',')) fields.push_back(f);
     double v[4];
-    int numbers = 0;
-    for (size_t k = 0; k < fields.size() && k < 4; ++k)
-      numbers += parse_particle_number(fields[k], v[k]);
-    if (fields.size() != 4 || numbers != 4) {
-      // The header is the first content line with four fields, none a
-      // number ("x,y,z,r"); a line with some numbers is a broken sphere
-      // line, never silently skipped.
-      if (!seen_content && fields.size() == 4 && numbers == 0) {
-        seen_content = true;
-        continue;
-      }
-      throw InputError(path, where(), "expected four numbers x,y,z,r, got " + quoted_value(line));
-    }
-    seen_content = true;
-    if (!std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2]) ||
-        !std::isfinite(v[3]))
-      throw InputError(path, where(), "values must be finite, got " + quoted_value(line));
-    if (!(v[3] > 0.0))
-      throw InputError(path, where(), "radius must be > 0, got " + quoted_value(line));
+    if (!parse_particle_fields(line, v, seen_content, path, where())) continue;  // the header
     a.x.push_back(v[0]);
     a.y.push_back(v[1]);
     a.z.push_back(v[2]);

@@ -3,9 +3,12 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 #include <sstream>
 
 #include "demcal/io/input_error.hpp"
+#include "demcal/io/json_integer.hpp"
+#include "demcal/scene/config.hpp"
 #include "demcal/scoring/triaxial_scoring.hpp"
 
 namespace demcal {
@@ -41,6 +44,17 @@ std::optional<double> meta_number(const ExternalSeries& s, const std::string& ke
   const auto it = s.meta.find(key);
   if (it == s.meta.end()) return std::nullopt;
   return parse_number(it->second, s.source, "# " + key);
+}
+
+/// A count of the file (a step, the particles): a whole number from 0 to
+/// `max`, never a cast of 1e300 to an integer (undefined behaviour).
+int64_t count(double v, const std::string& source, const std::string& where,
+              int64_t max = std::numeric_limits<int64_t>::max()) {
+  try {
+    return whole_number(v, 0, max, nlohmann::json(v).dump());
+  } catch (const std::out_of_range& e) {
+    throw InputError(source, where, e.what());
+  }
 }
 
 /// The file as read: its columns by name and its rows up to the first
@@ -97,7 +111,7 @@ Table read_table(const std::string& text, ExternalSeries& out) {
     if (!t.diverged &&
         std::any_of(row.begin(), row.end(), [](double v) { return !std::isfinite(v); })) {
       t.diverged = true;  // the engine's run blew up here: score what came before
-      t.diverged_step = static_cast<int64_t>(std::isfinite(row[0]) ? row[0] : -1);
+      t.diverged_step = std::isfinite(row[0]) ? count(row[0], source, where + ": step") : -1;
     }
     if (!t.diverged && !t.rows.empty() && row[0] == t.rows.back()[0]) continue;
     if (!t.diverged) t.rows.push_back(std::move(row));
@@ -137,7 +151,7 @@ void read_biaxial_rows(const Table& t, ExternalSeries& out) {
   out.torque_column = t.has("torque_stress");
   for (const auto& row : t.rows) {
     MonitorPoint p;
-    p.step = static_cast<int64_t>(t.value(row, "step", 0));
+    p.step = count(t.value(row, "step", 0), out.source, "step");
     p.strain_yy = t.value(row, "strain_yy", 0);
     for (int i = 0; i < 2; ++i)
       for (int j = 0; j < 2; ++j) {
@@ -175,7 +189,7 @@ void read_triaxial_rows(const Table& t, ExternalSeries& out) {
   const double s3 = out.lateral_stress;
   for (const auto& row : t.rows) {
     TriaxialPoint p;
-    p.step = static_cast<int64_t>(t.value(row, "step", 0));
+    p.step = count(t.value(row, "step", 0), out.source, "step");
     p.strain_zz = t.value(row, "strain_zz", 0);
     for (int i = 0; i < 3; ++i)
       for (int j = 0; j < 3; ++j) {
@@ -210,7 +224,7 @@ void read_run_facts(const Table& t, const ExternalSeries& out, Run& run) {
   const int64_t last = series.empty() ? 0 : series.back().step;
   const int64_t interval = series.size() >= 2 ? last - series[series.size() - 2].step : 0;
   const auto steps = meta_number(out, "steps");
-  run.steps_planned = steps ? static_cast<int64_t>(*steps) : last;
+  run.steps_planned = steps ? count(*steps, out.source, "# steps") : last;
   run.steps_run =
       (!t.diverged && steps && last < run.steps_planned && run.steps_planned - last < interval)
           ? run.steps_planned
@@ -220,7 +234,8 @@ void read_run_facts(const Table& t, const ExternalSeries& out, Run& run) {
     run.divergence = Divergence::kNotFinite;
     run.divergence_step = t.diverged_step;
   }
-  run.particles = static_cast<int>(meta_number(out, "particles").value_or(0));
+  run.particles = static_cast<int>(
+      count(meta_number(out, "particles").value_or(0), out.source, "# particles", kMaxParticles));
   run.integration.dt = meta_number(out, "dt").value_or(0);
   run.scales.dt_crit = meta_number(out, "dt_crit").value_or(0);
   run.integration.damping_ratio_translation =

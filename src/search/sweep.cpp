@@ -353,17 +353,24 @@ SweepRun sweep_run(const Run& run, std::string series) {
           run.steps_planned, run.integration.dt, run.wall_time_s,     std::move(series)};
 }
 
+/// What a sweep records of its scene and sample, disks and spheres alike.
+SweepResult sweep_of(const SceneConfig& config, int dimension, int particles,
+                     double consolidation_time_s) {
+  SweepResult res;
+  res.scene = config.name;
+  res.dimension = dimension;
+  res.particles = particles;
+  res.benchmark = config.algorithm;
+  res.lateral_stress = config.test.lateral_stress;
+  res.consolidation_time_s = consolidation_time_s;
+  return res;
+}
+
 }  // namespace
 
 SweepResult run_sweep(const SceneConfig& config, const ConsolidatedState& state,
                       const std::vector<SweepCase>& cases, const SweepSettings& settings) {
-  SweepResult res;
-  res.scene = config.name;
-  res.dimension = 2;
-  res.particles = state.world.size();
-  res.benchmark = config.algorithm;
-  res.lateral_stress = config.test.lateral_stress;
-  res.consolidation_time_s = state.wall_time_s;
+  SweepResult res = sweep_of(config, 2, state.world.size(), state.wall_time_s);
   res.analytical_peak = analytical_peak_stress(config);
   res.alpha_stable = state.world.stability_estimate().dt_ratio_stable;
   const double s3 = config.test.lateral_stress;
@@ -379,13 +386,7 @@ SweepResult run_sweep(const SceneConfig& config, const ConsolidatedState& state,
 
 SweepResult run_sweep(const SceneConfig& config, const TriaxialState& state,
                       const std::vector<SweepCase>& cases, const SweepSettings& settings) {
-  SweepResult res;
-  res.scene = config.name;
-  res.dimension = 3;
-  res.particles = state.world.size();
-  res.benchmark = config.algorithm;
-  res.lateral_stress = config.test.lateral_stress;
-  res.consolidation_time_s = state.wall_time_s;
+  SweepResult res = sweep_of(config, 3, state.world.size(), state.wall_time_s);
   const double s3 = config.test.lateral_stress;
   if (const auto ratio = analytical_peak_ratio_3d(config)) res.analytical_peak = -*ratio * s3;
   res.alpha_stable = estimated_stable_dt_ratio(state, config.algorithm);

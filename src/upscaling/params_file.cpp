@@ -4,6 +4,7 @@
 #include <string_view>
 
 #include "demcal/io/files.hpp"
+#include "demcal/io/json_integer.hpp"
 #include "demcal/scene/triaxial.hpp"
 #include "demcal/scoring/trial.hpp"
 #include "demcal/upscaling/upscaling.hpp"
@@ -40,22 +41,25 @@ nlohmann::json parse_params_text(std::string_view text, const std::string& path)
                        "must be a demcal version string, got " + quoted_value(version->dump()));
   }
   if (const auto d = params.find("dimension"); d != params.end())
-    if (!d->is_number_integer() || (d->get<int64_t>() != 2 && d->get<int64_t>() != 3))
-      throw InputError(path, "dimension", "must be 2 or 3, got " + quoted_value(d->dump()));
+    json_integer(*d, 2, 3, path, "dimension");
   if (params.contains("prototype") && params["prototype"].is_object() &&
       params["prototype"].contains("particles")) {
     const auto& n = params["prototype"]["particles"];
-    if (!n.is_number_integer() || n.get<int64_t>() < 1 || n.get<int64_t>() > kMaxParticles)
+    try {
+      json_integer(n, 1, kMaxParticles);
+    } catch (const std::logic_error&) {
       throw InputError(path, "prototype.particles",
                        std::string("must be a whole number from 1 to ") + kMaxParticlesWhy +
                            ", got " + quoted_value(n.dump()));
+    }
   }
   return params;
 }
 
 int params_dimension(const nlohmann::json& params) {
+  // parse_params_text has checked it: 2 or 3 when present.
   const auto d = params.find("dimension");
-  return d != params.end() && d->is_number_integer() ? static_cast<int>(d->get<int64_t>()) : 2;
+  return d != params.end() ? static_cast<int>(json_integer(*d, 2, 3)) : 2;
 }
 
 double particle_steps_run(const std::vector<TrialRecord>& trials, int64_t particles) {
@@ -115,7 +119,7 @@ nlohmann::json params_file(const SceneConfig& config, const TriaxialState& state
   // the default 3D law (N^(2/3); `demcal upscale --law` applies another).
   const ScalingLaw law = default_law(3);
   nlohmann::json prototype = prototype_block(config, summary.best, n_rev, law);
-  const int64_t n_proto = prototype.at("particles").get<int64_t>();
+  const int64_t n_proto = json_integer(prototype.at("particles"), 1);
   nlohmann::json params = calibration_record(config, n_rev, options, summary);
   params["schema"] = kParamsSchema;
   params["dimension"] = 3;

@@ -8,6 +8,8 @@
 #include <random>
 #include <sstream>
 
+#include "cut_window.hpp"
+#include "demcal/scene/packing.hpp"
 #include "demcal/upscaling/rev_3d.hpp"
 
 namespace demcal {
@@ -248,14 +250,7 @@ PackingStats stats_of(const std::array<std::span<const double>, D>& x, std::span
       for (; it != keyed.end() && it->first == key; ++it) {
         const int j = it->second;
         if (j <= i) continue;
-        double dist;
-        if constexpr (D == 2) {
-          dist = std::hypot(x[0][j] - x[0][i], x[1][j] - x[1][i]);
-        } else {
-          double d2 = 0.0;
-          for (size_t d = 0; d < D; ++d) d2 += (x[d][j] - x[d][i]) * (x[d][j] - x[d][i]);
-          dist = std::sqrt(d2);
-        }
+        const double dist = centre_distance<D>(x, i, j);
         if (dist < (r[i] + r[j]) * (1.0 + tol)) {
           ++contacts[i];
           ++contacts[j];
@@ -440,11 +435,7 @@ Assembly gas_of_radii(std::vector<double> radii, double aspect, uint64_t seed) {
 
 Assembly cut_rev(const Assembly& proto, int64_t count, double aspect) {
   const int n = proto.size();
-  if (count < 2) throw InputError("REV", "particles", "needs at least 2 particles");
-  if (count > n)
-    throw InputError("REV", "particles",
-                     "asked for " + std::to_string(count) + " particles, the prototype has only " +
-                         std::to_string(n));
+  detail::check_rev_count(count, n, "particles");
   const double cx = 0.5 * (proto.left + proto.right), cy = 0.5 * (proto.bottom + proto.top);
   const double w = proto.right - proto.left, h = proto.top - proto.bottom;
   if (!(aspect > 0.0)) aspect = h > 0.0 ? w / h : 1.0;
@@ -453,18 +444,7 @@ Assembly cut_rev(const Assembly& proto, int64_t count, double aspect) {
   auto inside = [&](double s, int i) {
     return std::abs(proto.x[i] - cx) <= 0.5 * s * aspect && std::abs(proto.y[i] - cy) <= 0.5 * s;
   };
-  auto count_at = [&](double s) {
-    int64_t c = 0;
-    for (int i = 0; i < n; ++i) c += inside(s, i);
-    return c;
-  };
-  double lo = 0.0, hi = 2.0 * std::max(h, w / aspect) + 1e-12;
-  for (int it = 0; it < 200 && hi - lo > 1e-14 * hi; ++it) {
-    const double mid = 0.5 * (lo + hi);
-    (count_at(mid) >= count ? hi : lo) = mid;
-  }
-  const int64_t c_hi = count_at(hi), c_lo = count_at(lo);
-  const double s = (c_lo >= 2 && count - c_lo < c_hi - count) ? lo : hi;
+  const double s = detail::window_scale(n, count, 2.0 * std::max(h, w / aspect) + 1e-12, inside);
   Assembly a;
   for (int i = 0; i < n; ++i) {
     if (!inside(s, i)) continue;

@@ -8,17 +8,14 @@
 #include <limits>
 #include <random>
 
+#include "cut_window.hpp"
 #include "demcal/io/input_error.hpp"
 
 namespace demcal {
 
 SphereAssembly cut_rev(const SphereAssembly& proto, int64_t count, double aspect) {
   const int n = proto.size();
-  if (count < 2) throw InputError("REV", "particles", "needs at least 2 particles");
-  if (count > n)
-    throw InputError("REV", "particles",
-                     "asked for " + std::to_string(count) + " spheres, the prototype has only " +
-                         std::to_string(n));
+  detail::check_rev_count(count, n, "spheres");
   // The window's half-edges are s·e[d]/2, centred on the box centre; the
   // count of centres inside is monotone in s.
   std::array<double, 3> centre, edge;
@@ -35,21 +32,11 @@ SphereAssembly cut_rev(const SphereAssembly& proto, int64_t count, double aspect
       if (!(std::abs((*pos[d])[i] - centre[d]) <= 0.5 * s * edge[d])) return false;
     return true;
   };
-  auto count_at = [&](double s) {
-    int64_t c = 0;
-    for (int i = 0; i < n; ++i) c += inside(s, i);
-    return c;
-  };
   // Every centre is inside at s = 2·(largest edge/smallest relative edge).
-  double lo = 0.0, hi = 1e-12;
+  double hi = 1e-12;
   for (int d = 0; d < 3; ++d)
     hi = std::max(hi, 2.0 * (proto.hi[d] - proto.lo[d]) / std::max(edge[d], 1e-12));
-  for (int it = 0; it < 200 && hi - lo > 1e-14 * hi; ++it) {
-    const double mid = 0.5 * (lo + hi);
-    (count_at(mid) >= count ? hi : lo) = mid;
-  }
-  const int64_t c_hi = count_at(hi), c_lo = count_at(lo);
-  const double s = (c_lo >= 2 && count - c_lo < c_hi - count) ? lo : hi;
+  const double s = detail::window_scale(n, count, hi, inside);
   SphereAssembly a;
   for (int i = 0; i < n; ++i) {
     if (!inside(s, i)) continue;

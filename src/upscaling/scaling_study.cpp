@@ -5,12 +5,14 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <sstream>
 
 #include "demcal/io/files.hpp"
 #include "demcal/io/format.hpp"
+#include "demcal/io/json_integer.hpp"
 #include "demcal/scene/packing.hpp"
 #include "demcal/scene/run_output.hpp"
 #include "demcal/scene/triaxial.hpp"
@@ -66,25 +68,33 @@ json to_json(const ScalingSize& r) {
 }
 
 ScalingSize scaling_size_from_json(const json& j, const std::string& source) {
+  // A count the file holds: a whole number in [min, max], or an InputError
+  // naming the file and the key (never a cast of 5e110 to an integer).
+  constexpr int64_t kAny = std::numeric_limits<int64_t>::max();
+  const auto count = [&source](const json& block, const std::string& key, int64_t min, int64_t max,
+                               const std::string& where = "") {
+    return json_integer(block.at(key), min, max, source, where + key);
+  };
   try {
     ScalingSize r;
-    r.requested = j.at("requested").get<int64_t>();
-    r.particles = j.at("particles").get<int64_t>();
+    r.requested = count(j, "requested", 1, kMaxParticles);
+    r.particles = count(j, "particles", 1, kMaxParticles);
     r.calibrated = j.at("calibrated").get<bool>();
-    r.consolidation_steps = j.value("consolidation_steps", int64_t{0});
+    if (j.contains("consolidation_steps"))
+      r.consolidation_steps = count(j, "consolidation_steps", 0, kAny);
     r.consolidation_s = j.value("consolidation_wall_time_s", 0.0);
     if (r.calibrated) {
       r.success = j.at("success").get<bool>();
       r.best = algorithm_from_json(j.at("best"), source, "best");
       r.richardson = j.at("richardson_error").get<double>();
       r.peak = j.at("peak_stress_yy").get<double>();
-      r.trials = j.at("trials").get<int>();
+      r.trials = static_cast<int>(count(j, "trials", 0, std::numeric_limits<int>::max()));
       r.wall_time_s = j.at("wall_time_s").get<double>();
     }
     if (j.contains("fixed_multipliers")) {
       const json& f = j.at("fixed_multipliers");
       r.fixed.found = f.at("found").get<bool>();
-      r.fixed.steps = f.at("steps").get<int64_t>();
+      r.fixed.steps = count(f, "steps", 0, kAny, "fixed_multipliers.");
       r.fixed.wall_time_s = f.value("wall_time_s", 0.0);
       if (r.fixed.found)
         r.fixed.best = trial_from_json(f.at("best"), source + ": fixed_multipliers.best");

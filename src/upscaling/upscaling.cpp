@@ -134,94 +134,117 @@ SceneConfig scene_of_size(const SceneConfig& config, int64_t particles) {
   return c;
 }
 
+namespace {
+
+/// Which prototype a command describes, in the order the flags and the
+/// config are asked: a particle file given (--prototype), a count given
+/// (--particles), the config's prototype.file, its prototype.particles,
+/// else the REV itself. Disks and spheres alike.
+struct PrototypeChoice {
+  enum Kind { kFile, kCount, kRev } kind = kRev;
+  std::string file;
+  int64_t particles = 0;
+};
+
+PrototypeChoice choose_prototype(const SceneConfig& config, int64_t particles,
+                                 const std::string& file) {
+  if (!file.empty()) return {PrototypeChoice::kFile, file, 0};
+  if (particles > 0) return {PrototypeChoice::kCount, "", particles};
+  if (!config.prototype.file.empty()) return {PrototypeChoice::kFile, config.prototype.file, 0};
+  if (config.prototype.particles > 0)
+    return {PrototypeChoice::kCount, "", config.prototype.particles};
+  return {};
+}
+
+/// What the prototype `choice` gave, `size` `noun` ("particles",
+/// "spheres"); a generated one says how in `generated`.
+PrototypeSource prototype_source(const PrototypeChoice& choice, int64_t size,
+                                 const std::string& noun, std::string generated) {
+  PrototypeSource src;
+  src.particles = size;
+  switch (choice.kind) {
+    case PrototypeChoice::kFile:
+      src.kind = "file";
+      src.file = choice.file;
+      src.description = std::to_string(size) + " " + noun + " read from " + choice.file;
+      break;
+    case PrototypeChoice::kCount:
+      src.kind = "generated";
+      src.description = std::move(generated);
+      break;
+    case PrototypeChoice::kRev:
+      src.kind = "rev";
+      src.description = "the REV itself (" + std::to_string(size) + " " + noun + ")";
+      break;
+  }
+  return src;
+}
+
+/// `n` disks: the config's generator resized, or for a REV read from a
+/// file (no generator to resize) a gas of radii drawn from that file.
+Assembly generated_disks(const SceneConfig& config, int64_t n, std::string& description) {
+  if (config.assembly.type == "file") {
+    const Assembly rev = read_particle_file(config.assembly.file);
+    description = std::to_string(n) + " particles with radii drawn from " + config.assembly.file;
+    return gas_of_radii(resample_radii(rev.r, n, config.calibration.seed), 1.0,
+                        config.calibration.seed);
+  }
+  const SceneConfig c = scene_of_size(config, n);
+  Assembly a = make_assembly(c);
+  description = std::to_string(a.size()) + " particles from the " + c.assembly.type +
+                " generator of " + config.name;
+  return a;
+}
+
+/// `n` spheres, likewise (an fcc generator names its cells).
+SphereAssembly generated_spheres(const SceneConfig& config, int64_t n, std::string& description) {
+  if (config.assembly.type == "file") {
+    SphereAssembly a =
+        generate_rev(read_sphere_file(config.assembly.file), n, config.calibration.seed);
+    description =
+        std::to_string(a.size()) + " spheres with radii drawn from " + config.assembly.file;
+    return a;
+  }
+  const SceneConfig c = scene_of_size(config, n);
+  SphereAssembly a = make_sphere_assembly(c);
+  const auto& s = c.assembly;
+  description =
+      std::to_string(a.size()) + " spheres from the " + s.type + " generator of " + config.name +
+      (s.type == "fcc" ? " (" + std::to_string(s.cells_x) + "x" + std::to_string(s.cells_y) + "x" +
+                             std::to_string(s.cells_z) + " cells)"
+                       : std::string());
+  return a;
+}
+
+}  // namespace
+
 Assembly prototype_assembly(const SceneConfig& config, int64_t particles, const std::string& file,
                             PrototypeSource* source) {
-  PrototypeSource src;
+  const PrototypeChoice choice = choose_prototype(config, particles, file);
+  std::string generated;
   Assembly a;
-  auto generated = [&](int64_t n) {
-    src.kind = "generated";
-    if (config.assembly.type == "file") {
-      // No generator to resize: draw the radii from the REV's file.
-      const Assembly rev = read_particle_file(config.assembly.file);
-      a = gas_of_radii(resample_radii(rev.r, n, config.calibration.seed), 1.0,
-                       config.calibration.seed);
-      src.description =
-          std::to_string(n) + " particles with radii drawn from " + config.assembly.file;
-    } else {
-      const SceneConfig c = scene_of_size(config, n);
-      a = make_assembly(c);
-      src.description = std::to_string(a.size()) + " particles from the " + c.assembly.type +
-                        " generator of " + config.name;
-    }
-  };
-  if (!file.empty()) {
-    a = read_particle_file(file);
-    src.kind = "file";
-    src.file = file;
-    src.description = std::to_string(a.size()) + " particles read from " + file;
-  } else if (particles > 0) {
-    generated(particles);
-  } else if (!config.prototype.file.empty()) {
-    a = read_particle_file(config.prototype.file);
-    src.kind = "file";
-    src.file = config.prototype.file;
-    src.description = std::to_string(a.size()) + " particles read from " + src.file;
-  } else if (config.prototype.particles > 0) {
-    generated(config.prototype.particles);
-  } else {
+  if (choice.kind == PrototypeChoice::kFile)
+    a = read_particle_file(choice.file);
+  else if (choice.kind == PrototypeChoice::kCount)
+    a = generated_disks(config, choice.particles, generated);
+  else
     a = make_assembly(config);
-    src.kind = "rev";
-    src.description = "the REV itself (" + std::to_string(a.size()) + " particles)";
-  }
-  src.particles = a.size();
-  if (source) *source = src;
+  if (source) *source = prototype_source(choice, a.size(), "particles", std::move(generated));
   return a;
 }
 
 SphereAssembly prototype_spheres(const SceneConfig& config, int64_t particles,
                                  const std::string& file, PrototypeSource* source) {
-  PrototypeSource src;
+  const PrototypeChoice choice = choose_prototype(config, particles, file);
+  std::string generated;
   SphereAssembly a;
-  auto read = [&](const std::string& path) {
-    a = read_sphere_file(path);
-    src.kind = "file";
-    src.file = path;
-    src.description = std::to_string(a.size()) + " spheres read from " + path;
-  };
-  auto generated = [&](int64_t n) {
-    if (config.assembly.type == "file") {
-      // No generator to resize: the REV file's radii drawn into a gas of n.
-      a = generate_rev(read_sphere_file(config.assembly.file), n, config.calibration.seed);
-      src.kind = "generated";
-      src.description =
-          std::to_string(a.size()) + " spheres with radii drawn from " + config.assembly.file;
-      return;
-    }
-    const SceneConfig c = scene_of_size(config, n);
-    a = make_sphere_assembly(c);
-    src.kind = "generated";
-    const auto& s = c.assembly;
-    src.description =
-        std::to_string(a.size()) + " spheres from the " + s.type + " generator of " + config.name +
-        (s.type == "fcc" ? " (" + std::to_string(s.cells_x) + "x" + std::to_string(s.cells_y) +
-                               "x" + std::to_string(s.cells_z) + " cells)"
-                         : std::string());
-  };
-  if (!file.empty()) {
-    read(file);
-  } else if (particles > 0) {
-    generated(particles);
-  } else if (!config.prototype.file.empty()) {
-    read(config.prototype.file);
-  } else if (config.prototype.particles > 0) {
-    generated(config.prototype.particles);
-  } else {
+  if (choice.kind == PrototypeChoice::kFile)
+    a = read_sphere_file(choice.file);
+  else if (choice.kind == PrototypeChoice::kCount)
+    a = generated_spheres(config, choice.particles, generated);
+  else
     a = make_sphere_assembly(config);
-    src.kind = "rev";
-    src.description = "the REV itself (" + std::to_string(a.size()) + " spheres)";
-  }
-  src.particles = a.size();
-  if (source) *source = src;
+  if (source) *source = prototype_source(choice, a.size(), "spheres", std::move(generated));
   return a;
 }
 

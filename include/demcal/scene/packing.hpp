@@ -1,7 +1,12 @@
 // Particle assemblies: generators and the particle-file reader.
 #pragma once
 
+#include <array>
+#include <cmath>
+#include <cstddef>
+#include <fstream>
 #include <istream>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -41,13 +46,39 @@ inline constexpr const char kParticleFileWalls[] = "# walls left right bottom to
 Assembly read_particle_file(const std::string& path);
 /// The same from a stream; `source` names it in errors.
 Assembly read_particles(std::istream& in, const std::string& source);
+/// A particle file opened for the 2D and the sphere readers (binary: they
+/// drop a CR themselves). A folder, a device, a symlink loop or a file that
+/// cannot be opened is one InputError naming it (exit 2).
+std::ifstream open_particle_file(const std::string& path);
 /// A particle-file line made ready to split, for the 2D and the sphere
 /// readers: the UTF-8 BOM of line 1 and a trailing CR dropped. A NUL byte
 /// (strtod would stop at it and take "1.5\0garbage" for 1.5) is an
 /// InputError naming `path` and the line.
 void prepare_particle_line(std::string& line, int line_no, const std::string& path);
-/// The whole of `field` (blanks around it allowed) as a number.
-bool parse_particle_number(const std::string& field, double& value);
+/// The distance between the centres of particles i and j of a packing held
+/// as coordinate arrays (x, y[, z]): std::hypot for disks, the root of the
+/// sum of squares for spheres. The particle files' overlap check and the
+/// REV's contact count measure pairs by it.
+template <size_t D>
+double centre_distance(const std::array<std::span<const double>, D>& x, int i, int j) {
+  if constexpr (D == 2) {
+    return std::hypot(x[0][j] - x[0][i], x[1][j] - x[1][i]);
+  } else {
+    double d2 = 0.0;
+    for (size_t d = 0; d < D; ++d) d2 += (x[d][j] - x[d][i]) * (x[d][j] - x[d][i]);
+    return std::sqrt(d2);
+  }
+}
+
+/// One content line of a particle file (neither blank nor a comment), for
+/// the 2D and the sphere readers: v.size() comma-separated numbers, the
+/// position then the radius (x,y,r; x,y,z,r), each finite, the radius > 0:
+/// true, the numbers in `v`. The first content line (`seen_content` still
+/// false) whose fields are none of them numbers is the header: false.
+/// Anything else is an InputError naming `path` and `where` (a line with
+/// some numbers is a broken particle line, never silently skipped).
+bool parse_particle_fields(const std::string& line, std::span<double> v, bool& seen_content,
+                           const std::string& path, const std::string& where);
 /// Build the assembly a config asks for.
 Assembly make_assembly(const SceneConfig& config);
 
