@@ -202,7 +202,9 @@ TEST(PackingLattice, PrecompressedHexagonalOverlapsEverywhereBy2rEps) {
   for (int i = 0; i < a.size(); ++i)
     for (int j = i + 1; j < a.size(); ++j) {
       const double gap = std::hypot(a.x[i] - a.x[j], a.y[i] - a.y[j]) - 2 * r;
-      if (gap < r) EXPECT_NEAR(gap, -overlap, 1e-15);  // a lattice neighbour
+      if (gap < r) {  // a lattice neighbour
+        EXPECT_NEAR(gap, -overlap, 1e-15);
+      }
     }
   EXPECT_NEAR(a.x[0] - r - a.left, -overlap, 1e-15);
   EXPECT_NEAR(a.y[0] - r - a.bottom, -overlap, 1e-15);

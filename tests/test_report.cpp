@@ -237,7 +237,14 @@ ReportInput synthetic_input(bool evidence) {
               trial(5, TrialPhase::certificate, 0.277, 178740, 0.004, true)};
   S.best_trial = S.trials[3];
   S.best = S.best_trial.params;
-  S.certificate = {89370, -6.255e5, -6.232e5, 0.0037, 0.0074, true};
+  S.certificate = {.steps = 89370,
+                   .peak = -6.255e5,
+                   .peak_doubled = -6.232e5,
+                   .steps_doubled_peak_change = 0.0037,
+                   .richardson_error = 0.0074,
+                   .peak_halved = std::nullopt,  // 2D: no halved level
+                   .steps_halved_peak_change = std::nullopt,
+                   .passed = true};
   S.trials_run = 6;
   S.wall_time_s = 7.5;
   in.params = {{"rev",

@@ -46,14 +46,6 @@ std::vector<double> white_noise(double sd, unsigned seed) {
   return v;
 }
 
-// Everything a defect could leak into.
-struct Leaks {
-  double force_balance, moment_balance, servo, oscillation, zigzag;
-};
-Leaks leaks(const Criteria& c) {
-  return {c.force_balance, c.moment_balance, c.servo, c.oscillation, c.zigzag};
-}
-
 TEST(ScoringSynthetic, CleanSeriesScoresZero) {
   const Criteria c = compute_criteria(clean_series(), kS3);
   EXPECT_EQ(c.points, kPoints);
