@@ -601,17 +601,21 @@ std::string sphere_svg_of(const std::string& html) {
   return html.substr(a, html.find("</svg>", a) + 6 - a);
 }
 
-/// A consolidated walled FCC sample of 2×2×2 cells (32 spheres).
-const TriaxialState& small_fcc() {
-  static const TriaxialState state = [] {
-    const SceneConfig c = parse_config_text(R"({"name": "fcc2", "dimension": 3,
+/// The config of a walled FCC sample of 2×2×2 cells (32 spheres).
+const SceneConfig& fcc2_config() {
+  static const SceneConfig c = parse_config_text(R"({"name": "fcc2", "dimension": 3,
       "material": {"density": 2650, "kn": 1e8, "kt": 5e7, "friction": 0.3},
       "assembly": {"type": "fcc", "cells_x": 2, "cells_y": 2, "cells_z": 2, "radius": 5e-4},
       "test": {"type": "triaxial", "lateral_stress": 1e5, "vertical_strain": 1e-5,
                "monitor_points": 40}})",
-                                            "fcc2.json");
-    return consolidate_triaxial(c, make_sphere_assembly(c));
-  }();
+                                                 "fcc2.json");
+  return c;
+}
+
+/// That sample consolidated.
+const TriaxialState& small_fcc() {
+  static const TriaxialState state =
+      consolidate_triaxial(fcc2_config(), make_sphere_assembly(fcc2_config()));
   return state;
 }
 
@@ -707,12 +711,7 @@ TEST(Report3D, EverySphereDrawnOnceColouredByItsContactForce) {
 // result at the monitoring point of its most compressive b_zz.
 TEST(Report3D, RerunsReproduceTheTrialsAndPictureThePeak) {
   const TriaxialState& state = small_fcc();
-  const SceneConfig c = parse_config_text(R"({"dimension": 3,
-      "material": {"density": 2650, "kn": 1e8, "kt": 5e7, "friction": 0.3},
-      "assembly": {"type": "fcc", "cells_x": 2, "cells_y": 2, "cells_z": 2, "radius": 5e-4},
-      "test": {"type": "triaxial", "lateral_stress": 1e5, "vertical_strain": 1e-5,
-               "monitor_points": 40}})",
-                                          "fcc2.json");
+  const SceneConfig& c = fcc2_config();
   const Tolerances tol;
   AlgorithmSpec best = c.algorithm, start = c.algorithm;
   best.steps = 3000;
@@ -746,12 +745,7 @@ TEST(Report3D, RerunsReproduceTheTrialsAndPictureThePeak) {
 // kept; a known run of other parameters, or one cut short, is not used.
 TEST(Report3D, KeptRunsAreTheReruns) {
   const TriaxialState& state = small_fcc();
-  const SceneConfig c = parse_config_text(R"({"dimension": 3,
-      "material": {"density": 2650, "kn": 1e8, "kt": 5e7, "friction": 0.3},
-      "assembly": {"type": "fcc", "cells_x": 2, "cells_y": 2, "cells_z": 2, "radius": 5e-4},
-      "test": {"type": "triaxial", "lateral_stress": 1e5, "vertical_strain": 1e-5,
-               "monitor_points": 40}})",
-                                          "fcc2.json");
+  const SceneConfig& c = fcc2_config();
   // Tolerances loose enough that the run passes: what is kept is at issue
   // here (ζ_r = 0: the rotational drag's tolerance is not a setting).
   Tolerances loose;
@@ -872,12 +866,7 @@ TEST(Report3D, CalibrateWritesThe3DReportAndTheVtk) {
 // and with one it shows that block.
 TEST(Report3D, NoResultAndThePrototypeBlock) {
   const TriaxialState& state = small_fcc();
-  const SceneConfig c = parse_config_text(R"({"dimension": 3,
-      "material": {"density": 2650, "kn": 1e8, "kt": 5e7, "friction": 0.3},
-      "assembly": {"type": "fcc", "cells_x": 2, "cells_y": 2, "cells_z": 2, "radius": 5e-4},
-      "test": {"type": "triaxial", "lateral_stress": 1e5, "vertical_strain": 1e-5,
-               "monitor_points": 40}})",
-                                          "fcc2.json");
+  const SceneConfig& c = fcc2_config();
   ReportInput in;
   in.scene = "fcc2";
   in.command = "demcal calibrate fcc2.json";

@@ -212,7 +212,10 @@ ReferenceEvidence run_refined_reference(const SceneConfig& config, const Consoli
                                         const AlgorithmSpec& best, const Tolerances& tolerances,
                                         int jobs) {
   ReferenceEvidence out;
-  const auto [coarse, fine] = reference_levels(best);
+  // Named copies, not a structured binding: clang 14 cannot capture one.
+  const auto levels = reference_levels(best);
+  const AlgorithmSpec& coarse = levels.first;
+  const AlgorithmSpec& fine = levels.second;
   LoadingResult fine_run;
   run_parallel(
       {[&] { out.fine = run_trial(config, state, fine, tolerances, false, 3.0, &fine_run); },
@@ -226,7 +229,10 @@ ReferenceEvidence run_refined_reference(const SceneConfig& config, const Consoli
 ReferenceEvidence run_refined_reference(const TrialRunner& runner, const AlgorithmSpec& best,
                                         const Tolerances& tolerances, int jobs) {
   ReferenceEvidence out;
-  const auto [coarse, fine] = reference_levels(best);
+  // Named copies, not a structured binding: clang 14 cannot capture one.
+  const auto levels = reference_levels(best);
+  const AlgorithmSpec& coarse = levels.first;
+  const AlgorithmSpec& fine = levels.second;
   run_parallel({[&] { out.fine = run_trial(runner, fine, tolerances); },
                 [&] { out.coarse = run_trial(runner, coarse, tolerances); }},
                jobs);

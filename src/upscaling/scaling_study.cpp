@@ -347,7 +347,7 @@ void forward_check(Family& family, const ScalingStudyOptions& o, ScalingStudy& s
   } else {
     family.log("forward reference at " + std::to_string(st.forward_size) + ": " +
                std::to_string(ref_params.steps) + " steps");
-    st.reference = run_record(*family.state(st.forward_size).runner, ref_params, st.tolerances);
+    st.reference = run_trial(*family.state(st.forward_size).runner, ref_params, st.tolerances);
     st.reference.phase = TrialPhase::reference;
     write_file_atomic(ref_path, to_json(st.reference).dump(2) + "\n");
   }

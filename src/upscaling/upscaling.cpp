@@ -426,15 +426,6 @@ LinearFit fit_power(std::span<const double> x, std::span<const double> y) {
 
 namespace demcal {
 
-TrialRecord run_record(const TrialRunner& runner, const AlgorithmSpec& params,
-                       const Tolerances& tol) {
-  const TrialRun run = runner.run(params, tol, false, 3.0, nullptr);
-  return {.params = params,
-          .score = run.score,
-          .steps_run = run.steps_run,
-          .wall_time_s = run.wall_time_s};
-}
-
 StepSearch smallest_passing_steps(const SceneConfig& config, const ConsolidatedState& state,
                                   const AlgorithmSpec& start, const Tolerances& tol, int max_runs) {
   return smallest_passing_steps(BiaxialRunner(config, state), start, tol, max_runs);
@@ -447,7 +438,7 @@ StepSearch smallest_passing_steps(const TrialRunner& runner, const AlgorithmSpec
   p.steps = round_steps(static_cast<double>(start.steps));
   int64_t largest_failing = 0;
   for (int k = 0; k < max_runs; ++k) {
-    TrialRecord r = run_record(runner, p, tol);
+    TrialRecord r = run_trial(runner, p, tol);
     r.id = k;
     r.phase = TrialPhase::steps_search;
     out.trials.push_back(r);

@@ -159,9 +159,6 @@ StepSearch smallest_passing_steps(const TrialRunner& runner, const AlgorithmSpec
 StepSearch smallest_passing_steps(const SceneConfig& config, const ConsolidatedState& state,
                                   const AlgorithmSpec& params, const Tolerances& tolerances = {},
                                   int max_runs = 8);
-/// One full run (no early stop) of `runner` as a TrialRecord.
-TrialRecord run_record(const TrialRunner& runner, const AlgorithmSpec& params,
-                       const Tolerances& tolerances = {});
 
 /// Least-squares fits of Nstep against N (scaling.md).
 struct LinearFit {
