@@ -142,95 +142,115 @@ std::string servo_lines(double tolerance) {
          " to graph 1, first -" + t + " nohead dt 2 lc rgb '#b3261e'\n";
 }
 
-void add_series_figures_2d(PlotPlan& plot, const ReportFacts& f) {
-  const ReportInput& in = *f.in;
-  const double s3 = in.lateral_stress;
+/// The axial panel: boundary stress b_ii and homogenized σ_ii along the
+/// loading axis `ii` ("yy" in 2D, "zz" in 3D), with the 16×Nstep reference
+/// where there is one. `Axis`: the strain's name, `bodies` what is loaded.
+void add_axial_figure(PlotPlan& plot, const ReportFacts& f, int b_col, int s_col,
+                      const std::string& ii, const std::string& Axis, const std::string& axis,
+                      const std::string& bodies) {
+  add_series_figure(plot, f,
+                    {"fig_a",
+                     "compressive stress [kPa]",
+                     {{b_col, "−b_{" + ii + "} boundary", "lw 5 lc rgb '#9ecae1'"},
+                      {s_col, "−σ_{" + ii + "} homogenized", "lw 1.5 lc rgb '#08306b'"}},
+                     "set key bottom right\n",
+                     true,
+                     "(a) " + Axis + " boundary stress b_" + ii + " and homogenized stress σ_" +
+                         ii + " against the " + axis +
+                         " strain, compression positive, start point (left) and calibrated run "
+                         "(right), same axes. A static run has the two curves on top of each "
+                         "other; a gap means the " +
+                         bodies +
+                         " are not in force balance (loading too fast, too much or too little "
+                         "damping).",
+                     {}});
+}
+
+/// A lateral panel: boundary stress b_ii and homogenized σ_ii against σ3
+/// (dashed), in light and dark shades of one colour.
+void add_lateral_figure(PlotPlan& plot, const ReportFacts& f, const std::string& name,
+                        const std::string& ii, int b_col, int s_col, const std::string& light,
+                        const std::string& dark, const std::string& caption) {
+  const double s3 = f.in->lateral_stress;
+  add_series_figure(plot, f,
+                    {name,
+                     "lateral compressive stress [kPa]",
+                     {{b_col, "−b_{" + ii + "} boundary", "lw 5 lc rgb '" + light + "'"},
+                      {s_col, "−σ_{" + ii + "} homogenized", "lw 1.5 lc rgb '" + dark + "'"}},
+                     sigma3_line(s3),
+                     false,
+                     caption,
+                     {s3 / 1e3}});
+}
+
+/// A shear panel: the pair σ_ij, σ_ji of the homogenized stress; `head`
+/// names them at the start of the caption.
+void add_shear_figure(PlotPlan& plot, const ReportFacts& f, const std::string& name,
+                      const std::string& ij, const std::string& ji, int ij_col, int ji_col,
+                      const std::string& light, const std::string& dark, const std::string& head) {
   add_series_figure(
       plot, f,
-      {"fig_a",
-       "compressive stress [kPa]",
-       {{col2::b_axial, "−b_{yy} boundary", "lw 5 lc rgb '#9ecae1'"},
-        {col2::s_axial, "−σ_{yy} homogenized", "lw 1.5 lc rgb '#08306b'"}},
-       "set key bottom right\n",
-       true,
-       "(a) Vertical boundary stress b_yy and homogenized stress σ_yy against the vertical strain, "
-       "compression positive, start point (left) and calibrated run (right), same axes. A static "
-       "run has the two curves on top of each other; a gap means the particles are not in "
-       "force balance (loading too fast, too much or too little damping).",
-       {}});
-  add_series_figure(
-      plot, f,
-      {"fig_b",
+      {name,
        "shear stress [kPa] (tension positive)",
-       {{col2::s_xy, "σ_{xy}", "lw 3 lc rgb '#fdae6b'"},
-        {col2::s_yx, "σ_{yx}", "lw 1.2 lc rgb '#7f2704'"}},
+       {{ij_col, "σ_{" + ij + "}", "lw 3 lc rgb '" + light + "'"},
+        {ji_col, "σ_{" + ji + "}", "lw 1.2 lc rgb '" + dark + "'"}},
        "",
        false,
-       "(b) Off-diagonal homogenized stresses σ_xy and σ_yx. Moment balance means they coincide; "
-       "large and opposite values mean rotational disequilibrium (time step too large, or "
-       "rotational damping too high).",
+       head + " Moment balance means they coincide; large and opposite values mean rotational "
+              "disequilibrium (time step too large, or rotational damping too high).",
        {}});
-  add_series_figure(
-      plot, f,
-      {"fig_lat",
-       "lateral compressive stress [kPa]",
-       {{col2::b_xx, "−b_{xx} boundary", "lw 5 lc rgb '#a1d99b'"},
-        {col2::s_xx, "−σ_{xx} homogenized", "lw 1.5 lc rgb '#00441b'"}},
-       sigma3_line(s3),
-       false,
-       "Lateral components: boundary stress b_xx and homogenized σ_xx against σ3 (dashed). Global "
-       "damping that drags against the lateral expansion shows up as σ_xx above b_xx: extra "
-       "confinement and an over-predicted peak.",
-       {s3 / 1e3}});
-  add_series_figure(
-      plot, f,
-      {"fig_servo",
-       "servo error (p_{lateral} − σ_3)/σ_3 [%]",
-       {{col2::servo, "servo error", "lw 1.5 lc rgb '#54278f'"}},
-       servo_lines(in.tolerances.servo),
-       false,
-       "Boundary-control (servo) error of the lateral walls: mean lateral wall stress against σ3, "
-       "in %. Dashed: ± the servo tolerance (applied to the trend of this curve).",
-       {-100.0 * in.tolerances.servo, 100.0 * in.tolerances.servo}});
+}
+
+/// The servo panel: the lateral walls' stress errors [%] against ± the
+/// servo tolerance (dashed).
+void add_servo_figure(PlotPlan& plot, const ReportFacts& f, const std::string& ylabel,
+                      std::vector<std::tuple<int, std::string, std::string>> curves,
+                      const std::string& caption) {
+  const double servo = f.in->tolerances.servo;
+  add_series_figure(plot, f,
+                    {"fig_servo",
+                     ylabel,
+                     std::move(curves),
+                     servo_lines(servo),
+                     false,
+                     caption,
+                     {-100.0 * servo, 100.0 * servo}});
+}
+
+/// The 2D panels: axial, the shear pair, lateral, the servo error.
+void add_series_figures_2d(PlotPlan& plot, const ReportFacts& f) {
+  add_axial_figure(plot, f, col2::b_axial, col2::s_axial, "yy", "Vertical", "vertical",
+                   "particles");
+  add_shear_figure(plot, f, "fig_b", "xy", "yx", col2::s_xy, col2::s_yx, "#fdae6b", "#7f2704",
+                   "(b) Off-diagonal homogenized stresses σ_xy and σ_yx.");
+  add_lateral_figure(
+      plot, f, "fig_lat", "xx", col2::b_xx, col2::s_xx, "#a1d99b", "#00441b",
+      "Lateral components: boundary stress b_xx and homogenized σ_xx against σ3 (dashed). Global "
+      "damping that drags against the lateral expansion shows up as σ_xx above b_xx: extra "
+      "confinement and an over-predicted peak.");
+  add_servo_figure(plot, f, "servo error (p_{lateral} − σ_3)/σ_3 [%]",
+                   {{col2::servo, "servo error", "lw 1.5 lc rgb '#54278f'"}},
+                   "Boundary-control (servo) error of the lateral walls: mean lateral wall stress "
+                   "against σ3, in %. Dashed: ± the servo tolerance (applied to the trend of this "
+                   "curve).");
 }
 
 /// The 3D panels: axial, each lateral component, the three shear pairs,
 /// the four lateral walls' servo errors.
 void add_series_figures_3d(PlotPlan& plot, const ReportFacts& f) {
-  const ReportInput& in = *f.in;
-  const double s3 = in.lateral_stress;
-  add_series_figure(
-      plot, f,
-      {"fig_a",
-       "compressive stress [kPa]",
-       {{col3::b_axial, "−b_{zz} boundary", "lw 5 lc rgb '#9ecae1'"},
-        {col3::s_axial, "−σ_{zz} homogenized", "lw 1.5 lc rgb '#08306b'"}},
-       "set key bottom right\n",
-       false,
-       "(a) Axial boundary stress b_zz and homogenized stress σ_zz against the axial strain, "
-       "compression positive, start point (left) and calibrated run (right), same axes. A static "
-       "run has the two curves on top of each other; a gap means the spheres are not in force "
-       "balance (loading too fast, too much or too little damping).",
-       {}});
-  const char* lateral[2][5] = {
-      {"fig_lat_x", "−b_{xx} boundary", "−σ_{xx} homogenized", "#a1d99b", "#00441b"},
-      {"fig_lat_y", "−b_{yy} boundary", "−σ_{yy} homogenized", "#fdd0a2", "#7f2704"}};
-  for (int a = 0; a < 2; ++a)
-    add_series_figure(
-        plot, f,
-        {lateral[a][0],
-         "lateral compressive stress [kPa]",
-         {{a == 0 ? col3::b_xx : col3::b_yy, lateral[a][1],
-           std::string("lw 5 lc rgb '") + lateral[a][3] + "'"},
-          {a == 0 ? col3::s_xx : col3::s_yy, lateral[a][2],
-           std::string("lw 1.5 lc rgb '") + lateral[a][4] + "'"}},
-         sigma3_line(s3),
-         false,
-         std::string("Lateral component ") + (a == 0 ? "xx" : "yy") + ": boundary stress b_" +
-             (a == 0 ? "xx" : "yy") + " and homogenized σ_" + (a == 0 ? "xx" : "yy") +
-             " against σ3 (dashed). Global damping that drags against the lateral expansion "
-             "shows up as σ above b: extra confinement and an over-predicted peak.",
-         {s3 / 1e3}});
+  add_axial_figure(plot, f, col3::b_axial, col3::s_axial, "zz", "Axial", "axial", "spheres");
+  const struct {
+    const char *name, *ii, *light, *dark;
+    int b_col, s_col;
+  } lateral[2] = {{"fig_lat_x", "xx", "#a1d99b", "#00441b", col3::b_xx, col3::s_xx},
+                  {"fig_lat_y", "yy", "#fdd0a2", "#7f2704", col3::b_yy, col3::s_yy}};
+  for (const auto& p : lateral)
+    add_lateral_figure(plot, f, p.name, p.ii, p.b_col, p.s_col, p.light, p.dark,
+                       std::string("Lateral component ") + p.ii + ": boundary stress b_" + p.ii +
+                           " and homogenized σ_" + p.ii +
+                           " against σ3 (dashed). Global damping that drags against the lateral "
+                           "expansion shows up as σ above b: extra confinement and an "
+                           "over-predicted peak.");
   const struct {
     const char *name, *ij, *ji, *light, *dark;
     int c1, c2;
@@ -238,32 +258,17 @@ void add_series_figures_3d(PlotPlan& plot, const ReportFacts& f) {
                 {"fig_shear_xz", "xz", "zx", "#bcbddc", "#3f007d", col3::s_xz, col3::s_zx},
                 {"fig_shear_yz", "yz", "zy", "#a6dba0", "#00441b", col3::s_yz, col3::s_zy}};
   for (const auto& p : shear)
-    add_series_figure(
-        plot, f,
-        {p.name,
-         "shear stress [kPa] (tension positive)",
-         {{p.c1, std::string("σ_{") + p.ij + "}", std::string("lw 3 lc rgb '") + p.light + "'"},
-          {p.c2, std::string("σ_{") + p.ji + "}", std::string("lw 1.2 lc rgb '") + p.dark + "'"}},
-         "",
-         false,
-         std::string("(b) Shear pair σ_") + p.ij + " and σ_" + p.ji +
-             " of the homogenized stress. Moment balance means they coincide; "
-             "large and opposite values mean rotational disequilibrium (time step "
-             "too large, or rotational damping too high).",
-         {}});
-  add_series_figure(
-      plot, f,
-      {"fig_servo",
-       "servo error (p_{wall} − σ_3)/σ_3 [%]",
-       {{col3::servo_xmin, "x min", "lw 1.5 lc rgb '#1b9e77'"},
-        {col3::servo_xmax, "x max", "lw 1.5 dt 2 lc rgb '#1b9e77'"},
-        {col3::servo_ymin, "y min", "lw 1.5 lc rgb '#7570b3'"},
-        {col3::servo_ymax, "y max", "lw 1.5 dt 2 lc rgb '#7570b3'"}},
-       servo_lines(in.tolerances.servo),
-       false,
-       "Boundary-control (servo) error of each of the four lateral walls: its stress against σ3, "
-       "in %. Dashed red: ± the servo tolerance (applied to the trend of each curve).",
-       {-100.0 * in.tolerances.servo, 100.0 * in.tolerances.servo}});
+    add_shear_figure(
+        plot, f, p.name, p.ij, p.ji, p.c1, p.c2, p.light, p.dark,
+        std::string("(b) Shear pair σ_") + p.ij + " and σ_" + p.ji + " of the homogenized stress.");
+  add_servo_figure(plot, f, "servo error (p_{wall} − σ_3)/σ_3 [%]",
+                   {{col3::servo_xmin, "x min", "lw 1.5 lc rgb '#1b9e77'"},
+                    {col3::servo_xmax, "x max", "lw 1.5 dt 2 lc rgb '#1b9e77'"},
+                    {col3::servo_ymin, "y min", "lw 1.5 lc rgb '#7570b3'"},
+                    {col3::servo_ymax, "y max", "lw 1.5 dt 2 lc rgb '#7570b3'"}},
+                   "Boundary-control (servo) error of each of the four lateral walls: its stress "
+                   "against σ3, in %. Dashed red: ± the servo tolerance (applied to the trend of "
+                   "each curve).");
 }
 
 void add_series_figures(PlotPlan& plot, const ReportFacts& f) {
