@@ -78,7 +78,6 @@ ConsolidatedState consolidate_fresh(const SceneConfig& config, const Assembly& a
   ConsolidatedState state{World(config.material, assembly.x, assembly.y, assembly.r, assembly.left,
                                 assembly.right, assembly.bottom, assembly.top)};
   World& world = state.world;
-  world.set_threads(options.threads);
   const double mu = config.material.particle.friction;
   // Damping for the fastest relaxation, not the loading's. ζ = 1 is critical
   // for one particle on one contact, so it heavily over-damps the packing's
@@ -104,16 +103,8 @@ ConsolidatedState consolidate_fresh(const SceneConfig& config, const Assembly& a
     const double dt0 = integration_for(world, settle).dt;
     settle.dt_ratio *= dashpot_step_factor(gamma_max / dt0);
   }
-  const detail::ConsolidationOutcome o = detail::run_consolidation<WallSide, 4>(
-      world, test, mu, settle,
-      [](const World& w, const AlgorithmSpec& a) { return integration_for(w, a); },
-      [&](const detail::ConsolidationOutcome& c) {
-        if (options.progress) options.progress(c.progress);
-      });
-  world.set_threads(1);
-  state.converged = o.converged;
-  state.stress_error = o.stress_error;
-  state.unbalanced_ratio = o.unbalanced_ratio;
+  const detail::ConsolidationOutcome o =
+      detail::run_consolidation<WallSide, 4>(world, test, mu, settle, integration_for, options);
   for (int i = 0; i < world.size(); ++i) world.set_velocity(i, 0.0, 0.0, 0.0);
   world.update_forces();
   // Every trial starts from this state: number the particles so that the
@@ -121,9 +112,7 @@ ConsolidatedState consolidate_fresh(const SceneConfig& config, const Assembly& a
   world.reorder(world.block_friendly_order());
   state.width0 = world.width();
   state.height0 = world.height();
-  state.steps = o.steps;
-  state.wall_time_s = seconds_since(t0);
-  if (!state.converged) throw std::runtime_error(detail::consolidation_failure(o, test));
+  detail::finish_consolidation(state, o, test, t0);
   return state;
 }
 
@@ -160,56 +149,31 @@ LoadingResult run_loading(const ConsolidatedState& start, const TestSpec& test,
   World world = start.world;
   LoadingResult out;
   const double h0 = start.height0;
-  const double top_velocity =
-      detail::start_loading(world, out, algorithm, test, h0, integration_for);
-  const int64_t nstep = algorithm.steps;
+  detail::start_loading(world, out, algorithm, test, h0, integration_for, kBottom, kTop);
   const double sigma3 = test.lateral_stress;
-  world.wall(kBottom).velocity = 0.0;
-  world.wall(kTop).velocity = top_velocity;
-
-  const int m = test.monitor_points;
-  out.series.reserve(m + 1);
-  auto record = [&](int64_t step) {
-    const Measures ms = world.measure(out.strain_rate);
-    MonitorPoint p;
-    p.step = step;
-    p.strain_yy = (world.height() - h0) / h0;
-    detail::copy_measures(p, ms);
-    const double lateral = 0.5 * (wall_pressure(world, kLeft) + wall_pressure(world, kRight));
-    p.lateral_stress_error = (lateral - sigma3) / sigma3;
-    p.left = world.wall(kLeft).position;
-    p.right = world.wall(kRight).position;
-    p.bottom = world.wall(kBottom).position;
-    p.top = world.wall(kTop).position;
-    out.series.push_back(p);
-    return !monitor || monitor(p);
-  };
-
-  bool keep_going = record(0);
-  int64_t done = 0;
-  for (int k = 1; k <= m && keep_going; ++k) {
-    const int64_t target = nstep * k / m;
-    while (done < target) {
-      world.wall(kLeft).velocity = servo_velocity(world, kLeft, sigma3, test.servo_gain);
-      world.wall(kRight).velocity = servo_velocity(world, kRight, sigma3, test.servo_gain);
-      if (!world.step(1)) break;
-      ++done;
-      const double vertical = -0.5 * (wall_pressure(world, kTop) + wall_pressure(world, kBottom));
-      if (vertical < out.peak_stress_yy) {
-        out.peak_stress_yy = vertical;
-        out.peak_strain_yy = (world.height() - h0) / h0;
-      }
-    }
-    if (world.divergence() != Divergence::kNone) {
-      out.diverged = true;
-      out.divergence = world.divergence();
-      out.divergence_step = world.divergence_step() - start.world.steps_taken();
-      break;
-    }
-    keep_going = record(done);
-  }
-  out.stopped_early = !out.diverged && !keep_going && done < nstep;
-  out.steps_run = done;
+  detail::run_monitored<MonitorPoint>(
+      world, out, test.monitor_points, start.world.steps_taken(),
+      [&](MonitorPoint& p) {
+        p.strain_yy = (world.height() - h0) / h0;
+        const double lateral = 0.5 * (wall_pressure(world, kLeft) + wall_pressure(world, kRight));
+        p.lateral_stress_error = (lateral - sigma3) / sigma3;
+        p.left = world.wall(kLeft).position;
+        p.right = world.wall(kRight).position;
+        p.bottom = world.wall(kBottom).position;
+        p.top = world.wall(kTop).position;
+      },
+      monitor,
+      [&] {
+        world.wall(kLeft).velocity = servo_velocity(world, kLeft, sigma3, test.servo_gain);
+        world.wall(kRight).velocity = servo_velocity(world, kRight, sigma3, test.servo_gain);
+      },
+      [&] {
+        const double vertical = -0.5 * (wall_pressure(world, kTop) + wall_pressure(world, kBottom));
+        if (vertical < out.peak_stress_yy) {
+          out.peak_stress_yy = vertical;
+          out.peak_strain_yy = (world.height() - h0) / h0;
+        }
+      });
   out.wall_time_s = seconds_since(t0);
   if (final_state) *final_state = std::move(world);
   return out;

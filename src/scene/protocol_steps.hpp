@@ -103,8 +103,9 @@ class ConsolidationClock {
 
 /// Runs the consolidation on `world` (its integration set from `settle`
 /// by `integration_for`, which the critical-damping fallback calls again),
-/// with `walls` walls of type `Side`, and calls on_check(outcome) after
-/// every check (outcome.progress: its report, time estimate included).
+/// with `walls` walls of type `Side`, on options.threads threads (one
+/// afterwards: its copies are the trials, which a calibration runs in
+/// parallel), and calls options.progress after every check.
 /// Only the blow-up checks (non-finite state, overlap beyond the limit)
 /// stay on meanwhile: with light damping the energy checks read the walls'
 /// work as energy made by the integrator — the kinetic energy a servo wall
@@ -114,10 +115,13 @@ class ConsolidationClock {
 /// REVs). Consolidation must reach the static state demanded, which no
 /// rattling or growing run does. Throws std::runtime_error when the kernel
 /// diverges; the caller decides what non-convergence means.
-template <class Side, int walls, class Sample, class IntegrationFor, class OnCheck>
+template <class Side, int walls, class Sample>
 ConsolidationOutcome run_consolidation(Sample& world, const TestSpec& test, double friction,
-                                       AlgorithmSpec settle, IntegrationFor integration_for,
-                                       OnCheck on_check) {
+                                       AlgorithmSpec settle,
+                                       Integration (*integration_for)(const Sample&,
+                                                                      const AlgorithmSpec&),
+                                       const ConsolidationOptions& options) {
+  world.set_threads(options.threads);
   world.set_integration(integration_for(world, settle));
   const KernelOptions kernel_options = world.options();
   KernelOptions no_ledger = kernel_options;
@@ -156,7 +160,7 @@ ConsolidationOutcome run_consolidation(Sample& world, const TestSpec& test, doub
       out.stress_error = err;
       out.unbalanced_ratio = world.measure().unbalanced_force_ratio;
       out.progress = clock.check(out.phase, out.steps, out.stress_error, out.unbalanced_ratio);
-      on_check(out);
+      if (options.progress) options.progress(out.progress);
       done = err < test.consolidation_tolerance &&
              out.unbalanced_ratio < test.consolidation_unbalanced;
       if (out.steps >= max_steps) break;
@@ -166,6 +170,7 @@ ConsolidationOutcome run_consolidation(Sample& world, const TestSpec& test, doub
   }
   if (out.phase > 1) out.phase = 1;
   world.set_options(kernel_options);
+  world.set_threads(1);
   for (int s = 0; s < walls; ++s) world.wall(static_cast<Side>(s)).velocity = 0.0;
   return out;
 }
@@ -183,6 +188,19 @@ inline std::string consolidation_failure(const ConsolidationOutcome& o, const Te
          "); raise test.consolidation_max_steps or loosen the tolerances";
 }
 
+/// The consolidated state's account of `o` (started at `t0`); throws
+/// std::runtime_error saying what was reached when it did not converge.
+template <class State>
+void finish_consolidation(State& state, const ConsolidationOutcome& o, const TestSpec& test,
+                          std::chrono::steady_clock::time_point t0) {
+  state.converged = o.converged;
+  state.stress_error = o.stress_error;
+  state.unbalanced_ratio = o.unbalanced_ratio;
+  state.steps = o.steps;
+  state.wall_time_s = seconds_since(t0);
+  if (!state.converged) throw std::runtime_error(consolidation_failure(o, test));
+}
+
 /// The stable α of a consolidated sample (a probe copy; its stable-step
 /// estimate of the contact network, which does not depend on Δt: any
 /// valid step will do).
@@ -197,13 +215,13 @@ double stable_dt_ratio_of(Sample probe, const AlgorithmSpec& algorithm,
 }
 
 /// The loading's start, the same in 2D and 3D: the spec's integration on
-/// `world`, the run's scales, planned steps and strain rate in `out`.
-/// Returns the platen speed (negative: compressing) that reaches
+/// `world`, the run's scales, planned steps and strain rate in `out`; the
+/// wall `fixed` at rest, the `platen` moving in at the speed that reaches
 /// test.vertical_strain of `h0` in Nstep steps.
-template <class Sample, class Result>
-double start_loading(Sample& world, Result& out, const AlgorithmSpec& algorithm,
-                     const TestSpec& test, double h0,
-                     Integration (*integration_for)(const Sample&, const AlgorithmSpec&)) {
+template <class Sample, class Result, class Side>
+void start_loading(Sample& world, Result& out, const AlgorithmSpec& algorithm, const TestSpec& test,
+                   double h0, Integration (*integration_for)(const Sample&, const AlgorithmSpec&),
+                   Side fixed, Side platen) {
   out.particles = world.size();
   out.integration = integration_for(world, algorithm);
   world.set_integration(out.integration);
@@ -212,7 +230,8 @@ double start_loading(Sample& world, Result& out, const AlgorithmSpec& algorithm,
   const int64_t nstep = algorithm.steps;
   out.steps_planned = nstep;
   out.strain_rate = test.vertical_strain / (static_cast<double>(nstep) * dt);
-  return -test.vertical_strain * h0 / (static_cast<double>(nstep) * dt);
+  world.wall(fixed).velocity = 0.0;
+  world.wall(platen).velocity = -test.vertical_strain * h0 / (static_cast<double>(nstep) * dt);
 }
 
 /// A monitoring point's stresses, energies and ratios from the kernel's
@@ -227,6 +246,50 @@ void copy_measures(Point& p, const Measures& ms) {
   p.unbalanced_force_ratio = ms.unbalanced_force_ratio;
   p.inertial_number = ms.inertial_number;
   p.coordination_number = ms.coordination_number;
+}
+
+/// The loading's monitoring loop, the same in 2D and 3D: out.steps_planned
+/// steps (start_loading) in `m` equal stretches, a monitoring point of type
+/// Point before the first and after each (its measures here, the rest by
+/// complete(point)), pushed to out.series and passed to `monitor`, which
+/// may stop the run. Each step: servo() sets the wall velocities, the
+/// kernel steps once, track() follows the peak. Fills out's step count,
+/// divergence and early stop; `start_steps`: the steps the world had taken
+/// before the run, for the divergence step.
+template <class Point, class Sample, class Result, class Complete, class Monitor, class Servo,
+          class Track>
+void run_monitored(Sample& world, Result& out, int m, int64_t start_steps, Complete complete,
+                   const Monitor& monitor, Servo servo, Track track) {
+  out.series.reserve(m + 1);
+  auto record = [&](int64_t step) {
+    Point p;
+    p.step = step;
+    copy_measures(p, world.measure(out.strain_rate));
+    complete(p);
+    out.series.push_back(p);
+    return !monitor || monitor(p);
+  };
+  const int64_t nstep = out.steps_planned;
+  bool keep_going = record(0);
+  int64_t done = 0;
+  for (int k = 1; k <= m && keep_going; ++k) {
+    const int64_t target = nstep * k / m;
+    while (done < target) {
+      servo();
+      if (!world.step(1)) break;
+      ++done;
+      track();
+    }
+    if (world.divergence() != Divergence::kNone) {
+      out.diverged = true;
+      out.divergence = world.divergence();
+      out.divergence_step = world.divergence_step() - start_steps;
+      break;
+    }
+    keep_going = record(done);
+  }
+  out.stopped_early = !out.diverged && !keep_going && done < nstep;
+  out.steps_run = done;
 }
 
 }  // namespace demcal::detail

@@ -142,29 +142,17 @@ TriaxialState consolidate_triaxial(const SceneConfig& config, const SphereAssemb
   TriaxialState state{SphereWorld(sphere_material(config.material), assembly.x, assembly.y,
                                   assembly.z, assembly.r, assembly.lo, assembly.hi)};
   SphereWorld& world = state.world;
-  world.set_threads(options.threads);
   const double mu = config.material.particle.friction;
   // Light damping for the fastest relaxation of the slow collective modes
   // (biaxial.cpp, consolidate(): measured there).
   const AlgorithmSpec settle = detail::consolidation_settings(config, kConsolidationDampingRatio);
   const detail::ConsolidationOutcome o = detail::run_consolidation<SphereWallSide, 6>(
-      world, test, mu, settle,
-      [](const SphereWorld& w, const AlgorithmSpec& a) { return integration_for(w, a); },
-      [&](const detail::ConsolidationOutcome& c) {
-        if (options.progress) options.progress(c.progress);
-      });
-  // Its copies are the trials, which a calibration runs in parallel.
-  world.set_threads(1);
-  state.converged = o.converged;
-  state.stress_error = o.stress_error;
-  state.unbalanced_ratio = o.unbalanced_ratio;
+      world, test, mu, settle, integration_for, options);
   for (int i = 0; i < world.size(); ++i)
     world.set_velocity(i, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
   world.update_forces();
   for (int axis = 0; axis < 3; ++axis) state.extent0[axis] = world.extent(axis);
-  state.steps = o.steps;
-  state.wall_time_s = seconds_since(t0);
-  if (!state.converged) throw std::runtime_error(detail::consolidation_failure(o, test));
+  detail::finish_consolidation(state, o, test, t0);
   return state;
 }
 
@@ -207,67 +195,43 @@ TriaxialResult run_triaxial_loading(const TriaxialState& start, const TestSpec& 
   SphereWorld world = start.world;
   TriaxialResult out;
   const double h0 = start.extent0[2];
-  const double top_velocity =
-      detail::start_loading(world, out, algorithm, test, h0, integration_for);
-  const int64_t nstep = algorithm.steps;
+  detail::start_loading(world, out, algorithm, test, h0, integration_for, kZMin, kZMax);
   const double sigma3 = test.lateral_stress;
-  world.wall(kZMin).velocity = 0.0;
-  world.wall(kZMax).velocity = top_velocity;
-
-  const int m = test.monitor_points;
-  out.series.reserve(m + 1);
-  auto record = [&](int64_t step) {
-    const SphereMeasures ms = world.measure(out.strain_rate);
-    TriaxialPoint p;
-    p.step = step;
-    p.strain_zz = (world.extent(2) - h0) / h0;
-    detail::copy_measures(p, ms);
-    double lateral = 0.0;
-    for (int k = 0; k < 4; ++k) {
-      const double pk = wall_pressure(world, kLateral[k]);
-      p.servo_error[k] = (pk - sigma3) / sigma3;
-      lateral += 0.25 * pk;
-    }
-    p.lateral_stress_error = (lateral - sigma3) / sigma3;
-    for (int s = 0; s < 6; ++s) p.walls[s] = world.wall(static_cast<SphereWallSide>(s)).position;
-    damping_powers(world, p);
-    out.series.push_back(p);
-    if (observe) observe(p, world);
-    return !monitor || monitor(p);
-  };
-
-  bool keep_going = record(0);
-  int64_t done = 0;
-  for (int k = 1; k <= m && keep_going; ++k) {
-    const int64_t target = nstep * k / m;
-    while (done < target) {
-      for (SphereWallSide side : kLateral)
-        world.wall(side).velocity = servo_velocity(world, side, sigma3, test.servo_gain);
-      if (!world.step(1)) break;
-      ++done;
-      const double axial = 0.5 * (wall_pressure(world, kZMin) + wall_pressure(world, kZMax));
-      double lateral = 0.0;
-      for (SphereWallSide side : kLateral) lateral += 0.25 * wall_pressure(world, side);
-      const double strain = (world.extent(2) - h0) / h0;
-      if (-axial < out.peak_stress_zz) {
-        out.peak_stress_zz = -axial;
-        out.peak_strain_zz = strain;
-      }
-      if (lateral > 0.0 && axial / lateral > out.peak_ratio) {
-        out.peak_ratio = axial / lateral;
-        out.peak_ratio_strain = strain;
-      }
-    }
-    if (world.divergence() != Divergence::kNone) {
-      out.diverged = true;
-      out.divergence = world.divergence();
-      out.divergence_step = world.divergence_step() - start.world.steps_taken();
-      break;
-    }
-    keep_going = record(done);
-  }
-  out.stopped_early = !out.diverged && !keep_going && done < nstep;
-  out.steps_run = done;
+  detail::run_monitored<TriaxialPoint>(
+      world, out, test.monitor_points, start.world.steps_taken(),
+      [&](TriaxialPoint& p) {
+        p.strain_zz = (world.extent(2) - h0) / h0;
+        double lateral = 0.0;
+        for (int k = 0; k < 4; ++k) {
+          const double pk = wall_pressure(world, kLateral[k]);
+          p.servo_error[k] = (pk - sigma3) / sigma3;
+          lateral += 0.25 * pk;
+        }
+        p.lateral_stress_error = (lateral - sigma3) / sigma3;
+        for (int s = 0; s < 6; ++s)
+          p.walls[s] = world.wall(static_cast<SphereWallSide>(s)).position;
+        damping_powers(world, p);
+        if (observe) observe(p, world);
+      },
+      monitor,
+      [&] {
+        for (SphereWallSide side : kLateral)
+          world.wall(side).velocity = servo_velocity(world, side, sigma3, test.servo_gain);
+      },
+      [&] {
+        const double axial = 0.5 * (wall_pressure(world, kZMin) + wall_pressure(world, kZMax));
+        double lateral = 0.0;
+        for (SphereWallSide side : kLateral) lateral += 0.25 * wall_pressure(world, side);
+        const double strain = (world.extent(2) - h0) / h0;
+        if (-axial < out.peak_stress_zz) {
+          out.peak_stress_zz = -axial;
+          out.peak_strain_zz = strain;
+        }
+        if (lateral > 0.0 && axial / lateral > out.peak_ratio) {
+          out.peak_ratio = axial / lateral;
+          out.peak_ratio_strain = strain;
+        }
+      });
   out.wall_time_s = seconds_since(t0);
   if (final_state) *final_state = std::move(world);
   return out;

@@ -14,24 +14,15 @@
 #include "demcal/kernel/world.hpp"
 #include "demcal/scene/config.hpp"
 #include "demcal/scene/consolidation_progress.hpp"
+#include "demcal/scene/loading_run.hpp"
 #include "demcal/scene/packing.hpp"
 
 namespace demcal {
 
-/// One monitoring point of a loading run. Stresses tension positive.
-struct MonitorPoint {
-  int64_t step = 0;
+/// One monitoring point of a loading run (the shared measures:
+/// loading_run.hpp).
+struct MonitorPoint : MonitorMeasures<Eigen::Matrix2d> {
   double strain_yy = 0.0;                           ///< (H − H0)/H0, negative in compression
-  Eigen::Matrix2d b = Eigen::Matrix2d::Zero();      ///< boundary stress
-  Eigen::Matrix2d sigma = Eigen::Matrix2d::Zero();  ///< homogenized stress
-  double kinetic_energy = 0.0;                      ///< translation + rotation
-  double kinetic_energy_rotation = 0.0;
-  double elastic_energy = 0.0;
-  double unbalanced_force_ratio = 0.0;
-  double inertial_number = 0.0;
-  double coordination_number = 0.0;
-  /// Lateral walls: (mean wall pressure − σ3)/σ3, signed.
-  double lateral_stress_error = 0.0;
   double left = 0, right = 0, bottom = 0, top = 0;  ///< wall positions
 };
 
@@ -73,19 +64,7 @@ ConsolidatedState consolidate(const SceneConfig& config, const Assembly& assembl
                               const std::string& cache_dir,
                               const ConsolidationOptions& options = {});
 
-struct LoadingResult {
-  std::vector<MonitorPoint> series;
-  int particles = 0;
-  Integration integration;  ///< what was run (absolute Δt)
-  ReferenceScales scales;
-  int64_t steps_planned = 0;
-  int64_t steps_run = 0;
-  bool diverged = false;
-  Divergence divergence = Divergence::kNone;
-  int64_t divergence_step = -1;
-  bool stopped_early = false;  ///< the monitor callback asked to stop
-  double wall_time_s = 0.0;
-  double strain_rate = 0.0;  ///< ε / (Nstep·Δt) [1/s]
+struct LoadingResult : LoadingRun<MonitorPoint> {
   /// The peak tracked at every step (monitoring points alone can miss a
   /// sharp peak by a monitoring interval): most compressive vertical wall
   /// stress −(p_top + p_bottom)/2, equal to b_yy for frictionless walls.

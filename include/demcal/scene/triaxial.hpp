@@ -17,26 +17,17 @@
 #include "demcal/kernel/sphere_world.hpp"
 #include "demcal/scene/config.hpp"
 #include "demcal/scene/consolidation_progress.hpp"
+#include "demcal/scene/loading_run.hpp"
 #include "demcal/scene/sphere_packing.hpp"
 
 namespace demcal {
 
-/// One monitoring point of a triaxial loading run.
-struct TriaxialPoint {
-  int64_t step = 0;
-  double strain_zz = 0.0;                           ///< (H − H0)/H0, negative in compression
-  Eigen::Matrix3d b = Eigen::Matrix3d::Zero();      ///< boundary stress
-  Eigen::Matrix3d sigma = Eigen::Matrix3d::Zero();  ///< homogenized stress
-  double kinetic_energy = 0.0;                      ///< translation + rotation
-  double kinetic_energy_rotation = 0.0;
-  double elastic_energy = 0.0;
-  double unbalanced_force_ratio = 0.0;
-  double inertial_number = 0.0;
-  double coordination_number = 0.0;
+/// One monitoring point of a triaxial loading run (the shared measures:
+/// loading_run.hpp; lateral_stress_error over the four lateral walls).
+struct TriaxialPoint : MonitorMeasures<Eigen::Matrix3d> {
+  double strain_zz = 0.0;  ///< (H − H0)/H0, negative in compression
   /// (p − σ3)/σ3, signed, of the lateral walls x min, x max, y min, y max.
   std::array<double, 4> servo_error{};
-  /// (mean pressure of the four lateral walls − σ3)/σ3.
-  double lateral_stress_error = 0.0;
   std::array<double, 6> walls{};  ///< positions, SphereWallSide order
   /// Power the global damping takes from the particles at this step [W]:
   /// Σ D_t·|v|² and Σ D_r·|ω|² (the rotational drag of the scoring).
@@ -96,19 +87,7 @@ TriaxialState consolidate_triaxial(const SceneConfig& config, const SphereAssemb
 /// The stable α of the consolidated contact network (6 DOF per sphere).
 double estimated_stable_dt_ratio(const TriaxialState& state, const AlgorithmSpec& algorithm);
 
-struct TriaxialResult {
-  std::vector<TriaxialPoint> series;
-  int particles = 0;
-  Integration integration;  ///< what was run (absolute Δt)
-  ReferenceScales scales;
-  int64_t steps_planned = 0;
-  int64_t steps_run = 0;
-  bool diverged = false;
-  Divergence divergence = Divergence::kNone;
-  int64_t divergence_step = -1;
-  bool stopped_early = false;
-  double wall_time_s = 0.0;
-  double strain_rate = 0.0;  ///< ε/(Nstep·Δt) [1/s]
+struct TriaxialResult : LoadingRun<TriaxialPoint> {
   /// Tracked every step: the most compressive axial wall stress
   /// −(p_top + p_bottom)/2 (= b_zz for frictionless walls) and its strain.
   double peak_stress_zz = 0.0;
