@@ -35,6 +35,26 @@ const char* const kFcc2 = R"({
 
 double relative(double a, double b) { return std::abs(a - b) / std::abs(b); }
 
+// The rotational-drag tests' sample: the FCC above consolidated, its runner,
+// the 3D tolerances, and their run: α = 0.17, 16000 steps, ζ_t = 0.5 and
+// rotational damping ζ_r.
+struct DraggedFcc {
+  SceneConfig config = parse_config_text(kFcc2, "fcc_2x2x2");
+  TriaxialState state = consolidate_triaxial(config, make_sphere_assembly(config));
+  TriaxialRunner runner{config, state};
+  Tolerances t = triaxial_tolerances();
+  double s3 = config.test.lateral_stress;
+
+  AlgorithmSpec spec(double zeta_r) const {
+    AlgorithmSpec p = config.algorithm;
+    p.dt_ratio = 0.17;
+    p.steps = 16000;
+    p.damping_ratio_translation = 0.5;
+    p.damping_ratio_rotation = zeta_r;
+    return p;
+  }
+};
+
 }  // namespace
 
 TEST(Calibration3D, SmallFccIsCertifiedAndMatchesARunEightTimesLonger) {
@@ -80,20 +100,12 @@ TEST(Calibration3D, SmallFccIsCertifiedAndMatchesARunEightTimesLonger) {
 // rotational damping, and its peak is raised by at least the share (energy
 // balance: the power the damping takes must come from the axial wall).
 TEST(Calibration3D, RotationalDragFailsTheDraggedRunAndPassesTheUndampedOne) {
-  const SceneConfig config = parse_config_text(kFcc2, "fcc_2x2x2");
-  const TriaxialState state = consolidate_triaxial(config, make_sphere_assembly(config));
-  const TriaxialRunner runner(config, state);
-  const Tolerances t = triaxial_tolerances();
-  const double s3 = config.test.lateral_stress;
-  AlgorithmSpec p = config.algorithm;
-  p.dt_ratio = 0.17;
-  p.steps = 16000;
-  p.damping_ratio_translation = 0.5;
-  p.damping_ratio_rotation = 0.0;
+  const DraggedFcc fcc;
+  const Tolerances& t = fcc.t;
+  const double s3 = fcc.s3;
   TriaxialResult free_run, dragged_run;
-  const TrialRun free = runner.run(p, t, false, 3.0, nullptr, &free_run);
-  p.damping_ratio_rotation = 2.0;
-  const TrialRun dragged = runner.run(p, t, false, 3.0, nullptr, &dragged_run);
+  const TrialRun free = fcc.runner.run(fcc.spec(0.0), t, false, 3.0, nullptr, &free_run);
+  const TrialRun dragged = fcc.runner.run(fcc.spec(2.0), t, false, 3.0, nullptr, &dragged_run);
   const TriaxialCriteria cf = compute_triaxial_criteria(free_run, s3);
   const TriaxialCriteria cd = compute_triaxial_criteria(dragged_run, s3);
 
@@ -121,17 +133,12 @@ TEST(Calibration3D, RotationalDragFailsTheDraggedRunAndPassesTheUndampedOne) {
 // reaches the final drag once the peak is kTrendHalfWidth points back, and
 // stops a trial once beyond factor × kRotationalDragTolerance.
 TEST(Calibration3D, RotationalDragEarlyStopIsALowerBound) {
-  const SceneConfig config = parse_config_text(kFcc2, "fcc_2x2x2");
-  const TriaxialState state = consolidate_triaxial(config, make_sphere_assembly(config));
-  const TriaxialRunner runner(config, state);
-  const Tolerances t = triaxial_tolerances();
-  const double s3 = config.test.lateral_stress;
-  const int m = config.test.monitor_points;
-  AlgorithmSpec p = config.algorithm;
-  p.dt_ratio = 0.17;
-  p.steps = 16000;
-  p.damping_ratio_translation = 0.5;
-  p.damping_ratio_rotation = 2.0;
+  const DraggedFcc fcc;
+  const TriaxialRunner& runner = fcc.runner;
+  const Tolerances& t = fcc.t;
+  const double s3 = fcc.s3;
+  const int m = fcc.config.test.monitor_points;
+  const AlgorithmSpec p = fcc.spec(2.0);
   TriaxialResult run;
   runner.run(p, t, false, 3.0, nullptr, &run);
   const std::vector<TriaxialPoint>& series = run.series;

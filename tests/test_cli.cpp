@@ -15,9 +15,11 @@
 #include <string>
 #include <vector>
 
+#include "support/csv.hpp"
 #include "support/files.hpp"
 #include "support/process.hpp"
 #include "support/scenes.hpp"
+#include "support/vtk.hpp"
 
 namespace {
 
@@ -30,12 +32,7 @@ using Result = test::RunResult;
 
 const std::string kHex5 = test::shipped_config("hex_5x5");
 
-std::vector<std::string> split(const std::string& line, char sep) {
-  std::vector<std::string> out;
-  std::stringstream s(line);
-  for (std::string f; std::getline(s, f, sep);) out.push_back(f);
-  return out;
-}
+using test::split;
 
 /// A fresh folder per test (the working directory of the runs), removed
 /// afterwards.
@@ -239,87 +236,9 @@ TEST_F(CliEndToEnd, CheckAcceptsAParticleFile) {
 
 // --- run outputs ------------------------------------------------------------
 
-/// Legacy VTK polydata as world_vtk writes it: check every count against
-/// the data that follows.
+/// The run's VTK (support/vtk.hpp) with the 2D fields.
 void expect_valid_vtk(const std::string& text, int particles, bool contacts = true) {
-  std::stringstream s(text);
-  std::string line;
-  std::getline(s, line);
-  EXPECT_EQ(line, "# vtk DataFile Version 3.0");
-  std::getline(s, line);  // title
-  EXPECT_LE(line.size(), 256u);
-  std::getline(s, line);
-  EXPECT_EQ(line, "ASCII");
-  std::getline(s, line);
-  EXPECT_EQ(line, "DATASET POLYDATA");
-  std::string word, type;
-  long n = -1, cells = -1;
-  s >> word >> n >> type;
-  ASSERT_EQ(word, "POINTS");
-  EXPECT_EQ(n, particles);
-  EXPECT_EQ(type, "double");
-  for (long i = 0; i < 3 * n; ++i) {
-    double v;
-    ASSERT_TRUE(s >> v) << "point " << i / 3;
-    EXPECT_TRUE(std::isfinite(v));
-  }
-  long count = -1, size = -1;
-  s >> word >> count >> size;
-  ASSERT_EQ(word, "VERTICES");
-  EXPECT_EQ(count, n);
-  EXPECT_EQ(size, 2 * n);
-  for (long i = 0; i < count; ++i) {
-    long one, index;
-    ASSERT_TRUE(s >> one >> index);
-    EXPECT_EQ(one, 1);
-    EXPECT_EQ(index, i);
-  }
-  long lines = -1;
-  s >> word >> lines >> size;
-  ASSERT_EQ(word, "LINES");
-  if (contacts) {
-    EXPECT_GT(lines, 0);  // a loaded packing has contacts
-  }
-  EXPECT_EQ(size, 3 * lines);
-  for (long i = 0; i < lines; ++i) {
-    long two, a, b;
-    ASSERT_TRUE(s >> two >> a >> b);
-    EXPECT_EQ(two, 2);
-    EXPECT_TRUE(a >= 0 && a < n && b >= 0 && b < n && a != b) << a << " " << b;
-  }
-  // POINT_DATA n: SCALARS/VECTORS blocks of n values; CELL_DATA n + lines.
-  long data_count = -1;
-  s >> word >> data_count;
-  ASSERT_EQ(word, "POINT_DATA");
-  EXPECT_EQ(data_count, n);
-  std::set<std::string> names;
-  for (;;) {
-    if (!(s >> word)) break;
-    if (word == "CELL_DATA") {
-      s >> data_count;
-      EXPECT_EQ(data_count, n + lines);
-      cells = data_count;
-      continue;
-    }
-    std::string name, vtype;
-    s >> name >> vtype;
-    names.insert(name);
-    int components = 1;
-    if (word == "SCALARS") {
-      s >> components;
-      std::string lut, table;
-      s >> lut >> table;
-      EXPECT_EQ(lut, "LOOKUP_TABLE");
-    } else {
-      ASSERT_EQ(word, "VECTORS") << "unexpected section";
-      components = 3;
-    }
-    for (long i = 0; i < data_count * components; ++i) {
-      double v;
-      ASSERT_TRUE(s >> v) << name << " value " << i;
-    }
-  }
-  EXPECT_EQ(cells, n + lines);
+  const std::set<std::string> names = test::check_vtk_polydata(text, particles, contacts);
   for (const char* field : {"radius", "rotation", "velocity", "normal_force", "tangential_force"})
     EXPECT_TRUE(names.count(field)) << field;
 }
@@ -330,9 +249,8 @@ TEST_F(CliEndToEnd, RunWritesSummarySeriesAndVtk) {
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.out.find("peak sigma_yy"), std::string::npos) << r.out;
   // Exactly the three files: no temporary or probe file left behind.
-  std::set<std::string> files;
-  for (const auto& e : fs::directory_iterator(out)) files.insert(e.path().filename().string());
-  EXPECT_EQ(files, (std::set<std::string>{"summary.json", "series.csv", "final.vtk"}));
+  EXPECT_EQ(test::names_in(out),
+            (std::set<std::string>{"summary.json", "series.csv", "final.vtk"}));
 
   const auto s = nlohmann::json::parse(read_text(out / "summary.json"));
   EXPECT_EQ(s.at("particles"), 25);
@@ -375,15 +293,7 @@ TEST_F(CliEndToEnd, RunWritesSummarySeriesAndVtk) {
   const auto header = split(rows[0], ',');
   ASSERT_GE(header.size(), expected.size());
   EXPECT_EQ(std::vector<std::string>(header.begin(), header.begin() + expected.size()), expected);
-  for (size_t k = 1; k < rows.size(); ++k) {
-    const auto fields = split(rows[k], ',');
-    ASSERT_EQ(fields.size(), header.size()) << "row " << k;
-    for (const auto& f : fields) {
-      char* end = nullptr;
-      std::strtod(f.c_str(), &end);
-      ASSERT_TRUE(end != f.c_str() && *end == '\0') << "row " << k << ": " << f;
-    }
-  }
+  ASSERT_NO_FATAL_FAILURE(test::expect_numeric_rows(rows));
   EXPECT_EQ(split(rows[1], ',')[0], "0");
   EXPECT_EQ(split(rows.back(), ',')[0], "2000");
 
@@ -397,9 +307,7 @@ TEST_F(CliEndToEnd, RunIntoAnExistingFolderAndWithoutVtk) {
   const Result r = demcal({"run", kHex5, "--set", "algorithm.steps=2000", "--set",
                            "output.vtk=false", "-o", out.string()});
   ASSERT_EQ(r.status, 0) << r.err;
-  std::set<std::string> files;
-  for (const auto& e : fs::directory_iterator(out)) files.insert(e.path().filename().string());
-  EXPECT_EQ(files, (std::set<std::string>{"keep.txt", "summary.json", "series.csv"}));
+  EXPECT_EQ(test::names_in(out), (std::set<std::string>{"keep.txt", "summary.json", "series.csv"}));
   // The default folder is demcal-run-NAME in the working directory.
   const Result d = demcal({"run", kHex5, "--set", "algorithm.steps=2000", "--set", "name=tiny"});
   ASSERT_EQ(d.status, 0) << d.err;

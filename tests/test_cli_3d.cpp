@@ -13,9 +13,11 @@
 #include <string>
 #include <vector>
 
+#include "support/csv.hpp"
 #include "support/files.hpp"
 #include "support/process.hpp"
 #include "support/scenes.hpp"
+#include "support/vtk.hpp"
 
 namespace {
 
@@ -25,12 +27,7 @@ namespace test = demcal::test;
 using test::lines_of;
 using test::read_text;
 
-std::vector<std::string> split(const std::string& line, char sep) {
-  std::vector<std::string> out;
-  std::stringstream s(line);
-  for (std::string f; std::getline(s, f, sep);) out.push_back(f);
-  return out;
-}
+using test::split;
 
 // FCC 2×2×2 (32 spheres), r = 5e-4 m, rotation free.
 std::string fcc_config(const std::string& extra_test = "") {
@@ -57,84 +54,6 @@ class Cli3D : public ::testing::Test {
   const fs::path dir_ = tmp_.path();
 };
 
-/// Legacy VTK polydata: every count checked against the data that follows;
-/// returns the names of the data arrays.
-std::set<std::string> parse_vtk(const std::string& text, long particles) {
-  std::set<std::string> names;
-  std::stringstream s(text);
-  std::string line, word, type;
-  std::getline(s, line);
-  EXPECT_EQ(line, "# vtk DataFile Version 3.0");
-  std::getline(s, line);  // title
-  std::getline(s, line);
-  EXPECT_EQ(line, "ASCII");
-  std::getline(s, line);
-  EXPECT_EQ(line, "DATASET POLYDATA");
-  long n = -1, count = -1, size = -1, lines = -1;
-  s >> word >> n >> type;
-  EXPECT_EQ(word, "POINTS");
-  EXPECT_EQ(n, particles);
-  for (long i = 0; i < 3 * n; ++i) {
-    double v;
-    if (!(s >> v) || !std::isfinite(v)) {
-      ADD_FAILURE() << "point " << i / 3;
-      return names;
-    }
-  }
-  s >> word >> count >> size;
-  EXPECT_EQ(word, "VERTICES");
-  EXPECT_EQ(count, n);
-  EXPECT_EQ(size, 2 * n);
-  for (long i = 0; i < count; ++i) {
-    long one, index;
-    s >> one >> index;
-    EXPECT_EQ(one, 1);
-    EXPECT_EQ(index, i);
-  }
-  s >> word >> lines >> size;
-  EXPECT_EQ(word, "LINES");
-  EXPECT_GT(lines, 0);  // a loaded packing has contacts
-  EXPECT_EQ(size, 3 * lines);
-  for (long i = 0; i < lines; ++i) {
-    long two, a, b;
-    s >> two >> a >> b;
-    EXPECT_EQ(two, 2);
-    EXPECT_TRUE(a >= 0 && a < n && b >= 0 && b < n && a != b) << a << " " << b;
-  }
-  long data = -1;
-  s >> word >> data;
-  EXPECT_EQ(word, "POINT_DATA");
-  EXPECT_EQ(data, n);
-  bool cell_data = false;
-  while (s >> word) {
-    if (word == "CELL_DATA") {
-      s >> data;
-      EXPECT_EQ(data, n + lines);
-      cell_data = true;
-      continue;
-    }
-    std::string name, vtype, lut, table;
-    s >> name >> vtype;
-    names.insert(name);
-    int components = 3;
-    if (word == "SCALARS") {
-      s >> components >> lut >> table;
-      EXPECT_EQ(lut, "LOOKUP_TABLE");
-    } else {
-      EXPECT_EQ(word, "VECTORS");
-    }
-    for (long i = 0; i < data * components; ++i) {
-      double v;
-      if (!(s >> v)) {
-        ADD_FAILURE() << name << " value " << i;
-        return names;
-      }
-    }
-  }
-  EXPECT_TRUE(cell_data);
-  return names;
-}
-
 TEST_F(Cli3D, RunWritesSummaryNineComponentSeriesAndSphereVtk) {
   const std::string config = write("fcc2.json", fcc_config());
   const fs::path out = dir_ / "work" / "out";
@@ -144,9 +63,8 @@ TEST_F(Cli3D, RunWritesSummaryNineComponentSeriesAndSphereVtk) {
   EXPECT_NE(r.out.find("peak sigma_zz"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("moment balance"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("the 3D default tolerances"), std::string::npos) << r.out;
-  std::set<std::string> files;
-  for (const auto& e : fs::directory_iterator(out)) files.insert(e.path().filename().string());
-  EXPECT_EQ(files, (std::set<std::string>{"summary.json", "series.csv", "final.vtk"}));
+  EXPECT_EQ(test::names_in(out),
+            (std::set<std::string>{"summary.json", "series.csv", "final.vtk"}));
 
   const auto s = nlohmann::json::parse(read_text(out / "summary.json"));
   EXPECT_EQ(s.at("dimension"), 3);
@@ -177,20 +95,12 @@ TEST_F(Cli3D, RunWritesSummaryNineComponentSeriesAndSphereVtk) {
   for (const char* extra : {"kinetic_energy", "unbalanced_force_ratio", "inertial_number",
                             "servo_error_xmin", "servo_error_ymax", "wall_zmax"})
     EXPECT_NE(std::find(header.begin(), header.end(), extra), header.end()) << extra;
-  for (size_t k = 1; k < rows.size(); ++k) {
-    const auto fields = split(rows[k], ',');
-    ASSERT_EQ(fields.size(), header.size()) << "row " << k;
-    for (const auto& f : fields) {
-      char* end = nullptr;
-      std::strtod(f.c_str(), &end);
-      ASSERT_TRUE(end != f.c_str() && *end == '\0') << "row " << k << ": " << f;
-    }
-  }
+  ASSERT_NO_FATAL_FAILURE(test::expect_numeric_rows(rows));
   EXPECT_EQ(split(rows.back(), ',')[0], "4000");
   // The axial stress at the end: compressive, beyond σ3 (b_zz column).
   EXPECT_LT(std::stod(split(rows.back(), ',')[10]), -1e7);
 
-  const auto names = parse_vtk(read_text(out / "final.vtk"), 32);
+  const auto names = test::check_vtk_polydata(read_text(out / "final.vtk"), 32);
   for (const char* field :
        {"radius", "diameter", "velocity", "angular_velocity", "normal_force", "tangential_force"})
     EXPECT_TRUE(names.count(field)) << field;

@@ -9,6 +9,7 @@
 #include <numbers>
 #include <vector>
 
+#include "support/head_on.hpp"
 #include "test_kernel_helpers.hpp"
 
 namespace demcal {
@@ -47,61 +48,26 @@ TEST(KernelContact, HeadOnCollisionForceDurationAndRestitution) {
   // Gap (negative overlap) along the centre line, as the kernel computes it.
   auto overlap = [&] { return 2.0 * r - std::hypot(w.x()[1] - w.x()[0], w.y()[1] - w.y()[0]); };
 
-  double t_in = -1.0, t_out = -1.0, max_overlap = 0.0;
-  // Overlaps on the steps that straddle entry (δ_k < 0 ≤ δ_k+1) and exit.
-  double d_k = 0.0, d_k1 = 0.0, d_m = 0.0, d_m1 = 0.0;
-  double prev = overlap();
-  int contact_steps = 0;
-  for (int s = 0; s < 2000 && t_out < 0.0; ++s) {
-    ASSERT_TRUE(w.step(1));
-    const double cur = overlap();
-    const auto c = w.contacts();
-    if (cur > 0.0) {
-      ++contact_steps;
-      ASSERT_EQ(c.size(), 1u);
-      // fn = kn·δ: the only error is the round-off of δ = 2r − d, a difference
-      // of two numbers of size 2r, i.e. a few ulps of 2r.
-      EXPECT_NEAR(c[0].fn, kn * cur, kn * 8.0 * kEps * 2.0 * r);
-      EXPECT_EQ(c[0].ft, 0.0);  // head-on: no tangential motion at all
-      EXPECT_DOUBLE_EQ(c[0].nx, 1.0);
-      // Newton's third law, and the force pushes the disks apart.
-      EXPECT_DOUBLE_EQ(w.fx()[0], -c[0].fn);
-      EXPECT_DOUBLE_EQ(w.fx()[1], c[0].fn);
-      max_overlap = std::max(max_overlap, cur);
-    } else {
-      EXPECT_TRUE(c.empty());
-    }
-    // Between steps the kernel moves each disk on a straight line
-    // (x += v(n+½)·Δt): interpolate the crossing times linearly.
-    const double t1 = w.time(), t0 = t1 - in.dt;
-    if (prev <= 0.0 && cur > 0.0) {
-      t_in = t0 + in.dt * (-prev) / (cur - prev);
-      d_k = prev;
-      d_k1 = cur;
-    }
-    if (prev > 0.0 && cur <= 0.0) {
-      t_out = t0 + in.dt * prev / (prev - cur);
-      d_m = prev;
-      d_m1 = cur;
-    }
-    prev = cur;
-  }
-  ASSERT_GT(t_in, 0.0);
-  ASSERT_GT(t_out, t_in);
-  ASSERT_GT(contact_steps, 100);  // the contact is resolved by ~110 steps
-
-  // Duration. While the spring acts, central difference gives
-  // δ(n+1) = (2 − h²)·δ(n) − δ(n−1); the samples from the last one before
-  // contact to the first one after it all lie on one discrete sine
-  // A·sin(θ·(n − n0)), θ = 2·asin(h/2), whose half period is π/θ steps.
-  // The only error of the measurement is the linear interpolation of that
-  // sine across its two zeros: at most (θ²/6)·max a(1−a)(1−2a) ≈ 0.016·θ²
-  // steps each, so |T_meas − π·Δt/θ| ≤ θ²·Δt/16. The discrete half period
-  // differs from the continuous one by T·(1 − h/θ) ≤ T·h²/24.
-  const double T = std::numbers::pi * std::sqrt(meff / kn);
-  const double theta = 2.0 * std::asin(0.5 * h);
-  EXPECT_NEAR(t_out - t_in, std::numbers::pi * in.dt / theta, theta * theta * in.dt / 16.0);
-  EXPECT_NEAR(t_out - t_in, T, T * h * h / 24.0 + theta * theta * in.dt / 16.0);
+  test::HeadOnCollision hit;
+  ASSERT_NO_FATAL_FAILURE(test::collide_head_on(
+      w, in.dt, overlap,
+      [&](const auto& c, double cur) {
+        // fn = kn·δ: the only error is the round-off of δ = 2r − d, a
+        // difference of two numbers of size 2r, i.e. a few ulps of 2r.
+        EXPECT_NEAR(c.fn, kn * cur, kn * 8.0 * kEps * 2.0 * r);
+        EXPECT_EQ(c.ft, 0.0);  // head-on: no tangential motion at all
+        EXPECT_DOUBLE_EQ(c.nx, 1.0);
+        // Newton's third law, and the force pushes the disks apart.
+        EXPECT_DOUBLE_EQ(w.fx()[0], -c.fn);
+        EXPECT_DOUBLE_EQ(w.fx()[1], c.fn);
+      },
+      hit));
+  ASSERT_GT(hit.t_in, 0.0);
+  ASSERT_GT(hit.t_out, hit.t_in);
+  ASSERT_GT(hit.contact_steps, 100);  // the contact is resolved by ~110 steps
+  // Duration T = π·sqrt(m_eff/kn) and largest overlap v_rel/ω, to the
+  // bounds of the discrete scheme (support/head_on.hpp derives them).
+  test::expect_head_on_bounds(hit, meff, kn, in.dt, v_rel);
 
   // Restitution. In contact the scheme conserves exactly
   // J = v(n+½)² + ω²·δ(n)·δ(n+1) (v = dδ/dt, the approach rate), so
@@ -110,16 +76,10 @@ TEST(KernelContact, HeadOnCollisionForceDurationAndRestitution) {
   // Since |δ_k·δ_k+1| ≤ (v·Δt)²/4, this also bounds |e − 1| ≤ h²/8.
   const double v_out = w.vx()[1] - w.vx()[0];
   const double e = v_out / v_rel;
-  const double e2_scheme = 1.0 + omega * omega * (d_k * d_k1 - d_m * d_m1) / (v_rel * v_rel);
+  const double e2_scheme =
+      1.0 + omega * omega * (hit.d_k * hit.d_k1 - hit.d_m * hit.d_m1) / (v_rel * v_rel);
   EXPECT_NEAR(e * e, e2_scheme, 1e-9);
   EXPECT_NEAR(e, 1.0, h * h / 8.0);
-
-  // Largest overlap δ_max = v_rel/ω. From J the discrete sine has amplitude
-  // A = sqrt(J)·Δt/sin θ with sqrt(J)/v_in ∈ [sqrt(1 − h²/4), 1], i.e.
-  // A/δ_max ∈ [sqrt(1 − h²/4), 1]/cos(θ/2); the sampled crest is within a
-  // factor cos(θ/2) below A. Hence |max δ/δ_max − 1| ≤ θ²/8 (θ ≥ h).
-  const double dmax = v_rel / omega;
-  EXPECT_NEAR(max_overlap, dmax, dmax * theta * theta / 8.0);
 }
 
 // A heavy disk pressed onto the bottom wall (wall friction μ_w > 0) is moved

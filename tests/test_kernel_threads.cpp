@@ -7,16 +7,15 @@
 // contact force, wall forces and the stress measures.
 #include <gtest/gtest.h>
 
-#include <cstring>
 #include <vector>
 
+#include "support/same_bits.hpp"
 #include "test_kernel_helpers.hpp"
 
 namespace demcal {
 namespace {
 
-// Bitwise equality (distinguishes −0 from +0 and compares NaNs by pattern).
-bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+using test::same_bits;
 
 void expect_identical(const World& a, const World& b) {
   ASSERT_EQ(a.size(), b.size());
@@ -33,26 +32,12 @@ void expect_identical(const World& a, const World& b) {
     if (!same && ++mismatches <= 5) ADD_FAILURE() << "particle " << i << " differs";
   }
   EXPECT_EQ(mismatches, 0);
-  const auto ca = a.contacts(), cb = b.contacts();
-  ASSERT_EQ(ca.size(), cb.size());
-  for (size_t k = 0; k < ca.size(); ++k) {
-    ASSERT_EQ(ca[k].i, cb[k].i);
-    ASSERT_EQ(ca[k].j, cb[k].j);
-    EXPECT_TRUE(same_bits(ca[k].fn, cb[k].fn) && same_bits(ca[k].ft, cb[k].ft)) << "contact " << k;
-  }
-  for (int s = 0; s < 4; ++s) {
-    const Wall &wa = a.wall(static_cast<WallSide>(s)), &wb = b.wall(static_cast<WallSide>(s));
-    EXPECT_TRUE(same_bits(wa.position, wb.position)) << "wall " << s;
-    EXPECT_TRUE(same_bits(wa.force.x(), wb.force.x()) && same_bits(wa.force.y(), wb.force.y()))
-        << "wall " << s;
-    EXPECT_EQ(wa.contacts, wb.contacts);
-  }
+  test::expect_same_contacts(a.contacts(), b.contacts(), [](const auto& ca, const auto& cb) {
+    return same_bits(ca.fn, cb.fn) && same_bits(ca.ft, cb.ft);
+  });
+  test::expect_same_walls<WallSide, 4>(a, b);
   const Measures ma = a.measure(), mb = b.measure();
-  for (int r = 0; r < 2; ++r)
-    for (int c = 0; c < 2; ++c) {
-      EXPECT_TRUE(same_bits(ma.homogenized_stress(r, c), mb.homogenized_stress(r, c)));
-      EXPECT_TRUE(same_bits(ma.boundary_stress(r, c), mb.boundary_stress(r, c)));
-    }
+  test::expect_same_stresses(ma, mb);
   EXPECT_TRUE(same_bits(ma.kinetic_energy_translation, mb.kinetic_energy_translation));
   EXPECT_TRUE(same_bits(ma.elastic_energy, mb.elastic_energy));
 }

@@ -10,6 +10,7 @@
 #include <numbers>
 #include <vector>
 
+#include "support/head_on.hpp"
 #include "test_sphere_helpers.hpp"
 
 namespace demcal {
@@ -24,7 +25,7 @@ using sphere_test::test_material;
 // every axis, undamped, and separate again. Linear spring, reduced mass
 // m_eff = m/2, ω = sqrt(kn/m_eff): fn = kn·δ at every instant, contact
 // duration T = π·sqrt(m_eff/kn), restitution 1, largest overlap v_rel/ω.
-// The discrete bounds are the 2D kernel's (test_kernel_contact.cpp derives
+// The discrete bounds are the 2D kernel's (support/head_on.hpp derives
 // them): the samples lie on a discrete sine of angle θ = 2·asin(h/2),
 // h = ω·Δt; linear interpolation of the crossings errs by ≤ θ²·Δt/16 each
 // side; the discrete half period differs from T by ≤ T·h²/24; |e − 1| ≤ h²/8;
@@ -50,45 +51,28 @@ TEST(SphereContact, HeadOnCollisionForceDurationAndRestitution) {
   auto overlap = [&] {
     return 2.0 * r - (sphere_test::position(w, 1) - sphere_test::position(w, 0)).norm();
   };
-  double t_in = -1.0, t_out = -1.0, max_overlap = 0.0, prev = overlap();
-  int contact_steps = 0;
-  for (int step = 0; step < 2000 && t_out < 0.0; ++step) {
-    ASSERT_TRUE(w.step(1));
-    const double cur = overlap();
-    const auto c = w.contacts();
-    if (cur > 0.0) {
-      ++contact_steps;
-      ASSERT_EQ(c.size(), 1u);
-      // δ = 2r − d: a few ulps of 2r.
-      EXPECT_NEAR(c[0].fn, kn * cur, kn * 8.0 * kEps * 2.0 * r);
-      // Head-on: the tangential velocity is round-off (a few ulps of v_rel),
-      // accumulated over at most the ~110 contact steps.
-      EXPECT_LE(c[0].tangential.norm(), kt * in.dt * 200.0 * 8.0 * kEps * v_rel);
-      EXPECT_NEAR(c[0].normal.dot(u), 1.0, 8.0 * kEps);
-      // Newton's third law, repulsive.
-      EXPECT_NEAR((sphere_test::force(w, 0) + c[0].fn * u).norm(), 0.0, 1e-12 * c[0].fn);
-      EXPECT_NEAR((sphere_test::force(w, 1) + sphere_test::force(w, 0)).norm(), 0.0,
-                  1e-14 * c[0].fn);
-      max_overlap = std::max(max_overlap, cur);
-    } else {
-      EXPECT_TRUE(c.empty());
-    }
-    const double t1 = w.time(), t0 = t1 - in.dt;
-    if (prev <= 0.0 && cur > 0.0) t_in = t0 + in.dt * (-prev) / (cur - prev);
-    if (prev > 0.0 && cur <= 0.0) t_out = t0 + in.dt * prev / (prev - cur);
-    prev = cur;
-  }
-  ASSERT_GT(t_in, 0.0);
-  ASSERT_GT(t_out, t_in);
-  ASSERT_GT(contact_steps, 100);
-  const double T = std::numbers::pi * std::sqrt(meff / kn);
-  const double theta = 2.0 * std::asin(0.5 * h);
-  EXPECT_NEAR(t_out - t_in, std::numbers::pi * in.dt / theta, theta * theta * in.dt / 16.0);
-  EXPECT_NEAR(t_out - t_in, T, T * h * h / 24.0 + theta * theta * in.dt / 16.0);
+  test::HeadOnCollision hit;
+  ASSERT_NO_FATAL_FAILURE(test::collide_head_on(
+      w, in.dt, overlap,
+      [&](const auto& c, double cur) {
+        // δ = 2r − d: a few ulps of 2r.
+        EXPECT_NEAR(c.fn, kn * cur, kn * 8.0 * kEps * 2.0 * r);
+        // Head-on: the tangential velocity is round-off (a few ulps of v_rel),
+        // accumulated over at most the ~110 contact steps.
+        EXPECT_LE(c.tangential.norm(), kt * in.dt * 200.0 * 8.0 * kEps * v_rel);
+        EXPECT_NEAR(c.normal.dot(u), 1.0, 8.0 * kEps);
+        // Newton's third law, repulsive.
+        EXPECT_NEAR((sphere_test::force(w, 0) + c.fn * u).norm(), 0.0, 1e-12 * c.fn);
+        EXPECT_NEAR((sphere_test::force(w, 1) + sphere_test::force(w, 0)).norm(), 0.0,
+                    1e-14 * c.fn);
+      },
+      hit));
+  ASSERT_GT(hit.t_in, 0.0);
+  ASSERT_GT(hit.t_out, hit.t_in);
+  ASSERT_GT(hit.contact_steps, 100);
+  test::expect_head_on_bounds(hit, meff, kn, in.dt, v_rel);
   const double e = (sphere_test::velocity(w, 1) - sphere_test::velocity(w, 0)).dot(u) / v_rel;
   EXPECT_NEAR(e, 1.0, h * h / 8.0);
-  const double dmax = v_rel / omega;
-  EXPECT_NEAR(max_overlap, dmax, dmax * theta * theta / 8.0);
 }
 
 // Two spheres overlapping by δ along an oblique normal n; sphere 1 slides

@@ -39,16 +39,23 @@ struct Scene {
   }
 };
 
-/// Set undamped integration at α = Δt/Δt_crit on `w` and return it.
-inline Integration set_undamped(SphereWorld& w, double alpha, double mass_scaling = 1.0) {
+/// Set integration at α = Δt/Δt_crit with global damping ratio ζ on
+/// translation and rotation on `w` and return it.
+inline Integration set_damped(SphereWorld& w, double alpha, double zeta,
+                              double mass_scaling = 1.0) {
   Integration in;
-  in.damping_ratio_translation = 0.0;
-  in.damping_ratio_rotation = 0.0;
+  in.damping_ratio_translation = zeta;
+  in.damping_ratio_rotation = zeta;
   in.mass_scaling = mass_scaling;
   w.set_integration(in);  // masses first, then the step from them
   in.dt = alpha * w.reference_scales().dt_crit;
   w.set_integration(in);
   return in;
+}
+
+/// Set undamped integration at α = Δt/Δt_crit on `w` and return it.
+inline Integration set_undamped(SphereWorld& w, double alpha, double mass_scaling = 1.0) {
+  return set_damped(w, alpha, 0.0, mass_scaling);
 }
 
 inline Eigen::Vector3d position(const SphereWorld& w, int i) {

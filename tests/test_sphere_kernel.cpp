@@ -29,12 +29,7 @@ SphereWorld fcc_world(int n, double eps, double mu) {
 
 // Relax with global damping (ζ = 1, α = 0.2) for `steps`.
 void relax(SphereWorld& w, int steps) {
-  Integration in;
-  in.damping_ratio_translation = 1.0;
-  in.damping_ratio_rotation = 1.0;
-  w.set_integration(in);
-  in.dt = 0.2 * w.reference_scales().dt_crit;
-  w.set_integration(in);
+  sphere_test::set_damped(w, 0.2, 1.0);
   ASSERT_TRUE(w.step(steps));
 }
 

@@ -14,7 +14,6 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <cstring>
 #include <filesystem>
 #include <map>
 #include <random>
@@ -23,6 +22,7 @@
 #include <vector>
 
 #include "demcal/scene/sphere_packing.hpp"
+#include "support/same_bits.hpp"
 #include "test_sphere_helpers.hpp"
 
 namespace demcal {
@@ -31,7 +31,7 @@ namespace {
 using Eigen::Vector3d;
 using sphere_test::kR;
 
-bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+using test::same_bits;
 
 // 5×5×5 FCC cells (500 spheres: 63 blocks, so up to 7 threads are used),
 // compressed, positions jittered, random velocities and spins.
@@ -69,28 +69,14 @@ void expect_identical(const SphereWorld& a, const SphereWorld& b) {
     if (!same && ++mismatches <= 5) ADD_FAILURE() << "sphere " << i << " differs";
   }
   EXPECT_EQ(mismatches, 0);
-  const auto ca = a.contacts(), cb = b.contacts();
-  ASSERT_EQ(ca.size(), cb.size());
-  for (size_t k = 0; k < ca.size(); ++k) {
-    ASSERT_EQ(ca[k].i, cb[k].i);
-    ASSERT_EQ(ca[k].j, cb[k].j);
-    bool same = same_bits(ca[k].fn, cb[k].fn);
-    for (int c = 0; c < 3; ++c) same = same && same_bits(ca[k].tangential[c], cb[k].tangential[c]);
-    EXPECT_TRUE(same) << "contact " << k;
-  }
-  for (int s = 0; s < 6; ++s) {
-    const SphereWall &wa = a.wall(static_cast<SphereWallSide>(s)),
-                     &wb = b.wall(static_cast<SphereWallSide>(s));
-    EXPECT_TRUE(same_bits(wa.position, wb.position)) << "wall " << s;
-    for (int c = 0; c < 3; ++c) EXPECT_TRUE(same_bits(wa.force[c], wb.force[c])) << "wall " << s;
-    EXPECT_EQ(wa.contacts, wb.contacts);
-  }
+  test::expect_same_contacts(a.contacts(), b.contacts(), [](const auto& ca, const auto& cb) {
+    bool same = same_bits(ca.fn, cb.fn);
+    for (int c = 0; c < 3; ++c) same = same && same_bits(ca.tangential[c], cb.tangential[c]);
+    return same;
+  });
+  test::expect_same_walls<SphereWallSide, 6>(a, b);
   const SphereMeasures ma = a.measure(), mb = b.measure();
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) {
-      EXPECT_TRUE(same_bits(ma.homogenized_stress(r, c), mb.homogenized_stress(r, c)));
-      EXPECT_TRUE(same_bits(ma.boundary_stress(r, c), mb.boundary_stress(r, c)));
-    }
+  test::expect_same_stresses(ma, mb);
   EXPECT_TRUE(same_bits(ma.kinetic_energy_rotation, mb.kinetic_energy_rotation));
   EXPECT_TRUE(same_bits(ma.elastic_energy, mb.elastic_energy));
   EXPECT_TRUE(same_bits(a.energy_created(), b.energy_created()));
@@ -108,12 +94,7 @@ SphereWorld run_threads(double contact_damping, int threads) {
   if (contact_damping > 0.0) options.max_energy_created = 1e300;
   options.threads = threads;
   SphereWorld w = agitated_fcc(contact_damping, options);
-  Integration in;
-  in.damping_ratio_translation = 0.05;
-  in.damping_ratio_rotation = 0.05;
-  w.set_integration(in);
-  in.dt = 0.2 * w.reference_scales().dt_crit;
-  w.set_integration(in);
+  sphere_test::set_damped(w, 0.2, 0.05);
   w.wall(kZMax).velocity = -0.2;
   w.wall(kXMin).velocity = -0.1;
   w.wall(kXMax).velocity = 0.1;
