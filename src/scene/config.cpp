@@ -149,7 +149,7 @@ ContactLaw read_contact(Reader& r, const ContactLaw& fallback) {
 AlgorithmSpec read_algorithm(Reader& a, AlgorithmSpec s) {
   s.dt_ratio = a.positive("dt_ratio", s.dt_ratio);
   if (s.dt_ratio > 2.0) a.fail("dt_ratio", "must be <= 2 (beyond the single-spring limit)");
-  s.steps = a.integer("steps", s.steps, 10, 10000000000LL);
+  s.steps = a.integer("steps", s.steps, 10, kMaxSteps);
   s.damping_ratio_translation =
       a.non_negative("damping_ratio_translation", s.damping_ratio_translation);
   s.damping_ratio_rotation = a.non_negative("damping_ratio_rotation", s.damping_ratio_rotation);

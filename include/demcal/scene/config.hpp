@@ -27,6 +27,9 @@ inline constexpr int64_t kMaxParticles = 10'000'000;
 inline constexpr const char* kMaxParticlesWhy =
     "10000000 (about 1 kB of kernel state per particle and trial: 10 GB; a calibration REV "
     "has 1e2 to 1e5)";
+/// The longest loading (Nstep) a config's algorithm.steps or a params.json's
+/// rev.steps may ask for.
+inline constexpr int64_t kMaxSteps = 10'000'000'000;
 /// A particle count a file holds (a config's prototype.particles, a
 /// params.json's rev.particles and prototype.particles): a whole number
 /// from `min` to kMaxParticles, read without a cast that can overflow
