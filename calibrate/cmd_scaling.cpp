@@ -40,9 +40,10 @@ int cmd_scaling(const ScalingOptions& o) {
             << num(st.lin_cal.slope, 5) << ", intercept " << num(st.lin_cal.intercept, 5) << ", R2 "
             << num(st.lin_cal.r2, 4) << "; fixed multipliers from the REV up: exponent "
             << num(st.measured.exponent, 3) << " (law " << st.chosen.name()
-            << "); forward check of the linear law at " << st.results.at(st.forward_size).particles
-            << ": " << (st.forward_ok ? "passed" : "FAILED") << "\n  wrote " << out_dir
-            << "/scaling.md, " << out_dir << "/scaling.json\n";
+            << "); forward check of the " << law_words(st.candidate) << " law at "
+            << st.results.at(st.forward_size).particles << ": "
+            << (st.forward_ok ? "passed" : "FAILED") << "\n  wrote " << out_dir << "/scaling.md, "
+            << out_dir << "/scaling.json\n";
   return st.forward_ok ? 0 : 1;
 }
 

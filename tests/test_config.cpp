@@ -378,5 +378,31 @@ TEST(ConfigOverrides, BadFormsNameTheOverride) {
   expect_set_rejected("material=5", "material");
 }
 
+// prototype.particles had a limit of 1e11 here and 1e7 in params.json: one
+// limit (kMaxParticles, what the kernel and the export hold), one message
+// (particle_count) for both files.
+TEST(ConfigErrors, PrototypeParticlesHaveTheKernelsLimit) {
+  const std::string at_limit =
+      R"({"prototype": {"particles": )" + std::to_string(kMaxParticles) + "}}";
+  EXPECT_EQ(parse(at_limit).prototype.particles, kMaxParticles);
+  for (const std::string v : {std::to_string(kMaxParticles + 1), std::string("1e11"),
+                              std::string("2.5"), std::string("\"100\"")}) {
+    const std::string text = R"({"prototype": {"particles": )" + v + "}}";
+    expect_rejected(text, "prototype.particles");
+    const auto e = input_error([&] { parse(text); });
+    ASSERT_TRUE(e);
+    EXPECT_NE(std::string(e->what()).find(kMaxParticlesWhy), std::string::npos) << e->what();
+  }
+  // params.json's prototype.particles and rev.particles: the same reader.
+  const auto p = input_error([] {
+    particle_count(nlohmann::json(kMaxParticles + 1), 1, "params.json", "prototype.particles");
+  });
+  ASSERT_TRUE(p);
+  EXPECT_EQ(std::string(p->what()), "params.json: prototype.particles: must be between 1 and " +
+                                        std::to_string(kMaxParticles) +
+                                        ", got \"10000001\" (a particle count: at most " +
+                                        kMaxParticlesWhy + ")");
+}
+
 }  // namespace
 }  // namespace demcal

@@ -367,8 +367,8 @@ TEST(ScalingStudy, ReportStatesTheVerdictAndTheLaw) {
     r.fixed.steps = 500 * n;
   }
   st.have_forward = st.forward_ok = true;
-  st.linear_run = st.reference = sample_trial();
-  st.linear_peak_error = 0.004;
+  st.law_run = st.reference = sample_trial();
+  st.law_peak_error = 0.004;
   st.measured.exponent = 1.0;
   st.linear_holds = true;
   st.accuracy = 0.02;

@@ -10,6 +10,10 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "demcal/scene/triaxial.hpp"
+#include "demcal/upscaling/params_file.hpp"
+#include "demcal/upscaling/scaling_study.hpp"
+#include "demcal/upscaling/upscaling.hpp"
 #include "support/files.hpp"
 #include "support/process.hpp"
 
@@ -18,12 +22,22 @@ namespace {
 namespace fs = std::filesystem;
 namespace test = demcal::test;
 
-TEST(Scaling3D, TinyFccFamilyFitsTheExponent) {
-  test::TempDir dir("scaling3d");
-  const test::RunResult r = test::run_demcal(
-      {"scaling", test::shipped_config("fcc_4x4x4"), "--sizes", "32,108,256", "--calibrate-max",
-       "108", "--max-trials", "20", "-j", "1", "-q", "-o", "out", "--work", "work"},
-      dir.path());
+/// The tiny study in its own folder, run once for check_fit() and
+/// check_default_law() (one TEST: ctest runs each in a process of its own).
+struct TinyStudy {
+  test::TempDir dir{"scaling3d"};
+  test::RunResult r;
+  TinyStudy() {
+    r = test::run_demcal(
+        {"scaling", test::shipped_config("fcc_4x4x4"), "--sizes", "32,108,256", "--calibrate-max",
+         "108", "--max-trials", "20", "-j", "1", "-q", "-o", "out", "--work", "work"},
+        dir.path());
+  }
+};
+/// scaling.json and scaling.md carry the 3D exponent fit.
+void check_fit(const TinyStudy& study) {
+  const test::TempDir& dir = study.dir;
+  const test::RunResult& r = study.r;
   ASSERT_TRUE(r.status == 0 || r.status == 1) << r.err;  // 1: the forward check failed
   const nlohmann::json j = nlohmann::json::parse(test::read_text(dir / "out" / "scaling.json"));
   EXPECT_EQ(j.at("dimension"), 3);
@@ -49,13 +63,93 @@ TEST(Scaling3D, TinyFccFamilyFitsTheExponent) {
     // In the sample's linear size L ∝ N^(1/3): Nstep ∝ L^(3p).
     EXPECT_NEAR(j.at("exponent_linear_size").get<double>(), 3.0 * p, 1e-9);
   }
-  // The forward check ran the linear law's Nstep: 108-sphere REV's × 256/108.
-  EXPECT_EQ(j.at("forward").at("linear").at("params").at("steps").get<int64_t>(),
+  // The forward check ran the candidate law's Nstep, the first run of the
+  // step search at 256 spheres.
+  EXPECT_EQ(j.at("forward").at("run").at("params").at("steps").get<int64_t>(),
             fixed.at("runs")[0].at("params").at("steps").get<int64_t>());
   const std::string md = test::read_text(dir / "out" / "scaling.md");
   EXPECT_NE(md.find("(3D)"), std::string::npos);
   EXPECT_NE(md.find("N^(1/3)"), std::string::npos);
   EXPECT_NE(md.find("## 4. Verdict"), std::string::npos);
+}
+
+// The 3D study checks and chooses the 3D default law, Nstep ∝ N^(2/3)
+// (default_law(3), reports/scaling-3d.md §4), beside its fitted exponent,
+// as the 2D study does the linear law: the forward run at 256 spheres is
+// the REV's Nstep × (256/108)^(2/3) (rounded as the step search rounds
+// it), and the law scaling.json carries goes through `demcal upscale
+// --law` to the Nstep the default law gives. (It used to check and choose
+// the linear law, which asks N/N_REV where L² needs (N/N_REV)^(2/3).)
+void check_default_law(const TinyStudy& study) {
+  const test::TempDir& dir = study.dir;
+  const test::RunResult& r = study.r;
+  ASSERT_TRUE(r.status == 0 || r.status == 1) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(test::read_text(dir / "out" / "scaling.json"));
+  const demcal::ScalingLaw two_thirds = demcal::default_law(3);
+  EXPECT_DOUBLE_EQ(two_thirds.exponent, 2.0 / 3.0);
+  EXPECT_DOUBLE_EQ(j.at("candidate_law").at("exponent").get<double>(), 2.0 / 3.0);
+  EXPECT_DOUBLE_EQ(j.at("forward").at("law").at("exponent").get<double>(), 2.0 / 3.0);
+  const auto& rev = j.at("results")[1];
+  ASSERT_TRUE(rev.at("success")) << r.err;
+  const demcal::AlgorithmSpec rev_best = demcal::algorithm_from_json(rev.at("best"), "rev");
+  const int64_t by_law = demcal::upscale_steps(rev_best.steps, 108, 256, two_thirds);
+  EXPECT_EQ(by_law, std::llround(rev_best.steps * std::pow(256.0 / 108.0, 2.0 / 3.0)));
+  // The step search runs Nstep rounded as the search rounds it.
+  EXPECT_EQ(j.at("forward").at("run").at("params").at("steps").get<int64_t>(),
+            demcal::round_steps(static_cast<double>(by_law)));
+
+  // The forward check passes on this family: the law chosen is the default
+  // one, exactly (2/3 through JSON), and says where it was checked.
+  ASSERT_TRUE(j.at("forward").at("passed")) << j.at("forward").dump(2);
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(j.at("law").at("exponent").get<double>(), two_thirds.exponent);
+  EXPECT_NE(j.at("law").at("source").get<std::string>().find("checked forward at 256 spheres"),
+            std::string::npos)
+      << j.at("law").dump();
+  const std::string md = test::read_text(dir / "out" / "scaling.md");
+  EXPECT_NE(md.find("Forward check of the default law Nstep ∝ N^0.667"), std::string::npos) << md;
+  EXPECT_NE(md.find("Upscaling uses: **Nstep ∝ N^0.667**"), std::string::npos) << md;
+
+  // --law scaling.json on a params.json of the study's REV (108 spheres,
+  // its calibrated multipliers and Nstep): 256 spheres get the Nstep the
+  // default law gives them.
+  const demcal::SceneConfig config =
+      demcal::scene_of_size(demcal::load_config(test::shipped_config("fcc_4x4x4")), 108);
+  const demcal::TriaxialState state =
+      demcal::consolidate_triaxial(config, demcal::make_sphere_assembly(config));
+  ASSERT_EQ(state.world.size(), 108);
+  demcal::CalibrationSummary summary;
+  summary.success = true;
+  summary.best = rev_best;
+  summary.best_trial.params = rev_best;
+  summary.dimension = 3;
+  const std::string params = test::write_text(
+      dir / "params.json",
+      demcal::params_file(config, state, demcal::CalibrationOptions::from(config.calibration),
+                          summary)
+              .dump(2) +
+          "\n");
+  for (const bool with_law : {true, false}) {
+    SCOPED_TRACE(with_law ? "--law scaling.json" : "the default");
+    std::vector<std::string> args{"upscale", params, "--particles", "256", "-o", "up.json"};
+    if (with_law) args.insert(args.end(), {"--law", (dir / "out" / "scaling.json").string()});
+    const test::RunResult u = test::run_demcal(args, dir.path());
+    ASSERT_EQ(u.status, 0) << u.err;
+    const nlohmann::json up = nlohmann::json::parse(test::read_text(dir / "up.json"));
+    EXPECT_EQ(up.at("prototype").at("particles"), 256);
+    EXPECT_EQ(up.at("prototype").at("steps").get<int64_t>(), by_law);
+    EXPECT_EQ(up.at("upscaling").at("exponent").get<double>(), two_thirds.exponent);
+  }
+}
+
+TEST(Scaling3D, TinyFccFamilyFitsTheExponentAndChoosesTheDefaultLaw) {
+  const TinyStudy study;
+  {
+    SCOPED_TRACE("the fit");
+    check_fit(study);
+  }
+  SCOPED_TRACE("the default law");
+  check_default_law(study);
 }
 
 }  // namespace

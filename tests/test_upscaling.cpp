@@ -283,5 +283,31 @@ TEST_F(UpscaleCli, VerifyRunsASmallPrototypeAndScoresIt) {
   EXPECT_EQ(read_particle_file((dir_ / "v" / "prototype.csv").string()).size(), 400);
 }
 
+// rev.steps and rev.particles were read as doubles and rounded: 2.5 steps
+// or 2.5 particles passed. Counts go through json_integer (steps) and
+// particle_count (particles): exit 2, the file and the key named.
+TEST_F(UpscaleCli, RevCountsMustBeWholeNumbers) {
+  write_params(false);
+  const nlohmann::json good = nlohmann::json::parse(test::read_text(dir_ / "params.json"));
+  for (const char* key : {"steps", "particles"})
+    for (const nlohmann::json& v :
+         {nlohmann::json(2.5), nlohmann::json(89480.5), nlohmann::json("100"), nlohmann::json(-4),
+          nlohmann::json(1e300)}) {
+      SCOPED_TRACE(std::string(key) + " = " + v.dump());
+      nlohmann::json j = good;
+      j["rev"][key] = v;
+      std::ofstream(dir_ / "bad.json", std::ios::trunc) << j.dump(2);
+      const Cli r = run("upscale bad.json --particles 2500");
+      EXPECT_EQ(r.status, 2) << r.err;
+      EXPECT_NE(r.err.find("bad.json: rev." + std::string(key) + ": "), std::string::npos) << r.err;
+    }
+  // Whole numbers written as floats are still counts.
+  nlohmann::json j = good;
+  j["rev"]["steps"] = 89480.0;
+  std::ofstream(dir_ / "whole.json", std::ios::trunc) << j.dump(2);
+  const Cli r = run("upscale whole.json --particles 2500");
+  EXPECT_EQ(r.status, 0) << r.err;
+}
+
 }  // namespace
 }  // namespace demcal

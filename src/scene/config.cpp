@@ -76,6 +76,12 @@ class Reader {
     if (!has(key)) return fallback;
     return json_integer(object_.at(key), min, max, file_, field(key));
   }
+  /// A particle count: particle_count() from `min` to kMaxParticles.
+  int64_t particles(const std::string& key, int64_t fallback, int64_t min) {
+    used_.insert(key);
+    if (!has(key)) return fallback;
+    return particle_count(object_.at(key), min, file_, field(key));
+  }
   bool boolean(const std::string& key, bool fallback) {
     used_.insert(key);
     if (!has(key)) return fallback;
@@ -143,7 +149,7 @@ ContactLaw read_contact(Reader& r, const ContactLaw& fallback) {
 AlgorithmSpec read_algorithm(Reader& a, AlgorithmSpec s) {
   s.dt_ratio = a.positive("dt_ratio", s.dt_ratio);
   if (s.dt_ratio > 2.0) a.fail("dt_ratio", "must be <= 2 (beyond the single-spring limit)");
-  s.steps = a.integer("steps", s.steps, 10, 10000000000LL);
+  s.steps = a.integer("steps", s.steps, 10, kMaxSteps);
   s.damping_ratio_translation =
       a.non_negative("damping_ratio_translation", s.damping_ratio_translation);
   s.damping_ratio_rotation = a.non_negative("damping_ratio_rotation", s.damping_ratio_rotation);
@@ -245,6 +251,17 @@ void require_material(const Reader& root, const json& root_json, const std::stri
 }
 
 }  // namespace
+
+int64_t particle_count(const nlohmann::json& value, int64_t min, const std::string& file,
+                       const std::string& field) {
+  try {
+    return json_integer(value, min, kMaxParticles);
+  } catch (const std::logic_error& e) {  // invalid_argument, out_of_range
+    throw InputError(
+        file, field,
+        std::string(e.what()) + " (a particle count: at most " + kMaxParticlesWhy + ")");
+  }
+}
 
 nlohmann::json to_json(const AlgorithmSpec& g) {
   return {{"dt_ratio", g.dt_ratio},
@@ -391,7 +408,9 @@ SceneConfig parse_config(const nlohmann::json& root_json, const std::string& sou
   }
   {
     Reader p = root.child("prototype");
-    c.prototype.particles = p.integer("particles", 0, 0, 100000000000LL);
+    // 0: the REV itself. The limit params.json's prototype.particles has:
+    // the prototype is generated, consolidated and verified by our kernel.
+    c.prototype.particles = p.particles("particles", 0, 0);
     c.prototype.file = p.string("file", "");
     if (!c.prototype.file.empty()) {
       const auto dir = std::filesystem::path(source).parent_path();

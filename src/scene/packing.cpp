@@ -95,7 +95,8 @@ bool parse_particle_number(const std::string& field, double& value) {
 }  // namespace
 
 bool parse_particle_fields(const std::string& line, std::span<double> v, bool& seen_content,
-                           const std::string& path, const std::string& where) {
+                           int64_t particles_read, const std::string& path,
+                           const std::string& where) {
   const size_t n = v.size();
   std::vector<std::string> fields;
   std::stringstream ss(line);
@@ -118,6 +119,14 @@ bool parse_particle_fields(const std::string& line, std::span<double> v, bool& s
     throw InputError(path, where, "values must be finite, got " + quoted_value(line));
   if (!(v[n - 1] > 0.0))
     throw InputError(path, where, "radius must be > 0, got " + quoted_value(line));
+  // The overlap test adds a few radii to a coordinate: that must stay finite.
+  for (size_t k = 0; k + 1 < n; ++k)
+    if (!std::isfinite(std::abs(v[k]) + 4.0 * v[n - 1]))
+      throw InputError(
+          path, where,
+          "values too large (|coordinate| + 4 r overflows a double), got " + quoted_value(line));
+  if (particles_read >= kMaxParticles)
+    throw InputError(path, where, std::string("more particles than the limit ") + kMaxParticlesWhy);
   return true;
 }
 
@@ -173,15 +182,8 @@ Assembly read_particles(std::istream& in, const std::string& path) {
     }
     if (first == std::string::npos || line[first] == '#') continue;
     double v[3];
-    if (!parse_particle_fields(line, v, seen_content, path, where())) continue;  // the header
-    // The overlap test adds a few radii to a coordinate: that must stay finite.
-    if (!std::isfinite(std::abs(v[0]) + 4.0 * v[2]) || !std::isfinite(std::abs(v[1]) + 4.0 * v[2]))
-      throw InputError(
-          path, where(),
-          "values too large (|x| + 4 r overflows a double), got " + quoted_value(line));
-    if (a.size() >= kMaxParticles)
-      throw InputError(path, where(),
-                       std::string("more particles than the limit ") + kMaxParticlesWhy);
+    if (!parse_particle_fields(line, v, seen_content, a.size(), path, where()))
+      continue;  // the header
     a.x.push_back(v[0]);
     a.y.push_back(v[1]);
     a.r.push_back(v[2]);

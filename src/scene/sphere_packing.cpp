@@ -104,7 +104,10 @@ SphereAssembly read_spheres(std::istream& in, const std::string& path) {
     const auto first = line.find_first_not_of(" \t");
     if (first == std::string::npos || line[first] == '#') continue;
     double v[4];
-    if (!parse_particle_fields(line, v, seen_content, path, where())) continue;  // the header
+    // The 2D reader's checks: fields, finite, radius > 0, |coordinate| + 4 r
+    // finite, at most kMaxParticles.
+    if (!parse_particle_fields(line, v, seen_content, a.size(), path, where()))
+      continue;  // the header
     a.x.push_back(v[0]);
     a.y.push_back(v[1]);
     a.z.push_back(v[2]);

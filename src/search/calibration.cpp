@@ -6,12 +6,15 @@
 #include <chrono>
 #include <cmath>
 #include <fstream>
+#include <functional>
 #include <future>
 #include <limits>
 #include <map>
 #include <mutex>
 #include <set>
 #include <sstream>
+#include <utility>
+#include <vector>
 
 #include "demcal/io/files.hpp"
 #include "demcal/io/format.hpp"
@@ -243,8 +246,56 @@ TrialRecord trial_from_json(const nlohmann::json& j, const std::string& source) 
 }
 
 // ---------------------------------------------------------------------------
+// Where a trial was asked for. A one-job calibration asks for its trials in
+// one order; with --jobs > 1 the branches of a parallel section (the two
+// starts' searches, the certificate's runs) ask and finish in any order. A
+// trial's id is its rank in the one-job order, so that trials.jsonl is the
+// same whatever --jobs is (up to the wall times): each request has a
+// position, the ranks of the sections and branches it was made in and its
+// own rank there, compared lexicographically, which is the order in which
+// a one-job run (branches one after the other) makes them.
+
+namespace {
+
+using Position = std::vector<int>;
+
+/// The calling thread's place: the position prefix of the branch it runs
+/// in and the next rank there.
+struct Place {
+  Position path;
+  int next = 0;
+};
+thread_local Place t_place;
+
+/// The calling thread's place for a scope; the previous one restored after.
+class PlaceScope {
+ public:
+  explicit PlaceScope(Place place) : saved_(std::exchange(t_place, std::move(place))) {}
+  ~PlaceScope() { t_place = std::move(saved_); }
+  PlaceScope(const PlaceScope&) = delete;
+  PlaceScope& operator=(const PlaceScope&) = delete;
+
+ private:
+  Place saved_;
+};
+
+Position next_position() {
+  Position p = t_place.path;
+  p.push_back(t_place.next++);
+  return p;
+}
+
+bool at_top_level() { return t_place.path.empty(); }
+
+}  // namespace
+
+// ---------------------------------------------------------------------------
 // The evaluator: a thread-safe cache of trials, written through to
 // trials.jsonl. Two searches asking for the same parameters share one run.
+// A trial is written when it finishes (a kill loses nothing finished); at
+// the top level, outside parallel sections, the trials finished since are
+// numbered in position order (and the file rewritten when that order is
+// not the finishing order).
 
 namespace {
 
@@ -258,7 +309,25 @@ class Evaluator {
     p.set_value(r);
     cache_.emplace(key_of(r.params), p.get_future().share());
     preloaded_.insert(key_of(r.params));
+    settled_.emplace(key_of(r.params), r);
     next_id_ = std::max(next_id_, r.id + 1);
+  }
+
+  /// run_parallel() for tasks that ask for trials: each task a branch of
+  /// one section at the caller's next rank. Back at the top level, the
+  /// section's trials are numbered.
+  void run_branches(const std::vector<std::function<void()>>& tasks, int jobs) {
+    const Position section = next_position();
+    std::vector<std::function<void()>> branches;
+    for (size_t i = 0; i < tasks.size(); ++i)
+      branches.push_back([&tasks, section, i] {
+        Place place{section, 0};
+        place.path.push_back(static_cast<int>(i));
+        const PlaceScope scope(std::move(place));
+        tasks[i]();
+      });
+    run_parallel(branches, jobs);
+    if (at_top_level()) settle();
   }
 
   /// The caller asked to stop (CalibrationOptions::stop).
@@ -273,6 +342,7 @@ class Evaluator {
     params = rounded_params(params);
     if (stopped()) return interrupted_record(params, phase);
     const Key key = key_of(params);
+    const Position position = next_position();
     std::shared_future<TrialRecord> future;
     std::promise<TrialRecord> promise;
     bool mine = false;
@@ -282,13 +352,19 @@ class Evaluator {
       if (it == cache_.end()) {
         future = promise.get_future().share();
         cache_.emplace(key, future);
+        first_request_[key] = {position, phase};
         mine = true;
       } else {
         future = it->second;
         if (preloaded_.erase(key)) ++reused_;
+        // Not numbered yet: the earliest request (in the one-job order)
+        // gives the trial its place and its phase.
+        const auto first = first_request_.find(key);
+        if (first != first_request_.end() && position < first->second.position)
+          first->second = {position, phase};
       }
     }
-    if (!mine) return future.get();
+    if (!mine) return settled_or(key, future.get());
     TrialRecord r;
     try {
       TrialRun run = runner_.run(params, options_.tolerances, options_.early_stop && early_stop,
@@ -307,15 +383,18 @@ class Evaluator {
       r = interrupted_record(params, phase);
       std::lock_guard<std::mutex> lock(mutex_);
       cache_.erase(key);
+      first_request_.erase(key);
       promise.set_value(r);
       return r;
     }
     {
       std::lock_guard<std::mutex> lock(mutex_);
-      r.id = next_id_++;
+      // Provisional: the finishing order; settle() numbers it.
+      r.id = next_id_ + static_cast<int>(unsettled_.size());
       ++run_;
-      if (!options_.trials_path.empty())
-        append_line_durable(options_.trials_path, to_json(r).dump());
+      const std::string line = to_json(r).dump();
+      if (!options_.trials_path.empty()) append_line_durable(options_.trials_path, line);
+      unsettled_.push_back({key, r, line});
       if (options_.progress) {
         std::ostringstream s;
         s.precision(3);
@@ -340,13 +419,16 @@ class Evaluator {
       }
     }
     promise.set_value(r);
-    return r;
+    if (at_top_level()) settle();
+    return settled_or(key, r);
   }
 
+  /// Every finished trial, in id order (called at the top level).
   std::vector<TrialRecord> all() {
+    settle();
     std::lock_guard<std::mutex> lock(mutex_);
     std::vector<TrialRecord> out;
-    for (auto& [k, f] : cache_) out.push_back(f.get());
+    for (const auto& [k, r] : settled_) out.push_back(r);
     std::sort(out.begin(), out.end(),
               [](const TrialRecord& a, const TrialRecord& b) { return a.id < b.id; });
     return out;
@@ -365,11 +447,59 @@ class Evaluator {
     return r;
   }
 
+  /// The trials finished since the last settle(), numbered in the order of
+  /// their first request, their phase that request's; trials.jsonl
+  /// rewritten when that is not the order they were written in.
+  void settle() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (unsettled_.empty()) return;
+    std::string written, numbered;
+    for (const Unsettled& u : unsettled_) written += u.line + "\n";
+    std::stable_sort(unsettled_.begin(), unsettled_.end(),
+                     [this](const Unsettled& a, const Unsettled& b) {
+                       return first_request_.at(a.key).position < first_request_.at(b.key).position;
+                     });
+    for (Unsettled& u : unsettled_) {
+      u.record.id = next_id_++;
+      u.record.phase = first_request_.at(u.key).phase;
+      numbered += to_json(u.record).dump() + "\n";
+      settled_.insert_or_assign(u.key, u.record);
+      first_request_.erase(u.key);
+    }
+    unsettled_.clear();
+    if (numbered == written || options_.trials_path.empty()) return;
+    const std::string text = read_text_file(options_.trials_path);
+    if (text.size() >= written.size() &&
+        text.compare(text.size() - written.size(), written.size(), written) == 0)
+      write_file_atomic(options_.trials_path,
+                        text.substr(0, text.size() - written.size()) + numbered);
+  }
+
+  /// The numbered record of a trial once settled, else `r`.
+  TrialRecord settled_or(const Key& key, const TrialRecord& r) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const auto it = settled_.find(key);
+    return it != settled_.end() ? it->second : r;
+  }
+
+  struct Request {
+    Position position;
+    TrialPhase phase;
+  };
+  struct Unsettled {
+    Key key;
+    TrialRecord record;
+    std::string line;  ///< as written to trials.jsonl
+  };
+
   const TrialRunner& runner_;
   const CalibrationOptions& options_;
   std::chrono::steady_clock::time_point t0_;
   std::mutex mutex_;
   std::map<Key, std::shared_future<TrialRecord>> cache_;
+  std::map<Key, Request> first_request_;  ///< trials not numbered yet
+  std::vector<Unsettled> unsettled_;
+  std::map<Key, TrialRecord> settled_;  ///< numbered (or preloaded)
   std::set<Key> preloaded_;
   int next_id_ = 0, run_ = 0, reused_ = 0;
   int64_t best_steps_ = 0;
@@ -628,7 +758,7 @@ std::optional<TrialRecord> model_search(Evaluator& evaluator, const SearchSpace&
   const int evals = std::max(8, max_evals - kVerifyBudget);
   const double first = std::min(a[1], b[1]);
   std::optional<ModelPrediction> pa, pb;
-  run_parallel(
+  evaluator.run_branches(
       {[&] { pa = model_predict(evaluator, space, tolerances, a, first, evals / 2); },
        [&] { pb = model_predict(evaluator, space, tolerances, b, first, evals - evals / 2); }},
       jobs);
@@ -674,7 +804,7 @@ Certificate certify(Evaluator& evaluator, const TrialRecord& best, double accura
   // The halved run is judged only by its peak: it runs to its end.
   if (three_level)
     runs.push_back([&] { h = evaluator.evaluate(halved, TrialPhase::certificate, false); });
-  run_parallel(runs, jobs);
+  evaluator.run_branches(runs, jobs);
   Certificate c;
   c.steps = best.params.steps;
   c.peak = a.score.criteria.peak_stress_yy;
@@ -758,6 +888,8 @@ CalibrationSummary calibrate(const TrialRunner& runner, const AlgorithmSpec& bas
   const int jobs = resolve_jobs(options.jobs);
   const int64_t n = runner.particles();
 
+  // Positions are counted from this call's top level (ids, Evaluator).
+  const PlaceScope top_level(Place{});
   Evaluator evaluator(runner, options);
   if (options.resume && !options.trials_path.empty())
     preload_trials(evaluator, options.trials_path);
@@ -815,9 +947,9 @@ CalibrationSummary calibrate(const TrialRunner& runner, const AlgorithmSpec& bas
       local_search(Strategy::cobyla, context, x, evals - evals / 3);
       return;
     }
-    run_parallel({[&] { local_search(options.strategy, context, a, evals / 2); },
-                  [&] { local_search(options.strategy, context, b, evals - evals / 2); }},
-                 jobs);
+    evaluator.run_branches({[&] { local_search(options.strategy, context, a, evals / 2); },
+                            [&] { local_search(options.strategy, context, b, evals - evals / 2); }},
+                           jobs);
   };
   search_round(start0, start1, budget, TrialPhase::search);
   const auto finish_interrupted = [&] {

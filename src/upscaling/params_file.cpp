@@ -44,14 +44,7 @@ nlohmann::json parse_params_text(std::string_view text, const std::string& path)
     json_integer(*d, 2, 3, path, "dimension");
   if (params.contains("prototype") && params["prototype"].is_object() &&
       params["prototype"].contains("particles")) {
-    const auto& n = params["prototype"]["particles"];
-    try {
-      json_integer(n, 1, kMaxParticles);
-    } catch (const std::logic_error&) {
-      throw InputError(path, "prototype.particles",
-                       std::string("must be a whole number from 1 to ") + kMaxParticlesWhy +
-                           ", got " + quoted_value(n.dump()));
-    }
+    particle_count(params["prototype"]["particles"], 1, path, "prototype.particles");
   }
   return params;
 }

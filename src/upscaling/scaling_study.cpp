@@ -107,6 +107,14 @@ ScalingSize scaling_size_from_json(const json& j, const std::string& source) {
   }
 }
 
+bool law_holds(double measured_exponent, const ScalingLaw& law) {
+  return std::abs(measured_exponent - law.exponent) <= 0.1;
+}
+
+std::string law_words(const ScalingLaw& law) {
+  return law.name() == "linear" ? "linear" : "N^" + num(law.exponent, 3);
+}
+
 Spread spread_of(const std::vector<double>& v) {
   Spread s;
   if (v.empty()) return s;
@@ -260,9 +268,10 @@ ScalingSize calibrate_size(Family& family, const SceneConfig& config, const Scal
 }
 
 /// Step 2: the smallest passing Nstep at the REV's multipliers at size n,
-/// from the linear prediction (or reuse fixed.json).
+/// from the prediction of `law` (the candidate; or reuse fixed.json).
 void fixed_multipliers(Family& family, const ScalingStudyOptions& o, const ScalingSize& ref,
-                       const Tolerances& tolerances, int64_t n, ScalingSize& r) {
+                       const ScalingLaw& law, const Tolerances& tolerances, int64_t n,
+                       ScalingSize& r) {
   const std::string fixed_path = family.dir(n) + "/fixed.json";
   if (o.resume && fs::exists(fixed_path)) {
     const ScalingSize stored = scaling_size_from_json(read_json(fixed_path), fixed_path);
@@ -274,10 +283,10 @@ void fixed_multipliers(Family& family, const ScalingStudyOptions& o, const Scali
   make_output_dir(family.dir(n));
   const SizeState& state = family.state(n);
   r.particles = state.particles;
-  const AlgorithmSpec start = upscale(ref.best, ref.particles, r.particles);
+  const AlgorithmSpec start = upscale(ref.best, ref.particles, r.particles, law);
   family.log("size " + std::to_string(r.particles) +
-             ": smallest passing Nstep at the REV's multipliers, from the linear prediction " +
-             std::to_string(start.steps) + " (" +
+             ": smallest passing Nstep at the REV's multipliers, from the " + law_words(law) +
+             " prediction " + std::to_string(start.steps) + " (" +
              num(static_cast<double>(start.steps) * r.particles, 3) + " particle-steps)");
   const auto t0 = std::chrono::steady_clock::now();
   const StepSearch search = smallest_passing_steps(*state.runner, start, tolerances);
@@ -326,22 +335,19 @@ void fit_laws(ScalingStudy& st) {
   st.measured.source = "demcal scaling " + st.scene + ": smallest passing Nstep at the " +
                        std::to_string(st.results[st.ref_size].particles) +
                        "-particle REV's multipliers, sizes >= REV";
-  // Linear when the measured exponent is within 0.1 of 1; a smaller one
-  // means the linear law spends steps for nothing, a larger one that it
-  // falls short.
-  st.linear_holds = std::abs(st.measured.exponent - 1.0) <= 0.1;
+  st.linear_holds = law_holds(st.measured.exponent, ScalingLaw{});
   st.alpha = spread_of(alphas), st.zeta_t = spread_of(zetas_t), st.zeta_r = spread_of(zetas_r);
 }
 
-/// Step 4: the forward check at the largest size, the linear law's run (the
-/// first of its search) against a reference with twice its steps.
+/// Step 4: the forward check at the largest size, the candidate law's run
+/// (the first of its search) against a reference with twice its steps.
 void forward_check(Family& family, const ScalingStudyOptions& o, ScalingStudy& st,
-                   const TrialRecord& linear_run) {
+                   const TrialRecord& law_run) {
   st.have_forward = true;
-  st.linear_run = linear_run;
+  st.law_run = law_run;
   const std::string ref_path = family.dir(st.forward_size) + "/reference.json";
-  AlgorithmSpec ref_params = linear_run.params;
-  ref_params.steps = 2 * linear_run.params.steps;
+  AlgorithmSpec ref_params = law_run.params;
+  ref_params.steps = 2 * law_run.params.steps;
   if (o.resume && fs::exists(ref_path)) {
     st.reference = trial_from_json(read_json(ref_path), ref_path);
   } else {
@@ -352,10 +358,10 @@ void forward_check(Family& family, const ScalingStudyOptions& o, ScalingStudy& s
     write_file_atomic(ref_path, to_json(st.reference).dump(2) + "\n");
   }
   const double ref_peak = st.reference.score.criteria.peak_stress_yy;
-  st.linear_peak_error =
-      ref_peak != 0.0 ? (std::abs(linear_run.score.criteria.peak_stress_yy) - std::abs(ref_peak)) /
-                            std::abs(ref_peak)
-                      : 0.0;
+  st.law_peak_error = ref_peak != 0.0
+                          ? (std::abs(law_run.score.criteria.peak_stress_yy) - std::abs(ref_peak)) /
+                                std::abs(ref_peak)
+                          : 0.0;
 }
 
 }  // namespace
@@ -382,6 +388,10 @@ ScalingStudy run_scaling_study(const SceneConfig& config, const ScalingStudyOpti
   st.calibrate_max = o.calibrate_max;
   st.accuracy = config.calibration.accuracy;
   st.resumed = o.resume;
+  // The law the study checks forward and carries unless it falls short:
+  // the dimension's default (Tu & Andrade's linear law for disks, N^(2/3)
+  // for spheres, reports/scaling-3d.md §4).
+  st.candidate = default_law(config.dimension);
   check_scaling_sizes(o);
   for (int64_t n : o.sizes)
     if (n <= o.calibrate_max) st.calibrated_sizes.push_back(n);
@@ -409,8 +419,8 @@ ScalingStudy run_scaling_study(const SceneConfig& config, const ScalingStudyOpti
                              ") did not calibrate: no multipliers to carry (see " + o.work_dir +
                              ")");
 
-  // At a size beyond the calibrated ones the search starts at the linear
-  // prediction: that first run is the forward check of the linear law.
+  // At a size beyond the calibrated ones the search starts at the
+  // candidate's prediction: that first run is the candidate's forward check.
   for (int64_t n : o.sizes) {
     ScalingSize& r = st.results[n];
     r.requested = n;
@@ -419,24 +429,24 @@ ScalingStudy run_scaling_study(const SceneConfig& config, const ScalingStudyOpti
       r.fixed.steps = r.best.steps;
       continue;
     }
-    fixed_multipliers(family, o, ref, st.tolerances, n, r);
+    fixed_multipliers(family, o, ref, st.candidate, st.tolerances, n, r);
   }
   fit_laws(st);
   const ScalingSize& fwd = st.results[st.forward_size];
   if (st.forward_size > o.calibrate_max && !fwd.fixed.trials.empty())
     forward_check(family, o, st, fwd.fixed.trials.front());
-  st.forward_ok = st.have_forward && st.linear_run.score.passed &&
-                  std::abs(st.linear_peak_error) <= st.accuracy;
-  // The law upscaling uses: linear while the forward check confirms it (a
-  // smaller measured exponent would save steps, but it was fitted on the
-  // forward size itself and has no independent check here); the measured
-  // exponent when the linear law falls short.
-  st.chosen = st.forward_ok || st.measured.exponent <= 1.0 ? ScalingLaw{} : st.measured;
-  if (st.dimension == 3 && st.chosen.name() == "linear")
-    st.chosen.source = "Tu & Andrade (2008): Nstep proportional to N, on spheres: demcal scaling " +
-                       st.scene +
-                       (st.forward_ok ? ", checked forward at " : ", forward check FAILED at ") +
-                       std::to_string(st.results[st.forward_size].particles) + " spheres";
+  st.forward_ok =
+      st.have_forward && st.law_run.score.passed && std::abs(st.law_peak_error) <= st.accuracy;
+  // The law upscaling uses: the candidate while the forward check confirms
+  // it (a smaller measured exponent would save steps, but it was fitted on
+  // the forward size itself and has no independent check here); the
+  // measured exponent when the candidate falls short.
+  const bool candidate = st.forward_ok || st.measured.exponent <= st.candidate.exponent;
+  st.chosen = candidate ? st.candidate : st.measured;
+  if (st.dimension == 3 && candidate)
+    st.chosen.source += "; demcal scaling " + st.scene +
+                        (st.forward_ok ? ": checked forward at " : ": forward check FAILED at ") +
+                        std::to_string(st.results[st.forward_size].particles) + " spheres";
   st.wall_time_s = seconds_since(t_start);
   return st;
 }
@@ -473,13 +483,16 @@ json to_json(const ScalingStudy& st, const SceneConfig& config) {
           {"dimension", st.dimension},
           {"exponent_linear_size", st.dimension * st.measured.exponent},
           {"law", to_json(st.chosen)},
+          {"candidate_law", to_json(st.candidate)},
           {"linear_holds", st.linear_holds},
+          {"candidate_holds", law_holds(st.measured.exponent, st.candidate)},
           {"forward",
            {{"particles", fwd.particles},
             {"from_rev", ref.particles},
-            {"linear", st.have_forward ? to_json(st.linear_run) : json()},
+            {"law", to_json(st.candidate)},
+            {"run", st.have_forward ? to_json(st.law_run) : json()},
             {"reference", st.have_forward ? to_json(st.reference) : json()},
-            {"peak_error_vs_reference", st.linear_peak_error},
+            {"peak_error_vs_reference", st.law_peak_error},
             {"accuracy", st.accuracy},
             {"passed", st.forward_ok}}},
           {"tolerances", to_json(st.tolerances)},

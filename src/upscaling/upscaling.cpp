@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "demcal/io/files.hpp"
+#include "demcal/io/json_integer.hpp"
 #include "demcal/scene/triaxial.hpp"
 #include "demcal/upscaling/rev.hpp"
 #include "demcal/upscaling/rev_3d.hpp"
@@ -333,24 +334,22 @@ RevParams rev_params_from_json(const nlohmann::json& params, const std::string& 
   RevParams out;
   auto& p = out.params;
   p.dt_ratio = number_at(b, "dt_ratio", source, "rev");
-  const double steps = number_at(b, "steps", source, "rev");
+  // Counts: whole numbers (json_integer), never a double rounded (2.5).
+  auto present = [&](const char* key) -> const nlohmann::json& {
+    if (!b.contains(key))
+      throw InputError(source, std::string("rev.") + key, "missing (not a demcal params.json?)");
+    return b[key];
+  };
+  p.steps = json_integer(present("steps"), 1, kMaxSteps, source, "rev.steps");
   p.damping_ratio_translation = number_at(b, "damping_ratio_translation", source, "rev");
   p.damping_ratio_rotation = number_at(b, "damping_ratio_rotation", source, "rev");
   p.mass_scaling = b.contains("mass_scaling") ? number_at(b, "mass_scaling", source, "rev") : 1.0;
-  const double particles = number_at(b, "particles", source, "rev");
+  out.particles = particle_count(present("particles"), 1, source, "rev.particles");
   if (!(p.dt_ratio > 0.0 && p.dt_ratio < 2.0))
     throw InputError(source, "rev.dt_ratio", "must be in (0, 2), got " + b["dt_ratio"].dump());
-  if (!(steps >= 1.0 && steps < 9e18))
-    throw InputError(source, "rev.steps", "must be a positive integer, got " + b["steps"].dump());
-  if (!(particles >= 1.0 && particles <= static_cast<double>(kMaxParticles)))
-    throw InputError(source, "rev.particles",
-                     std::string("must be a count from 1 to ") + kMaxParticlesWhy + ", got " +
-                         b["particles"].dump());
   if (p.damping_ratio_translation < 0.0 || p.damping_ratio_rotation < 0.0)
     throw InputError(source, "rev.damping_ratio_translation", "damping ratios must be >= 0");
   if (!(p.mass_scaling > 0.0)) throw InputError(source, "rev.mass_scaling", "must be > 0");
-  p.steps = std::llround(steps);
-  out.particles = std::llround(particles);
   auto& s = out.scales;
   s.particles = out.particles;
   s.dt_crit = number_at(b, "dt_crit", source, "rev");

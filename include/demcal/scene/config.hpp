@@ -27,6 +27,17 @@ inline constexpr int64_t kMaxParticles = 10'000'000;
 inline constexpr const char* kMaxParticlesWhy =
     "10000000 (about 1 kB of kernel state per particle and trial: 10 GB; a calibration REV "
     "has 1e2 to 1e5)";
+/// The longest loading (Nstep) a config's algorithm.steps or a params.json's
+/// rev.steps may ask for.
+inline constexpr int64_t kMaxSteps = 10'000'000'000;
+/// A particle count a file holds (a config's prototype.particles, a
+/// params.json's rev.particles and prototype.particles): a whole number
+/// from `min` to kMaxParticles, read without a cast that can overflow
+/// (json_integer); 2.5, "12", 1e11 are an InputError naming `file` and
+/// `field`, json_integer's message and the limit with its reason (exit
+/// status 2).
+int64_t particle_count(const nlohmann::json& value, int64_t min, const std::string& file,
+                       const std::string& field);
 /// The largest overlap at sigma3, relative to the radius, a config may ask
 /// for (test.lateral_stress): see check_lateral_stress in config.cpp.
 inline constexpr double kMaxOverlapAtSigma3 = 0.05;

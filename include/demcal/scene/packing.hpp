@@ -72,13 +72,16 @@ double centre_distance(const std::array<std::span<const double>, D>& x, int i, i
 
 /// One content line of a particle file (neither blank nor a comment), for
 /// the 2D and the sphere readers: v.size() comma-separated numbers, the
-/// position then the radius (x,y,r; x,y,z,r), each finite, the radius > 0:
-/// true, the numbers in `v`. The first content line (`seen_content` still
+/// position then the radius (x,y,r; x,y,z,r), each finite, the radius > 0,
+/// each |coordinate| + 4 r finite (the overlap test adds radii to
+/// coordinates), and fewer than kMaxParticles particles read before it
+/// (`particles_read`): true, the numbers in `v`. The first content line (`seen_content` still
 /// false) whose fields are none of them numbers is the header: false.
 /// Anything else is an InputError naming `path` and `where` (a line with
 /// some numbers is a broken particle line, never silently skipped).
 bool parse_particle_fields(const std::string& line, std::span<double> v, bool& seen_content,
-                           const std::string& path, const std::string& where);
+                           int64_t particles_read, const std::string& path,
+                           const std::string& where);
 /// Build the assembly a config asks for.
 Assembly make_assembly(const SceneConfig& config);
 

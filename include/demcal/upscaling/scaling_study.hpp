@@ -5,7 +5,11 @@
 // sizes is measured, the smallest passing Nstep at FIXED multipliers (the
 // largest calibrated REV's) is found at every size, and the law is checked
 // forward: the largest size is run with the REV's multipliers and Nstep
-// upscaled from it, and scored against a run with twice the steps.
+// upscaled from it by the dimension's default law (default_law(): linear
+// for disks, N^(2/3) for spheres), and scored against a run with twice the
+// steps. The law chosen (scaling.json's `law`, read by --law) is that
+// default while the forward check confirms it, the measured exponent when
+// the default falls short.
 //
 // Per-size work (trials, results) goes to a work folder and is reused with
 // `resume`; to_json() and scaling_markdown() give scaling.json and
@@ -65,6 +69,13 @@ struct ScalingSize {
 nlohmann::json to_json(const ScalingSize& size);
 ScalingSize scaling_size_from_json(const nlohmann::json& json, const std::string& source);
 
+/// A measured exponent within 0.1 of the law's: the law holds on the
+/// family (a smaller one means the law spends steps for nothing, a larger
+/// one that it falls short).
+bool law_holds(double measured_exponent, const ScalingLaw& law);
+/// The law in a few words for logs and scaling.md: "linear", "N^0.667".
+std::string law_words(const ScalingLaw& law);
+
 /// (max − min)/mean of a multiplier across sizes.
 struct Spread {
   double mean = 0, min = 0, max = 0, relative = 0;
@@ -86,12 +97,16 @@ struct ScalingStudy {
   LinearFit lin_cal, pow_cal, lin_fix, pow_fix, lin_rep, pow_rep;
   size_t n_cal = 0, n_fix = 0, n_rep = 0;
   Spread alpha, zeta_t, zeta_r;
+  /// The law checked forward and chosen unless it falls short: the
+  /// dimension's default_law() (linear for disks, N^(2/3) for spheres).
+  ScalingLaw candidate;
   ScalingLaw measured, chosen;
+  /// The measured exponent within 0.1 of 1 (law_holds() of the linear law).
   bool linear_holds = false;
-  /// The forward check: the linear law's run and its 2× reference.
+  /// The forward check: the candidate law's run and its 2× reference.
   bool have_forward = false, forward_ok = false;
-  TrialRecord linear_run, reference;
-  double linear_peak_error = 0.0;
+  TrialRecord law_run, reference;
+  double law_peak_error = 0.0;
   double accuracy = 0.0;
   Tolerances tolerances;
   bool resumed = false;
