@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <string>
 #include <vector>
 
 #include "support/head_on.hpp"
@@ -278,6 +279,63 @@ TEST(SphereContact, WallFrictionSticksThenSlidesWithTorque) {
   }
   EXPECT_GT(stuck, 700);  // μ_w·Fn/(kt_w·V·Δt) = 800 steps
   EXPECT_GT(slid, 600);
+}
+
+// The same law on each of the six walls, with the sphere spinning too: the
+// wall pass writes each wall along its own axis a and the two others, so
+// a slip of the contact point v_s = v + ω × (−dist·g) (g the inward
+// normal) tests every axis and sign. The spring gives F_t = −kt_w·v_s·t
+// while below μ_w·Fn, then μ_w·Fn along −v_s; Fn = kn_w·δ along g; the
+// torque is (−dist·g) × F_t; the wall feels −F. Mass scaling 1e15 keeps v
+// and ω constant to < 1e-6 relative.
+TEST(SphereContact, WallFrictionOnEveryWallWithSpin) {
+  const double mu_w = 0.4, r = kR, delta = 1e-6, V = 1e-3, L = 10 * r;
+  const SphereMaterial mat = test_material(0.3, mu_w);
+  for (int side = 0; side < 6; ++side) {
+    SCOPED_TRACE("wall " + std::to_string(side));
+    const int a = side / 2, b = (a + 1) % 3, c = (a + 2) % 3;
+    const double sign = (side % 2 == 0) ? 1.0 : -1.0;
+    const Vector3d g = sign * Vector3d::Unit(a);
+    sphere_test::Scene s;
+    s.add(-sign * L * Vector3d::Unit(a) + (r - delta) * g, r);
+    s.lo = {-L, -L, -L};
+    s.hi = {L, L, L};
+    SphereWorld w = s.make(mat);
+    Integration in = sphere_test::set_undamped(w, 0.0, 1e15);
+    in.dt = 1e-6;
+    w.set_integration(in);
+    const Vector3d v = V * (Vector3d::Unit(b) - 2.0 * Vector3d::Unit(c)).normalized();
+    const Vector3d omega = (0.7 * V / r) * Vector3d::Unit(b);
+    w.set_velocity(0, v, omega);
+    const Vector3d slip = v + omega.cross(-(r - delta) * g);
+    const double fn = mat.wall.kn * delta, ktw = mat.wall.kt;
+    // Steps until the spring reaches the cap (400 to 1400 here): run twice
+    // as many.
+    const double k_cap = mu_w * fn / (ktw * slip.norm() * in.dt);
+    int stuck = 0, slid = 0;
+    for (int k = 1; k <= static_cast<int>(2.0 * k_cap); ++k) {
+      ASSERT_TRUE(w.step(1));
+      const Vector3d f = sphere_test::force(w, 0);
+      EXPECT_NEAR(f.dot(g), fn, 1e-6 * fn);
+      const Vector3d ft = f - f.dot(g) * g;
+      EXPECT_NEAR(ft.normalized().dot(-slip.normalized()), 1.0, 1e-9);
+      const double stick = ktw * slip.norm() * in.dt * k, tol = 1e-6 * stick;
+      if (stick < mu_w * fn - tol) {
+        EXPECT_NEAR(ft.norm(), stick, tol);
+        ++stuck;
+      } else if (stick > mu_w * fn + tol) {
+        EXPECT_NEAR(ft.norm(), mu_w * f.dot(g), 1e-13 * fn);
+        ++slid;
+      }
+      const double dist = (sphere_test::position(w, 0)[a] + sign * L) * sign;
+      EXPECT_NEAR((sphere_test::torque(w, 0) - (-dist * g).cross(ft)).norm(), 0.0, 1e-13 * fn * r);
+      const SphereWall& wall = w.wall(static_cast<SphereWallSide>(side));
+      EXPECT_NEAR((wall.force + f).norm(), 0.0, 1e-13 * fn);
+      EXPECT_EQ(wall.contacts, 1);
+    }
+    EXPECT_GT(stuck, 0.9 * k_cap);
+    EXPECT_GT(slid, 0.9 * k_cap);
+  }
 }
 
 }  // namespace

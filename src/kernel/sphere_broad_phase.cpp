@@ -169,17 +169,35 @@ void SphereWorldImpl::rebuild_neighbours() {
     }
   update_thread_bounds();
 
-  // Wall candidates: particles within skin of a wall.
+  // Wall candidates: particles within skin of a wall, in increasing index;
+  // a candidate keeps its history (a merge with the old list), the others
+  // cannot be touching: no history to keep.
   for (int s = 0; s < 6; ++s) {
-    wall_candidates_[s].clear();
-    for (int i = 0; i < n; ++i) {
-      if (wall_distance(s, i) - r_[i] < skin_) {
-        wall_candidates_[s].push_back(i);
-      } else {  // cannot be touching: no history to keep
-        wall_hx_[s][i] = wall_hy_[s][i] = wall_hz_[s][i] = 0.0;
-        wall_fn_[s][i] = 0.0;
+    std::vector<int>& cand = wall_candidates_[s];
+    new_slot_j_.clear();  // the old list (scratch)
+    new_slot_j_.insert(new_slot_j_.end(), cand.begin(), cand.end());
+    cand.clear();
+    for (int i = 0; i < n; ++i)
+      if (wall_distance(s, i) - r_[i] < skin_) cand.push_back(i);
+    const size_t padded = (cand.size() + kBlock - 1) / kBlock * kBlock;
+    new_wall_hx_.assign(padded, 0.0);
+    new_wall_hy_.assign(padded, 0.0);
+    new_wall_hz_.assign(padded, 0.0);
+    size_t o = 0;
+    for (size_t k = 0; k < cand.size(); ++k) {
+      while (o < new_slot_j_.size() && new_slot_j_[o] < cand[k]) ++o;
+      if (o < new_slot_j_.size() && new_slot_j_[o] == cand[k]) {
+        new_wall_hx_[k] = wall_hx_[s][o];
+        new_wall_hy_[k] = wall_hy_[s][o];
+        new_wall_hz_[k] = wall_hz_[s][o];
       }
     }
+    wall_hx_[s].swap(new_wall_hx_);
+    wall_hy_[s].swap(new_wall_hy_);
+    wall_hz_[s].swap(new_wall_hz_);
+    wall_fn_[s].assign(padded, 0.0);  // written by the next force pass
+    wall_gather_[s].assign(padded, ghost_);
+    std::copy(cand.begin(), cand.end(), wall_gather_[s].begin());
   }
 
   std::copy(x_.begin(), x_.begin() + n, x_built_.begin());

@@ -73,7 +73,13 @@
 //
 // Walls: the inward normal g is fixed and the wall does not rotate, so a
 // wall history stays in the wall plane with no turning; the contact point is
-// the foot of the centre on the plane (lever arm −dist·g).
+// the foot of the centre on the plane (lever arm −dist·g). The wall pass
+// (wall_contacts) runs after the particles' pair sums, wall by wall in the
+// order 0..5, over each wall's candidate list W at a time (particle values
+// gathered by index, histories stored per candidate, contiguous), and adds
+// each contact's force and torque to its particle: the same order as the
+// scalar pass it replaced, and one order whatever the thread count (the
+// pass is not split among threads: ≈ 1 % of the pair pass's work).
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -420,6 +426,112 @@ DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
   return hmax<W>(mo);
 }
 
+struct WallArgs {
+  const int *__restrict idx;  // the wall's candidates, padded with the ghost to blocks of 8
+  int count;                  // candidates
+  // Per candidate: history components along u and v, normal force.
+  double *__restrict hu, *__restrict hv, *__restrict fn;
+  // Particle arrays along the wall's axis a and the other two, u and v.
+  const double *__restrict pa, *__restrict r, *__restrict m;
+  const double *__restrict va, *__restrict vu, *__restrict vv;
+  const double *__restrict wu, *__restrict wv;
+  double *__restrict fa, *__restrict fu, *__restrict fv, *__restrict tu, *__restrict tv;
+  double sign, position, velocity;  // inward normal g = sign·e_a; the wall's
+  double kn, kdt, mu, beta2;        // wall kn, kt·Δt, μ; beta2 = 2·contact damping ratio
+};
+
+// One wall's contacts, W candidates at a time (gathered by index; their
+// histories are contiguous), added to the particles' forces and torques.
+// The law of the file comment written along the wall's axis a and the two
+// others u = a + 1, v = a + 2 (cyclic): with g = σ·e_a (σ = ±1) and the
+// arm −dist·g, ω × g = σ·(ω_v, −ω_u) on (u, v) and g × h = σ·(−h_v, h_u),
+// so the relative velocity's tangential part is (σ·dist·ω_v − v_u, −v_v −
+// σ·dist·ω_u), the force σ·fn·e_a + h and the torque σ·dist·(h_v, −h_u).
+// The history's component along a stays 0 (its increment is the normal
+// part of a tangential vector, exactly 0), so it is never read. out =
+// {spheres' force on the wall −Σf along a, u, v; contacts; Σ|h|² of
+// contacts that opened; Σ cap·(|h_trial| − cap) of sliding ones; the
+// largest overlap/r}, each summed lane-wise over the list, then over the
+// lanes: one order whatever the thread count.
+template <int W>
+DEMCAL_INLINE void wall_contacts(const WallArgs &a, double *out) {
+  using D = typename Simd<W>::D;
+  using M = typename Simd<W>::M;
+  const D zero{}, one = zero + 1.0;
+  D lane;
+  for (int l = 0; l < W; ++l) lane[l] = l;
+  D wfa = zero, wfu = zero, wfv = zero, count = zero, released = zero, slid = zero, mo = zero;
+  const double sg = a.sign;
+  for (int k = 0; k < a.count; k += W) {
+    const int *J = a.idx + k;
+    const M valid = lane < static_cast<double>(a.count - k);
+    const D r = gather<W>(a.r, J);
+    const D dist = (gather<W>(a.pa, J) - a.position) * sg;
+    // (Masks combined through selects and one compare each: GCC rebuilds
+    // a mask made with & lane by lane on the AVX-512 path.)
+    const D ov = select<W>(valid, r - dist, zero - one);
+    const M touch = ov > zero;
+    const D hu0 = load<W>(a.hu + k), hv0 = load<W>(a.hv + k);
+    if (!any<W>(touch)) {  // histories released (the padding holds 0)
+      released += hu0 * hu0 + hv0 * hv0;
+      store<W>(a.hu + k, zero);
+      store<W>(a.hv + k, zero);
+      store<W>(a.fn + k, zero);
+      continue;
+    }
+    released += select<W>(touch, zero, hu0 * hu0 + hv0 * hv0);
+    const D ratio = select<W>(touch, ov / select<W>(touch, r, one), zero);
+    mo = mo > ratio ? mo : ratio;
+    const D sd = sg * dist;
+    const D dvu = sd * gather<W>(a.wv, J) - gather<W>(a.vu, J);
+    const D dvv = (zero - gather<W>(a.vv, J)) - sd * gather<W>(a.wu, J);
+    D fn = a.kn * ov;
+    if (a.beta2 > 0.0) {
+      const D vn = (gather<W>(a.va, J) - a.velocity) * sg;  // leaving the wall > 0
+      fn = fn - a.beta2 * vsqrt(a.kn * gather<W>(a.m, J)) * vn;
+      fn = fn > zero ? fn : zero;
+    }
+    fn = select<W>(touch, fn, zero);
+    D hu = hu0 + a.kdt * dvu, hv = hv0 + a.kdt * dvv;
+    const D cap = a.mu * fn, h2 = hu * hu + hv * hv;
+    const M sliding = select<W>(touch, h2, zero) > cap * cap;  // touching and sliding
+    if (any<W>(sliding)) {
+      const D mag = vsqrt(h2);
+      const D cut = select<W>(sliding, cap / select<W>(sliding, mag, one), one);
+      slid += select<W>(sliding, cap * (mag - cap), zero);
+      hu *= cut;
+      hv *= cut;
+    }
+    hu = select<W>(touch, hu, zero);
+    hv = select<W>(touch, hv, zero);
+    store<W>(a.hu + k, hu);
+    store<W>(a.hv + k, hv);
+    store<W>(a.fn + k, fn);
+    const D fa = sg * fn, tu = select<W>(touch, sd * hv, zero),
+            tv = select<W>(touch, sd * hu, zero);
+    // Each candidate once per list (the padding adds zeros to the ghost).
+    for (int l = 0; l < W; ++l) {
+      const int i = J[l];
+      a.fa[i] += fa[l];
+      a.fu[i] += hu[l];
+      a.fv[i] += hv[l];
+      a.tu[i] += tu[l];
+      a.tv[i] -= tv[l];
+    }
+    wfa -= fa;
+    wfu -= hu;
+    wfv -= hv;
+    count += select<W>(touch, one, zero);
+  }
+  out[0] = hsum<W>(wfa);
+  out[1] = hsum<W>(wfu);
+  out[2] = hsum<W>(wfv);
+  out[3] = hsum<W>(count);
+  out[4] = hsum<W>(released);
+  out[5] = hsum<W>(slid);
+  out[6] = hmax<W>(mo);
+}
+
 struct IntegrateArgs {
   double *__restrict x, *__restrict y, *__restrict z;
   double *__restrict vx, *__restrict vy, *__restrict vz;
@@ -486,34 +598,38 @@ DEMCAL_INLINE double integrate_blocks(const IntegrateArgs &a, int b0, int b1) {
 using PairFn = double (*)(const PairArgs &, int, int);
 using SumFn = double (*)(const SumArgs &, int, int);
 using IntegrateFn = double (*)(const IntegrateArgs &, int, int);
+using WallFn = void (*)(const WallArgs &, double *);
 
 struct Kernels {
   PairFn pairs, pairs_damped;
   SumFn sums;
   IntegrateFn integrate, integrate_locked;
   void (*one_pair)(const double *, double *);
+  WallFn walls;
 };
 
-#define DEMCAL_SPHERE_KERNELS(SUFFIX, TARGET, W)                                         \
-  TARGET double pairs_##SUFFIX(const PairArgs &a, int b0, int b1) {                      \
-    return pair_blocks<W, false>(a, b0, b1);                                             \
-  }                                                                                      \
-  TARGET double pairs_damped_##SUFFIX(const PairArgs &a, int b0, int b1) {               \
-    return pair_blocks<W, true>(a, b0, b1);                                              \
-  }                                                                                      \
-  TARGET double sums_##SUFFIX(const SumArgs &a, int b0, int b1) {                        \
-    return sum_blocks<W, SumArgs>(a, b0, b1);                                            \
-  }                                                                                      \
-  TARGET double integrate_##SUFFIX(const IntegrateArgs &a, int b0, int b1) {             \
-    return integrate_blocks<W, true>(a, b0, b1);                                         \
-  }                                                                                      \
-  TARGET double integrate_locked_##SUFFIX(const IntegrateArgs &a, int b0, int b1) {      \
-    return integrate_blocks<W, false>(a, b0, b1);                                        \
-  }                                                                                      \
-  TARGET void one_pair_##SUFFIX(const double *in, double *out) { one_pair<W>(in, out); } \
-  constexpr Kernels kKernels_##SUFFIX{                                                   \
-      pairs_##SUFFIX,     pairs_damped_##SUFFIX,     sums_##SUFFIX,                      \
-      integrate_##SUFFIX, integrate_locked_##SUFFIX, one_pair_##SUFFIX};
+#define DEMCAL_SPHERE_KERNELS(SUFFIX, TARGET, W)                                           \
+  TARGET double pairs_##SUFFIX(const PairArgs &a, int b0, int b1) {                        \
+    return pair_blocks<W, false>(a, b0, b1);                                               \
+  }                                                                                        \
+  TARGET double pairs_damped_##SUFFIX(const PairArgs &a, int b0, int b1) {                 \
+    return pair_blocks<W, true>(a, b0, b1);                                                \
+  }                                                                                        \
+  TARGET double sums_##SUFFIX(const SumArgs &a, int b0, int b1) {                          \
+    return sum_blocks<W, SumArgs>(a, b0, b1);                                              \
+  }                                                                                        \
+  TARGET double integrate_##SUFFIX(const IntegrateArgs &a, int b0, int b1) {               \
+    return integrate_blocks<W, true>(a, b0, b1);                                           \
+  }                                                                                        \
+  TARGET double integrate_locked_##SUFFIX(const IntegrateArgs &a, int b0, int b1) {        \
+    return integrate_blocks<W, false>(a, b0, b1);                                          \
+  }                                                                                        \
+  TARGET void one_pair_##SUFFIX(const double *in, double *out) { one_pair<W>(in, out); }   \
+  TARGET void walls_##SUFFIX(const WallArgs &a, double *out) { wall_contacts<W>(a, out); } \
+  constexpr Kernels kKernels_##SUFFIX{                                                     \
+      pairs_##SUFFIX,     pairs_damped_##SUFFIX,     sums_##SUFFIX,                        \
+      integrate_##SUFFIX, integrate_locked_##SUFFIX, one_pair_##SUFFIX,                    \
+      walls_##SUFFIX};
 
 #define DEMCAL_NO_TARGET
 DEMCAL_SPHERE_KERNELS(sse2, DEMCAL_NO_TARGET, 2)
@@ -625,68 +741,58 @@ SphereWorldImpl::PairGeometry SphereWorldImpl::pair_geometry(int i, int j) const
   return p;
 }
 
-void SphereWorldImpl::wall_forces() {
-  const double dt = integration_.dt;
-  const double beta = material_.contact_damping_ratio;
-  const double kw = material_.wall.kn, ktw_dt = material_.wall.kt * dt;
-  const double muw = material_.wall.friction;
+void SphereWorldImpl::wall_pass() {
+  const double kdt = material_.wall.kt * integration_.dt;
   const double compliance = material_.wall.kt > 0.0 ? 1.0 / material_.wall.kt : 0.0;
-  const double half_compliance = 0.5 * compliance;
+  const double *pos[3] = {x_.data(), y_.data(), z_.data()};
+  const double *vel[3] = {vx_.data(), vy_.data(), vz_.data()};
+  const double *spin[3] = {wx_.data(), wy_.data(), wz_.data()};
+  double *force[3] = {fx_.data(), fy_.data(), fz_.data()};
+  double *torque[3] = {tx_.data(), ty_.data(), tz_.data()};
   double max_overlap = 0.0, released = 0.0, slid = 0.0;
+  const Kernels &k = kernels();
   for (int s = 0; s < 6; ++s) {
     SphereWall &wall = walls_[s];
-    const int axis = s / 2;
-    V3 g = V3::Zero();
-    g[axis] = (s % 2 == 0) ? 1.0 : -1.0;  // inward normal
-    const V3 vw = wall.velocity * V3::Unit(axis);
-    V3 wf = V3::Zero();
-    int count = 0;
-    for (int i : wall_candidates_[s]) {
-      const double dist = wall_distance(s, i);
-      const double overlap = r_[i] - dist;
-      if (overlap <= 0.0) {
-        released += wall_hx_[s][i] * wall_hx_[s][i] + wall_hy_[s][i] * wall_hy_[s][i] +
-                    wall_hz_[s][i] * wall_hz_[s][i];
-        wall_hx_[s][i] = wall_hy_[s][i] = wall_hz_[s][i] = 0.0;
-        wall_fn_[s][i] = 0.0;
-        continue;
-      }
-      ++count;
-      max_overlap = std::max(max_overlap, overlap / r_[i]);
-      // Wall relative to the particle's contact point (arm −dist·g).
-      const V3 dv = vw - V3(vx_[i], vy_[i], vz_[i]) + dist * V3(wx_[i], wy_[i], wz_[i]).cross(g);
-      double fn = kw * overlap;
-      if (beta > 0.0) {
-        const double vn = -dv.dot(g);  // particle leaving the wall > 0
-        fn = std::max(0.0, fn - beta * 2.0 * std::sqrt(kw * m_[i]) * vn);
-      }
-      V3 h(wall_hx_[s][i], wall_hy_[s][i], wall_hz_[s][i]);
-      h += ktw_dt * (dv - dv.dot(g) * g);
-      const double cap = muw * fn, h2 = h.squaredNorm();
-      if (h2 > cap * cap) {
-        const double mag = std::sqrt(h2);
-        slid += cap * (mag - cap);
-        h *= cap / mag;
-      }
-      wall_hx_[s][i] = h.x();
-      wall_hy_[s][i] = h.y();
-      wall_hz_[s][i] = h.z();
-      wall_fn_[s][i] = fn;
-      const V3 f = fn * g + h;
-      const V3 t = -dist * g.cross(h);
-      fx_[i] += f.x();
-      fy_[i] += f.y();
-      fz_[i] += f.z();
-      tx_[i] += t.x();
-      ty_[i] += t.y();
-      tz_[i] += t.z();
-      wf -= f;
-    }
-    wall.force = wf;
-    wall.contacts = count;
+    const int ax = s / 2, u = (ax + 1) % 3, v = (ax + 2) % 3;
+    Array *h[3] = {&wall_hx_[s], &wall_hy_[s], &wall_hz_[s]};
+    const WallArgs a{wall_gather_[s].data(),
+                     static_cast<int>(wall_candidates_[s].size()),
+                     h[u]->data(),
+                     h[v]->data(),
+                     wall_fn_[s].data(),
+                     pos[ax],
+                     r_.data(),
+                     m_.data(),
+                     vel[ax],
+                     vel[u],
+                     vel[v],
+                     spin[u],
+                     spin[v],
+                     force[ax],
+                     force[u],
+                     force[v],
+                     torque[u],
+                     torque[v],
+                     (s % 2 == 0) ? 1.0 : -1.0,
+                     wall.position,
+                     wall.velocity,
+                     material_.wall.kn,
+                     kdt,
+                     material_.wall.friction,
+                     2.0 * material_.contact_damping_ratio};
+    double out[7];
+    k.walls(a, out);
+    wall.force = V3::Zero();
+    wall.force[ax] = out[0];
+    wall.force[u] = out[1];
+    wall.force[v] = out[2];
+    wall.contacts = static_cast<int>(out[3]);
+    released += out[4];
+    slid += out[5];
+    max_overlap = std::max(max_overlap, out[6]);
   }
   max_overlap_ratio_seen_ = std::max(max_overlap_ratio_seen_, max_overlap);
-  friction_dissipated_ += released * half_compliance + slid * compliance;
+  friction_dissipated_ += released * (0.5 * compliance) + slid * compliance;
 }
 
 void SphereWorldImpl::compute_forces() {
@@ -705,7 +811,7 @@ void SphereWorldImpl::compute_forces() {
     }
     friction_dissipated_ += released * (0.5 / kt) + slid / kt;
   }
-  wall_forces();
+  wall_pass();
 }
 
 }  // namespace demcal

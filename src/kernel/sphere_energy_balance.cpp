@@ -56,15 +56,16 @@ SphereWorldImpl::EnergySample SphereWorldImpl::energy_sample() const {
     const int axis = s / 2;
     const double sign = (s % 2 == 0) ? 1.0 : -1.0;
     const double* v[3] = {vx_.data(), vy_.data(), vz_.data()};
-    for (int i : wall_candidates_[s]) {
+    for (size_t k = 0; k < wall_candidates_[s].size(); ++k) {
+      const int i = wall_candidates_[s][k];
       const double ov = r_[i] - wall_distance(s, i);
       if (ov <= 0.0) continue;
       const double vn = (v[axis][i] - wall.velocity) * sign;  // leaving the wall > 0
       const double fn_elastic = kw * ov;
-      const double h2 = wall_hx_[s][i] * wall_hx_[s][i] + wall_hy_[s][i] * wall_hy_[s][i] +
-                        wall_hz_[s][i] * wall_hz_[s][i];
+      const double h2 = wall_hx_[s][k] * wall_hx_[s][k] + wall_hy_[s][k] * wall_hy_[s][k] +
+                        wall_hz_[s][k] * wall_hz_[s][k];
       e.elastic += 0.5 * fn_elastic * ov + (ktw > 0.0 ? 0.5 * h2 / ktw : 0.0);
-      if (damped) e.power_lost += (fn_elastic - wall_fn_[s][i]) * vn;
+      if (damped) e.power_lost += (fn_elastic - wall_fn_[s][k]) * vn;
     }
   }
   e.energy += e.elastic;

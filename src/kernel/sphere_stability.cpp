@@ -183,8 +183,9 @@ StabilityEstimate SphereWorldImpl::stability_estimate(int iterations) const {
   const double kw = material_.wall.kn;
   const double ktw = material_.wall.friction > 0.0 ? material_.wall.kt : 0.0;
   for (int s = 0; s < 6; ++s)
-    for (int i : wall_candidates_[s]) {
-      if (wall_fn_[s][i] <= 0.0) continue;
+    for (size_t k = 0; k < wall_candidates_[s].size(); ++k) {
+      const int i = wall_candidates_[s][k];
+      if (wall_fn_[s][k] <= 0.0) continue;
       V3 n = V3::Zero();
       n[s / 2] = (s % 2 == 0) ? -1.0 : 1.0;  // from the particle to the wall
       contacts.push_back({i, -1, n, wall_distance(s, i), 0.0, kw, ktw});

@@ -48,9 +48,10 @@ SphereMeasures SphereWorldImpl::measure(double strain_rate) const {
   for (int s = 0; s < 6; ++s) {
     V3 g = V3::Zero();
     g[s / 2] = (s % 2 == 0) ? 1.0 : -1.0;
-    for (int i : wall_candidates_[s]) {
-      const double fn = wall_fn_[s][i];
-      const V3 h(wall_hx_[s][i], wall_hy_[s][i], wall_hz_[s][i]);
+    for (size_t k = 0; k < wall_candidates_[s].size(); ++k) {
+      const int i = wall_candidates_[s][k];
+      const double fn = wall_fn_[s][k];
+      const V3 h(wall_hx_[s][k], wall_hy_[s][k], wall_hz_[s][k]);
       if (fn <= 0.0 && h.squaredNorm() == 0.0) continue;
       const V3 f = fn * g + h;
       const V3 arm = -wall_distance(s, i) * g;

@@ -63,7 +63,6 @@ SphereWorldImpl::SphereWorldImpl(const SphereMaterial& material, std::span<const
   block_slot_.assign(static_cast<size_t>(nblocks_) + 1, 0);
   mirror_block_.assign(static_cast<size_t>(nblocks_) + 1, 0);
   for (int s = 0; s < 6; ++s) {
-    for (auto* h : {&wall_hx_[s], &wall_hy_[s], &wall_hz_[s], &wall_fn_[s]}) h->assign(n, 0.0);
     walls_[s].position = (s % 2 == 0) ? lo[s / 2] : hi[s / 2];
   }
   nbr_start_.assign(n + 1, 0);

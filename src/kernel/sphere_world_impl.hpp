@@ -134,7 +134,9 @@ class SphereWorldImpl {
   double run_pass(double (SphereWorldImpl::*pass)(int, int), const std::vector<int>& bounds);
   int active_threads() const;
   void update_thread_bounds();
-  void wall_forces();
+  // The wall contacts (SIMD, one pass over every wall's candidates after
+  // the particles' sums; the same sums for any thread count).
+  void wall_pass();
   void compute_forces();
   /// Signed distance from wall s to the centre of i, along the inward normal.
   double wall_distance(int s, int i) const;
@@ -219,10 +221,17 @@ class SphereWorldImpl {
   // Block ranges of the threads: pair pass (balanced by slots), particle
   // passes (sum and integration).
   std::vector<int> pair_bounds_, particle_bounds_;
-  // Wall contacts: candidates within skin, tangential force history and
-  // last normal force per wall and particle.
+  // Wall contacts: per wall, the candidates (particles within skin of it,
+  // in increasing index), and per candidate k (not per particle) the
+  // tangential force history and the last normal force, contiguous for the
+  // SIMD wall pass (sphere_contact.cpp, wall_pass) and carried over
+  // rebuilds by a merge. A history's component along its wall's normal
+  // stays 0. wall_gather_: the candidates padded with the ghost to whole
+  // blocks of 8 (the arrays of k are padded alike, with zeros).
   std::array<std::vector<int>, 6> wall_candidates_;
-  std::array<std::vector<double>, 6> wall_hx_, wall_hy_, wall_hz_, wall_fn_;
+  std::array<detail::AlignedVector<int>, 6> wall_gather_;
+  std::array<Array, 6> wall_hx_, wall_hy_, wall_hz_, wall_fn_;
+  Array new_wall_hx_, new_wall_hy_, new_wall_hz_;  // rebuild scratch
   // Scratch for rebuilds (kept to avoid allocation).
   std::vector<int> cell_start_, cell_next_, new_block_slot_;
   detail::AlignedVector<int> new_slot_j_;
