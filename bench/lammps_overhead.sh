@@ -55,7 +55,7 @@ for n in $SIZES; do
   gamma=$(sed -n 's/^fix *dampt all viscous \([^ ]*\).*/\1/p' "$d/deck.lammps")
   dens=$(sed -n 's/^set .*density\/disc \([^ ]*\)/\1/p' "$d/deck.lammps")
   skin=$(sed -n 's/^neighbor *\([^ ]*\) bin/\1/p' "$d/deck.lammps")
-  xl=$(get xl0); xr=$(get xr0); yt=$(get yt0); from=none; deck_args=(); total="$STEPS"
+  xl=$(get xl0); xr=$(get xr0); yt=$(get yt0); from=0; deck_args=(); total="$STEPS"
   if [[ "${WARM:-0}" -gt 0 ]]; then
     (cd "$d" && lmp -in deck.lammps -var run_steps "$WARM" -var restart_out warm.restart \
        -log log.warm -screen none >/dev/null)
@@ -63,8 +63,8 @@ for n in $SIZES; do
     xl=$(sed -n 's/.*-var xl_now \([^ ]*\).*/\1/p' "$d/warm.restart.args")
     xr=$(sed -n 's/.*-var xr_now \([^ ]*\).*/\1/p' "$d/warm.restart.args")
     # the top wall at the restart: yb0 + H of the last thermo row (step dt time epsyy pt pl pr W H ke)
-    yt=$(awk -v yb="$(get yb0)" '/^Loop time/{print yb+h; exit} $1 ~ /^[0-9]+$/ && NF == 10 {h=$9}' "$d/log.warm")
-    from=warm.restart; total=$((WARM + STEPS))
+    yt=$(awk -v yb="$(get yb0)" '/^Loop time/{printf "%.17g\n", yb+h; exit} $1 ~ /^[0-9]+$/ && NF == 10 {h=$9}' "$d/log.warm")
+    from=1; total=$((WARM + STEPS))
   fi
   sed -e "s/@DT@/$(get dt)/; s/@KN@/$(get kn)/; s/@KT@/$(get kt)/; s/@MU@/$(get mu)/" \
       -e "s/@KW@/$(get kn_wall)/; s/@KTW@/$(get kt_wall)/; s/@XL@/$xl/; s/@XR@/$xr/; s/@YB@/$(get yb0)/" \
