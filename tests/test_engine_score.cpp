@@ -181,6 +181,104 @@ TEST(EngineLammps, TheDecksOwnSeriesScoresAsDemcalsRun) {
   EXPECT_LT(theirs.score.criteria.moment_balance, Tolerances{}.moment_balance);
 }
 
+/// `what` replaced by `with` in `text` (which must hold it once at least).
+std::string replaced(std::string text, const std::string& what, const std::string& with) {
+  const auto at = text.find(what);
+  EXPECT_NE(at, std::string::npos) << what;
+  if (at != std::string::npos) text.replace(at, what.size(), with);
+  return text;
+}
+
+class LammpsSeriesSources : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(LammpsSeriesSources, AreTheStoredContactForceAndTheWallArrays) {
+  // The deck takes σ's contact force F from the total force at monitoring
+  // steps (F = f + γ(v − Δt f/(2m)): fix viscous adds −γ v(t+Δt/2), the
+  // step ends with v = v(t+Δt/2) + Δt f/(2m)) and the frictionless top and
+  // bottom walls' forces from their overlaps (kn_wall·δ at the foot of the
+  // normal). The same deck with `fix store/force` before the damping and
+  // `contacts` on those walls, i.e. the sources the recovery replaces, gives
+  // the same numbers to rounding at every monitoring row (the start, where v
+  // is no half-step velocity, included) — per radius class on the random
+  // sample (8 atom types, one γ each).
+  const std::string lmp = test::find_on_path("lmp");
+  if (lmp.empty())
+    GTEST_SKIP() << "LAMMPS (lmp) is not installed (apt-get install lammps): the deck is not run";
+  SceneConfig c = hex5();
+  if (std::string(GetParam()) == "random") {
+    c.assembly.type = "random";
+    c.assembly.count = 100;
+  }
+  const ConsolidatedState state = consolidate(c, make_assembly(c));
+  ExportOptions o;
+  o.data_name = "sample.data";
+  const ExportResult r = export_deck(c, quasi_static(), assembly_of(state.world), o);
+  std::string deck = r.deck;
+  EXPECT_EQ(deck.find("store/force"), std::string::npos);
+  deck = replaced(deck, "fix             dampt all viscous",
+                  "fix             fchk all store/force\nfix             dampt all viscous");
+  deck = replaced(deck, "yplane ${yb0} NULL\n", "yplane ${yb0} NULL contacts\n");
+  deck = replaced(deck, "region rtop\n", "region rtop contacts\n");
+  const std::string check =
+      "variable        chk_df atom abs(v_fc1_a-f_fchk[1])+abs(v_fc2_a-f_fchk[2])\n"
+      "variable        chk_f atom abs(f_fchk[1])+abs(f_fchk[2])\n"
+      "variable        chk_xt atom f_wtop[5]*f_wtop[3]\n"
+      "variable        chk_yt atom f_wtop[6]*f_wtop[3]\n"
+      "variable        chk_xb atom f_wbottom[5]*f_wbottom[3]\n"
+      "variable        chk_yb atom f_wbottom[6]*f_wbottom[3]\n"
+      "variable        rec_xt atom x*v_fyt_a\n"
+      "variable        rec_xb atom x*v_fyb_a\n"
+      "compute         chk all reduce sum v_chk_df v_chk_f f_wtop[3] v_fyt_a f_wbottom[3] &\n"
+      "                v_fyb_a v_chk_xt v_rec_xt v_chk_yt v_chk_xb v_rec_xb v_chk_yb\n"
+      "variable        k1 equal c_chk[1]\n"
+      "variable        k2 equal c_chk[2]\n"
+      "variable        k3 equal c_chk[3]\n"
+      "variable        k4 equal c_chk[4]\n"
+      "variable        k5 equal c_chk[5]\n"
+      "variable        k6 equal c_chk[6]\n"
+      "variable        k7 equal c_chk[7]\n"
+      "variable        k8 equal c_chk[8]\n"
+      "variable        k9 equal c_chk[9]\n"
+      "variable        k10 equal v_yt*c_chk[4]\n"
+      "variable        k11 equal c_chk[10]\n"
+      "variable        k12 equal c_chk[11]\n"
+      "variable        k13 equal c_chk[12]\n"
+      "variable        k14 equal ${yb0}*c_chk[6]\n"
+      "variable        k15 equal v_W+v_H+abs(v_cx)+abs(v_cy)\n"
+      "fix             chk all print ${monitor_every} \"${k1} ${k2} ${k3} ${k4} ${k5} ${k6} ${k7} "
+      "${k8} ${k9} ${k10} ${k11} ${k12} ${k13} ${k14} ${k15}\" file check.txt screen no\n";
+  deck = replaced(deck, "# --- output and run", check + "# --- output and run");
+  const test::TempDir dir("engine_sources");
+  const test::DeckRun run = test::run_deck(lmp, dir.path(), deck, r.files,
+                                           {"-var", "run_steps", "4000", "-screen", "none"});
+  ASSERT_EQ(run.status, 0) << run.log;
+  std::stringstream lines(test::read_text(dir / "check.txt"));
+  int rows = 0;
+  for (std::string line; std::getline(lines, line);) {
+    if (line.empty() || line[0] == '#') continue;
+    std::stringstream f(line);
+    std::vector<double> v;
+    for (double x; f >> x;) v.push_back(x);
+    ASSERT_EQ(v.size(), 15u) << line;
+    ++rows;
+    // recovered − stored contact force, summed |.| over the particles, against
+    // the sum of |F|: rounding (a few ulps of f and γv per particle)
+    EXPECT_LT(v[0], 1e-10 * v[1]) << line;
+    EXPECT_LT(v[2], 0.0) << line;  // the top wall presses down on the particles
+    EXPECT_GT(v[4], 0.0) << line;  // the bottom wall up
+    // arrays against overlaps: the forces, then their moments (scale |F| times
+    // the box: W + H + |centre|)
+    for (int k : {2, 4}) EXPECT_NEAR(v[k + 1] / v[k], 1.0, 1e-9) << "column " << k << ": " << line;
+    for (int k : {6, 8, 10, 12}) {
+      const double scale = std::abs(v[k < 10 ? 2 : 4]) * v[14];
+      EXPECT_NEAR(v[k + 1], v[k], 1e-9 * scale) << "column " << k << ": " << line;
+    }
+  }
+  EXPECT_GE(rows, 4);
+}
+
+INSTANTIATE_TEST_SUITE_P(EngineLammps, LammpsSeriesSources, ::testing::Values("hex", "random"));
+
 TEST(EngineLammps, EditingNstepInTheDeckKeepsTheStrain) {
   // The user shortens the run in the parameters block: the top wall speed
   // and the monitoring interval follow, so the full strain is reached at the

@@ -77,7 +77,9 @@ TEST(Export, LammpsDeckMapsEveryParameter) {
         "fix             dampt all viscous", "#fix            dampr all viscous/sphere",
         "variable nstep     equal 85258", "variable run_steps index ${nstep}",
         "f = sqrt(1 + zeta_t^2) - zeta_t = 0.5206555616 (zeta_t = 0.7)",
-        "fix             fcon all store/force", "fix             series all print ${monitor_every}",
+        "variable        fc1_a atom fx+v_gam_a*(vx-v_hdt*fx/mass)",
+        "fix             wbottom gbottom wall/gran", "yplane ${yb0} NULL\n",
+        "fix             series all print ${monitor_every}",
         "variable vtop      equal $(v_strain*v_H0/(v_nstep*v_dt))", "then \"read_data proto.data\"",
         "variable kn        equal 100000000"})
     EXPECT_NE(r.deck.find(needle), std::string::npos) << needle;
@@ -96,6 +98,38 @@ TEST(Export, LammpsDeckMapsEveryParameter) {
         export_deck(c, params(), a, bad);
       }(),
       InputError);
+}
+
+TEST(Export, OnlyFrictionalTopAndBottomWallsKeepTheirContactArrays) {
+  // Frictionless (demcal's default) walls: the top and bottom wall forces
+  // come from the overlaps at monitoring steps, no per-step contact arrays
+  // or force store; the deck refuses an edited mu_wall. With wall friction
+  // the tangential force must be read back: `contacts` on all four walls.
+  SceneConfig c = default_config();
+  const Assembly a = hexagonal_packing(5, 5, 5e-4);
+  ExportOptions o;
+  o.data_name = "proto.data";
+  const std::string plain = export_deck(c, params(), a, o).deck;
+  c.material.wall.friction = 0.2;
+  const std::string rough = export_deck(c, params(), a, o).deck;
+  auto has = [](const std::string& deck, const std::string& s) {
+    return deck.find(s) != std::string::npos;
+  };
+  for (const std::string& deck : {plain, rough}) {
+    EXPECT_FALSE(has(deck, "store/force"));
+    EXPECT_TRUE(has(deck, "region rleft contacts\n"));
+    EXPECT_TRUE(has(deck, "region rright contacts\n"));
+    EXPECT_TRUE(has(deck, "fix             wbottom gbottom wall/gran"));
+  }
+  EXPECT_TRUE(has(plain, "yplane ${yb0} NULL\n"));
+  EXPECT_TRUE(has(plain, "region rtop\n"));
+  EXPECT_TRUE(has(plain, "compute         ct gtop reduce sum v_fyt_a\n"));
+  EXPECT_TRUE(has(plain, "\"${mu_wall} != 0 && ${kt_wall} != 0\""));
+  EXPECT_TRUE(has(rough, "yplane ${yb0} NULL contacts\n"));
+  EXPECT_TRUE(has(rough, "region rtop contacts\n"));
+  EXPECT_TRUE(has(rough, "f_wtop[5]*f_wtop[3]"));
+  EXPECT_FALSE(has(rough, "v_fyt_a"));
+  EXPECT_FALSE(has(rough, "${mu_wall} != 0"));
 }
 
 TEST(Export, ExplicitDampingStepFactorIsTheDampedOscillatorsStabilityLimit) {

@@ -160,6 +160,13 @@ std::string lammps_contact_law(double gamma_n, double r_min, const std::string& 
   return s.str();
 }
 
+namespace {
+/// fix viscous's scale ratio of type k+1 as the deck prints it.
+std::string viscous_scale(const std::vector<double>& gamma_t, size_t k, NumberFormat f) {
+  return f(gamma_t[k] / gamma_t[0]);
+}
+}  // namespace
+
 std::string lammps_translational_damping(double zeta_t, const std::vector<double>& gamma_t,
                                          NumberFormat f) {
   std::ostringstream s;
@@ -170,10 +177,44 @@ std::string lammps_translational_damping(double zeta_t, const std::vector<double
     // one "scale type ratio" keyword per type after the first
     s << "\nfix             dampt all viscous " << f(gamma_t[0]);
     for (size_t k = 1; k < gamma_t.size(); ++k)
-      s << " scale " << k + 1 << " " << f(gamma_t[k] / gamma_t[0]);
+      s << " scale " << k + 1 << " " << viscous_scale(gamma_t, k, f);
     s << "\n";
   } else {
     s << "# zeta_t = 0: no translational damping\n";
+  }
+  return s.str();
+}
+
+std::string lammps_contact_force_atom(int dimension, double zeta_t,
+                                      const std::vector<double>& gamma_t, NumberFormat f,
+                                      const std::string& first_step) {
+  std::ostringstream s;
+  s << "# the contact force F (pairs and walls) on each particle, from the total\n"
+    << "# force f at the end of the step: fix viscous adds -gamma*v(t+dt/2) and the\n"
+    << "# step ends with v = v(t+dt/2) + dt*f/(2m), so F = f + gamma*(v - dt*f/(2m));\n"
+    << "# at a run's first step (its setup) v is the start velocity: F = f + gamma*v\n";
+  const char* axis = "xyz";
+  if (zeta_t > 0.0) {
+    // gamma[type] = gamma_one*scale, the product fix viscous forms
+    s << "variable        gam_a atom ";
+    if (gamma_t.size() == 1) {
+      s << f(gamma_t[0]);
+    } else {
+      for (size_t k = 0; k < gamma_t.size(); ++k) {
+        if (k > 0) s << "+";
+        s << f(gamma_t[0]);
+        if (k > 0) s << "*" << viscous_scale(gamma_t, k, f);
+        s << "*(type==" << k + 1 << ")";
+      }
+    }
+    s << "\n"
+      << "variable        hdt equal (step>" << first_step << ")*0.5*dt\n";
+    for (int d = 0; d < dimension; ++d)
+      s << "variable        fc" << d + 1 << "_a atom f" << axis[d] << "+v_gam_a*(v" << axis[d]
+        << "-v_hdt*f" << axis[d] << "/mass)\n";
+  } else {
+    for (int d = 0; d < dimension; ++d)
+      s << "variable        fc" << d + 1 << "_a atom f" << axis[d] << "\n";
   }
   return s.str();
 }

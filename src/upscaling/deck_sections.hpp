@@ -105,6 +105,19 @@ std::string lammps_contact_law(double gamma_n, double r_min, const std::string& 
 std::string lammps_translational_damping(double zeta_t, const std::vector<double>& gamma_t,
                                          NumberFormat f);
 
+/// LAMMPS: the contact force F_p (pairs and walls) on each particle at a
+/// monitoring step, as atom-style variables fc1_a .. fcD_a (D the
+/// dimension), recovered from the total force instead of a per-step `fix
+/// store/force`. fix viscous adds -gamma·v(t+dt/2) at post_force and
+/// velocity Verlet ends the step with v = v(t+dt/2) + dt·f/(2m), so
+/// F = f + gamma·(v - dt·f/(2m)); at a run's first step (its setup,
+/// `first_step`, e.g. "${step0}") v is the start velocity: F = f + gamma·v.
+/// gamma per type as fix viscous takes it (gamma_t[0] times each type's
+/// printed scale); without damping (zeta_t = 0) F = f.
+std::string lammps_contact_force_atom(int dimension, double zeta_t,
+                                      const std::vector<double>& gamma_t, NumberFormat f,
+                                      const std::string& first_step);
+
 /// LAMMPS: the sum over the wall fixes `fixes` (e.g. "wleft") of
 /// f_FIX[a], times f_FIX[b] when b > 0: an atom-style variable's formula.
 std::string lammps_wall_sum(const std::vector<std::string>& fixes, int a, int b);

@@ -142,6 +142,15 @@ ExportResult result_of(const Plan& plan) {
 // ---------------------------------------------------------------------------
 // LAMMPS (29 Sep 2021)
 
+/// Whether the deck's top and bottom wall forces can be recomputed from the
+/// overlaps: the wall fixes carry no damping (gamma_n = gamma_t = 0 in
+/// every `fix wall/gran`: demcal's contact damping is not mapped to the
+/// walls), so with no tangential force (mu_wall = 0 or kt_wall = 0) a
+/// wall's force on a particle is kn_wall·(r − distance) along the normal,
+/// at the foot of the normal. Otherwise the deck keeps the walls' contact
+/// arrays (`contacts`), which carry the tangential part.
+bool normal_only_walls(const Material& m) { return m.wall.friction == 0.0 || m.wall.kt == 0.0; }
+
 /// The LAMMPS deck's monitoring series: b, sigma, kinetic energy, wall
 /// stresses, servo error and torque sum at every monitoring interval, in the
 /// CSV that `demcal score` reads (include/demcal/scoring/external_series.hpp).
@@ -157,10 +166,11 @@ std::string lammps_series_block(const SceneConfig& c, const AlgorithmSpec& p, co
     << "# per monitoring point, tension positive, SI units, origin at the box centre:\n"
     << "#   step, strain_yy          (H - H0)/H0\n"
     << "#   b_xx b_xy b_yx b_yy      boundary stress (1/V) sum_wall x^c (x) f^c, from the\n"
-    << "#                            four walls' contact arrays (contact point, force)\n"
+    << "#                            walls' contact arrays (contact point, force) or,\n"
+    << "#                            for frictionless top and bottom walls, their overlaps\n"
     << "#   s_xx s_xy s_yx s_yy      homogenized stress, from the identity\n"
     << "#                            V (b - sigma) = sum_p (x_p - c) (x) F_p, F_p the\n"
-    << "#                            contact force of fix store/force (before damping)\n"
+    << "#                            contact force (before damping, recovered below)\n"
     << "#   kinetic_energy           translation + rotation, disc inertia m r^2/2 [J]\n"
     << "#   kinetic_energy_rotation\n"
     << "#   lateral_stress_error     ((p_left + p_right)/2 - sigma3)/sigma3 (servo)\n"
@@ -176,23 +186,33 @@ std::string lammps_series_block(const SceneConfig& c, const AlgorithmSpec& p, co
     << "variable        cx equal (v_xl+v_xr)/2\n"
     << "variable        cy equal (v_yb0+v_yt)/2\n"
     << "variable        V  equal v_W*v_H*v_thick\n";
-  auto wall_sum = [](int a, int b) {
-    return deck::lammps_wall_sum({"wleft", "wright", "wtop", "wbottom"}, a, b);
-  };
+  const bool normal_only = normal_only_walls(c.material);
+  // The walls' b terms: the lateral walls' contact arrays; the top and
+  // bottom walls' from their arrays or, frictionless, from the overlaps
+  // (force fy*_a on the particle at the foot of the normal (x, wall)).
+  const std::vector<std::string> arrays =
+      normal_only ? std::vector<std::string>{"wleft", "wright"}
+                  : std::vector<std::string>{"wleft", "wright", "wtop", "wbottom"};
+  auto wall_sum = [&](int a, int b) { return deck::lammps_wall_sum(arrays, a, b); };
+  const std::string fy_tb = normal_only ? "+v_fyt_a+v_fyb_a" : "";
   s << "variable        bxx_a atom " << wall_sum(5, 2) << "\n"
-    << "variable        bxy_a atom " << wall_sum(5, 3) << "\n"
+    << "variable        bxy_a atom " << wall_sum(5, 3)
+    << (normal_only ? "+x*(v_fyt_a+v_fyb_a)" : "") << "\n"
     << "variable        byx_a atom " << wall_sum(6, 2) << "\n"
-    << "variable        byy_a atom " << wall_sum(6, 3) << "\n"
+    << "variable        byy_a atom " << wall_sum(6, 3)
+    << (normal_only ? "+v_yt*v_fyt_a+${yb0}*v_fyb_a" : "") << "\n"
     << "variable        fwx_a atom " << wall_sum(2, 0) << "\n"
-    << "variable        fwy_a atom " << wall_sum(3, 0) << "\n"
-    << "variable        mxx_a atom x*f_fcon[1]\n"
-    << "variable        mxy_a atom x*f_fcon[2]\n"
-    << "variable        myx_a atom y*f_fcon[1]\n"
-    << "variable        myy_a atom y*f_fcon[2]\n"
+    << "variable        fwy_a atom " << wall_sum(3, 0) << fy_tb << "\n"
+    << deck::lammps_contact_force_atom(2, p.damping_ratio_translation, plan.gamma_t, num,
+                                       "${step0}")
+    << "variable        mxx_a atom x*v_fc1_a\n"
+    << "variable        mxy_a atom x*v_fc2_a\n"
+    << "variable        myx_a atom y*v_fc1_a\n"
+    << "variable        myy_a atom y*v_fc2_a\n"
     << "compute         pa all property/atom radius omegaz tqz\n"
     << "variable        ker_a atom 0.25*mass*c_pa[1]*c_pa[1]*c_pa[2]*c_pa[2]\n"
     << "compute         meas all reduce sum v_bxx_a v_bxy_a v_byx_a v_byy_a v_fwx_a v_fwy_a &\n"
-    << "                v_mxx_a v_mxy_a v_myx_a v_myy_a f_fcon[1] f_fcon[2] v_ker_a c_pa[3]\n"
+    << "                v_mxx_a v_mxy_a v_myx_a v_myy_a v_fc1_a v_fc2_a v_ker_a c_pa[3]\n"
     << "compute         ket all ke\n"
     << "variable        b_xx equal (c_meas[1]-v_cx*c_meas[5])/v_V\n"
     << "variable        b_xy equal (c_meas[2]-v_cx*c_meas[6])/v_V\n"
@@ -217,6 +237,7 @@ std::string lammps_series_block(const SceneConfig& c, const AlgorithmSpec& p, co
                                   plan.dt_crit, p.mass_scaling)
     << "label           series_rows\n"
     << "fix             halt_top all halt ${monitor_every} v_clear_top < 0.0 error hard\n"
+    << "fix             halt_bottom all halt ${monitor_every} v_clear_bottom < 0.0 error hard\n"
     << "fix             halt_left all halt ${monitor_every} v_clear_left < 0.0 error hard\n"
     << "fix             halt_right all halt ${monitor_every} v_clear_right < 0.0 error hard\n"
     << "fix             series all print ${monitor_every} \"" << row
@@ -224,72 +245,105 @@ std::string lammps_series_block(const SceneConfig& c, const AlgorithmSpec& p, co
   return s.str();
 }
 
-// The walls, the servo and the measured wall stresses of the LAMMPS deck:
-// text only, every number comes from the deck's parameters block.
-constexpr const char kLammpsWalls[] =
-    "# --- walls -------------------------------------------------------------------\n"
-    "# top: a plane moving down at vtop; left/right: planes moved by the servo.\n"
-    "# The fix order matters: the walls, then fix store/force (contact forces\n"
-    "# only), then the damping.\n"
-    "# (evaluated every step: the constants substituted now, ${...}; in this\n"
-    "# release a v_ reference formats the other variable to text and back)\n"
-    "variable dytop  equal -${vtop}*step*dt\n"
-    "variable dxl    equal f_servo[1]*(step-${step0})\n"
-    "variable dxr    equal f_servo[2]*(step-${step0})\n"
-    "region          rtop   plane 0 ${yt0} 0  0 -1 0 side in move NULL v_dytop NULL units box\n"
-    "region          rleft  plane ${xl_now} 0 0  1 0 0  side in move v_dxl NULL NULL units box\n"
-    "region          rright plane ${xr_now} 0 0  -1 0 0 side in move v_dxr NULL NULL units box\n"
-    "# Each moving wall acts on the particles that can reach it (a wall fix loops\n"
-    "# over its group every step): those within band_v of the top, band_h of a\n"
-    "# lateral wall at the start. fix halt stops the run with an error should a\n"
-    "# particle outside a band ever touch that wall (then widen the bands).\n"
-    "region          bandtop block INF INF $(v_yt0-v_band_v) INF INF INF units box\n"
-    "region          bandleft block INF $(v_xl0+v_band_h) INF INF INF INF units box\n"
-    "region          bandright block $(v_xr0-v_band_h) INF INF INF INF INF units box\n"
-    "group           gtop region bandtop\n"
-    "group           gleft region bandleft\n"
-    "group           gright region bandright\n"
-    "group           gside union gleft gright\n"
-    "group           ntop subtract all gtop\n"
-    "group           nleft subtract all gleft\n"
-    "group           nright subtract all gright\n"
-    "fix             wbottom all wall/gran hooke/history ${kn_wall} ${kt_wall} 0 0 ${mu_wall} 0 "
-    "yplane ${yb0} NULL contacts\n"
-    "fix             wtop gtop wall/gran/region hooke/history ${kn_wall} ${kt_wall} 0 0 "
-    "${mu_wall} 0 region rtop contacts\n"
-    "fix             wleft gleft wall/gran/region hooke/history ${kn_wall} ${kt_wall} 0 0 "
-    "${mu_wall} 0 region rleft contacts\n"
-    "fix             wright gright wall/gran/region hooke/history ${kn_wall} ${kt_wall} 0 0 "
-    "${mu_wall} 0 region rright contacts\n"
-    "# contact force on every particle (pairs and walls), before the damping\n"
-    "fix             fcon all store/force\n"
-    "# wall contact arrays: [1] contacts, [2] [3] force on the particle, [5] [6]\n"
-    "# contact point\n"
-    "# the servo's input, both lateral walls in one reduction (one global sum per\n"
-    "# step under MPI): [1] [2] left contacts and force, [3] [4] right\n"
-    "compute         cs gside reduce sum f_wleft[1] f_wleft[2] f_wright[1] f_wright[2]\n"
-    "compute         ct gtop reduce sum f_wtop[1] f_wtop[3]\n"
-    "compute         cb all reduce sum f_wbottom[1] f_wbottom[3]\n"
-    "variable        xl equal v_xl_now+v_dxl\n"
-    "variable        xr equal v_xr_now+v_dxr\n"
-    "variable        yt equal v_yt0+v_dytop\n"
-    "variable        H  equal v_yt-v_yb0\n"
-    "variable        W  equal v_xr-v_xl\n"
-    "variable        pl equal c_cs[2]/(v_H*v_thick)\n"
-    "variable        pr equal -c_cs[4]/(v_H*v_thick)\n"
-    "variable        pt equal -c_ct[2]/(v_W*v_thick)\n"
-    "variable        pb equal c_cb[2]/(v_W*v_thick)\n"
-    "# clearance of the particles outside each band from its wall (> 0)\n"
-    "compute         rad all property/atom radius\n"
-    "variable        gap_top atom v_yt-y-c_rad\n"
-    "variable        gap_left atom x-c_rad-v_xl\n"
-    "variable        gap_right atom v_xr-x-c_rad\n"
-    "compute         clear_top ntop reduce min v_gap_top\n"
-    "compute         clear_left nleft reduce min v_gap_left\n"
-    "compute         clear_right nright reduce min v_gap_right\n"
-    "variable        clear_top equal c_clear_top\n"
-    "variable        clear_left equal c_clear_left\n"
-    "variable        clear_right equal c_clear_right\n";
+// The walls, the servo's input and the measured wall stresses of the LAMMPS
+// deck: text only, every number comes from the deck's parameters block.
+std::string lammps_walls(bool normal_only) {
+  // `contacts` on the top and bottom walls only where their tangential
+  // force must be read back (the lateral walls always: the servo's input).
+  const char* tb_contacts = normal_only ? "\n" : " contacts\n";
+  std::ostringstream s;
+  s << "# --- walls -------------------------------------------------------------------\n"
+       "# top: a plane moving down at vtop; left/right: planes moved by the servo.\n"
+       "# The fix order matters: the walls, then the damping (the series recovers\n"
+       "# the contact force from the total force at monitoring steps).\n"
+       "# (evaluated every step: the constants substituted now, ${...}; in this\n"
+       "# release a v_ reference formats the other variable to text and back)\n"
+       "variable dytop  equal -${vtop}*step*dt\n"
+       "variable dxl    equal f_servo[1]*(step-${step0})\n"
+       "variable dxr    equal f_servo[2]*(step-${step0})\n"
+       "region          rtop   plane 0 ${yt0} 0  0 -1 0 side in move NULL v_dytop NULL units box\n"
+       "region          rleft  plane ${xl_now} 0 0  1 0 0  side in move v_dxl NULL NULL units box\n"
+       "region          rright plane ${xr_now} 0 0  -1 0 0 side in move v_dxr NULL NULL units box\n"
+       "# Each wall acts on the particles that can reach it (a wall fix loops over\n"
+       "# its group every step): those within band_v of the top or the bottom,\n"
+       "# band_h of a lateral wall at the start. fix halt stops the run with an\n"
+       "# error should a particle outside a band ever touch that wall (then widen\n"
+       "# the bands).\n"
+       "region          bandtop block INF INF $(v_yt0-v_band_v) INF INF INF units box\n"
+       "region          bandbottom block INF INF INF $(v_yb0+v_band_v) INF INF units box\n"
+       "region          bandleft block INF $(v_xl0+v_band_h) INF INF INF INF units box\n"
+       "region          bandright block $(v_xr0-v_band_h) INF INF INF INF INF units box\n"
+       "group           gtop region bandtop\n"
+       "group           gbottom region bandbottom\n"
+       "group           gleft region bandleft\n"
+       "group           gright region bandright\n"
+       "group           gside union gleft gright\n"
+       "group           ntop subtract all gtop\n"
+       "group           nbottom subtract all gbottom\n"
+       "group           nleft subtract all gleft\n"
+       "group           nright subtract all gright\n";
+  if (normal_only)
+    s << "# The top and bottom wall forces are recomputed from the overlaps at\n"
+         "# monitoring steps (exact for these frictionless, undamped walls): an edited\n"
+         "# mu_wall needs the walls' contact arrays, i.e. a new export.\n"
+         "if              \"${mu_wall} != 0 && ${kt_wall} != 0\" then &\n"
+         "                \"print 'demcal deck: exported for frictionless walls (the top and "
+         "bottom wall forces come from the overlaps): export again with the wall friction'\" "
+         "\"quit 2\"\n";
+  s << "fix             wbottom gbottom wall/gran hooke/history ${kn_wall} ${kt_wall} 0 0 "
+       "${mu_wall} 0 yplane ${yb0} NULL"
+    << tb_contacts
+    << "fix             wtop gtop wall/gran/region hooke/history ${kn_wall} ${kt_wall} 0 0 "
+       "${mu_wall} 0 region rtop"
+    << tb_contacts
+    << "fix             wleft gleft wall/gran/region hooke/history ${kn_wall} ${kt_wall} 0 0 "
+       "${mu_wall} 0 region rleft contacts\n"
+       "fix             wright gright wall/gran/region hooke/history ${kn_wall} ${kt_wall} 0 0 "
+       "${mu_wall} 0 region rright contacts\n"
+       "# wall contact arrays: [1] contacts, [2] [3] force on the particle, [5] [6]\n"
+       "# contact point\n"
+       "# the servo's input, both lateral walls in one reduction (one global sum per\n"
+       "# step under MPI): [1] [2] left contacts and force, [3] [4] right\n"
+       "compute         cs gside reduce sum f_wleft[1] f_wleft[2] f_wright[1] f_wright[2]\n"
+       "variable        xl equal v_xl_now+v_dxl\n"
+       "variable        xr equal v_xr_now+v_dxr\n"
+       "variable        yt equal v_yt0+v_dytop\n"
+       "variable        H  equal v_yt-v_yb0\n"
+       "variable        W  equal v_xr-v_xl\n"
+       "compute         rad all property/atom radius\n";
+  if (normal_only)
+    s << "# top and bottom: the force on a particle is kn_wall * overlap along the\n"
+         "# wall's normal (y), at the foot of the normal (x, wall)\n"
+         "variable        ovt_a atom c_rad-(v_yt-y)\n"
+         "variable        ovb_a atom c_rad-(y-${yb0})\n"
+         "variable        fyt_a atom -${kn_wall}*v_ovt_a*(v_ovt_a>0)\n"
+         "variable        fyb_a atom ${kn_wall}*v_ovb_a*(v_ovb_a>0)\n"
+         "compute         ct gtop reduce sum v_fyt_a\n"
+         "compute         cb gbottom reduce sum v_fyb_a\n"
+         "variable        pt equal -c_ct/(v_W*v_thick)\n"
+         "variable        pb equal c_cb/(v_W*v_thick)\n";
+  else
+    s << "compute         ct gtop reduce sum f_wtop[1] f_wtop[3]\n"
+         "compute         cb gbottom reduce sum f_wbottom[1] f_wbottom[3]\n"
+         "variable        pt equal -c_ct[2]/(v_W*v_thick)\n"
+         "variable        pb equal c_cb[2]/(v_W*v_thick)\n";
+  s << "variable        pl equal c_cs[2]/(v_H*v_thick)\n"
+       "variable        pr equal -c_cs[4]/(v_H*v_thick)\n"
+       "# clearance of the particles outside each band from its wall (> 0)\n"
+       "variable        gap_top atom v_yt-y-c_rad\n"
+       "variable        gap_bottom atom y-c_rad-v_yb0\n"
+       "variable        gap_left atom x-c_rad-v_xl\n"
+       "variable        gap_right atom v_xr-x-c_rad\n"
+       "compute         clear_top ntop reduce min v_gap_top\n"
+       "compute         clear_bottom nbottom reduce min v_gap_bottom\n"
+       "compute         clear_left nleft reduce min v_gap_left\n"
+       "compute         clear_right nright reduce min v_gap_right\n"
+       "variable        clear_top equal c_clear_top\n"
+       "variable        clear_bottom equal c_clear_bottom\n"
+       "variable        clear_left equal c_clear_left\n"
+       "variable        clear_right equal c_clear_right\n";
+  return s.str();
+}
 
 /// demcal's servo law (scene/biaxial.cpp, servo_velocity) in the deck: one
 /// flat formula per lateral wall, evaluated every step by one fix ave/time.
@@ -669,8 +723,8 @@ ExportResult lammps(const SceneConfig& c, const AlgorithmSpec& p, const Assembly
       << lammps_derived();
   else
     s << lammps_derived() << lammps_system(c, plan, o, out);
-  s << kLammpsWalls << lammps_servo() << lammps_damping(p, plan) << lammps_series_block(c, p, plan)
-    << lammps_run(o.consolidate_in_deck);
+  s << lammps_walls(normal_only_walls(c.material)) << lammps_servo() << lammps_damping(p, plan)
+    << lammps_series_block(c, p, plan) << lammps_run(o.consolidate_in_deck);
   out.deck = s.str();
   return out;
 }

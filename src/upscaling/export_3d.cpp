@@ -394,9 +394,9 @@ void lammps_3d_consolidation(std::ostream& s, const SceneConfig& c, const Plan3&
 void lammps_3d_walls(std::ostream& s, const AlgorithmSpec& p, const Plan3& plan) {
   s << "# --- walls -------------------------------------------------------------------\n"
     << "# bottom: fixed plane; top: plane moving down at vtop; lateral: planes moved\n"
-    << "# by the servo. Order: the walls, then fix store/force (contact forces only),\n"
-    << "# then the damping. Wall contact arrays: [1] contact, [2-4] force on the\n"
-    << "# sphere, [5-7] contact point.\n"
+    << "# by the servo. Order: the walls, then the damping (the series recovers the\n"
+    << "# contact force from the total force at monitoring steps). Wall contact\n"
+    << "# arrays: [1] contact, [2-4] force on the sphere, [5-7] contact point.\n"
     << "variable        dzmax equal -${vtop}*step*dt\n";
   for (int sd = 0; sd < 4; ++sd)
     s << "variable        d" << kWall[sd] << " equal f_servo[" << sd + 1 << "]*step\n";
@@ -411,8 +411,7 @@ void lammps_3d_walls(std::ostream& s, const AlgorithmSpec& p, const Plan3& plan)
     s << "fix             w" << kWall[sd]
       << " all wall/gran/region hooke/history ${kn_wall} ${kt_wall} 0 0 ${mu_wall} 0 region r"
       << kWall[sd] << " contacts\n";
-  s << "# contact force on every sphere (pairs and walls), before the damping\n"
-    << "fix             fcon all store/force\n\n";
+  s << "\n";
 
   s << deck::lammps_translational_damping(p.damping_ratio_translation, plan.gamma_t, exact);
   s << "# LAMMPS >= 2022 only (absent in 29 Sep 2021): rotational damping D_r per class,\n"
@@ -428,7 +427,7 @@ void lammps_3d_walls(std::ostream& s, const AlgorithmSpec& p, const Plan3& plan)
 }
 
 // The servo's input, wall positions and pressures, b and sigma reductions.
-void lammps_3d_measures(std::ostream& s) {
+void lammps_3d_measures(std::ostream& s, const AlgorithmSpec& p, const Plan3& plan) {
   // Measures: wall forces for the servo and the pressures, one reduction.
   s << "# --- measures ----------------------------------------------------------------\n"
     << "# the servo's input, the four lateral walls in one reduction (one global sum per\n"
@@ -459,21 +458,23 @@ void lammps_3d_measures(std::ostream& s) {
   // The monitoring series: b and σ over the walls' contact arrays.
   s << "# b_ij = (1/V) sum_walls (x_i - c_i) f_j (contact point x, force f on the\n"
     << "# sphere, c the box centre); s_ij = b_ij - (1/V) sum_p (x_i - c_i) F_j, F the\n"
-    << "# contact force of fix store/force (V (b - sigma) = sum_p x_p (x) F_p)\n";
+    << "# contact force (V (b - sigma) = sum_p x_p (x) F_p)\n"
+    // the loading runs from step 0 (read_data, or reset_timestep after stage 1)
+    << deck::lammps_contact_force_atom(3, p.damping_ratio_translation, plan.gamma_t, exact, "0");
   std::string reduce;
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) {
       s << "variable        bw" << kAxis[i] << kAxis[j] << " atom " << wall_sum(5 + i, 2 + j)
         << "\n"
-        << "variable        mp" << kAxis[i] << kAxis[j] << " atom " << kAxis[i] << "*f_fcon["
-        << j + 1 << "]\n";
+        << "variable        mp" << kAxis[i] << kAxis[j] << " atom " << kAxis[i] << "*v_fc" << j + 1
+        << "_a\n";
       reduce += std::string(" v_bw") + kAxis[i] + kAxis[j] + " v_mp" + kAxis[i] + kAxis[j];
     }
   for (int j = 0; j < 3; ++j)
     s << "variable        fw" << kAxis[j] << " atom " << wall_sum(2 + j, 0) << "\n";
   s << "compute         cn all contact/atom\n"
     << "compute         meas all reduce sum" << reduce
-    << " v_fwx v_fwy v_fwz f_fcon[1] f_fcon[2] f_fcon[3] c_cn\n"
+    << " v_fwx v_fwy v_fwz v_fc1_a v_fc2_a v_fc3_a c_cn\n"
     << "compute         ket all ke\n"
     << "compute         ker all erotate/sphere\n"
     << "variable        cx equal (v_wall_xmin+v_wall_xmax)/2\n"
@@ -485,7 +486,7 @@ void lammps_3d_measures(std::ostream& s) {
 // b and sigma per component, the monitoring series and the peaks.
 void lammps_3d_series(std::ostream& s, const SceneConfig& c, const AlgorithmSpec& p,
                       const Plan3& plan) {
-  // c_meas layout: [1..18] bw/mp pairs, [19..21] fw, [22..24] fcon, [25] cn.
+  // c_meas layout: [1..18] bw/mp pairs, [19..21] fw, [22..24] fc, [25] cn.
   std::string row = "${stepn},${strain_zz}";
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) {
@@ -594,7 +595,7 @@ std::string lammps_deck(const SceneConfig& c, const AlgorithmSpec& p, const Plan
     lammps_3d_system(s, c, plan, o, out);
   }
   lammps_3d_walls(s, p, plan);
-  lammps_3d_measures(s);
+  lammps_3d_measures(s, p, plan);
   lammps_3d_series(s, c, p, plan);
   lammps_3d_servo_and_run(s);
   return s.str();
