@@ -150,6 +150,21 @@ void SphereWorldImpl::rebuild_neighbours() {
   // The pair terms, and the zero slot at index ns.
   for (auto* p : {&pfx_, &pfy_, &pfz_, &ptx_, &pty_, &ptz_}) p->assign(ns + 1, 0.0);
 
+  rebuild_mirror_list();
+  update_thread_bounds();
+
+  rebuild_wall_candidates();
+
+  std::copy(x_.begin(), x_.begin() + n, x_built_.begin());
+  std::copy(y_.begin(), y_.begin() + n, y_built_.begin());
+  std::copy(z_.begin(), z_.begin() + n, z_built_.begin());
+  for (int s = 0; s < 6; ++s) wall_built_[s] = walls_[s].position;
+  list_valid_ = true;
+}
+
+void SphereWorldImpl::rebuild_mirror_list() {
+  const int n = n_;
+  const size_t ns = static_cast<size_t>(block_slot_[nblocks_]);
   // Mirror list: the slots of the pairs (i, j), i < j, by j, in increasing i.
   mirror_count_.assign(static_cast<size_t>(kBlock) * nblocks_, 0);
   for (int k = 0; k < nbr_start_[n]; ++k) ++mirror_count_[nbr_j_[k]];
@@ -167,8 +182,10 @@ void SphereWorldImpl::rebuild_neighbours() {
       const int row = mirror_count_[j]++;
       mirror_slot_[mirror_block_[j / kBlock] + j % kBlock + kBlock * row] = pair_slot_[k];
     }
-  update_thread_bounds();
+}
 
+void SphereWorldImpl::rebuild_wall_candidates() {
+  const int n = n_;
   // Wall candidates: particles within skin of a wall, in increasing index;
   // a candidate keeps its history (a merge with the old list), the others
   // cannot be touching: no history to keep.
@@ -199,12 +216,6 @@ void SphereWorldImpl::rebuild_neighbours() {
     wall_gather_[s].assign(padded, ghost_);
     std::copy(cand.begin(), cand.end(), wall_gather_[s].begin());
   }
-
-  std::copy(x_.begin(), x_.begin() + n, x_built_.begin());
-  std::copy(y_.begin(), y_.begin() + n, y_built_.begin());
-  std::copy(z_.begin(), z_.begin() + n, z_built_.begin());
-  for (int s = 0; s < 6; ++s) wall_built_[s] = walls_[s].position;
-  list_valid_ = true;
 }
 
 }  // namespace demcal

@@ -109,6 +109,8 @@ class SphereWorldImpl {
 
   // sphere_broad_phase.cpp
   void rebuild_neighbours();
+  void rebuild_mirror_list();      // part of rebuild_neighbours
+  void rebuild_wall_candidates();  // part of rebuild_neighbours
   bool needs_rebuild() const;
   // sphere_contact.cpp
   struct PairGeometry {
