@@ -1,8 +1,7 @@
-// The triaxial test (DESIGN.md §8), the 3D counterpart of biaxial.hpp:
-// spheres in a box of six rigid frictionless walls. Consolidation to
-// isotropic σ3 with all six walls servo-controlled, once per sample
-// (frictionless, then friction on), then loading: bottom wall (z min) fixed,
-// top wall (z max) down at constant velocity to the axial strain ε over
+// The triaxial test (README "3D: spheres and the triaxial test"), the 3D counterpart of
+// biaxial.hpp: spheres in a box of six rigid frictionless walls. Consolidation to isotropic σ3 with
+// all six walls servo-controlled, once per sample (frictionless, then friction on), then loading:
+// bottom wall (z min) fixed, top wall (z max) down at constant velocity to the axial strain ε over
 // Nstep steps, the four lateral walls servo-controlled at σ3 (σ2 = σ3).
 // Monitored at M points. Stresses tension positive; z is the axial axis.
 #pragma once
