@@ -29,6 +29,16 @@ namespace {
 
 namespace fs = std::filesystem;
 
+/// The three stable step estimates `demcal check` prints, 2D and 3D.
+void print_stable_steps(const StabilityEstimate& est) {
+  std::cout << std::setprecision(6) << "  stable dt_ratio (Lanczos, rotation coupled) "
+            << est.dt_ratio_stable << "\n"
+            << "  stable dt_ratio (Gershgorin bound)         " << est.dt_ratio_stable_gershgorin
+            << "\n"
+            << "  stable dt_ratio (translation only)         " << est.dt_ratio_stable_translation
+            << "\n";
+}
+
 void print_scales(const SceneConfig& config, const World& world) {
   const ReferenceScales s = world.reference_scales();
   std::cout << "scene " << config.name << ": " << world.size() << " particles\n"
@@ -93,13 +103,8 @@ int check_3d(const SceneConfig& config) {
   const StabilityEstimate est = probe.stability_estimate();
   std::cout << "  consolidated in " << state.steps << " steps (" << std::setprecision(3)
             << state.wall_time_s << " s), box " << state.extent0[0] << " x " << state.extent0[1]
-            << " x " << state.extent0[2] << " m\n"
-            << std::setprecision(6) << "  stable dt_ratio (Lanczos, rotation coupled) "
-            << est.dt_ratio_stable << "\n"
-            << "  stable dt_ratio (Gershgorin bound)         " << est.dt_ratio_stable_gershgorin
-            << "\n"
-            << "  stable dt_ratio (translation only)         " << est.dt_ratio_stable_translation
-            << "\n";
+            << " x " << state.extent0[2] << " m\n";
+  print_stable_steps(est);
   if (auto r = analytical_peak_ratio_3d(config))
     std::cout << "  analytical peak sigma1/sigma3 " << *r << " (walled FCC, Thornton), "
               << fcc_peak_ratio(config.material.particle.friction) << " (periodic)\n";
@@ -173,13 +178,8 @@ int cmd_check(const std::string& path, const std::vector<std::string>& sets) {
   const StabilityEstimate est = state.world.stability_estimate();
   std::cout << "  consolidated in " << state.steps << " steps (" << std::setprecision(3)
             << state.wall_time_s << " s" << (state.from_cache ? ", from the cache" : "")
-            << "), box " << state.width0 << " x " << state.height0 << " m\n"
-            << std::setprecision(6) << "  stable dt_ratio (Lanczos, rotation coupled) "
-            << est.dt_ratio_stable << "\n"
-            << "  stable dt_ratio (Gershgorin bound)         " << est.dt_ratio_stable_gershgorin
-            << "\n"
-            << "  stable dt_ratio (translation only)         " << est.dt_ratio_stable_translation
-            << "\n";
+            << "), box " << state.width0 << " x " << state.height0 << " m\n";
+  print_stable_steps(est);
   if (auto peak = analytical_peak_stress(config)) {
     std::cout << "  analytical peak sigma1/sigma3 " << -*peak / config.test.lateral_stress
               << " (walled box), " << hexagonal_peak_ratio(config.material.particle.friction)

@@ -163,6 +163,18 @@ void write_verify_files(const std::string& dir, const nlohmann::json& verify,
 /// `demcal verify` on 3D params: the spheres of the prototype consolidated
 /// by the sphere kernel, loaded with the upscaled parameters on `threads`
 /// threads, scored with the triaxial criteria, the peak against the REV's.
+/// The verdict line and the four criteria against their tolerances, 2D and 3D.
+void print_verdict(bool passed, const std::string& prototype, const AlgorithmSpec& up,
+                   const Criteria& c, const Tolerances& tolerances) {
+  std::cout << (passed ? "PASS" : "FAIL") << ": " << prototype << ", " << up.steps
+            << " steps (alpha " << up.dt_ratio << ", zeta_t " << up.damping_ratio_translation
+            << ", zeta_r " << up.damping_ratio_rotation << ")\n"
+            << "  force balance " << c.force_balance << " (tol " << tolerances.force_balance
+            << "), moment balance " << c.moment_balance << " (tol " << tolerances.moment_balance
+            << "), servo " << c.servo << " (tol " << tolerances.servo << "), oscillation "
+            << c.oscillation << " (tol " << tolerances.oscillation << ")\n";
+}
+
 int verify_3d(const VerifyOptions& o, const nlohmann::json& params, const RevParams& rev,
               const SceneConfig& config, const ScalingLaw& law) {
   if (o.engine != "demcal")
@@ -270,14 +282,9 @@ int verify_3d(const VerifyOptions& o, const nlohmann::json& params, const RevPar
       {"wall_time_s", total_s},
       {"version", DEMCAL_VERSION}};
   write_verify_files(dir, out, series_csv(run.series));
-  std::cout << (score.passed ? "PASS" : "FAIL") << ": 3D prototype of " << n << " spheres, "
-            << up.steps << " steps (alpha " << up.dt_ratio << ", zeta_t "
-            << up.damping_ratio_translation << ", zeta_r " << up.damping_ratio_rotation << ")\n"
-            << "  force balance " << c.force_balance << " (tol " << tolerances.force_balance
-            << "), moment balance " << c.moment_balance << " (tol " << tolerances.moment_balance
-            << "), servo " << c.servo << " (tol " << tolerances.servo << "), oscillation "
-            << c.oscillation << " (tol " << tolerances.oscillation << ")\n"
-            << "  peak axial b_zz " << c.peak_stress_yy << " Pa (sigma1/sigma3 "
+  print_verdict(score.passed, "3D prototype of " + std::to_string(n) + " spheres", up, c,
+                tolerances);
+  std::cout << "  peak axial b_zz " << c.peak_stress_yy << " Pa (sigma1/sigma3 "
             << -c.peak_stress_yy / s3 << ")";
   if (peak_rev)
     std::cout << "; the REV's " << *peak_rev << " Pa ("
@@ -415,14 +422,9 @@ int cmd_verify(const VerifyOptions& o) {
   write_verify_files(dir, out, series_csv(run.series));
 
   const auto& c = trial.score.criteria;
-  std::cout << (trial.score.passed ? "PASS" : "FAIL") << ": prototype of " << n << " particles, "
-            << up.steps << " steps (alpha " << up.dt_ratio << ", zeta_t "
-            << up.damping_ratio_translation << ", zeta_r " << up.damping_ratio_rotation << ")\n"
-            << "  force balance " << c.force_balance << " (tol " << tolerances.force_balance
-            << "), moment balance " << c.moment_balance << " (tol " << tolerances.moment_balance
-            << "), servo " << c.servo << " (tol " << tolerances.servo << "), oscillation "
-            << c.oscillation << " (tol " << tolerances.oscillation << ")\n"
-            << "  peak sigma_yy " << c.peak_stress_yy << " Pa (sigma1/sigma3 "
+  print_verdict(trial.score.passed, "prototype of " + std::to_string(n) + " particles", up, c,
+                tolerances);
+  std::cout << "  peak sigma_yy " << c.peak_stress_yy << " Pa (sigma1/sigma3 "
             << -c.peak_stress_yy / config.test.lateral_stress << ")\n"
             << "  " << score.diagnosis.message << "\n"
             << "  consolidation " << state.wall_time_s << " s, loading " << trial.wall_time_s
