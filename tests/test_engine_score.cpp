@@ -279,6 +279,51 @@ TEST_P(LammpsSeriesSources, AreTheStoredContactForceAndTheWallArrays) {
 
 INSTANTIATE_TEST_SUITE_P(EngineLammps, LammpsSeriesSources, ::testing::Values("hex", "random"));
 
+TEST(EngineLammps, TheStoredServoMoveIsTheInlineFormulaBitForBit) {
+  // The 2D deck keeps each lateral wall's unclamped servo move in fix
+  // servo_raw and clamps the fix's value (a double), so the move's formula
+  // is parsed once per step instead of twice. The same deck with the clamp
+  // of the formula itself (the deck before this cut) prints the same series,
+  // character for character: same operations in the same order, on the
+  // same step (with fix servo_raw defined after fix servo, the clamp reads
+  // the previous step's move and the series differ).
+  const std::string lmp = test::find_on_path("lmp");
+  if (lmp.empty())
+    GTEST_SKIP() << "LAMMPS (lmp) is not installed (apt-get install lammps): the deck is not run";
+  const SceneConfig c = hex5();
+  const ConsolidatedState state = consolidate(c, make_assembly(c));
+  ExportOptions o;
+  o.data_name = "hex5.data";
+  const ExportResult r = export_deck(c, quasi_static(), assembly_of(state.world), o);
+  auto formula = [&](const std::string& name) {
+    const std::string head = "variable        " + name + " equal ";
+    const auto at = r.deck.find(head);
+    EXPECT_NE(at, std::string::npos) << head;
+    if (at == std::string::npos) return std::string();
+    const auto from = at + head.size();
+    return r.deck.substr(from, r.deck.find('\n', from) - from);
+  };
+  auto clamp = [](const std::string& x) {
+    return "(abs(" + x + "+${cap})-abs(" + x + "-${cap}))/2";
+  };
+  EXPECT_EQ(formula("movel"), clamp("f_servo_raw[1]"));
+  EXPECT_EQ(formula("mover"), "-" + clamp("f_servo_raw[2]"));
+  std::string inline_deck =
+      replaced(r.deck, "equal " + formula("movel"), "equal " + clamp(formula("rawl")));
+  inline_deck =
+      replaced(inline_deck, "equal " + formula("mover"), "equal -" + clamp(formula("rawr")));
+  const test::TempDir dir("engine_servo_raw");
+  const std::vector<std::string> args{"-var", "run_steps", "3000", "-screen", "none"};
+  const test::DeckRun stored = test::run_deck(lmp, dir / "stored", r.deck, r.files, args);
+  ASSERT_EQ(stored.status, 0) << stored.log;
+  const test::DeckRun inlined = test::run_deck(lmp, dir / "inline", inline_deck, r.files, args);
+  ASSERT_EQ(inlined.status, 0) << inlined.log;
+  const std::string a = test::read_text(dir / "stored" / "series.csv"),
+                    b = test::read_text(dir / "inline" / "series.csv");
+  EXPECT_GE(parse_external_series(a, "stored.csv").run.series.size(), 10u);
+  EXPECT_EQ(a, b);
+}
+
 TEST(EngineLammps, EditingNstepInTheDeckKeepsTheStrain) {
   // The user shortens the run in the parameters block: the top wall speed
   // and the monitoring interval follow, so the full strain is reached at the

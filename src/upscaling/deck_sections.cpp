@@ -229,11 +229,19 @@ std::string lammps_wall_sum(const std::vector<std::string>& fixes, int a, int b)
   return out;
 }
 
+std::string lammps_servo_raw(const std::string& area, const std::string& minus_force,
+                             const std::string& count) {
+  return "${gain}*(${sigma3}*" + area + minus_force + ")/(${kn_wall}*(1+" + count + "+abs(1-" +
+         count + "))/2)";
+}
+
+std::string lammps_servo_clamp(const std::string& x) {
+  return "(abs(" + x + "+${cap})-abs(" + x + "-${cap}))/2";
+}
+
 std::string lammps_servo_move(const std::string& area, const std::string& minus_force,
                               const std::string& count) {
-  const std::string raw = "${gain}*(${sigma3}*" + area + minus_force + ")/(${kn_wall}*(1+" + count +
-                          "+abs(1-" + count + "))/2)";
-  return "(abs(" + raw + "+${cap})-abs(" + raw + "-${cap}))/2";
+  return lammps_servo_clamp(lammps_servo_raw(area, minus_force, count));
 }
 
 std::string lammps_series_header(const std::string& deck, const std::string& scene, int particles,

@@ -131,6 +131,16 @@ std::string lammps_wall_sum(const std::vector<std::string>& fixes, int a, int b)
 std::string lammps_servo_move(const std::string& area, const std::string& minus_force,
                               const std::string& count);
 
+/// The two halves of lammps_servo_move: the unclamped move
+/// gain*(sigma3*A - F)/(kn_wall*max(1, n)), and clamp(x) of a formula x.
+/// lammps_servo_move = lammps_servo_clamp(lammps_servo_raw(...)); a deck that
+/// stores the raw move in a fix (a double, no text round trip) and clamps the
+/// fix's value parses the raw formula once per step instead of twice, with the
+/// same arithmetic, bit for bit.
+std::string lammps_servo_raw(const std::string& area, const std::string& minus_force,
+                             const std::string& count);
+std::string lammps_servo_clamp(const std::string& x);
+
 /// LAMMPS: the series file's header (print lines), what `demcal score`
 /// reads about the run: the deck (`deck`, e.g. "LAMMPS 3D deck"), scene,
 /// particles, sigma3, Nstep, dt, dt_crit (when given), the damping ratios

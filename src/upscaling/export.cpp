@@ -345,28 +345,33 @@ std::string lammps_walls(bool normal_only) {
   return s.str();
 }
 
-/// demcal's servo law (scene/biaxial.cpp, servo_velocity) in the deck: one
-/// flat formula per lateral wall, evaluated every step by one fix ave/time.
+/// demcal's servo law (scene/biaxial.cpp, servo_velocity) in the deck: per
+/// lateral wall one flat formula of the unclamped move and one clamp of it,
+/// evaluated every step by two fix ave/time.
 std::string lammps_servo() {
   // gain*(sigma3*H*t - F)/(kn_wall*max(1, n)); F, n from compute cs: the
   // left wall's force on the particles is +x (columns 1, 2), the right
   // wall's -x (columns 3, 4: F = -c_cs[4]).
-  auto move = [](const char* force_sign, int count, int force) {
-    return deck::lammps_servo_move("(${H0}-${vtop}*step*dt)*${thick}",
-                                   force_sign + ("c_cs[" + std::to_string(force) + "]"),
-                                   "c_cs[" + std::to_string(count) + "]");
+  auto raw = [](const char* force_sign, int count, int force) {
+    return deck::lammps_servo_raw("(${H0}-${vtop}*step*dt)*${thick}",
+                                  force_sign + ("c_cs[" + std::to_string(force) + "]"),
+                                  "c_cs[" + std::to_string(count) + "]");
   };
   std::ostringstream s;
   s << "# demcal's servo, one move per step toward the sample when p < sigma3:\n"
     << "#   move = gain*(sigma3*H*t - F)/(kn_wall*max(1, n)), clamped to +-cap,\n"
     << "# F the wall force, n its contacts; the wall's displacement is the sum of\n"
     << "# the moves (running mean times the steps of this run, dxl and dxr above).\n"
-    << "# One flat formula per wall with the numbers substituted now (each v_\n"
-    << "# reference, and each level of parsing, is paid every step); this\n"
-    << "# release has no min/max of two numbers: max(1, n) = (1+n+abs(1-n))/2,\n"
-    << "# clamp(x) = (abs(x+cap)-abs(x-cap))/2.\n"
-    << "variable        movel equal " << move("-", 1, 2) << "\n"
-    << "variable        mover equal -" << move("+", 3, 4) << "\n"
+    << "# Flat formulas with the numbers substituted now (each v_ reference, and\n"
+    << "# each level of parsing, is paid every step); the unclamped move is kept\n"
+    << "# by fix servo_raw (a double: the clamp reads it twice without parsing it\n"
+    << "# twice). This release has no min/max of two numbers: max(1, n) =\n"
+    << "# (1+n+abs(1-n))/2, clamp(x) = (abs(x+cap)-abs(x-cap))/2.\n"
+    << "variable        rawl equal " << raw("-", 1, 2) << "\n"
+    << "variable        rawr equal " << raw("+", 3, 4) << "\n"
+    << "fix             servo_raw all ave/time 1 1 1 v_rawl v_rawr\n"
+    << "variable        movel equal " << deck::lammps_servo_clamp("f_servo_raw[1]") << "\n"
+    << "variable        mover equal -" << deck::lammps_servo_clamp("f_servo_raw[2]") << "\n"
     << "fix             servo all ave/time 1 1 1 v_movel v_mover ave running\n\n";
   return s.str();
 }
