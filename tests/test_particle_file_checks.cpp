@@ -24,22 +24,14 @@ void expect_spheres_rejected(const std::string& content, const std::string& fiel
                              const std::string& words) {
   SCOPED_TRACE(content);
   std::istringstream in(content);
-  const auto e = input_error([&] { read_spheres(in, "s.csv"); });
-  ASSERT_TRUE(e);
-  EXPECT_EQ(e->file(), "s.csv");
-  EXPECT_EQ(e->field(), field) << e->what();
-  EXPECT_NE(std::string(e->what()).find(words), std::string::npos) << e->what();
+  test::expect_input_error([&] { read_spheres(in, "s.csv"); }, "s.csv", field, words);
 }
 
 void expect_disks_rejected(const std::string& content, const std::string& field,
                            const std::string& words) {
   SCOPED_TRACE(content);
   std::istringstream in(content);
-  const auto e = input_error([&] { read_particles(in, "p.csv"); });
-  ASSERT_TRUE(e);
-  EXPECT_EQ(e->file(), "p.csv");
-  EXPECT_EQ(e->field(), field) << e->what();
-  EXPECT_NE(std::string(e->what()).find(words), std::string::npos) << e->what();
+  test::expect_input_error([&] { read_particles(in, "p.csv"); }, "p.csv", field, words);
 }
 
 // |coordinate| + 4 r must be finite: the overlap test adds radii to the

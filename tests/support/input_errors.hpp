@@ -6,6 +6,7 @@
 #include <exception>
 #include <functional>
 #include <optional>
+#include <string>
 
 #include "demcal/io/input_error.hpp"
 
@@ -24,6 +25,17 @@ inline std::optional<InputError> input_error(const std::function<void()>& f) {
   }
   ADD_FAILURE() << "expected InputError, nothing thrown";
   return std::nullopt;
+}
+
+/// `f` fails with one InputError naming `file` and `field`, whose message
+/// contains `words`.
+inline void expect_input_error(const std::function<void()>& f, const std::string& file,
+                               const std::string& field, const std::string& words) {
+  const auto e = input_error(f);
+  ASSERT_TRUE(e);
+  EXPECT_EQ(e->file(), file);
+  EXPECT_EQ(e->field(), field) << e->what();
+  EXPECT_NE(std::string(e->what()).find(words), std::string::npos) << e->what();
 }
 
 }  // namespace demcal::test
