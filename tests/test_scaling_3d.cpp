@@ -15,6 +15,7 @@
 #include "demcal/upscaling/scaling_study.hpp"
 #include "demcal/upscaling/upscaling.hpp"
 #include "support/files.hpp"
+#include "support/params_3d.hpp"
 #include "support/process.hpp"
 
 namespace {
@@ -118,17 +119,8 @@ void check_default_law(const TinyStudy& study) {
   const demcal::TriaxialState state =
       demcal::consolidate_triaxial(config, demcal::make_sphere_assembly(config));
   ASSERT_EQ(state.world.size(), 108);
-  demcal::CalibrationSummary summary;
-  summary.success = true;
-  summary.best = rev_best;
-  summary.best_trial.params = rev_best;
-  summary.dimension = 3;
   const std::string params = test::write_text(
-      dir / "params.json",
-      demcal::params_file(config, state, demcal::CalibrationOptions::from(config.calibration),
-                          summary)
-              .dump(2) +
-          "\n");
+      dir / "params.json", test::params_3d(config, state, rev_best).dump(2) + "\n");
   for (const bool with_law : {true, false}) {
     SCOPED_TRACE(with_law ? "--law scaling.json" : "the default");
     std::vector<std::string> args{"upscale", params, "--particles", "256", "-o", "up.json"};

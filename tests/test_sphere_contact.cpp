@@ -243,6 +243,21 @@ namespace {
 // exactly μ_w·Fn; the torque about the centre is (−dist·g) × F_t, dist =
 // r − δ; the wall feels the opposite of the force on the sphere. Mass
 // scaling 1e15: the forces change the velocity by < 1e-6 relative.
+/// A wall's tangential force `ft` on a sphere pressed with `fn` (the
+/// imposed normal force; `f_normal` the one measured this step): the
+/// spring's `stick` while under the Coulomb cap μ_w·fn, the cap itself once
+/// above; steps within `tol` of the cap count as neither.
+void expect_stick_or_slide(double ft, double stick, double tol, double mu_w, double fn,
+                           double f_normal, int& stuck, int& slid) {
+  if (stick < mu_w * fn - tol) {
+    EXPECT_NEAR(ft, stick, tol);
+    ++stuck;
+  } else if (stick > mu_w * fn + tol) {
+    EXPECT_NEAR(ft, mu_w * f_normal, 1e-13 * fn);
+    ++slid;
+  }
+}
+
 TEST(SphereContact, WallFrictionSticksThenSlidesWithTorque) {
   const double mu_w = 0.4, r = kR, delta = 1e-6, V = 1e-3;
   const SphereMaterial mat = test_material(0.3, mu_w);
@@ -265,13 +280,7 @@ TEST(SphereContact, WallFrictionSticksThenSlidesWithTorque) {
     const Vector3d ft = f - f.dot(g) * g;
     EXPECT_NEAR(ft.normalized().dot(-u), 1.0, 1e-12);
     const double stick = ktw * V * in.dt * k, tol = 1e-6 * stick;
-    if (stick < mu_w * fn - tol) {
-      EXPECT_NEAR(ft.norm(), stick, tol);
-      ++stuck;
-    } else if (stick > mu_w * fn + tol) {
-      EXPECT_NEAR(ft.norm(), mu_w * f.dot(g), 1e-13 * fn);
-      ++slid;
-    }
+    expect_stick_or_slide(ft.norm(), stick, tol, mu_w, fn, f.dot(g), stuck, slid);
     const double dist = w.z()[0];
     EXPECT_NEAR((sphere_test::torque(w, 0) - (-dist * g).cross(ft)).norm(), 0.0, 1e-13 * fn * r);
     EXPECT_NEAR((w.wall(kZMin).force + f).norm(), 0.0, 1e-13 * fn);
@@ -320,13 +329,7 @@ TEST(SphereContact, WallFrictionOnEveryWallWithSpin) {
       const Vector3d ft = f - f.dot(g) * g;
       EXPECT_NEAR(ft.normalized().dot(-slip.normalized()), 1.0, 1e-9);
       const double stick = ktw * slip.norm() * in.dt * k, tol = 1e-6 * stick;
-      if (stick < mu_w * fn - tol) {
-        EXPECT_NEAR(ft.norm(), stick, tol);
-        ++stuck;
-      } else if (stick > mu_w * fn + tol) {
-        EXPECT_NEAR(ft.norm(), mu_w * f.dot(g), 1e-13 * fn);
-        ++slid;
-      }
+      expect_stick_or_slide(ft.norm(), stick, tol, mu_w, fn, f.dot(g), stuck, slid);
       const double dist = (sphere_test::position(w, 0)[a] + sign * L) * sign;
       EXPECT_NEAR((sphere_test::torque(w, 0) - (-dist * g).cross(ft)).norm(), 0.0, 1e-13 * fn * r);
       const SphereWall& wall = w.wall(static_cast<SphereWallSide>(side));

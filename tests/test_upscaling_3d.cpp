@@ -16,6 +16,7 @@
 #include "demcal/upscaling/params_file.hpp"
 #include "demcal/upscaling/upscaling.hpp"
 #include "support/files.hpp"
+#include "support/params_3d.hpp"
 #include "support/process.hpp"
 #include "support/scenes.hpp"
 
@@ -56,13 +57,7 @@ demcal::AlgorithmSpec rev_params() {
 nlohmann::json params_3d(const SceneConfig& config) {
   const demcal::TriaxialState state =
       demcal::consolidate_triaxial(config, demcal::make_sphere_assembly(config));
-  demcal::CalibrationSummary summary;
-  summary.success = true;
-  summary.best = rev_params();
-  summary.best_trial.params = summary.best;
-  summary.dimension = 3;
-  return demcal::params_file(config, state, demcal::CalibrationOptions::from(config.calibration),
-                             summary);
+  return test::params_3d(config, state, rev_params());
 }
 
 TEST(Upscaling3D, FccFamilyKeepsTheCellAspect) {

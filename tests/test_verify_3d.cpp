@@ -14,6 +14,7 @@
 #include "demcal/scene/triaxial.hpp"
 #include "demcal/upscaling/params_file.hpp"
 #include "support/files.hpp"
+#include "support/params_3d.hpp"
 #include "support/process.hpp"
 #include "support/scenes.hpp"
 
@@ -33,21 +34,14 @@ TEST(Verify3D, SmallFccPrototypeRunsAndReports) {
                                 "fcc2.json");
   const demcal::TriaxialState state =
       demcal::consolidate_triaxial(config, demcal::make_sphere_assembly(config));
-  demcal::CalibrationSummary summary;
-  summary.success = true;
-  summary.best.dt_ratio = 0.15;
-  summary.best.steps = 2000;
-  summary.best.damping_ratio_translation = 0.7;
-  summary.best.damping_ratio_rotation = 0.5;
-  summary.best_trial.params = summary.best;
-  summary.best_trial.score.criteria.peak_stress_yy = -3.3e5;  // the REV's peak, as recorded
-  summary.dimension = 3;
+  demcal::AlgorithmSpec best;
+  best.dt_ratio = 0.15;
+  best.steps = 2000;
+  best.damping_ratio_translation = 0.7;
+  best.damping_ratio_rotation = 0.5;
+  const double rev_peak = -3.3e5;  // the REV's peak, as recorded
   const std::string params = test::write_text(
-      dir / "params.json",
-      demcal::params_file(config, state, demcal::CalibrationOptions::from(config.calibration),
-                          summary)
-              .dump(2) +
-          "\n");
+      dir / "params.json", test::params_3d(config, state, best, rev_peak).dump(2) + "\n");
 
   const test::RunResult r = test::run_demcal({"verify", params, "-o", "v"}, dir.path());
   ASSERT_TRUE(r.status == 0 || r.status == 1) << r.err;  // PASS or FAIL, both reported
