@@ -143,6 +143,7 @@ int export_3d(const ExportCmdOptions& o, const nlohmann::json& params, const Rev
   const SphereAssembly proto = prototype_spheres(config, particles, file, &source);
   eo.consolidate_in_deck = consolidate_in_deck(o, proto.size());
   const AlgorithmSpec up = upscale(rev.params, rev.particles, proto.size(), law);
+  print_below_rev_note("export", rev.particles, proto.size(), law);
   eo.provenance = o.params + " (REV " + std::to_string(rev.particles) + " spheres, " +
                   std::to_string(rev.params.steps) + " steps; " + law.name() + " law, exponent " +
                   std::to_string(law.exponent) + ")";
@@ -178,6 +179,7 @@ int cmd_export(const ExportCmdOptions& o) {
   PrototypeSource source;
   Assembly proto = prototype_assembly(config, particles, file, &source);
   const AlgorithmSpec up = upscale(rev.params, rev.particles, proto.size(), law);
+  print_below_rev_note("export", rev.particles, proto.size(), law);
   eo.provenance = o.params + " (REV " + std::to_string(rev.particles) + " particles, " +
                   std::to_string(rev.params.steps) + " steps; " + law.name() + " law, exponent " +
                   std::to_string(law.exponent) + ")";

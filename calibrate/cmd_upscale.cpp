@@ -113,6 +113,12 @@ ScalingLaw resolve_law(const nlohmann::json& params, const std::string& params_p
   return default_law(params_dimension(params));
 }
 
+void print_below_rev_note(const char* command, int64_t n_rev, int64_t n_proto,
+                          const ScalingLaw& law) {
+  const std::string note = below_rev_note(n_rev, n_proto, law);
+  if (!note.empty()) std::cerr << "demcal " << command << ": note: " << note << "\n";
+}
+
 int cmd_upscale(const UpscaleOptions& o) {
   const nlohmann::json params = read_params_file(o.params);
   const RevParams rev = rev_params_from_json(params, o.params);
@@ -149,6 +155,7 @@ int cmd_upscale(const UpscaleOptions& o) {
   nlohmann::json out = params;
   out["prototype"] = block;
   out["upscaling"] = upscaling_block(rev.particles, n_proto, law);
+  print_below_rev_note("upscale", rev.particles, n_proto, law);
   const std::string text = out.dump(2) + "\n";
   // Which law scaled Nstep, on stderr whatever the output (the user must
   // know which law, measured or default, and its source).

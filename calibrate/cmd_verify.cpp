@@ -189,6 +189,7 @@ int verify_3d(const VerifyOptions& o, const nlohmann::json& params, const RevPar
   const SphereAssembly proto = prototype_spheres(config, particles, file, &source);
   const int64_t n = proto.size();
   const AlgorithmSpec up = upscale(rev.params, rev.particles, n, law);
+  print_below_rev_note("verify", rev.particles, n, law);
   const double particle_steps = static_cast<double>(n) * static_cast<double>(up.steps);
   const SphereWorld world(sphere_material(config.material), proto.x, proto.y, proto.z, proto.r,
                           proto.lo, proto.hi);
@@ -332,6 +333,7 @@ int cmd_verify(const VerifyOptions& o) {
   }
   const int64_t n = proto.size();
   const AlgorithmSpec up = upscale(rev.params, rev.particles, n, law);
+  print_below_rev_note("verify", rev.particles, n, law);
   const double particle_steps = static_cast<double>(n) * static_cast<double>(up.steps);
   const double speed0 = in_lammps ? kAssumedLammpsSpeed * o.np : kAssumedSpeed;
   const double estimate_s = particle_steps / speed0;

@@ -117,4 +117,8 @@ std::pair<std::string, int64_t> named_prototype(const nlohmann::json& params,
 ScalingLaw resolve_law(const nlohmann::json& params, const std::string& params_path,
                        const std::string& law_path, double exponent);
 
+/// below_rev_note() on stderr as "demcal COMMAND: note: ...", when it applies.
+void print_below_rev_note(const char* command, int64_t n_rev, int64_t n_proto,
+                          const ScalingLaw& law);
+
 }  // namespace demcal::cli

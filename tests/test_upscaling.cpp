@@ -250,6 +250,31 @@ TEST_F(UpscaleCli, UpscalesToACountAndWritesParams) {
   EXPECT_EQ(h["prototype"]["steps"].get<int64_t>(), 89480LL * 5);
 }
 
+// Below the REV the law shrinks Nstep as L² while the servo error needs L:
+// the commands say so (verify at 108 spheres from a 256-sphere REV failed on
+// the servo, 0.24 % > 0.2 %, with nothing to warn the user beforehand).
+TEST(Upscale, APrototypeSmallerThanTheRevIsNamed) {
+  const ScalingLaw spheres = default_law(3);
+  EXPECT_EQ(below_rev_note(256, 256, spheres), "");
+  EXPECT_EQ(below_rev_note(256, 500, spheres), "");
+  const std::string note = below_rev_note(256, 108, spheres);
+  EXPECT_NE(note.find("108 particles are fewer than the REV's 256"), std::string::npos) << note;
+  EXPECT_NE(note.find("x0.562"), std::string::npos) << note;  // (108/256)^(2/3)
+}
+
+TEST_F(UpscaleCli, SaysWhenThePrototypeIsSmallerThanTheRev) {
+  write_params(false);  // the default scene's REV: 100 particles
+  const Cli below = run("upscale params.json --particles 25 -o below.json");
+  ASSERT_EQ(below.status, 0) << below.err;
+  EXPECT_NE(below.err.find("demcal upscale: note: the prototype's 25 particles are fewer than the "
+                           "REV's 100"),
+            std::string::npos)
+      << below.err;
+  const Cli above = run("upscale params.json --particles 400 -o above.json");
+  ASSERT_EQ(above.status, 0) << above.err;
+  EXPECT_EQ(above.err.find("fewer than the REV"), std::string::npos) << above.err;
+}
+
 TEST_F(UpscaleCli, BadInputExitsTwoNamingTheProblem) {
   write_params(true);
   Cli r = run("upscale params.json");

@@ -63,6 +63,18 @@ int64_t upscale_steps(int64_t steps_rev, int64_t n_rev, int64_t n_proto, const S
       1, std::llround(static_cast<double>(steps_rev) * std::pow(ratio, law.exponent)));
 }
 
+std::string below_rev_note(int64_t n_rev, int64_t n_proto, const ScalingLaw& law) {
+  if (n_proto >= n_rev || n_proto <= 0) return "";
+  std::ostringstream s;
+  s.precision(3);
+  s << "the prototype's " << n_proto << " particles are fewer than the REV's " << n_rev << ": the "
+    << law.name() << " law is extrapolated below the size it was calibrated at (steps x"
+    << std::pow(static_cast<double>(n_proto) / static_cast<double>(n_rev), law.exponent)
+    << "); the servo error grows as L/Nstep there, faster than the law allows, so the criteria "
+       "may fail: use at least the REV's particles, or check with demcal verify";
+  return s.str();
+}
+
 AlgorithmSpec upscale(const AlgorithmSpec& rev, int64_t n_rev, int64_t n_proto,
                       const ScalingLaw& law) {
   AlgorithmSpec p = rev;

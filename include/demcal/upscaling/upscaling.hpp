@@ -58,6 +58,12 @@ ScalingLaw default_law(int dimension);
 /// Nstep for `n_proto` particles from a calibration on `n_rev` particles.
 int64_t upscale_steps(int64_t steps_rev, int64_t n_rev, int64_t n_proto,
                       const ScalingLaw& law = {});
+/// What a user must know when the prototype is smaller than the REV
+/// (empty when n_proto >= n_rev): the law was measured upward from the REV,
+/// and below it the steps shrink faster than the servo error allows (that
+/// error grows as L/Nstep, the law keeps only the force balance's L²/Nstep),
+/// so `demcal verify` may fail there. One text for every command.
+std::string below_rev_note(int64_t n_rev, int64_t n_proto, const ScalingLaw& law);
 /// The REV's parameters for the prototype: Nstep upscaled, every
 /// multiplier unchanged.
 AlgorithmSpec upscale(const AlgorithmSpec& rev, int64_t n_rev, int64_t n_proto,
