@@ -176,9 +176,12 @@ void SphereWorldImpl::rebuild_mirror_list() {
   }
   mirror_slot_.assign(static_cast<size_t>(mirror_block_[nblocks_]), static_cast<int>(ns));
   std::fill(mirror_count_.begin(), mirror_count_.end(), 0);
+  mirror_src_block_.resize(nblocks_);
+  for (int b = 0; b < nblocks_; ++b) mirror_src_block_[b] = b;
   for (int i = 0; i < n; ++i)
     for (int k = nbr_start_[i]; k < nbr_start_[i + 1]; ++k) {
       const int j = nbr_j_[k];
+      mirror_src_block_[j / kBlock] = std::min(mirror_src_block_[j / kBlock], i / kBlock);
       const int row = mirror_count_[j]++;
       mirror_slot_[mirror_block_[j / kBlock] + j % kBlock + kBlock * row] = pair_slot_[k];
     }

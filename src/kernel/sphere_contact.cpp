@@ -51,9 +51,14 @@
 // sums run in a fixed order whatever the thread split (each pass writes
 // only its own particles' or slots' values), so results are deterministic
 // and bit-identical for any thread count; non-touching slots add exact
-// zeros, so the skin does not change a bit either. (Until 365b7e6 the list
-// was full and each pair was evaluated twice, once from either side, the
-// law written so that both copies came out exact opposites under FMA
+// zeros, so the skin does not change a bit either. Each block's sums run
+// right after its own pairs, the pair terms still in cache, wherever the
+// same pass has written all of its mirrored slots: with one thread every
+// block; with threads the blocks whose mirrored slots all lie in the
+// thread's own range (all but about one lattice layer at the start of each
+// range), the others in a second pass after the barrier. (Until 365b7e6
+// the list was full and each pair was evaluated twice, once from either
+// side, the law written so that both copies came out exact opposites under FMA
 // contraction, e.g. the lever-arm term a_i·ω_i + a_j·ω_j as ½[(ω_i + ω_j)
 // (a_i + a_j) + (ω_i − ω_j)(a_i − a_j)]; evaluated once, it takes the
 // plain form.) The twist is applied even when it is 0 (the identity then).
@@ -69,7 +74,10 @@
 // divisions (1/|d|, A²), where it took three roots and four divisions; the
 // skipped branches give the same bits as the full evaluation (cut = 1, h
 // = 0 there), and each lane's polynomial-or-root choice depends on its own
-// A² alone.
+// A² alone. The root and the two divisions stay correctly rounded: on this
+// kernel's test CPU (AMD family 26) they do not bound the pass, and
+// estimates refined by Newton steps (vrsqrt14pd/vrcp14pd, or vrcpps on
+// AVX2) measured 3-16 % slower (reports/performance.md, 2026-12-02).
 //
 // Walls: the inward normal g is fixed and the wall does not rotate, so a
 // wall history stays in the wall plane with no turning; the contact point is
@@ -109,10 +117,14 @@ struct PairArgs {
   double *__restrict tx, *__restrict ty, *__restrict tz;
   double *__restrict block_released, *__restrict block_slid;
   double kn, kdt, half_dt, mu, beta2;  // beta2 = 2·contact damping ratio
-  // With fuse_sums, each block's mirrored sums right after its pairs.
+  // Each block's mirrored sums right after its pairs where the pass has
+  // written all its mirrored slots (its lowest source block src_block[b] ≥
+  // the pass's first block); fused[b] says so to the sum pass. With one
+  // thread (pair_blocks' kFuseAll), every block, fused not written.
   const int *__restrict mirror_block;
   const int *__restrict mirror_slot;
-  bool fuse_sums;
+  const int *__restrict src_block;
+  unsigned char *__restrict fused;
 };
 
 // v itself, rounded: the compiler cannot fuse it into an FMA with what
@@ -254,6 +266,7 @@ DEMCAL_INLINE double hsum(typename Simd<W>::D v) {
 struct SumArgs {
   const int *__restrict mirror_block;
   const int *__restrict mirror_slot;
+  const unsigned char *__restrict fused;  // blocks the pair pass summed already
   const double *__restrict pfx, *__restrict pfy, *__restrict pfz;
   const double *__restrict ptx, *__restrict pty, *__restrict ptz;
   double *__restrict fx, *__restrict fy, *__restrict fz;
@@ -297,10 +310,11 @@ DEMCAL_INLINE double sum_blocks(const A &a, int b0, int b1) {
 // Pairs of blocks [b0, b1) (half list: each pair once, from i < j): each
 // particle's force and torque summed over its own slots, written (not
 // added), and per slot the pair's force on i and torque on j for the sum
-// pass; with fuse_sums, each block's mirrored sums right after its pairs (one
-// thread over all blocks: the same sums in the same order as the separate
-// sum pass). Returns the largest overlap/min(r_i, r_j).
-template <int W, bool kDamped>
+// pass; and each block's mirrored sums right after its pairs where this
+// pass wrote all of its mirrored slots (with one thread, every block; the
+// same sums in the same order as the sum pass, which does the others).
+// Returns the largest overlap/min(r_i, r_j).
+template <int W, bool kDamped, bool kFuseAll>
 DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
   using D = typename Simd<W>::D;
   using M = typename Simd<W>::M;
@@ -418,10 +432,16 @@ DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
     }
     a.block_released[b] = hsum<W>(released);
     a.block_slid[b] = hsum<W>(slid);
-    // Block b's mirrored slots all belong to blocks ≤ b (i < j): with the
-    // blocks in one pass, its sums are complete now, the pair terms still
-    // in cache.
-    if (a.fuse_sums) sum_blocks<W>(a, b, b + 1);
+    // Block b's mirrored slots all belong to blocks in [src_block[b], b]
+    // (i < j): if this pass did those, its sums are complete now, the pair
+    // terms still in cache.
+    if constexpr (kFuseAll) {
+      sum_blocks<W>(a, b, b + 1);
+    } else {
+      const bool complete = a.src_block[b] >= b0;
+      a.fused[b] = complete;
+      if (complete) sum_blocks<W>(a, b, b + 1);
+    }
   }
   return hmax<W>(mo);
 }
@@ -601,34 +621,43 @@ using IntegrateFn = double (*)(const IntegrateArgs &, int, int);
 using WallFn = void (*)(const WallArgs &, double *);
 
 struct Kernels {
-  PairFn pairs, pairs_damped;
+  PairFn pairs, pairs_damped;      // one thread: every block's sums fused
+  PairFn pairs_t, pairs_damped_t;  // threads: the blocks a pass completes
   SumFn sums;
   IntegrateFn integrate, integrate_locked;
   void (*one_pair)(const double *, double *);
   WallFn walls;
 };
 
-#define DEMCAL_SPHERE_KERNELS(SUFFIX, TARGET, W)                                           \
-  TARGET double pairs_##SUFFIX(const PairArgs &a, int b0, int b1) {                        \
-    return pair_blocks<W, false>(a, b0, b1);                                               \
-  }                                                                                        \
-  TARGET double pairs_damped_##SUFFIX(const PairArgs &a, int b0, int b1) {                 \
-    return pair_blocks<W, true>(a, b0, b1);                                                \
-  }                                                                                        \
-  TARGET double sums_##SUFFIX(const SumArgs &a, int b0, int b1) {                          \
-    return sum_blocks<W, SumArgs>(a, b0, b1);                                              \
-  }                                                                                        \
-  TARGET double integrate_##SUFFIX(const IntegrateArgs &a, int b0, int b1) {               \
-    return integrate_blocks<W, true>(a, b0, b1);                                           \
-  }                                                                                        \
-  TARGET double integrate_locked_##SUFFIX(const IntegrateArgs &a, int b0, int b1) {        \
-    return integrate_blocks<W, false>(a, b0, b1);                                          \
-  }                                                                                        \
-  TARGET void one_pair_##SUFFIX(const double *in, double *out) { one_pair<W>(in, out); }   \
-  TARGET void walls_##SUFFIX(const WallArgs &a, double *out) { wall_contacts<W>(a, out); } \
-  constexpr Kernels kKernels_##SUFFIX{                                                     \
-      pairs_##SUFFIX,     pairs_damped_##SUFFIX,     sums_##SUFFIX,                        \
-      integrate_##SUFFIX, integrate_locked_##SUFFIX, one_pair_##SUFFIX,                    \
+#define DEMCAL_SPHERE_KERNELS(SUFFIX, TARGET, W)                                                 \
+  TARGET double pairs_##SUFFIX(const PairArgs &a, int b0, int b1) {                              \
+    return pair_blocks<W, false, true>(a, b0, b1);                                               \
+  }                                                                                              \
+  TARGET double pairs_damped_##SUFFIX(const PairArgs &a, int b0, int b1) {                       \
+    return pair_blocks<W, true, true>(a, b0, b1);                                                \
+  }                                                                                              \
+  TARGET double pairs_t_##SUFFIX(const PairArgs &a, int b0, int b1) {                            \
+    return pair_blocks<W, false, false>(a, b0, b1);                                              \
+  }                                                                                              \
+  TARGET double pairs_damped_t_##SUFFIX(const PairArgs &a, int b0, int b1) {                     \
+    return pair_blocks<W, true, false>(a, b0, b1);                                               \
+  }                                                                                              \
+  TARGET double sums_##SUFFIX(const SumArgs &a, int b0, int b1) {                                \
+    for (int b = b0; b < b1; ++b)                                                                \
+      if (!a.fused[b]) sum_blocks<W, SumArgs>(a, b, b + 1);                                      \
+    return 0.0;                                                                                  \
+  }                                                                                              \
+  TARGET double integrate_##SUFFIX(const IntegrateArgs &a, int b0, int b1) {                     \
+    return integrate_blocks<W, true>(a, b0, b1);                                                 \
+  }                                                                                              \
+  TARGET double integrate_locked_##SUFFIX(const IntegrateArgs &a, int b0, int b1) {              \
+    return integrate_blocks<W, false>(a, b0, b1);                                                \
+  }                                                                                              \
+  TARGET void one_pair_##SUFFIX(const double *in, double *out) { one_pair<W>(in, out); }         \
+  TARGET void walls_##SUFFIX(const WallArgs &a, double *out) { wall_contacts<W>(a, out); }       \
+  constexpr Kernels kKernels_##SUFFIX{                                                           \
+      pairs_##SUFFIX, pairs_damped_##SUFFIX, pairs_t_##SUFFIX,          pairs_damped_t_##SUFFIX, \
+      sums_##SUFFIX,  integrate_##SUFFIX,    integrate_locked_##SUFFIX, one_pair_##SUFFIX,       \
       walls_##SUFFIX};
 
 #define DEMCAL_NO_TARGET
@@ -694,15 +723,19 @@ double SphereWorldImpl::pair_pass(int b0, int b1) {
                    2.0 * material_.contact_damping_ratio,
                    mirror_block_.data(),
                    mirror_slot_.data(),
-                   active_threads() <= 1};
+                   mirror_src_block_.data(),
+                   block_fused_.data()};
   const Kernels &k = kernels();
-  return material_.contact_damping_ratio > 0.0 ? k.pairs_damped(a, b0, b1) : k.pairs(a, b0, b1);
+  const bool damped = material_.contact_damping_ratio > 0.0;
+  if (active_threads() <= 1) return damped ? k.pairs_damped(a, b0, b1) : k.pairs(a, b0, b1);
+  return damped ? k.pairs_damped_t(a, b0, b1) : k.pairs_t(a, b0, b1);
 }
 
 double SphereWorldImpl::sum_pass(int b0, int b1) {
-  const SumArgs a{mirror_block_.data(), mirror_slot_.data(), pfx_.data(), pfy_.data(), pfz_.data(),
-                  ptx_.data(),          pty_.data(),         ptz_.data(), fx_.data(),  fy_.data(),
-                  fz_.data(),           tx_.data(),          ty_.data(),  tz_.data()};
+  const SumArgs a{mirror_block_.data(), mirror_slot_.data(), block_fused_.data(), pfx_.data(),
+                  pfy_.data(),          pfz_.data(),         ptx_.data(),         pty_.data(),
+                  ptz_.data(),          fx_.data(),          fy_.data(),          fz_.data(),
+                  tx_.data(),           ty_.data(),          tz_.data()};
   return kernels().sums(a, b0, b1);
 }
 
@@ -796,8 +829,9 @@ void SphereWorldImpl::wall_pass() {
 }
 
 void SphereWorldImpl::compute_forces() {
-  // One thread: the sums fused into the pair pass, block by block (the
-  // same sums, same order); threads: a second pass once all pairs are done.
+  // The sums fused into the pair pass, block by block, where a thread's
+  // own pairs complete them (one thread: all; the same sums, same order);
+  // the others in a second pass once all pairs are done.
   max_overlap_ratio_seen_ = run_pass(&SphereWorldImpl::pair_pass, pair_bounds_);
   if (active_threads() > 1) run_pass(&SphereWorldImpl::sum_pass, particle_bounds_);
   // Friction's losses, block by block in a fixed order (every pair counted

@@ -62,6 +62,8 @@ SphereWorldImpl::SphereWorldImpl(const SphereMaterial& material, std::span<const
     a->assign(static_cast<size_t>(nblocks_) + 1, 0.0);
   block_slot_.assign(static_cast<size_t>(nblocks_) + 1, 0);
   mirror_block_.assign(static_cast<size_t>(nblocks_) + 1, 0);
+  mirror_src_block_.assign(static_cast<size_t>(nblocks_), 0);
+  block_fused_.assign(static_cast<size_t>(nblocks_), 0);
   for (int s = 0; s < 6; ++s) {
     walls_[s].position = (s % 2 == 0) ? lo[s / 2] : hi[s / 2];
   }

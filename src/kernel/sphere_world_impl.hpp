@@ -216,6 +216,10 @@ class SphereWorldImpl {
   // i, padded with the zero slot. The sum pass adds them, in this fixed
   // order, to the sums the pair pass wrote over j's own slots.
   std::vector<int> mirror_block_, mirror_count_;
+  // Per block: the lowest block holding one of its mirrored slots (itself
+  // if none), and whether the pair pass did its sums (sphere_contact.cpp).
+  std::vector<int> mirror_src_block_;
+  std::vector<unsigned char> block_fused_;
   detail::AlignedVector<int> mirror_slot_;
   // The half list (pairs i < j) in CSR form, each row sorted by j, and the
   // slot of each pair (for measures, views and the ledger).
