@@ -767,9 +767,8 @@ std::string stl_rectangle(const std::string& name, double x0, double y0, double 
 /// The LIGGGHTS deck's monitoring series: the LAMMPS deck's file (kColumns,
 /// demcal.series/1), at demcal's monitoring points, from LIGGGHTS' per-atom
 /// wall forces (`store_force yes`; the mesh walls are one fix: top, left and
-/// right add up on a particle) and the total force. Exact for frictionless
-/// walls; with wall friction a corner particle's tangential wall forces are
-/// placed approximately (said in the deck and at export).
+/// right add up on a particle, split at the corners with the meshes' own
+/// totals) and the total force.
 std::string liggghts_series_block(const SceneConfig& c, const AlgorithmSpec& p, const Plan& plan,
                                   const Assembly& a) {
   const auto& m = c.material;
@@ -797,15 +796,10 @@ std::string liggghts_series_block(const SceneConfig& c, const AlgorithmSpec& p, 
     << "#   wall_left wall_right wall_bottom wall_top  wall positions [m]\n"
     << "#   torque_stress            sum of the particles' contact torques / V [Pa]\n"
     << "# The top, left and right walls are one fix (LIGGGHTS allows one mesh wall fix):\n"
-    << "# a particle's x force is its lateral wall's if it touches one, the top's\n"
-    << "# otherwise; its y force the top's if it touches it, its lateral wall's otherwise.\n"
-    << "# Exact for frictionless walls";
-  if (normal_only_walls(m))
-    s << " (these: mu_wall = 0 or kt_wall = 0). With wall friction\n";
-  else
-    s << "; with wall friction (this deck)\n";
-  s << "# a particle touching a lateral wall and the top at once (a corner) has its\n"
-    << "# tangential forces placed at the other wall's contact: approximated.\n"
+    << "# a particle touching one of them has all its force there; a corner particle's\n"
+    << "# is split with the meshes' own totals (below). Exact with and without wall\n"
+    << "# friction while each top corner holds one particle at most; approximated\n"
+    << "# (the corner's particles at their mean position) when more touch both walls.\n"
     << "# Lever arm: LIGGGHTS applies a contact's tangential force at r_i - delta/2 as\n"
     << "# demcal does (walls: r_i - delta/2, demcal r_i - delta; the same without wall\n"
     << "# friction), so s_xy - s_yx = torque_stress: no lever-arm floor (the LAMMPS deck\n"
@@ -826,12 +820,20 @@ std::string liggghts_series_block(const SceneConfig& c, const AlgorithmSpec& p, 
     << "variable V equal v_W*v_H*" << t << "\n"
     << "variable epsyy equal (v_H-" << num(plan.height0) << ")/" << num(plan.height0) << "\n"
     << "compute pa all property/atom radius omegaz tqz\n"
-    << "# the walls a particle touches (overlap > 0), its lateral wall's position\n"
+    << "# the walls a particle touches (overlap > 0); a corner particle touches a\n"
+    << "# lateral wall and the top at once, the others one mesh wall at most\n"
     << "variable ll_a atom (x-c_pa[1])<v_xl\n"
     << "variable lr_a atom (x+c_pa[1])>v_xr\n"
     << "variable lt_a atom (y+c_pa[1])>v_yt\n"
-    << "variable lat_a atom v_ll_a+v_lr_a\n"
-    << "variable xw_a atom v_ll_a*v_xl+v_lr_a*v_xr\n"
+    << "variable cl_a atom v_ll_a*v_lt_a\n"
+    << "variable cr_a atom v_lr_a*v_lt_a\n"
+    << "variable one_a atom 1-v_cl_a-v_cr_a\n"
+    << "variable sl_a atom v_ll_a*(1-v_lt_a)\n"
+    << "variable sr_a atom v_lr_a*(1-v_lt_a)\n"
+    << "variable st_a atom v_lt_a*(1-v_ll_a)*(1-v_lr_a)\n"
+    << "# its one wall's contact point: (x_wall, y) on a lateral wall, (x, y_top)\n"
+    << "variable xc_a atom v_ll_a*v_xl+v_lr_a*v_xr+v_lt_a*x\n"
+    << "variable yc_a atom (v_ll_a+v_lr_a)*y+v_lt_a*v_yt\n"
     << "# wall forces on the particle: the meshes' (top, left, right), the bottom's\n"
     << "variable fwx_a atom f_force_walls[1]\n"
     << "variable fwy_a atom f_force_walls[2]\n"
@@ -839,29 +841,62 @@ std::string liggghts_series_block(const SceneConfig& c, const AlgorithmSpec& p, 
     << "variable fby_a atom f_force_bottom[2]\n"
     << "variable fx_a atom v_fwx_a+v_fbx_a\n"
     << "variable fy_a atom v_fwy_a+v_fby_a\n"
-    << "# x^c (x) f^c about the origin: the x force at (x_wall, y) or (x, y_top), the y\n"
-    << "# force at (x, y_top) or (x_wall, y); the bottom's at (x, y_bottom)\n"
-    << "variable bxx_a atom (v_xw_a+(1-v_lat_a)*x)*v_fwx_a+x*v_fbx_a\n"
-    << "variable bxy_a atom (v_lt_a*x+(1-v_lt_a)*v_xw_a)*v_fwy_a+x*v_fby_a\n"
-    << "variable byx_a atom (v_lat_a*y+(1-v_lat_a)*v_yt)*v_fwx_a+v_yb*v_fbx_a\n"
-    << "variable byy_a atom (v_lt_a*v_yt+(1-v_lt_a)*y)*v_fwy_a+v_yb*v_fby_a\n"
+    << "# x^c (x) f^c about the origin of the one-wall particles' contacts and the\n"
+    << "# bottom's (at (x, y_bottom)); the corners' below\n"
+    << "variable bxx_a atom v_one_a*v_xc_a*v_fwx_a+x*v_fbx_a\n"
+    << "variable bxy_a atom v_one_a*v_xc_a*v_fwy_a+x*v_fby_a\n"
+    << "variable byx_a atom v_one_a*v_yc_a*v_fwx_a+v_yb*v_fbx_a\n"
+    << "variable byy_a atom v_one_a*v_yc_a*v_fwy_a+v_yb*v_fby_a\n"
     << deck::lammps_contact_force_atom(2, p.damping_ratio_translation, plan.gamma_t, num, "0")
     << "variable mxx_a atom x*v_fc1_a\n"
     << "variable mxy_a atom x*v_fc2_a\n"
     << "variable myx_a atom y*v_fc1_a\n"
     << "variable myy_a atom y*v_fc2_a\n"
     << "variable ket_a atom 0.5*mass*(vx*vx+vy*vy)\n"
-    << "variable ker_a atom 0.25*mass*c_pa[1]*c_pa[1]*c_pa[2]*c_pa[2]\n"
-    << "variable pl_a atom v_ll_a*v_fwx_a\n"
-    << "variable pr_a atom v_lr_a*v_fwx_a\n"
-    << "variable pt_a atom v_lt_a*v_fwy_a\n"
-    << "compute meas all reduce sum v_bxx_a v_bxy_a v_byx_a v_byy_a v_fx_a v_fy_a &\n"
+    << "variable ker_a atom 0.25*mass*c_pa[1]*c_pa[1]*c_pa[2]*c_pa[2]\n";
+  // The per-particle sums: [16..20] the one-wall particles' forces per wall,
+  // [21..25] and [26..30] the left and right corners' forces, positions, count.
+  for (const char* w : {"sl", "sr"})
+    s << "variable " << w << "x_a atom v_" << w << "_a*v_fwx_a\n"
+      << "variable " << w << "y_a atom v_" << w << "_a*v_fwy_a\n";
+  s << "variable sty_a atom v_st_a*v_fwy_a\n";
+  for (const char* w : {"cl", "cr"})
+    s << "variable " << w << "x_a atom v_" << w << "_a*v_fwx_a\n"
+      << "variable " << w << "y_a atom v_" << w << "_a*v_fwy_a\n"
+      << "variable " << w << "X_a atom v_" << w << "_a*x\n"
+      << "variable " << w << "Y_a atom v_" << w << "_a*y\n";
+  s << "compute meas all reduce sum v_bxx_a v_bxy_a v_byx_a v_byy_a v_fx_a v_fy_a &\n"
     << "        v_mxx_a v_mxy_a v_myx_a v_myy_a v_fc1_a v_fc2_a v_ket_a v_ker_a c_pa[3] &\n"
-    << "        v_pl_a v_pr_a v_pt_a v_fby_a\n"
-    << "variable b_xx equal (c_meas[1]-v_cx*c_meas[5])/v_V\n"
-    << "variable b_xy equal (c_meas[2]-v_cx*c_meas[6])/v_V\n"
-    << "variable b_yx equal (c_meas[3]-v_cy*c_meas[5])/v_V\n"
-    << "variable b_yy equal (c_meas[4]-v_cy*c_meas[6])/v_V\n"
+    << "        v_slx_a v_sly_a v_srx_a v_sry_a v_sty_a &\n"
+    << "        v_clx_a v_cly_a v_clX_a v_clY_a v_cl_a v_crx_a v_cry_a v_crX_a v_crY_a v_cr_a &\n"
+    << "        v_fby_a\n"
+    << "# A corner particle's force is two walls' (one mesh wall fix): its lateral\n"
+    << "# wall's part is that wall's total (the mesh's own, -f_m on the particles)\n"
+    << "# less its one-wall particles', the rest the top's. At the start the meshes\n"
+    << "# have no totals yet and no wall carries a tangential force (the tangential\n"
+    << "# springs start at zero): the corners' x force is the lateral wall's.\n"
+    << "# Positions: the mean over a corner's particles (one in a packed sample:\n"
+    << "# exact; more share the wall forces as if at their mean).\n"
+    << "variable gLx equal (step>0)*(-f_mleft[1]-c_meas[16])+(step==0)*c_meas[21]\n"
+    << "variable gLy equal (step>0)*(-f_mleft[2]-c_meas[17])\n"
+    << "variable gRx equal (step>0)*(-f_mright[1]-c_meas[18])+(step==0)*c_meas[26]\n"
+    << "variable gRy equal (step>0)*(-f_mright[2]-c_meas[19])\n"
+    << "variable tLx equal c_meas[21]-v_gLx\n"
+    << "variable tLy equal c_meas[22]-v_gLy\n"
+    << "variable tRx equal c_meas[26]-v_gRx\n"
+    << "variable tRy equal c_meas[27]-v_gRy\n"
+    << "variable xcl equal c_meas[23]/(c_meas[25]+(c_meas[25]==0))\n"
+    << "variable ycl equal c_meas[24]/(c_meas[25]+(c_meas[25]==0))\n"
+    << "variable xcr equal c_meas[28]/(c_meas[30]+(c_meas[30]==0))\n"
+    << "variable ycr equal c_meas[29]/(c_meas[30]+(c_meas[30]==0))\n"
+    << "variable kxx equal v_xl*v_gLx+v_xcl*v_tLx+v_xr*v_gRx+v_xcr*v_tRx\n"
+    << "variable kxy equal v_xl*v_gLy+v_xcl*v_tLy+v_xr*v_gRy+v_xcr*v_tRy\n"
+    << "variable kyx equal v_ycl*v_gLx+v_yt*v_tLx+v_ycr*v_gRx+v_yt*v_tRx\n"
+    << "variable kyy equal v_ycl*v_gLy+v_yt*v_tLy+v_ycr*v_gRy+v_yt*v_tRy\n"
+    << "variable b_xx equal (c_meas[1]+v_kxx-v_cx*c_meas[5])/v_V\n"
+    << "variable b_xy equal (c_meas[2]+v_kxy-v_cx*c_meas[6])/v_V\n"
+    << "variable b_yx equal (c_meas[3]+v_kyx-v_cy*c_meas[5])/v_V\n"
+    << "variable b_yy equal (c_meas[4]+v_kyy-v_cy*c_meas[6])/v_V\n"
     << "variable s_xx equal v_b_xx-(c_meas[7]-v_cx*c_meas[11])/v_V\n"
     << "variable s_xy equal v_b_xy-(c_meas[8]-v_cx*c_meas[12])/v_V\n"
     << "variable s_yx equal v_b_yx-(c_meas[9]-v_cy*c_meas[11])/v_V\n"
@@ -869,10 +904,10 @@ std::string liggghts_series_block(const SceneConfig& c, const AlgorithmSpec& p, 
     << "variable ke equal c_meas[13]+c_meas[14]\n"
     << "variable ke_rot equal c_meas[14]\n"
     << "variable torque equal c_meas[15]/v_V\n"
-    << "variable pl equal c_meas[16]/(v_H*" << t << ")\n"
-    << "variable pr equal -c_meas[17]/(v_H*" << t << ")\n"
-    << "variable pt equal -c_meas[18]/(v_W*" << t << ")\n"
-    << "variable pb equal c_meas[19]/(v_W*" << t << ")\n"
+    << "variable pl equal (c_meas[16]+v_gLx)/(v_H*" << t << ")\n"
+    << "variable pr equal -(c_meas[18]+v_gRx)/(v_H*" << t << ")\n"
+    << "variable pt equal -(c_meas[20]+v_tLy+v_tRy)/(v_W*" << t << ")\n"
+    << "variable pb equal c_meas[31]/(v_W*" << t << ")\n"
     << "variable servo_err equal ((v_pl+v_pr)/2-v_sigma3)/v_sigma3\n"
     << "variable stepn equal step\n";
   const std::string row =
@@ -962,10 +997,6 @@ ExportResult liggghts(const SceneConfig& c, const AlgorithmSpec& p, const Assemb
     << "#  - the servo's per-step gain is fixed by the contacts at the start (demcal:\n"
     << "#    the current contacts).\n"
     << "#  - translational damping per radius class via fix viscous ... scale.\n";
-  if (!normal_only_walls(m))
-    out.notes.push_back(
-        "LIGGGHTS deck: with wall friction the series' b (and sigma) of a particle touching two "
-        "walls at once places its tangential wall forces approximately (one mesh wall fix)");
   s << deck::liggghts_preamble(2, "f f p", o.data_name, plan.r_min)
     << deck::liggghts_materials(m, ntypes, plan.dt, num)
     << "# the lateral walls' target forces, sigma3*H*t (left +x, right -x)\n"
