@@ -183,9 +183,14 @@ TEST(Export, LiggghtsDeckHasMeshesAndServo) {
   o.format = "liggghts";
   o.data_name = "proto.data";
   const ExportResult r = export_deck(c, params(), a, o);
-  for (const char* needle : {"pair_style gran model hooke/stiffness tangential history",
-                             "mesh/surface/stress/servo", "move/mesh", "fix twod all enforce2d",
-                             "Checked with LIGGGHTS 3.8", "primitive type 2 yplane"})
+  for (const char* needle :
+       {"pair_style gran model hooke/stiffness tangential history", "mesh/surface/stress/servo",
+        "move/mesh", "fix twod all enforce2d", "Checked with LIGGGHTS 3.8",
+        "primitive type 2 yplane",
+        // the series demcal score reads: per-atom wall forces, the
+        // servo on the current height, LIGGGHTS' lever arm
+        "store_force yes", "target_val v_ftl", "target_val v_ftr", "demcal.series/1: LIGGGHTS deck",
+        "moment_lever_arm = radius - overlap/2", "title \"step,strain_yy,b_xx"})
     EXPECT_NE(r.deck.find(needle), std::string::npos) << needle;
   // 2D masses: LIGGGHTS takes pi r^2 * density, so the density column is
   // the areal density f_ms*rho*t.

@@ -146,7 +146,12 @@ TEST(Export3d, LiggghtsDeckHasSixWallsAndTheServo) {
        {"fcc.data", "fcc-xmin.stl", "fcc-xmax.stl", "fcc-ymin.stl", "fcc-ymax.stl", "fcc-top.stl"})
     EXPECT_EQ(r.files.count(name), 1u) << name;
   for (const char* line : {"fix mbottom all mesh/surface/stress", "mesh/surface/stress/servo",
-                           "n_meshes 6", "move/mesh mesh mtop linear 0 0 -"})
+                           "n_meshes 6", "move/mesh mesh mtop linear 0 0 -",
+                           // the series demcal score reads: per-atom wall forces, each
+                           // servo on its wall's current area, LIGGGHTS' lever arm
+                           "store_force yes", "target_val v_ft_xmin", "target_val v_ft_ymax",
+                           "demcal.series/1: LIGGGHTS 3D deck",
+                           "moment_lever_arm = radius - overlap/2", "title \"step,strain_zz,b_xx"})
     EXPECT_NE(r.deck.find(line), std::string::npos) << line;
   EXPECT_EQ(r.deck.find("dimension 2"), std::string::npos);
 }

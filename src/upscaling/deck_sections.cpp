@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <limits>
 #include <sstream>
+#include <stdexcept>
 
 #include "demcal/kernel/particle_scales.hpp"
 
@@ -478,6 +479,19 @@ std::string liggghts_translational_damping(double zeta_t, const std::vector<doub
     s << " scale " << k + 1 << " " << f(gamma_t[k] / gamma_t[0]);
   s << "\n";
   return s.str();
+}
+
+std::string liggghts_series_header(const std::string& deck, const std::string& scene, int particles,
+                                   double zeta_t, std::optional<double> dt_crit,
+                                   std::optional<double> mass_scaling) {
+  // One home for the header's keys (lammps_series_header); only the lever
+  // arm's value differs.
+  std::string s = lammps_series_header(deck, scene, particles, zeta_t, dt_crit, mass_scaling);
+  const std::string radius = "moment_lever_arm = radius\"";
+  const auto at = s.find(radius);
+  if (at == std::string::npos) throw std::logic_error("series header: no moment_lever_arm line");
+  s.replace(at, radius.size(), "moment_lever_arm = radius - overlap/2\"");
+  return s;
 }
 
 }  // namespace demcal::deck

@@ -214,4 +214,13 @@ std::string liggghts_materials(const Material& m, int ntypes, double dt, NumberF
 std::string liggghts_translational_damping(double zeta_t, const std::vector<double>& gamma_t,
                                            NumberFormat f);
 
+/// LIGGGHTS: the series file's header, lammps_series_header's keys (the same
+/// print lines run in LIGGGHTS 3.8) with the lever arm LIGGGHTS applies a
+/// contact's tangential force at: r_i - delta/2, demcal's (its surface
+/// model's cri; walls too, where demcal takes the wall's distance r_i -
+/// delta: no difference without wall friction).
+std::string liggghts_series_header(const std::string& deck, const std::string& scene, int particles,
+                                   double zeta_t, std::optional<double> dt_crit,
+                                   std::optional<double> mass_scaling);
+
 }  // namespace demcal::deck

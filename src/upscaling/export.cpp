@@ -764,6 +764,169 @@ std::string stl_rectangle(const std::string& name, double x0, double y0, double 
   return s.str();
 }
 
+/// The LIGGGHTS deck's monitoring series: the LAMMPS deck's file (kColumns,
+/// demcal.series/1), at demcal's monitoring points, from LIGGGHTS' per-atom
+/// wall forces (`store_force yes`; the mesh walls are one fix: top, left and
+/// right add up on a particle, split at the corners with the meshes' own
+/// totals) and the total force.
+std::string liggghts_series_block(const SceneConfig& c, const AlgorithmSpec& p, const Plan& plan,
+                                  const Assembly& a) {
+  const auto& m = c.material;
+  const std::string t = num(m.thickness);
+  std::ostringstream s;
+  s << "\n# --- monitoring series (demcal score FILE) -----------------------------------\n"
+    << "# Written to ${series} at the start and every " << plan.thermo_every
+    << " steps (demcal's monitoring points),\n"
+    << "# the LAMMPS deck's columns, tension positive, SI units, origin at the box centre:\n"
+    << "#   step, strain_yy          (H - H0)/H0\n"
+    << "#   b_xx b_xy b_yx b_yy      boundary stress (1/V) sum_wall (x^c - c) (x) f^c, from\n"
+    << "#                            the walls' per-atom forces (store_force yes): a lateral\n"
+    << "#                            wall's contact at (x_wall, y), the top's and the\n"
+    << "#                            bottom's at (x, y_wall), the foot of the normal\n"
+    << "#   s_xx s_xy s_yx s_yy      homogenized stress, from the identity\n"
+    << "#                            V (b - sigma) = sum_p (x_p - c) (x) F_p, F_p the\n"
+    << "#                            contact force (before damping, recovered below)\n"
+    << "#   kinetic_energy           translation + rotation, disc inertia m r^2/2: LIGGGHTS\n"
+    << "#   kinetic_energy_rotation  3.8's fix nve/sphere rotates with m r^2/2 under\n"
+    << "#                            dimension 2 (as demcal), so this is the energy of its\n"
+    << "#                            motion [J]\n"
+    << "#   lateral_stress_error     ((p_left + p_right)/2 - sigma3)/sigma3 (servo)\n"
+    << "#   p_left p_right p_bottom p_top  compressive wall pressures on the current\n"
+    << "#                            height and width [Pa]\n"
+    << "#   wall_left wall_right wall_bottom wall_top  wall positions [m]\n"
+    << "#   torque_stress            sum of the particles' contact torques / V [Pa]\n"
+    << "# The top, left and right walls are one fix (LIGGGHTS allows one mesh wall fix):\n"
+    << "# a particle touching one of them has all its force there; a corner particle's\n"
+    << "# is split with the meshes' own totals (below). Exact with and without wall\n"
+    << "# friction while each top corner holds one particle at most; approximated\n"
+    << "# (the corner's particles at their mean position) when more touch both walls.\n"
+    << "# Lever arm: LIGGGHTS applies a contact's tangential force at r_i - delta/2 as\n"
+    << "# demcal does (walls: r_i - delta/2, demcal r_i - delta; the same without wall\n"
+    << "# friction), so s_xy - s_yx = torque_stress: no lever-arm floor (the LAMMPS deck\n"
+    << "# has one).\n"
+    << "variable series index series.csv\n"
+    << "variable sigma3 equal " << num(c.test.lateral_stress) << "\n"
+    << "variable nstep equal " << plan.steps << "\n"
+    << "variable dt equal " << num(plan.dt) << "\n"
+    << "variable yb equal " << num(a.bottom) << "\n"
+    << "variable yt equal " << num(a.top) << "-" << num(plan.top_speed) << "*step*" << num(plan.dt)
+    << "\n"
+    << "variable xl equal f_mleft[7]\n"
+    << "variable xr equal f_mright[7]\n"
+    << "variable H equal v_yt-v_yb\n"
+    << "variable W equal v_xr-v_xl\n"
+    << "variable cx equal (v_xl+v_xr)/2\n"
+    << "variable cy equal (v_yb+v_yt)/2\n"
+    << "variable V equal v_W*v_H*" << t << "\n"
+    << "variable epsyy equal (v_H-" << num(plan.height0) << ")/" << num(plan.height0) << "\n"
+    << "compute pa all property/atom radius omegaz tqz\n"
+    << "# the walls a particle touches (overlap > 0); a corner particle touches a\n"
+    << "# lateral wall and the top at once, the others one mesh wall at most\n"
+    << "variable ll_a atom (x-c_pa[1])<v_xl\n"
+    << "variable lr_a atom (x+c_pa[1])>v_xr\n"
+    << "variable lt_a atom (y+c_pa[1])>v_yt\n"
+    << "variable cl_a atom v_ll_a*v_lt_a\n"
+    << "variable cr_a atom v_lr_a*v_lt_a\n"
+    << "variable one_a atom 1-v_cl_a-v_cr_a\n"
+    << "variable sl_a atom v_ll_a*(1-v_lt_a)\n"
+    << "variable sr_a atom v_lr_a*(1-v_lt_a)\n"
+    << "variable st_a atom v_lt_a*(1-v_ll_a)*(1-v_lr_a)\n"
+    << "# its one wall's contact point: (x_wall, y) on a lateral wall, (x, y_top)\n"
+    << "variable xc_a atom v_ll_a*v_xl+v_lr_a*v_xr+v_lt_a*x\n"
+    << "variable yc_a atom (v_ll_a+v_lr_a)*y+v_lt_a*v_yt\n"
+    << "# wall forces on the particle: the meshes' (top, left, right), the bottom's\n"
+    << "variable fwx_a atom f_force_walls[1]\n"
+    << "variable fwy_a atom f_force_walls[2]\n"
+    << "variable fbx_a atom f_force_bottom[1]\n"
+    << "variable fby_a atom f_force_bottom[2]\n"
+    << "variable fx_a atom v_fwx_a+v_fbx_a\n"
+    << "variable fy_a atom v_fwy_a+v_fby_a\n"
+    << "# x^c (x) f^c about the origin of the one-wall particles' contacts and the\n"
+    << "# bottom's (at (x, y_bottom)); the corners' below\n"
+    << "variable bxx_a atom v_one_a*v_xc_a*v_fwx_a+x*v_fbx_a\n"
+    << "variable bxy_a atom v_one_a*v_xc_a*v_fwy_a+x*v_fby_a\n"
+    << "variable byx_a atom v_one_a*v_yc_a*v_fwx_a+v_yb*v_fbx_a\n"
+    << "variable byy_a atom v_one_a*v_yc_a*v_fwy_a+v_yb*v_fby_a\n"
+    << deck::lammps_contact_force_atom(2, p.damping_ratio_translation, plan.gamma_t, num, "0")
+    << "variable mxx_a atom x*v_fc1_a\n"
+    << "variable mxy_a atom x*v_fc2_a\n"
+    << "variable myx_a atom y*v_fc1_a\n"
+    << "variable myy_a atom y*v_fc2_a\n"
+    << "variable ket_a atom 0.5*mass*(vx*vx+vy*vy)\n"
+    << "variable ker_a atom 0.25*mass*c_pa[1]*c_pa[1]*c_pa[2]*c_pa[2]\n";
+  // The per-particle sums: [16..20] the one-wall particles' forces per wall,
+  // [21..25] and [26..30] the left and right corners' forces, positions, count.
+  for (const char* w : {"sl", "sr"})
+    s << "variable " << w << "x_a atom v_" << w << "_a*v_fwx_a\n"
+      << "variable " << w << "y_a atom v_" << w << "_a*v_fwy_a\n";
+  s << "variable sty_a atom v_st_a*v_fwy_a\n";
+  for (const char* w : {"cl", "cr"})
+    s << "variable " << w << "x_a atom v_" << w << "_a*v_fwx_a\n"
+      << "variable " << w << "y_a atom v_" << w << "_a*v_fwy_a\n"
+      << "variable " << w << "X_a atom v_" << w << "_a*x\n"
+      << "variable " << w << "Y_a atom v_" << w << "_a*y\n";
+  s << "compute meas all reduce sum v_bxx_a v_bxy_a v_byx_a v_byy_a v_fx_a v_fy_a &\n"
+    << "        v_mxx_a v_mxy_a v_myx_a v_myy_a v_fc1_a v_fc2_a v_ket_a v_ker_a c_pa[3] &\n"
+    << "        v_slx_a v_sly_a v_srx_a v_sry_a v_sty_a &\n"
+    << "        v_clx_a v_cly_a v_clX_a v_clY_a v_cl_a v_crx_a v_cry_a v_crX_a v_crY_a v_cr_a &\n"
+    << "        v_fby_a\n"
+    << "# A corner particle's force is two walls' (one mesh wall fix): its lateral\n"
+    << "# wall's part is that wall's total (the mesh's own, -f_m on the particles)\n"
+    << "# less its one-wall particles', the rest the top's. At the start the meshes\n"
+    << "# have no totals yet and no wall carries a tangential force (the tangential\n"
+    << "# springs start at zero): the corners' x force is the lateral wall's.\n"
+    << "# Positions: the mean over a corner's particles (one in a packed sample:\n"
+    << "# exact; more share the wall forces as if at their mean).\n"
+    << "variable gLx equal (step>0)*(-f_mleft[1]-c_meas[16])+(step==0)*c_meas[21]\n"
+    << "variable gLy equal (step>0)*(-f_mleft[2]-c_meas[17])\n"
+    << "variable gRx equal (step>0)*(-f_mright[1]-c_meas[18])+(step==0)*c_meas[26]\n"
+    << "variable gRy equal (step>0)*(-f_mright[2]-c_meas[19])\n"
+    << "variable tLx equal c_meas[21]-v_gLx\n"
+    << "variable tLy equal c_meas[22]-v_gLy\n"
+    << "variable tRx equal c_meas[26]-v_gRx\n"
+    << "variable tRy equal c_meas[27]-v_gRy\n"
+    << "variable xcl equal c_meas[23]/(c_meas[25]+(c_meas[25]==0))\n"
+    << "variable ycl equal c_meas[24]/(c_meas[25]+(c_meas[25]==0))\n"
+    << "variable xcr equal c_meas[28]/(c_meas[30]+(c_meas[30]==0))\n"
+    << "variable ycr equal c_meas[29]/(c_meas[30]+(c_meas[30]==0))\n"
+    << "variable kxx equal v_xl*v_gLx+v_xcl*v_tLx+v_xr*v_gRx+v_xcr*v_tRx\n"
+    << "variable kxy equal v_xl*v_gLy+v_xcl*v_tLy+v_xr*v_gRy+v_xcr*v_tRy\n"
+    << "variable kyx equal v_ycl*v_gLx+v_yt*v_tLx+v_ycr*v_gRx+v_yt*v_tRx\n"
+    << "variable kyy equal v_ycl*v_gLy+v_yt*v_tLy+v_ycr*v_gRy+v_yt*v_tRy\n"
+    << "variable b_xx equal (c_meas[1]+v_kxx-v_cx*c_meas[5])/v_V\n"
+    << "variable b_xy equal (c_meas[2]+v_kxy-v_cx*c_meas[6])/v_V\n"
+    << "variable b_yx equal (c_meas[3]+v_kyx-v_cy*c_meas[5])/v_V\n"
+    << "variable b_yy equal (c_meas[4]+v_kyy-v_cy*c_meas[6])/v_V\n"
+    << "variable s_xx equal v_b_xx-(c_meas[7]-v_cx*c_meas[11])/v_V\n"
+    << "variable s_xy equal v_b_xy-(c_meas[8]-v_cx*c_meas[12])/v_V\n"
+    << "variable s_yx equal v_b_yx-(c_meas[9]-v_cy*c_meas[11])/v_V\n"
+    << "variable s_yy equal v_b_yy-(c_meas[10]-v_cy*c_meas[12])/v_V\n"
+    << "variable ke equal c_meas[13]+c_meas[14]\n"
+    << "variable ke_rot equal c_meas[14]\n"
+    << "variable torque equal c_meas[15]/v_V\n"
+    << "variable pl equal (c_meas[16]+v_gLx)/(v_H*" << t << ")\n"
+    << "variable pr equal -(c_meas[18]+v_gRx)/(v_H*" << t << ")\n"
+    << "variable pt equal -(c_meas[20]+v_tLy+v_tRy)/(v_W*" << t << ")\n"
+    << "variable pb equal c_meas[31]/(v_W*" << t << ")\n"
+    << "variable servo_err equal ((v_pl+v_pr)/2-v_sigma3)/v_sigma3\n"
+    << "variable stepn equal step\n";
+  const std::string row =
+      "${stepn},${epsyy},${b_xx},${b_xy},${b_yx},${b_yy},${s_xx},${s_xy},${s_yx},${s_yy},"
+      "${ke},${ke_rot},${servo_err},${pl},${pr},${pb},${pt},${xl},${xr},${yb},${yt},${torque}";
+  s << "# the header: what demcal score needs to know about the run\n"
+    << deck::liggghts_series_header("LIGGGHTS deck", c.name, plan.n, p.damping_ratio_translation,
+                                    plan.dt_crit, p.mass_scaling)
+    << "fix series all print " << plan.thermo_every << " \"" << row
+    << "\" append ${series} screen no title \"" << kColumns << "\"\n"
+    << "# The start's row: this fix print does not print at the run's setup, and a\n"
+    << "# variable may read a compute between runs only if the last run computed it\n"
+    << "# (the thermo line below does)\n"
+    << "thermo_style custom step c_meas[1]\n"
+    << "run 0\n"
+    << "print \"" << row << "\" append ${series} screen no\n\n";
+  return s.str();
+}
+
 ExportResult liggghts(const SceneConfig& c, const AlgorithmSpec& p, const Assembly& a,
                       const ExportOptions& o) {
   const Plan plan = make_plan(c, p, a, o.max_types);
@@ -810,55 +973,59 @@ ExportResult liggghts(const SceneConfig& c, const AlgorithmSpec& p, const Assemb
   out.files[left] = stl_rectangle("left", a.left, ylo, a.left, yhi, z0, z1);
   out.files[right] = stl_rectangle("right", a.right, yhi, a.right, ylo, z0, z1);
 
+  // demcal's servo target sigma3*H*t on the current height H (the top wall
+  // moves down at top_speed from the start).
+  const std::string target = num(c.test.lateral_stress * m.thickness) + "*(" + num(plan.height0) +
+                             "-" + num(plan.top_speed) + "*step*" + num(plan.dt) + ")";
   std::ostringstream s;
   s << mapping_header(c, p, plan, o, "LIGGGHTS");
-  s << "#\n# Checked with LIGGGHTS 3.8 (Debian): on a 25-disc sample its peak is within\n"
-    << "# 1 % of demcal's (a test, where liggghts is installed; reports/engines.md).\n"
+  s << "#\n# Checked with LIGGGHTS 3.8 (Debian): on a 25-disc sample it scores as demcal's\n"
+    << "# run (same verdict, peak within 1 %: a test, where liggghts is installed;\n"
+    << "# reports/engines.md). It writes demcal's monitoring series: demcal score series.csv\n"
     << "# Servo: LIGGGHTS moves the mesh at vel_max * kp * (F_target - F)/|F_target|;\n"
-    << "# vel_max = cap/dt and kp = gain*F_target/(kn_wall*n_c*cap), n_c the wall\n"
+    << "# vel_max = cap/dt and kp = gain*F_target(0)/(kn_wall*n_c*cap), n_c the wall\n"
     << "# contacts at the start (" << n_contacts << "), give demcal's per-step move\n"
-    << "# gain*(F_target - F)/(kn_wall*n_c).\n"
+    << "# gain*(F_target - F)/(kn_wall*n_c), times F_target(0)/F_target (1 + the strain\n"
+    << "# at most: kp is a constant here). F_target = sigma3*H*t follows the current\n"
+    << "# height (target_val v_ftl), demcal's target.\n"
     << "# Run it with a screen (liggghts 3.8 crashes reading meshes with -screen none).\n"
     << "# Differences from demcal:\n"
-    << "#  - LIGGGHTS has no disc inertia: particles rotate as spheres (I = 2/5 m r^2,\n"
-    << "#    not 1/2 m r^2); masses are disc masses (2D: pi r^2 * areal density).\n"
-    << "#    The rotational stability limit of alpha moves by sqrt(0.8) = 0.89.\n"
+    << "#  - rotation: LIGGGHTS 3.8's fix nve/sphere takes the disc's inertia m r^2/2\n"
+    << "#    under dimension 2 (as demcal); masses are disc masses (pi r^2 * areal density).\n"
     << "#  - rotational damping (zeta_r = " << num(p.damping_ratio_rotation)
     << ") has no fix here and is not applied.\n"
-    << "#  - lateral walls: fix mesh/surface/stress/servo holds the wall FORCE at\n"
-    << "#    sigma3*H0*t (H0 the initial height), not the stress on the current height;\n"
-    << "#    the target is the force on the mesh along +x: positive on the left wall.\n"
+    << "#  - the servo's per-step gain is fixed by the contacts at the start (demcal:\n"
+    << "#    the current contacts).\n"
     << "#  - translational damping per radius class via fix viscous ... scale.\n";
-  out.notes.push_back(
-      "LIGGGHTS deck: lateral force held at sigma3*H0*t (not on the current height); discs "
-      "rotate as spheres");
   s << deck::liggghts_preamble(2, "f f p", o.data_name, plan.r_min)
     << deck::liggghts_materials(m, ntypes, plan.dt, num)
+    << "# the lateral walls' target forces, sigma3*H*t (left +x, right -x)\n"
+    << "variable ftl equal " << target << "\n"
+    << "variable ftr equal -" << target << "\n"
     << "fix bottom all wall/gran model hooke/stiffness tangential history primitive type "
-    << wall_type << " yplane " << num(a.bottom) << " absolute_damping on tangential_damping off\n"
+    << wall_type << " yplane " << num(a.bottom)
+    << " store_force yes absolute_damping on tangential_damping off\n"
     << "fix mtop all mesh/surface/stress file " << top << " type " << wall_type << "\n"
     << "fix mleft all mesh/surface/stress/servo file " << left << " type " << wall_type << " com "
     << num(a.left) << " " << num(0.5 * (a.bottom + a.top))
-    << " 0 ctrlPV force axis 1 0 0 target_val "
-    << num(c.test.lateral_stress * plan.height0 * m.thickness) << " vel_max "
-    << num(0.02 * plan.r_min / plan.dt) << " kp " << num(kp) << "\n"
+    << " 0 ctrlPV force axis 1 0 0 target_val v_ftl vel_max " << num(0.02 * plan.r_min / plan.dt)
+    << " kp " << num(kp) << "\n"
     << "fix mright all mesh/surface/stress/servo file " << right << " type " << wall_type << " com "
     << num(a.right) << " " << num(0.5 * (a.bottom + a.top))
-    << " 0 ctrlPV force axis 1 0 0 target_val "
-    << num(-c.test.lateral_stress * plan.height0 * m.thickness) << " vel_max "
-    << num(0.02 * plan.r_min / plan.dt) << " kp " << num(kp) << "\n"
+    << " 0 ctrlPV force axis 1 0 0 target_val v_ftr vel_max " << num(0.02 * plan.r_min / plan.dt)
+    << " kp " << num(kp) << "\n"
     << "fix walls all wall/gran model hooke/stiffness tangential history mesh n_meshes 3 meshes "
-       "mtop mleft mright absolute_damping on tangential_damping off\n"
+       "mtop mleft mright store_force yes absolute_damping on tangential_damping off\n"
     << "fix movetop all move/mesh mesh mtop linear 0 " << num(-plan.top_speed) << " 0\n\n"
     << "fix integrate all nve/sphere\n";
   s << deck::liggghts_translational_damping(p.damping_ratio_translation, plan.gamma_t, num)
-    << "fix twod all enforce2d\n\n"
-    << "# p_top: axial stress on the top wall; p_left, p_right: lateral (Pa)\n"
-    << "variable xl equal f_mleft[7]\n"
-    << "variable xr equal f_mright[7]\n"
-    << "variable p_top equal f_mtop[2]/((v_xr-v_xl)*" << num(m.thickness) << ")\n"
-    << "variable p_left equal -f_mleft[1]/(" << num(plan.height0 * m.thickness) << ")\n"
-    << "variable p_right equal f_mright[1]/(" << num(plan.height0 * m.thickness) << ")\n"
+    << "fix twod all enforce2d\n"
+    << liggghts_series_block(c, p, plan, a)
+    << "# thermo: the meshes' own forces (from the first step on): p_top axial,\n"
+    << "# p_left and p_right lateral, on the current width and height (Pa)\n"
+    << "variable p_top equal f_mtop[2]/(v_W*" << num(m.thickness) << ")\n"
+    << "variable p_left equal -f_mleft[1]/(v_H*" << num(m.thickness) << ")\n"
+    << "variable p_right equal f_mright[1]/(v_H*" << num(m.thickness) << ")\n"
     << "thermo_style custom step dt time ke v_p_top v_p_left v_p_right v_xl v_xr\n"
     << "thermo " << plan.thermo_every << "\n"
     << "variable run_steps index " << plan.steps << "\n"

@@ -630,6 +630,175 @@ std::string stl_rectangle(const std::string& name, const Eigen::Vector3d& p0,
   return s.str();
 }
 
+/// The LIGGGHTS 3D deck's monitoring series (the LAMMPS 3D deck's columns,
+/// demcal.series/1) from LIGGGHTS' per-atom wall forces: the six meshes are
+/// one wall fix (LIGGGHTS allows one), `store_force yes` gives each sphere's
+/// total wall force. `lateral_pos[sd]`: lateral wall sd's position (a
+/// formula).
+std::string liggghts_3d_series(const SceneConfig& c, const AlgorithmSpec& p, const Plan3& plan,
+                               const std::array<std::string, 4>& lateral_pos, int monitor_every) {
+  const char* mesh[6] = {"mxmin", "mxmax", "mymin", "mymax", "mbottom", "mtop"};
+  std::ostringstream s;
+  s << "\n# --- monitoring series (demcal score FILE) -----------------------------------\n"
+    << "# ${series}: at the start and every " << monitor_every
+    << " steps (demcal's monitoring points), the\n"
+    << "# LAMMPS 3D deck's columns, tension positive, SI, origin at the box centre:\n"
+    << "#   step, strain_zz (H - H0)/H0\n"
+    << "#   b_xx .. b_zz   boundary stress (1/V) sum_walls (x^c - c) (x) f^c, row by row,\n"
+    << "#                  from the spheres' wall forces (store_force yes)\n"
+    << "#   s_xx .. s_zz   homogenized stress (V (b - sigma) = sum_p x_p (x) F_p, F_p the\n"
+    << "#                  contact force, recovered below)\n"
+    << "#   kinetic_energy (translation + rotation, I = 2/5 m r^2, LIGGGHTS' and demcal's\n"
+    << "#                  sphere), kinetic_energy_rotation [J]\n"
+    << "#   lateral_stress_error  (mean of the four lateral pressures - sigma3)/sigma3\n"
+    << "#   servo_error_xmin .. ymax  (p - sigma3)/sigma3 of each lateral wall\n"
+    << "#   wall_xmin .. wall_zmax    wall positions [m]\n"
+    << "#   p_xmin .. p_zmax          compressive wall pressures on the current areas [Pa]\n"
+    << "#                             (the meshes' own totals; at the start, the spheres')\n"
+    << "#   contacts                  sphere-sphere contacts\n"
+    << "# The six walls are one fix: a sphere's wall force is the sum over the walls it\n"
+    << "# touches. Each component goes to the contact of the wall normal to it, (x, y,\n"
+    << "# z) with that coordinate at the wall; a component no touched wall is normal to\n"
+    << "# (friction) to the sphere's first touched wall (x, y, z order). Exact for\n"
+    << "# frictionless walls and for spheres touching one wall; with wall friction a\n"
+    << "# sphere on an edge or a corner has its tangential wall forces placed at one\n"
+    << "# of its walls: approximated.\n"
+    << "# Lever arm: LIGGGHTS applies a contact's tangential force at r_i - delta/2 as\n"
+    << "# demcal does (walls: demcal r_i - delta, the same without wall friction).\n"
+    << "variable series index series.csv\n"
+    << "variable sigma3 equal " << exact(c.test.lateral_stress) << "\n"
+    << "variable nstep equal " << plan.steps << "\n"
+    << "variable dt equal " << exact(plan.dt) << "\n";
+  for (int sd = 0; sd < 4; ++sd)
+    s << "variable wall_" << kWall[sd] << " equal " << lateral_pos[sd] << "\n";
+  s << "variable wall_zmin equal " << exact(plan.lo[2]) << "\n"
+    << "variable wall_zmax equal " << exact(plan.hi[2]) << "-" << exact(plan.top_speed) << "*step*"
+    << exact(plan.dt) << "\n"
+    << "variable Hs equal v_wall_zmax-v_wall_zmin\n"
+    << "variable Ax equal (v_wall_ymax-v_wall_ymin)*v_Hs\n"
+    << "variable Ay equal (v_wall_xmax-v_wall_xmin)*v_Hs\n"
+    << "variable Az equal (v_wall_xmax-v_wall_xmin)*(v_wall_ymax-v_wall_ymin)\n"
+    << "variable cx equal (v_wall_xmin+v_wall_xmax)/2\n"
+    << "variable cy equal (v_wall_ymin+v_wall_ymax)/2\n"
+    << "variable cz equal (v_wall_zmin+v_wall_zmax)/2\n"
+    << "variable V equal v_Az*v_Hs\n"
+    << "compute pa all property/atom radius omegax omegay omegaz\n"
+    << "# the walls a sphere touches (overlap > 0), per axis: T (0/1) and the wall's\n"
+    << "# coordinate P\n";
+  for (int sd = 0; sd < 6; ++sd) {
+    const char ax = kAxis[sd / 2];
+    s << "variable t" << sd << "_a atom (" << ax << (sd % 2 == 0 ? "-" : "+") << "c_pa[1])"
+      << (sd % 2 == 0 ? "<" : ">") << "v_wall_" << kWall[sd] << "\n";
+  }
+  for (int a = 0; a < 3; ++a)
+    s << "variable T" << kAxis[a] << "_a atom v_t" << 2 * a << "_a+v_t" << 2 * a + 1 << "_a\n"
+      << "variable P" << kAxis[a] << "_a atom v_t" << 2 * a << "_a*v_wall_" << kWall[2 * a]
+      << "+v_t" << 2 * a + 1 << "_a*v_wall_" << kWall[2 * a + 1] << "\n";
+  for (int j = 0; j < 3; ++j)
+    s << "variable fw" << kAxis[j] << "_a atom f_force_walls[" << j + 1 << "]\n";
+  s << "# x^c_i f_j about the origin: the contact's coordinate i is the wall's where\n"
+    << "# component j goes to a wall normal to i, the sphere's otherwise\n";
+  auto T = [](int a) { return std::string("v_T") + kAxis[a] + "_a"; };
+  for (int j = 0; j < 3; ++j) {
+    const int k1 = j == 0 ? 1 : 0, k2 = j == 2 ? 1 : 2;
+    for (int i = 0; i < 3; ++i) {
+      std::string own;  // component j goes to a wall normal to axis i
+      if (i == j)
+        own = T(j);
+      else if (i == k1)
+        own = "(1-" + T(j) + ")*" + T(k1);
+      else
+        own = "(1-" + T(j) + ")*(1-" + T(k1) + ")*" + T(k2);
+      s << "variable b" << kAxis[i] << kAxis[j] << "_a atom (" << kAxis[i] << "+" << own << "*(v_P"
+        << kAxis[i] << "_a-" << kAxis[i] << "))*v_fw" << kAxis[j] << "_a\n";
+    }
+  }
+  s << deck::lammps_contact_force_atom(3, p.damping_ratio_translation, plan.gamma_t, exact, "0");
+  std::string reduce;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      s << "variable m" << kAxis[i] << kAxis[j] << "_a atom " << kAxis[i] << "*v_fc" << j + 1
+        << "_a\n";
+      reduce += std::string(" v_b") + kAxis[i] + kAxis[j] + "_a v_m" + kAxis[i] + kAxis[j] + "_a";
+    }
+  // the spheres' normal force on each wall (the pressures at the start)
+  for (int sd = 0; sd < 6; ++sd)
+    s << "variable n" << sd << "_a atom v_t" << sd << "_a*v_fw" << kAxis[sd / 2] << "_a\n";
+  s << "variable ket_a atom 0.5*mass*(vx*vx+vy*vy+vz*vz)\n"
+    << "variable ker_a atom 0.2*mass*c_pa[1]*c_pa[1]*(c_pa[2]*c_pa[2]+c_pa[3]*c_pa[3]+c_pa[4]*"
+       "c_pa[4])\n"
+    << "compute cn all contact/atom\n"
+    << "# [1..18] b, m pairs row by row, [19..21] wall forces, [22..24] contact\n"
+    << "# forces, [25..30] normal forces per wall, [31] [32] kinetic energies, [33] contacts\n"
+    << "compute meas all reduce sum" << reduce
+    << " &\n        v_fwx_a v_fwy_a v_fwz_a v_fc1_a v_fc2_a v_fc3_a v_n0_a v_n1_a v_n2_a v_n3_a "
+       "v_n4_a v_n5_a &\n        v_ket_a v_ker_a c_cn\n";
+  std::string row = "${stepn},${strain_zz_s}";
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      const int k = 2 * (3 * i + j) + 1;
+      const std::string ij = std::string(1, kAxis[i]) + kAxis[j];
+      s << "variable b_" << ij << " equal (c_meas[" << k << "]-v_c" << kAxis[i] << "*c_meas["
+        << 19 + j << "])/v_V\n"
+        << "variable s_" << ij << " equal v_b_" << ij << "-(c_meas[" << k + 1 << "]-v_c" << kAxis[i]
+        << "*c_meas[" << 22 + j << "])/v_V\n";
+    }
+  for (const char* t : {"b_", "s_"})
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) row += std::string(",${") + t + kAxis[i] + kAxis[j] + "}";
+  // Pressures: the meshes' own totals (the force on a mesh is minus the
+  // spheres'), available from the first step; at the start the spheres'
+  // normal forces (no wall carries a tangential force yet).
+  const char* area[3] = {"v_Ax", "v_Ay", "v_Az"};
+  for (int sd = 0; sd < 6; ++sd) {
+    const int a = sd / 2;
+    const char* sign = sd % 2 == 0 ? "" : "-";
+    s << "variable p_" << kWall[sd] << "_s equal " << sign << "((step>0)*(-f_" << mesh[sd] << "["
+      << a + 1 << "])+(step==0)*c_meas[" << 25 + sd << "])/" << area[a] << "\n";
+  }
+  s << "variable lat_s equal (v_p_xmin_s+v_p_xmax_s+v_p_ymin_s+v_p_ymax_s)/4\n"
+    << "variable lat_err equal (v_lat_s-v_sigma3)/v_sigma3\n";
+  for (int sd = 0; sd < 4; ++sd)
+    s << "variable err_" << kWall[sd] << " equal (v_p_" << kWall[sd] << "_s-v_sigma3)/v_sigma3\n";
+  s << "variable strain_zz_s equal (v_Hs-" << exact(plan.hi[2] - plan.lo[2]) << ")/"
+    << exact(plan.hi[2] - plan.lo[2]) << "\n"
+    << "variable ke equal c_meas[31]+c_meas[32]\n"
+    << "variable ke_rot equal c_meas[32]\n"
+    << "variable contacts equal c_meas[33]/2\n"
+    << "variable stepn equal step\n";
+  row += ",${ke},${ke_rot},${lat_err}";
+  std::string columns = "step,strain_zz";
+  for (const char* t : {"b_", "s_"})
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) columns += std::string(",") + t + kAxis[i] + kAxis[j];
+  columns += ",kinetic_energy,kinetic_energy_rotation,lateral_stress_error";
+  for (int sd = 0; sd < 4; ++sd) {
+    row += std::string(",${err_") + kWall[sd] + "}";
+    columns += std::string(",servo_error_") + kWall[sd];
+  }
+  for (int sd = 0; sd < 6; ++sd) {
+    row += std::string(",${wall_") + kWall[sd] + "}";
+    columns += std::string(",wall_") + kWall[sd];
+  }
+  for (int sd = 0; sd < 6; ++sd) {
+    row += std::string(",${p_") + kWall[sd] + "_s}";
+    columns += std::string(",p_") + kWall[sd];
+  }
+  row += ",${contacts}";
+  columns += ",contacts";
+  s << deck::liggghts_series_header("LIGGGHTS 3D deck", c.name, plan.n, p.damping_ratio_translation,
+                                    std::nullopt, std::nullopt)
+    << "fix series all print " << monitor_every << " \"" << row
+    << "\" append ${series} screen no title \"" << columns << "\"\n"
+    << "# The start's row: this fix print does not print at the run's setup, and a\n"
+    << "# variable may read a compute between runs only if the last run computed it\n"
+    << "# (the thermo line below does)\n"
+    << "thermo_style custom step c_meas[1]\n"
+    << "run 0\n"
+    << "print \"" << row << "\" append ${series} screen no\n\n";
+  return s.str();
+}
+
 std::string liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p, const Plan3& plan,
                           const Export3dOptions& o, const SphereWorld& w, ExportResult& out) {
   const auto& m = c.material;
@@ -671,12 +840,13 @@ std::string liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p, const Pl
   s << mapping_header(c, p, plan, o, "LIGGGHTS");
   s << "#\n# Checked with LIGGGHTS 3.8 (Debian). Differences from demcal:\n"
     << "#  - rotational damping: no fix here (zeta_r not applied).\n"
-    << "#  - lateral walls: fix mesh/surface/stress/servo holds the wall FORCE at\n"
-    << "#    sigma3*A0 (A0 the wall's area at the start), not the stress on the current\n"
-    << "#    area; its gain kp = gain*F_target/(kn_wall*n_c*cap) with vel_max = cap/dt\n"
-    << "#    gives demcal's per-step move gain*(F_target - F)/(kn_wall*n_c), n_c the\n"
-    << "#    wall's contacts at the start (demcal uses the current count); the target\n"
-    << "#    is the force on the mesh along +axis: positive on a min wall.\n"
+    << "#  - lateral walls: fix mesh/surface/stress/servo holds the wall force at\n"
+    << "#    sigma3*A, A the wall's current area (target_val v_ft_WALL), demcal's\n"
+    << "#    target; its gain kp = gain*F_target(0)/(kn_wall*n_c*cap) with vel_max =\n"
+    << "#    cap/dt gives demcal's per-step move gain*(F_target - F)/(kn_wall*n_c) times\n"
+    << "#    F_target(0)/F_target (kp is a constant: within the strain), n_c the wall's\n"
+    << "#    contacts at the start (demcal uses the current count); the target is the\n"
+    << "#    force on the mesh along +axis: positive on a min wall.\n"
     << "#  - translational damping per radius class via fix viscous ... scale.\n"
     << "# Run it with a screen (liggghts 3.8 crashes reading meshes with -screen none).\n"
     << "#  - the bottom is a fixed mesh (not a primitive plane) so that its force is\n"
@@ -687,8 +857,7 @@ std::string liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p, const Pl
     << "# walls), Pa, on the current areas; sigma1/sigma3 = p_axial/p_lat (no\n"
     << "# column: both are 0 at the start, before LIGGGHTS computes mesh forces).\n";
   out.notes.push_back(
-      "LIGGGHTS deck: each lateral force held at sigma3*A0 (the area at the start), servo gain "
-      "from the wall contacts at the start; no rotational damping");
+      "LIGGGHTS deck: servo gain from the wall contacts at the start; no rotational damping");
   if (!o.lateral_servo)
     out.notes.push_back("LIGGGHTS deck: lateral walls fixed (lateral_servo off)");
   s << deck::liggghts_preamble(3, "f f f", o.data_name, plan.r_min)
@@ -705,10 +874,17 @@ std::string liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p, const Pl
     V3 com = centre;
     com[a] = sd % 2 == 0 ? plan.lo[a] : plan.hi[a];
     if (o.lateral_servo) {
+      // sigma3 on the wall's current area: the other lateral axis' width
+      // (its servo meshes' positions) times the height
+      const int b = 1 - a;
+      s << "variable ft_" << kWall[sd] << " equal " << (sd % 2 == 0 ? "" : "-")
+        << exact(c.test.lateral_stress) << "*(f_m" << kWall[2 * b + 1] << "[" << 7 + b << "]-f_m"
+        << kWall[2 * b] << "[" << 7 + b << "])*(" << exact(ext[2]) << "-" << exact(plan.top_speed)
+        << "*step*" << exact(plan.dt) << ")\n";
       s << "fix m" << kWall[sd] << " all mesh/surface/stress/servo file " << mesh_file[sd]
         << " type " << wall_type << " com " << exact(com.x()) << " " << exact(com.y()) << " "
-        << exact(com.z()) << " ctrlPV force axis " << (a == 0 ? "1 0 0" : "0 1 0") << " target_val "
-        << exact(sd % 2 == 0 ? target : -target) << " vel_max " << exact(cap / plan.dt) << " kp "
+        << exact(com.z()) << " ctrlPV force axis " << (a == 0 ? "1 0 0" : "0 1 0")
+        << " target_val v_ft_" << kWall[sd] << " vel_max " << exact(cap / plan.dt) << " kp "
         << exact(kp) << "\n";
     } else {
       s << "fix m" << kWall[sd] << " all mesh/surface/stress file " << mesh_file[sd] << " type "
@@ -716,7 +892,8 @@ std::string liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p, const Pl
     }
   }
   s << "fix walls all wall/gran model hooke/stiffness tangential history mesh n_meshes 6 meshes "
-       "mbottom mtop mxmin mxmax mymin mymax absolute_damping on tangential_damping off\n"
+       "mbottom mtop mxmin mxmax mymin mymax store_force yes absolute_damping on "
+       "tangential_damping off\n"
     << "fix movetop all move/mesh mesh mtop linear 0 0 " << exact(-plan.top_speed) << "\n\n"
     << "fix integrate all nve/sphere\n"
     << deck::liggghts_translational_damping(p.damping_ratio_translation, plan.gamma_t, exact);
@@ -736,6 +913,8 @@ std::string liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p, const Pl
     << "variable p_lat equal (-f_mxmin[1]+f_mxmax[1])/(4*v_Wy*v_H)+(-f_mymin[2]+f_mymax[2])/"
        "(4*v_Wx*v_H)\n"
     << "variable strain_zz equal (v_H-" << exact(ext[2]) << ")/" << exact(ext[2]) << "\n"
+    << liggghts_3d_series(c, p, plan, {wall_pos(0), wall_pos(1), wall_pos(2), wall_pos(3)},
+                          monitor_every)
     << "# LIGGGHTS 3.8 has no fix vector: the peaks are the largest p_axial and ratio\n"
     << "# over the thermo rows; -var thermo_every 1 for every step.\n"
     << "variable thermo_every index " << monitor_every << "\n"
