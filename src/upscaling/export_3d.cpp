@@ -193,16 +193,20 @@ const char* const kH = "f_geom[3]";
 std::string area_x() { return std::string(kLy) + "*" + kH; }
 std::string area_y() { return std::string(kLx) + "*" + kH; }
 std::string area_z() { return std::string(kLx) + "*" + kLy; }
+// Lateral wall k's contacts (what 1) or force along its axis (what 2), a
+// column of its axis's reduction (compute csx, csy: min wall, then max).
+std::string wall_column(int sd, int what) {
+  return std::string("c_cs") + kAxis[sd / 2] + "[" + std::to_string(2 * (sd % 2) + what) + "]";
+}
 // Wall k's unclamped servo move toward the sample, gain*(sigma3*A -
-// F)/(kn_wall*max(1, n)), over the lateral walls' columns of compute cs
-// (contacts and normal force on the spheres, in kWall order); fix servo_raw
+// F)/(kn_wall*max(1, n)), over its contacts and normal force on the spheres
+// (wall_column); fix servo_raw
 // stores it, and the move along +axis is the clamp of the stored value.
 std::string servo_raw(int sd) {
   const std::string area = sd < 2 ? area_x() : area_y();
   // The force on the particles along +axis: +P on a min wall, −P on a max wall.
-  const std::string pressure_force =
-      std::string(sd % 2 == 0 ? "" : "-") + "c_cs[" + std::to_string(2 * sd + 2) + "]";
-  const std::string count = "c_cs[" + std::to_string(2 * sd + 1) + "]";
+  const std::string pressure_force = std::string(sd % 2 == 0 ? "" : "-") + wall_column(sd, 2);
+  const std::string count = wall_column(sd, 1);
   return deck::lammps_servo_raw(area, "-(" + pressure_force + ")", count);
 }
 std::string servo_move(int sd) {
@@ -440,8 +444,9 @@ void lammps_3d_walls(std::ostream& s, const AlgorithmSpec& p, const Plan3& plan)
   }
   for (int sd = 0; sd < 6; ++sd)
     s << "group           g" << kWall[sd] << " region band" << kWall[sd] << "\n";
-  s << "group           gside union gxmin gxmax gymin gymax\n"
-    << "group           gwalls union gside gzmin gzmax\n";
+  for (int a = 0; a < 3; ++a)
+    s << "group           g" << kAxis[a] << " union g" << kWall[2 * a] << " g" << kWall[2 * a + 1]
+      << "\n";
   for (int sd = 0; sd < 6; ++sd)
     s << "group           n" << kWall[sd] << " subtract all g" << kWall[sd] << "\n";
   s << "fix             wzmin gzmin wall/gran hooke/history ${kn_wall} ${kt_wall} 0 0 ${mu_wall} "
@@ -469,11 +474,14 @@ void lammps_3d_walls(std::ostream& s, const AlgorithmSpec& p, const Plan3& plan)
 void lammps_3d_measures(std::ostream& s, const AlgorithmSpec& p, const Plan3& plan) {
   // Measures: wall forces for the servo and the pressures, one reduction.
   s << "# --- measures ----------------------------------------------------------------\n"
-    << "# the servo's and the peaks' input, one reduction over the walls' bands (one\n"
-    << "# global sum per step under MPI): contacts and force along the wall's axis of\n"
-    << "# xmin xmax ymin ymax, the force of zmin zmax\n"
-    << "compute         cs gwalls reduce sum f_wxmin[1] f_wxmin[2] f_wxmax[1] f_wxmax[2] &\n"
-    << "                f_wymin[1] f_wymin[3] f_wymax[1] f_wymax[3] f_wzmin[4] f_wzmax[4]\n"
+    << "# the servo's and the peaks' input, one reduction per axis over its two\n"
+    << "# walls' bands (a reduction loops over every sphere for each of its columns,\n"
+    << "# and adds those of its group): contacts and force along the axis of the\n"
+    << "# min then the max wall; for z the forces (three global sums per step under\n"
+    << "# MPI)\n"
+    << "compute         csx gx reduce sum f_wxmin[1] f_wxmin[2] f_wxmax[1] f_wxmax[2]\n"
+    << "compute         csy gy reduce sum f_wymin[1] f_wymin[3] f_wymax[1] f_wymax[3]\n"
+    << "compute         csz gz reduce sum f_wzmin[4] f_wzmax[4]\n"
     << "# the box's lengths and height, stored once per step by fix geom (a double\n"
     << "# each; defined before every fix that reads them, so that they see the walls\n"
     << "# where the forces were computed)\n"
@@ -490,12 +498,12 @@ void lammps_3d_measures(std::ostream& s, const AlgorithmSpec& p, const Plan3& pl
     << "variable        Ax equal " << area_x() << "\n"
     << "variable        Ay equal " << area_y() << "\n"
     << "variable        Az equal " << area_z() << "\n"
-    << "variable        p_xmin equal c_cs[2]/v_Ax\n"
-    << "variable        p_xmax equal -c_cs[4]/v_Ax\n"
-    << "variable        p_ymin equal c_cs[6]/v_Ay\n"
-    << "variable        p_ymax equal -c_cs[8]/v_Ay\n"
-    << "variable        p_zmin equal c_cs[9]/v_Az\n"
-    << "variable        p_zmax equal -c_cs[10]/v_Az\n"
+    << "variable        p_xmin equal c_csx[2]/v_Ax\n"
+    << "variable        p_xmax equal -c_csx[4]/v_Ax\n"
+    << "variable        p_ymin equal c_csy[2]/v_Ay\n"
+    << "variable        p_ymax equal -c_csy[4]/v_Ay\n"
+    << "variable        p_zmin equal c_csz[1]/v_Az\n"
+    << "variable        p_zmax equal -c_csz[2]/v_Az\n"
     << "variable        axial equal (v_p_zmin+v_p_zmax)/2\n"
     << "variable        lateral equal (v_p_xmin+v_p_xmax+v_p_ymin+v_p_ymax)/4\n"
     << "variable        ratio equal v_axial/v_lateral\n"
@@ -619,7 +627,7 @@ void lammps_3d_servo_and_run(std::ostream& s) {
   s << "# --- servo -------------------------------------------------------------------\n"
     << "# demcal's servo, one move per step and wall toward the sample when p < sigma3:\n"
     << "#   move = gain*(sigma3*A - F)/(kn_wall*max(1, n)), clamped to +-cap,\n"
-    << "# A = the wall's current area, F its force, n its contacts (compute cs). The\n"
+    << "# A = the wall's current area, F its force, n its contacts (compute csx, csy). The\n"
     << "# unclamped move, one flat formula per wall with the numbers substituted now,\n"
     << "# is kept by fix servo_raw (a double: the clamp reads it twice without\n"
     << "# parsing it twice); this release has no min/max of two numbers: max(1, n) =\n"
