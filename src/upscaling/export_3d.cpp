@@ -231,6 +231,8 @@ void lammps_3d_limitations(std::ostream& s, const SceneConfig& c, const Algorith
     << "#  - LAMMPS takes a contact's torque at the lever arm r_i (demcal r_i - delta/2):\n"
     << "#    the antisymmetric part of s carries a small static term.\n"
     << "#  - a sphere's velocities and the tangential springs start at zero.\n"
+    << "#  - each wall acts on the band of spheres near it (see the walls): fix halt\n"
+    << "#    stops the run should a sphere outside it reach the wall.\n"
     << "# Outputs: ${series} (columns below) and, at the end, peak_axial_stress and\n"
     << "# peak_ratio over every step (print; also appended to ${series} as comments).\n";
   if (p.damping_ratio_rotation > 0.0)
