@@ -199,9 +199,9 @@ std::string wall_column(int sd, int what) {
   return std::string("c_cs") + kAxis[sd / 2] + "[" + std::to_string(2 * (sd % 2) + what) + "]";
 }
 // Wall k's unclamped servo move toward the sample, gain*(sigma3*A -
-// F)/(kn_wall*max(1, n)), over its contacts and normal force on the spheres
-// (wall_column); fix servo_raw
-// stores it, and the move along +axis is the clamp of the stored value.
+// F)/(kn_wall*max(1, n)), from its contacts and normal force on the spheres
+// (wall_column); fix servo_raw stores it, and the move along +axis is the
+// clamp of the stored value (deck::lammps_servo_raw, lammps_servo_clamp).
 std::string servo_raw(int sd) {
   const std::string area = sd < 2 ? area_x() : area_y();
   // The force on the particles along +axis: +P on a min wall, −P on a max wall.
@@ -474,7 +474,8 @@ void lammps_3d_walls(std::ostream& s, const AlgorithmSpec& p, const Plan3& plan)
 
 // The servo's input, wall positions and pressures, b and sigma reductions.
 void lammps_3d_measures(std::ostream& s, const AlgorithmSpec& p, const Plan3& plan) {
-  // Measures: wall forces for the servo and the pressures, one reduction.
+  // Measures: wall forces for the servo and the pressures, one reduction per
+  // axis; the stored lengths; the bands' clearance checks.
   s << "# --- measures ----------------------------------------------------------------\n"
     << "# the servo's and the peaks' input, one reduction per axis over its two\n"
     << "# walls' bands (a reduction loops over every sphere for each of its columns,\n"
