@@ -89,9 +89,28 @@ TEST(Export3d, LammpsDeckMapsEveryParameter) {
         "pair_style      gran/hooke/history ${kn} ${kt} 0 0.0 ${mu} 0",
         "fix             integrate all nve/sphere\n",
         "variable        fc3_a atom fz+v_gam_a*(vz-v_hdt*fz/mass)",
-        "variable        hdt equal (step>0)*0.5*dt", "zplane ${zmin0} NULL contacts",
-        "region rzmax contacts", "region rxmin contacts", "region rxmax contacts",
-        "region rymin contacts", "region rymax contacts",
+        "variable        hdt equal (step>0)*0.5*dt",
+        // each wall on its band, contact arrays on all six (the z walls' force
+        // feeds the every-step peak), the clearance checks
+        "fix             wzmin gzmin wall/gran", "zplane ${zmin0} NULL contacts",
+        "fix             wzmax gzmax wall/gran/region", "region rzmax contacts",
+        "region rxmin contacts", "region rxmax contacts", "region rymin contacts",
+        "region rymax contacts", "variable band_v    equal $(v_strain*v_H0+6*v_r_max)",
+        "region          bandxmax block $(v_xmax0-v_band_x) INF INF INF INF INF units box",
+        "group           nzmax subtract all gzmax",
+        "fix             halt_zmax all halt ${monitor_every} v_clear_zmax < 0.0 error hard",
+        "compute         csx gx reduce sum f_wxmin[1] f_wxmin[2] f_wxmax[1] f_wxmax[2]\n"
+        "compute         csy gy reduce sum f_wymin[1] f_wymin[3] f_wymax[1] f_wymax[3]\n"
+        "compute         csz gz reduce sum f_wzmin[4] f_wzmax[4]\n",
+        "variable        p_zmax equal -c_csz[2]/v_Az",
+        // lengths and raw moves stored once per step, read as doubles
+        "fix             geom all ave/time 1 1 1 v_Lx_now v_Ly_now v_H_now",
+        "variable        Ax equal f_geom[2]*f_geom[3]",
+        "variable        rawxmax equal ${gain}*(${sigma3}*f_geom[2]*f_geom[3]-(-c_csx[4]))/"
+        "(${kn_wall}*(1+c_csx[3]+abs(1-c_csx[3]))/2)",
+        "fix             servo_raw all ave/time 1 1 1 v_rawxmin v_rawxmax v_rawymin v_rawymax\n"
+        "variable        mxmin equal (abs(f_servo_raw[1]+${cap})-abs(f_servo_raw[1]-${cap}))/2\n"
+        "variable        mxmax equal -(abs(f_servo_raw[2]+${cap})-abs(f_servo_raw[2]-${cap}))/2\n",
         "fix             servo all ave/time 1 1 1 v_mxmin v_mxmax v_mymin v_mymax ave running",
         "NOT APPLIED", "#fix            dampr all viscous/sphere"})
     EXPECT_NE(d.find(line), std::string::npos) << line;
@@ -306,6 +325,122 @@ TEST(Export3dLammps, PeakMatchesDemcalSerially) { check_lammps(1, 20000); }
 // A quarter of the steps under MPI: two ranks of a 256-sphere deck meet
 // several times a step, which a shared machine makes slow (reports/engines-3d.md).
 TEST(Export3dLammps, PeakMatchesDemcalUnderMpirunNp2) { check_lammps(2, 5000); }
+
+/// `what` replaced by `with` in `text` (which must hold it once at least).
+std::string replaced(std::string text, const std::string& what, const std::string& with) {
+  const auto at = text.find(what);
+  EXPECT_NE(at, std::string::npos) << what;
+  if (at != std::string::npos) text.replace(at, what.size(), with);
+  return text;
+}
+
+/// Every `what` in `text` replaced by `with`.
+std::string replaced_all(std::string text, const std::string& what, const std::string& with) {
+  for (auto at = text.find(what); at != std::string::npos; at = text.find(what, at + with.size()))
+    text.replace(at, what.size(), with);
+  return text;
+}
+
+/// The formula of the deck's equal-style variable `name`.
+std::string formula(const std::string& deck, const std::string& name) {
+  const std::string head = "variable        " + name + " equal ";
+  const auto at = deck.find(head);
+  EXPECT_NE(at, std::string::npos) << head;
+  if (at == std::string::npos) return "";
+  const auto from = at + head.size();
+  return deck.substr(from, deck.find('\n', from) - from);
+}
+
+/// fcc_4x4x4's lattice with 6 x 6 x 6 cells (864 spheres), consolidated:
+/// large enough that each wall's band leaves most spheres out (at 4 x 4 x 4
+/// the bands cover the sample).
+const TriaxialState& fcc6_state() {
+  static const TriaxialState state = [] {
+    SceneConfig c = fcc444();
+    c.assembly.cells_x = c.assembly.cells_y = c.assembly.cells_z = 6;
+    return consolidate_triaxial(c, make_sphere_assembly(c));
+  }();
+  return state;
+}
+
+TEST(Export3dLammps, TheDecksPerStepCutsLeaveTheSeriesAndPeaksBitForBit) {
+  // The deck's per-step cuts (reports/engines-3d.md, "The deck's per-step
+  // cuts"): each wall acts on the spheres of its band only; the box's lengths
+  // and height are stored once per step by fix geom and read as f_geom; the
+  // servo's unclamped move is stored by fix servo_raw and clamped from there;
+  // each axis's reduction runs over its walls' bands. The same deck with
+  // every wall on all spheres, the reductions over all, and the lengths and
+  // the raw moves written inline where they are read (the deck before the
+  // cuts, to the character) prints the same series and peaks, character for
+  // character: a wall ignores only spheres that cannot reach it, and every
+  // stored value is the double its inline formula gives, read on the same
+  // step. Fails with fix geom after fix servo (the stores read a step late;
+  // at the start, before it is computed: an error). A change in the last bit
+  // of a servo move (e.g. sigma3*(Ly*H) for (sigma3*Ly)*H) does not reach
+  // the series within this run (the running sum absorbs it; on the whole
+  // 73 888-step run of 500 spheres it does, from step 64 575): the whole-run
+  // comparison of engines-3d.md guards that.
+  const std::string lmp = test::find_on_path("lmp");
+  if (lmp.empty()) GTEST_SKIP() << "LAMMPS (lmp) is not installed: the 3D deck is not run";
+  const SceneConfig c = fcc444();
+  Export3dOptions o;
+  o.data_name = "fcc.data";
+  // 2 000 demcal steps: the whole run is 2 954 deck steps, 200 rows.
+  const ExportResult r = export_3d_decks(c, fixed_params(2000), fcc6_state(), o);
+  const std::string& cut = r.deck;
+  std::string whole = cut;
+  for (const char* a : {"x", "y", "z"})
+    whole = replaced(whole, std::string("compute         cs") + a + " g" + a + " ",
+                     std::string("compute         cs") + a + " all ");
+  for (const char* w : {"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"}) {
+    const std::string fix = std::string("fix             w") + w + " ";
+    whole = replaced(whole, fix + "g" + w + " ", fix + "all ");
+  }
+  const std::string lengths[3] = {"Lx_now", "Ly_now", "H_now"};
+  for (int k = 0; k < 3; ++k)
+    whole = replaced_all(whole, "f_geom[" + std::to_string(k + 1) + "]",
+                         "(" + formula(cut, lengths[k]) + ")");
+  const char* lateral[4] = {"xmin", "xmax", "ymin", "ymax"};
+  for (int k = 0; k < 4; ++k) {
+    const std::string raw = "(" + formula(whole, std::string("raw") + lateral[k]) + ")";
+    whole = replaced_all(whole, "f_servo_raw[" + std::to_string(k + 1) + "]", raw);
+  }
+  EXPECT_EQ(whole.find("f_geom"), std::string::npos);
+  EXPECT_EQ(whole.find("f_servo_raw["), std::string::npos);
+  const test::TempDir dir("export3d_cuts");
+  const test::DeckRun a = test::run_deck(lmp, dir / "cut", cut, r.files);
+  ASSERT_EQ(a.status, 0) << a.log;
+  const test::DeckRun b = test::run_deck(lmp, dir / "whole", whole, r.files);
+  ASSERT_EQ(b.status, 0) << b.log;
+  const std::string sa = test::read_text(dir / "cut" / "series.csv"),
+                    sb = test::read_text(dir / "whole" / "series.csv");
+  EXPECT_GE(std::count(sa.begin(), sa.end(), '\n'), 200);
+  EXPECT_NE(sa.find("# peak_axial_stress = "), std::string::npos);
+  EXPECT_EQ(sa, sb);
+}
+
+TEST(Export3dLammps, ASphereOutsideAWallsBandStopsTheRun) {
+  // With the bottom's band edited to nothing, the spheres resting on the
+  // bottom are outside it: the bottom wall would let them through, and the
+  // clearance check stops the run with an error at the first monitoring step.
+  const std::string lmp = test::find_on_path("lmp");
+  if (lmp.empty()) GTEST_SKIP() << "LAMMPS (lmp) is not installed: the 3D deck is not run";
+  Export3dOptions o;
+  o.data_name = "fcc.data";
+  const ExportResult r = export_3d_decks(fcc444(), fixed_params(2000), fcc_state(), o);
+  const std::string deck =
+      replaced(r.deck, "region          bandzmin block INF INF INF INF INF $(v_zmin0+v_band_v)",
+               "region          bandzmin block INF INF INF INF INF $(v_zmin0)");
+  const test::TempDir dir("export3d_band");
+  const test::DeckRun run = test::run_deck(lmp, dir.path(), deck, r.files,
+                                           {"-var", "run_steps", "100", "-screen", "none"});
+  EXPECT_NE(run.status, 0);
+  EXPECT_NE(run.log.find("Fix halt condition"), std::string::npos) << run.log;
+  // The exported deck runs the same steps without it.
+  const test::DeckRun ok = test::run_deck(lmp, dir / "ok", r.deck, r.files,
+                                          {"-var", "run_steps", "100", "-screen", "none"});
+  EXPECT_EQ(ok.status, 0) << ok.log;
+}
 
 /// configs/random_500_3d.json with `count` spheres (σ3 100 kPa, kn 1e6 N/m,
 /// radii 0.375–0.625 mm, μ 0.3).

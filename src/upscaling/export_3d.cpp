@@ -176,25 +176,42 @@ std::string wall_sum(int a, int b) {
   return deck::lammps_wall_sum({"wxmin", "wxmax", "wymin", "wymax", "wzmin", "wzmax"}, a, b);
 }
 
-// The servo moves, one flat formula each (numbers substituted now): wall
-// k's move toward the sample, gain*(sigma3*A - F)/(kn_wall*max(1, n))
-// clamped to ±cap; its displacement along +axis is f_servo[k]*step.
-// Columns of compute cs: contacts and normal force on the particles of
-// each lateral wall, in kWall order.
+// The walls' geometry: wall k's position along its axis (the servo's
+// running mean f_servo[k] times the step: its displacement), and the box's
+// lengths and height as fix geom stores them once per step (fix geom, a
+// double each: no text round trip, so that `f_geom[1]` is the double that the
+// parenthesized formula of Lx_now gives inline).
 std::string wall_pos(int sd) {
   return std::string("(${") + kWall[sd] + "0}+f_servo[" + std::to_string(sd + 1) + "]*step)";
 }
-const char* const kHeight = "(${H0}-${vtop}*step*dt)";
-std::string area_x() { return "(" + wall_pos(3) + "-" + wall_pos(2) + ")*" + kHeight; }
-std::string area_y() { return "(" + wall_pos(1) + "-" + wall_pos(0) + ")*" + kHeight; }
-std::string servo_move(int sd) {
+const char* const kHeight = "${H0}-${vtop}*step*dt";
+const char* const kLx = "f_geom[1]";
+const char* const kLy = "f_geom[2]";
+const char* const kH = "f_geom[3]";
+// The areas as products of the stored lengths, in the order the inline
+// formulas multiplied them: sigma3*Ly*H is (sigma3*Ly)*H either way.
+std::string area_x() { return std::string(kLy) + "*" + kH; }
+std::string area_y() { return std::string(kLx) + "*" + kH; }
+std::string area_z() { return std::string(kLx) + "*" + kLy; }
+// Lateral wall k's contacts (what 1) or force along its axis (what 2), a
+// column of its axis's reduction (compute csx, csy: min wall, then max).
+std::string wall_column(int sd, int what) {
+  return std::string("c_cs") + kAxis[sd / 2] + "[" + std::to_string(2 * (sd % 2) + what) + "]";
+}
+// Wall k's unclamped servo move toward the sample, gain*(sigma3*A -
+// F)/(kn_wall*max(1, n)), from its contacts and normal force on the spheres
+// (wall_column); fix servo_raw stores it, and the move along +axis is the
+// clamp of the stored value (deck::lammps_servo_raw, lammps_servo_clamp).
+std::string servo_raw(int sd) {
   const std::string area = sd < 2 ? area_x() : area_y();
   // The force on the particles along +axis: +P on a min wall, −P on a max wall.
-  const std::string pressure_force =
-      std::string(sd % 2 == 0 ? "" : "-") + "c_cs[" + std::to_string(2 * sd + 2) + "]";
-  const std::string count = "c_cs[" + std::to_string(2 * sd + 1) + "]";
+  const std::string pressure_force = std::string(sd % 2 == 0 ? "" : "-") + wall_column(sd, 2);
+  const std::string count = wall_column(sd, 1);
+  return deck::lammps_servo_raw(area, "-(" + pressure_force + ")", count);
+}
+std::string servo_move(int sd) {
   return std::string(sd % 2 == 0 ? "" : "-") +
-         deck::lammps_servo_move(area, "-(" + pressure_force + ")", count);
+         deck::lammps_servo_clamp("f_servo_raw[" + std::to_string(sd + 1) + "]");
 }
 
 // Header: the mapping and what this LAMMPS cannot do as demcal does.
@@ -214,6 +231,8 @@ void lammps_3d_limitations(std::ostream& s, const SceneConfig& c, const Algorith
     << "#  - LAMMPS takes a contact's torque at the lever arm r_i (demcal r_i - delta/2):\n"
     << "#    the antisymmetric part of s carries a small static term.\n"
     << "#  - a sphere's velocities and the tangential springs start at zero.\n"
+    << "#  - each wall acts on the band of spheres near it (see the walls): fix halt\n"
+    << "#    stops the run should a sphere outside it reach the wall.\n"
     << "# Outputs: ${series} (columns below) and, at the end, peak_axial_stress and\n"
     << "# peak_ratio over every step (print; also appended to ${series} as comments).\n";
   if (p.damping_ratio_rotation > 0.0)
@@ -238,7 +257,8 @@ void lammps_3d_parameters(std::ostream& s, const SceneConfig& c, const Plan3& pl
     << exact(c.test.lateral_stress) << "      # Pa\n"
     << "variable gain      equal " << exact(o.lateral_servo ? c.test.servo_gain : 0.0)
     << "      # servo gain (0: lateral walls fixed)\n"
-    << "variable r_min     equal " << exact(plan.r_min) << "      # m\n";
+    << "variable r_min     equal " << exact(plan.r_min) << "      # m\n"
+    << "variable r_max     equal " << exact(plan.r_max) << "      # m, for the walls' bands\n";
   for (int sd = 0; sd < 6; ++sd)
     s << "variable " << kWall[sd] << "0    equal "
       << exact(sd % 2 == 0 ? plan.lo[sd / 2] : plan.hi[sd / 2])
@@ -256,7 +276,10 @@ void lammps_3d_derived(std::ostream& s) {
     << "variable Wx0       equal $(v_xmax0-v_xmin0)\n"
     << "variable Wy0       equal $(v_ymax0-v_ymin0)\n"
     << deck::lammps_loading_derived()
-    << "variable peak_every equal $(ceil(v_nstep/1000000))      # fix vector length <= 1e6\n";
+    << "variable peak_every equal $(ceil(v_nstep/1000000))      # fix vector length <= 1e6\n"
+    << "variable band_v    equal $(v_strain*v_H0+6*v_r_max)      # m, see the walls\n"
+    << "variable band_x    equal $(2*v_strain*v_Wx0+6*v_r_max)\n"
+    << "variable band_y    equal $(2*v_strain*v_Wy0+6*v_r_max)\n";
 }
 
 // Units, box, data file, contact law.
@@ -405,11 +428,34 @@ void lammps_3d_walls(std::ostream& s, const AlgorithmSpec& p, const Plan3& plan)
     << "region          rymin plane 0 ${ymin0} 0 0  1 0 side in move NULL v_dymin NULL units box\n"
     << "region          rymax plane 0 ${ymax0} 0 0 -1 0 side in move NULL v_dymax NULL units box\n"
     << "region          rzmax plane 0 0 ${zmax0} 0 0 -1 side in move NULL NULL v_dzmax units box\n"
-    << "fix             wzmin all wall/gran hooke/history ${kn_wall} ${kt_wall} 0 0 ${mu_wall} 0 "
-       "zplane ${zmin0} NULL contacts\n";
+    << "# Each wall acts on the spheres that can reach it (a wall fix loops over its\n"
+    << "# group every step): those within band_v of the top or the bottom, band_x\n"
+    << "# (band_y) of an x (y) wall at the start: the motion the test allows plus six\n"
+    << "# radii. fix halt stops the run with an error should a sphere outside a band\n"
+    << "# ever touch that wall (then widen the bands).\n";
+  for (int sd = 0; sd < 6; ++sd) {
+    // block bounds xlo xhi ylo yhi zlo zhi: the band along the wall's axis
+    std::string bounds[6] = {"INF", "INF", "INF", "INF", "INF", "INF"};
+    const int a = sd / 2;
+    const std::string band = a == 2 ? "v_band_v" : std::string("v_band_") + kAxis[a];
+    bounds[sd % 2 == 0 ? 2 * a + 1 : 2 * a] =
+        std::string("$(v_") + kWall[sd] + (sd % 2 == 0 ? "0+" : "0-") + band + ")";
+    s << "region          band" << kWall[sd] << " block";
+    for (const std::string& b : bounds) s << " " << b;
+    s << " units box\n";
+  }
+  for (int sd = 0; sd < 6; ++sd)
+    s << "group           g" << kWall[sd] << " region band" << kWall[sd] << "\n";
+  for (int a = 0; a < 3; ++a)
+    s << "group           g" << kAxis[a] << " union g" << kWall[2 * a] << " g" << kWall[2 * a + 1]
+      << "\n";
+  for (int sd = 0; sd < 6; ++sd)
+    s << "group           n" << kWall[sd] << " subtract all g" << kWall[sd] << "\n";
+  s << "fix             wzmin gzmin wall/gran hooke/history ${kn_wall} ${kt_wall} 0 0 ${mu_wall} "
+       "0 zplane ${zmin0} NULL contacts\n";
   for (int sd : {5, 0, 1, 2, 3})
-    s << "fix             w" << kWall[sd]
-      << " all wall/gran/region hooke/history ${kn_wall} ${kt_wall} 0 0 ${mu_wall} 0 region r"
+    s << "fix             w" << kWall[sd] << " g" << kWall[sd]
+      << " wall/gran/region hooke/history ${kn_wall} ${kt_wall} 0 0 ${mu_wall} 0 region r"
       << kWall[sd] << " contacts\n";
   s << "\n";
 
@@ -428,32 +474,57 @@ void lammps_3d_walls(std::ostream& s, const AlgorithmSpec& p, const Plan3& plan)
 
 // The servo's input, wall positions and pressures, b and sigma reductions.
 void lammps_3d_measures(std::ostream& s, const AlgorithmSpec& p, const Plan3& plan) {
-  // Measures: wall forces for the servo and the pressures, one reduction.
+  // Measures: wall forces for the servo and the pressures, one reduction per
+  // axis; the stored lengths; the bands' clearance checks.
   s << "# --- measures ----------------------------------------------------------------\n"
-    << "# the servo's input, the four lateral walls in one reduction (one global sum per\n"
-    << "# step under MPI): contacts and force along the wall's axis, xmin xmax ymin ymax\n"
-    << "compute         cs all reduce sum f_wxmin[1] f_wxmin[2] f_wxmax[1] f_wxmax[2] &\n"
-    << "                f_wymin[1] f_wymin[3] f_wymax[1] f_wymax[3] f_wzmin[1] f_wzmin[4] &\n"
-    << "                f_wzmax[1] f_wzmax[4]\n";
+    << "# the servo's and the peaks' input, one reduction per axis over its two\n"
+    << "# walls' bands (a reduction loops over every sphere for each of its columns,\n"
+    << "# and adds those of its group): contacts and force along the axis of the\n"
+    << "# min then the max wall; for z the forces (three global sums per step under\n"
+    << "# MPI)\n"
+    << "compute         csx gx reduce sum f_wxmin[1] f_wxmin[2] f_wxmax[1] f_wxmax[2]\n"
+    << "compute         csy gy reduce sum f_wymin[1] f_wymin[3] f_wymax[1] f_wymax[3]\n"
+    << "compute         csz gz reduce sum f_wzmin[4] f_wzmax[4]\n"
+    << "# the box's lengths and height, stored once per step by fix geom (a double\n"
+    << "# each; defined before every fix that reads them, so that they see the walls\n"
+    << "# where the forces were computed)\n"
+    << "variable        Lx_now equal " << wall_pos(1) << "-" << wall_pos(0) << "\n"
+    << "variable        Ly_now equal " << wall_pos(3) << "-" << wall_pos(2) << "\n"
+    << "variable        H_now equal " << kHeight << "\n"
+    << "fix             geom all ave/time 1 1 1 v_Lx_now v_Ly_now v_H_now\n";
   // Wall positions and pressures (flat: positions from f_servo directly).
   for (int sd = 0; sd < 4; ++sd)
     s << "variable        wall_" << kWall[sd] << " equal " << wall_pos(sd) << "\n";
   s << "variable        wall_zmin equal ${zmin0}\n"
     << "variable        wall_zmax equal ${zmax0}-${vtop}*step*dt\n"
-    << "variable        H equal " << kHeight << "\n"
+    << "variable        H equal " << kH << "\n"
     << "variable        Ax equal " << area_x() << "\n"
     << "variable        Ay equal " << area_y() << "\n"
-    << "variable        Az equal (" << wall_pos(1) << "-" << wall_pos(0) << ")*(" << wall_pos(3)
-    << "-" << wall_pos(2) << ")\n"
-    << "variable        p_xmin equal c_cs[2]/v_Ax\n"
-    << "variable        p_xmax equal -c_cs[4]/v_Ax\n"
-    << "variable        p_ymin equal c_cs[6]/v_Ay\n"
-    << "variable        p_ymax equal -c_cs[8]/v_Ay\n"
-    << "variable        p_zmin equal c_cs[10]/v_Az\n"
-    << "variable        p_zmax equal -c_cs[12]/v_Az\n"
+    << "variable        Az equal " << area_z() << "\n"
+    << "variable        p_xmin equal c_csx[2]/v_Ax\n"
+    << "variable        p_xmax equal -c_csx[4]/v_Ax\n"
+    << "variable        p_ymin equal c_csy[2]/v_Ay\n"
+    << "variable        p_ymax equal -c_csy[4]/v_Ay\n"
+    << "variable        p_zmin equal c_csz[1]/v_Az\n"
+    << "variable        p_zmax equal -c_csz[2]/v_Az\n"
     << "variable        axial equal (v_p_zmin+v_p_zmax)/2\n"
     << "variable        lateral equal (v_p_xmin+v_p_xmax+v_p_ymin+v_p_ymax)/4\n"
-    << "variable        ratio equal v_axial/v_lateral\n";
+    << "variable        ratio equal v_axial/v_lateral\n"
+    << "# clearance of the spheres outside each band from its wall (> 0), checked at\n"
+    << "# every monitoring step\n"
+    << "compute         rad all property/atom radius\n";
+  for (int sd = 0; sd < 6; ++sd) {
+    const char ax = kAxis[sd / 2];
+    const std::string w = std::string("v_wall_") + kWall[sd];
+    s << "variable        gap_" << kWall[sd] << " atom "
+      << (sd % 2 == 0 ? std::string(1, ax) + "-c_rad-" + w : w + "-" + ax + "-c_rad") << "\n";
+  }
+  for (int sd = 0; sd < 6; ++sd)
+    s << "compute         clear_" << kWall[sd] << " n" << kWall[sd] << " reduce min v_gap_"
+      << kWall[sd] << "\n"
+      << "variable        clear_" << kWall[sd] << " equal c_clear_" << kWall[sd] << "\n"
+      << "fix             halt_" << kWall[sd] << " all halt ${monitor_every} v_clear_" << kWall[sd]
+      << " < 0.0 error hard\n";
 
   // The monitoring series: b and σ over the walls' contact arrays.
   s << "# b_ij = (1/V) sum_walls (x_i - c_i) f_j (contact point x, force f on the\n"
@@ -559,11 +630,16 @@ void lammps_3d_servo_and_run(std::ostream& s) {
   s << "# --- servo -------------------------------------------------------------------\n"
     << "# demcal's servo, one move per step and wall toward the sample when p < sigma3:\n"
     << "#   move = gain*(sigma3*A - F)/(kn_wall*max(1, n)), clamped to +-cap,\n"
-    << "# A = the wall's current area, F its force, n its contacts (compute cs). One\n"
-    << "# flat formula per wall with the numbers substituted now; this release has no\n"
-    << "# min/max of two numbers: max(1, n) = (1+n+abs(1-n))/2, clamp(x) =\n"
-    << "# (abs(x+cap)-abs(x-cap))/2. f_servo[k]: the running mean of the moves along\n"
-    << "# +axis (xmin xmax ymin ymax), times the step = the wall's displacement.\n";
+    << "# A = the wall's current area, F its force, n its contacts (compute csx, csy). The\n"
+    << "# unclamped move, one flat formula per wall with the numbers substituted now,\n"
+    << "# is kept by fix servo_raw (a double: the clamp reads it twice without\n"
+    << "# parsing it twice); this release has no min/max of two numbers: max(1, n) =\n"
+    << "# (1+n+abs(1-n))/2, clamp(x) = (abs(x+cap)-abs(x-cap))/2. f_servo[k]: the\n"
+    << "# running mean of the moves along +axis (xmin xmax ymin ymax), times the step\n"
+    << "# = the wall's displacement.\n";
+  for (int sd = 0; sd < 4; ++sd)
+    s << "variable        raw" << kWall[sd] << " equal " << servo_raw(sd) << "\n";
+  s << "fix             servo_raw all ave/time 1 1 1 v_rawxmin v_rawxmax v_rawymin v_rawymax\n";
   for (int sd = 0; sd < 4; ++sd)
     s << "variable        m" << kWall[sd] << " equal " << servo_move(sd) << "\n";
   s << "fix             servo all ave/time 1 1 1 v_mxmin v_mxmax v_mymin v_mymax ave running\n\n";
