@@ -7,6 +7,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -279,14 +280,18 @@ TEST_P(LammpsSeriesSources, AreTheStoredContactForceAndTheWallArrays) {
 
 INSTANTIATE_TEST_SUITE_P(EngineLammps, LammpsSeriesSources, ::testing::Values("hex", "random"));
 
-TEST(EngineLammps, TheStoredServoMoveIsTheInlineFormulaBitForBit) {
-  // The 2D deck keeps each lateral wall's unclamped servo move in fix
-  // servo_raw and clamps the fix's value (a double), so the move's formula
-  // is parsed once per step instead of twice. The same deck with the clamp
-  // of the formula itself (the deck before this cut) prints the same series,
-  // character for character: same operations in the same order, on the
-  // same step (with fix servo_raw defined after fix servo, the clamp reads
-  // the previous step's move and the series differ).
+TEST(EngineLammps, TheVectorServoIsThePerWallFormulaBitForBit) {
+  // The 2D deck evaluates both lateral walls' servo moves in one vector-style
+  // formula (parsed once per step for both walls; the right wall's with the
+  // opposite sign, the target load sigma3*H*t stored once per step by a fix,
+  // max(1, n) as n+(n<1)) and clamps them as doubles (the clamp's vector
+  // formula reads the first one's values). The same deck with the servo
+  // written per wall and inline (one scalar formula each, max(1, n) =
+  // (1+n+abs(1-n))/2, the clamp of the unclamped formula itself, the right
+  // wall's force and move with their own signs: the form before these cuts)
+  // gives the same walls' mean moves at every step to the last bit, and the
+  // same series, character for character. Fails if a sign or an operation of
+  // the law moves.
   const std::string lmp = test::find_on_path("lmp");
   if (lmp.empty())
     GTEST_SKIP() << "LAMMPS (lmp) is not installed (apt-get install lammps): the deck is not run";
@@ -295,33 +300,59 @@ TEST(EngineLammps, TheStoredServoMoveIsTheInlineFormulaBitForBit) {
   ExportOptions o;
   o.data_name = "hex5.data";
   const ExportResult r = export_deck(c, quasi_static(), assembly_of(state.world), o);
-  auto formula = [&](const std::string& name) {
-    const std::string head = "variable        " + name + " equal ";
+  auto line_of = [&](const std::string& head) {
     const auto at = r.deck.find(head);
     EXPECT_NE(at, std::string::npos) << head;
     if (at == std::string::npos) return std::string();
-    const auto from = at + head.size();
-    return r.deck.substr(from, r.deck.find('\n', from) - from);
+    return r.deck.substr(at, r.deck.find('\n', at) + 1 - at);
+  };
+  // demcal's law per wall: gain*(sigma3*H*t - F)/(kn_wall*max(1, n)), clamped
+  auto raw = [](const std::string& minus_force, const std::string& n) {
+    return "${gain}*(${sigma3}*(${H0}-${vtop}*step*dt)*${thick}" + minus_force +
+           ")/(${kn_wall}*(1+" + n + "+abs(1-" + n + "))/2)";
   };
   auto clamp = [](const std::string& x) {
     return "(abs(" + x + "+${cap})-abs(" + x + "-${cap}))/2";
   };
-  EXPECT_EQ(formula("movel"), clamp("f_servo_raw[1]"));
-  EXPECT_EQ(formula("mover"), "-" + clamp("f_servo_raw[2]"));
-  std::string inline_deck =
-      replaced(r.deck, "equal " + formula("movel"), "equal " + clamp(formula("rawl")));
-  inline_deck =
-      replaced(inline_deck, "equal " + formula("mover"), "equal -" + clamp(formula("rawr")));
-  const test::TempDir dir("engine_servo_raw");
+  EXPECT_EQ(line_of("variable        load equal "),
+            "variable        load equal ${sigma3}*(${H0}-${vtop}*step*dt)*${thick}\n");
+  EXPECT_EQ(line_of("variable        rawv vector "),
+            "variable        rawv vector ${gain}*(f_servo_sign*f_servo_load-c_cf)/"
+            "(${kn_wall}*(c_cn+(c_cn<1)))\n");
+  EXPECT_EQ(line_of("variable        movev vector "),
+            "variable        movev vector " + clamp("v_rawv") + "\n");
+  std::string per_wall = replaced(r.deck, line_of("variable        rawv vector "), "");
+  for (const char* head : {"variable        one internal", "variable        mone internal",
+                           "fix             servo_sign all", "variable        load equal",
+                           "fix             servo_load all", "variable        movev vector "})
+    per_wall = replaced(per_wall, line_of(head), "");
+  per_wall = replaced(per_wall, line_of("fix             servo all ave/time"),
+                      "variable        movel equal " + clamp(raw("-c_cf[1]", "c_cn[1]")) +
+                          "\nvariable        mover equal -" + clamp(raw("+c_cf[2]", "c_cn[2]")) +
+                          "\nfix             servo all ave/time 1 1 1 v_movel v_mover ave "
+                          "running\n");
+  // Every step, the walls' mean moves to the last bit (%.20g: the series' 15
+  // digits would hide a difference of the last bits for thousands of steps).
+  auto traced = [&](const std::string& deck) {
+    return replaced(deck, "# --- output and run",
+                    "fix             trace all print 1 \"$(f_servo[1]) $(f_servo[2])\" file "
+                    "trace.txt screen no\n# --- output and run");
+  };
+  const test::TempDir dir("engine_servo_vector");
   const std::vector<std::string> args{"-var", "run_steps", "3000", "-screen", "none"};
-  const test::DeckRun stored = test::run_deck(lmp, dir / "stored", r.deck, r.files, args);
-  ASSERT_EQ(stored.status, 0) << stored.log;
-  const test::DeckRun inlined = test::run_deck(lmp, dir / "inline", inline_deck, r.files, args);
-  ASSERT_EQ(inlined.status, 0) << inlined.log;
-  const std::string a = test::read_text(dir / "stored" / "series.csv"),
-                    b = test::read_text(dir / "inline" / "series.csv");
-  EXPECT_GE(parse_external_series(a, "stored.csv").run.series.size(), 10u);
+  const test::DeckRun vector = test::run_deck(lmp, dir / "vector", traced(r.deck), r.files, args);
+  ASSERT_EQ(vector.status, 0) << vector.log;
+  const test::DeckRun scalar =
+      test::run_deck(lmp, dir / "per_wall", traced(per_wall), r.files, args);
+  ASSERT_EQ(scalar.status, 0) << scalar.log;
+  const std::string a = test::read_text(dir / "vector" / "series.csv"),
+                    b = test::read_text(dir / "per_wall" / "series.csv");
+  EXPECT_GE(parse_external_series(a, "vector.csv").run.series.size(), 10u);
   EXPECT_EQ(a, b);
+  const std::string ta = test::read_text(dir / "vector" / "trace.txt"),
+                    tb = test::read_text(dir / "per_wall" / "trace.txt");
+  EXPECT_GE(std::count(ta.begin(), ta.end(), '\n'), 3000);
+  EXPECT_EQ(ta, tb);
 }
 
 TEST(EngineLammps, EditingNstepInTheDeckKeepsTheStrain) {
