@@ -386,8 +386,16 @@ TEST(EngineLammps, EditingNstepInTheDeckKeepsTheStrain) {
 TEST(EngineLammps, ASplitRunContinuesTheSameTest) {
   // The loading run in one piece, and split half-way with
   // write_restart / read_restart (the deck's continuation: the args file it
-  // writes gives the lateral walls' positions). The series agree: the servo
-  // restarts its sum at the split, so b_xx may differ by one step's move.
+  // writes puts the lateral walls where the first part's last step had them,
+  // to the last bit, and the continuation's servo takes that step's move
+  // again). The rows up to the split are the same characters; after it, the
+  // continuation differs only by what a LAMMPS restart changes: its setup
+  // recomputes the forces with fix viscous on v(t) (the single run's step
+  // used v(t - dt/2)) and after the restart's atom sort, so sums run in
+  // another order. Measured here (25 discs): stresses 5e-12 sigma3, walls
+  // 1.3e-14 of the width, kinetic energy 3.4e-10 relative (100 discs of
+  // example-hex_10x10: 5e-10, 2.5e-12, 4.5e-7). Before (the walls from the
+  // servo's running mean): b_xx 1e-4.
   const std::string lmp = test::find_on_path("lmp");
   if (lmp.empty())
     GTEST_SKIP() << "LAMMPS (lmp) is not installed (apt-get install lammps): the deck is not run";
@@ -416,16 +424,36 @@ TEST(EngineLammps, ASplitRunContinuesTheSameTest) {
   const ExternalSeries b = parse_external_series(split, "split.csv");
   ASSERT_EQ(a.run.series.size(), b.run.series.size());
   const double s3 = c.test.lateral_stress;
+  size_t same_rows = 0;
+  double worst_stress = 0.0, worst_wall = 0.0, worst_ke = 0.0;
   for (size_t k = 0; k < a.run.series.size(); ++k) {
     const MonitorPoint &p = a.run.series[k], &q = b.run.series[k];
     ASSERT_EQ(p.step, q.step);
-    EXPECT_NEAR(q.b(1, 1) / p.b(1, 1), 1.0, 1e-5) << "step " << p.step;
-    EXPECT_NEAR((q.b(0, 0) - p.b(0, 0)) / s3, 0.0, 1e-3) << "step " << p.step;
-    EXPECT_NEAR(q.strain_yy, p.strain_yy, 1e-12) << "step " << p.step;
+    EXPECT_EQ(q.strain_yy, p.strain_yy) << "step " << p.step;  // the top wall: no state
+    if (p.step <= r.steps / 2) {
+      same_rows += (p.b == q.b && p.sigma == q.sigma && p.left == q.left && p.right == q.right &&
+                    p.kinetic_energy == q.kinetic_energy);
+      continue;
+    }
+    for (int i = 0; i < 2; ++i)
+      for (int j = 0; j < 2; ++j)
+        worst_stress = std::max({worst_stress, std::abs(q.b(i, j) - p.b(i, j)) / s3,
+                                 std::abs(q.sigma(i, j) - p.sigma(i, j)) / s3});
+    const double width = p.right - p.left;
+    worst_wall = std::max(
+        {worst_wall, std::abs(q.left - p.left) / width, std::abs(q.right - p.right) / width});
+    worst_ke = std::max(worst_ke, std::abs(q.kinetic_energy / p.kinetic_energy - 1.0));
   }
+  // every row up to the split is the single run's (the same lines of text)
+  EXPECT_EQ(same_rows, static_cast<size_t>(std::count_if(
+                           a.run.series.begin(), a.run.series.end(),
+                           [&](const MonitorPoint& p) { return p.step <= r.steps / 2; })));
+  EXPECT_LT(worst_stress, 1e-10) << "largest stress difference / sigma3";
+  EXPECT_LT(worst_wall, 1e-12) << "largest wall position difference / width";
+  EXPECT_LT(worst_ke, 1e-8) << "largest kinetic energy difference, relative";
   const Score sa = score_external(a, Tolerances{}).score,
               sb = score_external(b, Tolerances{}).score;
-  EXPECT_NEAR(sb.criteria.peak_stress_yy / sa.criteria.peak_stress_yy, 1.0, 1e-5);
+  EXPECT_NEAR(sb.criteria.peak_stress_yy / sa.criteria.peak_stress_yy, 1.0, 1e-10);
   EXPECT_EQ(sa.passed, sb.passed);
 }
 

@@ -81,8 +81,17 @@ TEST(Export, LammpsDeckMapsEveryParameter) {
         "fix             wbottom gbottom wall/gran", "yplane ${yb0} NULL\n",
         "fix             series all print ${monitor_every}",
         "variable vtop      equal $(v_strain*v_H0/(v_nstep*v_dt))", "then \"read_data proto.data\"",
-        "variable kn        equal 100000000"})
+        "variable kn        equal 100000000",
+        // the lateral servo: both walls in one vector formula, summed after
+        // the series is printed; the continuation's walls to the last bit
+        "variable        rawv vector ${gain}*(f_servo_sign*f_servo_load-c_cf)/",
+        "fix             servo all ave/time 1 1 1 v_movev mode vector ave running",
+        "-var xl_now $(v_xl_now+f_servo_end[1])"})
     EXPECT_NE(r.deck.find(needle), std::string::npos) << needle;
+  // fix servo sums this step's moves after fix series printed the row, so a
+  // row gives the walls where this step's forces had them
+  EXPECT_LT(r.deck.find("fix             series all print"),
+            r.deck.find("fix             servo all ave/time"));
   // ζ_t·2·sqrt(kn·m) for the one class.
   const double gamma = 0.7 * s.damping_translation_crit;
   char buf[64];

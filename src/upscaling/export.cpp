@@ -392,7 +392,7 @@ std::string lammps_servo() {
     << "# move again from there\n"
     << "variable        end_every equal $((1+v_run_steps+abs(1-v_run_steps))/2)\n"
     << "fix             servo_end all ave/time ${end_every} 1 ${end_every} v_dxl v_dxr\n"
-    << "fix             servo all ave/time 1 1 1 v_movev mode vector ave running\n\n";
+    << "# (fix servo, which sums the moves, is defined after fix series below)\n\n";
   return s.str();
 }
 
@@ -719,7 +719,11 @@ std::string lammps_consolidation(const SceneConfig& c, const Plan& plan, double 
 /// (with stage 1, the args also carry the start walls it found).
 std::string lammps_run(bool consolidate_in_deck) {
   std::ostringstream s;
-  s << "# --- output and run ----------------------------------------------------------\n"
+  s << "# the servo's running sum of the moves, after fix series: a row prints the\n"
+    << "# lateral walls where this step's forces had them (the sum before this\n"
+    << "# step's move), in a single run and in a continued one alike\n"
+    << "fix             servo all ave/time 1 1 1 v_movev mode vector ave running\n\n"
+    << "# --- output and run ----------------------------------------------------------\n"
     << "# p_left, p_right: lateral wall pressures (servo target sigma3); p_top: axial\n"
     << "variable        epsyy equal (v_H-v_H0)/v_H0\n"
     << "thermo_style    custom step dt time v_epsyy v_pt v_pl v_pr v_W v_H ke\n"
