@@ -232,8 +232,17 @@ std::string lammps_wall_sum(const std::vector<std::string>& fixes, int a, int b)
 
 std::string lammps_servo_raw(const std::string& area, const std::string& minus_force,
                              const std::string& count) {
-  return "${gain}*(${sigma3}*" + area + minus_force + ")/(${kn_wall}*(1+" + count + "+abs(1-" +
-         count + "))/2)";
+  return lammps_servo_raw_of_load("${sigma3}*" + area, minus_force,
+                                  "(1+" + count + "+abs(1-" + count + "))/2");
+}
+
+std::string lammps_servo_raw_of_load(const std::string& load, const std::string& minus_force,
+                                     const std::string& count_max) {
+  return "${gain}*(" + load + minus_force + ")/(${kn_wall}*" + count_max + ")";
+}
+
+std::string lammps_count_at_least_one(const std::string& count) {
+  return "(" + count + "+(" + count + "<1))";
 }
 
 std::string lammps_servo_clamp(const std::string& x) {

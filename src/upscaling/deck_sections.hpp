@@ -140,6 +140,17 @@ std::string lammps_servo_move(const std::string& area, const std::string& minus_
 std::string lammps_servo_raw(const std::string& area, const std::string& minus_force,
                              const std::string& count);
 std::string lammps_servo_clamp(const std::string& x);
+/// lammps_servo_raw with the target load sigma3*A given whole (`load`, e.g. a
+/// fix's stored value of sigma3*A) and max(1, n) given as a formula
+/// (`count_max`): gain*(load - F)/(kn_wall*count_max). lammps_servo_raw is
+/// this with load = "${sigma3}*" + area and count_max = (1+n+abs(1-n))/2.
+std::string lammps_servo_raw_of_load(const std::string& load, const std::string& minus_force,
+                                     const std::string& count_max);
+/// max(1, n) of a contact count n (a sum of ones: an integer-valued double)
+/// as n+(n<1): for such n the same double as (1+n+abs(1-n))/2 and as
+/// kn_wall*(1+n+abs(1-n))/2 = kn_wall*max(1, n) (2n/2 is exact), two
+/// operations and no abs() fewer for the formula parser.
+std::string lammps_count_at_least_one(const std::string& count);
 
 /// LAMMPS: the series file's header (print lines), what `demcal score`
 /// reads about the run: the deck (`deck`, e.g. "LAMMPS 3D deck"), scene,

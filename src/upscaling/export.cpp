@@ -259,8 +259,9 @@ std::string lammps_walls(bool normal_only) {
        "# (evaluated every step: the constants substituted now, ${...}; in this\n"
        "# release a v_ reference formats the other variable to text and back)\n"
        "variable dytop  equal -${vtop}*step*dt\n"
-       "variable dxl    equal f_servo[1]*(step-${step0})\n"
-       "variable dxr    equal f_servo[2]*(step-${step0})\n"
+       "# (elapsed: the steps of this run, step-${step0}, one word to parse)\n"
+       "variable dxl    equal f_servo[1]*elapsed\n"
+       "variable dxr    equal f_servo[2]*elapsed\n"
        "region          rtop   plane 0 ${yt0} 0  0 -1 0 side in move NULL v_dytop NULL units box\n"
        "region          rleft  plane ${xl_now} 0 0  1 0 0  side in move v_dxl NULL NULL units box\n"
        "region          rright plane ${xr_now} 0 0  -1 0 0 side in move v_dxr NULL NULL units box\n"
@@ -302,9 +303,11 @@ std::string lammps_walls(bool normal_only) {
        "${mu_wall} 0 region rright contacts\n"
        "# wall contact arrays: [1] contacts, [2] [3] force on the particle, [5] [6]\n"
        "# contact point\n"
-       "# the servo's input, both lateral walls in one reduction (one global sum per\n"
-       "# step under MPI): [1] [2] left contacts and force, [3] [4] right\n"
-       "compute         cs gside reduce sum f_wleft[1] f_wleft[2] f_wright[1] f_wright[2]\n"
+       "# the servo's input, the left and the right wall side by side (a vector\n"
+       "# each, for the servo's vector formula): their contacts, their forces on\n"
+       "# the particles (x)\n"
+       "compute         cn gside reduce sum f_wleft[1] f_wright[1]\n"
+       "compute         cf gside reduce sum f_wleft[2] f_wright[2]\n"
        "variable        xl equal v_xl_now+v_dxl\n"
        "variable        xr equal v_xr_now+v_dxr\n"
        "variable        yt equal v_yt0+v_dytop\n"
@@ -327,8 +330,8 @@ std::string lammps_walls(bool normal_only) {
          "compute         cb gbottom reduce sum f_wbottom[1] f_wbottom[3]\n"
          "variable        pt equal -c_ct[2]/(v_W*v_thick)\n"
          "variable        pb equal c_cb[2]/(v_W*v_thick)\n";
-  s << "variable        pl equal c_cs[2]/(v_H*v_thick)\n"
-       "variable        pr equal -c_cs[4]/(v_H*v_thick)\n"
+  s << "variable        pl equal c_cf[1]/(v_H*v_thick)\n"
+       "variable        pr equal -c_cf[2]/(v_H*v_thick)\n"
        "# clearance of the particles outside each band from its wall (> 0)\n"
        "variable        gap_top atom v_yt-y-c_rad\n"
        "variable        gap_bottom atom y-c_rad-v_yb0\n"
@@ -345,34 +348,52 @@ std::string lammps_walls(bool normal_only) {
   return s.str();
 }
 
-/// demcal's servo law (scene/biaxial.cpp, servo_velocity) in the deck: per
-/// lateral wall one flat formula of the unclamped move and one clamp of it,
-/// evaluated every step by two fix ave/time.
+/// demcal's servo law (scene/biaxial.cpp, servo_velocity) in the deck: the
+/// unclamped move and its clamp of both lateral walls as two vector-style
+/// formulas (each parsed once per step for both walls), summed every step by
+/// fix servo; the walls' displacements at the end of the run for the
+/// restart args (lammps_run).
 std::string lammps_servo() {
-  // gain*(sigma3*H*t - F)/(kn_wall*max(1, n)); F, n from compute cs: the
-  // left wall's force on the particles is +x (columns 1, 2), the right
-  // wall's -x (columns 3, 4: F = -c_cs[4]).
-  auto raw = [](const char* force_sign, int count, int force) {
-    return deck::lammps_servo_raw("(${H0}-${vtop}*step*dt)*${thick}",
-                                  force_sign + ("c_cs[" + std::to_string(force) + "]"),
-                                  "c_cs[" + std::to_string(count) + "]");
-  };
+  // gain*(sigma3*H*t - F)/(kn_wall*max(1, n)) per wall, sigma3*H*t stored by
+  // fix servo_load, F the wall's force on the sample: c_cf[1] for the left
+  // wall (it pushes the particles +x), -c_cf[2] for the right one (-x). The
+  // right element is computed with the opposite sign, gain*(-sigma3*H*t -
+  // c_cf[2])/(...), exactly minus the right wall's move, and its clamp is
+  // exactly minus the clamp of the move (clamp(-x) = -clamp(x) bit for bit):
+  // fix servo keeps the displacements' signs, left +x, right -x, as dxl and
+  // dxr use them.
+  const std::string load = "${sigma3}*(${H0}-${vtop}*step*dt)*${thick}";
+  const std::string raw = deck::lammps_servo_raw_of_load("f_servo_sign*f_servo_load", "-c_cf",
+                                                         deck::lammps_count_at_least_one("c_cn"));
   std::ostringstream s;
   s << "# demcal's servo, one move per step toward the sample when p < sigma3:\n"
     << "#   move = gain*(sigma3*H*t - F)/(kn_wall*max(1, n)), clamped to +-cap,\n"
     << "# F the wall force, n its contacts; the wall's displacement is the sum of\n"
     << "# the moves (running mean times the steps of this run, dxl and dxr above).\n"
-    << "# Flat formulas with the numbers substituted now (each v_ reference, and\n"
-    << "# each level of parsing, is paid every step); the unclamped move is kept\n"
-    << "# by fix servo_raw (a double: the clamp reads it twice without parsing it\n"
-    << "# twice). This release has no min/max of two numbers: max(1, n) =\n"
-    << "# (1+n+abs(1-n))/2, clamp(x) = (abs(x+cap)-abs(x-cap))/2.\n"
-    << "variable        rawl equal " << raw("-", 1, 2) << "\n"
-    << "variable        rawr equal " << raw("+", 3, 4) << "\n"
-    << "fix             servo_raw all ave/time 1 1 1 v_rawl v_rawr\n"
-    << "variable        movel equal " << deck::lammps_servo_clamp("f_servo_raw[1]") << "\n"
-    << "variable        mover equal -" << deck::lammps_servo_clamp("f_servo_raw[2]") << "\n"
-    << "fix             servo all ave/time 1 1 1 v_movel v_mover ave running\n\n";
+    << "# Both walls in one vector-style formula (elements: left, right; the\n"
+    << "# right one with the opposite sign, so that the moves are displacements\n"
+    << "# along x), parsed once per step for both (parsing is what a step of\n"
+    << "# this deck pays for), with the numbers substituted now. The clamp reads\n"
+    << "# the unclamped moves as doubles (a vector variable is evaluated once per\n"
+    << "# step, then kept); the target load and the signs come from fixes\n"
+    << "# (doubles; the signs are internal variables, read without parsing).\n"
+    << "# This release has no min/max of two numbers: max(1, n) = n+(n<1) for\n"
+    << "# a contact count n, clamp(x) = (abs(x+cap)-abs(x-cap))/2.\n"
+    << "variable        one internal 1\n"
+    << "variable        mone internal -1\n"
+    << "fix             servo_sign all ave/time 1 1 1 v_one v_mone\n"
+    << "variable        load equal " << load << "\n"
+    << "fix             servo_load all ave/time 1 1 1 v_load\n"
+    << "variable        rawv vector " << raw << "\n"
+    << "variable        movev vector " << deck::lammps_servo_clamp("v_rawv") << "\n"
+    << "# the lateral walls' displacements at the run's last step (fix servo_end\n"
+    << "# evaluates them there only, before fix servo adds that step's move): the\n"
+    << "# restart args put a continuation's walls where this run's last step had\n"
+    << "# them (to the last bit), and the continuation's servo takes that step's\n"
+    << "# move again from there\n"
+    << "variable        end_every equal $((1+v_run_steps+abs(1-v_run_steps))/2)\n"
+    << "fix             servo_end all ave/time ${end_every} 1 ${end_every} v_dxl v_dxr\n"
+    << "# (fix servo, which sums the moves, is defined after fix series below)\n\n";
   return s.str();
 }
 
@@ -699,7 +720,11 @@ std::string lammps_consolidation(const SceneConfig& c, const Plan& plan, double 
 /// (with stage 1, the args also carry the start walls it found).
 std::string lammps_run(bool consolidate_in_deck) {
   std::ostringstream s;
-  s << "# --- output and run ----------------------------------------------------------\n"
+  s << "# the servo's running sum of the moves, after fix series: a row prints the\n"
+    << "# lateral walls where this step's forces had them (the sum before this\n"
+    << "# step's move), in a single run and in a continued one alike\n"
+    << "fix             servo all ave/time 1 1 1 v_movev mode vector ave running\n\n"
+    << "# --- output and run ----------------------------------------------------------\n"
     << "# p_left, p_right: lateral wall pressures (servo target sigma3); p_top: axial\n"
     << "variable        epsyy equal (v_H-v_H0)/v_H0\n"
     << "thermo_style    custom step dt time v_epsyy v_pt v_pl v_pr v_W v_H ke\n"
@@ -707,8 +732,8 @@ std::string lammps_run(bool consolidate_in_deck) {
     << "thermo          ${monitor_every}\n"
     << "run             ${run_steps} upto\n"
     << "write_restart   ${restart_out}\n"
-    << "print           \"-var continued 1 -var restart_from ${restart_out} -var xl_now ${xl} -var "
-       "xr_now ${xr}"
+    << "print           \"-var continued 1 -var restart_from ${restart_out} -var xl_now "
+       "$(v_xl_now+f_servo_end[1]) -var xr_now $(v_xr_now+f_servo_end[2])"
     << (consolidate_in_deck ? " -var xl0 ${xl0} -var xr0 ${xr0} -var yb0 ${yb0} -var yt0 ${yt0}"
                             : "")
     << "\" file ${restart_out}.args screen no\n";
