@@ -314,7 +314,14 @@ DEMCAL_INLINE double sum_blocks(const A &a, int b0, int b1) {
 // pass wrote all of its mirrored slots (with one thread, every block; the
 // same sums in the same order as the sum pass, which does the others).
 // Returns the largest overlap/min(r_i, r_j).
-template <int W, bool kDamped, bool kFuseAll>
+// Where the pair pass sums the mirrored terms (see PairArgs).
+enum FuseSums : int {
+  kFuseNone = 0,  // threads: every block's sums in the sum pass
+  kFuseOwn = 1,   // threads: the blocks this pass completes, the rest after
+  kFuseAll = 2,   // one thread: every block, right after its pairs
+};
+
+template <int W, bool kDamped, int kFuse>
 DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
   using D = typename Simd<W>::D;
   using M = typename Simd<W>::M;
@@ -435,12 +442,14 @@ DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
     // Block b's mirrored slots all belong to blocks in [src_block[b], b]
     // (i < j): if this pass did those, its sums are complete now, the pair
     // terms still in cache.
-    if constexpr (kFuseAll) {
+    if constexpr (kFuse == kFuseAll) {
       sum_blocks<W>(a, b, b + 1);
-    } else {
+    } else if constexpr (kFuse == kFuseOwn) {
       const bool complete = a.src_block[b] >= b0;
       a.fused[b] = complete;
       if (complete) sum_blocks<W>(a, b, b + 1);
+    } else {
+      a.fused[b] = 0;
     }
   }
   return hmax<W>(mo);
@@ -629,18 +638,23 @@ struct Kernels {
   WallFn walls;
 };
 
-#define DEMCAL_SPHERE_KERNELS(SUFFIX, TARGET, W)                                                 \
+// THREAD_FUSE: kFuseOwn or kFuseNone for the threaded pair pass. At 97 556
+// spheres on 2 threads (quiet machine, 7-8 alternating rounds against the
+// pass without it, 2026-12-02) the fusion gave avx512 1.05x (median; CPU
+// time 0.9x) but avx2 0.93x (CPU time 1.09x, every round): the AVX2 path
+// keeps the separate sum pass. One thread fuses every block on every path.
+#define DEMCAL_SPHERE_KERNELS(SUFFIX, TARGET, W, THREAD_FUSE)                                    \
   TARGET double pairs_##SUFFIX(const PairArgs &a, int b0, int b1) {                              \
-    return pair_blocks<W, false, true>(a, b0, b1);                                               \
+    return pair_blocks<W, false, kFuseAll>(a, b0, b1);                                           \
   }                                                                                              \
   TARGET double pairs_damped_##SUFFIX(const PairArgs &a, int b0, int b1) {                       \
-    return pair_blocks<W, true, true>(a, b0, b1);                                                \
+    return pair_blocks<W, true, kFuseAll>(a, b0, b1);                                            \
   }                                                                                              \
   TARGET double pairs_t_##SUFFIX(const PairArgs &a, int b0, int b1) {                            \
-    return pair_blocks<W, false, false>(a, b0, b1);                                              \
+    return pair_blocks<W, false, THREAD_FUSE>(a, b0, b1);                                        \
   }                                                                                              \
   TARGET double pairs_damped_t_##SUFFIX(const PairArgs &a, int b0, int b1) {                     \
-    return pair_blocks<W, true, false>(a, b0, b1);                                               \
+    return pair_blocks<W, true, THREAD_FUSE>(a, b0, b1);                                         \
   }                                                                                              \
   TARGET double sums_##SUFFIX(const SumArgs &a, int b0, int b1) {                                \
     for (int b = b0; b < b1; ++b)                                                                \
@@ -661,10 +675,10 @@ struct Kernels {
       walls_##SUFFIX};
 
 #define DEMCAL_NO_TARGET
-DEMCAL_SPHERE_KERNELS(sse2, DEMCAL_NO_TARGET, 2)
+DEMCAL_SPHERE_KERNELS(sse2, DEMCAL_NO_TARGET, 2, kFuseNone)
 #ifdef DEMCAL_X86_64
-DEMCAL_SPHERE_KERNELS(avx2, __attribute__((target("arch=x86-64-v3"))), 4)
-DEMCAL_SPHERE_KERNELS(avx512, __attribute__((target("arch=x86-64-v4"))), 8)
+DEMCAL_SPHERE_KERNELS(avx2, __attribute__((target("arch=x86-64-v3"))), 4, kFuseNone)
+DEMCAL_SPHERE_KERNELS(avx512, __attribute__((target("arch=x86-64-v4"))), 8, kFuseOwn)
 #endif
 
 // The path the 2D kernel chose (kernel_simd(): CPU and DEMCAL_SIMD).
