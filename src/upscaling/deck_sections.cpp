@@ -256,7 +256,7 @@ std::string lammps_servo_move(const std::string& area, const std::string& minus_
 
 std::string lammps_series_header(const std::string& deck, const std::string& scene, int particles,
                                  double zeta_t, std::optional<double> dt_crit,
-                                 std::optional<double> mass_scaling) {
+                                 std::optional<double> mass_scaling, const std::string& lever_arm) {
   auto line = [](const std::string& key, const std::string& value) {
     return "print           \"# " + key + " = " + value + "\" append ${series} screen no\n";
   };
@@ -268,7 +268,7 @@ std::string lammps_series_header(const std::string& deck, const std::string& sce
   if (dt_crit) s << line("dt_crit", num(*dt_crit));
   s << line("damping_ratio_translation", num(zeta_t)) << line("damping_ratio_rotation", "0");
   if (mass_scaling) s << line("mass_scaling", num(*mass_scaling));
-  s << line("moment_lever_arm", "radius");
+  s << line("moment_lever_arm", lever_arm);
   return s.str();
 }
 
@@ -490,17 +490,22 @@ std::string liggghts_translational_damping(double zeta_t, const std::vector<doub
   return s.str();
 }
 
-std::string liggghts_series_header(const std::string& deck, const std::string& scene, int particles,
-                                   double zeta_t, std::optional<double> dt_crit,
-                                   std::optional<double> mass_scaling) {
-  // One home for the header's keys (lammps_series_header); only the lever
-  // arm's value differs.
-  std::string s = lammps_series_header(deck, scene, particles, zeta_t, dt_crit, mass_scaling);
-  const std::string radius = "moment_lever_arm = radius\"";
-  const auto at = s.find(radius);
-  if (at == std::string::npos) throw std::logic_error("series header: no moment_lever_arm line");
-  s.replace(at, radius.size(), "moment_lever_arm = radius - overlap/2\"");
-  return s;
+std::string liggghts_series(const std::string& deck, const std::string& scene, int particles,
+                            double zeta_t, std::optional<double> dt_crit,
+                            std::optional<double> mass_scaling, int every, const std::string& row,
+                            const std::string& columns) {
+  std::ostringstream s;
+  s << lammps_series_header(deck, scene, particles, zeta_t, dt_crit, mass_scaling,
+                            "radius - overlap/2")
+    << "fix series all print " << every << " \"" << row << "\" append ${series} screen no title \""
+    << columns << "\"\n"
+    << "# The start's row: this fix print does not print at the run's setup, and a\n"
+    << "# variable may read a compute between runs only if the last run computed it\n"
+    << "# (the thermo line below does)\n"
+    << "thermo_style custom step c_meas[1]\n"
+    << "run 0\n"
+    << "print \"" << row << "\" append ${series} screen no\n\n";
+  return s.str();
 }
 
 }  // namespace demcal::deck

@@ -155,10 +155,12 @@ std::string lammps_count_at_least_one(const std::string& count);
 /// LAMMPS: the series file's header (print lines), what `demcal score`
 /// reads about the run: the deck (`deck`, e.g. "LAMMPS 3D deck"), scene,
 /// particles, sigma3, Nstep, dt, dt_crit (when given), the damping ratios
-/// applied (zeta_r 0: no rotational fix), f_ms (when given), the lever arm.
+/// applied (zeta_r 0: no rotational fix), f_ms (when given), the lever arm
+/// the engine applies a contact's tangential force at (LAMMPS: r_i).
 std::string lammps_series_header(const std::string& deck, const std::string& scene, int particles,
                                  double zeta_t, std::optional<double> dt_crit,
-                                 std::optional<double> mass_scaling);
+                                 std::optional<double> mass_scaling,
+                                 const std::string& lever_arm = "radius");
 
 /// Stage 1 of a deck that consolidates itself (LAMMPS; export.cpp in 2D,
 /// export_3d.cpp in 3D): demcal's consolidation (scene/protocol_steps.hpp)
@@ -225,13 +227,17 @@ std::string liggghts_materials(const Material& m, int ntypes, double dt, NumberF
 std::string liggghts_translational_damping(double zeta_t, const std::vector<double>& gamma_t,
                                            NumberFormat f);
 
-/// LIGGGHTS: the series file's header, lammps_series_header's keys (the same
-/// print lines run in LIGGGHTS 3.8) with the lever arm LIGGGHTS applies a
-/// contact's tangential force at: r_i - delta/2, demcal's (its surface
-/// model's cri; walls too, where demcal takes the wall's distance r_i -
-/// delta: no difference without wall friction).
-std::string liggghts_series_header(const std::string& deck, const std::string& scene, int particles,
-                                   double zeta_t, std::optional<double> dt_crit,
-                                   std::optional<double> mass_scaling);
+/// LIGGGHTS: the series file (`demcal score` reads it): its header,
+/// lammps_series_header's keys (the same print lines run in LIGGGHTS 3.8)
+/// with the lever arm LIGGGHTS applies a contact's tangential force at,
+/// r_i - delta/2 as demcal (its surface model's cri; walls too, where demcal
+/// takes the wall's distance r_i - delta: the same without wall friction);
+/// a `fix print` of `row` every `every` steps under the title `columns`;
+/// and the start's row, which LIGGGHTS 3.8's fix print does not write at
+/// setup, printed after a `run 0`.
+std::string liggghts_series(const std::string& deck, const std::string& scene, int particles,
+                            double zeta_t, std::optional<double> dt_crit,
+                            std::optional<double> mass_scaling, int every, const std::string& row,
+                            const std::string& columns);
 
 }  // namespace demcal::deck

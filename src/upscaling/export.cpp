@@ -939,16 +939,8 @@ std::string liggghts_series_block(const SceneConfig& c, const AlgorithmSpec& p, 
       "${stepn},${epsyy},${b_xx},${b_xy},${b_yx},${b_yy},${s_xx},${s_xy},${s_yx},${s_yy},"
       "${ke},${ke_rot},${servo_err},${pl},${pr},${pb},${pt},${xl},${xr},${yb},${yt},${torque}";
   s << "# the header: what demcal score needs to know about the run\n"
-    << deck::liggghts_series_header("LIGGGHTS deck", c.name, plan.n, p.damping_ratio_translation,
-                                    plan.dt_crit, p.mass_scaling)
-    << "fix series all print " << plan.thermo_every << " \"" << row
-    << "\" append ${series} screen no title \"" << kColumns << "\"\n"
-    << "# The start's row: this fix print does not print at the run's setup, and a\n"
-    << "# variable may read a compute between runs only if the last run computed it\n"
-    << "# (the thermo line below does)\n"
-    << "thermo_style custom step c_meas[1]\n"
-    << "run 0\n"
-    << "print \"" << row << "\" append ${series} screen no\n\n";
+    << deck::liggghts_series("LIGGGHTS deck", c.name, plan.n, p.damping_ratio_translation,
+                             plan.dt_crit, p.mass_scaling, plan.thermo_every, row, kColumns);
   return s.str();
 }
 

@@ -26,6 +26,31 @@ using deck::num;
 constexpr const char* kAxis = "xyz";
 constexpr const char* kWall[6] = {"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"};
 
+/// The 3D series file's columns (demcal.series/1 in 3D; `demcal score`
+/// reads them by name): one home for both engines' decks.
+std::string series_columns_3d() {
+  std::string columns = "step,strain_zz";
+  for (const char* t : {"b_", "s_"})
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) columns += std::string(",") + t + kAxis[i] + kAxis[j];
+  columns += ",kinetic_energy,kinetic_energy_rotation,lateral_stress_error";
+  for (int sd = 0; sd < 4; ++sd) columns += std::string(",servo_error_") + kWall[sd];
+  for (int sd = 0; sd < 6; ++sd) columns += std::string(",wall_") + kWall[sd];
+  for (int sd = 0; sd < 6; ++sd) columns += std::string(",p_") + kWall[sd];
+  return columns + ",contacts";
+}
+
+/// A series row from kinetic_energy on, in series_columns_3d()'s order: the
+/// deck's variables ke, ke_rot, lat_err, err_WALL, wall_WALL,
+/// p_WALL<p_suffix>, contacts.
+std::string series_row_tail_3d(const std::string& p_suffix) {
+  std::string row = ",${ke},${ke_rot},${lat_err}";
+  for (int sd = 0; sd < 4; ++sd) row += std::string(",${err_") + kWall[sd] + "}";
+  for (int sd = 0; sd < 6; ++sd) row += std::string(",${wall_") + kWall[sd] + "}";
+  for (int sd = 0; sd < 6; ++sd) row += std::string(",${p_") + kWall[sd] + p_suffix + "}";
+  return row + ",${contacts}";
+}
+
 /// Everything both decks need, computed once.
 struct Plan3 {
   int n = 0, types = 0;
@@ -580,26 +605,8 @@ void lammps_3d_series(std::ostream& s, const SceneConfig& c, const AlgorithmSpec
       << "-v_sigma3)/v_sigma3\n";
   s << "variable        contacts equal c_meas[25]/2\n"
     << "variable        stepn equal step\n";
-  row += ",${ke},${ke_rot},${lat_err}";
-  std::string columns = "step,strain_zz";
-  for (const char* t : {"b_", "s_"})
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) columns += std::string(",") + t + kAxis[i] + kAxis[j];
-  columns += ",kinetic_energy,kinetic_energy_rotation,lateral_stress_error";
-  for (int sd = 0; sd < 4; ++sd) {
-    row += std::string(",${err_") + kWall[sd] + "}";
-    columns += std::string(",servo_error_") + kWall[sd];
-  }
-  for (int sd = 0; sd < 6; ++sd) {
-    row += std::string(",${wall_") + kWall[sd] + "}";
-    columns += std::string(",wall_") + kWall[sd];
-  }
-  for (int sd = 0; sd < 6; ++sd) {
-    row += std::string(",${p_") + kWall[sd] + "}";
-    columns += std::string(",p_") + kWall[sd];
-  }
-  row += ",${contacts}";
-  columns += ",contacts";
+  row += series_row_tail_3d("");
+  const std::string columns = series_columns_3d();
 
   s << "\n# --- monitoring series -------------------------------------------------------\n"
     << "# ${series}: every monitor_every steps and at the start; tension positive, SI,\n"
@@ -842,36 +849,10 @@ std::string liggghts_3d_series(const SceneConfig& c, const AlgorithmSpec& p, con
     << "variable ke_rot equal c_meas[32]\n"
     << "variable contacts equal c_meas[33]/2\n"
     << "variable stepn equal step\n";
-  row += ",${ke},${ke_rot},${lat_err}";
-  std::string columns = "step,strain_zz";
-  for (const char* t : {"b_", "s_"})
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) columns += std::string(",") + t + kAxis[i] + kAxis[j];
-  columns += ",kinetic_energy,kinetic_energy_rotation,lateral_stress_error";
-  for (int sd = 0; sd < 4; ++sd) {
-    row += std::string(",${err_") + kWall[sd] + "}";
-    columns += std::string(",servo_error_") + kWall[sd];
-  }
-  for (int sd = 0; sd < 6; ++sd) {
-    row += std::string(",${wall_") + kWall[sd] + "}";
-    columns += std::string(",wall_") + kWall[sd];
-  }
-  for (int sd = 0; sd < 6; ++sd) {
-    row += std::string(",${p_") + kWall[sd] + "_s}";
-    columns += std::string(",p_") + kWall[sd];
-  }
-  row += ",${contacts}";
-  columns += ",contacts";
-  s << deck::liggghts_series_header("LIGGGHTS 3D deck", c.name, plan.n, p.damping_ratio_translation,
-                                    std::nullopt, std::nullopt)
-    << "fix series all print " << monitor_every << " \"" << row
-    << "\" append ${series} screen no title \"" << columns << "\"\n"
-    << "# The start's row: this fix print does not print at the run's setup, and a\n"
-    << "# variable may read a compute between runs only if the last run computed it\n"
-    << "# (the thermo line below does)\n"
-    << "thermo_style custom step c_meas[1]\n"
-    << "run 0\n"
-    << "print \"" << row << "\" append ${series} screen no\n\n";
+  row += series_row_tail_3d("_s");
+  const std::string columns = series_columns_3d();
+  s << deck::liggghts_series("LIGGGHTS 3D deck", c.name, plan.n, p.damping_ratio_translation,
+                             std::nullopt, std::nullopt, monitor_every, row, columns);
   return s.str();
 }
 
