@@ -99,19 +99,23 @@ TEST(Export3d, LammpsDeckMapsEveryParameter) {
         "region          bandxmax block $(v_xmax0-v_band_x) INF INF INF INF INF units box",
         "group           nzmax subtract all gzmax",
         "fix             halt_zmax all halt ${monitor_every} v_clear_zmax < 0.0 error hard",
-        "compute         csx gx reduce sum f_wxmin[1] f_wxmin[2] f_wxmax[1] f_wxmax[2]\n"
-        "compute         csy gy reduce sum f_wymin[1] f_wymin[3] f_wymax[1] f_wymax[3]\n"
+        "group           gxy union gxmin gxmax gymin gymax\n"
+        "group           gz union gzmin gzmax\n",
+        "compute         csn gxy reduce sum f_wxmin[1] f_wxmax[1] f_wymin[1] f_wymax[1]\n"
+        "compute         csf gxy reduce sum f_wxmin[2] f_wxmax[2] f_wymin[3] f_wymax[3]\n"
         "compute         csz gz reduce sum f_wzmin[4] f_wzmax[4]\n",
+        "variable        p_xmax equal -c_csf[2]/v_Ax", "variable        p_ymin equal c_csf[3]/v_Ay",
         "variable        p_zmax equal -c_csz[2]/v_Az",
-        // lengths and raw moves stored once per step, read as doubles
+        // lengths stored once per step, read as doubles; the four lateral
+        // walls' raw moves in one vector formula (max walls' negated), clamped
         "fix             geom all ave/time 1 1 1 v_Lx_now v_Ly_now v_H_now",
         "variable        Ax equal f_geom[2]*f_geom[3]",
-        "variable        rawxmax equal ${gain}*(${sigma3}*f_geom[2]*f_geom[3]-(-c_csx[4]))/"
-        "(${kn_wall}*(1+c_csx[3]+abs(1-c_csx[3]))/2)",
-        "fix             servo_raw all ave/time 1 1 1 v_rawxmin v_rawxmax v_rawymin v_rawymax\n"
-        "variable        mxmin equal (abs(f_servo_raw[1]+${cap})-abs(f_servo_raw[1]-${cap}))/2\n"
-        "variable        mxmax equal -(abs(f_servo_raw[2]+${cap})-abs(f_servo_raw[2]-${cap}))/2\n",
-        "fix             servo all ave/time 1 1 1 v_mxmin v_mxmax v_mymin v_mymax ave running",
+        "fix             servo_sign all ave/time 1 1 1 v_one v_mone v_one v_mone\n"
+        "fix             servo_len all ave/time 1 1 1 f_geom[2] f_geom[2] f_geom[1] f_geom[1]\n"
+        "variable        rawv vector ${gain}*(f_servo_sign*${sigma3}*f_servo_len*f_geom[3]-c_csf)/"
+        "(${kn_wall}*(c_csn+(c_csn<1)))\n"
+        "variable        movev vector (abs(v_rawv+${cap})-abs(v_rawv-${cap}))/2\n"
+        "fix             servo all ave/time 1 1 1 v_movev mode vector ave running",
         "NOT APPLIED", "#fix            dampr all viscous/sphere"})
     EXPECT_NE(d.find(line), std::string::npos) << line;
   // σ's contact force is recovered at monitoring steps, not stored every step
@@ -367,13 +371,15 @@ TEST(Export3dLammps, TheDecksPerStepCutsLeaveTheSeriesAndPeaksBitForBit) {
   // The deck's per-step cuts (reports/engines-3d.md, "The deck's per-step
   // cuts"): each wall acts on the spheres of its band only; the box's lengths
   // and height are stored once per step by fix geom and read as f_geom; the
-  // servo's unclamped move is stored by fix servo_raw and clamped from there;
-  // each axis's reduction runs over its walls' bands. The same deck with
-  // every wall on all spheres, the reductions over all, and the lengths and
-  // the raw moves written inline where they are read (the deck before the
-  // cuts, to the character) prints the same series and peaks, character for
-  // character: a wall ignores only spheres that cannot reach it, and every
-  // stored value is the double its inline formula gives, read on the same
+  // four lateral walls' unclamped moves are one vector-style formula (the
+  // max walls' negated: clamp(-x) = -clamp(x) exactly), max(1, n) = n+(n<1),
+  // clamped from the kept vector; the reductions run over the walls' bands.
+  // The same deck with every wall on all spheres, the reductions over all,
+  // the lengths written inline and each wall's move its own scalar formula,
+  // the clamp of the unclamped formula inline, max(1, n) = (1+n+abs(1-n))/2
+  // (the deck before the cuts) prints the same series and peaks, character
+  // for character: a wall ignores only spheres that cannot reach it, and
+  // every stored value is the double its inline formula gives, read on the same
   // step. Fails with fix geom after fix servo (the stores read a step late;
   // at the start, before it is computed: an error). A change in the last bit
   // of a servo move (e.g. sigma3*(Ly*H) for (sigma3*Ly)*H) does not reach
@@ -389,24 +395,40 @@ TEST(Export3dLammps, TheDecksPerStepCutsLeaveTheSeriesAndPeaksBitForBit) {
   const ExportResult r = export_3d_decks(c, fixed_params(2000), fcc6_state(), o);
   const std::string& cut = r.deck;
   std::string whole = cut;
-  for (const char* a : {"x", "y", "z"})
-    whole = replaced(whole, std::string("compute         cs") + a + " g" + a + " ",
-                     std::string("compute         cs") + a + " all ");
+  whole = replaced(whole, "compute         csz gz ", "compute         csz all ");
   for (const char* w : {"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"}) {
     const std::string fix = std::string("fix             w") + w + " ";
     whole = replaced(whole, fix + "g" + w + " ", fix + "all ");
   }
+  // The servo per wall and inline (the form before the vector formula and
+  // fix servo_raw): each wall's clamp of its own unclamped formula, max(1, n)
+  // = (1+n+abs(1-n))/2, the max walls' force and move with their own signs.
+  const std::string vector_servo = cut.substr(cut.find("variable        one internal 1\n"),
+                                              cut.find("fix             servo all ave/time") -
+                                                  cut.find("variable        one internal 1\n"));
+  std::string per_wall;
+  const char* lateral[4] = {"xmin", "xmax", "ymin", "ymax"};
+  for (int k = 0; k < 4; ++k) {
+    const std::string i = std::to_string(k + 1), n = "c_csn[" + i + "]";
+    const std::string area = k < 2 ? "f_geom[2]*f_geom[3]" : "f_geom[1]*f_geom[3]";
+    const std::string force = k % 2 == 0 ? "c_csf[" + i + "]" : "-c_csf[" + i + "]";
+    const std::string raw = "${gain}*(${sigma3}*" + area + "-(" + force + "))/(${kn_wall}*(1+" + n +
+                            "+abs(1-" + n + "))/2)";
+    per_wall += std::string("variable        m") + lateral[k] + " equal " +
+                (k % 2 == 0 ? "" : "-") + "(abs(" + raw + "+${cap})-abs(" + raw + "-${cap}))/2\n";
+  }
+  whole = replaced(whole, vector_servo, per_wall);
+  whole = replaced(whole, "v_movev mode vector ave running",
+                   "v_mxmin v_mxmax v_mymin v_mymax ave running");
+  whole = replaced(whole, "compute         csn gxy ", "compute         csn all ");
+  whole = replaced(whole, "compute         csf gxy ", "compute         csf all ");
   const std::string lengths[3] = {"Lx_now", "Ly_now", "H_now"};
   for (int k = 0; k < 3; ++k)
     whole = replaced_all(whole, "f_geom[" + std::to_string(k + 1) + "]",
                          "(" + formula(cut, lengths[k]) + ")");
-  const char* lateral[4] = {"xmin", "xmax", "ymin", "ymax"};
-  for (int k = 0; k < 4; ++k) {
-    const std::string raw = "(" + formula(whole, std::string("raw") + lateral[k]) + ")";
-    whole = replaced_all(whole, "f_servo_raw[" + std::to_string(k + 1) + "]", raw);
-  }
   EXPECT_EQ(whole.find("f_geom"), std::string::npos);
-  EXPECT_EQ(whole.find("f_servo_raw["), std::string::npos);
+  EXPECT_EQ(whole.find("v_rawv"), std::string::npos);
+  EXPECT_EQ(whole.find("f_servo_sign"), std::string::npos);
   const test::TempDir dir("export3d_cuts");
   const test::DeckRun a = test::run_deck(lmp, dir / "cut", cut, r.files);
   ASSERT_EQ(a.status, 0) << a.log;

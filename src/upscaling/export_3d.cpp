@@ -218,25 +218,16 @@ const char* const kH = "f_geom[3]";
 std::string area_x() { return std::string(kLy) + "*" + kH; }
 std::string area_y() { return std::string(kLx) + "*" + kH; }
 std::string area_z() { return std::string(kLx) + "*" + kLy; }
-// Lateral wall k's contacts (what 1) or force along its axis (what 2), a
-// column of its axis's reduction (compute csx, csy: min wall, then max).
-std::string wall_column(int sd, int what) {
-  return std::string("c_cs") + kAxis[sd / 2] + "[" + std::to_string(2 * (sd % 2) + what) + "]";
-}
-// Wall k's unclamped servo move toward the sample, gain*(sigma3*A -
-// F)/(kn_wall*max(1, n)), from its contacts and normal force on the spheres
-// (wall_column); fix servo_raw stores it, and the move along +axis is the
-// clamp of the stored value (deck::lammps_servo_raw, lammps_servo_clamp).
-std::string servo_raw(int sd) {
-  const std::string area = sd < 2 ? area_x() : area_y();
-  // The force on the particles along +axis: +P on a min wall, −P on a max wall.
-  const std::string pressure_force = std::string(sd % 2 == 0 ? "" : "-") + wall_column(sd, 2);
-  const std::string count = wall_column(sd, 1);
-  return deck::lammps_servo_raw(area, "-(" + pressure_force + ")", count);
-}
-std::string servo_move(int sd) {
-  return std::string(sd % 2 == 0 ? "" : "-") +
-         deck::lammps_servo_clamp("f_servo_raw[" + std::to_string(sd + 1) + "]");
+// The four lateral walls' unclamped servo moves toward the sample, one
+// vector-style formula (elements xmin xmax ymin ymax): gain*(sigma3*A -
+// F)/(kn_wall*max(1, n)) from each wall's area (fix servo_len: the box's
+// length across the wall, times H), contacts (c_csn) and force on the spheres
+// along +axis (c_csf), the max walls' elements with the opposite sign
+// (f_servo_sign), so that the clamp of each element is the wall's move along
+// +axis (deck::lammps_servo_raw_of_load, lammps_servo_clamp, as in 2D).
+std::string servo_raw_vector() {
+  return deck::lammps_servo_raw_of_load("f_servo_sign*${sigma3}*f_servo_len*" + std::string(kH),
+                                        "-c_csf", deck::lammps_count_at_least_one("c_csn"));
 }
 
 // Header: the mapping and what this LAMMPS cannot do as demcal does.
@@ -471,9 +462,8 @@ void lammps_3d_walls(std::ostream& s, const AlgorithmSpec& p, const Plan3& plan)
   }
   for (int sd = 0; sd < 6; ++sd)
     s << "group           g" << kWall[sd] << " region band" << kWall[sd] << "\n";
-  for (int a = 0; a < 3; ++a)
-    s << "group           g" << kAxis[a] << " union g" << kWall[2 * a] << " g" << kWall[2 * a + 1]
-      << "\n";
+  s << "group           gxy union gxmin gxmax gymin gymax\n"
+    << "group           gz union gzmin gzmax\n";
   for (int sd = 0; sd < 6; ++sd)
     s << "group           n" << kWall[sd] << " subtract all g" << kWall[sd] << "\n";
   s << "fix             wzmin gzmin wall/gran hooke/history ${kn_wall} ${kt_wall} 0 0 ${mu_wall} "
@@ -502,13 +492,14 @@ void lammps_3d_measures(std::ostream& s, const AlgorithmSpec& p, const Plan3& pl
   // Measures: wall forces for the servo and the pressures, one reduction per
   // axis; the stored lengths; the bands' clearance checks.
   s << "# --- measures ----------------------------------------------------------------\n"
-    << "# the servo's and the peaks' input, one reduction per axis over its two\n"
-    << "# walls' bands (a reduction loops over every sphere for each of its columns,\n"
-    << "# and adds those of its group): contacts and force along the axis of the\n"
-    << "# min then the max wall; for z the forces (three global sums per step under\n"
+    << "# the servo's and the peaks' input, reduced over the walls' bands (a\n"
+    << "# reduction loops over every sphere for each of its columns, and adds those\n"
+    << "# of its group): the four lateral walls' contacts (csn) and forces along\n"
+    << "# their axes (csf), xmin xmax ymin ymax (a sphere outside a wall's band\n"
+    << "# adds its zero); the z walls' forces (three global sums per step under\n"
     << "# MPI)\n"
-    << "compute         csx gx reduce sum f_wxmin[1] f_wxmin[2] f_wxmax[1] f_wxmax[2]\n"
-    << "compute         csy gy reduce sum f_wymin[1] f_wymin[3] f_wymax[1] f_wymax[3]\n"
+    << "compute         csn gxy reduce sum f_wxmin[1] f_wxmax[1] f_wymin[1] f_wymax[1]\n"
+    << "compute         csf gxy reduce sum f_wxmin[2] f_wxmax[2] f_wymin[3] f_wymax[3]\n"
     << "compute         csz gz reduce sum f_wzmin[4] f_wzmax[4]\n"
     << "# the box's lengths and height, stored once per step by fix geom (a double\n"
     << "# each; defined before every fix that reads them, so that they see the walls\n"
@@ -526,10 +517,10 @@ void lammps_3d_measures(std::ostream& s, const AlgorithmSpec& p, const Plan3& pl
     << "variable        Ax equal " << area_x() << "\n"
     << "variable        Ay equal " << area_y() << "\n"
     << "variable        Az equal " << area_z() << "\n"
-    << "variable        p_xmin equal c_csx[2]/v_Ax\n"
-    << "variable        p_xmax equal -c_csx[4]/v_Ax\n"
-    << "variable        p_ymin equal c_csy[2]/v_Ay\n"
-    << "variable        p_ymax equal -c_csy[4]/v_Ay\n"
+    << "variable        p_xmin equal c_csf[1]/v_Ax\n"
+    << "variable        p_xmax equal -c_csf[2]/v_Ax\n"
+    << "variable        p_ymin equal c_csf[3]/v_Ay\n"
+    << "variable        p_ymax equal -c_csf[4]/v_Ay\n"
     << "variable        p_zmin equal c_csz[1]/v_Az\n"
     << "variable        p_zmax equal -c_csz[2]/v_Az\n"
     << "variable        axial equal (v_p_zmin+v_p_zmax)/2\n"
@@ -637,19 +628,25 @@ void lammps_3d_servo_and_run(std::ostream& s) {
   s << "# --- servo -------------------------------------------------------------------\n"
     << "# demcal's servo, one move per step and wall toward the sample when p < sigma3:\n"
     << "#   move = gain*(sigma3*A - F)/(kn_wall*max(1, n)), clamped to +-cap,\n"
-    << "# A = the wall's current area, F its force, n its contacts (compute csx, csy). The\n"
-    << "# unclamped move, one flat formula per wall with the numbers substituted now,\n"
-    << "# is kept by fix servo_raw (a double: the clamp reads it twice without\n"
-    << "# parsing it twice); this release has no min/max of two numbers: max(1, n) =\n"
-    << "# (1+n+abs(1-n))/2, clamp(x) = (abs(x+cap)-abs(x-cap))/2. f_servo[k]: the\n"
-    << "# running mean of the moves along +axis (xmin xmax ymin ymax), times the step\n"
-    << "# = the wall's displacement.\n";
-  for (int sd = 0; sd < 4; ++sd)
-    s << "variable        raw" << kWall[sd] << " equal " << servo_raw(sd) << "\n";
-  s << "fix             servo_raw all ave/time 1 1 1 v_rawxmin v_rawxmax v_rawymin v_rawymax\n";
-  for (int sd = 0; sd < 4; ++sd)
-    s << "variable        m" << kWall[sd] << " equal " << servo_move(sd) << "\n";
-  s << "fix             servo all ave/time 1 1 1 v_mxmin v_mxmax v_mymin v_mymax ave running\n\n";
+    << "# A = the wall's current area, F its force, n its contacts (compute csn, csf).\n"
+    << "# The four walls in one vector-style formula (elements xmin xmax ymin ymax;\n"
+    << "# the max walls' with the opposite sign, so that each clamped element is\n"
+    << "# the wall's move along +axis), parsed once per step for all four, with the\n"
+    << "# numbers substituted now. The clamp reads the unclamped moves as doubles\n"
+    << "# (a vector variable is evaluated once per step, then kept); the signs\n"
+    << "# (internal variables, read without parsing) and the box's length across\n"
+    << "# each wall (Ly for the x walls, Lx for the y walls: fix geom's doubles)\n"
+    << "# come from fixes. This release has no min/max of two numbers: max(1, n) =\n"
+    << "# n+(n<1) for a contact count n, clamp(x) = (abs(x+cap)-abs(x-cap))/2.\n"
+    << "# f_servo[k]: the running mean of the moves along +axis, times the step =\n"
+    << "# the wall's displacement.\n"
+    << "variable        one internal 1\n"
+    << "variable        mone internal -1\n"
+    << "fix             servo_sign all ave/time 1 1 1 v_one v_mone v_one v_mone\n"
+    << "fix             servo_len all ave/time 1 1 1 f_geom[2] f_geom[2] f_geom[1] f_geom[1]\n"
+    << "variable        rawv vector " << servo_raw_vector() << "\n"
+    << "variable        movev vector " << deck::lammps_servo_clamp("v_rawv") << "\n";
+  s << "fix             servo all ave/time 1 1 1 v_movev mode vector ave running\n\n";
 
   s << "# --- output and run ----------------------------------------------------------\n"
     << "thermo_style    custom step time v_strain_zz v_axial v_lateral v_ratio ke\n"
