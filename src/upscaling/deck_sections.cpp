@@ -245,6 +245,15 @@ std::string lammps_count_at_least_one(const std::string& count) {
   return "(" + count + "+(" + count + "<1))";
 }
 
+std::string lammps_band(const std::string& name, const std::string& motion,
+                        const std::string& comment) {
+  std::string line = "variable " + name;
+  line.resize(std::max<size_t>(line.size() + 1, 19), ' ');
+  line += "equal $(" + motion + "+6*v_r_max)";
+  if (!comment.empty()) line += "      # " + comment;
+  return line + "\n";
+}
+
 std::string lammps_servo_clamp(const std::string& x) {
   return "(abs(" + x + "+${cap})-abs(" + x + "-${cap}))/2";
 }

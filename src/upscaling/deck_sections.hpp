@@ -152,6 +152,13 @@ std::string lammps_servo_raw_of_load(const std::string& load, const std::string&
 /// operations and no abs() fewer for the formula parser.
 std::string lammps_count_at_least_one(const std::string& count);
 
+/// LAMMPS: a wall's band depth (the particles a moving wall acts on lie
+/// within it of the wall's start), `motion` (the wall's largest travel in the
+/// test, a formula of the parameters) plus six of the largest radii: the
+/// line `variable NAME equal $(MOTION+6*v_r_max)`, with `comment` after it.
+std::string lammps_band(const std::string& name, const std::string& motion,
+                        const std::string& comment = "");
+
 /// LAMMPS: the series file's header (print lines), what `demcal score`
 /// reads about the run: the deck (`deck`, e.g. "LAMMPS 3D deck"), scene,
 /// particles, sigma3, Nstep, dt, dt_crit (when given), the damping ratios

@@ -509,8 +509,8 @@ std::string lammps_derived() {
   s << "\n# --- derived (do not edit) ---------------------------------------------------\n"
     << "variable H0        equal $(v_yt0-v_yb0)\n"
     << deck::lammps_loading_derived()
-    << "variable band_v    equal $(v_strain*v_H0+6*v_r_max)      # m, see the walls\n"
-    << "variable band_h    equal $(2*v_strain*(v_xr0-v_xl0)+6*v_r_max)\n";
+    << deck::lammps_band("band_v", "v_strain*v_H0", "m, see the walls")
+    << deck::lammps_band("band_h", "2*v_strain*(v_xr0-v_xl0)");
   return s.str();
 }
 

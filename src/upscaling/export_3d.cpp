@@ -293,9 +293,9 @@ void lammps_3d_derived(std::ostream& s) {
     << "variable Wy0       equal $(v_ymax0-v_ymin0)\n"
     << deck::lammps_loading_derived()
     << "variable peak_every equal $(ceil(v_nstep/1000000))      # fix vector length <= 1e6\n"
-    << "variable band_v    equal $(v_strain*v_H0+6*v_r_max)      # m, see the walls\n"
-    << "variable band_x    equal $(2*v_strain*v_Wx0+6*v_r_max)\n"
-    << "variable band_y    equal $(2*v_strain*v_Wy0+6*v_r_max)\n";
+    << deck::lammps_band("band_v", "v_strain*v_H0", "m, see the walls")
+    << deck::lammps_band("band_x", "2*v_strain*v_Wx0")
+    << deck::lammps_band("band_y", "2*v_strain*v_Wy0");
 }
 
 // Units, box, data file, contact law.
