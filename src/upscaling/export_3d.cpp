@@ -40,6 +40,35 @@ std::string series_columns_3d() {
   return columns + ",contacts";
 }
 
+/// b and sigma, component by component, from compute meas's sums about the
+/// origin (both decks' layout: [2k+1] [2k+2] the walls' and the particles'
+/// x (x) f of component k row by row, [19..21] the wall forces, [22..24] the
+/// contact forces) moved to the box centre (v_cx, v_cy, v_cz) and divided by
+/// v_V; `variable` is the command as the deck spaces it.
+std::string b_and_sigma_3d(const std::string& variable) {
+  std::ostringstream s;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      const int k = 2 * (3 * i + j) + 1;
+      const std::string ij = std::string(1, kAxis[i]) + kAxis[j];
+      s << variable << "b_" << ij << " equal (c_meas[" << k << "]-v_c" << kAxis[i] << "*c_meas["
+        << 19 + j << "])/v_V\n"
+        << variable << "s_" << ij << " equal v_b_" << ij << "-(c_meas[" << k + 1 << "]-v_c"
+        << kAxis[i] << "*c_meas[" << 22 + j << "])/v_V\n";
+    }
+  return s.str();
+}
+
+/// A series row up to kinetic_energy, in series_columns_3d()'s order: step,
+/// the strain variable `strain`, b and sigma row by row.
+std::string series_row_head_3d(const std::string& strain) {
+  std::string row = "${stepn},${" + strain + "}";
+  for (const char* t : {"b_", "s_"})
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) row += std::string(",${") + t + kAxis[i] + kAxis[j] + "}";
+  return row;
+}
+
 /// A series row from kinetic_energy on, in series_columns_3d()'s order: the
 /// deck's variables ke, ke_rot, lat_err, err_WALL, wall_WALL,
 /// p_WALL<p_suffix>, contacts.
@@ -574,19 +603,8 @@ void lammps_3d_measures(std::ostream& s, const AlgorithmSpec& p, const Plan3& pl
 void lammps_3d_series(std::ostream& s, const SceneConfig& c, const AlgorithmSpec& p,
                       const Plan3& plan) {
   // c_meas layout: [1..18] bw/mp pairs, [19..21] fw, [22..24] fc, [25] cn.
-  std::string row = "${stepn},${strain_zz}";
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) {
-      const int k = 2 * (3 * i + j) + 1;
-      const std::string ij = std::string(1, kAxis[i]) + kAxis[j];
-      s << "variable        b_" << ij << " equal (c_meas[" << k << "]-v_c" << kAxis[i] << "*c_meas["
-        << 19 + j << "])/v_V\n"
-        << "variable        s_" << ij << " equal v_b_" << ij << "-(c_meas[" << k + 1 << "]-v_c"
-        << kAxis[i] << "*c_meas[" << 22 + j << "])/v_V\n";
-    }
-  for (const char* t : {"b_", "s_"})
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) row += std::string(",${") + t + kAxis[i] + kAxis[j] + "}";
+  s << b_and_sigma_3d("variable        ");
+  std::string row = series_row_head_3d("strain_zz");
   s << "variable        strain_zz equal (v_H-v_H0)/v_H0\n"
     << "variable        ke equal c_ket+c_ker\n"
     << "variable        ke_rot equal c_ker\n"
@@ -813,19 +831,8 @@ std::string liggghts_3d_series(const SceneConfig& c, const AlgorithmSpec& p, con
     << "compute meas all reduce sum" << reduce
     << " &\n        v_fwx_a v_fwy_a v_fwz_a v_fc1_a v_fc2_a v_fc3_a v_n0_a v_n1_a v_n2_a v_n3_a "
        "v_n4_a v_n5_a &\n        v_ket_a v_ker_a c_cn\n";
-  std::string row = "${stepn},${strain_zz_s}";
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) {
-      const int k = 2 * (3 * i + j) + 1;
-      const std::string ij = std::string(1, kAxis[i]) + kAxis[j];
-      s << "variable b_" << ij << " equal (c_meas[" << k << "]-v_c" << kAxis[i] << "*c_meas["
-        << 19 + j << "])/v_V\n"
-        << "variable s_" << ij << " equal v_b_" << ij << "-(c_meas[" << k + 1 << "]-v_c" << kAxis[i]
-        << "*c_meas[" << 22 + j << "])/v_V\n";
-    }
-  for (const char* t : {"b_", "s_"})
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) row += std::string(",${") + t + kAxis[i] + kAxis[j] + "}";
+  s << b_and_sigma_3d("variable ");
+  std::string row = series_row_head_3d("strain_zz_s");
   // Pressures: the meshes' own totals (the force on a mesh is minus the
   // spheres'), available from the first step; at the start the spheres'
   // normal forces (no wall carries a tangential force yet).
