@@ -47,6 +47,15 @@ SceneConfig hex5() {
   return c;
 }
 
+/// The 2D LIGGGHTS deck of a consolidated state, its data file `data_name`.
+ExportResult liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p,
+                           const ConsolidatedState& state, const std::string& data_name) {
+  ExportOptions o;
+  o.format = "liggghts";
+  o.data_name = data_name;
+  return export_deck(c, p, assembly_of(state.world), o);
+}
+
 TEST(ExternalSeries, DemcalsOwnSeriesScoresAsTheRun) {
   const SceneConfig c = hex5();
   const ConsolidatedState state = consolidate(c, make_assembly(c));
@@ -529,10 +538,7 @@ TEST(EngineLiggghts, TheDecksPeakIsDemcalsWithinOnePercent) {
   const ConsolidatedState state = consolidate(c, make_assembly(c));
   const AlgorithmSpec p = quasi_static();
   const LoadingResult run = run_loading(state, c.test, p);
-  ExportOptions o;
-  o.format = "liggghts";
-  o.data_name = "hex5.data";
-  const ExportResult r = export_deck(c, p, assembly_of(state.world), o);
+  const ExportResult r = liggghts_deck(c, p, state, "hex5.data");
   const test::TempDir dir("liggghts");
   // With a screen (captured): liggghts 3.8 crashes reading meshes under
   // -screen none.
@@ -562,12 +568,6 @@ TEST(EngineLiggghts, TheDecksPeakIsDemcalsWithinOnePercent) {
   // The servo held σ3 on the current height.
   EXPECT_NEAR(last_lateral / c.test.lateral_stress, 1.0, 0.005);
 }
-
-}  // namespace
-}  // namespace demcal
-
-namespace demcal {
-namespace {
 
 /// The thermo rows of a LIGGGHTS deck's loading run (after its thermo_style
 /// line with v_p_top): step dt time ke p_top p_left p_right xl xr, by step.
@@ -615,10 +615,7 @@ TEST_P(LiggghtsSeries, ScoresAsDemcalsRun) {
   const AlgorithmSpec p = quasi_static();
   const LoadingResult run = run_loading(state, c.test, p);
   const Score ours = score_run(run, c.test.lateral_stress, Tolerances{});
-  ExportOptions o;
-  o.format = "liggghts";
-  o.data_name = "hex5.data";
-  const ExportResult r = export_deck(c, p, assembly_of(state.world), o);
+  const ExportResult r = liggghts_deck(c, p, state, "hex5.data");
   const test::TempDir dir(std::string("liggghts_score_") + GetParam());
   // With a screen (captured): liggghts 3.8 crashes reading meshes under
   // -screen none.
@@ -703,12 +700,6 @@ TEST_P(LiggghtsSeries, ScoresAsDemcalsRun) {
 INSTANTIATE_TEST_SUITE_P(EngineLiggghts, LiggghtsSeries,
                          ::testing::Values("frictionless", "wall_friction"));
 
-}  // namespace
-}  // namespace demcal
-
-namespace demcal {
-namespace {
-
 class LiggghtsContactForce : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(LiggghtsContactForce, IsTheStoredForceBeforeTheDamping) {
@@ -729,10 +720,7 @@ TEST_P(LiggghtsContactForce, IsTheStoredForceBeforeTheDamping) {
     c.assembly.count = 100;
   }
   const ConsolidatedState state = consolidate(c, make_assembly(c));
-  ExportOptions o;
-  o.format = "liggghts";
-  o.data_name = "sample.data";
-  const ExportResult r = export_deck(c, quasi_static(), assembly_of(state.world), o);
+  const ExportResult r = liggghts_deck(c, quasi_static(), state, "sample.data");
   std::string deck =
       replaced(r.deck, "fix dampt all viscous", "fix fchk all store/force\nfix dampt all viscous");
   deck = replaced(deck, "# thermo: the meshes' own forces",
@@ -763,12 +751,6 @@ TEST_P(LiggghtsContactForce, IsTheStoredForceBeforeTheDamping) {
 }
 
 INSTANTIATE_TEST_SUITE_P(EngineLiggghts, LiggghtsContactForce, ::testing::Values("hex", "random"));
-
-}  // namespace
-}  // namespace demcal
-
-namespace demcal {
-namespace {
 
 TEST(EngineLiggghts, RotatesDiscsWithTheDiscsInertia) {
   // The deck's series takes LIGGGHTS' rotational energy with the disc's
@@ -812,12 +794,6 @@ TEST(EngineLiggghts, RotatesDiscsWithTheDiscsInertia) {
   // rolling: a few 1e-4 of v0 (measured 3.6e-4).
   EXPECT_NEAR(v / 0.1, 2.0 / 3.0, 0.005 * 2.0 / 3.0);
 }
-
-}  // namespace
-}  // namespace demcal
-
-namespace demcal {
-namespace {
 
 TEST(EngineLiggghts, The3dDecksSeriesScoresAsDemcalsRun) {
   // The 3D LIGGGHTS deck on fcc_4x4x4 (256 spheres, 40 000 steps, ζ_t 0.4,
