@@ -135,7 +135,8 @@ TEST(Calibration, SameResultWithAnyJobs) {
 }
 
 // Kill a calibration with SIGKILL at random moments, resume each time: no
-// finished trial is rerun, and the result equals an uninterrupted run's.
+// finished trial is rerun, and the result (params.json and trials.jsonl)
+// equals an uninterrupted run's.
 TEST(Calibration, ResumeAfterSigkillEqualsUninterrupted) {
   const fs::path reference = test::fresh_path("cal_ref"), killed = test::fresh_path("cal_killed");
   ASSERT_EQ(wait_exit(spawn_calibrate(reference, false)), 0);
@@ -161,8 +162,61 @@ TEST(Calibration, ResumeAfterSigkillEqualsUninterrupted) {
   std::set<std::string> keys;
   for (const auto& t : trials) EXPECT_TRUE(keys.insert(t["params"].dump()).second);
   EXPECT_EQ(read_bytes(killed / "params.json"), read_bytes(reference / "params.json"));
+  // And the same trials file, wherever the kills fell (wall times apart).
+  std::vector<nlohmann::json> expected = read_trials(reference / "trials.jsonl"), got = trials;
+  for (auto* list : {&expected, &got})
+    for (nlohmann::json& t : *list) t.erase("wall_time_s");
+  EXPECT_EQ(got, expected);
   fs::remove_all(reference);
   fs::remove_all(killed);
+}
+
+// A kill inside a parallel section leaves its trials with the ids of their
+// finishing order (numbered by position only back at the top level). Here
+// that file is made by hand from an uninterrupted run's: 30 of its trials in
+// a shuffled order, numbered in that order, and one trial the search never
+// asks for. Resumed, the file equals the uninterrupted run's trial by trial
+// (wall times apart), the foreign trial kept after them.
+TEST(Calibration, ResumedTrialsAreNumberedAsInAnUninterruptedRun) {
+  const fs::path reference = test::fresh_path("cal_ids_ref"), resumed = test::fresh_path("cal_ids");
+  ASSERT_EQ(wait_exit(spawn_calibrate(reference, false)), 0);
+  std::vector<nlohmann::json> all = read_trials(reference / "trials.jsonl");
+  ASSERT_GE(all.size(), 40u);
+  std::vector<nlohmann::json> old(all.begin(), all.begin() + 30);
+  std::shuffle(old.begin(), old.end(), std::mt19937(3));
+  nlohmann::json foreign = all[0];
+  foreign["params"]["steps"] = 777;  // never asked for
+  old.push_back(foreign);
+  fs::create_directories(resumed);
+  fs::copy_file(reference / "resume.json", resumed / "resume.json");
+  {
+    std::ofstream out(resumed / "trials.jsonl");
+    for (size_t i = 0; i < old.size(); ++i) {
+      old[i]["id"] = static_cast<int>(i);
+      out << old[i].dump() << "\n";
+    }
+  }
+  ASSERT_EQ(wait_exit(spawn_calibrate(resumed, true)), 0);
+  std::vector<nlohmann::json> got = read_trials(resumed / "trials.jsonl");
+  ASSERT_EQ(got.size(), all.size() + 1);
+  for (auto* trials : {&all, &got})
+    for (nlohmann::json& t : *trials) t.erase("wall_time_s");
+  for (size_t i = 0; i < all.size(); ++i) EXPECT_EQ(got[i], all[i]) << "line " << i + 1;
+  EXPECT_EQ(got.back()["id"], static_cast<int>(all.size()));
+  EXPECT_EQ(got.back()["params"]["steps"], 777);
+  EXPECT_EQ(read_json(resumed / "run.json")["trials_reused"], 30);
+  // The same parameter set; the count of trials and their particle-steps
+  // include the foreign one.
+  nlohmann::json ours = read_json(resumed / "params.json"),
+                 theirs = read_json(reference / "params.json");
+  EXPECT_EQ(ours["trials"], theirs["trials"].get<int>() + 1);
+  for (auto* p : {&ours, &theirs}) {
+    p->erase("trials");
+    p->erase("particle_steps_run");
+  }
+  EXPECT_EQ(ours, theirs);
+  fs::remove_all(reference);
+  fs::remove_all(resumed);
 }
 
 // SIGINT, then SIGTERM, stop a calibration cleanly: exit 128 + signal,

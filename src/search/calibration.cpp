@@ -295,7 +295,10 @@ bool at_top_level() { return t_place.path.empty(); }
 // A trial is written when it finishes (a kill loses nothing finished); at
 // the top level, outside parallel sections, the trials finished since are
 // numbered in position order (and the file rewritten when that order is
-// not the finishing order).
+// not the finishing order). A resumed calibration numbers the trials of the
+// old file afresh when the search asks for them again, so that a kill in a
+// parallel section (its trials written with finishing-order ids) leaves no
+// trace in the final file: it equals an uninterrupted run's.
 
 namespace {
 
@@ -304,13 +307,13 @@ class Evaluator {
   Evaluator(const TrialRunner& runner, const CalibrationOptions& options)
       : runner_(runner), options_(options), t0_(std::chrono::steady_clock::now()) {}
 
+  /// A trial of the file being resumed: cached, numbered when asked for.
   void preload(const TrialRecord& r) {
     std::promise<TrialRecord> p;
     p.set_value(r);
     cache_.emplace(key_of(r.params), p.get_future().share());
-    preloaded_.insert(key_of(r.params));
-    settled_.emplace(key_of(r.params), r);
-    next_id_ = std::max(next_id_, r.id + 1);
+    preloaded_.emplace(key_of(r.params), r);
+    resumed_ = true;
   }
 
   /// run_parallel() for tasks that ask for trials: each task a branch of
@@ -356,7 +359,14 @@ class Evaluator {
         mine = true;
       } else {
         future = it->second;
-        if (preloaded_.erase(key)) ++reused_;
+        const auto old = preloaded_.find(key);
+        if (old != preloaded_.end()) {
+          // Asked for again: numbered as if it had just finished.
+          ++reused_;
+          first_request_[key] = {position, phase};
+          unsettled_.push_back({key, old->second, to_json(old->second).dump()});
+          preloaded_.erase(old);
+        }
         // Not numbered yet: the earliest request (in the one-job order)
         // gives the trial its place and its phase.
         const auto first = first_request_.find(key);
@@ -364,7 +374,11 @@ class Evaluator {
           first->second = {position, phase};
       }
     }
-    if (!mine) return settled_or(key, future.get());
+    if (!mine) {
+      const TrialRecord r = future.get();
+      if (at_top_level()) settle();
+      return settled_or(key, r);
+    }
     TrialRecord r;
     try {
       TrialRun run = runner_.run(params, options_.tolerances, options_.early_stop && early_stop,
@@ -423,7 +437,23 @@ class Evaluator {
     return settled_or(key, r);
   }
 
-  /// Every finished trial, in id order (called at the top level).
+  /// The trials of the resumed file this run never asked for (its search
+  /// took another path): kept, numbered after the run's own. Called once,
+  /// at the end.
+  void keep_unrequested() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      for (auto& [key, r] : preloaded_) {
+        r.id = next_id_++;
+        settled_.insert_or_assign(key, r);
+      }
+      preloaded_.clear();
+    }
+    settle();
+    if (resumed_) rewrite_resumed_file();
+  }
+
+  /// The trials this run asked for, in id order (called at the top level).
   std::vector<TrialRecord> all() {
     settle();
     std::lock_guard<std::mutex> lock(mutex_);
@@ -451,8 +481,32 @@ class Evaluator {
   /// their first request, their phase that request's; trials.jsonl
   /// rewritten when that is not the order they were written in.
   void settle() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (unsettled_.empty()) return;
+      number_unsettled();
+    }
+    if (resumed_) rewrite_resumed_file();
+  }
+
+  /// A resumed file is rewritten whole: the numbered trials in id order,
+  /// then those of the old file not asked for yet (old ids, renumbered when
+  /// asked for). Atomic: a kill leaves the old file or the new one.
+  void rewrite_resumed_file() {
+    if (options_.trials_path.empty()) return;
     std::lock_guard<std::mutex> lock(mutex_);
-    if (unsettled_.empty()) return;
+    std::vector<const TrialRecord*> numbered;
+    for (const auto& [k, r] : settled_) numbered.push_back(&r);
+    std::sort(numbered.begin(), numbered.end(),
+              [](const TrialRecord* a, const TrialRecord* b) { return a->id < b->id; });
+    std::string text;
+    for (const TrialRecord* r : numbered) text += to_json(*r).dump() + "\n";
+    for (const auto& [k, r] : preloaded_) text += to_json(r).dump() + "\n";
+    write_file_atomic(options_.trials_path, text);
+  }
+
+  /// settle()'s numbering; the caller holds the mutex.
+  void number_unsettled() {
     std::string written, numbered;
     for (const Unsettled& u : unsettled_) written += u.line + "\n";
     std::stable_sort(unsettled_.begin(), unsettled_.end(),
@@ -467,7 +521,7 @@ class Evaluator {
       first_request_.erase(u.key);
     }
     unsettled_.clear();
-    if (numbered == written || options_.trials_path.empty()) return;
+    if (resumed_ || numbered == written || options_.trials_path.empty()) return;
     const std::string text = read_text_file(options_.trials_path);
     if (text.size() >= written.size() &&
         text.compare(text.size() - written.size(), written.size(), written) == 0)
@@ -499,8 +553,9 @@ class Evaluator {
   std::map<Key, std::shared_future<TrialRecord>> cache_;
   std::map<Key, Request> first_request_;  ///< trials not numbered yet
   std::vector<Unsettled> unsettled_;
-  std::map<Key, TrialRecord> settled_;  ///< numbered (or preloaded)
-  std::set<Key> preloaded_;
+  std::map<Key, TrialRecord> settled_;    ///< numbered
+  std::map<Key, TrialRecord> preloaded_;  ///< of the resumed file, not asked for yet
+  bool resumed_ = false;
   int next_id_ = 0, run_ = 0, reused_ = 0;
   int64_t best_steps_ = 0;
 };
@@ -953,6 +1008,7 @@ CalibrationSummary calibrate(const TrialRunner& runner, const AlgorithmSpec& bas
   };
   search_round(start0, start1, budget, TrialPhase::search);
   const auto finish_interrupted = [&] {
+    evaluator.keep_unrequested();
     out.trials = evaluator.all();
     out.trials_run = evaluator.run_count();
     out.trials_reused = evaluator.reused_count();
@@ -1007,6 +1063,7 @@ CalibrationSummary calibrate(const TrialRunner& runner, const AlgorithmSpec& bas
   }
 
   if (evaluator.stopped()) return finish_interrupted();
+  evaluator.keep_unrequested();
   out.trials = evaluator.all();
   out.trials_run = evaluator.run_count();
   out.trials_reused = evaluator.reused_count();
