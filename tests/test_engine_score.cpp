@@ -520,6 +520,26 @@ TEST(EngineLammps, VerifyInLammpsAgreesWithDemcal) {
               0.005);
 }
 
+/// The thermo rows of a LIGGGHTS deck's loading run (after its thermo_style
+/// line with `after`), by step: the rows of `columns` numbers of every
+/// chunk of the run (the deck runs in chunks, `run ... every`, each with
+/// its header and its first step's row again).
+std::map<int64_t, std::vector<double>> liggghts_thermo(const std::string& log,
+                                                       const std::string& after = "v_p_top",
+                                                       size_t columns = 9) {
+  std::map<int64_t, std::vector<double>> rows;
+  const auto at = log.find(after);
+  if (at == std::string::npos) return rows;
+  std::stringstream lines(log.substr(log.find('\n', log.find("Step", at)) + 1));
+  for (std::string line; std::getline(lines, line);) {
+    std::stringstream f(line);
+    std::vector<double> v;
+    for (double x; f >> x;) v.push_back(x);
+    if (v.size() == columns) rows[static_cast<int64_t>(v[0])] = v;
+  }
+  return rows;
+}
+
 TEST(EngineLiggghts, TheDecksPeakIsDemcalsWithinOnePercent) {
   // The exported LIGGGHTS deck (argument order of fix wall/gran, 2D masses,
   // servo sign and gain) over the whole loading of the 25-disc sample,
@@ -547,43 +567,20 @@ TEST(EngineLiggghts, TheDecksPeakIsDemcalsWithinOnePercent) {
   const std::string& text = liggghts_run.log;
   ASSERT_EQ(text.find("ERROR"), std::string::npos) << text;
   // Thermo rows: step dt time ke p_top p_left p_right xl xr.
-  const auto at = text.find("v_p_top");
-  ASSERT_NE(at, std::string::npos) << text;
-  std::stringstream lines(text.substr(text.find('\n', text.find("Step", at)) + 1));
+  ASSERT_NE(text.find("v_p_top"), std::string::npos) << text;
   double peak = 0.0, last_lateral = 0.0;
-  int rows = 0;
-  for (std::string line;
-       std::getline(lines, line) && line.find("Loop time") == std::string::npos;) {
-    std::stringstream f(line);
-    std::vector<double> v;
-    for (double x; f >> x;) v.push_back(x);
-    if (v.size() != 9) continue;
-    ++rows;
+  const auto thermo = liggghts_thermo(text);
+  ASSERT_FALSE(thermo.empty()) << text;
+  for (const auto& [step, v] : thermo) {
     peak = std::max(peak, v[4]);
     last_lateral = 0.5 * (v[5] + v[6]);
   }
-  EXPECT_GT(rows, 100);
+  EXPECT_GT(thermo.size(), 100u);
+  EXPECT_EQ(thermo.rbegin()->first, r.steps);
   EXPECT_NEAR(peak / -run.peak_stress_yy, 1.0, 0.01)
       << "LIGGGHTS " << peak << " Pa, demcal " << -run.peak_stress_yy << " Pa";
   // The servo held σ3 on the current height.
   EXPECT_NEAR(last_lateral / c.test.lateral_stress, 1.0, 0.005);
-}
-
-/// The thermo rows of a LIGGGHTS deck's loading run (after its thermo_style
-/// line with v_p_top): step dt time ke p_top p_left p_right xl xr, by step.
-std::map<int64_t, std::vector<double>> liggghts_thermo(const std::string& log) {
-  std::map<int64_t, std::vector<double>> rows;
-  const auto at = log.find("v_p_top");
-  if (at == std::string::npos) return rows;
-  std::stringstream lines(log.substr(log.find('\n', log.find("Step", at)) + 1));
-  for (std::string line;
-       std::getline(lines, line) && line.find("Loop time") == std::string::npos;) {
-    std::stringstream f(line);
-    std::vector<double> v;
-    for (double x; f >> x;) v.push_back(x);
-    if (v.size() == 9) rows[static_cast<int64_t>(v[0])] = v;
-  }
-  return rows;
 }
 
 class LiggghtsSeries : public ::testing::TestWithParam<const char*> {};
@@ -814,7 +811,7 @@ TEST(EngineLiggghts, The3dDecksSeriesScoresAsDemcalsRun) {
   const TriaxialState state = consolidate_triaxial(c, make_sphere_assembly(c));
   AlgorithmSpec p;
   p.dt_ratio = 0.2;
-  p.steps = 40000;
+  p.steps = 20000;
   p.damping_ratio_translation = 0.4;
   p.damping_ratio_rotation = 0.0;
   const TriaxialResult run = run_triaxial_loading(state, c.test, p);
@@ -857,19 +854,10 @@ TEST(EngineLiggghts, The3dDecksSeriesScoresAsDemcalsRun) {
   ASSERT_EQ(static_cast<int>(series.triaxial.series.size()), c.test.monitor_points + 1);
   // Thermo rows of the loading: step time ke strain_zz p_axial p_lat p_top
   // p_bottom Wx Wy.
-  std::map<int64_t, std::vector<double>> thermo;
-  {
-    const auto at = lg.log.find("v_p_axial");
-    ASSERT_NE(at, std::string::npos);
-    std::stringstream lines(lg.log.substr(lg.log.find('\n', lg.log.find("Step", at)) + 1));
-    for (std::string line;
-         std::getline(lines, line) && line.find("Loop time") == std::string::npos;) {
-      std::stringstream f(line);
-      std::vector<double> v;
-      for (double x; f >> x;) v.push_back(x);
-      if (v.size() == 10) thermo[static_cast<int64_t>(v[0])] = v;
-    }
-  }
+  ASSERT_NE(lg.log.find("v_p_axial"), std::string::npos);
+  const auto thermo = liggghts_thermo(lg.log, "v_p_axial", 10);
+  ASSERT_FALSE(thermo.empty()) << lg.log;
+  EXPECT_EQ(thermo.rbegin()->first, r.steps);
   std::stringstream lines(test::read_text(dir / "series.csv"));
   std::vector<std::string> names;
   int compared = 0, rows = 0;
