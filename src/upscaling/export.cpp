@@ -951,16 +951,21 @@ ExportResult liggghts(const SceneConfig& c, const AlgorithmSpec& p, const Assemb
   ExportResult out = result_of(plan);
   const int wall_type = plan.types + 1;
   const int ntypes = plan.types + 1;
-  // The lateral walls' contacts at the start and the servo gain that makes
-  // LIGGGHTS' mesh servo move as demcal's (see the deck's header); the
-  // deck sets it from the current contacts as it runs.
-  int n_contacts = 0;
-  for (int i = 0; i < plan.n; ++i)
-    if (a.x[i] - a.r[i] <= a.left + 1e-9 * a.r[i]) ++n_contacts;
+  // The lateral walls' contacts at the start (the particles overlapping
+  // each) and the servo gains that make LIGGGHTS' mesh servo move as
+  // demcal's (see the deck's header); the deck sets them from the current
+  // contacts as it runs.
+  int n_left = 0, n_right = 0;
+  for (int i = 0; i < plan.n; ++i) {
+    if (a.x[i] - a.r[i] <= a.left + 1e-9 * a.r[i]) ++n_left;
+    if (a.x[i] + a.r[i] >= a.right - 1e-9 * a.r[i]) ++n_right;
+  }
   const double force_target = c.test.lateral_stress * plan.height0 * m.thickness;
   const double cap = 0.02 * plan.r_min;
-  const double kp =
-      deck::liggghts_servo_kp(c.test.servo_gain, force_target, m.wall.kn, n_contacts, cap);
+  const double kp_left =
+      deck::liggghts_servo_kp(c.test.servo_gain, force_target, m.wall.kn, n_left, cap);
+  const double kp_right =
+      deck::liggghts_servo_kp(c.test.servo_gain, force_target, m.wall.kn, n_right, cap);
   const double vel_max = deck::liggghts_servo_vel_max(cap, plan.dt, plan.step_factor);
 
   // LIGGGHTS with dimension 2 computes a particle's mass as π·r²·density:
@@ -1009,9 +1014,9 @@ ExportResult liggghts(const SceneConfig& c, const AlgorithmSpec& p, const Assemb
     << "# and its cap. LIGGGHTS' kp is a number: the run goes in chunks of\n"
     << "# ${servo_every} steps (one setup) and kp is set from the current n and\n"
     << "# F_target between them (fix_modify servo/ctrlParam; at the start from\n"
-    << "# demcal's count, " << n_contacts << "): the gain lags demcal's by one chunk at\n"
-    << "# most. F_target = sigma3*H*t follows the current height (target_val v_ftl),\n"
-    << "# demcal's target.\n"
+    << "# demcal's counts, " << n_left << " left and " << n_right << " right): the gain\n"
+    << "# lags demcal's by one chunk at most. F_target = sigma3*H*t follows the\n"
+    << "# current height (target_val v_ftl), demcal's target.\n"
     << "# Run it with a screen (liggghts 3.8 crashes reading meshes with -screen none).\n"
     << "# Differences from demcal:\n"
     << "#  - rotation: LIGGGHTS 3.8's fix nve/sphere takes the disc's inertia m r^2/2\n"
@@ -1032,12 +1037,12 @@ ExportResult liggghts(const SceneConfig& c, const AlgorithmSpec& p, const Assemb
     << "fix mtop all mesh/surface/stress file " << top << " type " << wall_type << "\n"
     << "fix mleft all mesh/surface/stress/servo file " << left << " type " << wall_type << " com "
     << num(a.left) << " " << num(0.5 * (a.bottom + a.top))
-    << " 0 ctrlPV force axis 1 0 0 target_val v_ftl vel_max " << num(vel_max) << " kp " << num(kp)
-    << "\n"
+    << " 0 ctrlPV force axis 1 0 0 target_val v_ftl vel_max " << num(vel_max) << " kp "
+    << num(kp_left) << "\n"
     << "fix mright all mesh/surface/stress/servo file " << right << " type " << wall_type << " com "
     << num(a.right) << " " << num(0.5 * (a.bottom + a.top))
-    << " 0 ctrlPV force axis 1 0 0 target_val v_ftr vel_max " << num(vel_max) << " kp " << num(kp)
-    << "\n"
+    << " 0 ctrlPV force axis 1 0 0 target_val v_ftr vel_max " << num(vel_max) << " kp "
+    << num(kp_right) << "\n"
     << "fix walls all wall/gran model hooke/stiffness tangential history mesh n_meshes 3 meshes "
        "mtop mleft mright store_force yes absolute_damping on tangential_damping off\n"
     << "fix movetop all move/mesh mesh mtop linear 0 " << num(-plan.top_speed) << " 0\n\n"
