@@ -520,6 +520,111 @@ TEST(EngineLammps, VerifyInLammpsAgreesWithDemcal) {
               0.005);
 }
 
+/// The thermo rows of a LIGGGHTS deck's loading run (after its thermo_style
+/// line with `after`), by step: the rows of `columns` numbers of every
+/// chunk of the run (the deck runs in chunks, `run ... every`, each with
+/// its header and its first step's row again).
+std::map<int64_t, std::vector<double>> liggghts_thermo(const std::string& log,
+                                                       const std::string& after = "v_p_top",
+                                                       size_t columns = 9) {
+  std::map<int64_t, std::vector<double>> rows;
+  const auto at = log.find(after);
+  if (at == std::string::npos) return rows;
+  std::stringstream lines(log.substr(log.find('\n', log.find("Step", at)) + 1));
+  for (std::string line; std::getline(lines, line);) {
+    std::stringstream f(line);
+    std::vector<double> v;
+    for (double x; f >> x;) v.push_back(x);
+    if (v.size() == columns) rows[static_cast<int64_t>(v[0])] = v;
+  }
+  return rows;
+}
+
+/// The number after `key` on the deck's line that starts with `head`.
+double deck_number(const std::string& deck, const std::string& head, const std::string& key) {
+  const auto at = deck.find("\n" + head);
+  if (at == std::string::npos) return std::nan("");
+  const std::string line = deck.substr(at + 1, deck.find('\n', at + 1) - at - 1);
+  const auto k = line.find(" " + key + " ");
+  return k == std::string::npos ? std::nan("") : std::stod(line.substr(k + key.size() + 2));
+}
+
+TEST(EngineLiggghts, TheDecksServoMovesAtDemcalsVelocity) {
+  // LIGGGHTS 3.8's servo (MeshModuleStressServo) moves a mesh at
+  // vel_max·kp·(F_target − F)/|F_target|; demcal's wall at
+  // gain·(F_target − F)/(kn_wall·max(1, n)·Δt), Δt demcal's step, which is
+  // the deck's divided by f (the deck runs Nstep/f steps of f·Δt: the same
+  // loading time). Both decks' numbers, at the start (n: demcal's contacts
+  // of each wall; the deck sets kp again from the current ones as it runs,
+  // fix_modify servo/ctrlParam between chunks of one monitoring interval).
+  // No engine needed. (Before 2026-12-02 vel_max was cap/(f·Δt) and both
+  // 2D walls took the left wall's count: 1/f times demcal's velocity.)
+  {
+    SceneConfig c = hex5();
+    c.assembly.type = "random";  // walls with different contact counts
+    c.assembly.count = 60;
+    const ConsolidatedState state = consolidate(c, make_assembly(c));
+    const AlgorithmSpec p = quasi_static();
+    const ExportResult r = liggghts_deck(c, p, state, "s.data");
+    const World& w = state.world;
+    const double force = c.test.lateral_stress *
+                         (w.wall(kTop).position - w.wall(kBottom).position) * c.material.thickness;
+    const double dt_demcal = r.dt / r.step_factor;
+    EXPECT_NE(w.wall(kLeft).contacts, w.wall(kRight).contacts);
+    for (const auto& [fix, side] :
+         {std::pair{"fix mleft ", kLeft}, std::pair{"fix mright ", kRight}}) {
+      const double velocity_per_force =
+          deck_number(r.deck, fix, "vel_max") * deck_number(r.deck, fix, "kp") / force;
+      const double demcal =
+          c.test.servo_gain / (c.material.wall.kn * std::max(1, w.wall(side).contacts) * dt_demcal);
+      // the deck's numbers are written with 10 digits
+      EXPECT_NEAR(velocity_per_force / demcal, 1.0, 1e-9) << fix;
+    }
+    const int every = static_cast<int>(r.steps / c.test.monitor_points);
+    for (const char* needle : {"compute nservo all reduce sum v_ll_a v_lr_a",
+                               "\"fix_modify mleft servo/ctrlParam ${kp_mleft} 0 0\"",
+                               "\"fix_modify mright servo/ctrlParam ${kp_mright} 0 0\"",
+                               "run ${run_steps} pre no post no every ${servo_every} "})
+      EXPECT_NE(r.deck.find(needle), std::string::npos) << needle;
+    EXPECT_NE(r.deck.find("variable servo_every index " + std::to_string(every) + "\n"),
+              std::string::npos);
+  }
+  {
+    const SceneConfig c = load_config(test::shipped_config("fcc_4x4x4"));
+    const TriaxialState state = consolidate_triaxial(c, make_sphere_assembly(c));
+    AlgorithmSpec p;
+    p.dt_ratio = 0.2;
+    p.steps = 20000;
+    p.damping_ratio_translation = 0.4;
+    Export3dOptions o;
+    o.format = "liggghts";
+    o.data_name = "fcc.data";
+    const ExportResult r = export_3d_decks(c, p, state, o);
+    const SphereWorld& w = state.world;
+    auto extent = [&](int a) {
+      return w.wall(static_cast<SphereWallSide>(2 * a + 1)).position -
+             w.wall(static_cast<SphereWallSide>(2 * a)).position;
+    };
+    const char* name[4] = {"xmin", "xmax", "ymin", "ymax"};
+    for (int sd = 0; sd < 4; ++sd) {
+      const std::string fix = std::string("fix m") + name[sd] + " ";
+      const int a = sd / 2;
+      const double force = c.test.lateral_stress * extent(1 - a) * extent(2);
+      const double velocity_per_force =
+          deck_number(r.deck, fix, "vel_max") * deck_number(r.deck, fix, "kp") / force;
+      const double demcal =
+          c.test.servo_gain /
+          (c.material.wall.kn * std::max(1, w.wall(static_cast<SphereWallSide>(sd)).contacts) *
+           r.dt / r.step_factor);
+      EXPECT_NEAR(velocity_per_force / demcal, 1.0, 1e-12) << fix;
+      EXPECT_NE(r.deck.find(std::string("\"fix_modify m") + name[sd] + " servo/ctrlParam ${kp_m" +
+                            name[sd] + "} 0 0\""),
+                std::string::npos)
+          << name[sd];
+    }
+  }
+}
+
 TEST(EngineLiggghts, TheDecksPeakIsDemcalsWithinOnePercent) {
   // The exported LIGGGHTS deck (argument order of fix wall/gran, 2D masses,
   // servo sign and gain) over the whole loading of the 25-disc sample,
@@ -547,43 +652,20 @@ TEST(EngineLiggghts, TheDecksPeakIsDemcalsWithinOnePercent) {
   const std::string& text = liggghts_run.log;
   ASSERT_EQ(text.find("ERROR"), std::string::npos) << text;
   // Thermo rows: step dt time ke p_top p_left p_right xl xr.
-  const auto at = text.find("v_p_top");
-  ASSERT_NE(at, std::string::npos) << text;
-  std::stringstream lines(text.substr(text.find('\n', text.find("Step", at)) + 1));
+  ASSERT_NE(text.find("v_p_top"), std::string::npos) << text;
   double peak = 0.0, last_lateral = 0.0;
-  int rows = 0;
-  for (std::string line;
-       std::getline(lines, line) && line.find("Loop time") == std::string::npos;) {
-    std::stringstream f(line);
-    std::vector<double> v;
-    for (double x; f >> x;) v.push_back(x);
-    if (v.size() != 9) continue;
-    ++rows;
+  const auto thermo = liggghts_thermo(text);
+  ASSERT_FALSE(thermo.empty()) << text;
+  for (const auto& [step, v] : thermo) {
     peak = std::max(peak, v[4]);
     last_lateral = 0.5 * (v[5] + v[6]);
   }
-  EXPECT_GT(rows, 100);
+  EXPECT_GT(thermo.size(), 100u);
+  EXPECT_EQ(thermo.rbegin()->first, r.steps);
   EXPECT_NEAR(peak / -run.peak_stress_yy, 1.0, 0.01)
       << "LIGGGHTS " << peak << " Pa, demcal " << -run.peak_stress_yy << " Pa";
   // The servo held σ3 on the current height.
   EXPECT_NEAR(last_lateral / c.test.lateral_stress, 1.0, 0.005);
-}
-
-/// The thermo rows of a LIGGGHTS deck's loading run (after its thermo_style
-/// line with v_p_top): step dt time ke p_top p_left p_right xl xr, by step.
-std::map<int64_t, std::vector<double>> liggghts_thermo(const std::string& log) {
-  std::map<int64_t, std::vector<double>> rows;
-  const auto at = log.find("v_p_top");
-  if (at == std::string::npos) return rows;
-  std::stringstream lines(log.substr(log.find('\n', log.find("Step", at)) + 1));
-  for (std::string line;
-       std::getline(lines, line) && line.find("Loop time") == std::string::npos;) {
-    std::stringstream f(line);
-    std::vector<double> v;
-    for (double x; f >> x;) v.push_back(x);
-    if (v.size() == 9) rows[static_cast<int64_t>(v[0])] = v;
-  }
-  return rows;
 }
 
 class LiggghtsSeries : public ::testing::TestWithParam<const char*> {};
@@ -629,15 +711,24 @@ TEST_P(LiggghtsSeries, ScoresAsDemcalsRun) {
   EXPECT_EQ(scored.status, ours.passed ? 0 : 1);
   EXPECT_TRUE(summary["complete"].get<bool>());
   const double peak = summary["peak"]["stress_yy"].get<double>();
-  // Measured −0.034 % (the lateral servo targets σ3 on the current height,
-  // as demcal's); 0.5 % as the LAMMPS deck's test: the damping's explicit
-  // discretisation and the servo's fixed gain are what still differ.
+  const nlohmann::json& crit = summary["criteria"];
+  std::printf(
+      "hex 5x5 LIGGGHTS series (%s): peak %.7g Pa, demcal %.7g Pa (%+.4f %%); servo %.5g / "
+      "%.5g\n",
+      GetParam(), peak, ours.criteria.peak_stress_yy,
+      100 * (peak / ours.criteria.peak_stress_yy - 1), crit["servo"].get<double>(),
+      ours.criteria.servo);
+  // 0.5 % as the LAMMPS deck's test (the lateral servo targets σ3 on the
+  // current height and moves at demcal's velocity with demcal's gain; the
+  // damping's explicit discretisation and the tangential springs starting
+  // at zero are what still differ; reports/engines.md §14, §16).
   EXPECT_NEAR(peak / ours.criteria.peak_stress_yy, 1.0, 0.005)
       << "LIGGGHTS " << peak << " Pa, demcal " << ours.criteria.peak_stress_yy << " Pa";
-  // Same physics, same size of each criterion (as the LAMMPS deck's test).
-  const nlohmann::json& crit = summary["criteria"];
+  // Same physics, same size of each criterion (as the LAMMPS deck's test);
+  // the servo's error is demcal's (measured within 0.03 %; 0.84 of it
+  // while the deck's servo ran 1/f times faster with the start's gain).
   EXPECT_NEAR(crit["force_balance"].get<double>() / ours.criteria.force_balance, 1.0, 0.5);
-  EXPECT_NEAR(crit["servo"].get<double>() / ours.criteria.servo, 1.0, 0.5);
+  EXPECT_NEAR(crit["servo"].get<double>() / ours.criteria.servo, 1.0, 0.01);
   EXPECT_LT(crit["moment_balance"].get<double>(), Tolerances{}.moment_balance);
   // Frictionless walls: σxy − σyx is the torque column to rounding. With
   // wall friction LIGGGHTS' wall contacts carry their tangential force at
@@ -796,9 +887,11 @@ TEST(EngineLiggghts, RotatesDiscsWithTheDiscsInertia) {
 }
 
 TEST(EngineLiggghts, The3dDecksSeriesScoresAsDemcalsRun) {
-  // The 3D LIGGGHTS deck on fcc_4x4x4 (256 spheres, 40 000 steps, ζ_t 0.4,
-  // ζ_r = 0; at 20 000 steps demcal's servo error is 1.34 times its
-  // tolerance, LIGGGHTS' 0.91: a verdict on the edge): its series, scored
+  // The 3D LIGGGHTS deck on fcc_4x4x4 (256 spheres, 20 000 steps, ζ_t 0.4,
+  // ζ_r = 0; demcal's servo error is 1.34 times its tolerance: FAIL, a
+  // verdict the servo decides. Until the deck's servo moved at demcal's
+  // velocity, LIGGGHTS' read 0.91 times and PASSED, and this test ran
+  // 40 000 steps; reports/engines.md §16): its series, scored
   // by `demcal score` with the 3D default tolerances, against demcal's
   // triaxial run: same verdict, axial peak within 0.5 % (the monitored one
   // against demcal's step-level peak). The columns: b = σ at the static
@@ -814,7 +907,7 @@ TEST(EngineLiggghts, The3dDecksSeriesScoresAsDemcalsRun) {
   const TriaxialState state = consolidate_triaxial(c, make_sphere_assembly(c));
   AlgorithmSpec p;
   p.dt_ratio = 0.2;
-  p.steps = 40000;
+  p.steps = 20000;
   p.damping_ratio_translation = 0.4;
   p.damping_ratio_rotation = 0.0;
   const TriaxialResult run = run_triaxial_loading(state, c.test, p);
@@ -844,11 +937,12 @@ TEST(EngineLiggghts, The3dDecksSeriesScoresAsDemcalsRun) {
       peak, ours.criteria.peak_stress_yy, 100 * (peak / ours.criteria.peak_stress_yy - 1),
       crit["force_balance"].get<double>(), ours.criteria.force_balance, crit["servo"].get<double>(),
       ours.criteria.servo);
-  // Same physics, same size (as the 2D decks' tests); LIGGGHTS' servo gain
-  // comes from the contacts at the start, demcal's from the current ones
-  // (measured 0.68 of demcal's servo error).
+  // Same physics, same size (as the 2D decks' tests). The servo moves at
+  // demcal's velocity with demcal's gain: its error is demcal's (measured
+  // equal to 4 digits; 0.68 of it while the deck's servo ran 1/f times
+  // faster with the start's gain).
   EXPECT_NEAR(crit["force_balance"].get<double>() / ours.criteria.force_balance, 1.0, 0.5);
-  EXPECT_NEAR(crit["servo"].get<double>() / ours.criteria.servo, 1.0, 0.5);
+  EXPECT_NEAR(crit["servo"].get<double>() / ours.criteria.servo, 1.0, 0.01);
   EXPECT_NEAR(peak / ours.criteria.peak_stress_yy, 1.0, 0.005);
 
   const ExternalSeries series =
@@ -857,19 +951,10 @@ TEST(EngineLiggghts, The3dDecksSeriesScoresAsDemcalsRun) {
   ASSERT_EQ(static_cast<int>(series.triaxial.series.size()), c.test.monitor_points + 1);
   // Thermo rows of the loading: step time ke strain_zz p_axial p_lat p_top
   // p_bottom Wx Wy.
-  std::map<int64_t, std::vector<double>> thermo;
-  {
-    const auto at = lg.log.find("v_p_axial");
-    ASSERT_NE(at, std::string::npos);
-    std::stringstream lines(lg.log.substr(lg.log.find('\n', lg.log.find("Step", at)) + 1));
-    for (std::string line;
-         std::getline(lines, line) && line.find("Loop time") == std::string::npos;) {
-      std::stringstream f(line);
-      std::vector<double> v;
-      for (double x; f >> x;) v.push_back(x);
-      if (v.size() == 10) thermo[static_cast<int64_t>(v[0])] = v;
-    }
-  }
+  ASSERT_NE(lg.log.find("v_p_axial"), std::string::npos);
+  const auto thermo = liggghts_thermo(lg.log, "v_p_axial", 10);
+  ASSERT_FALSE(thermo.empty()) << lg.log;
+  EXPECT_EQ(thermo.rbegin()->first, r.steps);
   std::stringstream lines(test::read_text(dir / "series.csv"));
   std::vector<std::string> names;
   int compared = 0, rows = 0;

@@ -517,4 +517,34 @@ std::string liggghts_series(const std::string& deck, const std::string& scene, i
   return s.str();
 }
 
+double liggghts_servo_vel_max(double cap, double dt, double step_factor) {
+  return cap * step_factor / dt;
+}
+
+double liggghts_servo_kp(double gain, double force_target, double kn_wall, int contacts,
+                         double cap) {
+  return gain * std::abs(force_target) / (kn_wall * std::max(1, contacts) * cap);
+}
+
+std::string liggghts_servo_run(const std::vector<LiggghtsServoWall>& walls, double gain,
+                               double kn_wall, double cap, int every, NumberFormat f) {
+  std::ostringstream s;
+  s << "# The servo's gain follows each lateral wall's current contacts n (the\n"
+    << "# particles overlapping it) and target, as demcal's: between chunks of\n"
+    << "# ${servo_every} steps, kp = gain*|F_target|/(kn_wall*max(1, n)*cap)\n"
+    << "compute nservo all reduce sum";
+  for (const LiggghtsServoWall& w : walls) s << " v_" << w.touch;
+  s << "\n";
+  std::string modify;
+  for (size_t k = 0; k < walls.size(); ++k) {
+    const std::string n = "c_nservo[" + std::to_string(k + 1) + "]";
+    s << "variable kp_" << walls[k].fix << " equal " << f(gain) << "*abs(v_" << walls[k].target
+      << ")/(" << f(kn_wall) << "*(" << n << "+(" << n << "<1))*" << f(cap) << ")\n";
+    modify += " \"fix_modify " + walls[k].fix + " servo/ctrlParam ${kp_" + walls[k].fix + "} 0 0\"";
+  }
+  s << "variable servo_every index " << every << "\n"
+    << "run ${run_steps} pre no post no every ${servo_every}" << modify << "\n";
+  return s.str();
+}
+
 }  // namespace demcal::deck

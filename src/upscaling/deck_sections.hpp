@@ -247,4 +247,31 @@ std::string liggghts_series(const std::string& deck, const std::string& scene, i
                             std::optional<double> mass_scaling, int every, const std::string& row,
                             const std::string& columns);
 
+/// LIGGGHTS: a lateral servo mesh (fix mesh/surface/stress/servo) and
+/// what its gain is made of: `fix` its id, `target` its equal-style target
+/// force variable (the force on the mesh along +axis), `touch` a per-atom
+/// variable, 1 on the particles that overlap it (the series' own).
+struct LiggghtsServoWall {
+  std::string fix, target, touch;
+};
+
+/// LIGGGHTS' servo law (MeshModuleStressServo, 3.8) moves a mesh at
+/// vel_max·kp·(F_target − F)/|F_target| per unit time. With vel_max =
+/// cap/Δt_demcal (Δt_demcal = dt/step_factor: demcal's step, the engine's
+/// divided by f) and kp = gain·|F_target|/(kn_wall·max(1, n)·cap), a wall
+/// moves at demcal's velocity gain·(F_target − F)/(kn_wall·max(1, n)·Δt_demcal),
+/// capped at demcal's cap/Δt_demcal: over the same loading time, demcal's
+/// servo (per engine step: f times demcal's per-step move).
+double liggghts_servo_vel_max(double cap, double dt, double step_factor);
+double liggghts_servo_kp(double gain, double force_target, double kn_wall, int contacts,
+                         double cap);
+
+/// LIGGGHTS: the loading run, `${run_steps}` steps in chunks of `every`
+/// (run ... pre no every: one setup, the chunks continue the trajectory
+/// exactly), each wall's kp set between chunks (fix_modify
+/// servo/ctrlParam) from its current contacts and target, the formula of
+/// liggghts_servo_kp: the gain lags demcal's by `every` steps at most.
+std::string liggghts_servo_run(const std::vector<LiggghtsServoWall>& walls, double gain,
+                               double kn_wall, double cap, int every, NumberFormat f);
+
 }  // namespace demcal::deck

@@ -951,14 +951,22 @@ ExportResult liggghts(const SceneConfig& c, const AlgorithmSpec& p, const Assemb
   ExportResult out = result_of(plan);
   const int wall_type = plan.types + 1;
   const int ntypes = plan.types + 1;
-  // The lateral walls' contacts at the start and the servo gain that makes
-  // LIGGGHTS' mesh servo move as demcal's (see the deck's header).
-  int n_contacts = 0;
-  for (int i = 0; i < plan.n; ++i)
-    if (a.x[i] - a.r[i] <= a.left + 1e-9 * a.r[i]) ++n_contacts;
-  n_contacts = std::max(1, n_contacts);
+  // The lateral walls' contacts at the start (the particles overlapping
+  // each) and the servo gains that make LIGGGHTS' mesh servo move as
+  // demcal's (see the deck's header); the deck sets them from the current
+  // contacts as it runs.
+  int n_left = 0, n_right = 0;
+  for (int i = 0; i < plan.n; ++i) {
+    if (a.x[i] - a.r[i] <= a.left + 1e-9 * a.r[i]) ++n_left;
+    if (a.x[i] + a.r[i] >= a.right - 1e-9 * a.r[i]) ++n_right;
+  }
   const double force_target = c.test.lateral_stress * plan.height0 * m.thickness;
-  const double kp = c.test.servo_gain * force_target / (m.wall.kn * n_contacts * 0.02 * plan.r_min);
+  const double cap = 0.02 * plan.r_min;
+  const double kp_left =
+      deck::liggghts_servo_kp(c.test.servo_gain, force_target, m.wall.kn, n_left, cap);
+  const double kp_right =
+      deck::liggghts_servo_kp(c.test.servo_gain, force_target, m.wall.kn, n_right, cap);
+  const double vel_max = deck::liggghts_servo_vel_max(cap, plan.dt, plan.step_factor);
 
   // LIGGGHTS with dimension 2 computes a particle's mass as π·r²·density:
   // the areal density f_ms·ρ·t gives the disc's mass f_ms·ρ·t·π·r².
@@ -1000,19 +1008,23 @@ ExportResult liggghts(const SceneConfig& c, const AlgorithmSpec& p, const Assemb
     << "# run (same verdict, peak within 1 %: a test, where liggghts is installed;\n"
     << "# reports/engines.md). It writes demcal's monitoring series: demcal score series.csv\n"
     << "# Servo: LIGGGHTS moves the mesh at vel_max * kp * (F_target - F)/|F_target|;\n"
-    << "# vel_max = cap/dt and kp = gain*F_target(0)/(kn_wall*n_c*cap), n_c the wall\n"
-    << "# contacts at the start (" << n_contacts << "), give demcal's per-step move\n"
-    << "# gain*(F_target - F)/(kn_wall*n_c), times F_target(0)/F_target (1 + the strain\n"
-    << "# at most: kp is a constant here). F_target = sigma3*H*t follows the current\n"
-    << "# height (target_val v_ftl), demcal's target.\n"
+    << "# vel_max = cap/dt_demcal (dt_demcal = dt/f, demcal's step) and\n"
+    << "# kp = gain*|F_target|/(kn_wall*max(1, n)*cap), n the wall's current contacts,\n"
+    << "# give demcal's wall velocity gain*(F_target - F)/(kn_wall*max(1, n)*dt_demcal)\n"
+    << "# and its cap. LIGGGHTS' kp is a number: the run goes in chunks of\n"
+    << "# ${servo_every} steps (one setup) and kp is set from the current n and\n"
+    << "# F_target between them (fix_modify servo/ctrlParam; at the start from\n"
+    << "# demcal's counts, " << n_left << " left and " << n_right << " right): the gain\n"
+    << "# lags demcal's by one chunk at most. F_target = sigma3*H*t follows the\n"
+    << "# current height (target_val v_ftl), demcal's target.\n"
     << "# Run it with a screen (liggghts 3.8 crashes reading meshes with -screen none).\n"
     << "# Differences from demcal:\n"
     << "#  - rotation: LIGGGHTS 3.8's fix nve/sphere takes the disc's inertia m r^2/2\n"
     << "#    under dimension 2 (as demcal); masses are disc masses (pi r^2 * areal density).\n"
     << "#  - rotational damping (zeta_r = " << num(p.damping_ratio_rotation)
     << ") has no fix here and is not applied.\n"
-    << "#  - the servo's per-step gain is fixed by the contacts at the start (demcal:\n"
-    << "#    the current contacts).\n"
+    << "#  - the servo's gain follows the contacts every ${servo_every} steps (demcal:\n"
+    << "#    every step).\n"
     << "#  - translational damping per radius class via fix viscous ... scale.\n";
   s << deck::liggghts_preamble(2, "f f p", o.data_name, plan.r_min)
     << deck::liggghts_materials(m, ntypes, plan.dt, num)
@@ -1025,12 +1037,12 @@ ExportResult liggghts(const SceneConfig& c, const AlgorithmSpec& p, const Assemb
     << "fix mtop all mesh/surface/stress file " << top << " type " << wall_type << "\n"
     << "fix mleft all mesh/surface/stress/servo file " << left << " type " << wall_type << " com "
     << num(a.left) << " " << num(0.5 * (a.bottom + a.top))
-    << " 0 ctrlPV force axis 1 0 0 target_val v_ftl vel_max " << num(0.02 * plan.r_min / plan.dt)
-    << " kp " << num(kp) << "\n"
+    << " 0 ctrlPV force axis 1 0 0 target_val v_ftl vel_max " << num(vel_max) << " kp "
+    << num(kp_left) << "\n"
     << "fix mright all mesh/surface/stress/servo file " << right << " type " << wall_type << " com "
     << num(a.right) << " " << num(0.5 * (a.bottom + a.top))
-    << " 0 ctrlPV force axis 1 0 0 target_val v_ftr vel_max " << num(0.02 * plan.r_min / plan.dt)
-    << " kp " << num(kp) << "\n"
+    << " 0 ctrlPV force axis 1 0 0 target_val v_ftr vel_max " << num(vel_max) << " kp "
+    << num(kp_right) << "\n"
     << "fix walls all wall/gran model hooke/stiffness tangential history mesh n_meshes 3 meshes "
        "mtop mleft mright store_force yes absolute_damping on tangential_damping off\n"
     << "fix movetop all move/mesh mesh mtop linear 0 " << num(-plan.top_speed) << " 0\n\n"
@@ -1046,7 +1058,8 @@ ExportResult liggghts(const SceneConfig& c, const AlgorithmSpec& p, const Assemb
     << "thermo_style custom step dt time ke v_p_top v_p_left v_p_right v_xl v_xr\n"
     << "thermo " << plan.thermo_every << "\n"
     << "variable run_steps index " << plan.steps << "\n"
-    << "run ${run_steps}\n";
+    << deck::liggghts_servo_run({{"mleft", "ftl", "ll_a"}, {"mright", "ftr", "lr_a"}},
+                                c.test.servo_gain, m.wall.kn, cap, plan.thermo_every, num);
   out.deck = s.str();
   return out;
 }

@@ -892,22 +892,27 @@ std::string liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p, const Pl
   out.files[mesh_file[4]] = stl_rectangle("top", V3(lo.x() - mx, lo.y() - my, hi.z()),
                                           V3(0, ext[1] + 2 * my, 0), V3(ext[0] + 2 * mx, 0, 0));
 
-  // Servo: LIGGGHTS moves a servo mesh at vel_max·kp·(F_target − F)/|F_target|
-  // per unit time; vel_max = cap/dt and kp = gain·F_target/(kn_wall·n_c·cap)
-  // give demcal's per-step move gain·(F_target − F)/(kn_wall·n_c), n_c the
-  // wall's contacts at the start (demcal: the current count).
+  // Servo: demcal's law over the same loading time (deck::liggghts_servo_kp
+  // and vel_max), the gain from each wall's current contacts, set between
+  // chunks of the run (deck::liggghts_servo_run); at the start from the
+  // contacts demcal counts.
   const double cap = 0.02 * plan.r_min;
+  const double vel_max = deck::liggghts_servo_vel_max(cap, plan.dt, plan.step_factor);
   std::ostringstream s;
   s << mapping_header(c, p, plan, o, "LIGGGHTS");
   s << "#\n# Checked with LIGGGHTS 3.8 (Debian). Differences from demcal:\n"
     << "#  - rotational damping: no fix here (zeta_r not applied).\n"
     << "#  - lateral walls: fix mesh/surface/stress/servo holds the wall force at\n"
     << "#    sigma3*A, A the wall's current area (target_val v_ft_WALL), demcal's\n"
-    << "#    target; its gain kp = gain*F_target(0)/(kn_wall*n_c*cap) with vel_max =\n"
-    << "#    cap/dt gives demcal's per-step move gain*(F_target - F)/(kn_wall*n_c) times\n"
-    << "#    F_target(0)/F_target (kp is a constant: within the strain), n_c the wall's\n"
-    << "#    contacts at the start (demcal uses the current count); the target is the\n"
-    << "#    force on the mesh along +axis: positive on a min wall.\n"
+    << "#    target (the force on the mesh along +axis: positive on a min wall).\n"
+    << "#    LIGGGHTS moves it at vel_max*kp*(F_target - F)/|F_target|: vel_max =\n"
+    << "#    cap/dt_demcal (dt_demcal = dt/f, demcal's step) and kp =\n"
+    << "#    gain*|F_target|/(kn_wall*max(1, n)*cap), n the wall's current contacts,\n"
+    << "#    give demcal's wall velocity gain*(F_target - F)/(kn_wall*max(1, n)*dt_demcal)\n"
+    << "#    and its cap. LIGGGHTS' kp is a number: the run goes in chunks of\n"
+    << "#    ${servo_every} steps (one setup) and kp is set from the current n and\n"
+    << "#    F_target between them (fix_modify servo/ctrlParam; at the start from\n"
+    << "#    demcal's count): the gain lags demcal's by one chunk at most.\n"
     << "#  - translational damping per radius class via fix viscous ... scale.\n"
     << "# Run it with a screen (liggghts 3.8 crashes reading meshes with -screen none).\n"
     << "#  - the bottom is a fixed mesh (not a primitive plane) so that its force is\n"
@@ -917,8 +922,9 @@ std::string liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p, const Pl
     << "# Thermo: p_axial = (p_top + p_bottom)/2, p_lat (mean of the four lateral\n"
     << "# walls), Pa, on the current areas; sigma1/sigma3 = p_axial/p_lat (no\n"
     << "# column: both are 0 at the start, before LIGGGHTS computes mesh forces).\n";
-  out.notes.push_back(
-      "LIGGGHTS deck: servo gain from the wall contacts at the start; no rotational damping");
+  out.notes.push_back("LIGGGHTS deck: servo gain from the walls' current contacts, set every " +
+                      std::to_string(deck::monitor_interval(plan.steps, c.test.monitor_points)) +
+                      " steps; no rotational damping");
   if (!o.lateral_servo)
     out.notes.push_back("LIGGGHTS deck: lateral walls fixed (lateral_servo off)");
   s << deck::liggghts_preamble(3, "f f f", o.data_name, plan.r_min)
@@ -930,8 +936,8 @@ std::string liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p, const Pl
     const int a = sd / 2;
     const double area = ext[(a + 1) % 3] * ext[(a + 2) % 3];
     const double target = c.test.lateral_stress * area;
-    const int n_c = std::max(1, plan.wall_contacts[sd]);
-    const double kp = o.lateral_servo ? c.test.servo_gain * target / (m.wall.kn * n_c * cap) : 0.0;
+    const double kp =
+        deck::liggghts_servo_kp(c.test.servo_gain, target, m.wall.kn, plan.wall_contacts[sd], cap);
     V3 com = centre;
     com[a] = sd % 2 == 0 ? plan.lo[a] : plan.hi[a];
     if (o.lateral_servo) {
@@ -945,8 +951,8 @@ std::string liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p, const Pl
       s << "fix m" << kWall[sd] << " all mesh/surface/stress/servo file " << mesh_file[sd]
         << " type " << wall_type << " com " << exact(com.x()) << " " << exact(com.y()) << " "
         << exact(com.z()) << " ctrlPV force axis " << (a == 0 ? "1 0 0" : "0 1 0")
-        << " target_val v_ft_" << kWall[sd] << " vel_max " << exact(cap / plan.dt) << " kp "
-        << exact(kp) << "\n";
+        << " target_val v_ft_" << kWall[sd] << " vel_max " << exact(vel_max) << " kp " << exact(kp)
+        << "\n";
     } else {
       s << "fix m" << kWall[sd] << " all mesh/surface/stress file " << mesh_file[sd] << " type "
         << wall_type << "\n";
@@ -982,8 +988,16 @@ std::string liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p, const Pl
     << "thermo_style custom step time ke v_strain_zz v_p_axial v_p_lat v_p_top v_p_bottom v_Wx "
        "v_Wy\n"
     << "thermo ${thermo_every}\n"
-    << "variable run_steps index " << plan.steps << "\n"
-    << "run ${run_steps}\n";
+    << "variable run_steps index " << plan.steps << "\n";
+  if (o.lateral_servo) {
+    std::vector<deck::LiggghtsServoWall> walls;
+    for (int sd = 0; sd < 4; ++sd)
+      walls.push_back({std::string("m") + kWall[sd], std::string("ft_") + kWall[sd],
+                       "t" + std::to_string(sd) + "_a"});
+    s << deck::liggghts_servo_run(walls, c.test.servo_gain, m.wall.kn, cap, monitor_every, exact);
+  } else {
+    s << "run ${run_steps}\n";
+  }
   return s.str();
 }
 
