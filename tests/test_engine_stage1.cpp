@@ -4,8 +4,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <regex>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -59,10 +61,12 @@ std::string stage1_outcome(const std::string& log) {
 /// is wall k's area variable (walls min, max, axis by axis). Both run stage 1
 /// to its end and `loading` steps of the loading; a trace of every stage-1
 /// step's moves and running means (%.20g), the printed step count, the end
-/// walls and the series compare character for character.
+/// walls and the series compare character for character. Both decks' cap is
+/// `cap` times r_min (the export's 0.02: the clamp would rarely bind), and
+/// over a hundred moves must bind and as many not.
 void expect_per_wall_bit_for_bit(const std::string& lmp, const ExportResult& r,
                                  const std::vector<std::string>& area, const std::string& tail,
-                                 const std::string& tag, int loading) {
+                                 const std::string& tag, int loading, const std::string& cap) {
   const size_t walls = area.size();
   const std::string rawv = line_of(r.deck, "variable        cons_rawv vector ");
   const std::string head =
@@ -119,10 +123,19 @@ void expect_per_wall_bit_for_bit(const std::string& lmp, const ExportResult& r,
   for (size_t k = 0; k < walls; ++k) fix_moves += " $(f_moves[" + std::to_string(k + 1) + "])";
   per_wall_deck = traced(per_wall_deck, per_wall_fixes, fix_moves);
 
+  // the cap (2 % of r_min) lowered in both decks so that the clamp binds at
+  // some steps and not at others: both branches of the clamp are compared
+  auto capped = [&](const std::string& deck) {
+    return replaced(deck, "variable        cap equal $(0.02*v_r_min)",
+                    "variable        cap equal $(" + cap + "*v_r_min)");
+  };
+  per_wall_deck = capped(per_wall_deck);
+
   const test::TempDir dir(tag);
   const std::vector<std::string> args{"-var", "run_steps", std::to_string(loading), "-screen",
                                       "none"};
-  const test::DeckRun vector = test::run_deck(lmp, dir / "vector", vector_deck, r.files, args);
+  const test::DeckRun vector =
+      test::run_deck(lmp, dir / "vector", capped(vector_deck), r.files, args);
   ASSERT_EQ(vector.status, 0) << vector.log;
   const test::DeckRun scalar = test::run_deck(lmp, dir / "per_wall", per_wall_deck, r.files, args);
   ASSERT_EQ(scalar.status, 0) << scalar.log;
@@ -135,6 +148,23 @@ void expect_per_wall_bit_for_bit(const std::string& lmp, const ExportResult& r,
                     tb = test::read_text(dir / "per_wall" / "trace.txt");
   EXPECT_GE(std::count(ta.begin(), ta.end(), '\n'), 500);
   EXPECT_EQ(ta, tb);
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(vector.log, m, std::regex("\nvariable +cap equal ([-+0-9.e]+)\n")));
+  const double cap_value = std::stod(m[1].str());
+  int clamped = 0, free = 0;
+  std::stringstream rows(ta);
+  for (std::string row; std::getline(rows, row);) {
+    if (row.empty() || row[0] == '#') continue;
+    std::stringstream fields(row);
+    std::vector<double> v;
+    for (double x; fields >> x;) v.push_back(x);
+    ASSERT_EQ(v.size(), 2 * walls) << row;
+    // a bound move is the cap to rounding ((x+cap)-(x-cap) is 2 cap to an ulp of x)
+    for (size_t k = walls; k < 2 * walls; ++k)
+      ++(std::abs(v[k]) > (1 - 1e-9) * cap_value ? clamped : free);
+  }
+  EXPECT_GT(clamped, 100) << "the clamp never bound";
+  EXPECT_GT(free, 100) << "the clamp always bound";
   const std::string sa = test::read_text(dir / "vector" / "series.csv"),
                     sb = test::read_text(dir / "per_wall" / "series.csv");
   EXPECT_GE(std::count(sa.begin(), sa.end(), '\n'), 10);
@@ -143,7 +173,8 @@ void expect_per_wall_bit_for_bit(const std::string& lmp, const ExportResult& r,
 
 TEST(EngineLammpsStage1, TheVectorServoIsThePerWallFormulaBitForBit2D) {
   // Hex 5x5 as generated, with contact damping: the servo's R carries the
-  // wall dashpots' c/dt, so that part of the formula is checked too.
+  // wall dashpots' c/dt, so that part of the formula is checked too. The
+  // cap at 1e-5 r_min: about half the moves bound.
   const std::string lmp = test::find_on_path("lmp");
   if (lmp.empty())
     GTEST_SKIP() << "LAMMPS (lmp) is not installed (apt-get install lammps): the deck is not run";
@@ -159,12 +190,12 @@ TEST(EngineLammpsStage1, TheVectorServoIsThePerWallFormulaBitForBit2D) {
   const ExportResult r = export_deck(c, p, make_assembly(c), o);
   EXPECT_NE(line_of(r.deck, "variable        cons_rawv vector ").find("/dt)"), std::string::npos);
   expect_per_wall_bit_for_bit(lmp, r, {"cons_H", "cons_H", "cons_W", "cons_W"}, "*${thick}",
-                              "engine_stage1_2d", 1000);
+                              "engine_stage1_2d", 1000, "0.00001");
 }
 
 TEST(EngineLammpsStage1, TheVectorServoIsThePerWallFormulaBitForBit3D) {
-  // The fcc_4x4x4 lattice as generated (256 spheres): the walls close in
-  // at the cap first, then the servo's law holds sigma3.
+  // The fcc_4x4x4 lattice as generated (256 spheres); its moves are mostly
+  // 1e-16 .. 1e-11 m, hence the cap at 1e-8 r_min (half the moves bound).
   const std::string lmp = test::find_on_path("lmp");
   if (lmp.empty())
     GTEST_SKIP() << "LAMMPS (lmp) is not installed (apt-get install lammps): the deck is not run";
@@ -179,7 +210,7 @@ TEST(EngineLammpsStage1, TheVectorServoIsThePerWallFormulaBitForBit3D) {
   const ExportResult r = export_3d_decks(c, p, make_sphere_assembly(c), o);
   expect_per_wall_bit_for_bit(lmp, r,
                               {"cons_Ax", "cons_Ax", "cons_Ay", "cons_Ay", "cons_Az", "cons_Az"},
-                              "", "engine_stage1_3d", 500);
+                              "", "engine_stage1_3d", 500, "0.00000001");
 }
 
 }  // namespace
