@@ -486,8 +486,7 @@ TEST(Export3d, LammpsDeckCarriesTheConsolidationStage) {
   for (const char* line :
        {"variable consolidate index 1", "variable cons_check equal 200",
         "if              \"${consolidate} == 0\" then \"jump SELF loading\"",
-        "fix             cons_servo all ave/time 1 1 1 v_cons_mxmin v_cons_mxmax v_cons_mymin "
-        "v_cons_mymax v_cons_mzmin v_cons_mzmax ave running",
+        "fix             cons_servo all ave/time 1 1 1 v_cons_movev mode vector ave running",
         "fix             cons_halt all halt ${cons_check} v_cons_static > 0.5",
         "pair_style      gran/hooke/history ${kn} ${kt} 0 0.0 0 0\n",
         "variable        zmax0 delete\n", "label           loading\n"})

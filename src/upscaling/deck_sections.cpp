@@ -237,8 +237,8 @@ std::string lammps_servo_raw(const std::string& area, const std::string& minus_f
 }
 
 std::string lammps_servo_raw_of_load(const std::string& load, const std::string& minus_force,
-                                     const std::string& count_max) {
-  return "${gain}*(" + load + minus_force + ")/(${kn_wall}*" + count_max + ")";
+                                     const std::string& count_max, const std::string& resist) {
+  return "${gain}*(" + load + minus_force + ")/(" + resist + "*" + count_max + ")";
 }
 
 std::string lammps_count_at_least_one(const std::string& count) {
@@ -305,6 +305,56 @@ std::string lammps_consolidation_viscous(const std::vector<double>& gamma) {
   return out;
 }
 
+std::string lammps_consolidation_reductions(const std::vector<ConsolidationWall>& walls) {
+  std::string n, f;
+  for (const ConsolidationWall& w : walls) {
+    n += " f_cons_w" + w.name + "[1]";
+    f += " f_cons_w" + w.name + "[" + std::to_string(2 + (w.axis - 'x')) + "]";
+  }
+  return "# each wall's contacts (cons_wn) and force along its axis on the particles\n"
+         "# (cons_wf), one column per wall\n"
+         "compute         cons_wn all reduce sum" +
+         n + "\ncompute         cons_wf all reduce sum" + f + "\n";
+}
+
+std::string lammps_consolidation_servo(const std::vector<ConsolidationWall>& walls,
+                                       const std::vector<std::string>& area,
+                                       const std::string& area_tail, const std::string& resist) {
+  std::ostringstream s;
+  s << "# The servo, one move per step and wall toward the sample when p < sigma3:\n"
+    << "#   move = gain*(sigma3*A - F)/(R*max(1, n)), clamped to +-cap,\n"
+    << "# all walls in one vector-style formula (elements in cons_wn's order; a max\n"
+    << "# wall's with the opposite sign, so that each clamped element is the wall's\n"
+    << "# move along +axis), parsed once per step for all, the clamp reading the\n"
+    << "# unclamped moves as doubles (a vector variable is evaluated once per step,\n"
+    << "# then kept). Each wall's area factor is the value a per-wall formula reads\n"
+    << "# (a v_ reference goes through text: cons_*q read it so), stored once per\n"
+    << "# step by fix cons_geom and laid out per wall by fix cons_len; the signs are\n"
+    << "# internal variables. No min/max of two numbers in this release: max(1, n)\n"
+    << "# = n+(n<1) for a contact count n, clamp(x) = (abs(x+cap)-abs(x-cap))/2.\n";
+  std::string geom, len, sign;
+  for (size_t a = 0; a < area.size(); ++a) {
+    s << "variable        " << area[a] << "q equal v_" << area[a] << "\n";
+    geom += " v_" + area[a] + "q";
+  }
+  for (size_t k = 0; k < walls.size(); ++k) {
+    len += " f_cons_geom[" + std::to_string(k / 2 + 1) + "]";
+    sign += walls[k].min ? " v_cons_one" : " v_cons_mone";
+  }
+  s << "fix             cons_geom all ave/time 1 1 1" << geom << "\n"
+    << "fix             cons_len all ave/time 1 1 1" << len << "\n"
+    << "variable        cons_one internal 1\n"
+    << "variable        cons_mone internal -1\n"
+    << "fix             cons_sign all ave/time 1 1 1" << sign << "\n"
+    << "variable        cons_rawv vector "
+    << lammps_servo_raw_of_load("f_cons_sign*${sigma3}*f_cons_len" + area_tail, "-c_cons_wf",
+                                lammps_count_at_least_one("c_cons_wn"), resist)
+    << "\n"
+    << "variable        cons_movev vector " << lammps_servo_clamp("v_cons_rawv") << "\n"
+    << "fix             cons_servo all ave/time 1 1 1 v_cons_movev mode vector ave running\n";
+  return s.str();
+}
+
 namespace {
 /// max(a, b) = (a+b+abs(a-b))/2: no max() of two numbers in this release.
 std::string max_of(const std::string& a, const std::string& b) {
@@ -338,7 +388,7 @@ std::string lammps_consolidation_criterion(int dimension,
     << "compute         cons_at all reduce sum v_cons_fnet v_cons_fw c_cons_nc\n"
     << "# (x==0) is 1 for x = 0: no contacts yet (a gas) gives ratio 0, as in demcal\n"
     << "variable        cons_nct equal c_cons_at[3]/2";
-  for (const ConsolidationWall& w : walls) s << "+c_cons_w[" << w.column << "]";
+  for (const ConsolidationWall& w : walls) s << "+c_cons_wn[" << w.column << "]";
   s << "\n"
     << "variable        cons_fct equal c_cons_fp+c_cons_at[2]\n"
     << "variable        cons_ufr equal (c_cons_at[1]/atoms)*(v_cons_nct+(v_cons_nct==0))/"
@@ -416,8 +466,8 @@ std::string lammps_consolidation_runs(double gamma_n, double dt_damped,
 }
 
 std::string lammps_consolidated_wall(const ConsolidationWall& w, int i) {
-  const std::string n = "c_cons_w[" + std::to_string(w.column) + "]";
-  const std::string f = "c_cons_w[" + std::to_string(w.column + 1) + "]";
+  const std::string n = "c_cons_wn[" + std::to_string(w.column) + "]";
+  const std::string f = "c_cons_wf[" + std::to_string(w.column) + "]";
   const std::string pos = "c_cons_pos[" + std::to_string(i + 1) + "]";
   return w.min ? "$((" + f + "/v_kn_wall-" + pos + ")/" + n + ")"
                : "$((" + pos + "+" + f + "/v_kn_wall)/" + n + ")";
@@ -430,9 +480,10 @@ std::string lammps_consolidation_end(const std::vector<ConsolidationWall>& walls
     << "set             group all omega 0 0 0\n"
     << "unfix           cons_halt\n";
   for (const char* c :
-       {"cons_at", "cons_pos", "cons_rad", "cons_fp", "cons_nc", "cons_pair", "cons_w"})
+       {"cons_at", "cons_pos", "cons_rad", "cons_fp", "cons_nc", "cons_pair", "cons_wn", "cons_wf"})
     s << "uncompute       " << c << "\n";
-  s << "unfix           cons_servo\n";
+  for (const char* f : {"cons_servo", "cons_sign", "cons_len", "cons_geom"})
+    s << "unfix           " << f << "\n";
   for (const std::string& f : extra_fixes) s << "unfix           " << f << "\n";
   s << "unfix           cons_damp\n"
     << "unfix           cons_fcon\n";

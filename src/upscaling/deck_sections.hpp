@@ -144,8 +144,10 @@ std::string lammps_servo_clamp(const std::string& x);
 /// fix's stored value of sigma3*A) and max(1, n) given as a formula
 /// (`count_max`): gain*(load - F)/(kn_wall*count_max). lammps_servo_raw is
 /// this with load = "${sigma3}*" + area and count_max = (1+n+abs(1-n))/2.
+/// `resist` replaces kn_wall (e.g. "(${kn_wall}+c/dt)" with wall dashpots).
 std::string lammps_servo_raw_of_load(const std::string& load, const std::string& minus_force,
-                                     const std::string& count_max);
+                                     const std::string& count_max,
+                                     const std::string& resist = "${kn_wall}");
 /// max(1, n) of a contact count n (a sum of ones: an integer-valued double)
 /// as n+(n<1): for such n the same double as (1+n+abs(1-n))/2 and as
 /// kn_wall*(1+n+abs(1-n))/2 = kn_wall*max(1, n) (2n/2 is exact), two
@@ -177,9 +179,29 @@ struct ConsolidationWall {
   std::string name;      ///< fix cons_w<name>, e.g. "l" (2D left), "xmin"
   char axis = 'x';       ///< the wall's axis
   bool min = true;       ///< inward normal +axis (left, bottom, x min ...)
-  int column = 0;        ///< compute cons_w: [column] its contacts, [column+1] its force
+  int column = 0;        ///< its contacts c_cons_wn[column], its force c_cons_wf[column]
   std::string pressure;  ///< its compressive pressure [Pa], an equal-style formula
 };
+
+/// Stage 1's per-wall sums over the particles (walls in pairs, min then max,
+/// axis by axis; wall k is column k+1): compute cons_wn, each wall's contact
+/// count, and compute cons_wf, its force along its axis on the particles
+/// (f_cons_wNAME[1] and [2 + axis]).
+std::string lammps_consolidation_reductions(const std::vector<ConsolidationWall>& walls);
+
+/// Stage 1's servo: every wall's move per step, gain*(sigma3*A - F)/(R*max(1,
+/// n)) clamped to ±cap, in one vector-style formula (cons_rawv, clamped by
+/// cons_movev; element k is wall k's move along +axis, the max walls' computed
+/// with the opposite sign), summed by fix cons_servo (f_cons_servo[k], the
+/// running mean). `area`: one equal-style variable per axis whose value (read
+/// as a `v_` reference reads it, through text) times `area_tail` is the area
+/// of that axis's walls (2D: "cons_H", "cons_W" and "*${thick}"; 3D:
+/// "cons_Ax" .. "cons_Az" and ""); `resist` R, e.g. "${kn_wall}". Each element
+/// is, bit for bit, the per-wall formula lammps_servo_move(A, ∓F, n) (negated
+/// for a max wall).
+std::string lammps_consolidation_servo(const std::vector<ConsolidationWall>& walls,
+                                       const std::vector<std::string>& area,
+                                       const std::string& area_tail, const std::string& resist);
 
 /// Stage 1's lines in the parameters block: consolidate (1: run it), the
 /// scene's test.consolidation_* values (cons_tol, cons_unbalanced,

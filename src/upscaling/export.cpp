@@ -591,22 +591,24 @@ std::string consolidation_viscous(const SceneConfig& c, const Plan& plan, double
   return deck::lammps_consolidation_viscous(gamma);
 }
 
+/// Stage 1's walls, in compute cons_wn's (cons_wf's) order.
+std::vector<deck::ConsolidationWall> consolidation_walls() {
+  return {{"l", 'x', true, 1, "c_cons_wf[1]/(v_cons_H*v_thick)"},
+          {"r", 'x', false, 2, "-c_cons_wf[2]/(v_cons_H*v_thick)"},
+          {"b", 'y', true, 3, "c_cons_wf[3]/(v_cons_W*v_thick)"},
+          {"t", 'y', false, 4, "-c_cons_wf[4]/(v_cons_W*v_thick)"}};
+}
+
 /// Stage 1's walls and servo: four planes moved by demcal's per-step law.
 std::string lammps_consolidation_walls(const SceneConfig& c, const Plan& plan,
                                        const ConsolidationSteps& st) {
   const double zeta = kConsolidationDampingRatio;
-  const std::string& resist = st.resist;
   const double alpha = st.alpha, dt_light = st.dt_light;
-  // move = gain*(sigma3*L*t - F)/(R*max(1, n)), clamped to +-cap; F, n of
-  // compute cons_w: [1] [2] left n, F_x; [3] [4] right; [5] [6] bottom n, F_y;
-  // [7] [8] top; the force on the particles, inward for left and bottom
-  auto move = [&](const char* length, const char* sign, int n) {
-    const std::string raw = "${gain}*(${sigma3}*" + std::string(length) + "*${thick}" + sign +
-                            "c_cons_w[" + std::to_string(n + 1) + "])/(" + resist +
-                            "*(1+c_cons_w[" + std::to_string(n) + "]+abs(1-c_cons_w[" +
-                            std::to_string(n) + "]))/2)";
-    return "(abs(" + raw + "+${cap})-abs(" + raw + "-${cap}))/2";
-  };
+  // move = gain*(sigma3*L*t - F)/(R*max(1, n)), clamped to +-cap, per wall
+  // (deck::lammps_consolidation_servo): L the wall's length (H for left and
+  // right, W for bottom and top), F, n its force on the particles and
+  // contacts (compute cons_wf, cons_wn: left, right, bottom, top)
+  const std::vector<deck::ConsolidationWall> walls = consolidation_walls();
   std::ostringstream s;
   s << "# --- stage 1: consolidation to isotropic sigma3 -------------------------------\n"
     << "# demcal's consolidation (demcal export --consolidate-in deck), run here so\n"
@@ -653,30 +655,15 @@ std::string lammps_consolidation_walls(const SceneConfig& c, const Plan& plan,
   s << "fix             cons_fcon all store/force\n"
     << consolidation_viscous(c, plan, zeta) << "\n"
     << "fix             cons_twod all enforce2d\n"
-    << "compute         cons_w all reduce sum f_cons_wl[1] f_cons_wl[2] f_cons_wr[1] "
-       "f_cons_wr[2] &\n"
-    << "                f_cons_wb[1] f_cons_wb[3] f_cons_wt[1] f_cons_wt[3]\n"
+    << deck::lammps_consolidation_reductions(walls)
     << "variable        cons_xl equal v_xl0+v_cons_dxl\n"
     << "variable        cons_xr equal v_xr0+v_cons_dxr\n"
     << "variable        cons_yb equal v_yb0+v_cons_dyb\n"
     << "variable        cons_yt equal v_yt0+v_cons_dyt\n"
     << "variable        cons_H equal v_cons_yt-v_cons_yb\n"
     << "variable        cons_W equal v_cons_xr-v_cons_xl\n"
-    << "variable        cons_ml equal " << move("v_cons_H", "-", 1) << "\n"
-    << "variable        cons_mr equal -" << move("v_cons_H", "+", 3) << "\n"
-    << "variable        cons_mb equal " << move("v_cons_W", "-", 5) << "\n"
-    << "variable        cons_mt equal -" << move("v_cons_W", "+", 7) << "\n"
-    << "fix             cons_servo all ave/time 1 1 1 v_cons_ml v_cons_mr v_cons_mb "
-       "v_cons_mt ave running\n";
+    << deck::lammps_consolidation_servo(walls, {"cons_H", "cons_W"}, "*${thick}", st.resist);
   return s.str();
-}
-
-/// Stage 1's walls, in compute cons_w's order.
-std::vector<deck::ConsolidationWall> consolidation_walls() {
-  return {{"l", 'x', true, 1, "c_cons_w[2]/(v_cons_H*v_thick)"},
-          {"r", 'x', false, 3, "-c_cons_w[4]/(v_cons_H*v_thick)"},
-          {"b", 'y', true, 5, "c_cons_w[6]/(v_cons_W*v_thick)"},
-          {"t", 'y', false, 7, "-c_cons_w[8]/(v_cons_W*v_thick)"}};
 }
 
 /// Stage 1's end: the loading's start walls, particles at rest, step 0.

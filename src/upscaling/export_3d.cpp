@@ -343,15 +343,14 @@ void lammps_3d_system(std::ostream& s, const SceneConfig& c, const Plan3& plan,
 // Stage 1: demcal's consolidation (triaxial.cpp consolidate_triaxial, the
 // shared loop of scene/protocol_steps.hpp) in LAMMPS
 
-/// Stage 1's six walls, in compute cons_w's order (kWall).
+/// Stage 1's six walls, in compute cons_wn's (cons_wf's) order (kWall).
 std::vector<deck::ConsolidationWall> consolidation_walls() {
   const char* area[3] = {"v_cons_Ax", "v_cons_Ay", "v_cons_Az"};
   std::vector<deck::ConsolidationWall> walls;
   for (int sd = 0; sd < 6; ++sd) {
-    const int col = 2 * sd + 1;
     const bool min = sd % 2 == 0;
-    walls.push_back({kWall[sd], kAxis[sd / 2], min, col,
-                     std::string(min ? "" : "-") + "c_cons_w[" + std::to_string(col + 1) + "]/" +
+    walls.push_back({kWall[sd], kAxis[sd / 2], min, sd + 1,
+                     std::string(min ? "" : "-") + "c_cons_wf[" + std::to_string(sd + 1) + "]/" +
                          area[sd / 2]});
   }
   return walls;
@@ -417,13 +416,7 @@ void lammps_3d_consolidation(std::ostream& s, const SceneConfig& c, const Plan3&
       << kWall[sd] << " contacts\n";
   s << "fix             cons_fcon all store/force\n"
     << deck::lammps_consolidation_viscous(light) << "\n"
-    << "# contacts and force along the wall's axis, xmin xmax ymin ymax zmin zmax\n"
-    << "compute         cons_w all reduce sum";
-  for (int sd = 0; sd < 6; ++sd) {
-    if (sd == 2 || sd == 4) s << " &\n               ";
-    s << " f_cons_w" << kWall[sd] << "[1] f_cons_w" << kWall[sd] << "[" << 2 + sd / 2 << "]";
-  }
-  s << "\n";
+    << deck::lammps_consolidation_reductions(walls);
   for (int sd = 0; sd < 6; ++sd)
     s << "variable        cons_" << kWall[sd] << " equal v_" << kWall[sd] << "0+v_cons_d"
       << kWall[sd] << "\n";
@@ -433,18 +426,9 @@ void lammps_3d_consolidation(std::ostream& s, const SceneConfig& c, const Plan3&
   for (int a = 0; a < 3; ++a)
     s << "variable        cons_A" << kAxis[a] << " equal v_cons_L" << kAxis[(a + 1) % 3]
       << "*v_cons_L" << kAxis[(a + 2) % 3] << "\n";
-  std::string servo;
-  for (int sd = 0; sd < 6; ++sd) {
-    const std::string col = std::to_string(2 * sd + 2);
-    // F, the compressive force: +c on a min wall, -c on a max wall.
-    const std::string minus_force = std::string(sd % 2 == 0 ? "-" : "+") + "c_cons_w[" + col + "]";
-    s << "variable        cons_m" << kWall[sd] << " equal " << (sd % 2 == 0 ? "" : "-")
-      << deck::lammps_servo_move(std::string("v_cons_A") + kAxis[sd / 2], minus_force,
-                                 "c_cons_w[" + std::to_string(2 * sd + 1) + "]")
-      << "\n";
-    servo += std::string(" v_cons_m") + kWall[sd];
-  }
-  s << "fix             cons_servo all ave/time 1 1 1" << servo << " ave running\n"
+  // each wall's move gain*(sigma3*A - F)/(kn_wall*max(1, n)), A its axis's
+  // current area, in one vector formula (deck::lammps_consolidation_servo)
+  s << deck::lammps_consolidation_servo(walls, {"cons_Ax", "cons_Ay", "cons_Az"}, "", "${kn_wall}")
     << deck::lammps_consolidation_criterion(3, walls, {"x", "y", "z"})
     << deck::lammps_consolidation_runs(deck::contact_gamma_n(c.material, plan.m_mean), dt_damped,
                                        deck::lammps_consolidation_viscous(critical))

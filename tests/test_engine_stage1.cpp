@@ -1,0 +1,217 @@
+// Stage 1 of the LAMMPS decks that consolidate themselves (--consolidate-in
+// deck): every wall's servo move in one vector-style formula is the per-wall
+// formula, bit for bit (reports/engines.md §17).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "demcal/scene/config.hpp"
+#include "demcal/scene/packing.hpp"
+#include "demcal/scene/triaxial.hpp"
+#include "demcal/upscaling/export.hpp"
+#include "demcal/upscaling/export_3d.hpp"
+#include "support/files.hpp"
+#include "support/process.hpp"
+
+namespace demcal {
+namespace {
+
+namespace fs = std::filesystem;
+
+/// `what` replaced by `with` in `text` (which must hold it once).
+std::string replaced(std::string text, const std::string& what, const std::string& with) {
+  const auto at = text.find(what);
+  EXPECT_NE(at, std::string::npos) << what;
+  EXPECT_EQ(text.find(what, at + 1), std::string::npos) << what;
+  if (at != std::string::npos) text.replace(at, what.size(), with);
+  return text;
+}
+
+/// The whole line of `deck` that starts with `head`.
+std::string line_of(const std::string& deck, const std::string& head) {
+  const auto at = deck.find(head);
+  EXPECT_NE(at, std::string::npos) << head;
+  if (at == std::string::npos) return {};
+  return deck.substr(at, deck.find('\n', at) + 1 - at);
+}
+
+/// What stage 1 decided, from a log: the step count it printed and the
+/// start walls it left to the loading (the echoed lines with the values).
+std::string stage1_outcome(const std::string& log) {
+  static const std::regex line(
+      "(demcal deck: consolidated in [0-9][^\n]*|variable +[xyz][a-z]*0 (index|equal) "
+      "[-+0-9.e]+)\n");
+  std::string out;
+  for (std::sregex_iterator it(log.begin(), log.end(), line), end; it != end; ++it)
+    out += (*it)[0].str();
+  return out;
+}
+
+/// The exported deck (stage 1's servo a vector formula) against the same deck
+/// with the servo per wall and inline: each wall's scalar formula
+/// clamp(gain*(sigma3*A*tail ∓ F)/(R*(1+n+abs(1-n))/2)), the clamp of the
+/// unclamped formula itself, max(1, n) as (1+n+abs(1-n))/2, a max wall's force
+/// and move with their own signs (the form before engines.md §17). `area[k]`
+/// is wall k's area variable (walls min, max, axis by axis). Both run stage 1
+/// to its end and `loading` steps of the loading; a trace of every stage-1
+/// step's moves and running means (%.20g), the printed step count, the end
+/// walls and the series compare character for character. Both decks' cap is
+/// `cap` times r_min (the export's 0.02: the clamp would rarely bind), and
+/// over a hundred moves must bind and as many not.
+void expect_per_wall_bit_for_bit(const std::string& lmp, const ExportResult& r,
+                                 const std::vector<std::string>& area, const std::string& tail,
+                                 const std::string& tag, int loading, const std::string& cap) {
+  const size_t walls = area.size();
+  const std::string rawv = line_of(r.deck, "variable        cons_rawv vector ");
+  const std::string head =
+      "variable        cons_rawv vector ${gain}*(f_cons_sign*${sigma3}*f_cons_len" + tail +
+      "-c_cons_wf)/(";
+  const std::string foot = "*(c_cons_wn+(c_cons_wn<1)))\n";
+  ASSERT_EQ(rawv.rfind(head, 0), 0u) << rawv;
+  ASSERT_GT(rawv.size(), head.size() + foot.size()) << rawv;
+  ASSERT_EQ(rawv.substr(rawv.size() - foot.size()), foot) << rawv;
+  // R: kn_wall, plus the wall dashpots' c/dt with contact damping
+  const std::string resist = rawv.substr(head.size(), rawv.size() - head.size() - foot.size());
+  auto clamp = [](const std::string& x) {
+    return "(abs(" + x + "+${cap})-abs(" + x + "-${cap}))/2";
+  };
+  EXPECT_EQ(line_of(r.deck, "variable        cons_movev vector "),
+            "variable        cons_movev vector " + clamp("v_cons_rawv") + "\n");
+  const std::string servo =
+      "fix             cons_servo all ave/time 1 1 1 v_cons_movev mode "
+      "vector ave running\n";
+  ASSERT_NE(r.deck.find(servo), std::string::npos);
+
+  std::string per_wall_moves, names, vector_moves, means;
+  for (size_t k = 0; k < walls; ++k) {
+    const std::string i = std::to_string(k + 1), n = "c_cons_wn[" + i + "]";
+    const bool min = k % 2 == 0;
+    const std::string raw = "${gain}*(${sigma3}*v_" + area[k] + tail + (min ? "-" : "+") +
+                            "c_cons_wf[" + i + "])/(" + resist + "*(1+" + n + "+abs(1-" + n +
+                            "))/2)";
+    per_wall_moves +=
+        "variable        cons_m" + i + " equal " + (min ? "" : "-") + clamp(raw) + "\n";
+    names += " v_cons_m" + i;
+    vector_moves += " $(v_cons_movev[" + i + "])";
+    means += " $(f_cons_servo[" + i + "])";
+  }
+  // the moves every step (the per-wall ones read from a fix: a `v_`
+  // reference would go through text), after the line `after`; unfixed
+  // before stage 1's fixes go
+  auto traced = [&](const std::string& deck, const std::string& after, const std::string& moves) {
+    return replaced(replaced(deck, after,
+                             after + "fix             trace all print 1 \"" + means.substr(1) +
+                                 moves + "\" file trace.txt screen no\n"),
+                    "unfix           cons_servo\n",
+                    "unfix           trace\nunfix           cons_servo\n");
+  };
+  const std::string vector_deck = traced(r.deck, servo, vector_moves);
+  // (fix moves before fix cons_servo: both read the walls before this step's move)
+  const std::string per_wall_fixes = "fix             moves all ave/time 1 1 1" + names +
+                                     "\nfix             cons_servo all ave/time 1 1 1" + names +
+                                     " ave running\n";
+  std::string per_wall_deck = replaced(r.deck, servo, per_wall_moves + per_wall_fixes);
+  per_wall_deck = replaced(per_wall_deck, "unfix           cons_servo\n",
+                           "unfix           cons_servo\nunfix           moves\n");
+  std::string fix_moves;
+  for (size_t k = 0; k < walls; ++k) fix_moves += " $(f_moves[" + std::to_string(k + 1) + "])";
+  per_wall_deck = traced(per_wall_deck, per_wall_fixes, fix_moves);
+
+  // the cap (2 % of r_min) lowered in both decks so that the clamp binds at
+  // some steps and not at others: both branches of the clamp are compared
+  auto capped = [&](const std::string& deck) {
+    return replaced(deck, "variable        cap equal $(0.02*v_r_min)",
+                    "variable        cap equal $(" + cap + "*v_r_min)");
+  };
+  per_wall_deck = capped(per_wall_deck);
+
+  const test::TempDir dir(tag);
+  const std::vector<std::string> args{"-var", "run_steps", std::to_string(loading), "-screen",
+                                      "none"};
+  const test::DeckRun vector =
+      test::run_deck(lmp, dir / "vector", capped(vector_deck), r.files, args);
+  ASSERT_EQ(vector.status, 0) << vector.log;
+  const test::DeckRun scalar = test::run_deck(lmp, dir / "per_wall", per_wall_deck, r.files, args);
+  ASSERT_EQ(scalar.status, 0) << scalar.log;
+  const std::string outcome = stage1_outcome(vector.log);
+  EXPECT_NE(outcome.find("demcal deck: consolidated in"), std::string::npos) << vector.log;
+  EXPECT_EQ(std::count(outcome.begin(), outcome.end(), '\n'), 1 + static_cast<long>(walls))
+      << outcome;
+  EXPECT_EQ(outcome, stage1_outcome(scalar.log));
+  const std::string ta = test::read_text(dir / "vector" / "trace.txt"),
+                    tb = test::read_text(dir / "per_wall" / "trace.txt");
+  EXPECT_GE(std::count(ta.begin(), ta.end(), '\n'), 500);
+  EXPECT_EQ(ta, tb);
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(vector.log, m, std::regex("\nvariable +cap equal ([-+0-9.e]+)\n")));
+  const double cap_value = std::stod(m[1].str());
+  int clamped = 0, free = 0;
+  std::stringstream rows(ta);
+  for (std::string row; std::getline(rows, row);) {
+    if (row.empty() || row[0] == '#') continue;
+    std::stringstream fields(row);
+    std::vector<double> v;
+    for (double x; fields >> x;) v.push_back(x);
+    ASSERT_EQ(v.size(), 2 * walls) << row;
+    // a bound move is the cap to rounding ((x+cap)-(x-cap) is 2 cap to an ulp of x)
+    for (size_t k = walls; k < 2 * walls; ++k)
+      ++(std::abs(v[k]) > (1 - 1e-9) * cap_value ? clamped : free);
+  }
+  EXPECT_GT(clamped, 100) << "the clamp never bound";
+  EXPECT_GT(free, 100) << "the clamp always bound";
+  const std::string sa = test::read_text(dir / "vector" / "series.csv"),
+                    sb = test::read_text(dir / "per_wall" / "series.csv");
+  EXPECT_GE(std::count(sa.begin(), sa.end(), '\n'), 10);
+  EXPECT_EQ(sa, sb);
+}
+
+TEST(EngineLammpsStage1, TheVectorServoIsThePerWallFormulaBitForBit2D) {
+  // Hex 5x5 as generated, with contact damping: the servo's R carries the
+  // wall dashpots' c/dt, so that part of the formula is checked too. The
+  // cap at 1e-5 r_min: about half the moves bound.
+  const std::string lmp = test::find_on_path("lmp");
+  if (lmp.empty())
+    GTEST_SKIP() << "LAMMPS (lmp) is not installed (apt-get install lammps): the deck is not run";
+  SceneConfig c = default_config();
+  c.assembly.columns = c.assembly.rows = 5;
+  c.material.contact_damping_ratio = 0.1;
+  AlgorithmSpec p;
+  p.steps = 8000;
+  p.damping_ratio_rotation = 0.0;
+  ExportOptions o;
+  o.data_name = "hex5.data";
+  o.consolidate_in_deck = true;
+  const ExportResult r = export_deck(c, p, make_assembly(c), o);
+  EXPECT_NE(line_of(r.deck, "variable        cons_rawv vector ").find("/dt)"), std::string::npos);
+  expect_per_wall_bit_for_bit(lmp, r, {"cons_H", "cons_H", "cons_W", "cons_W"}, "*${thick}",
+                              "engine_stage1_2d", 1000, "0.00001");
+}
+
+TEST(EngineLammpsStage1, TheVectorServoIsThePerWallFormulaBitForBit3D) {
+  // The fcc_4x4x4 lattice as generated (256 spheres); its moves are mostly
+  // 1e-16 .. 1e-11 m, hence the cap at 1e-8 r_min (half the moves bound).
+  const std::string lmp = test::find_on_path("lmp");
+  if (lmp.empty())
+    GTEST_SKIP() << "LAMMPS (lmp) is not installed (apt-get install lammps): the deck is not run";
+  const SceneConfig c = load_config(test::shipped_config("fcc_4x4x4"));
+  AlgorithmSpec p;
+  p.steps = 8000;
+  p.damping_ratio_translation = 0.4;
+  p.damping_ratio_rotation = 0.0;
+  Export3dOptions o;
+  o.data_name = "r.data";
+  o.consolidate_in_deck = true;
+  const ExportResult r = export_3d_decks(c, p, make_sphere_assembly(c), o);
+  expect_per_wall_bit_for_bit(lmp, r,
+                              {"cons_Ax", "cons_Ax", "cons_Ay", "cons_Ay", "cons_Az", "cons_Az"},
+                              "", "engine_stage1_3d", 500, "0.00000001");
+}
+
+}  // namespace
+}  // namespace demcal
