@@ -348,8 +348,8 @@ std::string lammps_walls(bool normal_only) {
 /// demcal's servo law (scene/biaxial.cpp, servo_velocity) in the deck: the
 /// unclamped move and its clamp of both lateral walls as two vector-style
 /// formulas (each parsed once per step for both walls), summed every step by
-/// fix servo; the walls' displacements at the end of the run for the
-/// restart args (lammps_run).
+/// fix servol and servor (lammps_run); the walls' displacements at the end of
+/// the run for the restart args.
 std::string lammps_servo() {
   // (gain/kn_wall)*(sigma3*H*t - F)/max(1, n) per wall, sigma3*H*t =
   // load0 - load_step*step stored by fix servo_load, F the wall's force on
@@ -388,10 +388,10 @@ std::string lammps_servo() {
     << "variable        rawv vector " << raw << "\n"
     << "variable        movev vector " << deck::lammps_servo_clamp("v_rawv") << "\n"
     << "# the lateral walls' displacements at the run's last step (fix servo_end\n"
-    << "# evaluates them there only, before fix servo adds that step's move): the\n"
-    << "# restart args put a continuation's walls where this run's last step had\n"
-    << "# them (to the last bit), and the continuation's servo takes that step's\n"
-    << "# move again from there\n"
+    << "# evaluates them there only, before fix servol/servor add that step's move):\n"
+    << "# the restart args put a continuation's walls where this run's last step\n"
+    << "# had them (to the last bit), and the continuation's servo takes that\n"
+    << "# step's move again from there\n"
     << "variable        end_every equal $((1+v_run_steps+abs(1-v_run_steps))/2)\n"
     << "fix             servo_end all ave/time ${end_every} 1 ${end_every} v_dxl v_dxr\n"
     << "# (fix servol and servor, which sum the moves, are defined after fix series\n"
