@@ -28,6 +28,8 @@
 #   OLD_BUILD=dir: a second demcal build (e.g. a worktree at an older
 #   commit); its deck for the same data file runs as "old", alternating with
 #   bare and deck, so that a change to the deck is timed side by side
+#   CORE=c: pin the serial runs to core c (taskset -c c), so that the
+#   kinds alternate on the same core (a shared machine: pick the quietest)
 # Installs nothing; needs lmp (and mpirun for NP > 1).
 set -euo pipefail
 params="${1:?usage: bench/lammps_overhead.sh PARAMS.json [BUILD_DIR]}"
@@ -73,7 +75,8 @@ for n in $SIZES; do
   for rep in $(seq "${REPEAT:-1}"); do
   for np in $NP; do
     for kind in $kinds; do
-      launch=(lmp); [[ "$np" -gt 1 ]] && launch=(mpirun --allow-run-as-root --oversubscribe ${MPI_FLAGS:-} -np "$np" lmp)
+      launch=(lmp); [[ -n "${CORE:-}" ]] && launch=(taskset -c "$CORE" lmp)
+      [[ "$np" -gt 1 ]] && launch=(mpirun --allow-run-as-root --oversubscribe ${MPI_FLAGS:-} -np "$np" lmp)
       load=$(cut -d' ' -f1 /proc/loadavg)
       if [[ "$kind" == bare ]]; then args=(-var run_steps "$STEPS"); else
         args=("${deck_args[@]}" -var run_steps "$total" -var restart_out timed.restart); fi

@@ -296,16 +296,16 @@ INSTANTIATE_TEST_SUITE_P(EngineLammps, LammpsSeriesSources, ::testing::Values("h
 TEST(EngineLammps, TheVectorServoIsThePerWallFormulaBitForBit) {
   // The 2D deck evaluates both lateral walls' servo moves in one vector-style
   // formula (parsed once per step for both walls; the right wall's with the
-  // opposite sign, the target load sigma3*H*t stored once per step by a fix,
-  // max(1, n) as n+(n<1)) and clamps them as doubles (the clamp's vector
-  // formula reads the first one's values). The same deck with the servo
-  // written per wall and inline (one scalar formula each, max(1, n) =
+  // opposite sign, the target load sigma3*H*t = load0-load_step*step stored
+  // once per step by a fix, gain/kn_wall folded into gain_kn, max(1, n) as
+  // n+!n) and clamps them as doubles (the clamp's vector formula reads the
+  // first one's values). The same deck with the servo written per wall and
+  // inline (one scalar formula each of the same folded law, max(1, n) =
   // (1+n+abs(1-n))/2, the clamp of the unclamped formula itself, the right
-  // wall's force and move with their own signs: the form before these cuts)
-  // gives the same walls' mean moves at every step to the last bit, and the
-  // same series, character for character. Fails if a sign or an operation of
-  // the law moves. (Below ~1e-11 of a move the clamp absorbs a difference:
-  // abs(x+cap) rounds x to the last bit of cap, 1e-5 m against moves of
+  // wall's force and move with their own signs) gives the same walls' mean
+  // moves at every step to the last bit, and the same series, character for
+  // character. Fails if a sign or an operation of the law moves. (Below ~1e-11 of a move the clamp
+  // absorbs a difference: abs(x+cap) rounds x to the last bit of cap, 1e-5 m against moves of
   // ~1e-10 m; a re-association of the unclamped formula, e.g.
   // (A-F)*(gain/D), passes. The whole-run byte comparison of engines.md §13
   // is the finer gate.)
@@ -323,19 +323,20 @@ TEST(EngineLammps, TheVectorServoIsThePerWallFormulaBitForBit) {
     if (at == std::string::npos) return std::string();
     return r.deck.substr(at, r.deck.find('\n', at) + 1 - at);
   };
-  // demcal's law per wall: gain*(sigma3*H*t - F)/(kn_wall*max(1, n)), clamped
+  // demcal's law per wall: gain*(sigma3*H*t - F)/(kn_wall*max(1, n)), clamped,
+  // as (gain/kn_wall)*(sigma3*t*H0 - sigma3*t*vtop*dt*step - F)/max(1, n)
   auto raw = [](const std::string& minus_force, const std::string& n) {
-    return "${gain}*(${sigma3}*(${H0}-${vtop}*step*dt)*${thick}" + minus_force +
-           ")/(${kn_wall}*(1+" + n + "+abs(1-" + n + "))/2)";
+    return "${gain_kn}*(${load0}-${load_step}*step" + minus_force + ")/((1+" + n + "+abs(1-" + n +
+           "))/2)";
   };
   auto clamp = [](const std::string& x) {
     return "(abs(" + x + "+${cap})-abs(" + x + "-${cap}))/2";
   };
   EXPECT_EQ(line_of("variable        load equal "),
-            "variable        load equal ${sigma3}*(${H0}-${vtop}*step*dt)*${thick}\n");
+            "variable        load equal ${load0}-${load_step}*step\n");
   EXPECT_EQ(line_of("variable        rawv vector "),
-            "variable        rawv vector ${gain}*(f_servo_sign*f_servo_load-c_cf)/"
-            "(${kn_wall}*(c_cn+(c_cn<1)))\n");
+            "variable        rawv vector ${gain_kn}*(f_servo_sign*f_servo_load-c_cf)/"
+            "(c_cn+!c_cn)\n");
   EXPECT_EQ(line_of("variable        movev vector "),
             "variable        movev vector " + clamp("v_rawv") + "\n");
   std::string per_wall = replaced(r.deck, line_of("variable        rawv vector "), "");
@@ -343,18 +344,19 @@ TEST(EngineLammps, TheVectorServoIsThePerWallFormulaBitForBit) {
                            "fix             servo_sign all", "variable        load equal",
                            "fix             servo_load all", "variable        movev vector "})
     per_wall = replaced(per_wall, line_of(head), "");
-  per_wall = replaced(per_wall, line_of("fix             servo all ave/time"),
+  per_wall = replaced(per_wall, line_of("fix             servor all ave/time"),
+                      "fix             servor all ave/time 1 1 1 v_mover ave running\n");
+  per_wall = replaced(per_wall, line_of("fix             servol all ave/time"),
                       "variable        movel equal " + clamp(raw("-c_cf[1]", "c_cn[1]")) +
                           "\nvariable        mover equal -" + clamp(raw("+c_cf[2]", "c_cn[2]")) +
-                          "\nfix             servo all ave/time 1 1 1 v_movel v_mover ave "
-                          "running\n");
+                          "\nfix             servol all ave/time 1 1 1 v_movel ave running\n");
   // Every step, both walls' moves and mean moves to the last bit (%.20g: the
   // series' 15 digits, or the means alone, would hide a difference of the
   // moves' last bits for thousands of steps). The per-wall moves are read
   // from a fix (a `v_` reference would go through text).
   auto traced = [&](const std::string& deck, const std::string& moves) {
     return replaced(deck, "# --- output and run",
-                    "fix             trace all print 1 \"$(f_servo[1]) $(f_servo[2]) " + moves +
+                    "fix             trace all print 1 \"$(f_servol) $(f_servor) " + moves +
                         "\" file trace.txt screen no\n# --- output and run");
   };
   per_wall = replaced(per_wall, "# --- output and run",

@@ -84,14 +84,15 @@ TEST(Export, LammpsDeckMapsEveryParameter) {
         "variable kn        equal 100000000",
         // the lateral servo: both walls in one vector formula, summed after
         // the series is printed; the continuation's walls to the last bit
-        "variable        rawv vector ${gain}*(f_servo_sign*f_servo_load-c_cf)/",
-        "fix             servo all ave/time 1 1 1 v_movev mode vector ave running",
+        "variable        rawv vector ${gain_kn}*(f_servo_sign*f_servo_load-c_cf)/",
+        "fix             servol all ave/time 1 1 1 v_movev[1] ave running",
+        "fix             servor all ave/time 1 1 1 v_movev[2] ave running",
         "-var xl_now $(v_xl_now+f_servo_end[1])"})
     EXPECT_NE(r.deck.find(needle), std::string::npos) << needle;
-  // fix servo sums this step's moves after fix series printed the row, so a
+  // fix servol sums this step's moves after fix series printed the row, so a
   // row gives the walls where this step's forces had them
   EXPECT_LT(r.deck.find("fix             series all print"),
-            r.deck.find("fix             servo all ave/time"));
+            r.deck.find("fix             servol all ave/time"));
   // ζ_t·2·sqrt(kn·m) for the one class.
   const double gamma = 0.7 * s.damping_translation_crit;
   char buf[64];

@@ -245,6 +245,15 @@ std::string lammps_count_at_least_one(const std::string& count) {
   return "(" + count + "+(" + count + "<1))";
 }
 
+std::string lammps_servo_raw_folded(const std::string& load, const std::string& minus_force,
+                                    const std::string& count_max) {
+  return "${gain_kn}*(" + load + minus_force + ")/" + count_max;
+}
+
+std::string lammps_count_max_one(const std::string& count) {
+  return "(" + count + "+!" + count + ")";
+}
+
 std::string lammps_band(const std::string& name, const std::string& motion,
                         const std::string& comment) {
   std::string line = "variable " + name;

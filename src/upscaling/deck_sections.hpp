@@ -153,6 +153,16 @@ std::string lammps_servo_raw_of_load(const std::string& load, const std::string&
 /// kn_wall*(1+n+abs(1-n))/2 = kn_wall*max(1, n) (2n/2 is exact), two
 /// operations and no abs() fewer for the formula parser.
 std::string lammps_count_at_least_one(const std::string& count);
+/// The unclamped move with gain/kn_wall folded into one constant (the
+/// deck's derived `gain_kn`): gain_kn*(load - F)/count_max, `count_max`
+/// max(1, n) as a formula (lammps_count_max_one). The same law as
+/// lammps_servo_raw_of_load, rounded once less (the 2D deck's servo).
+std::string lammps_servo_raw_folded(const std::string& load, const std::string& minus_force,
+                                    const std::string& count_max);
+/// max(1, n) of a contact count n (an integer-valued double) as n+!n: n for
+/// n >= 1, 1 for n = 0 (`!` is 1 for 0, else 0), the same double as
+/// lammps_count_at_least_one with one number and one comparison fewer.
+std::string lammps_count_max_one(const std::string& count);
 
 /// LAMMPS: a wall's band depth (the particles a moving wall acts on lie
 /// within it of the wall's start), `motion` (the wall's largest travel in the

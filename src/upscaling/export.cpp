@@ -236,10 +236,6 @@ std::string lammps_series_block(const SceneConfig& c, const AlgorithmSpec& p, co
     << deck::lammps_series_header("LAMMPS deck", c.name, plan.n, p.damping_ratio_translation,
                                   plan.dt_crit, p.mass_scaling)
     << "label           series_rows\n"
-    << "fix             halt_top all halt ${monitor_every} v_clear_top < 0.0 error hard\n"
-    << "fix             halt_bottom all halt ${monitor_every} v_clear_bottom < 0.0 error hard\n"
-    << "fix             halt_left all halt ${monitor_every} v_clear_left < 0.0 error hard\n"
-    << "fix             halt_right all halt ${monitor_every} v_clear_right < 0.0 error hard\n"
     << "fix             series all print ${monitor_every} \"" << row
     << "\" append ${series} screen no title \"" << kColumns << "\"\n\n";
   return s.str();
@@ -258,10 +254,11 @@ std::string lammps_walls(bool normal_only) {
        "# the contact force from the total force at monitoring steps).\n"
        "# (evaluated every step: the constants substituted now, ${...}; in this\n"
        "# release a v_ reference formats the other variable to text and back)\n"
-       "variable dytop  equal -${vtop}*step*dt\n"
-       "# (elapsed: the steps of this run, step-${step0}, one word to parse)\n"
-       "variable dxl    equal f_servo[1]*elapsed\n"
-       "variable dxr    equal f_servo[2]*elapsed\n"
+       "variable dytop  equal -${dy_step}*step\n"
+       "# (elapsed: the steps of this run, step-${step0}, one word to parse;\n"
+       "# f_servol, f_servor: the lateral walls' mean moves, fix servol/servor)\n"
+       "variable dxl    equal f_servol*elapsed\n"
+       "variable dxr    equal f_servor*elapsed\n"
        "region          rtop   plane 0 ${yt0} 0  0 -1 0 side in move NULL v_dytop NULL units box\n"
        "region          rleft  plane ${xl_now} 0 0  1 0 0  side in move v_dxl NULL NULL units box\n"
        "region          rright plane ${xr_now} 0 0  -1 0 0 side in move v_dxr NULL NULL units box\n"
@@ -351,23 +348,25 @@ std::string lammps_walls(bool normal_only) {
 /// demcal's servo law (scene/biaxial.cpp, servo_velocity) in the deck: the
 /// unclamped move and its clamp of both lateral walls as two vector-style
 /// formulas (each parsed once per step for both walls), summed every step by
-/// fix servo; the walls' displacements at the end of the run for the
-/// restart args (lammps_run).
+/// fix servol and servor (lammps_run); the walls' displacements at the end of
+/// the run for the restart args.
 std::string lammps_servo() {
-  // gain*(sigma3*H*t - F)/(kn_wall*max(1, n)) per wall, sigma3*H*t stored by
-  // fix servo_load, F the wall's force on the sample: c_cf[1] for the left
-  // wall (it pushes the particles +x), -c_cf[2] for the right one (-x). The
-  // right element is computed with the opposite sign, gain*(-sigma3*H*t -
-  // c_cf[2])/(...), exactly minus the right wall's move, and its clamp is
-  // exactly minus the clamp of the move (clamp(-x) = -clamp(x) bit for bit):
-  // fix servo keeps the displacements' signs, left +x, right -x, as dxl and
-  // dxr use them.
-  const std::string load = "${sigma3}*(${H0}-${vtop}*step*dt)*${thick}";
-  const std::string raw = deck::lammps_servo_raw_of_load("f_servo_sign*f_servo_load", "-c_cf",
-                                                         deck::lammps_count_at_least_one("c_cn"));
+  // (gain/kn_wall)*(sigma3*H*t - F)/max(1, n) per wall, sigma3*H*t =
+  // load0 - load_step*step stored by fix servo_load, F the wall's force on
+  // the sample: c_cf[1] for the left wall (it pushes the particles +x),
+  // -c_cf[2] for the right one (-x). The right element is computed with the
+  // opposite sign, gain_kn*(-sigma3*H*t - c_cf[2])/(...), exactly minus the
+  // right wall's move, and its clamp is exactly minus the clamp of the move
+  // (clamp(-x) = -clamp(x) bit for bit): fix servol and servor keep the
+  // displacements' signs, left +x, right -x, as dxl and dxr use them.
+  const std::string load = "${load0}-${load_step}*step";
+  const std::string raw = deck::lammps_servo_raw_folded("f_servo_sign*f_servo_load", "-c_cf",
+                                                        deck::lammps_count_max_one("c_cn"));
   std::ostringstream s;
   s << "# demcal's servo, one move per step toward the sample when p < sigma3:\n"
     << "#   move = gain*(sigma3*H*t - F)/(kn_wall*max(1, n)), clamped to +-cap,\n"
+    << "# as gain_kn*(load0 - load_step*step - F)/max(1, n) (constants folded in\n"
+    << "# the derived block: every number in a per-step formula costs a parse),\n"
     << "# F the wall force, n its contacts; the wall's displacement is the sum of\n"
     << "# the moves (running mean times the steps of this run, dxl and dxr above).\n"
     << "# Both walls in one vector-style formula (elements: left, right; the\n"
@@ -377,8 +376,10 @@ std::string lammps_servo() {
     << "# the unclamped moves as doubles (a vector variable is evaluated once per\n"
     << "# step, then kept); the target load and the signs come from fixes\n"
     << "# (doubles; the signs are internal variables, read without parsing).\n"
-    << "# This release has no min/max of two numbers: max(1, n) = n+(n<1) for\n"
-    << "# a contact count n, clamp(x) = (abs(x+cap)-abs(x-cap))/2.\n"
+    << "# rawv is the first variable of the deck (see its top: LAMMPS finds a\n"
+    << "# v_ name by a linear search). This release has no min/max of two\n"
+    << "# numbers: max(1, n) = n+!n for a contact count n (!n: 1 for n = 0,\n"
+    << "# else 0), clamp(x) = (abs(x+cap)-abs(x-cap))/2.\n"
     << "variable        one internal 1\n"
     << "variable        mone internal -1\n"
     << "fix             servo_sign all ave/time 1 1 1 v_one v_mone\n"
@@ -387,13 +388,14 @@ std::string lammps_servo() {
     << "variable        rawv vector " << raw << "\n"
     << "variable        movev vector " << deck::lammps_servo_clamp("v_rawv") << "\n"
     << "# the lateral walls' displacements at the run's last step (fix servo_end\n"
-    << "# evaluates them there only, before fix servo adds that step's move): the\n"
-    << "# restart args put a continuation's walls where this run's last step had\n"
-    << "# them (to the last bit), and the continuation's servo takes that step's\n"
-    << "# move again from there\n"
+    << "# evaluates them there only, before fix servol/servor add that step's move):\n"
+    << "# the restart args put a continuation's walls where this run's last step\n"
+    << "# had them (to the last bit), and the continuation's servo takes that\n"
+    << "# step's move again from there\n"
     << "variable        end_every equal $((1+v_run_steps+abs(1-v_run_steps))/2)\n"
     << "fix             servo_end all ave/time ${end_every} 1 ${end_every} v_dxl v_dxr\n"
-    << "# (fix servo, which sums the moves, is defined after fix series below)\n\n";
+    << "# (fix servol and servor, which sum the moves, are defined after fix series\n"
+    << "# below)\n\n";
   return s.str();
 }
 
@@ -510,7 +512,13 @@ std::string lammps_derived() {
     << "variable H0        equal $(v_yt0-v_yb0)\n"
     << deck::lammps_loading_derived()
     << deck::lammps_band("band_v", "v_strain*v_H0", "m, see the walls")
-    << deck::lammps_band("band_h", "2*v_strain*(v_xr0-v_xl0)");
+    << deck::lammps_band("band_h", "2*v_strain*(v_xr0-v_xl0)")
+    << "# the per-step constants of the top wall's move and the servo, folded now\n"
+    << "# (a number in a formula evaluated every step costs a parse there)\n"
+    << "variable dy_step   equal $(v_vtop*v_dt)      # m, the top wall's move per step\n"
+    << "variable load0     equal $(v_sigma3*v_thick*v_H0)      # N, sigma3*H*t at the start\n"
+    << "variable load_step equal $(v_sigma3*v_thick*v_vtop*v_dt)      # N, its decrease per step\n"
+    << "variable gain_kn   equal $(v_gain/v_kn_wall)      # m/N\n";
   return s.str();
 }
 
@@ -707,10 +715,19 @@ std::string lammps_consolidation(const SceneConfig& c, const Plan& plan, double 
 /// (with stage 1, the args also carry the start walls it found).
 std::string lammps_run(bool consolidate_in_deck) {
   std::ostringstream s;
-  s << "# the servo's running sum of the moves, after fix series: a row prints the\n"
+  s << "# the servo's running sums of the moves, after fix series: a row prints the\n"
     << "# lateral walls where this step's forces had them (the sum before this\n"
-    << "# step's move), in a single run and in a continued one alike\n"
-    << "fix             servo all ave/time 1 1 1 v_movev mode vector ave running\n\n"
+    << "# step's move), in a single run and in a continued one alike; one fix per\n"
+    << "# wall, a scalar each (dxl and dxr read them every step: no index to parse)\n"
+    << "fix             servol all ave/time 1 1 1 v_movev[1] ave running\n"
+    << "fix             servor all ave/time 1 1 1 v_movev[2] ave running\n"
+    << "# the clearance checks, last in the fix list (the fixes above are found by\n"
+    << "# name every step, by a linear search)\n"
+    << "fix             halt_top all halt ${monitor_every} v_clear_top < 0.0 error hard\n"
+    << "fix             halt_bottom all halt ${monitor_every} v_clear_bottom < 0.0 error hard\n"
+    << "fix             halt_left all halt ${monitor_every} v_clear_left < 0.0 error hard\n"
+    << "fix             halt_right all halt ${monitor_every} v_clear_right < 0.0 error hard\n"
+    << "\n"
     << "# --- output and run ----------------------------------------------------------\n"
     << "# p_left, p_right: lateral wall pressures (servo target sigma3); p_top: axial\n"
     << "variable        epsyy equal (v_H-v_H0)/v_H0\n"
@@ -734,6 +751,9 @@ ExportResult lammps(const SceneConfig& c, const AlgorithmSpec& p, const Assembly
   out.files[o.data_name] = lammps_data_file(c, a, plan, !o.consolidate_in_deck);
   std::ostringstream s;
   s << mapping_header(c, p, plan, o, "LAMMPS") << lammps_limitations(p, plan, out)
+    << "# (the servo's per-step formula, defined below, comes first in LAMMPS'\n"
+    << "# variable list: a formula finds a v_ name by a linear search)\n"
+    << "variable rawv      vector 0\n\n"
     << lammps_parameters(c, a, plan, o);
   if (o.consolidate_in_deck)
     s << lammps_system(c, plan, o, out) << lammps_consolidation(c, plan, contact_gamma_n(c, plan))
