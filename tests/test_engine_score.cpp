@@ -330,7 +330,7 @@ TEST(EngineLammps, TheVectorServoIsThePerWallFormulaBitForBit) {
            "))/2)";
   };
   auto clamp = [](const std::string& x) {
-    return "(abs(" + x + "+${cap})-abs(" + x + "-${cap}))/2";
+    return "(abs(" + x + "+${cap_step})-abs(" + x + "-${cap_step}))/2";
   };
   EXPECT_EQ(line_of("variable        load equal "),
             "variable        load equal ${load0}-${load_step}*step\n");

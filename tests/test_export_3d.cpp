@@ -112,9 +112,10 @@ TEST(Export3d, LammpsDeckMapsEveryParameter) {
         "variable        Ax equal f_geom[2]*f_geom[3]",
         "fix             servo_sign all ave/time 1 1 1 v_one v_mone v_one v_mone\n"
         "fix             servo_len all ave/time 1 1 1 f_geom[2] f_geom[2] f_geom[1] f_geom[1]\n"
-        "variable        rawv vector ${gain}*(f_servo_sign*${sigma3}*f_servo_len*f_geom[3]-c_csf)/"
-        "(${kn_wall}*(c_csn+(c_csn<1)))\n"
-        "variable        movev vector (abs(v_rawv+${cap})-abs(v_rawv-${cap}))/2\n"
+        "variable        rawv vector "
+        "${gain_kn}*(f_servo_sign*${sigma3}*f_servo_len*f_geom[3]-c_csf)/"
+        "(c_csn+!c_csn)\n"
+        "variable        movev vector (abs(v_rawv+${cap_step})-abs(v_rawv-${cap_step}))/2\n"
         "fix             servo all ave/time 1 1 1 v_movev mode vector ave running",
         "NOT APPLIED", "#fix            dampr all viscous/sphere"})
     EXPECT_NE(d.find(line), std::string::npos) << line;
@@ -289,7 +290,16 @@ void check_lammps(int np, int64_t steps) {
   dl.sigma = (1 - w) * series[k - 1].sigma + w * series[k].sigma;
   const double pz = 0.5 * (last[kColumns - 3] + last[kColumns - 2]);
   EXPECT_NEAR(-last[2 + 8], pz, 1e-6 * pz);
-  for (int k = 0; k < 4; ++k) EXPECT_LT(std::abs(last[23 + k]), 0.01) << "servo error " << k;
+  // Each lateral wall's servo error against demcal's at that strain: the
+  // deck moves a wall per step dt/servo_dt times demcal's per-step move, the
+  // same law per unit of time (measured equal to 4 digits; 5 % leaves the
+  // engines' damping discretisations their difference).
+  for (int wall = 0; wall < 4; ++wall) {
+    const double demcal_error =
+        (1 - w) * series[k - 1].servo_error[wall] + w * series[k].servo_error[wall];
+    EXPECT_NEAR(last[23 + wall], demcal_error, 0.05 * std::abs(demcal_error))
+        << "servo error " << wall;
+  }
   const double scale = std::abs(dl.b(2, 2));
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) {
@@ -320,9 +330,10 @@ void check_lammps(int np, int64_t steps) {
   // interval and the engines' difference, within the 1 % of the peaks above.
   EXPECT_NEAR(t.peak_stress_yy / d.result.peak_stress_zz, 1.0, 0.01);
   // Same physics, same size of each rate-driven criterion (the damping
-  // discretisations differ): within a factor 1.5, as in 2D.
+  // discretisations differ): within a factor 1.5, as in 2D; the servo's,
+  // the same law per unit of time, within 5 %.
   EXPECT_NEAR(t.force_balance / m.force_balance, 1.0, 0.5);
-  EXPECT_NEAR(t.servo / m.servo, 1.0, 0.5);
+  EXPECT_NEAR(t.servo / m.servo, 1.0, 0.05);
 }
 
 TEST(Export3dLammps, PeakMatchesDemcalSerially) { check_lammps(1, 20000); }
@@ -412,10 +423,11 @@ TEST(Export3dLammps, TheDecksPerStepCutsLeaveTheSeriesAndPeaksBitForBit) {
     const std::string i = std::to_string(k + 1), n = "c_csn[" + i + "]";
     const std::string area = k < 2 ? "f_geom[2]*f_geom[3]" : "f_geom[1]*f_geom[3]";
     const std::string force = k % 2 == 0 ? "c_csf[" + i + "]" : "-c_csf[" + i + "]";
-    const std::string raw = "${gain}*(${sigma3}*" + area + "-(" + force + "))/(${kn_wall}*(1+" + n +
-                            "+abs(1-" + n + "))/2)";
+    const std::string raw =
+        "${gain_kn}*(${sigma3}*" + area + "-(" + force + "))/((1+" + n + "+abs(1-" + n + "))/2)";
     per_wall += std::string("variable        m") + lateral[k] + " equal " +
-                (k % 2 == 0 ? "" : "-") + "(abs(" + raw + "+${cap})-abs(" + raw + "-${cap}))/2\n";
+                (k % 2 == 0 ? "" : "-") + "(abs(" + raw + "+${cap_step})-abs(" + raw +
+                "-${cap_step}))/2\n";
   }
   whole = replaced(whole, vector_servo, per_wall);
   whole = replaced(whole, "v_movev mode vector ave running",

@@ -40,6 +40,7 @@ DeckTiming deck_timing(double dt_ratio, int64_t steps, double zeta_t, double dt_
   DeckTiming out;
   out.step_factor = dashpot_step_factor(zeta_t);
   out.dt = dt_ratio * out.step_factor * dt_crit;
+  out.demcal_dt = dt_ratio * dt_crit;
   out.steps = std::max<int64_t>(1, std::llround(static_cast<double>(steps) / out.step_factor));
   return out;
 }
@@ -131,9 +132,19 @@ std::string lammps_material_variables(const Material& m, NumberFormat f) {
 
 std::string lammps_loading_derived() {
   return "variable vtop      equal $(v_strain*v_H0/(v_nstep*v_dt))      # m/s, top wall, down\n"
-         "variable cap       equal $(0.02*v_r_min)      # m per step, servo move cap\n"
+         "variable cap       equal $(0.02*v_r_min)      # m per demcal step, its servo move cap\n"
+         "# demcal's servo moves a wall per step of servo_dt; a step of dt moves it\n"
+         "# dt/servo_dt as far, so that the walls answer as fast per unit of time\n"
+         "variable servo_f   equal $(v_dt/v_servo_dt)\n"
+         "variable cap_step  equal $(v_cap*v_servo_f)      # m per step of dt\n"
+         "variable gain_kn   equal $(v_gain*v_servo_f/v_kn_wall)      # m/N per step of dt\n"
          "variable monitor_every equal "
          "$(floor((1+v_nstep/v_monitor_points+abs(1-v_nstep/v_monitor_points))/2))\n";
+}
+
+std::string lammps_servo_dt(double servo_dt, NumberFormat f) {
+  return "variable servo_dt  equal " + f(servo_dt) +
+         "      # s, demcal's step: its servo law is per servo_dt (keep)\n";
 }
 
 std::string lammps_system_head(int dimension, const std::string& boundary) {
@@ -230,12 +241,6 @@ std::string lammps_wall_sum(const std::vector<std::string>& fixes, int a, int b)
   return out;
 }
 
-std::string lammps_servo_raw(const std::string& area, const std::string& minus_force,
-                             const std::string& count) {
-  return lammps_servo_raw_of_load("${sigma3}*" + area, minus_force,
-                                  "(1+" + count + "+abs(1-" + count + "))/2");
-}
-
 std::string lammps_servo_raw_of_load(const std::string& load, const std::string& minus_force,
                                      const std::string& count_max, const std::string& resist) {
   return "${gain}*(" + load + minus_force + ")/(" + resist + "*" + count_max + ")";
@@ -263,13 +268,8 @@ std::string lammps_band(const std::string& name, const std::string& motion,
   return line + "\n";
 }
 
-std::string lammps_servo_clamp(const std::string& x) {
-  return "(abs(" + x + "+${cap})-abs(" + x + "-${cap}))/2";
-}
-
-std::string lammps_servo_move(const std::string& area, const std::string& minus_force,
-                              const std::string& count) {
-  return lammps_servo_clamp(lammps_servo_raw(area, minus_force, count));
+std::string lammps_servo_clamp(const std::string& x, const std::string& cap) {
+  return "(abs(" + x + "+" + cap + ")-abs(" + x + "-" + cap + "))/2";
 }
 
 std::string lammps_series_header(const std::string& deck, const std::string& scene, int particles,

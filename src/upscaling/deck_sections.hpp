@@ -40,6 +40,7 @@ RadiusClasses radius_class_bounds(const std::vector<double>& radii, int max_type
 /// same loading time, rate and strain, the same stability margin as demcal.
 struct DeckTiming {
   double step_factor = 1.0, dt = 0.0;
+  double demcal_dt = 0.0;  ///< α·Δt_crit: demcal's step, the servo law's time unit
   int64_t steps = 0;
 };
 DeckTiming deck_timing(double dt_ratio, int64_t steps, double zeta_t, double dt_crit);
@@ -88,9 +89,18 @@ std::string lammps_class_damping_note(int types, double class_error, const std::
 /// (variables kn kt mu kn_wall kt_wall mu_wall).
 std::string lammps_material_variables(const Material& m, NumberFormat f);
 
-/// LAMMPS derived block: the top wall's speed, the servo's cap and the
-/// monitoring interval (from the parameters block).
+/// LAMMPS derived block: the top wall's speed, the servo's cap and gain
+/// and the monitoring interval (from the parameters block). demcal's servo
+/// law is per demcal step, servo_dt (a parameter: α·Δt_crit); the deck's
+/// step dt is f·servo_dt (the engine's damping needs f < 1, engines.md §7),
+/// so a step moves a wall dt/servo_dt times demcal's per-step move
+/// (`gain_kn`, `cap_step`): over the same loading time the walls answer as
+/// fast as demcal's, and editing dt keeps that (without the factor, the
+/// walls were corrected 1/f times as often and the servo error read f times
+/// demcal's).
 std::string lammps_loading_derived();
+/// The parameters block's line of servo_dt (demcal's step, s).
+std::string lammps_servo_dt(double servo_dt, NumberFormat f);
 
 /// LAMMPS system block, head: units, dimension, boundary, atom style.
 std::string lammps_system_head(int dimension, const std::string& boundary);
@@ -124,27 +134,19 @@ std::string lammps_wall_sum(const std::vector<std::string>& fixes, int a, int b)
 
 /// LAMMPS: demcal's servo move of one wall in one step, toward the sample
 /// when its pressure is below sigma3: gain*(sigma3*A - F)/(kn_wall*max(1,
-/// n)), clamped to ±cap, as one flat formula of the deck's variables.
-/// `area` is A, `minus_force` the term that subtracts F (e.g. "-c_cs[2]"),
-/// `count` n. This release has no min/max of two numbers: max(1, n) =
-/// (1+n+abs(1-n))/2 and clamp(x) = (abs(x+cap)-abs(x-cap))/2.
-std::string lammps_servo_move(const std::string& area, const std::string& minus_force,
-                              const std::string& count);
-
-/// The two halves of lammps_servo_move: the unclamped move
-/// gain*(sigma3*A - F)/(kn_wall*max(1, n)), and clamp(x) of a formula x.
-/// lammps_servo_move = lammps_servo_clamp(lammps_servo_raw(...)); a deck that
-/// stores the raw move in a fix (a double, no text round trip) and clamps the
-/// fix's value parses the raw formula once per step instead of twice, with the
-/// same arithmetic, bit for bit.
-std::string lammps_servo_raw(const std::string& area, const std::string& minus_force,
-                             const std::string& count);
-std::string lammps_servo_clamp(const std::string& x);
-/// lammps_servo_raw with the target load sigma3*A given whole (`load`, e.g. a
-/// fix's stored value of sigma3*A) and max(1, n) given as a formula
-/// (`count_max`): gain*(load - F)/(kn_wall*count_max). lammps_servo_raw is
-/// this with load = "${sigma3}*" + area and count_max = (1+n+abs(1-n))/2.
-/// `resist` replaces kn_wall (e.g. "(${kn_wall}+c/dt)" with wall dashpots).
+/// n)), clamped to ±cap, in two formulas: the unclamped move and clamp(x)
+/// of a formula x, (abs(x+cap)-abs(x-cap))/2 (this release has no min/max
+/// of two numbers). A deck stores the unclamped moves in a vector variable
+/// (doubles, evaluated once per step) and clamps those: the raw formula is
+/// parsed once per step. `cap` the cap's variable (the loading's
+/// ${cap_step}: see lammps_loading_derived).
+std::string lammps_servo_clamp(const std::string& x, const std::string& cap = "${cap}");
+/// The unclamped move with the target load sigma3*A given whole (`load`,
+/// e.g. a fix's stored value of sigma3*A) and max(1, n) given as a formula
+/// (`count_max`): gain*(load - F)/(kn_wall*count_max), `minus_force` the
+/// term that subtracts F (e.g. "-c_cs[2]"). `resist` replaces kn_wall (e.g.
+/// "(${kn_wall}+c/dt)" with wall dashpots). Per step of demcal's own
+/// consolidation (stage 1).
 std::string lammps_servo_raw_of_load(const std::string& load, const std::string& minus_force,
                                      const std::string& count_max,
                                      const std::string& resist = "${kn_wall}");
@@ -156,7 +158,9 @@ std::string lammps_count_at_least_one(const std::string& count);
 /// The unclamped move with gain/kn_wall folded into one constant (the
 /// deck's derived `gain_kn`): gain_kn*(load - F)/count_max, `count_max`
 /// max(1, n) as a formula (lammps_count_max_one). The same law as
-/// lammps_servo_raw_of_load, rounded once less (the 2D deck's servo).
+/// lammps_servo_raw_of_load, rounded once less, per step of the deck's dt
+/// (gain_kn carries dt/servo_dt: lammps_loading_derived): the loading's
+/// servo in the 2D and 3D decks.
 std::string lammps_servo_raw_folded(const std::string& load, const std::string& minus_force,
                                     const std::string& count_max);
 /// max(1, n) of a contact count n (an integer-valued double) as n+!n: n for

@@ -24,6 +24,7 @@ struct Plan {
   std::vector<int> type;           // per particle, 1-based
   std::vector<double> r_lo, r_hi;  // per class (index type−1)
   double dt = 0.0, dt_crit = 0.0;
+  double demcal_dt = 0.0;    // α·Δt_crit: demcal's step, the servo law's time unit
   double step_factor = 1.0;  // f = sqrt(1 + zeta_t^2) - zeta_t: explicit fix viscous
   int64_t steps = 0;
   double areal_density = 0.0;  // f_ms·ρ·t [kg/m²]
@@ -53,6 +54,7 @@ Plan make_plan(const SceneConfig& c, const AlgorithmSpec& p, const Assembly& a, 
       deck::deck_timing(p.dt_ratio, p.steps, p.damping_ratio_translation, plan.dt_crit);
   plan.step_factor = timing.step_factor;
   plan.dt = timing.dt;
+  plan.demcal_dt = timing.demcal_dt;
   plan.steps = timing.steps;
   plan.areal_density = p.mass_scaling * c.material.density * c.material.thickness;
   plan.width0 = a.right - a.left;
@@ -365,8 +367,9 @@ std::string lammps_servo() {
   std::ostringstream s;
   s << "# demcal's servo, one move per step toward the sample when p < sigma3:\n"
     << "#   move = gain*(sigma3*H*t - F)/(kn_wall*max(1, n)), clamped to +-cap,\n"
-    << "# as gain_kn*(load0 - load_step*step - F)/max(1, n) (constants folded in\n"
-    << "# the derived block: every number in a per-step formula costs a parse),\n"
+    << "# per demcal step (servo_dt), so per step of dt that times dt/servo_dt:\n"
+    << "# gain_kn*(load0 - load_step*step - F)/max(1, n) within +-cap_step (constants\n"
+    << "# folded in the derived block: every number in a per-step formula costs a parse),\n"
     << "# F the wall force, n its contacts; the wall's displacement is the sum of\n"
     << "# the moves (running mean times the steps of this run, dxl and dxr above).\n"
     << "# Both walls in one vector-style formula (elements: left, right; the\n"
@@ -386,7 +389,7 @@ std::string lammps_servo() {
     << "variable        load equal " << load << "\n"
     << "fix             servo_load all ave/time 1 1 1 v_load\n"
     << "variable        rawv vector " << raw << "\n"
-    << "variable        movev vector " << deck::lammps_servo_clamp("v_rawv") << "\n"
+    << "variable        movev vector " << deck::lammps_servo_clamp("v_rawv", "${cap_step}") << "\n"
     << "# the lateral walls' displacements at the run's last step (fix servo_end\n"
     << "# evaluates them there only, before fix servol/servor add that step's move):\n"
     << "# the restart args put a continuation's walls where this run's last step\n"
@@ -471,7 +474,8 @@ std::string lammps_parameters(const SceneConfig& c, const Assembly& a, const Pla
     << "# strain, the loading rate per step count, the servo cap and the monitoring\n"
     << "# points right.\n"
     << "variable dt        equal " << num(plan.dt) << "      # s\n"
-    << "variable nstep     equal " << plan.steps << "      # loading steps Nstep\n"
+    << deck::lammps_servo_dt(plan.demcal_dt, num) << "variable nstep     equal " << plan.steps
+    << "      # loading steps Nstep\n"
     << "variable strain    equal " << num(c.test.vertical_strain)
     << "      # total vertical strain over nstep\n"
     << "variable monitor_points equal " << c.test.monitor_points
@@ -517,8 +521,7 @@ std::string lammps_derived() {
     << "# (a number in a formula evaluated every step costs a parse there)\n"
     << "variable dy_step   equal $(v_vtop*v_dt)      # m, the top wall's move per step\n"
     << "variable load0     equal $(v_sigma3*v_thick*v_H0)      # N, sigma3*H*t at the start\n"
-    << "variable load_step equal $(v_sigma3*v_thick*v_vtop*v_dt)      # N, its decrease per step\n"
-    << "variable gain_kn   equal $(v_gain/v_kn_wall)      # m/N\n";
+    << "variable load_step equal $(v_sigma3*v_thick*v_vtop*v_dt)      # N, its decrease per step\n";
   return s.str();
 }
 

@@ -87,7 +87,7 @@ struct Plan3 {
   std::vector<double> r_lo, r_hi;
   double density = 0.0;  // f_ms·ρ [kg/m³]
   double r_min = 0.0, r_max = 0.0, m_mean = 0.0;
-  double dt_crit = 0.0, step_factor = 1.0, dt = 0.0;
+  double dt_crit = 0.0, step_factor = 1.0, dt = 0.0, demcal_dt = 0.0;
   int64_t steps = 0;
   std::array<double, 3> lo{}, hi{};
   double top_speed = 0.0;  // [m/s], downward
@@ -120,6 +120,7 @@ Plan3 make_plan(const SceneConfig& c, const AlgorithmSpec& p, const SphereWorld&
       deck::deck_timing(p.dt_ratio, p.steps, p.damping_ratio_translation, plan.dt_crit);
   plan.step_factor = timing.step_factor;
   plan.dt = timing.dt;
+  plan.demcal_dt = timing.demcal_dt;
   plan.steps = timing.steps;
   for (int a = 0; a < 3; ++a) {
     plan.lo[a] = w.wall(static_cast<SphereWallSide>(2 * a)).position;
@@ -248,15 +249,16 @@ std::string area_x() { return std::string(kLy) + "*" + kH; }
 std::string area_y() { return std::string(kLx) + "*" + kH; }
 std::string area_z() { return std::string(kLx) + "*" + kLy; }
 // The four lateral walls' unclamped servo moves toward the sample, one
-// vector-style formula (elements xmin xmax ymin ymax): gain*(sigma3*A -
-// F)/(kn_wall*max(1, n)) from each wall's area (fix servo_len: the box's
-// length across the wall, times H), contacts (c_csn) and force on the spheres
-// along +axis (c_csf), the max walls' elements with the opposite sign
-// (f_servo_sign), so that the clamp of each element is the wall's move along
-// +axis (deck::lammps_servo_raw_of_load, lammps_servo_clamp, as in 2D).
+// vector-style formula (elements xmin xmax ymin ymax): gain_kn*(sigma3*A -
+// F)/max(1, n) (gain_kn = gain*(dt/servo_dt)/kn_wall) from each wall's area
+// (fix servo_len: the box's length across the wall, times H), contacts
+// (c_csn) and force on the spheres along +axis (c_csf), the max walls'
+// elements with the opposite sign (f_servo_sign), so that the clamp of each
+// element is the wall's move along +axis (deck::lammps_servo_raw_folded,
+// lammps_servo_clamp, as in 2D).
 std::string servo_raw_vector() {
-  return deck::lammps_servo_raw_of_load("f_servo_sign*${sigma3}*f_servo_len*" + std::string(kH),
-                                        "-c_csf", deck::lammps_count_at_least_one("c_csn"));
+  return deck::lammps_servo_raw_folded("f_servo_sign*${sigma3}*f_servo_len*" + std::string(kH),
+                                       "-c_csf", deck::lammps_count_max_one("c_csn"));
 }
 
 // Header: the mapping and what this LAMMPS cannot do as demcal does.
@@ -294,7 +296,8 @@ void lammps_3d_parameters(std::ostream& s, const SceneConfig& c, const Plan3& pl
     << "# Everything below is derived from this block: editing dt or nstep keeps the\n"
     << "# strain, the servo cap and the monitoring points right.\n"
     << "variable dt        equal " << exact(plan.dt) << "      # s\n"
-    << "variable nstep     equal " << plan.steps << "      # loading steps\n"
+    << deck::lammps_servo_dt(plan.demcal_dt, exact) << "variable nstep     equal " << plan.steps
+    << "      # loading steps\n"
     << "variable strain    equal " << exact(c.test.vertical_strain)
     << "      # axial (z) strain over nstep, compression\n"
     << "variable monitor_points equal " << c.test.monitor_points << "      # rows of ${series}\n"
@@ -630,7 +633,9 @@ void lammps_3d_servo_and_run(std::ostream& s) {
   s << "# --- servo -------------------------------------------------------------------\n"
     << "# demcal's servo, one move per step and wall toward the sample when p < sigma3:\n"
     << "#   move = gain*(sigma3*A - F)/(kn_wall*max(1, n)), clamped to +-cap,\n"
-    << "# A = the wall's current area, F its force, n its contacts (compute csn, csf).\n"
+    << "# A = the wall's current area, F its force, n its contacts (compute csn, csf),\n"
+    << "# per demcal step (servo_dt), so per step of dt that times dt/servo_dt:\n"
+    << "# gain_kn*(sigma3*A - F)/max(1, n) within +-cap_step (derived block).\n"
     << "# The four walls in one vector-style formula (elements xmin xmax ymin ymax;\n"
     << "# the max walls' with the opposite sign, so that each clamped element is\n"
     << "# the wall's move along +axis), parsed once per step for all four, with the\n"
@@ -639,7 +644,7 @@ void lammps_3d_servo_and_run(std::ostream& s) {
     << "# (internal variables, read without parsing) and the box's length across\n"
     << "# each wall (Ly for the x walls, Lx for the y walls: fix geom's doubles)\n"
     << "# come from fixes. This release has no min/max of two numbers: max(1, n) =\n"
-    << "# n+(n<1) for a contact count n, clamp(x) = (abs(x+cap)-abs(x-cap))/2.\n"
+    << "# n+!n for a contact count n, clamp(x) = (abs(x+c)-abs(x-c))/2.\n"
     << "# f_servo[k]: the running mean of the moves along +axis, times the step =\n"
     << "# the wall's displacement.\n"
     << "variable        one internal 1\n"
@@ -647,7 +652,7 @@ void lammps_3d_servo_and_run(std::ostream& s) {
     << "fix             servo_sign all ave/time 1 1 1 v_one v_mone v_one v_mone\n"
     << "fix             servo_len all ave/time 1 1 1 f_geom[2] f_geom[2] f_geom[1] f_geom[1]\n"
     << "variable        rawv vector " << servo_raw_vector() << "\n"
-    << "variable        movev vector " << deck::lammps_servo_clamp("v_rawv") << "\n";
+    << "variable        movev vector " << deck::lammps_servo_clamp("v_rawv", "${cap_step}") << "\n";
   s << "fix             servo all ave/time 1 1 1 v_movev mode vector ave running\n\n";
 
   s << "# --- output and run ----------------------------------------------------------\n"
