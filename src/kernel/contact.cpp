@@ -7,18 +7,26 @@
 // same lever arms enter the torques and the stress, so a moment-free particle
 // contributes a symmetric term to σ exactly.
 //
-// The particle–particle loop runs over the full neighbour list in blocks of
-// 8 particles (world.hpp), W lanes at a time with GCC vector extensions:
-// W = 8 on x86-64-v4 (AVX-512), 4 on x86-64-v3 (AVX2), 2 on baseline
-// x86-64 (SSE2). The path is chosen once from the CPU; the default build
-// needs no -march flag. Every pair is evaluated from both sides, by the same
-// instructions with the roles of i and j swapped. Every quantity the
-// tangential history depends on is then either invariant or exactly negated
-// under the swap — including under FMA contraction, which is why the
-// rotational term ω_i·a_i + ω_j·a_j is written in the symmetric form
-// ½[(ω_i + ω_j)(a_i + a_j) + (ω_i − ω_j)(a_i − a_j)] — so both copies of a
-// pair's history stay bit-identical and the forces on i and j are exact
-// opposites.
+// The particle–particle loop runs over the half neighbour list (pairs i <
+// j, broad_phase.cpp) in blocks of 8 particles, W lanes at a time with GCC
+// vector extensions: W = 8 on x86-64-v4 (AVX-512), 4 on x86-64-v3 (AVX2),
+// 2 on baseline x86-64 (SSE2). The path is chosen once from the CPU; the
+// default build needs no -march flag. Every pair is evaluated once, from
+// its lower index: each particle's force and torque are written as the
+// plain sum over its own slots (pairs j > i, increasing j), and per slot the
+// pass writes the pair's force on i and its torque on j; the sums
+// (sum_blocks) then add to each particle j, from its mirror list in
+// increasing i, the opposite of that force and that torque. Both sums run
+// in a fixed order whatever the thread split (each pass writes only its own
+// particles' or slots' values), so results are bit-identical for any thread
+// count; non-touching slots add exact zeros. With one thread each block's
+// sums run right after its pairs (its mirrored slots lie in blocks ≤ its
+// own), the pair terms still in cache; with threads, in a second pass after
+// the barrier. (Until the half list, issue #17, the list was full and each
+// pair was evaluated twice, once from either side, the rotational term
+// written ½[(ω_i + ω_j)(a_i + a_j) + (ω_i − ω_j)(a_i − a_j)] so that both
+// copies came out exact opposites under FMA contraction; evaluated once, it
+// takes the plain form. reports/performance.md has what it bought.)
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -39,20 +47,53 @@ struct PairArgs {
   const int *__restrict block_slot;
   const int *__restrict slot_j;
   double *__restrict slot_ft;
-  const double *__restrict slot_r;  // radius of each slot's neighbour
+  const double *__restrict slot_r, *__restrict slot_ir;  // the slot's neighbour: r, 1/r
+  double *__restrict pfx, *__restrict pfy;               // per slot: the pair's force on i
+  double *__restrict ptq;                                // per slot: its torque on j
   const double *__restrict x, *__restrict y, *__restrict vx, *__restrict vy, *__restrict om;
   const double *__restrict r, *__restrict inv_r, *__restrict m;
   double *__restrict fx, *__restrict fy, *__restrict tq;
   double *__restrict block_power;  // per block: power of the contact dashpots (damped pass)
   double kn, kdt, mu, beta2;       // beta2 = 2·contact damping ratio
+  const int *__restrict mirror_block;
+  const int *__restrict mirror_slot;
 };
 
-// Forces of blocks [b0, b1): each particle's sum over its own slots, written
-// (not added) to fx, fy, tq. Returns the largest overlap/r_own, which over
-// both copies of a pair is overlap/min(r_i, r_j). The damped pass also
-// writes each block's dashpot power, Σ (fe − fn)·v_n over its slots (every
-// pair counted from both sides), for the energy ledger.
-template <int W, bool kDamped>
+// Adds to each particle j of blocks [b0, b1) what it receives from its
+// pairs (i, j), i < j, in increasing i: the opposite of the force on i and
+// the torque on j. (A: PairArgs; the pair pass calls it fused, the sum pass
+// after the barrier with threads: the same sums in the same order.)
+template <int W>
+DEMCAL_INLINE void sum_blocks(const PairArgs &a, int b0, int b1) {
+  using D = typename Simd<W>::D;
+  for (int b = b0; b < b1; ++b) {
+    const int s0 = a.mirror_block[b], s1 = a.mirror_block[b + 1];
+    if (s0 == s1) continue;
+    for (int sub = 0; sub < kBlock; sub += W) {
+      const int i0 = kBlock * b + sub;
+      D fx = load<W>(a.fx + i0), fy = load<W>(a.fy + i0), tq = load<W>(a.tq + i0);
+      for (int s = s0 + sub; s < s1; s += kBlock) {
+        const int *S = a.mirror_slot + s;
+        fx -= gather<W>(a.pfx, S);
+        fy -= gather<W>(a.pfy, S);
+        tq += gather<W>(a.ptq, S);
+      }
+      store<W>(a.fx + i0, fx);
+      store<W>(a.fy + i0, fy);
+      store<W>(a.tq + i0, tq);
+    }
+  }
+}
+
+// Pairs of blocks [b0, b1) on the half list (each pair once, from i < j):
+// each particle's force and torque summed over its own slots, written (not
+// added) to fx, fy, tq, and per slot the pair's force on i and torque on j.
+// kFused (one thread): each block's mirrored sums right after its pairs
+// (its mirrored slots lie in blocks ≤ b, all done by then); with threads the
+// sum pass does them after the barrier. Returns the largest
+// overlap/min(r_i, r_j). The damped pass also writes each block's dashpot
+// power, Σ (fe − fn)·v_n over its slots, for the energy ledger.
+template <int W, bool kDamped, bool kFused>
 DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
   using D = typename Simd<W>::D;
   const D zero{};
@@ -93,17 +134,25 @@ DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
         }
         fn = select<W>(touch, fn, zero);
         // Tangential velocity of j's contact point relative to i's, along t.
-        const D rot = 0.5 * ((omi + omj) * (ai + aj) + (omi - omj) * (ai - aj));
+        const D rot = omi * ai + omj * aj;
         const D vt = (dvy * nx - dvx * ny) - rot;
         const D cap = mu * fn;
         D t = law::coulomb_clamp(load<W>(a.slot_ft + s) + kdt * vt, cap);
         t = select<W>(touch, t, zero);
         store<W>(a.slot_ft + s, t);
-        // Force on i: −fn·n + ft·t.
-        fx += -fn * nx - t * ny;
-        fy += -fn * ny + t * nx;
+        // Force on i: −fn·n + ft·t (on j its opposite); torques a_i·ft on
+        // i, a_j·ft on j.
+        const D qx = -fn * nx - t * ny, qy = -fn * ny + t * nx;
+        fx += qx;
+        fy += qy;
         tq += ai * t;
-        const D ovr = select<W>(touch, ov * iri, zero);
+        store<W>(a.pfx + s, qx);
+        store<W>(a.pfy + s, qy);
+        store<W>(a.ptq + s, aj * t);
+        // overlap/min(r_i, r_j) (ov ≥ 0 where touching: the product is
+        // monotone, the larger of the two ratios exactly).
+        const D irj = load<W>(a.slot_ir + s);
+        const D ovr = select<W>(touch, ov * (iri > irj ? iri : irj), zero);
         mo = mo > ovr ? mo : ovr;
       }
       store<W>(a.fx + i0, fx);
@@ -115,6 +164,7 @@ DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
       for (int l = 0; l < W; ++l) sum += power[l];
       a.block_power[b] = sum;
     }
+    if constexpr (kFused) sum_blocks<W>(a, b, b + 1);
   }
   return hmax<W>(mo);
 }
@@ -159,29 +209,45 @@ DEMCAL_INLINE double integrate_blocks(const IntegrateArgs &a, int b0, int b1) {
 // ---------------------------------------------------------------- dispatch
 
 using PairFn = double (*)(const PairArgs &, int, int);
+using SumFn = void (*)(const PairArgs &, int, int);
 using IntegrateFn = double (*)(const IntegrateArgs &, int, int);
 
 struct Kernels {
-  PairFn pairs, pairs_damped;
+  PairFn pairs, pairs_damped;              // one thread: the sums fused
+  PairFn pairs_split, pairs_damped_split;  // threads: the sums in the sum pass
+  SumFn sums;
   IntegrateFn integrate, integrate_locked;
   const char *name;
 };
 
-#define DEMCAL_KERNELS(SUFFIX, TARGET, W)                                                        \
-  TARGET double pairs_##SUFFIX(const PairArgs &a, int b0, int b1) {                              \
-    return pair_blocks<W, false>(a, b0, b1);                                                     \
-  }                                                                                              \
-  TARGET double pairs_damped_##SUFFIX(const PairArgs &a, int b0, int b1) {                       \
-    return pair_blocks<W, true>(a, b0, b1);                                                      \
-  }                                                                                              \
-  TARGET double integrate_##SUFFIX(const IntegrateArgs &a, int b0, int b1) {                     \
-    return integrate_blocks<W, true>(a, b0, b1);                                                 \
-  }                                                                                              \
-  TARGET double integrate_locked_##SUFFIX(const IntegrateArgs &a, int b0, int b1) {              \
-    return integrate_blocks<W, false>(a, b0, b1);                                                \
-  }                                                                                              \
-  constexpr Kernels kKernels_##SUFFIX{pairs_##SUFFIX, pairs_damped_##SUFFIX, integrate_##SUFFIX, \
-                                      integrate_locked_##SUFFIX, #SUFFIX};
+#define DEMCAL_KERNELS(SUFFIX, TARGET, W)                                                    \
+  TARGET double pairs_##SUFFIX(const PairArgs &a, int b0, int b1) {                          \
+    return pair_blocks<W, false, true>(a, b0, b1);                                           \
+  }                                                                                          \
+  TARGET double pairs_damped_##SUFFIX(const PairArgs &a, int b0, int b1) {                   \
+    return pair_blocks<W, true, true>(a, b0, b1);                                            \
+  }                                                                                          \
+  TARGET double pairs_split_##SUFFIX(const PairArgs &a, int b0, int b1) {                    \
+    return pair_blocks<W, false, false>(a, b0, b1);                                          \
+  }                                                                                          \
+  TARGET double pairs_damped_split_##SUFFIX(const PairArgs &a, int b0, int b1) {             \
+    return pair_blocks<W, true, false>(a, b0, b1);                                           \
+  }                                                                                          \
+  TARGET void sums_##SUFFIX(const PairArgs &a, int b0, int b1) { sum_blocks<W>(a, b0, b1); } \
+  TARGET double integrate_##SUFFIX(const IntegrateArgs &a, int b0, int b1) {                 \
+    return integrate_blocks<W, true>(a, b0, b1);                                             \
+  }                                                                                          \
+  TARGET double integrate_locked_##SUFFIX(const IntegrateArgs &a, int b0, int b1) {          \
+    return integrate_blocks<W, false>(a, b0, b1);                                            \
+  }                                                                                          \
+  constexpr Kernels kKernels_##SUFFIX{pairs_##SUFFIX,                                        \
+                                      pairs_damped_##SUFFIX,                                 \
+                                      pairs_split_##SUFFIX,                                  \
+                                      pairs_damped_split_##SUFFIX,                           \
+                                      sums_##SUFFIX,                                         \
+                                      integrate_##SUFFIX,                                    \
+                                      integrate_locked_##SUFFIX,                             \
+                                      #SUFFIX};
 
 #define DEMCAL_NO_TARGET
 DEMCAL_KERNELS(sse2, DEMCAL_NO_TARGET, 2)
@@ -230,11 +296,19 @@ const char *kernel_simd() {
 #endif
 }
 
-double WorldImpl::pair_pass(int b0, int b1) {
+double WorldImpl::pair_pass(int b0, int b1) { return pair_kernel(b0, b1, false); }
+
+double WorldImpl::sum_pass(int b0, int b1) { return pair_kernel(b0, b1, true); }
+
+double WorldImpl::pair_kernel(int b0, int b1, bool sums) {
   const PairArgs a{block_slot_.data(),
                    slot_j_.data(),
                    slot_ft_.data(),
                    slot_r_.data(),
+                   slot_ir_.data(),
+                   pfx_.data(),
+                   pfy_.data(),
+                   ptq_.data(),
                    x_.data(),
                    y_.data(),
                    vx_.data(),
@@ -250,9 +324,17 @@ double WorldImpl::pair_pass(int b0, int b1) {
                    material_.particle.kn,
                    material_.particle.kt * integration_.dt,
                    material_.particle.friction,
-                   2.0 * material_.contact_damping_ratio};
+                   2.0 * material_.contact_damping_ratio,
+                   mirror_block_.data(),
+                   mirror_slot_.data()};
   const Kernels &k = kernels();
-  return material_.contact_damping_ratio > 0.0 ? k.pairs_damped(a, b0, b1) : k.pairs(a, b0, b1);
+  const bool damped = material_.contact_damping_ratio > 0.0;
+  if (sums) {
+    k.sums(a, b0, b1);
+    return 0.0;
+  }
+  if (active_threads() <= 1) return damped ? k.pairs_damped(a, b0, b1) : k.pairs(a, b0, b1);
+  return damped ? k.pairs_damped_split(a, b0, b1) : k.pairs_split(a, b0, b1);
 }
 
 double WorldImpl::integrate_pass(int b0, int b1) {
@@ -357,7 +439,7 @@ double WorldImpl::dashpot_power() const {
   // Block by block in a fixed order: the same sum for any thread count.
   double pairs = 0.0;
   for (int b = 0; b < nblocks_; ++b) pairs += block_power_[b];
-  return 0.5 * pairs + wall_dashpot_power_;  // each pair was counted from both sides
+  return pairs + wall_dashpot_power_;
 }
 
 }  // namespace demcal
