@@ -137,7 +137,7 @@ void WorldImpl::rebuild_neighbours() {
   slot_r_.swap(new_slot_r_);
   slot_ir_.swap(new_slot_ir_);
   // The pair terms, and the zero slot at index ns.
-  for (Array* p : {&pfx_, &pfy_, &ptq_}) p->assign(ns + 1, 0.0);
+  for (Array* p : {&pfx_, &pfy_, &pti_, &ptj_}) p->assign(ns + 1, 0.0);
   rebuild_mirror_list();
   update_thread_bounds();
 

@@ -49,7 +49,7 @@ struct PairArgs {
   double *__restrict slot_ft;
   const double *__restrict slot_r, *__restrict slot_ir;  // the slot's neighbour: r, 1/r
   double *__restrict pfx, *__restrict pfy;               // per slot: the pair's force on i
-  double *__restrict ptq;                                // per slot: its torque on j
+  double *__restrict pti, *__restrict ptj;               // per slot: its torques on i and j
   const double *__restrict x, *__restrict y, *__restrict vx, *__restrict vy, *__restrict om;
   const double *__restrict r, *__restrict inv_r, *__restrict m;
   double *__restrict fx, *__restrict fy, *__restrict tq;
@@ -59,24 +59,35 @@ struct PairArgs {
   const int *__restrict mirror_slot;
 };
 
-// Adds to each particle j of blocks [b0, b1) what it receives from its
-// pairs (i, j), i < j, in increasing i: the opposite of the force on i and
-// the torque on j. (A: PairArgs; the pair pass calls it fused, the sum pass
-// after the barrier with threads: the same sums in the same order.)
+// Sums each particle's force and torque over its pairs in increasing index
+// of the partner, and writes them: first its pairs (i, j), i < j, from its
+// mirror list (the opposite of the force on i, the torque on j), then its
+// own slots (pairs j > i). That is the order, and the terms are the bits,
+// of the full list this kernel had until issue #17 ("each particle's
+// neighbours in increasing index": a pair's two evaluations there gave
+// exact opposites), so the forces are bit-identical to that kernel's. The
+// pair pass calls it fused (one thread) and the sum pass after the barrier
+// (threads): the same sums in the same order.
 template <int W>
 DEMCAL_INLINE void sum_blocks(const PairArgs &a, int b0, int b1) {
   using D = typename Simd<W>::D;
+  const D zero{};
   for (int b = b0; b < b1; ++b) {
-    const int s0 = a.mirror_block[b], s1 = a.mirror_block[b + 1];
-    if (s0 == s1) continue;
+    const int m0 = a.mirror_block[b], m1 = a.mirror_block[b + 1];
+    const int s0 = a.block_slot[b], s1 = a.block_slot[b + 1];
     for (int sub = 0; sub < kBlock; sub += W) {
       const int i0 = kBlock * b + sub;
-      D fx = load<W>(a.fx + i0), fy = load<W>(a.fy + i0), tq = load<W>(a.tq + i0);
-      for (int s = s0 + sub; s < s1; s += kBlock) {
+      D fx = zero, fy = zero, tq = zero;
+      for (int s = m0 + sub; s < m1; s += kBlock) {
         const int *S = a.mirror_slot + s;
         fx -= gather<W>(a.pfx, S);
         fy -= gather<W>(a.pfy, S);
-        tq += gather<W>(a.ptq, S);
+        tq += gather<W>(a.ptj, S);
+      }
+      for (int s = s0 + sub; s < s1; s += kBlock) {
+        fx += load<W>(a.pfx + s);
+        fy += load<W>(a.pfy + s);
+        tq += load<W>(a.pti + s);
       }
       store<W>(a.fx + i0, fx);
       store<W>(a.fy + i0, fy);
@@ -86,11 +97,10 @@ DEMCAL_INLINE void sum_blocks(const PairArgs &a, int b0, int b1) {
 }
 
 // Pairs of blocks [b0, b1) on the half list (each pair once, from i < j):
-// each particle's force and torque summed over its own slots, written (not
-// added) to fx, fy, tq, and per slot the pair's force on i and torque on j.
-// kFused (one thread): each block's mirrored sums right after its pairs
-// (its mirrored slots lie in blocks ≤ b, all done by then); with threads the
-// sum pass does them after the barrier. Returns the largest
+// per slot the pair's force on i and its torques on i and j. kFused (one
+// thread): each block's sums right after its pairs (its mirrored slots lie
+// in blocks ≤ b, all done by then); with threads the sum pass does them
+// after the barrier. Returns the largest
 // overlap/min(r_i, r_j). The damped pass also writes each block's dashpot
 // power, Σ (fe − fn)·v_n over its slots, for the energy ledger.
 template <int W, bool kDamped, bool kFused>
@@ -109,7 +119,6 @@ DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
       const D ri = load<W>(a.r + i0), iri = load<W>(a.inv_r + i0);
       D mi = zero;
       if constexpr (kDamped) mi = load<W>(a.m + i0);
-      D fx = zero, fy = zero, tq = zero;
       for (int s = s0 + sub; s < s1; s += kBlock) {
         const int *J = a.slot_j + s;
         const D rj = load<W>(a.slot_r + s);
@@ -134,7 +143,10 @@ DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
         }
         fn = select<W>(touch, fn, zero);
         // Tangential velocity of j's contact point relative to i's, along t.
-        const D rot = omi * ai + omj * aj;
+        // (The symmetric form of ω_i·a_i + ω_j·a_j: the full list needed it
+        // for its two copies of a pair to come out exact opposites; kept, so
+        // that the forces stay those bits, see sum_blocks.)
+        const D rot = 0.5 * ((omi + omj) * (ai + aj) + (omi - omj) * (ai - aj));
         const D vt = (dvy * nx - dvx * ny) - rot;
         const D cap = mu * fn;
         D t = law::coulomb_clamp(load<W>(a.slot_ft + s) + kdt * vt, cap);
@@ -142,22 +154,16 @@ DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
         store<W>(a.slot_ft + s, t);
         // Force on i: −fn·n + ft·t (on j its opposite); torques a_i·ft on
         // i, a_j·ft on j.
-        const D qx = -fn * nx - t * ny, qy = -fn * ny + t * nx;
-        fx += qx;
-        fy += qy;
-        tq += ai * t;
-        store<W>(a.pfx + s, qx);
-        store<W>(a.pfy + s, qy);
-        store<W>(a.ptq + s, aj * t);
+        store<W>(a.pfx + s, -fn * nx - t * ny);
+        store<W>(a.pfy + s, -fn * ny + t * nx);
+        store<W>(a.pti + s, ai * t);
+        store<W>(a.ptj + s, aj * t);
         // overlap/min(r_i, r_j) (ov ≥ 0 where touching: the product is
         // monotone, the larger of the two ratios exactly).
         const D irj = load<W>(a.slot_ir + s);
         const D ovr = select<W>(touch, ov * (iri > irj ? iri : irj), zero);
         mo = mo > ovr ? mo : ovr;
       }
-      store<W>(a.fx + i0, fx);
-      store<W>(a.fy + i0, fy);
-      store<W>(a.tq + i0, tq);
     }
     if constexpr (kDamped) {
       double sum = 0.0;
@@ -308,7 +314,8 @@ double WorldImpl::pair_kernel(int b0, int b1, bool sums) {
                    slot_ir_.data(),
                    pfx_.data(),
                    pfy_.data(),
-                   ptq_.data(),
+                   pti_.data(),
+                   ptj_.data(),
                    x_.data(),
                    y_.data(),
                    vx_.data(),

@@ -219,8 +219,9 @@ class WorldImpl {
   Array slot_r_;   // radius of the slot's neighbour (contiguous: one gather less)
   Array slot_ir_;  // its inverse
   // Per slot, written by the pair pass: the pair's force on i (pfx_, pfy_)
-  // and its torque on j (ptq_); index block_slot_.back() is a zero slot.
-  Array pfx_, pfy_, ptq_;
+  // and its torques on i and j (pti_, ptj_); index block_slot_.back() is a
+  // zero slot.
+  Array pfx_, pfy_, pti_, ptj_;
   // Mirror list (sliced ELLPACK like the list): block b's rows are
   // [mirror_block_[b], mirror_block_[b + 1]); particle j's entries are the
   // slots of its pairs (i, j), i < j, in increasing i, then the zero slot.

@@ -114,7 +114,7 @@ void WorldImpl::visit_state(Self& w, Visitor& v) {
         &w.r_,       &w.inv_r_,       &w.m_,           &w.inertia_,    &w.fx_,      &w.fy_,
         &w.tq_,      &w.block_power_, &w.ca_t_,        &w.cb_t_,       &w.ca_r_,    &w.cb_r_,
         &w.slot_ft_, &w.slot_r_,      &w.new_slot_ft_, &w.new_slot_r_, &w.x_built_, &w.y_built_,
-        &w.slot_ir_, &w.new_slot_ir_, &w.pfx_,         &w.pfy_,        &w.ptq_})
+        &w.slot_ir_, &w.new_slot_ir_, &w.pfx_,         &w.pfy_,        &w.pti_,     &w.ptj_})
     v(*a);
   v(w.wall_dashpot_power_);
   for (int s = 0; s < 4; ++s) {
@@ -189,7 +189,8 @@ WorldImpl WorldImpl::load_state(std::string_view bytes) {
       static_cast<size_t>(w.block_slot_.back()) <= w.slot_j_.size() &&
       w.slot_ir_.size() == w.slot_ft_.size() &&
       (w.pfx_.empty() || (w.pfx_.size() == static_cast<size_t>(w.block_slot_.back()) + 1 &&
-                          w.pfy_.size() == w.pfx_.size() && w.ptq_.size() == w.pfx_.size())) &&
+                          w.pfy_.size() == w.pfx_.size() && w.pti_.size() == w.pfx_.size() &&
+                          w.ptj_.size() == w.pfx_.size())) &&
       (w.mirror_block_.empty() ||
        (w.mirror_block_.size() == static_cast<size_t>(w.nblocks_) + 1 &&
         static_cast<size_t>(w.mirror_block_.back()) <= w.mirror_slot_.size()));
