@@ -177,8 +177,12 @@ void WorldImpl::rebuild_mirror_list() {
   }
   mirror_slot_.assign(static_cast<size_t>(mirror_block_[nblocks_]), ns);
   std::fill(mirror_count_.begin(), mirror_count_.end(), 0);
+  mirror_src_block_.resize(nblocks_);
+  for (int b = 0; b < nblocks_; ++b) mirror_src_block_[b] = b;
+  block_fused_.assign(nblocks_, 0);
   for (size_t k = 0; k < pair_j_.size(); ++k) {
     const int j = pair_j_[k];
+    mirror_src_block_[j / kBlock] = std::min(mirror_src_block_[j / kBlock], pair_i_[k] / kBlock);
     const int row = mirror_count_[j]++;
     mirror_slot_[mirror_block_[j / kBlock] + j % kBlock + kBlock * row] = pair_slot_[k];
   }

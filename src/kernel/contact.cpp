@@ -57,6 +57,11 @@ struct PairArgs {
   double kn, kdt, mu, beta2;       // beta2 = 2·contact damping ratio
   const int *__restrict mirror_block;
   const int *__restrict mirror_slot;
+  // Threads: block b's sums run right after its pairs where this pass has
+  // written all its mirrored slots (its lowest source block src_block[b] is
+  // in the pass's range); fused[b] tells the sum pass which are left.
+  const int *__restrict src_block;
+  unsigned char *__restrict fused;
 };
 
 // Sums each particle's force and torque over its pairs in increasing index
@@ -69,10 +74,11 @@ struct PairArgs {
 // pair pass calls it fused (one thread) and the sum pass after the barrier
 // (threads): the same sums in the same order.
 template <int W>
-DEMCAL_INLINE void sum_blocks(const PairArgs &a, int b0, int b1) {
+DEMCAL_INLINE void sum_blocks(const PairArgs &a, int b0, int b1, bool skip_fused = false) {
   using D = typename Simd<W>::D;
   const D zero{};
   for (int b = b0; b < b1; ++b) {
+    if (skip_fused && a.fused[b]) continue;
     const int m0 = a.mirror_block[b], m1 = a.mirror_block[b + 1];
     const int s0 = a.block_slot[b], s1 = a.block_slot[b + 1];
     for (int sub = 0; sub < kBlock; sub += W) {
@@ -97,13 +103,15 @@ DEMCAL_INLINE void sum_blocks(const PairArgs &a, int b0, int b1) {
 }
 
 // Pairs of blocks [b0, b1) on the half list (each pair once, from i < j):
-// per slot the pair's force on i and its torques on i and j. kFused (one
-// thread): each block's sums right after its pairs (its mirrored slots lie
-// in blocks ≤ b, all done by then); with threads the sum pass does them
-// after the barrier. Returns the largest
+// per slot the pair's force on i and its torques on i and j; and each
+// block's sums right after its pairs, the pair terms still in cache, where
+// this pass wrote all of its mirrored slots (they lie in blocks ≤ b): with
+// one thread (kAll) every block; with threads the blocks whose mirrored
+// slots all lie in the thread's own range, the others in the sum pass after
+// the barrier (the same sums). Returns the largest
 // overlap/min(r_i, r_j). The damped pass also writes each block's dashpot
 // power, Σ (fe − fn)·v_n over its slots, for the energy ledger.
-template <int W, bool kDamped, bool kFused>
+template <int W, bool kDamped, bool kAll>
 DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
   using D = typename Simd<W>::D;
   const D zero{};
@@ -170,7 +178,13 @@ DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
       for (int l = 0; l < W; ++l) sum += power[l];
       a.block_power[b] = sum;
     }
-    if constexpr (kFused) sum_blocks<W>(a, b, b + 1);
+    if constexpr (kAll) {
+      sum_blocks<W>(a, b, b + 1);
+    } else {
+      const bool complete = a.src_block[b] >= b0;
+      a.fused[b] = complete;
+      if (complete) sum_blocks<W>(a, b, b + 1);
+    }
   }
   return hmax<W>(mo);
 }
@@ -226,33 +240,33 @@ struct Kernels {
   const char *name;
 };
 
-#define DEMCAL_KERNELS(SUFFIX, TARGET, W)                                                    \
-  TARGET double pairs_##SUFFIX(const PairArgs &a, int b0, int b1) {                          \
-    return pair_blocks<W, false, true>(a, b0, b1);                                           \
-  }                                                                                          \
-  TARGET double pairs_damped_##SUFFIX(const PairArgs &a, int b0, int b1) {                   \
-    return pair_blocks<W, true, true>(a, b0, b1);                                            \
-  }                                                                                          \
-  TARGET double pairs_split_##SUFFIX(const PairArgs &a, int b0, int b1) {                    \
-    return pair_blocks<W, false, false>(a, b0, b1);                                          \
-  }                                                                                          \
-  TARGET double pairs_damped_split_##SUFFIX(const PairArgs &a, int b0, int b1) {             \
-    return pair_blocks<W, true, false>(a, b0, b1);                                           \
-  }                                                                                          \
-  TARGET void sums_##SUFFIX(const PairArgs &a, int b0, int b1) { sum_blocks<W>(a, b0, b1); } \
-  TARGET double integrate_##SUFFIX(const IntegrateArgs &a, int b0, int b1) {                 \
-    return integrate_blocks<W, true>(a, b0, b1);                                             \
-  }                                                                                          \
-  TARGET double integrate_locked_##SUFFIX(const IntegrateArgs &a, int b0, int b1) {          \
-    return integrate_blocks<W, false>(a, b0, b1);                                            \
-  }                                                                                          \
-  constexpr Kernels kKernels_##SUFFIX{pairs_##SUFFIX,                                        \
-                                      pairs_damped_##SUFFIX,                                 \
-                                      pairs_split_##SUFFIX,                                  \
-                                      pairs_damped_split_##SUFFIX,                           \
-                                      sums_##SUFFIX,                                         \
-                                      integrate_##SUFFIX,                                    \
-                                      integrate_locked_##SUFFIX,                             \
+#define DEMCAL_KERNELS(SUFFIX, TARGET, W)                                                          \
+  TARGET double pairs_##SUFFIX(const PairArgs &a, int b0, int b1) {                                \
+    return pair_blocks<W, false, true>(a, b0, b1);                                                 \
+  }                                                                                                \
+  TARGET double pairs_damped_##SUFFIX(const PairArgs &a, int b0, int b1) {                         \
+    return pair_blocks<W, true, true>(a, b0, b1);                                                  \
+  }                                                                                                \
+  TARGET double pairs_split_##SUFFIX(const PairArgs &a, int b0, int b1) {                          \
+    return pair_blocks<W, false, false>(a, b0, b1);                                                \
+  }                                                                                                \
+  TARGET double pairs_damped_split_##SUFFIX(const PairArgs &a, int b0, int b1) {                   \
+    return pair_blocks<W, true, false>(a, b0, b1);                                                 \
+  }                                                                                                \
+  TARGET void sums_##SUFFIX(const PairArgs &a, int b0, int b1) { sum_blocks<W>(a, b0, b1, true); } \
+  TARGET double integrate_##SUFFIX(const IntegrateArgs &a, int b0, int b1) {                       \
+    return integrate_blocks<W, true>(a, b0, b1);                                                   \
+  }                                                                                                \
+  TARGET double integrate_locked_##SUFFIX(const IntegrateArgs &a, int b0, int b1) {                \
+    return integrate_blocks<W, false>(a, b0, b1);                                                  \
+  }                                                                                                \
+  constexpr Kernels kKernels_##SUFFIX{pairs_##SUFFIX,                                              \
+                                      pairs_damped_##SUFFIX,                                       \
+                                      pairs_split_##SUFFIX,                                        \
+                                      pairs_damped_split_##SUFFIX,                                 \
+                                      sums_##SUFFIX,                                               \
+                                      integrate_##SUFFIX,                                          \
+                                      integrate_locked_##SUFFIX,                                   \
                                       #SUFFIX};
 
 #define DEMCAL_NO_TARGET
@@ -333,7 +347,9 @@ double WorldImpl::pair_kernel(int b0, int b1, bool sums) {
                    material_.particle.friction,
                    2.0 * material_.contact_damping_ratio,
                    mirror_block_.data(),
-                   mirror_slot_.data()};
+                   mirror_slot_.data(),
+                   mirror_src_block_.data(),
+                   block_fused_.data()};
   const Kernels &k = kernels();
   const bool damped = material_.contact_damping_ratio > 0.0;
   if (sums) {

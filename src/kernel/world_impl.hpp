@@ -227,6 +227,10 @@ class WorldImpl {
   // slots of its pairs (i, j), i < j, in increasing i, then the zero slot.
   std::vector<int> mirror_block_, mirror_count_;
   detail::AlignedVector<int> mirror_slot_;
+  // Per block: the lowest block holding one of its mirrored slots, and
+  // whether the threaded pair pass has summed it (contact.cpp).
+  std::vector<int> mirror_src_block_;
+  std::vector<unsigned char> block_fused_;
   // The pairs i < j of the list, sorted by (i, j), and the slot of i's copy.
   std::vector<int> pair_i_, pair_j_, pair_slot_;
   // Block ranges of the threads for the pair pass (balanced by slots) and

@@ -131,11 +131,12 @@ void WorldImpl::visit_state(Self& w, Visitor& v) {
   }
   for (auto* a : {&w.block_slot_, &w.pair_i_, &w.pair_j_, &w.pair_slot_, &w.pair_bounds_,
                   &w.particle_bounds_, &w.nbr_start_, &w.nbr_list_, &w.cell_start_, &w.cell_next_,
-                  &w.new_block_slot_, &w.mirror_block_, &w.mirror_count_})
+                  &w.new_block_slot_, &w.mirror_block_, &w.mirror_count_, &w.mirror_src_block_})
     v(*a);
   v(w.slot_j_);
   v(w.new_slot_j_);
   v(w.mirror_slot_);
+  v(w.block_fused_);
   v(w.skin_);
   v(w.r_max_);
   v(w.r_min_);
@@ -193,7 +194,9 @@ WorldImpl WorldImpl::load_state(std::string_view bytes) {
                           w.ptj_.size() == w.pfx_.size())) &&
       (w.mirror_block_.empty() ||
        (w.mirror_block_.size() == static_cast<size_t>(w.nblocks_) + 1 &&
-        static_cast<size_t>(w.mirror_block_.back()) <= w.mirror_slot_.size()));
+        static_cast<size_t>(w.mirror_block_.back()) <= w.mirror_slot_.size() &&
+        w.mirror_src_block_.size() == static_cast<size_t>(w.nblocks_) &&
+        w.block_fused_.size() == static_cast<size_t>(w.nblocks_)));
   for (int s = 0; s < 4; ++s)
     if (w.wall_ft_[s].size() != static_cast<size_t>(w.n_) ||
         w.wall_fn_[s].size() != static_cast<size_t>(w.n_))
