@@ -7,6 +7,7 @@
 // contact force, wall forces and the stress measures.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <vector>
 
 #include "support/same_bits.hpp"
@@ -106,6 +107,78 @@ TEST(KernelThreads, CopiesAndThreadChangesMidRunKeepTheTrajectory) {
   ASSERT_TRUE(c.step(2000));
   expect_identical(a, b);
   expect_identical(a, c);
+}
+
+// The kernel evaluates each pair once (half list) and adds the pair's force
+// and torque to the second particle in a separate sum (the mirror list):
+// every particle's force and torque must equal the plain sum over all its
+// touching pairs, found by brute force over all N² pairs, with the law
+// written out here (fn = kn·δ; the tangential force ft, the history, from
+// contacts(); force on i −fn·n + ft·t, t = (−n_y, n_x), on j the opposite;
+// torques (r − δ/2)·ft on both). Particles touching a wall are left out
+// (the wall law is checked in test_kernel_contact.cpp). Tolerance, per
+// contact: the overlap δ = (r_i + r_j) − d is a small difference of large
+// numbers, and d² rounds differently with FMA (the wide paths), so fn is
+// good to kn·8ε·(r_i + r_j) (as in test_kernel_neighbours.cpp); the sums
+// run in another order: 1e-12 of the particle's force scale Σ|f| covers
+// that. Far below any missing, doubled or misdirected contact (≥ 1e-4 of
+// the scale in this jammed packing). Run per path with DEMCAL_SIMD.
+TEST(KernelThreads, ForcesEqualABruteForceSumOverPairs) {
+  using kernel_test::kEps;
+  for (int threads : {1, 2}) {
+    const World w = sheared(jammed(0.0), threads, 600);
+    const int n = w.size();
+    const double kn = w.material().particle.kn;
+    std::vector<double> fx(n, 0.0), fy(n, 0.0), tq(n, 0.0), scale(n, 0.0), round_off(n, 0.0);
+    const auto views = w.contacts();
+    size_t v = 0;
+    int pairs = 0, sliding_or_loaded = 0;
+    for (int i = 0; i < n; ++i)
+      for (int j = i + 1; j < n; ++j) {
+        const double dx = w.x()[j] - w.x()[i], dy = w.y()[j] - w.y()[i];
+        const double rs = w.radius()[i] + w.radius()[j];
+        const double d2 = dx * dx + dy * dy;
+        if (!(d2 < rs * rs)) continue;
+        ++pairs;
+        while (v < views.size() && (views[v].i < i || (views[v].i == i && views[v].j < j))) ++v;
+        ASSERT_LT(v, views.size());
+        ASSERT_EQ(views[v].i, i);
+        ASSERT_EQ(views[v].j, j);
+        const double ft = views[v].ft;
+        sliding_or_loaded += ft != 0.0;
+        const double d = std::sqrt(d2), nx = dx / d, ny = dy / d, ov = rs - d;
+        const double fn = kn * ov;
+        const double px = -fn * nx - ft * ny, py = -fn * ny + ft * nx;
+        fx[i] += px;
+        fy[i] += py;
+        fx[j] -= px;
+        fy[j] -= py;
+        tq[i] += (w.radius()[i] - 0.5 * ov) * ft;
+        tq[j] += (w.radius()[j] - 0.5 * ov) * ft;
+        const double f = std::hypot(fn, ft);
+        scale[i] += f;
+        scale[j] += f;
+        round_off[i] += kn * 8.0 * kEps * rs;
+        round_off[j] += kn * 8.0 * kEps * rs;
+      }
+    ASSERT_GT(pairs, 1000);
+    ASSERT_GT(sliding_or_loaded, pairs / 2);  // the tangential springs carry load
+    int checked = 0;
+    for (int i = 0; i < n; ++i) {
+      const double r = w.radius()[i];
+      const bool on_wall =
+          w.x()[i] - r < w.wall(kLeft).position || w.x()[i] + r > w.wall(kRight).position ||
+          w.y()[i] - r < w.wall(kBottom).position || w.y()[i] + r > w.wall(kTop).position;
+      if (on_wall || scale[i] == 0.0) continue;
+      ++checked;
+      const double tol = round_off[i] + 1e-12 * scale[i];
+      EXPECT_NEAR(w.fx()[i], fx[i], tol) << "particle " << i << ", " << threads << " threads";
+      EXPECT_NEAR(w.fy()[i], fy[i], tol) << "particle " << i << ", " << threads << " threads";
+      EXPECT_NEAR(w.torque()[i], tq[i], tol * r)
+          << "particle " << i << ", " << threads << " threads";
+    }
+    EXPECT_GT(checked, n / 2);
+  }
 }
 
 }  // namespace

@@ -3,9 +3,11 @@
 // wall) has moved far enough that a pair outside the list could touch (the
 // displacement scan is fused into the integration pass, solver.cpp).
 //
-// The list is full (each pair from both sides) and stored as sliced
-// ELLPACK in blocks of 8 particles (world.hpp). The tangential history of a
-// pair carries over a rebuild in both of its copies.
+// The list is a half list (each pair (i, j) once, in i's row, i < j) stored
+// as sliced ELLPACK in blocks of 8 particles (world_impl.hpp); the mirror
+// list gives each particle j the slots of its pairs (i, j) in increasing i,
+// for the sums of the pair terms (contact.cpp). The tangential history of
+// a pair carries over a rebuild by a merge of the old and new rows.
 #include <algorithm>
 #include <cmath>
 
@@ -73,8 +75,9 @@ void WorldImpl::rebuild_neighbours() {
     cell_start_[c] = i;
   }
 
-  // Full neighbour lists (CSR), each sorted by index. The cut-off test is
-  // symmetric in i and j bit for bit, so j is i's neighbour iff i is j's.
+  // Half neighbour lists (CSR, pairs i < j), each sorted by index. The
+  // cut-off test is symmetric in i and j bit for bit, so the pair is the
+  // same whichever side finds it.
   nbr_start_.assign(static_cast<size_t>(n) + 1, 0);
   nbr_list_.clear();
   for (int i = 0; i < n; ++i) {
@@ -88,7 +91,7 @@ void WorldImpl::rebuild_neighbours() {
         const int xx = cx + dx;
         if (xx < 0 || xx >= ncx) continue;
         for (int j = cell_start_[yy * ncx + xx]; j >= 0; j = cell_next_[j]) {
-          if (j == i) continue;
+          if (j <= i) continue;
           const double ddx = x_[j] - x_[i], ddy = y_[j] - y_[i];
           const double cut = r_[i] + r_[j] + skin_;
           if (ddx * ddx + ddy * ddy < cut * cut) nbr_list_.push_back(j);
@@ -104,6 +107,7 @@ void WorldImpl::rebuild_neighbours() {
   new_slot_j_.assign(ns, ghost_);
   new_slot_ft_.assign(ns, 0.0);
   new_slot_r_.assign(ns, 0.0);
+  new_slot_ir_.assign(ns, 0.0);
   pair_i_.clear();
   pair_j_.clear();
   pair_slot_.clear();
@@ -119,19 +123,22 @@ void WorldImpl::rebuild_neighbours() {
       const int s = nb + kBlock * (k - nbr_start_[i]);
       new_slot_j_[s] = j;
       new_slot_r_[s] = r_[j];
+      new_slot_ir_[s] = inv_r_[j];
       while (o < old_end && slot_j_[o] < j) o += kBlock;
       if (o < old_end && slot_j_[o] == j) new_slot_ft_[s] = slot_ft_[o];
-      if (j > i) {
-        pair_i_.push_back(i);
-        pair_j_.push_back(j);
-        pair_slot_.push_back(s);
-      }
+      pair_i_.push_back(i);
+      pair_j_.push_back(j);
+      pair_slot_.push_back(s);
     }
   }
   block_slot_.swap(new_block_slot_);
   slot_j_.swap(new_slot_j_);
   slot_ft_.swap(new_slot_ft_);
   slot_r_.swap(new_slot_r_);
+  slot_ir_.swap(new_slot_ir_);
+  // The pair terms, and the zero slot at index ns.
+  for (Array* p : {&pfx_, &pfy_, &pti_, &ptj_}) p->assign(ns + 1, 0.0);
+  rebuild_mirror_list();
   update_thread_bounds();
 
   // Wall candidates: particles within skin of a wall.
@@ -154,6 +161,31 @@ void WorldImpl::rebuild_neighbours() {
   std::copy(y_.begin(), y_.begin() + n, y_built_.begin());
   for (int s = 0; s < 4; ++s) wall_built_[s] = walls_[s].position;
   list_valid_ = true;
+}
+
+void WorldImpl::rebuild_mirror_list() {
+  const int ns = block_slot_[nblocks_];
+  // The slots of the pairs (i, j), i < j, by j, in increasing i (pair_i_ is
+  // sorted by (i, j)); padded with the zero slot ns.
+  mirror_count_.assign(static_cast<size_t>(kBlock) * nblocks_, 0);
+  for (int j : pair_j_) ++mirror_count_[j];
+  mirror_block_.assign(static_cast<size_t>(nblocks_) + 1, 0);
+  for (int b = 0; b < nblocks_; ++b) {
+    const int rows = *std::max_element(mirror_count_.begin() + kBlock * b,
+                                       mirror_count_.begin() + kBlock * (b + 1));
+    mirror_block_[b + 1] = mirror_block_[b] + kBlock * rows;
+  }
+  mirror_slot_.assign(static_cast<size_t>(mirror_block_[nblocks_]), ns);
+  std::fill(mirror_count_.begin(), mirror_count_.end(), 0);
+  mirror_src_block_.resize(nblocks_);
+  for (int b = 0; b < nblocks_; ++b) mirror_src_block_[b] = b;
+  block_fused_.assign(nblocks_, 0);
+  for (size_t k = 0; k < pair_j_.size(); ++k) {
+    const int j = pair_j_[k];
+    mirror_src_block_[j / kBlock] = std::min(mirror_src_block_[j / kBlock], pair_i_[k] / kBlock);
+    const int row = mirror_count_[j]++;
+    mirror_slot_[mirror_block_[j / kBlock] + j % kBlock + kBlock * row] = pair_slot_[k];
+  }
 }
 
 }  // namespace demcal

@@ -7,18 +7,26 @@
 // same lever arms enter the torques and the stress, so a moment-free particle
 // contributes a symmetric term to σ exactly.
 //
-// The particle–particle loop runs over the full neighbour list in blocks of
-// 8 particles (world.hpp), W lanes at a time with GCC vector extensions:
-// W = 8 on x86-64-v4 (AVX-512), 4 on x86-64-v3 (AVX2), 2 on baseline
-// x86-64 (SSE2). The path is chosen once from the CPU; the default build
-// needs no -march flag. Every pair is evaluated from both sides, by the same
-// instructions with the roles of i and j swapped. Every quantity the
-// tangential history depends on is then either invariant or exactly negated
-// under the swap — including under FMA contraction, which is why the
-// rotational term ω_i·a_i + ω_j·a_j is written in the symmetric form
-// ½[(ω_i + ω_j)(a_i + a_j) + (ω_i − ω_j)(a_i − a_j)] — so both copies of a
-// pair's history stay bit-identical and the forces on i and j are exact
-// opposites.
+// The particle–particle loop runs over the half neighbour list (pairs i <
+// j, broad_phase.cpp) in blocks of 8 particles, W lanes at a time with GCC
+// vector extensions: W = 8 on x86-64-v4 (AVX-512), 4 on x86-64-v3 (AVX2),
+// 2 on baseline x86-64 (SSE2). The path is chosen once from the CPU; the
+// default build needs no -march flag. Every pair is evaluated once, from
+// its lower index: each particle's force and torque are written as the
+// plain sum over its own slots (pairs j > i, increasing j), and per slot the
+// pass writes the pair's force on i and its torque on j; the sums
+// (sum_blocks) then add to each particle j, from its mirror list in
+// increasing i, the opposite of that force and that torque. Both sums run
+// in a fixed order whatever the thread split (each pass writes only its own
+// particles' or slots' values), so results are bit-identical for any thread
+// count; non-touching slots add exact zeros. With one thread each block's
+// sums run right after its pairs (its mirrored slots lie in blocks ≤ its
+// own), the pair terms still in cache; with threads, in a second pass after
+// the barrier. (Until the half list, issue #17, the list was full and each
+// pair was evaluated twice, once from either side, the rotational term
+// written ½[(ω_i + ω_j)(a_i + a_j) + (ω_i − ω_j)(a_i − a_j)] so that both
+// copies came out exact opposites under FMA contraction; evaluated once, it
+// takes the plain form. reports/performance.md has what it bought.)
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -39,20 +47,71 @@ struct PairArgs {
   const int *__restrict block_slot;
   const int *__restrict slot_j;
   double *__restrict slot_ft;
-  const double *__restrict slot_r;  // radius of each slot's neighbour
+  const double *__restrict slot_r, *__restrict slot_ir;  // the slot's neighbour: r, 1/r
+  double *__restrict pfx, *__restrict pfy;               // per slot: the pair's force on i
+  double *__restrict pti, *__restrict ptj;               // per slot: its torques on i and j
   const double *__restrict x, *__restrict y, *__restrict vx, *__restrict vy, *__restrict om;
   const double *__restrict r, *__restrict inv_r, *__restrict m;
   double *__restrict fx, *__restrict fy, *__restrict tq;
   double *__restrict block_power;  // per block: power of the contact dashpots (damped pass)
   double kn, kdt, mu, beta2;       // beta2 = 2·contact damping ratio
+  const int *__restrict mirror_block;
+  const int *__restrict mirror_slot;
+  // Threads: block b's sums run right after its pairs where this pass has
+  // written all its mirrored slots (its lowest source block src_block[b] is
+  // in the pass's range); fused[b] tells the sum pass which are left.
+  const int *__restrict src_block;
+  unsigned char *__restrict fused;
 };
 
-// Forces of blocks [b0, b1): each particle's sum over its own slots, written
-// (not added) to fx, fy, tq. Returns the largest overlap/r_own, which over
-// both copies of a pair is overlap/min(r_i, r_j). The damped pass also
-// writes each block's dashpot power, Σ (fe − fn)·v_n over its slots (every
-// pair counted from both sides), for the energy ledger.
-template <int W, bool kDamped>
+// Sums each particle's force and torque over its pairs in increasing index
+// of the partner, and writes them: first its pairs (i, j), i < j, from its
+// mirror list (the opposite of the force on i, the torque on j), then its
+// own slots (pairs j > i). That is the order, and the terms are the bits,
+// of the full list this kernel had until issue #17 ("each particle's
+// neighbours in increasing index": a pair's two evaluations there gave
+// exact opposites), so the forces are bit-identical to that kernel's. The
+// pair pass calls it fused (one thread) and the sum pass after the barrier
+// (threads): the same sums in the same order.
+template <int W>
+DEMCAL_INLINE void sum_blocks(const PairArgs &a, int b0, int b1, bool skip_fused = false) {
+  using D = typename Simd<W>::D;
+  const D zero{};
+  for (int b = b0; b < b1; ++b) {
+    if (skip_fused && a.fused[b]) continue;
+    const int m0 = a.mirror_block[b], m1 = a.mirror_block[b + 1];
+    const int s0 = a.block_slot[b], s1 = a.block_slot[b + 1];
+    for (int sub = 0; sub < kBlock; sub += W) {
+      const int i0 = kBlock * b + sub;
+      D fx = zero, fy = zero, tq = zero;
+      for (int s = m0 + sub; s < m1; s += kBlock) {
+        const int *S = a.mirror_slot + s;
+        fx -= gather<W>(a.pfx, S);
+        fy -= gather<W>(a.pfy, S);
+        tq += gather<W>(a.ptj, S);
+      }
+      for (int s = s0 + sub; s < s1; s += kBlock) {
+        fx += load<W>(a.pfx + s);
+        fy += load<W>(a.pfy + s);
+        tq += load<W>(a.pti + s);
+      }
+      store<W>(a.fx + i0, fx);
+      store<W>(a.fy + i0, fy);
+      store<W>(a.tq + i0, tq);
+    }
+  }
+}
+
+// Pairs of blocks [b0, b1) on the half list (each pair once, from i < j):
+// per slot the pair's force on i and its torques on i and j; and each
+// block's sums right after its pairs, the pair terms still in cache, where
+// this pass wrote all of its mirrored slots (they lie in blocks ≤ b): with
+// one thread (kAll) every block; with threads the blocks whose mirrored
+// slots all lie in the thread's own range, the others in the sum pass after
+// the barrier (the same sums). Returns the largest
+// overlap/min(r_i, r_j). The damped pass also writes each block's dashpot
+// power, Σ (fe − fn)·v_n over its slots, for the energy ledger.
+template <int W, bool kDamped, bool kAll>
 DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
   using D = typename Simd<W>::D;
   const D zero{};
@@ -68,7 +127,6 @@ DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
       const D ri = load<W>(a.r + i0), iri = load<W>(a.inv_r + i0);
       D mi = zero;
       if constexpr (kDamped) mi = load<W>(a.m + i0);
-      D fx = zero, fy = zero, tq = zero;
       for (int s = s0 + sub; s < s1; s += kBlock) {
         const int *J = a.slot_j + s;
         const D rj = load<W>(a.slot_r + s);
@@ -93,27 +151,39 @@ DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
         }
         fn = select<W>(touch, fn, zero);
         // Tangential velocity of j's contact point relative to i's, along t.
+        // (The symmetric form of ω_i·a_i + ω_j·a_j: the full list needed it
+        // for its two copies of a pair to come out exact opposites; kept, so
+        // that the forces stay those bits, see sum_blocks.)
         const D rot = 0.5 * ((omi + omj) * (ai + aj) + (omi - omj) * (ai - aj));
         const D vt = (dvy * nx - dvx * ny) - rot;
         const D cap = mu * fn;
         D t = law::coulomb_clamp(load<W>(a.slot_ft + s) + kdt * vt, cap);
         t = select<W>(touch, t, zero);
         store<W>(a.slot_ft + s, t);
-        // Force on i: −fn·n + ft·t.
-        fx += -fn * nx - t * ny;
-        fy += -fn * ny + t * nx;
-        tq += ai * t;
-        const D ovr = select<W>(touch, ov * iri, zero);
+        // Force on i: −fn·n + ft·t (on j its opposite); torques a_i·ft on
+        // i, a_j·ft on j.
+        store<W>(a.pfx + s, -fn * nx - t * ny);
+        store<W>(a.pfy + s, -fn * ny + t * nx);
+        store<W>(a.pti + s, ai * t);
+        store<W>(a.ptj + s, aj * t);
+        // overlap/min(r_i, r_j) (ov ≥ 0 where touching: the product is
+        // monotone, the larger of the two ratios exactly).
+        const D irj = load<W>(a.slot_ir + s);
+        const D ovr = select<W>(touch, ov * (iri > irj ? iri : irj), zero);
         mo = mo > ovr ? mo : ovr;
       }
-      store<W>(a.fx + i0, fx);
-      store<W>(a.fy + i0, fy);
-      store<W>(a.tq + i0, tq);
     }
     if constexpr (kDamped) {
       double sum = 0.0;
       for (int l = 0; l < W; ++l) sum += power[l];
       a.block_power[b] = sum;
+    }
+    if constexpr (kAll) {
+      sum_blocks<W>(a, b, b + 1);
+    } else {
+      const bool complete = a.src_block[b] >= b0;
+      a.fused[b] = complete;
+      if (complete) sum_blocks<W>(a, b, b + 1);
     }
   }
   return hmax<W>(mo);
@@ -159,29 +229,45 @@ DEMCAL_INLINE double integrate_blocks(const IntegrateArgs &a, int b0, int b1) {
 // ---------------------------------------------------------------- dispatch
 
 using PairFn = double (*)(const PairArgs &, int, int);
+using SumFn = void (*)(const PairArgs &, int, int);
 using IntegrateFn = double (*)(const IntegrateArgs &, int, int);
 
 struct Kernels {
-  PairFn pairs, pairs_damped;
+  PairFn pairs, pairs_damped;              // one thread: the sums fused
+  PairFn pairs_split, pairs_damped_split;  // threads: the sums in the sum pass
+  SumFn sums;
   IntegrateFn integrate, integrate_locked;
   const char *name;
 };
 
-#define DEMCAL_KERNELS(SUFFIX, TARGET, W)                                                        \
-  TARGET double pairs_##SUFFIX(const PairArgs &a, int b0, int b1) {                              \
-    return pair_blocks<W, false>(a, b0, b1);                                                     \
-  }                                                                                              \
-  TARGET double pairs_damped_##SUFFIX(const PairArgs &a, int b0, int b1) {                       \
-    return pair_blocks<W, true>(a, b0, b1);                                                      \
-  }                                                                                              \
-  TARGET double integrate_##SUFFIX(const IntegrateArgs &a, int b0, int b1) {                     \
-    return integrate_blocks<W, true>(a, b0, b1);                                                 \
-  }                                                                                              \
-  TARGET double integrate_locked_##SUFFIX(const IntegrateArgs &a, int b0, int b1) {              \
-    return integrate_blocks<W, false>(a, b0, b1);                                                \
-  }                                                                                              \
-  constexpr Kernels kKernels_##SUFFIX{pairs_##SUFFIX, pairs_damped_##SUFFIX, integrate_##SUFFIX, \
-                                      integrate_locked_##SUFFIX, #SUFFIX};
+#define DEMCAL_KERNELS(SUFFIX, TARGET, W)                                                          \
+  TARGET double pairs_##SUFFIX(const PairArgs &a, int b0, int b1) {                                \
+    return pair_blocks<W, false, true>(a, b0, b1);                                                 \
+  }                                                                                                \
+  TARGET double pairs_damped_##SUFFIX(const PairArgs &a, int b0, int b1) {                         \
+    return pair_blocks<W, true, true>(a, b0, b1);                                                  \
+  }                                                                                                \
+  TARGET double pairs_split_##SUFFIX(const PairArgs &a, int b0, int b1) {                          \
+    return pair_blocks<W, false, false>(a, b0, b1);                                                \
+  }                                                                                                \
+  TARGET double pairs_damped_split_##SUFFIX(const PairArgs &a, int b0, int b1) {                   \
+    return pair_blocks<W, true, false>(a, b0, b1);                                                 \
+  }                                                                                                \
+  TARGET void sums_##SUFFIX(const PairArgs &a, int b0, int b1) { sum_blocks<W>(a, b0, b1, true); } \
+  TARGET double integrate_##SUFFIX(const IntegrateArgs &a, int b0, int b1) {                       \
+    return integrate_blocks<W, true>(a, b0, b1);                                                   \
+  }                                                                                                \
+  TARGET double integrate_locked_##SUFFIX(const IntegrateArgs &a, int b0, int b1) {                \
+    return integrate_blocks<W, false>(a, b0, b1);                                                  \
+  }                                                                                                \
+  constexpr Kernels kKernels_##SUFFIX{pairs_##SUFFIX,                                              \
+                                      pairs_damped_##SUFFIX,                                       \
+                                      pairs_split_##SUFFIX,                                        \
+                                      pairs_damped_split_##SUFFIX,                                 \
+                                      sums_##SUFFIX,                                               \
+                                      integrate_##SUFFIX,                                          \
+                                      integrate_locked_##SUFFIX,                                   \
+                                      #SUFFIX};
 
 #define DEMCAL_NO_TARGET
 DEMCAL_KERNELS(sse2, DEMCAL_NO_TARGET, 2)
@@ -230,11 +316,20 @@ const char *kernel_simd() {
 #endif
 }
 
-double WorldImpl::pair_pass(int b0, int b1) {
+double WorldImpl::pair_pass(int b0, int b1) { return pair_kernel(b0, b1, false); }
+
+double WorldImpl::sum_pass(int b0, int b1) { return pair_kernel(b0, b1, true); }
+
+double WorldImpl::pair_kernel(int b0, int b1, bool sums) {
   const PairArgs a{block_slot_.data(),
                    slot_j_.data(),
                    slot_ft_.data(),
                    slot_r_.data(),
+                   slot_ir_.data(),
+                   pfx_.data(),
+                   pfy_.data(),
+                   pti_.data(),
+                   ptj_.data(),
                    x_.data(),
                    y_.data(),
                    vx_.data(),
@@ -250,9 +345,19 @@ double WorldImpl::pair_pass(int b0, int b1) {
                    material_.particle.kn,
                    material_.particle.kt * integration_.dt,
                    material_.particle.friction,
-                   2.0 * material_.contact_damping_ratio};
+                   2.0 * material_.contact_damping_ratio,
+                   mirror_block_.data(),
+                   mirror_slot_.data(),
+                   mirror_src_block_.data(),
+                   block_fused_.data()};
   const Kernels &k = kernels();
-  return material_.contact_damping_ratio > 0.0 ? k.pairs_damped(a, b0, b1) : k.pairs(a, b0, b1);
+  const bool damped = material_.contact_damping_ratio > 0.0;
+  if (sums) {
+    k.sums(a, b0, b1);
+    return 0.0;
+  }
+  if (active_threads() <= 1) return damped ? k.pairs_damped(a, b0, b1) : k.pairs(a, b0, b1);
+  return damped ? k.pairs_damped_split(a, b0, b1) : k.pairs_split(a, b0, b1);
 }
 
 double WorldImpl::integrate_pass(int b0, int b1) {
@@ -357,7 +462,7 @@ double WorldImpl::dashpot_power() const {
   // Block by block in a fixed order: the same sum for any thread count.
   double pairs = 0.0;
   for (int b = 0; b < nblocks_; ++b) pairs += block_power_[b];
-  return 0.5 * pairs + wall_dashpot_power_;  // each pair was counted from both sides
+  return pairs + wall_dashpot_power_;
 }
 
 }  // namespace demcal

@@ -241,7 +241,13 @@ double WorldImpl::run_pass(double (WorldImpl::*pass)(int, int), const std::vecto
   return *std::max_element(ctx.out, ctx.out + t);
 }
 
-double WorldImpl::run_pair_pass() { return run_pass(&WorldImpl::pair_pass, pair_bounds_); }
+double WorldImpl::run_pair_pass() {
+  // One thread sums the mirrored pair terms block by block inside the pair
+  // pass; threads in a second pass after the barrier (the same sums).
+  const double mo = run_pass(&WorldImpl::pair_pass, pair_bounds_);
+  if (active_threads() > 1) run_pass(&WorldImpl::sum_pass, particle_bounds_);
+  return mo;
+}
 
 double WorldImpl::run_integrate_pass() {
   return run_pass(&WorldImpl::integrate_pass, particle_bounds_);

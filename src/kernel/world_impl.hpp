@@ -138,9 +138,13 @@ class WorldImpl {
   // Block offsets of the sliced ELLPACK list for per-particle lists
   // [start[i], start[i + 1]): each block as many rows as its longest list.
   void layout_blocks(const std::vector<int>& start, std::vector<int>& block_slot) const;
+  // The mirror list (mirror_block_, mirror_slot_) from the half list.
+  void rebuild_mirror_list();
   // contact.cpp: the SIMD passes over blocks [b0, b1), and the walls
-  double pair_pass(int b0, int b1);       // returns the largest overlap/r
-  double integrate_pass(int b0, int b1);  // returns the largest displacement²
+  double pair_pass(int b0, int b1);               // returns the largest overlap/min(r_i, r_j)
+  double sum_pass(int b0, int b1);                // mirrored pair terms (threads only)
+  double pair_kernel(int b0, int b1, bool sums);  // the two above
+  double integrate_pass(int b0, int b1);          // returns the largest displacement²
   void wall_pass();
   void compute_forces();
   /// Geometry and normal force of the pair (i, j) in the current state,
@@ -204,14 +208,29 @@ class WorldImpl {
   std::array<std::vector<double>, 4> wall_ft_;
   std::array<std::vector<double>, 4> wall_fn_;  // last normal force (0 when apart)
 
-  // Verlet neighbour list (full, sliced ELLPACK, see the file comment):
-  // block b's slots are [block_slot_[b], block_slot_[b + 1]), rows of 8;
-  // each particle's neighbours in increasing index, then ghosts. slot_ft_ is
-  // the tangential force of each slot, kept across rebuilds.
+  // Verlet neighbour list (half: pairs i < j; sliced ELLPACK, see
+  // broad_phase.cpp): block b's slots are [block_slot_[b], block_slot_[b +
+  // 1]), rows of 8; each particle's neighbours j > i in increasing index,
+  // then ghosts. slot_ft_ is the tangential force of each slot (pair), kept
+  // across rebuilds.
   std::vector<int> block_slot_;
   detail::AlignedVector<int> slot_j_;
   Array slot_ft_;
-  Array slot_r_;  // radius of the slot's neighbour (contiguous: one gather less)
+  Array slot_r_;   // radius of the slot's neighbour (contiguous: one gather less)
+  Array slot_ir_;  // its inverse
+  // Per slot, written by the pair pass: the pair's force on i (pfx_, pfy_)
+  // and its torques on i and j (pti_, ptj_); index block_slot_.back() is a
+  // zero slot.
+  Array pfx_, pfy_, pti_, ptj_;
+  // Mirror list (sliced ELLPACK like the list): block b's rows are
+  // [mirror_block_[b], mirror_block_[b + 1]); particle j's entries are the
+  // slots of its pairs (i, j), i < j, in increasing i, then the zero slot.
+  std::vector<int> mirror_block_, mirror_count_;
+  detail::AlignedVector<int> mirror_slot_;
+  // Per block: the lowest block holding one of its mirrored slots, and
+  // whether the threaded pair pass has summed it (contact.cpp).
+  std::vector<int> mirror_src_block_;
+  std::vector<unsigned char> block_fused_;
   // The pairs i < j of the list, sorted by (i, j), and the slot of i's copy.
   std::vector<int> pair_i_, pair_j_, pair_slot_;
   // Block ranges of the threads for the pair pass (balanced by slots) and
@@ -221,7 +240,7 @@ class WorldImpl {
   std::vector<int> nbr_start_, nbr_list_, cell_start_, cell_next_;
   std::vector<int> new_block_slot_;
   detail::AlignedVector<int> new_slot_j_;
-  Array new_slot_ft_, new_slot_r_;
+  Array new_slot_ft_, new_slot_r_, new_slot_ir_;
   std::array<std::vector<int>, 4> wall_candidates_;
   Array x_built_, y_built_;
   std::array<double, 4> wall_built_{};

@@ -19,7 +19,9 @@ namespace demcal {
 
 namespace {
 
-constexpr char kMagic[8] = {'d', 'e', 'm', 'W', 'o', 'r', 'l', 'd'};
+// The last character numbers the layout: '2' since the half neighbour list
+// (a state of the full-list layout does not read: rebuilt, not misread).
+constexpr char kMagic[8] = {'d', 'e', 'm', 'W', 'o', 'r', 'l', '2'};
 
 template <class T>
 constexpr bool kScalar = std::is_arithmetic_v<T> || std::is_enum_v<T>;
@@ -111,7 +113,8 @@ void WorldImpl::visit_state(Self& w, Visitor& v) {
        {&w.x_,       &w.y_,           &w.vx_,          &w.vy_,         &w.theta_,   &w.omega_,
         &w.r_,       &w.inv_r_,       &w.m_,           &w.inertia_,    &w.fx_,      &w.fy_,
         &w.tq_,      &w.block_power_, &w.ca_t_,        &w.cb_t_,       &w.ca_r_,    &w.cb_r_,
-        &w.slot_ft_, &w.slot_r_,      &w.new_slot_ft_, &w.new_slot_r_, &w.x_built_, &w.y_built_})
+        &w.slot_ft_, &w.slot_r_,      &w.new_slot_ft_, &w.new_slot_r_, &w.x_built_, &w.y_built_,
+        &w.slot_ir_, &w.new_slot_ir_, &w.pfx_,         &w.pfy_,        &w.pti_,     &w.ptj_})
     v(*a);
   v(w.wall_dashpot_power_);
   for (int s = 0; s < 4; ++s) {
@@ -126,12 +129,14 @@ void WorldImpl::visit_state(Self& w, Visitor& v) {
     v(wall.force.y());
     v(wall.contacts);
   }
-  for (auto* a :
-       {&w.block_slot_, &w.pair_i_, &w.pair_j_, &w.pair_slot_, &w.pair_bounds_, &w.particle_bounds_,
-        &w.nbr_start_, &w.nbr_list_, &w.cell_start_, &w.cell_next_, &w.new_block_slot_})
+  for (auto* a : {&w.block_slot_, &w.pair_i_, &w.pair_j_, &w.pair_slot_, &w.pair_bounds_,
+                  &w.particle_bounds_, &w.nbr_start_, &w.nbr_list_, &w.cell_start_, &w.cell_next_,
+                  &w.new_block_slot_, &w.mirror_block_, &w.mirror_count_, &w.mirror_src_block_})
     v(*a);
   v(w.slot_j_);
   v(w.new_slot_j_);
+  v(w.mirror_slot_);
+  v(w.block_fused_);
   v(w.skin_);
   v(w.r_max_);
   v(w.r_min_);
@@ -182,7 +187,16 @@ WorldImpl WorldImpl::load_state(std::string_view bytes) {
       w.cb_t_.size() == cap && w.ca_r_.size() == cap && w.cb_r_.size() == cap &&
       w.block_slot_.size() == static_cast<size_t>(w.nblocks_) + 1 &&
       w.slot_j_.size() == w.slot_ft_.size() && w.slot_r_.size() == w.slot_ft_.size() &&
-      static_cast<size_t>(w.block_slot_.back()) <= w.slot_j_.size();
+      static_cast<size_t>(w.block_slot_.back()) <= w.slot_j_.size() &&
+      w.slot_ir_.size() == w.slot_ft_.size() &&
+      (w.pfx_.empty() || (w.pfx_.size() == static_cast<size_t>(w.block_slot_.back()) + 1 &&
+                          w.pfy_.size() == w.pfx_.size() && w.pti_.size() == w.pfx_.size() &&
+                          w.ptj_.size() == w.pfx_.size())) &&
+      (w.mirror_block_.empty() ||
+       (w.mirror_block_.size() == static_cast<size_t>(w.nblocks_) + 1 &&
+        static_cast<size_t>(w.mirror_block_.back()) <= w.mirror_slot_.size() &&
+        w.mirror_src_block_.size() == static_cast<size_t>(w.nblocks_) &&
+        w.block_fused_.size() == static_cast<size_t>(w.nblocks_)));
   for (int s = 0; s < 4; ++s)
     if (w.wall_ft_[s].size() != static_cast<size_t>(w.n_) ||
         w.wall_fn_[s].size() != static_cast<size_t>(w.n_))
@@ -190,6 +204,8 @@ WorldImpl WorldImpl::load_state(std::string_view bytes) {
   if (!fits) Reader::fail();
   for (int j : w.slot_j_)
     if (j < 0 || j > w.ghost_) Reader::fail();
+  for (int s : w.mirror_slot_)
+    if (s < 0 || static_cast<size_t>(s) >= w.pfx_.size()) Reader::fail();
   return w;
 }
 

@@ -31,17 +31,16 @@
 // (src/kernel/world_impl.hpp, private), which World owns and forwards to.
 //
 // Layout for speed (reports/performance.md): particles are processed in
-// blocks of 8 (arrays padded to whole blocks, 64-byte aligned). Every
-// particle keeps its full neighbour list — each pair appears twice, once
-// from either side — in a sliced-ELLPACK layout: block b holds rows of 8
-// slots, slot (row, lane) being the row-th neighbour of particle 8b + lane
-// (a ghost index where a lane has fewer neighbours). A pair is thus
-// evaluated twice, but a particle's force is a plain sum over its own slots:
-// no scatter, SIMD lanes never conflict, and each particle's summation order
-// (its neighbours in increasing index, then the walls) does not depend on
-// how blocks are shared among threads. Both copies of a pair compute
-// bit-identical forces (the formulas are symmetric under i <-> j), so the
-// two copies of the tangential history never drift apart.
+// blocks of 8 (arrays padded to whole blocks, 64-byte aligned). The
+// neighbour list is a half list — each pair (i, j), i < j, once, in i's row
+// — in a sliced-ELLPACK layout: block b holds rows of 8 slots, slot (row,
+// lane) being the row-th neighbour j > i of particle i = 8b + lane (a ghost
+// index where a lane has fewer neighbours). Each pair is evaluated once;
+// its force and torques are stored per slot, and each particle sums them in
+// increasing index of the partner (its pairs with lower particles through a
+// mirror list of their slots, then its own slots), then the walls: no
+// scatter, SIMD lanes never conflict, and the summation order does not
+// depend on how blocks are shared among threads.
 #pragma once
 
 #include <Eigen/Core>
@@ -185,11 +184,11 @@ class World {
   /// permutation of 0 … size() − 1.
   void reorder(std::span<const int> order);
   /// An order for reorder() that fills the SIMD blocks: the kernel evaluates
-  /// 8 particles at once and pads their neighbour lists to the longest, so
-  /// inside each window of 64 consecutive particles (locality kept) the
-  /// particles are sorted by neighbour count. On the random 400-disk REV it
-  /// raises the share of real neighbours among the evaluated slots from 82 %
-  /// to about 95 % (reports/performance.md).
+  /// 8 particles at once and pads their half rows (neighbours of higher
+  /// index) and mirror rows (lower index) to the longest of the block, so
+  /// each window of 64 consecutive particles (locality kept) is ordered so
+  /// that the particles of a block have as many neighbours on either side
+  /// (reports/performance.md).
   std::vector<int> block_friendly_order() const;
   int threads() const;
   /// Set the friction coefficient of particle–particle contacts (used by
