@@ -139,7 +139,9 @@ TEST_F(CliEndToEnd, StabilityScanWritesItsReport) {
   const auto j = nlohmann::json::parse(read_text(out / "stability.json"));
   EXPECT_NEAR(j["measured_over_estimate"].get<double>(), 1.0, 0.03);
   for (const auto& t : j["trials"])
-    if (t["diverged"].get<bool>()) EXPECT_GT(t["divergence_step"].get<int>(), 0);
+    if (t["diverged"].get<bool>()) {
+      EXPECT_GT(t["divergence_step"].get<int>(), 0);
+    }
   EXPECT_NE(read_text(out / "stability.md").find("| alpha |"), std::string::npos);
 }
 

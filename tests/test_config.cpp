@@ -385,8 +385,8 @@ TEST(ConfigErrors, PrototypeParticlesHaveTheKernelsLimit) {
   const std::string at_limit =
       R"({"prototype": {"particles": )" + std::to_string(kMaxParticles) + "}}";
   EXPECT_EQ(parse(at_limit).prototype.particles, kMaxParticles);
-  for (const std::string v : {std::to_string(kMaxParticles + 1), std::string("1e11"),
-                              std::string("2.5"), std::string("\"100\"")}) {
+  for (const std::string& v : {std::to_string(kMaxParticles + 1), std::string("1e11"),
+                               std::string("2.5"), std::string("\"100\"")}) {
     const std::string text = R"({"prototype": {"particles": )" + v + "}}";
     expect_rejected(text, "prototype.particles");
     const auto e = input_error([&] { parse(text); });

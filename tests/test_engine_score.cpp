@@ -736,7 +736,9 @@ TEST_P(LiggghtsSeries, ScoresAsDemcalsRun) {
   // wall friction LIGGGHTS' wall contacts carry their tangential force at
   // r_i − δ/2, σ's (demcal's) at the wall, r_i − δ: a floor of Σ δ f_t/(2V)
   // (measured 7.9e-5 σ3 RMS), reported apart, not counted.
-  if (frictionless) EXPECT_LT(summary["lever_arm_floor"]["max"].get<double>(), 1e-9);
+  if (frictionless) {
+    EXPECT_LT(summary["lever_arm_floor"]["max"].get<double>(), 1e-9);
+  }
 
   const ExternalSeries series =
       parse_external_series(test::read_text(dir / "series.csv"), "series.csv");
