@@ -47,6 +47,26 @@ SceneConfig hex5() {
   return c;
 }
 
+/// fcc_4x4x4's parameters for the 3D LIGGGHTS tests: 20 000 steps, where
+/// demcal's servo error (1.34 times its tolerance) decides the verdict.
+AlgorithmSpec fcc_20000() {
+  AlgorithmSpec p;
+  p.dt_ratio = 0.2;
+  p.steps = 20000;
+  p.damping_ratio_translation = 0.4;
+  p.damping_ratio_rotation = 0.0;  // LIGGGHTS 3.8 has no rotational damping
+  return p;
+}
+
+/// The 3D LIGGGHTS deck of fcc_4x4x4's consolidated state (fcc.data).
+ExportResult fcc_liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p,
+                               const TriaxialState& state) {
+  Export3dOptions o;
+  o.format = "liggghts";
+  o.data_name = "fcc.data";
+  return export_3d_decks(c, p, state, o);
+}
+
 /// The 2D LIGGGHTS deck of a consolidated state, its data file `data_name`.
 ExportResult liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p,
                            const ConsolidatedState& state, const std::string& data_name) {
@@ -594,14 +614,8 @@ TEST(EngineLiggghts, TheDecksServoMovesAtDemcalsVelocity) {
   {
     const SceneConfig c = load_config(test::shipped_config("fcc_4x4x4"));
     const TriaxialState state = consolidate_triaxial(c, make_sphere_assembly(c));
-    AlgorithmSpec p;
-    p.dt_ratio = 0.2;
-    p.steps = 20000;
-    p.damping_ratio_translation = 0.4;
-    Export3dOptions o;
-    o.format = "liggghts";
-    o.data_name = "fcc.data";
-    const ExportResult r = export_3d_decks(c, p, state, o);
+    const AlgorithmSpec p = fcc_20000();
+    const ExportResult r = fcc_liggghts_deck(c, p, state);
     const SphereWorld& w = state.world;
     auto extent = [&](int a) {
       return w.wall(static_cast<SphereWallSide>(2 * a + 1)).position -
@@ -909,18 +923,11 @@ TEST(EngineLiggghts, The3dDecksSeriesScoresAsDemcalsRun) {
                     "deck's series is not scored";
   const SceneConfig c = load_config(test::shipped_config("fcc_4x4x4"));
   const TriaxialState state = consolidate_triaxial(c, make_sphere_assembly(c));
-  AlgorithmSpec p;
-  p.dt_ratio = 0.2;
-  p.steps = 20000;
-  p.damping_ratio_translation = 0.4;
-  p.damping_ratio_rotation = 0.0;
+  const AlgorithmSpec p = fcc_20000();
   const TriaxialResult run = run_triaxial_loading(state, c.test, p);
   const double s3 = c.test.lateral_stress;
   const Score ours = score_triaxial_run(run, s3, triaxial_tolerances());
-  Export3dOptions o;
-  o.format = "liggghts";
-  o.data_name = "fcc.data";
-  const ExportResult r = export_3d_decks(c, p, state, o);
+  const ExportResult r = fcc_liggghts_deck(c, p, state);
   const test::TempDir dir("liggghts3d_score");
   // With a screen (captured): liggghts 3.8 crashes reading meshes under
   // -screen none.

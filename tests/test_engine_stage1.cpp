@@ -72,7 +72,7 @@ void expect_per_wall_bit_for_bit(const std::string& lmp, const ExportResult& r,
   const std::string head =
       "variable        cons_rawv vector ${gain}*(f_cons_sign*${sigma3}*f_cons_len" + tail +
       "-c_cons_wf)/(";
-  const std::string foot = "*(c_cons_wn+(c_cons_wn<1)))\n";
+  const std::string foot = "*(c_cons_wn+!c_cons_wn))\n";
   ASSERT_EQ(rawv.rfind(head, 0), 0u) << rawv;
   ASSERT_GT(rawv.size(), head.size() + foot.size()) << rawv;
   ASSERT_EQ(rawv.substr(rawv.size() - foot.size()), foot) << rawv;

@@ -383,7 +383,7 @@ TEST(Export3dLammps, TheDecksPerStepCutsLeaveTheSeriesAndPeaksBitForBit) {
   // cuts"): each wall acts on the spheres of its band only; the box's lengths
   // and height are stored once per step by fix geom and read as f_geom; the
   // four lateral walls' unclamped moves are one vector-style formula (the
-  // max walls' negated: clamp(-x) = -clamp(x) exactly), max(1, n) = n+(n<1),
+  // max walls' negated: clamp(-x) = -clamp(x) exactly), max(1, n) = n+!n,
   // clamped from the kept vector; the reductions run over the walls' bands.
   // The same deck with every wall on all spheres, the reductions over all,
   // the lengths written inline and each wall's move its own scalar formula,

@@ -246,10 +246,6 @@ std::string lammps_servo_raw_of_load(const std::string& load, const std::string&
   return "${gain}*(" + load + minus_force + ")/(" + resist + "*" + count_max + ")";
 }
 
-std::string lammps_count_at_least_one(const std::string& count) {
-  return "(" + count + "+(" + count + "<1))";
-}
-
 std::string lammps_servo_raw_folded(const std::string& load, const std::string& minus_force,
                                     const std::string& count_max) {
   return "${gain_kn}*(" + load + minus_force + ")/" + count_max;
@@ -340,7 +336,7 @@ std::string lammps_consolidation_servo(const std::vector<ConsolidationWall>& wal
     << "# (a v_ reference goes through text: cons_*q read it so), stored once per\n"
     << "# step by fix cons_geom and laid out per wall by fix cons_len; the signs are\n"
     << "# internal variables. No min/max of two numbers in this release: max(1, n)\n"
-    << "# = n+(n<1) for a contact count n, clamp(x) = (abs(x+cap)-abs(x-cap))/2.\n";
+    << "# = n+!n for a contact count n, clamp(x) = (abs(x+cap)-abs(x-cap))/2.\n";
   std::string geom, len, sign;
   for (size_t a = 0; a < area.size(); ++a) {
     s << "variable        " << area[a] << "q equal v_" << area[a] << "\n";
@@ -357,7 +353,7 @@ std::string lammps_consolidation_servo(const std::vector<ConsolidationWall>& wal
     << "fix             cons_sign all ave/time 1 1 1" << sign << "\n"
     << "variable        cons_rawv vector "
     << lammps_servo_raw_of_load("f_cons_sign*${sigma3}*f_cons_len" + area_tail, "-c_cons_wf",
-                                lammps_count_at_least_one("c_cons_wn"), resist)
+                                lammps_count_max_one("c_cons_wn"), resist)
     << "\n"
     << "variable        cons_movev vector " << lammps_servo_clamp("v_cons_rawv") << "\n"
     << "fix             cons_servo all ave/time 1 1 1 v_cons_movev mode vector ave running\n";

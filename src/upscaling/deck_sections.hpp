@@ -150,11 +150,6 @@ std::string lammps_servo_clamp(const std::string& x, const std::string& cap = "$
 std::string lammps_servo_raw_of_load(const std::string& load, const std::string& minus_force,
                                      const std::string& count_max,
                                      const std::string& resist = "${kn_wall}");
-/// max(1, n) of a contact count n (a sum of ones: an integer-valued double)
-/// as n+(n<1): for such n the same double as (1+n+abs(1-n))/2 and as
-/// kn_wall*(1+n+abs(1-n))/2 = kn_wall*max(1, n) (2n/2 is exact), two
-/// operations and no abs() fewer for the formula parser.
-std::string lammps_count_at_least_one(const std::string& count);
 /// The unclamped move with gain/kn_wall folded into one constant (the
 /// deck's derived `gain_kn`): gain_kn*(load - F)/count_max, `count_max`
 /// max(1, n) as a formula (lammps_count_max_one). The same law as
@@ -163,9 +158,10 @@ std::string lammps_count_at_least_one(const std::string& count);
 /// servo in the 2D and 3D decks.
 std::string lammps_servo_raw_folded(const std::string& load, const std::string& minus_force,
                                     const std::string& count_max);
-/// max(1, n) of a contact count n (an integer-valued double) as n+!n: n for
-/// n >= 1, 1 for n = 0 (`!` is 1 for 0, else 0), the same double as
-/// lammps_count_at_least_one with one number and one comparison fewer.
+/// max(1, n) of a contact count n (a sum of ones: an integer-valued double)
+/// as n+!n: n for n >= 1, 1 for n = 0 (`!` is 1 for 0, else 0), the same
+/// double as (1+n+abs(1-n))/2 and, times kn_wall, as kn_wall*(1+n+abs(1-n))/2
+/// = kn_wall*max(1, n) (2n/2 is exact), with fewer tokens for the parser.
 std::string lammps_count_max_one(const std::string& count);
 
 /// LAMMPS: a wall's band depth (the particles a moving wall acts on lie
