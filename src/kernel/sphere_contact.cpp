@@ -65,19 +65,25 @@
 //
 // Cost per slot: the rescale and the twist share one factor, h' = A·[(1 −
 // c²)·p + 2c·n × p] with A = sqrt(|h|²/(|p|²·(1 + c²)²)) (the rescale
-// sqrt(|h|²/|p|²) times the Cayley 1/(1 + c²)): one division, and the
-// root by a Taylor polynomial where A is within 1e-4 of 1, as it is unless
-// the contact turned a lot in one step (root_near_one). The Coulomb cap
-// compares squares; its root and division run only for a vector with a
-// touching lane that slides, and a vector with no touching lane only
-// releases its histories. So the common slot takes one root (|d|) and two
-// divisions (1/|d|, A²), where it took three roots and four divisions; the
-// skipped branches give the same bits as the full evaluation (cut = 1, h
-// = 0 there), and each lane's polynomial-or-root choice depends on its own
-// A² alone. The root and the two divisions stay correctly rounded: on this
-// kernel's test CPU (AMD family 26) they do not bound the pass, and
-// estimates refined by Newton steps (vrsqrt14pd/vrcp14pd, or vrcpps on
-// AVX2) measured 3-16 % slower (reports/performance.md, 2026-12-02).
+// sqrt(|h|²/|p|²) times the Cayley 1/(1 + c²)). The pass is bound by the
+// latency of one chain per slot — root, normal, history, its scale, the
+// clamp — more than by its arithmetic (reports/performance.md, "the
+// chain"), so what can leave the chain does: 1/|d| is d·(1/d²), the
+// division beside the root; 1/A² = |p|²(1 + c²)²/|h|² takes |p|² = |h|² −
+// hn² and the 1/|h|² divided at the load, and A comes from the series of
+// y^(-1/2) where y = 1/A² is within 1e-4 of 1, as it is unless the contact
+// turned a lot in one step (turn_scale; the exact quotient and root
+// elsewhere). The Coulomb cap compares squares; its root and division run
+// only for a vector with a touching lane that slides, and a vector with
+// no touching lane only releases its histories. So the common slot takes
+// one root and two divisions (1/d², 1/|h|²), none of the divisions on the
+// chain; the skipped branches give the same bits as the full evaluation
+// (cut = 1, h = 0 there), and each lane's series-or-root choice depends on
+// its own inputs alone. Estimates of the root and divisions refined by
+// Newton steps (vrsqrt14pd/vrcp14pd, or vrcpps on AVX2) measured 3-16 %
+// slower on this kernel's test CPU (AMD family 26; performance.md,
+// 2026-12-02): the results stay within an ulp or two of the correctly
+// rounded ones.
 //
 // Walls: the inward normal g is fixed and the wall does not rotate, so a
 // wall history stays in the wall plane with no turning; the contact point is
@@ -161,7 +167,9 @@ DEMCAL_INLINE Normal<W> normal_part(typename Simd<W>::D dx, typename Simd<W>::D 
   const D rs = ri + rj;
   g.touch = d2 < rs * rs;
   const D d = vsqrt(d2);
-  const D inv = 1.0 / d;
+  // 1/d as d·(1/d²): the division runs beside the root instead of after
+  // it (the normal heads the slot's dependency chain); within 1.5 ulp.
+  const D inv = d * (1.0 / d2);
   g.nx = dx * inv;
   g.ny = dy * inv;
   g.nz = dz * inv;
@@ -241,19 +249,27 @@ DEMCAL_INLINE bool any(typename Simd<W>::M m) {
 #endif
 }
 
-// sqrt(z) for z ≥ 0. Near 1 (|z − 1| < 1e-4, the rescale-and-twist factor
-// of a history that turned little in a step: the usual case) the Taylor
-// polynomial 1 + e/2 − e²/8 + e³/16 of sqrt(1 + e), whose truncation error
-// 5e⁴/128 < 4e-18 is below half an ulp of 1; the correctly rounded root
-// only where a lane needs it. Lane by lane, the value depends on z alone.
+// The history's turning scale A = sqrt(|h|²/|p|²)/(1 + c²) (file
+// comment) from y = 1/A² computed without a division: near 1 (|y − 1| <
+// 1e-4, a contact that turned little in the step: the usual case) the
+// Taylor polynomial 1 − e/2 + 3e²/8 − 5e³/16 of (1 + e)^(-1/2), whose
+// truncation error 35e⁴/128 < 3e-17 is below half an ulp of 1; elsewhere
+// the exact form from |p|² itself, 0 where p = 0. Lane by lane, the value
+// depends on that lane's inputs alone.
 template <int W>
-DEMCAL_INLINE typename Simd<W>::D root_near_one(typename Simd<W>::D z) {
+DEMCAL_INLINE typename Simd<W>::D turn_scale(typename Simd<W>::D y, typename Simd<W>::D mag2,
+                                             typename Simd<W>::D px, typename Simd<W>::D py,
+                                             typename Simd<W>::D pz, typename Simd<W>::D t) {
   using D = typename Simd<W>::D;
-  const D e = z - 1.0;
-  const D series = 1.0 + e * (0.5 + e * (-0.125 + e * 0.0625));
+  const D zero{}, one = zero + 1.0;
+  const D e = y - 1.0;
+  const D series = 1.0 + e * (-0.5 + e * (0.375 + e * -0.3125));
   const typename Simd<W>::M far = e * e >= 1e-8;
   if (!any<W>(far)) return series;
-  return select<W>(far, vsqrt(z), series);
+  const D p2 = px * px + py * py + pz * pz;
+  const typename Simd<W>::M turnable = p2 > zero;
+  const D z = select<W>(turnable, mag2, one) / select<W>(turnable, p2 * t * t, one);
+  return select<W>(far, select<W>(turnable, vsqrt(z), zero), series);
 }
 
 template <int W>
@@ -354,6 +370,8 @@ DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
         const M touch = g.touch;
         const D hx0 = load<W>(a.hx + s), hy0 = load<W>(a.hy + s), hz0 = load<W>(a.hz + s);
         const D mag2 = hx0 * hx0 + hy0 * hy0 + hz0 * hz0;
+        const M held = mag2 > zero;
+        const D inv_mag2 = one / select<W>(held, mag2, one);
         if (!any<W>(touch)) {  // no lane touches: histories released, no force
           released += mag2;
           for (double *p : {a.hx, a.hy, a.hz, a.pfx, a.pfy, a.pfz, a.ptx, a.pty, a.ptz})
@@ -379,16 +397,19 @@ DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
         // scale A = sqrt(|h|²/|p|²)/(1 + c²) for both (file comment).
         const D hn = hx0 * nx + hy0 * ny + hz0 * nz;
         const D px = hx0 - hn * nx, py = hy0 - hn * ny, pz = hz0 - hn * nz;
-        const D p2 = px * px + py * py + pz * pz;
-        const M turnable = p2 > zero;
         const D c = half_dt * 0.5 * (nx * sx + ny * sy + nz * sz);
-        const D t = 1.0 + c * c;
-        const D z = select<W>(turnable, mag2, one) / select<W>(turnable, p2 * t * t, one);
-        const D A = select<W>(turnable, root_near_one<W>(z), zero);
-        const D ca = A * (1.0 - c * c), cb = (2.0 * c) * A;
-        D hx = px * ca + (ny * pz - nz * py) * cb + kdt * vtx;
-        D hy = py * ca + (nz * px - nx * pz) * cb + kdt * vty;
-        D hz = pz * ca + (nx * py - ny * px) * cb + kdt * vtz;
+        const D c2 = c * c, t = 1.0 + c2;
+        // 1/A² = |p|²(1 + c²)²/|h|² with |p|² = |h|² − hn² (|n| = 1): no
+        // division on the chain (1/|h|² came with the load), and A by the
+        // series of y^(-1/2) near 1; where a lane is far from 1, the exact
+        // form (turn_scale). Lanes without history take y = 1 (p = 0 there,
+        // so A does not matter).
+        const D y = select<W>(held, (mag2 - hn * hn) * (t * t * inv_mag2), one);
+        const D A = turn_scale<W>(y, mag2, px, py, pz, t);
+        const D s1 = 1.0 - c2, s2 = 2.0 * c;
+        D hx = A * (px * s1 + (ny * pz - nz * py) * s2) + kdt * vtx;
+        D hy = A * (py * s1 + (nz * px - nx * pz) * s2) + kdt * vty;
+        D hz = A * (pz * s1 + (nx * py - ny * px) * s2) + kdt * vtz;
         // Coulomb: |h| ≤ μ·fn. The root and the division only when a
         // touching lane slides (else cut = 1 in every lane that counts).
         const D cap = mu * fn, h2 = hx * hx + hy * hy + hz * hz;
