@@ -264,7 +264,10 @@ DEMCAL_INLINE typename Simd<W>::D turn_scale(typename Simd<W>::D y, typename Sim
   const D zero{}, one = zero + 1.0;
   const D e = y - 1.0;
   const D series = 1.0 + e * (-0.5 + e * (0.375 + e * -0.3125));
-  const typename Simd<W>::M far = e * e >= 1e-8;
+  // Far: every lane not near 1, NaN included (y = 0·∞ where |h|² < 1e-308,
+  // so that 1/|h|² overflowed, and |h|² − hn² is 0): the exact form there.
+  const typename Simd<W>::M near = e * e < 1e-8;
+  const typename Simd<W>::M far = select<W>(near, zero, one) > zero;
   if (!any<W>(far)) return series;
   const D p2 = px * px + py * py + pz * pz;
   const typename Simd<W>::M turnable = p2 > zero;
