@@ -209,6 +209,91 @@ TEST(Export, LiggghtsDeckHasMeshesAndServo) {
   EXPECT_EQ(r.files.count("proto-left.stl"), 1u);
 }
 
+/// The number of `variable NAME equal NUMBER` in a deck (NaN if absent).
+double deck_variable(const std::string& deck, const std::string& name) {
+  std::istringstream lines(deck);
+  for (std::string line; std::getline(lines, line);) {
+    std::istringstream in(line);
+    std::string word, var, style;
+    double v = 0.0;
+    if (in >> word >> var >> style && word == "variable" && var == name && style == "equal" &&
+        in >> v)
+      return v;
+  }
+  return std::nan("");
+}
+
+/// demcal's servo move per unit of force error, gain/(R·max(1, n)) [m/N]
+/// per demcal step, on a wall without contacts (n = 1): from
+/// servo_velocity itself, at a target small enough not to be clamped.
+double demcal_move_per_force(const SceneConfig& c, const AlgorithmSpec& p, const Assembly& a) {
+  World w(c.material, a.x, a.y, a.r, a.left, a.right, a.bottom, a.top);
+  w.set_integration(integration_for(w, p));
+  w.update_forces();
+  EXPECT_EQ(w.wall(kLeft).contacts, 0);
+  const double target = 1e-3;  // Pa: a move ~1e-16 m, far from the cap
+  const double force = target * w.height() * c.material.thickness;
+  return servo_velocity(w, kLeft, target, c.test.servo_gain) * w.integration().dt / force;
+}
+
+TEST(Export, TheLoadingServosGainIsDemcalsWithTheWallDashpots) {
+  // demcal's 2D servo divides by R = kn_wall + c/Δt with contact damping
+  // (c = 2ζ_c·sqrt(kn_wall·m_max), the heaviest disc's; servo_resistance):
+  // the LAMMPS deck's gain_kn, per step of dt, is demcal's per-step law
+  // times dt/servo_dt, and the LIGGGHTS deck's kp·vel_max is demcal's wall
+  // velocity per unit of force. Polydisperse (m_max > m_min) and with
+  // mass scaling; without contact damping R = kn_wall. (Before 2026-12-02
+  // both decks divided by kn_wall only: with ζ_c 0.25 here a servo
+  // 1 + c/(Δt·kn_wall) = 2.9 times as stiff as demcal's.)
+  SceneConfig c = default_config();
+  c.assembly.type = "random";
+  c.assembly.count = 40;
+  const Assembly a = make_assembly(c);
+  AlgorithmSpec p = params();
+  p.mass_scaling = 4.0;
+  for (const double zeta_c : {0.0, 0.25}) {
+    c.material.contact_damping_ratio = zeta_c;
+    const double demcal = demcal_move_per_force(c, p, a);
+    ExportOptions o;
+    o.data_name = "proto.data";
+    const ExportResult r = export_deck(c, p, a, o);
+    const std::string& d = r.deck;
+    const double servo_dt = deck_variable(d, "servo_dt");
+    const double dt = deck_variable(d, "dt");
+    EXPECT_NEAR(dt / servo_dt, r.step_factor, 1e-9);
+    const std::string gain_kn_line = d.substr(d.find("variable gain_kn"), 60);
+    double resist = deck_variable(d, "kn_wall");
+    if (zeta_c > 0.0) {
+      EXPECT_NE(gain_kn_line.find("$(v_gain*v_servo_f/v_resist)"), std::string::npos)
+          << gain_kn_line;
+      EXPECT_NE(d.find("variable resist    equal $(v_kn_wall+v_c_wall/v_servo_dt)"),
+                std::string::npos);
+      resist += deck_variable(d, "c_wall") / servo_dt;
+      EXPECT_GT(resist / c.material.wall.kn, 2.0);  // the stiffness it had before
+    } else {
+      EXPECT_NE(gain_kn_line.find("$(v_gain*v_servo_f/v_kn_wall)"), std::string::npos)
+          << gain_kn_line;
+      EXPECT_EQ(d.find("variable c_wall"), std::string::npos);
+    }
+    const double gain_kn = deck_variable(d, "gain") * (dt / servo_dt) / resist;
+    // the deck's numbers are written with 10 digits
+    EXPECT_NEAR(gain_kn / (demcal * r.step_factor), 1.0, 1e-9) << "zeta_c " << zeta_c;
+
+    o.format = "liggghts";
+    const ExportResult g = export_deck(c, p, a, o);
+    const double h = a.top - a.bottom;
+    const double force = c.test.lateral_stress * h * c.material.thickness;
+    // the left wall starts without contacts in this packing (n = 1 as demcal's)
+    const std::string fix = g.deck.substr(g.deck.find("fix mleft "));
+    auto number_after = [&](const std::string& key) {
+      return std::stod(fix.substr(fix.find(" " + key + " ") + key.size() + 2));
+    };
+    const double velocity_per_force = number_after("vel_max") * number_after("kp") / force;
+    const double dt_demcal = g.dt / g.step_factor;
+    EXPECT_NEAR(velocity_per_force * dt_demcal / demcal, 1.0, 1e-9) << "zeta_c " << zeta_c;
+  }
+}
+
 TEST(Export, AConsolidatedStateReadBackGivesTheSameDeck) {
   // `demcal verify` writes the consolidated prototype (particle_csv); read
   // back (`export --prototype FILE --no-consolidate`) it carries its walls,

@@ -28,6 +28,16 @@ double wall_pressure(const World& world, WallSide side) {
   return -kInward[side] * normal_force / (length * world.material().thickness);
 }
 
+double servo_wall_dashpot(const Material& material, double m_max) {
+  if (material.contact_damping_ratio <= 0.0) return 0.0;
+  return 2.0 * material.contact_damping_ratio * std::sqrt(material.wall.kn * m_max);
+}
+
+double servo_resistance(const Material& material, double m_max, double dt) {
+  const double c = servo_wall_dashpot(material, m_max);
+  return c > 0.0 ? material.wall.kn + c / dt : material.wall.kn;
+}
+
 double servo_velocity(const World& world, WallSide side, double target_stress, double gain) {
   const bool vertical = side == kLeft || side == kRight;
   const double length = vertical ? world.height() : world.width();
@@ -40,13 +50,11 @@ double servo_velocity(const World& world, WallSide side, double target_stress, d
   // overshoot by gain·c/(Δt·kw) = gain·ζ_c/α each step, and beyond 1 the
   // wall velocity flips and grows: the loop, not the integrator, creates
   // energy (issue 14: contact damping 0.2 "diverged" in consolidation).
+  // R = kw + c/Δt: servo_resistance, which the exported decks share.
   const Material& mat = world.material();
-  double resistance = mat.wall.kn;
-  if (mat.contact_damping_ratio > 0.0) {
-    const double m_max =
-        disk_mass(disk_areal_density(mat, world.integration().mass_scaling), world.max_radius());
-    resistance += 2.0 * mat.contact_damping_ratio * std::sqrt(mat.wall.kn * m_max) / dt;
-  }
+  const double m_max =
+      disk_mass(disk_areal_density(mat, world.integration().mass_scaling), world.max_radius());
+  const double resistance = servo_resistance(mat, m_max, dt);
   double move = gain * error * length * mat.thickness / (resistance * contacts);
   // Never more than 2 % of the smallest radius per step (a gas far from the
   // walls is approached at this speed; a packing never gets near it).

@@ -130,16 +130,31 @@ std::string lammps_material_variables(const Material& m, NumberFormat f) {
   return s.str();
 }
 
-std::string lammps_loading_derived() {
-  return "variable vtop      equal $(v_strain*v_H0/(v_nstep*v_dt))      # m/s, top wall, down\n"
-         "variable cap       equal $(0.02*v_r_min)      # m per demcal step, its servo move cap\n"
-         "# demcal's servo moves a wall per step of servo_dt; a step of dt moves it\n"
-         "# dt/servo_dt as far, so that the walls answer as fast per unit of time\n"
-         "variable servo_f   equal $(v_dt/v_servo_dt)\n"
-         "variable cap_step  equal $(v_cap*v_servo_f)      # m per step of dt\n"
-         "variable gain_kn   equal $(v_gain*v_servo_f/v_kn_wall)      # m/N per step of dt\n"
-         "variable monitor_every equal "
-         "$(floor((1+v_nstep/v_monitor_points+abs(1-v_nstep/v_monitor_points))/2))\n";
+std::string lammps_loading_derived(double wall_dashpot, NumberFormat f) {
+  std::string s =
+      "variable vtop      equal $(v_strain*v_H0/(v_nstep*v_dt))      # m/s, top wall, down\n"
+      "variable cap       equal $(0.02*v_r_min)      # m per demcal step, its servo move cap\n"
+      "# demcal's servo moves a wall per step of servo_dt; a step of dt moves it\n"
+      "# dt/servo_dt as far, so that the walls answer as fast per unit of time\n"
+      "variable servo_f   equal $(v_dt/v_servo_dt)\n"
+      "variable cap_step  equal $(v_cap*v_servo_f)      # m per step of dt\n";
+  if (wall_dashpot > 0.0) {
+    s += "# demcal's wall contacts resist a move within its step by kn_wall and by\n"
+         "# their dashpots' c_wall/servo_dt (contact damping: c_wall =\n"
+         "# 2*zeta_c*sqrt(kn_wall*m_max), the heaviest disc's); its servo divides by\n"
+         "# both (without the dashpots it overshoots by gain*c_wall/(servo_dt*kn_wall)\n"
+         "# per step), so does this deck's\n"
+         "variable c_wall    equal " +
+         f(wall_dashpot) +
+         "      # N*s/m\n"
+         "variable resist    equal $(v_kn_wall+v_c_wall/v_servo_dt)      # N/m, demcal's R\n"
+         "variable gain_kn   equal $(v_gain*v_servo_f/v_resist)      # m/N per step of dt\n";
+  } else {
+    s += "variable gain_kn   equal $(v_gain*v_servo_f/v_kn_wall)      # m/N per step of dt\n";
+  }
+  s += "variable monitor_every equal "
+       "$(floor((1+v_nstep/v_monitor_points+abs(1-v_nstep/v_monitor_points))/2))\n";
+  return s;
 }
 
 std::string lammps_servo_dt(double servo_dt, NumberFormat f) {
@@ -577,17 +592,18 @@ double liggghts_servo_vel_max(double cap, double dt, double step_factor) {
   return cap * step_factor / dt;
 }
 
-double liggghts_servo_kp(double gain, double force_target, double kn_wall, int contacts,
+double liggghts_servo_kp(double gain, double force_target, double resist, int contacts,
                          double cap) {
-  return gain * std::abs(force_target) / (kn_wall * std::max(1, contacts) * cap);
+  return gain * std::abs(force_target) / (resist * std::max(1, contacts) * cap);
 }
 
 std::string liggghts_servo_run(const std::vector<LiggghtsServoWall>& walls, double gain,
-                               double kn_wall, double cap, int every, NumberFormat f) {
+                               double resist, double cap, int every, NumberFormat f,
+                               const std::string& resist_name) {
   std::ostringstream s;
   s << "# The servo's gain follows each lateral wall's current contacts n (the\n"
     << "# particles overlapping it) and target, as demcal's: between chunks of\n"
-    << "# ${servo_every} steps, kp = gain*|F_target|/(kn_wall*max(1, n)*cap)\n"
+    << "# ${servo_every} steps, kp = gain*|F_target|/(" << resist_name << "*max(1, n)*cap)\n"
     << "compute nservo all reduce sum";
   for (const LiggghtsServoWall& w : walls) s << " v_" << w.touch;
   s << "\n";
@@ -595,7 +611,7 @@ std::string liggghts_servo_run(const std::vector<LiggghtsServoWall>& walls, doub
   for (size_t k = 0; k < walls.size(); ++k) {
     const std::string n = "c_nservo[" + std::to_string(k + 1) + "]";
     s << "variable kp_" << walls[k].fix << " equal " << f(gain) << "*abs(v_" << walls[k].target
-      << ")/(" << f(kn_wall) << "*(" << n << "+(" << n << "<1))*" << f(cap) << ")\n";
+      << ")/(" << f(resist) << "*(" << n << "+(" << n << "<1))*" << f(cap) << ")\n";
     modify += " \"fix_modify " + walls[k].fix + " servo/ctrlParam ${kp_" + walls[k].fix + "} 0 0\"";
   }
   s << "variable servo_every index " << every << "\n"

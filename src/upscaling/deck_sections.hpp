@@ -98,7 +98,12 @@ std::string lammps_material_variables(const Material& m, NumberFormat f);
 /// fast as demcal's, and editing dt keeps that (without the factor, the
 /// walls were corrected 1/f times as often and the servo error read f times
 /// demcal's).
-std::string lammps_loading_derived();
+/// `wall_dashpot` > 0: demcal's wall contacts' dashpot c (contact damping;
+/// servo_wall_dashpot, scene/biaxial.hpp): the 2D servo divides by
+/// R = kn_wall + c/servo_dt, as demcal's (servo_resistance), and the block
+/// derives it from `c_wall` (written with `f`). 0: R = kn_wall (the 3D
+/// servo, as demcal's triaxial one).
+std::string lammps_loading_derived(double wall_dashpot = 0.0, NumberFormat f = num);
 /// The parameters block's line of servo_dt (demcal's step, s).
 std::string lammps_servo_dt(double servo_dt, NumberFormat f);
 
@@ -293,17 +298,22 @@ struct LiggghtsServoWall {
 /// divided by f) and kp = gain·|F_target|/(kn_wall·max(1, n)·cap), a wall
 /// moves at demcal's velocity gain·(F_target − F)/(kn_wall·max(1, n)·Δt_demcal),
 /// capped at demcal's cap/Δt_demcal: over the same loading time, demcal's
-/// servo (per engine step: f times demcal's per-step move).
+/// servo (per engine step: f times demcal's per-step move). `resist` is
+/// the R demcal's servo divides by in place of kn_wall: the 2D servo's
+/// kn_wall + c/Δt_demcal with contact damping (servo_resistance,
+/// scene/biaxial.hpp), the 3D one's kn_wall.
 double liggghts_servo_vel_max(double cap, double dt, double step_factor);
-double liggghts_servo_kp(double gain, double force_target, double kn_wall, int contacts,
-                         double cap);
+double liggghts_servo_kp(double gain, double force_target, double resist, int contacts, double cap);
 
 /// LIGGGHTS: the loading run, `${run_steps}` steps in chunks of `every`
 /// (run ... pre no every: one setup, the chunks continue the trajectory
 /// exactly), each wall's kp set between chunks (fix_modify
 /// servo/ctrlParam) from its current contacts and target, the formula of
 /// liggghts_servo_kp: the gain lags demcal's by `every` steps at most.
+/// `resist` R as in liggghts_servo_kp, `resist_name` how the deck's
+/// comment names it.
 std::string liggghts_servo_run(const std::vector<LiggghtsServoWall>& walls, double gain,
-                               double kn_wall, double cap, int every, NumberFormat f);
+                               double resist, double cap, int every, NumberFormat f,
+                               const std::string& resist_name = "kn_wall");
 
 }  // namespace demcal::deck

@@ -33,6 +33,10 @@ struct Plan {
   std::vector<double> gamma_t, gamma_r;  // per class [N·s/m], [N·m·s]
   double class_error = 0.0;
   double r_min = 0.0, r_max = 0.0;
+  // The servo's: the heaviest disc's mass m_max [kg] (as scene/biaxial.cpp
+  // computes it), its wall dashpot c [N·s/m] (0 without contact damping)
+  // and R = kn_wall + c/demcal_dt [N/m] (servo_resistance).
+  double m_max = 0.0, wall_dashpot = 0.0, servo_resist = 0.0;
   int thermo_every = 1;
   ParticleScales scales;
 };
@@ -57,6 +61,9 @@ Plan make_plan(const SceneConfig& c, const AlgorithmSpec& p, const Assembly& a, 
   plan.demcal_dt = timing.demcal_dt;
   plan.steps = timing.steps;
   plan.areal_density = p.mass_scaling * c.material.density * c.material.thickness;
+  plan.m_max = disk_mass(disk_areal_density(c.material, p.mass_scaling), plan.r_max);
+  plan.wall_dashpot = servo_wall_dashpot(c.material, plan.m_max);
+  plan.servo_resist = servo_resistance(c.material, plan.m_max, plan.demcal_dt);
   plan.width0 = a.right - a.left;
   plan.height0 = a.top - a.bottom;
   plan.top_speed =
@@ -366,7 +373,8 @@ std::string lammps_servo() {
                                                         deck::lammps_count_max_one("c_cn"));
   std::ostringstream s;
   s << "# demcal's servo, one move per step toward the sample when p < sigma3:\n"
-    << "#   move = gain*(sigma3*H*t - F)/(kn_wall*max(1, n)), clamped to +-cap,\n"
+    << "#   move = gain*(sigma3*H*t - F)/(R*max(1, n)), clamped to +-cap,\n"
+    << "# R = kn_wall (+ the wall dashpots' c_wall/servo_dt with contact damping),\n"
     << "# per demcal step (servo_dt), so per step of dt that times dt/servo_dt:\n"
     << "# gain_kn*(load0 - load_step*step - F)/max(1, n) within +-cap_step (constants\n"
     << "# folded in the derived block: every number in a per-step formula costs a parse),\n"
@@ -447,7 +455,7 @@ std::string lammps_limitations(const AlgorithmSpec& p, const Plan& plan, ExportR
     << "#    above so that the explicit drag does not cost the stability margin.\n"
     << "#  - servo walls are not native: the lateral walls are fix wall/gran/region\n"
     << "#    planes whose displacement is the running sum of demcal's per-step servo\n"
-    << "#    move gain*(sigma3 - p)*H*t/(kn_wall*n_contacts), capped at 2 % of r_min,\n"
+    << "#    move gain*(sigma3 - p)*H*t/(R*n_contacts), capped at 2 % of r_min,\n"
     << "#    kept by fix ave/time (running mean times the steps of this run); a split\n"
     << "#    run restarts it from the walls' positions (see restart_from).\n"
     << "#  - the moving walls act on bands of particles near them (see the walls).\n";
@@ -510,11 +518,11 @@ std::string lammps_parameters(const SceneConfig& c, const Assembly& a, const Pla
 }
 
 /// Quantities LAMMPS derives from the parameters block (and the start walls).
-std::string lammps_derived() {
+std::string lammps_derived(const Plan& plan) {
   std::ostringstream s;
   s << "\n# --- derived (do not edit) ---------------------------------------------------\n"
     << "variable H0        equal $(v_yt0-v_yb0)\n"
-    << deck::lammps_loading_derived()
+    << deck::lammps_loading_derived(plan.wall_dashpot, num)
     << deck::lammps_band("band_v", "v_strain*v_H0", "m, see the walls")
     << deck::lammps_band("band_h", "2*v_strain*(v_xr0-v_xl0)")
     << "# the per-step constants of the top wall's move and the servo, folded now\n"
@@ -576,17 +584,16 @@ ConsolidationSteps consolidation_steps(const SceneConfig& c, const Plan& plan) {
   const auto& m = c.material;
   ConsolidationSteps st;
   st.alpha = AlgorithmSpec{}.dt_ratio;
-  double resist_dash = 0.0;  // the wall dashpots' c [N*s/m]
-  const double m_max = plan.areal_density * std::numbers::pi * plan.r_max * plan.r_max;
   if (m.contact_damping_ratio > 0.0) {
     const double gamma_max =
-        2.0 * m.contact_damping_ratio * std::sqrt(m_max / std::min(m.particle.kn, m.wall.kn));
+        2.0 * m.contact_damping_ratio * std::sqrt(plan.m_max / std::min(m.particle.kn, m.wall.kn));
     st.alpha *= dashpot_step_factor(gamma_max / (st.alpha * plan.dt_crit));
-    resist_dash = 2.0 * m.contact_damping_ratio * std::sqrt(m.wall.kn * m_max);
   }
   st.dt_light = deck::consolidation_dt(st.alpha, kConsolidationDampingRatio, plan.dt_crit);
   st.dt_damped = deck::consolidation_dt(st.alpha, 1.0, plan.dt_crit);
-  st.resist = resist_dash > 0.0 ? "(${kn_wall}+" + num(resist_dash) + "/dt)" : "${kn_wall}";
+  // the wall dashpots' c (servo_wall_dashpot: demcal's formula)
+  st.resist =
+      plan.wall_dashpot > 0.0 ? "(${kn_wall}+" + num(plan.wall_dashpot) + "/dt)" : "${kn_wall}";
   return st;
 }
 
@@ -760,9 +767,9 @@ ExportResult lammps(const SceneConfig& c, const AlgorithmSpec& p, const Assembly
     << lammps_parameters(c, a, plan, o);
   if (o.consolidate_in_deck)
     s << lammps_system(c, plan, o, out) << lammps_consolidation(c, plan, contact_gamma_n(c, plan))
-      << lammps_derived();
+      << lammps_derived(plan);
   else
-    s << lammps_derived() << lammps_system(c, plan, o, out);
+    s << lammps_derived(plan) << lammps_system(c, plan, o, out);
   s << lammps_walls(normal_only_walls(c.material)) << lammps_servo() << lammps_damping(p, plan)
     << lammps_series_block(c, p, plan) << lammps_run(o.consolidate_in_deck);
   out.deck = s.str();
@@ -973,9 +980,9 @@ ExportResult liggghts(const SceneConfig& c, const AlgorithmSpec& p, const Assemb
   const double force_target = c.test.lateral_stress * plan.height0 * m.thickness;
   const double cap = 0.02 * plan.r_min;
   const double kp_left =
-      deck::liggghts_servo_kp(c.test.servo_gain, force_target, m.wall.kn, n_left, cap);
+      deck::liggghts_servo_kp(c.test.servo_gain, force_target, plan.servo_resist, n_left, cap);
   const double kp_right =
-      deck::liggghts_servo_kp(c.test.servo_gain, force_target, m.wall.kn, n_right, cap);
+      deck::liggghts_servo_kp(c.test.servo_gain, force_target, plan.servo_resist, n_right, cap);
   const double vel_max = deck::liggghts_servo_vel_max(cap, plan.dt, plan.step_factor);
 
   // LIGGGHTS with dimension 2 computes a particle's mass as π·r²·density:
@@ -1019,9 +1026,17 @@ ExportResult liggghts(const SceneConfig& c, const AlgorithmSpec& p, const Assemb
     << "# reports/engines.md). It writes demcal's monitoring series: demcal score series.csv\n"
     << "# Servo: LIGGGHTS moves the mesh at vel_max * kp * (F_target - F)/|F_target|;\n"
     << "# vel_max = cap/dt_demcal (dt_demcal = dt/f, demcal's step) and\n"
-    << "# kp = gain*|F_target|/(kn_wall*max(1, n)*cap), n the wall's current contacts,\n"
-    << "# give demcal's wall velocity gain*(F_target - F)/(kn_wall*max(1, n)*dt_demcal)\n"
-    << "# and its cap. LIGGGHTS' kp is a number: the run goes in chunks of\n"
+    << "# kp = gain*|F_target|/(R*max(1, n)*cap), n the wall's current contacts,\n"
+    << "# give demcal's wall velocity gain*(F_target - F)/(R*max(1, n)*dt_demcal)\n"
+    << "# and its cap; R = kn_wall";
+  if (plan.wall_dashpot > 0.0)
+    s << " + c/dt_demcal = " << num(plan.servo_resist) << " N/m: demcal's wall contacts\n"
+      << "# resist a move within its step by their dashpots too, c = 2*zeta_c*\n"
+      << "# sqrt(kn_wall*m_max) = " << num(plan.wall_dashpot)
+      << " N*s/m (the heaviest disc's), and its servo divides by both\n";
+  else
+    s << "\n";
+  s << "# LIGGGHTS' kp is a number: the run goes in chunks of\n"
     << "# ${servo_every} steps (one setup) and kp is set from the current n and\n"
     << "# F_target between them (fix_modify servo/ctrlParam; at the start from\n"
     << "# demcal's counts, " << n_left << " left and " << n_right << " right): the gain\n"
@@ -1069,7 +1084,8 @@ ExportResult liggghts(const SceneConfig& c, const AlgorithmSpec& p, const Assemb
     << "thermo " << plan.thermo_every << "\n"
     << "variable run_steps index " << plan.steps << "\n"
     << deck::liggghts_servo_run({{"mleft", "ftl", "ll_a"}, {"mright", "ftr", "lr_a"}},
-                                c.test.servo_gain, m.wall.kn, cap, plan.thermo_every, num);
+                                c.test.servo_gain, plan.servo_resist, cap, plan.thermo_every, num,
+                                plan.wall_dashpot > 0.0 ? "R" : "kn_wall");
   out.deck = s.str();
   return out;
 }

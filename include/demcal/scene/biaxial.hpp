@@ -42,9 +42,19 @@ struct ConsolidatedState {
   bool from_cache = false;
 };
 
-/// Servo: each step move the wall by gain·(σ3 − p)·L·t/(kn_wall·n_c) toward
-/// the sample (see TestSpec::servo_gain). Returns the wall velocity.
+/// Servo: each step move the wall by gain·(σ3 − p)·L·t/(R·n_c) toward the
+/// sample (see TestSpec::servo_gain), R = servo_resistance(). Returns the
+/// wall velocity.
 double servo_velocity(const World& world, WallSide side, double target_stress, double gain);
+/// The wall contacts' dashpot c = 2ζ_c·sqrt(kn_wall·m_max) [N·s/m] of the
+/// heaviest disk (mass m_max, with the run's mass scaling): the most
+/// damping; 0 without contact damping.
+double servo_wall_dashpot(const Material& material, double m_max);
+/// What a wall contact resists the 2D servo's move by within a step Δt,
+/// per unit of the move: R = kn_wall + c/Δt [N/m], c = servo_wall_dashpot
+/// (kn_wall alone without contact damping). The one formula of demcal's
+/// servo_velocity and the exported 2D decks' servo (stage 1 and loading).
+double servo_resistance(const Material& material, double m_max, double dt);
 /// Compressive pressure on a wall from the particles [Pa].
 double wall_pressure(const World& world, WallSide side);
 
