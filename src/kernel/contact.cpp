@@ -53,10 +53,11 @@ struct PairArgs {
   const double *__restrict x, *__restrict y, *__restrict vx, *__restrict vy, *__restrict om;
   const double *__restrict r, *__restrict inv_r, *__restrict m;
   double *__restrict fx, *__restrict fy, *__restrict tq;
-  double *__restrict block_power;  // per block: power of the contact dashpots (damped pass)
-  double kn, kdt, mu, beta2;       // beta2 = 2·contact damping ratio
+  double *__restrict block_power;    // per block: power of the contact dashpots (damped pass)
+  double kn, kdt, mu, beta2;         // beta2 = 2·contact damping ratio
+  const int *__restrict term_block;  // where block b's slots have their pair terms
   const int *__restrict mirror_block;
-  const int *__restrict mirror_slot;
+  const int *__restrict mirror_term;  // places of the mirrored pair terms
   // Threads: block b's sums run right after its pairs where this pass has
   // written all its mirrored slots (its lowest source block src_block[b] is
   // in the pass's range); fused[b] tells the sum pass which are left.
@@ -81,19 +82,20 @@ DEMCAL_INLINE void sum_blocks(const PairArgs &a, int b0, int b1, bool skip_fused
     if (skip_fused && a.fused[b]) continue;
     const int m0 = a.mirror_block[b], m1 = a.mirror_block[b + 1];
     const int s0 = a.block_slot[b], s1 = a.block_slot[b + 1];
+    const int t0 = a.term_block[b] - s0;  // slot s's terms at t0 + s
     for (int sub = 0; sub < kBlock; sub += W) {
       const int i0 = kBlock * b + sub;
       D fx = zero, fy = zero, tq = zero;
       for (int s = m0 + sub; s < m1; s += kBlock) {
-        const int *S = a.mirror_slot + s;
+        const int *S = a.mirror_term + s;
         fx -= gather<W>(a.pfx, S);
         fy -= gather<W>(a.pfy, S);
         tq += gather<W>(a.ptj, S);
       }
       for (int s = s0 + sub; s < s1; s += kBlock) {
-        fx += load<W>(a.pfx + s);
-        fy += load<W>(a.pfy + s);
-        tq += load<W>(a.pti + s);
+        fx += load<W>(a.pfx + t0 + s);
+        fy += load<W>(a.pfy + t0 + s);
+        tq += load<W>(a.pti + t0 + s);
       }
       store<W>(a.fx + i0, fx);
       store<W>(a.fy + i0, fy);
@@ -119,6 +121,7 @@ DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
   const double kn = a.kn, kdt = a.kdt, mu = a.mu;
   for (int b = b0; b < b1; ++b) {
     const int s0 = a.block_slot[b], s1 = a.block_slot[b + 1];
+    const int t0 = a.term_block[b] - s0;  // slot s's terms at t0 + s
     D power = zero;
     for (int sub = 0; sub < kBlock; sub += W) {
       const int i0 = kBlock * b + sub;
@@ -162,10 +165,10 @@ DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
         store<W>(a.slot_ft + s, t);
         // Force on i: −fn·n + ft·t (on j its opposite); torques a_i·ft on
         // i, a_j·ft on j.
-        store<W>(a.pfx + s, -fn * nx - t * ny);
-        store<W>(a.pfy + s, -fn * ny + t * nx);
-        store<W>(a.pti + s, ai * t);
-        store<W>(a.ptj + s, aj * t);
+        store<W>(a.pfx + t0 + s, -fn * nx - t * ny);
+        store<W>(a.pfy + t0 + s, -fn * ny + t * nx);
+        store<W>(a.pti + t0 + s, ai * t);
+        store<W>(a.ptj + t0 + s, aj * t);
         // overlap/min(r_i, r_j) (ov ≥ 0 where touching: the product is
         // monotone, the larger of the two ratios exactly).
         const D irj = load<W>(a.slot_ir + s);
@@ -346,8 +349,9 @@ double WorldImpl::pair_kernel(int b0, int b1, bool sums) {
                    material_.particle.kt * integration_.dt,
                    material_.particle.friction,
                    2.0 * material_.contact_damping_ratio,
+                   term_block_.data(),
                    mirror_block_.data(),
-                   mirror_slot_.data(),
+                   mirror_term_.data(),
                    mirror_src_block_.data(),
                    block_fused_.data()};
   const Kernels &k = kernels();
