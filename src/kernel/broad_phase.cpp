@@ -221,33 +221,40 @@ void WorldImpl::layout_terms() {
     const int b0 = pair_bounds_[k], b1 = pair_bounds_[k + 1];
     int64_t total = 0, span = 0;
     int largest = 0;
-    for (int b = b0; b < b1; ++b)
+    // The first ring block of block b's window, or b + 1 if none.
+    auto first_in_ring = [&](int b) {
+      int first = src(b);
+      while (first <= b && own_place[first]) ++first;
+      return first;
+    };
+    // Places for capacity `cap`: a block that would cross the ring's end
+    // starts it again. Returns the longest window, from the start of its
+    // first ring block to the end of its last, over the blocks the pass sums
+    // (a block with a place of its own may be one of them: its window's
+    // ring blocks must wait too).
+    auto place_ring = [&](int64_t cap) {
+      int64_t a = 0, longest = 0;
+      for (int b = b0; b < b1; ++b) {
+        if (!own_place[b]) {
+          if (a % cap + size(b) > cap) a = (a / cap + 1) * cap;
+          at[b] = a;
+          a += size(b);
+        }
+        if (src(b) < b0) continue;  // summed after the barrier
+        const int first = first_in_ring(b);
+        if (first <= b) longest = std::max(longest, a - at[first]);
+      }
+      return longest;
+    };
+    for (int b = b0; b < b1; ++b) {
       if (!own_place[b]) {
         total += size(b);
         largest = std::max(largest, size(b));
       }
-    // Places for capacity `cap`: a block that would cross the ring's end
-    // starts it again. Returns the longest window of ring blocks, first
-    // block's start to last block's end, over the blocks summed in the pass.
-    auto place_ring = [&](int64_t cap) {
-      int64_t a = 0, longest = 0;
-      for (int b = b0; b < b1; ++b) {
-        if (own_place[b]) continue;
-        if (a % cap + size(b) > cap) a = (a / cap + 1) * cap;
-        at[b] = a;
-        a += size(b);
-        int first = std::max(src(b), b0);
-        while (first < b && own_place[first]) ++first;
-        longest = std::max(longest, a - at[first]);
-      }
-      return longest;
-    };
-    for (int b = b0; b < b1; ++b)
-      if (!own_place[b]) {
-        int first = std::max(src(b), b0);
-        while (first < b && own_place[first]) ++first;
+      const int first = first_in_ring(b);
+      if (src(b) >= b0 && first <= b)
         span = std::max<int64_t>(span, block_slot_[b + 1] - block_slot_[first]);
-      }
+    }
     int64_t cap = std::max<int64_t>(span + largest, 1);
     if (cap >= total) cap = std::max<int64_t>(total, 1);
     // A window fits when its blocks all lie within one capacity of its first.
