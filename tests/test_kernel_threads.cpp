@@ -88,6 +88,20 @@ TEST(KernelThreads, TwoAndThreeThreadsGiveBitIdenticalResultsToOne) {
   expect_identical(one, three);
 }
 
+// With many threads most blocks border another thread's range: their pair
+// terms wait for the sum pass after the barrier in places of their own, the
+// rest in each thread's ring (layout_terms, broad_phase.cpp).
+TEST(KernelThreads, ManyThreadsGiveBitIdenticalResultsToo) {
+  const World& start = jammed(0.0);
+  const World one = sheared(start, 1, 1500);
+  for (int threads : {5, 8}) {
+    SCOPED_TRACE(threads);
+    const World many = sheared(start, threads, 1500);
+    EXPECT_EQ(many.threads(), threads);
+    expect_identical(one, many);
+  }
+}
+
 TEST(KernelThreads, ContactDampingIsBitIdenticalToo) {
   const World& start = jammed(0.2);
   const World one = sheared(start, 1, 2000);

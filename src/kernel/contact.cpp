@@ -53,10 +53,11 @@ struct PairArgs {
   const double *__restrict x, *__restrict y, *__restrict vx, *__restrict vy, *__restrict om;
   const double *__restrict r, *__restrict inv_r, *__restrict m;
   double *__restrict fx, *__restrict fy, *__restrict tq;
-  double *__restrict block_power;  // per block: power of the contact dashpots (damped pass)
-  double kn, kdt, mu, beta2;       // beta2 = 2·contact damping ratio
+  double *__restrict block_power;    // per block: power of the contact dashpots (damped pass)
+  double kn, kdt, mu, beta2;         // beta2 = 2·contact damping ratio
+  const int *__restrict term_block;  // where block b's slots have their pair terms
   const int *__restrict mirror_block;
-  const int *__restrict mirror_slot;
+  const int *__restrict mirror_term;  // places of the mirrored pair terms
   // Threads: block b's sums run right after its pairs where this pass has
   // written all its mirrored slots (its lowest source block src_block[b] is
   // in the pass's range); fused[b] tells the sum pass which are left.
@@ -77,27 +78,31 @@ template <int W>
 DEMCAL_INLINE void sum_blocks(const PairArgs &a, int b0, int b1, bool skip_fused = false) {
   using D = typename Simd<W>::D;
   const D zero{};
+  const int *__restrict p_mirror_term = a.mirror_term;  // locals: see pair_blocks
+  const double *p_pfx = a.pfx, *p_pfy = a.pfy, *p_pti = a.pti, *p_ptj = a.ptj;
+  double *__restrict p_fx = a.fx, *__restrict p_fy = a.fy, *__restrict p_tq = a.tq;
   for (int b = b0; b < b1; ++b) {
     if (skip_fused && a.fused[b]) continue;
     const int m0 = a.mirror_block[b], m1 = a.mirror_block[b + 1];
     const int s0 = a.block_slot[b], s1 = a.block_slot[b + 1];
+    const int t0 = a.term_block[b] - s0;  // slot s's terms at t0 + s
     for (int sub = 0; sub < kBlock; sub += W) {
       const int i0 = kBlock * b + sub;
       D fx = zero, fy = zero, tq = zero;
       for (int s = m0 + sub; s < m1; s += kBlock) {
-        const int *S = a.mirror_slot + s;
-        fx -= gather<W>(a.pfx, S);
-        fy -= gather<W>(a.pfy, S);
-        tq += gather<W>(a.ptj, S);
+        const int *S = p_mirror_term + s;
+        fx -= gather<W>(p_pfx, S);
+        fy -= gather<W>(p_pfy, S);
+        tq += gather<W>(p_ptj, S);
       }
       for (int s = s0 + sub; s < s1; s += kBlock) {
-        fx += load<W>(a.pfx + s);
-        fy += load<W>(a.pfy + s);
-        tq += load<W>(a.pti + s);
+        fx += load<W>(p_pfx + t0 + s);
+        fy += load<W>(p_pfy + t0 + s);
+        tq += load<W>(p_pti + t0 + s);
       }
-      store<W>(a.fx + i0, fx);
-      store<W>(a.fy + i0, fy);
-      store<W>(a.tq + i0, tq);
+      store<W>(p_fx + i0, fx);
+      store<W>(p_fy + i0, fy);
+      store<W>(p_tq + i0, tq);
     }
   }
 }
@@ -117,20 +122,30 @@ DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
   const D zero{};
   D mo = zero;
   const double kn = a.kn, kdt = a.kdt, mu = a.mu;
+  // The arrays as locals: the stores (memcpy) could otherwise alias the
+  // pointers in `a`, which the loop would reload every iteration.
+  const int *__restrict p_slot_j = a.slot_j;
+  double *__restrict p_slot_ft = a.slot_ft;
+  const double *__restrict p_slot_r = a.slot_r, *__restrict p_slot_ir = a.slot_ir;
+  const double *__restrict p_x = a.x, *__restrict p_y = a.y, *__restrict p_vx = a.vx,
+                           *__restrict p_vy = a.vy, *__restrict p_om = a.om;
+  const double *__restrict p_r = a.r, *__restrict p_inv_r = a.inv_r, *__restrict p_m = a.m;
+  double *p_pfx = a.pfx, *p_pfy = a.pfy, *p_pti = a.pti, *p_ptj = a.ptj;  // sum_blocks reads them
   for (int b = b0; b < b1; ++b) {
     const int s0 = a.block_slot[b], s1 = a.block_slot[b + 1];
+    const int t0 = a.term_block[b] - s0;  // slot s's terms at t0 + s
     D power = zero;
     for (int sub = 0; sub < kBlock; sub += W) {
       const int i0 = kBlock * b + sub;
-      const D xi = load<W>(a.x + i0), yi = load<W>(a.y + i0);
-      const D vxi = load<W>(a.vx + i0), vyi = load<W>(a.vy + i0), omi = load<W>(a.om + i0);
-      const D ri = load<W>(a.r + i0), iri = load<W>(a.inv_r + i0);
+      const D xi = load<W>(p_x + i0), yi = load<W>(p_y + i0);
+      const D vxi = load<W>(p_vx + i0), vyi = load<W>(p_vy + i0), omi = load<W>(p_om + i0);
+      const D ri = load<W>(p_r + i0), iri = load<W>(p_inv_r + i0);
       D mi = zero;
-      if constexpr (kDamped) mi = load<W>(a.m + i0);
+      if constexpr (kDamped) mi = load<W>(p_m + i0);
       for (int s = s0 + sub; s < s1; s += kBlock) {
-        const int *J = a.slot_j + s;
-        const D rj = load<W>(a.slot_r + s);
-        const D dx = gather<W>(a.x, J) - xi, dy = gather<W>(a.y, J) - yi;
+        const int *J = p_slot_j + s;
+        const D rj = load<W>(p_slot_r + s);
+        const D dx = gather<W>(p_x, J) - xi, dy = gather<W>(p_y, J) - yi;
         const D d2 = dx * dx + dy * dy;
         const D rs = ri + rj;
         const typename Simd<W>::M touch = d2 < rs * rs;
@@ -139,11 +154,11 @@ DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
         const D nx = dx * inv, ny = dy * inv;
         const D ov = rs - d;
         const D ai = ri - 0.5 * ov, aj = rj - 0.5 * ov;
-        const D omj = gather<W>(a.om, J);
-        const D dvx = gather<W>(a.vx, J) - vxi, dvy = gather<W>(a.vy, J) - vyi;
+        const D omj = gather<W>(p_om, J);
+        const D dvx = gather<W>(p_vx, J) - vxi, dvy = gather<W>(p_vy, J) - vyi;
         D fn = law::elastic_normal_force(kn, ov);
         if constexpr (kDamped) {
-          const D meff = law::reduced_mass(mi, gather<W>(a.m, J));
+          const D meff = law::reduced_mass(mi, gather<W>(p_m, J));
           const D vn = dvx * nx + dvy * ny;  // > 0 when separating
           const D fe = fn;
           fn = law::damped_normal_force(fe, a.beta2, vsqrt(kn * meff), vn);
@@ -157,18 +172,18 @@ DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
         const D rot = 0.5 * ((omi + omj) * (ai + aj) + (omi - omj) * (ai - aj));
         const D vt = (dvy * nx - dvx * ny) - rot;
         const D cap = mu * fn;
-        D t = law::coulomb_clamp(load<W>(a.slot_ft + s) + kdt * vt, cap);
+        D t = law::coulomb_clamp(load<W>(p_slot_ft + s) + kdt * vt, cap);
         t = select<W>(touch, t, zero);
-        store<W>(a.slot_ft + s, t);
+        store<W>(p_slot_ft + s, t);
         // Force on i: −fn·n + ft·t (on j its opposite); torques a_i·ft on
         // i, a_j·ft on j.
-        store<W>(a.pfx + s, -fn * nx - t * ny);
-        store<W>(a.pfy + s, -fn * ny + t * nx);
-        store<W>(a.pti + s, ai * t);
-        store<W>(a.ptj + s, aj * t);
+        store<W>(p_pfx + t0 + s, -fn * nx - t * ny);
+        store<W>(p_pfy + t0 + s, -fn * ny + t * nx);
+        store<W>(p_pti + t0 + s, ai * t);
+        store<W>(p_ptj + t0 + s, aj * t);
         // overlap/min(r_i, r_j) (ov ≥ 0 where touching: the product is
         // monotone, the larger of the two ratios exactly).
-        const D irj = load<W>(a.slot_ir + s);
+        const D irj = load<W>(p_slot_ir + s);
         const D ovr = select<W>(touch, ov * (iri > irj ? iri : irj), zero);
         mo = mo > ovr ? mo : ovr;
       }
@@ -346,8 +361,9 @@ double WorldImpl::pair_kernel(int b0, int b1, bool sums) {
                    material_.particle.kt * integration_.dt,
                    material_.particle.friction,
                    2.0 * material_.contact_damping_ratio,
+                   term_block_.data(),
                    mirror_block_.data(),
-                   mirror_slot_.data(),
+                   mirror_term_.data(),
                    mirror_src_block_.data(),
                    block_fused_.data()};
   const Kernels &k = kernels();

@@ -219,6 +219,7 @@ void WorldImpl::update_thread_bounds() {
     pair_bounds_[k] = b;
   }
   pair_bounds_[t] = nblocks_;
+  layout_terms();
 }
 
 double WorldImpl::run_pass(double (WorldImpl::*pass)(int, int), const std::vector<int>& bounds) {

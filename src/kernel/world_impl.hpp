@@ -140,6 +140,9 @@ class WorldImpl {
   void layout_blocks(const std::vector<int>& start, std::vector<int>& block_slot) const;
   // The mirror list (mirror_block_, mirror_slot_) from the half list.
   void rebuild_mirror_list();
+  // The places of the pair terms (term_block_, mirror_term_) for the list
+  // and the threads' block ranges (pair_bounds_).
+  void layout_terms();
   // contact.cpp: the SIMD passes over blocks [b0, b1), and the walls
   double pair_pass(int b0, int b1);               // returns the largest overlap/min(r_i, r_j)
   double sum_pass(int b0, int b1);                // mirrored pair terms (threads only)
@@ -219,14 +222,19 @@ class WorldImpl {
   Array slot_r_;   // radius of the slot's neighbour (contiguous: one gather less)
   Array slot_ir_;  // its inverse
   // Per slot, written by the pair pass: the pair's force on i (pfx_, pfy_)
-  // and its torques on i and j (pti_, ptj_); index block_slot_.back() is a
-  // zero slot.
+  // and its torques on i and j (pti_, ptj_). Block b's slot s has its terms
+  // at term_block_[b] + s − block_slot_[b]: blocks share places in a ring
+  // once no sum needs their terms any more (layout_terms, broad_phase.cpp);
+  // index term_block_.back() is a zero slot.
   Array pfx_, pfy_, pti_, ptj_;
+  std::vector<int> term_block_;
   // Mirror list (sliced ELLPACK like the list): block b's rows are
   // [mirror_block_[b], mirror_block_[b + 1]); particle j's entries are the
-  // slots of its pairs (i, j), i < j, in increasing i, then the zero slot.
+  // slots of its pairs (i, j), i < j, in increasing i, then the zero slot
+  // block_slot_.back(); mirror_term_ the same entries as places of the pair
+  // terms.
   std::vector<int> mirror_block_, mirror_count_;
-  detail::AlignedVector<int> mirror_slot_;
+  detail::AlignedVector<int> mirror_slot_, mirror_term_;
   // Per block: the lowest block holding one of its mirrored slots, and
   // whether the threaded pair pass has summed it (contact.cpp).
   std::vector<int> mirror_src_block_;

@@ -19,9 +19,10 @@ namespace demcal {
 
 namespace {
 
-// The last character numbers the layout: '2' since the half neighbour list
-// (a state of the full-list layout does not read: rebuilt, not misread).
-constexpr char kMagic[8] = {'d', 'e', 'm', 'W', 'o', 'r', 'l', '2'};
+// The last character numbers the layout: '2' since the half neighbour list,
+// '3' since the pair terms' places (term_block_, mirror_term_); a state of
+// an older layout does not read: rebuilt, not misread.
+constexpr char kMagic[8] = {'d', 'e', 'm', 'W', 'o', 'r', 'l', '3'};
 
 template <class T>
 constexpr bool kScalar = std::is_arithmetic_v<T> || std::is_enum_v<T>;
@@ -129,13 +130,15 @@ void WorldImpl::visit_state(Self& w, Visitor& v) {
     v(wall.force.y());
     v(wall.contacts);
   }
-  for (auto* a : {&w.block_slot_, &w.pair_i_, &w.pair_j_, &w.pair_slot_, &w.pair_bounds_,
-                  &w.particle_bounds_, &w.nbr_start_, &w.nbr_list_, &w.cell_start_, &w.cell_next_,
-                  &w.new_block_slot_, &w.mirror_block_, &w.mirror_count_, &w.mirror_src_block_})
+  for (auto* a :
+       {&w.block_slot_, &w.pair_i_, &w.pair_j_, &w.pair_slot_, &w.pair_bounds_, &w.particle_bounds_,
+        &w.nbr_start_, &w.nbr_list_, &w.cell_start_, &w.cell_next_, &w.new_block_slot_,
+        &w.mirror_block_, &w.mirror_count_, &w.mirror_src_block_, &w.term_block_})
     v(*a);
   v(w.slot_j_);
   v(w.new_slot_j_);
   v(w.mirror_slot_);
+  v(w.mirror_term_);
   v(w.block_fused_);
   v(w.skin_);
   v(w.r_max_);
@@ -189,9 +192,11 @@ WorldImpl WorldImpl::load_state(std::string_view bytes) {
       w.slot_j_.size() == w.slot_ft_.size() && w.slot_r_.size() == w.slot_ft_.size() &&
       static_cast<size_t>(w.block_slot_.back()) <= w.slot_j_.size() &&
       w.slot_ir_.size() == w.slot_ft_.size() &&
-      (w.pfx_.empty() || (w.pfx_.size() == static_cast<size_t>(w.block_slot_.back()) + 1 &&
-                          w.pfy_.size() == w.pfx_.size() && w.pti_.size() == w.pfx_.size() &&
-                          w.ptj_.size() == w.pfx_.size())) &&
+      (w.pfx_.empty() ||
+       (w.term_block_.size() == static_cast<size_t>(w.nblocks_) + 1 &&
+        w.pfx_.size() == static_cast<size_t>(w.term_block_.back()) + 1 &&
+        w.pfy_.size() == w.pfx_.size() && w.pti_.size() == w.pfx_.size() &&
+        w.ptj_.size() == w.pfx_.size() && w.mirror_term_.size() == w.mirror_slot_.size())) &&
       (w.mirror_block_.empty() ||
        (w.mirror_block_.size() == static_cast<size_t>(w.nblocks_) + 1 &&
         static_cast<size_t>(w.mirror_block_.back()) <= w.mirror_slot_.size() &&
@@ -205,7 +210,14 @@ WorldImpl WorldImpl::load_state(std::string_view bytes) {
   for (int j : w.slot_j_)
     if (j < 0 || j > w.ghost_) Reader::fail();
   for (int s : w.mirror_slot_)
+    if (s < 0 || s > w.block_slot_.back()) Reader::fail();
+  for (int s : w.mirror_term_)
     if (s < 0 || static_cast<size_t>(s) >= w.pfx_.size()) Reader::fail();
+  if (!w.pfx_.empty())
+    for (int b = 0; b < w.nblocks_; ++b)
+      if (w.term_block_[b] < 0 ||
+          w.term_block_[b] + (w.block_slot_[b + 1] - w.block_slot_[b]) > w.term_block_.back())
+        Reader::fail();
   return w;
 }
 
