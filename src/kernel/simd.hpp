@@ -38,7 +38,11 @@ DEMCAL_INLINE typename Simd<W>::D load(const double *p) {
 }
 template <int W>
 DEMCAL_INLINE void store(double *p, typename Simd<W>::D v) {
-  std::memcpy(p, &v, sizeof v);
+  // A typed (unaligned) vector store, not memcpy: a memcpy may alias any
+  // object, so GCC would reload every array pointer of a pass's argument
+  // struct after each store; a store of doubles cannot alias a pointer.
+  typedef double U __attribute__((vector_size(8 * W), aligned(8)));
+  *reinterpret_cast<U *>(p) = v;
 }
 template <int W>
 DEMCAL_INLINE typename Simd<W>::D gather(const double *__restrict b, const int *__restrict j) {
