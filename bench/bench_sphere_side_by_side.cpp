@@ -1,17 +1,20 @@
 // Side-by-side driver for the sphere kernel: an FCC lattice of n×n×n cells
 // (4n³ spheres, fcc_packing pre-compressed by 1e-4), μ = 0.3, ζ_t = 0.1,
-// ζ_r = 0, α = 0.2, the top wall moving down slowly; it times
+// ζ_r = 0, α = 0.2, the top wall moving down slowly; after the preload the
+// spheres are renumbered to fill the kernel's SIMD blocks, as demcal does
+// after a consolidation (--no-order keeps the lattice's numbering); it times
 // SphereWorld::step over the run and can write the same scene for LAMMPS
 // (bench/lammps/in.sphere_compress reads it; bench/lammps_compare_sphere.sh
 // runs both).
 //
-//   bench_sphere_side_by_side --cells 4 --steps 20000 --preload 2000
+//   bench_sphere_side_by_side --cells 4 --steps 20000 --preload 2000 [--no-order]
 //   bench_sphere_side_by_side --cells 4 --write-lammps /tmp/fcc4 --no-run
 //   DEMCAL_SIMD=avx2 bench_sphere_side_by_side --cells 19 --threads 2
 //
 // Output: one line of key=value pairs (engine, particles, steps, seconds,
 // particle_steps_per_s, contacts at the end — LAMMPS must report the same —
-// and the SIMD path, threads, neighbour-list rebuilds and slot fill).
+// and the SIMD path, threads, neighbour-list rebuilds, the half and mirror
+// lists' slot fills and whether the spheres were renumbered).
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -90,7 +93,7 @@ int main(int argc, char** argv) {
   long steps = 20000, preload = 2000;
   int threads = 1;
   std::string lammps_prefix;
-  bool run = true;
+  bool run = true, order = true;
   for (int k = 1; k < argc; ++k) {
     const std::string arg = argv[k];
     auto value = [&] {
@@ -112,6 +115,8 @@ int main(int argc, char** argv) {
       lammps_prefix = value();
     else if (arg == "--no-run")
       run = false;
+    else if (arg == "--no-order")
+      order = false;
     else {
       std::fprintf(stderr, "unknown argument %s\n", arg.c_str());
       return 2;
@@ -126,6 +131,7 @@ int main(int argc, char** argv) {
   w.set_integration(s.integration);
   w.wall(kZMax).velocity = s.top_speed;
   if (!w.step(preload)) return 1;
+  if (order) w.reorder(w.block_friendly_order());
   const auto t0 = std::chrono::steady_clock::now();
   const std::clock_t c0 = std::clock();
   if (!w.step(steps)) return 1;
@@ -133,9 +139,10 @@ int main(int argc, char** argv) {
   const double cpu = static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC;
   std::printf(
       "engine=demcal scene=fcc_%dx%dx%d particles=%d steps=%ld seconds=%.4g cpu_seconds=%.4g "
-      "particle_steps_per_s=%.4g contacts=%d rebuilds=%lld simd=%s threads=%d slot_fill=%.3f\n",
+      "particle_steps_per_s=%.4g contacts=%d rebuilds=%lld simd=%s threads=%d slot_fill=%.3f "
+      "mirror_fill=%.3f ordered=%d\n",
       cells, cells, cells, w.size(), steps, sec, cpu, w.size() * static_cast<double>(steps) / sec,
       w.measure().particle_contacts, static_cast<long long>(w.rebuilds()), kernel_simd(),
-      w.threads(), w.neighbour_slot_fill());
+      w.threads(), w.neighbour_slot_fill(), w.mirror_slot_fill(), order ? 1 : 0);
   return 0;
 }

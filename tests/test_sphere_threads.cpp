@@ -3,7 +3,7 @@
 //    force is summed by one thread over its own slots in a fixed order; the
 //    per-block energy sums are added in block order), checked through
 //    neighbour-list rebuilds, sliding, moving walls, with and without
-//    contact damping;
+//    contact damping, and after a renumbering (SphereWorld::reorder);
 //  - the SIMD pair law: one step of the kernel against a plain scalar
 //    evaluation of the contact law (written out below from the formulas of
 //    sphere_contact.cpp, brute force over all pairs), to rounding; and the
@@ -114,6 +114,34 @@ TEST(SphereThreads, BitIdenticalForAnyThreadCount) {
       EXPECT_EQ(many.threads(), t);
       expect_identical(one, many);
     }
+  }
+}
+
+// After a renumbering (the block-friendly order, mid-run, as a trial starts
+// from a reordered consolidated state): still bit-identical for any thread
+// count.
+SphereWorld run_threads_reordered(int threads) {
+  KernelOptions options;
+  options.skin_ratio = 0.002;
+  options.threads = threads;
+  SphereWorld w = agitated_fcc(0.0, options);
+  sphere_test::set_damped(w, 0.2, 0.05);
+  w.wall(kZMax).velocity = -0.2;
+  w.wall(kXMin).velocity = -0.1;
+  w.wall(kXMax).velocity = 0.1;
+  EXPECT_TRUE(w.step(500)) << to_string(w.divergence());
+  w.reorder(w.block_friendly_order());
+  EXPECT_TRUE(w.step(700)) << to_string(w.divergence()) << " at " << w.divergence_step();
+  return w;
+}
+
+TEST(SphereThreads, BitIdenticalForAnyThreadCountAfterReorder) {
+  const SphereWorld one = run_threads_reordered(1);
+  for (int t : {2, 3}) {
+    SCOPED_TRACE(t);
+    const SphereWorld many = run_threads_reordered(t);
+    EXPECT_EQ(many.threads(), t);
+    expect_identical(one, many);
   }
 }
 

@@ -1,17 +1,18 @@
 // Renumbering the particles (WorldImpl::reorder) and the order that fills the
-// SIMD blocks (WorldImpl::block_friendly_order). See world.hpp.
+// SIMD blocks (WorldImpl::block_friendly_order, block_order.cpp). See
+// world.hpp.
 #include <algorithm>
 #include <stdexcept>
 #include <tuple>
 #include <vector>
 
+#include "block_order.hpp"
 #include "world_impl.hpp"
 
 namespace demcal {
 
 namespace {
 constexpr int kBlock = 8;
-constexpr int kWindow = 64;  // particles sorted together: 8 blocks
 }  // namespace
 
 double WorldImpl::neighbour_slot_fill() const {
@@ -23,59 +24,7 @@ double WorldImpl::neighbour_slot_fill() const {
 }
 
 std::vector<int> WorldImpl::block_friendly_order() const {
-  // The pair pass pads each block's rows to its longest half row (h: the
-  // neighbours j > i) and the sums to its longest mirror row (m: the
-  // neighbours j < i), so a block costs max h + max m over its lanes. Each
-  // window of 64 consecutive particles (locality kept) is filled from its
-  // last position down: a particle's h is then known when it is placed (its
-  // neighbours in later windows and those already placed after it), and
-  // each pick is the one that raises its block's cost least (ties: the most
-  // neighbours, then the lowest index; a block's first pick: the most
-  // neighbours).
-  const int n = n_;
-  std::vector<int> start(static_cast<size_t>(n) + 1, 0);
-  for (size_t k = 0; k < pair_i_.size(); ++k) {
-    ++start[pair_i_[k] + 1];
-    ++start[pair_j_[k] + 1];
-  }
-  for (int i = 0; i < n; ++i) start[i + 1] += start[i];
-  std::vector<int> adj(static_cast<size_t>(start[n])), fill(start.begin(), start.end() - 1);
-  for (size_t k = 0; k < pair_i_.size(); ++k) {
-    adj[fill[pair_i_[k]]++] = pair_j_[k];
-    adj[fill[pair_j_[k]]++] = pair_i_[k];
-  }
-  std::vector<int> order(n), after(n, 0);
-  std::vector<char> placed(n, 0);
-  for (int w = 0; w < n; w += kWindow) {
-    const int e = std::min(n, w + kWindow);
-    for (int p = w; p < e; ++p)
-      for (int k = start[p]; k < start[p + 1]; ++k) after[p] += adj[k] >= e;
-    for (int pos = e - 1; pos >= w;) {
-      const int lo = std::max(w, pos / kBlock * kBlock);
-      int H = 0, M = 0;
-      for (int q = pos; q >= lo; --q) {
-        int best = -1, best_inc = 0, best_deg = 0;
-        for (int p = w; p < e; ++p) {
-          if (placed[p]) continue;
-          const int deg = start[p + 1] - start[p], h = after[p], m = deg - h;
-          const int inc = q == pos ? 0 : std::max(H, h) + std::max(M, m) - (H + M);
-          if (best < 0 || inc < best_inc || (inc == best_inc && deg > best_deg)) {
-            best = p;
-            best_inc = inc;
-            best_deg = deg;
-          }
-        }
-        order[q] = best;
-        placed[best] = 1;
-        H = std::max(H, after[best]);
-        M = std::max(M, best_deg - after[best]);
-        for (int k = start[best]; k < start[best + 1]; ++k)
-          if (adj[k] >= w && adj[k] < e) ++after[adj[k]];
-      }
-      pos = lo - 1;
-    }
-  }
-  return order;
+  return detail::block_friendly_order(n_, pair_i_, pair_j_);
 }
 
 void WorldImpl::reorder(std::span<const int> order) {

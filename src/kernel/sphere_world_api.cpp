@@ -83,6 +83,9 @@ Eigen::Vector3d SphereWorld::centre() const { return impl_->centre(); }
 std::vector<SphereWorld::ContactView> SphereWorld::contacts() const { return impl_->contacts(); }
 int64_t SphereWorld::rebuilds() const { return impl_->rebuilds(); }
 double SphereWorld::neighbour_slot_fill() const { return impl_->neighbour_slot_fill(); }
+double SphereWorld::mirror_slot_fill() const { return impl_->mirror_slot_fill(); }
+void SphereWorld::reorder(std::span<const int> order) { impl_->reorder(order); }
+std::vector<int> SphereWorld::block_friendly_order() const { return impl_->block_friendly_order(); }
 void SphereWorld::set_threads(int threads) { impl_->set_threads(threads); }
 int SphereWorld::threads() const { return impl_->threads(); }
 void SphereWorld::update_forces() { impl_->update_forces(); }

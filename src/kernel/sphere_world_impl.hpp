@@ -93,6 +93,13 @@ class SphereWorldImpl {
   /// Share of the neighbour slots the pair pass evaluates that hold a real
   /// neighbour (the rest pad each block's rows to its longest list).
   double neighbour_slot_fill() const;
+  /// The same share for the mirror list (each pair once more, padded to the
+  /// longest row of its higher index's block).
+  double mirror_slot_fill() const;
+  /// Renumber the spheres (SphereWorld::reorder; sphere_world_reorder.cpp).
+  void reorder(std::span<const int> order);
+  /// An order for reorder() that fills the SIMD blocks (block_order.hpp).
+  std::vector<int> block_friendly_order() const;
 
   /// Threads for stepping this world (KernelOptions::threads: 0 = all
   /// cores). Results are bit-identical for any thread count.

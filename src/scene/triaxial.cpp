@@ -151,6 +151,9 @@ TriaxialState consolidate_triaxial(const SceneConfig& config, const SphereAssemb
   for (int i = 0; i < world.size(); ++i)
     world.set_velocity(i, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
   world.update_forces();
+  // Every trial starts from this state: number the particles so that the
+  // kernel's SIMD blocks are full (the same physical state).
+  world.reorder(world.block_friendly_order());
   for (int axis = 0; axis < 3; ++axis) state.extent0[axis] = world.extent(axis);
   detail::finish_consolidation(state, o, test, t0);
   return state;

@@ -184,6 +184,27 @@ class SphereWorld {
   /// Share of the neighbour slots the pair pass evaluates that hold a real
   /// neighbour (the rest pad each block's rows to its longest list).
   double neighbour_slot_fill() const;
+  /// The same share for the mirror list, which gives each particle its
+  /// pairs with lower indices (padded to the longest such row of its block).
+  double mirror_slot_fill() const;
+  /// Renumber the particles: particle order[k] becomes particle k. Every
+  /// per-particle quantity moves with its particle, contact histories
+  /// included (pair and wall: a pair's history, the tangential force on its
+  /// lower index, changes sign where the new numbering swaps the pair), and
+  /// the forces are re-evaluated in the new order: the same physical state
+  /// (sums run in another order, so later steps differ in the last bits).
+  /// Throws std::invalid_argument unless `order` is a permutation of
+  /// 0 … size() − 1.
+  void reorder(std::span<const int> order);
+  /// An order for reorder() that fills the SIMD blocks, the 2D kernel's
+  /// (World::block_friendly_order): the kernel evaluates 8 particles at once
+  /// and pads their half rows (neighbours of higher index) and mirror rows
+  /// (lower index) to the longest of the block, so each window of 64
+  /// consecutive particles (locality kept) is ordered so that the particles
+  /// of a block have as many neighbours on either side; the identity where
+  /// that would not fill the blocks better (a lattice in lattice order)
+  /// (reports/performance.md).
+  std::vector<int> block_friendly_order() const;
 
   /// Threads for stepping this world (KernelOptions::threads: 0 = all
   /// cores). Results are bit-identical for any thread count.

@@ -1,0 +1,29 @@
+// The particle order that fills the kernels' SIMD blocks, one algorithm for
+// both (World::block_friendly_order, SphereWorld::block_friendly_order).
+// Private to src/kernel, like kernel_detail.hpp.
+#pragma once
+
+#include <span>
+#include <vector>
+
+namespace demcal::detail {
+
+/// An order for reorder() of n particles whose neighbour pairs are
+/// (pair_i[k], pair_j[k]) (each pair once, either way round): order[k] is
+/// the particle to become particle k. The pair pass evaluates blocks of 8
+/// particles and pads their half rows (neighbours of higher index) and
+/// mirror rows (lower index) to the longest of the block; each window of 64
+/// consecutive particles (locality kept) is ordered so that the particles
+/// of a block have as many neighbours on either side.
+std::vector<int> block_friendly_order(int n, std::span<const int> pair_i,
+                                      std::span<const int> pair_j);
+
+/// The slots the pair pass evaluates per lane under `order` (as
+/// block_friendly_order returns it): over the blocks of 8 new indices, the
+/// longest half row plus the longest mirror row. The greedy order of
+/// block_friendly_order can lose to a numbering that is already regular (a
+/// lattice in lattice order): compare with the identity's.
+long block_slot_rows(int n, std::span<const int> pair_i, std::span<const int> pair_j,
+                     std::span<const int> order);
+
+}  // namespace demcal::detail
