@@ -420,6 +420,38 @@ TEST(Export3dLammps, PeakMatchesDemcalSerially) { check_lammps(1, 20000); }
 // several times a step, which a shared machine makes slow (reports/engines-3d.md).
 TEST(Export3dLammps, PeakMatchesDemcalUnderMpirunNp2) { check_lammps(2, 5000); }
 
+TEST(Export3dLammps, WithContactDampingTheDecksServoIsDemcals) {
+  // Contact damping ζ_c 0.3: demcal's servo divides by R = kn_wall +
+  // c/Δt, so does the deck's (gain_kn from `resist`). The deck's walls
+  // carry no dashpots (wall/gran), its pair dashpot is demcal's (one sphere
+  // size): the servo criterion as demcal's within 5 % and the peak within
+  // 1 % (as the deck without contact damping, check_lammps). α 0.1: stable
+  // with these dashpots (0.2 is not).
+  const std::string lmp = test::find_on_path("lmp");
+  if (lmp.empty()) GTEST_SKIP() << "LAMMPS (lmp) is not installed: the 3D deck is not run";
+  SceneConfig c = fcc444();
+  c.material.contact_damping_ratio = 0.3;
+  const TriaxialState state = consolidate_triaxial(c, make_sphere_assembly(c));
+  ASSERT_TRUE(state.converged);
+  AlgorithmSpec p = fixed_params(10000);
+  p.dt_ratio = 0.1;
+  const TriaxialResult d = run_triaxial_loading(state, c.test, p);
+  ASSERT_FALSE(d.diverged);
+  Export3dOptions o;
+  o.data_name = "fcc.data";
+  const ExportResult r = export_3d_decks(c, p, state, o);
+  const EngineRun l = run_engine(lmp, {"-screen", "none"}, r, "lammps3d_damped");
+  ASSERT_EQ(l.status, 0) << l.log;
+  const ExternalSeries external = parse_external_series(l.csv, "series.csv");
+  const ExternalScore theirs = score_external(external, Tolerances{});
+  const Score ours = score_triaxial_run(d, c.test.lateral_stress, Tolerances{});
+  const Criteria &t = theirs.score.criteria, &m = ours.criteria;
+  std::printf("fcc_4x4x4, contact damping 0.3: servo demcal %.5g / LAMMPS %.5g, peak %.6g / %.6g\n",
+              m.servo, t.servo, -d.peak_stress_zz, l.peak_axial);
+  EXPECT_NEAR(t.servo / m.servo, 1.0, 0.05);
+  EXPECT_NEAR(l.peak_axial / -d.peak_stress_zz, 1.0, 0.01);
+}
+
 /// `what` replaced by `with` in `text` (which must hold it once at least).
 std::string replaced(std::string text, const std::string& what, const std::string& with) {
   const auto at = text.find(what);
