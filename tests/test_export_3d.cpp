@@ -180,6 +180,85 @@ TEST(Export3d, LiggghtsDeckHasSixWallsAndTheServo) {
   EXPECT_EQ(r.deck.find("dimension 2"), std::string::npos);
 }
 
+/// The number of `variable NAME equal NUMBER` in a deck (NaN if absent).
+double deck_variable(const std::string& deck, const std::string& name) {
+  std::istringstream lines(deck);
+  for (std::string line; std::getline(lines, line);) {
+    std::istringstream in(line);
+    std::string word, var, style;
+    double v = 0.0;
+    if (in >> word >> var >> style && word == "variable" && var == name && style == "equal" &&
+        in >> v)
+      return v;
+  }
+  return std::nan("");
+}
+
+TEST(Export3d, TheLoadingServosGainIsDemcalsWithTheWallDashpots) {
+  // demcal's 3D servo divides by R = kn_wall + c/Δt with contact damping
+  // (c = 2ζ_c·sqrt(kn_wall·m_max), the heaviest sphere's at the mass
+  // scaling; servo_resistance, as in 2D): the LAMMPS deck's gain_kn, per
+  // step of dt, is demcal's per-step law times dt/servo_dt, and the
+  // LIGGGHTS deck's kp·vel_max is demcal's wall velocity per unit of force
+  // (from servo_velocity itself, on the x-min wall without contacts, at a
+  // target far from the cap). Polydisperse and with mass scaling; without
+  // contact damping R = kn_wall. (Before 2026-12-02 demcal's triaxial
+  // servo and both decks divided by kn_wall only.)
+  SceneConfig c = fcc444();
+  c.assembly.type = "random";
+  c.assembly.count = 40;
+  c.assembly.radius_min = 4e-4;
+  c.assembly.radius_max = 8e-4;
+  const SphereAssembly a = make_sphere_assembly(c);
+  AlgorithmSpec p = fixed_params();
+  p.mass_scaling = 4.0;
+  for (const double zeta_c : {0.0, 0.3}) {
+    c.material.contact_damping_ratio = zeta_c;
+    SphereWorld w(sphere_material(c.material), a.x, a.y, a.z, a.r, a.lo, a.hi);
+    w.set_integration(integration_for(w, p));
+    w.update_forces();
+    ASSERT_EQ(w.wall(kXMin).contacts, 0);
+    const double target = 1e-3;  // Pa: a move ~1e-16 m, far from the cap
+    const double force = target * w.extent(1) * w.extent(2);
+    const double demcal =
+        servo_velocity(w, kXMin, target, c.test.servo_gain) * w.integration().dt / force;
+    Export3dOptions o;
+    o.data_name = "proto.data";
+    const ExportResult r = export_3d_decks(c, p, a, o);
+    const std::string& d = r.deck;
+    const double servo_dt = deck_variable(d, "servo_dt");
+    const double dt = deck_variable(d, "dt");
+    EXPECT_NEAR(dt / servo_dt, r.step_factor, 1e-12);
+    double resist = deck_variable(d, "kn_wall");
+    const std::string gain_kn_line = d.substr(d.find("variable gain_kn"), 60);
+    if (zeta_c > 0.0) {
+      EXPECT_NE(gain_kn_line.find("$(v_gain*v_servo_f/v_resist)"), std::string::npos)
+          << gain_kn_line;
+      EXPECT_NE(d.find("variable resist    equal $(v_kn_wall+v_c_wall/v_servo_dt)"),
+                std::string::npos);
+      resist += deck_variable(d, "c_wall") / servo_dt;
+      EXPECT_GT(resist / c.material.wall.kn, 2.0);  // the stiffness it had before
+    } else {
+      EXPECT_NE(gain_kn_line.find("$(v_gain*v_servo_f/v_kn_wall)"), std::string::npos)
+          << gain_kn_line;
+      EXPECT_EQ(d.find("variable c_wall"), std::string::npos);
+    }
+    const double gain_kn = deck_variable(d, "gain") * (dt / servo_dt) / resist;
+    EXPECT_NEAR(gain_kn / (demcal * r.step_factor), 1.0, 1e-12) << "zeta_c " << zeta_c;
+
+    o.format = "liggghts";
+    const ExportResult g = export_3d_decks(c, p, a, o);
+    const std::string fix = g.deck.substr(g.deck.find("fix mxmin "));
+    auto number_after = [&](const std::string& key) {
+      return std::stod(fix.substr(fix.find(" " + key + " ") + key.size() + 2));
+    };
+    const double f_target = c.test.lateral_stress * w.extent(1) * w.extent(2);
+    const double velocity_per_force = number_after("vel_max") * number_after("kp") / f_target;
+    const double dt_demcal = g.dt / g.step_factor;
+    EXPECT_NEAR(velocity_per_force * dt_demcal / demcal, 1.0, 1e-12) << "zeta_c " << zeta_c;
+  }
+}
+
 // --- the engines ------------------------------------------------------------
 
 struct EngineRun {
@@ -340,6 +419,38 @@ TEST(Export3dLammps, PeakMatchesDemcalSerially) { check_lammps(1, 20000); }
 // A quarter of the steps under MPI: two ranks of a 256-sphere deck meet
 // several times a step, which a shared machine makes slow (reports/engines-3d.md).
 TEST(Export3dLammps, PeakMatchesDemcalUnderMpirunNp2) { check_lammps(2, 5000); }
+
+TEST(Export3dLammps, WithContactDampingTheDecksServoIsDemcals) {
+  // Contact damping ζ_c 0.3: demcal's servo divides by R = kn_wall +
+  // c/Δt, so does the deck's (gain_kn from `resist`). The deck's walls
+  // carry no dashpots (wall/gran), its pair dashpot is demcal's (one sphere
+  // size): the servo criterion as demcal's within 5 % and the peak within
+  // 1 % (as the deck without contact damping, check_lammps). α 0.1: stable
+  // with these dashpots (0.2 is not).
+  const std::string lmp = test::find_on_path("lmp");
+  if (lmp.empty()) GTEST_SKIP() << "LAMMPS (lmp) is not installed: the 3D deck is not run";
+  SceneConfig c = fcc444();
+  c.material.contact_damping_ratio = 0.3;
+  const TriaxialState state = consolidate_triaxial(c, make_sphere_assembly(c));
+  ASSERT_TRUE(state.converged);
+  AlgorithmSpec p = fixed_params(10000);
+  p.dt_ratio = 0.1;
+  const TriaxialResult d = run_triaxial_loading(state, c.test, p);
+  ASSERT_FALSE(d.diverged);
+  Export3dOptions o;
+  o.data_name = "fcc.data";
+  const ExportResult r = export_3d_decks(c, p, state, o);
+  const EngineRun l = run_engine(lmp, {"-screen", "none"}, r, "lammps3d_damped");
+  ASSERT_EQ(l.status, 0) << l.log;
+  const ExternalSeries external = parse_external_series(l.csv, "series.csv");
+  const ExternalScore theirs = score_external(external, Tolerances{});
+  const Score ours = score_triaxial_run(d, c.test.lateral_stress, Tolerances{});
+  const Criteria &t = theirs.score.criteria, &m = ours.criteria;
+  std::printf("fcc_4x4x4, contact damping 0.3: servo demcal %.5g / LAMMPS %.5g, peak %.6g / %.6g\n",
+              m.servo, t.servo, -d.peak_stress_zz, l.peak_axial);
+  EXPECT_NEAR(t.servo / m.servo, 1.0, 0.05);
+  EXPECT_NEAR(l.peak_axial / -d.peak_stress_zz, 1.0, 0.01);
+}
 
 /// `what` replaced by `with` in `text` (which must hold it once at least).
 std::string replaced(std::string text, const std::string& what, const std::string& with) {

@@ -192,5 +192,34 @@ TEST(TriaxialScene, FccPeakWithRotationLockedMatchesThornton) {
   for (double e : last.servo_error) EXPECT_LT(std::abs(e), 0.05);
 }
 
+// Contact damping ζ_c 0.3 (the wall contacts' dashpots too): the servo
+// divides by R = kn_wall + c/Δt and the consolidation shrinks α for the
+// dashpots, as in 2D (servo_resistance, consolidation_dashpot_factor).
+// Before 2026-12-02 neither: this sample did not consolidate in the default
+// 2·10⁶ steps (wall stress error 100 %, unbalanced-force ratio 3.5). The
+// loading, at an α stable with the dashpots (0.1), then reaches Thornton's
+// peak as without damping (the dashpots slow nothing at this rate).
+TEST(TriaxialScene, WithContactDampingConsolidatesAndLoads) {
+  const int n = 3;
+  SceneConfig c = parse(fcc_text(n, 1e7, 5e-4, 20000, true));
+  c.material.contact_damping_ratio = 0.3;
+  c.algorithm.dt_ratio = 0.1;
+  const TriaxialState s = consolidate_triaxial(c, make_sphere_assembly(c));
+  ASSERT_TRUE(s.converged);
+  EXPECT_LT(s.stress_error, c.test.consolidation_tolerance);
+  EXPECT_LT(s.unbalanced_ratio, c.test.consolidation_unbalanced);
+  const TriaxialResult r = run_triaxial_loading(s, c.test, c.algorithm);
+  ASSERT_FALSE(r.diverged);
+  EXPECT_EQ(r.steps_run, c.algorithm.steps);
+  const double analytical = fcc_peak_ratio_walled(0.3, n, n, n);
+  const double ratio = -r.peak_stress_zz / c.test.lateral_stress;
+  std::printf(
+      "FCC 3x3x3, contact damping 0.3: consolidated in %lld steps; peak sigma1/sigma3 "
+      "%.4f, analytical %.4f (%+.2f %%)\n",
+      static_cast<long long>(s.steps), ratio, analytical, 100.0 * (ratio / analytical - 1.0));
+  EXPECT_NEAR(ratio, analytical, 0.02 * analytical);
+  for (double e : r.series.back().servo_error) EXPECT_LT(std::abs(e), 0.05);
+}
+
 }  // namespace
 }  // namespace demcal

@@ -28,14 +28,29 @@ double wall_pressure(const World& world, WallSide side) {
   return -kInward[side] * normal_force / (length * world.material().thickness);
 }
 
+double servo_wall_dashpot(double kn_wall, double zeta_c, double m_max) {
+  if (zeta_c <= 0.0) return 0.0;
+  return 2.0 * zeta_c * std::sqrt(kn_wall * m_max);
+}
+
 double servo_wall_dashpot(const Material& material, double m_max) {
-  if (material.contact_damping_ratio <= 0.0) return 0.0;
-  return 2.0 * material.contact_damping_ratio * std::sqrt(material.wall.kn * m_max);
+  return servo_wall_dashpot(material.wall.kn, material.contact_damping_ratio, m_max);
+}
+
+double servo_resistance(double kn_wall, double zeta_c, double m_max, double dt) {
+  const double c = servo_wall_dashpot(kn_wall, zeta_c, m_max);
+  return c > 0.0 ? kn_wall + c / dt : kn_wall;
 }
 
 double servo_resistance(const Material& material, double m_max, double dt) {
-  const double c = servo_wall_dashpot(material, m_max);
-  return c > 0.0 ? material.wall.kn + c / dt : material.wall.kn;
+  return servo_resistance(material.wall.kn, material.contact_damping_ratio, m_max, dt);
+}
+
+double consolidation_dashpot_factor(double zeta_c, double m_max, double kn, double kn_wall,
+                                    double dt0) {
+  if (zeta_c <= 0.0) return 1.0;
+  const double gamma_max = 2.0 * zeta_c * std::sqrt(m_max / std::min(kn, kn_wall));
+  return dashpot_step_factor(gamma_max / dt0);
 }
 
 double servo_velocity(const World& world, WallSide side, double target_stress, double gain) {
@@ -104,12 +119,10 @@ ConsolidatedState consolidate_fresh(const SceneConfig& config, const Assembly& a
   // the softer of particle and wall springs).
   if (const double zeta_c = config.material.contact_damping_ratio; zeta_c > 0.0) {
     const Material& mat = config.material;
-    const double density = disk_areal_density(mat, settle.mass_scaling);
-    const double gamma_max =
-        2.0 * zeta_c *
-        std::sqrt(disk_mass(density, world.max_radius()) / std::min(mat.particle.kn, mat.wall.kn));
-    const double dt0 = integration_for(world, settle).dt;
-    settle.dt_ratio *= dashpot_step_factor(gamma_max / dt0);
+    const double m_max =
+        disk_mass(disk_areal_density(mat, settle.mass_scaling), world.max_radius());
+    settle.dt_ratio *= consolidation_dashpot_factor(zeta_c, m_max, mat.particle.kn, mat.wall.kn,
+                                                    integration_for(world, settle).dt);
   }
   const detail::ConsolidationOutcome o =
       detail::run_consolidation<WallSide, 4>(world, test, mu, settle, integration_for, options);

@@ -107,7 +107,14 @@ double servo_velocity(const SphereWorld& world, SphereWallSide side, double targ
   const double dt = world.integration().dt;
   const int contacts = std::max(1, world.wall(side).contacts);
   const double error = target_stress - wall_pressure(world, side);
-  double move = gain * error * wall_area(world, side) / (world.material().wall.kn * contacts);
+  // R = kn_wall + c/Δt with the wall contacts' dashpots (servo_resistance,
+  // the 2D servo's formula and reason, biaxial.cpp; c of the heaviest
+  // sphere at this run's mass scaling, as integration_for's masses).
+  const SphereMaterial& mat = world.material();
+  const double m_max =
+      sphere_mass(mat.density * world.integration().mass_scaling, world.max_radius());
+  const double resistance = servo_resistance(mat.wall.kn, mat.contact_damping_ratio, m_max, dt);
+  double move = gain * error * wall_area(world, side) / (resistance * contacts);
   const double r_min = world.min_radius();
   move = std::clamp(move, -0.02 * r_min, 0.02 * r_min);
   return inward(side) * move / dt;
@@ -145,7 +152,12 @@ TriaxialState consolidate_triaxial(const SceneConfig& config, const SphereAssemb
   const double mu = config.material.particle.friction;
   // Light damping for the fastest relaxation of the slow collective modes
   // (biaxial.cpp, consolidate(): measured there).
-  const AlgorithmSpec settle = detail::consolidation_settings(config, kConsolidationDampingRatio);
+  AlgorithmSpec settle = detail::consolidation_settings(config, kConsolidationDampingRatio);
+  // Contact dashpots lower the stable step: α shrunk as in 2D (biaxial.cpp).
+  settle.dt_ratio *= consolidation_dashpot_factor(
+      config.material.contact_damping_ratio,
+      sphere_mass(config.material.density * settle.mass_scaling, world.max_radius()),
+      config.material.particle.kn, config.material.wall.kn, integration_for(world, settle).dt);
   const detail::ConsolidationOutcome o = detail::run_consolidation<SphereWallSide, 6>(
       world, test, mu, settle, integration_for, options);
   for (int i = 0; i < world.size(); ++i)

@@ -130,7 +130,8 @@ std::string lammps_material_variables(const Material& m, NumberFormat f) {
   return s.str();
 }
 
-std::string lammps_loading_derived(double wall_dashpot, NumberFormat f) {
+std::string lammps_loading_derived(double wall_dashpot, NumberFormat f,
+                                   const std::string& particle) {
   std::string s =
       "variable vtop      equal $(v_strain*v_H0/(v_nstep*v_dt))      # m/s, top wall, down\n"
       "variable cap       equal $(0.02*v_r_min)      # m per demcal step, its servo move cap\n"
@@ -141,7 +142,9 @@ std::string lammps_loading_derived(double wall_dashpot, NumberFormat f) {
   if (wall_dashpot > 0.0) {
     s += "# demcal's wall contacts resist a move within its step by kn_wall and by\n"
          "# their dashpots' c_wall/servo_dt (contact damping: c_wall =\n"
-         "# 2*zeta_c*sqrt(kn_wall*m_max), the heaviest disc's); its servo divides by\n"
+         "# 2*zeta_c*sqrt(kn_wall*m_max), the heaviest " +
+         particle +
+         "'s); its servo divides by\n"
          "# both (without the dashpots it overshoots by gain*c_wall/(servo_dt*kn_wall)\n"
          "# per step), so does this deck's\n"
          "variable c_wall    equal " +

@@ -99,11 +99,13 @@ std::string lammps_material_variables(const Material& m, NumberFormat f);
 /// walls were corrected 1/f times as often and the servo error read f times
 /// demcal's).
 /// `wall_dashpot` > 0: demcal's wall contacts' dashpot c (contact damping;
-/// servo_wall_dashpot, scene/biaxial.hpp): the 2D servo divides by
+/// servo_wall_dashpot, scene/biaxial.hpp): demcal's servo divides by
 /// R = kn_wall + c/servo_dt, as demcal's (servo_resistance), and the block
-/// derives it from `c_wall` (written with `f`). 0: R = kn_wall (the 3D
-/// servo, as demcal's triaxial one).
-std::string lammps_loading_derived(double wall_dashpot = 0.0, NumberFormat f = num);
+/// derives it from `c_wall` (written with `f`); the 3D servo likewise
+/// (triaxial.cpp), `particle` names the heaviest one ("disc", "sphere").
+/// 0: R = kn_wall.
+std::string lammps_loading_derived(double wall_dashpot = 0.0, NumberFormat f = num,
+                                   const std::string& particle = "disc");
 /// The parameters block's line of servo_dt (demcal's step, s).
 std::string lammps_servo_dt(double servo_dt, NumberFormat f);
 

@@ -584,11 +584,9 @@ ConsolidationSteps consolidation_steps(const SceneConfig& c, const Plan& plan) {
   const auto& m = c.material;
   ConsolidationSteps st;
   st.alpha = AlgorithmSpec{}.dt_ratio;
-  if (m.contact_damping_ratio > 0.0) {
-    const double gamma_max =
-        2.0 * m.contact_damping_ratio * std::sqrt(plan.m_max / std::min(m.particle.kn, m.wall.kn));
-    st.alpha *= dashpot_step_factor(gamma_max / (st.alpha * plan.dt_crit));
-  }
+  if (m.contact_damping_ratio > 0.0)
+    st.alpha *= consolidation_dashpot_factor(m.contact_damping_ratio, plan.m_max, m.particle.kn,
+                                             m.wall.kn, st.alpha * plan.dt_crit);
   st.dt_light = deck::consolidation_dt(st.alpha, kConsolidationDampingRatio, plan.dt_crit);
   st.dt_damped = deck::consolidation_dt(st.alpha, 1.0, plan.dt_crit);
   // the wall dashpots' c (servo_wall_dashpot: demcal's formula)

@@ -95,6 +95,11 @@ struct Plan3 {
   std::vector<double> gamma_critical;  // per class, zeta 1 [N·s/m]: stage 1's damping
   double class_error = 0.0;
   std::array<int, 6> wall_contacts{};  // at the start
+  // The servo's (as scene/triaxial.cpp servo_velocity): the heaviest
+  // sphere's mass m_max [kg] at the mass scaling, the wall dashpots' c
+  // [N·s/m] (servo_wall_dashpot, 0 without contact damping) and
+  // R = kn_wall + c/demcal_dt [N/m] (servo_resistance).
+  double m_max = 0.0, wall_dashpot = 0.0, servo_resist = 0.0;
 };
 
 Plan3 make_plan(const SceneConfig& c, const AlgorithmSpec& p, const SphereWorld& w, int max_types) {
@@ -122,6 +127,9 @@ Plan3 make_plan(const SceneConfig& c, const AlgorithmSpec& p, const SphereWorld&
   plan.dt = timing.dt;
   plan.demcal_dt = timing.demcal_dt;
   plan.steps = timing.steps;
+  plan.m_max = sphere_mass(plan.density, plan.r_max);
+  plan.wall_dashpot = servo_wall_dashpot(c.material, plan.m_max);
+  plan.servo_resist = servo_resistance(c.material, plan.m_max, plan.demcal_dt);
   for (int a = 0; a < 3; ++a) {
     plan.lo[a] = w.wall(static_cast<SphereWallSide>(2 * a)).position;
     plan.hi[a] = w.wall(static_cast<SphereWallSide>(2 * a + 1)).position;
@@ -318,12 +326,12 @@ void lammps_3d_parameters(std::ostream& s, const SceneConfig& c, const Plan3& pl
 }
 
 // What is derived from the parameters block (and the start walls).
-void lammps_3d_derived(std::ostream& s) {
+void lammps_3d_derived(std::ostream& s, const Plan3& plan) {
   s << "\n# --- derived (do not edit) ---------------------------------------------------\n"
     << "variable H0        equal $(v_zmax0-v_zmin0)\n"
     << "variable Wx0       equal $(v_xmax0-v_xmin0)\n"
     << "variable Wy0       equal $(v_ymax0-v_ymin0)\n"
-    << deck::lammps_loading_derived()
+    << deck::lammps_loading_derived(plan.wall_dashpot, exact, "sphere")
     << "variable peak_every equal $(ceil(v_nstep/1000000))      # fix vector length <= 1e6\n"
     << deck::lammps_band("band_v", "v_strain*v_H0", "m, see the walls")
     << deck::lammps_band("band_x", "2*v_strain*v_Wx0")
@@ -367,7 +375,13 @@ void lammps_3d_consolidation(std::ostream& s, const SceneConfig& c, const Plan3&
   const double zeta = kConsolidationDampingRatio;
   // demcal's consolidation step: alpha of AlgorithmSpec{} (0.2), the
   // sphere kernel's dt_crit; times the explicit damper's factor.
-  const double alpha = AlgorithmSpec{}.dt_ratio;
+  // alpha shrunk for the contact dashpots as demcal's consolidation
+  // (consolidation_dashpot_factor, scene/triaxial.cpp)
+  const auto& m = c.material;
+  const double alpha =
+      AlgorithmSpec{}.dt_ratio *
+      consolidation_dashpot_factor(m.contact_damping_ratio, plan.m_max, m.particle.kn, m.wall.kn,
+                                   AlgorithmSpec{}.dt_ratio * plan.dt_crit);
   const double dt_light = deck::consolidation_dt(alpha, zeta, plan.dt_crit);
   const double dt_damped = deck::consolidation_dt(alpha, 1.0, plan.dt_crit);
   std::vector<double> light, critical;
@@ -431,7 +445,10 @@ void lammps_3d_consolidation(std::ostream& s, const SceneConfig& c, const Plan3&
       << "*v_cons_L" << kAxis[(a + 2) % 3] << "\n";
   // each wall's move gain*(sigma3*A - F)/(kn_wall*max(1, n)), A its axis's
   // current area, in one vector formula (deck::lammps_consolidation_servo)
-  s << deck::lammps_consolidation_servo(walls, {"cons_Ax", "cons_Ay", "cons_Az"}, "", "${kn_wall}")
+  // (R = kn_wall + c/dt with the wall dashpots: demcal's servo_resistance)
+  const std::string resist =
+      plan.wall_dashpot > 0.0 ? "(${kn_wall}+" + exact(plan.wall_dashpot) + "/dt)" : "${kn_wall}";
+  s << deck::lammps_consolidation_servo(walls, {"cons_Ax", "cons_Ay", "cons_Az"}, "", resist)
     << deck::lammps_consolidation_criterion(3, walls, {"x", "y", "z"})
     << deck::lammps_consolidation_runs(deck::contact_gamma_n(c.material, plan.m_mean), dt_damped,
                                        deck::lammps_consolidation_viscous(critical))
@@ -676,9 +693,9 @@ std::string lammps_deck(const SceneConfig& c, const AlgorithmSpec& p, const Plan
   if (o.consolidate_in_deck) {
     lammps_3d_system(s, c, plan, o, out);
     lammps_3d_consolidation(s, c, plan);
-    lammps_3d_derived(s);
+    lammps_3d_derived(s, plan);
   } else {
-    lammps_3d_derived(s);
+    lammps_3d_derived(s, plan);
     lammps_3d_system(s, c, plan, o, out);
   }
   lammps_3d_walls(s, p, plan);
@@ -887,6 +904,9 @@ std::string liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p, const Pl
   // contacts demcal counts.
   const double cap = 0.02 * plan.r_min;
   const double vel_max = deck::liggghts_servo_vel_max(cap, plan.dt, plan.step_factor);
+  // R: kn_wall, and the wall dashpots' c/dt_demcal with contact damping
+  const bool dashpots = plan.wall_dashpot > 0.0;
+  const std::string resist_name = dashpots ? "R" : "kn_wall";
   std::ostringstream s;
   s << mapping_header(c, p, plan, o, "LIGGGHTS");
   s << "#\n# Checked with LIGGGHTS 3.8 (Debian). Differences from demcal:\n"
@@ -896,9 +916,16 @@ std::string liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p, const Pl
     << "#    target (the force on the mesh along +axis: positive on a min wall).\n"
     << "#    LIGGGHTS moves it at vel_max*kp*(F_target - F)/|F_target|: vel_max =\n"
     << "#    cap/dt_demcal (dt_demcal = dt/f, demcal's step) and kp =\n"
-    << "#    gain*|F_target|/(kn_wall*max(1, n)*cap), n the wall's current contacts,\n"
-    << "#    give demcal's wall velocity gain*(F_target - F)/(kn_wall*max(1, n)*dt_demcal)\n"
-    << "#    and its cap. LIGGGHTS' kp is a number: the run goes in chunks of\n"
+    << "#    gain*|F_target|/(" << resist_name << "*max(1, n)*cap), n the wall's current "
+    << "contacts,\n#    give demcal's wall velocity gain*(F_target - F)/(" << resist_name
+    << "*max(1, n)*dt_demcal)\n"
+    << "#    and its cap";
+  if (dashpots)
+    s << "; R = kn_wall + c/dt_demcal = " << exact(plan.servo_resist) << " N/m: demcal's\n"
+      << "#    wall contacts resist a move within its step by their dashpots too, c =\n"
+      << "#    2*zeta_c*sqrt(kn_wall*m_max) = " << exact(plan.wall_dashpot)
+      << " N*s/m (the heaviest sphere's),\n#    and its servo divides by both";
+  s << ". LIGGGHTS' kp is a number: the run goes in chunks of\n"
     << "#    ${servo_every} steps (one setup) and kp is set from the current n and\n"
     << "#    F_target between them (fix_modify servo/ctrlParam; at the start from\n"
     << "#    demcal's count): the gain lags demcal's by one chunk at most.\n"
@@ -925,8 +952,8 @@ std::string liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p, const Pl
     const int a = sd / 2;
     const double area = ext[(a + 1) % 3] * ext[(a + 2) % 3];
     const double target = c.test.lateral_stress * area;
-    const double kp =
-        deck::liggghts_servo_kp(c.test.servo_gain, target, m.wall.kn, plan.wall_contacts[sd], cap);
+    const double kp = deck::liggghts_servo_kp(c.test.servo_gain, target, plan.servo_resist,
+                                              plan.wall_contacts[sd], cap);
     V3 com = centre;
     com[a] = sd % 2 == 0 ? plan.lo[a] : plan.hi[a];
     if (o.lateral_servo) {
@@ -983,7 +1010,8 @@ std::string liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p, const Pl
     for (int sd = 0; sd < 4; ++sd)
       walls.push_back({std::string("m") + kWall[sd], std::string("ft_") + kWall[sd],
                        "t" + std::to_string(sd) + "_a"});
-    s << deck::liggghts_servo_run(walls, c.test.servo_gain, m.wall.kn, cap, monitor_every, exact);
+    s << deck::liggghts_servo_run(walls, c.test.servo_gain, plan.servo_resist, cap, monitor_every,
+                                  exact, resist_name);
   } else {
     s << "run ${run_steps}\n";
   }

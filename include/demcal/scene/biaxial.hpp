@@ -47,14 +47,27 @@ struct ConsolidatedState {
 /// wall velocity.
 double servo_velocity(const World& world, WallSide side, double target_stress, double gain);
 /// The wall contacts' dashpot c = 2ζ_c·sqrt(kn_wall·m_max) [N·s/m] of the
-/// heaviest disk (mass m_max, with the run's mass scaling): the most
-/// damping; 0 without contact damping.
+/// heaviest particle (mass m_max, with the run's mass scaling): the most
+/// damping; 0 without contact damping (ζ_c ≤ 0). The one formula of the 2D
+/// and the 3D servo (triaxial.cpp) and of the exported decks.
+double servo_wall_dashpot(double kn_wall, double zeta_c, double m_max);
+/// servo_wall_dashpot with the material's kn_wall and ζ_c.
 double servo_wall_dashpot(const Material& material, double m_max);
-/// What a wall contact resists the 2D servo's move by within a step Δt,
-/// per unit of the move: R = kn_wall + c/Δt [N/m], c = servo_wall_dashpot
+/// What a wall contact resists the servo's move by within a step Δt, per
+/// unit of the move: R = kn_wall + c/Δt [N/m], c = servo_wall_dashpot
 /// (kn_wall alone without contact damping). The one formula of demcal's
-/// servo_velocity and the exported 2D decks' servo (stage 1 and loading).
+/// servo_velocity (2D and 3D) and the exported decks' servo (stage 1 and
+/// loading).
+double servo_resistance(double kn_wall, double zeta_c, double m_max, double dt);
+/// servo_resistance with the material's kn_wall and ζ_c.
 double servo_resistance(const Material& material, double m_max, double dt);
+/// The factor demcal's consolidation shrinks its step ratio α by for the
+/// contact dashpots (2D and 3D, and the decks' stage 1): f(γ_max/Δt0),
+/// f = dashpot_step_factor, γ_max = 2ζ_c·sqrt(m_max/min(kn, kn_wall)) (the
+/// heaviest particle on the softer of particle and wall springs), Δt0 the
+/// step before the shrink; 1 without contact damping (ζ_c ≤ 0).
+double consolidation_dashpot_factor(double zeta_c, double m_max, double kn, double kn_wall,
+                                    double dt0);
 /// Compressive pressure on a wall from the particles [Pa].
 double wall_pressure(const World& world, WallSide side);
 
