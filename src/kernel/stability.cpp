@@ -203,14 +203,7 @@ StabilityEstimate WorldImpl::stability_estimate(int iterations) const {
       gamma = std::max(gamma, 2.0 * zeta_c * std::sqrt(m_eff / c.kn));
     }
   }
-  // No contact: no limit from the springs.
-  auto step_for = [gamma](double w2) {
-    if (!(w2 > 0.0)) return std::numeric_limits<double>::infinity();
-    const double omega = std::sqrt(w2);
-    if (gamma == 0.0) return 2.0 / omega;
-    const double zeta = 0.5 * gamma * omega;
-    return 2.0 / omega * dashpot_step_factor(zeta);
-  };
+  auto step_for = [gamma](double w2) { return stable_step(w2, gamma); };
   est.dt_stable = step_for(est.omega2_max);
   est.dt_stable_gershgorin = step_for(est.omega2_gershgorin);
   if (dt_crit > 0.0) {

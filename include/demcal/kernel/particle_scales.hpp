@@ -16,6 +16,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <numbers>
 #include <span>
 
@@ -63,6 +64,19 @@ inline double critical_damping_rotation(double kt, double radius, double inertia
 /// digits at large ζ.
 inline double dashpot_step_factor(double zeta) {
   return 1.0 / (std::sqrt(1.0 + zeta * zeta) + zeta);
+}
+
+/// The stable step of the fastest mode, ω² its squared frequency, with
+/// contact dashpots of at most γ_max = max 2ζ_c·sqrt(m_eff/k) over the
+/// contacts (0 without them): a mode of frequency ω then carries at most ζ =
+/// γ_max·ω/2, so Δt < 2/ω·dashpot_step_factor(ζ) (kernel/stability.cpp).
+/// Infinite for ω² ≤ 0 (no contact: no limit from the springs). Both
+/// kernels' estimates.
+inline double stable_step(double omega2, double gamma_max) {
+  if (!(omega2 > 0.0)) return std::numeric_limits<double>::infinity();
+  const double omega = std::sqrt(omega2);
+  if (gamma_max == 0.0) return 2.0 / omega;
+  return 2.0 / omega * dashpot_step_factor(0.5 * gamma_max * omega);
 }
 
 /// D_r^crit of a disk of mass m, with the inertia m·r²/2 written out:
