@@ -16,6 +16,7 @@
 // law: the SIMD pass and the scalar paths must give the same bits.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 
 // The templates are always inlined: no SIMD vector crosses a call boundary,
@@ -35,6 +36,21 @@ constexpr double kWallNormal[4][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}};
 template <class V>
 DEMCAL_LAW V reduced_mass(V mi, V mj) {
   return mi * mj / (mi + mj);
+}
+
+/// γ_max = max 2ζ_c·sqrt(m_eff/kn) of the contact dashpots over `contacts`
+/// (each with i, j — j < 0 a wall, m_eff the particle's mass — and kn), for
+/// the stable-step estimates of both kernels (stability.cpp's file
+/// comment); 0 without dashpots.
+template <class Contacts, class Masses>
+double dashpot_gamma_max(const Contacts& contacts, const Masses& m, double zeta_c) {
+  double gamma = 0.0;
+  if (zeta_c > 0.0)
+    for (const auto& c : contacts) {
+      const double m_eff = c.j >= 0 ? reduced_mass(m[c.i], m[c.j]) : m[c.i];
+      gamma = std::max(gamma, 2.0 * zeta_c * std::sqrt(m_eff / c.kn));
+    }
+  return gamma;
 }
 
 /// The elastic normal force kn·δ (δ > 0: overlap).

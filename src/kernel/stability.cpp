@@ -195,14 +195,10 @@ StabilityEstimate WorldImpl::stability_estimate(int iterations) const {
   const double omega2_translation = lanczos_max(contacts, ism, isi, false, iterations);
 
   const double dt_crit = reference_scales().dt_crit;
-  // γ_max of the contact dashpots (0 without them), see the file comment.
-  double gamma = 0.0;
-  if (const double zeta_c = material_.contact_damping_ratio; zeta_c > 0.0) {
-    for (const auto& c : contacts) {
-      const double m_eff = c.j >= 0 ? law::reduced_mass(m_[c.i], m_[c.j]) : m_[c.i];
-      gamma = std::max(gamma, 2.0 * zeta_c * std::sqrt(m_eff / c.kn));
-    }
-  }
+  // γ_max of the contact dashpots (0 without them), as in the file comment
+  // of stability.cpp (each pair's normal dashpot, a wall's with the
+  // particle's mass).
+  const double gamma = law::dashpot_gamma_max(contacts, m_, material_.contact_damping_ratio);
   auto step_for = [gamma](double w2) { return stable_step(w2, gamma); };
   est.dt_stable = step_for(est.omega2_max);
   est.dt_stable_gershgorin = step_for(est.omega2_gershgorin);
