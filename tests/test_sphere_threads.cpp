@@ -17,6 +17,7 @@
 #include <filesystem>
 #include <map>
 #include <random>
+#include <span>
 #include <string>
 #include <utility>
 #include <vector>
@@ -301,6 +302,88 @@ TEST(SphereSimd, EveryPathMatchesScalarContactLaw) {
 #else
   GTEST_SKIP() << "one SIMD path on this architecture";
 #endif
+}
+
+// Every bit of a run, one value per line ("bits <name> <hexfloat>"): the
+// spheres' state, the walls, the stresses and the energy ledger.
+void print_bits(const SphereWorld& w) {
+  auto put = [](const char* name, int index, double v) {
+    std::printf("bits %s[%d] %a\n", name, index, v);
+  };
+  const std::pair<const char*, std::span<const double> (SphereWorld::*)() const> fields[] = {
+      {"x", &SphereWorld::x},         {"y", &SphereWorld::y},
+      {"z", &SphereWorld::z},         {"vx", &SphereWorld::vx},
+      {"vy", &SphereWorld::vy},       {"vz", &SphereWorld::vz},
+      {"wx", &SphereWorld::omega_x},  {"wy", &SphereWorld::omega_y},
+      {"wz", &SphereWorld::omega_z},  {"fx", &SphereWorld::fx},
+      {"fy", &SphereWorld::fy},       {"fz", &SphereWorld::fz},
+      {"tx", &SphereWorld::torque_x}, {"ty", &SphereWorld::torque_y},
+      {"tz", &SphereWorld::torque_z}};
+  for (const auto& [name, field] : fields)
+    for (int i = 0; i < w.size(); ++i) put(name, i, (w.*field)()[i]);
+  for (int s = 0; s < 6; ++s) {
+    const SphereWall& wall = w.wall(static_cast<SphereWallSide>(s));
+    put("wall.position", s, wall.position);
+    for (int c = 0; c < 3; ++c) put("wall.force", 3 * s + c, wall.force[c]);
+  }
+  const SphereMeasures m = w.measure();
+  for (int k = 0; k < 9; ++k) {
+    put("sigma", k, m.homogenized_stress(k / 3, k % 3));
+    put("b", k, m.boundary_stress(k / 3, k % 3));
+  }
+  put("kinetic_energy_rotation", 0, m.kinetic_energy_rotation);
+  put("elastic_energy", 0, m.elastic_energy);
+  put("energy_created", 0, w.energy_created());
+}
+
+// The child run of AvxPathsGiveTheSameBits: run_threads' runs (walls
+// moving, many rebuilds, sliding, with and without contact dashpots) on
+// this process's SIMD path, every bit printed.
+TEST(SphereSimd, RunBits) {
+  for (double damping : {0.0, 0.3}) {
+    std::printf("bits run %g\n", damping);
+    print_bits(run_threads(damping, 1));
+  }
+}
+
+// The AVX2 and AVX-512 paths (both with FMA) give the same bits: the same
+// law in the same order lane by lane, and every sum over lanes (wall
+// forces, the ledger's block sums) in the order of 8 lanes whatever the
+// width (BlockLanes, sphere_contact.cpp). (Summed W lanes wide, the wall
+// forces differed in the last bit, and through the triaxial test's servo
+// a consolidated random sample differed: a calibration on an AVX2 machine
+// and one on an AVX-512 machine certified different samples.) (The sse2
+// path has no FMA and rounds differently.)
+TEST(SphereSimd, AvxPathsGiveTheSameBits) {
+  if (std::getenv("DEMCAL_SIMD")) GTEST_SKIP() << "already a child run on one path";
+  if (std::string(kernel_simd()) != "avx512")
+    GTEST_SKIP() << "needs a CPU with both the AVX2 and the AVX-512 path (this one: "
+                 << kernel_simd() << ")";
+  const std::string self = std::filesystem::read_symlink("/proc/self/exe").string();
+  std::map<std::string, std::vector<std::string>> bits;
+  for (const std::string p : {"avx2", "avx512"}) {
+    const std::string cmd =
+        "DEMCAL_SIMD=" + p + " '" + self + "' --gtest_filter=SphereSimd.RunBits 2>&1";
+    std::string out;
+    if (FILE* pipe = popen(cmd.c_str(), "r")) {
+      char buf[512];
+      while (std::fgets(buf, sizeof buf, pipe)) {
+        const std::string line = buf;
+        if (line.rfind("bits ", 0) == 0)
+          bits[p].push_back(line);
+        else
+          out += line;
+      }
+      EXPECT_EQ(pclose(pipe), 0) << "path " << p << ":\n" << out;
+    }
+    ASSERT_GT(bits[p].size(), 15000u) << "path " << p << ":\n" << out;
+  }
+  ASSERT_EQ(bits["avx2"].size(), bits["avx512"].size());
+  int differ = 0;
+  for (size_t k = 0; k < bits["avx2"].size(); ++k)
+    if (bits["avx2"][k] != bits["avx512"][k] && ++differ <= 5)
+      ADD_FAILURE() << "avx2:   " << bits["avx2"][k] << "avx512: " << bits["avx512"][k];
+  EXPECT_EQ(differ, 0) << "of " << bits["avx2"].size() << " values";
 }
 
 }  // namespace

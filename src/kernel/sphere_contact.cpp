@@ -275,12 +275,18 @@ DEMCAL_INLINE typename Simd<W>::D turn_scale(typename Simd<W>::D y, typename Sim
   return select<W>(far, select<W>(turnable, vsqrt(z), zero), series);
 }
 
+// A sum kept lane by lane over groups of 8 lanes (8 wall candidates) on
+// any path's width W: one W-wide part per W lanes, added up by
+// detail::lane_sum, so that every path gives the same bits.
 template <int W>
-DEMCAL_INLINE double hsum(typename Simd<W>::D v) {
-  double s = v[0];
-  for (int l = 1; l < W; ++l) s += v[l];
-  return s;
-}
+struct BlockLanes {
+  typename Simd<W>::D part[kBlock / W] = {};
+  DEMCAL_INLINE double total() const {
+    double l[kBlock];
+    for (int q = 0; q < kBlock / W; ++q) store<W>(l + q * W, part[q]);
+    return detail::lane_sum(l);
+  }
+};
 
 struct SumArgs {
   const int *__restrict mirror_block;
@@ -349,9 +355,9 @@ DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
   const double kn = a.kn, kdt = a.kdt, half_dt = a.half_dt, mu = a.mu;
   for (int b = b0; b < b1; ++b) {
     const int s0 = a.block_slot[b], s1 = a.block_slot[b + 1];
-    D released = zero, slid = zero;
     for (int sub = 0; sub < kBlock; sub += W) {
       const int i0 = kBlock * b + sub;
+      D released = zero, slid = zero;  // this sub-block's lanes, into block_* after the slots
       const D xi = load<W>(a.x + i0), yi = load<W>(a.y + i0), zi = load<W>(a.z + i0);
       const D vxi = load<W>(a.vx + i0), vyi = load<W>(a.vy + i0), vzi = load<W>(a.vz + i0);
       const D wxi = load<W>(a.wx + i0), wyi = load<W>(a.wy + i0), wzi = load<W>(a.wz + i0);
@@ -460,9 +466,9 @@ DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
       store<W>(a.tx + i0, tx);
       store<W>(a.ty + i0, ty);
       store<W>(a.tz + i0, tz);
+      store<W>(a.block_released + i0, released);
+      store<W>(a.block_slid + i0, slid);
     }
-    a.block_released[b] = hsum<W>(released);
-    a.block_slid[b] = hsum<W>(slid);
     // Block b's mirrored slots all belong to blocks in [src_block[b], b]
     // (i < j): if this pass did those, its sums are complete now, the pair
     // terms still in cache.
@@ -513,75 +519,85 @@ DEMCAL_INLINE void wall_contacts(const WallArgs &a, double *out) {
   const D zero{}, one = zero + 1.0;
   D lane;
   for (int l = 0; l < W; ++l) lane[l] = l;
-  D wfa = zero, wfu = zero, wfv = zero, count = zero, released = zero, slid = zero, mo = zero;
+  // The sums by 8 candidates, W at a time (BlockLanes): the same bits on
+  // every path. The list is padded to a multiple of 8 (with the ghost,
+  // histories 0), so every group of 8 is read whole; unrolled, each part
+  // stays in registers.
+  BlockLanes<W> sum_fa, sum_fu, sum_fv, sum_count, sum_released, sum_slid;
+  D mo = zero;
   const double sg = a.sign;
-  for (int k = 0; k < a.count; k += W) {
-    const int *J = a.idx + k;
-    const M valid = lane < static_cast<double>(a.count - k);
-    const D r = gather<W>(a.r, J);
-    const D dist = (gather<W>(a.pa, J) - a.position) * sg;
-    // (Masks combined through selects and one compare each: GCC rebuilds
-    // a mask made with & lane by lane on the AVX-512 path.)
-    const D ov = select<W>(valid, r - dist, zero - one);
-    const M touch = ov > zero;
-    const D hu0 = load<W>(a.hu + k), hv0 = load<W>(a.hv + k);
-    if (!any<W>(touch)) {  // histories released (the padding holds 0)
-      released += hu0 * hu0 + hv0 * hv0;
-      store<W>(a.hu + k, zero);
-      store<W>(a.hv + k, zero);
-      store<W>(a.fn + k, zero);
-      continue;
+  for (int k8 = 0; k8 < a.count; k8 += kBlock)
+#pragma GCC unroll 4
+    for (int q = 0; q < kBlock / W; ++q) {
+      const int k = k8 + q * W;
+      D &wfa = sum_fa.part[q], &wfu = sum_fu.part[q], &wfv = sum_fv.part[q];
+      D &count = sum_count.part[q], &released = sum_released.part[q], &slid = sum_slid.part[q];
+      const int *J = a.idx + k;
+      const M valid = lane < static_cast<double>(a.count - k);
+      const D r = gather<W>(a.r, J);
+      const D dist = (gather<W>(a.pa, J) - a.position) * sg;
+      // (Masks combined through selects and one compare each: GCC rebuilds
+      // a mask made with & lane by lane on the AVX-512 path.)
+      const D ov = select<W>(valid, r - dist, zero - one);
+      const M touch = ov > zero;
+      const D hu0 = load<W>(a.hu + k), hv0 = load<W>(a.hv + k);
+      if (!any<W>(touch)) {  // histories released (the padding holds 0)
+        released += hu0 * hu0 + hv0 * hv0;
+        store<W>(a.hu + k, zero);
+        store<W>(a.hv + k, zero);
+        store<W>(a.fn + k, zero);
+        continue;
+      }
+      released += select<W>(touch, zero, hu0 * hu0 + hv0 * hv0);
+      const D ratio = select<W>(touch, ov / select<W>(touch, r, one), zero);
+      mo = mo > ratio ? mo : ratio;
+      const D sd = sg * dist;
+      const D dvu = sd * gather<W>(a.wv, J) - gather<W>(a.vu, J);
+      const D dvv = (zero - gather<W>(a.vv, J)) - sd * gather<W>(a.wu, J);
+      D fn = a.kn * ov;
+      if (a.beta2 > 0.0) {
+        const D vn = (gather<W>(a.va, J) - a.velocity) * sg;  // leaving the wall > 0
+        fn = fn - a.beta2 * vsqrt(a.kn * gather<W>(a.m, J)) * vn;
+        fn = fn > zero ? fn : zero;
+      }
+      fn = select<W>(touch, fn, zero);
+      D hu = hu0 + a.kdt * dvu, hv = hv0 + a.kdt * dvv;
+      const D cap = a.mu * fn, h2 = hu * hu + hv * hv;
+      const M sliding = select<W>(touch, h2, zero) > cap * cap;  // touching and sliding
+      if (any<W>(sliding)) {
+        const D mag = vsqrt(h2);
+        const D cut = select<W>(sliding, cap / select<W>(sliding, mag, one), one);
+        slid += select<W>(sliding, cap * (mag - cap), zero);
+        hu *= cut;
+        hv *= cut;
+      }
+      hu = select<W>(touch, hu, zero);
+      hv = select<W>(touch, hv, zero);
+      store<W>(a.hu + k, hu);
+      store<W>(a.hv + k, hv);
+      store<W>(a.fn + k, fn);
+      const D fa = sg * fn, tu = select<W>(touch, sd * hv, zero),
+              tv = select<W>(touch, sd * hu, zero);
+      // Each candidate once per list (the padding adds zeros to the ghost).
+      for (int l = 0; l < W; ++l) {
+        const int i = J[l];
+        a.fa[i] += fa[l];
+        a.fu[i] += hu[l];
+        a.fv[i] += hv[l];
+        a.tu[i] += tu[l];
+        a.tv[i] -= tv[l];
+      }
+      wfa -= fa;
+      wfu -= hu;
+      wfv -= hv;
+      count += select<W>(touch, one, zero);
     }
-    released += select<W>(touch, zero, hu0 * hu0 + hv0 * hv0);
-    const D ratio = select<W>(touch, ov / select<W>(touch, r, one), zero);
-    mo = mo > ratio ? mo : ratio;
-    const D sd = sg * dist;
-    const D dvu = sd * gather<W>(a.wv, J) - gather<W>(a.vu, J);
-    const D dvv = (zero - gather<W>(a.vv, J)) - sd * gather<W>(a.wu, J);
-    D fn = a.kn * ov;
-    if (a.beta2 > 0.0) {
-      const D vn = (gather<W>(a.va, J) - a.velocity) * sg;  // leaving the wall > 0
-      fn = fn - a.beta2 * vsqrt(a.kn * gather<W>(a.m, J)) * vn;
-      fn = fn > zero ? fn : zero;
-    }
-    fn = select<W>(touch, fn, zero);
-    D hu = hu0 + a.kdt * dvu, hv = hv0 + a.kdt * dvv;
-    const D cap = a.mu * fn, h2 = hu * hu + hv * hv;
-    const M sliding = select<W>(touch, h2, zero) > cap * cap;  // touching and sliding
-    if (any<W>(sliding)) {
-      const D mag = vsqrt(h2);
-      const D cut = select<W>(sliding, cap / select<W>(sliding, mag, one), one);
-      slid += select<W>(sliding, cap * (mag - cap), zero);
-      hu *= cut;
-      hv *= cut;
-    }
-    hu = select<W>(touch, hu, zero);
-    hv = select<W>(touch, hv, zero);
-    store<W>(a.hu + k, hu);
-    store<W>(a.hv + k, hv);
-    store<W>(a.fn + k, fn);
-    const D fa = sg * fn, tu = select<W>(touch, sd * hv, zero),
-            tv = select<W>(touch, sd * hu, zero);
-    // Each candidate once per list (the padding adds zeros to the ghost).
-    for (int l = 0; l < W; ++l) {
-      const int i = J[l];
-      a.fa[i] += fa[l];
-      a.fu[i] += hu[l];
-      a.fv[i] += hv[l];
-      a.tu[i] += tu[l];
-      a.tv[i] -= tv[l];
-    }
-    wfa -= fa;
-    wfu -= hu;
-    wfv -= hv;
-    count += select<W>(touch, one, zero);
-  }
-  out[0] = hsum<W>(wfa);
-  out[1] = hsum<W>(wfu);
-  out[2] = hsum<W>(wfv);
-  out[3] = hsum<W>(count);
-  out[4] = hsum<W>(released);
-  out[5] = hsum<W>(slid);
+  out[0] = sum_fa.total();
+  out[1] = sum_fu.total();
+  out[2] = sum_fv.total();
+  out[3] = sum_count.total();
+  out[4] = sum_released.total();
+  out[5] = sum_slid.total();
   out[6] = hmax<W>(mo);
 }
 
@@ -607,7 +623,6 @@ DEMCAL_INLINE double integrate_blocks(const IntegrateArgs &a, int b0, int b1) {
   D md = D{};
   const double dt = a.dt;
   for (int b = b0; b < b1; ++b) {
-    D lost = D{};
     for (int i = kBlock * b; i < kBlock * (b + 1); i += W) {
       const D cat = load<W>(a.ca_t + i), cbt = load<W>(a.cb_t + i);
       const D ux = load<W>(a.vx + i), uy = load<W>(a.vy + i), uz = load<W>(a.vz + i);
@@ -615,7 +630,7 @@ DEMCAL_INLINE double integrate_blocks(const IntegrateArgs &a, int b0, int b1) {
       const D vy = cat * uy + cbt * load<W>(a.fy + i);
       const D vz = cat * uz + cbt * load<W>(a.fz + i);
       const D bx = ux + vx, by = uy + vy, bz = uz + vz;
-      lost += 0.25 * load<W>(a.d_t + i) * (bx * bx + by * by + bz * bz);
+      D lost = 0.25 * load<W>(a.d_t + i) * (bx * bx + by * by + bz * bz);
       const D x = load<W>(a.x + i) + vx * dt, y = load<W>(a.y + i) + vy * dt,
               z = load<W>(a.z + i) + vz * dt;
       store<W>(a.vx + i, vx);
@@ -640,8 +655,8 @@ DEMCAL_INLINE double integrate_blocks(const IntegrateArgs &a, int b0, int b1) {
               dz = z - load<W>(a.z_built + i);
       const D d2 = dx * dx + dy * dy + dz * dz;
       md = d2 > md ? d2 : md;
+      store<W>(a.block_lost + i, lost);
     }
-    a.block_lost[b] = hsum<W>(lost);
   }
   return hmax<W>(md);
 }
@@ -872,15 +887,12 @@ void SphereWorldImpl::compute_forces() {
   // the others in a second pass once all pairs are done.
   max_overlap_ratio_seen_ = run_pass(&SphereWorldImpl::pair_pass, pair_bounds_);
   if (active_threads() > 1) run_pass(&SphereWorldImpl::sum_pass, particle_bounds_);
-  // Friction's losses, block by block in a fixed order (every pair counted
-  // once).
+  // Friction's losses, lane by lane over the blocks in a fixed order (every
+  // pair counted once; detail::block_lanes_sum).
   const double kt = material_.particle.kt;
   if (kt > 0.0) {
-    double released = 0.0, slid = 0.0;
-    for (int b = 0; b < nblocks_; ++b) {
-      released += block_released_[b];
-      slid += block_slid_[b];
-    }
+    const double released = detail::block_lanes_sum(block_released_.data(), nblocks_);
+    const double slid = detail::block_lanes_sum(block_slid_.data(), nblocks_);
     friction_dissipated_ += released * (0.5 / kt) + slid / kt;
   }
   wall_pass();

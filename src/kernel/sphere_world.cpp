@@ -58,8 +58,7 @@ SphereWorldImpl::SphereWorldImpl(const SphereMaterial& material, std::span<const
   x_built_ = x_;
   y_built_ = y_;
   z_built_ = z_;
-  for (auto* a : {&block_lost_, &block_released_, &block_slid_})
-    a->assign(static_cast<size_t>(nblocks_) + 1, 0.0);
+  for (auto* a : {&block_lost_, &block_released_, &block_slid_}) a->assign(cap, 0.0);
   block_slot_.assign(static_cast<size_t>(nblocks_) + 1, 0);
   mirror_block_.assign(static_cast<size_t>(nblocks_) + 1, 0);
   mirror_src_block_.assign(static_cast<size_t>(nblocks_), 0);
@@ -225,13 +224,13 @@ void SphereWorldImpl::book_wall_work() {
 void SphereWorldImpl::integrate() {
   // The scheme is m·(v⁺ − v⁻)/Δt = F − D·v̄, v̄ = (v⁺ + v⁻)/2, so the
   // damping removes exactly D·|v̄|²·Δt of (half-step) kinetic energy per
-  // step: summed for the energy ledger (each block's share by the pass, the
-  // blocks here in order), exact however fast the decay. The pass also
+  // step: summed for the energy ledger (each block's lanes by the pass, the
+  // blocks here in order: detail::block_lanes_sum), exact however fast the
+  // decay. The pass also
   // scans the displacements since the last list build.
   const double dt = integration_.dt;
   const double max_d2 = run_pass(&SphereWorldImpl::integrate_pass, particle_bounds_);
-  double lost = 0.0;
-  for (int b = 0; b < nblocks_; ++b) lost += block_lost_[b];
+  const double lost = detail::block_lanes_sum(block_lost_.data(), nblocks_);
   damping_dissipated_ += lost * dt;
   for (int s = 0; s < 6; ++s) {
     wall_move_[s] = walls_[s].velocity * dt;

@@ -178,10 +178,12 @@ class SphereWorldImpl {
   Array fx_, fy_, fz_, tx_, ty_, tz_;
   Array ca_t_, cb_t_, ca_r_, cb_r_;  // v ← a·v + b·F per particle (0 for padding)
   Array d_t_, d_r_;                  // damping coefficients D_t, D_r
-  // Per block, written by the passes and summed in block order (the same
-  // sums for any thread count): global damping loss of the step (Σ D·|v̄|²/4)
-  // and, over the block's slots, Σ|h|² of contacts that opened and
-  // Σ μFn·(|h_trial| − μFn) of sliding ones (every pair counted once).
+  // Per block and lane (8 per block), written by the passes and summed
+  // block by block in block order, each block by detail::lane_sum (the same
+  // sums for any thread count and on every path): global damping loss of
+  // the step (Σ D·|v̄|²/4) and, over the lane's slots, Σ|h|² of contacts
+  // that opened and Σ μFn·(|h_trial| − μFn) of sliding ones (every pair
+  // counted once).
   Array block_lost_, block_released_, block_slid_;
   // Energy taken by global damping since the energy ledger started [J] (a
   // running total from the start, not a difference of two totals: that
