@@ -275,6 +275,25 @@ DEMCAL_INLINE typename Simd<W>::D turn_scale(typename Simd<W>::D y, typename Sim
   return select<W>(far, select<W>(turnable, vsqrt(z), zero), series);
 }
 
+// Coulomb's cap on a tangential force h (|h|² = h2) of the touching lanes:
+// false when no touching lane slides (|h| ≤ cap = μ·fn in all of them);
+// else cut = cap/|h| where one slides and 1 elsewhere, and the slip work
+// cap·(|h| − cap) of the sliding lanes added to slid (file comment). The
+// root and the division only then: the common slot skips both.
+template <int W>
+DEMCAL_INLINE bool coulomb_cut(typename Simd<W>::M touch, typename Simd<W>::D h2,
+                               typename Simd<W>::D cap, typename Simd<W>::D &slid,
+                               typename Simd<W>::D &cut) {
+  using D = typename Simd<W>::D;
+  const D zero{}, one = zero + 1.0;
+  const typename Simd<W>::M sliding = select<W>(touch, h2, zero) > cap * cap;
+  if (!any<W>(sliding)) return false;
+  const D mag = vsqrt(h2);
+  cut = select<W>(sliding, cap / select<W>(sliding, mag, one), one);
+  slid += select<W>(sliding, cap * (mag - cap), zero);
+  return true;
+}
+
 // A sum kept lane by lane over groups of 8 lanes (8 wall candidates) on
 // any path's width W: one W-wide part per W lanes, added up by
 // detail::lane_sum, so that every path gives the same bits.
@@ -422,11 +441,7 @@ DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
         // Coulomb: |h| ≤ μ·fn. The root and the division only when a
         // touching lane slides (else cut = 1 in every lane that counts).
         const D cap = mu * fn, h2 = hx * hx + hy * hy + hz * hz;
-        const M sliding = select<W>(touch, h2, zero) > cap * cap;  // touching and sliding
-        if (any<W>(sliding)) {
-          const D mag = vsqrt(h2);
-          const D cut = select<W>(sliding, cap / select<W>(sliding, mag, one), one);
-          slid += select<W>(sliding, cap * (mag - cap), zero);
+        if (D cut; coulomb_cut<W>(touch, h2, cap, slid, cut)) {
           hx *= cut;
           hy *= cut;
           hz *= cut;
@@ -563,11 +578,7 @@ DEMCAL_INLINE void wall_contacts(const WallArgs &a, double *out) {
       fn = select<W>(touch, fn, zero);
       D hu = hu0 + a.kdt * dvu, hv = hv0 + a.kdt * dvv;
       const D cap = a.mu * fn, h2 = hu * hu + hv * hv;
-      const M sliding = select<W>(touch, h2, zero) > cap * cap;  // touching and sliding
-      if (any<W>(sliding)) {
-        const D mag = vsqrt(h2);
-        const D cut = select<W>(sliding, cap / select<W>(sliding, mag, one), one);
-        slid += select<W>(sliding, cap * (mag - cap), zero);
+      if (D cut; coulomb_cut<W>(touch, h2, cap, slid, cut)) {
         hu *= cut;
         hv *= cut;
       }
