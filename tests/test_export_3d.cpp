@@ -24,6 +24,7 @@
 #include "demcal/scoring/triaxial_scoring.hpp"
 #include "demcal/upscaling/export_3d.hpp"
 #include "support/files.hpp"
+#include "support/head_on.hpp"
 #include "support/process.hpp"
 
 namespace demcal {
@@ -802,6 +803,89 @@ TEST(Export3dLiggghts, PeakAgainstDemcal) {
   EXPECT_NEAR(peak_ratio / d.result.peak_ratio, 1.0, 0.01);
   // The servo held the lateral force (σ3·A0: within the strain of σ3).
   EXPECT_NEAR(last_lateral / fcc444().test.lateral_stress, 1.0, 0.005);
+}
+
+TEST(Export3dLiggghts, TheDecksContactDashpotsGiveDemcalsRestitution) {
+  // Contact damping ζ_c 0.3 in the deck's materials (gamman_abs per type
+  // pair, limitForce on: deck_sections.cpp liggghts_materials): two of the
+  // deck's spheres colliding head-on, and one falling onto a plane with the
+  // deck's wall settings, in LIGGGHTS, rebound with the restitution of
+  // demcal's clamped dashpot, a function of ζ alone
+  // (test::clamped_restitution, 0.451): m_eff = m/2 between spheres and m
+  // against a wall, so a dashpot mapped with the wrong mass shows (ζ off by
+  // √2: e 0.346 or 0.555), and one missing gives 1 (the decks before
+  // 2026-12-02 wrote gamman_abs 0). The deck's materials block and wall
+  // settings are used as written, the step cut to T/400 (T the contact's
+  // duration): the rebound within 0.3 % then (the step in which the force
+  // reaches 0 ends the contact a fraction of a step late or early), 1 %
+  // allowed.
+  const std::string liggghts = test::find_on_path("liggghts");
+  if (liggghts.empty())
+    GTEST_SKIP() << "LIGGGHTS (liggghts) is not installed (apt-get install liggghts): the 3D "
+                    "deck is not run";
+  SceneConfig c = fcc444();
+  const double zeta = 0.3;
+  c.material.contact_damping_ratio = zeta;
+  Export3dOptions o;
+  o.format = "liggghts";
+  o.data_name = "fcc.data";
+  const ExportResult r = export_3d_decks(c, fixed_params(), fcc_state(), o);
+  const auto from = r.deck.find("# type 2 is the walls' material");
+  const auto to = r.deck.find('\n', r.deck.find("\ntimestep ", from) + 1);
+  ASSERT_NE(from, std::string::npos) << r.deck;
+  ASSERT_NE(to, std::string::npos) << r.deck;
+  const std::string materials = r.deck.substr(from, to - from + 1);
+  const auto settings_at = r.deck.find("store_force yes ", r.deck.find("fix walls all wall/gran"));
+  ASSERT_NE(settings_at, std::string::npos) << r.deck;
+  const std::string settings =
+      r.deck.substr(settings_at + 16, r.deck.find('\n', settings_at) - settings_at - 16);
+  EXPECT_NE(settings.find("limitForce on"), std::string::npos) << settings;
+
+  const double radius = c.assembly.radius, rho = c.material.density;
+  const double m = sphere_mass(rho, radius), kn = c.material.particle.kn;
+  ASSERT_EQ(c.material.wall.kn, kn);  // one duration for both collisions
+  const double T = std::numbers::pi * std::sqrt(0.5 * m / kn), dt = T / 400.0;
+  const double v = 0.1, gap = 0.02 * v * T;  // [m/s], [m]: contact a few steps in
+  char atoms[600];
+  std::snprintf(atoms, sizeof atoms,
+                "1 1 %.17g %.17g %.17g %.17g %.17g\n2 1 %.17g %.17g %.17g %.17g %.17g\n"
+                "3 1 %.17g %.17g %.17g %.17g %.17g\n",
+                2 * radius, rho, 5 * radius, 5 * radius, 5 * radius,        // the pair,
+                2 * radius, rho, 7 * radius + gap, 5 * radius, 5 * radius,  // along x
+                2 * radius, rho, 12 * radius, 12 * radius, radius + gap);   // over z = 0
+  const std::string data =
+      "collisions\n\n3 atoms\n2 atom types\n\n0 0.01 xlo xhi\n"
+      "0 0.01 ylo yhi\n0 0.01 zlo zhi\n\nAtoms\n\n" +
+      std::string(atoms);
+  std::ostringstream deck;
+  deck << "atom_style granular\natom_modify map array\nboundary f f f\nnewton off\n"
+          "communicate single vel yes\nunits si\nread_data collide.data\n"
+          "neighbor "
+       << 0.3 * radius << " bin\nneigh_modify delay 0\n\n"
+       << materials << "timestep " << dt << "\n"
+       << "fix floor all wall/gran model hooke/stiffness tangential history primitive type 2 "
+          "zplane 0 "
+       << settings << "\nfix integr all nve/sphere\n"
+       << "group a1 id 1\ngroup a2 id 2\ngroup a3 id 3\n"
+       << "velocity a1 set " << v << " 0 0\nvelocity a2 set " << -v << " 0 0\n"
+       << "velocity a3 set 0 0 " << -v << "\n"
+       << "run 2000\n"
+       << "variable e_pair equal (vx[2]-vx[1])/" << 2 * v << "\n"
+       << "variable e_wall equal vz[3]/" << v << "\n"
+       << "print \"pair_restitution = ${e_pair}\"\nprint \"wall_restitution = ${e_wall}\"\n";
+  const test::TempDir dir("liggghts_restitution");
+  const test::DeckRun run =
+      test::run_deck(liggghts, dir.path(), deck.str(), {{"collide.data", data}}, {});
+  ASSERT_EQ(run.status, 0) << run.log;
+  const double e = test::clamped_restitution(zeta);
+  const double e_pair = logged(run.log, "pair_restitution");
+  const double e_wall = logged(run.log, "wall_restitution");
+  std::printf(
+      "LIGGGHTS deck, zeta_c %.2f: restitution sphere-sphere %.5f, sphere-wall %.5f, "
+      "demcal's clamped dashpot %.5f\n",
+      zeta, e_pair, e_wall, e);
+  EXPECT_NEAR(e_pair, e, 0.01 * e);
+  EXPECT_NEAR(e_wall, e, 0.01 * e);
 }
 
 }  // namespace

@@ -19,6 +19,7 @@
 #include "demcal/scene/biaxial.hpp"
 #include "demcal/scene/config.hpp"
 #include "demcal/scene/packing.hpp"
+#include "support/head_on.hpp"
 #include "test_kernel_helpers.hpp"
 
 namespace demcal {
@@ -27,12 +28,7 @@ namespace {
 using kernel_test::kR;
 using kernel_test::reference_material;
 
-double clamped_restitution(double zeta) {
-  const double s = std::sqrt(1.0 - zeta * zeta);
-  const double phase = std::numbers::pi - std::atan(2.0 * zeta * s / (1.0 - 2.0 * zeta * zeta));
-  const double t = phase / s;  // ω·t*
-  return std::exp(-zeta * t) * std::abs(std::cos(phase) - zeta / s * std::sin(phase));
-}
+using test::clamped_restitution;
 
 struct Collision {
   double restitution = 0.0;

@@ -535,28 +535,51 @@ std::string liggghts_preamble(int dimension, const std::string& boundary,
   return s.str();
 }
 
-std::string liggghts_materials(const Material& m, int ntypes, double dt, NumberFormat f) {
-  const int wall_type = ntypes;
-  auto pair_matrix = [&](double pp, double pw) {
+std::string liggghts_model_settings(const Material& m) {
+  return std::string("absolute_damping on tangential_damping off") +
+         (m.contact_damping_ratio > 0.0 ? " limitForce on" : "");
+}
+
+std::string liggghts_materials(const Material& m, const std::vector<double>& class_mass, double dt,
+                               NumberFormat f) {
+  const int classes = static_cast<int>(class_mass.size());
+  const int ntypes = classes + 1, wall_type = ntypes;
+  // The value of a type pair: per class pair and against the wall.
+  auto pair_matrix = [&](auto value) {
     std::ostringstream s;
     for (int i = 1; i <= ntypes; ++i)
-      for (int j = 1; j <= ntypes; ++j) s << " " << f((i == wall_type || j == wall_type) ? pw : pp);
+      for (int j = 1; j <= ntypes; ++j)
+        s << " " << f(value(i, j, i == wall_type || j == wall_type));
     return s.str();
+  };
+  auto constant = [](double pp, double pw) {
+    return [=](int, int, bool wall) { return wall ? pw : pp; };
+  };
+  const double zeta = m.contact_damping_ratio;
+  auto dashpot = [&](int i, int j, bool wall) {
+    if (zeta <= 0.0 || (i == wall_type && j == wall_type)) return 0.0;
+    if (wall) return zeta * critical_damping_translation(m.wall.kn, class_mass[std::min(i, j) - 1]);
+    const double mi = class_mass[i - 1], mj = class_mass[j - 1];
+    return zeta * critical_damping_translation(m.particle.kn, mi * mj / (mi + mj));
   };
   std::ostringstream s;
   s << "# type " << wall_type << " is the walls' material\n"
     << "fix m1 all property/global kn peratomtypepair " << ntypes
-    << pair_matrix(m.particle.kn, m.wall.kn) << "\n"
+    << pair_matrix(constant(m.particle.kn, m.wall.kn)) << "\n"
     << "fix m2 all property/global kt peratomtypepair " << ntypes
-    << pair_matrix(m.particle.kt, m.wall.kt) << "\n"
-    << "fix m3 all property/global gamman_abs peratomtypepair " << ntypes << pair_matrix(0, 0)
+    << pair_matrix(constant(m.particle.kt, m.wall.kt)) << "\n";
+  if (zeta > 0.0)
+    s << "# contact damping zeta_c = " << f(zeta)
+      << ": gamman_abs = zeta_c*2*sqrt(kn*m_eff) per type pair, each class's\n"
+         "# mass at its mid radius, m_eff = m_i*m_j/(m_i + m_j), m_i against a wall\n";
+  s << "fix m3 all property/global gamman_abs peratomtypepair " << ntypes << pair_matrix(dashpot)
     << "\n"
-    << "fix m4 all property/global gammat_abs peratomtypepair " << ntypes << pair_matrix(0, 0)
-    << "\n"
+    << "fix m4 all property/global gammat_abs peratomtypepair " << ntypes
+    << pair_matrix(constant(0, 0)) << "\n"
     << "fix m5 all property/global coefficientFriction peratomtypepair " << ntypes
-    << pair_matrix(m.particle.friction, m.wall.friction) << "\n\n"
-    << "pair_style gran model hooke/stiffness tangential history absolute_damping on "
-       "tangential_damping off\n"
+    << pair_matrix(constant(m.particle.friction, m.wall.friction)) << "\n\n"
+    << "pair_style gran model hooke/stiffness tangential history " << liggghts_model_settings(m)
+    << "\n"
     << "pair_coeff * *\n"
     << "timestep " << f(dt) << "\n\n";
   return s.str();

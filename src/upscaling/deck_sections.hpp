@@ -265,9 +265,21 @@ std::string lammps_consolidation_end(const std::vector<ConsolidationWall>& walls
 std::string liggghts_preamble(int dimension, const std::string& boundary,
                               const std::string& data_name, double r_min);
 
-/// LIGGGHTS: the materials (type ntypes is the walls'), the granular pair
-/// style without damping (absolute_damping with gamma 0) and the timestep.
-std::string liggghts_materials(const Material& m, int ntypes, double dt, NumberFormat f);
+/// LIGGGHTS: the materials (types 1..K the radius classes, of mass
+/// class_mass[k − 1] each; type K + 1 the walls'), the granular pair style
+/// and the timestep. The normal dashpot is demcal's per type pair:
+/// gamman_abs = ζ_c·2·sqrt(kn·m_eff), m_eff = m_i·m_j/(m_i + m_j) between
+/// classes and m_i against a wall (with the wall's kn), as the kernels'
+/// contact law; 0 without contact damping. No tangential dashpot (demcal
+/// has none).
+std::string liggghts_materials(const Material& m, const std::vector<double>& class_mass, double dt,
+                               NumberFormat f);
+
+/// LIGGGHTS: the hooke/stiffness model's settings for the pair style and
+/// every wall fix: absolute damping (gamman_abs is a damping coefficient),
+/// no tangential damping, and with contact damping `limitForce on` (the
+/// normal force never pulls: demcal's max(0, kn·δ − c·v_n)).
+std::string liggghts_model_settings(const Material& m);
 
 /// LIGGGHTS: fix viscous per radius class (nothing when zeta_t = 0).
 std::string liggghts_translational_damping(double zeta_t, const std::vector<double>& gamma_t,

@@ -31,6 +31,7 @@ struct Plan {
   double width0 = 0.0, height0 = 0.0;
   double top_speed = 0.0;                // [m/s], downward
   std::vector<double> gamma_t, gamma_r;  // per class [N·s/m], [N·m·s]
+  std::vector<double> class_mass;        // per class, at its mid radius [kg]
   double class_error = 0.0;
   double r_min = 0.0, r_max = 0.0;
   // The servo's: the heaviest disc's mass m_max [kg] (as scene/biaxial.cpp
@@ -75,6 +76,7 @@ Plan make_plan(const SceneConfig& c, const AlgorithmSpec& p, const Assembly& a, 
   for (int k = 0; k < plan.types; ++k) {
     const double r = 0.5 * (plan.r_lo[k] + plan.r_hi[k]);
     const double m = plan.areal_density * std::numbers::pi * r * r;
+    plan.class_mass.push_back(m);
     plan.gamma_t.push_back(p.damping_ratio_translation * 2.0 * std::sqrt(kn * m));
     plan.gamma_r.push_back(p.damping_ratio_rotation * 2.0 *
                            std::sqrt(kt * r * r * 0.5 * m * r * r));
@@ -1050,13 +1052,13 @@ ExportResult liggghts(const SceneConfig& c, const AlgorithmSpec& p, const Assemb
     << "#    every step).\n"
     << "#  - translational damping per radius class via fix viscous ... scale.\n";
   s << deck::liggghts_preamble(2, "f f p", o.data_name, plan.r_min)
-    << deck::liggghts_materials(m, ntypes, plan.dt, num)
+    << deck::liggghts_materials(m, plan.class_mass, plan.dt, num)
     << "# the lateral walls' target forces, sigma3*H*t (left +x, right -x)\n"
     << "variable ftl equal " << target << "\n"
     << "variable ftr equal -" << target << "\n"
     << "fix bottom all wall/gran model hooke/stiffness tangential history primitive type "
-    << wall_type << " yplane " << num(a.bottom)
-    << " store_force yes absolute_damping on tangential_damping off\n"
+    << wall_type << " yplane " << num(a.bottom) << " store_force yes "
+    << deck::liggghts_model_settings(m) << "\n"
     << "fix mtop all mesh/surface/stress file " << top << " type " << wall_type << "\n"
     << "fix mleft all mesh/surface/stress/servo file " << left << " type " << wall_type << " com "
     << num(a.left) << " " << num(0.5 * (a.bottom + a.top))
@@ -1067,7 +1069,8 @@ ExportResult liggghts(const SceneConfig& c, const AlgorithmSpec& p, const Assemb
     << " 0 ctrlPV force axis 1 0 0 target_val v_ftr vel_max " << num(vel_max) << " kp "
     << num(kp_right) << "\n"
     << "fix walls all wall/gran model hooke/stiffness tangential history mesh n_meshes 3 meshes "
-       "mtop mleft mright store_force yes absolute_damping on tangential_damping off\n"
+       "mtop mleft mright store_force yes "
+    << deck::liggghts_model_settings(m) << "\n"
     << "fix movetop all move/mesh mesh mtop linear 0 " << num(-plan.top_speed) << " 0\n\n"
     << "fix integrate all nve/sphere\n";
   s << deck::liggghts_translational_damping(p.damping_ratio_translation, plan.gamma_t, num)

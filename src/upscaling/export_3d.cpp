@@ -92,6 +92,7 @@ struct Plan3 {
   std::array<double, 3> lo{}, hi{};
   double top_speed = 0.0;  // [m/s], downward
   std::vector<double> gamma_t, gamma_r;
+  std::vector<double> class_mass;      // per class, at its mid radius [kg]
   std::vector<double> gamma_critical;  // per class, zeta 1 [N·s/m]: stage 1's damping
   double class_error = 0.0;
   std::array<int, 6> wall_contacts{};  // at the start
@@ -141,6 +142,7 @@ Plan3 make_plan(const SceneConfig& c, const AlgorithmSpec& p, const SphereWorld&
   for (int k = 0; k < plan.types; ++k) {
     const double r = 0.5 * (plan.r_lo[k] + plan.r_hi[k]);
     const double m = sphere_mass(plan.density, r);
+    plan.class_mass.push_back(m);
     plan.gamma_critical.push_back(critical_damping_translation(kn, m));
     plan.gamma_t.push_back(p.damping_ratio_translation * plan.gamma_critical.back());
     plan.gamma_r.push_back(p.damping_ratio_rotation *
@@ -944,7 +946,7 @@ std::string liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p, const Pl
   if (!o.lateral_servo)
     out.notes.push_back("LIGGGHTS deck: lateral walls fixed (lateral_servo off)");
   s << deck::liggghts_preamble(3, "f f f", o.data_name, plan.r_min)
-    << deck::liggghts_materials(m, ntypes, plan.dt, exact)
+    << deck::liggghts_materials(m, plan.class_mass, plan.dt, exact)
     << "fix mbottom all mesh/surface/stress file " << mesh_file[5] << " type " << wall_type << "\n"
     << "fix mtop all mesh/surface/stress file " << mesh_file[4] << " type " << wall_type << "\n";
   const V3 centre = 0.5 * (lo + hi);
@@ -975,8 +977,8 @@ std::string liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p, const Pl
     }
   }
   s << "fix walls all wall/gran model hooke/stiffness tangential history mesh n_meshes 6 meshes "
-       "mbottom mtop mxmin mxmax mymin mymax store_force yes absolute_damping on "
-       "tangential_damping off\n"
+       "mbottom mtop mxmin mxmax mymin mymax store_force yes "
+    << deck::liggghts_model_settings(m) << "\n"
     << "fix movetop all move/mesh mesh mtop linear 0 0 " << exact(-plan.top_speed) << "\n\n"
     << "fix integrate all nve/sphere\n"
     << deck::liggghts_translational_damping(p.damping_ratio_translation, plan.gamma_t, exact);

@@ -1,7 +1,8 @@
 // Test support: a head-on collision of two bodies, undamped, stepped until
 // they separate, and the bounds of the discrete contact duration and largest
 // overlap, for the contact-law tests of both kernels
-// (test_kernel_contact.cpp, test_sphere_contact.cpp).
+// (test_kernel_contact.cpp, test_sphere_contact.cpp); the restitution of the
+// clamped dashpot (test_kernel_contact_damping.cpp, the LIGGGHTS decks).
 #pragma once
 
 #include <gtest/gtest.h>
@@ -84,6 +85,18 @@ inline void expect_head_on_bounds(const HeadOnCollision& c, double meff, double 
   EXPECT_NEAR(c.t_out - c.t_in, T, T * h * h / 24.0 + theta * theta * dt / 16.0);
   const double dmax = v_rel / omega;
   EXPECT_NEAR(c.max_overlap, dmax, dmax * theta * theta / 8.0);
+}
+
+/// The restitution of a head-on collision under demcal's dashpot, which
+/// never pulls (fn = max(0, kn·δ + c·δ̇), c = 2ζ·sqrt(kn·m_eff), ζ < 1/√2):
+/// the bodies part when kn·δ + c·δ̇ = 0, at ω_d·t* = π − atan(2ζ·sqrt(1−ζ²)/
+/// (1−2ζ²)), and e = e^(−ζωt*)·|cos(ω_d·t*) − ζ/sqrt(1−ζ²)·sin(ω_d·t*)|
+/// (test_kernel_contact_damping.cpp derives it). A function of ζ alone.
+inline double clamped_restitution(double zeta) {
+  const double s = std::sqrt(1.0 - zeta * zeta);
+  const double phase = std::numbers::pi - std::atan(2.0 * zeta * s / (1.0 - 2.0 * zeta * zeta));
+  const double t = phase / s;  // ω·t*
+  return std::exp(-zeta * t) * std::abs(std::cos(phase) - zeta / s * std::sin(phase));
 }
 
 }  // namespace demcal::test
