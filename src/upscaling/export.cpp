@@ -546,7 +546,11 @@ double contact_gamma_n(const SceneConfig& c, const Plan& plan) {
 std::string lammps_system(const SceneConfig& c, const Plan& plan, const ExportOptions& o,
                           ExportResult& out) {
   const double gamma_n = contact_gamma_n(c, plan);
-  if (gamma_n > 0.0) out.notes.push_back("contact damping mapped at the mean particle mass");
+  if (gamma_n > 0.0)
+    out.notes.push_back(
+        "contact damping mapped at the mean particle mass; the walls carry no dashpots here "
+        "(demcal's do: in the quasi-static series the difference is at rounding's scale, "
+        "engines.md section 20)");
   std::ostringstream s;
   s << deck::lammps_system_head(2, "f f p")
     << "if              \"${continued} == 0\" then \"read_data " << o.data_name

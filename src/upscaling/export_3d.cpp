@@ -345,7 +345,11 @@ void lammps_3d_system(std::ostream& s, const SceneConfig& c, const Plan3& plan,
                       const Export3dOptions& o, ExportResult& out) {
   const auto& m = c.material;
   const double gamma_n = deck::contact_gamma_n(m, plan.m_mean);
-  if (gamma_n > 0.0) out.notes.push_back("contact damping mapped at the mean sphere mass");
+  if (gamma_n > 0.0)
+    out.notes.push_back(
+        "contact damping mapped at the mean sphere mass; the walls carry no dashpots here "
+        "(demcal's do: in the quasi-static series the difference is at rounding's scale, "
+        "engines.md section 20)");
   s << deck::lammps_system_head(3, "f f f") << "newton          off\n"
     << "read_data       " << o.data_name << "\n"
     << "# sphere masses f_ms*rho*4/3*pi*r^3 (density column), inertia 2/5 m r^2\n"
