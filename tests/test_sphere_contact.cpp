@@ -76,6 +76,39 @@ TEST(SphereContact, HeadOnCollisionForceDurationAndRestitution) {
   EXPECT_NEAR(e, 1.0, h * h / 8.0);
 }
 
+// Contact dashpot: two spheres overlapping by δ along an oblique normal n,
+// sphere 1 set moving towards sphere 0 at V after a step (update_forces()
+// must read the velocities set since, not the step's: a pair pass that
+// read a copy of the neighbour's state refreshed only by the integration
+// pass would fail here). Normal force kn·δ + 2ζ·sqrt(kn·m_eff)·V, m_eff =
+// m/2, on 0 along −n; no tangential force (v_rel ∥ n, and update_forces
+// adds no increment).
+TEST(SphereContact, DampedNormalForceReadsAVelocitySetSinceTheLastStep) {
+  SphereMaterial mat = test_material(0.3);
+  mat.contact_damping_ratio = 0.2;
+  const double r = kR, delta = 1e-3 * r, V = 0.05;
+  const Vector3d u = Vector3d(1.0, 2.0, 2.0) / 3.0;
+  sphere_test::Scene s;
+  s.add(Vector3d::Zero(), r);
+  s.add((2.0 * r - delta) * u, r);
+  s.lo = {-10 * r, -10 * r, -10 * r};
+  s.hi = {12 * r, 12 * r, 12 * r};
+  SphereWorld w = s.make(mat);
+  sphere_test::set_undamped(w, 0.1);
+  ASSERT_TRUE(w.step(1));  // the spring sets them moving apart
+  const double kn = mat.particle.kn, meff = 0.5 * w.mass()[0];
+  const double dist = (sphere_test::position(w, 1) - sphere_test::position(w, 0)).norm();
+  const double spring = kn * (2.0 * r - dist);
+  w.set_velocity(0, Vector3d::Zero(), Vector3d::Zero());
+  w.set_velocity(1, -V * u, Vector3d::Zero());
+  w.update_forces();
+  const double fn = spring + 2.0 * mat.contact_damping_ratio * std::sqrt(kn * meff) * V;
+  // δ = 2r − d cancels most of d: a few ulps of 2r relative to δ.
+  const double tol = kn * 8.0 * kEps * 2.0 * r + 8.0 * kEps * fn;
+  EXPECT_NEAR((sphere_test::force(w, 0) + fn * u).norm(), 0.0, tol);
+  EXPECT_NEAR((sphere_test::force(w, 1) - fn * u).norm(), 0.0, tol);
+}
+
 // Two spheres overlapping by δ along an oblique normal n; sphere 1 slides
 // past sphere 0 at constant speed V along a tangent t. Heavy spheres (mass
 // scaling 1e15): the contact forces change the velocities by a fraction
