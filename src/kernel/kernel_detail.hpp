@@ -34,10 +34,11 @@ using AlignedVector = std::vector<T, AlignedAllocator<T>>;
 /// The sum of 8 SIMD lanes (a block's, or 8 wall candidates'), one tree
 /// whatever the path's width: ((l0 + l4) + (l2 + l6)) + ((l1 + l5) + (l3 +
 /// l7)). A pass keeps such a sum lane by lane and writes the 8 lanes; the
-/// caller adds them here (block_lanes_sum for a whole pass). (Reduced W lanes wide inside a pass,
-/// lane l and lane l + W of the narrower path would meet first, so AVX2 and AVX-512 would round the
-/// sphere kernel's wall forces and its ledger differently and, through the triaxial test's servo,
-/// end in different samples.)
+/// caller adds them here (block_lanes_sum for a whole pass). (Reduced W
+/// lanes wide inside a pass, lane l and lane l + W of the narrower path
+/// would meet first, so AVX2 and AVX-512 would round the sphere kernel's
+/// wall forces and its ledger differently and, through the triaxial test's
+/// servo, end in different samples.)
 inline double lane_sum(const double* l) {
   return ((l[0] + l[4]) + (l[2] + l[6])) + ((l[1] + l[5]) + (l[3] + l[7]));
 }

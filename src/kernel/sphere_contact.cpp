@@ -525,8 +525,9 @@ struct WallArgs {
 // part of a tangential vector, exactly 0), so it is never read. out =
 // {spheres' force on the wall −Σf along a, u, v; contacts; Σ|h|² of
 // contacts that opened; Σ cap·(|h_trial| − cap) of sliding ones; the
-// largest overlap/r}, each summed lane-wise over the list, then over the
-// lanes: one order whatever the thread count.
+// largest overlap/r}, each summed over the list in 8 lanes, then over the
+// lanes by detail::lane_sum: one order whatever the thread count and the
+// path's width.
 template <int W>
 DEMCAL_INLINE void wall_contacts(const WallArgs &a, double *out) {
   using D = typename Simd<W>::D;

@@ -226,8 +226,7 @@ void SphereWorldImpl::integrate() {
   // damping removes exactly D·|v̄|²·Δt of (half-step) kinetic energy per
   // step: summed for the energy ledger (each block's lanes by the pass, the
   // blocks here in order: detail::block_lanes_sum), exact however fast the
-  // decay. The pass also
-  // scans the displacements since the last list build.
+  // decay. The pass also scans the displacements since the last list build.
   const double dt = integration_.dt;
   const double max_d2 = run_pass(&SphereWorldImpl::integrate_pass, particle_bounds_);
   const double lost = detail::block_lanes_sum(block_lost_.data(), nblocks_);
