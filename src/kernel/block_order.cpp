@@ -2,6 +2,8 @@
 #include "block_order.hpp"
 
 #include <algorithm>
+#include <stdexcept>
+#include <string>
 
 namespace demcal::detail {
 
@@ -82,6 +84,19 @@ long block_slot_rows(int n, std::span<const int> pair_i, std::span<const int> pa
             *std::max_element(m.begin() + b, m.begin() + e);
   }
   return rows;
+}
+
+std::vector<int> inverse_permutation(int n, std::span<const int> order, std::string_view caller) {
+  if (static_cast<int>(order.size()) != n)
+    throw std::invalid_argument(std::string(caller) + ": order must list every particle once");
+  std::vector<int> new_index(n, -1);
+  for (int k = 0; k < n; ++k) {
+    const int i = order[k];
+    if (i < 0 || i >= n || new_index[i] >= 0)
+      throw std::invalid_argument(std::string(caller) + ": order is not a permutation");
+    new_index[i] = k;
+  }
+  return new_index;
 }
 
 }  // namespace demcal::detail

@@ -1,9 +1,11 @@
 // The particle order that fills the kernels' SIMD blocks, one algorithm for
-// both (World::block_friendly_order, SphereWorld::block_friendly_order).
-// Private to src/kernel, like kernel_detail.hpp.
+// both (World::block_friendly_order, SphereWorld::block_friendly_order), and
+// the check and inversion of an order both reorder()s take. Private to
+// src/kernel, like kernel_detail.hpp.
 #pragma once
 
 #include <span>
+#include <string_view>
 #include <vector>
 
 namespace demcal::detail {
@@ -25,5 +27,12 @@ std::vector<int> block_friendly_order(int n, std::span<const int> pair_i,
 /// lattice in lattice order): compare with the identity's.
 long block_slot_rows(int n, std::span<const int> pair_i, std::span<const int> pair_j,
                      std::span<const int> order);
+
+/// The inverse of an order for reorder() of n particles: new_index[order[k]]
+/// = k. Throws std::invalid_argument, its message starting with `caller`
+/// ("<caller>: order must list every particle once" unless order has n
+/// entries, "<caller>: order is not a permutation" for an entry out of
+/// 0 … n − 1 or repeated).
+std::vector<int> inverse_permutation(int n, std::span<const int> order, std::string_view caller);
 
 }  // namespace demcal::detail

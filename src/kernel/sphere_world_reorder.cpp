@@ -2,7 +2,6 @@
 // fills the SIMD blocks (block_friendly_order, block_order.cpp), as
 // reorder.cpp is for the 2D kernel. See sphere_world.hpp.
 #include <algorithm>
-#include <stdexcept>
 #include <tuple>
 #include <vector>
 
@@ -39,15 +38,7 @@ std::vector<int> SphereWorldImpl::block_friendly_order() const {
 
 void SphereWorldImpl::reorder(std::span<const int> order) {
   const int n = n_;
-  if (static_cast<int>(order.size()) != n)
-    throw std::invalid_argument("SphereWorld::reorder: order must list every particle once");
-  std::vector<int> new_index(n, -1);
-  for (int k = 0; k < n; ++k) {
-    const int i = order[k];
-    if (i < 0 || i >= n || new_index[i] >= 0)
-      throw std::invalid_argument("SphereWorld::reorder: order is not a permutation");
-    new_index[i] = k;
-  }
+  const std::vector<int> new_index = detail::inverse_permutation(n, order, "SphereWorld::reorder");
   // The identity changes nothing (not even the last bits of the forces).
   bool identity = true;
   for (int k = 0; k < n && identity; ++k) identity = order[k] == k;
