@@ -866,16 +866,16 @@ std::string liggghts_3d_series(const SceneConfig& c, const AlgorithmSpec& p, con
   return s.str();
 }
 
-std::string liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p, const Plan3& plan,
-                          const Export3dOptions& o, const SphereWorld& w, ExportResult& out) {
-  const auto& m = c.material;
-  const int wall_type = plan.types + 1, ntypes = plan.types + 1;
+/// The particle file's box and the six walls' meshes (the files go to
+/// `out`): the top (normal −z) and the bottom a little wider than the box;
+/// the lateral walls from below the bottom to above the top, a little wider
+/// than the box (the meshes cross at the edges; they do not touch each
+/// other). Returns the mesh files by wall, kWall's order (xmin xmax ymin
+/// ymax), then top, bottom.
+std::array<std::string, 6> liggghts_3d_meshes(const Plan3& plan, const Export3dOptions& o,
+                                              ExportResult& out) {
   const std::array<double, 3> ext{plan.hi[0] - plan.lo[0], plan.hi[1] - plan.lo[1],
                                   plan.hi[2] - plan.lo[2]};
-  out.files[o.data_name] = data_file("LIGGGHTS", c, plan, w, ntypes, "Atoms");
-  // Meshes: the top (normal −z) a little wider than the box; the lateral
-  // walls from below the bottom to above the top, a little wider than the
-  // box (the meshes cross at the edges; they do not touch each other).
   const std::string stem = o.data_name.substr(0, o.data_name.rfind('.'));
   const double mx = 0.1 * ext[0] + 2 * plan.r_max, my = 0.1 * ext[1] + 2 * plan.r_max;
   const double mz = 0.1 * ext[2] + 2 * plan.r_max;
@@ -897,13 +897,81 @@ std::string liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p, const Pl
                                           V3(ext[0] + 2 * mx, 0, 0), V3(0, ext[1] + 2 * my, 0));
   out.files[mesh_file[4]] = stl_rectangle("top", V3(lo.x() - mx, lo.y() - my, hi.z()),
                                           V3(0, ext[1] + 2 * my, 0), V3(ext[0] + 2 * mx, 0, 0));
+  return mesh_file;
+}
+
+/// The four lateral walls' meshes: servo meshes holding sigma3 on the
+/// wall's current area (demcal's law, deck::liggghts_servo_kp and vel_max;
+/// kp at the start from the contacts demcal counts), or fixed meshes
+/// without the lateral servo.
+void liggghts_3d_lateral_walls(std::ostream& s, const SceneConfig& c, const Plan3& plan,
+                               const Export3dOptions& o,
+                               const std::array<std::string, 6>& mesh_file, int wall_type,
+                               double cap) {
+  const double vel_max = deck::liggghts_servo_vel_max(cap, plan.dt, plan.step_factor);
+  const std::array<double, 3> ext{plan.hi[0] - plan.lo[0], plan.hi[1] - plan.lo[1],
+                                  plan.hi[2] - plan.lo[2]};
+  const Eigen::Vector3d centre(0.5 * (plan.lo[0] + plan.hi[0]), 0.5 * (plan.lo[1] + plan.hi[1]),
+                               0.5 * (plan.lo[2] + plan.hi[2]));
+  for (int sd = 0; sd < 4; ++sd) {
+    const int a = sd / 2;
+    const double area = ext[(a + 1) % 3] * ext[(a + 2) % 3];
+    const double target = c.test.lateral_stress * area;
+    const double kp = deck::liggghts_servo_kp(c.test.servo_gain, target, plan.servo_resist,
+                                              plan.wall_contacts[sd], cap);
+    Eigen::Vector3d com = centre;
+    com[a] = sd % 2 == 0 ? plan.lo[a] : plan.hi[a];
+    if (o.lateral_servo) {
+      // sigma3 on the wall's current area: the other lateral axis' width
+      // (its servo meshes' positions) times the height
+      const int b = 1 - a;
+      s << "variable ft_" << kWall[sd] << " equal " << (sd % 2 == 0 ? "" : "-")
+        << exact(c.test.lateral_stress) << "*(f_m" << kWall[2 * b + 1] << "[" << 7 + b << "]-f_m"
+        << kWall[2 * b] << "[" << 7 + b << "])*(" << exact(ext[2]) << "-" << exact(plan.top_speed)
+        << "*step*" << exact(plan.dt) << ")\n";
+      s << "fix m" << kWall[sd] << " all mesh/surface/stress/servo file " << mesh_file[sd]
+        << " type " << wall_type << " com " << exact(com.x()) << " " << exact(com.y()) << " "
+        << exact(com.z()) << " ctrlPV force axis " << (a == 0 ? "1 0 0" : "0 1 0")
+        << " target_val v_ft_" << kWall[sd] << " vel_max " << exact(vel_max) << " kp " << exact(kp)
+        << "\n";
+    } else {
+      s << "fix m" << kWall[sd] << " all mesh/surface/stress file " << mesh_file[sd] << " type "
+        << wall_type << "\n";
+    }
+  }
+}
+
+/// The loading run: with the lateral servo in chunks, each servo mesh's kp
+/// set between them from its current contacts (deck::liggghts_servo_run);
+/// one run without.
+void liggghts_3d_run(std::ostream& s, const SceneConfig& c, const Plan3& plan,
+                     const Export3dOptions& o, double cap, int monitor_every,
+                     const std::string& resist_name) {
+  if (!o.lateral_servo) {
+    s << "run ${run_steps}\n";
+    return;
+  }
+  std::vector<deck::LiggghtsServoWall> walls;
+  for (int sd = 0; sd < 4; ++sd)
+    walls.push_back({std::string("m") + kWall[sd], std::string("ft_") + kWall[sd],
+                     "t" + std::to_string(sd) + "_a"});
+  s << deck::liggghts_servo_run(walls, c.test.servo_gain, plan.servo_resist, cap, monitor_every,
+                                exact, resist_name);
+}
+
+std::string liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p, const Plan3& plan,
+                          const Export3dOptions& o, const SphereWorld& w, ExportResult& out) {
+  const auto& m = c.material;
+  const int wall_type = plan.types + 1, ntypes = plan.types + 1;
+  const double h0 = plan.hi[2] - plan.lo[2];
+  out.files[o.data_name] = data_file("LIGGGHTS", c, plan, w, ntypes, "Atoms");
+  const std::array<std::string, 6> mesh_file = liggghts_3d_meshes(plan, o, out);
 
   // Servo: demcal's law over the same loading time (deck::liggghts_servo_kp
   // and vel_max), the gain from each wall's current contacts, set between
   // chunks of the run (deck::liggghts_servo_run); at the start from the
   // contacts demcal counts.
   const double cap = 0.02 * plan.r_min;
-  const double vel_max = deck::liggghts_servo_vel_max(cap, plan.dt, plan.step_factor);
   // R: kn_wall, and the wall dashpots' c/dt_demcal with contact damping
   const bool dashpots = plan.wall_dashpot > 0.0;
   const std::string resist_name = dashpots ? "R" : "kn_wall";
@@ -947,33 +1015,7 @@ std::string liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p, const Pl
     << deck::liggghts_materials(m, ntypes, plan.dt, exact)
     << "fix mbottom all mesh/surface/stress file " << mesh_file[5] << " type " << wall_type << "\n"
     << "fix mtop all mesh/surface/stress file " << mesh_file[4] << " type " << wall_type << "\n";
-  const V3 centre = 0.5 * (lo + hi);
-  for (int sd = 0; sd < 4; ++sd) {
-    const int a = sd / 2;
-    const double area = ext[(a + 1) % 3] * ext[(a + 2) % 3];
-    const double target = c.test.lateral_stress * area;
-    const double kp = deck::liggghts_servo_kp(c.test.servo_gain, target, plan.servo_resist,
-                                              plan.wall_contacts[sd], cap);
-    V3 com = centre;
-    com[a] = sd % 2 == 0 ? plan.lo[a] : plan.hi[a];
-    if (o.lateral_servo) {
-      // sigma3 on the wall's current area: the other lateral axis' width
-      // (its servo meshes' positions) times the height
-      const int b = 1 - a;
-      s << "variable ft_" << kWall[sd] << " equal " << (sd % 2 == 0 ? "" : "-")
-        << exact(c.test.lateral_stress) << "*(f_m" << kWall[2 * b + 1] << "[" << 7 + b << "]-f_m"
-        << kWall[2 * b] << "[" << 7 + b << "])*(" << exact(ext[2]) << "-" << exact(plan.top_speed)
-        << "*step*" << exact(plan.dt) << ")\n";
-      s << "fix m" << kWall[sd] << " all mesh/surface/stress/servo file " << mesh_file[sd]
-        << " type " << wall_type << " com " << exact(com.x()) << " " << exact(com.y()) << " "
-        << exact(com.z()) << " ctrlPV force axis " << (a == 0 ? "1 0 0" : "0 1 0")
-        << " target_val v_ft_" << kWall[sd] << " vel_max " << exact(vel_max) << " kp " << exact(kp)
-        << "\n";
-    } else {
-      s << "fix m" << kWall[sd] << " all mesh/surface/stress file " << mesh_file[sd] << " type "
-        << wall_type << "\n";
-    }
-  }
+  liggghts_3d_lateral_walls(s, c, plan, o, mesh_file, wall_type, cap);
   s << "fix walls all wall/gran model hooke/stiffness tangential history mesh n_meshes 6 meshes "
        "mbottom mtop mxmin mxmax mymin mymax store_force yes absolute_damping on "
        "tangential_damping off\n"
@@ -987,7 +1029,7 @@ std::string liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p, const Pl
     return std::string("f_m") + kWall[sd] + "[" + std::to_string(7 + sd / 2) + "]";
   };
   const int monitor_every = deck::monitor_interval(plan.steps, c.test.monitor_points);
-  s << "\nvariable H equal " << exact(ext[2]) << "-" << exact(plan.top_speed) << "*step*dt\n"
+  s << "\nvariable H equal " << exact(h0) << "-" << exact(plan.top_speed) << "*step*dt\n"
     << "variable Wx equal " << wall_pos(1) << "-(" << wall_pos(0) << ")\n"
     << "variable Wy equal " << wall_pos(3) << "-(" << wall_pos(2) << ")\n"
     << "variable p_top equal f_mtop[3]/(v_Wx*v_Wy)\n"
@@ -995,7 +1037,7 @@ std::string liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p, const Pl
     << "variable p_axial equal (v_p_top+v_p_bottom)/2\n"
     << "variable p_lat equal (-f_mxmin[1]+f_mxmax[1])/(4*v_Wy*v_H)+(-f_mymin[2]+f_mymax[2])/"
        "(4*v_Wx*v_H)\n"
-    << "variable strain_zz equal (v_H-" << exact(ext[2]) << ")/" << exact(ext[2]) << "\n"
+    << "variable strain_zz equal (v_H-" << exact(h0) << ")/" << exact(h0) << "\n"
     << liggghts_3d_series(c, p, plan, {wall_pos(0), wall_pos(1), wall_pos(2), wall_pos(3)},
                           monitor_every)
     << "# LIGGGHTS 3.8 has no fix vector: the peaks are the largest p_axial and ratio\n"
@@ -1005,16 +1047,7 @@ std::string liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p, const Pl
        "v_Wy\n"
     << "thermo ${thermo_every}\n"
     << "variable run_steps index " << plan.steps << "\n";
-  if (o.lateral_servo) {
-    std::vector<deck::LiggghtsServoWall> walls;
-    for (int sd = 0; sd < 4; ++sd)
-      walls.push_back({std::string("m") + kWall[sd], std::string("ft_") + kWall[sd],
-                       "t" + std::to_string(sd) + "_a"});
-    s << deck::liggghts_servo_run(walls, c.test.servo_gain, plan.servo_resist, cap, monitor_every,
-                                  exact, resist_name);
-  } else {
-    s << "run ${run_steps}\n";
-  }
+  liggghts_3d_run(s, c, plan, o, cap, monitor_every, resist_name);
   return s.str();
 }
 
