@@ -153,6 +153,11 @@ Plan3 make_plan(const SceneConfig& c, const AlgorithmSpec& p, const SphereWorld&
   return plan;
 }
 
+/// How the decks' comments name the servo's R (demcal's servo_resistance):
+/// "kn_wall" without contact damping (R = kn_wall: the decks read as before
+/// the wall dashpots), "R" with them (a comment then defines it).
+std::string resist_name(const Plan3& plan) { return plan.wall_dashpot > 0.0 ? "R" : "kn_wall"; }
+
 ExportResult result_of(const Plan3& plan) {
   return deck::plan_result(plan.dt, plan.steps, plan.step_factor, plan.types, plan.class_error);
 }
@@ -258,7 +263,8 @@ std::string area_y() { return std::string(kLx) + "*" + kH; }
 std::string area_z() { return std::string(kLx) + "*" + kLy; }
 // The four lateral walls' unclamped servo moves toward the sample, one
 // vector-style formula (elements xmin xmax ymin ymax): gain_kn*(sigma3*A -
-// F)/max(1, n) (gain_kn = gain*(dt/servo_dt)/kn_wall) from each wall's area
+// F)/max(1, n) (gain_kn = gain*(dt/servo_dt)/R, R = kn_wall without contact
+// damping: lammps_loading_derived) from each wall's area
 // (fix servo_len: the box's length across the wall, times H), contacts
 // (c_csn) and force on the spheres along +axis (c_csf), the max walls'
 // elements with the opposite sign (f_servo_sign), so that the clamp of each
@@ -280,10 +286,15 @@ void lammps_3d_limitations(std::ostream& s, const SceneConfig& c, const Algorith
     << "#  - damping explicit (fix viscous) vs demcal's semi-implicit: the factor f.\n"
     << "#  - servo walls are not native: each lateral wall is a wall/gran/region plane\n"
     << "#    whose displacement is the running sum of demcal's per-step servo move\n"
-    << "#    gain*(sigma3*A - F)/(kn_wall*max(1, n)), capped at 2 % of r_min (A the\n"
+    << "#    gain*(sigma3*A - F)/(" << resist_name(plan)
+    << "*max(1, n)), capped at 2 % of r_min (A the\n"
     << "#    wall's current area, F its force, n its contacts), kept by fix ave/time\n"
-    << "#    (running mean times the step); one run command only (no restart split).\n"
-    << "#  - LAMMPS takes a contact's torque at the lever arm r_i (demcal r_i - delta/2):\n"
+    << "#    (running mean times the step); one run command only (no restart split).\n";
+  if (plan.wall_dashpot > 0.0)
+    s << "#    R = kn_wall + c_wall/servo_dt: demcal's wall contacts resist a move\n"
+      << "#    within its step by their dashpots too (contact damping; c_wall and\n"
+      << "#    resist in the derived block).\n";
+  s << "#  - LAMMPS takes a contact's torque at the lever arm r_i (demcal r_i - delta/2):\n"
     << "#    the antisymmetric part of s carries a small static term.\n"
     << "#  - a sphere's velocities and the tangential springs start at zero.\n"
     << "#  - each wall acts on the band of spheres near it (see the walls): fix halt\n"
@@ -368,9 +379,9 @@ std::vector<deck::ConsolidationWall> consolidation_walls() {
 }
 
 /// The six walls servoed at sigma3 with demcal's per-step law (triaxial.cpp
-/// servo_velocity: gain*(sigma3*A - F)/(kn_wall*max(1, n)), cap 2 % of
-/// r_min, A the wall's current area), light damping, the criterion, the
-/// runs and the start walls of the loading.
+/// servo_velocity: gain*(sigma3*A - F)/(R*max(1, n)), R = kn_wall + c/dt
+/// (servo_resistance), cap 2 % of r_min, A the wall's current area), light
+/// damping, the criterion, the runs and the start walls of the loading.
 void lammps_3d_consolidation(std::ostream& s, const SceneConfig& c, const Plan3& plan) {
   const double zeta = kConsolidationDampingRatio;
   // demcal's consolidation step: alpha of AlgorithmSpec{} (0.2), the
@@ -393,8 +404,13 @@ void lammps_3d_consolidation(std::ostream& s, const SceneConfig& c, const Plan3&
   s << "\n# --- stage 1: consolidation to isotropic sigma3 -------------------------------\n"
     << "# demcal's consolidation (demcal export --consolidate-in deck), run here so\n"
     << "# that it scales under MPI: all six walls servoed with the loading's law (each\n"
-    << "# wall: move = gain*(sigma3*A - F)/(kn_wall*max(1, n)) per step, A its current\n"
-    << "# area, cap 2 % of r_min), global damping zeta " << num(zeta)
+    << "# wall: move = gain*(sigma3*A - F)/(" << resist_name(plan) << "*max(1, n)) per step, ";
+  if (plan.wall_dashpot > 0.0)
+    s << "R = kn_wall +\n"
+      << "# c/dt, c the wall dashpots' (the number in cons_rawv), A its current\n";
+  else
+    s << "A its current\n";
+  s << "# area, cap 2 % of r_min), global damping zeta " << num(zeta)
     << " on translation (demcal also\n"
     << "# damps rotation; this LAMMPS cannot), particle friction 0 until static, then\n"
     << "# mu until static again; critical damping (zeta 1, timestep * f(1)/f(" << num(zeta)
@@ -443,7 +459,7 @@ void lammps_3d_consolidation(std::ostream& s, const SceneConfig& c, const Plan3&
   for (int a = 0; a < 3; ++a)
     s << "variable        cons_A" << kAxis[a] << " equal v_cons_L" << kAxis[(a + 1) % 3]
       << "*v_cons_L" << kAxis[(a + 2) % 3] << "\n";
-  // each wall's move gain*(sigma3*A - F)/(kn_wall*max(1, n)), A its axis's
+  // each wall's move gain*(sigma3*A - F)/(R*max(1, n)), A its axis's
   // current area, in one vector formula (deck::lammps_consolidation_servo)
   // (R = kn_wall + c/dt with the wall dashpots: demcal's servo_resistance)
   const std::string resist =
@@ -646,11 +662,14 @@ void lammps_3d_series(std::ostream& s, const SceneConfig& c, const AlgorithmSpec
 }
 
 // The servo's per-step moves, then the run and the peaks printed.
-void lammps_3d_servo_and_run(std::ostream& s) {
+void lammps_3d_servo_and_run(std::ostream& s, const Plan3& plan) {
   s << "# --- servo -------------------------------------------------------------------\n"
     << "# demcal's servo, one move per step and wall toward the sample when p < sigma3:\n"
-    << "#   move = gain*(sigma3*A - F)/(kn_wall*max(1, n)), clamped to +-cap,\n"
-    << "# A = the wall's current area, F its force, n its contacts (compute csn, csf),\n"
+    << "#   move = gain*(sigma3*A - F)/(" << resist_name(plan)
+    << "*max(1, n)), clamped to +-cap,\n";
+  if (plan.wall_dashpot > 0.0)
+    s << "# R = kn_wall + c_wall/servo_dt (the wall dashpots too: resist, derived block),\n";
+  s << "# A = the wall's current area, F its force, n its contacts (compute csn, csf),\n"
     << "# per demcal step (servo_dt), so per step of dt that times dt/servo_dt:\n"
     << "# gain_kn*(sigma3*A - F)/max(1, n) within +-cap_step (derived block).\n"
     << "# The four walls in one vector-style formula (elements xmin xmax ymin ymax;\n"
@@ -701,7 +720,7 @@ std::string lammps_deck(const SceneConfig& c, const AlgorithmSpec& p, const Plan
   lammps_3d_walls(s, p, plan);
   lammps_3d_measures(s, p, plan);
   lammps_3d_series(s, c, p, plan);
-  lammps_3d_servo_and_run(s);
+  lammps_3d_servo_and_run(s, plan);
   return s.str();
 }
 
@@ -945,8 +964,7 @@ void liggghts_3d_lateral_walls(std::ostream& s, const SceneConfig& c, const Plan
 /// set between them from its current contacts (deck::liggghts_servo_run);
 /// one run without.
 void liggghts_3d_run(std::ostream& s, const SceneConfig& c, const Plan3& plan,
-                     const Export3dOptions& o, double cap, int monitor_every,
-                     const std::string& resist_name) {
+                     const Export3dOptions& o, double cap, int monitor_every) {
   if (!o.lateral_servo) {
     s << "run ${run_steps}\n";
     return;
@@ -954,9 +972,9 @@ void liggghts_3d_run(std::ostream& s, const SceneConfig& c, const Plan3& plan,
   std::vector<deck::LiggghtsServoWall> walls;
   for (int sd = 0; sd < 4; ++sd)
     walls.push_back({std::string("m") + kWall[sd], std::string("ft_") + kWall[sd],
-                     "t" + std::to_string(sd) + "_a"});
+                     std::string("t") + std::to_string(sd) + "_a"});
   s << deck::liggghts_servo_run(walls, c.test.servo_gain, plan.servo_resist, cap, monitor_every,
-                                exact, resist_name);
+                                exact, resist_name(plan));
 }
 
 std::string liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p, const Plan3& plan,
@@ -974,7 +992,6 @@ std::string liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p, const Pl
   const double cap = 0.02 * plan.r_min;
   // R: kn_wall, and the wall dashpots' c/dt_demcal with contact damping
   const bool dashpots = plan.wall_dashpot > 0.0;
-  const std::string resist_name = dashpots ? "R" : "kn_wall";
   std::ostringstream s;
   s << mapping_header(c, p, plan, o, "LIGGGHTS");
   s << "#\n# Checked with LIGGGHTS 3.8 (Debian). Differences from demcal:\n"
@@ -984,8 +1001,8 @@ std::string liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p, const Pl
     << "#    target (the force on the mesh along +axis: positive on a min wall).\n"
     << "#    LIGGGHTS moves it at vel_max*kp*(F_target - F)/|F_target|: vel_max =\n"
     << "#    cap/dt_demcal (dt_demcal = dt/f, demcal's step) and kp =\n"
-    << "#    gain*|F_target|/(" << resist_name << "*max(1, n)*cap), n the wall's current "
-    << "contacts,\n#    give demcal's wall velocity gain*(F_target - F)/(" << resist_name
+    << "#    gain*|F_target|/(" << resist_name(plan) << "*max(1, n)*cap), n the wall's current "
+    << "contacts,\n#    give demcal's wall velocity gain*(F_target - F)/(" << resist_name(plan)
     << "*max(1, n)*dt_demcal)\n"
     << "#    and its cap";
   if (dashpots)
@@ -1047,7 +1064,7 @@ std::string liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p, const Pl
        "v_Wy\n"
     << "thermo ${thermo_every}\n"
     << "variable run_steps index " << plan.steps << "\n";
-  liggghts_3d_run(s, c, plan, o, cap, monitor_every, resist_name);
+  liggghts_3d_run(s, c, plan, o, cap, monitor_every);
   return s.str();
 }
 
