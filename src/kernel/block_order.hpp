@@ -16,15 +16,17 @@ namespace demcal::detail {
 /// particles and pads their half rows (neighbours of higher index) and
 /// mirror rows (lower index) to the longest of the block; each window of 64
 /// consecutive particles (locality kept) is ordered so that the particles
-/// of a block have as many neighbours on either side.
+/// of a block have as many neighbours on either side. The identity unless
+/// that order needs fewer slot rows (block_slot_rows) than the current
+/// numbering: a greedy order can lose to one that is already regular.
 std::vector<int> block_friendly_order(int n, std::span<const int> pair_i,
                                       std::span<const int> pair_j);
 
 /// The slots the pair pass evaluates per lane under `order` (as
 /// block_friendly_order returns it): over the blocks of 8 new indices, the
-/// longest half row plus the longest mirror row. The greedy order of
-/// block_friendly_order can lose to a numbering that is already regular (a
-/// lattice in lattice order): compare with the identity's.
+/// longest half row plus the longest mirror row: what block_friendly_order
+/// compares its greedy order and the identity (a lattice in lattice order)
+/// by.
 long block_slot_rows(int n, std::span<const int> pair_i, std::span<const int> pair_j,
                      std::span<const int> order);
 

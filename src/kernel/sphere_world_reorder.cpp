@@ -24,16 +24,7 @@ std::vector<int> SphereWorldImpl::block_friendly_order() const {
   std::vector<int> pair_i(nbr_j_.size());
   for (int i = 0; i < n_; ++i)
     std::fill(pair_i.begin() + nbr_start_[i], pair_i.begin() + nbr_start_[i + 1], i);
-  // The current numbering where the greedy order would not fill the blocks
-  // better (the FCC lattice in lattice order: 2.39 slots per pair, the
-  // greedy order 2.53).
-  std::vector<int> order = detail::block_friendly_order(n_, pair_i, nbr_j_);
-  std::vector<int> identity(n_);
-  for (int i = 0; i < n_; ++i) identity[i] = i;
-  if (detail::block_slot_rows(n_, pair_i, nbr_j_, order) >=
-      detail::block_slot_rows(n_, pair_i, nbr_j_, identity))
-    return identity;
-  return order;
+  return detail::block_friendly_order(n_, pair_i, nbr_j_);
 }
 
 void SphereWorldImpl::reorder(std::span<const int> order) {
