@@ -11,7 +11,11 @@
 #include <map>
 #include <numeric>
 #include <random>
+#include <stdexcept>
+#include <string>
+#include <vector>
 
+#include "test_bad_orders.hpp"
 #include "test_kernel_helpers.hpp"
 
 namespace demcal {
@@ -98,6 +102,45 @@ TEST(KernelReorder, BlockFriendlyOrderFillsTheBlocksAndRejectsBadOrders) {
   RecordProperty("fill_after", std::to_string(after));
   EXPECT_THROW(w.reorder(std::vector<int>(w.size(), 0)), std::invalid_argument);
   EXPECT_THROW(w.reorder(std::vector<int>(w.size() - 1, 0)), std::invalid_argument);
+}
+
+// An order that is not a permutation of 0 … n − 1 (a repeat, an index out
+// of range, a wrong length) is refused with the reason, the world untouched.
+TEST(KernelReorder, RefusesOrdersThatAreNotPermutations) {
+  auto scene = kernel_test::random_loose_scene(6, 5, 3);
+  World w = scene.make(kernel_test::reference_material(0.3));
+  const std::vector<double> x(w.x().begin(), w.x().end()), y(w.y().begin(), w.y().end());
+  for (const auto& [reason, order] : reorder_test::bad_orders(w.size())) {
+    try {
+      w.reorder(order);
+      ADD_FAILURE() << "accepted an order of " << order.size() << " entries (" << reason << ")";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_EQ(std::string(e.what()), "WorldImpl::reorder" + reason);
+    }
+  }
+  EXPECT_TRUE(std::equal(x.begin(), x.end(), w.x().begin()));
+  EXPECT_TRUE(std::equal(y.begin(), y.end(), w.y().begin()));
+}
+
+// A hexagonal lattice in lattice order fills the blocks better than the
+// greedy order would (configs/hex_10x10: 74 slot rows against 82): the
+// numbering is kept. Shuffled, the same lattice is renumbered, and the
+// blocks fill better for it.
+TEST(KernelReorder, BlockFriendlyOrderKeepsALatticesOwnNumbering) {
+  World w = kernel_test::hex_scene(10, 10).make(kernel_test::reference_material(0.3));
+  w.update_forces();
+  std::vector<int> identity(w.size());
+  std::iota(identity.begin(), identity.end(), 0);
+  EXPECT_EQ(w.block_friendly_order(), identity);
+
+  std::vector<int> shuffled = identity;
+  std::shuffle(shuffled.begin(), shuffled.end(), std::mt19937(3));
+  w.reorder(shuffled);
+  const std::vector<int> order = w.block_friendly_order();
+  EXPECT_NE(order, identity);
+  const double before = w.neighbour_slot_fill();
+  w.reorder(order);
+  EXPECT_GT(w.neighbour_slot_fill(), before);
 }
 
 }  // namespace

@@ -20,6 +20,7 @@
 
 #include "demcal/scene/config.hpp"
 #include "demcal/scene/sphere_packing.hpp"
+#include "test_bad_orders.hpp"
 #include "test_sphere_helpers.hpp"
 
 namespace demcal {
@@ -223,6 +224,31 @@ TEST(SphereReorder, BlockFriendlyOrderFillsTheBlocksAndRejectsBadOrders) {
               w.neighbour_slot_fill(), mirror, w.mirror_slot_fill());
   EXPECT_THROW(w.reorder(std::vector<int>(w.size(), 0)), std::invalid_argument);
   EXPECT_THROW(w.reorder(std::vector<int>(w.size() - 1, 0)), std::invalid_argument);
+}
+
+// An order that is not a permutation of 0 … n − 1 (a repeat, an index out
+// of range, a wrong length) is refused with the reason, the world untouched.
+TEST(SphereReorder, RefusesOrdersThatAreNotPermutations) {
+  AssemblySpec spec;
+  spec.type = "random";
+  spec.count = 40;
+  spec.radius_min = 0.75 * sphere_test::kR;
+  spec.radius_max = 1.25 * sphere_test::kR;
+  spec.seed = 4;
+  const SphereAssembly a = random_sphere_gas(spec);
+  SphereWorld w(sphere_test::test_material(0.3), a.x, a.y, a.z, a.r, a.lo, a.hi);
+  for (const auto& [reason, order] : reorder_test::bad_orders(w.size())) {
+    try {
+      w.reorder(order);
+      ADD_FAILURE() << "accepted an order of " << order.size() << " entries (" << reason << ")";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_EQ(std::string(e.what()), "SphereWorld::reorder" + reason);
+    }
+  }
+  for (int i = 0; i < w.size(); ++i) {
+    EXPECT_EQ(w.x()[i], a.x[i]);
+    EXPECT_EQ(w.z()[i], a.z[i]);
+  }
 }
 
 }  // namespace

@@ -1,9 +1,11 @@
 // The particle order that fills the kernels' SIMD blocks, one algorithm for
-// both (World::block_friendly_order, SphereWorld::block_friendly_order).
-// Private to src/kernel, like kernel_detail.hpp.
+// both (World::block_friendly_order, SphereWorld::block_friendly_order), and
+// the check and inversion of an order both reorder()s take. Private to
+// src/kernel, like kernel_detail.hpp.
 #pragma once
 
 #include <span>
+#include <string_view>
 #include <vector>
 
 namespace demcal::detail {
@@ -14,16 +16,25 @@ namespace demcal::detail {
 /// particles and pads their half rows (neighbours of higher index) and
 /// mirror rows (lower index) to the longest of the block; each window of 64
 /// consecutive particles (locality kept) is ordered so that the particles
-/// of a block have as many neighbours on either side.
+/// of a block have as many neighbours on either side. The identity unless
+/// that order needs fewer slot rows (block_slot_rows) than the current
+/// numbering: a greedy order can lose to one that is already regular.
 std::vector<int> block_friendly_order(int n, std::span<const int> pair_i,
                                       std::span<const int> pair_j);
 
 /// The slots the pair pass evaluates per lane under `order` (as
 /// block_friendly_order returns it): over the blocks of 8 new indices, the
-/// longest half row plus the longest mirror row. The greedy order of
-/// block_friendly_order can lose to a numbering that is already regular (a
-/// lattice in lattice order): compare with the identity's.
+/// longest half row plus the longest mirror row: what block_friendly_order
+/// compares its greedy order and the identity (a lattice in lattice order)
+/// by.
 long block_slot_rows(int n, std::span<const int> pair_i, std::span<const int> pair_j,
                      std::span<const int> order);
+
+/// The inverse of an order for reorder() of n particles: new_index[order[k]]
+/// = k. Throws std::invalid_argument, its message starting with `caller`
+/// ("<caller>: order must list every particle once" unless order has n
+/// entries, "<caller>: order is not a permutation" for an entry out of
+/// 0 … n − 1 or repeated).
+std::vector<int> inverse_permutation(int n, std::span<const int> order, std::string_view caller);
 
 }  // namespace demcal::detail

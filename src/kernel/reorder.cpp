@@ -2,7 +2,6 @@
 // SIMD blocks (WorldImpl::block_friendly_order, block_order.cpp). See
 // world.hpp.
 #include <algorithm>
-#include <stdexcept>
 #include <tuple>
 #include <vector>
 
@@ -29,15 +28,7 @@ std::vector<int> WorldImpl::block_friendly_order() const {
 
 void WorldImpl::reorder(std::span<const int> order) {
   const int n = n_;
-  if (static_cast<int>(order.size()) != n)
-    throw std::invalid_argument("WorldImpl::reorder: order must list every particle once");
-  std::vector<int> new_index(n, -1);
-  for (int k = 0; k < n; ++k) {
-    const int i = order[k];
-    if (i < 0 || i >= n || new_index[i] >= 0)
-      throw std::invalid_argument("WorldImpl::reorder: order is not a permutation");
-    new_index[i] = k;
-  }
+  const std::vector<int> new_index = detail::inverse_permutation(n, order, "WorldImpl::reorder");
 
   // Contact histories by pair (i, j), i < j in the new numbering (the
   // scalar tangential force is the same seen from either side).

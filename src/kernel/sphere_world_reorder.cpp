@@ -2,7 +2,6 @@
 // fills the SIMD blocks (block_friendly_order, block_order.cpp), as
 // reorder.cpp is for the 2D kernel. See sphere_world.hpp.
 #include <algorithm>
-#include <stdexcept>
 #include <tuple>
 #include <vector>
 
@@ -25,29 +24,12 @@ std::vector<int> SphereWorldImpl::block_friendly_order() const {
   std::vector<int> pair_i(nbr_j_.size());
   for (int i = 0; i < n_; ++i)
     std::fill(pair_i.begin() + nbr_start_[i], pair_i.begin() + nbr_start_[i + 1], i);
-  // The current numbering where the greedy order would not fill the blocks
-  // better (the FCC lattice in lattice order: 2.39 slots per pair, the
-  // greedy order 2.53).
-  std::vector<int> order = detail::block_friendly_order(n_, pair_i, nbr_j_);
-  std::vector<int> identity(n_);
-  for (int i = 0; i < n_; ++i) identity[i] = i;
-  if (detail::block_slot_rows(n_, pair_i, nbr_j_, order) >=
-      detail::block_slot_rows(n_, pair_i, nbr_j_, identity))
-    return identity;
-  return order;
+  return detail::block_friendly_order(n_, pair_i, nbr_j_);
 }
 
 void SphereWorldImpl::reorder(std::span<const int> order) {
   const int n = n_;
-  if (static_cast<int>(order.size()) != n)
-    throw std::invalid_argument("SphereWorld::reorder: order must list every particle once");
-  std::vector<int> new_index(n, -1);
-  for (int k = 0; k < n; ++k) {
-    const int i = order[k];
-    if (i < 0 || i >= n || new_index[i] >= 0)
-      throw std::invalid_argument("SphereWorld::reorder: order is not a permutation");
-    new_index[i] = k;
-  }
+  const std::vector<int> new_index = detail::inverse_permutation(n, order, "SphereWorld::reorder");
   // The identity changes nothing (not even the last bits of the forces).
   bool identity = true;
   for (int k = 0; k < n && identity; ++k) identity = order[k] == k;

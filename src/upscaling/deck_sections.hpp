@@ -313,9 +313,8 @@ struct LiggghtsServoWall {
 /// moves at demcal's velocity gain·(F_target − F)/(kn_wall·max(1, n)·Δt_demcal),
 /// capped at demcal's cap/Δt_demcal: over the same loading time, demcal's
 /// servo (per engine step: f times demcal's per-step move). `resist` is
-/// the R demcal's servo divides by in place of kn_wall: the 2D servo's
-/// kn_wall + c/Δt_demcal with contact damping (servo_resistance,
-/// scene/biaxial.hpp), the 3D one's kn_wall.
+/// the R demcal's servo divides by in place of kn_wall: kn_wall + c/Δt_demcal
+/// with contact damping, 2D and 3D (servo_resistance, scene/biaxial.hpp).
 double liggghts_servo_vel_max(double cap, double dt, double step_factor);
 double liggghts_servo_kp(double gain, double force_target, double resist, int contacts, double cap);
 

@@ -155,6 +155,11 @@ Plan3 make_plan(const SceneConfig& c, const AlgorithmSpec& p, const SphereWorld&
   return plan;
 }
 
+/// How the decks' comments name the servo's R (demcal's servo_resistance):
+/// "kn_wall" without contact damping (R = kn_wall: the decks read as before
+/// the wall dashpots), "R" with them (a comment then defines it).
+std::string resist_name(const Plan3& plan) { return plan.wall_dashpot > 0.0 ? "R" : "kn_wall"; }
+
 ExportResult result_of(const Plan3& plan) {
   return deck::plan_result(plan.dt, plan.steps, plan.step_factor, plan.types, plan.class_error);
 }
@@ -260,7 +265,8 @@ std::string area_y() { return std::string(kLx) + "*" + kH; }
 std::string area_z() { return std::string(kLx) + "*" + kLy; }
 // The four lateral walls' unclamped servo moves toward the sample, one
 // vector-style formula (elements xmin xmax ymin ymax): gain_kn*(sigma3*A -
-// F)/max(1, n) (gain_kn = gain*(dt/servo_dt)/kn_wall) from each wall's area
+// F)/max(1, n) (gain_kn = gain*(dt/servo_dt)/R, R = kn_wall without contact
+// damping: lammps_loading_derived) from each wall's area
 // (fix servo_len: the box's length across the wall, times H), contacts
 // (c_csn) and force on the spheres along +axis (c_csf), the max walls'
 // elements with the opposite sign (f_servo_sign), so that the clamp of each
@@ -282,10 +288,15 @@ void lammps_3d_limitations(std::ostream& s, const SceneConfig& c, const Algorith
     << "#  - damping explicit (fix viscous) vs demcal's semi-implicit: the factor f.\n"
     << "#  - servo walls are not native: each lateral wall is a wall/gran/region plane\n"
     << "#    whose displacement is the running sum of demcal's per-step servo move\n"
-    << "#    gain*(sigma3*A - F)/(kn_wall*max(1, n)), capped at 2 % of r_min (A the\n"
+    << "#    gain*(sigma3*A - F)/(" << resist_name(plan)
+    << "*max(1, n)), capped at 2 % of r_min (A the\n"
     << "#    wall's current area, F its force, n its contacts), kept by fix ave/time\n"
-    << "#    (running mean times the step); one run command only (no restart split).\n"
-    << "#  - LAMMPS takes a contact's torque at the lever arm r_i (demcal r_i - delta/2):\n"
+    << "#    (running mean times the step); one run command only (no restart split).\n";
+  if (plan.wall_dashpot > 0.0)
+    s << "#    R = kn_wall + c_wall/servo_dt: demcal's wall contacts resist a move\n"
+      << "#    within its step by their dashpots too (contact damping; c_wall and\n"
+      << "#    resist in the derived block).\n";
+  s << "#  - LAMMPS takes a contact's torque at the lever arm r_i (demcal r_i - delta/2):\n"
     << "#    the antisymmetric part of s carries a small static term.\n"
     << "#  - a sphere's velocities and the tangential springs start at zero.\n"
     << "#  - each wall acts on the band of spheres near it (see the walls): fix halt\n"
@@ -374,9 +385,9 @@ std::vector<deck::ConsolidationWall> consolidation_walls() {
 }
 
 /// The six walls servoed at sigma3 with demcal's per-step law (triaxial.cpp
-/// servo_velocity: gain*(sigma3*A - F)/(kn_wall*max(1, n)), cap 2 % of
-/// r_min, A the wall's current area), light damping, the criterion, the
-/// runs and the start walls of the loading.
+/// servo_velocity: gain*(sigma3*A - F)/(R*max(1, n)), R = kn_wall + c/dt
+/// (servo_resistance), cap 2 % of r_min, A the wall's current area), light
+/// damping, the criterion, the runs and the start walls of the loading.
 void lammps_3d_consolidation(std::ostream& s, const SceneConfig& c, const Plan3& plan) {
   const double zeta = kConsolidationDampingRatio;
   // demcal's consolidation step: alpha of AlgorithmSpec{} (0.2), the
@@ -399,8 +410,13 @@ void lammps_3d_consolidation(std::ostream& s, const SceneConfig& c, const Plan3&
   s << "\n# --- stage 1: consolidation to isotropic sigma3 -------------------------------\n"
     << "# demcal's consolidation (demcal export --consolidate-in deck), run here so\n"
     << "# that it scales under MPI: all six walls servoed with the loading's law (each\n"
-    << "# wall: move = gain*(sigma3*A - F)/(kn_wall*max(1, n)) per step, A its current\n"
-    << "# area, cap 2 % of r_min), global damping zeta " << num(zeta)
+    << "# wall: move = gain*(sigma3*A - F)/(" << resist_name(plan) << "*max(1, n)) per step, ";
+  if (plan.wall_dashpot > 0.0)
+    s << "R = kn_wall +\n"
+      << "# c/dt, c the wall dashpots' (the number in cons_rawv), A its current\n";
+  else
+    s << "A its current\n";
+  s << "# area, cap 2 % of r_min), global damping zeta " << num(zeta)
     << " on translation (demcal also\n"
     << "# damps rotation; this LAMMPS cannot), particle friction 0 until static, then\n"
     << "# mu until static again; critical damping (zeta 1, timestep * f(1)/f(" << num(zeta)
@@ -449,7 +465,7 @@ void lammps_3d_consolidation(std::ostream& s, const SceneConfig& c, const Plan3&
   for (int a = 0; a < 3; ++a)
     s << "variable        cons_A" << kAxis[a] << " equal v_cons_L" << kAxis[(a + 1) % 3]
       << "*v_cons_L" << kAxis[(a + 2) % 3] << "\n";
-  // each wall's move gain*(sigma3*A - F)/(kn_wall*max(1, n)), A its axis's
+  // each wall's move gain*(sigma3*A - F)/(R*max(1, n)), A its axis's
   // current area, in one vector formula (deck::lammps_consolidation_servo)
   // (R = kn_wall + c/dt with the wall dashpots: demcal's servo_resistance)
   const std::string resist =
@@ -652,11 +668,14 @@ void lammps_3d_series(std::ostream& s, const SceneConfig& c, const AlgorithmSpec
 }
 
 // The servo's per-step moves, then the run and the peaks printed.
-void lammps_3d_servo_and_run(std::ostream& s) {
+void lammps_3d_servo_and_run(std::ostream& s, const Plan3& plan) {
   s << "# --- servo -------------------------------------------------------------------\n"
     << "# demcal's servo, one move per step and wall toward the sample when p < sigma3:\n"
-    << "#   move = gain*(sigma3*A - F)/(kn_wall*max(1, n)), clamped to +-cap,\n"
-    << "# A = the wall's current area, F its force, n its contacts (compute csn, csf),\n"
+    << "#   move = gain*(sigma3*A - F)/(" << resist_name(plan)
+    << "*max(1, n)), clamped to +-cap,\n";
+  if (plan.wall_dashpot > 0.0)
+    s << "# R = kn_wall + c_wall/servo_dt (the wall dashpots too: resist, derived block),\n";
+  s << "# A = the wall's current area, F its force, n its contacts (compute csn, csf),\n"
     << "# per demcal step (servo_dt), so per step of dt that times dt/servo_dt:\n"
     << "# gain_kn*(sigma3*A - F)/max(1, n) within +-cap_step (derived block).\n"
     << "# The four walls in one vector-style formula (elements xmin xmax ymin ymax;\n"
@@ -707,7 +726,7 @@ std::string lammps_deck(const SceneConfig& c, const AlgorithmSpec& p, const Plan
   lammps_3d_walls(s, p, plan);
   lammps_3d_measures(s, p, plan);
   lammps_3d_series(s, c, p, plan);
-  lammps_3d_servo_and_run(s);
+  lammps_3d_servo_and_run(s, plan);
   return s.str();
 }
 
@@ -872,16 +891,16 @@ std::string liggghts_3d_series(const SceneConfig& c, const AlgorithmSpec& p, con
   return s.str();
 }
 
-std::string liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p, const Plan3& plan,
-                          const Export3dOptions& o, const SphereWorld& w, ExportResult& out) {
-  const auto& m = c.material;
-  const int wall_type = plan.types + 1, ntypes = plan.types + 1;
+/// The particle file's box and the six walls' meshes (the files go to
+/// `out`): the top (normal −z) and the bottom a little wider than the box;
+/// the lateral walls from below the bottom to above the top, a little wider
+/// than the box (the meshes cross at the edges; they do not touch each
+/// other). Returns the mesh files by wall, kWall's order (xmin xmax ymin
+/// ymax), then top, bottom.
+std::array<std::string, 6> liggghts_3d_meshes(const Plan3& plan, const Export3dOptions& o,
+                                              ExportResult& out) {
   const std::array<double, 3> ext{plan.hi[0] - plan.lo[0], plan.hi[1] - plan.lo[1],
                                   plan.hi[2] - plan.lo[2]};
-  out.files[o.data_name] = data_file("LIGGGHTS", c, plan, w, ntypes, "Atoms");
-  // Meshes: the top (normal −z) a little wider than the box; the lateral
-  // walls from below the bottom to above the top, a little wider than the
-  // box (the meshes cross at the edges; they do not touch each other).
   const std::string stem = o.data_name.substr(0, o.data_name.rfind('.'));
   const double mx = 0.1 * ext[0] + 2 * plan.r_max, my = 0.1 * ext[1] + 2 * plan.r_max;
   const double mz = 0.1 * ext[2] + 2 * plan.r_max;
@@ -903,16 +922,82 @@ std::string liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p, const Pl
                                           V3(ext[0] + 2 * mx, 0, 0), V3(0, ext[1] + 2 * my, 0));
   out.files[mesh_file[4]] = stl_rectangle("top", V3(lo.x() - mx, lo.y() - my, hi.z()),
                                           V3(0, ext[1] + 2 * my, 0), V3(ext[0] + 2 * mx, 0, 0));
+  return mesh_file;
+}
+
+/// The four lateral walls' meshes: servo meshes holding sigma3 on the
+/// wall's current area (demcal's law, deck::liggghts_servo_kp and vel_max;
+/// kp at the start from the contacts demcal counts), or fixed meshes
+/// without the lateral servo.
+void liggghts_3d_lateral_walls(std::ostream& s, const SceneConfig& c, const Plan3& plan,
+                               const Export3dOptions& o,
+                               const std::array<std::string, 6>& mesh_file, int wall_type,
+                               double cap) {
+  const double vel_max = deck::liggghts_servo_vel_max(cap, plan.dt, plan.step_factor);
+  const std::array<double, 3> ext{plan.hi[0] - plan.lo[0], plan.hi[1] - plan.lo[1],
+                                  plan.hi[2] - plan.lo[2]};
+  const Eigen::Vector3d centre(0.5 * (plan.lo[0] + plan.hi[0]), 0.5 * (plan.lo[1] + plan.hi[1]),
+                               0.5 * (plan.lo[2] + plan.hi[2]));
+  for (int sd = 0; sd < 4; ++sd) {
+    const int a = sd / 2;
+    const double area = ext[(a + 1) % 3] * ext[(a + 2) % 3];
+    const double target = c.test.lateral_stress * area;
+    const double kp = deck::liggghts_servo_kp(c.test.servo_gain, target, plan.servo_resist,
+                                              plan.wall_contacts[sd], cap);
+    Eigen::Vector3d com = centre;
+    com[a] = sd % 2 == 0 ? plan.lo[a] : plan.hi[a];
+    if (o.lateral_servo) {
+      // sigma3 on the wall's current area: the other lateral axis' width
+      // (its servo meshes' positions) times the height
+      const int b = 1 - a;
+      s << "variable ft_" << kWall[sd] << " equal " << (sd % 2 == 0 ? "" : "-")
+        << exact(c.test.lateral_stress) << "*(f_m" << kWall[2 * b + 1] << "[" << 7 + b << "]-f_m"
+        << kWall[2 * b] << "[" << 7 + b << "])*(" << exact(ext[2]) << "-" << exact(plan.top_speed)
+        << "*step*" << exact(plan.dt) << ")\n";
+      s << "fix m" << kWall[sd] << " all mesh/surface/stress/servo file " << mesh_file[sd]
+        << " type " << wall_type << " com " << exact(com.x()) << " " << exact(com.y()) << " "
+        << exact(com.z()) << " ctrlPV force axis " << (a == 0 ? "1 0 0" : "0 1 0")
+        << " target_val v_ft_" << kWall[sd] << " vel_max " << exact(vel_max) << " kp " << exact(kp)
+        << "\n";
+    } else {
+      s << "fix m" << kWall[sd] << " all mesh/surface/stress file " << mesh_file[sd] << " type "
+        << wall_type << "\n";
+    }
+  }
+}
+
+/// The loading run: with the lateral servo in chunks, each servo mesh's kp
+/// set between them from its current contacts (deck::liggghts_servo_run);
+/// one run without.
+void liggghts_3d_run(std::ostream& s, const SceneConfig& c, const Plan3& plan,
+                     const Export3dOptions& o, double cap, int monitor_every) {
+  if (!o.lateral_servo) {
+    s << "run ${run_steps}\n";
+    return;
+  }
+  std::vector<deck::LiggghtsServoWall> walls;
+  for (int sd = 0; sd < 4; ++sd)
+    walls.push_back({std::string("m") + kWall[sd], std::string("ft_") + kWall[sd],
+                     std::string("t") + std::to_string(sd) + "_a"});
+  s << deck::liggghts_servo_run(walls, c.test.servo_gain, plan.servo_resist, cap, monitor_every,
+                                exact, resist_name(plan));
+}
+
+std::string liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p, const Plan3& plan,
+                          const Export3dOptions& o, const SphereWorld& w, ExportResult& out) {
+  const auto& m = c.material;
+  const int wall_type = plan.types + 1, ntypes = plan.types + 1;
+  const double h0 = plan.hi[2] - plan.lo[2];
+  out.files[o.data_name] = data_file("LIGGGHTS", c, plan, w, ntypes, "Atoms");
+  const std::array<std::string, 6> mesh_file = liggghts_3d_meshes(plan, o, out);
 
   // Servo: demcal's law over the same loading time (deck::liggghts_servo_kp
   // and vel_max), the gain from each wall's current contacts, set between
   // chunks of the run (deck::liggghts_servo_run); at the start from the
   // contacts demcal counts.
   const double cap = 0.02 * plan.r_min;
-  const double vel_max = deck::liggghts_servo_vel_max(cap, plan.dt, plan.step_factor);
   // R: kn_wall, and the wall dashpots' c/dt_demcal with contact damping
   const bool dashpots = plan.wall_dashpot > 0.0;
-  const std::string resist_name = dashpots ? "R" : "kn_wall";
   std::ostringstream s;
   s << mapping_header(c, p, plan, o, "LIGGGHTS");
   s << "#\n# Checked with LIGGGHTS 3.8 (Debian). Differences from demcal:\n"
@@ -922,8 +1007,8 @@ std::string liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p, const Pl
     << "#    target (the force on the mesh along +axis: positive on a min wall).\n"
     << "#    LIGGGHTS moves it at vel_max*kp*(F_target - F)/|F_target|: vel_max =\n"
     << "#    cap/dt_demcal (dt_demcal = dt/f, demcal's step) and kp =\n"
-    << "#    gain*|F_target|/(" << resist_name << "*max(1, n)*cap), n the wall's current "
-    << "contacts,\n#    give demcal's wall velocity gain*(F_target - F)/(" << resist_name
+    << "#    gain*|F_target|/(" << resist_name(plan) << "*max(1, n)*cap), n the wall's current "
+    << "contacts,\n#    give demcal's wall velocity gain*(F_target - F)/(" << resist_name(plan)
     << "*max(1, n)*dt_demcal)\n"
     << "#    and its cap";
   if (dashpots)
@@ -953,33 +1038,7 @@ std::string liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p, const Pl
     << deck::liggghts_materials(m, plan.class_mass, plan.dt, exact)
     << "fix mbottom all mesh/surface/stress file " << mesh_file[5] << " type " << wall_type << "\n"
     << "fix mtop all mesh/surface/stress file " << mesh_file[4] << " type " << wall_type << "\n";
-  const V3 centre = 0.5 * (lo + hi);
-  for (int sd = 0; sd < 4; ++sd) {
-    const int a = sd / 2;
-    const double area = ext[(a + 1) % 3] * ext[(a + 2) % 3];
-    const double target = c.test.lateral_stress * area;
-    const double kp = deck::liggghts_servo_kp(c.test.servo_gain, target, plan.servo_resist,
-                                              plan.wall_contacts[sd], cap);
-    V3 com = centre;
-    com[a] = sd % 2 == 0 ? plan.lo[a] : plan.hi[a];
-    if (o.lateral_servo) {
-      // sigma3 on the wall's current area: the other lateral axis' width
-      // (its servo meshes' positions) times the height
-      const int b = 1 - a;
-      s << "variable ft_" << kWall[sd] << " equal " << (sd % 2 == 0 ? "" : "-")
-        << exact(c.test.lateral_stress) << "*(f_m" << kWall[2 * b + 1] << "[" << 7 + b << "]-f_m"
-        << kWall[2 * b] << "[" << 7 + b << "])*(" << exact(ext[2]) << "-" << exact(plan.top_speed)
-        << "*step*" << exact(plan.dt) << ")\n";
-      s << "fix m" << kWall[sd] << " all mesh/surface/stress/servo file " << mesh_file[sd]
-        << " type " << wall_type << " com " << exact(com.x()) << " " << exact(com.y()) << " "
-        << exact(com.z()) << " ctrlPV force axis " << (a == 0 ? "1 0 0" : "0 1 0")
-        << " target_val v_ft_" << kWall[sd] << " vel_max " << exact(vel_max) << " kp " << exact(kp)
-        << "\n";
-    } else {
-      s << "fix m" << kWall[sd] << " all mesh/surface/stress file " << mesh_file[sd] << " type "
-        << wall_type << "\n";
-    }
-  }
+  liggghts_3d_lateral_walls(s, c, plan, o, mesh_file, wall_type, cap);
   s << "fix walls all wall/gran model hooke/stiffness tangential history mesh n_meshes 6 meshes "
        "mbottom mtop mxmin mxmax mymin mymax store_force yes "
     << deck::liggghts_model_settings(m) << "\n"
@@ -993,7 +1052,7 @@ std::string liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p, const Pl
     return std::string("f_m") + kWall[sd] + "[" + std::to_string(7 + sd / 2) + "]";
   };
   const int monitor_every = deck::monitor_interval(plan.steps, c.test.monitor_points);
-  s << "\nvariable H equal " << exact(ext[2]) << "-" << exact(plan.top_speed) << "*step*dt\n"
+  s << "\nvariable H equal " << exact(h0) << "-" << exact(plan.top_speed) << "*step*dt\n"
     << "variable Wx equal " << wall_pos(1) << "-(" << wall_pos(0) << ")\n"
     << "variable Wy equal " << wall_pos(3) << "-(" << wall_pos(2) << ")\n"
     << "variable p_top equal f_mtop[3]/(v_Wx*v_Wy)\n"
@@ -1001,7 +1060,7 @@ std::string liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p, const Pl
     << "variable p_axial equal (v_p_top+v_p_bottom)/2\n"
     << "variable p_lat equal (-f_mxmin[1]+f_mxmax[1])/(4*v_Wy*v_H)+(-f_mymin[2]+f_mymax[2])/"
        "(4*v_Wx*v_H)\n"
-    << "variable strain_zz equal (v_H-" << exact(ext[2]) << ")/" << exact(ext[2]) << "\n"
+    << "variable strain_zz equal (v_H-" << exact(h0) << ")/" << exact(h0) << "\n"
     << liggghts_3d_series(c, p, plan, {wall_pos(0), wall_pos(1), wall_pos(2), wall_pos(3)},
                           monitor_every)
     << "# LIGGGHTS 3.8 has no fix vector: the peaks are the largest p_axial and ratio\n"
@@ -1011,16 +1070,7 @@ std::string liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p, const Pl
        "v_Wy\n"
     << "thermo ${thermo_every}\n"
     << "variable run_steps index " << plan.steps << "\n";
-  if (o.lateral_servo) {
-    std::vector<deck::LiggghtsServoWall> walls;
-    for (int sd = 0; sd < 4; ++sd)
-      walls.push_back({std::string("m") + kWall[sd], std::string("ft_") + kWall[sd],
-                       "t" + std::to_string(sd) + "_a"});
-    s << deck::liggghts_servo_run(walls, c.test.servo_gain, plan.servo_resist, cap, monitor_every,
-                                  exact, resist_name);
-  } else {
-    s << "run ${run_steps}\n";
-  }
+  liggghts_3d_run(s, c, plan, o, cap, monitor_every);
   return s.str();
 }
 

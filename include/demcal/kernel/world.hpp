@@ -187,8 +187,9 @@ class World {
   /// 8 particles at once and pads their half rows (neighbours of higher
   /// index) and mirror rows (lower index) to the longest of the block, so
   /// each window of 64 consecutive particles (locality kept) is ordered so
-  /// that the particles of a block have as many neighbours on either side
-  /// (reports/performance.md).
+  /// that the particles of a block have as many neighbours on either side;
+  /// the identity where that would not fill the blocks better (a lattice in
+  /// lattice order) (reports/performance.md).
   std::vector<int> block_friendly_order() const;
   int threads() const;
   /// Set the friction coefficient of particle–particle contacts (used by
