@@ -71,10 +71,9 @@ double servo_velocity(const World& world, WallSide side, double target_stress, d
       disk_mass(disk_areal_density(mat, world.integration().mass_scaling), world.max_radius());
   const double resistance = servo_resistance(mat, m_max, dt);
   double move = gain * error * length * mat.thickness / (resistance * contacts);
-  // Never more than 2 % of the smallest radius per step (a gas far from the
-  // walls is approached at this speed; a packing never gets near it).
-  const double r_min = world.min_radius();
-  move = std::clamp(move, -0.02 * r_min, 0.02 * r_min);
+  // Never more than 2 % of the smallest radius per step (servo_move_cap).
+  const double cap = servo_move_cap(world.min_radius());
+  move = std::clamp(move, -cap, cap);
   return kInward[side] * move / dt;
 }
 

@@ -115,8 +115,8 @@ double servo_velocity(const SphereWorld& world, SphereWallSide side, double targ
       sphere_mass(mat.density * world.integration().mass_scaling, world.max_radius());
   const double resistance = servo_resistance(mat.wall.kn, mat.contact_damping_ratio, m_max, dt);
   double move = gain * error * wall_area(world, side) / (resistance * contacts);
-  const double r_min = world.min_radius();
-  move = std::clamp(move, -0.02 * r_min, 0.02 * r_min);
+  const double cap = servo_move_cap(world.min_radius());
+  move = std::clamp(move, -cap, cap);
   return inward(side) * move / dt;
 }
 

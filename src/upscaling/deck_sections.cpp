@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "demcal/kernel/particle_scales.hpp"
+#include "demcal/scene/biaxial.hpp"
 
 namespace demcal::deck {
 
@@ -134,7 +135,9 @@ std::string lammps_loading_derived(double wall_dashpot, NumberFormat f,
                                    const std::string& particle) {
   std::string s =
       "variable vtop      equal $(v_strain*v_H0/(v_nstep*v_dt))      # m/s, top wall, down\n"
-      "variable cap       equal $(0.02*v_r_min)      # m per demcal step, its servo move cap\n"
+      "variable cap       equal $(" +
+      num(kServoMoveCapRatio) +
+      "*v_r_min)      # m per demcal step, its servo move cap\n"
       "# demcal's servo moves a wall per step of servo_dt; a step of dt moves it\n"
       "# dt/servo_dt as far, so that the walls answer as fast per unit of time\n"
       "variable servo_f   equal $(v_dt/v_servo_dt)\n"

@@ -651,7 +651,7 @@ std::string lammps_consolidation_walls(const SceneConfig& c, const Plan& plan,
     << "# walls' start at zero. Progress: the thermo lines (cons_err, cons_ufr).\n"
     << "if              \"${consolidate} == 0 || ${continued} != 0\" then \"jump SELF "
        "loading\"\n"
-    << "variable        cap equal $(0.02*v_r_min)\n"
+    << "variable        cap equal $(" << num(kServoMoveCapRatio) << "*v_r_min)\n"
     << "timestep        " << num(dt_light) << "      # alpha*f(zeta)*dt_crit, alpha " << num(alpha)
     << "\n"
     << "variable        cons_s0 equal $(step)\n"
@@ -982,7 +982,7 @@ ExportResult liggghts(const SceneConfig& c, const AlgorithmSpec& p, const Assemb
     if (a.x[i] + a.r[i] >= a.right - 1e-9 * a.r[i]) ++n_right;
   }
   const double force_target = c.test.lateral_stress * plan.height0 * m.thickness;
-  const double cap = 0.02 * plan.r_min;
+  const double cap = servo_move_cap(plan.r_min);
   const double kp_left =
       deck::liggghts_servo_kp(c.test.servo_gain, force_target, plan.servo_resist, n_left, cap);
   const double kp_right =

@@ -430,7 +430,7 @@ void lammps_3d_consolidation(std::ostream& s, const SceneConfig& c, const Plan3&
     << "# count starts at 0; the pair contacts keep their tangential springs, the\n"
     << "# walls' start at zero. Progress: the thermo lines (cons_err, cons_ufr).\n"
     << "if              \"${consolidate} == 0\" then \"jump SELF loading\"\n"
-    << "variable        cap equal $(0.02*v_r_min)\n"
+    << "variable        cap equal $(" << deck::num(kServoMoveCapRatio) << "*v_r_min)\n"
     << "timestep        " << num(dt_light) << "      # alpha*f(zeta)*dt_crit, alpha " << num(alpha)
     << "\n"
     << "variable        cons_s0 equal $(step)\n"
@@ -995,7 +995,7 @@ std::string liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p, const Pl
   // and vel_max), the gain from each wall's current contacts, set between
   // chunks of the run (deck::liggghts_servo_run); at the start from the
   // contacts demcal counts.
-  const double cap = 0.02 * plan.r_min;
+  const double cap = servo_move_cap(plan.r_min);
   // R: kn_wall, and the wall dashpots' c/dt_demcal with contact damping
   const bool dashpots = plan.wall_dashpot > 0.0;
   std::ostringstream s;

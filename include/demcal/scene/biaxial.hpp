@@ -42,6 +42,14 @@ struct ConsolidatedState {
   bool from_cache = false;
 };
 
+/// The servo's largest wall move per step, as a share of the smallest
+/// radius: a gas far from the walls is approached at this speed, a packing
+/// never gets near it. demcal's servo_velocity (2D and 3D) and the exported
+/// decks' servo (stage 1 and loading, `cap`) use it.
+inline constexpr double kServoMoveCapRatio = 0.02;
+/// kServoMoveCapRatio·r_min [m per step].
+inline double servo_move_cap(double r_min) { return kServoMoveCapRatio * r_min; }
+
 /// Servo: each step move the wall by gain·(σ3 − p)·L·t/(R·n_c) toward the
 /// sample (see TestSpec::servo_gain), R = servo_resistance(). Returns the
 /// wall velocity.
