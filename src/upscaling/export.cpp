@@ -635,8 +635,13 @@ std::string lammps_consolidation_walls(const SceneConfig& c, const Plan& plan,
   s << "# --- stage 1: consolidation to isotropic sigma3 -------------------------------\n"
     << "# demcal's consolidation (demcal export --consolidate-in deck), run here so\n"
     << "# that it scales under MPI: all four walls servoed with the loading's law\n"
-    << "# (each wall: move = gain*(sigma3*L*t - F)/(kn_wall*max(1, n)) per step, cap\n"
-    << "# 2 % of r_min), global damping zeta " << num(zeta)
+    << "# (each wall: move = gain*(sigma3*L*t - F)/(" << (plan.wall_dashpot > 0.0 ? "R" : "kn_wall")
+    << "*max(1, n)) per step, ";
+  if (plan.wall_dashpot > 0.0)
+    s << "R =\n# kn_wall + c/dt, c the wall dashpots' (demcal's servo_resistance), cap\n";
+  else
+    s << "cap\n";
+  s << "# 2 % of r_min), global damping zeta " << num(zeta)
     << " on translation (demcal also damps\n"
     << "# rotation; this LAMMPS cannot), particle friction 0 until static, then\n"
     << "# mu until static again; critical damping (zeta 1, timestep * f(1)/f(" << num(zeta)
