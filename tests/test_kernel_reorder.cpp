@@ -123,8 +123,9 @@ TEST(KernelReorder, RefusesOrdersThatAreNotPermutations) {
 }
 
 // A hexagonal lattice in lattice order fills the blocks better than the
-// greedy order would (configs/hex_10x10: 74 slot rows against 82): the
-// numbering is kept. Shuffled, the same lattice is renumbered, and the
+// greedy order would (consolidated configs/hex_10x10: 74 slot rows
+// against 82; this lattice, unconsolidated, the same way): the numbering is
+// kept. Shuffled, the same lattice is renumbered, and the
 // blocks fill better for it.
 TEST(KernelReorder, BlockFriendlyOrderKeepsALatticesOwnNumbering) {
   World w = kernel_test::hex_scene(10, 10).make(kernel_test::reference_material(0.3));

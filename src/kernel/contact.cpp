@@ -53,7 +53,7 @@ struct PairArgs {
   const double *__restrict x, *__restrict y, *__restrict vx, *__restrict vy, *__restrict om;
   const double *__restrict r, *__restrict inv_r, *__restrict m;
   double *__restrict fx, *__restrict fy, *__restrict tq;
-  double *__restrict block_power;    // per block: power of the contact dashpots (damped pass)
+  double *__restrict block_power;    // per lane (8 per block): power of the contact dashpots
   double kn, kdt, mu, beta2;         // beta2 = 2·contact damping ratio
   const int *__restrict term_block;  // where block b's slots have their pair terms
   const int *__restrict mirror_block;
@@ -134,9 +134,9 @@ DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
   for (int b = b0; b < b1; ++b) {
     const int s0 = a.block_slot[b], s1 = a.block_slot[b + 1];
     const int t0 = a.term_block[b] - s0;  // slot s's terms at t0 + s
-    D power = zero;
     for (int sub = 0; sub < kBlock; sub += W) {
       const int i0 = kBlock * b + sub;
+      D power = zero;  // this sub-block's lanes, into block_power after the slots
       const D xi = load<W>(p_x + i0), yi = load<W>(p_y + i0);
       const D vxi = load<W>(p_vx + i0), vyi = load<W>(p_vy + i0), omi = load<W>(p_om + i0);
       const D ri = load<W>(p_r + i0), iri = load<W>(p_inv_r + i0);
@@ -187,11 +187,7 @@ DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
         const D ovr = select<W>(touch, ov * (iri > irj ? iri : irj), zero);
         mo = mo > ovr ? mo : ovr;
       }
-    }
-    if constexpr (kDamped) {
-      double sum = 0.0;
-      for (int l = 0; l < W; ++l) sum += power[l];
-      a.block_power[b] = sum;
+      if constexpr (kDamped) store<W>(a.block_power + i0, power);
     }
     if constexpr (kAll) {
       sum_blocks<W>(a, b, b + 1);
@@ -475,10 +471,9 @@ void WorldImpl::compute_forces() {
 
 double WorldImpl::dashpot_power() const {
   if (!(material_.contact_damping_ratio > 0.0)) return 0.0;
-  // Block by block in a fixed order: the same sum for any thread count.
-  double pairs = 0.0;
-  for (int b = 0; b < nblocks_; ++b) pairs += block_power_[b];
-  return pairs + wall_dashpot_power_;
+  // Lane by lane over the blocks in a fixed order: the same sum for any
+  // thread count and on every path (detail::block_lanes_sum).
+  return detail::block_lanes_sum(block_power_.data(), nblocks_) + wall_dashpot_power_;
 }
 
 }  // namespace demcal

@@ -168,7 +168,7 @@ WorldImpl::WorldImpl(const Material& material, std::span<const double> x, std::s
   for (auto& h : wall_ft_) h.assign(n, 0.0);
   for (auto& h : wall_fn_) h.assign(n, 0.0);
   block_slot_.assign(static_cast<size_t>(nblocks_) + 1, 0);
-  block_power_.assign(static_cast<size_t>(nblocks_) + 1, 0.0);
+  block_power_.assign(static_cast<size_t>(kBlock) * (nblocks_ + 1), 0.0);  // 8 lanes per block
   r_min_ = n ? *std::min_element(radius.begin(), radius.end()) : 1.0;
   r_max_ = n ? *std::max_element(radius.begin(), radius.end()) : 1.0;
   skin_ = options_.skin_ratio * r_min_;

@@ -203,7 +203,7 @@ class WorldImpl {
   Array x_, y_, vx_, vy_, theta_, omega_, r_, inv_r_;
   Array m_, inertia_;   // scaled mass and inertia
   Array fx_, fy_, tq_;  // net contact force and torque
-  Array block_power_;   // dashpot power of each block's slots (damped pass only)
+  Array block_power_;   // dashpot power of each block's lanes, 8 per block (damped pass only)
   double wall_dashpot_power_ = 0.0;
   // per-particle integration coefficients: v ← a·v + b·F (0 for padding)
   Array ca_t_, cb_t_, ca_r_, cb_r_;

@@ -20,9 +20,10 @@ namespace demcal {
 namespace {
 
 // The last character numbers the layout: '2' since the half neighbour list,
-// '3' since the pair terms' places (term_block_, mirror_term_); a state of
-// an older layout does not read: rebuilt, not misread.
-constexpr char kMagic[8] = {'d', 'e', 'm', 'W', 'o', 'r', 'l', '3'};
+// '3' since the pair terms' places (term_block_, mirror_term_), '4' since
+// block_power_ holds 8 lanes per block; a state of an older layout does not
+// read: rebuilt, not misread.
+constexpr char kMagic[8] = {'d', 'e', 'm', 'W', 'o', 'r', 'l', '4'};
 
 template <class T>
 constexpr bool kScalar = std::is_arithmetic_v<T> || std::is_enum_v<T>;

@@ -549,8 +549,9 @@ std::string lammps_system(const SceneConfig& c, const Plan& plan, const ExportOp
   if (gamma_n > 0.0)
     out.notes.push_back(
         "contact damping mapped at the mean particle mass; the walls carry no dashpots here "
-        "(demcal's do: in the quasi-static series the difference is at rounding's scale, "
-        "engines.md section 20)");
+        "(demcal's do), so a servo move meets kn_wall alone while the servo divides by R = "
+        "kn_wall + c/dt (measured on hex_5x5, zeta_c 0.25: servo criterion 5e-4 and peak "
+        "4e-5 relative from demcal's; engines.md section 20)");
   std::ostringstream s;
   s << deck::lammps_system_head(2, "f f p")
     << "if              \"${continued} == 0\" then \"read_data " << o.data_name

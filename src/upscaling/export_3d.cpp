@@ -359,8 +359,9 @@ void lammps_3d_system(std::ostream& s, const SceneConfig& c, const Plan3& plan,
   if (gamma_n > 0.0)
     out.notes.push_back(
         "contact damping mapped at the mean sphere mass; the walls carry no dashpots here "
-        "(demcal's do: in the quasi-static series the difference is at rounding's scale, "
-        "engines.md section 20)");
+        "(demcal's do), so a servo move meets kn_wall alone while the servo divides by R = "
+        "kn_wall + c/dt (measured on hex_5x5, zeta_c 0.25: servo criterion 5e-4 and peak "
+        "4e-5 relative from demcal's; engines.md section 20)");
   s << deck::lammps_system_head(3, "f f f") << "newton          off\n"
     << "read_data       " << o.data_name << "\n"
     << "# sphere masses f_ms*rho*4/3*pi*r^3 (density column), inertia 2/5 m r^2\n"
