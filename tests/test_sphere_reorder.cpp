@@ -31,17 +31,22 @@ using sphere_test::kEps;
 
 constexpr double kWallMu = 0.2;
 
-// A random polydisperse gas (radii uniform in [0.75, 1.25]·r) compressed by
-// the six walls into a frictional packing, then sheared (the top wall in,
-// the x walls out): pair and wall contacts with histories, many sliding.
-SphereWorld sheared_random_packing() {
+// A gas of `count` spheres, radii uniform in [0.75, 1.25]·r, seed 4.
+SphereAssembly random_gas(int count) {
   AssemblySpec spec;
   spec.type = "random";
-  spec.count = 300;
+  spec.count = count;
   spec.radius_min = 0.75 * sphere_test::kR;
   spec.radius_max = 1.25 * sphere_test::kR;
   spec.seed = 4;
-  const SphereAssembly a = random_sphere_gas(spec);
+  return random_sphere_gas(spec);
+}
+
+// random_gas(300) compressed by the six walls into a frictional packing,
+// then sheared (the top wall in, the x walls out): pair and wall contacts
+// with histories, many sliding.
+SphereWorld sheared_random_packing() {
+  const SphereAssembly a = random_gas(300);
   SphereWorld w(sphere_test::test_material(0.3, kWallMu), a.x, a.y, a.z, a.r, a.lo, a.hi);
   const Integration in = sphere_test::set_damped(w, 0.2, 0.3);
   // Each wall moves in by 15 % of its edge over the compression.
@@ -229,13 +234,7 @@ TEST(SphereReorder, BlockFriendlyOrderFillsTheBlocksAndRejectsBadOrders) {
 // An order that is not a permutation of 0 … n − 1 (a repeat, an index out
 // of range, a wrong length) is refused with the reason, the world untouched.
 TEST(SphereReorder, RefusesOrdersThatAreNotPermutations) {
-  AssemblySpec spec;
-  spec.type = "random";
-  spec.count = 40;
-  spec.radius_min = 0.75 * sphere_test::kR;
-  spec.radius_max = 1.25 * sphere_test::kR;
-  spec.seed = 4;
-  const SphereAssembly a = random_sphere_gas(spec);
+  const SphereAssembly a = random_gas(40);
   SphereWorld w(sphere_test::test_material(0.3), a.x, a.y, a.z, a.r, a.lo, a.hi);
   for (const auto& [reason, order] : reorder_test::bad_orders(w.size())) {
     try {
