@@ -65,11 +65,14 @@
 //
 // Cost per slot: the rescale and the twist share one factor, h' = A·[(1 −
 // c²)·p + 2c·n × p] with A = sqrt(|h|²/(|p|²·(1 + c²)²)) (the rescale
-// sqrt(|h|²/|p|²) times the Cayley 1/(1 + c²)). The pass is bound by the
-// latency of one chain per slot — root, normal, history, its scale, the
-// clamp — more than by its arithmetic (reports/performance.md, 3D
-// section, "The slot's dependency chain, not its arithmetic"), so what can
-// leave the chain does: 1/|d| is d·(1/d²), the division beside the root;
+// sqrt(|h|²/|p|²) times the Cayley 1/(1 + c²)). A slot's values form one
+// long chain — root, normal, history, its scale, the clamp — and what can
+// leave it does (1.06-1.09×, reports/performance.md, 3D section, "The
+// slot's dependency chain, not its arithmetic"), though the pass is bound
+// by the throughput of its µops rather than by that chain (split in two
+// passes over blocks of rows, it ran at par: same section, "Two tests of
+// the 'one chain per slot' reading"): 1/|d| is d·(1/d²), the division
+// beside the root;
 // 1/A² = |p|²(1 + c²)²/|h|² takes |p|² = |h|² − hn² and the 1/|h|²
 // divided at the load, and A comes from the series of
 // y^(-1/2) where y = 1/A² is within 1e-4 of 1, as it is unless the contact
