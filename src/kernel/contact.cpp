@@ -160,7 +160,7 @@ DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
         const D dvx = gather<W>(p_vx, J) - vxi, dvy = gather<W>(p_vy, J) - vyi;
         D fn = law::elastic_normal_force(kn, ov);
         if constexpr (kDamped) {
-          const D meff = law::reduced_mass(mi, gather<W>(p_m, J));
+          const D meff = reduced_mass(mi, gather<W>(p_m, J));
           const D vn = dvx * nx + dvy * ny;  // > 0 when separating
           const D fe = fn;
           fn = law::damped_normal_force(fe, a.beta2, vsqrt(kn * meff), vn);
@@ -424,7 +424,7 @@ WorldImpl::PairState WorldImpl::pair_state(int i, int j) const {
   double fn = fe;
   const double beta2 = 2.0 * material_.contact_damping_ratio;
   if (beta2 > 0.0)
-    fn = law::damped_normal_force(fe, beta2, std::sqrt(kn * law::reduced_mass(m_[i], m_[j])), p.vn);
+    fn = law::damped_normal_force(fe, beta2, std::sqrt(kn * reduced_mass(m_[i], m_[j])), p.vn);
   p.fn_elastic = p.touching ? fe : 0.0;
   p.fn = p.touching ? fn : 0.0;
   return p;
