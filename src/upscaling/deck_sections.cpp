@@ -131,6 +131,8 @@ std::string lammps_material_variables(const Material& m, NumberFormat f) {
   return s.str();
 }
 
+std::string servo_cap_text() { return num(100.0 * kServoMoveCapRatio) + " % of r_min"; }
+
 std::string lammps_loading_derived(double wall_dashpot, NumberFormat f,
                                    const std::string& particle) {
   std::string s =
