@@ -2,8 +2,10 @@
 // subcommand lives in its own cmd_*.cpp.
 #include <CLI/CLI.hpp>
 #include <iostream>
+#include <stdexcept>
 
 #include "commands.hpp"
+#include "demcal/io/input_error.hpp"
 #include "demcal/kernel/world.hpp"
 #include "demcal/scene/config.hpp"
 #include "demcal/search/calibration.hpp"
@@ -135,6 +137,13 @@ int main(int argc, char** argv) {
     return kBadInput;
   }
   try {
+    // A DEMCAL_SIMD the kernel cannot honour is bad input, found before a
+    // command reads or writes anything.
+    try {
+      demcal::kernel_simd();
+    } catch (const std::invalid_argument& e) {
+      throw demcal::InputError("environment", "", e.what());
+    }
     if (check->parsed()) return cmd_check(config_path, sets);
     if (run->parsed()) return cmd_run(config_path, sets, out_dir, allow_unstable);
     if (sweep->parsed()) return cmd_sweep(sweep_options);

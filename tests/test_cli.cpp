@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "demcal/kernel/world.hpp"
 #include "support/csv.hpp"
 #include "support/files.hpp"
 #include "support/process.hpp"
@@ -40,9 +41,14 @@ class CliEndToEnd : public ::testing::Test {
  protected:
   void SetUp() override { fs::create_directories(dir_ / "work"); }
 
-  /// Run `demcal ARGS` in dir_/work with stdout and stderr captured.
-  Result demcal(const std::vector<std::string>& args) {
-    return test::run_demcal(args, dir_ / "work");
+  /// Run `demcal ARGS` in dir_/work with stdout and stderr captured, with
+  /// `env` ("NAME=VALUE") added to the environment.
+  Result demcal(const std::vector<std::string>& args, const std::vector<std::string>& env = {}) {
+    if (env.empty()) return test::run_demcal(args, dir_ / "work");
+    std::vector<std::string> command = env;
+    command.push_back(test::kDemcalBinary);
+    command.insert(command.end(), args.begin(), args.end());
+    return test::run_program("/usr/bin/env", command, dir_ / "work");
   }
   std::string write(const std::string& name, const std::string& content) {
     return test::write_text(dir_ / name, content);
@@ -58,11 +64,13 @@ class CliEndToEnd : public ::testing::Test {
   /// Bad input: exit 2, exactly one line on stderr that contains every one
   /// of `mentions`, nothing on stdout, and nothing written.
   void expect_bad_input(const std::vector<std::string>& args,
-                        const std::vector<std::string>& mentions) {
+                        const std::vector<std::string>& mentions,
+                        const std::vector<std::string>& env = {}) {
     std::string trace;
+    for (const auto& a : env) trace += a + " ";
     for (const auto& a : args) trace += a + " ";
     SCOPED_TRACE(trace);
-    const Result r = demcal(args);
+    const Result r = demcal(args, env);
     EXPECT_EQ(r.status, 2) << r.err;
     const auto err_lines = lines_of(r.err);
     EXPECT_EQ(err_lines.size(), 1u) << r.err;
@@ -128,6 +136,33 @@ TEST_F(CliEndToEnd, UsageErrorsExitTwo) {
   const Result help = demcal({"--help"});
   EXPECT_EQ(help.status, 0);
   EXPECT_NE(help.out.find("stability"), std::string::npos);
+}
+
+// A SIMD path (DEMCAL_SIMD) the kernel does not know, or one this CPU cannot
+// run, is bad input: one line naming the variable, the value and the paths,
+// before anything is written (it used to be ignored: the kernel ran its
+// default path, and a comparison of two paths compared one with itself).
+// Empty is unset.
+TEST_F(CliEndToEnd, AnUnknownSimdPathIsBadInput) {
+  const std::string out = (dir_ / "work" / "out").string();
+  const std::vector<std::string> paths = {"sse2", "avx2", "avx512"};
+  for (const std::string value : {"bogus", "AVX2", "avx2 ", "generic"}) {
+    std::vector<std::string> mentions = {"DEMCAL_SIMD", "\"" + value + "\"", "this CPU runs"};
+    mentions.insert(mentions.end(), paths.begin(), paths.end());
+    const std::vector<std::string> env = {"DEMCAL_SIMD=" + value};
+    expect_bad_input({"run", kHex5, "-o", out}, mentions, env);
+    expect_bad_input({"run", kHex5}, mentions, env);  // nor the default folder
+    expect_bad_input({"check", kHex5}, mentions, env);
+  }
+  // A path this CPU lacks (the widest path the kernel chose tells which).
+  const std::string best = demcal::kernel_simd();
+  for (const std::string path : {"avx2", "avx512"})
+    if (best == "sse2" || (best == "avx2" && path == "avx512"))
+      expect_bad_input({"run", kHex5, "-o", out}, {"DEMCAL_SIMD", path, "this CPU"},
+                       {"DEMCAL_SIMD=" + path});
+  const Result unset = demcal({"check", kHex5}, {"DEMCAL_SIMD="});
+  EXPECT_EQ(unset.status, 0) << unset.err;
+  EXPECT_EQ(unset.err, "");
 }
 
 // `demcal stability`: the limit against the estimate, both files written.

@@ -122,6 +122,26 @@ TEST(KernelReorder, RefusesOrdersThatAreNotPermutations) {
   EXPECT_TRUE(std::equal(y.begin(), y.end(), w.y().begin()));
 }
 
+// The identity changes nothing: every byte of the state (save_state: the
+// arrays, the neighbour list and the positions it was built at, the
+// histories, the rebuild count) as before, and stepped on, too. It rebuilt
+// the list (SphereWorld's did not): a lattice's block_friendly_order is the
+// identity, and its consolidation rebuilt once for nothing.
+TEST(KernelReorder, TheIdentityChangesNoBitAndRebuildsNothing) {
+  World a = loaded_world();
+  std::vector<int> identity(a.size());
+  std::iota(identity.begin(), identity.end(), 0);
+  World b = a;
+  ASSERT_TRUE(b.save_state() == a.save_state());
+  b.reorder(identity);
+  EXPECT_EQ(b.rebuilds(), a.rebuilds());
+  EXPECT_TRUE(b.save_state() == a.save_state());
+  a.step(500);
+  b.step(500);
+  EXPECT_GT(a.rebuilds(), 0);
+  EXPECT_TRUE(b.save_state() == a.save_state());
+}
+
 // A hexagonal lattice in lattice order fills the blocks better than the
 // greedy order would (consolidated configs/hex_10x10: 74 slot rows
 // against 82; this lattice, unconsolidated, the same way): the numbering is

@@ -379,8 +379,8 @@ TEST(SphereSimd, AvxPathsGiveTheSameBits) {
       EXPECT_EQ(pclose(pipe), 0) << "path " << p << ":\n" << out;
     }
     ASSERT_GT(bits[p].size(), 15000u) << "path " << p << ":\n" << out;
-    // The child ran on the path asked for (an unknown DEMCAL_SIMD would
-    // fall back to the widest silently, and this test would test nothing).
+    // The child ran on the path asked for (the kernel refuses a DEMCAL_SIMD
+    // it cannot honour; a silent fallback would make this test test nothing).
     EXPECT_EQ(bits[p].front(), "bits path " + p + "\n");
     bits[p].erase(bits[p].begin());
   }

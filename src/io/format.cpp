@@ -26,7 +26,12 @@ std::string pct(double fraction, int decimals) {
 
 std::string signed_pct(double fraction, int decimals) {
   if (!std::isfinite(fraction)) return "n/a";
-  return (fraction >= 0 ? "+" : "") + fixed(100.0 * fraction, decimals) + " %";
+  // The sign appended, not inserted in front ("+" + string): GCC 12 warns
+  // -Wrestrict (a false positive) on the inlined insert.
+  std::string out = fraction >= 0 ? "+" : "";
+  out += fixed(100.0 * fraction, decimals);
+  out += " %";
+  return out;
 }
 
 std::string sci(double v) {

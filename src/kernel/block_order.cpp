@@ -100,6 +100,12 @@ long block_slot_rows(int n, std::span<const int> pair_i, std::span<const int> pa
   return rows;
 }
 
+bool is_identity(std::span<const int> order) {
+  for (size_t k = 0; k < order.size(); ++k)
+    if (order[k] != static_cast<int>(k)) return false;
+  return true;
+}
+
 std::vector<int> inverse_permutation(int n, std::span<const int> order, std::string_view caller) {
   if (static_cast<int>(order.size()) != n)
     throw std::invalid_argument(std::string(caller) + ": order must list every particle once");

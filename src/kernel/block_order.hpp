@@ -30,6 +30,11 @@ std::vector<int> block_friendly_order(int n, std::span<const int> pair_i,
 long block_slot_rows(int n, std::span<const int> pair_i, std::span<const int> pair_j,
                      std::span<const int> order);
 
+/// True when `order` keeps every particle where it is (order[k] = k): both
+/// reorder()s then change nothing, not even the last bits of the forces,
+/// and rebuild nothing.
+bool is_identity(std::span<const int> order);
+
 /// The inverse of an order for reorder() of n particles: new_index[order[k]]
 /// = k. Throws std::invalid_argument, its message starting with `caller`
 /// ("<caller>: order must list every particle once" unless order has n

@@ -31,6 +31,8 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <stdexcept>
+#include <string>
 #include <string_view>
 
 #include "contact_law.hpp"
@@ -158,7 +160,7 @@ DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
         const D dvx = gather<W>(p_vx, J) - vxi, dvy = gather<W>(p_vy, J) - vyi;
         D fn = law::elastic_normal_force(kn, ov);
         if constexpr (kDamped) {
-          const D meff = law::reduced_mass(mi, gather<W>(p_m, J));
+          const D meff = reduced_mass(mi, gather<W>(p_m, J));
           const D vn = dvx * nx + dvy * ny;  // > 0 when separating
           const D fe = fn;
           fn = law::damped_normal_force(fe, a.beta2, vsqrt(kn * meff), vn);
@@ -287,33 +289,55 @@ DEMCAL_KERNELS(avx2, __attribute__((target("arch=x86-64-v3"))), 4)
 DEMCAL_KERNELS(avx512, __attribute__((target("arch=x86-64-v4"))), 8)
 #endif
 
-const Kernels &kernels() {
-  static const Kernels chosen = [] {
+// The path for this process: the widest this CPU runs, or the one
+// DEMCAL_SIMD names (unset or empty: the widest). A name that is no path,
+// or a path this CPU cannot run, throws std::invalid_argument (ignored
+// silently, a run meant for one path ran on another).
+const Kernels &choose_kernels() {
+  const char *env = std::getenv("DEMCAL_SIMD");
+  const std::string_view want = env ? env : "";
 #ifdef DEMCAL_X86_64
-    __builtin_cpu_init();
+  __builtin_cpu_init();
 #ifdef __clang__
-    // Clang 14 knows no "x86-64-vN" level names: the levels' features one
-    // by one (x86-64-v3's F16C, LZCNT, MOVBE and XSAVE it cannot query;
-    // every CPU with AVX2, FMA and BMI2 has them).
-    const bool v3 = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") &&
-                    __builtin_cpu_supports("bmi") && __builtin_cpu_supports("bmi2");
-    const bool v4 = v3 && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") &&
-                    __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512vl");
+  // Clang 14 knows no "x86-64-vN" level names: the levels' features one
+  // by one (x86-64-v3's F16C, LZCNT, MOVBE and XSAVE it cannot query;
+  // every CPU with AVX2, FMA and BMI2 has them).
+  const bool v3 = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") &&
+                  __builtin_cpu_supports("bmi") && __builtin_cpu_supports("bmi2");
+  const bool v4 = v3 && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") &&
+                  __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512vl");
 #else
-    const bool v4 = __builtin_cpu_supports("x86-64-v4") != 0;
-    const bool v3 = __builtin_cpu_supports("x86-64-v3") != 0;
+  const bool v4 = __builtin_cpu_supports("x86-64-v4") != 0;
+  const bool v3 = __builtin_cpu_supports("x86-64-v3") != 0;
 #endif
-    if (const char *env = std::getenv("DEMCAL_SIMD")) {
-      const std::string_view want(env);
-      if (want == "sse2") return kKernels_sse2;
-      if (want == "avx2" && v3) return kKernels_avx2;
-      if (want == "avx512" && v4) return kKernels_avx512;
+  const struct {
+    const Kernels &kernels;
+    bool runs;
+  } paths[] = {{kKernels_sse2, true}, {kKernels_avx2, v3}, {kKernels_avx512, v4}};
+  if (want.empty()) return v4 ? kKernels_avx512 : v3 ? kKernels_avx2 : kKernels_sse2;
+  std::string runs;
+  for (const auto &p : paths)
+    if (p.runs) runs += (runs.empty() ? "" : ", ") + std::string(p.kernels.name);
+  auto refused = [&](const char *why) {
+    return std::invalid_argument("DEMCAL_SIMD=\"" + std::string(want) + "\"" + why +
+                                 "; accepted: sse2|avx2|avx512, of which this CPU runs " + runs);
+  };
+  for (const auto &p : paths)
+    if (want == p.kernels.name) {
+      if (p.runs) return p.kernels;
+      throw refused(": this CPU cannot run that path");
     }
-    if (v4) return kKernels_avx512;
-    if (v3) return kKernels_avx2;
+  throw refused(" is not a SIMD path");
+#else
+  if (!want.empty())
+    throw std::invalid_argument("DEMCAL_SIMD=\"" + std::string(want) +
+                                "\": this build has one code path (generic); unset DEMCAL_SIMD");
+  return kKernels_sse2;
 #endif
-    return kKernels_sse2;
-  }();
+}
+
+const Kernels &kernels() {
+  static const Kernels &chosen = choose_kernels();
   return chosen;
 }
 
@@ -323,6 +347,7 @@ const char *kernel_simd() {
 #ifdef DEMCAL_X86_64
   return kernels().name;
 #else
+  kernels();  // DEMCAL_SIMD checked
   return "generic";
 #endif
 }
@@ -399,7 +424,7 @@ WorldImpl::PairState WorldImpl::pair_state(int i, int j) const {
   double fn = fe;
   const double beta2 = 2.0 * material_.contact_damping_ratio;
   if (beta2 > 0.0)
-    fn = law::damped_normal_force(fe, beta2, std::sqrt(kn * law::reduced_mass(m_[i], m_[j])), p.vn);
+    fn = law::damped_normal_force(fe, beta2, std::sqrt(kn * reduced_mass(m_[i], m_[j])), p.vn);
   p.fn_elastic = p.touching ? fe : 0.0;
   p.fn = p.touching ? fn : 0.0;
   return p;

@@ -2,6 +2,7 @@
 //
 // Particle–particle and particle–wall contacts share one law:
 //   normal     fn = max(0, kn·δ − c·v_n),  c = 2ζ·sqrt(kn·m_eff)
+//              (m_eff: reduced_mass, kernel/particle_scales.hpp; m_i at a wall)
 //              (v_n > 0 when the contact opens; the dashpot never pulls)
 //   tangential ft = clamp(ft_prev + kt·Δu_t, −μ·fn, μ·fn)
 //   energy     ½·fe²/kn in the normal spring (fe = kn·δ, the elastic part
@@ -19,6 +20,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "demcal/kernel/particle_scales.hpp"  // reduced_mass
+
 // The templates are always inlined: no SIMD vector crosses a call boundary,
 // so the ABI note about passing AVX vectors does not apply.
 #pragma GCC diagnostic push
@@ -31,12 +34,6 @@ namespace demcal::law {
 /// Inward unit normals of the walls, indexed by WallSide (left, right,
 /// bottom, top).
 constexpr double kWallNormal[4][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}};
-
-/// Reduced mass m_i·m_j/(m_i + m_j) of a pair.
-template <class V>
-DEMCAL_LAW V reduced_mass(V mi, V mj) {
-  return mi * mj / (mi + mj);
-}
 
 /// γ_max = max 2ζ_c·sqrt(m_eff/kn) of the contact dashpots over `contacts`
 /// (each with i, j — j < 0 a wall, m_eff the particle's mass — and kn), for

@@ -146,6 +146,10 @@ WorldImpl::WorldImpl(const Material& material, std::span<const double> x, std::s
   if (n > static_cast<size_t>(1) << 28) throw std::invalid_argument("World: too many particles");
   for (double r : radius)
     if (!(r > 0.0) || !std::isfinite(r)) throw std::invalid_argument("World: radius must be > 0");
+  // The SIMD path is chosen here, in the caller's thread: kernel_simd()
+  // throws for a DEMCAL_SIMD it cannot honour (a pass may first run on a
+  // worker thread).
+  kernel_simd();
   n_ = static_cast<int>(n);
   nblocks_ = (n_ + kBlock - 1) / kBlock;
   ghost_ = kBlock * nblocks_;

@@ -36,6 +36,10 @@ SphereWorldImpl::SphereWorldImpl(const SphereMaterial& material, std::span<const
   for (double r : radius)
     if (!(r > 0.0) || !std::isfinite(r))
       throw std::invalid_argument("SphereWorld: radius must be > 0");
+  // The SIMD path is chosen here, in the caller's thread: kernel_simd()
+  // throws for a DEMCAL_SIMD it cannot honour (a pass may first run on a
+  // worker thread).
+  kernel_simd();
   n_ = static_cast<int>(n);
   nblocks_ = (n_ + kBlock - 1) / kBlock;
   ghost_ = kBlock * nblocks_;

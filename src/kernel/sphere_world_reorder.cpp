@@ -30,10 +30,7 @@ std::vector<int> SphereWorldImpl::block_friendly_order() const {
 void SphereWorldImpl::reorder(std::span<const int> order) {
   const int n = n_;
   const std::vector<int> new_index = detail::inverse_permutation(n, order, "SphereWorld::reorder");
-  // The identity changes nothing (not even the last bits of the forces).
-  bool identity = true;
-  for (int k = 0; k < n && identity; ++k) identity = order[k] == k;
-  if (identity) return;
+  if (detail::is_identity(order)) return;
   // The list must describe the current pairs (a step or update_forces()
   // leaves it so; a set_position() since may not have).
   if (!list_valid_) rebuild_neighbours();

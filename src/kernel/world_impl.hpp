@@ -32,8 +32,8 @@ class WorldImpl {
   /// per-particle quantity moves with its particle, contact histories
   /// included, and the forces are re-evaluated in the new order: the same
   /// physical state (sums run in another order, so later steps differ in the
-  /// last bits). Throws std::invalid_argument unless `order` is a
-  /// permutation of 0 … size() − 1.
+  /// last bits); the identity changes no bit and rebuilds nothing. Throws
+  /// std::invalid_argument unless `order` is a permutation of 0 … size() − 1.
   void reorder(std::span<const int> order);
   /// An order for reorder() that fills the SIMD blocks: the kernel evaluates
   /// 8 particles at once and pads their neighbour lists to the longest, so

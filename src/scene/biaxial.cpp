@@ -71,7 +71,8 @@ double servo_velocity(const World& world, WallSide side, double target_stress, d
       disk_mass(disk_areal_density(mat, world.integration().mass_scaling), world.max_radius());
   const double resistance = servo_resistance(mat, m_max, dt);
   double move = gain * error * length * mat.thickness / (resistance * contacts);
-  // Never more than 2 % of the smallest radius per step (servo_move_cap).
+  // Never more than servo_move_cap (kServoMoveCapRatio of the smallest
+  // radius) per step.
   const double cap = servo_move_cap(world.min_radius());
   move = std::clamp(move, -cap, cap);
   return kInward[side] * move / dt;

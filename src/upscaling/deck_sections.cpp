@@ -131,6 +131,8 @@ std::string lammps_material_variables(const Material& m, NumberFormat f) {
   return s.str();
 }
 
+std::string servo_cap_text() { return num(100.0 * kServoMoveCapRatio) + " % of r_min"; }
+
 std::string lammps_loading_derived(double wall_dashpot, NumberFormat f,
                                    const std::string& particle) {
   std::string s =
@@ -562,8 +564,8 @@ std::string liggghts_materials(const Material& m, const std::vector<double>& cla
   auto dashpot = [&](int i, int j, bool wall) {
     if (zeta <= 0.0 || (i == wall_type && j == wall_type)) return 0.0;
     if (wall) return zeta * critical_damping_translation(m.wall.kn, class_mass[std::min(i, j) - 1]);
-    const double mi = class_mass[i - 1], mj = class_mass[j - 1];
-    return zeta * critical_damping_translation(m.particle.kn, mi * mj / (mi + mj));
+    return zeta * critical_damping_translation(m.particle.kn,
+                                               reduced_mass(class_mass[i - 1], class_mass[j - 1]));
   };
   std::ostringstream s;
   s << "# type " << wall_type << " is the walls' material\n"

@@ -89,6 +89,10 @@ std::string lammps_class_damping_note(int types, double class_error, const std::
 /// (variables kn kt mu kn_wall kt_wall mu_wall).
 std::string lammps_material_variables(const Material& m, NumberFormat f);
 
+/// The servo's move cap as the decks' comments state it: "P % of r_min",
+/// P = 100·kServoMoveCapRatio (scene/biaxial.hpp).
+std::string servo_cap_text();
+
 /// LAMMPS derived block: the top wall's speed, the servo's cap and gain
 /// and the monitoring interval (from the parameters block). demcal's servo
 /// law is per demcal step, servo_dt (a parameter: α·Δt_crit); the deck's

@@ -457,7 +457,8 @@ std::string lammps_limitations(const AlgorithmSpec& p, const Plan& plan, ExportR
     << "#    above so that the explicit drag does not cost the stability margin.\n"
     << "#  - servo walls are not native: the lateral walls are fix wall/gran/region\n"
     << "#    planes whose displacement is the running sum of demcal's per-step servo\n"
-    << "#    move gain*(sigma3 - p)*H*t/(R*n_contacts), capped at 2 % of r_min,\n"
+    << "#    move gain*(sigma3 - p)*H*t/(R*n_contacts), capped at " << deck::servo_cap_text()
+    << ",\n"
     << "#    kept by fix ave/time (running mean times the steps of this run); a split\n"
     << "#    run restarts it from the walls' positions (see restart_from).\n"
     << "#  - the moving walls act on bands of particles near them (see the walls).\n";
@@ -642,7 +643,7 @@ std::string lammps_consolidation_walls(const SceneConfig& c, const Plan& plan,
     s << "R =\n# kn_wall + c/dt, c the wall dashpots' (demcal's servo_resistance), cap\n";
   else
     s << "cap\n";
-  s << "# 2 % of r_min), global damping zeta " << num(zeta)
+  s << "# " << deck::servo_cap_text() << "), global damping zeta " << num(zeta)
     << " on translation (demcal also damps\n"
     << "# rotation; this LAMMPS cannot), particle friction 0 until static, then\n"
     << "# mu until static again; critical damping (zeta 1, timestep * f(1)/f(" << num(zeta)

@@ -288,8 +288,8 @@ void lammps_3d_limitations(std::ostream& s, const SceneConfig& c, const Algorith
     << "#  - damping explicit (fix viscous) vs demcal's semi-implicit: the factor f.\n"
     << "#  - servo walls are not native: each lateral wall is a wall/gran/region plane\n"
     << "#    whose displacement is the running sum of demcal's per-step servo move\n"
-    << "#    gain*(sigma3*A - F)/(" << resist_name(plan)
-    << "*max(1, n)), capped at 2 % of r_min (A the\n"
+    << "#    gain*(sigma3*A - F)/(" << resist_name(plan) << "*max(1, n)), capped at "
+    << deck::servo_cap_text() << " (A the\n"
     << "#    wall's current area, F its force, n its contacts), kept by fix ave/time\n"
     << "#    (running mean times the step); one run command only (no restart split).\n";
   if (plan.wall_dashpot > 0.0)
@@ -387,7 +387,7 @@ std::vector<deck::ConsolidationWall> consolidation_walls() {
 
 /// The six walls servoed at sigma3 with demcal's per-step law (triaxial.cpp
 /// servo_velocity: gain*(sigma3*A - F)/(R*max(1, n)), R = kn_wall + c/dt
-/// (servo_resistance), cap 2 % of r_min, A the wall's current area), light
+/// (servo_resistance), cap servo_move_cap, A the wall's current area), light
 /// damping, the criterion, the runs and the start walls of the loading.
 void lammps_3d_consolidation(std::ostream& s, const SceneConfig& c, const Plan3& plan) {
   const double zeta = kConsolidationDampingRatio;
@@ -417,7 +417,7 @@ void lammps_3d_consolidation(std::ostream& s, const SceneConfig& c, const Plan3&
       << "# c/dt, c the wall dashpots' (the number in cons_rawv), A its current\n";
   else
     s << "A its current\n";
-  s << "# area, cap 2 % of r_min), global damping zeta " << num(zeta)
+  s << "# area, cap " << deck::servo_cap_text() << "), global damping zeta " << num(zeta)
     << " on translation (demcal also\n"
     << "# damps rotation; this LAMMPS cannot), particle friction 0 until static, then\n"
     << "# mu until static again; critical damping (zeta 1, timestep * f(1)/f(" << num(zeta)

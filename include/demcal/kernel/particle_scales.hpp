@@ -8,6 +8,7 @@
 //   sphere mass        m = f_ms·ρ·(4/3)·π·r³,  I = (2/5)·m·r²
 //   critical step      Δt_crit = 2·sqrt(m_min/kn)
 //   critical damping   D_t^crit = 2·sqrt(kn·m),  D_r^crit = 2·sqrt(kt·r²·I)
+//   reduced mass       m_eff = m_i·m_j/(m_i + m_j) of a contact
 //
 // The order of the floating-point operations is part of the contract: the
 // kernel integrates with these masses, and the calibration's outputs quote
@@ -40,6 +41,20 @@ inline double sphere_mass(double density, double radius) {
 }
 /// I = (2/5)·m·r² [kg·m²] of a uniform sphere.
 inline double sphere_inertia(double mass, double radius) { return 0.4 * mass * radius * radius; }
+/// m_eff = m_i·m_j/(m_i + m_j) [kg]: the reduced mass of a pair of
+/// particles, a contact's effective mass (against a wall: m_i). Its one
+/// home: the kernels' contact laws (with V a GCC vector of doubles in their
+/// SIMD passes, hence a template, always inlined) and the engine decks'
+/// dashpots compute it here, in this order.
+/// (Always inlined: no vector crosses a call boundary, so GCC's note on
+/// the ABI of AVX vector arguments does not apply.)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wpsabi"
+template <class V>
+inline __attribute__((always_inline)) V reduced_mass(V mi, V mj) {
+  return mi * mj / (mi + mj);
+}
+#pragma GCC diagnostic pop
 /// Δt_crit = 2·sqrt(m/kn) [s]: twice the inverse angular frequency of a
 /// mass on one spring.
 inline double critical_time_step(double mass, double kn) { return 2.0 * std::sqrt(mass / kn); }

@@ -192,9 +192,9 @@ class SphereWorld {
   /// included (pair and wall: a pair's history, the tangential force on its
   /// lower index, changes sign where the new numbering swaps the pair), and
   /// the forces are re-evaluated in the new order: the same physical state
-  /// (sums run in another order, so later steps differ in the last bits).
-  /// Throws std::invalid_argument unless `order` is a permutation of
-  /// 0 … size() − 1.
+  /// (sums run in another order, so later steps differ in the last bits);
+  /// the identity changes no bit and rebuilds nothing. Throws
+  /// std::invalid_argument unless `order` is a permutation of 0 … size() − 1.
   void reorder(std::span<const int> order);
   /// An order for reorder() that fills the SIMD blocks, the 2D kernel's
   /// (World::block_friendly_order): the kernel evaluates 8 particles at once

@@ -149,8 +149,11 @@ struct KernelOptions {
 /// The SIMD code path the kernel uses on this machine: "avx512" (x86-64-v4),
 /// "avx2" (x86-64-v3) or "sse2" (any x86-64), chosen once at start-up from
 /// the CPU (DEMCAL_SIMD=sse2|avx2|avx512 in the environment overrides it, for
-/// benchmarks). Results are deterministic on a given path; the paths with
-/// FMA may differ from the sse2 one in the last bits.
+/// benchmarks; unset or empty: the widest). Results are deterministic on a
+/// given path; the paths with FMA may differ from the sse2 one in the last
+/// bits. Throws std::invalid_argument, its message naming DEMCAL_SIMD, its
+/// value and the paths this CPU runs, when DEMCAL_SIMD names no path or one
+/// this CPU cannot run (so does every World and SphereWorld constructor).
 const char* kernel_simd();
 
 class WorldImpl;
@@ -180,8 +183,8 @@ class World {
   /// per-particle quantity moves with its particle, contact histories
   /// included, and the forces are re-evaluated in the new order: the same
   /// physical state (sums run in another order, so later steps differ in the
-  /// last bits). Throws std::invalid_argument unless `order` is a
-  /// permutation of 0 … size() − 1.
+  /// last bits); the identity changes no bit and rebuilds nothing. Throws
+  /// std::invalid_argument unless `order` is a permutation of 0 … size() − 1.
   void reorder(std::span<const int> order);
   /// An order for reorder() that fills the SIMD blocks: the kernel evaluates
   /// 8 particles at once and pads their half rows (neighbours of higher

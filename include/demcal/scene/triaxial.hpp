@@ -57,8 +57,8 @@ SphereAssembly make_sphere_assembly(const SceneConfig& config);
 /// Compressive pressure on a wall from the spheres [Pa].
 double wall_pressure(const SphereWorld& world, SphereWallSide side);
 /// Servo: move the wall by gain·(σ3 − p)·A/(R·n_c) toward the sample
-/// this step (A the wall's area, n_c its contacts; at most 2 % of the
-/// smallest radius per step), as the 2D servo_velocity: R =
+/// this step (A the wall's area, n_c its contacts; at most servo_move_cap,
+/// biaxial.hpp, per step), as the 2D servo_velocity: R =
 /// servo_resistance (biaxial.hpp), kn_wall plus the wall dashpots' c/Δt
 /// with contact damping (c of the heaviest sphere at the run's mass
 /// scaling). Returns the wall velocity along its axis.
