@@ -180,7 +180,7 @@ DEMCAL_INLINE Normal<W> normal_part(typename Simd<W>::D dx, typename Simd<W>::D 
   g.ov = rs - d;
   D fn = kn * g.ov;
   if constexpr (kDamped) {
-    const D meff = mi * mj / (mi + mj);
+    const D meff = reduced_mass(mi, mj);
     const D vn = dvx * g.nx + dvy * g.ny + dvz * g.nz;  // > 0 when separating
     fn = fn - beta2 * vsqrt(kn * meff) * vn;
     fn = fn > zero ? fn : zero;
