@@ -107,6 +107,10 @@ TEST(SphereContact, DampedNormalForceReadsAVelocitySetSinceTheLastStep) {
   const double tol = kn * 8.0 * kEps * 2.0 * r + 8.0 * kEps * fn;
   EXPECT_NEAR((sphere_test::force(w, 0) + fn * u).norm(), 0.0, tol);
   EXPECT_NEAR((sphere_test::force(w, 1) - fn * u).norm(), 0.0, tol);
+  // The springs hold ½·(kn·δ)²/kn, the dashpot's share of fn none (the
+  // motion was along n, so no tangential spring); d(½f²/kn) = f·df/kn.
+  const double tol_spring = kn * 8.0 * kEps * 2.0 * r + 8.0 * kEps * spring;
+  EXPECT_NEAR(w.measure().elastic_energy, 0.5 * spring * spring / kn, spring * tol_spring / kn);
 }
 
 // Two spheres overlapping by δ along an oblique normal n; sphere 1 slides

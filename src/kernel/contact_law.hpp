@@ -13,7 +13,8 @@
 // (contact.cpp, with V a GCC vector of doubles), the scalar re-evaluation
 // for measures and views (World::pair_state), the walls, the energy ledger
 // (energy_balance.cpp), the stress measure (stress.cpp) and the stability
-// estimate (stability.cpp). The operations and their order are part of the
+// estimate (stability.cpp); the sphere kernel's springs' energy too
+// (sphere_stress.cpp, sphere_energy_balance.cpp). The operations and their order are part of the
 // law: the SIMD pass and the scalar paths must give the same bits.
 #pragma once
 
@@ -73,10 +74,17 @@ DEMCAL_LAW V coulomb_clamp(V ft, V cap) {
   return ft > cap ? cap : ft;
 }
 
+/// Energy ½·|f|²/k stored in a linear spring carrying a force of squared
+/// magnitude f2 (0 for k = 0: no spring); the sphere kernel's tangential
+/// spring holds a 3-vector.
+DEMCAL_LAW double spring_energy_squared(double force2, double stiffness) {
+  return stiffness > 0.0 ? 0.5 * force2 / stiffness : 0.0;
+}
+
 /// Energy ½·f²/k stored in a linear spring carrying force f (0 for k = 0:
 /// no spring).
 DEMCAL_LAW double spring_energy(double force, double stiffness) {
-  return stiffness > 0.0 ? 0.5 * force * force / stiffness : 0.0;
+  return spring_energy_squared(force * force, stiffness);
 }
 
 /// Power taken by the dashpot: (fe − fn)·v_n, the force it removed from the

@@ -18,6 +18,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "contact_law.hpp"
 #include "sphere_world_impl.hpp"
 
 namespace demcal {
@@ -40,11 +41,11 @@ SphereWorldImpl::EnergySample SphereWorldImpl::energy_sample() const {
       const int j = nbr_j_[k];
       const PairGeometry g = pair_geometry(i, j);
       if (!g.touching) continue;
-      const double fn_elastic = kn * g.overlap;
+      const double fn_elastic = law::elastic_normal_force(kn, g.overlap);
       const double vn = (vx_[j] - vx_[i]) * g.n.x() + (vy_[j] - vy_[i]) * g.n.y() +
                         (vz_[j] - vz_[i]) * g.n.z();  // > 0 when separating
       const double h2 = pair_history(k).squaredNorm();
-      e.elastic += 0.5 * fn_elastic * g.overlap + (kt > 0.0 ? 0.5 * h2 / kt : 0.0);
+      e.elastic += law::spring_energy(fn_elastic, kn) + law::spring_energy_squared(h2, kt);
       e.power_lost += (fn_elastic - g.fn) * vn;
     }
 
@@ -61,10 +62,10 @@ SphereWorldImpl::EnergySample SphereWorldImpl::energy_sample() const {
       const double ov = r_[i] - wall_distance(s, i);
       if (ov <= 0.0) continue;
       const double vn = (v[axis][i] - wall.velocity) * sign;  // leaving the wall > 0
-      const double fn_elastic = kw * ov;
+      const double fn_elastic = law::elastic_normal_force(kw, ov);
       const double h2 = wall_hx_[s][k] * wall_hx_[s][k] + wall_hy_[s][k] * wall_hy_[s][k] +
                         wall_hz_[s][k] * wall_hz_[s][k];
-      e.elastic += 0.5 * fn_elastic * ov + (ktw > 0.0 ? 0.5 * h2 / ktw : 0.0);
+      e.elastic += law::spring_energy(fn_elastic, kw) + law::spring_energy_squared(h2, ktw);
       if (damped) e.power_lost += (fn_elastic - wall_fn_[s][k]) * vn;
     }
   }

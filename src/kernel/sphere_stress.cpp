@@ -10,6 +10,7 @@
 // are the stored histories, i.e. the forces the last evaluation applied.
 #include <cmath>
 
+#include "contact_law.hpp"
 #include "sphere_world_impl.hpp"
 
 namespace demcal {
@@ -34,6 +35,11 @@ SphereMeasures SphereWorldImpl::measure(double strain_rate) const {
       const V3 h = pair_history(k);
       const PairGeometry g = pair_geometry(i, j);
       const double fn = g.touching ? g.fn : 0.0;
+      // The springs' energy: the elastic part kn·δ of the normal force, not
+      // fn, which carries the dashpot's share with contact damping (and is
+      // 0 on a contact opening fast whose spring is still compressed).
+      const double fe = g.touching ? law::elastic_normal_force(kn, g.overlap) : 0.0;
+      elastic += law::spring_energy(fe, kn) + law::spring_energy_squared(h.squaredNorm(), kt);
       if (fn <= 0.0 && h.squaredNorm() == 0.0) continue;
       const V3 f = -fn * g.n + h;  // on i
       const V3 branch(x_[j] - x_[i], y_[j] - y_[i], z_[j] - z_[i]);
@@ -41,7 +47,6 @@ SphereMeasures SphereWorldImpl::measure(double strain_rate) const {
       sum_contact_force += f.norm();
       ++contact_count;
       ++out.particle_contacts;
-      elastic += 0.5 * fn * fn / kn + (kt > 0 ? 0.5 * h.squaredNorm() / kt : 0.0);
     }
 
   const double kw = material_.wall.kn, ktw = material_.wall.kt;
@@ -52,6 +57,9 @@ SphereMeasures SphereWorldImpl::measure(double strain_rate) const {
       const int i = wall_candidates_[s][k];
       const double fn = wall_fn_[s][k];
       const V3 h(wall_hx_[s][k], wall_hy_[s][k], wall_hz_[s][k]);
+      const double overlap = r_[i] - wall_distance(s, i);
+      const double fe = overlap > 0.0 ? law::elastic_normal_force(kw, overlap) : 0.0;
+      elastic += law::spring_energy(fe, kw) + law::spring_energy_squared(h.squaredNorm(), ktw);
       if (fn <= 0.0 && h.squaredNorm() == 0.0) continue;
       const V3 f = fn * g + h;
       const V3 arm = -wall_distance(s, i) * g;
@@ -61,7 +69,6 @@ SphereMeasures SphereWorldImpl::measure(double strain_rate) const {
       sum_contact_force += f.norm();
       ++contact_count;
       ++out.wall_contacts;
-      elastic += 0.5 * fn * fn / kw + (ktw > 0 ? 0.5 * h.squaredNorm() / ktw : 0.0);
     }
   }
   out.homogenized_stress = sigma / volume;
