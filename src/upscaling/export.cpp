@@ -470,7 +470,7 @@ std::string lammps_limitations(const AlgorithmSpec& p, const Plan& plan, ExportR
   }
   out.notes.push_back(
       "lateral servo walls emulated with variables (running sum of demcal's per-step servo "
-      "move): one run command only");
+      "move); a split run carries their positions in its restart args");
   return s.str();
 }
 
