@@ -174,6 +174,64 @@ TEST(SphereContact, ObliqueContactSticksThenSlidesAtCoulombLimit) {
   EXPECT_GT(slid, 300);
 }
 
+// The oblique contact of the test above, slid past the Coulomb limit, then
+// driven back: the spring unloads elastically from the capped force, by
+// kt·V·Δt per step along the current tangent, through zero after
+// μ·Fn/(kt·V·Δt) = 600 steps, and slides again at −μ·Fn after 1 200. A
+// history reset when the contact slides, or set to μ·Fn along the slip,
+// flips the force at the first step back and fails. Tolerances as above:
+// the normal turns by φ ≤ s/d over the whole slip s (O(φ²) of the force),
+// the spheres' velocities drift by < 1e-6 relative, and round-off.
+TEST(SphereContact, ObliqueContactUnloadsElasticallyAfterSliding) {
+  const double mu = 0.3, r = kR, delta = 1e-6, V = 1e-3;
+  const SphereMaterial mat = test_material(mu);
+  const Vector3d n0 = Vector3d(2.0, 3.0, 6.0) / 7.0, t = Vector3d(3.0, -6.0, 2.0) / 7.0;
+  sphere_test::Scene s;
+  s.add(Vector3d::Zero(), r);
+  s.add((2.0 * r - delta) * n0, r);
+  s.lo = {-10 * r, -10 * r, -10 * r};
+  s.hi = {10 * r, 10 * r, 10 * r};
+  SphereWorld w = s.make(mat);
+  Integration in = sphere_test::set_undamped(w, 0.0, 1e15);
+  in.dt = 1e-6;
+  w.set_integration(in);
+  const double kn = mat.particle.kn, kt = mat.particle.kt, inc = kt * V * in.dt;
+  const int forth = 1000, back = 1600;
+  const double phi = V * in.dt * (forth + back) / (2.0 * r - delta);
+  const double drift = kn * 2.0 * delta * (forth + back) * in.dt / (w.mass()[0] * V);
+  ASSERT_LT(drift, 1e-6);
+  // Along t_now, the tangent t turns into, and the normal force now.
+  auto along = [&](double& fn) {
+    const auto c = w.contacts();
+    EXPECT_EQ(c.size(), 1u);
+    const Vector3d n = c.at(0).normal;
+    fn = c.at(0).fn;
+    return c.at(0).tangential.dot((t - t.dot(n) * n).normalized());
+  };
+  w.set_velocity(1, V * t, Vector3d::Zero());
+  ASSERT_TRUE(w.step(forth));
+  double fn = 0.0;
+  const double f0 = along(fn);
+  ASSERT_NEAR(f0, mu * fn, 1e-13 * mu * fn);  // sliding forward
+  w.set_velocity(1, -V * t, Vector3d::Zero());
+  int unloading = 0, sliding_back = 0;
+  for (int k = 1; k <= back; ++k) {
+    ASSERT_TRUE(w.step(1));
+    const double ft = along(fn);
+    const double elastic = f0 - inc * k;
+    const double tol = (f0 + inc * k) * (phi * phi + drift) + 1e-12 * mu * fn;
+    if (elastic > -mu * fn + tol) {
+      EXPECT_NEAR(ft, elastic, tol) << "step " << k << " back";
+      ++unloading;
+    } else if (elastic < -mu * fn - tol) {
+      EXPECT_NEAR(ft, -mu * fn, 1e-13 * mu * fn) << "step " << k << " back";
+      ++sliding_back;
+    }
+  }
+  EXPECT_GT(unloading, 1150);  // 2·μ·Fn/(kt·V·Δt) = 1 200 steps
+  EXPECT_GT(sliding_back, 350);
+}
+
 // A contact pair loaded in shear, then turned rigidly by Θ = 90° about an
 // axis through its centre (the driver prescribes the rigid velocity field
 // every step: v = (R(Ω·Δt) − I)(x − c)/Δt, so the centres move exactly on
