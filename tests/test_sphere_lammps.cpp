@@ -142,7 +142,10 @@ Comparison compare(const std::vector<Sample>& d, const std::vector<Sample>& l) {
   return c;
 }
 
-void check_against_lammps(const char* name, const SphereWorld& w, const Protocol& p) {
+// tol: the largest relative difference of b and of the peak b_zz/b_xx
+// allowed (the 1 % for a random packing, whose contacts form and
+// break chaotically; tighter for a lattice, see its test).
+void check_against_lammps(const char* name, const SphereWorld& w, const Protocol& p, double tol) {
   const std::string lmp = test::find_on_path("lmp");
   if (lmp.empty()) GTEST_SKIP() << "LAMMPS (lmp) is not installed: the cross-check is not run";
   Export3dOptions o;
@@ -164,16 +167,22 @@ void check_against_lammps(const char* name, const SphereWorld& w, const Protocol
       d.back().b.z(), l.back().b.z(), d.back().b.x(), l.back().b.x(), c.b_error, c.peak_demcal,
       c.peak_lammps);
   EXPECT_NEAR(l.back().contacts, d.back().contacts, 0.01 * d.back().contacts);
-  EXPECT_LT(c.b_error, 0.01);
-  EXPECT_NEAR(c.peak_lammps, c.peak_demcal, 0.01 * c.peak_demcal);
+  EXPECT_LT(c.b_error, tol);
+  EXPECT_NEAR(c.peak_lammps, c.peak_demcal, tol * c.peak_demcal);
 }
 
 // FCC 3×3×3 (108 spheres), pre-compressed, μ = 0.3: the top wall
 // compresses the lattice by 0.2 % over 20 000 steps at α = 0.2, ζ_t = 0.3.
+// The two codes differ by known small terms only: LAMMPS takes torques at
+// r_i, demcal at r_i − δ/2 (δ/2r ≈ 1e-4 here), its history is projected
+// without demcal's rescale and twist (O(θ²) per step, θ the contacts'
+// turn), and its velocity-Verlet with fix viscous against demcal's
+// semi-implicit damping (same continuous equation, O(Δt²)): 1e-3 bounds
+// them with a margin (measured 1.3e-5 for b, 3e-5 for the peak).
 TEST(SphereLammps, FccCompressionMatchesLammps) {
   const SphereAssembly a = fcc_packing(3, 3, 3, kR, 2e-4);
   SphereWorld w(sphere_test::test_material(0.3), a.x, a.y, a.z, a.r, a.lo, a.hi);
-  check_against_lammps("FCC 3x3x3", w, protocol(w.material(), 2e-3, 0.3, 20000));
+  check_against_lammps("FCC 3x3x3", w, protocol(w.material(), 2e-3, 0.3, 20000), 1e-3);
 }
 
 // A random polydisperse sample: 300 spheres, radii uniform in [0.8, 1.2]·r,
@@ -223,7 +232,7 @@ TEST(SphereLammps, RandomSampleCompressionMatchesLammps) {
   m = w.measure();
   std::printf("random 300: consolidated to %.3g Pa, %d contacts, coordination %.2f\n",
               m.mean_pressure, m.particle_contacts, m.coordination_number);
-  check_against_lammps("random 300", w, protocol(w.material(), 1e-2, 0.3, 20000));
+  check_against_lammps("random 300", w, protocol(w.material(), 1e-2, 0.3, 20000), 1e-2);
 }
 
 }  // namespace
