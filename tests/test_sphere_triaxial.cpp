@@ -40,6 +40,12 @@ void servo(SphereWorld& w, int s, double target, double gain) {
   wall.velocity = outward * gain * error / (stiffness * w.integration().dt);
 }
 
+// The energy ledger's largest reading while loading (energy created by the
+// integration, relative to the energy scale; the kernel's divergence check
+// trips at 0.1): a stable step at α = 0.2 creates none beyond the ledger's
+// sampling error, measured ≤ 1.0e-6 in these runs.
+constexpr double kLedgerBound = 1e-4;
+
 struct TriaxialResult {
   double peak_ratio = 0.0;     // max of σ_zz/σ_xx (wall stresses)
   double peak_strain = 0.0;    // axial strain at the peak
@@ -126,6 +132,7 @@ TEST(SphereTriaxial, FccPeakWithRotationLockedMatchesThornton) {
       r.peak_strain, r.consolidated, r.lateral_error, r.ledger_max);
   EXPECT_NEAR(r.consolidated, 1.0, 1e-3);
   EXPECT_NEAR(r.peak_ratio, analytical, 0.02 * analytical);
+  EXPECT_LT(r.ledger_max, kLedgerBound);
 }
 
 // The finite box's correction, run: in a 2×2×4 box (64 spheres) the walls
@@ -148,12 +155,17 @@ TEST(SphereTriaxial, FccPeakInANonCubicBoxMatchesTheWalledValue) {
       r.ledger_max);
   EXPECT_NEAR(r.consolidated, 1.0, 1e-3);
   EXPECT_NEAR(r.peak_ratio, walled, 0.01 * walled);
+  EXPECT_LT(r.ledger_max, kLedgerBound);
 }
 
 // Free rotation: the spheres can roll, which opens failure mechanisms the
 // locked lattice does not have, so the peak cannot exceed the locked
 // (analytical) one. Measured 3.178 at 40 000 steps, 14 % below (4×4×4:
 // 3.327, 10 % below) — the 2D kernel's hexagonal samples show 10–15 %.
+// A bound, not an analytical value: no closed form covers the rolling
+// mechanisms, so rotation itself is checked by the contact tests (lever
+// arms, torques, the history's turn) and here only the ordering and the
+// energy ledger.
 TEST(SphereTriaxial, FccPeakWithFreeRotationIsBelowTheLockedOne) {
   const double mu = 0.3;
   const int n = 3;
@@ -166,6 +178,7 @@ TEST(SphereTriaxial, FccPeakWithFreeRotationIsBelowTheLockedOne) {
       r.peak_strain, r.ledger_max);
   EXPECT_GT(r.peak_ratio, 1.0);
   EXPECT_LT(r.peak_ratio, analytical);
+  EXPECT_LT(r.ledger_max, kLedgerBound);
 }
 
 }  // namespace
