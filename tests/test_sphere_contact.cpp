@@ -113,6 +113,23 @@ TEST(SphereContact, DampedNormalForceReadsAVelocitySetSinceTheLastStep) {
   EXPECT_NEAR(w.measure().elastic_energy, 0.5 * spring * spring / kn, spring * tol_spring / kn);
 }
 
+// The oblique tests' scene: two heavy spheres of radius kR (mass scaling
+// 1e15) overlapping by δ along n0, undamped, Δt = 1e-6 s.
+SphereWorld oblique_pair(const SphereMaterial& mat, const Vector3d& n0, double delta,
+                         Integration& in) {
+  const double r = kR;
+  sphere_test::Scene s;
+  s.add(Vector3d::Zero(), r);
+  s.add((2.0 * r - delta) * n0, r);
+  s.lo = {-10 * r, -10 * r, -10 * r};
+  s.hi = {10 * r, 10 * r, 10 * r};
+  SphereWorld w = s.make(mat);
+  in = sphere_test::set_undamped(w, 0.0, 1e15);
+  in.dt = 1e-6;
+  w.set_integration(in);
+  return w;
+}
+
 // Two spheres overlapping by δ along an oblique normal n; sphere 1 slides
 // past sphere 0 at constant speed V along a tangent t. Heavy spheres (mass
 // scaling 1e15): the contact forces change the velocities by a fraction
@@ -125,15 +142,8 @@ TEST(SphereContact, ObliqueContactSticksThenSlidesAtCoulombLimit) {
   const double mu = 0.3, r = kR, delta = 1e-6, V = 1e-3;
   const SphereMaterial mat = test_material(mu);
   const Vector3d n0 = Vector3d(2.0, 3.0, 6.0) / 7.0, t = Vector3d(3.0, -6.0, 2.0) / 7.0;
-  sphere_test::Scene s;
-  s.add(Vector3d::Zero(), r);
-  s.add((2.0 * r - delta) * n0, r);
-  s.lo = {-10 * r, -10 * r, -10 * r};
-  s.hi = {10 * r, 10 * r, 10 * r};
-  SphereWorld w = s.make(mat);
-  Integration in = sphere_test::set_undamped(w, 0.0, 1e15);
-  in.dt = 1e-6;
-  w.set_integration(in);
+  Integration in;
+  SphereWorld w = oblique_pair(mat, n0, delta, in);
   w.set_velocity(1, V * t, Vector3d::Zero());
   const double kn = mat.particle.kn, kt = mat.particle.kt;
   const int steps = 1000;
@@ -186,15 +196,8 @@ TEST(SphereContact, ObliqueContactUnloadsElasticallyAfterSliding) {
   const double mu = 0.3, r = kR, delta = 1e-6, V = 1e-3;
   const SphereMaterial mat = test_material(mu);
   const Vector3d n0 = Vector3d(2.0, 3.0, 6.0) / 7.0, t = Vector3d(3.0, -6.0, 2.0) / 7.0;
-  sphere_test::Scene s;
-  s.add(Vector3d::Zero(), r);
-  s.add((2.0 * r - delta) * n0, r);
-  s.lo = {-10 * r, -10 * r, -10 * r};
-  s.hi = {10 * r, 10 * r, 10 * r};
-  SphereWorld w = s.make(mat);
-  Integration in = sphere_test::set_undamped(w, 0.0, 1e15);
-  in.dt = 1e-6;
-  w.set_integration(in);
+  Integration in;
+  SphereWorld w = oblique_pair(mat, n0, delta, in);
   const double kn = mat.particle.kn, kt = mat.particle.kt, inc = kt * V * in.dt;
   const int forth = 1000, back = 1600;
   const double phi = V * in.dt * (forth + back) / (2.0 * r - delta);
