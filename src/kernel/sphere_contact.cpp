@@ -102,6 +102,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "contact_law.hpp"
 #include "simd.hpp"
 #include "sphere_world_impl.hpp"
 
@@ -126,6 +127,7 @@ struct PairArgs {
   double *__restrict fx, *__restrict fy, *__restrict fz;
   double *__restrict tx, *__restrict ty, *__restrict tz;
   double *__restrict block_released, *__restrict block_slid;
+  double *__restrict block_power;      // the contact dashpots' power (damped pass only)
   double kn, kdt, half_dt, mu, beta2;  // beta2 = 2·contact damping ratio
   // Each block's mirrored sums right after its pairs where the pass has
   // written all its mirrored slots (its lowest source block src_block[b] ≥
@@ -146,12 +148,13 @@ DEMCAL_INLINE typename Simd<W>::D rounded(typename Simd<W>::D v) {
 }
 
 // Normal geometry and force of a pair: unit normal, overlap, normal force
-// (0 when apart), contact flag. One home for the pair pass and the scalar
+// (0 when apart), the dashpot's power (0 when apart or undamped), contact
+// flag. One home for the pair pass and the scalar
 // re-evaluation (SphereWorldImpl::pair_geometry, through one_pair below on the
 // same SIMD path), so that both round alike, FMA contractions included.
 template <int W>
 struct Normal {
-  typename Simd<W>::D nx, ny, nz, ov, fn;
+  typename Simd<W>::D nx, ny, nz, ov, fn, power;
   typename Simd<W>::M touch;
 };
 template <int W, bool kDamped>
@@ -178,12 +181,14 @@ DEMCAL_INLINE Normal<W> normal_part(typename Simd<W>::D dx, typename Simd<W>::D 
   g.ny = dy * inv;
   g.nz = dz * inv;
   g.ov = rs - d;
-  D fn = kn * g.ov;
+  D fn = law::elastic_normal_force(kn, g.ov);
+  g.power = zero;
   if constexpr (kDamped) {
     const D meff = reduced_mass(mi, mj);
     const D vn = dvx * g.nx + dvy * g.ny + dvz * g.nz;  // > 0 when separating
-    fn = fn - beta2 * vsqrt(kn * meff) * vn;
-    fn = fn > zero ? fn : zero;
+    const D fe = fn;
+    fn = law::damped_normal_force(fe, beta2, vsqrt(kn * meff), vn);
+    g.power = select<W>(g.touch, law::dashpot_power(fe, fn, vn), zero);
   }
   g.fn = select<W>(g.touch, fn, zero);
   return g;
@@ -380,7 +385,8 @@ DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
     const int s0 = a.block_slot[b], s1 = a.block_slot[b + 1];
     for (int sub = 0; sub < kBlock; sub += W) {
       const int i0 = kBlock * b + sub;
-      D released = zero, slid = zero;  // this sub-block's lanes, into block_* after the slots
+      // This sub-block's lanes, into block_* after the slots.
+      D released = zero, slid = zero, power = zero;
       const D xi = load<W>(a.x + i0), yi = load<W>(a.y + i0), zi = load<W>(a.z + i0);
       const D vxi = load<W>(a.vx + i0), vyi = load<W>(a.vy + i0), vzi = load<W>(a.vz + i0);
       const D wxi = load<W>(a.wx + i0), wyi = load<W>(a.wy + i0), wzi = load<W>(a.wz + i0);
@@ -400,6 +406,7 @@ DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
         const Normal<W> g =
             normal_part<W, kDamped>(dx, dy, dz, ri, rj, dvx, dvy, dvz, mi, mj, kn, a.beta2);
         const M touch = g.touch;
+        if constexpr (kDamped) power += g.power;
         const D hx0 = load<W>(a.hx + s), hy0 = load<W>(a.hy + s), hz0 = load<W>(a.hz + s);
         const D mag2 = hx0 * hx0 + hy0 * hy0 + hz0 * hz0;
         const M held = mag2 > zero;
@@ -487,6 +494,7 @@ DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
       store<W>(a.tz + i0, tz);
       store<W>(a.block_released + i0, released);
       store<W>(a.block_slid + i0, slid);
+      if constexpr (kDamped) store<W>(a.block_power + i0, power);
     }
     // Block b's mirrored slots all belong to blocks in [src_block[b], b]
     // (i < j): if this pass did those, its sums are complete now, the pair
@@ -529,9 +537,9 @@ struct WallArgs {
 // part of a tangential vector, exactly 0), so it is never read. out =
 // {spheres' force on the wall −Σf along a, u, v; contacts; Σ|h|² of
 // contacts that opened; Σ cap·(|h_trial| − cap) of sliding ones; the
-// largest overlap/r}, each summed over the list in 8 lanes, then over the
-// lanes by detail::lane_sum: one order whatever the thread count and the
-// path's width.
+// largest overlap/r; the dashpots' power Σ (fe − fn)·v_n}, each summed over the list in 8 lanes,
+// then over the lanes by detail::lane_sum: one order whatever the thread count and the path's
+// width.
 template <int W>
 DEMCAL_INLINE void wall_contacts(const WallArgs &a, double *out) {
   using D = typename Simd<W>::D;
@@ -543,7 +551,7 @@ DEMCAL_INLINE void wall_contacts(const WallArgs &a, double *out) {
   // every path. The list is padded to a multiple of 8 (with the ghost,
   // histories 0), so every group of 8 is read whole; unrolled, each part
   // stays in registers.
-  BlockLanes<W> sum_fa, sum_fu, sum_fv, sum_count, sum_released, sum_slid;
+  BlockLanes<W> sum_fa, sum_fu, sum_fv, sum_count, sum_released, sum_slid, sum_power;
   D mo = zero;
   const double sg = a.sign;
   for (int k8 = 0; k8 < a.count; k8 += kBlock)
@@ -552,6 +560,7 @@ DEMCAL_INLINE void wall_contacts(const WallArgs &a, double *out) {
       const int k = k8 + q * W;
       D &wfa = sum_fa.part[q], &wfu = sum_fu.part[q], &wfv = sum_fv.part[q];
       D &count = sum_count.part[q], &released = sum_released.part[q], &slid = sum_slid.part[q];
+      D &power = sum_power.part[q];
       const int *J = a.idx + k;
       const M valid = lane < static_cast<double>(a.count - k);
       const D r = gather<W>(a.r, J);
@@ -574,11 +583,12 @@ DEMCAL_INLINE void wall_contacts(const WallArgs &a, double *out) {
       const D sd = sg * dist;
       const D dvu = sd * gather<W>(a.wv, J) - gather<W>(a.vu, J);
       const D dvv = (zero - gather<W>(a.vv, J)) - sd * gather<W>(a.wu, J);
-      D fn = a.kn * ov;
+      D fn = law::elastic_normal_force(a.kn, ov);
       if (a.beta2 > 0.0) {
         const D vn = (gather<W>(a.va, J) - a.velocity) * sg;  // leaving the wall > 0
-        fn = fn - a.beta2 * vsqrt(a.kn * gather<W>(a.m, J)) * vn;
-        fn = fn > zero ? fn : zero;
+        const D fe = fn;
+        fn = law::damped_normal_force(fe, a.beta2, vsqrt(a.kn * gather<W>(a.m, J)), vn);
+        power += select<W>(touch, law::dashpot_power(fe, fn, vn), zero);
       }
       fn = select<W>(touch, fn, zero);
       D hu = hu0 + a.kdt * dvu, hv = hv0 + a.kdt * dvv;
@@ -615,6 +625,7 @@ DEMCAL_INLINE void wall_contacts(const WallArgs &a, double *out) {
   out[4] = sum_released.total();
   out[5] = sum_slid.total();
   out[6] = hmax<W>(mo);
+  out[7] = sum_power.total();
 }
 
 struct IntegrateArgs {
@@ -785,6 +796,7 @@ double SphereWorldImpl::pair_pass(int b0, int b1) {
                    tz_.data(),
                    block_released_.data(),
                    block_slid_.data(),
+                   block_power_.data(),
                    material_.particle.kn,
                    material_.particle.kt * integration_.dt,
                    0.5 * integration_.dt,
@@ -851,7 +863,7 @@ void SphereWorldImpl::wall_pass() {
   const double *spin[3] = {wx_.data(), wy_.data(), wz_.data()};
   double *force[3] = {fx_.data(), fy_.data(), fz_.data()};
   double *torque[3] = {tx_.data(), ty_.data(), tz_.data()};
-  double max_overlap = 0.0, released = 0.0, slid = 0.0;
+  double max_overlap = 0.0, released = 0.0, slid = 0.0, power = 0.0;
   const Kernels &k = kernels();
   for (int s = 0; s < 6; ++s) {
     SphereWall &wall = walls_[s];
@@ -882,7 +894,7 @@ void SphereWorldImpl::wall_pass() {
                      kdt,
                      material_.wall.friction,
                      2.0 * material_.contact_damping_ratio};
-    double out[7];
+    double out[8];
     k.walls(a, out);
     wall.force = V3::Zero();
     wall.force[ax] = out[0];
@@ -892,9 +904,11 @@ void SphereWorldImpl::wall_pass() {
     released += out[4];
     slid += out[5];
     max_overlap = std::max(max_overlap, out[6]);
+    power += out[7];
   }
   max_overlap_ratio_seen_ = std::max(max_overlap_ratio_seen_, max_overlap);
   friction_dissipated_ += released * (0.5 * compliance) + slid * compliance;
+  dashpot_power_ += power;
 }
 
 void SphereWorldImpl::compute_forces() {
@@ -911,6 +925,11 @@ void SphereWorldImpl::compute_forces() {
     const double slid = detail::block_lanes_sum(block_slid_.data(), nblocks_);
     friction_dissipated_ += released * (0.5 / kt) + slid / kt;
   }
+  // The contact dashpots' power of these forces, booked by step() over the
+  // step that applies them (the walls' share added by wall_pass).
+  dashpot_power_ = material_.contact_damping_ratio > 0.0
+                       ? detail::block_lanes_sum(block_power_.data(), nblocks_)
+                       : 0.0;
   wall_pass();
 }
 

@@ -11,10 +11,15 @@
 // (SphereWorldImpl::integrate), and so is the work of the moving walls
 // (SphereWorldImpl::book_wall_work: sampled, it missed collisions shorter than
 // the interval, and a wall throwing a resting sphere read as energy
-// created); the contact damping is sampled every energy_check_interval
-// steps and integrated with the trapezoidal rule. (Sampling the global damping too, as the 2D
-// ledger does, overestimates the loss many times over when the kinetic energy decays within a
-// sampling interval — a free sphere at ζ = 0.7, α = 0.1 read as creating energy.)
+// created), and so is the contact dashpots' loss, at the forces each step
+// applies (SphereWorldImpl::step, as the 2D ledger does: sampled every
+// energy_check_interval steps and integrated by the trapezoidal rule, a
+// damped collision that began just before a sample booked the dashpot's
+// initial power c·v² over the whole interval, and a lone bounce at
+// α = 0.002 stopped as "energy created"). (Sampling the global damping
+// too, as the 2D ledger does, overestimates the loss many times over when
+// the kinetic energy decays within a sampling interval — a free sphere at
+// ζ = 0.7, α = 0.1 read as creating energy.)
 #include <algorithm>
 #include <cmath>
 
@@ -34,41 +39,28 @@ SphereWorldImpl::EnergySample SphereWorldImpl::energy_sample() const {
     e.energy += 0.5 * (m_[i] * v2 + inertia_[i] * w2);
   }
 
-  // Pairs: spring energy and contact damping (the non-elastic part of fn
-  // times the separation speed).
+  // Pairs: the energy of both springs (the dashpots' loss is booked every
+  // step: dashpot_dissipated_).
   for (int i = 0; i < n_; ++i)
     for (int k = nbr_start_[i]; k < nbr_start_[i + 1]; ++k) {
-      const int j = nbr_j_[k];
-      const PairGeometry g = pair_geometry(i, j);
+      const PairGeometry g = pair_geometry(i, nbr_j_[k]);
       if (!g.touching) continue;
-      const double fn_elastic = law::elastic_normal_force(kn, g.overlap);
-      const double vn = (vx_[j] - vx_[i]) * g.n.x() + (vy_[j] - vy_[i]) * g.n.y() +
-                        (vz_[j] - vz_[i]) * g.n.z();  // > 0 when separating
       const double h2 = pair_history(k).squaredNorm();
-      e.elastic += law::spring_energy(fn_elastic, kn) + law::spring_energy_squared(h2, kt);
-      e.power_lost += (fn_elastic - g.fn) * vn;
+      e.elastic += law::spring_energy(law::elastic_normal_force(kn, g.overlap), kn) +
+                   law::spring_energy_squared(h2, kt);
     }
 
-  // Walls: spring energy, contact damping.
+  // Walls: the energy of both springs.
   const double kw = material_.wall.kn, ktw = material_.wall.kt;
-  const bool damped = material_.contact_damping_ratio > 0.0;
-  for (int s = 0; s < 6; ++s) {
-    const SphereWall& wall = walls_[s];
-    const int axis = s / 2;
-    const double sign = (s % 2 == 0) ? 1.0 : -1.0;
-    const double* v[3] = {vx_.data(), vy_.data(), vz_.data()};
+  for (int s = 0; s < 6; ++s)
     for (size_t k = 0; k < wall_candidates_[s].size(); ++k) {
-      const int i = wall_candidates_[s][k];
-      const double ov = r_[i] - wall_distance(s, i);
+      const double ov = r_[wall_candidates_[s][k]] - wall_distance(s, wall_candidates_[s][k]);
       if (ov <= 0.0) continue;
-      const double vn = (v[axis][i] - wall.velocity) * sign;  // leaving the wall > 0
-      const double fn_elastic = law::elastic_normal_force(kw, ov);
       const double h2 = wall_hx_[s][k] * wall_hx_[s][k] + wall_hy_[s][k] * wall_hy_[s][k] +
                         wall_hz_[s][k] * wall_hz_[s][k];
-      e.elastic += law::spring_energy(fn_elastic, kw) + law::spring_energy_squared(h2, ktw);
-      if (damped) e.power_lost += (fn_elastic - wall_fn_[s][k]) * vn;
+      e.elastic += law::spring_energy(law::elastic_normal_force(kw, ov), kw) +
+                   law::spring_energy_squared(h2, ktw);
     }
-  }
   e.energy += e.elastic;
   return e;
 }
@@ -84,17 +76,14 @@ bool SphereWorldImpl::ledger_record(const EnergySample& e) {
     l.started = true;
     l.step = steps_;
     l.energy0 = e.energy;
-    l.power_lost = e.power_lost;
     damping_dissipated_ = 0.0;
+    dashpot_dissipated_ = 0.0;
     wall_work_ = 0.0;
     friction_dissipated_ = 0.0;
     return false;
   }
-  const double h = static_cast<double>(steps_ - l.step) * integration_.dt;
-  l.lost += 0.5 * (l.power_lost + e.power_lost) * h;
-  l.power_lost = e.power_lost;
   l.step = steps_;
-  const double lost = l.lost + damping_dissipated_ + friction_dissipated_;
+  const double lost = damping_dissipated_ + friction_dissipated_ + dashpot_dissipated_;
   const double created = e.energy - l.energy0 - wall_work_ + lost;
   const double scale = l.energy0 + std::abs(wall_work_) + lost;
   l.created = scale > 0.0 ? created / scale : 0.0;

@@ -62,7 +62,7 @@ SphereWorldImpl::SphereWorldImpl(const SphereMaterial& material, std::span<const
   x_built_ = x_;
   y_built_ = y_;
   z_built_ = z_;
-  for (auto* a : {&block_lost_, &block_released_, &block_slid_}) a->assign(cap, 0.0);
+  for (auto* a : {&block_lost_, &block_released_, &block_slid_, &block_power_}) a->assign(cap, 0.0);
   block_slot_.assign(static_cast<size_t>(nblocks_) + 1, 0);
   mirror_block_.assign(static_cast<size_t>(nblocks_) + 1, 0);
   mirror_src_block_.assign(static_cast<size_t>(nblocks_), 0);
@@ -292,6 +292,9 @@ bool SphereWorldImpl::step(int64_t count) {
   }
   const int interval = std::max(1, options_.check_interval);
   for (int64_t s = 0; s < count; ++s) {
+    // The contact dashpots' loss over this step, at the forces it applies
+    // (0 without dashpots).
+    dashpot_dissipated_ += integration_.dt * dashpot_power_;
     integrate();
     if (!list_valid_) rebuild_neighbours();
     compute_forces();

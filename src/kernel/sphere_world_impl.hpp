@@ -152,7 +152,6 @@ class SphereWorldImpl {
   // sphere_energy_balance.cpp
   struct EnergySample {
     double energy = 0.0, elastic = 0.0;
-    double power_lost = 0.0;  // contact damping [W] (global damping is summed each step)
   };
   EnergySample energy_sample() const;
   bool ledger_due() const;
@@ -183,8 +182,9 @@ class SphereWorldImpl {
   // sums for any thread count and on every path): global damping loss of
   // the step (Σ D·|v̄|²/4) and, over the lane's slots, Σ|h|² of contacts
   // that opened and Σ μFn·(|h_trial| − μFn) of sliding ones (every pair
-  // counted once).
-  Array block_lost_, block_released_, block_slid_;
+  // counted once); and (damped pass only) the contact dashpots' power
+  // Σ (fe − fn)·v_n over the lane's slots.
+  Array block_lost_, block_released_, block_slid_, block_power_;
   // Energy taken by global damping since the energy ledger started [J] (a
   // running total from the start, not a difference of two totals: that
   // would cancel catastrophically once most of the energy is gone).
@@ -194,6 +194,14 @@ class SphereWorldImpl {
   // (sliding) or when it opens (sphere_contact.cpp explains why that is
   // dissipated, not created).
   double friction_dissipated_ = 0.0;
+  // The contact dashpots' power at the last force evaluation, pairs and
+  // walls [W], and the energy they took since the ledger started [J],
+  // booked every step over the step that applies those forces (as the 2D
+  // ledger does: sampled every energy_check_interval steps, a collision
+  // shorter than the interval aliased, and one starting just before a
+  // sample read as energy created).
+  double dashpot_power_ = 0.0;
+  double dashpot_dissipated_ = 0.0;
   // Work of the moving walls on the spheres since the ledger started [J],
   // summed every step by the trapezoidal rule over each wall's move: the
   // wall's push along its axis before and after the move (wall_push_) times
@@ -264,7 +272,7 @@ class SphereWorldImpl {
   struct Ledger {
     bool started = false;
     int64_t step = 0;
-    double energy0 = 0.0, lost = 0.0, power_lost = 0.0;
+    double energy0 = 0.0;
     double created = 0.0;
   } ledger_;
 
