@@ -86,8 +86,8 @@ constexpr double kZetas[] = {0.05, 0.3, 0.7};
 /// ledger integrates the contact dashpots' power by the trapezoidal rule
 /// between samples 128 steps apart, so a collision that starts just before
 /// a sample books the jump c·v² at entry over the whole interval, reads as
-/// energy created and stops the run as diverged: a kernel bug (the 2D
-/// ledger sums that power every step).
+/// energy created and stops the run as diverged: a kernel bug, see
+/// LedgerDoesNotReadADampedCollisionAsEnergyCreated below.
 KernelOptions trajectory_only() {
   KernelOptions o;
   o.max_energy_created = std::numeric_limits<double>::infinity();
@@ -273,6 +273,30 @@ TEST(SphereRestitution, UnequalSpheresBounceWithTheReducedMassesRestitution) {
                 b.restitution, e, b.restitution - e, restitution_tolerance(zeta, b.h),
                 b.ledger_max);
   }
+}
+
+}  // namespace
+}  // namespace demcal
+
+namespace demcal {
+namespace {
+
+// KERNEL BUG, FAILS on bf15a62 (reported to the lead; src/ is not this
+// branch's): the 3D ledger samples the contact dashpots' power every
+// energy_check_interval (128) steps and integrates it by the trapezoidal
+// rule (sphere_energy_balance.cpp), so a collision that begins a step
+// before a sample books ½·c·v²·128·Δt of dissipation that has not
+// happened: here the ledger reads 0.198 at the first touching step (step
+// 159, the sample at 160) and the run stops as "energy created by the
+// integrator (step beyond the stable one)" at α = 0.002, far inside the
+// stable step. With energy_check_interval = 1 the same collision runs
+// through (e = 0.45101 against 0.45098). The 2D ledger sums the dashpots'
+// power every step for that reason (energy_balance.cpp: "which such
+// samples would alias", WorldImpl::dashpot_power).
+TEST(SphereRestitution, LedgerDoesNotReadADampedCollisionAsEnergyCreated) {
+  const Bounce b = pair_bounce(0.3, 0.05, KernelOptions{});
+  EXPECT_TRUE(b.separated);
+  EXPECT_LT(b.ledger_max, KernelOptions{}.max_energy_created);
 }
 
 }  // namespace
