@@ -235,6 +235,108 @@ TEST(SphereContact, ObliqueContactUnloadsElasticallyAfterSliding) {
   EXPECT_GT(sliding_back, 350);
 }
 
+// Lever arms with unequal radii, by hand. A small sphere (r_s = r) and a
+// large one (r_b = 1.6·r) overlap by δ = 1e-5 m along n (from the small
+// to the large), δ/(2·r_s) = 1 %; neither moves, both may spin about axes
+// normal to n. The contact point is the middle of the overlap, at arms a_s
+// = r_s − δ/2 and a_b = r_b − δ/2 from the centres, so the large sphere's
+// contact point moves relative to the small one's at
+//   v_t = ω_b × (−a_b·n) − ω_s × (a_s·n) = n × S,  S = a_s·ω_s + a_b·ω_b,
+// tangential (S ⊥ n). Centres fixed, the normal never turns and, the spins
+// being normal to n, the history does not twist: the incremental spring
+// gives, on the small sphere, h = kt·Δt·k·v_t after k steps while |h| <
+// μ·Fn, then μ·Fn·v_t/|v_t| (friction drags each body along with the
+// other's surface), Fn = kn·δ; the force on the small sphere −Fn·n + h, on
+// the large one its opposite. The torques a·n × h are, with n × (n × S) =
+// −S, −a_s·(h/|v_t|)·S on the small sphere and −a_b·(h/|v_t|)·S on the large
+// one: each opposes S, in the ratio of the arms. With the small sphere at
+// rest (S = a_b·ω_b) the large one is braked (−a_b²·ω_b) and the small one
+// driven the other way, as meshing gears. Run with either sphere the lower
+// index (the kernel's n, and the force it books on "i", flip with it).
+//
+// Tolerances. Mass scaling 1e19 makes both spheres near-immovable: over T =
+// 2 000·Δt the spins change by at most a·μFn·T/I, the centres' speeds by
+// 2Fn·T/m and the overlap by 2Fn·T²/m, which changes |v_t| and Fn by the
+// `drift` computed below (1.4e-10 of themselves), and h, a sum of
+// increments, by as much. Round-off: δ = r_s + r_b
+// − d cancels d, a few ulps of d relative to δ (8ε·(r_s + r_b)/δ ≈ 2e-13),
+// and h sums ≤ 2 000 increments (2 000·ε). Swapping the arms (a_b·ω_s +
+// a_s·ω_b) changes |v_t| by a factor a_s/a_b ≈ 0.63, and arms r instead of
+// r − δ/2 change the forces or torques by δ/(2r) ≥ 0.6 %.
+void expect_lever_arms(bool small_first, const Vector3d& omega_small, const Vector3d& omega_big) {
+  const double mu = 0.3, rs = kR, rb = 1.6 * kR, delta = 1e-5;
+  const SphereMaterial mat = test_material(mu);
+  const Vector3d n = Vector3d(2.0, 3.0, 6.0) / 7.0;
+  const int is = small_first ? 0 : 1, ib = 1 - is;
+  sphere_test::Scene s;
+  const Vector3d x_small = Vector3d::Zero(), x_big = (rs + rb - delta) * n;
+  s.add(small_first ? x_small : x_big, small_first ? rs : rb);
+  s.add(small_first ? x_big : x_small, small_first ? rb : rs);
+  s.lo = {-10 * rb, -10 * rb, -10 * rb};
+  s.hi = {10 * rb, 10 * rb, 10 * rb};
+  SphereWorld w = s.make(mat);
+  Integration in = sphere_test::set_undamped(w, 0.0, 1e19);
+  in.dt = 1e-6;
+  w.set_integration(in);
+  ASSERT_FALSE(in.lock_rotation);
+  w.set_velocity(is, Vector3d::Zero(), omega_small);
+  w.set_velocity(ib, Vector3d::Zero(), omega_big);
+
+  const double kn = mat.particle.kn, kt = mat.particle.kt, fn = kn * delta, cap = mu * fn;
+  const double as = rs - 0.5 * delta, ab = rb - 0.5 * delta;
+  const Vector3d S = as * omega_small + ab * omega_big, vt = n.cross(S);
+  ASSERT_NEAR(S.dot(n), 0.0, 1e-15 * S.norm());
+  const int steps = 2000;
+  const double T = steps * in.dt;
+  const double ms = w.mass()[is], mb = w.mass()[ib], Is = w.inertia()[is], Ib = w.inertia()[ib];
+  const double drift = T * (as * as * cap / Is + ab * ab * cap / Ib) / vt.norm() +
+                       2.0 * fn * T / (std::min(ms, mb) * vt.norm()) +
+                       2.0 * fn * T * T / (std::min(ms, mb) * delta);
+  ASSERT_LT(drift, 1e-9);
+  const double tol = (drift + 2000.0 * kEps + 8.0 * kEps * (rs + rb) / delta) * (fn + cap);
+  int stuck = 0, slid = 0;
+  for (int k = 1; k <= steps; ++k) {
+    ASSERT_TRUE(w.step(1));
+    const double stick = kt * in.dt * k * vt.norm();
+    if (std::abs(stick - cap) < tol) continue;
+    const double ht = std::min(stick, cap);  // |h|
+    (stick < cap ? stuck : slid)++;
+    const Vector3d h = ht * vt.normalized();
+    const Vector3d f_small = -fn * n + h;
+    EXPECT_NEAR((sphere_test::force(w, is) - f_small).norm(), 0.0, tol) << "step " << k;
+    EXPECT_NEAR((sphere_test::force(w, ib) + f_small).norm(), 0.0, tol) << "step " << k;
+    const Vector3d m_small = -as * (ht / vt.norm()) * S, m_big = -ab * (ht / vt.norm()) * S;
+    EXPECT_NEAR((sphere_test::torque(w, is) - m_small).norm(), 0.0, tol * rs) << "step " << k;
+    EXPECT_NEAR((sphere_test::torque(w, ib) - m_big).norm(), 0.0, tol * rb) << "step " << k;
+    // The contact's own view: the force on the lower index, tangential part.
+    const auto c = w.contacts();
+    ASSERT_EQ(c.size(), 1u);
+    EXPECT_NEAR((c[0].tangential - (small_first ? h : Vector3d(-h))).norm(), 0.0, tol);
+    EXPECT_NEAR(c[0].overlap, delta, drift * delta + 8.0 * kEps * (rs + rb));
+  }
+  // μ·Fn/(kt·Δt·|v_t|) = 1 200 steps of sticking (|v_t| = 5e-3 m/s).
+  EXPECT_GT(stuck, 1150);
+  EXPECT_GT(slid, 750);
+}
+
+TEST(SphereContact, LeverArmsOfUnequalSpheresByHand) {
+  const double rs = kR, rb = 1.6 * kR, delta = 1e-5;
+  const double as = rs - 0.5 * delta, ab = rb - 0.5 * delta;
+  // Two unit vectors normal to n = (2, 3, 6)/7 and to each other.
+  const Vector3d e1 = Vector3d(3.0, -6.0, 2.0) / 7.0, e2 = Vector3d(6.0, 2.0, -3.0) / 7.0;
+  for (bool small_first : {true, false}) {
+    SCOPED_TRACE(small_first ? "small sphere first" : "large sphere first");
+    {
+      SCOPED_TRACE("small at rest, large spinning");
+      expect_lever_arms(small_first, Vector3d::Zero(), (5e-3 / ab) * e1);
+    }
+    {
+      SCOPED_TRACE("both spinning");
+      expect_lever_arms(small_first, (4e-3 / as) * e2, (3e-3 / ab) * e1);
+    }
+  }
+}
+
 // A contact pair loaded in shear, then turned rigidly by Θ = 90° about an
 // axis through its centre (the driver prescribes the rigid velocity field
 // every step: v = (R(Ω·Δt) − I)(x − c)/Δt, so the centres move exactly on
