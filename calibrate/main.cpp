@@ -96,16 +96,22 @@ int main(int argc, char** argv) {
 
   ScoreOptions score_options;
   auto* score = app.add_subcommand(
-      "score", "criteria, verdict and diagnosis of another engine's monitoring series (CSV)");
-  score->add_option("file", score_options.file, "series file (e.g. the LAMMPS deck's series.csv)")
+      "score",
+      "criteria, verdict and diagnosis of a monitoring series (CSV: another engine's, or demcal "
+      "run's)");
+  score
+      ->add_option("file", score_options.file,
+                   "series file (e.g. the LAMMPS deck's series.csv, or demcal run's)")
       ->required();
   score
       ->add_option("--lateral-stress", score_options.lateral_stress,
                    "sigma3 in Pa, if the file has no '# lateral_stress = ' line")
       ->check(real_above(0.0, 1e12));
   score
-      ->add_option("--reference-peak", score_options.reference_peak,
-                   "a reference peak |sigma_yy| in Pa to report the peak error against")
+      ->add_option(
+          "--reference-peak", score_options.reference_peak,
+          "a reference peak |sigma_yy| in Pa to report the peak error against (default: the "
+          "file's '# reference_peak = ' line, if any)")
       ->check(real_above(0.0, 1e15));
   score->add_option("-o,--output", score_options.out_dir,
                     "output folder (default demcal-score-STEM)");

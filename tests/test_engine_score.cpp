@@ -174,7 +174,7 @@ TEST(ScoreCli, ScoresAFileAndRejectsBadInputWithStatus2) {
   EXPECT_TRUE(summary);
   EXPECT_EQ(bad, 2);
   EXPECT_EQ(missing, 2);
-  EXPECT_EQ(no_s3, 2);  // demcal's series.csv has no "# lateral_stress"
+  EXPECT_EQ(no_s3, 2);  // series_csv() without metadata has no "# lateral_stress"
   EXPECT_FALSE(partial);
 }
 
