@@ -15,7 +15,11 @@
 #include <string>
 #include <vector>
 
+#include "demcal/kernel/particle_scales.hpp"
 #include "demcal/kernel/world.hpp"
+#include "demcal/scene/config.hpp"
+#include "demcal/scene/packing.hpp"
+#include "demcal/upscaling/upscaling.hpp"
 #include "support/csv.hpp"
 #include "support/files.hpp"
 #include "support/process.hpp"
@@ -163,6 +167,28 @@ TEST_F(CliEndToEnd, AnUnknownSimdPathIsBadInput) {
   const Result unset = demcal({"check", kHex5}, {"DEMCAL_SIMD="});
   EXPECT_EQ(unset.status, 0) << unset.err;
   EXPECT_EQ(unset.err, "");
+}
+
+// `demcal verify --consolidate-only` consolidates and stops: what it says on
+// stderr announces no loading (it said "loading now, about … min", then
+// stopped).
+TEST_F(CliEndToEnd, VerifyConsolidateOnlyAnnouncesNoLoading) {
+  const demcal::SceneConfig c = demcal::default_config();
+  demcal::AlgorithmSpec p;
+  p.steps = 20000;
+  const auto scales = demcal::particle_scales(demcal::make_assembly(c).r, c.material);
+  write("params.json", nlohmann::json{{"schema", "demcal.params/1"},
+                                      {"scene", c.name},
+                                      {"rev", demcal::param_block(p, scales)}}
+                           .dump());
+  const Result r = demcal({"verify", (dir_ / "params.json").string(), "--particles", "25",
+                           "--consolidate-only", "-o", "v"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(fs::exists(dir_ / "work" / "v" / "prototype.csv"));
+  EXPECT_NE(r.out.find("consolidated prototype of 25 particles"), std::string::npos) << r.out;
+  EXPECT_NE(r.err.find("consolidated in"), std::string::npos) << r.err;
+  for (const char* announce : {"loading now", "loading =", " min"})
+    EXPECT_EQ(r.err.find(announce), std::string::npos) << announce << " in " << r.err;
 }
 
 // `demcal stability`: the limit against the estimate, both files written.
