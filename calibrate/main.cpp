@@ -108,10 +108,9 @@ int main(int argc, char** argv) {
                    "sigma3 in Pa, if the file has no '# lateral_stress = ' line")
       ->check(real_above(0.0, 1e12));
   score
-      ->add_option(
-          "--reference-peak", score_options.reference_peak,
-          "a reference peak |sigma_yy| in Pa to report the peak error against (default: the "
-          "file's '# reference_peak = ' line, if any)")
+      ->add_option("--reference-peak", score_options.reference_peak,
+                   "a reference peak |sigma_yy| (3D: |sigma_zz|) in Pa to report the peak error "
+                   "against (default: the file's '# reference_peak = ' line, if any)")
       ->check(real_above(0.0, 1e15));
   score->add_option("-o,--output", score_options.out_dir,
                     "output folder (default demcal-score-STEM)");
