@@ -169,6 +169,23 @@ TEST_F(CliEndToEnd, AnUnknownSimdPathIsBadInput) {
   EXPECT_EQ(unset.err, "");
 }
 
+// The refusal quotes the environment's value: its control characters and
+// bytes beyond ASCII are shown as \xNN, so the message stays one line of
+// text (a newline in the value made it two, an escape sequence drove the
+// terminal).
+TEST_F(CliEndToEnd, ASimdPathWithControlCharactersIsShownEscaped) {
+  const std::string value = "avx2\nnext line \x1b[2J\x7f\xc3\xa9\x01\t";
+  const Result r = demcal({"check", kHex5}, {"DEMCAL_SIMD=" + value});
+  EXPECT_EQ(r.status, 2) << r.err;
+  ASSERT_EQ(lines_of(r.err).size(), 1u) << r.err;
+  EXPECT_NE(r.err.find("DEMCAL_SIMD=\"avx2\\x0anext line \\x1b[2J\\x7f\\xc3\\xa9\\x01\\x09\""),
+            std::string::npos)
+      << r.err;
+  for (const char c : r.err.substr(0, r.err.size() - 1))  // all printable before the newline
+    EXPECT_TRUE(c >= 0x20 && c < 0x7f) << static_cast<int>(static_cast<unsigned char>(c));
+  EXPECT_EQ(r.out, "");
+}
+
 // `demcal verify --consolidate-only` consolidates and stops: what it says on
 // stderr announces no loading (it said "loading now, about … min", then
 // stopped).
