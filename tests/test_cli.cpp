@@ -430,7 +430,8 @@ void expect_scores_as_the_run(const fs::path& out, const Result& run) {
 // and the analytical reference): `demcal score` gives its criteria, verdict
 // and diagnosis, on a passing and a failing run.
 TEST_F(CliEndToEnd, ScoreOnARunsSeriesGivesTheRunsVerdict) {
-  for (const char* steps : {"algorithm.steps=2000", "algorithm.steps=40000"}) {
+  bool seen[2] = {false, false};
+  for (const char* steps : {"algorithm.steps=2000", "algorithm.steps=100000"}) {
     SCOPED_TRACE(steps);
     const fs::path out = dir_ / "work" / ("run" + std::string(steps).substr(16));
     const Result r =
@@ -438,8 +439,10 @@ TEST_F(CliEndToEnd, ScoreOnARunsSeriesGivesTheRunsVerdict) {
     ASSERT_EQ(r.status, 0) << r.err;
     const auto ran = nlohmann::json::parse(read_text(out / "summary.json"));
     EXPECT_TRUE(ran.at("criteria").contains("peak_error"));  // against the analytical peak
+    seen[ran.at("passed").get<bool>()] = true;
     expect_scores_as_the_run(out, r);
   }
+  EXPECT_TRUE(seen[0] && seen[1]) << "wanted a failing and a passing run";
 }
 
 TEST_F(CliEndToEnd, RunIntoAnExistingFolderAndWithoutVtk) {
