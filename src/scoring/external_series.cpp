@@ -292,7 +292,8 @@ ExternalSeries parse_external_series(const std::string& text, const std::string&
   if (!(out.lateral_stress > 0.0))
     throw InputError(source, "lateral_stress", "must be positive (sigma3, Pa)");
 
-  out.reference_peak = meta_number(out, "reference_peak");
+  // A compressive peak, whichever sign the file gives it (as --reference-peak).
+  if (const auto ref = meta_number(out, "reference_peak")) out.reference_peak = -std::abs(*ref);
   if (out.dimension == 2) {
     read_biaxial_rows(t, out);
     read_run_facts(t, out, out.run);

@@ -59,7 +59,8 @@ struct ExternalSeries {
   LoadingResult run;            ///< 2D: series and what is known of the run
   TriaxialResult triaxial;      ///< 3D: the same
   double lateral_stress = 0.0;  ///< σ3 [Pa]
-  /// "# reference_peak" [Pa]: what the writer's peak error was taken against.
+  /// "# reference_peak" [Pa]: what the writer's peak error was taken
+  /// against, compressive (negative) whichever sign the file gives it.
   std::optional<double> reference_peak;
   bool torque_column = false;  ///< torque_stress was given
   /// Per monitoring point: ((σxy − σyx) − torque_stress)/σ3 (empty without
