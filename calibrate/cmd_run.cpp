@@ -129,7 +129,7 @@ int run_3d(const SceneConfig& config, const std::string& out_dir, bool allow_uns
   {
     OutputFolder out(dir);
     out.write("summary.json", summary.dump(2) + "\n");
-    out.write("series.csv", series_csv(run.series));
+    out.write("series.csv", series_csv(series_metadata(config.name, config.test, run), run.series));
     if (config.output.vtk)
       out.write("final.vtk", world_vtk(final_state, "demcal " + config.name));
     else
@@ -201,8 +201,8 @@ int cmd_run(const std::string& path, const std::vector<std::string>& sets,
   World final_state = state.world;
   const LoadingResult run = run_loading(state, config.test, config.algorithm, {}, &final_state);
   const Tolerances tolerances;
-  const Score score =
-      score_run(run, config.test.lateral_stress, tolerances, analytical_peak_stress(config));
+  const std::optional<double> reference_peak = analytical_peak_stress(config);
+  const Score score = score_run(run, config.test.lateral_stress, tolerances, reference_peak);
   nlohmann::json summary = run_summary(config, run, score);
   summary["tolerances"] = to_json(tolerances);
   summary["consolidation"] = {
@@ -213,7 +213,10 @@ int cmd_run(const std::string& path, const std::vector<std::string>& sets,
   {
     OutputFolder out(dir);
     out.write("summary.json", summary.dump(2) + "\n");
-    out.write("series.csv", series_csv(run.series));
+    // With the metadata `demcal score` needs to score it as this run.
+    out.write(
+        "series.csv",
+        series_csv(series_metadata(config.name, config.test, run, reference_peak), run.series));
     if (config.output.vtk)
       out.write("final.vtk", world_vtk(final_state, "demcal " + config.name));
     else

@@ -1,7 +1,8 @@
 // `demcal score FILE [--lateral-stress PA] [-o DIR]`: the criteria, verdict
 // and diagnosis of a monitoring series written by another engine (the
 // exported LAMMPS deck's series.csv, 2D or 3D, or any code writing the
-// documented CSV), as `demcal run` prints them for its own runs;
+// documented CSV) or by `demcal run` (its metadata carry what the run was
+// scored with), as `demcal run` prints them for its own runs;
 // DIR/summary.json.
 #include <filesystem>
 #include <fstream>
@@ -30,7 +31,8 @@ int cmd_score(const ScoreOptions& o) {
       o.out_dir.empty() ? "demcal-score-" + fs::path(o.file).stem().string() : o.out_dir;
   OutputFolder::check(dir);
   const Tolerances tolerances = series.dimension == 3 ? triaxial_tolerances() : Tolerances{};
-  std::optional<double> reference;
+  // --reference-peak, else the file's (demcal's own runs write theirs).
+  std::optional<double> reference = series.reference_peak;
   if (o.reference_peak != 0.0) reference = -std::abs(o.reference_peak);
   const ExternalScore scored = score_external(series, tolerances, reference);
   {
@@ -63,8 +65,8 @@ int cmd_score(const ScoreOptions& o) {
               << tolerances.oscillation << ")\n";
   }
   if (c.peak_error)
-    std::cout << "  peak error against " << -std::abs(o.reference_peak)
-              << " Pa: " << 100.0 * *c.peak_error << " %\n";
+    std::cout << "  peak error against " << *reference << " Pa: " << 100.0 * *c.peak_error
+              << " %\n";
   std::cout << "  " << (score.passed ? "PASS" : "FAIL") << ": " << score.diagnosis.message << "\n";
   if (is_3d ? series.triaxial.diverged : series.run.diverged)
     std::cout << "  DIVERGED: non-finite values from step "

@@ -49,11 +49,13 @@ std::function<int()> add_upscaling_commands(CLI::App& app) {
                    "refuse a loading run estimated longer than this (default 8)")
       ->check(real_above(0.0, kMaxMinutes));
   verify->add_flag("--consolidate-only", ve->consolidate_only,
-                   "consolidate the prototype, write DIR/prototype.csv, and stop");
+                   "2D: consolidate the prototype, write DIR/prototype.csv, and stop");
   verify->add_option("--tile", ve->tile,
-                     "NXxNY: mirror-tile the --prototype packing into a larger test prototype");
+                     "2D: NXxNY, mirror-tile the --prototype packing into a larger test "
+                     "prototype");
   verify->add_option("--engine", ve->engine,
-                     "demcal (default) or lammps: run the exported deck with lmp and score it");
+                     "demcal (default) or, 2D, lammps: run the exported deck with lmp and score "
+                     "it");
   verify->add_option("--np", ve->np, "MPI ranks for --engine lammps (mpirun -np N; default 1)")
       ->check(CLI::Range(1, 4096));
   verify
@@ -89,7 +91,8 @@ std::function<int()> add_upscaling_commands(CLI::App& app) {
   // Values are checked by the command (exit 2, one message), not by CLI11.
   exp->add_option("--format", ex->format, "lammps (default) or liggghts");
   exp->add_option("-o,--output", ex->output, "the deck (default demcal-NAME.FORMAT)");
-  exp->add_option("--prototype", ex->prototype, "the prototype's particle file (CSV x,y,r)");
+  exp->add_option("--prototype", ex->prototype,
+                  "the prototype's particle file (CSV x,y,r; 3D: x,y,z,r)");
   exp->add_option("--particles", ex->particles, "a generated prototype of N particles")
       ->check(whole_number(1, kMaxParticles));
   exp->add_option("--config", ex->config, "scene config, if params.json carries none");
@@ -113,7 +116,8 @@ std::function<int()> add_upscaling_commands(CLI::App& app) {
       "rev", "cut or generate a REV from the prototype and report how representative it is");
   rev->add_option("config", rv->config, "scene config (JSON); default: the embedded one");
   rev->add_option("--set", rv->sets, "override a key: section.key=value (repeatable)");
-  rev->add_option("--prototype", rv->prototype, "the prototype's particle file (CSV x,y,r)");
+  rev->add_option("--prototype", rv->prototype,
+                  "the prototype's particle file (CSV x,y,r; 3D: x,y,z,r)");
   rev->add_option("--particles", rv->particles, "particles in the REV (default 400)")
       ->check(whole_number(1, kMaxParticles));
   rev->add_option("--method", rv->method, "cut (a window of the prototype) or generate");

@@ -345,10 +345,16 @@ int cmd_verify(const VerifyOptions& o) {
                          std::to_string(o.max_minutes) + " min; raise --max-minutes to run it");
   std::cerr << "demcal verify: prototype " << source.description << "; " << up.steps
             << " steps upscaled (" << law.name() << " law, exponent " << law.exponent << ") from "
-            << rev.particles << " particles / " << rev.params.steps << " steps\n"
-            << "demcal verify: loading = " << particle_steps << " particle-steps, estimated "
-            << estimate_s / 60.0 << " min at " << speed0 << " particle-steps/s (plus consolidation"
-            << (proto.dense ? ", short for a dense packing" : ", long for a loose gas") << ")\n";
+            << rev.particles << " particles / " << rev.params.steps << " steps\n";
+  const char* consolidation_time =
+      proto.dense ? "short for a dense packing" : "long for a loose gas";
+  if (o.consolidate_only)
+    std::cerr << "demcal verify: --consolidate-only: the consolidation alone ("
+              << consolidation_time << "), no loading\n";
+  else
+    std::cerr << "demcal verify: loading = " << particle_steps << " particle-steps, estimated "
+              << estimate_s / 60.0 << " min at " << speed0
+              << " particle-steps/s (plus consolidation, " << consolidation_time << ")\n";
   const std::string dir = o.out_dir.empty() ? "demcal-verify-" + config.name : o.out_dir;
   make_output_dir(dir);
 
@@ -358,8 +364,11 @@ int cmd_verify(const VerifyOptions& o) {
                                                      static_cast<double>(n) / state.wall_time_s
                                                : kAssumedSpeed;
   std::cerr << "demcal verify: consolidated in " << state.steps << " steps, " << state.wall_time_s
-            << " s; loading now, about " << particle_steps / (in_lammps ? speed0 : speed) / 60.0
-            << " min\n";
+            << " s";
+  if (!o.consolidate_only)
+    std::cerr << "; loading now, about " << particle_steps / (in_lammps ? speed0 : speed) / 60.0
+              << " min";
+  std::cerr << "\n";
   // The prototype's state, reusable by `demcal export --prototype` and by
   // later runs (read_particle_file reads it back).
   write_file_atomic(dir + "/prototype.csv", particle_csv(assembly_of(state.world)));

@@ -3,6 +3,8 @@
 #include <CLI/CLI.hpp>
 #include <iostream>
 #include <stdexcept>
+#include <string>
+#include <string_view>
 
 #include "commands.hpp"
 #include "demcal/io/input_error.hpp"
@@ -10,6 +12,30 @@
 #include "demcal/scene/config.hpp"
 #include "demcal/search/calibration.hpp"
 #include "option_checks.hpp"
+
+namespace {
+
+/// `text` with every byte outside printable ASCII (a control character, a
+/// byte of 0x80 and above) shown as \xNN: the kernel's message on a
+/// DEMCAL_SIMD it cannot honour quotes the environment's value as it is,
+/// and the one-line error must stay one readable line.
+std::string printable(std::string_view text) {
+  static const char* const kHex = "0123456789abcdef";
+  std::string out;
+  for (const char ch : text) {
+    const auto c = static_cast<unsigned char>(ch);
+    if (c >= 0x20 && c < 0x7f) {
+      out += ch;
+    } else {
+      out += "\\x";
+      out += kHex[c >> 4];
+      out += kHex[c & 15];
+    }
+  }
+  return out;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   using namespace demcal::cli;
@@ -96,8 +122,12 @@ int main(int argc, char** argv) {
 
   ScoreOptions score_options;
   auto* score = app.add_subcommand(
-      "score", "criteria, verdict and diagnosis of another engine's monitoring series (CSV)");
-  score->add_option("file", score_options.file, "series file (e.g. the LAMMPS deck's series.csv)")
+      "score",
+      "criteria, verdict and diagnosis of a monitoring series (CSV: another engine's, or demcal "
+      "run's)");
+  score
+      ->add_option("file", score_options.file,
+                   "series file (e.g. the LAMMPS deck's series.csv, or demcal run's)")
       ->required();
   score
       ->add_option("--lateral-stress", score_options.lateral_stress,
@@ -105,7 +135,8 @@ int main(int argc, char** argv) {
       ->check(real_above(0.0, 1e12));
   score
       ->add_option("--reference-peak", score_options.reference_peak,
-                   "a reference peak |sigma_yy| in Pa to report the peak error against")
+                   "a reference peak |sigma_yy| (3D: |sigma_zz|) in Pa to report the peak error "
+                   "against (default: the file's '# reference_peak = ' line, if any)")
       ->check(real_above(0.0, 1e15));
   score->add_option("-o,--output", score_options.out_dir,
                     "output folder (default demcal-score-STEM)");
@@ -142,7 +173,7 @@ int main(int argc, char** argv) {
     try {
       demcal::kernel_simd();
     } catch (const std::invalid_argument& e) {
-      throw demcal::InputError("environment", "", e.what());
+      throw demcal::InputError("environment", "", printable(e.what()));
     }
     if (check->parsed()) return cmd_check(config_path, sets);
     if (run->parsed()) return cmd_run(config_path, sets, out_dir, allow_unstable);

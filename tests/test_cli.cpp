@@ -15,7 +15,11 @@
 #include <string>
 #include <vector>
 
+#include "demcal/kernel/particle_scales.hpp"
 #include "demcal/kernel/world.hpp"
+#include "demcal/scene/config.hpp"
+#include "demcal/scene/packing.hpp"
+#include "demcal/upscaling/upscaling.hpp"
 #include "support/csv.hpp"
 #include "support/files.hpp"
 #include "support/process.hpp"
@@ -165,6 +169,45 @@ TEST_F(CliEndToEnd, AnUnknownSimdPathIsBadInput) {
   EXPECT_EQ(unset.err, "");
 }
 
+// The refusal quotes the environment's value: its control characters and
+// bytes beyond ASCII are shown as \xNN, so the message stays one line of
+// text (a newline in the value made it two, an escape sequence drove the
+// terminal).
+TEST_F(CliEndToEnd, ASimdPathWithControlCharactersIsShownEscaped) {
+  const std::string value = "avx2\nnext line \x1b[2J\x7f\xc3\xa9\x01\t";
+  const Result r = demcal({"check", kHex5}, {"DEMCAL_SIMD=" + value});
+  EXPECT_EQ(r.status, 2) << r.err;
+  ASSERT_EQ(lines_of(r.err).size(), 1u) << r.err;
+  EXPECT_NE(r.err.find("DEMCAL_SIMD=\"avx2\\x0anext line \\x1b[2J\\x7f\\xc3\\xa9\\x01\\x09\""),
+            std::string::npos)
+      << r.err;
+  for (const char c : r.err.substr(0, r.err.size() - 1))  // all printable before the newline
+    EXPECT_TRUE(c >= 0x20 && c < 0x7f) << static_cast<int>(static_cast<unsigned char>(c));
+  EXPECT_EQ(r.out, "");
+}
+
+// `demcal verify --consolidate-only` consolidates and stops: what it says on
+// stderr announces no loading (it said "loading now, about … min", then
+// stopped).
+TEST_F(CliEndToEnd, VerifyConsolidateOnlyAnnouncesNoLoading) {
+  const demcal::SceneConfig c = demcal::default_config();
+  demcal::AlgorithmSpec p;
+  p.steps = 20000;
+  const auto scales = demcal::particle_scales(demcal::make_assembly(c).r, c.material);
+  write("params.json", nlohmann::json{{"schema", "demcal.params/1"},
+                                      {"scene", c.name},
+                                      {"rev", demcal::param_block(p, scales)}}
+                           .dump());
+  const Result r = demcal({"verify", (dir_ / "params.json").string(), "--particles", "25",
+                           "--consolidate-only", "-o", "v"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(fs::exists(dir_ / "work" / "v" / "prototype.csv"));
+  EXPECT_NE(r.out.find("consolidated prototype of 25 particles"), std::string::npos) << r.out;
+  EXPECT_NE(r.err.find("consolidated in"), std::string::npos) << r.err;
+  for (const char* announce : {"loading now", "loading =", " min"})
+    EXPECT_EQ(r.err.find(announce), std::string::npos) << announce << " in " << r.err;
+}
+
 // `demcal stability`: the limit against the estimate, both files written.
 TEST_F(CliEndToEnd, StabilityScanWritesItsReport) {
   const fs::path out = dir_ / "work" / "scan";
@@ -312,7 +355,14 @@ TEST_F(CliEndToEnd, RunWritesSummarySeriesAndVtk) {
   EXPECT_GT(s.at("wall_time_s").get<double>(), 0.0);
   EXPECT_GT(s.at("particle_steps_per_s").get<double>(), 0.0);
 
-  const auto rows = lines_of(read_text(out / "series.csv"));
+  // The metadata `demcal score` reads, then the table.
+  const std::string series = read_text(out / "series.csv");
+  const auto meta = test::series_metadata(series);
+  EXPECT_EQ(std::stod(meta.at("lateral_stress")), 1e5);
+  EXPECT_EQ(meta.at("steps"), "2000");
+  EXPECT_EQ(meta.at("particles"), "25");
+  EXPECT_EQ(std::stod(meta.at("dt")), p.at("dt").get<double>());
+  const auto rows = test::series_table(series);
   ASSERT_EQ(rows.size(), 202u);  // header + monitor_points + 1
   const std::vector<std::string> expected = {"step",
                                              "strain_yy",
@@ -335,6 +385,64 @@ TEST_F(CliEndToEnd, RunWritesSummarySeriesAndVtk) {
   EXPECT_EQ(split(rows.back(), ',')[0], "2000");
 
   expect_valid_vtk(read_text(out / "final.vtk"), 25);
+}
+
+/// `demcal score` on the series.csv of the run `run` wrote into `out`,
+/// with no option but -o: the run's criteria (to the file's digits), steps,
+/// verdict, diagnosis and divergence, from the file's metadata alone, and
+/// the same verdict line on stdout.
+void expect_scores_as_the_run(const fs::path& out, const Result& run) {
+  const Result r = test::run_demcal({"score", "series.csv", "-o", "scored"}, out);
+  const auto ran = nlohmann::json::parse(read_text(out / "summary.json"));
+  ASSERT_EQ(r.status, ran.at("passed").get<bool>() ? 0 : 1) << r.err;
+  const auto scored = nlohmann::json::parse(read_text(out / "scored" / "summary.json"));
+  test::expect_same_criteria(ran.at("criteria"), scored.at("criteria"));
+  // A diverged run's series ends at its last monitoring point before the
+  // divergence: its steps run are that point's.
+  if (!ran.at("diverged").get<bool>()) {
+    EXPECT_EQ(scored.at("steps_run"), ran.at("steps_run"));
+  }
+  EXPECT_EQ(scored.at("steps_planned"), ran.at("params").at("steps"));
+  EXPECT_EQ(scored.at("passed"), ran.at("passed"));
+  // The diagnosis: its confidence is a function of the criteria (to the
+  // file's digits), the rest is the same text.
+  auto diagnosis = [](nlohmann::json d) {
+    d.erase("confidence");
+    return d;
+  };
+  EXPECT_EQ(diagnosis(scored.at("diagnosis")), diagnosis(ran.at("diagnosis")));
+  EXPECT_NEAR(scored.at("diagnosis").at("confidence").get<double>(),
+              ran.at("diagnosis").at("confidence").get<double>(), 1e-8);
+  EXPECT_EQ(scored.at("diverged"), ran.at("diverged"));
+  if (ran.contains("divergence")) {
+    EXPECT_EQ(scored.at("divergence").at("step"), ran.at("divergence").at("step"));
+  }
+  auto verdict = [](const std::string& out) {
+    for (const std::string& line : lines_of(out))
+      if (line.rfind("  PASS: ", 0) == 0 || line.rfind("  FAIL: ", 0) == 0) return line;
+    return std::string("no verdict line");
+  };
+  EXPECT_EQ(verdict(r.out), verdict(run.out));
+}
+
+// The run's series.csv carries what the run was scored with (σ3, Nstep,
+// Δt and Δt_crit, the damping ratios, the mass scaling, the step-level peak
+// and the analytical reference): `demcal score` gives its criteria, verdict
+// and diagnosis, on a passing and a failing run.
+TEST_F(CliEndToEnd, ScoreOnARunsSeriesGivesTheRunsVerdict) {
+  bool seen[2] = {false, false};
+  for (const char* steps : {"algorithm.steps=2000", "algorithm.steps=100000"}) {
+    SCOPED_TRACE(steps);
+    const fs::path out = dir_ / "work" / ("run" + std::string(steps).substr(16));
+    const Result r =
+        demcal({"run", kHex5, "--set", steps, "--set", "output.vtk=false", "-o", out.string()});
+    ASSERT_EQ(r.status, 0) << r.err;
+    const auto ran = nlohmann::json::parse(read_text(out / "summary.json"));
+    EXPECT_TRUE(ran.at("criteria").contains("peak_error"));  // against the analytical peak
+    seen[ran.at("passed").get<bool>()] = true;
+    expect_scores_as_the_run(out, r);
+  }
+  EXPECT_TRUE(seen[0] && seen[1]) << "wanted a failing and a passing run";
 }
 
 TEST_F(CliEndToEnd, RunIntoAnExistingFolderAndWithoutVtk) {
@@ -388,6 +496,9 @@ TEST_F(CliEndToEnd, DivergedRunIsReportedNotFatal) {
   EXPECT_TRUE(s.at("divergence").at("reason").is_string());
   EXPECT_LT(s.at("steps_run").get<int>(), 20000);
   expect_valid_vtk(read_text(out / "final.vtk"), 25, false);  // finite, counts consistent
+  // Its series.csv (finite rows up to the divergence) scores as diverged,
+  // with the run's diagnosis.
+  expect_scores_as_the_run(out, r);
 }
 
 }  // namespace

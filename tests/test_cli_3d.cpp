@@ -15,6 +15,8 @@
 #include <vector>
 
 #include "demcal/kernel/world.hpp"
+#include "demcal/scoring/scoring.hpp"
+#include "demcal/scoring/triaxial_scoring.hpp"
 #include "support/csv.hpp"
 #include "support/files.hpp"
 #include "support/process.hpp"
@@ -83,7 +85,9 @@ TEST_F(Cli3D, RunWritesSummaryNineComponentSeriesAndSphereVtk) {
   EXPECT_NEAR(s.at("analytical_peak").at("ratio").get<double>(), 2.0 * 1.3 / 0.7, 1e-9);
   EXPECT_EQ(s.at("diverged"), false);
 
-  const auto rows = lines_of(read_text(out / "series.csv"));
+  const std::string series = read_text(out / "series.csv");
+  EXPECT_EQ(std::stod(test::series_metadata(series).at("lateral_stress")), 1e7);
+  const auto rows = test::series_table(series);
   ASSERT_EQ(rows.size(), 52u);  // header + monitor_points + 1
   const auto header = split(rows[0], ',');
   std::vector<std::string> stresses;
@@ -106,6 +110,44 @@ TEST_F(Cli3D, RunWritesSummaryNineComponentSeriesAndSphereVtk) {
   for (const char* field :
        {"radius", "diameter", "velocity", "angular_velocity", "normal_force", "tangential_force"})
     EXPECT_TRUE(names.count(field)) << field;
+}
+
+// The run's series.csv carries what the run was scored with (σ3, Nstep,
+// Δt, Δt_crit, the damping ratios, the mass scaling): `demcal score` with
+// no option but -o gives its criteria, those of each plane, and its
+// verdict, on a run within the tolerances and one outside them.
+TEST_F(Cli3D, ScoreOnARunsSeriesGivesTheRunsVerdict) {
+  const std::string config = write("fcc2.json", fcc_config());
+  bool seen[2] = {false, false};
+  for (const char* steps : {"algorithm.steps=4000", "algorithm.steps=20000"}) {
+    SCOPED_TRACE(steps);
+    const fs::path out = dir_ / "work" / ("run" + std::string(steps).substr(16));
+    const test::RunResult r =
+        demcal({"run", config, "--set", steps, "--set", "output.vtk=false", "-o", out.string()});
+    ASSERT_EQ(r.status, 0) << r.err;
+    const test::RunResult sc = test::run_demcal({"score", "series.csv", "-o", "scored"}, out);
+    const auto ran = nlohmann::json::parse(read_text(out / "summary.json"));
+    const bool within = ran.at("verdict").at("within_tolerances").get<bool>();
+    seen[within] = true;
+    ASSERT_EQ(sc.status, within ? 0 : 1) << sc.err << sc.out;
+    const auto scored = nlohmann::json::parse(read_text(out / "scored" / "summary.json"));
+    EXPECT_EQ(scored.at("dimension"), 3);
+    test::expect_same_criteria(ran.at("criteria_planes"), scored.at("criteria_planes"));
+    // The run writes the planes' combination as measured, `score` the one its
+    // verdict judges (the rotational drag folded into moment balance):
+    // the run's folded the same way.
+    demcal::TriaxialCriteria c;
+    c.combined = demcal::criteria_from_json(ran.at("criteria"));
+    c.rotational_drag = ran.at("criteria_planes").at("rotational_drag").get<double>();
+    test::expect_same_criteria(
+        demcal::to_json(demcal::scored_criteria(c, demcal::triaxial_tolerances())),
+        scored.at("criteria"));
+    EXPECT_EQ(scored.at("passed"), within);
+    EXPECT_EQ(scored.at("steps_run"), ran.at("steps_run"));
+    EXPECT_EQ(scored.at("steps_planned"), ran.at("params").at("steps"));
+    EXPECT_EQ(scored.at("metadata").at("particles"), "32");
+  }
+  EXPECT_TRUE(seen[0] && seen[1]) << "wanted a run outside and one within the tolerances";
 }
 
 TEST_F(Cli3D, CheckPrintsTheSphereScales) {

@@ -152,6 +152,42 @@ TEST(ExternalSeries, BadFilesNameTheFileAndTheLine) {
   EXPECT_FALSE(score_external(d, Tolerances{}).score.passed);
 }
 
+// The keys demcal's own runs add (SeriesMetadata): the step-level peak is
+// the criteria's peak, the reference peak is compressive whatever its sign,
+// and a divergence found by the run's own checks (finite rows, maybe a
+// single one) is a divergence.
+TEST(ExternalSeries, ReadsTheKeysOfDemcalsOwnRuns) {
+  const std::string head =
+      "# lateral_stress = 1e5\n# steps = 20\n# peak_stress_yy = -3e5\n# peak_strain_yy = "
+      "-0.015\n# reference_peak = 2.5e5\n";
+  const std::string table =
+      "step,strain_yy,b_xx,b_xy,b_yx,b_yy,s_xx,s_xy,s_yx,s_yy\n"
+      "0,0,-1e5,0,0,-1e5,-1e5,0,0,-1e5\n10,-0.01,-1e5,0,0,-2e5,-1e5,0,0,-2e5\n"
+      "20,-0.02,-1e5,0,0,-2.5e5,-1e5,0,0,-2.5e5\n";
+  const ExternalSeries s = parse_external_series(head + table, "t.csv");
+  ASSERT_TRUE(s.reference_peak);
+  EXPECT_EQ(*s.reference_peak, -2.5e5);
+  const Criteria c = score_external(s, Tolerances{}, s.reference_peak).score.criteria;
+  EXPECT_EQ(c.peak_stress_yy, -3e5);  // not the monitored -2.5e5
+  EXPECT_EQ(c.peak_strain_yy, -0.015);
+  ASSERT_TRUE(c.peak_error);
+  EXPECT_DOUBLE_EQ(*c.peak_error, 0.2);  // (-2.5e5 + 3e5) / 2.5e5
+  EXPECT_FALSE(s.run.diverged);
+
+  const ExternalSeries d = parse_external_series(
+      "# lateral_stress = 1e5\n# steps = 20\n# divergence_step = 7\n# divergence = " +
+          std::string(to_string(Divergence::kOverlap)) +
+          "\nstep,strain_yy,b_xx,b_xy,b_yx,b_yy,s_xx,s_xy,s_yx,s_yy\n0,0,-1e5,0,0,-1e5,-1e5,0,0,"
+          "-1e5\n",
+      "d.csv");
+  EXPECT_TRUE(d.run.diverged);
+  EXPECT_EQ(d.run.divergence_step, 7);
+  EXPECT_EQ(d.run.divergence, Divergence::kOverlap);
+  const Score sd = score_external(d, Tolerances{}).score;
+  EXPECT_FALSE(sd.passed);
+  EXPECT_EQ(sd.diagnosis.signature, "divergence");
+}
+
 TEST(ScoreCli, ScoresAFileAndRejectsBadInputWithStatus2) {
   const test::TempDir dir("score_cli");
   const SceneConfig c = hex5();
@@ -174,7 +210,7 @@ TEST(ScoreCli, ScoresAFileAndRejectsBadInputWithStatus2) {
   EXPECT_TRUE(summary);
   EXPECT_EQ(bad, 2);
   EXPECT_EQ(missing, 2);
-  EXPECT_EQ(no_s3, 2);  // demcal's series.csv has no "# lateral_stress"
+  EXPECT_EQ(no_s3, 2);  // series_csv() without metadata has no "# lateral_stress"
   EXPECT_FALSE(partial);
 }
 

@@ -62,7 +62,7 @@ TEST(ParticleFileChecks, NanAndNonPositiveRadiiNameTheLine) {
 // file of 10^7 lines is too large for a unit test: the parser is called
 // with the count each reader passes it, a.size()).
 TEST(ParticleFileChecks, CountLimitIsInTheSharedParser) {
-  for (const std::string line : {std::string("1,2,3"), std::string("1,2,3,4")}) {
+  for (const std::string& line : {std::string("1,2,3"), std::string("1,2,3,4")}) {
     SCOPED_TRACE(line);
     std::array<double, 4> storage{};
     const std::span<double> v(storage.data(), line == "1,2,3" ? 3 : 4);

@@ -1,9 +1,98 @@
 #include "demcal/scene/run_output.hpp"
 
+#include <charconv>
 #include <iomanip>
 #include <sstream>
 
 namespace demcal {
+
+std::vector<std::string> series_metadata_lines(const SeriesMetadata& m) {
+  std::vector<std::string> out{"# demcal.series/1: " + m.writer + " written by demcal " +
+                               DEMCAL_VERSION + ", scene " + m.scene};
+  auto line = [&](const char* key, const std::string& value) {
+    out.push_back(std::string("# ") + key + " = " + value);
+  };
+  auto optional = [&](const char* key, const std::optional<std::string>& value) {
+    if (value) line(key, *value);
+  };
+  line("particles", std::to_string(m.particles));
+  line("lateral_stress", m.lateral_stress);
+  line("steps", m.steps);
+  line("dt", m.dt);
+  optional("dt_crit", m.dt_crit);
+  line("damping_ratio_translation", m.damping_ratio_translation);
+  line("damping_ratio_rotation", m.damping_ratio_rotation);
+  optional("mass_scaling", m.mass_scaling);
+  line("moment_lever_arm", m.moment_lever_arm);
+  optional("peak_stress_yy", m.peak_stress_yy);
+  optional("peak_strain_yy", m.peak_strain_yy);
+  optional("reference_peak", m.reference_peak);
+  optional("divergence_step", m.divergence_step);
+  optional("divergence", m.divergence);
+  return out;
+}
+
+namespace {
+
+/// A double as the shortest text that reads back as the same double.
+std::string round_trip(double v) {
+  char buffer[32];
+  const auto end = std::to_chars(buffer, buffer + sizeof buffer, v).ptr;
+  return std::string(buffer, end);
+}
+
+/// The metadata LoadingResult and TriaxialResult share (their fields are
+/// named alike).
+template <class Run>
+SeriesMetadata run_metadata(const std::string& scene, const TestSpec& test, const Run& run) {
+  SeriesMetadata m;
+  m.writer = "demcal run";
+  m.scene = scene;
+  m.particles = run.particles;
+  m.lateral_stress = round_trip(test.lateral_stress);
+  m.steps = std::to_string(run.steps_planned);
+  m.dt = round_trip(run.integration.dt);
+  m.dt_crit = round_trip(run.scales.dt_crit);
+  m.damping_ratio_translation = round_trip(run.integration.damping_ratio_translation);
+  m.damping_ratio_rotation = round_trip(run.integration.damping_ratio_rotation);
+  m.mass_scaling = round_trip(run.integration.mass_scaling);
+  m.moment_lever_arm = "radius - overlap/2";
+  if (run.diverged) {
+    m.divergence_step = std::to_string(run.divergence_step);
+    m.divergence = to_string(run.divergence);
+  }
+  return m;
+}
+
+std::string metadata_text(const SeriesMetadata& m) {
+  std::string out;
+  for (const std::string& line : series_metadata_lines(m)) out += line + "\n";
+  return out;
+}
+
+}  // namespace
+
+SeriesMetadata series_metadata(const std::string& scene, const TestSpec& test,
+                               const LoadingResult& run, std::optional<double> reference_peak) {
+  SeriesMetadata m = run_metadata(scene, test, run);
+  m.peak_stress_yy = round_trip(run.peak_stress_yy);
+  m.peak_strain_yy = round_trip(run.peak_strain_yy);
+  if (reference_peak) m.reference_peak = round_trip(*reference_peak);
+  return m;
+}
+
+SeriesMetadata series_metadata(const std::string& scene, const TestSpec& test,
+                               const TriaxialResult& run) {
+  return run_metadata(scene, test, run);
+}
+
+std::string series_csv(const SeriesMetadata& metadata, const std::vector<MonitorPoint>& series) {
+  return metadata_text(metadata) + series_csv(series);
+}
+
+std::string series_csv(const SeriesMetadata& metadata, const std::vector<TriaxialPoint>& series) {
+  return metadata_text(metadata) + series_csv(series);
+}
 
 std::string series_csv(const std::vector<MonitorPoint>& series) {
   std::ostringstream s;

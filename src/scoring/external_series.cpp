@@ -214,6 +214,15 @@ void read_triaxial_rows(const Table& t, ExternalSeries& out) {
   }
 }
 
+/// The reason of "# divergence = REASON" (to_string(Divergence)); a
+/// missing or unknown one reads as values that are not finite.
+Divergence divergence_named(const ExternalSeries& s) {
+  const auto it = s.meta.find("divergence");
+  for (Divergence d : {Divergence::kOverlap, Divergence::kEnergy, Divergence::kEnergyCreated})
+    if (it != s.meta.end() && it->second == to_string(d)) return d;
+  return Divergence::kNotFinite;
+}
+
 /// What the metadata and the rows say of the run (LoadingResult and
 /// TriaxialResult name these fields alike). Its last monitoring point may
 /// fall short of the last step by less than one interval (Nstep not a
@@ -223,17 +232,22 @@ void read_run_facts(const Table& t, const ExternalSeries& out, Run& run) {
   const auto& series = run.series;
   const int64_t last = series.empty() ? 0 : series.back().step;
   const int64_t interval = series.size() >= 2 ? last - series[series.size() - 2].step : 0;
-  const auto steps = meta_number(out, "steps");
-  run.steps_planned = steps ? count(*steps, out.source, "# steps") : last;
-  run.steps_run =
-      (!t.diverged && steps && last < run.steps_planned && run.steps_planned - last < interval)
-          ? run.steps_planned
-          : last;
   run.diverged = t.diverged;
   if (t.diverged) {
     run.divergence = Divergence::kNotFinite;
     run.divergence_step = t.diverged_step;
+  } else if (const auto step = meta_number(out, "divergence_step")) {
+    // A run whose own checks stopped it (demcal's): its rows are finite.
+    run.diverged = true;
+    run.divergence_step = count(*step, out.source, "# divergence_step");
+    run.divergence = divergence_named(out);
   }
+  const auto steps = meta_number(out, "steps");
+  run.steps_planned = steps ? count(*steps, out.source, "# steps") : last;
+  run.steps_run =
+      (!run.diverged && steps && last < run.steps_planned && run.steps_planned - last < interval)
+          ? run.steps_planned
+          : last;
   run.particles = static_cast<int>(
       count(meta_number(out, "particles").value_or(0), out.source, "# particles", kMaxParticles));
   run.integration.dt = meta_number(out, "dt").value_or(0);
@@ -263,7 +277,8 @@ ExternalSeries parse_external_series(const std::string& text, const std::string&
       for (int i = 0; i < 3; ++i)
         for (int j = 0; j < 3; ++j) require_columns(t, source, {component(prefix, i, j)});
   }
-  if (t.rows.size() < 2 && !t.diverged)
+  // A diverged run may have fewer (its engine's or demcal's own checks).
+  if (t.rows.size() < 2 && !t.diverged && !out.meta.count("divergence_step"))
     throw InputError(source, "", "fewer than two monitoring points");
 
   if (lateral_stress) {
@@ -277,9 +292,17 @@ ExternalSeries parse_external_series(const std::string& text, const std::string&
   if (!(out.lateral_stress > 0.0))
     throw InputError(source, "lateral_stress", "must be positive (sigma3, Pa)");
 
+  // A compressive peak, whichever sign the file gives it (as --reference-peak).
+  if (const auto ref = meta_number(out, "reference_peak")) out.reference_peak = -std::abs(*ref);
   if (out.dimension == 2) {
     read_biaxial_rows(t, out);
     read_run_facts(t, out, out.run);
+    // The peak tracked at every step, when the writer tracked one (demcal):
+    // score_run() takes it over the monitored one, as for demcal's runs.
+    if (const auto peak = meta_number(out, "peak_stress_yy")) {
+      out.run.peak_stress_yy = *peak;
+      out.run.peak_strain_yy = meta_number(out, "peak_strain_yy").value_or(0.0);
+    }
   } else {
     read_triaxial_rows(t, out);
     read_run_facts(t, out, out.triaxial);

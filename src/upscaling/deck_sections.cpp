@@ -9,6 +9,7 @@
 
 #include "demcal/kernel/particle_scales.hpp"
 #include "demcal/scene/biaxial.hpp"
+#include "demcal/scene/run_output.hpp"
 
 namespace demcal::deck {
 
@@ -294,19 +295,24 @@ std::string lammps_servo_clamp(const std::string& x, const std::string& cap) {
 std::string lammps_series_header(const std::string& deck, const std::string& scene, int particles,
                                  double zeta_t, std::optional<double> dt_crit,
                                  std::optional<double> mass_scaling, const std::string& lever_arm) {
-  auto line = [](const std::string& key, const std::string& value) {
-    return "print           \"# " + key + " = " + value + "\" append ${series} screen no\n";
-  };
-  std::ostringstream s;
-  s << "print           \"# demcal.series/1: " << deck << " written by demcal " << DEMCAL_VERSION
-    << ", scene " << scene << "\" file ${series} screen no\n"
-    << line("particles", std::to_string(particles)) << line("lateral_stress", "${sigma3}")
-    << line("steps", "${nstep}") << line("dt", "${dt}");
-  if (dt_crit) s << line("dt_crit", num(*dt_crit));
-  s << line("damping_ratio_translation", num(zeta_t)) << line("damping_ratio_rotation", "0");
-  if (mass_scaling) s << line("mass_scaling", num(*mass_scaling));
-  s << line("moment_lever_arm", lever_arm);
-  return s.str();
+  SeriesMetadata m;
+  m.writer = deck;
+  m.scene = scene;
+  m.particles = particles;
+  m.lateral_stress = "${sigma3}";
+  m.steps = "${nstep}";
+  m.dt = "${dt}";
+  if (dt_crit) m.dt_crit = num(*dt_crit);
+  m.damping_ratio_translation = num(zeta_t);
+  m.damping_ratio_rotation = "0";
+  if (mass_scaling) m.mass_scaling = num(*mass_scaling);
+  m.moment_lever_arm = lever_arm;
+  // The first line starts the file, the others are appended to it.
+  std::string out;
+  for (const std::string& line : series_metadata_lines(m))
+    out += "print           \"" + line + "\" " + (out.empty() ? "file" : "append") +
+           " ${series} screen no\n";
+  return out;
 }
 
 std::string lammps_consolidation_parameters(const TestSpec& test) {

@@ -182,7 +182,8 @@ std::string lammps_count_max_one(const std::string& count);
 std::string lammps_band(const std::string& name, const std::string& motion,
                         const std::string& comment = "");
 
-/// LAMMPS: the series file's header (print lines), what `demcal score`
+/// LAMMPS: the series file's header (print lines of SeriesMetadata's
+/// lines, scene/run_output.hpp), what `demcal score`
 /// reads about the run: the deck (`deck`, e.g. "LAMMPS 3D deck"), scene,
 /// particles, sigma3, Nstep, dt, dt_crit (when given), the damping ratios
 /// applied (zeta_r 0: no rotational fix), f_ms (when given), the lever arm

@@ -50,9 +50,14 @@ fs::path capture_file() {
 RunResult run_program(const std::string& program, const std::vector<std::string>& args,
                       const fs::path& cwd) {
   const fs::path out = capture_file(), err = capture_file();
-  std::string cmd = "cd " + shell_quote(cwd.string()) + " && " + shell_quote(program);
-  for (const auto& a : args) cmd += " " + shell_quote(a);
-  cmd += " >" + shell_quote(out.string()) + " 2>" + shell_quote(err.string()) + " </dev/null";
+  // Appended piece by piece: `" >" + std::string` chains made GCC 12 warn
+  // (-Wrestrict, a false positive inside std::string's insert).
+  std::string cmd = "cd ";
+  cmd.append(shell_quote(cwd.string())).append(" && ").append(shell_quote(program));
+  for (const auto& a : args) cmd.append(" ").append(shell_quote(a));
+  cmd.append(" >").append(shell_quote(out.string()));
+  cmd.append(" 2>").append(shell_quote(err.string()));
+  cmd.append(" </dev/null");
   const int raw = std::system(cmd.c_str());
   RunResult r;
   r.status = raw != -1 && WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;

@@ -2,6 +2,7 @@
 // gnuplot) and final.vtk (ParaView).
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -11,6 +12,59 @@
 #include "demcal/scene/triaxial.hpp"
 
 namespace demcal {
+
+/// What a monitoring series says of its run ahead of its columns, the
+/// facts `demcal score` reads (scoring/external_series.hpp) to score it as
+/// `demcal run` scores its own: the one home of the keys and of the line
+/// format, "# key = value". demcal's own series.csv (series_metadata()) and
+/// the LAMMPS and LIGGGHTS decks' (upscaling, print lines) are written from
+/// here. Values are text: a number as its writer formats it, or an
+/// engine's variable (${sigma3}); an empty optional is left out.
+struct SeriesMetadata {
+  std::string writer;  ///< who wrote the series, e.g. "LAMMPS deck"
+  std::string scene;   ///< the scene's name
+  int particles = 0;
+  std::string lateral_stress;  ///< σ3 [Pa]
+  std::string steps;           ///< Nstep, the steps planned
+  std::string dt;              ///< [s]
+  std::optional<std::string> dt_crit;
+  std::string damping_ratio_translation, damping_ratio_rotation;  ///< as applied
+  std::optional<std::string> mass_scaling;
+  /// Where the engine applies a contact's tangential force: "radius"
+  /// (LAMMPS), "radius - overlap/2" (demcal, LIGGGHTS).
+  std::string moment_lever_arm;
+  /// 2D, demcal only: the peak tracked at every step (LoadingResult's
+  /// peak_stress_yy [Pa] and peak_strain_yy), which the monitoring points
+  /// can miss.
+  std::optional<std::string> peak_stress_yy, peak_strain_yy;
+  /// The reference peak [Pa] the run's peak error was taken against.
+  std::optional<std::string> reference_peak;
+  /// A diverged run (demcal's divergence checks; an engine's run that blew
+  /// up writes non-finite values instead): the step and the reason
+  /// (to_string(Divergence)).
+  std::optional<std::string> divergence_step, divergence;
+};
+
+/// The metadata's lines, each "# key = value" without the line end, after
+/// a first line "# demcal.series/1: WRITER written by demcal VERSION,
+/// scene SCENE".
+std::vector<std::string> series_metadata_lines(const SeriesMetadata& m);
+
+/// The metadata of a run of demcal (2D, 3D): every value written to
+/// round-trip the double (the scores of `demcal score` and `demcal run`
+/// then agree), σ3 from `test`, the writer "demcal run"; in 2D the peak
+/// tracked at every step and the reference peak the run was scored
+/// against, if any.
+SeriesMetadata series_metadata(const std::string& scene, const TestSpec& test,
+                               const LoadingResult& run,
+                               std::optional<double> reference_peak = std::nullopt);
+SeriesMetadata series_metadata(const std::string& scene, const TestSpec& test,
+                               const TriaxialResult& run);
+
+/// series.csv with its metadata: the lines of series_metadata_lines(), then
+/// series_csv(series).
+std::string series_csv(const SeriesMetadata& metadata, const std::vector<MonitorPoint>& series);
+std::string series_csv(const SeriesMetadata& metadata, const std::vector<TriaxialPoint>& series);
 
 /// series.csv: step,strain_yy,b_xx,b_xy,b_yx,b_yy,s_xx,s_xy,s_yx,s_yy,
 /// kinetic_energy,unbalanced_force_ratio,lateral_stress_error, then extras.

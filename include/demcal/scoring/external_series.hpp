@@ -5,7 +5,11 @@
 // The file (README "Scoring another engine's run"): comment lines start
 // with '#'; a comment "# key = value" is metadata (lateral_stress [Pa],
 // steps, dt, dt_crit [s], particles, damping_ratio_translation,
-// damping_ratio_rotation, mass_scaling, moment_lever_arm); the first other
+// damping_ratio_rotation, mass_scaling, moment_lever_arm; the keys demcal's
+// own runs add: peak_stress_yy [Pa] and peak_strain_yy, the 2D peak tracked
+// at every step, taken over the monitored one; reference_peak [Pa], the
+// reference of the peak error; divergence_step and divergence, a run its
+// own checks stopped: SeriesMetadata, scene/run_output.hpp); the first other
 // line names the columns, comma-separated; every further line is one
 // monitoring point, tension positive, SI units. Columns are found by name,
 // in any order: required step, strain_yy, b_xx, b_xy, b_yx, b_yy, s_xx,
@@ -13,7 +17,8 @@
 // elastic_energy, unbalanced_force_ratio, inertial_number,
 // coordination_number, lateral_stress_error (else from p_left and p_right),
 // wall_left, wall_right, wall_bottom, wall_top, torque_stress. demcal's own
-// series.csv is such a file.
+// series.csv is such a file, with the metadata its run was scored with:
+// scored here, it gives the run's criteria, verdict and diagnosis.
 //
 // A triaxial (3D) series is recognised by its axial strain column
 // strain_zz: required step, strain_zz and the nine components of b
@@ -54,7 +59,10 @@ struct ExternalSeries {
   LoadingResult run;            ///< 2D: series and what is known of the run
   TriaxialResult triaxial;      ///< 3D: the same
   double lateral_stress = 0.0;  ///< σ3 [Pa]
-  bool torque_column = false;   ///< torque_stress was given
+  /// "# reference_peak" [Pa]: what the writer's peak error was taken
+  /// against, compressive (negative) whichever sign the file gives it.
+  std::optional<double> reference_peak;
+  bool torque_column = false;  ///< torque_stress was given
   /// Per monitoring point: ((σxy − σyx) − torque_stress)/σ3 (empty without
   /// torque_stress).
   std::vector<double> lever_arm_floor;
