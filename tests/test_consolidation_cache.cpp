@@ -329,7 +329,16 @@ TEST(SphereWorldState, ReadBackIsTheSameWorldAndStepsIdentically) {
   back.world = SphereWorld::load_state(bytes);
   EXPECT_EQ(back.world.save_state(), bytes);  // save → load → save: the same bytes
   expect_same_spheres(back.world, s.world);
-  expect_same_loading(load_spheres(c, back), load_spheres(c, s));
+  const SphereLoading loaded = load_spheres(c, s);
+  expect_same_loading(load_spheres(c, back), loaded);
+  // Mid-run (the energy ledger's running totals, the walls moving): a copy
+  // read back continues as the original does.
+  SphereWorld original = loaded.end;
+  SphereWorld again = SphereWorld::load_state(original.save_state());
+  ASSERT_TRUE(original.step(2000));
+  ASSERT_TRUE(again.step(2000));
+  expect_same_spheres(again, original);
+  EXPECT_NE(original.energy_created(), 0.0);
   // Bytes that do not read whole, and another kernel's, throw.
   EXPECT_THROW(SphereWorld::load_state(bytes.substr(0, bytes.size() - 1)), std::runtime_error);
   EXPECT_THROW(SphereWorld::load_state(bytes + "x"), std::runtime_error);
