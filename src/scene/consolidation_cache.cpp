@@ -9,6 +9,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <type_traits>
 
@@ -31,15 +32,18 @@ std::string hex_float(double v) {
   return buf;
 }
 
-/// The whole file, in one piece (a character at a time, a 4 MB program took
-/// 0.1 s); nothing when it cannot be read.
+/// The whole file, read at once into a string of its size (a character at a
+/// time, the 3.7 MB program took 0.1 s); nothing when it cannot be read.
 std::optional<std::string> read_whole(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
   if (!in) return std::nullopt;
-  std::ostringstream bytes;
-  bytes << in.rdbuf();  // an empty file sets failbit on `bytes`: read as ""
-  if (in.bad() || bytes.bad()) return std::nullopt;
-  return std::move(bytes).str();
+  const std::streamoff size = in.tellg();
+  if (size < 0) return std::nullopt;
+  std::string bytes(static_cast<size_t>(size), '\0');
+  in.seekg(0);
+  if (!in.read(bytes.data(), size) || in.peek() != std::ifstream::traits_type::eof())
+    return std::nullopt;  // cut short, or grown meanwhile
+  return bytes;
 }
 
 /// SHA-256 of the running program (the build), once per process; "" when it
