@@ -103,8 +103,8 @@ int check_3d(const SceneConfig& config) {
   const StabilityEstimate est = probe.stability_estimate();
   std::cout << "  consolidated in " << state.steps << " steps (" << std::setprecision(3)
             << state.wall_time_s << " s" << (state.from_cache ? ", from the cache" : "")
-            << "), box " << state.extent0[0] << " x " << state.extent0[1]
-            << " x " << state.extent0[2] << " m\n";
+            << "), box " << state.extent0[0] << " x " << state.extent0[1] << " x "
+            << state.extent0[2] << " m\n";
   print_stable_steps(est);
   if (auto r = analytical_peak_ratio_3d(config))
     std::cout << "  analytical peak sigma1/sigma3 " << *r << " (walled FCC, Thornton), "
@@ -157,8 +157,7 @@ int run_3d(const SceneConfig& config, const std::string& out_dir, bool allow_uns
             << "\n"
             << "  wall time " << run.wall_time_s << " s (consolidation " << state.wall_time_s
             << " s, " << state.steps << " steps" << (state.from_cache ? ", from the cache" : "")
-            << "), " << summary["particle_steps_per_s"].get<double>()
-            << " particle-steps/s\n"
+            << "), " << summary["particle_steps_per_s"].get<double>() << " particle-steps/s\n"
             << "  wrote " << dir << "/summary.json, series.csv"
             << (config.output.vtk ? ", final.vtk" : "") << "\n";
   if (run.diverged)
