@@ -141,7 +141,7 @@ void require_same_run(const std::string& dir, const nlohmann::json& key) {
 
 /// The consolidated REV of either dimension, made once.
 struct Consolidated {
-  std::optional<ConsolidatedState> disks;  ///< 2D: biaxial, cached
+  std::optional<ConsolidatedState> disks;  ///< 2D: biaxial
   std::optional<TriaxialState> spheres;    ///< 3D: triaxial
   int64_t particles = 0, steps = 0;
   double wall_time_s = 0.0;
@@ -221,7 +221,7 @@ Invocation prepare(const CalibrateOptions& o) {
   return v;
 }
 
-/// The consolidated REV: disks (biaxial, cached) or spheres (triaxial).
+/// The consolidated REV: disks (biaxial) or spheres (triaxial), cached.
 Consolidated consolidate_rev(const CalibrateOptions& o, const SceneConfig& config, bool three_d) {
   Consolidated c;
   if (three_d) {
@@ -233,6 +233,7 @@ Consolidated consolidate_rev(const CalibrateOptions& o, const SceneConfig& confi
     c.particles = c.spheres->world.size();
     c.steps = c.spheres->steps;
     c.wall_time_s = c.spheres->wall_time_s;
+    c.from_cache = c.spheres->from_cache;
   } else {
     Assembly assembly = make_assembly(config);
     if (!o.quiet)

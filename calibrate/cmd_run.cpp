@@ -102,8 +102,9 @@ int check_3d(const SceneConfig& config) {
   print_scales_3d(config, probe);
   const StabilityEstimate est = probe.stability_estimate();
   std::cout << "  consolidated in " << state.steps << " steps (" << std::setprecision(3)
-            << state.wall_time_s << " s), box " << state.extent0[0] << " x " << state.extent0[1]
-            << " x " << state.extent0[2] << " m\n";
+            << state.wall_time_s << " s" << (state.from_cache ? ", from the cache" : "")
+            << "), box " << state.extent0[0] << " x " << state.extent0[1] << " x "
+            << state.extent0[2] << " m\n";
   print_stable_steps(est);
   if (auto r = analytical_peak_ratio_3d(config))
     std::cout << "  analytical peak sigma1/sigma3 " << *r << " (walled FCC, Thornton), "
@@ -125,7 +126,8 @@ int run_3d(const SceneConfig& config, const std::string& out_dir, bool allow_uns
   const Tolerances tolerances = triaxial_tolerances();
   const Excesses e = excesses(scored_criteria(c, tolerances), tolerances);
   const bool within = !run.diverged && e.worst() <= 1.0;
-  const nlohmann::json summary = triaxial_run_summary(config, state, run, c, tolerances, e, within);
+  nlohmann::json summary = triaxial_run_summary(config, state, run, c, tolerances, e, within);
+  summary["consolidation"]["from_cache"] = state.from_cache;
   {
     OutputFolder out(dir);
     out.write("summary.json", summary.dump(2) + "\n");
@@ -154,8 +156,8 @@ int run_3d(const SceneConfig& config, const std::string& out_dir, bool allow_uns
             << (within ? "" : " (worst: " + e.worst_name() + ")") << ". " << kTriaxialVerdictNote
             << "\n"
             << "  wall time " << run.wall_time_s << " s (consolidation " << state.wall_time_s
-            << " s, " << state.steps << " steps), " << summary["particle_steps_per_s"].get<double>()
-            << " particle-steps/s\n"
+            << " s, " << state.steps << " steps" << (state.from_cache ? ", from the cache" : "")
+            << "), " << summary["particle_steps_per_s"].get<double>() << " particle-steps/s\n"
             << "  wrote " << dir << "/summary.json, series.csv"
             << (config.output.vtk ? ", final.vtk" : "") << "\n";
   if (run.diverged)

@@ -12,6 +12,7 @@ SphereWorld::SphereWorld(const SphereMaterial& material, std::span<const double>
                          std::span<const double> radius, const std::array<double, 3>& lo,
                          const std::array<double, 3>& hi, KernelOptions options)
     : impl_(std::make_unique<SphereWorldImpl>(material, x, y, z, radius, lo, hi, options)) {}
+SphereWorld::SphereWorld(std::unique_ptr<SphereWorldImpl> impl) : impl_(std::move(impl)) {}
 SphereWorld::SphereWorld(const SphereWorld& other)
     : impl_(std::make_unique<SphereWorldImpl>(*other.impl_)) {}
 SphereWorld::SphereWorld(SphereWorld&& other) noexcept = default;
@@ -89,5 +90,10 @@ std::vector<int> SphereWorld::block_friendly_order() const { return impl_->block
 void SphereWorld::set_threads(int threads) { impl_->set_threads(threads); }
 int SphereWorld::threads() const { return impl_->threads(); }
 void SphereWorld::update_forces() { impl_->update_forces(); }
+
+std::string SphereWorld::save_state() const { return impl_->save_state(); }
+SphereWorld SphereWorld::load_state(std::string_view bytes) {
+  return SphereWorld(std::make_unique<SphereWorldImpl>(SphereWorldImpl::load_state(bytes)));
+}
 
 }  // namespace demcal

@@ -110,7 +110,21 @@ class SphereWorldImpl {
   /// without a tangential increment.
   void update_forces();
 
+  // --- the whole state as bytes (sphere_world_state.cpp) -----------------
+  /// Every member of the state, bit for bit (this build's layout and byte
+  /// order; the threads are not state): the SphereWorld load_state() reads
+  /// back steps exactly as this one, as a copy does. For the consolidation
+  /// cache.
+  std::string save_state() const;
+  /// The SphereWorld of save_state()'s bytes. Bytes that do not read as one
+  /// (another kernel's or layout's, cut, sizes that do not fit together)
+  /// throw std::runtime_error.
+  static SphereWorldImpl load_state(std::string_view bytes);
+
  private:
+  SphereWorldImpl() = default;  // load_state()
+  template <class Self, class Visitor>
+  static void visit_state(Self& self, Visitor& visit);  // every member (sphere_world_state.cpp)
   using Array = detail::AlignedVector<double>;
   std::span<const double> view(const Array& a) const { return {a.data(), static_cast<size_t>(n_)}; }
 

@@ -5,14 +5,10 @@
 // that a World read back is a copy of the one saved: it rebuilds its list,
 // sums its forces and steps exactly as the original would (a state rebuilt
 // from positions alone would differ in the tangential histories and in when
-// the list is next rebuilt). Numbers are stored as their bytes (native byte
-// order): exact, and readable only by the same build, which is what the
-// cache's key demands anyway. The threads are not state: a World read back
-// starts its own on first use, as a copy does.
-#include <cstring>
-#include <stdexcept>
-#include <type_traits>
-
+// the list is next rebuilt). The bytes: state_bytes.hpp (shared with the
+// sphere kernel, sphere_world_state.cpp). The threads are not state: a World
+// read back starts its own on first use, as a copy does.
+#include "state_bytes.hpp"
 #include "world_impl.hpp"
 
 namespace demcal {
@@ -23,90 +19,25 @@ namespace {
 // '3' since the pair terms' places (term_block_, mirror_term_), '4' since
 // block_power_ holds 8 lanes per block; a state of an older layout does not
 // read: rebuilt, not misread.
-constexpr char kMagic[8] = {'d', 'e', 'm', 'W', 'o', 'r', 'l', '4'};
-
-template <class T>
-constexpr bool kScalar = std::is_arithmetic_v<T> || std::is_enum_v<T>;
-
-class Writer {
- public:
-  std::string out;
-
-  template <class T>
-  requires kScalar<T>
-  void operator()(const T& v) { out.append(reinterpret_cast<const char*>(&v), sizeof(T)); }
-  template <class T, class A>
-  requires kScalar<T>
-  void operator()(const std::vector<T, A>& v) {
-    (*this)(static_cast<uint64_t>(v.size()));
-    out.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
-  }
-};
-
-class Reader {
- public:
-  explicit Reader(std::string_view bytes) : in_(bytes) {}
-
-  template <class T>
-  requires kScalar<T>
-  void operator()(T& v) { take(&v, sizeof(T)); }
-  template <class T, class A>
-  requires kScalar<T>
-  void operator()(std::vector<T, A>& v) {
-    uint64_t n = 0;
-    (*this)(n);
-    if (n > (in_.size() - at_) / sizeof(T)) fail();
-    v.resize(n);
-    take(v.data(), n * sizeof(T));
-  }
-  bool done() const { return at_ == in_.size(); }
-  [[noreturn]] static void fail() {
-    throw std::runtime_error("WorldImpl::load_state: not the bytes of a saved World");
-  }
-
- private:
-  void take(void* to, size_t n) {
-    if (n > in_.size() - at_) fail();
-    if (n) std::memcpy(to, in_.data() + at_, n);
-    at_ += n;
-  }
-  std::string_view in_;
-  size_t at_ = 0;
-};
+constexpr std::string_view kMark("demWorl4", 8);
+constexpr const char* kWhat = "World::load_state";
 
 // A new member of these structs must be visited below: the sizes catch one
-// that is not (x86-64 layouts).
+// that is not (x86-64 layouts; the shared ones: state_bytes.hpp).
 static_assert(sizeof(Material) == 9 * sizeof(double));
-static_assert(sizeof(KernelOptions) == 4 * sizeof(double) + 4 * sizeof(int));
-static_assert(sizeof(Integration) == 5 * sizeof(double));
 static_assert(sizeof(Wall) == 48);  // 4 doubles and an int, 16-byte aligned
 
 }  // namespace
 
 template <class Self, class Visitor>
 void WorldImpl::visit_state(Self& w, Visitor& v) {
-  for (auto* law : {&w.material_.particle, &w.material_.wall}) {
-    v(law->kn);
-    v(law->kt);
-    v(law->friction);
-  }
+  detail::visit_law(w.material_.particle, v);
+  detail::visit_law(w.material_.wall, v);
   v(w.material_.density);
   v(w.material_.thickness);
   v(w.material_.contact_damping_ratio);
-  auto& o = w.options_;
-  v(o.skin_ratio);
-  v(o.max_overlap_ratio);
-  v(o.check_interval);
-  v(o.max_energy_ratio);
-  v(o.max_energy_created);
-  v(o.energy_check_interval);
-  v(o.threads);
-  auto& in = w.integration_;
-  v(in.dt);
-  v(in.damping_ratio_translation);
-  v(in.damping_ratio_rotation);
-  v(in.mass_scaling);
-  v(in.lock_rotation);
+  detail::visit_options(w.options_, v);
+  detail::visit_integration(w.integration_, v);
   v(w.threads_);
   v(w.n_);
   v(w.nblocks_);
@@ -166,19 +97,16 @@ void WorldImpl::visit_state(Self& w, Visitor& v) {
 }
 
 std::string WorldImpl::save_state() const {
-  Writer writer;
-  writer.out.append(kMagic, sizeof kMagic);
+  detail::StateWriter writer(kMark);
   visit_state(*this, writer);
   return std::move(writer.out);
 }
 
 WorldImpl WorldImpl::load_state(std::string_view bytes) {
-  if (bytes.size() < sizeof kMagic || bytes.substr(0, sizeof kMagic) != std::string_view(kMagic, 8))
-    Reader::fail();
-  Reader reader(bytes.substr(sizeof kMagic));
+  detail::StateReader reader(bytes, kMark, kWhat);
   WorldImpl w;
   visit_state(w, reader);
-  if (!reader.done()) Reader::fail();
+  reader.finish();
   // The arrays the passes index by particle, block and slot must fit the
   // sizes read (a checksum guards the cache's bytes; this guards the reader).
   const size_t cap = static_cast<size_t>(w.ghost_) + 8;
@@ -206,19 +134,19 @@ WorldImpl WorldImpl::load_state(std::string_view bytes) {
   for (int s = 0; s < 4; ++s)
     if (w.wall_ft_[s].size() != static_cast<size_t>(w.n_) ||
         w.wall_fn_[s].size() != static_cast<size_t>(w.n_))
-      Reader::fail();
-  if (!fits) Reader::fail();
+      reader.fail();
+  if (!fits) reader.fail();
   for (int j : w.slot_j_)
-    if (j < 0 || j > w.ghost_) Reader::fail();
+    if (j < 0 || j > w.ghost_) reader.fail();
   for (int s : w.mirror_slot_)
-    if (s < 0 || s > w.block_slot_.back()) Reader::fail();
+    if (s < 0 || s > w.block_slot_.back()) reader.fail();
   for (int s : w.mirror_term_)
-    if (s < 0 || static_cast<size_t>(s) >= w.pfx_.size()) Reader::fail();
+    if (s < 0 || static_cast<size_t>(s) >= w.pfx_.size()) reader.fail();
   if (!w.pfx_.empty())
     for (int b = 0; b < w.nblocks_; ++b)
       if (w.term_block_[b] < 0 ||
           w.term_block_[b] + (w.block_slot_[b + 1] - w.block_slot_[b]) > w.term_block_.back())
-        Reader::fail();
+        reader.fail();
   return w;
 }
 

@@ -15,6 +15,7 @@
 #include "demcal/io/input_error.hpp"
 #include "demcal/kernel/particle_scales.hpp"
 #include "demcal/scene/biaxial.hpp"
+#include "demcal/scene/consolidation_cache.hpp"
 #include "protocol_steps.hpp"
 
 namespace demcal {
@@ -135,15 +136,10 @@ Integration integration_for(const SphereWorld& world, const AlgorithmSpec& algor
   return in;
 }
 
-TriaxialState consolidate_triaxial(const SceneConfig& config, const SphereAssembly& assembly,
-                                   const ConsolidationCallback& progress) {
-  ConsolidationOptions options;
-  options.progress = progress;
-  return consolidate_triaxial(config, assembly, options);
-}
+namespace {
 
-TriaxialState consolidate_triaxial(const SceneConfig& config, const SphereAssembly& assembly,
-                                   const ConsolidationOptions& options) {
+TriaxialState consolidate_fresh(const SceneConfig& config, const SphereAssembly& assembly,
+                                const ConsolidationOptions& options) {
   const auto t0 = std::chrono::steady_clock::now();
   const TestSpec& test = config.test;
   TriaxialState state{SphereWorld(sphere_material(config.material), assembly.x, assembly.y,
@@ -169,6 +165,35 @@ TriaxialState consolidate_triaxial(const SceneConfig& config, const SphereAssemb
   for (int axis = 0; axis < 3; ++axis) state.extent0[axis] = world.extent(axis);
   detail::finish_consolidation(state, o, test, t0);
   return state;
+}
+
+}  // namespace
+
+TriaxialState consolidate_triaxial(const SceneConfig& config, const SphereAssembly& assembly,
+                                   const std::string& cache_dir,
+                                   const ConsolidationOptions& options) {
+  if (cache_dir.empty()) return consolidate_fresh(config, assembly, options);
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::string key = consolidation_key(config, assembly);
+  if (auto cached = load_consolidated_triaxial(cache_dir, key)) {
+    cached->wall_time_s = seconds_since(t0);
+    return std::move(*cached);
+  }
+  TriaxialState state = consolidate_fresh(config, assembly, options);  // a failure is not stored
+  store_consolidated(cache_dir, key, state);
+  return state;
+}
+
+TriaxialState consolidate_triaxial(const SceneConfig& config, const SphereAssembly& assembly,
+                                   const ConsolidationOptions& options) {
+  return consolidate_triaxial(config, assembly, consolidation_cache_dir(), options);
+}
+
+TriaxialState consolidate_triaxial(const SceneConfig& config, const SphereAssembly& assembly,
+                                   const ConsolidationCallback& progress) {
+  ConsolidationOptions options;
+  options.progress = progress;
+  return consolidate_triaxial(config, assembly, options);
 }
 
 double estimated_stable_dt_ratio(const TriaxialState& state, const AlgorithmSpec& algorithm) {

@@ -42,6 +42,8 @@
 #include <cstdint>
 #include <memory>
 #include <span>
+#include <string>
+#include <string_view>
 #include <vector>
 
 #include "demcal/kernel/world.hpp"
@@ -215,7 +217,19 @@ class SphereWorld {
   /// without a tangential increment.
   void update_forces();
 
+  // --- the whole state as bytes (sphere_world_state.cpp) -----------------
+  /// Every member of the state, bit for bit (this build's layout and byte
+  /// order; the threads are not state): the SphereWorld load_state() reads
+  /// back steps exactly as this one, as a copy does. For the consolidation
+  /// cache (World::save_state is the 2D kernel's).
+  std::string save_state() const;
+  /// The SphereWorld of save_state()'s bytes. Bytes that do not read as one
+  /// (another kernel's or layout's, cut, sizes that do not fit together)
+  /// throw std::runtime_error.
+  static SphereWorld load_state(std::string_view bytes);
+
  private:
+  explicit SphereWorld(std::unique_ptr<SphereWorldImpl> impl);
   // The state and passes (src/kernel/sphere_world_impl.hpp, private to the
   // kernel).
   std::unique_ptr<SphereWorldImpl> impl_;

@@ -1,10 +1,11 @@
 // The on-disk cache of consolidated samples (issue #15): consolidation is
-// the same for every check, run, calibrate, sweep and verify of a scene, so
-// consolidate() keeps its result in a folder, keyed by everything that
+// the same for every check, run, calibrate, sweep, verify and scaling study
+// of a scene, so consolidate() (disks, biaxial) and consolidate_triaxial()
+// (spheres) keep their result in a folder, keyed by everything that
 // determines it, and later commands read it back instead of consolidating
-// again. Bit-exact: the state read back is the state consolidate() made
-// (World::save_state), so every result is byte-identical with and without
-// the cache.
+// again. Bit-exact: the state read back is the state the consolidation made
+// (World::save_state, SphereWorld::save_state), so every result is
+// byte-identical with and without the cache.
 //
 // The folder: $DEMCAL_CACHE_DIR if set ("off" or "" disables the cache),
 // else $XDG_CACHE_HOME/demcal, else $HOME/.cache/demcal. One file per key,
@@ -22,6 +23,8 @@
 #include "demcal/scene/biaxial.hpp"
 #include "demcal/scene/config.hpp"
 #include "demcal/scene/packing.hpp"
+#include "demcal/scene/sphere_packing.hpp"
+#include "demcal/scene/triaxial.hpp"
 
 namespace demcal {
 
@@ -30,13 +33,19 @@ namespace demcal {
 std::string consolidation_cache_dir();
 
 /// Everything that determines consolidate()'s result, as text: the
-/// assembly it starts from (a SHA-256 of its disks and box, so the
-/// assembly spec, seed and particle file's content all enter through what
-/// they produce), the material, σ3 and the servo and consolidation
-/// settings, the rotation lock, the kernel options and SIMD path, and the
-/// program (demcal version and a SHA-256 of the running executable, so that
-/// a rebuilt consolidation never reads another build's entries).
+/// protocol (biaxial), the assembly it starts from (a SHA-256 of its disks
+/// and box, so the assembly spec, seed and particle file's content all
+/// enter through what they produce), the material, σ3 and the servo and
+/// consolidation settings, the rotation lock, the kernel options and SIMD
+/// path, and the program (demcal version and a SHA-256 of the running
+/// executable, so that a rebuilt consolidation never reads another build's
+/// entries; what the program does after the loop, such as the
+/// block-friendly renumbering, enters through it).
 std::string consolidation_key(const SceneConfig& config, const Assembly& assembly);
+/// The same for consolidate_triaxial(): the protocol (triaxial) and the
+/// spheres and six walls in place of the disks and four; the other lines
+/// are the 2D key's. A 2D and a 3D key differ in their first line.
+std::string consolidation_key(const SceneConfig& config, const SphereAssembly& assembly);
 
 /// The entry file of `key` in `dir`.
 std::string consolidation_cache_path(const std::string& dir, const std::string& key);
@@ -44,11 +53,15 @@ std::string consolidation_cache_path(const std::string& dir, const std::string& 
 /// The state stored for `key`, or nothing: no entry, or one that does not
 /// read back whole. Never throws.
 std::optional<ConsolidatedState> load_consolidated(const std::string& dir, const std::string& key);
+/// The same for a triaxial (sphere) state.
+std::optional<TriaxialState> load_consolidated_triaxial(const std::string& dir,
+                                                        const std::string& key);
 
 /// Store `state` for `key` (the folder is created). Best effort: a folder
 /// that cannot be written leaves no entry, and is not an error. Returns
 /// whether the entry was written.
 bool store_consolidated(const std::string& dir, const std::string& key,
                         const ConsolidatedState& state);
+bool store_consolidated(const std::string& dir, const std::string& key, const TriaxialState& state);
 
 }  // namespace demcal

@@ -40,7 +40,7 @@ struct ConsolidationOptions {
   /// steps on one thread, as every World starts (its trials run in parallel).
   int threads = 1;
   /// Called at every check (every 200 steps) of a fresh consolidation; not
-  /// called for a state read from the (2D) consolidation cache.
+  /// called for a state read from the consolidation cache.
   ConsolidationCallback progress;
 };
 

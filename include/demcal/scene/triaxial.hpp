@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <functional>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "demcal/kernel/sphere_world.hpp"
@@ -38,6 +39,9 @@ struct TriaxialPoint : MonitorMeasures<Eigen::Matrix3d> {
 
 /// The consolidated sample, made once and copied by every run.
 struct TriaxialState {
+  /// The static packing. Its particles are renumbered for the kernel
+  /// (SphereWorld::block_friendly_order()), so they need not be in the
+  /// assembly's order.
   SphereWorld world;
   std::array<double, 3> extent0{};  ///< box edges after consolidation
   int64_t steps = 0;                ///< consolidation steps taken
@@ -45,6 +49,9 @@ struct TriaxialState {
   bool converged = false;
   double stress_error = 0.0;      ///< max |p − σ3|/σ3 over the six walls at the end
   double unbalanced_ratio = 0.0;  ///< at the end
+  /// Read from the consolidation cache (consolidation_cache.hpp): `steps`
+  /// are those the consolidation took, wall_time_s the reading's.
+  bool from_cache = false;
 };
 
 /// The sphere material of a config's material block (thickness unused).
@@ -78,10 +85,18 @@ Integration integration_for(const SphereWorld& world, const AlgorithmSpec& algor
 /// std::runtime_error saying what was reached if it cannot. options.threads
 /// steps the sphere kernel on that many threads (0: every core; the state
 /// is bit-identical for any count and steps on one thread afterwards);
-/// options.progress is called at every check (every 200 steps).
+/// options.progress is called at every check (every 200 steps). Through the
+/// consolidation cache in consolidation_cache_dir() (the environment's;
+/// consolidation_cache.hpp), as the 2D consolidate(): the same state, bit
+/// for bit.
 TriaxialState consolidate_triaxial(const SceneConfig& config, const SphereAssembly& assembly,
                                    const ConsolidationOptions& options = {});
-/// The same, single-threaded, with a progress callback.
+/// The same through the cache in `cache_dir`; "" consolidates afresh.
+TriaxialState consolidate_triaxial(const SceneConfig& config, const SphereAssembly& assembly,
+                                   const std::string& cache_dir,
+                                   const ConsolidationOptions& options = {});
+/// The same (the environment's cache), single-threaded, with a progress
+/// callback.
 TriaxialState consolidate_triaxial(const SceneConfig& config, const SphereAssembly& assembly,
                                    const ConsolidationCallback& progress);
 
