@@ -28,7 +28,7 @@ constexpr const char* kWhat = "SphereWorld::load_state";
 // below: the sizes catch one that is not (x86-64 layouts, libstdc++).
 static_assert(sizeof(SphereMaterial) == 8 * sizeof(double));
 static_assert(sizeof(SphereWall) == 48);  // 5 doubles and an int
-static_assert(sizeof(SphereWorldImpl) == 3232,
+static_assert(sizeof(SphereWorldImpl) == 3256,
               "a member was added to SphereWorldImpl: visit it in visit_state "
               "(sphere_world_state.cpp), renumber kMark, then update this size");
 
@@ -55,19 +55,21 @@ void SphereWorldImpl::visit_state(Self& w, Visitor& v) {
   v(w.n_);
   v(w.nblocks_);
   v(w.ghost_);
-  for (auto* a : {&w.x_,         &w.y_,          &w.z_,
-                  &w.vx_,        &w.vy_,         &w.vz_,
-                  &w.wx_,        &w.wy_,         &w.wz_,
-                  &w.r_,         &w.inv_r_,      &w.m_,
-                  &w.inertia_,   &w.fx_,         &w.fy_,
-                  &w.fz_,        &w.tx_,         &w.ty_,
-                  &w.tz_,        &w.ca_t_,       &w.cb_t_,
-                  &w.ca_r_,      &w.cb_r_,       &w.d_t_,
-                  &w.d_r_,       &w.block_lost_, &w.block_released_,
-                  &w.block_slid_})
+  for (auto* a : {&w.x_,          &w.y_,          &w.z_,
+                  &w.vx_,         &w.vy_,         &w.vz_,
+                  &w.wx_,         &w.wy_,         &w.wz_,
+                  &w.r_,          &w.inv_r_,      &w.m_,
+                  &w.inertia_,    &w.fx_,         &w.fy_,
+                  &w.fz_,         &w.tx_,         &w.ty_,
+                  &w.tz_,         &w.ca_t_,       &w.cb_t_,
+                  &w.ca_r_,       &w.cb_r_,       &w.d_t_,
+                  &w.d_r_,        &w.block_lost_, &w.block_released_,
+                  &w.block_slid_, &w.block_power_})
     v(*a);
   v(w.damping_dissipated_);
   v(w.friction_dissipated_);
+  v(w.dashpot_power_);
+  v(w.dashpot_dissipated_);
   v(w.wall_work_);
   v(w.wall_work_abs_);
   for (auto& d : w.wall_push_) v(d);
@@ -112,8 +114,6 @@ void SphereWorldImpl::visit_state(Self& w, Visitor& v) {
   v(l.started);
   v(l.step);
   v(l.energy0);
-  v(l.lost);
-  v(l.power_lost);
   v(l.created);
   v(w.divergence_);
   v(w.divergence_step_);
@@ -139,17 +139,17 @@ SphereWorldImpl SphereWorldImpl::load_state(std::string_view bytes) {
                  w.threads_ >= 1);
   const size_t n = static_cast<size_t>(w.n_), nb = static_cast<size_t>(w.nblocks_);
   const size_t cap = static_cast<size_t>(w.ghost_) + 8;
-  for (const Array* a : {&w.x_,          &w.y_,          &w.z_,
-                         &w.vx_,         &w.vy_,         &w.vz_,
-                         &w.wx_,         &w.wy_,         &w.wz_,
-                         &w.r_,          &w.inv_r_,      &w.m_,
-                         &w.inertia_,    &w.fx_,         &w.fy_,
-                         &w.fz_,         &w.tx_,         &w.ty_,
-                         &w.tz_,         &w.ca_t_,       &w.cb_t_,
-                         &w.ca_r_,       &w.cb_r_,       &w.d_t_,
-                         &w.d_r_,        &w.block_lost_, &w.block_released_,
-                         &w.block_slid_, &w.x_built_,    &w.y_built_,
-                         &w.z_built_})
+  for (const Array* a : {&w.x_,          &w.y_,           &w.z_,
+                         &w.vx_,         &w.vy_,          &w.vz_,
+                         &w.wx_,         &w.wy_,          &w.wz_,
+                         &w.r_,          &w.inv_r_,       &w.m_,
+                         &w.inertia_,    &w.fx_,          &w.fy_,
+                         &w.fz_,         &w.tx_,          &w.ty_,
+                         &w.tz_,         &w.ca_t_,        &w.cb_t_,
+                         &w.ca_r_,       &w.cb_r_,        &w.d_t_,
+                         &w.d_r_,        &w.block_lost_,  &w.block_released_,
+                         &w.block_slid_, &w.block_power_, &w.x_built_,
+                         &w.y_built_,    &w.z_built_})
     reader.require(a->size() == cap);
   // The half list: block_slot_ ascending, its slots' arrays of that size,
   // the pair terms one more (the zero slot).
