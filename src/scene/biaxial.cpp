@@ -141,17 +141,8 @@ ConsolidatedState consolidate_fresh(const SceneConfig& config, const Assembly& a
 
 ConsolidatedState consolidate(const SceneConfig& config, const Assembly& assembly,
                               const std::string& cache_dir, const ConsolidationOptions& options) {
-  if (cache_dir.empty()) return consolidate_fresh(config, assembly, options);
-  const auto t0 = std::chrono::steady_clock::now();
-  const std::string key = consolidation_key(config, assembly);
-  if (auto cached = load_consolidated(cache_dir, key)) {
-    cached->wall_time_s = seconds_since(t0);
-    return std::move(*cached);
-  }
-  ConsolidatedState state =
-      consolidate_fresh(config, assembly, options);  // a failure is not stored
-  store_consolidated(cache_dir, key, state);
-  return state;
+  return consolidate_cached<ConsolidatedState>(
+      cache_dir, config, assembly, [&] { return consolidate_fresh(config, assembly, options); });
 }
 
 ConsolidatedState consolidate(const SceneConfig& config, const Assembly& assembly,

@@ -172,16 +172,8 @@ TriaxialState consolidate_fresh(const SceneConfig& config, const SphereAssembly&
 TriaxialState consolidate_triaxial(const SceneConfig& config, const SphereAssembly& assembly,
                                    const std::string& cache_dir,
                                    const ConsolidationOptions& options) {
-  if (cache_dir.empty()) return consolidate_fresh(config, assembly, options);
-  const auto t0 = std::chrono::steady_clock::now();
-  const std::string key = consolidation_key(config, assembly);
-  if (auto cached = load_consolidated_triaxial(cache_dir, key)) {
-    cached->wall_time_s = seconds_since(t0);
-    return std::move(*cached);
-  }
-  TriaxialState state = consolidate_fresh(config, assembly, options);  // a failure is not stored
-  store_consolidated(cache_dir, key, state);
-  return state;
+  return consolidate_cached<TriaxialState>(
+      cache_dir, config, assembly, [&] { return consolidate_fresh(config, assembly, options); });
 }
 
 TriaxialState consolidate_triaxial(const SceneConfig& config, const SphereAssembly& assembly,

@@ -17,9 +17,12 @@
 // half a file; two writers of one key write the same bytes.
 #pragma once
 
+#include <chrono>
 #include <optional>
 #include <string>
+#include <type_traits>
 
+#include "demcal/io/format.hpp"
 #include "demcal/scene/biaxial.hpp"
 #include "demcal/scene/config.hpp"
 #include "demcal/scene/packing.hpp"
@@ -63,5 +66,29 @@ std::optional<TriaxialState> load_consolidated_triaxial(const std::string& dir,
 bool store_consolidated(const std::string& dir, const std::string& key,
                         const ConsolidatedState& state);
 bool store_consolidated(const std::string& dir, const std::string& key, const TriaxialState& state);
+
+/// The cached entry points of both protocols (consolidate(),
+/// consolidate_triaxial()): the state stored for this config and assembly
+/// in `dir`, else `fresh()`'s, then stored ("" for dir: no cache). A fresh
+/// consolidation that fails throws, and nothing is stored.
+template <class State, class AnyAssembly, class Fresh>
+State consolidate_cached(const std::string& dir, const SceneConfig& config,
+                         const AnyAssembly& assembly, Fresh&& fresh) {
+  if (dir.empty()) return fresh();
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::string key = consolidation_key(config, assembly);
+  std::optional<State> cached;
+  if constexpr (std::is_same_v<State, TriaxialState>)
+    cached = load_consolidated_triaxial(dir, key);
+  else
+    cached = load_consolidated(dir, key);
+  if (cached) {
+    cached->wall_time_s = seconds_since(t0);
+    return std::move(*cached);
+  }
+  State state = fresh();
+  store_consolidated(dir, key, state);
+  return state;
+}
 
 }  // namespace demcal
