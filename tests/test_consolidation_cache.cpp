@@ -25,6 +25,7 @@
 #include "support/files.hpp"
 #include "support/process.hpp"
 #include "support/same_bits.hpp"
+#include "support/same_spheres.hpp"
 #include "support/scenes.hpp"
 
 namespace demcal {
@@ -238,39 +239,6 @@ SceneConfig sphere_gas() {
                    "test": {"lateral_stress": 1e7, "monitor_points": 20}})");
 }
 
-/// Two spheres' worlds compared through their public face, bit for bit:
-/// every sphere's position, velocity, spin, force and torque, every contact
-/// (its normal and tangential force: the history), the walls, the stresses
-/// and the energy ledger.
-void expect_same_spheres(const SphereWorld& a, const SphereWorld& b) {
-  ASSERT_EQ(a.size(), b.size());
-  EXPECT_EQ(a.steps_taken(), b.steps_taken());
-  EXPECT_EQ(a.rebuilds(), b.rebuilds());
-  int mismatches = 0;
-  for (int i = 0; i < a.size(); ++i) {
-    bool same = true;
-    for (auto f : {&SphereWorld::x, &SphereWorld::y, &SphereWorld::z, &SphereWorld::vx,
-                   &SphereWorld::vy, &SphereWorld::vz, &SphereWorld::omega_x, &SphereWorld::omega_y,
-                   &SphereWorld::omega_z, &SphereWorld::fx, &SphereWorld::fy, &SphereWorld::fz,
-                   &SphereWorld::torque_x, &SphereWorld::torque_y, &SphereWorld::torque_z})
-      same = same && same_bits((a.*f)()[i], (b.*f)()[i]);
-    if (!same && ++mismatches <= 5) ADD_FAILURE() << "sphere " << i << " differs";
-  }
-  EXPECT_EQ(mismatches, 0);
-  test::expect_same_contacts(a.contacts(), b.contacts(), [](const auto& ca, const auto& cb) {
-    bool same = same_bits(ca.fn, cb.fn) && same_bits(ca.overlap, cb.overlap);
-    for (int c = 0; c < 3; ++c) same = same && same_bits(ca.tangential[c], cb.tangential[c]);
-    return same;
-  });
-  test::expect_same_walls<SphereWallSide, 6>(a, b);
-  const SphereMeasures ma = a.measure(), mb = b.measure();
-  test::expect_same_stresses(ma, mb);
-  EXPECT_TRUE(same_bits(ma.kinetic_energy_translation, mb.kinetic_energy_translation));
-  EXPECT_TRUE(same_bits(ma.kinetic_energy_rotation, mb.kinetic_energy_rotation));
-  EXPECT_TRUE(same_bits(ma.elastic_energy, mb.elastic_energy));
-  EXPECT_TRUE(same_bits(a.energy_created(), b.energy_created()));
-}
-
 /// A short loading run from `state` (light damping: the spheres move, the
 /// contacts slide, the list is rebuilt): its series, peak and final world.
 struct SphereLoading {
@@ -306,12 +274,12 @@ void expect_same_loading(const SphereLoading& a, const SphereLoading& b) {
   }
   EXPECT_TRUE(same_bits(a.run.peak_stress_zz, b.run.peak_stress_zz));
   EXPECT_TRUE(same_bits(a.run.peak_ratio, b.run.peak_ratio));
-  expect_same_spheres(a.end, b.end);
+  test::expect_same_spheres(a.end, b.end);
   EXPECT_EQ(a.end.save_state(), b.end.save_state());
 }
 
 void expect_same_state(const TriaxialState& a, const TriaxialState& b) {
-  expect_same_spheres(a.world, b.world);
+  test::expect_same_spheres(a.world, b.world);
   EXPECT_EQ(a.world.save_state(), b.world.save_state());
   EXPECT_EQ(a.steps, b.steps);
   for (int axis = 0; axis < 3; ++axis) EXPECT_TRUE(same_bits(a.extent0[axis], b.extent0[axis]));
@@ -328,7 +296,7 @@ TEST(SphereWorldState, ReadBackIsTheSameWorldAndStepsIdentically) {
   TriaxialState back = s;
   back.world = SphereWorld::load_state(bytes);
   EXPECT_EQ(back.world.save_state(), bytes);  // save → load → save: the same bytes
-  expect_same_spheres(back.world, s.world);
+  test::expect_same_spheres(back.world, s.world);
   const SphereLoading loaded = load_spheres(c, s);
   expect_same_loading(load_spheres(c, back), loaded);
   // Mid-run (the energy ledger's running totals, the walls moving): a copy
@@ -337,7 +305,7 @@ TEST(SphereWorldState, ReadBackIsTheSameWorldAndStepsIdentically) {
   SphereWorld again = SphereWorld::load_state(original.save_state());
   ASSERT_TRUE(original.step(2000));
   ASSERT_TRUE(again.step(2000));
-  expect_same_spheres(again, original);
+  test::expect_same_spheres(again, original);
   EXPECT_NE(original.energy_created(), 0.0);
   // Bytes that do not read whole, and another kernel's, throw.
   EXPECT_THROW(SphereWorld::load_state(bytes.substr(0, bytes.size() - 1)), std::runtime_error);

@@ -24,6 +24,7 @@
 
 #include "demcal/scene/sphere_packing.hpp"
 #include "support/same_bits.hpp"
+#include "support/same_spheres.hpp"
 #include "test_sphere_helpers.hpp"
 
 namespace demcal {
@@ -55,51 +56,26 @@ SphereWorld agitated_fcc(double contact_damping, KernelOptions options = {}) {
   return w;
 }
 
-void expect_identical(const SphereWorld& a, const SphereWorld& b) {
-  ASSERT_EQ(a.size(), b.size());
-  ASSERT_EQ(a.steps_taken(), b.steps_taken());
-  EXPECT_EQ(a.rebuilds(), b.rebuilds());
-  int mismatches = 0;
-  for (int i = 0; i < a.size(); ++i) {
-    bool same = true;
-    for (auto f : {&SphereWorld::x, &SphereWorld::y, &SphereWorld::z, &SphereWorld::vx,
-                   &SphereWorld::vy, &SphereWorld::vz, &SphereWorld::omega_x, &SphereWorld::omega_y,
-                   &SphereWorld::omega_z, &SphereWorld::fx, &SphereWorld::fy, &SphereWorld::fz,
-                   &SphereWorld::torque_x, &SphereWorld::torque_y, &SphereWorld::torque_z})
-      same = same && same_bits((a.*f)()[i], (b.*f)()[i]);
-    if (!same && ++mismatches <= 5) ADD_FAILURE() << "sphere " << i << " differs";
-  }
-  EXPECT_EQ(mismatches, 0);
-  test::expect_same_contacts(a.contacts(), b.contacts(), [](const auto& ca, const auto& cb) {
-    bool same = same_bits(ca.fn, cb.fn);
-    for (int c = 0; c < 3; ++c) same = same && same_bits(ca.tangential[c], cb.tangential[c]);
-    return same;
-  });
-  test::expect_same_walls<SphereWallSide, 6>(a, b);
-  const SphereMeasures ma = a.measure(), mb = b.measure();
-  test::expect_same_stresses(ma, mb);
-  EXPECT_TRUE(same_bits(ma.kinetic_energy_rotation, mb.kinetic_energy_rotation));
-  EXPECT_TRUE(same_bits(ma.elastic_energy, mb.elastic_energy));
-  EXPECT_TRUE(same_bits(a.energy_created(), b.energy_created()));
-}
-
 // Agitated packing, light damping, the top wall moving in and the x walls
-// out, a small skin (many rebuilds), on `threads` threads. With contact
-// dashpots the energy ledger's divergence test is off: its dashpot term is
-// sampled (sphere_energy_balance.cpp), and the fast decay of the agitation
-// in the first steps reads as energy created (kEnergyCreated within a few
-// steps, on any thread count); the ledger is still computed and compared.
+// out, a small skin (many rebuilds), on `threads` threads, the energy
+// ledger's divergence test on. The contact dashpots (ζ_c = 0.3) lower the
+// stable step from α ≈ 0.23 to 0.077 (Lanczos estimate of this packing):
+// with them the run takes α = 0.07 and as many more steps, over the same
+// time. (Until 118864c the ledger was off with dashpots, the run at α = 0.2
+// beyond their stable step; the comment blamed the ledger's sampling of
+// their loss, which now runs every step and flags the step itself.)
 SphereWorld run_threads(double contact_damping, int threads) {
   KernelOptions options;
   options.skin_ratio = 0.002;
-  if (contact_damping > 0.0) options.max_energy_created = 1e300;
   options.threads = threads;
   SphereWorld w = agitated_fcc(contact_damping, options);
-  sphere_test::set_damped(w, 0.2, 0.05);
+  const double alpha = contact_damping > 0.0 ? 0.07 : 0.2;
+  sphere_test::set_damped(w, alpha, 0.05);
   w.wall(kZMax).velocity = -0.2;
   w.wall(kXMin).velocity = -0.1;
   w.wall(kXMax).velocity = 0.1;
-  EXPECT_TRUE(w.step(1500)) << to_string(w.divergence()) << " at " << w.divergence_step();
+  const auto steps = static_cast<int64_t>(std::lround(1500 * 0.2 / alpha));
+  EXPECT_TRUE(w.step(steps)) << to_string(w.divergence()) << " at " << w.divergence_step();
   return w;
 }
 
@@ -113,7 +89,7 @@ TEST(SphereThreads, BitIdenticalForAnyThreadCount) {
       SCOPED_TRACE(t);
       const SphereWorld many = run_threads(damping, t);
       EXPECT_EQ(many.threads(), t);
-      expect_identical(one, many);
+      test::expect_same_spheres(one, many);
     }
   }
 }
@@ -142,7 +118,7 @@ TEST(SphereThreads, BitIdenticalForAnyThreadCountAfterReorder) {
     SCOPED_TRACE(t);
     const SphereWorld many = run_threads_reordered(t);
     EXPECT_EQ(many.threads(), t);
-    expect_identical(one, many);
+    test::expect_same_spheres(one, many);
   }
 }
 
