@@ -26,6 +26,8 @@ std::vector<std::string> series_metadata_lines(const SeriesMetadata& m) {
   line("moment_lever_arm", m.moment_lever_arm);
   optional("peak_stress_yy", m.peak_stress_yy);
   optional("peak_strain_yy", m.peak_strain_yy);
+  optional("peak_stress_zz", m.peak_stress_zz);
+  optional("peak_strain_zz", m.peak_strain_zz);
   optional("reference_peak", m.reference_peak);
   optional("divergence_step", m.divergence_step);
   optional("divergence", m.divergence);
@@ -83,7 +85,12 @@ SeriesMetadata series_metadata(const std::string& scene, const TestSpec& test,
 
 SeriesMetadata series_metadata(const std::string& scene, const TestSpec& test,
                                const TriaxialResult& run) {
-  return run_metadata(scene, test, run);
+  SeriesMetadata m = run_metadata(scene, test, run);
+  if (run.peak_stress_zz < 0.0) {  // tracked (compute_triaxial_criteria takes it then)
+    m.peak_stress_zz = round_trip(run.peak_stress_zz);
+    m.peak_strain_zz = round_trip(run.peak_strain_zz);
+  }
+  return m;
 }
 
 std::string series_csv(const SeriesMetadata& metadata, const std::vector<MonitorPoint>& series) {

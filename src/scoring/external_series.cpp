@@ -306,6 +306,10 @@ ExternalSeries parse_external_series(const std::string& text, const std::string&
   } else {
     read_triaxial_rows(t, out);
     read_run_facts(t, out, out.triaxial);
+    if (const auto peak = meta_number(out, "peak_stress_zz")) {  // as in 2D
+      out.triaxial.peak_stress_zz = *peak;
+      out.triaxial.peak_strain_zz = meta_number(out, "peak_strain_zz").value_or(0.0);
+    }
   }
   return out;
 }
@@ -314,11 +318,12 @@ ExternalScore score_external(const ExternalSeries& series, const Tolerances& tol
                              std::optional<double> reference_peak) {
   ExternalScore out;
   if (series.dimension == 3) {
-    // The criteria of the three planes, as `demcal run` scores its own 3D
-    // runs (the rotational drag folded into moment balance; 0 without the
-    // power columns); the peak is the monitored one (as in 2D).
+    // The criteria of the three planes, as `demcal run` and the calibration
+    // score demcal's 3D runs (the rotational drag folded into moment
+    // balance; 0 without the power columns); the peak tracked at every step
+    // where the file gives one (demcal's own), else the monitored one.
     const TriaxialResult& run = series.triaxial;
-    TriaxialCriteria c = compute_triaxial_criteria(run.series, series.lateral_stress);
+    TriaxialCriteria c = compute_triaxial_criteria(run, series.lateral_stress);
     c.combined.peak_error = peak_error_of(c.combined.peak_stress_yy, reference_peak);
     out.score = score_of(scored_criteria(c, tolerances),
                          {run.diverged, run.stopped_early, run.steps_run, run.steps_planned,

@@ -37,6 +37,9 @@ struct SeriesMetadata {
   /// peak_stress_yy [Pa] and peak_strain_yy), which the monitoring points
   /// can miss.
   std::optional<std::string> peak_stress_yy, peak_strain_yy;
+  /// 3D, demcal only: the same for σ_zz (TriaxialResult's peak_stress_zz
+  /// and peak_strain_zz).
+  std::optional<std::string> peak_stress_zz, peak_strain_zz;
   /// The reference peak [Pa] the run's peak error was taken against.
   std::optional<std::string> reference_peak;
   /// A diverged run (demcal's divergence checks; an engine's run that blew
@@ -52,9 +55,9 @@ std::vector<std::string> series_metadata_lines(const SeriesMetadata& m);
 
 /// The metadata of a run of demcal (2D, 3D): every value written to
 /// round-trip the double (the scores of `demcal score` and `demcal run`
-/// then agree), σ3 from `test`, the writer "demcal run"; in 2D the peak
-/// tracked at every step and the reference peak the run was scored
-/// against, if any.
+/// then agree), σ3 from `test`, the writer "demcal run"; the peak tracked
+/// at every step, and in 2D the reference peak the run was scored against,
+/// if any.
 SeriesMetadata series_metadata(const std::string& scene, const TestSpec& test,
                                const LoadingResult& run,
                                std::optional<double> reference_peak = std::nullopt);
