@@ -125,6 +125,10 @@ class SphereWorldImpl {
   SphereWorldImpl() = default;  // load_state()
   template <class Self, class Visitor>
   static void visit_state(Self& self, Visitor& visit);  // every member (sphere_world_state.cpp)
+  // The arrays of one value per particle lane (padding and ghost included),
+  // as pointers (sphere_world_state.cpp: saved, and sized when read back).
+  template <class Self>
+  static auto particle_arrays(Self& self);
   using Array = detail::AlignedVector<double>;
   std::span<const double> view(const Array& a) const { return {a.data(), static_cast<size_t>(n_)}; }
 

@@ -10,6 +10,7 @@
 // state_bytes.hpp. The threads are not state: a SphereWorld read back
 // starts its own on first use, as a copy does.
 #include <algorithm>
+#include <array>
 #include <string>
 
 #include "sphere_world_impl.hpp"
@@ -43,6 +44,21 @@ bool within(const V& a, int lo, int hi) {
 
 }  // namespace
 
+template <class Self>
+auto SphereWorldImpl::particle_arrays(Self& w) {
+  return std::array{&w.x_,          &w.y_,           &w.z_,
+                    &w.vx_,         &w.vy_,          &w.vz_,
+                    &w.wx_,         &w.wy_,          &w.wz_,
+                    &w.r_,          &w.inv_r_,       &w.m_,
+                    &w.inertia_,    &w.fx_,          &w.fy_,
+                    &w.fz_,         &w.tx_,          &w.ty_,
+                    &w.tz_,         &w.ca_t_,        &w.cb_t_,
+                    &w.ca_r_,       &w.cb_r_,        &w.d_t_,
+                    &w.d_r_,        &w.block_lost_,  &w.block_released_,
+                    &w.block_slid_, &w.block_power_, &w.x_built_,
+                    &w.y_built_,    &w.z_built_};
+}
+
 template <class Self, class Visitor>
 void SphereWorldImpl::visit_state(Self& w, Visitor& v) {
   v(w.material_.density);
@@ -55,17 +71,7 @@ void SphereWorldImpl::visit_state(Self& w, Visitor& v) {
   v(w.n_);
   v(w.nblocks_);
   v(w.ghost_);
-  for (auto* a : {&w.x_,          &w.y_,          &w.z_,
-                  &w.vx_,         &w.vy_,         &w.vz_,
-                  &w.wx_,         &w.wy_,         &w.wz_,
-                  &w.r_,          &w.inv_r_,      &w.m_,
-                  &w.inertia_,    &w.fx_,         &w.fy_,
-                  &w.fz_,         &w.tx_,         &w.ty_,
-                  &w.tz_,         &w.ca_t_,       &w.cb_t_,
-                  &w.ca_r_,       &w.cb_r_,       &w.d_t_,
-                  &w.d_r_,        &w.block_lost_, &w.block_released_,
-                  &w.block_slid_, &w.block_power_})
-    v(*a);
+  for (auto* a : particle_arrays(w)) v(*a);
   v(w.damping_dissipated_);
   v(w.friction_dissipated_);
   v(w.dashpot_power_);
@@ -92,9 +98,7 @@ void SphereWorldImpl::visit_state(Self& w, Visitor& v) {
   for (auto* a : {&w.new_wall_hx_, &w.new_wall_hy_, &w.new_wall_hz_}) v(*a);
   for (auto* a : {&w.cell_start_, &w.cell_next_, &w.new_block_slot_}) v(*a);
   v(w.new_slot_j_);
-  for (auto* a : {&w.new_hx_, &w.new_hy_, &w.new_hz_, &w.new_slot_r_, &w.new_slot_ir_, &w.x_built_,
-                  &w.y_built_, &w.z_built_})
-    v(*a);
+  for (auto* a : {&w.new_hx_, &w.new_hy_, &w.new_hz_, &w.new_slot_r_, &w.new_slot_ir_}) v(*a);
   for (auto& d : w.wall_built_) v(d);
   v(w.skin_);
   v(w.r_min_);
@@ -139,18 +143,7 @@ SphereWorldImpl SphereWorldImpl::load_state(std::string_view bytes) {
                  w.threads_ >= 1);
   const size_t n = static_cast<size_t>(w.n_), nb = static_cast<size_t>(w.nblocks_);
   const size_t cap = static_cast<size_t>(w.ghost_) + 8;
-  for (const Array* a : {&w.x_,          &w.y_,           &w.z_,
-                         &w.vx_,         &w.vy_,          &w.vz_,
-                         &w.wx_,         &w.wy_,          &w.wz_,
-                         &w.r_,          &w.inv_r_,       &w.m_,
-                         &w.inertia_,    &w.fx_,          &w.fy_,
-                         &w.fz_,         &w.tx_,          &w.ty_,
-                         &w.tz_,         &w.ca_t_,        &w.cb_t_,
-                         &w.ca_r_,       &w.cb_r_,        &w.d_t_,
-                         &w.d_r_,        &w.block_lost_,  &w.block_released_,
-                         &w.block_slid_, &w.block_power_, &w.x_built_,
-                         &w.y_built_,    &w.z_built_})
-    reader.require(a->size() == cap);
+  for (const Array* a : particle_arrays(w)) reader.require(a->size() == cap);
   // The half list: block_slot_ ascending, its slots' arrays of that size,
   // the pair terms one more (the zero slot).
   reader.require(w.block_slot_.size() == nb + 1 && ascending_from_zero(w.block_slot_));
