@@ -128,6 +128,29 @@ struct Bounce {
   double ledger_max = 0.0;  // the energy ledger's largest reading
 };
 
+/// Steps `w` one at a time until the contact (overlap() > 0) has been made
+/// and has parted, at most 20 000 steps: its steps, whether it parted and
+/// the ledger's largest reading into `out`. A stop of the kernel fails.
+template <class Overlap>
+void step_until_parted(SphereWorld& w, const Overlap& overlap, Bounce& out) {
+  out.ledger_max = -1e300;
+  bool touched = false;
+  for (int k = 0; k < 20000 && !out.separated; ++k) {
+    if (!w.step(1)) {
+      ADD_FAILURE() << to_string(w.divergence()) << " at step " << k << ", ledger "
+                    << w.energy_created();
+      break;
+    }
+    out.ledger_max = std::max(out.ledger_max, w.energy_created());
+    if (overlap() > 0.0) {
+      touched = true;
+      ++out.contact_steps;
+    } else {
+      out.separated = touched;
+    }
+  }
+}
+
 /// A sphere of radius kR a gap of 1e-5·r from wall `side` moving onto it at
 /// `v0` (plus `vt` along the wall, which is frictionless by default), the
 /// wall moving along its axis at `wall_speed` towards the sphere, the
@@ -159,22 +182,7 @@ Bounce wall_bounce(int side, double zeta, double v0, double wall_speed, double v
   Bounce out;
   out.h = std::sqrt(mat.wall.kn / w.mass()[0]) * in.dt;
   out.tangential_before = v - v.dot(g) * g;
-  out.ledger_max = -1e300;
-  bool touched = false;
-  for (int k = 0; k < 20000 && !out.separated; ++k) {
-    if (!w.step(1)) {
-      ADD_FAILURE() << to_string(w.divergence()) << " at step " << k << ", ledger "
-                    << w.energy_created();
-      break;
-    }
-    out.ledger_max = std::max(out.ledger_max, w.energy_created());
-    if (overlap() > 0.0) {
-      touched = true;
-      ++out.contact_steps;
-    } else {
-      out.separated = touched;
-    }
-  }
+  step_until_parted(w, overlap, out);
   const Vector3d v_after = sphere_test::velocity(w, 0);
   out.restitution = -(v_after - W).dot(g) / u_in;
   out.tangential_after = v_after - v_after.dot(g) * g;
@@ -204,22 +212,7 @@ Bounce pair_bounce(double zeta, double v0, const KernelOptions& options = Kernel
   };
   Bounce out;
   out.h = std::sqrt(mat.particle.kn / meff) * in.dt;
-  out.ledger_max = -1e300;
-  bool touched = false;
-  for (int k = 0; k < 20000 && !out.separated; ++k) {
-    if (!w.step(1)) {
-      ADD_FAILURE() << to_string(w.divergence()) << " at step " << k << ", ledger "
-                    << w.energy_created();
-      break;
-    }
-    out.ledger_max = std::max(out.ledger_max, w.energy_created());
-    if (overlap() > 0.0) {
-      touched = true;
-      ++out.contact_steps;
-    } else {
-      out.separated = touched;
-    }
-  }
+  step_until_parted(w, overlap, out);
   out.restitution = (sphere_test::velocity(w, 1) - sphere_test::velocity(w, 0)).dot(u) / (2.0 * v0);
   return out;
 }
