@@ -57,6 +57,15 @@ std::string find_on_path(const std::string& name) {
   return "";
 }
 
+/// series.csv's metadata for a prototype run of verify (`demcal score`
+/// reads it: the same criteria and verdict as verify's).
+template <class Run>
+SeriesMetadata verify_metadata(const SceneConfig& config, const Run& run) {
+  SeriesMetadata m = series_metadata(config.name, config.test, run);
+  m.writer = "demcal verify";
+  return m;
+}
+
 /// `verify --engine lammps`: the exported deck of the consolidated
 /// prototype, run by lmp in DIR/lammps, its series scored.
 int verify_in_lammps(const VerifyOptions& o, const SceneConfig& config,
@@ -282,7 +291,7 @@ int verify_3d(const VerifyOptions& o, const nlohmann::json& params, const RevPar
         {"particle_steps_per_s", rate_run}}},
       {"wall_time_s", total_s},
       {"version", DEMCAL_VERSION}};
-  write_verify_files(dir, out, series_csv(run.series));
+  write_verify_files(dir, out, series_csv(verify_metadata(config, run), run.series));
   print_verdict(score.passed, "3D prototype of " + std::to_string(n) + " spheres", up, c,
                 tolerances);
   std::cout << "  peak axial b_zz " << c.peak_stress_yy << " Pa (sigma1/sigma3 "
@@ -430,7 +439,7 @@ int cmd_verify(const VerifyOptions& o) {
          trial.wall_time_s > 0 ? particle_steps / trial.wall_time_s : 0.0}}},
       {"wall_time_s", total_s},
       {"version", DEMCAL_VERSION}};
-  write_verify_files(dir, out, series_csv(run.series));
+  write_verify_files(dir, out, series_csv(verify_metadata(config, run), run.series));
 
   const auto& c = trial.score.criteria;
   print_verdict(trial.score.passed, "prototype of " + std::to_string(n) + " particles", up, c,

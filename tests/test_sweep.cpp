@@ -291,6 +291,18 @@ TEST(Sweep, CommandWritesTheAtlas) {
   EXPECT_EQ(j["scene"], "hex_5x5");
   EXPECT_GT(j["cases"].size(), 60u);
   EXPECT_EQ(j["benchmark"]["steps"], 2000);
+  // A case's series carries its run's metadata: `demcal score` on it, no
+  // option, gives the case's peak (the step-level one) and verdict.
+  const test::RunResult sc =
+      test::run_demcal({"score", "benchmark.csv", "-o", "scored"}, dir / "series");
+  ASSERT_TRUE(sc.status == 0 || sc.status == 1) << sc.err << sc.out;
+  std::ifstream scored_in(dir / "series" / "scored" / "summary.json");
+  const nlohmann::json scored = nlohmann::json::parse(scored_in);
+  for (const auto& c : j["cases"])
+    if (c["name"] == "benchmark") {
+      EXPECT_EQ(scored["criteria"]["peak_stress_yy"], c["criteria"]["peak_stress_yy"]);
+      EXPECT_EQ(scored["passed"], c["passed"]);
+    }
 }
 
 }  // namespace

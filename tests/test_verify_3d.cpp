@@ -70,6 +70,15 @@ TEST(Verify3D, SmallFccPrototypeRunsAndReports) {
   EXPECT_NEAR(v.at("peak").at("relative_to_rev").get<double>(), (peak + 3.3e5) / 3.3e5, 1e-12);
   // series.csv: a header and the monitored points.
   EXPECT_GE(test::lines_of(test::read_text(dir / "v" / "series.csv")).size(), 50u);
+  // With the metadata of its run: `demcal score` on it, no option, gives
+  // verify's peak and verdict.
+  const test::RunResult sc = test::run_demcal({"score", "series.csv", "-o", "scored"}, dir / "v");
+  ASSERT_TRUE(sc.status == 0 || sc.status == 1) << sc.err << sc.out;
+  const nlohmann::json scored =
+      nlohmann::json::parse(test::read_text(dir / "v" / "scored" / "summary.json"));
+  EXPECT_EQ(scored.at("criteria").at("peak_stress_yy").get<double>(), peak);
+  EXPECT_EQ(scored.at("passed").get<bool>(), v.at("passed").get<bool>());
+  EXPECT_EQ(sc.status, r.status);
 }
 
 }  // namespace

@@ -368,6 +368,19 @@ SweepResult sweep_of(const SceneConfig& config, int dimension, int particles,
 
 }  // namespace
 
+namespace {
+
+/// A case's series.csv metadata (`demcal score` reads it: the case's
+/// criteria and verdict).
+template <class Run>
+SeriesMetadata sweep_metadata(const SceneConfig& config, const Run& run) {
+  SeriesMetadata m = series_metadata(config.name, config.test, run);
+  m.writer = "demcal sweep";
+  return m;
+}
+
+}  // namespace
+
 SweepResult run_sweep(const SceneConfig& config, const ConsolidatedState& state,
                       const std::vector<SweepCase>& cases, const SweepSettings& settings) {
   SweepResult res = sweep_of(config, 2, state.world.size(), state.wall_time_s);
@@ -380,7 +393,7 @@ SweepResult run_sweep(const SceneConfig& config, const ConsolidatedState& state,
     const LoadingResult run = run_loading(local, config.test, r.spec.algorithm, {}, &final_state);
     r.score = score_run(run, s3, settings.tolerances);
     r.identity_residual = gap_identity_residual(final_state);
-    r.run = sweep_run(run, series_csv(run.series));
+    r.run = sweep_run(run, series_csv(sweep_metadata(config, run), run.series));
   });
 }
 
@@ -397,7 +410,7 @@ SweepResult run_sweep(const SceneConfig& config, const TriaxialState& state,
     r.score = score_triaxial_run(run, s3, settings.tolerances);
     r.planes = compute_triaxial_criteria(run, s3);
     r.identity_residual = gap_identity_residual(final_state);
-    r.run = sweep_run(run, series_csv(run.series));
+    r.run = sweep_run(run, series_csv(sweep_metadata(config, run), run.series));
   });
 }
 
