@@ -95,23 +95,12 @@ namespace {
 
 using Eigen::Vector3d;
 using sphere_test::kR;
+using test::bounce_ledger_bound;
 using test::clamped_restitution;
+using test::clamped_restitution_tolerance;
 
 constexpr double kAlpha = 0.002;  // Δt/Δt_crit: ~800 steps of contact against a wall
 constexpr double kZetas[] = {0.05, 0.3, 0.7};
-
-/// The ledger's bound of the file comment, (1 + 6ζ)·h.
-double ledger_bound(double zeta, double h) { return (1.0 + 6.0 * zeta) * h; }
-
-/// The bound of the file comment, e·[h·(ζ + ζ²·|d ln e/dζ|/2) + h²], the
-/// slope by a central difference of clamped_restitution.
-double restitution_tolerance(double zeta, double h) {
-  const double e = clamped_restitution(zeta), dz = 1e-6;
-  const double slope = std::abs(std::log(clamped_restitution(zeta + dz)) -
-                                std::log(clamped_restitution(zeta - dz))) /
-                       (2.0 * dz);
-  return e * (h * (zeta + 0.5 * zeta * zeta * slope) + h * h);
-}
 
 /// The law that could pull (contact to δ = 0): what the clamp is told from.
 double unclamped_restitution(double zeta) {
@@ -222,7 +211,7 @@ TEST(SphereRestitution, TheClampedDashpotIsToldFromTheOneThatPulls) {
   // more than twice the bound at every ratio tested.
   for (double zeta : kZetas) {
     const double e = clamped_restitution(zeta);
-    EXPECT_GT(e - unclamped_restitution(zeta), 2.0 * restitution_tolerance(zeta, 0.005))
+    EXPECT_GT(e - unclamped_restitution(zeta), 2.0 * clamped_restitution_tolerance(zeta, 0.005))
         << "zeta " << zeta;
   }
 }
@@ -239,14 +228,14 @@ TEST(SphereRestitution, ASphereBouncesOffEachWallWithTheClampedDashpotsRestituti
       ASSERT_TRUE(b.separated);
       EXPECT_GT(b.contact_steps, 400);
       const double e = clamped_restitution(zeta);
-      EXPECT_NEAR(b.restitution, e, restitution_tolerance(zeta, b.h));
+      EXPECT_NEAR(b.restitution, e, clamped_restitution_tolerance(zeta, b.h));
       EXPECT_EQ(b.tangential_after, b.tangential_before);
       EXPECT_EQ(b.spin_after, Vector3d::Zero());
-      EXPECT_LE(b.ledger_max, ledger_bound(zeta, b.h));
+      EXPECT_LE(b.ledger_max, bounce_ledger_bound(zeta, b.h));
       if (side == 0)
         std::printf("wall, zeta %.2f: e %.6f, clamped %.6f (%+.2e, bound %.1e), pulling %.6f\n",
-                    zeta, b.restitution, e, b.restitution - e, restitution_tolerance(zeta, b.h),
-                    unclamped_restitution(zeta));
+                    zeta, b.restitution, e, b.restitution - e,
+                    clamped_restitution_tolerance(zeta, b.h), unclamped_restitution(zeta));
     }
 }
 
@@ -260,8 +249,9 @@ TEST(SphereRestitution, AMovingWallHitsARestingSphereWithTheSameRestitution) {
       SCOPED_TRACE("zeta " + std::to_string(zeta) + " wall " + std::to_string(side));
       const Bounce b = wall_bounce(side, zeta, 0.0, 0.05, 0.0);
       ASSERT_TRUE(b.separated);
-      EXPECT_NEAR(b.restitution, clamped_restitution(zeta), restitution_tolerance(zeta, b.h));
-      EXPECT_LE(b.ledger_max, ledger_bound(zeta, b.h));
+      EXPECT_NEAR(b.restitution, clamped_restitution(zeta),
+                  clamped_restitution_tolerance(zeta, b.h));
+      EXPECT_LE(b.ledger_max, bounce_ledger_bound(zeta, b.h));
     }
 }
 
@@ -272,10 +262,10 @@ TEST(SphereRestitution, UnequalSpheresBounceWithTheReducedMassesRestitution) {
     ASSERT_TRUE(b.separated);
     EXPECT_GT(b.contact_steps, 400);
     const double e = clamped_restitution(zeta);
-    EXPECT_NEAR(b.restitution, e, restitution_tolerance(zeta, b.h));
-    EXPECT_LE(b.ledger_max, ledger_bound(zeta, b.h));
+    EXPECT_NEAR(b.restitution, e, clamped_restitution_tolerance(zeta, b.h));
+    EXPECT_LE(b.ledger_max, bounce_ledger_bound(zeta, b.h));
     std::printf("pair, zeta %.2f: e %.6f, clamped %.6f (%+.2e, bound %.1e), ledger <= %.1e\n", zeta,
-                b.restitution, e, b.restitution - e, restitution_tolerance(zeta, b.h),
+                b.restitution, e, b.restitution - e, clamped_restitution_tolerance(zeta, b.h),
                 b.ledger_max);
   }
 }

@@ -99,4 +99,24 @@ inline double clamped_restitution(double zeta) {
   return std::exp(-zeta * t) * std::abs(std::cos(phase) - zeta / s * std::sin(phase));
 }
 
+/// How far the kernels' explicit scheme may put a bounce's restitution
+/// from clamped_restitution(ζ), h = ω·Δt (ω = sqrt(kn/m_eff)):
+/// e·[h·(ζ + ζ²·|d ln e/dζ|/2) + h²] — the dashpot switching on partway
+/// through the first touching step, its half-step lag (a ratio ζ(1 + ζh/2))
+/// and second-order terms (test_sphere_restitution.cpp derives it). The
+/// slope by a central difference.
+inline double clamped_restitution_tolerance(double zeta, double h) {
+  const double e = clamped_restitution(zeta), dz = 1e-6;
+  const double slope = std::abs(std::log(clamped_restitution(zeta + dz)) -
+                                std::log(clamped_restitution(zeta - dz))) /
+                       (2.0 * dz);
+  return e * (h * (zeta + 0.5 * zeta * zeta * slope) + h * h);
+}
+
+/// The energy ledger's bound on a lone damped bounce, (1 + 6ζ)·h: the
+/// leapfrog energy (h), the dashpot's loss booked for the whole first
+/// touching step (4ζh) and at the half-step-old velocity (2ζh), each of
+/// the incoming kinetic energy (test_sphere_restitution.cpp derives it).
+inline double bounce_ledger_bound(double zeta, double h) { return (1.0 + 6.0 * zeta) * h; }
+
 }  // namespace demcal::test
