@@ -144,6 +144,31 @@ TEST(TriaxialScene, ConsolidationReachesSigma3OnAllSixWalls) {
   EXPECT_EQ(s.world.material().particle.friction, c.material.particle.friction);
 }
 
+// Contact dashpots at ζ_c = 0.3 shrink the consolidation's step (α 0.2 →
+// 0.035 here, consolidation_dashpot_factor), so the light damping needs
+// more steps to the same simulated time: 164 800 for this sample
+// (configs/random_500_3d.json's material and σ3, 60 spheres). The
+// critical-damping fallback used to come after a quarter of the step budget
+// whatever the step, here at 75 000 steps, before the packing was static,
+// and critical damping then did not bring it there within 300 000 steps
+// (wall stress error 4 %, unbalanced-force ratio 0.088; random_500_3d at
+// ζ_c 0.2 and 0.3 stalled the same way in 2·10⁶). It now comes after the
+// same simulated time as undamped.
+TEST(TriaxialScene, ContactDampingConsolidatesARandomSampleWithinAModestBudget) {
+  SceneConfig c = parse(
+      R"({"dimension": 3, "material": {"density": 2650, "kn": 1e6, "kt": 5e5, "friction": 0.3,
+          "wall": {"kn": 1e6, "kt": 5e5, "friction": 0.0}, "contact_damping_ratio": 0.3},
+          "assembly": {"type": "random", "count": 60, "radius_min": 4e-4, "radius_max": 6e-4,
+          "seed": 2}, "test": {"lateral_stress": 1e5, "consolidation_max_steps": 300000},
+          "algorithm": {"dt_ratio": 0.05}})");
+  const TriaxialState s = consolidate_triaxial(c, make_sphere_assembly(c), std::string());
+  std::printf("60 spheres, contact damping 0.3: consolidated in %lld steps\n",
+              static_cast<long long>(s.steps));
+  EXPECT_TRUE(s.converged);
+  EXPECT_LT(max_wall_error(s.world, c.test.lateral_stress), c.test.consolidation_tolerance);
+  EXPECT_LT(s.world.measure().unbalanced_force_ratio, c.test.consolidation_unbalanced);
+}
+
 TEST(TriaxialScene, ConsolidationThatCannotFinishSaysWhatItReached) {
   SceneConfig c = parse(fcc_text(2, 1e7, 5e-4, 1000, true));
   c.test.consolidation_max_steps = 1000;

@@ -79,7 +79,9 @@ Integration integration_for(const SphereWorld& world, const AlgorithmSpec& algor
 
 /// Consolidate: all six walls servo to σ3, frictionless until static, then
 /// friction on and static again; light global damping (ζ = 0.02) with the
-/// 2D fallback to critical damping after a quarter of the budget. Static:
+/// 2D fallback to critical damping after a quarter of the budget (of
+/// simulated time at the undamped step: later when contact dashpots shrink
+/// the step, protocol_steps.hpp). Static:
 /// every wall stress within test.consolidation_tolerance of σ3 and the
 /// unbalanced-force ratio below test.consolidation_unbalanced. Throws
 /// std::runtime_error saying what was reached if it cannot. options.threads
