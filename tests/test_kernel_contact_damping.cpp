@@ -47,17 +47,23 @@ struct Collision {
   double energy_created = 0.0;
 };
 
+/// No global damping, the step α·Δt_crit: set on `w` and returned.
+Integration set_undamped(World& w, double alpha) {
+  Integration in;
+  in.damping_ratio_translation = 0.0;
+  in.damping_ratio_rotation = 0.0;
+  in.dt = alpha * w.reference_scales().dt_crit;
+  w.set_integration(in);
+  return in;
+}
+
 Collision collide(double zeta, double alpha) {
   Material mat = reference_material(0.3);
   mat.contact_damping_ratio = zeta;
   const double r = kR, v0 = 0.05;
   const std::vector<double> x{0.0, 2.0 * r + 2e-3 * r}, y{0.0, 0.0}, rad{r, r};
   World w(mat, x, y, rad, -10 * r, 12 * r, -10 * r, 10 * r);
-  Integration in;
-  in.damping_ratio_translation = 0.0;
-  in.damping_ratio_rotation = 0.0;
-  in.dt = alpha * w.reference_scales().dt_crit;
-  w.set_integration(in);
+  set_undamped(w, alpha);
   w.set_velocity(0, v0, 0.0, 0.0);
   w.set_velocity(1, -v0, 0.0, 0.0);
   const double kn = mat.particle.kn;
@@ -144,11 +150,7 @@ Bounce2D wall_bounce(WallSide side, double zeta, double v0, double wall_speed) {
   const double along = -sign * L + (r + gap) * sign;
   const std::vector<double> x{vertical ? along : 0.3 * r}, y{vertical ? 0.3 * r : along}, rad{r};
   World w(mat, x, y, rad, -L, L, -L, L);
-  Integration in;
-  in.damping_ratio_translation = 0.0;
-  in.damping_ratio_rotation = 0.0;
-  in.dt = kAlpha * w.reference_scales().dt_crit;
-  w.set_integration(in);
+  const Integration in = set_undamped(w, kAlpha);
   const double un = -v0 * sign, ut = 0.02;  // normal and tangential velocity
   w.set_velocity(0, vertical ? un : ut, vertical ? ut : un, 0.0);
   Wall& wall = w.wall(side);
@@ -208,11 +210,7 @@ TEST(KernelContactDamping, UnequalDisksBounceWithTheReducedMassesRestitution) {
     const double d = r0 + r1 + 1e-5 * kR;
     const std::vector<double> x{0.0, d * ux}, y{0.0, d * uy}, rad{r0, r1};
     World w(mat, x, y, rad, -L, L, -L, L);
-    Integration in;
-    in.damping_ratio_translation = 0.0;
-    in.damping_ratio_rotation = 0.0;
-    in.dt = kAlpha * w.reference_scales().dt_crit;
-    w.set_integration(in);
+    const Integration in = set_undamped(w, kAlpha);
     w.set_velocity(0, v0 * ux, v0 * uy, 0.0);
     w.set_velocity(1, -v0 * ux, -v0 * uy, 0.0);
     auto overlap = [&] { return r0 + r1 - std::hypot(w.x()[1] - w.x()[0], w.y()[1] - w.y()[0]); };
