@@ -65,6 +65,11 @@ struct ScoreOptions {
 };
 int cmd_score(const ScoreOptions& options);
 
+// check, run, sweep, calibrate, stability, score (cmd_trial_cli.cpp). Adds
+// the subcommands to `app`; the function returned runs the one that was
+// parsed, or returns -1 when none of them was.
+std::function<int()> add_trial_commands(CLI::App& app);
+
 // Issue #6: upscale, verify, scaling, export, rev (options in
 // upscaling_cli.hpp). Adds the subcommands to `app`; the function returned
 // runs the one that was parsed, or returns -1 when none of them was.

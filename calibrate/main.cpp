@@ -10,8 +10,6 @@
 #include "demcal/io/input_error.hpp"
 #include "demcal/kernel/world.hpp"
 #include "demcal/scene/config.hpp"
-#include "demcal/search/calibration.hpp"
-#include "option_checks.hpp"
 
 namespace {
 
@@ -35,6 +33,20 @@ std::string printable(std::string_view text) {
   return out;
 }
 
+/// A first word that is neither an option nor a command, named with the
+/// commands there are (CLI11 says only that a subcommand is required); ""
+/// when the first word is fine.
+std::string unknown_command(const CLI::App& app, int argc, char** argv) {
+  if (argc <= 1 || argv[1][0] == '-') return "";
+  const std::string word = argv[1];
+  std::string names;
+  for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) {
+    if (sub->get_name() == word) return "";
+    names += (names.empty() ? "" : ", ") + sub->get_name();
+  }
+  return "unknown command " + demcal::quoted_value(word) + "; the commands are " + names;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -45,119 +57,12 @@ int main(int argc, char** argv) {
       "demcal: calibrate the algorithmic parameters (dt, steps, damping) of quasi-static "
       "DEM runs"};
   app.require_subcommand(1);
-  std::string config_path, out_dir;
-  std::vector<std::string> sets;
-
-  auto* check = app.add_subcommand("check", "validate a config and print the derived scales");
-  check->add_option("config", config_path, "scene config (JSON); default: the embedded one");
-  check->add_option("--set", sets, "override a key: section.key=value");
-
-  auto* run = app.add_subcommand("run", "run one trial and print its criteria");
-  run->add_option("config", config_path, "scene config (JSON); default: the embedded one");
-  run->add_option("--set", sets, "override a key: section.key=value (repeatable)");
-  run->add_option("-o,--output", out_dir, "output folder (default demcal-run-NAME)");
-  bool allow_unstable = false;
-  run->add_flag("--allow-unstable", allow_unstable,
-                "run a dt_ratio beyond the estimated stable step (to watch it diverge)");
-
-  SweepOptions sweep_options;
-  auto* sweep =
-      app.add_subcommand("sweep", "the signature atlas: one parameter out of bounds at a time");
-  sweep->add_option("config", sweep_options.config,
-                    "scene config (JSON); default: the embedded one");
-  sweep->add_option("--set", sweep_options.sets, "override a key: section.key=value (repeatable)");
-  sweep->add_option("-o,--output", sweep_options.out_dir,
-                    "output folder (default demcal-sweep-NAME)");
-  sweep->add_option("-j,--jobs", sweep_options.jobs, "trials in parallel (default: cores)")
-      ->check(whole_number(1, kMaxJobs));
-
-  CalibrateOptions cal;
-  auto* calibrate = app.add_subcommand("calibrate", "calibrate dt, steps and damping on the REV");
-  calibrate->add_option("config", cal.config, "scene config (JSON); default: the embedded one");
-  calibrate->add_option("--set", cal.sets, "override a key: section.key=value (repeatable)");
-  calibrate->add_option("-o,--output", cal.out_dir, "output folder (default demcal-NAME)");
-  calibrate->add_option("-j,--jobs", cal.jobs, "trials in parallel (default: cores)")
-      ->check(whole_number(1, kMaxJobs));
-  calibrate->add_option("--max-trials", cal.max_trials, "search trials (default: config, 80)")
-      ->check(whole_number(1, kMaxTrials));
-  calibrate->add_option("--accuracy", cal.accuracy, "peak accuracy target (default 0.02)")
-      ->check(real_between(0.0, 1.0));
-  std::string strategies;
-  for (demcal::Strategy s : demcal::kStrategies)
-    strategies += (strategies.empty() ? "" : ", ") + demcal::to_string(s);
-  calibrate->add_option("--strategy", cal.strategy, "search strategy: " + strategies);
-  calibrate->add_flag("--resume", cal.resume, "continue from DIR/trials.jsonl");
-  calibrate->add_flag("-q,--quiet", cal.quiet, "no progress lines on stderr");
-  calibrate->add_flag("--evidence", cal.evidence,
-                      "also run the paper-recipe baseline and a converged reference (8x and 16x "
-                      "Nstep) so the report shows every trial's peak error");
-
-  StabilityOptions stab;
-  auto* stability = app.add_subcommand(
-      "stability", "find the time step at which the REV diverges and compare it with the estimate");
-  stability->add_option("config", stab.config, "scene config (JSON); default: the embedded one");
-  stability->add_option("--set", stab.sets, "override a key: section.key=value (repeatable)");
-  stability->add_option("-o,--output", stab.out_dir,
-                        "output folder (default demcal-stability-NAME)");
-  stability->add_option("-j,--jobs", stab.jobs, "trials in parallel (default: cores)")
-      ->check(whole_number(1, kMaxJobs));
-  stability->add_option("--from", stab.from, "first rung, x the estimated stable dt_ratio (0.5)")
-      ->check(real_above(0.0, 100.0));
-  stability->add_option("--to", stab.to, "last rung, x the estimated stable dt_ratio (2)")
-      ->check(real_above(0.0, 100.0));
-  stability->add_option("--points", stab.points, "rungs of the ladder (16)")
-      ->check(CLI::Range(2, 1000));
-  // Fewer steps than this cannot show a divergence: the energy ledger is
-  // sampled every energy_check_interval steps, and a step past the stable
-  // one needs a few thousand steps to create energy beyond the threshold
-  // (KernelOptions in demcal/kernel/world.hpp); 100 steps called 2x the
-  // stable step "stable".
-  constexpr int64_t kMinStabilitySteps = 16LL * demcal::KernelOptions{}.energy_check_interval;
-  stability->add_option("--steps", stab.steps, "loading steps per trial (20000)")
-      ->check(whole_number(kMinStabilitySteps, 1'000'000'000,
-                           "fewer steps cannot show a divergence: the energy ledger is sampled "
-                           "every " +
-                               std::to_string(demcal::KernelOptions{}.energy_check_interval) +
-                               " steps"));
-
-  ScoreOptions score_options;
-  auto* score = app.add_subcommand(
-      "score",
-      "criteria, verdict and diagnosis of a monitoring series (CSV: another engine's, or demcal "
-      "run's)");
-  score
-      ->add_option("file", score_options.file,
-                   "series file (e.g. the LAMMPS deck's series.csv, or demcal run's)")
-      ->required();
-  score
-      ->add_option("--lateral-stress", score_options.lateral_stress,
-                   "sigma3 in Pa, if the file has no '# lateral_stress = ' line")
-      ->check(real_above(0.0, 1e12));
-  score
-      ->add_option("--reference-peak", score_options.reference_peak,
-                   "a reference peak |sigma_yy| (3D: |sigma_zz|) in Pa to report the peak error "
-                   "against (default: the file's '# reference_peak = ' line, if any)")
-      ->check(real_above(0.0, 1e15));
-  score->add_option("-o,--output", score_options.out_dir,
-                    "output folder (default demcal-score-STEM)");
-
+  const auto run_trial = add_trial_commands(app);  // check, run, sweep, calibrate, stability, score
   const auto run_upscaling = add_upscaling_commands(app);  // upscale, verify, scaling, export, rev
 
-  // A first word that is neither an option nor a command: name it (CLI11
-  // says only that a subcommand is required).
-  if (argc > 1 && argv[1][0] != '-') {
-    const std::string word = argv[1];
-    std::string names;
-    bool known = false;
-    for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) {
-      known |= sub->get_name() == word;
-      names += (names.empty() ? "" : ", ") + sub->get_name();
-    }
-    if (!known) {
-      std::cerr << "demcal: error: unknown command " << demcal::quoted_value(word)
-                << "; the commands are " << names << " (see --help)\n";
-      return kBadInput;
-    }
+  if (const std::string error = unknown_command(app, argc, argv); !error.empty()) {
+    std::cerr << "demcal: error: " << error << " (see --help)\n";
+    return kBadInput;
   }
   try {
     app.parse(argc, argv);
@@ -175,12 +80,7 @@ int main(int argc, char** argv) {
     } catch (const std::invalid_argument& e) {
       throw demcal::InputError("environment", "", printable(e.what()));
     }
-    if (check->parsed()) return cmd_check(config_path, sets);
-    if (run->parsed()) return cmd_run(config_path, sets, out_dir, allow_unstable);
-    if (sweep->parsed()) return cmd_sweep(sweep_options);
-    if (calibrate->parsed()) return cmd_calibrate(cal);
-    if (stability->parsed()) return cmd_stability(stab);
-    if (score->parsed()) return cmd_score(score_options);
+    if (const int status = run_trial(); status >= 0) return status;
     if (const int status = run_upscaling(); status >= 0) return status;
   } catch (const demcal::InputError& e) {
     std::cerr << "demcal: error: " << e.what() << "\n";
