@@ -436,8 +436,7 @@ void lammps_3d_consolidation(std::ostream& s, const SceneConfig& c, const Plan3&
     << "\n"
     << "variable        cons_s0 equal $(step)\n"
     << "# runs end on check steps, where the criterion's computes are current\n"
-    << "variable        cons_quarter equal $(v_cons_check*floor(v_cons_max_steps/4/v_cons_check))\n"
-    << "variable        cons_last equal $(v_cons_check*floor(v_cons_max_steps/v_cons_check))\n";
+    << deck::lammps_consolidation_quarter(alpha, c.test.consolidation_max_steps);
   for (int sd = 0; sd < 6; ++sd)
     s << "variable        cons_d" << kWall[sd] << " equal f_cons_servo[" << sd + 1
       << "]*(step-${cons_s0})\n";
@@ -474,7 +473,7 @@ void lammps_3d_consolidation(std::ostream& s, const SceneConfig& c, const Plan3&
   s << deck::lammps_consolidation_servo(walls, {"cons_Ax", "cons_Ay", "cons_Az"}, "", resist)
     << deck::lammps_consolidation_criterion(3, walls, {"x", "y", "z"})
     << deck::lammps_consolidation_runs(deck::contact_gamma_n(c.material, plan.m_mean), dt_damped,
-                                       deck::lammps_consolidation_viscous(critical))
+                                       deck::lammps_consolidation_viscous(critical), alpha)
     << "# the loading starts from here: walls, step 0, spheres at rest. Each wall\n"
     << "# where its contacts put it (F = kn_wall * sum of overlaps, exact for these\n"
     << "# undamped walls), so the loading starts from the forces of the static state.\n";
