@@ -306,12 +306,13 @@ TEST(Calibration3D, ExportWritesTheRevsDeckAndAnUpscaledPrototypesDeck) {
   const test::RunResult ran =
       test::run_program(lmp, {"-in", "fcc.lammps", "-screen", "none"}, dir / "deck");
   ASSERT_EQ(ran.status, 0) << ran.err;
-  // The deck appends "# peak_axial_stress = P" to its series at the end.
+  // The deck appends its axial peak to its series at the end, in demcal's
+  // key: "# peak_stress_zz = -P".
   const std::string series = test::read_text(dir / "deck" / "series.csv");
-  const std::string tag = "# peak_axial_stress = ";
+  const std::string tag = "# peak_stress_zz = ";
   const size_t at = series.rfind(tag);
   ASSERT_NE(at, std::string::npos) << "no peak in the deck's series.csv";
-  const double lammps_peak = std::stod(series.substr(at + tag.size()));
+  const double lammps_peak = -std::stod(series.substr(at + tag.size()));
 
   // demcal with the same parameters and ζ_r = 0 (LAMMPS 2021 has no
   // rotational viscous fix; the deck says so).

@@ -1,6 +1,7 @@
 // Stage 1 of the LAMMPS decks that consolidate themselves (--consolidate-in
 // deck): every wall's servo move in one vector-style formula is the per-wall
-// formula, bit for bit (reports/engines.md §17).
+// formula, bit for bit (reports/engines.md §17); with contact dashpots the
+// critical-damping fallback comes at demcal's check (§21).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -11,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "demcal/scene/biaxial.hpp"
 #include "demcal/scene/config.hpp"
 #include "demcal/scene/packing.hpp"
 #include "demcal/scene/triaxial.hpp"
@@ -18,6 +20,9 @@
 #include "demcal/upscaling/export_3d.hpp"
 #include "support/files.hpp"
 #include "support/process.hpp"
+// critical_damping_after, consolidation_step_shrink: demcal's consolidation
+// and the decks' stage 1 share them (the rest of the header is private)
+#include "../src/scene/protocol_steps.hpp"
 
 namespace demcal {
 namespace {
@@ -211,6 +216,152 @@ TEST(EngineLammpsStage1, TheVectorServoIsThePerWallFormulaBitForBit3D) {
   expect_per_wall_bit_for_bit(lmp, r,
                               {"cons_Ax", "cons_Ax", "cons_Ay", "cons_Ay", "cons_Az", "cons_Az"},
                               "", "engine_stage1_3d", 500, "0.00000001");
+}
+
+/// A number the deck defines: the value LAMMPS echoed in `log` for
+/// `variable NAME equal VALUE` (its immediate $(...) evaluated), -1 if absent.
+double echoed(const std::string& log, const std::string& name) {
+  std::smatch m;
+  if (!std::regex_search(log, m, std::regex("\nvariable +" + name + " equal ([-+0-9.e]+)\n")))
+    return -1;
+  return std::stod(m[1].str());
+}
+
+/// Where demcal's consolidation switches to critical damping, as a check of
+/// stage 1 (every cons_check = 200 steps from 0): the first check at or after
+/// critical_damping_after, never beyond the budget's last check.
+int64_t demcal_switch_check(int64_t budget, double shrink) {
+  const int64_t after = detail::critical_damping_after(budget, shrink);
+  return std::min((after + 199) / 200 * 200, budget / 200 * 200);
+}
+
+// With contact dashpots stage 1's step is demcal's shrunk one (alpha
+// 0.2·S, consolidation_dashpot_factor), and its critical-damping fallback
+// comes where demcal's does: after a quarter of the budget in the simulated
+// time of the undamped step, i.e. (cons_max_steps/4)/S steps, at a check,
+// never beyond the budget. The deck computes it from cons_max_steps, so a
+// budget edited in its parameters block moves it as it moves demcal's. Each
+// deck is run up to the definition of cons_quarter (then quit) with the
+// exported budget and edited ones; LAMMPS' value must be
+// demcal_switch_check's, to the step. (The deck before put it at a quarter
+// of cons_max_steps in steps: 500 000 of 2·10⁶ where demcal's came after
+// 3 299 212 steps, i.e. never, on random_500_3d at ζ_c 0.3.)
+TEST(EngineLammpsStage1, WithContactDashpotsTheCriticalFallbackComesAtDemcalsCheck) {
+  const std::string lmp = test::find_on_path("lmp");
+  if (lmp.empty())
+    GTEST_SKIP() << "LAMMPS (lmp) is not installed (apt-get install lammps): the deck is not run";
+  AlgorithmSpec p;
+  p.steps = 8000;
+  p.damping_ratio_rotation = 0.0;
+  struct Case {
+    std::string name;
+    ExportResult deck;
+  };
+  std::vector<Case> cases;
+  for (double zeta_c : {0.02}) {
+    SceneConfig c = load_config(test::shipped_config("random_400"));
+    c.assembly.count = 100;
+    c.material.contact_damping_ratio = zeta_c;
+    ExportOptions o;
+    o.data_name = "r.data";
+    o.consolidate_in_deck = true;
+    cases.push_back(
+        {"2D zeta_c " + std::to_string(zeta_c), export_deck(c, p, make_assembly(c), o)});
+  }
+  {
+    SceneConfig c = load_config(test::shipped_config("random_500_3d"));
+    c.assembly.count = 60;
+    c.material.contact_damping_ratio = 0.3;
+    Export3dOptions o;
+    o.data_name = "r.data";
+    o.consolidate_in_deck = true;
+    cases.push_back({"3D zeta_c 0.3", export_3d_decks(c, p, make_sphere_assembly(c), o)});
+  }
+  const test::TempDir dir("engine_stage1_fallback");
+  int switching = 0, never = 0;
+  for (const Case& k : cases) {
+    SCOPED_TRACE(k.name);
+    // S as the deck holds it (17 digits) and stage 1's alpha (10 digits)
+    std::smatch m;
+    ASSERT_TRUE(std::regex_search(
+        k.deck.deck, m,
+        std::regex("\\(floor\\(v_cons_max_steps/4\\)/([0-9.e+-]+)\\)/v_cons_check\\)\\)\n")))
+        << "no shrunk quarter in the deck";
+    const double shrink = std::stod(m[1].str());
+    ASSERT_TRUE(std::regex_search(
+        k.deck.deck, m, std::regex("# alpha\\*f\\(zeta\\)\\*dt_crit, alpha ([0-9.e+-]+)\n")));
+    EXPECT_NEAR(shrink, std::stod(m[1].str()) / AlgorithmSpec{}.dt_ratio, 1e-9 * shrink);
+    EXPECT_LT(shrink, 1.0);
+    const std::string budget_line = line_of(k.deck.deck, "variable cons_max_steps equal ");
+    const std::string quarter_line = line_of(k.deck.deck, "variable        cons_quarter equal ");
+    for (int64_t budget : {int64_t{2000000}, int64_t{123457}, int64_t{1000}}) {
+      SCOPED_TRACE("cons_max_steps " + std::to_string(budget));
+      std::string deck = replaced(k.deck.deck, budget_line,
+                                  "variable cons_max_steps equal " + std::to_string(budget) + "\n");
+      deck = replaced(deck, quarter_line, quarter_line + "quit 0\n");
+      const test::DeckRun run = test::run_deck(
+          lmp, dir / (std::to_string(&k - cases.data()) + "_" + std::to_string(budget)), deck,
+          k.deck.files);
+      ASSERT_EQ(run.status, 0) << run.log;
+      const int64_t expected = demcal_switch_check(budget, shrink);
+      EXPECT_EQ(echoed(run.log, "cons_quarter"), static_cast<double>(expected)) << run.log;
+      ++(expected < budget / 200 * 200 ? switching : never);
+    }
+  }
+  // both branches: a switch within the budget and none
+  EXPECT_GT(switching, 0);
+  EXPECT_GT(never, 0);
+}
+
+// The deck's own consolidation with contact dashpots (ζ_c 0.3 shrinks stage
+// 1's step, alpha 0.2 → 0.039 on this material) certifies within a modest
+// budget, as demcal's does: 200 disks of random_400, budget 120 000 steps.
+// Its fallback now comes after (30 000/S) steps, beyond the budget, so it
+// runs at light damping throughout; the deck before switched to critical
+// damping at 30 000 steps, long before the packing was static, and crept
+// there to the end of the budget (quit 2; with a budget of 160 000 its wall
+// stress error was still 12 % and the unbalanced-force ratio 0.22 at the
+// end). demcal's own consolidation takes 89 800 steps, the deck 90 600
+// (engines.md §21).
+TEST(EngineLammpsStage1, WithContactDashpotsTheDeckConsolidatesARandomSampleWithinAModestBudget) {
+  const std::string lmp = test::find_on_path("lmp");
+  if (lmp.empty())
+    GTEST_SKIP() << "LAMMPS (lmp) is not installed (apt-get install lammps): the deck is not run";
+  SceneConfig c = load_config(test::shipped_config("random_400"));
+  c.assembly.count = 200;
+  c.material.contact_damping_ratio = 0.3;
+  c.test.consolidation_max_steps = 120000;
+  AlgorithmSpec p;
+  p.steps = 8000;
+  p.damping_ratio_rotation = 0.0;
+  ExportOptions o;
+  o.data_name = "r.data";
+  o.consolidate_in_deck = true;
+  const Assembly a = make_assembly(c);
+  const ExportResult r = export_deck(c, p, a, o);
+  const test::TempDir dir("engine_stage1_damped");
+  const test::DeckRun run = test::run_deck(lmp, dir.path(), r.deck, r.files,
+                                           {"-var", "run_steps", "0", "-screen", "none"});
+  const std::regex done(
+      "\ndemcal deck: consolidated in ([0-9]+) steps \\(wall stress error ([-+0-9.eE]+), "
+      "unbalanced-force ratio ([-+0-9.eE]+)\\)");
+  std::smatch m;
+  ASSERT_EQ(run.status, 0) << run.log.substr(run.log.size() > 3000 ? run.log.size() - 3000 : 0);
+  ASSERT_TRUE(std::regex_search(run.log, m, done)) << run.log;
+  const long long deck_steps = std::stoll(m[1].str());
+  EXPECT_LT(std::stod(m[2].str()), c.test.consolidation_tolerance);
+  EXPECT_LT(std::stod(m[3].str()), c.test.consolidation_unbalanced);
+  EXPECT_LE(deck_steps, c.test.consolidation_max_steps);
+  // at light damping throughout, as demcal's consolidation of this budget
+  EXPECT_EQ(echoed(run.log, "cons_quarter"), static_cast<double>(c.test.consolidation_max_steps));
+  EXPECT_EQ(run.log.find("\nvariable cons_critical equal 1\n"), std::string::npos);
+  const ConsolidatedState d = consolidate(c, a, std::string());
+  EXPECT_TRUE(d.converged);
+  std::printf(
+      "200 disks, contact damping 0.3, budget %lld: the deck consolidated in %lld steps, demcal "
+      "in %lld\n",
+      static_cast<long long>(c.test.consolidation_max_steps), deck_steps,
+      static_cast<long long>(d.steps));
 }
 
 }  // namespace

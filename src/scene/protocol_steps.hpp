@@ -1,5 +1,5 @@
 // The steps the biaxial (disks, biaxial.cpp) and triaxial (spheres,
-// triaxial.cpp) protocols share, written once. Private to src/scene.
+// triaxial.cpp) protocols share, written once.
 //
 // Consolidation: every wall servoed at σ3; phase 0
 // frictionless (a packing without friction finds its densest state), phase
@@ -13,6 +13,9 @@
 // at critical damping (the paper's start point) — a quarter in simulated
 // time of the undamped step, so later where contact dashpots shrink the
 // step (run_consolidation says why).
+//
+// Private to src/scene, but for critical_damping_after and
+// consolidation_step_shrink, which the decks' stage 1 (src/upscaling) shares.
 #pragma once
 
 #include <algorithm>
@@ -41,6 +44,26 @@ inline AlgorithmSpec consolidation_settings(const SceneConfig& config, double da
   settle.damping_ratio_rotation = damping_ratio;
   settle.lock_rotation = config.algorithm.lock_rotation;
   return settle;
+}
+
+/// The consolidation's step shrink: its α (`dt_ratio`, consolidation_settings'
+/// shrunk by consolidation_dashpot_factor where contact dashpots lower the
+/// stable step) over the undamped consolidation's (AlgorithmSpec{}.dt_ratio).
+inline double consolidation_step_shrink(double dt_ratio) {
+  return dt_ratio / AlgorithmSpec{}.dt_ratio;
+}
+
+/// The step from which the consolidation runs at critical damping (the
+/// first check at or after it switches): a quarter of the budget
+/// `max_steps` in the simulated time of the undamped step, i.e. as many more
+/// steps as the step shrank (`step_shrink`: consolidation_step_shrink;
+/// run_consolidation says why). The one home of the formula: demcal's
+/// consolidation and the exported decks' stage 1 (src/upscaling,
+/// deck::lammps_consolidation_quarter) use it.
+inline int64_t critical_damping_after(int64_t max_steps, double step_shrink) {
+  return step_shrink < 1.0
+             ? static_cast<int64_t>(std::ceil(static_cast<double>(max_steps / 4) / step_shrink))
+             : max_steps / 4;
 }
 
 struct ConsolidationOutcome {
@@ -144,11 +167,8 @@ ConsolidationOutcome run_consolidation(Sample& world, const TestSpec& test, doub
   // (x walls out, y walls in, no servo reversal) with the wall stress error
   // near 0.2 % and the unbalanced-force ratio near 0.01 for the rest of a
   // 2·10⁶-step budget.
-  const double step_shrink = settle.dt_ratio / AlgorithmSpec{}.dt_ratio;
   const int64_t critical_after =
-      step_shrink < 1.0
-          ? static_cast<int64_t>(std::ceil(static_cast<double>(max_steps / 4) / step_shrink))
-          : max_steps / 4;
+      critical_damping_after(max_steps, consolidation_step_shrink(settle.dt_ratio));
   ConsolidationOutcome out;
   ConsolidationClock clock(test);
   bool critical = false;

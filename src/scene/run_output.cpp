@@ -6,11 +6,18 @@
 
 namespace demcal {
 
+namespace {
+/// The one format of a metadata line.
+std::string metadata_line(const char* key, const std::string& value) {
+  return std::string("# ") + key + " = " + value;
+}
+}  // namespace
+
 std::vector<std::string> series_metadata_lines(const SeriesMetadata& m) {
   std::vector<std::string> out{"# demcal.series/1: " + m.writer + " written by demcal " +
                                DEMCAL_VERSION + ", scene " + m.scene};
   auto line = [&](const char* key, const std::string& value) {
-    out.push_back(std::string("# ") + key + " = " + value);
+    out.push_back(metadata_line(key, value));
   };
   auto optional = [&](const char* key, const std::optional<std::string>& value) {
     if (value) line(key, *value);
@@ -24,6 +31,16 @@ std::vector<std::string> series_metadata_lines(const SeriesMetadata& m) {
   line("damping_ratio_rotation", m.damping_ratio_rotation);
   optional("mass_scaling", m.mass_scaling);
   line("moment_lever_arm", m.moment_lever_arm);
+  const std::vector<std::string> results = series_result_lines(m);
+  out.insert(out.end(), results.begin(), results.end());
+  return out;
+}
+
+std::vector<std::string> series_result_lines(const SeriesMetadata& m) {
+  std::vector<std::string> out;
+  auto optional = [&](const char* key, const std::optional<std::string>& value) {
+    if (value) out.push_back(metadata_line(key, *value));
+  };
   optional("peak_stress_yy", m.peak_stress_yy);
   optional("peak_strain_yy", m.peak_strain_yy);
   optional("peak_stress_zz", m.peak_stress_zz);

@@ -10,6 +10,9 @@
 #include "demcal/kernel/particle_scales.hpp"
 #include "demcal/scene/biaxial.hpp"
 #include "demcal/scene/run_output.hpp"
+// critical_damping_after, consolidation_step_shrink: shared with demcal's
+// consolidation (the rest of the header is private to src/scene)
+#include "../scene/protocol_steps.hpp"
 
 namespace demcal::deck {
 
@@ -332,6 +335,35 @@ double consolidation_dt(double alpha, double zeta, double dt_crit) {
   return alpha * dashpot_step_factor(zeta) * dt_crit;
 }
 
+std::string lammps_consolidation_quarter(double alpha, int64_t max_steps) {
+  const char* last =
+      "variable        cons_last equal $(v_cons_check*floor(v_cons_max_steps/v_cons_check))\n";
+  const double shrink = detail::consolidation_step_shrink(alpha);
+  if (!(shrink < 1.0))
+    return "variable        cons_quarter equal "
+           "$(v_cons_check*floor(v_cons_max_steps/4/v_cons_check))\n" +
+           std::string(last);
+  // demcal switches at its first check at or after critical_damping_after
+  // (a multiple of cons_check: its checks come every 200 steps from 0), and
+  // never beyond the budget; min(a, b) = (a+b-abs(a-b))/2 (LAMMPS 2021 has
+  // no min of two numbers), exact for these whole numbers
+  std::ostringstream s;
+  s << "# critical damping from the first check at or after a quarter of the budget\n"
+    << "# in the simulated time of the undamped step: the contact dashpots shrink\n"
+    << "# this step by " << num(shrink) << " (alpha " << num(alpha) << " instead of "
+    << num(AlgorithmSpec{}.dt_ratio) << "), so\n"
+    << "# (cons_max_steps/4)/" << num(shrink) << " steps (demcal's critical_damping_after: step "
+    << detail::critical_damping_after(max_steps, shrink) << "\n"
+    << "# at cons_max_steps " << max_steps << "), at most the budget\n"
+    << last
+    << "variable        cons_after equal "
+       "$(v_cons_check*ceil(ceil(floor(v_cons_max_steps/4)/"
+    << exact(shrink) << ")/v_cons_check))\n"
+    << "variable        cons_quarter equal "
+       "$((v_cons_after+v_cons_last-abs(v_cons_after-v_cons_last))/2)\n";
+  return s.str();
+}
+
 std::string lammps_consolidation_viscous(const std::vector<double>& gamma) {
   std::string out = "fix cons_damp all viscous " + num(gamma[0]);
   for (size_t k = 1; k < gamma.size(); ++k)
@@ -471,14 +503,21 @@ std::string lammps_consolidation_criterion(int dimension,
   return s.str();
 }
 
-std::string lammps_consolidation_runs(double gamma_n, double dt_damped,
-                                      const std::string& critical) {
+std::string lammps_consolidation_runs(double gamma_n, double dt_damped, const std::string& critical,
+                                      double alpha) {
+  // A shrunk step's quarter may be the budget's end (lammps_consolidation_
+  // quarter): then stage 1 never switches, as demcal's, and runs no step
+  // beyond cons_last (a run of 0 steps would leave the criterion's computes
+  // stale). Unshrunk, the lines as before.
+  const bool shrunk = detail::consolidation_step_shrink(alpha) < 1.0;
+  const std::string may_switch = shrunk ? " && ${cons_quarter} < ${cons_last}" : "";
+  const std::string before_last = shrunk ? " && $(step) < ${cons_last}" : "";
   std::ostringstream s;
   s << "# phase 0: frictionless\n"
     << "pair_style      gran/hooke/history ${kn} ${kt} " << num(gamma_n) << " 0.0 0 0\n"
     << "variable        cons_critical equal 0\n"
     << "run             ${cons_quarter} upto\n"
-    << "if              \"${cons_static} == 0\" then \"" << critical << "\" &\n"
+    << "if              \"${cons_static} == 0" << may_switch << "\" then \"" << critical << "\" &\n"
     << "                \"timestep " << num(dt_damped) << "\" \"variable cons_critical equal 1\" "
     << "\"run ${cons_last} upto\"\n"
     << "if              \"${cons_static} == 0\" then \"print 'demcal deck: consolidation "
@@ -488,10 +527,11 @@ std::string lammps_consolidation_runs(double gamma_n, double dt_damped,
     << "pair_style      gran/hooke/history ${kn} ${kt} " << num(gamma_n) << " 0.0 ${mu} 0\n"
     << "if              \"${cons_critical} == 0 && $(step+v_cons_check) <= ${cons_quarter}\" "
        "then \"run ${cons_quarter} upto\" else \"run ${cons_check}\"\n"
-    << "if              \"${cons_static} == 0 && ${cons_critical} == 0\" then \"" << critical
-    << "\" &\n"
+    << "if              \"${cons_static} == 0 && ${cons_critical} == 0" << may_switch
+    << "\" then \"" << critical << "\" &\n"
     << "                \"timestep " << num(dt_damped) << "\" \"variable cons_critical equal 1\"\n"
-    << "if              \"${cons_static} == 0\" then \"run ${cons_last} upto\"\n"
+    << "if              \"${cons_static} == 0" << before_last
+    << "\" then \"run ${cons_last} upto\"\n"
     << "if              \"${cons_static} == 0\" then \"print 'demcal deck: consolidation did "
        "not reach a static state in ${cons_max_steps} steps: raise cons_max_steps'\" \"quit 2\"\n"
     << "print           \"demcal deck: consolidated in $(step-v_cons_s0) steps (wall stress "

@@ -234,6 +234,18 @@ std::string lammps_consolidation_parameters(const TestSpec& test);
 /// explicit damper's factor, as the loading's deck_timing).
 double consolidation_dt(double alpha, double zeta, double dt_crit);
 
+/// Stage 1's cons_quarter and cons_last (runs end on check steps): the
+/// budget's last check, and the check from which stage 1 runs at critical
+/// damping, demcal's (scene/protocol_steps.hpp, critical_damping_after): a
+/// quarter of cons_max_steps in the simulated time of the undamped step.
+/// `alpha`: stage 1's, demcal's consolidation α (shrunk for contact
+/// dashpots); `max_steps` the exported budget, for the comment. Unshrunk
+/// (alpha = AlgorithmSpec{}.dt_ratio): a quarter of cons_max_steps, the
+/// lines as before; shrunk by S: the first check at or after
+/// (cons_max_steps/4)/S steps, at most the last, computed by LAMMPS from
+/// cons_max_steps with S's 17 digits (the same doubles as demcal's).
+std::string lammps_consolidation_quarter(double alpha, int64_t max_steps);
+
 /// Stage 1's fix viscous per radius class, gamma[k] for type k+1.
 std::string lammps_consolidation_viscous(const std::vector<double>& gamma);
 
@@ -249,9 +261,11 @@ std::string lammps_consolidation_criterion(int dimension,
 
 /// Stage 1's runs: frictionless, then friction on, each until static;
 /// critical damping (`critical`: its fix viscous line, step dt_damped) once a
-/// quarter of the budget has passed; quit 2 when the budget is spent.
-std::string lammps_consolidation_runs(double gamma_n, double dt_damped,
-                                      const std::string& critical);
+/// quarter of the budget has passed (cons_quarter: lammps_consolidation_
+/// quarter of the same `alpha`, whose quarter may then be the budget's end);
+/// quit 2 when the budget is spent.
+std::string lammps_consolidation_runs(double gamma_n, double dt_damped, const std::string& critical,
+                                      double alpha);
 
 /// Where stage 1 leaves a wall (i its index in `walls`, cons_pos's column
 /// i+1): placed by its contacts, F = kn_wall·sum of overlaps (exact for

@@ -663,8 +663,7 @@ std::string lammps_consolidation_walls(const SceneConfig& c, const Plan& plan,
     << "\n"
     << "variable        cons_s0 equal $(step)\n"
     << "# runs end on check steps, where the criterion's computes are current\n"
-    << "variable        cons_quarter equal $(v_cons_check*floor(v_cons_max_steps/4/v_cons_check))\n"
-    << "variable        cons_last equal $(v_cons_check*floor(v_cons_max_steps/v_cons_check))\n"
+    << deck::lammps_consolidation_quarter(alpha, c.test.consolidation_max_steps)
     << "variable        cons_dxl equal f_cons_servo[1]*(step-${cons_s0})\n"
     << "variable        cons_dxr equal f_cons_servo[2]*(step-${cons_s0})\n"
     << "variable        cons_dyb equal f_cons_servo[3]*(step-${cons_s0})\n"
@@ -727,8 +726,8 @@ std::string lammps_consolidation(const SceneConfig& c, const Plan& plan, double 
   const ConsolidationSteps st = consolidation_steps(c, plan);
   return lammps_consolidation_walls(c, plan, st) +
          deck::lammps_consolidation_criterion(2, consolidation_walls(), {"h", "v"}) +
-         deck::lammps_consolidation_runs(gamma_n, st.dt_damped,
-                                         consolidation_viscous(c, plan, 1.0)) +
+         deck::lammps_consolidation_runs(gamma_n, st.dt_damped, consolidation_viscous(c, plan, 1.0),
+                                         st.alpha) +
          lammps_consolidation_end();
 }
 

@@ -14,6 +14,7 @@
 #include "demcal/io/input_error.hpp"
 #include "demcal/kernel/particle_scales.hpp"
 #include "demcal/scene/biaxial.hpp"
+#include "demcal/scene/run_output.hpp"
 
 namespace demcal {
 
@@ -302,7 +303,8 @@ void lammps_3d_limitations(std::ostream& s, const SceneConfig& c, const Algorith
     << "#  - each wall acts on the band of spheres near it (see the walls): fix halt\n"
     << "#    stops the run should a sphere outside it reach the wall.\n"
     << "# Outputs: ${series} (columns below) and, at the end, peak_axial_stress and\n"
-    << "# peak_ratio over every step (print; also appended to ${series} as comments).\n";
+    << "# peak_ratio over every step (print); ${series} ends with the axial peak\n"
+    << "# and its strain (# peak_stress_zz, # peak_strain_zz: demcal's keys).\n";
   if (p.damping_ratio_rotation > 0.0)
     out.notes.push_back(deck::lammps_rotational_damping_note(p.damping_ratio_rotation));
   if (plan.types > 1)
@@ -436,8 +438,7 @@ void lammps_3d_consolidation(std::ostream& s, const SceneConfig& c, const Plan3&
     << "\n"
     << "variable        cons_s0 equal $(step)\n"
     << "# runs end on check steps, where the criterion's computes are current\n"
-    << "variable        cons_quarter equal $(v_cons_check*floor(v_cons_max_steps/4/v_cons_check))\n"
-    << "variable        cons_last equal $(v_cons_check*floor(v_cons_max_steps/v_cons_check))\n";
+    << deck::lammps_consolidation_quarter(alpha, c.test.consolidation_max_steps);
   for (int sd = 0; sd < 6; ++sd)
     s << "variable        cons_d" << kWall[sd] << " equal f_cons_servo[" << sd + 1
       << "]*(step-${cons_s0})\n";
@@ -474,7 +475,7 @@ void lammps_3d_consolidation(std::ostream& s, const SceneConfig& c, const Plan3&
   s << deck::lammps_consolidation_servo(walls, {"cons_Ax", "cons_Ay", "cons_Az"}, "", resist)
     << deck::lammps_consolidation_criterion(3, walls, {"x", "y", "z"})
     << deck::lammps_consolidation_runs(deck::contact_gamma_n(c.material, plan.m_mean), dt_damped,
-                                       deck::lammps_consolidation_viscous(critical))
+                                       deck::lammps_consolidation_viscous(critical), alpha)
     << "# the loading starts from here: walls, step 0, spheres at rest. Each wall\n"
     << "# where its contacts put it (F = kn_wall * sum of overlaps, exact for these\n"
     << "# undamped walls), so the loading starts from the forces of the static state.\n";
@@ -665,7 +666,25 @@ void lammps_3d_series(std::ostream& s, const SceneConfig& c, const AlgorithmSpec
     << "fix             series all print ${monitor_every} \"" << row
     << "\" append ${series} screen no title \"" << columns << "\"\n"
     << "# the peaks over every peak_every steps: axial pressure and sigma1/sigma3\n"
-    << "fix             peaks all vector ${peak_every} v_axial v_ratio\n\n";
+    << "# (and the strain, for the axial peak's)\n"
+    << "fix             peaks all vector ${peak_every} v_axial v_ratio v_strain_zz\n\n";
+}
+
+// The axial peak appended to the series, in demcal's keys (SeriesMetadata,
+// the tracked peak: `demcal score` takes it as it takes demcal's own): the
+// most compressive sigma_zz = -max(axial pressure), and the strain of its
+// first step (the strain falls at every step): the largest strain among
+// the rows at the peak (the others masked to -2).
+std::string peak_metadata() {
+  SeriesMetadata peak;
+  peak.peak_stress_zz = "$(-max(f_peaks[1]))";
+  peak.peak_strain_zz = "$(max(v_peak_strain))";
+  std::string out =
+      "variable        peak_strain vector (f_peaks[1]==max(f_peaks[1]))*f_peaks[3]+"
+      "((f_peaks[1]==max(f_peaks[1]))-1)*2\n";
+  for (const std::string& line : series_result_lines(peak))
+    out += "print           \"" + line + "\" append ${series} screen no\n";
+  return out;
 }
 
 // The servo's per-step moves, then the run and the peaks printed.
@@ -707,8 +726,7 @@ void lammps_3d_servo_and_run(std::ostream& s, const Plan3& plan) {
     << "variable        peak_ratio equal max(f_peaks[2])\n"
     << "print           \"peak_axial_stress = ${peak_axial}\"\n"
     << "print           \"peak_ratio = ${peak_ratio}\"\n"
-    << "print           \"# peak_axial_stress = ${peak_axial}\" append ${series} screen no\n"
-    << "print           \"# peak_ratio = ${peak_ratio}\" append ${series} screen no\n";
+    << peak_metadata();
 }
 
 std::string lammps_deck(const SceneConfig& c, const AlgorithmSpec& p, const Plan3& plan,

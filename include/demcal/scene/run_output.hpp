@@ -50,8 +50,13 @@ struct SeriesMetadata {
 
 /// The metadata's lines, each "# key = value" without the line end, after
 /// a first line "# demcal.series/1: WRITER written by demcal VERSION,
-/// scene SCENE".
+/// scene SCENE"; they end with series_result_lines(m).
 std::vector<std::string> series_metadata_lines(const SeriesMetadata& m);
+/// The lines of what the run found (its tracked peak, the reference peak,
+/// its divergence), in series_metadata_lines' form and order: the end of
+/// that list, and what an engine's deck appends to its series once its run
+/// is over (a reader takes "# key = value" lines anywhere in the file).
+std::vector<std::string> series_result_lines(const SeriesMetadata& m);
 
 /// The metadata of a run of demcal (2D, 3D): every value written to
 /// round-trip the double (the scores of `demcal score` and `demcal run`

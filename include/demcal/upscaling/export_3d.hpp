@@ -73,7 +73,11 @@ struct Export3dOptions : ExportOptions {
 ///   - at the end, on screen and in the log, `peak_axial_stress = P` (the
 ///     largest (p_zmin + p_zmax)/2 over every step, compressive positive:
 ///     −TriaxialResult::peak_stress_zz) and `peak_ratio = R` (the largest
-///     axial/mean lateral wall pressure, TriaxialResult::peak_ratio).
+///     axial/mean lateral wall pressure, TriaxialResult::peak_ratio); and
+///     appended to `series.csv`, the axial peak in SeriesMetadata's keys
+///     (series_result_lines): `# peak_stress_zz = -P` and `# peak_strain_zz`,
+///     the strain of its first step, which `demcal score` takes as it takes
+///     demcal's own tracked peak.
 /// Throws InputError for an unknown format, an empty state or a config that
 /// is not 3D.
 ExportResult export_3d_decks(const SceneConfig& config, const AlgorithmSpec& params,
