@@ -62,7 +62,10 @@ double servo_resistance(const Material& material, double m_max, double dt) {
 // is stable (E bounds v and x̄) if
 //   Δt/2·vᵀCv + Δt²/4·vᵀKv < vᵀMv   for every v.                       (S)
 // For one mass on one spring this is ω²Δt² + 4ζωΔt < 4, the root of
-// dashpot_step_factor (particle_scales.hpp), exactly.
+// dashpot_step_factor (particle_scales.hpp), exactly. The walls move at the
+// servo's velocity: a forcing of this system, not one of its modes (the
+// servo's own loop divides by R = kn_wall + c/Δt, servo_resistance, which
+// keeps its gain per step whatever Δt).
 //
 // 2. The dashpots against the springs and the masses. For any τ > 0,
 // c_k·(b_kᵀv)² = 2ζ_c·sqrt(kn_k(b_kᵀv)²·m_eff,k(b_kᵀv)²)
