@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 #include "demcal/scene/biaxial.hpp"
@@ -192,6 +193,58 @@ TEST(BiaxialConsolidation, GivesUpWithAClearErrorAfterMaxSteps) {
     ADD_FAILURE() << "a computation that fails is not bad input";
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("consolidation_max_steps"), std::string::npos) << e.what();
+  }
+}
+
+// Λ of consolidation_dashpot_factor for one size, in closed form: every
+// neighbour has w = 1 and the cap β = 30° (t = t* = ½), so Λ = 1 + J(β)/A
+// with J = π + 2β + sin 2β, A = 2β (2D), J = 4π(1 − ⅔cos β + ⅓sin 2β),
+// A = 2π(1 − cos β) (3D) (biaxial.cpp); it grows with the radius ratio
+// (the smallest neighbour's cap, t*, narrows every cap).
+TEST(BiaxialConsolidation, DashpotCoordinationBoundOfOneSizeIsItsClosedForm) {
+  const double pi = std::acos(-1.0), beta = pi / 6.0;
+  EXPECT_NEAR(consolidation_dashpot_coordination(2, 1.0),
+              1.0 + (pi + 2.0 * beta + std::sin(2.0 * beta)) / (2.0 * beta), 1e-12);
+  EXPECT_NEAR(consolidation_dashpot_coordination(3, 1.0),
+              1.0 + 4.0 * pi * (1.0 - 2.0 / 3.0 * std::cos(beta) + std::sin(2.0 * beta) / 3.0) /
+                        (2.0 * pi * (1.0 - std::cos(beta))),
+              1e-12);
+  for (const int d : {2, 3}) {
+    double previous = consolidation_dashpot_coordination(d, 1.0);
+    for (const double ratio : {1.25, 5.0 / 3.0, 3.0, 5.0}) {
+      const double lambda = consolidation_dashpot_coordination(d, ratio);
+      EXPECT_GT(lambda, previous) << d << " " << ratio;
+      previous = lambda;
+    }
+  }
+  // ζ_c·sqrt(Λ) into dashpot_step_factor; 1 without dashpots.
+  EXPECT_EQ(consolidation_dashpot_factor(0.0, 2, 1e-3, 2e-3), 1.0);
+  EXPECT_DOUBLE_EQ(
+      consolidation_dashpot_factor(0.3, 3, 1e-3, 1e-3),
+      dashpot_step_factor(0.3 * std::sqrt(consolidation_dashpot_coordination(3, 1.0))));
+}
+
+// The 2D twin of TriaxialScene.DampedConsolidationStepIsBelowTheStableStepOfItsPacking:
+// the consolidation's step with contact dashpots stays below the kernel's
+// dashpot-aware estimate on the packing it consolidated (1.49× at ζ_c
+// 0.3, 1.47× at 0.7).
+TEST(BiaxialConsolidation, DampedConsolidationStepIsBelowTheStableStepOfItsPacking) {
+  for (const double zeta_c : {0.3, 0.7}) {
+    SceneConfig c = scene(R"({"assembly": {"type": "random", "count": 60, "seed": 3},
+                              "algorithm": {"dt_ratio": 0.02}})");
+    c.material.contact_damping_ratio = zeta_c;
+    const Assembly gas = make_assembly(c);
+    const ConsolidatedState s = consolidate(c, gas);
+    ASSERT_TRUE(s.converged) << zeta_c;
+    const double alpha =
+        AlgorithmSpec{}.dt_ratio *
+        consolidation_dashpot_factor(zeta_c, 2, s.world.min_radius(), s.world.max_radius());
+    const double stable = estimated_stable_dt_ratio(s, c.algorithm);
+    std::printf(
+        "60 disks, contact damping %.1f: consolidation alpha %.4f, %lld steps; stable "
+        "alpha of the packing %.4f (%.2fx)\n",
+        zeta_c, alpha, static_cast<long long>(s.steps), stable, stable / alpha);
+    EXPECT_LT(alpha, stable) << zeta_c;
   }
 }
 

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <string>
 
+#include "demcal/scene/biaxial.hpp"  // consolidation_dashpot_factor
 #include "demcal/scene/config.hpp"
 #include "demcal/scene/sphere_packing.hpp"
 #include "demcal/scene/triaxial.hpp"
@@ -145,9 +146,10 @@ TEST(TriaxialScene, ConsolidationReachesSigma3OnAllSixWalls) {
 }
 
 // Contact dashpots at ζ_c = 0.3 shrink the consolidation's step (α 0.2 →
-// 0.035 here, consolidation_dashpot_factor), so the light damping needs
-// more steps to the same simulated time: 164 800 for this sample
-// (configs/random_500_3d.json's material and σ3, 60 spheres). The
+// 0.074 here, consolidation_dashpot_factor; 0.035 before 2026-12-03), so
+// the light damping needs more steps to the same simulated time: 149 400
+// for this sample (configs/random_500_3d.json's material and σ3, 60
+// spheres; 164 800 at α 0.035). The
 // critical-damping fallback used to come after a quarter of the step budget
 // whatever the step, here at 75 000 steps, before the packing was static,
 // and critical damping then did not bring it there within 300 000 steps
@@ -172,6 +174,35 @@ TEST(TriaxialScene, ContactDampingConsolidatesARandomSampleWithinAModestBudget) 
   EXPECT_TRUE(s.converged);
   EXPECT_LT(s.stress_error, c.test.consolidation_tolerance);
   EXPECT_LT(s.unbalanced_ratio, c.test.consolidation_unbalanced);
+}
+
+// The consolidation's step with contact dashpots (consolidation_dashpot_factor,
+// ζ_c·sqrt(Λ) the damping ratio a mode can carry, biaxial.cpp) stays below
+// the kernel's dashpot-aware estimate of the stable step on the packing it
+// consolidated (Lanczos ω_max with the contacts' own γ_max, stability.cpp):
+// it is 1.66× below at ζ_c 0.3 and 1.71× at 0.7, so a factor that much
+// bolder fails. The step before 2026-12-03 (0.035 and 0.015) was 3.5× and
+// 3.9× below.
+TEST(TriaxialScene, DampedConsolidationStepIsBelowTheStableStepOfItsPacking) {
+  for (const double zeta_c : {0.3, 0.7}) {
+    SceneConfig c = parse(
+        R"({"dimension": 3, "material": {"density": 2650, "kn": 1e6, "kt": 5e5, "friction": 0.3,
+            "wall": {"kn": 1e6, "kt": 5e5, "friction": 0.0}},
+            "assembly": {"type": "random", "count": 60, "radius_min": 4e-4, "radius_max": 6e-4,
+            "seed": 2}, "test": {"lateral_stress": 1e5}, "algorithm": {"dt_ratio": 0.02}})");
+    c.material.contact_damping_ratio = zeta_c;
+    const TriaxialState s = consolidate_triaxial(c, make_sphere_assembly(c), std::string());
+    ASSERT_TRUE(s.converged) << zeta_c;
+    const double alpha =
+        AlgorithmSpec{}.dt_ratio *
+        consolidation_dashpot_factor(zeta_c, 3, s.world.min_radius(), s.world.max_radius());
+    const double stable = estimated_stable_dt_ratio(s, c.algorithm);
+    std::printf(
+        "60 spheres, contact damping %.1f: consolidation alpha %.4f, %lld steps; stable "
+        "alpha of the packing %.4f (%.2fx)\n",
+        zeta_c, alpha, static_cast<long long>(s.steps), stable, stable / alpha);
+    EXPECT_LT(alpha, stable) << zeta_c;
+  }
 }
 
 TEST(TriaxialScene, ConsolidationThatCannotFinishSaysWhatItReached) {

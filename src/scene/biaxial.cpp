@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <stdexcept>
 
 #include "demcal/io/format.hpp"
@@ -44,6 +45,115 @@ double servo_resistance(double kn_wall, double zeta_c, double m_max, double dt) 
 
 double servo_resistance(const Material& material, double m_max, double dt) {
   return servo_resistance(material.wall.kn, material.contact_damping_ratio, m_max, dt);
+}
+
+// The consolidation's step with contact dashpots (consolidation_dashpot_factor).
+//
+// 1. Stability. The kernel's step is leapfrog, the dashpots explicit (their
+// force at x(n) uses v(n−½)), the global damping centred: linearised on a
+// contact network, M(v⁺ − v⁻) = −Δt·K·x − Δt·C·v⁻ − Δt·D·(v⁺ + v⁻)/2 with
+// M the masses and inertias, K the springs (normal and tangential, walls'
+// kn_wall too), C = Σ c_k·b_k·b_kᵀ the normal dashpots (b_k: the contact's
+// normal relative velocity, c_k = 2ζ_c·sqrt(kn_k·m_eff,k), m_eff the
+// reduced mass, m_i at a wall), D ≥ 0 diagonal. With v⁻ = v̄ − (v⁺ − v⁻)/2
+// this is the centred scheme with the mass M' = M − Δt·C/2, whose energy
+//   E = ½·vᵀ(M' − Δt²·K/4)·v + ½·x̄ᵀ·K·x̄   (v = v(n−½), x̄ the mid-step x)
+// falls by Δt·v̄ᵀ(C + D)·v̄ ≥ 0 each step (v̄ = (v⁺ + v⁻)/2), so the scheme
+// is stable (E bounds v and x̄) if
+//   Δt/2·vᵀCv + Δt²/4·vᵀKv < vᵀMv   for every v.                       (S)
+// For one mass on one spring this is ω²Δt² + 4ζωΔt < 4, the root of
+// dashpot_step_factor (particle_scales.hpp), exactly. The walls move at the
+// servo's velocity: a forcing of this system, not one of its modes (the
+// servo's own loop divides by R = kn_wall + c/Δt, servo_resistance, which
+// keeps its gain per step whatever Δt).
+//
+// 2. The dashpots against the springs and the masses. For any τ > 0,
+// c_k·(b_kᵀv)² = 2ζ_c·sqrt(kn_k(b_kᵀv)²·m_eff,k(b_kᵀv)²)
+//             ≤ ζ_c·(τ·kn_k(b_kᵀv)² + m_eff,k(b_kᵀv)²/τ),
+// so vᵀCv ≤ ζ_c·(τ·vᵀKv + vᵀGv/τ), G = Σ m_eff,k·b_k·b_kᵀ (K holds the
+// normal springs and more). If vᵀGv ≤ Λ·vᵀMv (3.), the best τ gives
+// vᵀCv ≤ 2ζ_c·sqrt(Λ·κ)·vᵀMv, κ = vᵀKv/vᵀMv ≤ ω²_max, and (S) holds if
+// Δt·ζ_c·sqrt(Λ)·ω + Δt²ω²/4 < 1 at ω = ω_max (the left side grows with κ):
+//   ω_max·Δt < 2·f(ζ_c·sqrt(Λ)),   f = dashpot_step_factor.
+// Every mode carries at most the damping ratio ζ_c·sqrt(Λ), whatever its
+// frequency. The undamped consolidation step Δt0 (α = 0.2) is taken to be
+// stable, ω_max·Δt0 ≤ 2, in every state it passes through (the protocol's
+// premise: a gas has no springs, a packing's ω_max is its contacts'); then
+// Δt0·f(ζ_c·sqrt(Λ)) is stable with the dashpots. The bound before
+// 2026-12-03 paired the heaviest particle's dashpot γ_max with the fastest
+// mode Δt0 could carry (ζ = γ_max/Δt0), which no mode has at once: on
+// random_500_3d (r_max/r_min = 5/3) 10.7·ζ_c against ζ_c·sqrt(Λ) = 4.0·ζ_c.
+//
+// 3. Λ, geometric. (p − q)² ≤ 2p² + 2q² and m_eff ≤ m_i, m_j give
+//   vᵀGv ≤ Σ_i m_i·Σ_{k∋i} w_k·(n_k·v_i)² ≤ Σ_i m_i|v_i|²·λ_max(Σ_{k∋i} w_k·n_k·n_kᵀ)
+// with w_k = 2m_j/(m_i + m_j) for a neighbour j, 1 for a wall. At most one
+// wall per axis touches i (the box is wider than a particle), their
+// normals are orthogonal: Σ_walls (n·e)² ≤ 1 for a unit e. The neighbours:
+// j and k, touching i and not each other, radii u_j·r_i and u_k·r_i, lie at
+// an angle φ seen from i's centre with sin²(φ/2) ≥ t_j·t_k, t = u/(1 + u)
+// (law of cosines, equality when they touch). Give each neighbour the cap
+// of directions within β_j = asin(sqrt(t_j·t*)) of its own, t* = t of the
+// smallest radius r_min: β_j + β_k ≤ 2·asin(sqrt(t_j·t_k)) ≤ φ (t* ≤ t_j,
+// t_k), so the caps are disjoint. For a unit e and ψ the angle to the axis
+// ±e, ψ_j ≥ ψ − β_max over j's cap, so w_j·cos²ψ_j ≤ (w_j/A_j)·∫_cap
+// cos²(max(0, ψ − β_max)) and, the caps disjoint,
+//   Σ_j w_j·(n_j·e)² ≤ max_j (w_j/A_j)·J(β_max),
+//   J = ∫_sphere cos²(max(0, ψ − β)) = 4π·(1 − ⅔cos β + ⅓sin 2β)  (3D),
+//                                     = π + 2β + sin 2β            (2D),
+// A_j the cap's area 2π(1 − cos β_j) (3D) or length 2β_j (2D), β_max the
+// largest neighbour's. Λ = 1 + that, the worst over r_i in [r_min, r_max]:
+// w grows with r_j and falls with r_i, β (so A) the same, so on a cell of
+// radii [s_a, s_b]·r_min × [q_a, q_b]·r_min w/A ≤ w(s_a, q_b)/A(s_b, q_a):
+// the grid's maximum bounds it (kGrid cells a side, ~1 % above the limit).
+// Λ = 7.6 (2D), 16.0 (3D) at r_max/r_min = 5/3; 5.8 and 11.6 for one size.
+// Linearised on the current contacts, as the kernel's estimates; exact for
+// touching particles (overlaps of δ/r narrow the angles by about as much).
+namespace {
+
+double radius_cap_area(int dimension, double beta) {
+  return dimension == 3 ? 2.0 * std::numbers::pi * (1.0 - std::cos(beta)) : 2.0 * beta;
+}
+
+double axis_weight_integral(int dimension, double beta) {
+  return dimension == 3 ? 4.0 * std::numbers::pi *
+                              (1.0 - 2.0 / 3.0 * std::cos(beta) + std::sin(2.0 * beta) / 3.0)
+                        : std::numbers::pi + 2.0 * beta + std::sin(2.0 * beta);
+}
+
+}  // namespace
+
+double consolidation_dashpot_coordination(int dimension, double radius_ratio) {
+  if (dimension != 2 && dimension != 3)
+    throw std::invalid_argument("consolidation_dashpot_coordination: dimension 2 or 3");
+  if (!(radius_ratio >= 1.0) || !std::isfinite(radius_ratio))
+    throw std::invalid_argument("consolidation_dashpot_coordination: radius ratio >= 1");
+  constexpr int kGrid = 64;
+  const int cells = radius_ratio > 1.0 ? kGrid : 1;
+  const auto radius = [&](int k) { return 1.0 + (radius_ratio - 1.0) * k / cells; };
+  // Neighbour q against particle s (radii in units of r_min).
+  const auto weight = [&](double s, double q) {
+    return 2.0 * std::pow(q, dimension) / (std::pow(s, dimension) + std::pow(q, dimension));
+  };
+  const auto cap_angle = [](double s, double q) {
+    return std::asin(std::sqrt(q / (s + q) / (1.0 + s)));
+  };
+  double lambda = 0.0;
+  for (int a = 0; a < cells; ++a) {
+    const double sa = radius(a), sb = radius(a + 1);
+    double density = 0.0;
+    for (int c = 0; c < cells; ++c)
+      density = std::max(density, weight(sa, radius(c + 1)) /
+                                      radius_cap_area(dimension, cap_angle(sb, radius(c))));
+    lambda = std::max(lambda,
+                      1.0 + density * axis_weight_integral(dimension, cap_angle(sa, radius_ratio)));
+  }
+  return lambda;
+}
+
+double consolidation_dashpot_factor(double zeta_c, int dimension, double r_min, double r_max) {
+  if (zeta_c <= 0.0) return 1.0;
+  return dashpot_step_factor(
+      zeta_c * std::sqrt(consolidation_dashpot_coordination(dimension, r_max / r_min)));
 }
 
 double consolidation_dashpot_factor(double zeta_c, double m_max, double kn, double kn_wall,
@@ -112,18 +222,10 @@ ConsolidatedState consolidate_fresh(const SceneConfig& config, const Assembly& a
   // a 400-disk REV with radius ratio 3 did not converge in 2·10⁶ steps at
   // ζ = 1 and needs 60 600 at 0.02; hexagonal REVs need 1 400 at most.
   AlgorithmSpec settle = detail::consolidation_settings(config, kConsolidationDampingRatio);
-  // Contact dashpots lower the stable step: 2/ω·f(ζ), f = sqrt(1 + ζ²) − ζ,
-  // ζ = ½·γ·ω, γ = 2·ζ_c·sqrt(m_eff/k) (stability.cpp). 2/ω·f(½·γ·ω)
-  // decreases with ω, so if α = 0.2 is stable without them (ω_max·Δt₀ ≤ 2),
-  // Δt₀·f(γ_max/Δt₀) is stable with them (γ_max: the heaviest particle on
-  // the softer of particle and wall springs).
-  if (const double zeta_c = config.material.contact_damping_ratio; zeta_c > 0.0) {
-    const Material& mat = config.material;
-    const double m_max =
-        disk_mass(disk_areal_density(mat, settle.mass_scaling), world.max_radius());
-    settle.dt_ratio *= consolidation_dashpot_factor(zeta_c, m_max, mat.particle.kn, mat.wall.kn,
-                                                    integration_for(world, settle).dt);
-  }
+  // Contact dashpots lower the stable step: α·f(ζ_c·sqrt(Λ)) is stable
+  // wherever α is without them (consolidation_dashpot_factor).
+  settle.dt_ratio *= consolidation_dashpot_factor(config.material.contact_damping_ratio, 2,
+                                                  world.min_radius(), world.max_radius());
   const detail::ConsolidationOutcome o =
       detail::run_consolidation<WallSide, 4>(world, test, mu, settle, integration_for, options);
   for (int i = 0; i < world.size(); ++i) world.set_velocity(i, 0.0, 0.0, 0.0);

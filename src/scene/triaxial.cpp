@@ -150,10 +150,8 @@ TriaxialState consolidate_fresh(const SceneConfig& config, const SphereAssembly&
   // (biaxial.cpp, consolidate(): measured there).
   AlgorithmSpec settle = detail::consolidation_settings(config, kConsolidationDampingRatio);
   // Contact dashpots lower the stable step: α shrunk as in 2D (biaxial.cpp).
-  settle.dt_ratio *= consolidation_dashpot_factor(
-      config.material.contact_damping_ratio,
-      sphere_mass(config.material.density * settle.mass_scaling, world.max_radius()),
-      config.material.particle.kn, config.material.wall.kn, integration_for(world, settle).dt);
+  settle.dt_ratio *= consolidation_dashpot_factor(config.material.contact_damping_ratio, 3,
+                                                  world.min_radius(), world.max_radius());
   const detail::ConsolidationOutcome o = detail::run_consolidation<SphereWallSide, 6>(
       world, test, mu, settle, integration_for, options);
   for (int i = 0; i < world.size(); ++i)

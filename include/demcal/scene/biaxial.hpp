@@ -69,11 +69,26 @@ double servo_wall_dashpot(const Material& material, double m_max);
 double servo_resistance(double kn_wall, double zeta_c, double m_max, double dt);
 /// servo_resistance with the material's kn_wall and ζ_c.
 double servo_resistance(const Material& material, double m_max, double dt);
+/// Λ, the bound on the dashpot network's "reduced-mass Laplacian"
+/// G = Σ m_eff·b·bᵀ over the contacts (walls included) against the mass
+/// matrix, vᵀGv ≤ Λ·vᵀMv, for any packing of particles of one density with
+/// radii in [r_min, r_max] (radius_ratio = r_max/r_min ≥ 1) in a box, in
+/// `dimension` 2 (disks) or 3 (spheres); biaxial.cpp derives it. A mode
+/// then carries at most the damping ratio ζ_c·sqrt(Λ) from the contact
+/// dashpots, whatever its frequency.
+double consolidation_dashpot_coordination(int dimension, double radius_ratio);
 /// The factor demcal's consolidation shrinks its step ratio α by for the
-/// contact dashpots (2D and 3D, and the decks' stage 1): f(γ_max/Δt0),
-/// f = dashpot_step_factor, γ_max = 2ζ_c·sqrt(m_max/min(kn, kn_wall)) (the
-/// heaviest particle on the softer of particle and wall springs), Δt0 the
-/// step before the shrink; 1 without contact damping (ζ_c ≤ 0).
+/// contact dashpots (2D and 3D): f(ζ_c·sqrt(Λ)), f = dashpot_step_factor,
+/// Λ = consolidation_dashpot_coordination(dimension, r_max/r_min); stable
+/// wherever the undamped α is (biaxial.cpp says why); 1 without contact
+/// damping (ζ_c ≤ 0).
+double consolidation_dashpot_factor(double zeta_c, int dimension, double r_min, double r_max);
+/// The factor before 2026-12-03, f(γ_max/Δt0), γ_max =
+/// 2ζ_c·sqrt(m_max/min(kn, kn_wall)): the heaviest particle's dashpot with
+/// the fastest mode the step Δt0 could carry, 2.4× more cautious on
+/// random_500_3d at ζ_c 0.3. Kept only for the exported decks' stage 1
+/// (upscaling/export.cpp, export_3d.cpp) until they call the one above
+/// with (ζ_c, 2 or 3, plan.r_min, plan.r_max).
 double consolidation_dashpot_factor(double zeta_c, double m_max, double kn, double kn_wall,
                                     double dt0);
 /// Compressive pressure on a wall from the particles [Pa].
