@@ -271,11 +271,11 @@ TEST(EngineLammpsStage1, WithContactDashpotsTheCriticalFallbackComesAtDemcalsChe
   {
     SceneConfig c = load_config(test::shipped_config("random_500_3d"));
     c.assembly.count = 60;
-    c.material.contact_damping_ratio = 0.3;
+    c.material.contact_damping_ratio = 0.7;
     Export3dOptions o;
     o.data_name = "r.data";
     o.consolidate_in_deck = true;
-    cases.push_back({"3D zeta_c 0.3", export_3d_decks(c, p, make_sphere_assembly(c), o)});
+    cases.push_back({"3D zeta_c 0.7", export_3d_decks(c, p, make_sphere_assembly(c), o)});
   }
   const test::TempDir dir("engine_stage1_fallback");
   int switching = 0, never = 0;
@@ -314,15 +314,14 @@ TEST(EngineLammpsStage1, WithContactDashpotsTheCriticalFallbackComesAtDemcalsChe
 }
 
 // The deck's own consolidation with contact dashpots (ζ_c 0.3 shrinks stage
-// 1's step, alpha 0.2 → 0.039 on this material) certifies within a modest
-// budget, as demcal's does: 200 disks of random_400, budget 120 000 steps.
-// Its fallback now comes after (30 000/S) steps, beyond the budget, so it
-// runs at light damping throughout; the deck before switched to critical
-// damping at 30 000 steps, long before the packing was static, and crept
-// there to the end of the budget (quit 2; with a budget of 160 000 its wall
-// stress error was still 12 % and the unbalanced-force ratio 0.22 at the
-// end). demcal's own consolidation takes 89 800 steps, the deck 90 600
-// (engines.md §21).
+// 1's step, alpha 0.2 → 0.094 on this material: consolidation_dashpot_factor)
+// certifies within a modest budget, as demcal's does: 200 disks of
+// random_400, budget 120 000 steps. Its fallback comes at demcal's check,
+// (30 000/S) steps (63 800), and the packing is static before it, at light
+// damping throughout (the deck 37 000 steps, demcal 33 400). The deck before
+// switched to critical damping at a quarter of the budget in steps (30 000),
+// before the packing was static (with the older, smaller step it then crept
+// to the end of the budget: quit 2, engines.md §21).
 TEST(EngineLammpsStage1, WithContactDashpotsTheDeckConsolidatesARandomSampleWithinAModestBudget) {
   const std::string lmp = test::find_on_path("lmp");
   if (lmp.empty())
@@ -352,8 +351,17 @@ TEST(EngineLammpsStage1, WithContactDashpotsTheDeckConsolidatesARandomSampleWith
   EXPECT_LT(std::stod(m[2].str()), c.test.consolidation_tolerance);
   EXPECT_LT(std::stod(m[3].str()), c.test.consolidation_unbalanced);
   EXPECT_LE(deck_steps, c.test.consolidation_max_steps);
-  // at light damping throughout, as demcal's consolidation of this budget
-  EXPECT_EQ(echoed(run.log, "cons_quarter"), static_cast<double>(c.test.consolidation_max_steps));
+  // at light damping throughout, the fallback at demcal's check, after the
+  // packing was static
+  std::smatch q;
+  ASSERT_TRUE(std::regex_search(
+      r.deck, q,
+      std::regex("\\(floor\\(v_cons_max_steps/4\\)/([0-9.e+-]+)\\)/v_cons_check\\)\\)\n")))
+      << "no shrunk quarter in the deck";
+  const int64_t switch_at =
+      demcal_switch_check(c.test.consolidation_max_steps, std::stod(q[1].str()));
+  EXPECT_EQ(echoed(run.log, "cons_quarter"), static_cast<double>(switch_at));
+  EXPECT_LT(deck_steps, switch_at);
   EXPECT_EQ(run.log.find("\nvariable cons_critical equal 1\n"), std::string::npos);
   const ConsolidatedState d = consolidate(c, a, std::string());
   EXPECT_TRUE(d.converged);

@@ -156,13 +156,6 @@ double consolidation_dashpot_factor(double zeta_c, int dimension, double r_min, 
       zeta_c * std::sqrt(consolidation_dashpot_coordination(dimension, r_max / r_min)));
 }
 
-double consolidation_dashpot_factor(double zeta_c, double m_max, double kn, double kn_wall,
-                                    double dt0) {
-  if (zeta_c <= 0.0) return 1.0;
-  const double gamma_max = 2.0 * zeta_c * std::sqrt(m_max / std::min(kn, kn_wall));
-  return dashpot_step_factor(gamma_max / dt0);
-}
-
 double servo_velocity(const World& world, WallSide side, double target_stress, double gain) {
   const bool vertical = side == kLeft || side == kRight;
   const double length = vertical ? world.height() : world.width();

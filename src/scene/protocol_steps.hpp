@@ -162,7 +162,8 @@ ConsolidationOutcome run_consolidation(Sample& world, const TestSpec& test, doub
   // contact dashpots shrank the step (consolidation_dashpot_factor), as
   // many more steps as it shrank, i.e. after the same simulated time. With
   // dashpots the light damping needs those steps (random_500_3d at ζ_c =
-  // 0.3, α 0.0303: 1 269 800 steps), and critical damping switched on
+  // 0.3: 1 269 800 steps at the α 0.0303 of the factor before 2026-12-03,
+  // 568 200 at today's 0.0725), and critical damping switched on
   // before the packing is static does not bring it there: its walls creep
   // (x walls out, y walls in, no servo reversal) with the wall stress error
   // near 0.2 % and the unbalanced-force ratio near 0.01 for the rest of a

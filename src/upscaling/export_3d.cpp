@@ -400,8 +400,7 @@ void lammps_3d_consolidation(std::ostream& s, const SceneConfig& c, const Plan3&
   const auto& m = c.material;
   const double alpha =
       AlgorithmSpec{}.dt_ratio *
-      consolidation_dashpot_factor(m.contact_damping_ratio, plan.m_max, m.particle.kn, m.wall.kn,
-                                   AlgorithmSpec{}.dt_ratio * plan.dt_crit);
+      consolidation_dashpot_factor(m.contact_damping_ratio, 3, plan.r_min, plan.r_max);
   const double dt_light = deck::consolidation_dt(alpha, zeta, plan.dt_crit);
   const double dt_damped = deck::consolidation_dt(alpha, 1.0, plan.dt_crit);
   std::vector<double> light, critical;

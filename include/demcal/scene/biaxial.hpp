@@ -83,14 +83,6 @@ double consolidation_dashpot_coordination(int dimension, double radius_ratio);
 /// wherever the undamped α is (biaxial.cpp says why); 1 without contact
 /// damping (ζ_c ≤ 0).
 double consolidation_dashpot_factor(double zeta_c, int dimension, double r_min, double r_max);
-/// The factor before 2026-12-03, f(γ_max/Δt0), γ_max =
-/// 2ζ_c·sqrt(m_max/min(kn, kn_wall)): the heaviest particle's dashpot with
-/// the fastest mode the step Δt0 could carry, 2.4× more cautious on
-/// random_500_3d at ζ_c 0.3. Kept only for the exported decks' stage 1
-/// (upscaling/export.cpp, export_3d.cpp) until they call the one above
-/// with (ζ_c, 2 or 3, plan.r_min, plan.r_max).
-double consolidation_dashpot_factor(double zeta_c, double m_max, double kn, double kn_wall,
-                                    double dt0);
 /// Compressive pressure on a wall from the particles [Pa].
 double wall_pressure(const World& world, WallSide side);
 
