@@ -107,33 +107,15 @@ TEST(KernelContactDamping, RestitutionOfTheDampedHeadOnCollision) {
   }
 }
 
-// A bounce stepped one step at a time until the bodies part (as the
-// sphere kernel's tests): restitution, ω·Δt and the ledger's largest
-// reading, the ledger's stop on (a false "energy created" fails).
+// A bounce stepped one step at a time until the bodies part
+// (test::step_until_parted, as the sphere kernel's tests): restitution,
+// ω·Δt and the ledger's largest reading, the ledger's stop on (a false
+// "energy created" fails).
 struct Bounce2D {
   double restitution = 0.0, h = 0.0, ledger_max = -1e300;
   int contact_steps = 0;
   bool parted = false;
 };
-
-template <class Overlap>
-void step_until_parted(World& w, const Overlap& overlap, Bounce2D& out) {
-  bool touched = false;
-  for (int k = 0; k < 20000 && !out.parted; ++k) {
-    if (!w.step(1)) {
-      ADD_FAILURE() << to_string(w.divergence()) << " at step " << k << ", ledger "
-                    << w.energy_created();
-      return;
-    }
-    out.ledger_max = std::max(out.ledger_max, w.energy_created());
-    if (overlap() > 0.0) {
-      touched = true;
-      ++out.contact_steps;
-    } else {
-      out.parted = touched;
-    }
-  }
-}
 
 constexpr double kAlpha = 0.002;  // Δt/Δt_crit: ≈ 800 steps in contact
 constexpr double kZetas[] = {0.05, 0.3, 0.7};
@@ -159,7 +141,7 @@ Bounce2D wall_bounce(WallSide side, double zeta, double v0, double wall_speed) {
   auto overlap = [&] { return r - (pos() - wall.position) * sign; };
   Bounce2D out;
   out.h = std::sqrt(mat.wall.kn / w.mass()[0]) * in.dt;
-  step_until_parted(w, overlap, out);
+  test::step_until_parted(w, overlap, out);
   const double v_after = vertical ? w.vx()[0] : w.vy()[0];
   out.restitution = -(v_after - wall.velocity) * sign / ((un - wall.velocity) * sign);
   EXPECT_EQ(vertical ? w.vy()[0] : w.vx()[0], ut);  // frictionless: untouched
@@ -216,7 +198,7 @@ TEST(KernelContactDamping, UnequalDisksBounceWithTheReducedMassesRestitution) {
     auto overlap = [&] { return r0 + r1 - std::hypot(w.x()[1] - w.x()[0], w.y()[1] - w.y()[0]); };
     Bounce2D b;
     b.h = std::sqrt(mat.particle.kn / reduced_mass(w.mass()[0], w.mass()[1])) * in.dt;
-    step_until_parted(w, overlap, b);
+    test::step_until_parted(w, overlap, b);
     ASSERT_TRUE(b.parted);
     EXPECT_GT(b.contact_steps, 400);
     b.restitution = ((w.vx()[1] - w.vx()[0]) * ux + (w.vy()[1] - w.vy()[0]) * uy) / (2.0 * v0);

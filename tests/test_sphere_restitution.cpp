@@ -111,34 +111,11 @@ struct Bounce {
   double restitution = 0.0;  // outgoing/incoming normal speed, relative to the other body
   double h = 0.0;            // ω·Δt
   int contact_steps = 0;
-  bool separated = false;
+  bool parted = false;
   Vector3d tangential_before, tangential_after;  // the sphere's velocity along the wall
   Vector3d spin_after;
   double ledger_max = 0.0;  // the energy ledger's largest reading
 };
-
-/// Steps `w` one at a time until the contact (overlap() > 0) has been made
-/// and has parted, at most 20 000 steps: its steps, whether it parted and
-/// the ledger's largest reading into `out`. A stop of the kernel fails.
-template <class Overlap>
-void step_until_parted(SphereWorld& w, const Overlap& overlap, Bounce& out) {
-  out.ledger_max = -1e300;
-  bool touched = false;
-  for (int k = 0; k < 20000 && !out.separated; ++k) {
-    if (!w.step(1)) {
-      ADD_FAILURE() << to_string(w.divergence()) << " at step " << k << ", ledger "
-                    << w.energy_created();
-      break;
-    }
-    out.ledger_max = std::max(out.ledger_max, w.energy_created());
-    if (overlap() > 0.0) {
-      touched = true;
-      ++out.contact_steps;
-    } else {
-      out.separated = touched;
-    }
-  }
-}
 
 /// A sphere of radius kR a gap of 1e-5·r from wall `side` moving onto it at
 /// `v0` (plus `vt` along the wall, which is frictionless by default), the
@@ -171,7 +148,7 @@ Bounce wall_bounce(int side, double zeta, double v0, double wall_speed, double v
   Bounce out;
   out.h = std::sqrt(mat.wall.kn / w.mass()[0]) * in.dt;
   out.tangential_before = v - v.dot(g) * g;
-  step_until_parted(w, overlap, out);
+  test::step_until_parted(w, overlap, out);
   const Vector3d v_after = sphere_test::velocity(w, 0);
   out.restitution = -(v_after - W).dot(g) / u_in;
   out.tangential_after = v_after - v_after.dot(g) * g;
@@ -201,7 +178,7 @@ Bounce pair_bounce(double zeta, double v0, const KernelOptions& options = Kernel
   };
   Bounce out;
   out.h = std::sqrt(mat.particle.kn / meff) * in.dt;
-  step_until_parted(w, overlap, out);
+  test::step_until_parted(w, overlap, out);
   out.restitution = (sphere_test::velocity(w, 1) - sphere_test::velocity(w, 0)).dot(u) / (2.0 * v0);
   return out;
 }
@@ -225,7 +202,7 @@ TEST(SphereRestitution, ASphereBouncesOffEachWallWithTheClampedDashpotsRestituti
       // dashpot reads the normal velocity only and nothing acts along the
       // wall, so the tangential velocity and the spin do not change a bit.
       const Bounce b = wall_bounce(side, zeta, v0, 0.0, 0.02);
-      ASSERT_TRUE(b.separated);
+      ASSERT_TRUE(b.parted);
       EXPECT_GT(b.contact_steps, 400);
       const double e = clamped_restitution(zeta);
       EXPECT_NEAR(b.restitution, e, clamped_restitution_tolerance(zeta, b.h));
@@ -248,7 +225,7 @@ TEST(SphereRestitution, AMovingWallHitsARestingSphereWithTheSameRestitution) {
     for (int side : {kXMax, kZMin}) {
       SCOPED_TRACE("zeta " + std::to_string(zeta) + " wall " + std::to_string(side));
       const Bounce b = wall_bounce(side, zeta, 0.0, 0.05, 0.0);
-      ASSERT_TRUE(b.separated);
+      ASSERT_TRUE(b.parted);
       EXPECT_NEAR(b.restitution, clamped_restitution(zeta),
                   clamped_restitution_tolerance(zeta, b.h));
       EXPECT_LE(b.ledger_max, bounce_ledger_bound(zeta, b.h));
@@ -259,7 +236,7 @@ TEST(SphereRestitution, UnequalSpheresBounceWithTheReducedMassesRestitution) {
   for (double zeta : kZetas) {
     SCOPED_TRACE("zeta " + std::to_string(zeta));
     const Bounce b = pair_bounce(zeta, 0.05);
-    ASSERT_TRUE(b.separated);
+    ASSERT_TRUE(b.parted);
     EXPECT_GT(b.contact_steps, 400);
     const double e = clamped_restitution(zeta);
     EXPECT_NEAR(b.restitution, e, clamped_restitution_tolerance(zeta, b.h));

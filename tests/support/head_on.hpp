@@ -119,4 +119,31 @@ inline double clamped_restitution_tolerance(double zeta, double h) {
 /// the incoming kinetic energy (test_sphere_restitution.cpp derives it).
 inline double bounce_ledger_bound(double zeta, double h) { return (1.0 + 6.0 * zeta) * h; }
 
+/// Steps `w` one step at a time until the contact (overlap() > 0) has been
+/// made and has parted, at most 20 000 steps, with the energy ledger on:
+/// into `out` (fields contact_steps, parted, ledger_max) its steps in
+/// contact, whether it parted and the ledger's largest reading. A stop of
+/// the kernel (a false "energy created") fails the test. Both kernels'
+/// restitution tests (test_kernel_contact_damping.cpp,
+/// test_sphere_restitution.cpp).
+template <class Sample, class Overlap, class Bounce>
+void step_until_parted(Sample& w, const Overlap& overlap, Bounce& out) {
+  out.ledger_max = -1e300;
+  bool touched = false;
+  for (int k = 0; k < 20000 && !out.parted; ++k) {
+    if (!w.step(1)) {
+      ADD_FAILURE() << to_string(w.divergence()) << " at step " << k << ", ledger "
+                    << w.energy_created();
+      return;
+    }
+    out.ledger_max = std::max(out.ledger_max, w.energy_created());
+    if (overlap() > 0.0) {
+      touched = true;
+      ++out.contact_steps;
+    } else {
+      out.parted = touched;
+    }
+  }
+}
+
 }  // namespace demcal::test
