@@ -105,6 +105,14 @@ TEST_F(Cli3D, RunWritesSummaryNineComponentSeriesAndSphereVtk) {
   EXPECT_EQ(split(rows.back(), ',')[0], "4000");
   // The axial stress at the end: compressive, beyond σ3 (b_zz column).
   EXPECT_LT(std::stod(split(rows.back(), ',')[10]), -1e7);
+  // The monitored peak is the most compressive b_zz of the rows (written to
+  // 10 digits); the one tracked at every step is at least as compressive.
+  double monitored = 0.0;
+  for (size_t k = 1; k < rows.size(); ++k)
+    monitored = std::min(monitored, std::stod(split(rows[k], ',')[10]));
+  const auto& peak = s.at("peak");
+  EXPECT_NEAR(peak.at("monitored_stress_zz").get<double>(), monitored, 1e-9 * std::abs(monitored));
+  EXPECT_LE(peak.at("stress_zz").get<double>(), peak.at("monitored_stress_zz").get<double>());
 
   const auto names = test::check_vtk_polydata(read_text(out / "final.vtk"), 32);
   for (const char* field :

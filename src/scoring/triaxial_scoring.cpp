@@ -120,6 +120,8 @@ TriaxialCriteria compute_triaxial_criteria(const std::vector<TriaxialPoint>& ser
                       c.servo_walls[3]});
   m.oscillation = std::max({c.xz.oscillation, c.yz.oscillation, c.xy.oscillation});
   m.interior_lateral = std::max(c.xz.interior_lateral, c.yz.interior_lateral);
+  c.monitored_peak_stress_zz = m.peak_stress_yy;
+  c.monitored_peak_strain_zz = m.peak_strain_yy;
   return c;
 }
 
@@ -257,8 +259,8 @@ nlohmann::json triaxial_run_summary(const SceneConfig& config, const TriaxialSta
            {"deviator", -run.peak_stress_zz - s3},
            {"ratio_wall_lateral", run.peak_ratio},
            {"ratio_wall_lateral_strain", run.peak_ratio_strain},
-           {"monitored_stress_zz", c.combined.peak_stress_yy},
-           {"monitored_strain_zz", c.combined.peak_strain_yy}}},
+           {"monitored_stress_zz", c.monitored_peak_stress_zz},
+           {"monitored_strain_zz", c.monitored_peak_strain_zz}}},
          {"diverged", run.diverged},
          {"steps_run", run.steps_run},
          {"wall_time_s", run.wall_time_s},

@@ -42,6 +42,10 @@ struct TriaxialCriteria {
   double rotational_drag = 0.0;
   double translational_drag = 0.0;
   Criteria combined;
+  /// The most compressive b_zz among the monitoring points and its strain
+  /// (combined.peak_stress_yy holds the step-level peak when the run
+  /// tracked one: compute_triaxial_criteria(TriaxialResult)).
+  double monitored_peak_stress_zz = 0.0, monitored_peak_strain_zz = 0.0;
 };
 
 /// Tolerance on the rotational drag: a quarter of the 2 % peak accuracy
