@@ -125,9 +125,11 @@ int run_3d(const SceneConfig& config, const std::string& out_dir, bool allow_uns
   // The step-level peak, as the calibration's trials score it.
   const TriaxialCriteria c = compute_triaxial_criteria(run, s3);
   const Tolerances tolerances = triaxial_tolerances();
-  const Excesses e = excesses(scored_criteria(c, tolerances), tolerances);
-  const bool within = !run.diverged && e.worst() <= 1.0;
-  nlohmann::json summary = triaxial_run_summary(config, state, run, c, tolerances, e, within);
+  // The criteria judged (the rotational drag folded in), as `demcal score`
+  // judges the run's series.csv.
+  const Score score = score_triaxial_run(run, c, tolerances);
+  const bool within = score.passed;
+  nlohmann::json summary = triaxial_run_summary(config, state, run, c, score, tolerances);
   summary["consolidation"]["from_cache"] = state.from_cache;
   {
     OutputFolder out(dir);
@@ -139,7 +141,7 @@ int run_3d(const SceneConfig& config, const std::string& out_dir, bool allow_uns
       out.retire("final.vtk");
     out.commit();
   }
-  const Criteria& m = c.combined;
+  const Criteria& m = score.criteria;
   std::cout << std::setprecision(4) << "scene " << config.name
             << " (3D, triaxial): " << run.particles << " spheres, " << run.steps_run
             << " steps, dt " << run.integration.dt << " s\n"
@@ -149,13 +151,13 @@ int run_3d(const SceneConfig& config, const std::string& out_dir, bool allow_uns
   if (auto a = analytical_peak_ratio_3d(config))
     std::cout << "  analytical (walled FCC, Thornton, rotation locked) sigma1/sigma3 " << *a
               << "\n";
-  print_triaxial_criteria(std::cout, c);
+  print_triaxial_criteria(std::cout, c, score.criteria);
   std::cout << "  kinetic/elastic energy max " << m.kinetic_energy_ratio_max
             << ", unbalanced-force ratio mean " << m.unbalanced_force_ratio_mean
             << ", inertial number max " << m.inertial_number_max << "\n"
             << "  " << (within ? "WITHIN" : "OUTSIDE") << " the 3D default tolerances"
-            << (within ? "" : " (worst: " + e.worst_name() + ")") << ". " << kTriaxialVerdictNote
-            << "\n"
+            << (within ? "" : " (worst: " + summary["verdict"]["worst"].get<std::string>() + ")")
+            << ". " << kTriaxialVerdictNote << "\n"
             << "  wall time " << run.wall_time_s << " s (consolidation " << state.wall_time_s
             << " s, " << state.steps << " steps" << (state.from_cache ? ", from the cache" : "")
             << "), " << summary["particle_steps_per_s"].get<double>() << " particle-steps/s\n"

@@ -52,7 +52,7 @@ int cmd_score(const ScoreOptions& o) {
             << "  peak sigma_" << (is_3d ? "zz " : "yy ") << c.peak_stress_yy << " Pa at strain "
             << c.peak_strain_yy << " (sigma1/sigma3 " << -c.peak_stress_yy / sigma3 << ")\n";
   if (scored.planes) {
-    print_triaxial_criteria(std::cout, *scored.planes);
+    print_triaxial_criteria(std::cout, *scored.planes, c);
     std::cout << "  tolerances: force balance " << tolerances.force_balance << ", moment balance "
               << tolerances.moment_balance << ", servo " << tolerances.servo << ", oscillation "
               << tolerances.oscillation

@@ -5,6 +5,7 @@
 #include <optional>
 
 #include "demcal/io/format.hpp"
+#include "demcal/scoring/triaxial_scoring.hpp"
 #include "html.hpp"
 #include "sections.hpp"
 
@@ -180,7 +181,11 @@ void write_criteria(Doc& d, const ReportFacts& f) {
       d3 ? row("  shear", "sym(b − σ)_ij/σ3, the largest of xy, xz, yz", c.force_balance_shear,
                tol.force_balance)
          : row("  shear", "sym(b − σ)_xy/σ3", c.force_balance_shear, tol.force_balance),
-      d3 ? row("moment balance", "RMS (σ_ij − σ_ji)/σ3, the largest of the three pairs",
+      d3 ? row("moment balance",
+               "RMS (σ_ij − σ_ji)/σ3, the largest of the three pairs, or tolerance × rotational "
+               "drag/" +
+                   num(kRotationalDragTolerance) +
+                   " if larger (the drag: the rotational damping's share of the axial power)",
                c.moment_balance, tol.moment_balance)
          : row("moment balance", "RMS (σ_xy − σ_yx)/σ3", c.moment_balance, tol.moment_balance),
       d3 ? row("servo", "max |trend| (wall stress − σ3)/σ3, the largest of the four lateral walls",

@@ -325,10 +325,7 @@ ExternalScore score_external(const ExternalSeries& series, const Tolerances& tol
     const TriaxialResult& run = series.triaxial;
     TriaxialCriteria c = compute_triaxial_criteria(run, series.lateral_stress);
     c.combined.peak_error = peak_error_of(c.combined.peak_stress_yy, reference_peak);
-    out.score = score_of(scored_criteria(c, tolerances),
-                         {run.diverged, run.stopped_early, run.steps_run, run.steps_planned,
-                          run.particles, run_parameters(run)},
-                         tolerances);
+    out.score = score_triaxial_run(run, c, tolerances);
     out.planes = c;
     return out;
   }

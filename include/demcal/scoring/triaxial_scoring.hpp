@@ -42,6 +42,10 @@ struct TriaxialCriteria {
   double rotational_drag = 0.0;
   double translational_drag = 0.0;
   Criteria combined;
+  /// The most compressive b_zz among the monitoring points and its strain
+  /// (combined.peak_stress_yy holds the step-level peak when the run
+  /// tracked one: compute_triaxial_criteria(TriaxialResult)).
+  double monitored_peak_stress_zz = 0.0, monitored_peak_strain_zz = 0.0;
 };
 
 /// Tolerance on the rotational drag: a quarter of the 2 % peak accuracy
@@ -76,13 +80,22 @@ TriaxialCriteria compute_triaxial_criteria(const std::vector<TriaxialPoint>& ser
 TriaxialCriteria compute_triaxial_criteria(const TriaxialResult& run, double s3);
 
 /// The planes' criteria as summary.json holds them ("criteria_planes": xz,
-/// yz, the xy shear and moment terms, the four walls' servo errors).
+/// yz, the xy shear and moment terms, the four walls' servo errors, the
+/// drags, and "combined_without_drag": `c.combined`, the planes' largest
+/// values before the rotational drag is folded in). The criteria a verdict
+/// judges are the Score's (scored_criteria()), "criteria" beside it.
 nlohmann::json to_json(const TriaxialCriteria& c);
 
 /// A triaxial run scored as score_run() scores a biaxial one: the combined
 /// criteria (peak_stress_yy holds the axial peak b_zz), the verdict against
 /// `tolerances`, completeness, cost and the diagnosis.
 Score score_triaxial_run(const TriaxialResult& run, double s3, const Tolerances& tolerances);
+/// The same from the run's criteria already computed (`demcal run` and
+/// `demcal score` write them beside the Score): score_of() on
+/// scored_criteria(c, tolerances), so every 3D verdict judges the same
+/// numbers.
+Score score_triaxial_run(const TriaxialResult& run, const TriaxialCriteria& c,
+                         const Tolerances& tolerances);
 /// The algorithmic parameters a triaxial run was made with.
 AlgorithmSpec run_parameters(const TriaxialResult& run);
 
@@ -123,9 +136,12 @@ class TriaxialEarlyFailure {
 /// What `demcal run` says of a 3D verdict: the 3D tolerances and what they hold.
 extern const char* const kTriaxialVerdictNote;
 
-/// summary.json of a triaxial run (`demcal run` on a 3D config).
+/// summary.json of a triaxial run (`demcal run` on a 3D config): "criteria"
+/// and the verdict are the Score's (score_triaxial_run(run, c, t): the
+/// criteria judged, as `demcal score` writes them for the run's series),
+/// "criteria_planes" to_json(c).
 nlohmann::json triaxial_run_summary(const SceneConfig& config, const TriaxialState& state,
                                     const TriaxialResult& run, const TriaxialCriteria& c,
-                                    const Tolerances& t, const Excesses& e, bool within);
+                                    const Score& score, const Tolerances& t);
 
 }  // namespace demcal
