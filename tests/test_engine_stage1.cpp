@@ -20,9 +20,6 @@
 #include "demcal/upscaling/export_3d.hpp"
 #include "support/files.hpp"
 #include "support/process.hpp"
-// critical_damping_after, consolidation_step_shrink: demcal's consolidation
-// and the decks' stage 1 share them (the rest of the header is private)
-#include "../src/scene/protocol_steps.hpp"
 
 namespace demcal {
 namespace {
@@ -231,7 +228,7 @@ double echoed(const std::string& log, const std::string& name) {
 /// stage 1 (every cons_check = 200 steps from 0): the first check at or after
 /// critical_damping_after, never beyond the budget's last check.
 int64_t demcal_switch_check(int64_t budget, double shrink) {
-  const int64_t after = detail::critical_damping_after(budget, shrink);
+  const int64_t after = critical_damping_after(budget, shrink);
   return std::min((after + 199) / 200 * 200, budget / 200 * 200);
 }
 

@@ -10,9 +10,6 @@
 #include "demcal/kernel/particle_scales.hpp"
 #include "demcal/scene/biaxial.hpp"
 #include "demcal/scene/run_output.hpp"
-// critical_damping_after, consolidation_step_shrink: shared with demcal's
-// consolidation (the rest of the header is private to src/scene)
-#include "../scene/protocol_steps.hpp"
 
 namespace demcal::deck {
 
@@ -338,7 +335,7 @@ double consolidation_dt(double alpha, double zeta, double dt_crit) {
 std::string lammps_consolidation_quarter(double alpha, int64_t max_steps) {
   const char* last =
       "variable        cons_last equal $(v_cons_check*floor(v_cons_max_steps/v_cons_check))\n";
-  const double shrink = detail::consolidation_step_shrink(alpha);
+  const double shrink = consolidation_step_shrink(alpha);
   if (!(shrink < 1.0))
     return "variable        cons_quarter equal "
            "$(v_cons_check*floor(v_cons_max_steps/4/v_cons_check))\n" +
@@ -353,7 +350,7 @@ std::string lammps_consolidation_quarter(double alpha, int64_t max_steps) {
     << "# this step by " << num(shrink) << " (alpha " << num(alpha) << " instead of "
     << num(AlgorithmSpec{}.dt_ratio) << "), so\n"
     << "# (cons_max_steps/4)/" << num(shrink) << " steps (demcal's critical_damping_after: step "
-    << detail::critical_damping_after(max_steps, shrink) << "\n"
+    << critical_damping_after(max_steps, shrink) << "\n"
     << "# at cons_max_steps " << max_steps << "), at most the budget\n"
     << last
     << "variable        cons_after equal "
@@ -509,7 +506,7 @@ std::string lammps_consolidation_runs(double gamma_n, double dt_damped, const st
   // quarter): then stage 1 never switches, as demcal's, and runs no step
   // beyond cons_last (a run of 0 steps would leave the criterion's computes
   // stale). Unshrunk, the lines as before.
-  const bool shrunk = detail::consolidation_step_shrink(alpha) < 1.0;
+  const bool shrunk = consolidation_step_shrink(alpha) < 1.0;
   const std::string may_switch = shrunk ? " && ${cons_quarter} < ${cons_last}" : "";
   const std::string before_last = shrunk ? " && $(step) < ${cons_last}" : "";
   std::ostringstream s;

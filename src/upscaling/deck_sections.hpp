@@ -236,7 +236,7 @@ double consolidation_dt(double alpha, double zeta, double dt_crit);
 
 /// Stage 1's cons_quarter and cons_last (runs end on check steps): the
 /// budget's last check, and the check from which stage 1 runs at critical
-/// damping, demcal's (scene/protocol_steps.hpp, critical_damping_after): a
+/// damping, demcal's (scene/biaxial.hpp, critical_damping_after): a
 /// quarter of cons_max_steps in the simulated time of the undamped step.
 /// `alpha`: stage 1's, demcal's consolidation α (shrunk for contact
 /// dashpots); `max_steps` the exported budget, for the comment. Unshrunk
