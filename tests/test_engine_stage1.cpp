@@ -232,6 +232,86 @@ int64_t demcal_switch_check(int64_t budget, double shrink) {
   return std::min((after + 199) / 200 * 200, budget / 200 * 200);
 }
 
+/// The step at which stage 1's phase 0 ended in `log` (the marker
+/// with_phase0_marker prints), -1 if it did not.
+int64_t phase0_end(const std::string& log) {
+  std::smatch m;
+  if (!std::regex_search(log, m, std::regex("\nPHASE0_END ([0-9]+)\n"))) return -1;
+  return std::stoll(m[1].str());
+}
+
+/// `deck` printing the step at which phase 0 ended ("PHASE0_END step").
+std::string with_phase0_marker(const std::string& deck) {
+  return replaced(deck, "# phase 1: friction on",
+                  "print           \"PHASE0_END $(step)\"\n# phase 1: friction on");
+}
+
+// Phase 0 may end at the budget's last check or at the one before (with
+// light damping, or at critical damping after the fallback); phase 1's
+// first check interval then reaches or passes cons_last. demcal's
+// consolidation stops there, not static (it runs phase 1's first check
+// interval, then its budget is spent); the deck must too: quit 2 with its
+// message. The deck before ran phase 1 on `run ${cons_last} upto` when its
+// contacts had no dashpots: 0 steps at the last check, after which LAMMPS
+// stopped with "Compute used in variable between runs is not current", and
+// an error ("Invalid run command upto value") past it. A sample of 30
+// disks, no contact damping: its phase 0 ends at light damping (step S0,
+// 2 600 here) and phase 1 needs more than one check interval; the same deck
+// with a budget whose last check is S0 + 200 or S0 takes the same path to
+// S0 once its quarter is the budget's last check (no fallback before:
+// without that edit phase 0 would end there only at critical damping, which
+// a budget cannot aim at; a shrunk deck's quarter is the last check by
+// itself when (cons_max_steps/4)/S passes it).
+TEST(EngineLammpsStage1, WhenPhase0EndsAtTheBudgetsLastChecksPhase1StopsThereWithQuit2) {
+  const std::string lmp = test::find_on_path("lmp");
+  if (lmp.empty())
+    GTEST_SKIP() << "LAMMPS (lmp) is not installed (apt-get install lammps): the deck is not run";
+  SceneConfig c = load_config(test::shipped_config("random_400"));
+  c.assembly.count = 30;
+  AlgorithmSpec p;
+  p.steps = 8000;
+  p.damping_ratio_rotation = 0.0;
+  ExportOptions o;
+  o.data_name = "r.data";
+  o.consolidate_in_deck = true;
+  const ExportResult r = export_deck(c, p, make_assembly(c), o);
+  ASSERT_EQ(r.deck.find("/dt)"), std::string::npos) << "the sample has contact dashpots";
+  const std::string deck = with_phase0_marker(r.deck);
+  const std::vector<std::string> args{"-var", "run_steps", "0", "-screen", "none"};
+  const test::TempDir dir("engine_stage1_end");
+  const test::DeckRun full = test::run_deck(lmp, dir / "full", deck, r.files, args);
+  ASSERT_EQ(full.status, 0) << full.log;
+  const int64_t s0 = phase0_end(full.log);
+  std::smatch m;
+  ASSERT_TRUE(
+      std::regex_search(full.log, m, std::regex("\ndemcal deck: consolidated in ([0-9]+) steps")))
+      << full.log;
+  const int64_t steps = std::stoll(m[1].str());
+  ASSERT_GT(s0, 0) << full.log;
+  ASSERT_EQ(s0 % 200, 0);
+  // the premise: phase 1 needs more than one check interval
+  ASSERT_GT(steps - s0, 200) << "phase 1 was static at its first check: nothing to test";
+  const std::string budget_line = line_of(deck, "variable cons_max_steps equal ");
+  const std::string quarter_line = line_of(deck, "variable        cons_quarter equal ");
+  for (int64_t budget : {s0 + 200, s0 + 399, s0}) {
+    SCOPED_TRACE("cons_max_steps " + std::to_string(budget));
+    std::string edited = replaced(deck, budget_line,
+                                  "variable cons_max_steps equal " + std::to_string(budget) + "\n");
+    edited = replaced(edited, quarter_line,
+                      "variable        cons_quarter equal "
+                      "$(v_cons_check*floor(v_cons_max_steps/v_cons_check))\n");
+    const test::DeckRun run =
+        test::run_deck(lmp, dir / std::to_string(budget), edited, r.files, args);
+    EXPECT_EQ(phase0_end(run.log), s0) << run.log;
+    EXPECT_EQ(run.status, 2) << run.log;
+    EXPECT_NE(run.log.find("\ndemcal deck: consolidation did not reach a static state in " +
+                           std::to_string(budget) + " steps"),
+              std::string::npos)
+        << run.log;
+    EXPECT_EQ(run.log.find("ERROR"), std::string::npos) << run.log;
+  }
+}
+
 // With contact dashpots stage 1's step is demcal's shrunk one (alpha
 // 0.2·S, consolidation_dashpot_factor), and its critical-damping fallback
 // comes where demcal's does: after a quarter of the budget in the simulated

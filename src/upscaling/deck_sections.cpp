@@ -503,12 +503,17 @@ std::string lammps_consolidation_criterion(int dimension,
 std::string lammps_consolidation_runs(double gamma_n, double dt_damped, const std::string& critical,
                                       double alpha) {
   // A shrunk step's quarter may be the budget's end (lammps_consolidation_
-  // quarter): then stage 1 never switches, as demcal's, and runs no step
-  // beyond cons_last (a run of 0 steps would leave the criterion's computes
-  // stale). Unshrunk, the lines as before.
+  // quarter): then stage 1 never switches, as demcal's (unshrunk, the lines
+  // as before). Phase 1 runs no step beyond cons_last, shrunk or not: phase 0
+  // may end at the budget's last check or the one before, and phase 1's
+  // first check interval then reaches or passes cons_last; a run of 0 steps
+  // would leave the criterion's computes stale ("Compute used in variable
+  // between runs is not current"), one up to a step already passed is an
+  // error. demcal's consolidation, too, stops after phase 1's first check
+  // when that is at or past its budget.
   const bool shrunk = consolidation_step_shrink(alpha) < 1.0;
   const std::string may_switch = shrunk ? " && ${cons_quarter} < ${cons_last}" : "";
-  const std::string before_last = shrunk ? " && $(step) < ${cons_last}" : "";
+  const std::string before_last = " && $(step) < ${cons_last}";
   std::ostringstream s;
   s << "# phase 0: frictionless\n"
     << "pair_style      gran/hooke/history ${kn} ${kt} " << num(gamma_n) << " 0.0 0 0\n"
