@@ -312,18 +312,21 @@ TEST(EngineLammpsStage1, WhenPhase0EndsAtTheBudgetsLastChecksPhase1StopsThereWit
   }
 }
 
-// With contact dashpots stage 1's step is demcal's shrunk one (alpha
-// 0.2·S, consolidation_dashpot_factor), and its critical-damping fallback
-// comes where demcal's does: after a quarter of the budget in the simulated
-// time of the undamped step, i.e. (cons_max_steps/4)/S steps, at a check,
-// never beyond the budget. The deck computes it from cons_max_steps, so a
-// budget edited in its parameters block moves it as it moves demcal's. Each
-// deck is run up to the definition of cons_quarter (then quit) with the
-// exported budget and edited ones; LAMMPS' value must be
-// demcal_switch_check's, to the step. (The deck before put it at a quarter
-// of cons_max_steps in steps: 500 000 of 2·10⁶ where demcal's came after
-// 3 299 212 steps, i.e. never, on random_500_3d at ζ_c 0.3.)
-TEST(EngineLammpsStage1, WithContactDashpotsTheCriticalFallbackComesAtDemcalsCheck) {
+// Stage 1's critical-damping fallback comes where demcal's does: after a
+// quarter of the budget in the simulated time of the undamped step, i.e.
+// (cons_max_steps/4)/S steps, at a check (the first at or after it), never
+// beyond the budget; with contact dashpots the step is demcal's shrunk one
+// (alpha 0.2·S, consolidation_dashpot_factor), without them S = 1. The deck
+// computes it from cons_max_steps, so a budget edited in its parameters
+// block moves it as it moves demcal's. Each deck is run up to the
+// definition of cons_quarter (then quit) with the exported budget and
+// edited ones (123 457 and 1 000 are no multiples of 4·cons_check = 800);
+// LAMMPS' value must be demcal_switch_check's, to the step. (The deck
+// before put it at a quarter of cons_max_steps in steps with dashpots:
+// 500 000 of 2·10⁶ where demcal's came after 3 299 212 steps, i.e. never,
+// on random_500_3d at ζ_c 0.3; and without them at the check at or BEFORE
+// a quarter: 30 800 and 200 where demcal switches at 31 000 and 400.)
+TEST(EngineLammpsStage1, TheCriticalFallbackComesAtDemcalsCheck) {
   const std::string lmp = test::find_on_path("lmp");
   if (lmp.empty())
     GTEST_SKIP() << "LAMMPS (lmp) is not installed (apt-get install lammps): the deck is not run";
@@ -335,7 +338,7 @@ TEST(EngineLammpsStage1, WithContactDashpotsTheCriticalFallbackComesAtDemcalsChe
     ExportResult deck;
   };
   std::vector<Case> cases;
-  for (double zeta_c : {0.02}) {
+  for (double zeta_c : {0.0, 0.02}) {
     SceneConfig c = load_config(test::shipped_config("random_400"));
     c.assembly.count = 100;
     c.material.contact_damping_ratio = zeta_c;
@@ -343,7 +346,7 @@ TEST(EngineLammpsStage1, WithContactDashpotsTheCriticalFallbackComesAtDemcalsChe
     o.data_name = "r.data";
     o.consolidate_in_deck = true;
     cases.push_back(
-        {"2D zeta_c " + std::to_string(zeta_c), export_deck(c, p, make_assembly(c), o)});
+        {zeta_c > 0.0 ? "2D zeta_c 0.02" : "2D zeta_c 0", export_deck(c, p, make_assembly(c), o)});
   }
   {
     SceneConfig c = load_config(test::shipped_config("random_500_3d"));
@@ -353,6 +356,8 @@ TEST(EngineLammpsStage1, WithContactDashpotsTheCriticalFallbackComesAtDemcalsChe
     o.data_name = "r.data";
     o.consolidate_in_deck = true;
     cases.push_back({"3D zeta_c 0.7", export_3d_decks(c, p, make_sphere_assembly(c), o)});
+    c.material.contact_damping_ratio = 0.0;
+    cases.push_back({"3D zeta_c 0", export_3d_decks(c, p, make_sphere_assembly(c), o)});
   }
   const test::TempDir dir("engine_stage1_fallback");
   int switching = 0, never = 0;
@@ -363,12 +368,15 @@ TEST(EngineLammpsStage1, WithContactDashpotsTheCriticalFallbackComesAtDemcalsChe
     ASSERT_TRUE(std::regex_search(
         k.deck.deck, m,
         std::regex("\\(floor\\(v_cons_max_steps/4\\)/([0-9.e+-]+)\\)/v_cons_check\\)\\)\n")))
-        << "no shrunk quarter in the deck";
+        << "no quarter (cons_max_steps/4)/S in the deck";
     const double shrink = std::stod(m[1].str());
     ASSERT_TRUE(std::regex_search(
         k.deck.deck, m, std::regex("# alpha\\*f\\(zeta\\)\\*dt_crit, alpha ([0-9.e+-]+)\n")));
     EXPECT_NEAR(shrink, std::stod(m[1].str()) / AlgorithmSpec{}.dt_ratio, 1e-9 * shrink);
-    EXPECT_LT(shrink, 1.0);
+    if (k.name.ends_with("zeta_c 0"))
+      EXPECT_EQ(shrink, 1.0);
+    else
+      EXPECT_LT(shrink, 1.0);
     const std::string budget_line = line_of(k.deck.deck, "variable cons_max_steps equal ");
     const std::string quarter_line = line_of(k.deck.deck, "variable        cons_quarter equal ");
     for (int64_t budget : {int64_t{2000000}, int64_t{123457}, int64_t{1000}}) {
