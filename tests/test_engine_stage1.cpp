@@ -20,9 +20,6 @@
 #include "demcal/upscaling/export_3d.hpp"
 #include "support/files.hpp"
 #include "support/process.hpp"
-// critical_damping_after, consolidation_step_shrink: demcal's consolidation
-// and the decks' stage 1 share them (the rest of the header is private)
-#include "../src/scene/protocol_steps.hpp"
 
 namespace demcal {
 namespace {
@@ -231,22 +228,105 @@ double echoed(const std::string& log, const std::string& name) {
 /// stage 1 (every cons_check = 200 steps from 0): the first check at or after
 /// critical_damping_after, never beyond the budget's last check.
 int64_t demcal_switch_check(int64_t budget, double shrink) {
-  const int64_t after = detail::critical_damping_after(budget, shrink);
+  const int64_t after = critical_damping_after(budget, shrink);
   return std::min((after + 199) / 200 * 200, budget / 200 * 200);
 }
 
-// With contact dashpots stage 1's step is demcal's shrunk one (alpha
-// 0.2·S, consolidation_dashpot_factor), and its critical-damping fallback
-// comes where demcal's does: after a quarter of the budget in the simulated
-// time of the undamped step, i.e. (cons_max_steps/4)/S steps, at a check,
-// never beyond the budget. The deck computes it from cons_max_steps, so a
-// budget edited in its parameters block moves it as it moves demcal's. Each
-// deck is run up to the definition of cons_quarter (then quit) with the
-// exported budget and edited ones; LAMMPS' value must be
-// demcal_switch_check's, to the step. (The deck before put it at a quarter
-// of cons_max_steps in steps: 500 000 of 2·10⁶ where demcal's came after
-// 3 299 212 steps, i.e. never, on random_500_3d at ζ_c 0.3.)
-TEST(EngineLammpsStage1, WithContactDashpotsTheCriticalFallbackComesAtDemcalsCheck) {
+/// The step at which stage 1's phase 0 ended in `log` (the marker
+/// with_phase0_marker prints), -1 if it did not.
+int64_t phase0_end(const std::string& log) {
+  std::smatch m;
+  if (!std::regex_search(log, m, std::regex("\nPHASE0_END ([0-9]+)\n"))) return -1;
+  return std::stoll(m[1].str());
+}
+
+/// `deck` printing the step at which phase 0 ended ("PHASE0_END step").
+std::string with_phase0_marker(const std::string& deck) {
+  return replaced(deck, "# phase 1: friction on",
+                  "print           \"PHASE0_END $(step)\"\n# phase 1: friction on");
+}
+
+// Phase 0 may end at the budget's last check or at the one before (with
+// light damping, or at critical damping after the fallback); phase 1's
+// first check interval then reaches or passes cons_last. demcal's
+// consolidation stops there, not static (it runs phase 1's first check
+// interval, then its budget is spent); the deck must too: quit 2 with its
+// message. The deck before ran phase 1 on `run ${cons_last} upto` when its
+// contacts had no dashpots: 0 steps at the last check, after which LAMMPS
+// stopped with "Compute used in variable between runs is not current", and
+// an error ("Invalid run command upto value") past it. A sample of 30
+// disks, no contact damping: its phase 0 ends at light damping (step S0,
+// 2 600 here) and phase 1 needs more than one check interval; the same deck
+// with a budget whose last check is S0 + 200 or S0 takes the same path to
+// S0 once its quarter is the budget's last check (no fallback before:
+// without that edit phase 0 would end there only at critical damping, which
+// a budget cannot aim at; a shrunk deck's quarter is the last check by
+// itself when (cons_max_steps/4)/S passes it).
+TEST(EngineLammpsStage1, WhenPhase0EndsAtTheBudgetsLastChecksPhase1StopsThereWithQuit2) {
+  const std::string lmp = test::find_on_path("lmp");
+  if (lmp.empty())
+    GTEST_SKIP() << "LAMMPS (lmp) is not installed (apt-get install lammps): the deck is not run";
+  SceneConfig c = load_config(test::shipped_config("random_400"));
+  c.assembly.count = 30;
+  AlgorithmSpec p;
+  p.steps = 8000;
+  p.damping_ratio_rotation = 0.0;
+  ExportOptions o;
+  o.data_name = "r.data";
+  o.consolidate_in_deck = true;
+  const ExportResult r = export_deck(c, p, make_assembly(c), o);
+  ASSERT_EQ(r.deck.find("/dt)"), std::string::npos) << "the sample has contact dashpots";
+  const std::string deck = with_phase0_marker(r.deck);
+  const std::vector<std::string> args{"-var", "run_steps", "0", "-screen", "none"};
+  const test::TempDir dir("engine_stage1_end");
+  const test::DeckRun full = test::run_deck(lmp, dir / "full", deck, r.files, args);
+  ASSERT_EQ(full.status, 0) << full.log;
+  const int64_t s0 = phase0_end(full.log);
+  std::smatch m;
+  ASSERT_TRUE(
+      std::regex_search(full.log, m, std::regex("\ndemcal deck: consolidated in ([0-9]+) steps")))
+      << full.log;
+  const int64_t steps = std::stoll(m[1].str());
+  ASSERT_GT(s0, 0) << full.log;
+  ASSERT_EQ(s0 % 200, 0);
+  // the premise: phase 1 needs more than one check interval
+  ASSERT_GT(steps - s0, 200) << "phase 1 was static at its first check: nothing to test";
+  const std::string budget_line = line_of(deck, "variable cons_max_steps equal ");
+  const std::string quarter_line = line_of(deck, "variable        cons_quarter equal ");
+  for (int64_t budget : {s0 + 200, s0 + 399, s0}) {
+    SCOPED_TRACE("cons_max_steps " + std::to_string(budget));
+    std::string edited = replaced(deck, budget_line,
+                                  "variable cons_max_steps equal " + std::to_string(budget) + "\n");
+    edited = replaced(edited, quarter_line,
+                      "variable        cons_quarter equal "
+                      "$(v_cons_check*floor(v_cons_max_steps/v_cons_check))\n");
+    const test::DeckRun run =
+        test::run_deck(lmp, dir / std::to_string(budget), edited, r.files, args);
+    EXPECT_EQ(phase0_end(run.log), s0) << run.log;
+    EXPECT_EQ(run.status, 2) << run.log;
+    EXPECT_NE(run.log.find("\ndemcal deck: consolidation did not reach a static state in " +
+                           std::to_string(budget) + " steps"),
+              std::string::npos)
+        << run.log;
+    EXPECT_EQ(run.log.find("ERROR"), std::string::npos) << run.log;
+  }
+}
+
+// Stage 1's critical-damping fallback comes where demcal's does: after a
+// quarter of the budget in the simulated time of the undamped step, i.e.
+// (cons_max_steps/4)/S steps, at a check (the first at or after it), never
+// beyond the budget; with contact dashpots the step is demcal's shrunk one
+// (alpha 0.2·S, consolidation_dashpot_factor), without them S = 1. The deck
+// computes it from cons_max_steps, so a budget edited in its parameters
+// block moves it as it moves demcal's. Each deck is run up to the
+// definition of cons_quarter (then quit) with the exported budget and
+// edited ones (123 457 and 1 000 are no multiples of 4·cons_check = 800);
+// LAMMPS' value must be demcal_switch_check's, to the step. (The deck
+// before put it at a quarter of cons_max_steps in steps with dashpots:
+// 500 000 of 2·10⁶ where demcal's came after 3 299 212 steps, i.e. never,
+// on random_500_3d at ζ_c 0.3; and without them at the check at or BEFORE
+// a quarter: 30 800 and 200 where demcal switches at 31 000 and 400.)
+TEST(EngineLammpsStage1, TheCriticalFallbackComesAtDemcalsCheck) {
   const std::string lmp = test::find_on_path("lmp");
   if (lmp.empty())
     GTEST_SKIP() << "LAMMPS (lmp) is not installed (apt-get install lammps): the deck is not run";
@@ -258,7 +338,7 @@ TEST(EngineLammpsStage1, WithContactDashpotsTheCriticalFallbackComesAtDemcalsChe
     ExportResult deck;
   };
   std::vector<Case> cases;
-  for (double zeta_c : {0.02}) {
+  for (double zeta_c : {0.0, 0.02}) {
     SceneConfig c = load_config(test::shipped_config("random_400"));
     c.assembly.count = 100;
     c.material.contact_damping_ratio = zeta_c;
@@ -266,7 +346,7 @@ TEST(EngineLammpsStage1, WithContactDashpotsTheCriticalFallbackComesAtDemcalsChe
     o.data_name = "r.data";
     o.consolidate_in_deck = true;
     cases.push_back(
-        {"2D zeta_c " + std::to_string(zeta_c), export_deck(c, p, make_assembly(c), o)});
+        {zeta_c > 0.0 ? "2D zeta_c 0.02" : "2D zeta_c 0", export_deck(c, p, make_assembly(c), o)});
   }
   {
     SceneConfig c = load_config(test::shipped_config("random_500_3d"));
@@ -276,6 +356,8 @@ TEST(EngineLammpsStage1, WithContactDashpotsTheCriticalFallbackComesAtDemcalsChe
     o.data_name = "r.data";
     o.consolidate_in_deck = true;
     cases.push_back({"3D zeta_c 0.7", export_3d_decks(c, p, make_sphere_assembly(c), o)});
+    c.material.contact_damping_ratio = 0.0;
+    cases.push_back({"3D zeta_c 0", export_3d_decks(c, p, make_sphere_assembly(c), o)});
   }
   const test::TempDir dir("engine_stage1_fallback");
   int switching = 0, never = 0;
@@ -286,12 +368,15 @@ TEST(EngineLammpsStage1, WithContactDashpotsTheCriticalFallbackComesAtDemcalsChe
     ASSERT_TRUE(std::regex_search(
         k.deck.deck, m,
         std::regex("\\(floor\\(v_cons_max_steps/4\\)/([0-9.e+-]+)\\)/v_cons_check\\)\\)\n")))
-        << "no shrunk quarter in the deck";
+        << "no quarter (cons_max_steps/4)/S in the deck";
     const double shrink = std::stod(m[1].str());
     ASSERT_TRUE(std::regex_search(
         k.deck.deck, m, std::regex("# alpha\\*f\\(zeta\\)\\*dt_crit, alpha ([0-9.e+-]+)\n")));
     EXPECT_NEAR(shrink, std::stod(m[1].str()) / AlgorithmSpec{}.dt_ratio, 1e-9 * shrink);
-    EXPECT_LT(shrink, 1.0);
+    if (k.name.ends_with("zeta_c 0"))
+      EXPECT_EQ(shrink, 1.0);
+    else
+      EXPECT_LT(shrink, 1.0);
     const std::string budget_line = line_of(k.deck.deck, "variable cons_max_steps equal ");
     const std::string quarter_line = line_of(k.deck.deck, "variable        cons_quarter equal ");
     for (int64_t budget : {int64_t{2000000}, int64_t{123457}, int64_t{1000}}) {

@@ -14,8 +14,9 @@
 // time of the undamped step, so later where contact dashpots shrink the
 // step (run_consolidation says why).
 //
-// Private to src/scene, but for critical_damping_after and
-// consolidation_step_shrink, which the decks' stage 1 (src/upscaling) shares.
+// Private to src/scene. The consolidation's critical-damping switch
+// (critical_damping_after, consolidation_step_shrink), which the decks'
+// stage 1 (src/upscaling) shares, is public: demcal/scene/biaxial.hpp.
 #pragma once
 
 #include <algorithm>
@@ -30,6 +31,7 @@
 
 #include "demcal/io/format.hpp"
 #include "demcal/kernel/world.hpp"
+#include "demcal/scene/biaxial.hpp"
 #include "demcal/scene/config.hpp"
 #include "demcal/scene/consolidation_progress.hpp"
 
@@ -44,26 +46,6 @@ inline AlgorithmSpec consolidation_settings(const SceneConfig& config, double da
   settle.damping_ratio_rotation = damping_ratio;
   settle.lock_rotation = config.algorithm.lock_rotation;
   return settle;
-}
-
-/// The consolidation's step shrink: its α (`dt_ratio`, consolidation_settings'
-/// shrunk by consolidation_dashpot_factor where contact dashpots lower the
-/// stable step) over the undamped consolidation's (AlgorithmSpec{}.dt_ratio).
-inline double consolidation_step_shrink(double dt_ratio) {
-  return dt_ratio / AlgorithmSpec{}.dt_ratio;
-}
-
-/// The step from which the consolidation runs at critical damping (the
-/// first check at or after it switches): a quarter of the budget
-/// `max_steps` in the simulated time of the undamped step, i.e. as many more
-/// steps as the step shrank (`step_shrink`: consolidation_step_shrink;
-/// run_consolidation says why). The one home of the formula: demcal's
-/// consolidation and the exported decks' stage 1 (src/upscaling,
-/// deck::lammps_consolidation_quarter) use it.
-inline int64_t critical_damping_after(int64_t max_steps, double step_shrink) {
-  return step_shrink < 1.0
-             ? static_cast<int64_t>(std::ceil(static_cast<double>(max_steps / 4) / step_shrink))
-             : max_steps / 4;
 }
 
 struct ConsolidationOutcome {

@@ -10,9 +10,6 @@
 #include "demcal/kernel/particle_scales.hpp"
 #include "demcal/scene/biaxial.hpp"
 #include "demcal/scene/run_output.hpp"
-// critical_damping_after, consolidation_step_shrink: shared with demcal's
-// consolidation (the rest of the header is private to src/scene)
-#include "../scene/protocol_steps.hpp"
 
 namespace demcal::deck {
 
@@ -336,26 +333,25 @@ double consolidation_dt(double alpha, double zeta, double dt_crit) {
 }
 
 std::string lammps_consolidation_quarter(double alpha, int64_t max_steps) {
-  const char* last =
-      "variable        cons_last equal $(v_cons_check*floor(v_cons_max_steps/v_cons_check))\n";
-  const double shrink = detail::consolidation_step_shrink(alpha);
-  if (!(shrink < 1.0))
-    return "variable        cons_quarter equal "
-           "$(v_cons_check*floor(v_cons_max_steps/4/v_cons_check))\n" +
-           std::string(last);
+  const double shrink = consolidation_step_shrink(alpha);
   // demcal switches at its first check at or after critical_damping_after
   // (a multiple of cons_check: its checks come every 200 steps from 0), and
-  // never beyond the budget; min(a, b) = (a+b-abs(a-b))/2 (LAMMPS 2021 has
-  // no min of two numbers), exact for these whole numbers
+  // never beyond the budget; one formula with and without contact dashpots
+  // (S = 1: floor(cons_max_steps/4), critical_damping_after's unshrunk
+  // branch); min(a, b) = (a+b-abs(a-b))/2 (LAMMPS 2021 has no min of two
+  // numbers), exact for these whole numbers
   std::ostringstream s;
-  s << "# critical damping from the first check at or after a quarter of the budget\n"
-    << "# in the simulated time of the undamped step: the contact dashpots shrink\n"
-    << "# this step by " << num(shrink) << " (alpha " << num(alpha) << " instead of "
-    << num(AlgorithmSpec{}.dt_ratio) << "), so\n"
-    << "# (cons_max_steps/4)/" << num(shrink) << " steps (demcal's critical_damping_after: step "
-    << detail::critical_damping_after(max_steps, shrink) << "\n"
+  s << "# critical damping from the first check at or after a quarter of the budget\n";
+  if (shrink < 1.0)
+    s << "# in the simulated time of the undamped step: the contact dashpots shrink\n"
+      << "# this step by " << num(shrink) << " (alpha " << num(alpha) << " instead of "
+      << num(AlgorithmSpec{}.dt_ratio) << "), so\n"
+      << "# (cons_max_steps/4)/" << num(shrink) << " steps (demcal's critical_damping_after: step ";
+  else
+    s << "# (demcal's critical_damping_after: step ";
+  s << critical_damping_after(max_steps, shrink) << "\n"
     << "# at cons_max_steps " << max_steps << "), at most the budget\n"
-    << last
+    << "variable        cons_last equal $(v_cons_check*floor(v_cons_max_steps/v_cons_check))\n"
     << "variable        cons_after equal "
        "$(v_cons_check*ceil(ceil(floor(v_cons_max_steps/4)/"
     << exact(shrink) << ")/v_cons_check))\n"
@@ -503,15 +499,18 @@ std::string lammps_consolidation_criterion(int dimension,
   return s.str();
 }
 
-std::string lammps_consolidation_runs(double gamma_n, double dt_damped, const std::string& critical,
-                                      double alpha) {
-  // A shrunk step's quarter may be the budget's end (lammps_consolidation_
-  // quarter): then stage 1 never switches, as demcal's, and runs no step
-  // beyond cons_last (a run of 0 steps would leave the criterion's computes
-  // stale). Unshrunk, the lines as before.
-  const bool shrunk = detail::consolidation_step_shrink(alpha) < 1.0;
-  const std::string may_switch = shrunk ? " && ${cons_quarter} < ${cons_last}" : "";
-  const std::string before_last = shrunk ? " && $(step) < ${cons_last}" : "";
+std::string lammps_consolidation_runs(double gamma_n, double dt_damped,
+                                      const std::string& critical) {
+  // The quarter may be the budget's end (lammps_consolidation_quarter, a
+  // shrunk step's): then stage 1 never switches, as demcal's. Phase 1 runs
+  // no step beyond cons_last: phase 0 may end at the budget's last check or
+  // the one before, and phase 1's first check interval then reaches or
+  // passes cons_last; a run of 0 steps would leave the criterion's computes
+  // stale ("Compute used in variable between runs is not current"), one up
+  // to a step already passed is an error. demcal's consolidation, too,
+  // stops after phase 1's first check when that is at or past its budget.
+  const std::string may_switch = " && ${cons_quarter} < ${cons_last}";
+  const std::string before_last = " && $(step) < ${cons_last}";
   std::ostringstream s;
   s << "# phase 0: frictionless\n"
     << "pair_style      gran/hooke/history ${kn} ${kt} " << num(gamma_n) << " 0.0 0 0\n"

@@ -236,14 +236,14 @@ double consolidation_dt(double alpha, double zeta, double dt_crit);
 
 /// Stage 1's cons_quarter and cons_last (runs end on check steps): the
 /// budget's last check, and the check from which stage 1 runs at critical
-/// damping, demcal's (scene/protocol_steps.hpp, critical_damping_after): a
-/// quarter of cons_max_steps in the simulated time of the undamped step.
-/// `alpha`: stage 1's, demcal's consolidation α (shrunk for contact
-/// dashpots); `max_steps` the exported budget, for the comment. Unshrunk
-/// (alpha = AlgorithmSpec{}.dt_ratio): a quarter of cons_max_steps, the
-/// lines as before; shrunk by S: the first check at or after
-/// (cons_max_steps/4)/S steps, at most the last, computed by LAMMPS from
-/// cons_max_steps with S's 17 digits (the same doubles as demcal's).
+/// damping, demcal's (scene/biaxial.hpp, critical_damping_after): the first
+/// check at or after a quarter of cons_max_steps in the simulated time of
+/// the undamped step, (cons_max_steps/4)/S steps, S the step shrink
+/// (consolidation_step_shrink: 1 without contact dashpots), at most the
+/// last, computed by LAMMPS from cons_max_steps with S's 17 digits (the
+/// same doubles as demcal's). `alpha`: stage 1's, demcal's consolidation α
+/// (shrunk for contact dashpots); `max_steps` the exported budget, for the
+/// comment.
 std::string lammps_consolidation_quarter(double alpha, int64_t max_steps);
 
 /// Stage 1's fix viscous per radius class, gamma[k] for type k+1.
@@ -260,12 +260,11 @@ std::string lammps_consolidation_criterion(int dimension,
                                            const std::vector<std::string>& axis_names);
 
 /// Stage 1's runs: frictionless, then friction on, each until static;
-/// critical damping (`critical`: its fix viscous line, step dt_damped) once a
-/// quarter of the budget has passed (cons_quarter: lammps_consolidation_
-/// quarter of the same `alpha`, whose quarter may then be the budget's end);
-/// quit 2 when the budget is spent.
-std::string lammps_consolidation_runs(double gamma_n, double dt_damped, const std::string& critical,
-                                      double alpha);
+/// critical damping (`critical`: its fix viscous line, step dt_damped) from
+/// cons_quarter (lammps_consolidation_quarter), none when that is the
+/// budget's end; quit 2 when the budget is spent.
+std::string lammps_consolidation_runs(double gamma_n, double dt_damped,
+                                      const std::string& critical);
 
 /// Where stage 1 leaves a wall (i its index in `walls`, cons_pos's column
 /// i+1): placed by its contacts, F = kn_wall·sum of overlaps (exact for

@@ -725,8 +725,8 @@ std::string lammps_consolidation(const SceneConfig& c, const Plan& plan, double 
   const ConsolidationSteps st = consolidation_steps(c, plan);
   return lammps_consolidation_walls(c, plan, st) +
          deck::lammps_consolidation_criterion(2, consolidation_walls(), {"h", "v"}) +
-         deck::lammps_consolidation_runs(gamma_n, st.dt_damped, consolidation_viscous(c, plan, 1.0),
-                                         st.alpha) +
+         deck::lammps_consolidation_runs(gamma_n, st.dt_damped,
+                                         consolidation_viscous(c, plan, 1.0)) +
          lammps_consolidation_end();
 }
 

@@ -474,7 +474,7 @@ void lammps_3d_consolidation(std::ostream& s, const SceneConfig& c, const Plan3&
   s << deck::lammps_consolidation_servo(walls, {"cons_Ax", "cons_Ay", "cons_Az"}, "", resist)
     << deck::lammps_consolidation_criterion(3, walls, {"x", "y", "z"})
     << deck::lammps_consolidation_runs(deck::contact_gamma_n(c.material, plan.m_mean), dt_damped,
-                                       deck::lammps_consolidation_viscous(critical), alpha)
+                                       deck::lammps_consolidation_viscous(critical))
     << "# the loading starts from here: walls, step 0, spheres at rest. Each wall\n"
     << "# where its contacts put it (F = kn_wall * sum of overlaps, exact for these\n"
     << "# undamped walls), so the loading starts from the forces of the static state.\n";

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -83,6 +84,25 @@ double consolidation_dashpot_coordination(int dimension, double radius_ratio);
 /// wherever the undamped α is (biaxial.cpp says why); 1 without contact
 /// damping (ζ_c ≤ 0).
 double consolidation_dashpot_factor(double zeta_c, int dimension, double r_min, double r_max);
+/// The consolidation's step shrink: its α (`dt_ratio`, the undamped
+/// consolidation's AlgorithmSpec{}.dt_ratio shrunk by
+/// consolidation_dashpot_factor where contact dashpots lower the stable
+/// step) over the undamped consolidation's.
+inline double consolidation_step_shrink(double dt_ratio) {
+  return dt_ratio / AlgorithmSpec{}.dt_ratio;
+}
+/// The step from which the consolidation runs at critical damping (the
+/// first check at or after it switches): a quarter of the budget
+/// `max_steps` in the simulated time of the undamped step, i.e. as many more
+/// steps as the step shrank (`step_shrink`: consolidation_step_shrink;
+/// scene/protocol_steps.hpp run_consolidation says why). The one home of the
+/// formula: demcal's consolidations (2D and 3D) and the exported decks'
+/// stage 1 (src/upscaling, deck::lammps_consolidation_quarter) use it.
+inline int64_t critical_damping_after(int64_t max_steps, double step_shrink) {
+  return step_shrink < 1.0
+             ? static_cast<int64_t>(std::ceil(static_cast<double>(max_steps / 4) / step_shrink))
+             : max_steps / 4;
+}
 /// Compressive pressure on a wall from the particles [Pa].
 double wall_pressure(const World& world, WallSide side);
 
