@@ -1,9 +1,7 @@
 // The triaxial test (triaxial.hpp): the biaxial protocol (biaxial.cpp) with
 // six walls. The servo law, the consolidation damping and its fallback, the
 // static criteria and the divergence handling are the 2D ones; the reasons
-// given there hold here and are not repeated. One difference: the
-// consolidation's servo carries the wall dashpots' share of its last move
-// (consolidation_servo_velocity; without contact damping the 2D law).
+// given there hold here and are not repeated.
 #include "demcal/scene/triaxial.hpp"
 
 #include <algorithm>
@@ -168,12 +166,8 @@ Integration integration_for(const SphereWorld& world, const AlgorithmSpec& algor
 
 namespace {
 
-// The consolidation's walls: run_consolidation (protocol_steps.hpp, shared
-// with 2D) servoes each wall through servo_velocity(world, side, σ3, gain)
-// with side of its Side type; for this one that call finds, by
-// argument-dependent lookup, the overload below, which is
-// consolidation_servo_velocity. Everything else (world.wall,
-// wall_pressure) takes it as the SphereWallSide it holds.
+// The consolidation's walls, as in 2D (biaxial.cpp says how): the servo
+// call of run_consolidation finds consolidation_servo_velocity.
 struct ConsolidationWall {
   explicit ConsolidationWall(int s) : side(static_cast<SphereWallSide>(s)) {}
   operator SphereWallSide() const { return side; }
