@@ -226,8 +226,9 @@ TEST(BiaxialConsolidation, DashpotCoordinationBoundOfOneSizeIsItsClosedForm) {
 
 // The 2D twin of TriaxialScene.DampedConsolidationStepIsBelowTheStableStepOfItsPacking:
 // the consolidation's step with contact dashpots stays below the kernel's
-// dashpot-aware estimate on the packing it consolidated (1.49× at ζ_c
-// 0.3, 1.47× at 0.7).
+// dashpot-aware estimate on the packing it consolidated (1.74× at ζ_c
+// 0.3, 1.68× at 0.7; 1.49× and 1.47× on the packings of the per-step servo
+// law, before consolidation_servo_velocity).
 TEST(BiaxialConsolidation, DampedConsolidationStepIsBelowTheStableStepOfItsPacking) {
   for (const double zeta_c : {0.3, 0.7}) {
     SceneConfig c = scene(R"({"assembly": {"type": "random", "count": 60, "seed": 3},
@@ -245,6 +246,50 @@ TEST(BiaxialConsolidation, DampedConsolidationStepIsBelowTheStableStepOfItsPacki
         "alpha of the packing %.4f (%.2fx)\n",
         zeta_c, alpha, static_cast<long long>(s.steps), stable, stable / alpha);
     EXPECT_LT(alpha, stable) << zeta_c;
+  }
+}
+
+// The 2D twin of TriaxialScene.ConsolidationServoDrivesASteadyErrorAtTheUndampedVelocity:
+// the consolidation's servo (servo_velocity plus servo_carry of the last
+// move) has the undamped law's velocity gain·error·L·t/(n·kn_wall·Δt) as
+// its fixed point; the per-step law reaches kn_wall/R of it; at rest, and
+// whatever the velocity without contact damping, the two laws are equal.
+TEST(BiaxialConsolidation, ConsolidationServoDrivesASteadyErrorAtTheUndampedVelocity) {
+  for (const double zeta_c : {0.0, 0.7}) {
+    SceneConfig c = scene(R"({"assembly": {"type": "random", "count": 60, "seed": 3}})");
+    c.material.contact_damping_ratio = zeta_c;
+    const Assembly a = make_assembly(c);
+    World w(c.material, a.x, a.y, a.r, a.left, a.right, a.bottom, a.top);
+    AlgorithmSpec settle;
+    settle.dt_ratio = 0.05;
+    w.set_integration(integration_for(w, settle));
+    w.update_forces();
+    const double dt = w.integration().dt, kn_wall = c.material.wall.kn;
+    const double gain = c.test.servo_gain;
+    const double target = 1.0;  // [Pa]: far below the move cap
+    for (int s = 0; s < 4; ++s) {
+      const auto side = static_cast<WallSide>(s);
+      const bool vertical = side == kLeft || side == kRight;
+      const double length = vertical ? w.height() : w.width();
+      const double inward = s % 2 == 0 ? 1.0 : -1.0;
+      const double error = target - wall_pressure(w, side);
+      const double undamped = inward * gain * error * length * c.material.thickness /
+                              (std::max(1, w.wall(side).contacts) * kn_wall * dt);
+      const double per_step = servo_velocity(w, side, target, gain);
+      if (zeta_c == 0.0) {
+        w.wall(side).velocity = 0.3 * undamped;  // any velocity: no carry
+        EXPECT_EQ(consolidation_servo_velocity(w, side, target, gain), per_step) << s;
+        EXPECT_NEAR(per_step, undamped, 1e-12 * std::abs(undamped)) << s;
+        continue;
+      }
+      w.wall(side).velocity = 0.0;
+      EXPECT_EQ(consolidation_servo_velocity(w, side, target, gain), per_step) << s;
+      w.wall(side).velocity = undamped;
+      EXPECT_NEAR(consolidation_servo_velocity(w, side, target, gain), undamped,
+                  1e-12 * std::abs(undamped))
+          << s;
+      EXPECT_LT(std::abs(per_step), 0.1 * std::abs(undamped)) << s;
+    }
   }
 }
 

@@ -156,7 +156,15 @@ double consolidation_dashpot_factor(double zeta_c, int dimension, double r_min, 
       zeta_c * std::sqrt(consolidation_dashpot_coordination(dimension, r_max / r_min)));
 }
 
-double servo_velocity(const World& world, WallSide side, double target_stress, double gain) {
+namespace {
+
+// servo_velocity's move before the cap [m, toward the sample] and its R.
+struct ServoMove {
+  double move;
+  double resistance;
+};
+
+ServoMove servo_move(const World& world, WallSide side, double target_stress, double gain) {
   const bool vertical = side == kLeft || side == kRight;
   const double length = vertical ? world.height() : world.width();
   const double dt = world.integration().dt;
@@ -173,12 +181,31 @@ double servo_velocity(const World& world, WallSide side, double target_stress, d
   const double m_max =
       disk_mass(disk_areal_density(mat, world.integration().mass_scaling), world.max_radius());
   const double resistance = servo_resistance(mat, m_max, dt);
-  double move = gain * error * length * mat.thickness / (resistance * contacts);
-  // Never more than servo_move_cap (kServoMoveCapRatio of the smallest
-  // radius) per step.
+  return {gain * error * length * mat.thickness / (resistance * contacts), resistance};
+}
+
+// Never more than servo_move_cap (kServoMoveCapRatio of the smallest
+// radius) per step.
+double capped_velocity(const World& world, WallSide side, double move) {
   const double cap = servo_move_cap(world.min_radius());
   move = std::clamp(move, -cap, cap);
-  return kInward[side] * move / dt;
+  return kInward[side] * move / world.integration().dt;
+}
+
+}  // namespace
+
+double servo_velocity(const World& world, WallSide side, double target_stress, double gain) {
+  return capped_velocity(world, side, servo_move(world, side, target_stress, gain).move);
+}
+
+double consolidation_servo_velocity(const World& world, WallSide side, double target_stress,
+                                    double gain) {
+  ServoMove m = servo_move(world, side, target_stress, gain);
+  const double carry = servo_carry(world.material().wall.kn, m.resistance);
+  // The last move, toward the sample (velocity·Δt along the inward axis).
+  if (carry > 0.0)
+    m.move += carry * kInward[side] * world.wall(side).velocity * world.integration().dt;
+  return capped_velocity(world, side, m.move);
 }
 
 Integration integration_for(const World& world, const AlgorithmSpec& algorithm) {
@@ -196,6 +223,23 @@ Integration integration_for(const World& world, const AlgorithmSpec& algorithm) 
 }
 
 namespace {
+
+// The consolidation's walls: run_consolidation (protocol_steps.hpp, shared
+// with 3D) servoes each wall through servo_velocity(world, side, σ3, gain)
+// with side of its Side type; for this one that call finds, by
+// argument-dependent lookup, the overload below, which is
+// consolidation_servo_velocity. Everything else (world.wall,
+// wall_pressure) takes it as the WallSide it holds.
+struct ConsolidationWall {
+  explicit ConsolidationWall(int s) : side(static_cast<WallSide>(s)) {}
+  operator WallSide() const { return side; }
+  WallSide side;
+};
+
+[[maybe_unused]] double servo_velocity(const World& world, ConsolidationWall wall,
+                                       double target_stress, double gain) {
+  return consolidation_servo_velocity(world, wall.side, target_stress, gain);
+}
 
 ConsolidatedState consolidate_fresh(const SceneConfig& config, const Assembly& assembly,
                                     const ConsolidationOptions& options) {
@@ -219,8 +263,8 @@ ConsolidatedState consolidate_fresh(const SceneConfig& config, const Assembly& a
   // wherever α is without them (consolidation_dashpot_factor).
   settle.dt_ratio *= consolidation_dashpot_factor(config.material.contact_damping_ratio, 2,
                                                   world.min_radius(), world.max_radius());
-  const detail::ConsolidationOutcome o =
-      detail::run_consolidation<WallSide, 4>(world, test, mu, settle, integration_for, options);
+  const detail::ConsolidationOutcome o = detail::run_consolidation<ConsolidationWall, 4>(
+      world, test, mu, settle, integration_for, options);
   for (int i = 0; i < world.size(); ++i) world.set_velocity(i, 0.0, 0.0, 0.0);
   world.update_forces();
   // Every trial starts from this state: number the particles so that the

@@ -103,8 +103,16 @@ double wall_pressure(const SphereWorld& world, SphereWallSide side) {
   return -inward(side) * world.wall(side).force[side / 2] / wall_area(world, side);
 }
 
-double servo_velocity(const SphereWorld& world, SphereWallSide side, double target_stress,
-                      double gain) {
+namespace {
+
+// servo_velocity's move before the cap [m, toward the sample] and its R.
+struct ServoMove {
+  double move;
+  double resistance;
+};
+
+ServoMove servo_move(const SphereWorld& world, SphereWallSide side, double target_stress,
+                     double gain) {
   const double dt = world.integration().dt;
   const int contacts = std::max(1, world.wall(side).contacts);
   const double error = target_stress - wall_pressure(world, side);
@@ -115,10 +123,30 @@ double servo_velocity(const SphereWorld& world, SphereWallSide side, double targ
   const double m_max =
       sphere_mass(mat.density * world.integration().mass_scaling, world.max_radius());
   const double resistance = servo_resistance(mat.wall.kn, mat.contact_damping_ratio, m_max, dt);
-  double move = gain * error * wall_area(world, side) / (resistance * contacts);
+  return {gain * error * wall_area(world, side) / (resistance * contacts), resistance};
+}
+
+double capped_velocity(const SphereWorld& world, SphereWallSide side, double move) {
   const double cap = servo_move_cap(world.min_radius());
   move = std::clamp(move, -cap, cap);
-  return inward(side) * move / dt;
+  return inward(side) * move / world.integration().dt;
+}
+
+}  // namespace
+
+double servo_velocity(const SphereWorld& world, SphereWallSide side, double target_stress,
+                      double gain) {
+  return capped_velocity(world, side, servo_move(world, side, target_stress, gain).move);
+}
+
+double consolidation_servo_velocity(const SphereWorld& world, SphereWallSide side,
+                                    double target_stress, double gain) {
+  ServoMove m = servo_move(world, side, target_stress, gain);
+  const double carry = servo_carry(world.material().wall.kn, m.resistance);
+  // The last move, toward the sample (velocity·Δt along the inward axis).
+  if (carry > 0.0)
+    m.move += carry * inward(side) * world.wall(side).velocity * world.integration().dt;
+  return capped_velocity(world, side, m.move);
 }
 
 Integration integration_for(const SphereWorld& world, const AlgorithmSpec& algorithm) {
@@ -138,6 +166,19 @@ Integration integration_for(const SphereWorld& world, const AlgorithmSpec& algor
 
 namespace {
 
+// The consolidation's walls, as in 2D (biaxial.cpp says how): the servo
+// call of run_consolidation finds consolidation_servo_velocity.
+struct ConsolidationWall {
+  explicit ConsolidationWall(int s) : side(static_cast<SphereWallSide>(s)) {}
+  operator SphereWallSide() const { return side; }
+  SphereWallSide side;
+};
+
+[[maybe_unused]] double servo_velocity(const SphereWorld& world, ConsolidationWall wall,
+                                       double target_stress, double gain) {
+  return consolidation_servo_velocity(world, wall.side, target_stress, gain);
+}
+
 TriaxialState consolidate_fresh(const SceneConfig& config, const SphereAssembly& assembly,
                                 const ConsolidationOptions& options) {
   const auto t0 = std::chrono::steady_clock::now();
@@ -152,7 +193,7 @@ TriaxialState consolidate_fresh(const SceneConfig& config, const SphereAssembly&
   // Contact dashpots lower the stable step: α shrunk as in 2D (biaxial.cpp).
   settle.dt_ratio *= consolidation_dashpot_factor(config.material.contact_damping_ratio, 3,
                                                   world.min_radius(), world.max_radius());
-  const detail::ConsolidationOutcome o = detail::run_consolidation<SphereWallSide, 6>(
+  const detail::ConsolidationOutcome o = detail::run_consolidation<ConsolidationWall, 6>(
       world, test, mu, settle, integration_for, options);
   for (int i = 0; i < world.size(); ++i)
     world.set_velocity(i, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());

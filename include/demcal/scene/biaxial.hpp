@@ -55,6 +55,13 @@ inline double servo_move_cap(double r_min) { return kServoMoveCapRatio * r_min; 
 /// sample (see TestSpec::servo_gain), R = servo_resistance(). Returns the
 /// wall velocity.
 double servo_velocity(const World& world, WallSide side, double target_stress, double gain);
+/// The consolidation's servo: servo_velocity's move plus servo_carry of the
+/// wall's last move (its current velocity, which only this servo sets
+/// during the consolidation), at most servo_move_cap. Without contact
+/// damping the carry is 0 and this is servo_velocity, bit for bit. The
+/// loading keeps servo_velocity (the exported decks' law).
+double consolidation_servo_velocity(const World& world, WallSide side, double target_stress,
+                                    double gain);
 /// The wall contacts' dashpot c = 2ζ_c·sqrt(kn_wall·m_max) [N·s/m] of the
 /// heaviest particle (mass m_max, with the run's mass scaling): the most
 /// damping; 0 without contact damping (ζ_c ≤ 0). The one formula of the 2D
@@ -70,6 +77,21 @@ double servo_wall_dashpot(const Material& material, double m_max);
 double servo_resistance(double kn_wall, double zeta_c, double m_max, double dt);
 /// servo_resistance with the material's kn_wall and ζ_c.
 double servo_resistance(const Material& material, double m_max, double dt);
+/// The share of its last move that the consolidation's servo carries into
+/// the next (consolidation_servo_velocity, 2D and 3D): (R −
+/// kn_wall)/R = (c/Δt)/R, R = servo_resistance; 0 without contact damping.
+/// A wall already moving at v has the dashpot force c·v of that motion in
+/// its reading; a move u_k changes the wall force within the step by
+/// kn_wall·u_k + c·(u_k − u_{k−1})/Δt per contact (the dashpot sees the
+/// change of velocity). The move that changes it by gain·error is then
+/// gain·error/R + servo_carry·u_{k−1}: the step's response is the per-step
+/// law's (R), and a steady error drives the wall at the undamped law's
+/// velocity gain·error/(kn_wall·Δt), not the kn_wall/R of it that the
+/// per-step law reaches (reports/robustness.md, "The 3D consolidation at
+/// contact damping 0.7").
+inline double servo_carry(double kn_wall, double resistance) {
+  return resistance > kn_wall ? (resistance - kn_wall) / resistance : 0.0;
+}
 /// Λ, the bound on the dashpot network's "reduced-mass Laplacian"
 /// G = Σ m_eff·b·bᵀ over the contacts (walls included) against the mass
 /// matrix, vᵀGv ≤ Λ·vᵀMv, for any packing of particles of one density with

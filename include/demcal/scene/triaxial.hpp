@@ -71,6 +71,13 @@ double wall_pressure(const SphereWorld& world, SphereWallSide side);
 /// scaling). Returns the wall velocity along its axis.
 double servo_velocity(const SphereWorld& world, SphereWallSide side, double target_stress,
                       double gain);
+/// The consolidation's servo: servo_velocity's move plus servo_carry
+/// (biaxial.hpp) of the wall's last move (its current velocity, which only
+/// this servo sets during the consolidation), at most servo_move_cap.
+/// Without contact damping the carry is 0 and this is servo_velocity, bit
+/// for bit. The loading keeps servo_velocity (the exported decks' law).
+double consolidation_servo_velocity(const SphereWorld& world, SphereWallSide side,
+                                    double target_stress, double gain);
 
 /// Absolute integration parameters for an algorithm spec: Δt = α·Δt_crit
 /// with Δt_crit from the kernel's masses at the spec's mass scaling
