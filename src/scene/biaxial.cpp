@@ -224,23 +224,6 @@ Integration integration_for(const World& world, const AlgorithmSpec& algorithm) 
 
 namespace {
 
-// The consolidation's walls: run_consolidation (protocol_steps.hpp, shared
-// with 3D) servoes each wall through servo_velocity(world, side, σ3, gain)
-// with side of its Side type; for this one that call finds, by
-// argument-dependent lookup, the overload below, which is
-// consolidation_servo_velocity. Everything else (world.wall,
-// wall_pressure) takes it as the WallSide it holds.
-struct ConsolidationWall {
-  explicit ConsolidationWall(int s) : side(static_cast<WallSide>(s)) {}
-  operator WallSide() const { return side; }
-  WallSide side;
-};
-
-[[maybe_unused]] double servo_velocity(const World& world, ConsolidationWall wall,
-                                       double target_stress, double gain) {
-  return consolidation_servo_velocity(world, wall.side, target_stress, gain);
-}
-
 ConsolidatedState consolidate_fresh(const SceneConfig& config, const Assembly& assembly,
                                     const ConsolidationOptions& options) {
   const auto t0 = std::chrono::steady_clock::now();
@@ -263,8 +246,8 @@ ConsolidatedState consolidate_fresh(const SceneConfig& config, const Assembly& a
   // wherever α is without them (consolidation_dashpot_factor).
   settle.dt_ratio *= consolidation_dashpot_factor(config.material.contact_damping_ratio, 2,
                                                   world.min_radius(), world.max_radius());
-  const detail::ConsolidationOutcome o = detail::run_consolidation<ConsolidationWall, 4>(
-      world, test, mu, settle, integration_for, options);
+  const detail::ConsolidationOutcome o =
+      detail::run_consolidation<WallSide, 4>(world, test, mu, settle, integration_for, options);
   for (int i = 0; i < world.size(); ++i) world.set_velocity(i, 0.0, 0.0, 0.0);
   world.update_forces();
   // Every trial starts from this state: number the particles so that the

@@ -166,19 +166,6 @@ Integration integration_for(const SphereWorld& world, const AlgorithmSpec& algor
 
 namespace {
 
-// The consolidation's walls, as in 2D (biaxial.cpp says how): the servo
-// call of run_consolidation finds consolidation_servo_velocity.
-struct ConsolidationWall {
-  explicit ConsolidationWall(int s) : side(static_cast<SphereWallSide>(s)) {}
-  operator SphereWallSide() const { return side; }
-  SphereWallSide side;
-};
-
-[[maybe_unused]] double servo_velocity(const SphereWorld& world, ConsolidationWall wall,
-                                       double target_stress, double gain) {
-  return consolidation_servo_velocity(world, wall.side, target_stress, gain);
-}
-
 TriaxialState consolidate_fresh(const SceneConfig& config, const SphereAssembly& assembly,
                                 const ConsolidationOptions& options) {
   const auto t0 = std::chrono::steady_clock::now();
@@ -193,7 +180,7 @@ TriaxialState consolidate_fresh(const SceneConfig& config, const SphereAssembly&
   // Contact dashpots lower the stable step: α shrunk as in 2D (biaxial.cpp).
   settle.dt_ratio *= consolidation_dashpot_factor(config.material.contact_damping_ratio, 3,
                                                   world.min_radius(), world.max_radius());
-  const detail::ConsolidationOutcome o = detail::run_consolidation<ConsolidationWall, 6>(
+  const detail::ConsolidationOutcome o = detail::run_consolidation<SphereWallSide, 6>(
       world, test, mu, settle, integration_for, options);
   for (int i = 0; i < world.size(); ++i)
     world.set_velocity(i, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
