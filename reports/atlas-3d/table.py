@@ -9,7 +9,7 @@ file's reference (e.g. a longer run measured afterwards).
 --tighten F: force balance and servo tolerances multiplied by F (a 3D
 tolerance candidate derived from the table).
 --3d: the 3D default tolerances (triaxial_tolerances(): force balance 0.0064,
-servo 0.0020) and the rotational drag criterion (tolerance 0.005), read from
+servo 0.0020) and the rotational drag criterion (tolerance 0.003, kRotationalDragTolerance), read from
 the run's criteria_planes; a trial record has it folded into moment balance.
 """
 import json, sys
@@ -24,7 +24,7 @@ three_d = "--3d" in sys.argv
 if three_d:
     TOL["force_balance"] = 0.0064
     TOL["servo"] = 0.0020
-DRAG_TOL = 0.005
+DRAG_TOL = 0.003  # kRotationalDragTolerance (scoring/triaxial_scoring.hpp)
 target = float(sys.argv[sys.argv.index("--target") + 1]) if "--target" in sys.argv else 0.02
 lines = [json.loads(l) for l in open(path)]
 head, runs = lines[0], lines[1:]
