@@ -390,12 +390,13 @@ std::string lammps_consolidation_servo(const std::vector<ConsolidationWall>& wal
   std::ostringstream s;
   s << "# The servo, one move per step and wall toward the sample when p < sigma3:\n";
   if (carry > 0.0)
-    s << "#   move = gain*(sigma3*A - F)/(R*max(1, n)) + carry*(its last move),\n"
-      << "# clamped to +-cap: demcal's consolidation servo (consolidation_servo_velocity):\n"
-      << "# a wall already moving has its dashpots' force of that motion in F, so the\n"
-      << "# move carries carry = (R - kn_wall)/R of its last one (the walls start at\n"
-      << "# rest), R that of this step dt (cons_carry follows the switch to critical\n"
-      << "# damping); the last moves, as applied, are kept by fix cons_prev (after fix\n"
+    s << "#   move = gain*(sigma3*A - F)/(R*max(1, n)) + carry*u, clamped to +-cap,\n"
+      << "# u the wall's last move (demcal's consolidation servo,\n"
+      << "# consolidation_servo_velocity: demcal's walls have dashpots, whose force of\n"
+      << "# a moving wall is in its F, so a move carries carry = (R - kn_wall)/R of the\n"
+      << "# last; these walls have none, the law is demcal's; R at this step's dt, and\n"
+      << "# cons_carry with it from the switch to critical damping; u is 0 before the\n"
+      << "# first step, the walls start at rest, then kept by fix cons_prev, after fix\n"
       << "# cons_servo: at this step's end it still holds the step before's),\n";
   else
     s << "#   move = gain*(sigma3*A - F)/(R*max(1, n)), clamped to +-cap,\n";
