@@ -1,17 +1,22 @@
 // Stage 1 of the LAMMPS decks that consolidate themselves (--consolidate-in
 // deck): every wall's servo move in one vector-style formula is the per-wall
 // formula, bit for bit (reports/engines.md §17); with contact dashpots the
-// critical-damping fallback comes at demcal's check (§21).
+// critical-damping fallback comes at demcal's check (§21) and the servo
+// carries its last move as demcal's consolidation servo (§23).
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
+#include <functional>
+#include <map>
 #include <regex>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "demcal/kernel/particle_scales.hpp"
 #include "demcal/scene/biaxial.hpp"
 #include "demcal/scene/config.hpp"
 #include "demcal/scene/packing.hpp"
@@ -74,7 +79,10 @@ void expect_per_wall_bit_for_bit(const std::string& lmp, const ExportResult& r,
   const std::string head =
       "variable        cons_rawv vector ${gain}*(f_cons_sign*${sigma3}*f_cons_len" + tail +
       "-c_cons_wf)/(";
-  const std::string foot = "*(c_cons_wn+!c_cons_wn))\n";
+  // with contact dashpots the carry of the last moves (f_cons_prev) follows
+  const std::string carry_tail = "+v_cons_carry*f_cons_prev\n";
+  const bool carried = rawv.ends_with(carry_tail);
+  const std::string foot = "*(c_cons_wn+!c_cons_wn))" + (carried ? carry_tail : "\n");
   ASSERT_EQ(rawv.rfind(head, 0), 0u) << rawv;
   ASSERT_GT(rawv.size(), head.size() + foot.size()) << rawv;
   ASSERT_EQ(rawv.substr(rawv.size() - foot.size()), foot) << rawv;
@@ -94,9 +102,13 @@ void expect_per_wall_bit_for_bit(const std::string& lmp, const ExportResult& r,
   for (size_t k = 0; k < walls; ++k) {
     const std::string i = std::to_string(k + 1), n = "c_cons_wn[" + i + "]";
     const bool min = k % 2 == 0;
+    // (a max wall's inward move: its last move along +axis negated)
     const std::string raw = "${gain}*(${sigma3}*v_" + area[k] + tail + (min ? "-" : "+") +
                             "c_cons_wf[" + i + "])/(" + resist + "*(1+" + n + "+abs(1-" + n +
-                            "))/2)";
+                            "))/2)" +
+                            (carried ? "+v_cons_carry*" + std::string(min ? "" : "(-") +
+                                           "f_cons_prev[" + i + "]" + (min ? "" : ")")
+                                     : "");
     per_wall_moves +=
         "variable        cons_m" + i + " equal " + (min ? "" : "-") + clamp(raw) + "\n";
     names += " v_cons_m" + i;
@@ -119,6 +131,16 @@ void expect_per_wall_bit_for_bit(const std::string& lmp, const ExportResult& r,
                                      "\nfix             cons_servo all ave/time 1 1 1" + names +
                                      " ave running\n";
   std::string per_wall_deck = replaced(r.deck, servo, per_wall_moves + per_wall_fixes);
+  if (carried) {
+    // the last moves: the per-wall ones (fix cons_prev after cons_servo)
+    std::string prev_fix = "fix             cons_prev all ave/time 1 1 1", last;
+    for (size_t k = 0; k < walls; ++k) {
+      prev_fix += " v_cons_movev[" + std::to_string(k + 1) + "]";
+      last += " f_moves[" + std::to_string(k + 1) + "]";
+    }
+    per_wall_deck = replaced(per_wall_deck, prev_fix + "\n",
+                             "fix             cons_prev all ave/time 1 1 1" + last + "\n");
+  }
   per_wall_deck = replaced(per_wall_deck, "unfix           cons_servo\n",
                            "unfix           cons_servo\nunfix           moves\n");
   std::string fix_moves;
@@ -403,7 +425,8 @@ TEST(EngineLammpsStage1, TheCriticalFallbackComesAtDemcalsCheck) {
 // certifies within a modest budget, as demcal's does: 200 disks of
 // random_400, budget 120 000 steps. Its fallback comes at demcal's check,
 // (30 000/S) steps (63 800), and the packing is static before it, at light
-// damping throughout (the deck 37 000 steps, demcal 33 400). The deck before
+// damping throughout (the deck 17 400 steps, demcal 39 400, both servoes
+// carrying their last moves; 37 000 without the deck's carry, §23). The deck before
 // switched to critical damping at a quarter of the budget in steps (30 000),
 // before the packing was static (with the older, smaller step it then crept
 // to the end of the budget: quit 2, engines.md §21).
@@ -455,6 +478,196 @@ TEST(EngineLammpsStage1, WithContactDashpotsTheDeckConsolidatesARandomSampleWith
       "in %lld\n",
       static_cast<long long>(c.test.consolidation_max_steps), deck_steps,
       static_cast<long long>(d.steps));
+}
+
+/// A step for a message, 10 significant digits.
+std::string deck_number(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.10g", v);
+  return b;
+}
+
+/// Stage 1 of a deck with contact dashpots (`r`, of scene `c`), traced at
+/// every step: each wall's position, contact count n, force F on the
+/// particles and the move the deck computed, with the step dt. Every move
+/// must be demcal's consolidation servo (consolidation_servo_velocity,
+/// scene/biaxial.hpp), clamp(gain*(sigma3*A - F)/(R*max(1, n)) +
+/// carry*u_prev, +-cap) along +axis (a max wall's load -sigma3*A), R =
+/// servo_resistance(kn_wall, zeta_c, m_max, dt) at the row's dt, carry =
+/// servo_carry(kn_wall, R), A from the traced positions (`area`), u_prev
+/// the wall's move of the step before (0 at the first: the walls start at
+/// rest); and each move must be the one applied: the wall's position one
+/// step later is its position plus the move. Tolerance: 1e-9 of |law| +
+/// |carry*u_prev| (the 2D deck writes the wall dashpot's c with 10
+/// digits; the rest is rounding, 1e-15). The budget is edited to `budget`
+/// so that the critical-damping switch (a smaller dt: R and the carry
+/// change) comes within the trace, and the cap to `cap` r_min so that the
+/// clamp binds at some steps and not at others. `positions`: the deck's
+/// position variables, walls in cons_wn's order.
+void expect_the_servo_carries_its_last_move(
+    const std::string& lmp, const ExportResult& r, const SceneConfig& c, double m_max,
+    const std::vector<std::string>& positions,
+    const std::function<double(const std::vector<double>&, size_t)>& area, int64_t budget,
+    const std::string& cap, const std::string& tag) {
+  const size_t walls = positions.size();
+  const std::string servo =
+      "fix             cons_servo all ave/time 1 1 1 v_cons_movev mode "
+      "vector ave running\n";
+  ASSERT_NE(r.deck.find(servo), std::string::npos);
+  // the trace before fix cons_servo: the positions where this step's forces
+  // were computed (cons_servo's running sum then takes this step's move)
+  std::string row = "$(step) $(dt:%.17g)";
+  for (size_t k = 0; k < walls; ++k) {
+    const std::string i = std::to_string(k + 1);
+    row += " $(v_" + positions[k] + ":%.17g) $(c_cons_wn[" + i + "]:%.17g) $(c_cons_wf[" + i +
+           "]:%.17g) $(v_cons_movev[" + i + "]:%.17g)";
+  }
+  std::string deck = replaced(
+      r.deck, servo,
+      "fix             trace all print 1 \"" + row + "\" file trace.txt screen no\n" + servo);
+  deck = replaced(deck, "unfix           cons_servo\n",
+                  "unfix           trace\nunfix           cons_servo\n");
+  deck = replaced(deck, line_of(deck, "variable cons_max_steps equal "),
+                  "variable cons_max_steps equal " + std::to_string(budget) + "\n");
+  deck = replaced(deck, "variable        cap equal $(0.02*v_r_min)",
+                  "variable        cap equal $(" + cap + "*v_r_min)");
+  const test::TempDir dir(tag);
+  const test::DeckRun run =
+      test::run_deck(lmp, dir.path(), deck, r.files, {"-var", "run_steps", "0", "-screen", "none"});
+  // static within the budget (0) or not (2: quit at the budget's end)
+  ASSERT_TRUE(run.status == 0 || run.status == 2) << run.log;
+  EXPECT_EQ(run.log.find("ERROR"), std::string::npos) << run.log;
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(run.log, m, std::regex("\nvariable +cap equal ([-+0-9.e]+)\n")));
+  const double cap_value = std::stod(m[1].str());
+  // the rows by step: a run's setup prints its first step again (keep the
+  // first row, that of the step's end)
+  std::map<int64_t, std::vector<double>> rows;
+  std::stringstream text(test::read_text(dir / "trace.txt"));
+  for (std::string line; std::getline(text, line);) {
+    if (line.empty() || line[0] == '#') continue;
+    std::stringstream fields(line);
+    std::vector<double> v;
+    for (double x; fields >> x;) v.push_back(x);
+    ASSERT_EQ(v.size(), 2 + 4 * walls) << line;
+    rows.emplace(static_cast<int64_t>(v[0]), v);
+  }
+  ASSERT_GE(rows.size(), 1000u);
+  ASSERT_EQ(rows.begin()->first, 0);
+  ASSERT_EQ(rows.rbegin()->first, static_cast<int64_t>(rows.size()) - 1) << "a step is missing";
+  const double kn_wall = c.material.wall.kn, zeta_c = c.material.contact_damping_ratio;
+  const double sigma3 = c.test.lateral_stress, gain = c.test.servo_gain;
+  std::vector<double> prev(walls, 0.0), last_position(walls, 0.0);
+  std::map<double, int> carried;  // per dt: free moves whose carry term is >= 10 % of the law's
+  int clamped = 0, free = 0;
+  for (const auto& [step, v] : rows) {
+    SCOPED_TRACE("step " + std::to_string(step));
+    const double dt = v[1];
+    const double resist = servo_resistance(kn_wall, zeta_c, m_max, dt);
+    const double carry = servo_carry(kn_wall, resist);
+    std::vector<double> position(walls);
+    for (size_t k = 0; k < walls; ++k) position[k] = v[2 + 4 * k];
+    for (size_t k = 0; k < walls; ++k) {
+      const double n = v[3 + 4 * k], force = v[4 + 4 * k], move = v[5 + 4 * k];
+      const double load = (k % 2 == 0 ? 1.0 : -1.0) * sigma3 * area(position, k);
+      const double law = gain * (load - force) / (resist * std::max(1.0, n));
+      const double expected = std::clamp(law + carry * prev[k], -cap_value, cap_value);
+      const double scale = std::abs(law) + carry * std::abs(prev[k]);
+      ASSERT_LE(std::abs(move - expected), 1e-9 * scale)
+          << "wall " << k << ": move " << move << ", demcal's law " << expected << " (law " << law
+          << ", carry " << carry << ", last move " << prev[k] << ")";
+      if (step > 0) {
+        // the move of the step before, applied: the position is x0 + the
+        // running mean times the steps, rounded to 1e-16 of the box
+        const double box = std::abs(position[k]) + std::abs(position[k ^ 1]);
+        EXPECT_NEAR(position[k] - last_position[k], prev[k], 1e-13 * box + 1e-9 * std::abs(prev[k]))
+            << "wall " << k;
+      }
+      if (std::abs(move) > (1 - 1e-9) * cap_value) {
+        ++clamped;
+      } else {
+        ++free;
+        if (carry * std::abs(prev[k]) >= 0.1 * std::abs(law)) ++carried[dt];
+      }
+      prev[k] = move;
+    }
+    last_position = position;
+  }
+  EXPECT_GT(clamped, 100) << "the clamp never bound";
+  EXPECT_GT(free, 100) << "the clamp always bound";
+  // both steps (light damping, then critical from the switch), and in each
+  // the carry weighed in the free moves
+  std::string counts;
+  for (const auto& [dt, count] : carried)
+    counts += ", at dt " + deck_number(dt) + " " + std::to_string(count) + " carried";
+  std::printf("%s: %zu steps, %d moves clamped, %d free%s\n", tag.c_str(), rows.size(), clamped,
+              free, counts.c_str());
+  ASSERT_EQ(carried.size(), 2u) << "the trace does not cross the critical-damping switch";
+  for (const auto& [dt, count] : carried) EXPECT_GT(count, 100) << "dt " << dt;
+}
+
+// demcal's consolidation servo with contact damping carries (R - kn_wall)/R
+// of each wall's last move (consolidation_servo_velocity: robustness.md, "The
+// 3D consolidation at contact damping 0.7"); the decks' stage 1 must too, with
+// R at its step, at light and at critical damping. 100 disks of random_400 and
+// 60 spheres of random_500_3d at zeta_c 0.3, budget 4 000 steps (the switch at
+// 2 200 and 2 800: demcal's check of (1 000/S) steps), the cap at 5e-4 r_min
+// (the export's 0.02 does not bind on these samples). The deck before moved
+// each wall by the per-step law alone: its moves miss the law by the carry
+// term, 0.84 of the last move at light damping.
+TEST(EngineLammpsStage1, WithContactDashpotsTheServoCarriesItsLastMoveAsDemcals2D) {
+  const std::string lmp = test::find_on_path("lmp");
+  if (lmp.empty())
+    GTEST_SKIP() << "LAMMPS (lmp) is not installed (apt-get install lammps): the deck is not run";
+  SceneConfig c = load_config(test::shipped_config("random_400"));
+  c.assembly.count = 100;
+  c.material.contact_damping_ratio = 0.3;
+  AlgorithmSpec p;
+  p.steps = 8000;
+  p.damping_ratio_rotation = 0.0;
+  ExportOptions o;
+  o.data_name = "r.data";
+  o.consolidate_in_deck = true;
+  const Assembly a = make_assembly(c);
+  const ExportResult r = export_deck(c, p, a, o);
+  // the heaviest disc, with this run's mass scaling: the wall dashpot's
+  const double m_max = disk_mass(disk_areal_density(c.material, p.mass_scaling),
+                                 *std::max_element(a.r.begin(), a.r.end()));
+  const double thick = c.material.thickness;
+  expect_the_servo_carries_its_last_move(
+      lmp, r, c, m_max, {"cons_xl", "cons_xr", "cons_yb", "cons_yt"},
+      [thick](const std::vector<double>& x, size_t k) {
+        return (k < 2 ? x[3] - x[2] : x[1] - x[0]) * thick;
+      },
+      4000, "0.002", "engine_stage1_carry_2d");
+}
+
+TEST(EngineLammpsStage1, WithContactDashpotsTheServoCarriesItsLastMoveAsDemcals3D) {
+  const std::string lmp = test::find_on_path("lmp");
+  if (lmp.empty())
+    GTEST_SKIP() << "LAMMPS (lmp) is not installed (apt-get install lammps): the deck is not run";
+  SceneConfig c = load_config(test::shipped_config("random_500_3d"));
+  c.assembly.count = 60;
+  c.material.contact_damping_ratio = 0.3;
+  AlgorithmSpec p;
+  p.steps = 8000;
+  p.damping_ratio_rotation = 0.0;
+  Export3dOptions o;
+  o.data_name = "r.data";
+  o.consolidate_in_deck = true;
+  const SphereAssembly a = make_sphere_assembly(c);
+  const ExportResult r = export_3d_decks(c, p, a, o);
+  const double m_max =
+      sphere_mass(c.material.density * p.mass_scaling, *std::max_element(a.r.begin(), a.r.end()));
+  // A of an x wall L_y*L_z, of a y wall L_z*L_x, of a z wall L_x*L_y
+  expect_the_servo_carries_its_last_move(
+      lmp, r, c, m_max,
+      {"cons_xmin", "cons_xmax", "cons_ymin", "cons_ymax", "cons_zmin", "cons_zmax"},
+      [](const std::vector<double>& x, size_t k) {
+        const size_t a = k / 2, b = (a + 1) % 3, d = (a + 2) % 3;
+        return (x[2 * b + 1] - x[2 * b]) * (x[2 * d + 1] - x[2 * d]);
+      },
+      4000, "0.0005", "engine_stage1_carry_3d");
 }
 
 }  // namespace

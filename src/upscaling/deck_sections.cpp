@@ -379,13 +379,28 @@ std::string lammps_consolidation_reductions(const std::vector<ConsolidationWall>
          n + "\ncompute         cons_wf all reduce sum" + f + "\n";
 }
 
+double consolidation_carry(const Material& m, double m_max, double dt) {
+  return servo_carry(m.wall.kn, servo_resistance(m, m_max, dt));
+}
+
 std::string lammps_consolidation_servo(const std::vector<ConsolidationWall>& walls,
                                        const std::vector<std::string>& area,
-                                       const std::string& area_tail, const std::string& resist) {
+                                       const std::string& area_tail, const std::string& resist,
+                                       double carry) {
   std::ostringstream s;
-  s << "# The servo, one move per step and wall toward the sample when p < sigma3:\n"
-    << "#   move = gain*(sigma3*A - F)/(R*max(1, n)), clamped to +-cap,\n"
-    << "# all walls in one vector-style formula (elements in cons_wn's order; a max\n"
+  s << "# The servo, one move per step and wall toward the sample when p < sigma3:\n";
+  if (carry > 0.0)
+    s << "#   move = gain*(sigma3*A - F)/(R*max(1, n)) + carry*u, clamped to +-cap,\n"
+      << "# u the wall's last move (demcal's consolidation servo,\n"
+      << "# consolidation_servo_velocity: demcal's walls have dashpots, whose force of\n"
+      << "# a moving wall is in its F, so a move carries carry = (R - kn_wall)/R of the\n"
+      << "# last; these walls have none, the law is demcal's; R at this step's dt, and\n"
+      << "# cons_carry with it from the switch to critical damping; u is 0 before the\n"
+      << "# first step, the walls start at rest, then kept by fix cons_prev, after fix\n"
+      << "# cons_servo: at this step's end it still holds the step before's),\n";
+  else
+    s << "#   move = gain*(sigma3*A - F)/(R*max(1, n)), clamped to +-cap,\n";
+  s << "# all walls in one vector-style formula (elements in cons_wn's order; a max\n"
     << "# wall's with the opposite sign, so that each clamped element is the wall's\n"
     << "# move along +axis), parsed once per step for all, the clamp reading the\n"
     << "# unclamped moves as doubles (a vector variable is evaluated once per step,\n"
@@ -407,13 +422,19 @@ std::string lammps_consolidation_servo(const std::vector<ConsolidationWall>& wal
     << "fix             cons_len all ave/time 1 1 1" << len << "\n"
     << "variable        cons_one internal 1\n"
     << "variable        cons_mone internal -1\n"
-    << "fix             cons_sign all ave/time 1 1 1" << sign << "\n"
-    << "variable        cons_rawv vector "
+    << "fix             cons_sign all ave/time 1 1 1" << sign << "\n";
+  if (carry > 0.0) s << "variable        cons_carry equal " << exact(carry) << "\n";
+  s << "variable        cons_rawv vector "
     << lammps_servo_raw_of_load("f_cons_sign*${sigma3}*f_cons_len" + area_tail, "-c_cons_wf",
                                 lammps_count_max_one("c_cons_wn"), resist)
-    << "\n"
+    << (carry > 0.0 ? "+v_cons_carry*f_cons_prev" : "") << "\n"
     << "variable        cons_movev vector " << lammps_servo_clamp("v_cons_rawv") << "\n"
     << "fix             cons_servo all ave/time 1 1 1 v_cons_movev mode vector ave running\n";
+  if (carry > 0.0) {
+    s << "fix             cons_prev all ave/time 1 1 1";
+    for (size_t k = 0; k < walls.size(); ++k) s << " v_cons_movev[" << k + 1 << "]";
+    s << "\n";
+  }
   return s.str();
 }
 
@@ -499,8 +520,8 @@ std::string lammps_consolidation_criterion(int dimension,
   return s.str();
 }
 
-std::string lammps_consolidation_runs(double gamma_n, double dt_damped,
-                                      const std::string& critical) {
+std::string lammps_consolidation_runs(double gamma_n, double dt_damped, const std::string& critical,
+                                      double carry_damped) {
   // The quarter may be the budget's end (lammps_consolidation_quarter, a
   // shrunk step's): then stage 1 never switches, as demcal's. Phase 1 runs
   // no step beyond cons_last: phase 0 may end at the budget's last check or
@@ -511,14 +532,17 @@ std::string lammps_consolidation_runs(double gamma_n, double dt_damped,
   // stops after phase 1's first check when that is at or past its budget.
   const std::string may_switch = " && ${cons_quarter} < ${cons_last}";
   const std::string before_last = " && $(step) < ${cons_last}";
+  // with the servo's carry, the carry of the critical step's R
+  const std::string carry =
+      carry_damped > 0.0 ? " \"variable cons_carry equal " + exact(carry_damped) + "\"" : "";
   std::ostringstream s;
   s << "# phase 0: frictionless\n"
     << "pair_style      gran/hooke/history ${kn} ${kt} " << num(gamma_n) << " 0.0 0 0\n"
     << "variable        cons_critical equal 0\n"
     << "run             ${cons_quarter} upto\n"
     << "if              \"${cons_static} == 0" << may_switch << "\" then \"" << critical << "\" &\n"
-    << "                \"timestep " << num(dt_damped) << "\" \"variable cons_critical equal 1\" "
-    << "\"run ${cons_last} upto\"\n"
+    << "                \"timestep " << num(dt_damped) << "\" \"variable cons_critical equal 1\""
+    << carry << " \"run ${cons_last} upto\"\n"
     << "if              \"${cons_static} == 0\" then \"print 'demcal deck: consolidation "
        "(frictionless) did not reach a static state in ${cons_max_steps} steps: raise "
        "cons_max_steps'\" \"quit 2\"\n"
@@ -528,7 +552,8 @@ std::string lammps_consolidation_runs(double gamma_n, double dt_damped,
        "then \"run ${cons_quarter} upto\" else \"run ${cons_check}\"\n"
     << "if              \"${cons_static} == 0 && ${cons_critical} == 0" << may_switch
     << "\" then \"" << critical << "\" &\n"
-    << "                \"timestep " << num(dt_damped) << "\" \"variable cons_critical equal 1\"\n"
+    << "                \"timestep " << num(dt_damped) << "\" \"variable cons_critical equal 1\""
+    << carry << "\n"
     << "if              \"${cons_static} == 0" << before_last
     << "\" then \"run ${cons_last} upto\"\n"
     << "if              \"${cons_static} == 0\" then \"print 'demcal deck: consolidation did "

@@ -220,10 +220,19 @@ std::string lammps_consolidation_reductions(const std::vector<ConsolidationWall>
 /// of that axis's walls (2D: "cons_H", "cons_W" and "*${thick}"; 3D:
 /// "cons_Ax" .. "cons_Az" and ""); `resist` R, e.g. "${kn_wall}". Each element
 /// is, bit for bit, the per-wall formula lammps_servo_move(A, ∓F, n) (negated
-/// for a max wall).
+/// for a max wall). `carry` > 0 (contact damping): demcal's consolidation
+/// servo (consolidation_servo_velocity, scene/biaxial.hpp), the raw move plus
+/// v_cons_carry (defined here as `carry`, consolidation_carry of stage 1's
+/// light step) times the wall's previous clamped move (fix cons_prev, after
+/// cons_servo, 0 before the first step); 0: the per-step law alone.
 std::string lammps_consolidation_servo(const std::vector<ConsolidationWall>& walls,
                                        const std::vector<std::string>& area,
-                                       const std::string& area_tail, const std::string& resist);
+                                       const std::string& area_tail, const std::string& resist,
+                                       double carry = 0.0);
+/// The carry of stage 1's servo at its step `dt`: servo_carry(kn_wall, R),
+/// R = servo_resistance(m, m_max, dt), the R that the deck's raw move
+/// divides by (kn_wall + c/dt); 0 without contact damping.
+double consolidation_carry(const Material& m, double m_max, double dt);
 
 /// Stage 1's lines in the parameters block: consolidate (1: run it), the
 /// scene's test.consolidation_* values (cons_tol, cons_unbalanced,
@@ -262,9 +271,11 @@ std::string lammps_consolidation_criterion(int dimension,
 /// Stage 1's runs: frictionless, then friction on, each until static;
 /// critical damping (`critical`: its fix viscous line, step dt_damped) from
 /// cons_quarter (lammps_consolidation_quarter), none when that is the
-/// budget's end; quit 2 when the budget is spent.
-std::string lammps_consolidation_runs(double gamma_n, double dt_damped,
-                                      const std::string& critical);
+/// budget's end; quit 2 when the budget is spent. `carry_damped` > 0: the
+/// servo's carry (lammps_consolidation_servo's cons_carry) from the switch
+/// on, consolidation_carry at dt_damped.
+std::string lammps_consolidation_runs(double gamma_n, double dt_damped, const std::string& critical,
+                                      double carry_damped = 0.0);
 
 /// Where stage 1 leaves a wall (i its index in `walls`, cons_pos's column
 /// i+1): placed by its contacts, F = kn_wall·sum of overlaps (exact for

@@ -586,6 +586,8 @@ std::string lammps_damping(const AlgorithmSpec& p, const Plan& plan) {
 struct ConsolidationSteps {
   double alpha = 0.0, dt_light = 0.0, dt_damped = 0.0;
   std::string resist;  ///< the servo's R: kn_wall (+ the wall dashpots' c/dt)
+  /// the servo's carry at dt_light and dt_damped (0 without contact damping)
+  double carry_light = 0.0, carry_damped = 0.0;
 };
 
 ConsolidationSteps consolidation_steps(const SceneConfig& c, const Plan& plan) {
@@ -599,6 +601,8 @@ ConsolidationSteps consolidation_steps(const SceneConfig& c, const Plan& plan) {
   // the wall dashpots' c (servo_wall_dashpot: demcal's formula)
   st.resist =
       plan.wall_dashpot > 0.0 ? "(${kn_wall}+" + num(plan.wall_dashpot) + "/dt)" : "${kn_wall}";
+  st.carry_light = deck::consolidation_carry(m, plan.m_max, st.dt_light);
+  st.carry_damped = deck::consolidation_carry(m, plan.m_max, st.dt_damped);
   return st;
 }
 
@@ -639,7 +643,8 @@ std::string lammps_consolidation_walls(const SceneConfig& c, const Plan& plan,
     << "# (each wall: move = gain*(sigma3*L*t - F)/(" << (plan.wall_dashpot > 0.0 ? "R" : "kn_wall")
     << "*max(1, n)) per step, ";
   if (plan.wall_dashpot > 0.0)
-    s << "R =\n# kn_wall + c/dt, c the wall dashpots' (demcal's servo_resistance), cap\n";
+    s << "R =\n# kn_wall + c/dt, c the wall dashpots' (demcal's servo_resistance), plus\n"
+      << "# (R - kn_wall)/R of its last move (demcal's consolidation servo), cap\n";
   else
     s << "cap\n";
   s << "# " << deck::servo_cap_text() << "), global damping zeta " << num(zeta)
@@ -689,12 +694,14 @@ std::string lammps_consolidation_walls(const SceneConfig& c, const Plan& plan,
     << "variable        cons_yt equal v_yt0+v_cons_dyt\n"
     << "variable        cons_H equal v_cons_yt-v_cons_yb\n"
     << "variable        cons_W equal v_cons_xr-v_cons_xl\n"
-    << deck::lammps_consolidation_servo(walls, {"cons_H", "cons_W"}, "*${thick}", st.resist);
+    << deck::lammps_consolidation_servo(walls, {"cons_H", "cons_W"}, "*${thick}", st.resist,
+                                        st.carry_light);
   return s.str();
 }
 
-/// Stage 1's end: the loading's start walls, particles at rest, step 0.
-std::string lammps_consolidation_end() {
+/// Stage 1's end: the loading's start walls, particles at rest, step 0
+/// (`carry`: the servo's fix cons_prev goes too).
+std::string lammps_consolidation_end(bool carry) {
   const std::vector<deck::ConsolidationWall> walls = consolidation_walls();
   const char* start[] = {"xl0", "xr0", "yb0", "yt0"};
   std::ostringstream s;
@@ -709,7 +716,9 @@ std::string lammps_consolidation_end() {
     << "variable        xr_now delete\n"
     << "variable        xl_now index ${xl0}\n"
     << "variable        xr_now index ${xr0}\n"
-    << deck::lammps_consolidation_end(walls, {"cons_twod"});
+    << deck::lammps_consolidation_end(walls,
+                                      carry ? std::vector<std::string>{"cons_twod", "cons_prev"}
+                                            : std::vector<std::string>{"cons_twod"});
   return s.str();
 }
 
@@ -725,9 +734,9 @@ std::string lammps_consolidation(const SceneConfig& c, const Plan& plan, double 
   const ConsolidationSteps st = consolidation_steps(c, plan);
   return lammps_consolidation_walls(c, plan, st) +
          deck::lammps_consolidation_criterion(2, consolidation_walls(), {"h", "v"}) +
-         deck::lammps_consolidation_runs(gamma_n, st.dt_damped,
-                                         consolidation_viscous(c, plan, 1.0)) +
-         lammps_consolidation_end();
+         deck::lammps_consolidation_runs(gamma_n, st.dt_damped, consolidation_viscous(c, plan, 1.0),
+                                         st.carry_damped) +
+         lammps_consolidation_end(st.carry_light > 0.0);
 }
 
 /// Thermo, the run up to run_steps, and the restart a split run continues

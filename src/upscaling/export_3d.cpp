@@ -415,7 +415,8 @@ void lammps_3d_consolidation(std::ostream& s, const SceneConfig& c, const Plan3&
     << "# wall: move = gain*(sigma3*A - F)/(" << resist_name(plan) << "*max(1, n)) per step, ";
   if (plan.wall_dashpot > 0.0)
     s << "R = kn_wall +\n"
-      << "# c/dt, c the wall dashpots' (the number in cons_rawv), A its current\n";
+      << "# c/dt, c the wall dashpots' (the number in cons_rawv), plus (R - kn_wall)/R\n"
+      << "# of its last move (demcal's consolidation servo), A its current\n";
   else
     s << "A its current\n";
   s << "# area, cap " << deck::servo_cap_text() << "), global damping zeta " << num(zeta)
@@ -471,10 +472,15 @@ void lammps_3d_consolidation(std::ostream& s, const SceneConfig& c, const Plan3&
   // (R = kn_wall + c/dt with the wall dashpots: demcal's servo_resistance)
   const std::string resist =
       plan.wall_dashpot > 0.0 ? "(${kn_wall}+" + exact(plan.wall_dashpot) + "/dt)" : "${kn_wall}";
-  s << deck::lammps_consolidation_servo(walls, {"cons_Ax", "cons_Ay", "cons_Az"}, "", resist)
+  // demcal's consolidation servo carries (R - kn_wall)/R of the last move,
+  // R at this phase's step (0 without contact damping)
+  const double carry_light = deck::consolidation_carry(m, plan.m_max, dt_light);
+  const double carry_damped = deck::consolidation_carry(m, plan.m_max, dt_damped);
+  s << deck::lammps_consolidation_servo(walls, {"cons_Ax", "cons_Ay", "cons_Az"}, "", resist,
+                                        carry_light)
     << deck::lammps_consolidation_criterion(3, walls, {"x", "y", "z"})
     << deck::lammps_consolidation_runs(deck::contact_gamma_n(c.material, plan.m_mean), dt_damped,
-                                       deck::lammps_consolidation_viscous(critical))
+                                       deck::lammps_consolidation_viscous(critical), carry_damped)
     << "# the loading starts from here: walls, step 0, spheres at rest. Each wall\n"
     << "# where its contacts put it (F = kn_wall * sum of overlaps, exact for these\n"
     << "# undamped walls), so the loading starts from the forces of the static state.\n";
@@ -482,7 +488,9 @@ void lammps_3d_consolidation(std::ostream& s, const SceneConfig& c, const Plan3&
     s << "variable        " << kWall[sd] << "0 delete\n"
       << "variable        " << kWall[sd] << "0 equal "
       << deck::lammps_consolidated_wall(walls[sd], sd) << "\n";
-  s << deck::lammps_consolidation_end(walls, {});
+  s << deck::lammps_consolidation_end(walls, carry_light > 0.0
+                                                 ? std::vector<std::string>{"cons_prev"}
+                                                 : std::vector<std::string>{});
 }
 
 // The six walls, the contact-force store and the damping.
