@@ -652,7 +652,7 @@ std::string lammps_consolidation_walls(const SceneConfig& c, const Plan& plan,
     << "# rotation; this LAMMPS cannot), particle friction 0 until static, then\n"
     << "# mu until static again; critical damping (zeta 1, timestep * f(1)/f(" << num(zeta)
     << "))\n"
-    << "# once a quarter of cons_max_steps has passed without. Static: every wall\n"
+    << "# from step cons_quarter on if not static by then. Static: every wall\n"
     << "# within cons_tol of sigma3 and the unbalanced-force ratio mean|F_p| / mean\n"
     << "# |f_c| below cons_unbalanced (demcal's test.consolidation_* values), checked\n"
     << "# every cons_check steps by fix halt; |f_c| of a particle contact is its normal\n"
