@@ -195,6 +195,24 @@ void expect_per_wall_bit_for_bit(const std::string& lmp, const ExportResult& r,
   EXPECT_EQ(sa, sb);
 }
 
+/// The loading every stage-1 test exports after the consolidation it
+/// checks: short, no rotational damping (this LAMMPS has none).
+AlgorithmSpec stage1_loading() {
+  AlgorithmSpec p;
+  p.steps = 8000;
+  p.damping_ratio_rotation = 0.0;
+  return p;
+}
+
+/// Export options of a deck that consolidates itself (stage 1).
+template <class Options>
+Options stage1_options(const char* data_name) {
+  Options o;
+  o.data_name = data_name;
+  o.consolidate_in_deck = true;
+  return o;
+}
+
 TEST(EngineLammpsStage1, TheVectorServoIsThePerWallFormulaBitForBit2D) {
   // Hex 5x5 as generated, with contact damping: the servo's R carries the
   // wall dashpots' c/dt, so that part of the formula is checked too. The
@@ -205,12 +223,8 @@ TEST(EngineLammpsStage1, TheVectorServoIsThePerWallFormulaBitForBit2D) {
   SceneConfig c = default_config();
   c.assembly.columns = c.assembly.rows = 5;
   c.material.contact_damping_ratio = 0.1;
-  AlgorithmSpec p;
-  p.steps = 8000;
-  p.damping_ratio_rotation = 0.0;
-  ExportOptions o;
-  o.data_name = "hex5.data";
-  o.consolidate_in_deck = true;
+  const AlgorithmSpec p = stage1_loading();
+  const ExportOptions o = stage1_options<ExportOptions>("hex5.data");
   const ExportResult r = export_deck(c, p, make_assembly(c), o);
   EXPECT_NE(line_of(r.deck, "variable        cons_rawv vector ").find("/dt)"), std::string::npos);
   expect_per_wall_bit_for_bit(lmp, r, {"cons_H", "cons_H", "cons_W", "cons_W"}, "*${thick}",
@@ -224,13 +238,9 @@ TEST(EngineLammpsStage1, TheVectorServoIsThePerWallFormulaBitForBit3D) {
   if (lmp.empty())
     GTEST_SKIP() << "LAMMPS (lmp) is not installed (apt-get install lammps): the deck is not run";
   const SceneConfig c = load_config(test::shipped_config("fcc_4x4x4"));
-  AlgorithmSpec p;
-  p.steps = 8000;
+  AlgorithmSpec p = stage1_loading();
   p.damping_ratio_translation = 0.4;
-  p.damping_ratio_rotation = 0.0;
-  Export3dOptions o;
-  o.data_name = "r.data";
-  o.consolidate_in_deck = true;
+  const Export3dOptions o = stage1_options<Export3dOptions>("r.data");
   const ExportResult r = export_3d_decks(c, p, make_sphere_assembly(c), o);
   expect_per_wall_bit_for_bit(lmp, r,
                               {"cons_Ax", "cons_Ax", "cons_Ay", "cons_Ay", "cons_Az", "cons_Az"},
@@ -290,12 +300,8 @@ TEST(EngineLammpsStage1, WhenPhase0EndsAtTheBudgetsLastChecksPhase1StopsThereWit
     GTEST_SKIP() << "LAMMPS (lmp) is not installed (apt-get install lammps): the deck is not run";
   SceneConfig c = load_config(test::shipped_config("random_400"));
   c.assembly.count = 30;
-  AlgorithmSpec p;
-  p.steps = 8000;
-  p.damping_ratio_rotation = 0.0;
-  ExportOptions o;
-  o.data_name = "r.data";
-  o.consolidate_in_deck = true;
+  const AlgorithmSpec p = stage1_loading();
+  const ExportOptions o = stage1_options<ExportOptions>("r.data");
   const ExportResult r = export_deck(c, p, make_assembly(c), o);
   ASSERT_EQ(r.deck.find("/dt)"), std::string::npos) << "the sample has contact dashpots";
   const std::string deck = with_phase0_marker(r.deck);
@@ -352,9 +358,7 @@ TEST(EngineLammpsStage1, TheCriticalFallbackComesAtDemcalsCheck) {
   const std::string lmp = test::find_on_path("lmp");
   if (lmp.empty())
     GTEST_SKIP() << "LAMMPS (lmp) is not installed (apt-get install lammps): the deck is not run";
-  AlgorithmSpec p;
-  p.steps = 8000;
-  p.damping_ratio_rotation = 0.0;
+  const AlgorithmSpec p = stage1_loading();
   struct Case {
     std::string name;
     ExportResult deck;
@@ -364,9 +368,7 @@ TEST(EngineLammpsStage1, TheCriticalFallbackComesAtDemcalsCheck) {
     SceneConfig c = load_config(test::shipped_config("random_400"));
     c.assembly.count = 100;
     c.material.contact_damping_ratio = zeta_c;
-    ExportOptions o;
-    o.data_name = "r.data";
-    o.consolidate_in_deck = true;
+    const ExportOptions o = stage1_options<ExportOptions>("r.data");
     cases.push_back(
         {zeta_c > 0.0 ? "2D zeta_c 0.02" : "2D zeta_c 0", export_deck(c, p, make_assembly(c), o)});
   }
@@ -374,9 +376,7 @@ TEST(EngineLammpsStage1, TheCriticalFallbackComesAtDemcalsCheck) {
     SceneConfig c = load_config(test::shipped_config("random_500_3d"));
     c.assembly.count = 60;
     c.material.contact_damping_ratio = 0.7;
-    Export3dOptions o;
-    o.data_name = "r.data";
-    o.consolidate_in_deck = true;
+    const Export3dOptions o = stage1_options<Export3dOptions>("r.data");
     cases.push_back({"3D zeta_c 0.7", export_3d_decks(c, p, make_sphere_assembly(c), o)});
     c.material.contact_damping_ratio = 0.0;
     cases.push_back({"3D zeta_c 0", export_3d_decks(c, p, make_sphere_assembly(c), o)});
@@ -438,12 +438,8 @@ TEST(EngineLammpsStage1, WithContactDashpotsTheDeckConsolidatesARandomSampleWith
   c.assembly.count = 200;
   c.material.contact_damping_ratio = 0.3;
   c.test.consolidation_max_steps = 120000;
-  AlgorithmSpec p;
-  p.steps = 8000;
-  p.damping_ratio_rotation = 0.0;
-  ExportOptions o;
-  o.data_name = "r.data";
-  o.consolidate_in_deck = true;
+  const AlgorithmSpec p = stage1_loading();
+  const ExportOptions o = stage1_options<ExportOptions>("r.data");
   const Assembly a = make_assembly(c);
   const ExportResult r = export_deck(c, p, a, o);
   const test::TempDir dir("engine_stage1_damped");
@@ -622,12 +618,8 @@ TEST(EngineLammpsStage1, WithContactDashpotsTheServoCarriesItsLastMoveAsDemcals2
   SceneConfig c = load_config(test::shipped_config("random_400"));
   c.assembly.count = 100;
   c.material.contact_damping_ratio = 0.3;
-  AlgorithmSpec p;
-  p.steps = 8000;
-  p.damping_ratio_rotation = 0.0;
-  ExportOptions o;
-  o.data_name = "r.data";
-  o.consolidate_in_deck = true;
+  const AlgorithmSpec p = stage1_loading();
+  const ExportOptions o = stage1_options<ExportOptions>("r.data");
   const Assembly a = make_assembly(c);
   const ExportResult r = export_deck(c, p, a, o);
   // the heaviest disc, with this run's mass scaling: the wall dashpot's
@@ -649,12 +641,8 @@ TEST(EngineLammpsStage1, WithContactDashpotsTheServoCarriesItsLastMoveAsDemcals3
   SceneConfig c = load_config(test::shipped_config("random_500_3d"));
   c.assembly.count = 60;
   c.material.contact_damping_ratio = 0.3;
-  AlgorithmSpec p;
-  p.steps = 8000;
-  p.damping_ratio_rotation = 0.0;
-  Export3dOptions o;
-  o.data_name = "r.data";
-  o.consolidate_in_deck = true;
+  const AlgorithmSpec p = stage1_loading();
+  const Export3dOptions o = stage1_options<Export3dOptions>("r.data");
   const SphereAssembly a = make_sphere_assembly(c);
   const ExportResult r = export_3d_decks(c, p, a, o);
   const double m_max =
