@@ -158,6 +158,7 @@ int run_3d(const SceneConfig& config, const std::string& out_dir, bool allow_uns
             << "  " << (within ? "WITHIN" : "OUTSIDE") << " the 3D default tolerances"
             << (within ? "" : " (worst: " + summary["verdict"]["worst"].get<std::string>() + ")")
             << ". " << kTriaxialVerdictNote << "\n"
+            << "  " << (within ? "PASS" : "FAIL") << ": " << score.diagnosis.message << "\n"
             << "  wall time " << run.wall_time_s << " s (consolidation " << state.wall_time_s
             << " s, " << state.steps << " steps" << (state.from_cache ? ", from the cache" : "")
             << "), " << summary["particle_steps_per_s"].get<double>() << " particle-steps/s\n"

@@ -164,6 +164,13 @@ TEST_F(Cli3D, ScoreOnARunsSeriesGivesTheRunsVerdict) {
     EXPECT_EQ(ran.at("criteria").at("peak_stress_yy"), ran.at("peak").at("stress_zz"));
     EXPECT_EQ(ran.at("criteria").at("peak_strain_yy"), ran.at("peak").at("strain_zz"));
     EXPECT_EQ(scored.at("passed"), within);
+    // The 2D summary's keys too, as `demcal score` gives them.
+    EXPECT_EQ(ran.at("passed"), within);
+    // (the confidence from the series' printed digits: to 1e-9)
+    for (const char* key : {"message", "parameter", "direction", "signature"})
+      EXPECT_EQ(ran.at("diagnosis").at(key), scored.at("diagnosis").at(key)) << key;
+    EXPECT_NEAR(ran.at("diagnosis").at("confidence").get<double>(),
+                scored.at("diagnosis").at("confidence").get<double>(), 1e-9);
     EXPECT_EQ(scored.at("steps_run"), ran.at("steps_run"));
     EXPECT_EQ(scored.at("steps_planned"), ran.at("params").at("steps"));
     EXPECT_EQ(scored.at("metadata").at("particles"), "32");

@@ -247,6 +247,10 @@ nlohmann::json triaxial_run_summary(const SceneConfig& config, const TriaxialSta
          {"criteria", to_json(score.criteria)},
          {"criteria_planes", to_json(c)},
          {"tolerances", to_json(t)},
+         // The 2D summary's keys (and `demcal score`'s): a script reads a
+         // run of either dimension the same way.
+         {"passed", score.passed},
+         {"diagnosis", to_json(score.diagnosis)},
          {"verdict",
           {{"within_tolerances", score.passed},
            {"worst", e.worst_name()},
