@@ -228,7 +228,7 @@ TEST(BiaxialConsolidation, DashpotCoordinationBoundOfOneSizeIsItsClosedForm) {
 // the consolidation's step with contact dashpots stays below the kernel's
 // dashpot-aware estimate on the packing it consolidated (1.74× at ζ_c
 // 0.3, 1.68× at 0.7; 1.49× and 1.47× on the packings of the per-step servo
-// law, before consolidation_servo_velocity).
+// law, before servo_velocity).
 TEST(BiaxialConsolidation, DampedConsolidationStepIsBelowTheStableStepOfItsPacking) {
   for (const double zeta_c : {0.3, 0.7}) {
     SceneConfig c = scene(R"({"assembly": {"type": "random", "count": 60, "seed": 3},
@@ -250,10 +250,10 @@ TEST(BiaxialConsolidation, DampedConsolidationStepIsBelowTheStableStepOfItsPacki
 }
 
 // The 2D twin of TriaxialScene.ConsolidationServoDrivesASteadyErrorAtTheUndampedVelocity:
-// the consolidation's servo (servo_velocity plus servo_carry of the last
-// move) has the undamped law's velocity gain·error·L·t/(n·kn_wall·Δt) as
-// its fixed point; the per-step law reaches kn_wall/R of it; at rest, and
-// whatever the velocity without contact damping, the two laws are equal.
+// the servo (its per-step move plus servo_carry of the last move) has the
+// undamped law's velocity gain·error·L·t/(n·kn_wall·Δt) as its fixed
+// point; the per-step law alone (the wall at rest) reaches kn_wall/R of
+// it; without contact damping nothing is carried, whatever the velocity.
 TEST(BiaxialConsolidation, ConsolidationServoDrivesASteadyErrorAtTheUndampedVelocity) {
   for (const double zeta_c : {0.0, 0.7}) {
     SceneConfig c = scene(R"({"assembly": {"type": "random", "count": 60, "seed": 3}})");
@@ -275,19 +275,17 @@ TEST(BiaxialConsolidation, ConsolidationServoDrivesASteadyErrorAtTheUndampedVelo
       const double error = target - wall_pressure(w, side);
       const double undamped = inward * gain * error * length * c.material.thickness /
                               (std::max(1, w.wall(side).contacts) * kn_wall * dt);
+      // At rest the law is the per-step one (nothing to carry).
+      w.wall(side).velocity = 0.0;
       const double per_step = servo_velocity(w, side, target, gain);
       if (zeta_c == 0.0) {
         w.wall(side).velocity = 0.3 * undamped;  // any velocity: no carry
-        EXPECT_EQ(consolidation_servo_velocity(w, side, target, gain), per_step) << s;
+        EXPECT_EQ(servo_velocity(w, side, target, gain), per_step) << s;
         EXPECT_NEAR(per_step, undamped, 1e-12 * std::abs(undamped)) << s;
         continue;
       }
-      w.wall(side).velocity = 0.0;
-      EXPECT_EQ(consolidation_servo_velocity(w, side, target, gain), per_step) << s;
-      w.wall(side).velocity = undamped;
-      EXPECT_NEAR(consolidation_servo_velocity(w, side, target, gain), undamped,
-                  1e-12 * std::abs(undamped))
-          << s;
+      w.wall(side).velocity = undamped;  // moving at the undamped velocity, it stays there
+      EXPECT_NEAR(servo_velocity(w, side, target, gain), undamped, 1e-12 * std::abs(undamped)) << s;
       EXPECT_LT(std::abs(per_step), 0.1 * std::abs(undamped)) << s;
     }
   }

@@ -151,7 +151,7 @@ TEST(TriaxialScene, ConsolidationReachesSigma3OnAllSixWalls) {
 // the light damping needs more steps to the same simulated time: 149 400
 // for this sample (configs/random_500_3d.json's material and σ3, 60
 // spheres; 164 800 at α 0.035), 59 800 since the consolidation's servo
-// carries its dashpots' share (consolidation_servo_velocity). The
+// carries its dashpots' share (servo_velocity). The
 // critical-damping fallback used to come after a quarter of the step budget
 // whatever the step, here at 75 000 steps, before the packing was static,
 // and critical damping then did not bring it there within 300 000 steps
@@ -178,12 +178,12 @@ TEST(TriaxialScene, ContactDampingConsolidatesARandomSampleWithinAModestBudget) 
   EXPECT_LT(s.unbalanced_ratio, c.test.consolidation_unbalanced);
 }
 
-// The consolidation's servo carries servo_carry = (c/Δt)/R of its last move
-// into the next (consolidation_servo_velocity): a steady error then drives
+// The servo (consolidation and loading) carries servo_carry = (c/Δt)/R of
+// its last move into the next (servo_velocity): a steady error then drives
 // the wall at the undamped law's velocity gain·error·A/(n·kn_wall·Δt), the
-// fixed point of the law, where servo_velocity (the per-step law, R =
-// kn_wall + c/Δt) reaches kn_wall/R of it. Without contact damping the two
-// are one law, bit for bit, whatever the wall's velocity.
+// fixed point of the law, where the per-step law alone (the wall at rest,
+// R = kn_wall + c/Δt) reaches kn_wall/R of it. Without contact damping
+// nothing is carried, bit for bit, whatever the wall's velocity.
 TEST(TriaxialScene, ConsolidationServoDrivesASteadyErrorAtTheUndampedVelocity) {
   for (const double zeta_c : {0.0, 0.7}) {
     SceneConfig c = parse(
@@ -209,21 +209,18 @@ TEST(TriaxialScene, ConsolidationServoDrivesASteadyErrorAtTheUndampedVelocity) {
       const double error = target - wall_pressure(w, side);
       const double undamped =
           inward * gain * error * area / (std::max(1, w.wall(side).contacts) * kn_wall * dt);
+      // At rest the law is the per-step one (nothing to carry).
+      w.wall(side).velocity = 0.0;
       const double per_step = servo_velocity(w, side, target, gain);
       if (zeta_c == 0.0) {
         w.wall(side).velocity = 0.3 * undamped;  // any velocity: no carry
-        EXPECT_EQ(consolidation_servo_velocity(w, side, target, gain), per_step) << s;
+        EXPECT_EQ(servo_velocity(w, side, target, gain), per_step) << s;
         EXPECT_NEAR(per_step, undamped, 1e-12 * std::abs(undamped)) << s;
         continue;
       }
-      // At rest the law is the per-step one; moving at the undamped velocity
-      // it stays there.
-      w.wall(side).velocity = 0.0;
-      EXPECT_EQ(consolidation_servo_velocity(w, side, target, gain), per_step) << s;
+      // Moving at the undamped velocity, it stays there.
       w.wall(side).velocity = undamped;
-      EXPECT_NEAR(consolidation_servo_velocity(w, side, target, gain), undamped,
-                  1e-12 * std::abs(undamped))
-          << s;
+      EXPECT_NEAR(servo_velocity(w, side, target, gain), undamped, 1e-12 * std::abs(undamped)) << s;
       // The per-step law alone is kn_wall/R of it (R/kn_wall ≈ 27 here).
       EXPECT_LT(std::abs(per_step), 0.05 * std::abs(undamped)) << s;
     }
@@ -238,7 +235,7 @@ TEST(TriaxialScene, ConsolidationServoDrivesASteadyErrorAtTheUndampedVelocity) {
 // frictionless packing rearranges, and the servo chased it: not static in
 // 300 000 steps (wall stress error 12 %, unbalanced-force ratio 0.0052),
 // nor in 600 000 (random_500_3d itself: 1–5 % to the end of 2·10⁶). With
-// the carry (consolidation_servo_velocity): static in 97 800 steps.
+// the carry (servo_velocity): static in 97 800 steps.
 // (reports/robustness.md, "The 3D consolidation at contact damping 0.7".)
 TEST(TriaxialScene, HeavilyDampedRandomSampleConsolidatesWithinAModestBudget) {
   SceneConfig c = parse(
@@ -261,7 +258,7 @@ TEST(TriaxialScene, HeavilyDampedRandomSampleConsolidatesWithinAModestBudget) {
 // the kernel's dashpot-aware estimate of the stable step on the packing it
 // consolidated (Lanczos ω_max with the contacts' own γ_max, stability.cpp):
 // it is 1.54× below at ζ_c 0.3 and 1.74× at 0.7 (1.66× and 1.71× on the
-// packings of the per-step servo law, before consolidation_servo_velocity),
+// packings of the per-step servo law, before servo_velocity),
 // so a factor that much bolder fails. The step before 2026-12-03 (0.035 and 0.015) was 3.5× and
 // 3.9× below.
 TEST(TriaxialScene, DampedConsolidationStepIsBelowTheStableStepOfItsPacking) {
