@@ -486,7 +486,7 @@ std::string deck_number(double v) {
 /// Stage 1 of a deck with contact dashpots (`r`, of scene `c`), traced at
 /// every step: each wall's position, contact count n, force F on the
 /// particles and the move the deck computed, with the step dt. Every move
-/// must be demcal's consolidation servo (consolidation_servo_velocity,
+/// must be demcal's consolidation servo (servo_velocity,
 /// scene/biaxial.hpp), clamp(gain*(sigma3*A - F)/(R*max(1, n)) +
 /// carry*u_prev, +-cap) along +axis (a max wall's load -sigma3*A), R =
 /// servo_resistance(kn_wall, zeta_c, m_max, dt) at the row's dt, carry =
@@ -603,7 +603,7 @@ void expect_the_servo_carries_its_last_move(
 }
 
 // demcal's consolidation servo with contact damping carries (R - kn_wall)/R
-// of each wall's last move (consolidation_servo_velocity: robustness.md, "The
+// of each wall's last move (servo_velocity: robustness.md, "The
 // 3D consolidation at contact damping 0.7"); the decks' stage 1 must too, with
 // R at its step, at light and at critical damping. 100 disks of random_400 and
 // 60 spheres of random_500_3d at zeta_c 0.3, budget 4 000 steps (the switch at

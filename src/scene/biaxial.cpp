@@ -158,7 +158,7 @@ double consolidation_dashpot_factor(double zeta_c, int dimension, double r_min, 
 
 namespace {
 
-// servo_velocity's move before the cap [m, toward the sample] and its R.
+// The per-step move before the carry and the cap [m, toward the sample] and its R.
 struct ServoMove {
   double move;
   double resistance;
@@ -195,11 +195,6 @@ double capped_velocity(const World& world, WallSide side, double move) {
 }  // namespace
 
 double servo_velocity(const World& world, WallSide side, double target_stress, double gain) {
-  return capped_velocity(world, side, servo_move(world, side, target_stress, gain).move);
-}
-
-double consolidation_servo_velocity(const World& world, WallSide side, double target_stress,
-                                    double gain) {
   ServoMove m = servo_move(world, side, target_stress, gain);
   const double carry = servo_carry(world.material().wall.kn, m.resistance);
   // The last move, toward the sample (velocity·Δt along the inward axis).

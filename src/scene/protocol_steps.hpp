@@ -162,8 +162,7 @@ ConsolidationOutcome run_consolidation(Sample& world, const TestSpec& test, doub
       for (int k = 0; k < kCheckEvery; ++k) {
         for (int s = 0; s < walls; ++s) {
           const auto side = static_cast<Side>(s);
-          world.wall(side).velocity =
-              consolidation_servo_velocity(world, side, sigma3, test.servo_gain);
+          world.wall(side).velocity = servo_velocity(world, side, sigma3, test.servo_gain);
         }
         if (!world.step(1))
           throw std::runtime_error(std::string("consolidation diverged: ") +

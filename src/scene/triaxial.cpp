@@ -105,7 +105,7 @@ double wall_pressure(const SphereWorld& world, SphereWallSide side) {
 
 namespace {
 
-// servo_velocity's move before the cap [m, toward the sample] and its R.
+// The per-step move before the carry and the cap [m, toward the sample] and its R.
 struct ServoMove {
   double move;
   double resistance;
@@ -136,11 +136,6 @@ double capped_velocity(const SphereWorld& world, SphereWallSide side, double mov
 
 double servo_velocity(const SphereWorld& world, SphereWallSide side, double target_stress,
                       double gain) {
-  return capped_velocity(world, side, servo_move(world, side, target_stress, gain).move);
-}
-
-double consolidation_servo_velocity(const SphereWorld& world, SphereWallSide side,
-                                    double target_stress, double gain) {
   ServoMove m = servo_move(world, side, target_stress, gain);
   const double carry = servo_carry(world.material().wall.kn, m.resistance);
   // The last move, toward the sample (velocity·Δt along the inward axis).

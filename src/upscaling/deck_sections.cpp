@@ -392,7 +392,7 @@ std::string lammps_consolidation_servo(const std::vector<ConsolidationWall>& wal
   if (carry > 0.0)
     s << "#   move = gain*(sigma3*A - F)/(R*max(1, n)) + carry*u, clamped to +-cap,\n"
       << "# u the wall's last move (demcal's consolidation servo,\n"
-      << "# consolidation_servo_velocity: demcal's walls have dashpots, whose force of\n"
+      << "# servo_velocity: demcal's walls have dashpots, whose force of\n"
       << "# a moving wall is in its F, so a move carries carry = (R - kn_wall)/R of the\n"
       << "# last; these walls have none, the law is demcal's; R at this step's dt, and\n"
       << "# cons_carry with it from the switch to critical damping; u is 0 before the\n"

@@ -221,7 +221,7 @@ std::string lammps_consolidation_reductions(const std::vector<ConsolidationWall>
 /// "cons_Ax" .. "cons_Az" and ""); `resist` R, e.g. "${kn_wall}". Each element
 /// is, bit for bit, the per-wall formula lammps_servo_move(A, ∓F, n) (negated
 /// for a max wall). `carry` > 0 (contact damping): demcal's consolidation
-/// servo (consolidation_servo_velocity, scene/biaxial.hpp), the raw move plus
+/// servo (servo_velocity, scene/biaxial.hpp), the raw move plus
 /// v_cons_carry (defined here as `carry`, consolidation_carry of stage 1's
 /// light step) times the wall's previous clamped move (fix cons_prev, after
 /// cons_servo, 0 before the first step); 0: the per-step law alone.

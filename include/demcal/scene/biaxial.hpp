@@ -51,17 +51,13 @@ inline constexpr double kServoMoveCapRatio = 0.02;
 /// kServoMoveCapRatio·r_min [m per step].
 inline double servo_move_cap(double r_min) { return kServoMoveCapRatio * r_min; }
 
-/// Servo: each step move the wall by gain·(σ3 − p)·L·t/(R·n_c) toward the
-/// sample (see TestSpec::servo_gain), R = servo_resistance(). Returns the
-/// wall velocity.
+/// Servo of the consolidation and the loading: each step move the wall by
+/// gain·(σ3 − p)·L·t/(R·n_c) toward the sample (see TestSpec::servo_gain),
+/// R = servo_resistance(), plus servo_carry of the wall's last move (its
+/// current velocity, which only this servo sets; walls start each phase
+/// at rest), at most servo_move_cap. Without contact damping the carry is
+/// 0. Returns the wall velocity.
 double servo_velocity(const World& world, WallSide side, double target_stress, double gain);
-/// The consolidation's servo: servo_velocity's move plus servo_carry of the
-/// wall's last move (its current velocity, which only this servo sets
-/// during the consolidation), at most servo_move_cap. Without contact
-/// damping the carry is 0 and this is servo_velocity, bit for bit. The
-/// loading keeps servo_velocity (the exported decks' law).
-double consolidation_servo_velocity(const World& world, WallSide side, double target_stress,
-                                    double gain);
 /// The wall contacts' dashpot c = 2ζ_c·sqrt(kn_wall·m_max) [N·s/m] of the
 /// heaviest particle (mass m_max, with the run's mass scaling): the most
 /// damping; 0 without contact damping (ζ_c ≤ 0). The one formula of the 2D
@@ -77,8 +73,8 @@ double servo_wall_dashpot(const Material& material, double m_max);
 double servo_resistance(double kn_wall, double zeta_c, double m_max, double dt);
 /// servo_resistance with the material's kn_wall and ζ_c.
 double servo_resistance(const Material& material, double m_max, double dt);
-/// The share of its last move that the consolidation's servo carries into
-/// the next (consolidation_servo_velocity, 2D and 3D): (R −
+/// The share of its last move that the servo carries into the next
+/// (servo_velocity, 2D and 3D, consolidation and loading): (R −
 /// kn_wall)/R = (c/Δt)/R, R = servo_resistance; 0 without contact damping.
 /// A wall already moving at v has the dashpot force c·v of that motion in
 /// its reading; a move u_k changes the wall force within the step by

@@ -63,21 +63,17 @@ SphereAssembly make_sphere_assembly(const SceneConfig& config);
 
 /// Compressive pressure on a wall from the spheres [Pa].
 double wall_pressure(const SphereWorld& world, SphereWallSide side);
-/// Servo: move the wall by gain·(σ3 − p)·A/(R·n_c) toward the sample
-/// this step (A the wall's area, n_c its contacts; at most servo_move_cap,
-/// biaxial.hpp, per step), as the 2D servo_velocity: R =
-/// servo_resistance (biaxial.hpp), kn_wall plus the wall dashpots' c/Δt
-/// with contact damping (c of the heaviest sphere at the run's mass
-/// scaling). Returns the wall velocity along its axis.
+/// Servo of the consolidation and the loading: move the wall by
+/// gain·(σ3 − p)·A/(R·n_c) toward the sample this step (A the wall's area,
+/// n_c its contacts), as the 2D servo_velocity: R = servo_resistance
+/// (biaxial.hpp), kn_wall plus the wall dashpots' c/Δt with contact damping
+/// (c of the heaviest sphere at the run's mass scaling), plus servo_carry
+/// (biaxial.hpp) of the wall's last move (its current velocity, which only
+/// this servo sets; walls start each phase at rest), at most servo_move_cap
+/// per step. Without contact damping the carry is 0. Returns the wall
+/// velocity along its axis.
 double servo_velocity(const SphereWorld& world, SphereWallSide side, double target_stress,
                       double gain);
-/// The consolidation's servo: servo_velocity's move plus servo_carry
-/// (biaxial.hpp) of the wall's last move (its current velocity, which only
-/// this servo sets during the consolidation), at most servo_move_cap.
-/// Without contact damping the carry is 0 and this is servo_velocity, bit
-/// for bit. The loading keeps servo_velocity (the exported decks' law).
-double consolidation_servo_velocity(const SphereWorld& world, SphereWallSide side,
-                                    double target_stress, double gain);
 
 /// Absolute integration parameters for an algorithm spec: Δt = α·Δt_crit
 /// with Δt_crit from the kernel's masses at the spec's mass scaling
