@@ -597,9 +597,10 @@ std::string lammps_system(const SceneConfig& c, const Plan& plan, const ExportOp
   if (gamma_n > 0.0)
     out.notes.push_back(
         "contact damping mapped at the mean particle mass; the walls carry no dashpots here "
-        "(demcal's do), so a servo move meets kn_wall alone while the servo divides by R = "
-        "kn_wall + c/dt (measured on hex_5x5, zeta_c 0.25: servo criterion 5e-4 and peak "
-        "4e-5 relative from demcal's; engines.md section 20)");
+        "(demcal's do), so a servo move meets kn_wall alone while the servo is demcal's: it "
+        "divides by R = kn_wall + c/dt and carries (R - kn_wall)/R of the wall's last move "
+        "(measured on hex_5x5, zeta_c 0.25: servo criterion 5e-4 and peak 5e-5 relative from "
+        "demcal's; fcc_4x4x4, zeta_c 0.3: both equal to 5 digits; engines.md sections 20, 24)");
   std::ostringstream s;
   s << deck::lammps_system_head(2, "f f p")
     << "if              \"${continued} == 0\" then \"read_data " << o.data_name

@@ -370,9 +370,10 @@ void lammps_3d_system(std::ostream& s, const SceneConfig& c, const Plan3& plan,
   if (gamma_n > 0.0)
     out.notes.push_back(
         "contact damping mapped at the mean sphere mass; the walls carry no dashpots here "
-        "(demcal's do), so a servo move meets kn_wall alone while the servo divides by R = "
-        "kn_wall + c/dt (measured on hex_5x5, zeta_c 0.25: servo criterion 5e-4 and peak "
-        "4e-5 relative from demcal's; engines.md section 20)");
+        "(demcal's do), so a servo move meets kn_wall alone while the servo is demcal's: it "
+        "divides by R = kn_wall + c/dt and carries (R - kn_wall)/R of the wall's last move "
+        "(measured on hex_5x5, zeta_c 0.25: servo criterion 5e-4 and peak 5e-5 relative from "
+        "demcal's; fcc_4x4x4, zeta_c 0.3: both equal to 5 digits; engines.md sections 20, 24)");
   s << deck::lammps_system_head(3, "f f f") << "newton          off\n"
     << "read_data       " << o.data_name << "\n"
     << "# sphere masses f_ms*rho*4/3*pi*r^3 (density column), inertia 2/5 m r^2\n"
