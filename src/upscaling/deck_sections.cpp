@@ -134,8 +134,8 @@ std::string lammps_material_variables(const Material& m, NumberFormat f) {
 
 std::string servo_cap_text() { return num(100.0 * kServoMoveCapRatio) + " % of r_min"; }
 
-std::string lammps_loading_derived(double wall_dashpot, NumberFormat f,
-                                   const std::string& particle) {
+std::string lammps_loading_derived(double wall_dashpot, NumberFormat f, const std::string& particle,
+                                   double carry) {
   std::string s =
       "variable vtop      equal $(v_strain*v_H0/(v_nstep*v_dt))      # m/s, top wall, down\n"
       "variable cap       equal $(" +
@@ -158,6 +158,13 @@ std::string lammps_loading_derived(double wall_dashpot, NumberFormat f,
          "      # N*s/m\n"
          "variable resist    equal $(v_kn_wall+v_c_wall/v_servo_dt)      # N/m, demcal's R\n"
          "variable gain_kn   equal $(v_gain*v_servo_f/v_resist)      # m/N per step of dt\n";
+    if (carry > 0.0)
+      s += "# and a wall already moving has its dashpots' force c_wall*v in its F, so\n"
+           "# demcal's servo carries (R - kn_wall)/R of each move into the next (its\n"
+           "# servo_carry at servo_dt; a number, as c_wall: export again for another\n"
+           "# kn_wall): a steady error then moves a wall as the law with kn_wall alone\n"
+           "variable carry     equal " +
+           exact(carry) + "\n";
   } else {
     s += "variable gain_kn   equal $(v_gain*v_servo_f/v_kn_wall)      # m/N per step of dt\n";
   }
@@ -379,8 +386,16 @@ std::string lammps_consolidation_reductions(const std::vector<ConsolidationWall>
          n + "\ncompute         cons_wf all reduce sum" + f + "\n";
 }
 
-double consolidation_carry(const Material& m, double m_max, double dt) {
+double servo_carry_at(const Material& m, double m_max, double dt) {
   return servo_carry(m.wall.kn, servo_resistance(m, m_max, dt));
+}
+
+std::string lammps_servo_carried(const std::string& prev) { return "+${carry}*" + prev; }
+
+std::string lammps_previous_moves(const std::string& fix, const std::string& movev, size_t count) {
+  std::string s = "fix             " + fix + " all ave/time 1 1 1";
+  for (size_t k = 0; k < count; ++k) s += " v_" + movev + "[" + std::to_string(k + 1) + "]";
+  return s + "\n";
 }
 
 std::string lammps_consolidation_servo(const std::vector<ConsolidationWall>& walls,
@@ -430,11 +445,7 @@ std::string lammps_consolidation_servo(const std::vector<ConsolidationWall>& wal
     << (carry > 0.0 ? "+v_cons_carry*f_cons_prev" : "") << "\n"
     << "variable        cons_movev vector " << lammps_servo_clamp("v_cons_rawv") << "\n"
     << "fix             cons_servo all ave/time 1 1 1 v_cons_movev mode vector ave running\n";
-  if (carry > 0.0) {
-    s << "fix             cons_prev all ave/time 1 1 1";
-    for (size_t k = 0; k < walls.size(); ++k) s << " v_cons_movev[" << k + 1 << "]";
-    s << "\n";
-  }
+  if (carry > 0.0) s << lammps_previous_moves("cons_prev", "cons_movev", walls.size());
   return s.str();
 }
 

@@ -106,10 +106,25 @@ std::string servo_cap_text();
 /// servo_wall_dashpot, scene/biaxial.hpp): demcal's servo divides by
 /// R = kn_wall + c/servo_dt, as demcal's (servo_resistance), and the block
 /// derives it from `c_wall` (written with `f`); the 3D servo likewise
-/// (triaxial.cpp), `particle` names the heaviest one ("disc", "sphere").
-/// 0: R = kn_wall.
+/// (triaxial.cpp), `particle` names the heaviest one ("disc", "sphere"),
+/// and `carry` is demcal's servo_carry at servo_dt (servo_carry_at), the
+/// share of its last move that demcal's servo carries into the next (the
+/// block defines `carry`, written with 17 digits; lammps_servo_carried).
+/// 0: R = kn_wall, nothing carried.
 std::string lammps_loading_derived(double wall_dashpot = 0.0, NumberFormat f = num,
-                                   const std::string& particle = "disc");
+                                   const std::string& particle = "disc", double carry = 0.0);
+/// The loading servo's carried term, "+${carry}*" `prev` (`prev` the walls'
+/// last moves, a vector: the deck's fix of them, defined after the fix that
+/// sums the moves, so that at a step's end it still holds the step
+/// before's), appended to the unclamped move before the clamp: demcal's
+/// servo_velocity, move = law + carry*u, clamped. Per step of dt: the last
+/// move u is dt/servo_dt times demcal's, as the law's move is, so the
+/// carry (of demcal's step) multiplies it as it is.
+std::string lammps_servo_carried(const std::string& prev);
+/// `fix FIX all ave/time 1 1 1 v_MOVEV[1] .. v_MOVEV[count]`: the walls'
+/// moves of this step, which the servo's formula reads as the last ones at
+/// the next (0 before the first step: the walls start at rest).
+std::string lammps_previous_moves(const std::string& fix, const std::string& movev, size_t count);
 /// The parameters block's line of servo_dt (demcal's step, s).
 std::string lammps_servo_dt(double servo_dt, NumberFormat f);
 
@@ -222,17 +237,18 @@ std::string lammps_consolidation_reductions(const std::vector<ConsolidationWall>
 /// is, bit for bit, the per-wall formula lammps_servo_move(A, ∓F, n) (negated
 /// for a max wall). `carry` > 0 (contact damping): demcal's consolidation
 /// servo (servo_velocity, scene/biaxial.hpp), the raw move plus
-/// v_cons_carry (defined here as `carry`, consolidation_carry of stage 1's
+/// v_cons_carry (defined here as `carry`, servo_carry_at stage 1's
 /// light step) times the wall's previous clamped move (fix cons_prev, after
 /// cons_servo, 0 before the first step); 0: the per-step law alone.
 std::string lammps_consolidation_servo(const std::vector<ConsolidationWall>& walls,
                                        const std::vector<std::string>& area,
                                        const std::string& area_tail, const std::string& resist,
                                        double carry = 0.0);
-/// The carry of stage 1's servo at its step `dt`: servo_carry(kn_wall, R),
+/// The carry of demcal's servo at its step `dt`: servo_carry(kn_wall, R),
 /// R = servo_resistance(m, m_max, dt), the R that the deck's raw move
-/// divides by (kn_wall + c/dt); 0 without contact damping.
-double consolidation_carry(const Material& m, double m_max, double dt);
+/// divides by (stage 1: kn_wall + c/dt at its step; the loading: at
+/// servo_dt, demcal's step); 0 without contact damping.
+double servo_carry_at(const Material& m, double m_max, double dt);
 
 /// Stage 1's lines in the parameters block: consolidate (1: run it), the
 /// scene's test.consolidation_* values (cons_tol, cons_unbalanced,
@@ -273,7 +289,7 @@ std::string lammps_consolidation_criterion(int dimension,
 /// cons_quarter (lammps_consolidation_quarter), none when that is the
 /// budget's end; quit 2 when the budget is spent. `carry_damped` > 0: the
 /// servo's carry (lammps_consolidation_servo's cons_carry) from the switch
-/// on, consolidation_carry at dt_damped.
+/// on, servo_carry_at dt_damped.
 std::string lammps_consolidation_runs(double gamma_n, double dt_damped, const std::string& critical,
                                       double carry_damped = 0.0);
 

@@ -36,8 +36,10 @@ struct Plan {
   double r_min = 0.0, r_max = 0.0;
   // The servo's: the heaviest disc's mass m_max [kg] (as scene/biaxial.cpp
   // computes it), its wall dashpot c [N·s/m] (0 without contact damping)
-  // and R = kn_wall + c/demcal_dt [N/m] (servo_resistance).
-  double m_max = 0.0, wall_dashpot = 0.0, servo_resist = 0.0;
+  // and R = kn_wall + c/demcal_dt [N/m] (servo_resistance), and the share
+  // of its last move that the servo carries into the next (servo_carry at
+  // demcal_dt, 0 without contact damping).
+  double m_max = 0.0, wall_dashpot = 0.0, servo_resist = 0.0, servo_carry = 0.0;
   int thermo_every = 1;
   ParticleScales scales;
 };
@@ -65,6 +67,7 @@ Plan make_plan(const SceneConfig& c, const AlgorithmSpec& p, const Assembly& a, 
   plan.m_max = disk_mass(disk_areal_density(c.material, p.mass_scaling), plan.r_max);
   plan.wall_dashpot = servo_wall_dashpot(c.material, plan.m_max);
   plan.servo_resist = servo_resistance(c.material, plan.m_max, plan.demcal_dt);
+  plan.servo_carry = deck::servo_carry_at(c.material, plan.m_max, plan.demcal_dt);
   plan.width0 = a.right - a.left;
   plan.height0 = a.top - a.bottom;
   plan.top_speed =
@@ -360,8 +363,10 @@ std::string lammps_walls(bool normal_only) {
 /// unclamped move and its clamp of both lateral walls as two vector-style
 /// formulas (each parsed once per step for both walls), summed every step by
 /// fix servol and servor (lammps_run); the walls' displacements at the end of
-/// the run for the restart args.
-std::string lammps_servo() {
+/// the run for the restart args. `carry` (contact damping): each move carries
+/// ${carry} of the wall's last (fix servo_prev, lammps_run), as demcal's
+/// servo_velocity does, and the restart args carry the last moves too.
+std::string lammps_servo(bool carry) {
   // (gain/kn_wall)*(sigma3*H*t - F)/max(1, n) per wall, sigma3*H*t =
   // load0 - load_step*step stored by fix servo_load, F the wall's force on
   // the sample: c_cf[1] for the left wall (it pushes the particles +x),
@@ -371,16 +376,28 @@ std::string lammps_servo() {
   // (clamp(-x) = -clamp(x) bit for bit): fix servol and servor keep the
   // displacements' signs, left +x, right -x, as dxl and dxr use them.
   const std::string load = "${load0}-${load_step}*step";
-  const std::string raw = deck::lammps_servo_raw_folded("f_servo_sign*f_servo_load", "-c_cf",
-                                                        deck::lammps_count_max_one("c_cn"));
+  std::string raw = deck::lammps_servo_raw_folded("f_servo_sign*f_servo_load", "-c_cf",
+                                                  deck::lammps_count_max_one("c_cn"));
+  // the right element's carried move is minus the right wall's too:
+  // -(law + carry*u) = (-law) + carry*(-u) bit for bit
+  if (carry) raw += deck::lammps_servo_carried("${servo_carried}");
   std::ostringstream s;
-  s << "# demcal's servo, one move per step toward the sample when p < sigma3:\n"
-    << "#   move = gain*(sigma3*H*t - F)/(R*max(1, n)), clamped to +-cap,\n"
-    << "# R = kn_wall (+ the wall dashpots' c_wall/servo_dt with contact damping),\n"
-    << "# per demcal step (servo_dt), so per step of dt that times dt/servo_dt:\n"
-    << "# gain_kn*(load0 - load_step*step - F)/max(1, n) within +-cap_step (constants\n"
-    << "# folded in the derived block: every number in a per-step formula costs a parse),\n"
-    << "# F the wall force, n its contacts; the wall's displacement is the sum of\n"
+  s << "# demcal's servo, one move per step toward the sample when p < sigma3:\n";
+  if (carry)
+    s << "#   move = gain*(sigma3*H*t - F)/(R*max(1, n)) + carry*u, clamped to +-cap,\n"
+      << "# R = kn_wall + the wall dashpots' c_wall/servo_dt (contact damping), u the\n"
+      << "# wall's last move (carry: derived block), per demcal step (servo_dt), so per\n"
+      << "# step of dt that times dt/servo_dt: gain_kn*(load0 - load_step*step - F)/\n"
+      << "# max(1, n) + carry*u within +-cap_step (u, a move of this deck, is dt/servo_dt\n"
+      << "# times demcal's already; constants folded in the derived block: every number\n"
+      << "# in a per-step formula costs a parse),\n";
+  else
+    s << "#   move = gain*(sigma3*H*t - F)/(R*max(1, n)), clamped to +-cap,\n"
+      << "# R = kn_wall (+ the wall dashpots' c_wall/servo_dt with contact damping),\n"
+      << "# per demcal step (servo_dt), so per step of dt that times dt/servo_dt:\n"
+      << "# gain_kn*(load0 - load_step*step - F)/max(1, n) within +-cap_step (constants\n"
+      << "# folded in the derived block: every number in a per-step formula costs a parse),\n";
+  s << "# F the wall force, n its contacts; the wall's displacement is the sum of\n"
     << "# the moves (running mean times the steps of this run, dxl and dxr above).\n"
     << "# Both walls in one vector-style formula (elements: left, right; the\n"
     << "# right one with the opposite sign, so that the moves are displacements\n"
@@ -397,16 +414,34 @@ std::string lammps_servo() {
     << "variable        mone internal -1\n"
     << "fix             servo_sign all ave/time 1 1 1 v_one v_mone\n"
     << "variable        load equal " << load << "\n"
-    << "fix             servo_load all ave/time 1 1 1 v_load\n"
-    << "variable        rawv vector " << raw << "\n"
+    << "fix             servo_load all ave/time 1 1 1 v_load\n";
+  if (carry)
+    s << "# u: fix servo_prev (after fix servol/servor: at a step's end it still holds\n"
+      << "# the step before's moves, the walls' displacements along x), 0 at a run's\n"
+      << "# first step (the walls start the loading at rest); a continuation's first\n"
+      << "# step carries the moves of the step before it instead (ul_now, ur_now: its\n"
+      << "# restart args; servo_ul, servo_ur: this run's, for the args)\n"
+      << "variable        servo_carried string f_servo_prev\n"
+      << "variable        servo_ul equal f_servo_prev[1]\n"
+      << "variable        servo_ur equal f_servo_prev[2]\n"
+      << "if              \"${continued} != 0\" then &\n"
+      << "                \"variable servo_ul0 internal ${ul_now}\" &\n"
+      << "                \"variable servo_ur0 internal ${ur_now}\" &\n"
+      << "                \"fix servo_u0 all ave/time 1 1 1 v_servo_ul0 v_servo_ur0\" &\n"
+      << "                \"variable servo_carried string (f_servo_prev+!elapsed*f_servo_u0)\" &\n"
+      << "                \"variable servo_ul equal f_servo_prev[1]+!elapsed*v_servo_ul0\" &\n"
+      << "                \"variable servo_ur equal f_servo_prev[2]+!elapsed*v_servo_ur0\"\n";
+  s << "variable        rawv vector " << raw << "\n"
     << "variable        movev vector " << deck::lammps_servo_clamp("v_rawv", "${cap_step}") << "\n"
     << "# the lateral walls' displacements at the run's last step (fix servo_end\n"
     << "# evaluates them there only, before fix servol/servor add that step's move):\n"
     << "# the restart args put a continuation's walls where this run's last step\n"
     << "# had them (to the last bit), and the continuation's servo takes that\n"
-    << "# step's move again from there\n"
+    << "# step's move again from there"
+    << (carry ? ", with the moves of the step before (servo_ul,\n# servo_ur)\n" : "\n")
     << "variable        end_every equal $((1+v_run_steps+abs(1-v_run_steps))/2)\n"
-    << "fix             servo_end all ave/time ${end_every} 1 ${end_every} v_dxl v_dxr\n"
+    << "fix             servo_end all ave/time ${end_every} 1 ${end_every} v_dxl v_dxr"
+    << (carry ? " v_servo_ul v_servo_ur\n" : "\n")
     << "# (fix servol and servor, which sum the moves, are defined after fix series\n"
     << "# below)\n\n";
   return s.str();
@@ -457,11 +492,19 @@ std::string lammps_limitations(const AlgorithmSpec& p, const Plan& plan, ExportR
     << "#    above so that the explicit drag does not cost the stability margin.\n"
     << "#  - servo walls are not native: the lateral walls are fix wall/gran/region\n"
     << "#    planes whose displacement is the running sum of demcal's per-step servo\n"
-    << "#    move gain*(sigma3 - p)*H*t/(R*n_contacts), capped at " << deck::servo_cap_text()
-    << ",\n"
-    << "#    kept by fix ave/time (running mean times the steps of this run); a split\n"
-    << "#    run restarts it from the walls' positions (see restart_from).\n"
-    << "#  - the moving walls act on bands of particles near them (see the walls).\n";
+    << "#    move gain*(sigma3 - p)*H*t/(R*n_contacts)";
+  if (plan.servo_carry > 0.0)
+    s << " plus (R - kn_wall)/R of the\n"
+      << "#    wall's last move (contact damping: demcal's wall dashpots), capped at\n"
+      << "#    " << deck::servo_cap_text()
+      << ", kept by fix ave/time (running mean times the steps of\n"
+      << "#    this run); a split run restarts it from the walls' positions and last\n"
+      << "#    moves (see restart_from).\n";
+  else
+    s << ", capped at " << deck::servo_cap_text() << ",\n"
+      << "#    kept by fix ave/time (running mean times the steps of this run); a split\n"
+      << "#    run restarts it from the walls' positions (see restart_from).\n";
+  s << "#  - the moving walls act on bands of particles near them (see the walls).\n";
   if (plan.types > 1) {
     s << "#  - per-particle damping D_t ~ sqrt(m): fix viscous has one gamma per atom type,\n"
       << "#    so the particles are grouped in " << plan.types << " radius classes (types 1.."
@@ -508,13 +551,17 @@ std::string lammps_parameters(const SceneConfig& c, const Assembly& a, const Pla
     << "# A split run: the first part writes ${restart_out} and ${restart_out}.args at its\n"
     << "# end; continue it with  lmp $(cat final.restart.args) -in THIS_DECK\n"
     << "# (the args give continued, restart_from and the lateral walls' positions, xl_now, "
-       "xr_now).\n"
+    << (plan.servo_carry > 0.0 ? "xr_now,\n# and their last moves, ul_now, ur_now).\n"
+                               : "xr_now).\n")
     << "variable continued index 0      # 1: continue from ${restart_from}\n"
     << "variable restart_from index final.restart\n"
     << "variable restart_out index final.restart\n"
     << "variable xl_now    index ${xl0}      # lateral walls where this run starts\n"
-    << "variable xr_now    index ${xr0}\n"
-    << "variable run_steps index ${nstep}      # run up to this step; -var run_steps 300 for a "
+    << "variable xr_now    index ${xr0}\n";
+  if (plan.servo_carry > 0.0)
+    s << "variable ul_now    index 0      # their moves at the step before it (m, along x)\n"
+      << "variable ur_now    index 0\n";
+  s << "variable run_steps index ${nstep}      # run up to this step; -var run_steps 300 for a "
        "check\n";
   if (o.consolidate_in_deck) s << deck::lammps_consolidation_parameters(c.test);
   return s.str();
@@ -525,7 +572,7 @@ std::string lammps_derived(const Plan& plan) {
   std::ostringstream s;
   s << "\n# --- derived (do not edit) ---------------------------------------------------\n"
     << "variable H0        equal $(v_yt0-v_yb0)\n"
-    << deck::lammps_loading_derived(plan.wall_dashpot, num)
+    << deck::lammps_loading_derived(plan.wall_dashpot, num, "disc", plan.servo_carry)
     << deck::lammps_band("band_v", "v_strain*v_H0", "m, see the walls")
     << deck::lammps_band("band_h", "2*v_strain*(v_xr0-v_xl0)")
     << "# the per-step constants of the top wall's move and the servo, folded now\n"
@@ -550,9 +597,10 @@ std::string lammps_system(const SceneConfig& c, const Plan& plan, const ExportOp
   if (gamma_n > 0.0)
     out.notes.push_back(
         "contact damping mapped at the mean particle mass; the walls carry no dashpots here "
-        "(demcal's do), so a servo move meets kn_wall alone while the servo divides by R = "
-        "kn_wall + c/dt (measured on hex_5x5, zeta_c 0.25: servo criterion 5e-4 and peak "
-        "4e-5 relative from demcal's; engines.md section 20)");
+        "(demcal's do), so a servo move meets kn_wall alone while the servo is demcal's: it "
+        "divides by R = kn_wall + c/dt and carries (R - kn_wall)/R of the wall's last move "
+        "(measured on hex_5x5, zeta_c 0.25: servo criterion 5e-4 and peak 5e-5 relative from "
+        "demcal's; fcc_4x4x4, zeta_c 0.3: both equal to 5 digits; engines.md sections 20, 24)");
   std::ostringstream s;
   s << deck::lammps_system_head(2, "f f p")
     << "if              \"${continued} == 0\" then \"read_data " << o.data_name
@@ -601,8 +649,8 @@ ConsolidationSteps consolidation_steps(const SceneConfig& c, const Plan& plan) {
   // the wall dashpots' c (servo_wall_dashpot: demcal's formula)
   st.resist =
       plan.wall_dashpot > 0.0 ? "(${kn_wall}+" + num(plan.wall_dashpot) + "/dt)" : "${kn_wall}";
-  st.carry_light = deck::consolidation_carry(m, plan.m_max, st.dt_light);
-  st.carry_damped = deck::consolidation_carry(m, plan.m_max, st.dt_damped);
+  st.carry_light = deck::servo_carry_at(m, plan.m_max, st.dt_light);
+  st.carry_damped = deck::servo_carry_at(m, plan.m_max, st.dt_damped);
   return st;
 }
 
@@ -741,15 +789,19 @@ std::string lammps_consolidation(const SceneConfig& c, const Plan& plan, double 
 
 /// Thermo, the run up to run_steps, and the restart a split run continues
 /// (with stage 1, the args also carry the start walls it found).
-std::string lammps_run(bool consolidate_in_deck) {
+std::string lammps_run(bool consolidate_in_deck, bool carry) {
   std::ostringstream s;
   s << "# the servo's running sums of the moves, after fix series: a row prints the\n"
     << "# lateral walls where this step's forces had them (the sum before this\n"
     << "# step's move), in a single run and in a continued one alike; one fix per\n"
     << "# wall, a scalar each (dxl and dxr read them every step: no index to parse)\n"
     << "fix             servol all ave/time 1 1 1 v_movev[1] ave running\n"
-    << "fix             servor all ave/time 1 1 1 v_movev[2] ave running\n"
-    << "# the clearance checks, last in the fix list (the fixes above are found by\n"
+    << "fix             servor all ave/time 1 1 1 v_movev[2] ave running\n";
+  if (carry)
+    s << "# the moves of this step, the servo's last ones at the next (with contact\n"
+      << "# damping it carries them)\n"
+      << deck::lammps_previous_moves("servo_prev", "movev", 2);
+  s << "# the clearance checks, last in the fix list (the fixes above are found by\n"
     << "# name every step, by a linear search)\n"
     << "fix             halt_top all halt ${monitor_every} v_clear_top < 0.0 error hard\n"
     << "fix             halt_bottom all halt ${monitor_every} v_clear_bottom < 0.0 error hard\n"
@@ -766,6 +818,7 @@ std::string lammps_run(bool consolidate_in_deck) {
     << "write_restart   ${restart_out}\n"
     << "print           \"-var continued 1 -var restart_from ${restart_out} -var xl_now "
        "$(v_xl_now+f_servo_end[1]) -var xr_now $(v_xr_now+f_servo_end[2])"
+    << (carry ? " -var ul_now $(f_servo_end[3]) -var ur_now $(f_servo_end[4])" : "")
     << (consolidate_in_deck ? " -var xl0 ${xl0} -var xr0 ${xr0} -var yb0 ${yb0} -var yt0 ${yt0}"
                             : "")
     << "\" file ${restart_out}.args screen no\n";
@@ -788,8 +841,9 @@ ExportResult lammps(const SceneConfig& c, const AlgorithmSpec& p, const Assembly
       << lammps_derived(plan);
   else
     s << lammps_derived(plan) << lammps_system(c, plan, o, out);
-  s << lammps_walls(normal_only_walls(c.material)) << lammps_servo() << lammps_damping(p, plan)
-    << lammps_series_block(c, p, plan) << lammps_run(o.consolidate_in_deck);
+  const bool carry = plan.servo_carry > 0.0;
+  s << lammps_walls(normal_only_walls(c.material)) << lammps_servo(carry) << lammps_damping(p, plan)
+    << lammps_series_block(c, p, plan) << lammps_run(o.consolidate_in_deck, carry);
   out.deck = s.str();
   return out;
 }

@@ -100,8 +100,10 @@ struct Plan3 {
   // The servo's (as scene/triaxial.cpp servo_velocity): the heaviest
   // sphere's mass m_max [kg] at the mass scaling, the wall dashpots' c
   // [N·s/m] (servo_wall_dashpot, 0 without contact damping) and
-  // R = kn_wall + c/demcal_dt [N/m] (servo_resistance).
-  double m_max = 0.0, wall_dashpot = 0.0, servo_resist = 0.0;
+  // R = kn_wall + c/demcal_dt [N/m] (servo_resistance), and the share of
+  // its last move that the servo carries into the next (servo_carry at
+  // demcal_dt, 0 without contact damping).
+  double m_max = 0.0, wall_dashpot = 0.0, servo_resist = 0.0, servo_carry = 0.0;
 };
 
 Plan3 make_plan(const SceneConfig& c, const AlgorithmSpec& p, const SphereWorld& w, int max_types) {
@@ -132,6 +134,7 @@ Plan3 make_plan(const SceneConfig& c, const AlgorithmSpec& p, const SphereWorld&
   plan.m_max = sphere_mass(plan.density, plan.r_max);
   plan.wall_dashpot = servo_wall_dashpot(c.material, plan.m_max);
   plan.servo_resist = servo_resistance(c.material, plan.m_max, plan.demcal_dt);
+  plan.servo_carry = deck::servo_carry_at(c.material, plan.m_max, plan.demcal_dt);
   for (int a = 0; a < 3; ++a) {
     plan.lo[a] = w.wall(static_cast<SphereWallSide>(2 * a)).position;
     plan.hi[a] = w.wall(static_cast<SphereWallSide>(2 * a + 1)).position;
@@ -272,10 +275,14 @@ std::string area_z() { return std::string(kLx) + "*" + kLy; }
 // (c_csn) and force on the spheres along +axis (c_csf), the max walls'
 // elements with the opposite sign (f_servo_sign), so that the clamp of each
 // element is the wall's move along +axis (deck::lammps_servo_raw_folded,
-// lammps_servo_clamp, as in 2D).
-std::string servo_raw_vector() {
+// lammps_servo_clamp, as in 2D). `carry` (contact damping): plus ${carry}
+// times each wall's last move along +axis (fix servo_prev; a max wall's
+// element -(law + carry*u) = (-law) + carry*(-u) bit for bit), demcal's
+// servo_velocity.
+std::string servo_raw_vector(bool carry) {
   return deck::lammps_servo_raw_folded("f_servo_sign*${sigma3}*f_servo_len*" + std::string(kH),
-                                       "-c_csf", deck::lammps_count_max_one("c_csn"));
+                                       "-c_csf", deck::lammps_count_max_one("c_csn")) +
+         (carry ? deck::lammps_servo_carried("f_servo_prev") : "");
 }
 
 // Header: the mapping and what this LAMMPS cannot do as demcal does.
@@ -289,14 +296,16 @@ void lammps_3d_limitations(std::ostream& s, const SceneConfig& c, const Algorith
     << "#  - damping explicit (fix viscous) vs demcal's semi-implicit: the factor f.\n"
     << "#  - servo walls are not native: each lateral wall is a wall/gran/region plane\n"
     << "#    whose displacement is the running sum of demcal's per-step servo move\n"
-    << "#    gain*(sigma3*A - F)/(" << resist_name(plan) << "*max(1, n)), capped at "
+    << "#    gain*(sigma3*A - F)/(" << resist_name(plan) << "*max(1, n))"
+    << (plan.servo_carry > 0.0 ? " + carry*u,\n#    capped at " : ", capped at ")
     << deck::servo_cap_text() << " (A the\n"
     << "#    wall's current area, F its force, n its contacts), kept by fix ave/time\n"
     << "#    (running mean times the step); one run command only (no restart split).\n";
   if (plan.wall_dashpot > 0.0)
     s << "#    R = kn_wall + c_wall/servo_dt: demcal's wall contacts resist a move\n"
       << "#    within its step by their dashpots too (contact damping; c_wall and\n"
-      << "#    resist in the derived block).\n";
+      << "#    resist in the derived block); and a moving wall has their force in\n"
+      << "#    its F, so a move carries carry = (R - kn_wall)/R of the wall's last, u.\n";
   s << "#  - LAMMPS takes a contact's torque at the lever arm r_i (demcal r_i - delta/2):\n"
     << "#    the antisymmetric part of s carries a small static term.\n"
     << "#  - a sphere's velocities and the tangential springs start at zero.\n"
@@ -346,7 +355,7 @@ void lammps_3d_derived(std::ostream& s, const Plan3& plan) {
     << "variable H0        equal $(v_zmax0-v_zmin0)\n"
     << "variable Wx0       equal $(v_xmax0-v_xmin0)\n"
     << "variable Wy0       equal $(v_ymax0-v_ymin0)\n"
-    << deck::lammps_loading_derived(plan.wall_dashpot, exact, "sphere")
+    << deck::lammps_loading_derived(plan.wall_dashpot, exact, "sphere", plan.servo_carry)
     << "variable peak_every equal $(ceil(v_nstep/1000000))      # fix vector length <= 1e6\n"
     << deck::lammps_band("band_v", "v_strain*v_H0", "m, see the walls")
     << deck::lammps_band("band_x", "2*v_strain*v_Wx0")
@@ -361,9 +370,10 @@ void lammps_3d_system(std::ostream& s, const SceneConfig& c, const Plan3& plan,
   if (gamma_n > 0.0)
     out.notes.push_back(
         "contact damping mapped at the mean sphere mass; the walls carry no dashpots here "
-        "(demcal's do), so a servo move meets kn_wall alone while the servo divides by R = "
-        "kn_wall + c/dt (measured on hex_5x5, zeta_c 0.25: servo criterion 5e-4 and peak "
-        "4e-5 relative from demcal's; engines.md section 20)");
+        "(demcal's do), so a servo move meets kn_wall alone while the servo is demcal's: it "
+        "divides by R = kn_wall + c/dt and carries (R - kn_wall)/R of the wall's last move "
+        "(measured on hex_5x5, zeta_c 0.25: servo criterion 5e-4 and peak 5e-5 relative from "
+        "demcal's; fcc_4x4x4, zeta_c 0.3: both equal to 5 digits; engines.md sections 20, 24)");
   s << deck::lammps_system_head(3, "f f f") << "newton          off\n"
     << "read_data       " << o.data_name << "\n"
     << "# sphere masses f_ms*rho*4/3*pi*r^3 (density column), inertia 2/5 m r^2\n"
@@ -474,8 +484,8 @@ void lammps_3d_consolidation(std::ostream& s, const SceneConfig& c, const Plan3&
       plan.wall_dashpot > 0.0 ? "(${kn_wall}+" + exact(plan.wall_dashpot) + "/dt)" : "${kn_wall}";
   // demcal's consolidation servo carries (R - kn_wall)/R of the last move,
   // R at this phase's step (0 without contact damping)
-  const double carry_light = deck::consolidation_carry(m, plan.m_max, dt_light);
-  const double carry_damped = deck::consolidation_carry(m, plan.m_max, dt_damped);
+  const double carry_light = deck::servo_carry_at(m, plan.m_max, dt_light);
+  const double carry_damped = deck::servo_carry_at(m, plan.m_max, dt_damped);
   s << deck::lammps_consolidation_servo(walls, {"cons_Ax", "cons_Ay", "cons_Az"}, "", resist,
                                         carry_light)
     << deck::lammps_consolidation_criterion(3, walls, {"x", "y", "z"})
@@ -698,13 +708,22 @@ std::string peak_metadata() {
 void lammps_3d_servo_and_run(std::ostream& s, const Plan3& plan) {
   s << "# --- servo -------------------------------------------------------------------\n"
     << "# demcal's servo, one move per step and wall toward the sample when p < sigma3:\n"
-    << "#   move = gain*(sigma3*A - F)/(" << resist_name(plan)
-    << "*max(1, n)), clamped to +-cap,\n";
-  if (plan.wall_dashpot > 0.0)
+    << "#   move = gain*(sigma3*A - F)/(" << resist_name(plan) << "*max(1, n))"
+    << (plan.servo_carry > 0.0 ? " + carry*u" : "") << ", clamped to +-cap,\n";
+  if (plan.servo_carry > 0.0)
+    s << "# R = kn_wall + c_wall/servo_dt (the wall dashpots too: resist, derived block),\n"
+      << "# u the wall's last move (carry: derived block; fix servo_prev, after fix\n"
+      << "# servo: at a step's end it still holds the step before's moves, 0 at the\n"
+      << "# first step: the walls start the loading at rest),\n";
+  else if (plan.wall_dashpot > 0.0)
     s << "# R = kn_wall + c_wall/servo_dt (the wall dashpots too: resist, derived block),\n";
   s << "# A = the wall's current area, F its force, n its contacts (compute csn, csf),\n"
     << "# per demcal step (servo_dt), so per step of dt that times dt/servo_dt:\n"
-    << "# gain_kn*(sigma3*A - F)/max(1, n) within +-cap_step (derived block).\n"
+    << "# gain_kn*(sigma3*A - F)/max(1, n)" << (plan.servo_carry > 0.0 ? " + carry*u" : "")
+    << " within +-cap_step (derived"
+    << (plan.servo_carry > 0.0
+            ? "\n# block; u, a move of this deck, is dt/servo_dt times demcal's already).\n"
+            : " block).\n")
     << "# The four walls in one vector-style formula (elements xmin xmax ymin ymax;\n"
     << "# the max walls' with the opposite sign, so that each clamped element is\n"
     << "# the wall's move along +axis), parsed once per step for all four, with the\n"
@@ -720,9 +739,11 @@ void lammps_3d_servo_and_run(std::ostream& s, const Plan3& plan) {
     << "variable        mone internal -1\n"
     << "fix             servo_sign all ave/time 1 1 1 v_one v_mone v_one v_mone\n"
     << "fix             servo_len all ave/time 1 1 1 f_geom[2] f_geom[2] f_geom[1] f_geom[1]\n"
-    << "variable        rawv vector " << servo_raw_vector() << "\n"
+    << "variable        rawv vector " << servo_raw_vector(plan.servo_carry > 0.0) << "\n"
     << "variable        movev vector " << deck::lammps_servo_clamp("v_rawv", "${cap_step}") << "\n";
-  s << "fix             servo all ave/time 1 1 1 v_movev mode vector ave running\n\n";
+  s << "fix             servo all ave/time 1 1 1 v_movev mode vector ave running\n";
+  if (plan.servo_carry > 0.0) s << deck::lammps_previous_moves("servo_prev", "movev", 4);
+  s << "\n";
 
   s << "# --- output and run ----------------------------------------------------------\n"
     << "thermo_style    custom step time v_strain_zz v_axial v_lateral v_ratio ke\n"
