@@ -365,12 +365,13 @@ std::string liggghts_servo_run(const std::vector<LiggghtsServoWall>& walls, doub
 /// reports/engines.md §25). The lateral walls are then plain stress meshes
 /// (fix mesh/surface/stress with reference_point at the wall's centre, so
 /// f_FIX[7..9] is its position as the servo mesh's) moved by fix move/mesh
-/// linear/variable at demcal's velocity: each step's end (fix servo_u, an
-/// ave/time of one step, which reads its own last value) stores a wall's
+/// linear/variable at demcal's velocity: each step's end stores a wall's
 /// move along +axis u = clamp(gain*(F_target + F)/(R*max(1, n)) + carry*u',
-/// +-cap), F the mesh's force along +axis, n its current contacts (compute
-/// nservo), u' its last move, 0 at the run's first step; the mesh moves at
-/// u/dt_demcal in the next. Then the loading run.
+/// +-cap) (fix servo_w the move before the clamp, then fix servo_u u: one-step
+/// ave/time fixes), F the mesh's force along +axis, n its current contacts
+/// (compute nservo), u' its last move (servo_u's last value), 0 at the run's
+/// first step; the mesh moves at u/dt_demcal in the next. Then the loading
+/// run.
 std::string liggghts_carried_servo_run(const std::vector<LiggghtsServoWall>& walls, double gain,
                                        double resist, double carry, double cap, double dt_demcal,
                                        NumberFormat f);

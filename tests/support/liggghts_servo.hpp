@@ -13,7 +13,8 @@
 namespace demcal::test {
 
 /// A lateral wall's servo law in a LIGGGHTS deck: u = clamp(gain*(F_target
-/// + F)/(resist*max(1, n)) + carry*u', +-cap) per demcal step, moved at
+/// + F)/(resist*max(1, n)) + carry*u', +-cap) per demcal step (the move
+/// before the clamp stored by fix servo_w, u by fix servo_u), moved at
 /// u/dt_demcal.
 struct LiggghtsCarriedLaw {
   double gain = std::nan(""), resist = std::nan(""), carry = std::nan("");
@@ -33,9 +34,14 @@ inline LiggghtsCarriedLaw liggghts_carried_law(const std::string& deck, const st
                        target + "\\+f_" + fix + "\\[" + std::to_string(axis + 1) + "\\]\\)/\\(" +
                        number + "\\*\\(" + n + "\\+\\(" + n + "<1\\)\\)\\)\\+" + number + "\\*" +
                        u + "\\)\n");
-  const std::regex clamp("\nvariable su_" + fix + " equal v_sw_" + fix + "\\*\\(abs\\(v_sw_" + fix +
-                         "\\)<=" + number + "\\)\\+\\1\\*\\(v_sw_" + fix +
-                         ">\\1\\)-\\1\\*\\(v_sw_" + fix + "<-\\1\\)\n");
+  // the clamp of the stored move before it (fix servo_w, before fix servo_u)
+  const std::string w = "f_servo_w\\[" + std::to_string(k) + "\\]";
+  const std::regex clamp("\nvariable su_" + fix + " equal " + w + "\\*\\(abs\\(" + w + "\\)<=" +
+                         number + "\\)\\+\\1\\*\\(" + w + ">\\1\\)-\\1\\*\\(" + w + "<-\\1\\)\n");
+  const auto raw_fix = deck.find("\nfix servo_w all ave/time 1 1 1 ");
+  const auto move_fix = deck.find("\nfix servo_u all ave/time 1 1 1 ");
+  if (raw_fix == std::string::npos || move_fix == std::string::npos || move_fix < raw_fix)
+    ADD_FAILURE() << "fix servo_w must store the moves before the clamp, before fix servo_u";
   const std::regex velocity("\nvariable sv_" + fix + " equal " + u + "/" + number + "\n");
   LiggghtsCarriedLaw out;
   std::smatch m;
