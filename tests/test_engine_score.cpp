@@ -12,10 +12,12 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "demcal/kernel/particle_scales.hpp"
 #include "demcal/scene/biaxial.hpp"
 #include "demcal/scene/run_output.hpp"
 #include "demcal/scene/triaxial.hpp"
@@ -319,6 +321,194 @@ std::string replaced(std::string text, const std::string& what, const std::strin
   EXPECT_NE(at, std::string::npos) << what;
   if (at != std::string::npos) text.replace(at, what.size(), with);
   return text;
+}
+
+/// A lateral wall of a LIGGGHTS deck with contact damping: its mesh fix,
+/// +1 for a min wall (its load sigma3*A along +axis), -1 for a max wall,
+/// and its axis (0 x, 1 y).
+struct CarriedWall {
+  std::string fix;
+  double side;
+  int axis;
+};
+
+/// The loading of a LIGGGHTS deck with contact damping (`r`), traced at
+/// every step's end for `steps` steps: each lateral wall's force F on its
+/// mesh along +axis, contacts n, position and stored move u, and the
+/// sample's height. Every move must be demcal's servo (servo_velocity,
+/// scene/biaxial.hpp and triaxial.hpp): clamp(gain*(side*sigma3*A + F)/(R*
+/// max(1, n)) + carry*u_prev, +-cap) along +axis, A the wall's area from
+/// the traced positions (`area`), R = `resist` (servo_resistance at
+/// demcal's step), carry = servo_carry(kn_wall, R), u_prev the wall's move
+/// of the step before (0 before the first: the walls start at rest); and
+/// each move must be the one applied: one step later the wall is u_prev·f
+/// further (f = dt/dt_demcal). Tolerance: 1e-9 of the terms,
+/// gain*|sigma3*A|/(R*max(1, n)) + |carry*u_prev| (the 2D deck writes its
+/// numbers with 10 digits; F cancels the load to 1e-7 of it and less). The cap is edited to
+/// `cap` (a fraction of the deck's) so that the clamp binds at some steps
+/// and not at others.
+void expect_the_loading_servo_carries_its_last_move(
+    const std::string& liggghts, const ExportResult& r, const SceneConfig& c,
+    const std::vector<CarriedWall>& walls,
+    const std::function<double(const std::vector<double>&, double, size_t)>& area, double resist,
+    double cap_fraction, int steps, const std::string& tag) {
+  const size_t nw = walls.size();
+  std::string row = "$(step) $(v_H)";
+  for (size_t k = 0; k < nw; ++k) {
+    const std::string& f = walls[k].fix;
+    const std::string i = std::to_string(k + 1);
+    row += " $(f_" + f + "[" + std::to_string(walls[k].axis + 1) + "]) $(c_nservo[" + i +
+           "]) $(f_" + f + "[" + std::to_string(walls[k].axis + 7) + "]) $(f_servo_u[" + i + "])";
+  }
+  // the trace after fix servo_u (end_of_step in the fixes' order): this
+  // step's move, from this step's force, contacts and positions
+  std::string deck = replaced(
+      r.deck, "\nrun ${run_steps}\n",
+      "\nfix trace all print 1 \"" + row + "\" file trace.txt screen no\nrun ${run_steps}\n");
+  // the cap, edited in each wall's clamp
+  double cap_value = std::nan("");
+  for (const CarriedWall& w : walls) {
+    const std::string head = "variable su_" + w.fix + " equal ";
+    const auto at = deck.find(head);
+    ASSERT_NE(at, std::string::npos) << head;
+    const auto end = deck.find('\n', at);
+    std::string line = deck.substr(at, end - at);
+    const auto le = line.find("<=");
+    const std::string old_cap = line.substr(le + 2, line.find(')', le) - le - 2);
+    char b[32];
+    std::snprintf(b, sizeof b, "%.17g", cap_fraction * std::stod(old_cap));
+    cap_value = std::stod(b);
+    for (auto p = line.find(old_cap); p != std::string::npos; p = line.find(old_cap, p + 1))
+      line.replace(p, old_cap.size(), b);
+    deck.replace(at, end - at, line);
+  }
+  const test::TempDir dir(tag);
+  // with a screen (captured): liggghts 3.8 crashes reading meshes under -screen none
+  const test::DeckRun run = test::run_deck(liggghts, dir.path(), deck, r.files,
+                                           {"-var", "run_steps", std::to_string(steps)});
+  ASSERT_EQ(run.status, 0) << run.log;
+  ASSERT_EQ(run.log.find("ERROR"), std::string::npos) << run.log;
+  std::map<int64_t, std::vector<double>> rows;
+  std::stringstream text(test::read_text(dir / "trace.txt"));
+  for (std::string line; std::getline(text, line);) {
+    if (line.empty() || line[0] == '#') continue;
+    std::stringstream fields(line);
+    std::vector<double> v;
+    for (double x; fields >> x;) v.push_back(x);
+    ASSERT_EQ(v.size(), 2 + 4 * nw) << line;
+    rows.emplace(static_cast<int64_t>(v[0]), v);
+  }
+  ASSERT_EQ(static_cast<int>(rows.size()), steps);
+  ASSERT_EQ(rows.begin()->first, 1);
+  ASSERT_EQ(rows.rbegin()->first, steps) << "a step is missing";
+  const double carry = servo_carry(c.material.wall.kn, resist);
+  ASSERT_GT(carry, 0.1);
+  const double sigma3 = c.test.lateral_stress, gain = c.test.servo_gain, f = r.step_factor;
+  std::vector<double> prev(nw, 0.0), last_position(nw, std::nan(""));
+  int clamped = 0, free = 0, carried = 0;
+  double largest = 0.0;  // |u| before the clamp
+  for (const auto& [step, v] : rows) {
+    SCOPED_TRACE("step " + std::to_string(step));
+    std::vector<double> position(nw);
+    for (size_t k = 0; k < nw; ++k) position[k] = v[4 + 4 * k];
+    for (size_t k = 0; k < nw; ++k) {
+      const double force = v[2 + 4 * k], n = v[3 + 4 * k], move = v[5 + 4 * k];
+      const double load = walls[k].side * sigma3 * area(position, v[1], k);
+      const double law = gain * (load + force) / (resist * std::max(1.0, n));
+      const double expected = std::clamp(law + carry * prev[k], -cap_value, cap_value);
+      // the terms' sizes: the load's (F cancels most of it) and the carry's
+      const double scale =
+          gain * std::abs(load) / (resist * std::max(1.0, n)) + carry * std::abs(prev[k]);
+      ASSERT_LE(std::abs(move - expected), 1e-9 * scale)
+          << walls[k].fix << ": move " << move << ", demcal's law " << expected << " (law " << law
+          << ", carry " << carry << ", last move " << prev[k] << ")";
+      if (step > 1) {
+        // the last move, applied at demcal's velocity for one step of dt
+        EXPECT_NEAR(position[k] - last_position[k], f * prev[k],
+                    1e-13 * std::abs(position[k]) + 1e-9 * std::abs(prev[k]))
+            << walls[k].fix;
+      }
+      largest = std::max(largest, std::abs(law + carry * prev[k]));
+      if (std::abs(move) > (1 - 1e-9) * cap_value) {
+        ++clamped;
+      } else {
+        ++free;
+        if (carry * std::abs(prev[k]) >= 0.1 * std::abs(law)) ++carried;
+      }
+      prev[k] = move;
+    }
+    last_position = position;
+  }
+  std::printf(
+      "%s: %zu steps, carry %.6f, cap %.3g, largest move %.3g, %d moves clamped, %d free, %d of "
+      "them carried\n",
+      tag.c_str(), rows.size(), carry, cap_value, largest, clamped, free, carried);
+  EXPECT_GT(clamped, 100) << "the clamp never bound";
+  EXPECT_GT(free, 100) << "the clamp always bound";
+  EXPECT_GT(carried, 100) << "the carry never weighed";
+}
+
+// demcal's loading servo with contact damping carries (R - kn_wall)/R of
+// each lateral wall's last move (servo_velocity since 483ff94); LIGGGHTS
+// 3.8's mesh servo cannot (reports/engines.md §25), so the deck moves the
+// lateral meshes by demcal's law itself (deck::liggghts_carried_servo_run).
+// hex_5x5 at zeta_c 0.25 (WithContactDampingTheDecksServoIsDemcals'
+// sample and step), 3 000 steps, the cap at 1/20 of demcal's so that
+// it binds at the start; both fail on the deck with the mesh servo (no
+// servo_u).
+TEST(EngineLiggghts, WithContactDampingTheLoadingServoCarriesItsLastMoveAsDemcals2D) {
+  const std::string liggghts = test::find_on_path("liggghts");
+  if (liggghts.empty())
+    GTEST_SKIP() << "LIGGGHTS (liggghts) is not installed (apt-get install liggghts): the "
+                    "deck is not run";
+  SceneConfig c = hex5();
+  c.material.contact_damping_ratio = 0.25;
+  const ConsolidatedState state = consolidate(c, make_assembly(c));
+  ASSERT_TRUE(state.converged);
+  AlgorithmSpec p = quasi_static();
+  p.steps = 20000;
+  p.dt_ratio = std::min(p.dt_ratio, 0.9 * estimated_stable_dt_ratio(state, p));
+  const ExportResult r = liggghts_deck(c, p, state, "hex5.data");
+  // demcal's R at its step: the wall dashpot of the heaviest disc at the
+  // run's mass scaling
+  const World& w = state.world;
+  const double m_max = disk_mass(disk_areal_density(c.material, p.mass_scaling), w.max_radius());
+  const double resist = servo_resistance(c.material, m_max, integration_for(w, p).dt);
+  const double t = c.material.thickness;
+  expect_the_loading_servo_carries_its_last_move(
+      liggghts, r, c, {{"mleft", 1.0, 0}, {"mright", -1.0, 0}},
+      [t](const std::vector<double>&, double h, size_t) { return h * t; }, resist, 1.5e-5, 3000,
+      "liggghts_carry_2d");
+}
+
+// The same for the 3D deck's four lateral walls: fcc_4x4x4 at zeta_c 0.3,
+// alpha 0.1 (Export3dLammps.WithContactDampingTheDecksServoIsDemcals'
+// parameters), 2 000 steps.
+TEST(EngineLiggghts, WithContactDampingTheLoadingServoCarriesItsLastMoveAsDemcals3D) {
+  const std::string liggghts = test::find_on_path("liggghts");
+  if (liggghts.empty())
+    GTEST_SKIP() << "LIGGGHTS (liggghts) is not installed (apt-get install liggghts): the "
+                    "deck is not run";
+  SceneConfig c = load_config(test::shipped_config("fcc_4x4x4"));
+  c.material.contact_damping_ratio = 0.3;
+  const TriaxialState state = consolidate_triaxial(c, make_sphere_assembly(c));
+  ASSERT_TRUE(state.converged);
+  AlgorithmSpec p = fcc_20000();
+  p.steps = 10000;
+  p.dt_ratio = 0.1;
+  const ExportResult r = fcc_liggghts_deck(c, p, state);
+  const SphereWorld& w = state.world;
+  const double m_max = sphere_mass(c.material.density * p.mass_scaling, w.max_radius());
+  const double resist = servo_resistance(c.material.wall.kn, c.material.contact_damping_ratio,
+                                         m_max, integration_for(w, p).dt);
+  // A of an x wall L_y*H, of a y wall L_x*H (walls xmin xmax ymin ymax)
+  expect_the_loading_servo_carries_its_last_move(
+      liggghts, r, c,
+      {{"mxmin", 1.0, 0}, {"mxmax", -1.0, 0}, {"mymin", 1.0, 1}, {"mymax", -1.0, 1}},
+      [](const std::vector<double>& x, double h, size_t k) {
+        return (k < 2 ? x[3] - x[2] : x[1] - x[0]) * h;
+      },
+      resist, 3.3e-8, 2000, "liggghts_carry_3d");
 }
 
 class LammpsSeriesSources : public ::testing::TestWithParam<const char*> {};
@@ -1031,6 +1221,46 @@ TEST(EngineLiggghts, RotatesDiscsWithTheDiscsInertia) {
   // The tangential spring's elastic energy and its oscillation about
   // rolling: a few 1e-4 of v0 (measured 3.6e-4).
   EXPECT_NEAR(v / 0.1, 2.0 / 3.0, 0.005 * 2.0 / 3.0);
+}
+
+// Contact damping zeta_c 0.3 on fcc_4x4x4 (Export3dLammps.WithContactDampingTheDecksServoIsDemcals'
+// parameters: alpha 0.1, 10 000 steps): demcal's servo divides by R =
+// kn_wall + c/dt and carries (R - kn_wall)/R of each wall's last move, the
+// deck's too (deck::liggghts_carried_servo_run): the deck's scored servo
+// criterion as demcal's within 5 % and the peak within 1 % (measured
+// 0.0053777 against 0.0053776, the peak the same to 6 digits). With the
+// mesh servo (kp from R, no carry: the deck of 483ff94) the servo read 4.0
+// times demcal's and the peak 1.6 % more.
+TEST(EngineLiggghts, WithContactDampingThe3dDecksServoIsDemcals) {
+  const std::string liggghts = test::find_on_path("liggghts");
+  if (liggghts.empty())
+    GTEST_SKIP() << "LIGGGHTS (liggghts) is not installed (apt-get install liggghts): the 3D "
+                    "deck is not run";
+  SceneConfig c = load_config(test::shipped_config("fcc_4x4x4"));
+  c.material.contact_damping_ratio = 0.3;
+  const TriaxialState state = consolidate_triaxial(c, make_sphere_assembly(c));
+  ASSERT_TRUE(state.converged);
+  AlgorithmSpec p = fcc_20000();
+  p.steps = 10000;
+  p.dt_ratio = 0.1;
+  const TriaxialResult d = run_triaxial_loading(state, c.test, p);
+  ASSERT_FALSE(d.diverged);
+  const ExportResult r = fcc_liggghts_deck(c, p, state);
+  const test::TempDir dir("liggghts3d_damped");
+  // with a screen (captured): liggghts 3.8 crashes reading meshes under -screen none
+  const test::DeckRun lg = test::run_deck(liggghts, dir.path(), r.deck, r.files, {});
+  ASSERT_EQ(lg.status, 0) << lg.log;
+  ASSERT_EQ(lg.log.find("ERROR"), std::string::npos) << lg.log;
+  const ExternalSeries series =
+      parse_external_series(test::read_text(dir / "series.csv"), "series.csv");
+  const ExternalScore theirs = score_external(series, Tolerances{});
+  const Score ours = score_triaxial_run(d, c.test.lateral_stress, Tolerances{});
+  const Criteria &t = theirs.score.criteria, &m = ours.criteria;
+  std::printf(
+      "fcc_4x4x4, contact damping 0.3: servo demcal %.5g / LIGGGHTS %.5g, peak %.6g / %.6g Pa\n",
+      m.servo, t.servo, m.peak_stress_yy, t.peak_stress_yy);
+  EXPECT_NEAR(t.servo / m.servo, 1.0, 0.05);
+  EXPECT_NEAR(t.peak_stress_yy / m.peak_stress_yy, 1.0, 0.01);
 }
 
 TEST(EngineLiggghts, The3dDecksSeriesScoresAsDemcalsRun) {

@@ -25,6 +25,7 @@
 #include "demcal/upscaling/export_3d.hpp"
 #include "support/files.hpp"
 #include "support/head_on.hpp"
+#include "support/liggghts_servo.hpp"
 #include "support/process.hpp"
 
 namespace demcal {
@@ -249,13 +250,43 @@ TEST(Export3d, TheLoadingServosGainIsDemcalsWithTheWallDashpots) {
 
     o.format = "liggghts";
     const ExportResult g = export_3d_decks(c, p, a, o);
+    const double dt_demcal = g.dt / g.step_factor;
+    // demcal's carry, from servo_velocity itself: at the target 0 (no
+    // error) only the carried share of the wall's velocity remains
+    w.wall(kXMin).velocity = 1e-6;  // m/s toward the sample: far from the cap
+    const double carry = servo_velocity(w, kXMin, 0.0, c.test.servo_gain) / 1e-6;
+    w.wall(kXMin).velocity = 0.0;
+    if (zeta_c > 0.0) {
+      // demcal's servo carries a share of the last move, LIGGGHTS' mesh
+      // servo cannot: the deck moves the walls by demcal's law itself (per
+      // demcal step, gain/R per unit of force on the x-min wall without
+      // contacts, the carry, at u/dt_demcal)
+      EXPECT_EQ(g.deck.find("mesh/surface/stress/servo"), std::string::npos);
+      EXPECT_GT(carry, 0.5);
+      const char* name[4] = {"xmin", "xmax", "ymin", "ymax"};
+      for (int sd = 0; sd < 4; ++sd) {
+        const std::string fix = std::string("m") + name[sd];
+        const test::LiggghtsCarriedLaw law =
+            test::liggghts_carried_law(g.deck, fix, sd + 1, std::string("ft_") + name[sd], sd / 2);
+        if (sd == 0) EXPECT_NEAR(law.gain / law.resist / demcal, 1.0, 1e-12);
+        EXPECT_NEAR(law.carry / carry, 1.0, 1e-12) << fix;
+        EXPECT_NEAR(law.dt_demcal / dt_demcal, 1.0, 1e-12) << fix;
+        EXPECT_NEAR(law.cap / servo_move_cap(w.min_radius()), 1.0, 1e-15) << fix;
+        const std::string v = " v_sv_" + fix, zero = " v_servo_zero";
+        EXPECT_NE(g.deck.find("fix smove_" + fix + " all move/mesh mesh " + fix +
+                              " linear/variable" + (sd < 2 ? v + zero : zero + v) + zero + "\n"),
+                  std::string::npos)
+            << fix;
+      }
+      continue;
+    }
+    EXPECT_EQ(carry, 0.0);
     const std::string fix = g.deck.substr(g.deck.find("fix mxmin "));
     auto number_after = [&](const std::string& key) {
       return std::stod(fix.substr(fix.find(" " + key + " ") + key.size() + 2));
     };
     const double f_target = c.test.lateral_stress * w.extent(1) * w.extent(2);
     const double velocity_per_force = number_after("vel_max") * number_after("kp") / f_target;
-    const double dt_demcal = g.dt / g.step_factor;
     EXPECT_NEAR(velocity_per_force * dt_demcal / demcal, 1.0, 1e-12) << "zeta_c " << zeta_c;
   }
 }

@@ -731,4 +731,51 @@ std::string liggghts_servo_run(const std::vector<LiggghtsServoWall>& walls, doub
   return s.str();
 }
 
+std::string liggghts_carried_servo_run(const std::vector<LiggghtsServoWall>& walls, double gain,
+                                       double resist, double carry, double cap, double dt_demcal,
+                                       NumberFormat f) {
+  std::ostringstream s;
+  s << "# demcal's servo with contact damping (servo_velocity): each step a lateral\n"
+    << "# wall moves along +axis by u = clamp(gain*(F_target + F)/(R*max(1, n))\n"
+    << "# + carry*u', +-cap) in demcal's step dt_demcal, F the force on its mesh\n"
+    << "# along +axis, n its current contacts, u' its last move: demcal's wall\n"
+    << "# dashpots put the force c*v of a moving wall into F, so a move carries\n"
+    << "# carry = (R - kn_wall)/R of the last and a steady error moves the wall at\n"
+    << "# the undamped law's speed. At each step's end fix servo_w stores the move\n"
+    << "# before the clamp (once: the clamp reads it four times), from u' = fix\n"
+    << "# servo_u's last value (0 before its first), then servo_u stores u (fix\n"
+    << "# ave/time runs in the fixes' order); the mesh moves at u/dt_demcal in the\n"
+    << "# next step (fix move/mesh linear/variable), as LIGGGHTS' mesh servo would\n"
+    << "# with kp, which cannot carry a move. The walls start at rest: u = 0 at the\n"
+    << "# run's start, where the meshes have no force yet.\n"
+    << "compute nservo all reduce sum";
+  for (const LiggghtsServoWall& w : walls) s << " v_" << w.touch;
+  s << "\n";
+  std::string raw_moves, moves;
+  for (size_t k = 0; k < walls.size(); ++k) {
+    const LiggghtsServoWall& w = walls[k];
+    const std::string i = std::to_string(k + 1);
+    const std::string n = "c_nservo[" + i + "]", raw = "f_servo_w[" + i + "]", c = f(cap);
+    s << "variable sw_" << w.fix << " equal (step>0)*(" << f(gain) << "*(v_" << w.target << "+f_"
+      << w.fix << "[" << w.axis + 1 << "])/(" << f(resist) << "*(" << n << "+(" << n << "<1)))+"
+      << f(carry) << "*f_servo_u[" << i << "])\n"
+      << "variable su_" << w.fix << " equal " << raw << "*(abs(" << raw << ")<=" << c << ")+" << c
+      << "*(" << raw << ">" << c << ")-" << c << "*(" << raw << "<-" << c << ")\n";
+    raw_moves += " v_sw_" + w.fix;
+    moves += " v_su_" + w.fix;
+  }
+  s << "fix servo_w all ave/time 1 1 1" << raw_moves << "\n"
+    << "fix servo_u all ave/time 1 1 1" << moves << "\n"
+    << "variable servo_zero equal 0\n";
+  for (size_t k = 0; k < walls.size(); ++k) {
+    const LiggghtsServoWall& w = walls[k];
+    s << "variable sv_" << w.fix << " equal f_servo_u[" << k + 1 << "]/" << f(dt_demcal) << "\n"
+      << "fix smove_" << w.fix << " all move/mesh mesh " << w.fix << " linear/variable";
+    for (int a = 0; a < 3; ++a) s << (a == w.axis ? " v_sv_" + w.fix : " v_servo_zero");
+    s << "\n";
+  }
+  s << "run ${run_steps}\n";
+  return s.str();
+}
+
 }  // namespace demcal::deck

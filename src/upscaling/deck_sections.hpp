@@ -349,6 +349,7 @@ std::string liggghts_series(const std::string& deck, const std::string& scene, i
 /// variable, 1 on the particles that overlap it (the series' own).
 struct LiggghtsServoWall {
   std::string fix, target, touch;
+  int axis = 0;  // the wall's normal: 0 x, 1 y
 };
 
 /// LIGGGHTS' servo law (MeshModuleStressServo, 3.8) moves a mesh at
@@ -373,5 +374,22 @@ double liggghts_servo_kp(double gain, double force_target, double resist, int co
 std::string liggghts_servo_run(const std::vector<LiggghtsServoWall>& walls, double gain,
                                double resist, double cap, int every, NumberFormat f,
                                const std::string& resist_name = "kn_wall");
+
+/// LIGGGHTS with contact damping: demcal's servo carries `carry` =
+/// servo_carry(kn_wall, R) of a wall's last move (scene/biaxial.hpp), which
+/// LIGGGHTS 3.8's mesh servo cannot (its law is kp, ki, kd on the error:
+/// reports/engines.md §25). The lateral walls are then plain stress meshes
+/// (fix mesh/surface/stress with reference_point at the wall's centre, so
+/// f_FIX[7..9] is its position as the servo mesh's) moved by fix move/mesh
+/// linear/variable at demcal's velocity: each step's end stores a wall's
+/// move along +axis u = clamp(gain*(F_target + F)/(R*max(1, n)) + carry*u',
+/// +-cap) (fix servo_w the move before the clamp, then fix servo_u u: one-step
+/// ave/time fixes), F the mesh's force along +axis, n its current contacts
+/// (compute nservo), u' its last move (servo_u's last value), 0 at the run's
+/// first step; the mesh moves at u/dt_demcal in the next. Then the loading
+/// run.
+std::string liggghts_carried_servo_run(const std::vector<LiggghtsServoWall>& walls, double gain,
+                                       double resist, double carry, double cap, double dt_demcal,
+                                       NumberFormat f);
 
 }  // namespace demcal::deck

@@ -1056,6 +1056,11 @@ ExportResult liggghts(const SceneConfig& c, const AlgorithmSpec& p, const Assemb
   const double kp_right =
       deck::liggghts_servo_kp(c.test.servo_gain, force_target, plan.servo_resist, n_right, cap);
   const double vel_max = deck::liggghts_servo_vel_max(cap, plan.dt, plan.step_factor);
+  // With contact damping demcal's servo carries a share of the wall's last
+  // move, which LIGGGHTS' mesh servo cannot: the walls are then moved by
+  // deck::liggghts_carried_servo_run.
+  const double carry = servo_carry(m.wall.kn, plan.servo_resist);
+  const bool carried = carry > 0.0;
 
   // LIGGGHTS with dimension 2 computes a particle's mass as π·r²·density:
   // the areal density f_ms·ρ·t gives the disc's mass f_ms·ρ·t·π·r².
@@ -1095,34 +1100,43 @@ ExportResult liggghts(const SceneConfig& c, const AlgorithmSpec& p, const Assemb
   s << mapping_header(c, p, plan, o, "LIGGGHTS");
   s << "#\n# Checked with LIGGGHTS 3.8 (Debian): on a 25-disc sample it scores as demcal's\n"
     << "# run (same verdict, peak within 1 %: a test, where liggghts is installed;\n"
-    << "# reports/engines.md). It writes demcal's monitoring series: demcal score series.csv\n"
-    << "# Servo: LIGGGHTS moves the mesh at vel_max * kp * (F_target - F)/|F_target|;\n"
-    << "# vel_max = cap/dt_demcal (dt_demcal = dt/f, demcal's step) and\n"
-    << "# kp = gain*|F_target|/(R*max(1, n)*cap), n the wall's current contacts,\n"
-    << "# give demcal's wall velocity gain*(F_target - F)/(R*max(1, n)*dt_demcal)\n"
-    << "# and its cap; R = kn_wall";
-  if (plan.wall_dashpot > 0.0)
-    s << " + c/dt_demcal = " << num(plan.servo_resist) << " N/m: demcal's wall contacts\n"
-      << "# resist a move within its step by their dashpots too, c = 2*zeta_c*\n"
-      << "# sqrt(kn_wall*m_max) = " << num(plan.wall_dashpot)
-      << " N*s/m (the heaviest disc's), and its servo divides by both\n";
+    << "# reports/engines.md). It writes demcal's monitoring series: demcal score series.csv\n";
+  if (carried)
+    s << "# Servo: demcal's law with contact damping (below, before the run): each step\n"
+      << "# a lateral wall moves by gain*(F_target - F)/(R*max(1, n)) + carry*(its last\n"
+      << "# move), clamped to +-cap, n its current contacts, in demcal's step\n"
+      << "# dt_demcal = dt/f. R = kn_wall + c/dt_demcal = " << num(plan.servo_resist) << " N/m:\n"
+      << "# demcal's wall contacts resist a move within its step by their dashpots\n"
+      << "# too, c = 2*zeta_c*sqrt(kn_wall*m_max) = " << num(plan.wall_dashpot)
+      << " N*s/m (the heaviest disc's);\n"
+      << "# carry = (R - kn_wall)/R = " << num(carry)
+      << ". F_target = sigma3*H*t follows the current\n"
+      << "# height (v_ftl), demcal's target.\n";
   else
-    s << "\n";
-  s << "# LIGGGHTS' kp is a number: the run goes in chunks of\n"
-    << "# ${servo_every} steps (one setup) and kp is set from the current n and\n"
-    << "# F_target between them (fix_modify servo/ctrlParam; at the start from\n"
-    << "# demcal's counts, " << n_left << " left and " << n_right << " right): the gain\n"
-    << "# lags demcal's by one chunk at most. F_target = sigma3*H*t follows the\n"
-    << "# current height (target_val v_ftl), demcal's target.\n"
-    << "# Run it with a screen (liggghts 3.8 crashes reading meshes with -screen none).\n"
+    s << "# Servo: LIGGGHTS moves the mesh at vel_max * kp * (F_target - F)/|F_target|;\n"
+      << "# vel_max = cap/dt_demcal (dt_demcal = dt/f, demcal's step) and\n"
+      << "# kp = gain*|F_target|/(R*max(1, n)*cap), n the wall's current contacts,\n"
+      << "# give demcal's wall velocity gain*(F_target - F)/(R*max(1, n)*dt_demcal)\n"
+      << "# and its cap; R = kn_wall\n"
+      << "# LIGGGHTS' kp is a number: the run goes in chunks of\n"
+      << "# ${servo_every} steps (one setup) and kp is set from the current n and\n"
+      << "# F_target between them (fix_modify servo/ctrlParam; at the start from\n"
+      << "# demcal's counts, " << n_left << " left and " << n_right << " right): the gain\n"
+      << "# lags demcal's by one chunk at most. F_target = sigma3*H*t follows the\n"
+      << "# current height (target_val v_ftl), demcal's target.\n";
+  s << "# Run it with a screen (liggghts 3.8 crashes reading meshes with -screen none).\n"
     << "# Differences from demcal:\n"
     << "#  - rotation: LIGGGHTS 3.8's fix nve/sphere takes the disc's inertia m r^2/2\n"
     << "#    under dimension 2 (as demcal); masses are disc masses (pi r^2 * areal density).\n"
     << "#  - rotational damping (zeta_r = " << num(p.damping_ratio_rotation)
-    << ") has no fix here and is not applied.\n"
-    << "#  - the servo's gain follows the contacts every ${servo_every} steps (demcal:\n"
-    << "#    every step).\n"
-    << "#  - translational damping per radius class via fix viscous ... scale.\n";
+    << ") has no fix here and is not applied.\n";
+  if (carried)
+    s << "#  - the servo's first move comes one step after demcal's (the meshes have\n"
+      << "#    no force before the first step).\n";
+  else
+    s << "#  - the servo's gain follows the contacts every ${servo_every} steps (demcal:\n"
+      << "#    every step).\n";
+  s << "#  - translational damping per radius class via fix viscous ... scale.\n";
   s << deck::liggghts_preamble(2, "f f p", o.data_name, plan.r_min)
     << deck::liggghts_materials(m, plan.class_mass, plan.dt, num)
     << "# the lateral walls' target forces, sigma3*H*t (left +x, right -x)\n"
@@ -1131,16 +1145,24 @@ ExportResult liggghts(const SceneConfig& c, const AlgorithmSpec& p, const Assemb
     << "fix bottom all wall/gran model hooke/stiffness tangential history primitive type "
     << wall_type << " yplane " << num(a.bottom) << " store_force yes "
     << deck::liggghts_model_settings(m) << "\n"
-    << "fix mtop all mesh/surface/stress file " << top << " type " << wall_type << "\n"
-    << "fix mleft all mesh/surface/stress/servo file " << left << " type " << wall_type << " com "
-    << num(a.left) << " " << num(0.5 * (a.bottom + a.top))
-    << " 0 ctrlPV force axis 1 0 0 target_val v_ftl vel_max " << num(vel_max) << " kp "
-    << num(kp_left) << "\n"
-    << "fix mright all mesh/surface/stress/servo file " << right << " type " << wall_type << " com "
-    << num(a.right) << " " << num(0.5 * (a.bottom + a.top))
-    << " 0 ctrlPV force axis 1 0 0 target_val v_ftr vel_max " << num(vel_max) << " kp "
-    << num(kp_right) << "\n"
-    << "fix walls all wall/gran model hooke/stiffness tangential history mesh n_meshes 3 meshes "
+    << "fix mtop all mesh/surface/stress file " << top << " type " << wall_type << "\n";
+  if (carried)
+    s << "# the lateral walls: stress meshes, their reference point the wall's centre\n"
+      << "# (f_mleft[7]), moved by demcal's servo (fix move/mesh, before the run)\n"
+      << "fix mleft all mesh/surface/stress file " << left << " type " << wall_type
+      << " reference_point " << num(a.left) << " " << num(0.5 * (a.bottom + a.top)) << " 0\n"
+      << "fix mright all mesh/surface/stress file " << right << " type " << wall_type
+      << " reference_point " << num(a.right) << " " << num(0.5 * (a.bottom + a.top)) << " 0\n";
+  else
+    s << "fix mleft all mesh/surface/stress/servo file " << left << " type " << wall_type << " com "
+      << num(a.left) << " " << num(0.5 * (a.bottom + a.top))
+      << " 0 ctrlPV force axis 1 0 0 target_val v_ftl vel_max " << num(vel_max) << " kp "
+      << num(kp_left) << "\n"
+      << "fix mright all mesh/surface/stress/servo file " << right << " type " << wall_type
+      << " com " << num(a.right) << " " << num(0.5 * (a.bottom + a.top))
+      << " 0 ctrlPV force axis 1 0 0 target_val v_ftr vel_max " << num(vel_max) << " kp "
+      << num(kp_right) << "\n";
+  s << "fix walls all wall/gran model hooke/stiffness tangential history mesh n_meshes 3 meshes "
        "mtop mleft mright store_force yes "
     << deck::liggghts_model_settings(m) << "\n"
     << "fix movetop all move/mesh mesh mtop linear 0 " << num(-plan.top_speed) << " 0\n\n"
@@ -1155,10 +1177,15 @@ ExportResult liggghts(const SceneConfig& c, const AlgorithmSpec& p, const Assemb
     << "variable p_right equal f_mright[1]/(v_H*" << num(m.thickness) << ")\n"
     << "thermo_style custom step dt time ke v_p_top v_p_left v_p_right v_xl v_xr\n"
     << "thermo " << plan.thermo_every << "\n"
-    << "variable run_steps index " << plan.steps << "\n"
-    << deck::liggghts_servo_run({{"mleft", "ftl", "ll_a"}, {"mright", "ftr", "lr_a"}},
-                                c.test.servo_gain, plan.servo_resist, cap, plan.thermo_every, num,
-                                plan.wall_dashpot > 0.0 ? "R" : "kn_wall");
+    << "variable run_steps index " << plan.steps << "\n";
+  const std::vector<deck::LiggghtsServoWall> servo_walls{{"mleft", "ftl", "ll_a"},
+                                                         {"mright", "ftr", "lr_a"}};
+  if (carried)
+    s << deck::liggghts_carried_servo_run(servo_walls, c.test.servo_gain, plan.servo_resist, carry,
+                                          cap, plan.dt / plan.step_factor, num);
+  else
+    s << deck::liggghts_servo_run(servo_walls, c.test.servo_gain, plan.servo_resist, cap,
+                                  plan.thermo_every, num, "kn_wall");
   out.deck = s.str();
   return out;
 }

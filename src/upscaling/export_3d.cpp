@@ -979,7 +979,7 @@ std::array<std::string, 6> liggghts_3d_meshes(const Plan3& plan, const Export3dO
 void liggghts_3d_lateral_walls(std::ostream& s, const SceneConfig& c, const Plan3& plan,
                                const Export3dOptions& o,
                                const std::array<std::string, 6>& mesh_file, int wall_type,
-                               double cap) {
+                               double cap, bool carried) {
   const double vel_max = deck::liggghts_servo_vel_max(cap, plan.dt, plan.step_factor);
   const std::array<double, 3> ext{plan.hi[0] - plan.lo[0], plan.hi[1] - plan.lo[1],
                                   plan.hi[2] - plan.lo[2]};
@@ -1001,11 +1001,16 @@ void liggghts_3d_lateral_walls(std::ostream& s, const SceneConfig& c, const Plan
         << exact(c.test.lateral_stress) << "*(f_m" << kWall[2 * b + 1] << "[" << 7 + b << "]-f_m"
         << kWall[2 * b] << "[" << 7 + b << "])*(" << exact(ext[2]) << "-" << exact(plan.top_speed)
         << "*step*" << exact(plan.dt) << ")\n";
-      s << "fix m" << kWall[sd] << " all mesh/surface/stress/servo file " << mesh_file[sd]
-        << " type " << wall_type << " com " << exact(com.x()) << " " << exact(com.y()) << " "
-        << exact(com.z()) << " ctrlPV force axis " << (a == 0 ? "1 0 0" : "0 1 0")
-        << " target_val v_ft_" << kWall[sd] << " vel_max " << exact(vel_max) << " kp " << exact(kp)
-        << "\n";
+      if (carried)  // moved by demcal's servo (deck::liggghts_carried_servo_run)
+        s << "fix m" << kWall[sd] << " all mesh/surface/stress file " << mesh_file[sd] << " type "
+          << wall_type << " reference_point " << exact(com.x()) << " " << exact(com.y()) << " "
+          << exact(com.z()) << "\n";
+      else
+        s << "fix m" << kWall[sd] << " all mesh/surface/stress/servo file " << mesh_file[sd]
+          << " type " << wall_type << " com " << exact(com.x()) << " " << exact(com.y()) << " "
+          << exact(com.z()) << " ctrlPV force axis " << (a == 0 ? "1 0 0" : "0 1 0")
+          << " target_val v_ft_" << kWall[sd] << " vel_max " << exact(vel_max) << " kp "
+          << exact(kp) << "\n";
     } else {
       s << "fix m" << kWall[sd] << " all mesh/surface/stress file " << mesh_file[sd] << " type "
         << wall_type << "\n";
@@ -1017,7 +1022,7 @@ void liggghts_3d_lateral_walls(std::ostream& s, const SceneConfig& c, const Plan
 /// set between them from its current contacts (deck::liggghts_servo_run);
 /// one run without.
 void liggghts_3d_run(std::ostream& s, const SceneConfig& c, const Plan3& plan,
-                     const Export3dOptions& o, double cap, int monitor_every) {
+                     const Export3dOptions& o, double cap, int monitor_every, double carry) {
   if (!o.lateral_servo) {
     s << "run ${run_steps}\n";
     return;
@@ -1025,9 +1030,13 @@ void liggghts_3d_run(std::ostream& s, const SceneConfig& c, const Plan3& plan,
   std::vector<deck::LiggghtsServoWall> walls;
   for (int sd = 0; sd < 4; ++sd)
     walls.push_back({std::string("m") + kWall[sd], std::string("ft_") + kWall[sd],
-                     std::string("t") + std::to_string(sd) + "_a"});
-  s << deck::liggghts_servo_run(walls, c.test.servo_gain, plan.servo_resist, cap, monitor_every,
-                                exact, resist_name(plan));
+                     std::string("t") + std::to_string(sd) + "_a", sd / 2});
+  if (carry > 0.0)
+    s << deck::liggghts_carried_servo_run(walls, c.test.servo_gain, plan.servo_resist, carry, cap,
+                                          plan.dt / plan.step_factor, exact);
+  else
+    s << deck::liggghts_servo_run(walls, c.test.servo_gain, plan.servo_resist, cap, monitor_every,
+                                  exact, resist_name(plan));
 }
 
 std::string liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p, const Plan3& plan,
@@ -1043,31 +1052,48 @@ std::string liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p, const Pl
   // chunks of the run (deck::liggghts_servo_run); at the start from the
   // contacts demcal counts.
   const double cap = servo_move_cap(plan.r_min);
-  // R: kn_wall, and the wall dashpots' c/dt_demcal with contact damping
+  // R: kn_wall, and the wall dashpots' c/dt_demcal with contact damping;
+  // then demcal's servo carries a share of the last move, which LIGGGHTS'
+  // mesh servo cannot: the walls are moved by deck::liggghts_carried_servo_run.
   const bool dashpots = plan.wall_dashpot > 0.0;
+  const double carry = servo_carry(m.wall.kn, plan.servo_resist);
+  const bool carried = o.lateral_servo && carry > 0.0;
   std::ostringstream s;
   s << mapping_header(c, p, plan, o, "LIGGGHTS");
   s << "#\n# Checked with LIGGGHTS 3.8 (Debian). Differences from demcal:\n"
-    << "#  - rotational damping: no fix here (zeta_r not applied).\n"
-    << "#  - lateral walls: fix mesh/surface/stress/servo holds the wall force at\n"
-    << "#    sigma3*A, A the wall's current area (target_val v_ft_WALL), demcal's\n"
-    << "#    target (the force on the mesh along +axis: positive on a min wall).\n"
-    << "#    LIGGGHTS moves it at vel_max*kp*(F_target - F)/|F_target|: vel_max =\n"
-    << "#    cap/dt_demcal (dt_demcal = dt/f, demcal's step) and kp =\n"
-    << "#    gain*|F_target|/(" << resist_name(plan) << "*max(1, n)*cap), n the wall's current "
-    << "contacts,\n#    give demcal's wall velocity gain*(F_target - F)/(" << resist_name(plan)
-    << "*max(1, n)*dt_demcal)\n"
-    << "#    and its cap";
-  if (dashpots)
-    s << "; R = kn_wall + c/dt_demcal = " << exact(plan.servo_resist) << " N/m: demcal's\n"
-      << "#    wall contacts resist a move within its step by their dashpots too, c =\n"
+    << "#  - rotational damping: no fix here (zeta_r not applied).\n";
+  if (carried)
+    s << "#  - lateral walls: stress meshes moved by demcal's servo (fix move/mesh,\n"
+      << "#    before the run): each step by gain*(sigma3*A - F)/(R*max(1, n)) +\n"
+      << "#    carry*(its last move), clamped to +-cap, in demcal's step dt_demcal =\n"
+      << "#    dt/f, A the wall's current area, n its current contacts; R = kn_wall +\n"
+      << "#    c/dt_demcal = " << exact(plan.servo_resist) << " N/m: demcal's wall contacts\n"
+      << "#    resist a move within its step by their dashpots too, c =\n"
       << "#    2*zeta_c*sqrt(kn_wall*m_max) = " << exact(plan.wall_dashpot)
-      << " N*s/m (the heaviest sphere's),\n#    and its servo divides by both";
-  s << ". LIGGGHTS' kp is a number: the run goes in chunks of\n"
-    << "#    ${servo_every} steps (one setup) and kp is set from the current n and\n"
-    << "#    F_target between them (fix_modify servo/ctrlParam; at the start from\n"
-    << "#    demcal's count): the gain lags demcal's by one chunk at most.\n"
-    << "#  - translational damping per radius class via fix viscous ... scale.\n"
+      << " N*s/m (the heaviest sphere's);\n"
+      << "#    carry = (R - kn_wall)/R = " << exact(carry) << ". The first move comes one\n"
+      << "#    step after demcal's (the meshes have no force before the first step).\n";
+  else {
+    s << "#  - lateral walls: fix mesh/surface/stress/servo holds the wall force at\n"
+      << "#    sigma3*A, A the wall's current area (target_val v_ft_WALL), demcal's\n"
+      << "#    target (the force on the mesh along +axis: positive on a min wall).\n"
+      << "#    LIGGGHTS moves it at vel_max*kp*(F_target - F)/|F_target|: vel_max =\n"
+      << "#    cap/dt_demcal (dt_demcal = dt/f, demcal's step) and kp =\n"
+      << "#    gain*|F_target|/(" << resist_name(plan) << "*max(1, n)*cap), n the wall's current "
+      << "contacts,\n#    give demcal's wall velocity gain*(F_target - F)/(" << resist_name(plan)
+      << "*max(1, n)*dt_demcal)\n"
+      << "#    and its cap";
+    if (dashpots)
+      s << "; R = kn_wall + c/dt_demcal = " << exact(plan.servo_resist) << " N/m: demcal's\n"
+        << "#    wall contacts resist a move within its step by their dashpots too, c =\n"
+        << "#    2*zeta_c*sqrt(kn_wall*m_max) = " << exact(plan.wall_dashpot)
+        << " N*s/m (the heaviest sphere's),\n#    and its servo divides by both";
+    s << ". LIGGGHTS' kp is a number: the run goes in chunks of\n"
+      << "#    ${servo_every} steps (one setup) and kp is set from the current n and\n"
+      << "#    F_target between them (fix_modify servo/ctrlParam; at the start from\n"
+      << "#    demcal's count): the gain lags demcal's by one chunk at most.\n";
+  }
+  s << "#  - translational damping per radius class via fix viscous ... scale.\n"
     << "# Run it with a screen (liggghts 3.8 crashes reading meshes with -screen none).\n"
     << "#  - the bottom is a fixed mesh (not a primitive plane) so that its force is\n"
     << "#    known: the axial stress is the mean of top and bottom, as demcal's (the\n"
@@ -1076,16 +1102,21 @@ std::string liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p, const Pl
     << "# Thermo: p_axial = (p_top + p_bottom)/2, p_lat (mean of the four lateral\n"
     << "# walls), Pa, on the current areas; sigma1/sigma3 = p_axial/p_lat (no\n"
     << "# column: both are 0 at the start, before LIGGGHTS computes mesh forces).\n";
-  out.notes.push_back("LIGGGHTS deck: servo gain from the walls' current contacts, set every " +
-                      std::to_string(deck::monitor_interval(plan.steps, c.test.monitor_points)) +
-                      " steps; no rotational damping");
+  if (carried)
+    out.notes.push_back(
+        "LIGGGHTS deck: the lateral walls moved by demcal's servo with its carry (contact "
+        "damping), fix move/mesh; no rotational damping");
+  else
+    out.notes.push_back("LIGGGHTS deck: servo gain from the walls' current contacts, set every " +
+                        std::to_string(deck::monitor_interval(plan.steps, c.test.monitor_points)) +
+                        " steps; no rotational damping");
   if (!o.lateral_servo)
     out.notes.push_back("LIGGGHTS deck: lateral walls fixed (lateral_servo off)");
   s << deck::liggghts_preamble(3, "f f f", o.data_name, plan.r_min)
     << deck::liggghts_materials(m, plan.class_mass, plan.dt, exact)
     << "fix mbottom all mesh/surface/stress file " << mesh_file[5] << " type " << wall_type << "\n"
     << "fix mtop all mesh/surface/stress file " << mesh_file[4] << " type " << wall_type << "\n";
-  liggghts_3d_lateral_walls(s, c, plan, o, mesh_file, wall_type, cap);
+  liggghts_3d_lateral_walls(s, c, plan, o, mesh_file, wall_type, cap, carried);
   s << "fix walls all wall/gran model hooke/stiffness tangential history mesh n_meshes 6 meshes "
        "mbottom mtop mxmin mxmax mymin mymax store_force yes "
     << deck::liggghts_model_settings(m) << "\n"
@@ -1117,7 +1148,7 @@ std::string liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p, const Pl
        "v_Wy\n"
     << "thermo ${thermo_every}\n"
     << "variable run_steps index " << plan.steps << "\n";
-  liggghts_3d_run(s, c, plan, o, cap, monitor_every);
+  liggghts_3d_run(s, c, plan, o, cap, monitor_every, carried ? carry : 0.0);
   return s.str();
 }
 
