@@ -254,8 +254,10 @@ TEST(EngineLammps, TheDecksOwnSeriesScoresAsDemcalsRun) {
 }
 
 /// ζ_c = 0.25 on the 25-disc sample: demcal's servo divides by
-/// R = kn_wall + c/Δt (its wall dashpots, servo_resistance), the deck's
-/// servo too (`format` "lammps": gain_kn; "liggghts": kp). The deck's series
+/// R = kn_wall + c/Δt (its wall dashpots, servo_resistance) and carries
+/// (R − kn_wall)/R of each wall's last move (servo_velocity), the deck's
+/// servo too (`format` "lammps": gain_kn and carry, engines.md §24;
+/// "liggghts": the law in variables, fix move/mesh, §25). The deck's series
 /// against demcal's run of the same parameters: the servo error at the end
 /// and the scored servo criterion within 5 % (as the 3D decks',
 /// reports/engines.md §18), the peak within 1 %. (Until 2026-12-02 the
