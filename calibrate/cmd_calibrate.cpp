@@ -29,6 +29,7 @@
 #include "demcal/io/format.hpp"
 #include "demcal/report/report.hpp"
 #include "demcal/scene/biaxial.hpp"
+#include "demcal/scene/consolidation_cache.hpp"
 #include "demcal/scene/packing.hpp"
 #include "demcal/scene/run_output.hpp"
 #include "demcal/scene/triaxial.hpp"
@@ -97,13 +98,16 @@ nlohmann::json run_record(double wall_time_s, const CalibrationSummary& summary,
 /// Written when a calibration starts afresh; --resume reuses the trials only
 /// when everything that changes a trial's outcome or the search is the same
 /// (the config as given with its --set, --accuracy, --strategy, demcal's
-/// version). --max-trials, --jobs and --evidence do not change a trial.
+/// version and build: program_digest, since the version is not bumped for
+/// every change of a law or of the rounding). --max-trials, --jobs and
+/// --evidence do not change a trial.
 nlohmann::json resume_key(const SceneConfig& config, const Strategy strategy) {
   return {{"schema", "demcal.resume/1"},
           {"config_sha256", sha256_hex(config.text)},
           {"accuracy", config.calibration.accuracy},
           {"strategy", to_string(strategy)},
-          {"version", DEMCAL_VERSION}};
+          {"version", DEMCAL_VERSION},
+          {"program_sha256", program_digest()}};
 }
 
 /// --resume into `dir`: the trials there must come from the same settings,
@@ -135,7 +139,7 @@ void require_same_run(const std::string& dir, const nlohmann::json& key) {
                                                                         : std::string("nothing")) +
                            ", this run has " + shown(value) +
                            "; --resume reuses only trials of the same config, --set, --accuracy, "
-                           "--strategy and demcal version: " +
+                           "--strategy and demcal build: " +
                            fresh);
 }
 

@@ -118,6 +118,15 @@ TEST_F(RobustCli, ResumeWithOtherSettingsIsRefusedAndChangesNothing) {
   expect_refused(
       {"calibrate", kHex5, "--strategy", "cobyla", "-o", "A", "-q", "-j", "1", "--resume"},
       "strategy");
+  // Trials of another build (a law or only the rounding changed; the
+  // version is not bumped for each) are not reused either.
+  {
+    auto key = nlohmann::json::parse(read_text(work() / "A" / "resume.json"));
+    ASSERT_EQ(key.at("program_sha256").get<std::string>().size(), 64u);
+    key["program_sha256"] = std::string(64, '0');
+    std::ofstream(work() / "A" / "resume.json") << key.dump(2) << "\n";
+  }
+  expect_refused({"calibrate", kHex5, "-o", "A", "-q", "-j", "1", "--resume"}, "program_sha256");
   // Without the record of its settings a folder's trials cannot be reused.
   fs::remove(work() / "A" / "resume.json");
   expect_refused({"calibrate", kHex5, "-o", "A", "-q", "-j", "1", "--resume"}, "resume.json");

@@ -46,16 +46,6 @@ std::optional<std::string> read_whole(const std::string& path) {
   return bytes;
 }
 
-/// SHA-256 of the running program (the build), once per process; "" when it
-/// cannot be read (then the version alone stands for the build).
-const std::string& program_digest() {
-  static const std::string digest = [] {
-    const auto bytes = read_whole("/proc/self/exe");
-    return bytes ? sha256_hex(*bytes) : std::string();
-  }();
-  return digest;
-}
-
 template <class T>
 void put(std::string& out, const T& v) {
   out.append(reinterpret_cast<const char*>(&v), sizeof(T));
@@ -218,6 +208,14 @@ bool store(const std::string& dir, const std::string& key, const State& state) {
 }
 
 }  // namespace
+
+const std::string& program_digest() {
+  static const std::string digest = [] {
+    const auto bytes = read_whole("/proc/self/exe");
+    return bytes ? sha256_hex(*bytes) : std::string();
+  }();
+  return digest;
+}
 
 std::string consolidation_cache_dir() {
   if (const char* d = std::getenv("DEMCAL_CACHE_DIR"))

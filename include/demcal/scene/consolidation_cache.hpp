@@ -35,6 +35,13 @@ namespace demcal {
 /// the cache is off or there is no home folder.
 std::string consolidation_cache_dir();
 
+/// SHA-256 of the running program (the build), once per process; "" when it
+/// cannot be read (then the version alone stands for the build). Part of
+/// the cache's keys and of `demcal calibrate --resume`'s: trials and
+/// states of another build are never reused (a build that changed a law,
+/// or only the rounding, gives other trials).
+const std::string& program_digest();
+
 /// Everything that determines consolidate()'s result, as text: the
 /// protocol (biaxial), the assembly it starts from (a SHA-256 of its disks
 /// and box, so the assembly spec, seed and particle file's content all
