@@ -29,7 +29,6 @@
 #include "demcal/io/format.hpp"
 #include "demcal/report/report.hpp"
 #include "demcal/scene/biaxial.hpp"
-#include "demcal/scene/consolidation_cache.hpp"
 #include "demcal/scene/packing.hpp"
 #include "demcal/scene/run_output.hpp"
 #include "demcal/scene/triaxial.hpp"
@@ -40,6 +39,7 @@
 #include "demcal/upscaling/params_file.hpp"
 #include "demcal/upscaling/upscaling.hpp"
 #include "output_folder.hpp"
+#include "resume_key.hpp"
 #include "stop_signal.hpp"
 
 namespace demcal::cli {
@@ -98,49 +98,24 @@ nlohmann::json run_record(double wall_time_s, const CalibrationSummary& summary,
 /// Written when a calibration starts afresh; --resume reuses the trials only
 /// when everything that changes a trial's outcome or the search is the same
 /// (the config as given with its --set, --accuracy, --strategy, demcal's
-/// version and build: program_digest, since the version is not bumped for
-/// every change of a law or of the rounding). --max-trials, --jobs and
-/// --evidence do not change a trial.
+/// version and build: add_build). --max-trials, --jobs and --evidence do not
+/// change a trial.
 nlohmann::json resume_key(const SceneConfig& config, const Strategy strategy) {
-  return {{"schema", "demcal.resume/1"},
-          {"config_sha256", sha256_hex(config.text)},
-          {"accuracy", config.calibration.accuracy},
-          {"strategy", to_string(strategy)},
-          {"version", DEMCAL_VERSION},
-          {"program_sha256", program_digest()}};
+  nlohmann::json key{{"schema", "demcal.resume/1"},
+                     {"config_sha256", sha256_hex(config.text)},
+                     {"accuracy", config.calibration.accuracy},
+                     {"strategy", to_string(strategy)}};
+  add_build(key);
+  return key;
 }
 
 /// --resume into `dir`: the trials there must come from the same settings,
 /// or the result would be another calibration's (one error, exit 2,
 /// nothing changed).
-void require_same_run(const std::string& dir, const nlohmann::json& key) {
-  const std::string path = dir + "/resume.json";
-  const char* fresh = "calibrate afresh without --resume (or into another -o)";
-  std::error_code ec;
-  if (!std::filesystem::exists(path, ec))
-    throw InputError(path, "",
-                     std::string("missing: the trials in this folder cannot be matched to their "
-                                 "settings (an older demcal or not a calibration); ") +
-                         fresh);
-  nlohmann::json stored;
-  try {
-    stored = parse_config_json(read_text_file(path), path);
-  } catch (const InputError& e) {
-    throw InputError(path, "", std::string(e.what()) + "; " + fresh);
-  }
-  const auto shown = [](const nlohmann::json& v) {
-    return v.is_string() ? quoted_value(v.get<std::string>()) : quoted_value(v.dump());
-  };
-  for (const auto& [name, value] : key.items())
-    if (!stored.is_object() || !stored.contains(name) || stored[name] != value)
-      throw InputError(path, name,
-                       "the trials in " + dir + "/trials.jsonl were run with " +
-                           (stored.is_object() && stored.contains(name) ? shown(stored[name])
-                                                                        : std::string("nothing")) +
-                           ", this run has " + shown(value) +
-                           "; --resume reuses only trials of the same config, --set, --accuracy, "
-                           "--strategy and demcal build: " +
-                           fresh);
+void require_same_trials(const std::string& dir, const nlohmann::json& key) {
+  require_same_run(dir, key, "the trials in " + dir + "/trials.jsonl",
+                   "config, --set, --accuracy, --strategy and demcal build",
+                   "calibrate afresh without --resume (or into another -o)");
 }
 
 /// The consolidated REV of either dimension, made once.
@@ -220,7 +195,7 @@ Invocation prepare(const CalibrateOptions& o) {
   v.key = resume_key(config, v.strategy);
   if (o.resume) {
     require_readable_file(v.trials_path);  // a folder named trials.jsonl: one line
-    require_same_run(v.dir, v.key);        // before the consolidation's seconds
+    require_same_trials(v.dir, v.key);     // before the consolidation's seconds
   }
   return v;
 }
@@ -262,7 +237,7 @@ Consolidated consolidate_rev(const CalibrateOptions& o, const SceneConfig& confi
 void ready_output_folder(const CalibrateOptions& o, const Invocation& v) {
   const std::string& dir = v.dir;
   if (o.resume) {
-    require_same_run(dir, v.key);  // unchanged since the check in prepare()?
+    require_same_trials(dir, v.key);  // unchanged since the check in prepare()?
     // A damaged trials.jsonl stops the run before anything is removed.
     read_trials_text(read_text_file(v.trials_path), v.trials_path);
   }
@@ -270,7 +245,7 @@ void ready_output_folder(const CalibrateOptions& o, const Invocation& v) {
   if (!o.resume) {
     require_regular_file_target(v.trials_path);
     std::filesystem::remove(v.trials_path);
-    write_file_atomic(dir + "/resume.json", v.key.dump(2) + "\n");
+    write_resume_key(dir, v.key);
   }
   // Results of an earlier run in this folder would not match the trials
   // from here on; they are rewritten at the end.

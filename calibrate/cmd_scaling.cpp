@@ -1,6 +1,7 @@
 // `demcal scaling`: the proof of the upscaling law (scaling_study.hpp).
 // Writes DIR/scaling.md and DIR/scaling.json; per-size work (trials,
 // results) goes to --work and is reused with --resume.
+#include <filesystem>
 #include <iostream>
 
 #include "commands.hpp"
@@ -8,6 +9,7 @@
 #include "demcal/io/format.hpp"
 #include "demcal/upscaling/scaling_study.hpp"
 #include "output_folder.hpp"
+#include "resume_key.hpp"
 #include "upscaling_cli.hpp"
 
 namespace demcal::cli {
@@ -22,13 +24,40 @@ int cmd_scaling(const ScalingOptions& o) {
   so.calibrate_max = o.calibrate_max > 0 ? o.calibrate_max : 400;
   so.work_dir = o.work_dir.empty() ? "demcal-scaling-" + config.name : o.work_dir;
   so.jobs = o.jobs;
-  so.resume = o.resume;
   if (!o.quiet)
     so.log = [](const std::string& line) { std::cerr << "demcal scaling: " << line << "\n"; };
   check_scaling_sizes(so);  // bad sizes fail before any folder is made
   const std::string out_dir = o.out_dir.empty() ? "reports" : o.out_dir;
   OutputFolder::check(out_dir);  // an unwritable -o fails now, not after the study
+  // What the work folder's results (per size: calibration, fixed-multiplier
+  // runs, references, consolidated samples) were made with: --resume reuses
+  // them only under the same config (with its --set), --max-trials and
+  // build. A work folder that does not exist yet has nothing to reuse.
+  nlohmann::json key{{"schema", "demcal.scaling-resume/1"},
+                     {"config_sha256", sha256_hex(config.text)},
+                     {"max_trials", config.calibration.max_trials}};
+  add_build(key);
+  std::error_code ec;
+  const bool reuse = o.resume && std::filesystem::exists(so.work_dir, ec);
+  if (reuse)
+    require_same_run(so.work_dir, key, "the results in " + so.work_dir,
+                     "config, --set, --max-trials and demcal build",
+                     "run the study afresh without --resume (or with another --work)");
+  so.resume = reuse;
 
+  if (!reuse) {
+    // A fresh start: an earlier study's per-size results would otherwise
+    // stay under the new key until overwritten, and a resume after an
+    // interruption would take them for this study's.
+    make_output_dir(so.work_dir);
+    for (const auto& e : std::filesystem::directory_iterator(so.work_dir)) {
+      const std::string name = e.path().filename().string();
+      if (e.is_directory() && name.rfind("size-", 0) == 0 && name.size() > 5 &&
+          name.find_first_not_of("0123456789", 5) == std::string::npos)
+        std::filesystem::remove_all(e.path());
+    }
+    write_resume_key(so.work_dir, key);
+  }
   const ScalingStudy st = run_scaling_study(config, so);
   {
     OutputFolder out(out_dir);  // both files replaced together, or neither

@@ -132,6 +132,40 @@ TEST_F(RobustCli, ResumeWithOtherSettingsIsRefusedAndChangesNothing) {
   expect_refused({"calibrate", kHex5, "-o", "A", "-q", "-j", "1", "--resume"}, "resume.json");
 }
 
+// `demcal scaling --resume` reuses the per-size results of its --work
+// folder only when they were made with the same config (and --set),
+// --max-trials and build (S/resume.json); a fresh start clears the earlier
+// study's sizes, so that a later resume cannot take them for its own.
+TEST_F(RobustCli, ScalingResumeWithOtherSettingsIsRefusedAndAFreshStartClearsTheSizes) {
+  const std::vector<std::string> study = {
+      "scaling", kHex5, "--sizes", "16,25,36", "--calibrate-max", "25", "--max-trials", "8", "-j",
+      "1",       "-q",  "-o",      "out",      "--work",          "S"};
+  const auto with = [&](std::vector<std::string> extra) {
+    std::vector<std::string> args = study;
+    args.insert(args.end(), extra.begin(), extra.end());
+    return args;
+  };
+  fs::create_directories(work() / "S" / "size-99");
+  std::ofstream(work() / "S" / "size-99" / "result.json") << "{}\n";  // an earlier study's
+  const Result first = demcal(study);
+  ASSERT_TRUE(first.status == 0 || first.status == 1) << first.err;  // 1: the forward check
+  EXPECT_FALSE(fs::exists(work() / "S" / "size-99"));
+  ASSERT_TRUE(fs::exists(work() / "S" / "size-25" / "result.json"));
+  expect_refused(with({"--resume", "--set", "material.friction=0.5"}), "config_sha256");
+  std::vector<std::string> more_trials = study;
+  more_trials[7] = "9";  // --max-trials
+  more_trials.push_back("--resume");
+  expect_refused(more_trials, "max_trials");
+  {
+    auto key = nlohmann::json::parse(read_text(work() / "S" / "resume.json"));
+    key["program_sha256"] = std::string(64, '0');
+    std::ofstream(work() / "S" / "resume.json") << key.dump(2) << "\n";
+  }
+  expect_refused(with({"--resume"}), "program_sha256");
+  fs::remove(work() / "S" / "resume.json");
+  expect_refused(with({"--resume"}), "resume.json");
+}
+
 TEST_F(RobustCli, ResumeWithTheSameSettingsReusesEveryTrial) {
   calibrate_a();
   const Result r =
