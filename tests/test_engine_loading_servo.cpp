@@ -137,10 +137,11 @@ void expect_the_loading_servo_carries_its_last_move(const std::string& lmp, cons
       ASSERT_LE(std::abs(move - expected), 1e-9 * scale)
           << "wall " << k << ": move " << move << ", demcal's law " << expected << " (law " << law
           << ", carry " << carry << ", last move " << prev[k] << ")";
-      if (step > 0)
+      if (step > 0) {
         EXPECT_NEAR(position - last_position[k], prev[k],
                     1e-13 * std::abs(position) + 1e-9 * std::abs(prev[k]))
             << "wall " << k;
+      }
       moves.push_back(std::abs(move) / cap_step);
       if (std::abs(move) > (1 - 1e-9) * cap_step) {
         ++clamped;

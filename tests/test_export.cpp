@@ -310,8 +310,9 @@ TEST(Export, TheLoadingServosGainIsDemcalsWithTheWallDashpots) {
       for (const auto& [fix, k, target] :
            {std::tuple{"mleft", 1, "ftl"}, std::tuple{"mright", 2, "ftr"}}) {
         const test::LiggghtsCarriedLaw law = test::liggghts_carried_law(g.deck, fix, k, target, 0);
-        if (std::string(fix) == "mleft")  // without contacts in this packing: n = 1
+        if (std::string(fix) == "mleft") {  // without contacts in this packing: n = 1
           EXPECT_NEAR(law.gain / law.resist / demcal, 1.0, 1e-9);
+        }
         EXPECT_NEAR(law.carry / carry, 1.0, 1e-9) << fix;
         EXPECT_NEAR(law.dt_demcal / dt_demcal, 1.0, 1e-9) << fix;
         EXPECT_NEAR(law.cap / servo_move_cap(*std::min_element(a.r.begin(), a.r.end())), 1.0, 1e-9)

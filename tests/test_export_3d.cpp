@@ -268,7 +268,9 @@ TEST(Export3d, TheLoadingServosGainIsDemcalsWithTheWallDashpots) {
         const std::string fix = std::string("m") + name[sd];
         const test::LiggghtsCarriedLaw law =
             test::liggghts_carried_law(g.deck, fix, sd + 1, std::string("ft_") + name[sd], sd / 2);
-        if (sd == 0) EXPECT_NEAR(law.gain / law.resist / demcal, 1.0, 1e-12);
+        if (sd == 0) {
+          EXPECT_NEAR(law.gain / law.resist / demcal, 1.0, 1e-12);
+        }
         EXPECT_NEAR(law.carry / carry, 1.0, 1e-12) << fix;
         EXPECT_NEAR(law.dt_demcal / dt_demcal, 1.0, 1e-12) << fix;
         EXPECT_NEAR(law.cap / servo_move_cap(w.min_radius()), 1.0, 1e-15) << fix;
