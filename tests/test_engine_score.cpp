@@ -27,6 +27,7 @@
 #include "demcal/upscaling/export_3d.hpp"
 #include "demcal/upscaling/rev.hpp"
 #include "support/files.hpp"
+#include "support/liggghts_servo.hpp"
 #include "support/process.hpp"
 
 namespace demcal {
@@ -359,14 +360,24 @@ void expect_the_loading_servo_carries_its_last_move(
   for (size_t k = 0; k < nw; ++k) {
     const std::string& f = walls[k].fix;
     const std::string i = std::to_string(k + 1);
-    row += " $(f_" + f + "[" + std::to_string(walls[k].axis + 1) + "]) $(c_nservo[" + i +
-           "]) $(f_" + f + "[" + std::to_string(walls[k].axis + 7) + "]) $(f_servo_u[" + i + "])";
+    row += " $(f_" + f + "[" + std::to_string(walls[k].axis + 1) + "]) $(c_nservo_" + f + ") $(f_" +
+           f + "[" + std::to_string(walls[k].axis + 7) + "]) $(f_servo_u[" + i + "])";
+  }
+  // n over all the particles (the deck counts over the wall's band only):
+  // the same overlap flag summed by an extra compute, traced after the rest
+  std::string all_counts;
+  for (size_t k = 0; k < nw; ++k) {
+    const test::LiggghtsBand band =
+        test::liggghts_band(r.deck, walls[k].fix, walls[k].axis, walls[k].side < 0);
+    all_counts += "compute nall_" + walls[k].fix + " all reduce sum v_" + band.touch + "\n";
+    row += " $(c_nall_" + walls[k].fix + ")";
   }
   // the trace after fix servo_u (end_of_step in the fixes' order): this
   // step's move, from this step's force, contacts and positions
-  std::string deck = replaced(
-      r.deck, "\nrun ${run_steps}\n",
-      "\nfix trace all print 1 \"" + row + "\" file trace.txt screen no\nrun ${run_steps}\n");
+  const std::string run_line = "\nrun ${run_steps} pre no post no every ${band_check} ";
+  std::string deck = replaced(r.deck, run_line,
+                              "\n" + all_counts + "fix trace all print 1 \"" + row +
+                                  "\" file trace.txt screen no" + run_line);
   // the cap, edited in each wall's clamp
   double cap_value = std::nan("");
   for (const CarriedWall& w : walls) {
@@ -397,7 +408,7 @@ void expect_the_loading_servo_carries_its_last_move(
     std::stringstream fields(line);
     std::vector<double> v;
     for (double x; fields >> x;) v.push_back(x);
-    ASSERT_EQ(v.size(), 2 + 4 * nw) << line;
+    ASSERT_EQ(v.size(), 2 + 5 * nw) << line;
     rows.emplace(static_cast<int64_t>(v[0]), v);
   }
   ASSERT_EQ(static_cast<int>(rows.size()), steps);
@@ -415,6 +426,8 @@ void expect_the_loading_servo_carries_its_last_move(
     for (size_t k = 0; k < nw; ++k) position[k] = v[4 + 4 * k];
     for (size_t k = 0; k < nw; ++k) {
       const double force = v[2 + 4 * k], n = v[3 + 4 * k], move = v[5 + 4 * k];
+      // the band's count is every particle's
+      ASSERT_EQ(n, v[2 + 4 * nw + k]) << walls[k].fix << ": contacts in the band";
       const double load = walls[k].side * sigma3 * area(position, v[1], k);
       const double law = gain * (load + force) / (resist * std::max(1.0, n));
       const double expected = std::clamp(law + carry * prev[k], -cap_value, cap_value);
