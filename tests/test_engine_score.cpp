@@ -15,6 +15,7 @@
 #include <functional>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <regex>
 #include <sstream>
 
 #include "demcal/kernel/particle_scales.hpp"
@@ -494,6 +495,52 @@ TEST(EngineLiggghts, WithContactDampingTheLoadingServoCarriesItsLastMoveAsDemcal
       liggghts, r, c, {{"mleft", 1.0, 0}, {"mright", -1.0, 0}},
       [t](const std::vector<double>&, double h, size_t) { return h * t; }, resist, 1.5e-5, 3000,
       "liggghts_carry_2d");
+}
+
+// The deck counts a lateral wall's contacts over its band only (the
+// particles near it at the start, deck::liggghts_carried_servo_run): a
+// particle outside the band at the wall would be missed, so the run stops
+// with an error at the next check. hex_5x5 at zeta_c 0.25, the left band
+// emptied (its bound 1 m left of the sample): the particles the left wall
+// touches are all outside it.
+TEST(EngineLiggghts, WithContactDampingAParticleOutsideAWallsBandStopsTheRun) {
+  const std::string liggghts = test::find_on_path("liggghts");
+  if (liggghts.empty())
+    GTEST_SKIP() << "LIGGGHTS (liggghts) is not installed (apt-get install liggghts): the "
+                    "deck is not run";
+  SceneConfig c = hex5();
+  c.material.contact_damping_ratio = 0.25;
+  const ConsolidatedState state = consolidate(c, make_assembly(c));
+  ASSERT_TRUE(state.converged);
+  AlgorithmSpec p = quasi_static();
+  p.steps = 20000;
+  p.dt_ratio = std::min(p.dt_ratio, 0.9 * estimated_stable_dt_ratio(state, p));
+  const ExportResult r = liggghts_deck(c, p, state, "hex5.data");
+  ASSERT_TRUE(std::isfinite(test::liggghts_band(r.deck, "mleft", 0, false).bound));
+  const double left = state.world.wall(kLeft).position;
+  const std::string narrowed =
+      std::regex_replace(r.deck, std::regex("\nregion rband_mleft block INF [^ ]+ "),
+                         "\nregion rband_mleft block INF " + std::to_string(left - 1.0) + " ");
+  ASSERT_NE(narrowed, r.deck);
+  for (const bool narrow : {false, true}) {
+    const test::TempDir dir(narrow ? "liggghts_band_narrow" : "liggghts_band");
+    const test::DeckRun run =
+        test::run_deck(liggghts, dir.path(), narrow ? narrowed : r.deck, r.files,
+                       {"-var", "run_steps", "1000", "-var", "band_check", "100"});
+    // the message printed (the deck's echo has it after band_msg's quotes)
+    const bool stopped =
+        run.log.find("\ndemcal deck: a particle outside the band of a lateral wall touches it") !=
+        std::string::npos;
+    if (narrow) {
+      EXPECT_NE(run.log.find("\n0 atoms in group band_mleft"), std::string::npos) << run.log;
+      EXPECT_NE(run.status, 0) << run.log;
+      EXPECT_TRUE(stopped) << run.log;
+    } else {
+      EXPECT_EQ(run.status, 0) << run.log;
+      EXPECT_FALSE(stopped) << run.log;
+      EXPECT_EQ(run.log.find("ERROR"), std::string::npos) << run.log;
+    }
+  }
 }
 
 // The same for the 3D deck's four lateral walls: fcc_4x4x4 at zeta_c 0.3,
