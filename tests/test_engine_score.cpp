@@ -15,6 +15,7 @@
 #include <functional>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <regex>
 #include <sstream>
 
 #include "demcal/kernel/particle_scales.hpp"
@@ -27,6 +28,7 @@
 #include "demcal/upscaling/export_3d.hpp"
 #include "demcal/upscaling/rev.hpp"
 #include "support/files.hpp"
+#include "support/liggghts_servo.hpp"
 #include "support/process.hpp"
 
 namespace demcal {
@@ -359,14 +361,24 @@ void expect_the_loading_servo_carries_its_last_move(
   for (size_t k = 0; k < nw; ++k) {
     const std::string& f = walls[k].fix;
     const std::string i = std::to_string(k + 1);
-    row += " $(f_" + f + "[" + std::to_string(walls[k].axis + 1) + "]) $(c_nservo[" + i +
-           "]) $(f_" + f + "[" + std::to_string(walls[k].axis + 7) + "]) $(f_servo_u[" + i + "])";
+    row += " $(f_" + f + "[" + std::to_string(walls[k].axis + 1) + "]) $(c_nservo_" + f + ") $(f_" +
+           f + "[" + std::to_string(walls[k].axis + 7) + "]) $(f_servo_u[" + i + "])";
+  }
+  // n over all the particles (the deck counts over the wall's band only):
+  // the same overlap flag summed by an extra compute, traced after the rest
+  std::string all_counts;
+  for (size_t k = 0; k < nw; ++k) {
+    const test::LiggghtsBand band =
+        test::liggghts_band(r.deck, walls[k].fix, walls[k].axis, walls[k].side < 0);
+    all_counts += "compute nall_" + walls[k].fix + " all reduce sum v_" + band.touch + "\n";
+    row += " $(c_nall_" + walls[k].fix + ")";
   }
   // the trace after fix servo_u (end_of_step in the fixes' order): this
   // step's move, from this step's force, contacts and positions
-  std::string deck = replaced(
-      r.deck, "\nrun ${run_steps}\n",
-      "\nfix trace all print 1 \"" + row + "\" file trace.txt screen no\nrun ${run_steps}\n");
+  const std::string run_line = "\nrun ${run_steps} pre no post no every ${band_check} ";
+  std::string deck = replaced(r.deck, run_line,
+                              "\n" + all_counts + "fix trace all print 1 \"" + row +
+                                  "\" file trace.txt screen no" + run_line);
   // the cap, edited in each wall's clamp
   double cap_value = std::nan("");
   for (const CarriedWall& w : walls) {
@@ -397,7 +409,7 @@ void expect_the_loading_servo_carries_its_last_move(
     std::stringstream fields(line);
     std::vector<double> v;
     for (double x; fields >> x;) v.push_back(x);
-    ASSERT_EQ(v.size(), 2 + 4 * nw) << line;
+    ASSERT_EQ(v.size(), 2 + 5 * nw) << line;
     rows.emplace(static_cast<int64_t>(v[0]), v);
   }
   ASSERT_EQ(static_cast<int>(rows.size()), steps);
@@ -415,6 +427,8 @@ void expect_the_loading_servo_carries_its_last_move(
     for (size_t k = 0; k < nw; ++k) position[k] = v[4 + 4 * k];
     for (size_t k = 0; k < nw; ++k) {
       const double force = v[2 + 4 * k], n = v[3 + 4 * k], move = v[5 + 4 * k];
+      // the band's count is every particle's
+      ASSERT_EQ(n, v[2 + 4 * nw + k]) << walls[k].fix << ": contacts in the band";
       const double load = walls[k].side * sigma3 * area(position, v[1], k);
       const double law = gain * (load + force) / (resist * std::max(1.0, n));
       const double expected = std::clamp(law + carry * prev[k], -cap_value, cap_value);
@@ -481,6 +495,52 @@ TEST(EngineLiggghts, WithContactDampingTheLoadingServoCarriesItsLastMoveAsDemcal
       liggghts, r, c, {{"mleft", 1.0, 0}, {"mright", -1.0, 0}},
       [t](const std::vector<double>&, double h, size_t) { return h * t; }, resist, 1.5e-5, 3000,
       "liggghts_carry_2d");
+}
+
+// The deck counts a lateral wall's contacts over its band only (the
+// particles near it at the start, deck::liggghts_carried_servo_run): a
+// particle outside the band at the wall would be missed, so the run stops
+// with an error at the next check. hex_5x5 at zeta_c 0.25, the left band
+// emptied (its bound 1 m left of the sample): the particles the left wall
+// touches are all outside it.
+TEST(EngineLiggghts, WithContactDampingAParticleOutsideAWallsBandStopsTheRun) {
+  const std::string liggghts = test::find_on_path("liggghts");
+  if (liggghts.empty())
+    GTEST_SKIP() << "LIGGGHTS (liggghts) is not installed (apt-get install liggghts): the "
+                    "deck is not run";
+  SceneConfig c = hex5();
+  c.material.contact_damping_ratio = 0.25;
+  const ConsolidatedState state = consolidate(c, make_assembly(c));
+  ASSERT_TRUE(state.converged);
+  AlgorithmSpec p = quasi_static();
+  p.steps = 20000;
+  p.dt_ratio = std::min(p.dt_ratio, 0.9 * estimated_stable_dt_ratio(state, p));
+  const ExportResult r = liggghts_deck(c, p, state, "hex5.data");
+  ASSERT_TRUE(std::isfinite(test::liggghts_band(r.deck, "mleft", 0, false).bound));
+  const double left = state.world.wall(kLeft).position;
+  const std::string narrowed =
+      std::regex_replace(r.deck, std::regex("\nregion rband_mleft block INF [^ ]+ "),
+                         "\nregion rband_mleft block INF " + std::to_string(left - 1.0) + " ");
+  ASSERT_NE(narrowed, r.deck);
+  for (const bool narrow : {false, true}) {
+    const test::TempDir dir(narrow ? "liggghts_band_narrow" : "liggghts_band");
+    const test::DeckRun run =
+        test::run_deck(liggghts, dir.path(), narrow ? narrowed : r.deck, r.files,
+                       {"-var", "run_steps", "1000", "-var", "band_check", "100"});
+    // the message printed (the deck's echo has it after band_msg's quotes)
+    const bool stopped =
+        run.log.find("\ndemcal deck: a particle outside the band of a lateral wall touches it") !=
+        std::string::npos;
+    if (narrow) {
+      EXPECT_NE(run.log.find("\n0 atoms in group band_mleft"), std::string::npos) << run.log;
+      EXPECT_NE(run.status, 0) << run.log;
+      EXPECT_TRUE(stopped) << run.log;
+    } else {
+      EXPECT_EQ(run.status, 0) << run.log;
+      EXPECT_FALSE(stopped) << run.log;
+      EXPECT_EQ(run.log.find("ERROR"), std::string::npos) << run.log;
+    }
+  }
 }
 
 // The same for the 3D deck's four lateral walls: fcc_4x4x4 at zeta_c 0.3,

@@ -322,6 +322,26 @@ TEST(Export, TheLoadingServosGainIsDemcalsWithTheWallDashpots) {
                   std::string::npos)
             << fix;
       }
+      // the contacts n are counted over the walls' bands, the LAMMPS decks'
+      // (2*strain*width + 6*r_max from the wall's start), with the series'
+      // overlap flags; a particle outside a band at its wall stops the run
+      const double band = 2.0 * c.test.vertical_strain * (a.right - a.left) +
+                          6.0 * *std::max_element(a.r.begin(), a.r.end());
+      const test::LiggghtsBand left = test::liggghts_band(g.deck, "mleft", 0, false);
+      const test::LiggghtsBand right = test::liggghts_band(g.deck, "mright", 0, true);
+      EXPECT_NEAR(left.bound, a.left + band, 1e-9 * band);
+      EXPECT_NEAR(right.bound, a.right - band, 1e-9 * band);
+      EXPECT_EQ(left.touch, "ll_a");
+      EXPECT_EQ(right.touch, "lr_a");
+      for (const char* needle :
+           {"\nvariable gap_mleft atom x-c_pa[1]-v_xl\n",
+            "\nvariable gap_mright atom v_xr-x-c_pa[1]\n",
+            "\ncompute clear_mleft out_mleft reduce min v_gap_mleft\n",
+            "\ngroup out_mleft subtract all band_mleft\n",
+            "\nvariable band_out equal (c_clear_mleft<0)+(c_clear_mright<0)\n",
+            "\nrun ${run_steps} pre no post no every ${band_check} 'if \"${band_out} > 0\" then "
+            "\"print ${band_msg}\" quit'\n"})
+        EXPECT_NE(g.deck.find(needle), std::string::npos) << needle;
       continue;
     }
     EXPECT_EQ(demcal_servo_carry(c, p, a), 0.0);

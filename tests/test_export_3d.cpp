@@ -279,7 +279,28 @@ TEST(Export3d, TheLoadingServosGainIsDemcalsWithTheWallDashpots) {
                               " linear/variable" + (sd < 2 ? v + zero : zero + v) + zero + "\n"),
                   std::string::npos)
             << fix;
+        // n is counted over the wall's band, the LAMMPS deck's (2*strain*
+        // width + 6*r_max from its start), with the series' overlap flag
+        const int axis = sd / 2;
+        const bool upper = sd % 2 == 1;
+        const double band = 2.0 * c.test.vertical_strain * w.extent(axis) + 6.0 * w.max_radius();
+        const double start = w.wall(static_cast<SphereWallSide>(sd)).position;
+        const test::LiggghtsBand b = test::liggghts_band(g.deck, fix, axis, upper);
+        EXPECT_NEAR(b.bound, upper ? start - band : start + band, 1e-12 * band) << fix;
+        EXPECT_EQ(b.touch, "t" + std::to_string(sd) + "_a") << fix;
+        const std::string x(1, "xy"[axis]);
+        const std::string gap = upper ? "v_wall_" + std::string(name[sd]) + "-" + x + "-c_pa[1]"
+                                      : x + "-c_pa[1]-v_wall_" + name[sd];
+        EXPECT_NE(g.deck.find("\nvariable gap_" + fix + " atom " + gap + "\n"), std::string::npos)
+            << fix;
+        EXPECT_NE(g.deck.find("\ncompute clear_" + fix + " out_" + fix + " reduce min v_gap_" +
+                              fix + "\n"),
+                  std::string::npos)
+            << fix;
       }
+      EXPECT_NE(g.deck.find("\nrun ${run_steps} pre no post no every ${band_check} 'if "
+                            "\"${band_out} > 0\" then \"print ${band_msg}\" quit'\n"),
+                std::string::npos);
       continue;
     }
     EXPECT_EQ(carry, 0.0);

@@ -731,9 +731,13 @@ std::string liggghts_servo_run(const std::vector<LiggghtsServoWall>& walls, doub
   return s.str();
 }
 
+double liggghts_band(double strain, double width, double r_max) {
+  return 2.0 * strain * width + 6.0 * r_max;
+}
+
 std::string liggghts_carried_servo_run(const std::vector<LiggghtsServoWall>& walls, double gain,
                                        double resist, double carry, double cap, double dt_demcal,
-                                       NumberFormat f) {
+                                       const std::string& radius, int check_every, NumberFormat f) {
   std::ostringstream s;
   s << "# demcal's servo with contact damping (servo_velocity): each step a lateral\n"
     << "# wall moves along +axis by u = clamp(gain*(F_target + F)/(R*max(1, n))\n"
@@ -748,14 +752,36 @@ std::string liggghts_carried_servo_run(const std::vector<LiggghtsServoWall>& wal
     << "# next step (fix move/mesh linear/variable), as LIGGGHTS' mesh servo would\n"
     << "# with kp, which cannot carry a move. The walls start at rest: u = 0 at the\n"
     << "# run's start, where the meshes have no force yet.\n"
-    << "compute nservo all reduce sum";
-  for (const LiggghtsServoWall& w : walls) s << " v_" << w.touch;
-  s << "\n";
+    << "# n is counted every step over the particles that can touch the wall only:\n"
+    << "# those whose centre is within the wall's band of its start (group band_W;\n"
+    << "# band = 2*strain*width + 6*r_max, the LAMMPS decks'). Every ${band_check}\n"
+    << "# steps the run checks that no particle outside a band touches its wall\n"
+    << "# (clearance gap_W >= 0 over group out_W) and stops with an error if one\n"
+    << "# does: then n would miss it; widen the bands.\n";
+  const char coord[] = {'x', 'y', 'z'};
+  std::string out_of_band;
+  for (const LiggghtsServoWall& w : walls) {
+    const std::string lo = w.upper ? f(w.start - w.band) : "INF";
+    const std::string hi = w.upper ? "INF" : f(w.start + w.band);
+    s << "region rband_" << w.fix << " block";
+    for (int a = 0; a < 3; ++a) s << " " << (a == w.axis ? lo + " " + hi : "INF INF");
+    s << " units box\n"
+      << "group band_" << w.fix << " region rband_" << w.fix << "\n"
+      << "group out_" << w.fix << " subtract all band_" << w.fix << "\n"
+      << "compute nservo_" << w.fix << " band_" << w.fix << " reduce sum v_" << w.touch << "\n"
+      << "variable gap_" << w.fix << " atom ";
+    if (w.upper)
+      s << w.position << "-" << coord[w.axis] << "-" << radius << "\n";
+    else
+      s << coord[w.axis] << "-" << radius << "-" << w.position << "\n";
+    s << "compute clear_" << w.fix << " out_" << w.fix << " reduce min v_gap_" << w.fix << "\n";
+    out_of_band += (out_of_band.empty() ? "" : "+") + ("(c_clear_" + w.fix + "<0)");
+  }
   std::string raw_moves, moves;
   for (size_t k = 0; k < walls.size(); ++k) {
     const LiggghtsServoWall& w = walls[k];
     const std::string i = std::to_string(k + 1);
-    const std::string n = "c_nservo[" + i + "]", raw = "f_servo_w[" + i + "]", c = f(cap);
+    const std::string n = "c_nservo_" + w.fix, raw = "f_servo_w[" + i + "]", c = f(cap);
     s << "variable sw_" << w.fix << " equal (step>0)*(" << f(gain) << "*(v_" << w.target << "+f_"
       << w.fix << "[" << w.axis + 1 << "])/(" << f(resist) << "*(" << n << "+(" << n << "<1)))+"
       << f(carry) << "*f_servo_u[" << i << "])\n"
@@ -774,7 +800,12 @@ std::string liggghts_carried_servo_run(const std::vector<LiggghtsServoWall>& wal
     for (int a = 0; a < 3; ++a) s << (a == w.axis ? " v_sv_" + w.fix : " v_servo_zero");
     s << "\n";
   }
-  s << "run ${run_steps}\n";
+  s << "variable band_out equal " << out_of_band << "\n"
+    << "variable band_msg string '\"demcal deck: a particle outside the band of a lateral wall "
+       "touches it, so the servo contact count misses it: widen the bands (band_W regions)\"'\n"
+    << "variable band_check index " << check_every << "\n"
+    << "run ${run_steps} pre no post no every ${band_check} "
+       "'if \"${band_out} > 0\" then \"print ${band_msg}\" quit'\n";
   return s.str();
 }
 

@@ -350,7 +350,20 @@ std::string liggghts_series(const std::string& deck, const std::string& scene, i
 struct LiggghtsServoWall {
   std::string fix, target, touch;
   int axis = 0;  // the wall's normal: 0 x, 1 y
+  // With contact damping (liggghts_carried_servo_run) the count n reads
+  // the particles within `band` of the wall's start `start` only; `upper`
+  // the wall bounds the sample from above along its axis; `position` the
+  // equal-style variable (v_...) of its current position.
+  double band = 0.0, start = 0.0;
+  bool upper = false;
+  std::string position;
 };
+
+/// The band of particles that can touch a lateral wall during the loading,
+/// as the LAMMPS decks' walls (lammps_band): the wall's motion bound,
+/// 2·strain·width (strain the loading's vertical strain, width the sample's
+/// across the wall at the start), and 6·r_max.
+double liggghts_band(double strain, double width, double r_max);
 
 /// LIGGGHTS' servo law (MeshModuleStressServo, 3.8) moves a mesh at
 /// vel_max·kp·(F_target − F)/|F_target| per unit time. With vel_max =
@@ -386,10 +399,15 @@ std::string liggghts_servo_run(const std::vector<LiggghtsServoWall>& walls, doub
 /// +-cap) (fix servo_w the move before the clamp, then fix servo_u u: one-step
 /// ave/time fixes), F the mesh's force along +axis, n its current contacts
 /// (compute nservo), u' its last move (servo_u's last value), 0 at the run's
-/// first step; the mesh moves at u/dt_demcal in the next. Then the loading
-/// run.
+/// first step; the mesh moves at u/dt_demcal in the next. n is counted
+/// every step over the wall's band only (compute nservo_FIX over the static
+/// group band_FIX: the particles whose centre lies within wall.band of the
+/// wall's start); the loading run goes in chunks of `check_every` steps
+/// (one setup: the chunks continue the trajectory exactly) and stops with
+/// an error (print, quit) at a chunk's end if a particle outside a band
+/// touches its wall (`radius` the per-atom radius reference, c_pa[1]).
 std::string liggghts_carried_servo_run(const std::vector<LiggghtsServoWall>& walls, double gain,
                                        double resist, double carry, double cap, double dt_demcal,
-                                       NumberFormat f);
+                                       const std::string& radius, int check_every, NumberFormat f);
 
 }  // namespace demcal::deck

@@ -1178,11 +1178,15 @@ ExportResult liggghts(const SceneConfig& c, const AlgorithmSpec& p, const Assemb
     << "thermo_style custom step dt time ke v_p_top v_p_left v_p_right v_xl v_xr\n"
     << "thermo " << plan.thermo_every << "\n"
     << "variable run_steps index " << plan.steps << "\n";
-  const std::vector<deck::LiggghtsServoWall> servo_walls{{"mleft", "ftl", "ll_a"},
-                                                         {"mright", "ftr", "lr_a"}};
+  // with contact damping the contacts are counted over the walls' bands
+  const double band = deck::liggghts_band(c.test.vertical_strain, plan.width0, plan.r_max);
+  const std::vector<deck::LiggghtsServoWall> servo_walls{
+      {"mleft", "ftl", "ll_a", 0, band, a.left, false, "v_xl"},
+      {"mright", "ftr", "lr_a", 0, band, a.right, true, "v_xr"}};
   if (carried)
     s << deck::liggghts_carried_servo_run(servo_walls, c.test.servo_gain, plan.servo_resist, carry,
-                                          cap, plan.dt / plan.step_factor, num);
+                                          cap, plan.dt / plan.step_factor, "c_pa[1]",
+                                          plan.thermo_every, num);
   else
     s << deck::liggghts_servo_run(servo_walls, c.test.servo_gain, plan.servo_resist, cap,
                                   plan.thermo_every, num, "kn_wall");

@@ -1028,12 +1028,20 @@ void liggghts_3d_run(std::ostream& s, const SceneConfig& c, const Plan3& plan,
     return;
   }
   std::vector<deck::LiggghtsServoWall> walls;
-  for (int sd = 0; sd < 4; ++sd)
-    walls.push_back({std::string("m") + kWall[sd], std::string("ft_") + kWall[sd],
-                     std::string("t") + std::to_string(sd) + "_a", sd / 2});
+  for (int sd = 0; sd < 4; ++sd) {
+    // with contact damping the contacts are counted over the walls' bands
+    const int a = sd / 2;
+    const bool upper = sd % 2 == 1;
+    walls.push_back(
+        {std::string("m") + kWall[sd], std::string("ft_") + kWall[sd],
+         std::string("t") + std::to_string(sd) + "_a", a,
+         deck::liggghts_band(c.test.vertical_strain, plan.hi[a] - plan.lo[a], plan.r_max),
+         upper ? plan.hi[a] : plan.lo[a], upper, std::string("v_wall_") + kWall[sd]});
+  }
   if (carry > 0.0)
     s << deck::liggghts_carried_servo_run(walls, c.test.servo_gain, plan.servo_resist, carry, cap,
-                                          plan.dt / plan.step_factor, exact);
+                                          plan.dt / plan.step_factor, "c_pa[1]", monitor_every,
+                                          exact);
   else
     s << deck::liggghts_servo_run(walls, c.test.servo_gain, plan.servo_resist, cap, monitor_every,
                                   exact, resist_name(plan));

@@ -21,13 +21,46 @@ struct LiggghtsCarriedLaw {
   double cap = std::nan(""), dt_demcal = std::nan("");
 };
 
-/// The law of the deck's wall `fix` (e.g. "mleft"), its k-th (1-based) in
-/// compute nservo and fix servo_u, target variable `target`, force
+/// The band over which a LIGGGHTS deck with contact damping counts the
+/// contacts of its wall `fix` (compute nservo_FIX over group band_FIX, the
+/// region rband_FIX: `touch` the per-atom flag it sums, `bound` the band's
+/// inner bound along the wall's axis `axis`); NaN and a failure if the deck
+/// does not write it in that form.
+struct LiggghtsBand {
+  std::string touch;
+  double bound = std::nan("");
+};
+
+inline LiggghtsBand liggghts_band(const std::string& deck, const std::string& fix, int axis,
+                                  bool upper) {
+  const std::string number = "([-+0-9.e]+)";
+  std::string limits;
+  for (int a = 0; a < 3; ++a)
+    limits += a != axis ? " INF INF" : upper ? " " + number + " INF" : " INF " + number;
+  const std::regex region("\nregion rband_" + fix + " block" + limits + " units box\n");
+  const std::regex group("\ngroup band_" + fix + " region rband_" + fix + "\n");
+  const std::regex count("\ncompute nservo_" + fix + " band_" + fix + " reduce sum v_(\\w+)\n");
+  LiggghtsBand out;
+  std::smatch m;
+  if (std::regex_search(deck, m, region))
+    out.bound = std::stod(m[1].str());
+  else
+    ADD_FAILURE() << "no band region for " << fix;
+  if (!std::regex_search(deck, group)) ADD_FAILURE() << "no band group for " << fix;
+  if (std::regex_search(deck, m, count))
+    out.touch = m[1].str();
+  else
+    ADD_FAILURE() << "no band count for " << fix;
+  return out;
+}
+
+/// The law of the deck's wall `fix` (e.g. "mleft"), its count compute
+/// nservo_FIX, its k-th (1-based) in fix servo_u, target variable `target`, force
 /// component `axis` + 1 of its mesh; NaN members (and a failure) if the
 /// deck does not write it in that form.
 inline LiggghtsCarriedLaw liggghts_carried_law(const std::string& deck, const std::string& fix,
                                                int k, const std::string& target, int axis) {
-  const std::string n = "c_nservo\\[" + std::to_string(k) + "\\]";
+  const std::string n = "c_nservo_" + fix;
   const std::string u = "f_servo_u\\[" + std::to_string(k) + "\\]";
   const std::string number = "([-+0-9.e]+)";
   const std::regex law("\nvariable sw_" + fix + " equal \\(step>0\\)\\*\\(" + number + "\\*\\(v_" +
