@@ -1033,69 +1033,36 @@ std::string liggghts_series_block(const SceneConfig& c, const AlgorithmSpec& p, 
   return s.str();
 }
 
-ExportResult liggghts(const SceneConfig& c, const AlgorithmSpec& p, const Assembly& a,
-                      const ExportOptions& o) {
-  const Plan plan = make_plan(c, p, a, o.max_types);
+/// The 2D LIGGGHTS deck's data file. LIGGGHTS with dimension 2 computes a
+/// particle's mass as π·r²·density: the areal density f_ms·ρ·t gives the
+/// disc's mass f_ms·ρ·t·π·r².
+std::string liggghts_data_2d(const SceneConfig& c, const Plan& plan, const Assembly& a,
+                             int ntypes) {
   const auto& m = c.material;
-  ExportResult out = result_of(plan);
-  const int wall_type = plan.types + 1;
-  const int ntypes = plan.types + 1;
-  // The lateral walls' contacts at the start (the particles overlapping
-  // each) and the servo gains that make LIGGGHTS' mesh servo move as
-  // demcal's (see the deck's header); the deck sets them from the current
-  // contacts as it runs.
-  int n_left = 0, n_right = 0;
+  std::ostringstream d;
+  const double mx = 0.5 * plan.width0, my = 0.1 * plan.height0;
+  d << "LIGGGHTS data file written by demcal " << DEMCAL_VERSION << " (scene " << c.name << ")\n\n"
+    << plan.n << " atoms\n"
+    << ntypes << " atom types\n\n"
+    << num(a.left - mx) << " " << num(a.right + mx) << " xlo xhi\n"
+    << num(a.bottom - my) << " " << num(a.top + my) << " ylo yhi\n"
+    << num(-0.5 * m.thickness) << " " << num(0.5 * m.thickness) << " zlo zhi\n\n"
+    << "Atoms\n\n";
+  char line[160];
   for (int i = 0; i < plan.n; ++i) {
-    if (a.x[i] - a.r[i] <= a.left + 1e-9 * a.r[i]) ++n_left;
-    if (a.x[i] + a.r[i] >= a.right - 1e-9 * a.r[i]) ++n_right;
+    std::snprintf(line, sizeof line, "%d %d %.17g %.10g %.17g %.17g 0\n", i + 1, plan.type[i],
+                  2.0 * a.r[i], plan.areal_density, a.x[i], a.y[i]);
+    d << line;
   }
-  const double force_target = c.test.lateral_stress * plan.height0 * m.thickness;
-  const double cap = servo_move_cap(plan.r_min);
-  const double kp_left =
-      deck::liggghts_servo_kp(c.test.servo_gain, force_target, plan.servo_resist, n_left, cap);
-  const double kp_right =
-      deck::liggghts_servo_kp(c.test.servo_gain, force_target, plan.servo_resist, n_right, cap);
-  const double vel_max = deck::liggghts_servo_vel_max(cap, plan.dt, plan.step_factor);
-  // With contact damping demcal's servo carries a share of the wall's last
-  // move, which LIGGGHTS' mesh servo cannot: the walls are then moved by
-  // deck::liggghts_carried_servo_run.
-  const double carry = servo_carry(m.wall.kn, plan.servo_resist);
+  return d.str();
+}
+
+/// The 2D LIGGGHTS deck's header: the mapping, how its servo follows
+/// demcal's (LIGGGHTS' mesh servo, or with contact damping demcal's carried
+/// law, `carry` > 0) and the differences from demcal.
+std::string liggghts_header_2d(const SceneConfig& c, const AlgorithmSpec& p, const Plan& plan,
+                               const ExportOptions& o, double carry, int n_left, int n_right) {
   const bool carried = carry > 0.0;
-
-  // LIGGGHTS with dimension 2 computes a particle's mass as π·r²·density:
-  // the areal density f_ms·ρ·t gives the disc's mass f_ms·ρ·t·π·r².
-  {
-    std::ostringstream d;
-    const double mx = 0.5 * plan.width0, my = 0.1 * plan.height0;
-    d << "LIGGGHTS data file written by demcal " << DEMCAL_VERSION << " (scene " << c.name
-      << ")\n\n"
-      << plan.n << " atoms\n"
-      << ntypes << " atom types\n\n"
-      << num(a.left - mx) << " " << num(a.right + mx) << " xlo xhi\n"
-      << num(a.bottom - my) << " " << num(a.top + my) << " ylo yhi\n"
-      << num(-0.5 * m.thickness) << " " << num(0.5 * m.thickness) << " zlo zhi\n\n"
-      << "Atoms\n\n";
-    char line[160];
-    for (int i = 0; i < plan.n; ++i) {
-      std::snprintf(line, sizeof line, "%d %d %.17g %.10g %.17g %.17g 0\n", i + 1, plan.type[i],
-                    2.0 * a.r[i], plan.areal_density, a.x[i], a.y[i]);
-      d << line;
-    }
-    out.files[o.data_name] = d.str();
-  }
-  const double z0 = -0.5 * m.thickness, z1 = 0.5 * m.thickness;
-  const double ylo = a.bottom - 0.1 * plan.height0, yhi = a.top + 0.1 * plan.height0;
-  const double xlo = a.left - 0.5 * plan.width0, xhi = a.right + 0.5 * plan.width0;
-  const std::string stem = o.data_name.substr(0, o.data_name.rfind('.'));
-  const std::string top = stem + "-top.stl", left = stem + "-left.stl", right = stem + "-right.stl";
-  out.files[top] = stl_rectangle("top", xhi, a.top, xlo, a.top, z0, z1);
-  out.files[left] = stl_rectangle("left", a.left, ylo, a.left, yhi, z0, z1);
-  out.files[right] = stl_rectangle("right", a.right, yhi, a.right, ylo, z0, z1);
-
-  // demcal's servo target sigma3*H*t on the current height H (the top wall
-  // moves down at top_speed from the start).
-  const std::string target = num(c.test.lateral_stress * m.thickness) + "*(" + num(plan.height0) +
-                             "-" + num(plan.top_speed) + "*step*" + num(plan.dt) + ")";
   std::ostringstream s;
   s << mapping_header(c, p, plan, o, "LIGGGHTS");
   s << "#\n# Checked with LIGGGHTS 3.8 (Debian): on a 25-disc sample it scores as demcal's\n"
@@ -1137,6 +1104,54 @@ ExportResult liggghts(const SceneConfig& c, const AlgorithmSpec& p, const Assemb
     s << "#  - the servo's gain follows the contacts every ${servo_every} steps (demcal:\n"
       << "#    every step).\n";
   s << "#  - translational damping per radius class via fix viscous ... scale.\n";
+  return s.str();
+}
+
+ExportResult liggghts(const SceneConfig& c, const AlgorithmSpec& p, const Assembly& a,
+                      const ExportOptions& o) {
+  const Plan plan = make_plan(c, p, a, o.max_types);
+  const auto& m = c.material;
+  ExportResult out = result_of(plan);
+  const int wall_type = plan.types + 1;
+  const int ntypes = plan.types + 1;
+  // The lateral walls' contacts at the start (the particles overlapping
+  // each) and the servo gains that make LIGGGHTS' mesh servo move as
+  // demcal's (see the deck's header); the deck sets them from the current
+  // contacts as it runs.
+  int n_left = 0, n_right = 0;
+  for (int i = 0; i < plan.n; ++i) {
+    if (a.x[i] - a.r[i] <= a.left + 1e-9 * a.r[i]) ++n_left;
+    if (a.x[i] + a.r[i] >= a.right - 1e-9 * a.r[i]) ++n_right;
+  }
+  const double force_target = c.test.lateral_stress * plan.height0 * m.thickness;
+  const double cap = servo_move_cap(plan.r_min);
+  const double kp_left =
+      deck::liggghts_servo_kp(c.test.servo_gain, force_target, plan.servo_resist, n_left, cap);
+  const double kp_right =
+      deck::liggghts_servo_kp(c.test.servo_gain, force_target, plan.servo_resist, n_right, cap);
+  const double vel_max = deck::liggghts_servo_vel_max(cap, plan.dt, plan.step_factor);
+  // With contact damping demcal's servo carries a share of the wall's last
+  // move, which LIGGGHTS' mesh servo cannot: the walls are then moved by
+  // deck::liggghts_carried_servo_run.
+  const double carry = servo_carry(m.wall.kn, plan.servo_resist);
+  const bool carried = carry > 0.0;
+
+  out.files[o.data_name] = liggghts_data_2d(c, plan, a, ntypes);
+  const double z0 = -0.5 * m.thickness, z1 = 0.5 * m.thickness;
+  const double ylo = a.bottom - 0.1 * plan.height0, yhi = a.top + 0.1 * plan.height0;
+  const double xlo = a.left - 0.5 * plan.width0, xhi = a.right + 0.5 * plan.width0;
+  const std::string stem = o.data_name.substr(0, o.data_name.rfind('.'));
+  const std::string top = stem + "-top.stl", left = stem + "-left.stl", right = stem + "-right.stl";
+  out.files[top] = stl_rectangle("top", xhi, a.top, xlo, a.top, z0, z1);
+  out.files[left] = stl_rectangle("left", a.left, ylo, a.left, yhi, z0, z1);
+  out.files[right] = stl_rectangle("right", a.right, yhi, a.right, ylo, z0, z1);
+
+  // demcal's servo target sigma3*H*t on the current height H (the top wall
+  // moves down at top_speed from the start).
+  const std::string target = num(c.test.lateral_stress * m.thickness) + "*(" + num(plan.height0) +
+                             "-" + num(plan.top_speed) + "*step*" + num(plan.dt) + ")";
+  std::ostringstream s;
+  s << liggghts_header_2d(c, p, plan, o, carry, n_left, n_right);
   s << deck::liggghts_preamble(2, "f f p", o.data_name, plan.r_min)
     << deck::liggghts_materials(m, plan.class_mass, plan.dt, num)
     << "# the lateral walls' target forces, sigma3*H*t (left +x, right -x)\n"
