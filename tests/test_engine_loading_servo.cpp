@@ -26,6 +26,7 @@
 #include "support/carried_servo.hpp"
 #include "support/files.hpp"
 #include "support/process.hpp"
+#include "support/trace_rows.hpp"
 
 namespace demcal {
 namespace {
@@ -99,16 +100,8 @@ void expect_the_loading_servo_carries_its_last_move(const std::string& lmp, cons
   const double dt_deck = deck_value(r.deck, "dt"), servo_dt = deck_value(r.deck, "servo_dt");
   const double servo_f = dt_deck / servo_dt;
   const double cap_step = std::stod(cap) * servo.r_min * servo_f;
-  std::map<int64_t, std::vector<double>> rows;
-  std::stringstream text(test::read_text(dir / "trace.txt"));
-  for (std::string line; std::getline(text, line);) {
-    if (line.empty() || line[0] == '#') continue;
-    std::stringstream fields(line);
-    std::vector<double> v;
-    for (double x; fields >> x;) v.push_back(x);
-    ASSERT_EQ(v.size(), 2 + geometry + 4 * walls) << line;
-    rows.emplace(static_cast<int64_t>(v[0]), v);  // a run's setup prints its first step once
-  }
+  const std::map<int64_t, std::vector<double>> rows =
+      test::trace_rows(test::read_text(dir / "trace.txt"), 2 + geometry + 4 * walls);
   ASSERT_EQ(rows.size(), static_cast<size_t>(steps) + 1);
   ASSERT_EQ(rows.begin()->first, 0);
   const double kn_wall = c.material.wall.kn, zeta_c = c.material.contact_damping_ratio;

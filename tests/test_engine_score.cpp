@@ -31,6 +31,7 @@
 #include "support/files.hpp"
 #include "support/liggghts_servo.hpp"
 #include "support/process.hpp"
+#include "support/trace_rows.hpp"
 
 namespace demcal {
 namespace {
@@ -403,16 +404,8 @@ void expect_the_loading_servo_carries_its_last_move(
                                            {"-var", "run_steps", std::to_string(steps)});
   ASSERT_EQ(run.status, 0) << run.log;
   ASSERT_EQ(run.log.find("ERROR"), std::string::npos) << run.log;
-  std::map<int64_t, std::vector<double>> rows;
-  std::stringstream text(test::read_text(dir / "trace.txt"));
-  for (std::string line; std::getline(text, line);) {
-    if (line.empty() || line[0] == '#') continue;
-    std::stringstream fields(line);
-    std::vector<double> v;
-    for (double x; fields >> x;) v.push_back(x);
-    ASSERT_EQ(v.size(), 2 + 5 * nw) << line;
-    rows.emplace(static_cast<int64_t>(v[0]), v);
-  }
+  const std::map<int64_t, std::vector<double>> rows =
+      test::trace_rows(test::read_text(dir / "trace.txt"), 2 + 5 * nw);
   ASSERT_EQ(static_cast<int>(rows.size()), steps);
   ASSERT_EQ(rows.begin()->first, 1);
   ASSERT_EQ(rows.rbegin()->first, steps) << "a step is missing";

@@ -25,6 +25,7 @@
 #include "demcal/upscaling/export_3d.hpp"
 #include "support/files.hpp"
 #include "support/process.hpp"
+#include "support/trace_rows.hpp"
 
 namespace demcal {
 namespace {
@@ -538,16 +539,8 @@ void expect_the_servo_carries_its_last_move(
   const double cap_value = std::stod(m[1].str());
   // the rows by step: a run's setup prints its first step again (keep the
   // first row, that of the step's end)
-  std::map<int64_t, std::vector<double>> rows;
-  std::stringstream text(test::read_text(dir / "trace.txt"));
-  for (std::string line; std::getline(text, line);) {
-    if (line.empty() || line[0] == '#') continue;
-    std::stringstream fields(line);
-    std::vector<double> v;
-    for (double x; fields >> x;) v.push_back(x);
-    ASSERT_EQ(v.size(), 2 + 4 * walls) << line;
-    rows.emplace(static_cast<int64_t>(v[0]), v);
-  }
+  const std::map<int64_t, std::vector<double>> rows =
+      test::trace_rows(test::read_text(dir / "trace.txt"), 2 + 4 * walls);
   ASSERT_GE(rows.size(), 1000u);
   ASSERT_EQ(rows.begin()->first, 0);
   ASSERT_EQ(rows.rbegin()->first, static_cast<int64_t>(rows.size()) - 1) << "a step is missing";
