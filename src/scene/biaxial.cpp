@@ -156,15 +156,7 @@ double consolidation_dashpot_factor(double zeta_c, int dimension, double r_min, 
       zeta_c * std::sqrt(consolidation_dashpot_coordination(dimension, r_max / r_min)));
 }
 
-namespace {
-
-// The per-step move before the carry and the cap [m, toward the sample] and its R.
-struct ServoMove {
-  double move;
-  double resistance;
-};
-
-ServoMove servo_move(const World& world, WallSide side, double target_stress, double gain) {
+double servo_velocity(const World& world, WallSide side, double target_stress, double gain) {
   const bool vertical = side == kLeft || side == kRight;
   const double length = vertical ? world.height() : world.width();
   const double dt = world.integration().dt;
@@ -181,26 +173,16 @@ ServoMove servo_move(const World& world, WallSide side, double target_stress, do
   const double m_max =
       disk_mass(disk_areal_density(mat, world.integration().mass_scaling), world.max_radius());
   const double resistance = servo_resistance(mat, m_max, dt);
-  return {gain * error * length * mat.thickness / (resistance * contacts), resistance};
-}
-
-// Never more than servo_move_cap (kServoMoveCapRatio of the smallest
-// radius) per step.
-double capped_velocity(const World& world, WallSide side, double move) {
+  double move = gain * error * length * mat.thickness / (resistance * contacts);
+  // A moving wall's dashpot force is in its reading: carry servo_carry of
+  // the last move (velocity·Δt, toward the sample) into this one.
+  const double carry = servo_carry(mat.wall.kn, resistance);
+  if (carry > 0.0) move += carry * kInward[side] * world.wall(side).velocity * dt;
+  // Never more than servo_move_cap (kServoMoveCapRatio of the smallest
+  // radius) per step.
   const double cap = servo_move_cap(world.min_radius());
   move = std::clamp(move, -cap, cap);
-  return kInward[side] * move / world.integration().dt;
-}
-
-}  // namespace
-
-double servo_velocity(const World& world, WallSide side, double target_stress, double gain) {
-  ServoMove m = servo_move(world, side, target_stress, gain);
-  const double carry = servo_carry(world.material().wall.kn, m.resistance);
-  // The last move, toward the sample (velocity·Δt along the inward axis).
-  if (carry > 0.0)
-    m.move += carry * kInward[side] * world.wall(side).velocity * world.integration().dt;
-  return capped_velocity(world, side, m.move);
+  return kInward[side] * move / dt;
 }
 
 Integration integration_for(const World& world, const AlgorithmSpec& algorithm) {

@@ -103,16 +103,8 @@ double wall_pressure(const SphereWorld& world, SphereWallSide side) {
   return -inward(side) * world.wall(side).force[side / 2] / wall_area(world, side);
 }
 
-namespace {
-
-// The per-step move before the carry and the cap [m, toward the sample] and its R.
-struct ServoMove {
-  double move;
-  double resistance;
-};
-
-ServoMove servo_move(const SphereWorld& world, SphereWallSide side, double target_stress,
-                     double gain) {
+double servo_velocity(const SphereWorld& world, SphereWallSide side, double target_stress,
+                      double gain) {
   const double dt = world.integration().dt;
   const int contacts = std::max(1, world.wall(side).contacts);
   const double error = target_stress - wall_pressure(world, side);
@@ -123,25 +115,13 @@ ServoMove servo_move(const SphereWorld& world, SphereWallSide side, double targe
   const double m_max =
       sphere_mass(mat.density * world.integration().mass_scaling, world.max_radius());
   const double resistance = servo_resistance(mat.wall.kn, mat.contact_damping_ratio, m_max, dt);
-  return {gain * error * wall_area(world, side) / (resistance * contacts), resistance};
-}
-
-double capped_velocity(const SphereWorld& world, SphereWallSide side, double move) {
+  double move = gain * error * wall_area(world, side) / (resistance * contacts);
+  // servo_carry of the last move (velocity·Δt, toward the sample), as in 2D.
+  const double carry = servo_carry(mat.wall.kn, resistance);
+  if (carry > 0.0) move += carry * inward(side) * world.wall(side).velocity * dt;
   const double cap = servo_move_cap(world.min_radius());
   move = std::clamp(move, -cap, cap);
-  return inward(side) * move / world.integration().dt;
-}
-
-}  // namespace
-
-double servo_velocity(const SphereWorld& world, SphereWallSide side, double target_stress,
-                      double gain) {
-  ServoMove m = servo_move(world, side, target_stress, gain);
-  const double carry = servo_carry(world.material().wall.kn, m.resistance);
-  // The last move, toward the sample (velocity·Δt along the inward axis).
-  if (carry > 0.0)
-    m.move += carry * inward(side) * world.wall(side).velocity * world.integration().dt;
-  return capped_velocity(world, side, m.move);
+  return inward(side) * move / dt;
 }
 
 Integration integration_for(const SphereWorld& world, const AlgorithmSpec& algorithm) {
