@@ -17,6 +17,7 @@
 #include "demcal/search/trial_runner.hpp"
 #include "support/files.hpp"
 #include "support/process.hpp"
+#include "support/programs.hpp"
 
 namespace fs = std::filesystem;
 using namespace demcal;
@@ -301,8 +302,7 @@ TEST(Calibration3D, ExportWritesTheRevsDeckAndAnUpscaledPrototypesDeck) {
   // steps over the REV deck's, below 3.
   EXPECT_NEAR(steps_of(big.out) / steps_of(exported.out), 2.25, 3.0 / steps_of(exported.out));
 
-  const std::string lmp = test::find_on_path("lmp");
-  if (lmp.empty()) GTEST_SKIP() << "lmp (Debian package lammps) is not installed: deck not run";
+  DEMCAL_FIND_PROGRAM(lmp, "lmp", "lammps", "deck not run");
   const test::RunResult ran =
       test::run_program(lmp, {"-in", "fcc.lammps", "-screen", "none"}, dir / "deck");
   ASSERT_EQ(ran.status, 0) << ran.err;

@@ -26,6 +26,7 @@
 #include "support/carried_servo.hpp"
 #include "support/files.hpp"
 #include "support/process.hpp"
+#include "support/programs.hpp"
 #include "support/trace_rows.hpp"
 
 namespace demcal {
@@ -158,9 +159,7 @@ void expect_the_loading_servo_carries_its_last_move(const std::string& lmp, cons
 // each wall by the per-step law alone: it fails at the second step (move
 // -5.9509e-14 where demcal's law gives -5.9300e-14).
 TEST(EngineLammpsLoading, WithContactDashpotsTheServoCarriesItsLastMoveAsDemcals2D) {
-  const std::string lmp = test::find_on_path("lmp");
-  if (lmp.empty())
-    GTEST_SKIP() << "LAMMPS (lmp) is not installed (apt-get install lammps): the deck is not run";
+  DEMCAL_FIND_PROGRAM(lmp, "lmp", "lammps", "the deck is not run");
   SceneConfig c = default_config();
   c.assembly.columns = c.assembly.rows = 5;
   c.material.contact_damping_ratio = 0.25;
@@ -198,9 +197,7 @@ TEST(EngineLammpsLoading, WithContactDashpotsTheServoCarriesItsLastMoveAsDemcals
 // clamped, 7 312 free, 7 308 of which carried). The deck before fails at
 // the second step (-3.1227e-18 where the law gives -2.5133e-18).
 TEST(EngineLammpsLoading, WithContactDashpotsTheServoCarriesItsLastMoveAsDemcals3D) {
-  const std::string lmp = test::find_on_path("lmp");
-  if (lmp.empty())
-    GTEST_SKIP() << "LAMMPS (lmp) is not installed (apt-get install lammps): the deck is not run";
+  DEMCAL_FIND_PROGRAM(lmp, "lmp", "lammps", "the deck is not run");
   SceneConfig c = load_config(test::shipped_config("fcc_4x4x4"));
   c.material.contact_damping_ratio = 0.3;
   const TriaxialState state = consolidate_triaxial(c, make_sphere_assembly(c));

@@ -31,6 +31,7 @@
 #include "support/files.hpp"
 #include "support/liggghts_servo.hpp"
 #include "support/process.hpp"
+#include "support/programs.hpp"
 #include "support/trace_rows.hpp"
 
 namespace demcal {
@@ -224,10 +225,7 @@ TEST(EngineLammps, TheDecksOwnSeriesScoresAsDemcalsRun) {
   // The whole loading of the 25-particle sample in LAMMPS; its series.csv,
   // scored, against demcal's run of the same parameters: same verdict, the
   // peak within 0.5 %, each criterion of the same size.
-  const std::string lmp = test::find_on_path("lmp");
-  if (lmp.empty())
-    GTEST_SKIP() << "LAMMPS (lmp) is not installed (apt-get install lammps): the deck's "
-                    "series is not scored";
+  DEMCAL_FIND_PROGRAM(lmp, "lmp", "lammps", "the deck's series is not scored");
   const SceneConfig c = hex5();
   const ConsolidatedState state = consolidate(c, make_assembly(c));
   const AlgorithmSpec p = quasi_static();
@@ -307,17 +305,12 @@ void expect_demcals_servo_with_contact_damping(const std::string& engine,
 }
 
 TEST(EngineLammps, WithContactDampingTheDecksServoIsDemcals) {
-  const std::string lmp = test::find_on_path("lmp");
-  if (lmp.empty())
-    GTEST_SKIP() << "LAMMPS (lmp) is not installed (apt-get install lammps): the deck is not run";
+  DEMCAL_FIND_PROGRAM(lmp, "lmp", "lammps", "the deck is not run");
   expect_demcals_servo_with_contact_damping(lmp, "lammps");
 }
 
 TEST(EngineLiggghts, WithContactDampingTheDecksServoIsDemcals) {
-  const std::string liggghts = test::find_on_path("liggghts");
-  if (liggghts.empty())
-    GTEST_SKIP() << "LIGGGHTS (liggghts) is not installed (apt-get install liggghts): the "
-                    "deck is not run";
+  DEMCAL_FIND_PROGRAM(liggghts, "liggghts", "liggghts", "the deck is not run");
   expect_demcals_servo_with_contact_damping(liggghts, "liggghts");
 }
 
@@ -457,10 +450,7 @@ void expect_the_loading_servo_carries_its_last_move(
 // it binds at the start; both fail on the deck with the mesh servo (no
 // servo_u).
 TEST(EngineLiggghts, WithContactDampingTheLoadingServoCarriesItsLastMoveAsDemcals2D) {
-  const std::string liggghts = test::find_on_path("liggghts");
-  if (liggghts.empty())
-    GTEST_SKIP() << "LIGGGHTS (liggghts) is not installed (apt-get install liggghts): the "
-                    "deck is not run";
+  DEMCAL_FIND_PROGRAM(liggghts, "liggghts", "liggghts", "the deck is not run");
   SceneConfig c = hex5();
   c.material.contact_damping_ratio = 0.25;
   const ConsolidatedState state = consolidate(c, make_assembly(c));
@@ -488,10 +478,7 @@ TEST(EngineLiggghts, WithContactDampingTheLoadingServoCarriesItsLastMoveAsDemcal
 // emptied (its bound 1 m left of the sample): the particles the left wall
 // touches are all outside it.
 TEST(EngineLiggghts, WithContactDampingAParticleOutsideAWallsBandStopsTheRun) {
-  const std::string liggghts = test::find_on_path("liggghts");
-  if (liggghts.empty())
-    GTEST_SKIP() << "LIGGGHTS (liggghts) is not installed (apt-get install liggghts): the "
-                    "deck is not run";
+  DEMCAL_FIND_PROGRAM(liggghts, "liggghts", "liggghts", "the deck is not run");
   SceneConfig c = hex5();
   c.material.contact_damping_ratio = 0.25;
   const ConsolidatedState state = consolidate(c, make_assembly(c));
@@ -531,10 +518,7 @@ TEST(EngineLiggghts, WithContactDampingAParticleOutsideAWallsBandStopsTheRun) {
 // alpha 0.1 (Export3dLammps.WithContactDampingTheDecksServoIsDemcals'
 // parameters), 2 000 steps.
 TEST(EngineLiggghts, WithContactDampingTheLoadingServoCarriesItsLastMoveAsDemcals3D) {
-  const std::string liggghts = test::find_on_path("liggghts");
-  if (liggghts.empty())
-    GTEST_SKIP() << "LIGGGHTS (liggghts) is not installed (apt-get install liggghts): the "
-                    "deck is not run";
+  DEMCAL_FIND_PROGRAM(liggghts, "liggghts", "liggghts", "the deck is not run");
   SceneConfig c = load_config(test::shipped_config("fcc_4x4x4"));
   c.material.contact_damping_ratio = 0.3;
   const TriaxialState state = consolidate_triaxial(c, make_sphere_assembly(c));
@@ -569,9 +553,7 @@ TEST_P(LammpsSeriesSources, AreTheStoredContactForceAndTheWallArrays) {
   // the same numbers to rounding at every monitoring row (the start, where v
   // is no half-step velocity, included) — per radius class on the random
   // sample (8 atom types, one γ each).
-  const std::string lmp = test::find_on_path("lmp");
-  if (lmp.empty())
-    GTEST_SKIP() << "LAMMPS (lmp) is not installed (apt-get install lammps): the deck is not run";
+  DEMCAL_FIND_PROGRAM(lmp, "lmp", "lammps", "the deck is not run");
   SceneConfig c = hex5();
   if (std::string(GetParam()) == "random") {
     c.assembly.type = "random";
@@ -663,9 +645,7 @@ TEST(EngineLammps, TheVectorServoIsThePerWallFormulaBitForBit) {
   // ~1e-10 m; a re-association of the unclamped formula, e.g.
   // (A-F)*(gain/D), passes. The whole-run byte comparison of engines.md §13
   // is the finer gate.)
-  const std::string lmp = test::find_on_path("lmp");
-  if (lmp.empty())
-    GTEST_SKIP() << "LAMMPS (lmp) is not installed (apt-get install lammps): the deck is not run";
+  DEMCAL_FIND_PROGRAM(lmp, "lmp", "lammps", "the deck is not run");
   const SceneConfig c = hex5();
   const ConsolidatedState state = consolidate(c, make_assembly(c));
   ExportOptions o;
@@ -738,9 +718,7 @@ TEST(EngineLammps, EditingNstepInTheDeckKeepsTheStrain) {
   // The user shortens the run in the parameters block: the top wall speed
   // and the monitoring interval follow, so the full strain is reached at the
   // new Nstep and the series still has M + 1 rows.
-  const std::string lmp = test::find_on_path("lmp");
-  if (lmp.empty())
-    GTEST_SKIP() << "LAMMPS (lmp) is not installed (apt-get install lammps): the deck is not run";
+  DEMCAL_FIND_PROGRAM(lmp, "lmp", "lammps", "the deck is not run");
   SceneConfig c = hex5();
   c.test.monitor_points = 20;
   const ConsolidatedState state = consolidate(c, make_assembly(c));
@@ -846,9 +824,7 @@ TEST(EngineLammps, ASplitRunContinuesTheSameTest) {
   // 1.3e-14 of the width, kinetic energy 3.4e-10 relative (100 discs of
   // example-hex_10x10: 5e-10, 2.5e-12, 4.5e-7). Before (the walls from the
   // servo's running mean): b_xx 1e-4.
-  const std::string lmp = test::find_on_path("lmp");
-  if (lmp.empty())
-    GTEST_SKIP() << "LAMMPS (lmp) is not installed (apt-get install lammps): the deck is not run";
+  DEMCAL_FIND_PROGRAM(lmp, "lmp", "lammps", "the deck is not run");
   expect_the_split_run_continues_the_test(lmp, 0.0, "engine_split");
 }
 
@@ -861,9 +837,7 @@ TEST(EngineLammps, WithContactDampingASplitRunContinuesTheSameTest) {
   // 6e-10); a continuation that starts its walls at rest (without ul_now and
   // ur_now in the args) misses the single run by 3e-7 sigma3, 6e-9 of the
   // width and 2e-5 in kinetic energy, and fails.
-  const std::string lmp = test::find_on_path("lmp");
-  if (lmp.empty())
-    GTEST_SKIP() << "LAMMPS (lmp) is not installed (apt-get install lammps): the deck is not run";
+  DEMCAL_FIND_PROGRAM(lmp, "lmp", "lammps", "the deck is not run");
   expect_the_split_run_continues_the_test(lmp, 0.25, "engine_split_damped");
 }
 
@@ -871,10 +845,7 @@ TEST(EngineLammps, VerifyInLammpsAgreesWithDemcal) {
   // `demcal verify --engine lammps` on the 25-disc prototype of a hex_5x5
   // calibration (ζ_r set to 0: this LAMMPS has none): the LAMMPS-scored
   // verdict and peak agree with demcal's own verify within 0.5 %.
-  const std::string lmp = test::find_on_path("lmp");
-  if (lmp.empty())
-    GTEST_SKIP() << "LAMMPS (lmp) is not installed (apt-get install lammps): verify --engine "
-                    "lammps is not run";
+  DEMCAL_FIND_PROGRAM(lmp, "lmp", "lammps", "verify --engine lammps is not run");
   const test::TempDir dir("engine_verify");
   ASSERT_EQ(
       test::run_demcal({"calibrate", test::shipped_config("hex_5x5"), "-o", "cal", "-j1", "-q"},
@@ -1016,10 +987,7 @@ TEST(EngineLiggghts, TheDecksPeakIsDemcalsWithinOnePercent) {
   // strain ε, and the peaks were 0.84 % apart; the target is now σ3·H·t on
   // the current height (−0.034 %). (LIGGGHTS 3.8 rotates discs with the
   // disc's inertia: RotatesDiscsWithTheDiscsInertia.)
-  const std::string liggghts = test::find_on_path("liggghts");
-  if (liggghts.empty())
-    GTEST_SKIP() << "LIGGGHTS (liggghts) is not installed (apt-get install liggghts): the "
-                    "deck is not run";
+  DEMCAL_FIND_PROGRAM(liggghts, "liggghts", "liggghts", "the deck is not run");
   const SceneConfig c = hex5();
   const ConsolidatedState state = consolidate(c, make_assembly(c));
   const AlgorithmSpec p = quasi_static();
@@ -1067,10 +1035,7 @@ TEST_P(LiggghtsSeries, ScoresAsDemcalsRun) {
   // corner particle's force is split with the meshes' totals; the series'
   // wall pressures are still the meshes' own, b_xx takes the top and bottom
   // walls' friction.
-  const std::string liggghts = test::find_on_path("liggghts");
-  if (liggghts.empty())
-    GTEST_SKIP() << "LIGGGHTS (liggghts) is not installed (apt-get install liggghts): the "
-                    "deck's series is not scored";
+  DEMCAL_FIND_PROGRAM(liggghts, "liggghts", "liggghts", "the deck's series is not scored");
   SceneConfig c = hex5();
   const bool frictionless = std::string(GetParam()) == "frictionless";
   if (!frictionless) c.material.wall.friction = 0.2;
@@ -1184,10 +1149,7 @@ TEST_P(LiggghtsContactForce, IsTheStoredForceBeforeTheDamping) {
   // same deck with `fix store/force` before the damping: the two agree to
   // rounding at every check of 4 000 steps, per radius class on the random
   // sample (8 atom types, one γ each).
-  const std::string liggghts = test::find_on_path("liggghts");
-  if (liggghts.empty())
-    GTEST_SKIP() << "LIGGGHTS (liggghts) is not installed (apt-get install liggghts): the deck "
-                    "is not run";
+  DEMCAL_FIND_PROGRAM(liggghts, "liggghts", "liggghts", "the deck is not run");
   SceneConfig c = hex5();
   if (std::string(GetParam()) == "random") {
     c.assembly.type = "random";
@@ -1233,10 +1195,7 @@ TEST(EngineLiggghts, RotatesDiscsWithTheDiscsInertia) {
   // Coulomb friction slides until it rolls: the impulse J gives v = v0 − J/m
   // and ω r = J r²/I, so it rolls at v0/(1 + I/(m r²)) = 2/3 v0 (a sphere's
   // inertia would give 5/7 v0, 7 % more).
-  const std::string liggghts = test::find_on_path("liggghts");
-  if (liggghts.empty())
-    GTEST_SKIP() << "LIGGGHTS (liggghts) is not installed (apt-get install liggghts): the "
-                    "deck is not run";
+  DEMCAL_FIND_PROGRAM(liggghts, "liggghts", "liggghts", "the deck is not run");
   const std::string data =
       "LIGGGHTS data file\n\n1 atoms\n2 atom types\n\n-0.01 0.01 xlo xhi\n-0.01 0.01 ylo yhi\n"
       "-0.0005 0.0005 zlo zhi\n\nAtoms\n\n1 1 0.002 1000 0 0.000999 0\n";
@@ -1278,10 +1237,7 @@ TEST(EngineLiggghts, RotatesDiscsWithTheDiscsInertia) {
 // mesh servo (kp from R, no carry: the deck of 483ff94) the servo read 4.0
 // times demcal's and the peak 1.6 % more.
 TEST(EngineLiggghts, WithContactDampingThe3dDecksServoIsDemcals) {
-  const std::string liggghts = test::find_on_path("liggghts");
-  if (liggghts.empty())
-    GTEST_SKIP() << "LIGGGHTS (liggghts) is not installed (apt-get install liggghts): the 3D "
-                    "deck is not run";
+  DEMCAL_FIND_PROGRAM(liggghts, "liggghts", "liggghts", "the 3D deck is not run");
   SceneConfig c = load_config(test::shipped_config("fcc_4x4x4"));
   c.material.contact_damping_ratio = 0.3;
   const TriaxialState state = consolidate_triaxial(c, make_sphere_assembly(c));
@@ -1322,10 +1278,7 @@ TEST(EngineLiggghts, The3dDecksSeriesScoresAsDemcalsRun) {
   // (frictionless walls); the pressures equal the meshes' own (the thermo's
   // p_top and p_bottom, 8 digits), the translational kinetic energy
   // LIGGGHTS' ke.
-  const std::string liggghts = test::find_on_path("liggghts");
-  if (liggghts.empty())
-    GTEST_SKIP() << "LIGGGHTS (liggghts) is not installed (apt-get install liggghts): the 3D "
-                    "deck's series is not scored";
+  DEMCAL_FIND_PROGRAM(liggghts, "liggghts", "liggghts", "the 3D deck's series is not scored");
   const SceneConfig c = load_config(test::shipped_config("fcc_4x4x4"));
   const TriaxialState state = consolidate_triaxial(c, make_sphere_assembly(c));
   const AlgorithmSpec p = fcc_20000();

@@ -25,6 +25,7 @@
 #include "demcal/upscaling/export_3d.hpp"
 #include "support/files.hpp"
 #include "support/process.hpp"
+#include "support/programs.hpp"
 #include "support/trace_rows.hpp"
 
 namespace demcal {
@@ -218,9 +219,7 @@ TEST(EngineLammpsStage1, TheVectorServoIsThePerWallFormulaBitForBit2D) {
   // Hex 5x5 as generated, with contact damping: the servo's R carries the
   // wall dashpots' c/dt, so that part of the formula is checked too. The
   // cap at 1e-5 r_min: about half the moves bound.
-  const std::string lmp = test::find_on_path("lmp");
-  if (lmp.empty())
-    GTEST_SKIP() << "LAMMPS (lmp) is not installed (apt-get install lammps): the deck is not run";
+  DEMCAL_FIND_PROGRAM(lmp, "lmp", "lammps", "the deck is not run");
   SceneConfig c = default_config();
   c.assembly.columns = c.assembly.rows = 5;
   c.material.contact_damping_ratio = 0.1;
@@ -235,9 +234,7 @@ TEST(EngineLammpsStage1, TheVectorServoIsThePerWallFormulaBitForBit2D) {
 TEST(EngineLammpsStage1, TheVectorServoIsThePerWallFormulaBitForBit3D) {
   // The fcc_4x4x4 lattice as generated (256 spheres); its moves are mostly
   // 1e-16 .. 1e-11 m, hence the cap at 1e-8 r_min (half the moves bound).
-  const std::string lmp = test::find_on_path("lmp");
-  if (lmp.empty())
-    GTEST_SKIP() << "LAMMPS (lmp) is not installed (apt-get install lammps): the deck is not run";
+  DEMCAL_FIND_PROGRAM(lmp, "lmp", "lammps", "the deck is not run");
   const SceneConfig c = load_config(test::shipped_config("fcc_4x4x4"));
   AlgorithmSpec p = stage1_loading();
   p.damping_ratio_translation = 0.4;
@@ -296,9 +293,7 @@ std::string with_phase0_marker(const std::string& deck) {
 // a budget cannot aim at; a shrunk deck's quarter is the last check by
 // itself when (cons_max_steps/4)/S passes it).
 TEST(EngineLammpsStage1, WhenPhase0EndsAtTheBudgetsLastChecksPhase1StopsThereWithQuit2) {
-  const std::string lmp = test::find_on_path("lmp");
-  if (lmp.empty())
-    GTEST_SKIP() << "LAMMPS (lmp) is not installed (apt-get install lammps): the deck is not run";
+  DEMCAL_FIND_PROGRAM(lmp, "lmp", "lammps", "the deck is not run");
   SceneConfig c = load_config(test::shipped_config("random_400"));
   c.assembly.count = 30;
   const AlgorithmSpec p = stage1_loading();
@@ -356,9 +351,7 @@ TEST(EngineLammpsStage1, WhenPhase0EndsAtTheBudgetsLastChecksPhase1StopsThereWit
 // on random_500_3d at ζ_c 0.3; and without them at the check at or BEFORE
 // a quarter: 30 800 and 200 where demcal switches at 31 000 and 400.)
 TEST(EngineLammpsStage1, TheCriticalFallbackComesAtDemcalsCheck) {
-  const std::string lmp = test::find_on_path("lmp");
-  if (lmp.empty())
-    GTEST_SKIP() << "LAMMPS (lmp) is not installed (apt-get install lammps): the deck is not run";
+  DEMCAL_FIND_PROGRAM(lmp, "lmp", "lammps", "the deck is not run");
   const AlgorithmSpec p = stage1_loading();
   struct Case {
     std::string name;
@@ -432,9 +425,7 @@ TEST(EngineLammpsStage1, TheCriticalFallbackComesAtDemcalsCheck) {
 // before the packing was static (with the older, smaller step it then crept
 // to the end of the budget: quit 2, engines.md §21).
 TEST(EngineLammpsStage1, WithContactDashpotsTheDeckConsolidatesARandomSampleWithinAModestBudget) {
-  const std::string lmp = test::find_on_path("lmp");
-  if (lmp.empty())
-    GTEST_SKIP() << "LAMMPS (lmp) is not installed (apt-get install lammps): the deck is not run";
+  DEMCAL_FIND_PROGRAM(lmp, "lmp", "lammps", "the deck is not run");
   SceneConfig c = load_config(test::shipped_config("random_400"));
   c.assembly.count = 200;
   c.material.contact_damping_ratio = 0.3;
@@ -605,9 +596,7 @@ void expect_the_servo_carries_its_last_move(
 // each wall by the per-step law alone: its moves miss the law by the carry
 // term, 0.84 of the last move at light damping.
 TEST(EngineLammpsStage1, WithContactDashpotsTheServoCarriesItsLastMoveAsDemcals2D) {
-  const std::string lmp = test::find_on_path("lmp");
-  if (lmp.empty())
-    GTEST_SKIP() << "LAMMPS (lmp) is not installed (apt-get install lammps): the deck is not run";
+  DEMCAL_FIND_PROGRAM(lmp, "lmp", "lammps", "the deck is not run");
   SceneConfig c = load_config(test::shipped_config("random_400"));
   c.assembly.count = 100;
   c.material.contact_damping_ratio = 0.3;
@@ -628,9 +617,7 @@ TEST(EngineLammpsStage1, WithContactDashpotsTheServoCarriesItsLastMoveAsDemcals2
 }
 
 TEST(EngineLammpsStage1, WithContactDashpotsTheServoCarriesItsLastMoveAsDemcals3D) {
-  const std::string lmp = test::find_on_path("lmp");
-  if (lmp.empty())
-    GTEST_SKIP() << "LAMMPS (lmp) is not installed (apt-get install lammps): the deck is not run";
+  DEMCAL_FIND_PROGRAM(lmp, "lmp", "lammps", "the deck is not run");
   SceneConfig c = load_config(test::shipped_config("random_500_3d"));
   c.assembly.count = 60;
   c.material.contact_damping_ratio = 0.3;

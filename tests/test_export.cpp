@@ -22,6 +22,7 @@
 #include "support/files.hpp"
 #include "support/liggghts_servo.hpp"
 #include "support/process.hpp"
+#include "support/programs.hpp"
 
 namespace demcal {
 namespace {
@@ -396,8 +397,7 @@ TEST(Export, AConsolidatedStateReadBackGivesTheSameDeck) {
 class LammpsRun : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(LammpsRun, TheDeckStartsWithOurTimestepAndSigma3OnTheWalls) {
-  const std::string lmp = test::find_on_path("lmp");
-  if (lmp.empty()) GTEST_SKIP() << "LAMMPS (lmp) is not installed: the exported deck is not run";
+  DEMCAL_FIND_PROGRAM(lmp, "lmp", "lammps", "the exported deck is not run");
   SceneConfig c = default_config();
   if (std::string(GetParam()) == "hexagonal") {
     c.assembly.columns = c.assembly.rows = 5;
@@ -466,8 +466,7 @@ TEST(Export, LammpsReproducesDemcalsPeak) {
   // The whole loading of the 25-particle sample in both codes (ζ_r = 0:
   // this LAMMPS has no rotational damping, so both run the same model):
   // the axial peak agrees within 1 %. ~1·10⁶ particle-steps each.
-  const std::string lmp = test::find_on_path("lmp");
-  if (lmp.empty()) GTEST_SKIP() << "LAMMPS (lmp) is not installed: the exported deck is not run";
+  DEMCAL_FIND_PROGRAM(lmp, "lmp", "lammps", "the exported deck is not run");
   SceneConfig c = default_config();
   c.assembly.columns = c.assembly.rows = 5;
   const ConsolidatedState state = consolidate(c, make_assembly(c));
@@ -512,8 +511,7 @@ TEST(Export, LammpsDeckConsolidatesItselfToDemcalsPeak) {
   // demcal's within 2 * consolidation_tolerance (both loaded in LAMMPS, so
   // the engines' differences cancel). Under mpirun -np 2 the same run: the
   // peak within 1e-9 (the order of the MPI sums).
-  const std::string lmp = test::find_on_path("lmp");
-  if (lmp.empty()) GTEST_SKIP() << "LAMMPS (lmp) is not installed: the exported deck is not run";
+  DEMCAL_FIND_PROGRAM(lmp, "lmp", "lammps", "the exported deck is not run");
   SceneConfig c = default_config();
   c.assembly.columns = c.assembly.rows = 5;
   AlgorithmSpec p = params();
@@ -567,8 +565,7 @@ TEST(Export, LammpsDeckConsolidatesItselfToDemcalsPeak) {
   EXPECT_EQ(second_part.log.find("demcal deck: consolidated in"), std::string::npos);
   EXPECT_NEAR(series_peak(d4.path(), c) / peak_deck, 1.0, 1e-10);
 
-  const std::string mpirun = test::find_on_path("mpirun");
-  if (mpirun.empty()) GTEST_SKIP() << "mpirun is not installed: the deck is not run under MPI";
+  DEMCAL_FIND_PROGRAM(mpirun, "mpirun", "openmpi-bin", "the deck is not run under MPI");
   setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 0);
   setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1", 0);
   const test::DeckRun r3 = test::run_deck(mpirun, d3.path(), in_deck.deck, in_deck.files,

@@ -27,6 +27,7 @@
 #include "support/head_on.hpp"
 #include "support/liggghts_servo.hpp"
 #include "support/process.hpp"
+#include "support/programs.hpp"
 
 namespace demcal {
 namespace {
@@ -372,12 +373,10 @@ DemcalRun demcal_run(const AlgorithmSpec& p) {
 constexpr size_t kColumns = 2 + 18 + 3 + 4 + 6 + 6 + 1;
 
 void check_lammps(int np, int64_t steps) {
-  const std::string lmp = test::find_on_path("lmp");
-  if (lmp.empty()) GTEST_SKIP() << "LAMMPS (lmp) is not installed: the 3D deck is not run";
+  DEMCAL_FIND_PROGRAM(lmp, "lmp", "lammps", "the 3D deck is not run");
   const std::string mpirun = test::find_on_path("mpirun");
   if (np > 1 && mpirun.empty())
-    GTEST_SKIP() << "mpirun is not installed (apt-get install openmpi-bin): the 3D deck is not "
-                    "run under MPI";
+    DEMCAL_SKIP_MISSING("mpirun", "openmpi-bin", "the 3D deck is not run under MPI");
   const SceneConfig c = fcc444();
   Export3dOptions o;
   o.data_name = "fcc.data";
@@ -500,8 +499,7 @@ TEST(Export3dLammps, WithContactDampingTheDecksServoIsDemcals) {
   // check_lammps). α 0.1: stable with these dashpots (0.2 is not). The deck
   // without the carry reads 0.021511 (4.0× demcal's 0.0053776) and a peak
   // 1.6 % higher (reports/engines.md §24).
-  const std::string lmp = test::find_on_path("lmp");
-  if (lmp.empty()) GTEST_SKIP() << "LAMMPS (lmp) is not installed: the 3D deck is not run";
+  DEMCAL_FIND_PROGRAM(lmp, "lmp", "lammps", "the 3D deck is not run");
   SceneConfig c = fcc444();
   c.material.contact_damping_ratio = 0.3;
   const TriaxialState state = consolidate_triaxial(c, make_sphere_assembly(c));
@@ -584,8 +582,7 @@ TEST(Export3dLammps, TheDecksPerStepCutsLeaveTheSeriesAndPeaksBitForBit) {
   // the series within this run (the running sum absorbs it; on the whole
   // 73 888-step run of 500 spheres it does, from step 64 575): the whole-run
   // comparison of engines-3d.md guards that.
-  const std::string lmp = test::find_on_path("lmp");
-  if (lmp.empty()) GTEST_SKIP() << "LAMMPS (lmp) is not installed: the 3D deck is not run";
+  DEMCAL_FIND_PROGRAM(lmp, "lmp", "lammps", "the 3D deck is not run");
   const SceneConfig c = fcc444();
   Export3dOptions o;
   o.data_name = "fcc.data";
@@ -645,8 +642,7 @@ TEST(Export3dLammps, ASphereOutsideAWallsBandStopsTheRun) {
   // With the bottom's band edited to nothing, the spheres resting on the
   // bottom are outside it: the bottom wall would let them through, and the
   // clearance check stops the run with an error at the first monitoring step.
-  const std::string lmp = test::find_on_path("lmp");
-  if (lmp.empty()) GTEST_SKIP() << "LAMMPS (lmp) is not installed: the 3D deck is not run";
+  DEMCAL_FIND_PROGRAM(lmp, "lmp", "lammps", "the 3D deck is not run");
   Export3dOptions o;
   o.data_name = "fcc.data";
   const ExportResult r = export_3d_decks(fcc444(), fixed_params(2000), fcc_state(), o);
@@ -731,8 +727,7 @@ TEST(Export3d, LammpsDeckCarriesTheConsolidationStage) {
 // give two packings, so the peaks agree only within the sample-to-sample
 // scatter; measured and printed, not asserted (reports/engines.md §10).
 TEST(Export3dLammps, DeckConsolidatesARandomSampleAndLoads) {
-  const std::string lmp = test::find_on_path("lmp");
-  if (lmp.empty()) GTEST_SKIP() << "LAMMPS (lmp) is not installed: the 3D deck is not run";
+  DEMCAL_FIND_PROGRAM(lmp, "lmp", "lammps", "the 3D deck is not run");
   const SceneConfig c = random3d(150);
   const SphereAssembly a = make_sphere_assembly(c);
   // A short loading (8 000 steps to ε = 1 %): the test is the consolidation.
@@ -835,10 +830,7 @@ TEST(Export3dCli, ConsolidateInChoosesWhereAndPrintsProgress) {
 // meshes, as demcal's: the top wall alone reads 0.32 % higher at the peak
 // (the damping drag on the spheres moving with it; reports/engines-3d.md).
 TEST(Export3dLiggghts, PeakAgainstDemcal) {
-  const std::string liggghts = test::find_on_path("liggghts");
-  if (liggghts.empty())
-    GTEST_SKIP() << "LIGGGHTS (liggghts) is not installed (apt-get install liggghts): the 3D "
-                    "deck is not run";
+  DEMCAL_FIND_PROGRAM(liggghts, "liggghts", "liggghts", "the 3D deck is not run");
   Export3dOptions o;
   o.format = "liggghts";
   o.data_name = "fcc.data";
@@ -896,10 +888,7 @@ TEST(Export3dLiggghts, TheDecksContactDashpotsGiveDemcalsRestitution) {
   // longer): the rebound within 0.35 % then (the step in which the force
   // reaches 0 ends the contact a fraction of a step late or early), 1 %
   // allowed.
-  const std::string liggghts = test::find_on_path("liggghts");
-  if (liggghts.empty())
-    GTEST_SKIP() << "LIGGGHTS (liggghts) is not installed (apt-get install liggghts): the 3D "
-                    "deck is not run";
+  DEMCAL_FIND_PROGRAM(liggghts, "liggghts", "liggghts", "the 3D deck is not run");
   SceneConfig c = fcc444();
   const double zeta = 0.3;
   c.material.contact_damping_ratio = zeta;
@@ -977,8 +966,7 @@ namespace {
 //     --gtest_filter='Export3dLammps.DISABLED_Random500'   (one command line)
 // (reports/engines-3d.md has the figures).
 TEST(Export3dLammps, DISABLED_Random500) {
-  const std::string lmp = test::find_on_path("lmp");
-  if (lmp.empty()) GTEST_SKIP() << "LAMMPS (lmp) is not installed: the 3D deck is not run";
+  DEMCAL_FIND_PROGRAM(lmp, "lmp", "lammps", "the 3D deck is not run");
   const SceneConfig c = load_config(test::shipped_config("random_500_3d"));
   auto t0 = std::chrono::steady_clock::now();
   const TriaxialState state = consolidate_triaxial(c, make_sphere_assembly(c));

@@ -27,6 +27,7 @@
 #include "demcal/search/trial_runner.hpp"
 #include "support/files.hpp"
 #include "support/process.hpp"
+#include "support/programs.hpp"
 
 namespace fs = std::filesystem;
 using namespace demcal;
@@ -397,7 +398,7 @@ TEST(Report, WithoutGnuplotEveryNumberAndHowToGetThePlots) {
 
 TEST(Report, WithGnuplotThePlotsAreInlineAndDeterministic) {
   if (find_program("gnuplot").empty())
-    GTEST_SKIP() << "gnuplot is not installed (apt-get install gnuplot-nox): plot checks skipped";
+    DEMCAL_SKIP_MISSING("gnuplot", "gnuplot-nox", "plot checks skipped");
   const ReportInput in = synthetic_input(true);
   const Report r = make_report(in);
   EXPECT_TRUE(r.plots) << r.plot_status;
@@ -444,7 +445,9 @@ TEST(Report, GnuplotRunnerNeedsNoShell) {
   auto none = run_gnuplot("demcal-test-no-such-gnuplot", "", {}, {"a.svg"}, &error);
   EXPECT_TRUE(none.empty());
   EXPECT_NE(error.find("not found"), std::string::npos);
-  if (find_program("gnuplot").empty()) GTEST_SKIP() << "gnuplot is not installed";
+  if (find_program("gnuplot").empty())
+    DEMCAL_SKIP_MISSING("gnuplot", "gnuplot-nox",
+                        "a file name with shell metacharacters is not plotted");
   // A data file name with shell metacharacters is only ever a file name.
   auto out = run_gnuplot("gnuplot",
                          "set terminal svg\nset output 'a.svg'\nplot 'd;$(x).dat' u 1:2 w l\n"

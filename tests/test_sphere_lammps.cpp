@@ -40,6 +40,7 @@
 #include "demcal/upscaling/export_3d.hpp"
 #include "support/files.hpp"
 #include "support/process.hpp"
+#include "support/programs.hpp"
 #include "test_sphere_helpers.hpp"
 
 namespace demcal {
@@ -146,8 +147,7 @@ Comparison compare(const std::vector<Sample>& d, const std::vector<Sample>& l) {
 // allowed (the 1 % for a random packing, whose contacts form and
 // break chaotically; tighter for a lattice, see its test).
 void check_against_lammps(const char* name, const SphereWorld& w, const Protocol& p, double tol) {
-  const std::string lmp = test::find_on_path("lmp");
-  if (lmp.empty()) GTEST_SKIP() << "LAMMPS (lmp) is not installed: the cross-check is not run";
+  DEMCAL_FIND_PROGRAM(lmp, "lmp", "lammps", "the cross-check is not run");
   Export3dOptions o;
   o.lateral_servo = false;
   o.max_types = w.size();  // one class per distinct radius: each sphere its own γ
@@ -193,7 +193,7 @@ TEST(SphereLammps, FccCompressionMatchesLammps) {
 TEST(SphereLammps, RandomSampleCompressionMatchesLammps) {
   // Before the consolidation (seconds): nothing to compare without LAMMPS.
   if (test::find_on_path("lmp").empty())
-    GTEST_SKIP() << "LAMMPS (lmp) is not installed: the cross-check is not run";
+    DEMCAL_SKIP_MISSING("lmp", "lammps", "the cross-check is not run");
   AssemblySpec spec;
   spec.count = 300;
   spec.radius_min = 0.8 * kR;
