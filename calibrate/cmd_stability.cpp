@@ -66,6 +66,8 @@ int cmd_stability(const StabilityOptions& o) {
   std::cout << "\n  " << r.trials.size() << " trials, " << diverged << " diverged, "
             << r.stable_above_limit << " stable above the limit, " << r.wall_time_s << " s; wrote "
             << dir << "/stability.json, " << dir << "/stability.md\n";
+  if (const std::string caveat = beyond_estimate_caveat(r); !caveat.empty())
+    std::cout << "  " << caveat << "\n";
   return 0;
 }
 

@@ -56,12 +56,43 @@ TEST(StabilityScan, MeasuredLimitMatchesTheEstimateWhenDamped) {
 
 // Undamped, the hexagonal REV's rattle still shows in the energy ledger.
 // (On random_400 with ζ_r = 0 friction alone absorbs it up to 1.14 × the
-// estimate: the ledger does not count friction; moment balance catches
-// those runs in scoring. Not asserted here.)
+// estimate: sliding contacts bound the rattle; moment balance catches
+// those runs in scoring. Not asserted here; see the polydisperse test.)
 TEST(StabilityScan, UndampedHexagonalLimitIsFound) {
   const StabilityScanResult r = scan("hex_10x10", 0.0, 0.0);
   expect_sharp_limit(r);
   EXPECT_NEAR(r.ratio(), 1.0, 0.03);
+}
+
+// On a polydisperse sample the scan's "limit" lies above the estimate
+// (1.09 × on these 200 disks), yet the estimate is the scheme's limit:
+// with friction 10, so that no contact can slide, the runs diverge there.
+// In between, the unstable modes stay bounded by sliding contacts, a local
+// rattle the global checks miss (reports/robustness.md §3); the report
+// says so rather than offering the higher figure as the limit.
+TEST(StabilityScan, OnAPolydisperseSampleTheEstimateIsTheLimitWhenNoContactCanSlide) {
+  SceneConfig config =
+      load_config(std::string(DEMCAL_SOURCE_DIR) + "/configs/poly_lognormal_500.json");
+  config.assembly.count = 200;
+  StabilityScanOptions options;
+  options.steps = 20000;
+  options.from = 0.9;
+  options.to = 1.2;
+  options.points = 7;
+
+  SceneConfig sticking = config;
+  sticking.material.particle.friction = 10.0;
+  const StabilityScanResult s =
+      stability_scan(sticking, consolidate(sticking, make_assembly(sticking)), options);
+  expect_sharp_limit(s);
+  EXPECT_NEAR(s.ratio(), 1.0, 0.03);
+  EXPECT_EQ(beyond_estimate_caveat(s), "");
+
+  const StabilityScanResult r =
+      stability_scan(config, consolidate(config, make_assembly(config)), options);
+  ASSERT_GT(r.ratio(), 1.03);  // the rattle the checks miss (measured 1.093)
+  EXPECT_NE(stability_markdown(r, "poly200").find(beyond_estimate_caveat(r)), std::string::npos);
+  EXPECT_NE(beyond_estimate_caveat(r), "");
 }
 
 }  // namespace

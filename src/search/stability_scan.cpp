@@ -146,6 +146,14 @@ nlohmann::json to_json(const StabilityScanResult& r) {
   return j;
 }
 
+std::string beyond_estimate_caveat(const StabilityScanResult& r) {
+  if (!(r.ratio() > 1.03)) return "";
+  return "Caution: the runs between the estimate and this limit did not blow up, but they need "
+         "not be stable: past the estimate an unstable mode can stay bounded by sliding contacts, "
+         "a local rattle the kernel's checks (overlap, kinetic energy, energy ledger) do not see "
+         "(with friction 10 such a sample's limit is the estimate). Use the estimate as the limit.";
+}
+
 std::string stability_markdown(const StabilityScanResult& r, const std::string& scene) {
   std::ostringstream s;
   s.precision(4);
@@ -162,6 +170,7 @@ std::string stability_markdown(const StabilityScanResult& r, const std::string& 
     s << "Every rung diverged: the limit is below the first one (lower --from).\n\n";
   else
     s << "No rung diverged: the limit is above the last one (raise --to).\n\n";
+  if (const std::string caveat = beyond_estimate_caveat(r); !caveat.empty()) s << caveat << "\n\n";
   if (r.stable_above_limit > 0)
     s << "Warning: " << r.stable_above_limit
       << " rung(s) above the first diverged one ran to the end.\n\n";
