@@ -4,8 +4,10 @@
 // params.json (spheres, triaxial test) gives the 3D deck of its prototype.
 #include <algorithm>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <thread>
+#include <vector>
 
 #include "commands.hpp"
 #include "consolidation_progress.hpp"
@@ -37,8 +39,65 @@ namespace {
 
 namespace fs = std::filesystem;
 
+/// Whether `file` is a deck demcal exported (its opening says so).
+bool is_exported_deck(const fs::path& file) {
+  std::ifstream in(file);
+  std::string first, second;
+  return std::getline(in, first) && std::getline(in, second) && first.rfind("# ===", 0) == 0 &&
+         second.rfind("# demcal ", 0) == 0 && second.find(" export: ") != std::string::npos;
+}
+
+/// Whether a deck's text names `file` as a word (read_data FILE, mesh file
+/// FILE, the header's "(FILE)").
+bool names_file(const std::string& text, const std::string& file) {
+  auto delimits = [](char c) {
+    return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '"' || c == '\'' || c == '(' ||
+           c == ')';
+  };
+  for (size_t at = text.find(file); at != std::string::npos; at = text.find(file, at + 1)) {
+    const size_t end = at + file.size();
+    if ((at == 0 || delimits(text[at - 1])) && (end == text.size() || delimits(text[end])))
+      return true;
+  }
+  return false;
+}
+
+/// An export never overwrites another deck's files: the files it writes in
+/// `dir` (the deck `deck` and `sides`, the files it reads) must be neither
+/// an earlier export's deck other than `deck` nor a file such a deck reads
+/// (a deck named FILE.data, or a deck of an older demcal naming its data
+/// file after the deck's stem). Re-exporting a deck replaces it and its
+/// own files. InputError (exit 2) naming the other deck.
+void check_other_decks(const fs::path& dir, const std::string& deck,
+                       const std::vector<std::string>& sides) {
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) return;
+  for (const fs::directory_entry& e : fs::directory_iterator(dir, ec)) {
+    const std::string other = e.path().filename().string();
+    if (other == deck || !e.is_regular_file(ec) || e.file_size(ec) > (16u << 20) ||
+        !is_exported_deck(e.path()))
+      continue;
+    if (std::find(sides.begin(), sides.end(), other) != sides.end())
+      throw InputError(e.path().string(), "",
+                       "an exported deck, which the deck " + deck +
+                           " would overwrite with a file it reads; export to another name (-o)");
+    const std::string text = read_text_file(e.path().string());
+    std::vector<std::string> ours = sides;
+    ours.push_back(deck);
+    for (const std::string& name : ours)
+      if (names_file(text, name))
+        throw InputError(e.path().string(), "",
+                         "this exported deck reads " + name + ", which exporting " + deck +
+                             " would overwrite; export to another name (-o), or move that deck "
+                             "and its files elsewhere first");
+  }
+}
+
 /// Where the deck goes: -o FILE or demcal-NAME.FORMAT, checked writable now
-/// (not after a consolidation); the data file is named after the deck.
+/// (not after a consolidation). The files it reads are named after the whole
+/// deck file name (NAME.lammps.data, NAME.liggghts.data, NAME.liggghts-top.stl),
+/// so two decks in one folder never share one; check_other_decks refuses
+/// what would overwrite another deck's files.
 fs::path deck_destination(const ExportCmdOptions& o, const SceneConfig& config, ExportOptions& eo) {
   if (o.format != "lammps" && o.format != "liggghts")
     throw InputError("--format", "", "must be lammps or liggghts, got \"" + o.format + "\"");
@@ -47,9 +106,9 @@ fs::path deck_destination(const ExportCmdOptions& o, const SceneConfig& config, 
     throw InputError(deck_fs.string(), "", "is a folder; give a file name");
   OutputFolder::check(deck_fs.has_parent_path() ? deck_fs.parent_path().string() : ".");
   eo.format = o.format;
-  const std::string ext = deck_fs.extension().string();
-  const bool known = ext == ".lammps" || ext == ".liggghts" || ext == ".in" || ext == ".lmp";
-  eo.data_name = (known ? deck_fs.stem() : deck_fs.filename()).string() + ".data";
+  eo.data_name = deck_fs.filename().string() + ".data";
+  check_other_decks(deck_fs.has_parent_path() ? deck_fs.parent_path() : fs::path("."),
+                    deck_fs.filename().string(), {eo.data_name});
   return deck_fs;
 }
 
@@ -58,6 +117,9 @@ fs::path deck_destination(const ExportCmdOptions& o, const SceneConfig& config, 
 void write_deck(const fs::path& deck_fs, const ExportCmdOptions& o, const ExportResult& r,
                 int particles, const char* what) {
   const fs::path dir = deck_fs.has_parent_path() ? deck_fs.parent_path() : fs::path(".");
+  std::vector<std::string> sides;
+  for (const auto& file : r.files) sides.push_back(file.first);
+  check_other_decks(dir, deck_fs.filename().string(), sides);
   {
     OutputFolder out(dir.string());
     for (const auto& [name, content] : r.files) out.write(name, content);

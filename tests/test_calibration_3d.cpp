@@ -279,7 +279,7 @@ TEST(Calibration3D, ExportWritesTheRevsDeckAndAnUpscaledPrototypesDeck) {
       test::run_demcal({"export", params, "-o", deck.string()}, dir.path());
   ASSERT_EQ(exported.status, 0) << exported.err;
   ASSERT_TRUE(fs::exists(deck));
-  ASSERT_TRUE(fs::exists(dir / "deck" / "fcc.data"));
+  ASSERT_TRUE(fs::exists(dir / "deck" / "fcc.lammps.data"));
   EXPECT_NE(exported.out.find("32 spheres"), std::string::npos) << exported.out;
 
   // A larger prototype (FCC 3x3x3, 108 spheres): the lattice resized, Nstep

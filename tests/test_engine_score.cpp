@@ -17,6 +17,7 @@
 #include <nlohmann/json.hpp>
 #include <regex>
 #include <sstream>
+#include <utility>
 
 #include "demcal/kernel/particle_scales.hpp"
 #include "demcal/scene/biaxial.hpp"
@@ -773,6 +774,24 @@ void expect_the_split_run_continues_the_test(const std::string& lmp, double zeta
   const ExternalSeries a = parse_external_series(whole, "whole.csv");
   const ExternalSeries b = parse_external_series(split, "split.csv");
   ASSERT_EQ(a.run.series.size(), b.run.series.size());
+  // The text itself, as other readers see it: one column header, and the
+  // continuation appends rows only (after a comment line), each step once.
+  auto headers_and_steps = [](const std::string& csv) {
+    std::istringstream lines(csv);
+    int headers = 0;
+    std::vector<std::string> steps;
+    for (std::string line; std::getline(lines, line);) {
+      if (line.empty() || line[0] == '#') continue;
+      if (line.rfind("step,", 0) == 0)
+        ++headers;
+      else
+        steps.push_back(line.substr(0, line.find(',')));
+    }
+    return std::make_pair(headers, steps);
+  };
+  EXPECT_EQ(headers_and_steps(split).first, 1) << "column header lines in the split series";
+  EXPECT_EQ(headers_and_steps(split).second, headers_and_steps(whole).second)
+      << "the split series' steps, row by row";
   const double s3 = c.test.lateral_stress;
   size_t same_rows = 0;
   double worst_stress = 0.0, worst_wall = 0.0, worst_ke = 0.0;

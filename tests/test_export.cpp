@@ -608,5 +608,86 @@ TEST(ExportCli, ConsolidateInChoosesWhereAndRejectsBadCombinations) {
   EXPECT_FALSE(fs::exists(dir.path() / "c"));
 }
 
+TEST(ExportCli, TwoDecksInOneFolderReadTheirOwnFiles) {
+  // Both formats exported into one folder with their default names: each
+  // deck reads files named after its whole file name, the same bytes as
+  // when exported alone (before: both wrote demcal-NAME.data, and the
+  // LAMMPS data file's one atom type broke the LIGGGHTS deck's walls).
+  // An export that would overwrite a file another deck reads is refused.
+  const test::TempDir dir("export_two_decks");
+  const std::string params =
+      (fs::path(test::shipped_config("hex_5x5")).parent_path().parent_path() / "reports" /
+       "example-hex_10x10" / "params.json")
+          .string();
+  auto run = [&](std::vector<std::string> args, const fs::path& where) {
+    args.insert(args.begin(), {"export", params, "--particles", "25"});
+    return test::run_demcal(args, where);
+  };
+  const fs::path alone = dir / "alone", both = dir / "both";
+  fs::create_directories(alone);
+  fs::create_directories(both);
+  ASSERT_EQ(run({"--format", "liggghts"}, alone).status, 0);
+  const auto liggghts = run({"--format", "liggghts"}, both);
+  ASSERT_EQ(liggghts.status, 0) << liggghts.err;
+  const auto lammps = run({"--consolidate-in", "deck"}, both);
+  ASSERT_EQ(lammps.status, 0) << lammps.err;
+  const std::string l_deck = "demcal-hex_10x10.liggghts", m_deck = "demcal-hex_10x10.lammps";
+  const std::string l_text = test::read_text(both / l_deck),
+                    m_text = test::read_text(both / m_deck);
+  // the files each deck reads: read_data FILE, mesh ... file FILE
+  auto read_by = [](const std::string& deck) {
+    std::vector<std::string> names;
+    std::istringstream lines(deck);
+    for (std::string line; std::getline(lines, line);) {
+      if (line.rfind('#', 0) == 0) continue;
+      std::istringstream words(line);
+      for (std::string w, last; words >> w; last = w)
+        if ((last == "read_data" || last == "\"read_data" || last == "file") && w[0] != '$')
+          names.push_back(w.substr(0, w.find('"')));
+    }
+    return names;
+  };
+  const std::vector<std::string> l_files = read_by(l_text), m_files = read_by(m_text);
+  ASSERT_EQ(l_files.size(), 4u) << l_text;  // the data file and three meshes
+  ASSERT_FALSE(m_files.empty());
+  for (const std::string& f : l_files) {
+    EXPECT_EQ(f.rfind(l_deck, 0), 0u) << f;
+    EXPECT_EQ(test::read_text(both / f), test::read_text(alone / f)) << f;
+  }
+  for (const std::string& f : m_files) {
+    EXPECT_EQ(f.rfind(m_deck, 0), 0u) << f;
+    EXPECT_TRUE(fs::exists(both / f)) << f;
+  }
+  EXPECT_EQ(test::read_text(both / l_deck), test::read_text(alone / l_deck));
+
+  // A deck named as another deck's data file: refused, nothing written.
+  const std::string m_data = m_deck + ".data";
+  const std::string before = test::read_text(both / m_data);
+  const auto clash = run({"--format", "liggghts", "-o", m_data}, both);
+  EXPECT_EQ(clash.status, 2) << clash.err;
+  EXPECT_NE(clash.err.find(m_deck), std::string::npos) << clash.err;
+  EXPECT_EQ(test::read_text(both / m_data), before);
+  EXPECT_FALSE(fs::exists(both / (m_data + ".data")));
+  // A deck of an older demcal that names its data file after its stem
+  // (old.lammps reads old.data): exporting `old` (data old.data) is refused.
+  std::string old_deck = m_text;
+  for (size_t at; (at = old_deck.find(m_data)) != std::string::npos;)
+    old_deck.replace(at, m_data.size(), "old.data");
+  test::write_text(both / "old.lammps", old_deck);
+  test::write_text(both / "old.data", "the old deck's particles");
+  EXPECT_EQ(run({"-o", "old"}, both).status, 2);
+  EXPECT_EQ(test::read_text(both / "old.data"), "the old deck's particles");
+  // Exporting a deck again replaces it and its own files.
+  EXPECT_EQ(run({"--consolidate-in", "deck"}, both).status, 0);
+  EXPECT_EQ(test::read_text(both / m_deck), m_text);
+
+  // The LIGGGHTS deck runs beside the LAMMPS one (3.8 needs a screen).
+  DEMCAL_FIND_PROGRAM(liggghts_program, "liggghts", "liggghts", "the deck is not run");
+  const test::RunResult ran = test::run_program(
+      liggghts_program, {"-var", "run_steps", "50", "-in", l_deck, "-log", "log.liggghts"}, both);
+  EXPECT_EQ(ran.status, 0) << test::read_text(both / "log.liggghts");
+  EXPECT_EQ(test::read_text(both / "log.liggghts").find("ERROR"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace demcal

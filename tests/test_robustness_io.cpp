@@ -287,7 +287,7 @@ TEST_F(RobustIo, ExportReplacesDeckAndDataTogetherOrNotAtAll) {
   const fs::path out = disk / "out";
   fs::create_directories(out);
   std::ofstream(out / "deck.lammps") << "old deck";
-  std::ofstream(out / "deck.data") << "old data";
+  std::ofstream(out / "deck.lammps.data") << "old data";
   std::ofstream(out / "keep.txt") << "mine";
   fill_disk(disk);
   // Room for the data file (6 kB) but not the deck (17 kB) as well: written
@@ -299,14 +299,14 @@ TEST_F(RobustIo, ExportReplacesDeckAndDataTogetherOrNotAtAll) {
   EXPECT_NE(full.status, 0);
   EXPECT_NE(full.err.find("No space left on device"), std::string::npos) << full.err;
   EXPECT_EQ(read_text(out / "deck.lammps"), "old deck");
-  EXPECT_EQ(read_text(out / "deck.data"), "old data");
+  EXPECT_EQ(read_text(out / "deck.lammps.data"), "old data");
   EXPECT_EQ(names_in(out).size(), 3u);
 
   fs::remove(disk / "filler");
   const Result r = run_demcal(args, dir_);
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(read_text(out / "deck.lammps").find("read_data"), std::string::npos);
-  EXPECT_NE(read_text(out / "deck.data"), "old data");
+  EXPECT_NE(read_text(out / "deck.lammps.data"), "old data");
   EXPECT_EQ(read_text(out / "keep.txt"), "mine");
   EXPECT_EQ(names_in(out).size(), 3u);
   ::umount(disk.c_str());

@@ -249,9 +249,17 @@ std::string lammps_series_block(const SceneConfig& c, const AlgorithmSpec& p, co
     << "if              \"${continued} != 0\" then \"jump SELF series_rows\"\n"
     << deck::lammps_series_header("LAMMPS deck", c.name, plan.n, p.damping_ratio_translation,
                                   plan.dt_crit, p.mass_scaling)
-    << "label           series_rows\n"
     << "fix             series all print ${monitor_every} \"" << row
-    << "\" append ${series} screen no title \"" << kColumns << "\"\n\n";
+    << "\" append ${series} screen no title \"" << kColumns << "\"\n"
+    << "jump            SELF series_done\n"
+    << "label           series_rows\n"
+    << "# a continuation: its rows from the next monitoring step on (the first part\n"
+    << "# wrote the row of the step it ended at), after a comment line instead of the\n"
+    << "# column header (fix print always opens its file with a title line)\n"
+    << "variable        series_next equal (floor(step/v_monitor_every)+1)*v_monitor_every\n"
+    << "fix             series all print v_series_next \"" << row
+    << "\" append ${series} screen no title \"# continued from a restart: the rows go on\"\n"
+    << "label           series_done\n\n";
   return s.str();
 }
 
