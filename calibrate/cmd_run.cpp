@@ -51,11 +51,6 @@ void print_scales(const SceneConfig& config, const World& world) {
 
 }  // namespace
 
-namespace {
-
-/// A prescribed Δt beyond `stable` (the dt_ratio estimated from the
-/// consolidated contact network, 2D or 3D) is bad input: the run would
-/// diverge or rattle, unless asked for.
 void require_stable_step(const SceneConfig& config, double stable, bool allow_unstable) {
   if (allow_unstable || config.algorithm.dt_ratio <= stable) return;
   std::ostringstream s;
@@ -66,8 +61,6 @@ void require_stable_step(const SceneConfig& config, double stable, bool allow_un
     << "`demcal run --allow-unstable` runs it anyway)";
   throw InputError(config.source, "algorithm.dt_ratio", s.str());
 }
-
-}  // namespace
 
 namespace {
 

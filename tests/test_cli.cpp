@@ -475,13 +475,19 @@ TEST_F(CliEndToEnd, FailedConsolidationExitsOneAndWritesNothing) {
 
 // A diverged trial is a result, not a crash: written, flagged, exit 0.
 // A Δt beyond the estimated stable step is bad input for `run` and
-// `check` (issue #9 §1), named with the estimate.
+// `check` (issue #9 §1), named with the estimate; for `sweep` too, whose
+// benchmark is the config's algorithm block (it wrote an atlas around a
+// diverging benchmark).
 TEST_F(CliEndToEnd, DtBeyondTheStableStepIsBadInput) {
   const std::string out = (dir_ / "work" / "out").string();
   expect_bad_input({"run", kHex5, "--set", "algorithm.dt_ratio=0.4", "-o", out},
                    {kHex5, "algorithm.dt_ratio", "0.4", "stable step", "0.30"});
   expect_bad_input({"check", kHex5, "--set", "algorithm.dt_ratio=0.4"},
                    {kHex5, "algorithm.dt_ratio"});
+  expect_bad_input({"sweep", kHex5, "--set", "algorithm.dt_ratio=0.4", "-o", out},
+                   {kHex5, "algorithm.dt_ratio", "0.4", "stable step", "0.30"});
+  expect_bad_input({"sweep", kHex5, "--set", "algorithm.dt_ratio=0.4"},
+                   {kHex5, "algorithm.dt_ratio"});  // nor the default folder
 }
 
 TEST_F(CliEndToEnd, DivergedRunIsReportedNotFatal) {
