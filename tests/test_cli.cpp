@@ -460,6 +460,35 @@ TEST_F(CliEndToEnd, RunIntoAnExistingFolderAndWithoutVtk) {
   test::expect_run_status(d.status, dir_ / "work" / "demcal-run-tiny", d.err);
 }
 
+// A calibration into a folder of an earlier one: the files it names on its
+// "wrote" line are all it leaves of demcal's (every one it writes is named,
+// resume.json too), so an earlier run's final.vtk (a 3D report's, beside a
+// 2D one) does not survive looking like this run's; the user's own files
+// stay.
+TEST_F(CliEndToEnd, CalibrateNamesWhatItWroteAndLeavesNoEarlierResult) {
+  const fs::path out = dir_ / "work" / "out";
+  fs::create_directories(out);
+  std::ofstream(out / "final.vtk") << "an earlier 3D calibration's\n";
+  std::ofstream(out / "evidence.jsonl") << "{}\n";
+  std::ofstream(out / "keep.txt") << "mine\n";
+  const Result r =
+      demcal({"calibrate", kHex5, "-o", out.string(), "-q", "-j", "1", "--max-trials", "8"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::set<std::string> named{"keep.txt"};
+  for (const std::string& line : lines_of(r.out)) {
+    const auto at = line.find("  wrote ");
+    if (at != 0) continue;
+    for (std::string path : split(line.substr(8), ',')) {
+      if (path.front() == ' ') path.erase(0, 1);
+      EXPECT_EQ(path.rfind(out.string() + "/", 0), 0u) << path;
+      named.insert(fs::path(path).filename().string());
+    }
+  }
+  EXPECT_TRUE(named.count("resume.json")) << r.out;
+  EXPECT_EQ(test::names_in(out), named) << r.out;
+  EXPECT_FALSE(fs::exists(out / "final.vtk"));
+}
+
 // A computation that fails (consolidation gives up) is not bad input: exit
 // 1, one line, and again nothing written.
 TEST_F(CliEndToEnd, FailedConsolidationExitsOneAndWritesNothing) {
