@@ -1,8 +1,10 @@
 // `demcal sweep CONFIG [--jobs N] [-o DIR]`: the signature atlas
 // (demcal/search/sweep.hpp; reports/signature-atlas.md), on a 2D or a 3D scene. The config's
 // algorithm block is the benchmark; every other case changes one parameter.
+#include <filesystem>
 #include <iomanip>
 #include <iostream>
+#include <set>
 #include <sstream>
 
 #include "commands.hpp"
@@ -62,8 +64,19 @@ int cmd_sweep(const SweepOptions& options) {
 
   {
     OutputFolder out(dir);  // all files replaced together, or none
-    for (const auto& r : result.cases)
+    std::set<std::string> written;
+    for (const auto& r : result.cases) {
       out.write("series/" + r.spec.name + ".csv", r.run.series_csv);
+      written.insert(r.spec.name + ".csv");
+    }
+    // An earlier sweep's series that this one does not write (the alpha
+    // scan's names follow the estimated stable step) would pass for this
+    // sweep's cases: they go with the rest.
+    std::error_code ec;
+    for (const auto& e : std::filesystem::directory_iterator(dir + "/series", ec))
+      if (e.is_regular_file() && e.path().extension() == ".csv" &&
+          !written.count(e.path().filename().string()))
+        out.retire("series/" + e.path().filename().string());
     out.write("evidence.csv", evidence_csv(result));
     nlohmann::json j = to_json(result);
     j["config_sha256"] = sha256_hex(config.text);
