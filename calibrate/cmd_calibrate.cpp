@@ -248,10 +248,14 @@ void ready_output_folder(const CalibrateOptions& o, const Invocation& v) {
     write_resume_key(dir, v.key);
   }
   // Results of an earlier run in this folder would not match the trials
-  // from here on; they are rewritten at the end.
-  for (const char* name : {"params.json", "run.json", "report.html", "report.md", "evidence.jsonl"})
+  // from here on: every file a calibration writes at the end goes, whether
+  // or not this one writes it again (final.vtk of a 3D report stayed beside
+  // a 2D one). Not a refusal of a non-empty folder: --resume and a
+  // recalibration into the same -o are how the folder is meant to be used,
+  // and the user's own files in it stay.
+  for (const char* name :
+       {"params.json", "run.json", "report.html", "report.md", "evidence.jsonl", "final.vtk"})
     std::filesystem::remove(dir + "/" + name);
-  if (v.three_d) std::filesystem::remove(dir + "/final.vtk");  // the 3D report's
 }
 
 /// The --evidence runs: the paper's recipe done mechanically (α = 0.2,
@@ -481,7 +485,7 @@ int cmd_calibrate(const CalibrateOptions& o) {
                                                std::move(evidence), jobs, std::move(known));
   write_file_atomic(dir + "/run.json", run_json());
   std::cout << summary.BriefReport() << "  wrote " << dir << "/params.json, " << dir
-            << "/run.json, " << dir << "/trials.jsonl" << report_note
+            << "/run.json, " << dir << "/trials.jsonl, " << dir << "/resume.json" << report_note
             << (evidence_runs ? ", " + dir + "/evidence.jsonl" : "") << "\n";
   if (stop.stopped()) {
     std::cerr << "demcal: interrupted after the last run; every output was written\n";

@@ -51,11 +51,6 @@ void print_scales(const SceneConfig& config, const World& world) {
 
 }  // namespace
 
-namespace {
-
-/// A prescribed Δt beyond `stable` (the dt_ratio estimated from the
-/// consolidated contact network, 2D or 3D) is bad input: the run would
-/// diverge or rattle, unless asked for.
 void require_stable_step(const SceneConfig& config, double stable, bool allow_unstable) {
   if (allow_unstable || config.algorithm.dt_ratio <= stable) return;
   std::ostringstream s;
@@ -65,6 +60,35 @@ void require_stable_step(const SceneConfig& config, double stable, bool allow_un
     << (config.dimension == 2 ? "`demcal stability` measures the limit, " : "")
     << "`demcal run --allow-unstable` runs it anyway)";
   throw InputError(config.source, "algorithm.dt_ratio", s.str());
+}
+
+namespace {
+
+/// "3000 steps"; a run that did not run them all: "143 of 3000 steps
+/// (diverged)".
+template <class Point>
+std::string steps_words(const LoadingRun<Point>& run) {
+  std::ostringstream s;
+  s << run.steps_run;
+  if (run.diverged || run.steps_run != run.steps_planned) s << " of " << run.steps_planned;
+  s << " steps";
+  if (run.diverged) s << " (diverged)";
+  return s.str();
+}
+
+/// A diverged run's criteria are not scored (its verdict is FAIL whatever
+/// they read): the trend ones (force balance, servo) need a window of
+/// monitoring points it did not reach and read 0. 2D: the RMS lateral
+/// force balance and servo error over the points it did reach, as a clue.
+template <class Point>
+void print_unscored_criteria(const LoadingRun<Point>& run, const Criteria& c, bool rms) {
+  std::cout << std::setprecision(4) << "  criteria not scored: the run diverged at step "
+            << run.divergence_step << " of " << run.steps_planned << ", after " << c.points
+            << (c.points == 1 ? " monitoring point" : " monitoring points");
+  if (rms)
+    std::cout << " (over them: lateral force balance RMS " << c.force_balance_xx_rms
+              << ", servo RMS " << c.servo_rms << ")";
+  std::cout << "\n";
 }
 
 }  // namespace
@@ -143,22 +167,26 @@ int run_3d(const SceneConfig& config, const std::string& out_dir, bool allow_uns
   }
   const Criteria& m = score.criteria;
   std::cout << std::setprecision(4) << "scene " << config.name
-            << " (3D, triaxial): " << run.particles << " spheres, " << run.steps_run
-            << " steps, dt " << run.integration.dt << " s\n"
+            << " (3D, triaxial): " << run.particles << " spheres, " << steps_words(run) << ", dt "
+            << run.integration.dt << " s\n"
             << "  peak sigma_zz " << run.peak_stress_zz << " Pa at strain " << run.peak_strain_zz
             << " (sigma1/sigma3 " << -run.peak_stress_zz / s3 << "; against the lateral wall "
             << "stress " << run.peak_ratio << ")\n";
   if (auto a = analytical_peak_ratio_3d(config))
     std::cout << "  analytical (walled FCC, Thornton, rotation locked) sigma1/sigma3 " << *a
               << "\n";
-  print_triaxial_criteria(std::cout, c, score.criteria);
+  if (run.diverged)
+    print_unscored_criteria(run, m, false);
+  else
+    print_triaxial_criteria(std::cout, c, score.criteria);
   std::cout << "  kinetic/elastic energy max " << m.kinetic_energy_ratio_max
             << ", unbalanced-force ratio mean " << m.unbalanced_force_ratio_mean
-            << ", inertial number max " << m.inertial_number_max << "\n"
-            << "  " << (within ? "WITHIN" : "OUTSIDE") << " the 3D default tolerances"
-            << (within ? "" : " (worst: " + summary["verdict"]["worst"].get<std::string>() + ")")
-            << ". " << kTriaxialVerdictNote << "\n"
-            << "  " << (within ? "PASS" : "FAIL") << ": " << score.diagnosis.message << "\n"
+            << ", inertial number max " << m.inertial_number_max << "\n";
+  if (!run.diverged)  // a diverged run's criteria are not scored: no worst one
+    std::cout << "  " << (within ? "WITHIN" : "OUTSIDE") << " the 3D default tolerances"
+              << (within ? "" : " (worst: " + summary["verdict"]["worst"].get<std::string>() + ")")
+              << ". " << kTriaxialVerdictNote << "\n";
+  std::cout << "  " << (within ? "PASS" : "FAIL") << ": " << score.diagnosis.message << "\n"
             << "  wall time " << run.wall_time_s << " s (consolidation " << state.wall_time_s
             << " s, " << state.steps << " steps" << (state.from_cache ? ", from the cache" : "")
             << "), " << summary["particle_steps_per_s"].get<double>() << " particle-steps/s\n"
@@ -167,7 +195,7 @@ int run_3d(const SceneConfig& config, const std::string& out_dir, bool allow_uns
   if (run.diverged)
     std::cout << "  DIVERGED at step " << run.divergence_step << ": " << to_string(run.divergence)
               << "\n";
-  return 0;
+  return score.passed ? 0 : 1;  // as `demcal score` judges the run's series.csv
 }
 
 }  // namespace
@@ -232,16 +260,19 @@ int cmd_run(const std::string& path, const std::vector<std::string>& sets,
 
   const auto& c = score.criteria;
   std::cout << std::setprecision(4) << "scene " << config.name << ": " << run.particles
-            << " particles, " << run.steps_run << " steps, dt " << run.integration.dt << " s\n"
+            << " particles, " << steps_words(run) << ", dt " << run.integration.dt << " s\n"
             << "  peak sigma_yy " << c.peak_stress_yy << " Pa at strain " << c.peak_strain_yy
             << " (sigma1/sigma3 " << -c.peak_stress_yy / config.test.lateral_stress << ")\n";
   if (auto a = analytical_peak_stress(config))
     std::cout << "  analytical (walled, rotation locked) sigma1/sigma3 "
               << -*a / config.test.lateral_stress << "\n";
-  std::cout << "  force balance " << c.force_balance << " (paper form " << c.force_balance_paper
-            << "), moment balance " << c.moment_balance << ", servo " << c.servo << ", oscillation "
-            << c.oscillation << "\n"
-            << "  " << (score.passed ? "PASS" : "FAIL") << ": " << score.diagnosis.message << "\n"
+  if (run.diverged)
+    print_unscored_criteria(run, c, true);
+  else
+    std::cout << "  force balance " << c.force_balance << " (paper form " << c.force_balance_paper
+              << "), moment balance " << c.moment_balance << ", servo " << c.servo
+              << ", oscillation " << c.oscillation << "\n";
+  std::cout << "  " << (score.passed ? "PASS" : "FAIL") << ": " << score.diagnosis.message << "\n"
             << "  wall time " << run.wall_time_s << " s, "
             << summary["particle_steps_per_s"].get<double>() << " particle-steps/s\n"
             << "  wrote " << dir << "/summary.json, series.csv"
@@ -249,7 +280,9 @@ int cmd_run(const std::string& path, const std::vector<std::string>& sets,
   if (run.diverged)
     std::cout << "  DIVERGED at step " << run.divergence_step << ": " << to_string(run.divergence)
               << "\n";
-  return 0;
+  // Exit 1 on FAIL (a diverged run fails), as `demcal score` judges the
+  // run's series.csv; the files are written either way.
+  return score.passed ? 0 : 1;
 }
 
 }  // namespace demcal::cli

@@ -27,7 +27,8 @@ int cmd_scaling(const ScalingOptions& o) {
   if (!o.quiet)
     so.log = [](const std::string& line) { std::cerr << "demcal scaling: " << line << "\n"; };
   check_scaling_sizes(so);  // bad sizes fail before any folder is made
-  const std::string out_dir = o.out_dir.empty() ? "reports" : o.out_dir;
+  // Not "reports": run from the repository it overwrote the shipped study.
+  const std::string out_dir = o.out_dir.empty() ? "demcal-scaling-" + config.name : o.out_dir;
   OutputFolder::check(out_dir);  // an unwritable -o fails now, not after the study
   // What the work folder's results (per size: calibration, fixed-multiplier
   // runs, references, consolidated samples) were made with: --resume reuses

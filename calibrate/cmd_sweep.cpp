@@ -1,11 +1,14 @@
 // `demcal sweep CONFIG [--jobs N] [-o DIR]`: the signature atlas
 // (demcal/search/sweep.hpp; reports/signature-atlas.md), on a 2D or a 3D scene. The config's
 // algorithm block is the benchmark; every other case changes one parameter.
+#include <filesystem>
 #include <iomanip>
 #include <iostream>
+#include <set>
 #include <sstream>
 
 #include "commands.hpp"
+#include "consolidation_progress.hpp"
 #include "demcal/io/files.hpp"
 #include "demcal/scene/biaxial.hpp"
 #include "demcal/scene/packing.hpp"
@@ -31,32 +34,49 @@ int cmd_sweep(const SweepOptions& options) {
     std::cerr << "  [" << k << "/" << n << "] " << name << " (" << std::fixed
               << std::setprecision(1) << seconds << " s)\n";
   };
-  // The consolidated state, once; the cases around the config's algorithm block.
-  auto sweep = [&](const auto& state, double alpha_stable) {
+  // The consolidated state, once (progress lines only when it is slow, as
+  // for `demcal run`: bad input stays one line); the cases around the
+  // config's algorithm block.
+  auto sweep = [&](const auto& state, double alpha_stable, const char* what) {
+    // The benchmark is the config's algorithm block as given: past the
+    // stable step it is bad input, as for `demcal run` (the atlas's own
+    // cases beyond it are meant).
+    require_stable_step(config, estimated_stable_dt_ratio(state, config.algorithm), false);
     const std::vector<SweepCase> cases = atlas_cases(config.algorithm, alpha_stable);
-    std::cerr << "  " << cases.size() << " trials, benchmark Nstep " << config.algorithm.steps
+    std::cerr << "sweep " << config.name << ": " << state.world.size() << " " << what
+              << " consolidated (once" << (state.from_cache ? ", from the cache" : "") << "); "
+              << cases.size() << " trials, benchmark Nstep " << config.algorithm.steps
               << ", alpha_stable " << std::setprecision(3) << alpha_stable << "\n";
     return run_sweep(config, state, cases, settings);
   };
   SweepResult result;
   if (three_d) {
     const SphereAssembly assembly = make_sphere_assembly(config);
-    std::cerr << "sweep " << config.name << ": consolidating " << assembly.size()
-              << " spheres (once; 3D, triaxial)\n";
-    const TriaxialState state = consolidate_triaxial(config, assembly);
-    result = sweep(state, estimated_stable_dt_ratio(state, config.algorithm));
+    const TriaxialState state = consolidate_triaxial(config, assembly, consolidation_progress());
+    result =
+        sweep(state, estimated_stable_dt_ratio(state, config.algorithm), "spheres (3D, triaxial)");
   } else {
     Assembly assembly = make_assembly(config);
-    std::cerr << "sweep " << config.name << ": consolidating " << assembly.r.size()
-              << " particles (once)\n";
-    const ConsolidatedState state = consolidate(config, assembly);
-    result = sweep(state, state.world.stability_estimate().dt_ratio_stable);
+    const ConsolidatedState state =
+        consolidate(config, assembly, ConsolidationOptions{.progress = consolidation_progress()});
+    result = sweep(state, state.world.stability_estimate().dt_ratio_stable, "particles");
   }
 
   {
     OutputFolder out(dir);  // all files replaced together, or none
-    for (const auto& r : result.cases)
+    std::set<std::string> written;
+    for (const auto& r : result.cases) {
       out.write("series/" + r.spec.name + ".csv", r.run.series_csv);
+      written.insert(r.spec.name + ".csv");
+    }
+    // An earlier sweep's series that this one does not write (the alpha
+    // scan's names follow the estimated stable step) would pass for this
+    // sweep's cases: they go with the rest.
+    std::error_code ec;
+    for (const auto& e : std::filesystem::directory_iterator(dir + "/series", ec))
+      if (e.is_regular_file() && e.path().extension() == ".csv" &&
+          !written.count(e.path().filename().string()))
+        out.retire("series/" + e.path().filename().string());
     out.write("evidence.csv", evidence_csv(result));
     nlohmann::json j = to_json(result);
     j["config_sha256"] = sha256_hex(config.text);

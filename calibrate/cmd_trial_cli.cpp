@@ -40,7 +40,9 @@ void add_calibrate_options(CLI::App* calibrate, CalibrateOptions& cal) {
       ->check(whole_number(1, kMaxJobs));
   calibrate->add_option("--max-trials", cal.max_trials, "search trials (default: config, 80)")
       ->check(whole_number(1, kMaxTrials));
-  calibrate->add_option("--accuracy", cal.accuracy, "peak accuracy target (default 0.02)")
+  calibrate
+      ->add_option("--accuracy", cal.accuracy,
+                   "peak accuracy target (default: the config's calibration.accuracy, 0.02)")
       ->check(real_between(0.0, 1.0));
   calibrate->add_option("--strategy", cal.strategy, "search strategy: " + strategy_names());
   calibrate->add_flag("--resume", cal.resume, "continue from DIR/trials.jsonl");

@@ -15,6 +15,16 @@ class App;
 
 namespace demcal::cli {
 
+/// The config's Δt (algorithm.dt_ratio) against `stable`, the dt_ratio
+/// estimated from the consolidated contact network (estimated_stable_dt_ratio,
+/// 2D or 3D): beyond it is bad input (InputError naming the key, exit 2), as
+/// the run would diverge or rattle, unless `allow_unstable`. Checked by every
+/// command that runs the config's algorithm block as given: check, run and
+/// sweep (its benchmark). Not by stability (it sets its own steps, beyond the
+/// limit on purpose), nor calibrate and scaling (their search starts from
+/// its own Δt, below dt_ratio_max).
+void require_stable_step(const SceneConfig& config, double stable, bool allow_unstable);
+
 int cmd_check(const std::string& path, const std::vector<std::string>& sets);
 /// `allow_unstable`: run a Δt beyond the estimated stable step (otherwise
 /// bad input).

@@ -23,6 +23,7 @@
 #include "support/csv.hpp"
 #include "support/files.hpp"
 #include "support/process.hpp"
+#include "support/run_status.hpp"
 #include "support/scenes.hpp"
 #include "support/vtk.hpp"
 
@@ -326,7 +327,7 @@ void expect_valid_vtk(const std::string& text, int particles, bool contacts = tr
 TEST_F(CliEndToEnd, RunWritesSummarySeriesAndVtk) {
   const fs::path out = dir_ / "work" / "a" / "b";  // parents are made
   const Result r = demcal({"run", kHex5, "--set", "algorithm.steps=2000", "-o", out.string()});
-  ASSERT_EQ(r.status, 0) << r.err;
+  ASSERT_NO_FATAL_FAILURE(test::expect_run_status(r.status, out, r.err));
   EXPECT_NE(r.out.find("peak sigma_yy"), std::string::npos) << r.out;
   // Exactly the three files: no temporary or probe file left behind.
   EXPECT_EQ(test::names_in(out),
@@ -436,7 +437,8 @@ TEST_F(CliEndToEnd, ScoreOnARunsSeriesGivesTheRunsVerdict) {
     const fs::path out = dir_ / "work" / ("run" + std::string(steps).substr(16));
     const Result r =
         demcal({"run", kHex5, "--set", steps, "--set", "output.vtk=false", "-o", out.string()});
-    ASSERT_EQ(r.status, 0) << r.err;
+    ASSERT_NO_FATAL_FAILURE(
+        test::expect_run_status(r.status, out, r.err));  // as `demcal score`'s, below
     const auto ran = nlohmann::json::parse(read_text(out / "summary.json"));
     EXPECT_TRUE(ran.at("criteria").contains("peak_error"));  // against the analytical peak
     seen[ran.at("passed").get<bool>()] = true;
@@ -451,12 +453,40 @@ TEST_F(CliEndToEnd, RunIntoAnExistingFolderAndWithoutVtk) {
   std::ofstream(out / "keep.txt") << "mine\n";
   const Result r = demcal({"run", kHex5, "--set", "algorithm.steps=2000", "--set",
                            "output.vtk=false", "-o", out.string()});
-  ASSERT_EQ(r.status, 0) << r.err;
+  ASSERT_NO_FATAL_FAILURE(test::expect_run_status(r.status, out, r.err));
   EXPECT_EQ(test::names_in(out), (std::set<std::string>{"keep.txt", "summary.json", "series.csv"}));
   // The default folder is demcal-run-NAME in the working directory.
   const Result d = demcal({"run", kHex5, "--set", "algorithm.steps=2000", "--set", "name=tiny"});
-  ASSERT_EQ(d.status, 0) << d.err;
-  EXPECT_TRUE(fs::exists(dir_ / "work" / "demcal-run-tiny" / "summary.json"));
+  test::expect_run_status(d.status, dir_ / "work" / "demcal-run-tiny", d.err);
+}
+
+// A calibration into a folder of an earlier one: the files it names on its
+// "wrote" line are all it leaves of demcal's (every one it writes is named,
+// resume.json too), so an earlier run's final.vtk (a 3D report's, beside a
+// 2D one) does not survive looking like this run's; the user's own files
+// stay.
+TEST_F(CliEndToEnd, CalibrateNamesWhatItWroteAndLeavesNoEarlierResult) {
+  const fs::path out = dir_ / "work" / "out";
+  fs::create_directories(out);
+  std::ofstream(out / "final.vtk") << "an earlier 3D calibration's\n";
+  std::ofstream(out / "evidence.jsonl") << "{}\n";
+  std::ofstream(out / "keep.txt") << "mine\n";
+  const Result r =
+      demcal({"calibrate", kHex5, "-o", out.string(), "-q", "-j", "1", "--max-trials", "8"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::set<std::string> named{"keep.txt"};
+  for (const std::string& line : lines_of(r.out)) {
+    const auto at = line.find("  wrote ");
+    if (at != 0) continue;
+    for (std::string path : split(line.substr(8), ',')) {
+      if (path.front() == ' ') path.erase(0, 1);
+      EXPECT_EQ(path.rfind(out.string() + "/", 0), 0u) << path;
+      named.insert(fs::path(path).filename().string());
+    }
+  }
+  EXPECT_TRUE(named.count("resume.json")) << r.out;
+  EXPECT_EQ(test::names_in(out), named) << r.out;
+  EXPECT_FALSE(fs::exists(out / "final.vtk"));
 }
 
 // A computation that fails (consolidation gives up) is not bad input: exit
@@ -473,24 +503,39 @@ TEST_F(CliEndToEnd, FailedConsolidationExitsOneAndWritesNothing) {
   EXPECT_TRUE(work_contents().empty());
 }
 
-// A diverged trial is a result, not a crash: written, flagged, exit 0.
 // A Δt beyond the estimated stable step is bad input for `run` and
-// `check` (issue #9 §1), named with the estimate.
+// `check` (issue #9 §1), named with the estimate; for `sweep` too, whose
+// benchmark is the config's algorithm block (it wrote an atlas around a
+// diverging benchmark).
 TEST_F(CliEndToEnd, DtBeyondTheStableStepIsBadInput) {
   const std::string out = (dir_ / "work" / "out").string();
   expect_bad_input({"run", kHex5, "--set", "algorithm.dt_ratio=0.4", "-o", out},
                    {kHex5, "algorithm.dt_ratio", "0.4", "stable step", "0.30"});
   expect_bad_input({"check", kHex5, "--set", "algorithm.dt_ratio=0.4"},
                    {kHex5, "algorithm.dt_ratio"});
+  expect_bad_input({"sweep", kHex5, "--set", "algorithm.dt_ratio=0.4", "-o", out},
+                   {kHex5, "algorithm.dt_ratio", "0.4", "stable step", "0.30"});
+  expect_bad_input({"sweep", kHex5, "--set", "algorithm.dt_ratio=0.4"},
+                   {kHex5, "algorithm.dt_ratio"});  // nor the default folder
 }
 
+// A diverged trial is a result, not a crash: written and flagged, and
+// judged as `demcal score` judges its series, FAIL, exit 1. The headline
+// says how far it got against the steps asked, and its criteria (the trend
+// ones read 0 on a few points) are said to be unscored, not printed as a
+// perfect run's.
 TEST_F(CliEndToEnd, DivergedRunIsReportedNotFatal) {
   const fs::path out = dir_ / "work" / "out";
   const Result r = demcal({"run", kHex5, "--allow-unstable", "--set", "algorithm.dt_ratio=1.5",
                            "--set", "algorithm.damping_ratio_translation=0", "--set",
                            "algorithm.damping_ratio_rotation=0", "--set", "algorithm.steps=20000",
                            "-o", out.string()});
-  ASSERT_EQ(r.status, 0) << r.err;
+  ASSERT_EQ(r.status, 1) << r.err;
+  EXPECT_NE(r.out.find(" of 20000 steps (diverged), dt "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("  criteria not scored: the run diverged at step "), std::string::npos)
+      << r.out;
+  EXPECT_EQ(r.out.find("  force balance "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("  FAIL: "), std::string::npos) << r.out;
   const auto s = nlohmann::json::parse(read_text(out / "summary.json"));
   EXPECT_EQ(s.at("diverged"), true);
   EXPECT_TRUE(s.at("divergence").at("reason").is_string());

@@ -20,6 +20,7 @@
 #include "support/csv.hpp"
 #include "support/files.hpp"
 #include "support/process.hpp"
+#include "support/run_status.hpp"
 #include "support/scenes.hpp"
 #include "support/vtk.hpp"
 
@@ -62,7 +63,7 @@ TEST_F(Cli3D, RunWritesSummaryNineComponentSeriesAndSphereVtk) {
   const std::string config = write("fcc2.json", fcc_config());
   const fs::path out = dir_ / "work" / "out";
   const test::RunResult r = demcal({"run", config, "-o", out.string()});
-  ASSERT_EQ(r.status, 0) << r.err;
+  ASSERT_NO_FATAL_FAILURE(test::expect_run_status(r.status, out, r.err));
   EXPECT_NE(r.out.find("32 spheres"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("peak sigma_zz"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("moment balance"), std::string::npos) << r.out;
@@ -137,7 +138,7 @@ TEST_F(Cli3D, ScoreOnARunsSeriesGivesTheRunsVerdict) {
     const fs::path out = dir_ / "work" / ("run" + std::string(steps).substr(16));
     const test::RunResult r =
         demcal({"run", config, "--set", steps, "--set", "output.vtk=false", "-o", out.string()});
-    ASSERT_EQ(r.status, 0) << r.err;
+    ASSERT_NO_FATAL_FAILURE(test::expect_run_status(r.status, out, r.err));  // as score's, below
     const test::RunResult sc = test::run_demcal({"score", "series.csv", "-o", "scored"}, out);
     const auto ran = nlohmann::json::parse(read_text(out / "summary.json"));
     const bool within = ran.at("verdict").at("within_tolerances").get<bool>();
@@ -256,7 +257,7 @@ TEST_F(Cli3D, RunWritesTheSameFilesOnTheAvx2AndAvx512Paths) {
       args.insert(args.end(), run.begin(), run.end());
       args.insert(args.end(), {"-o", out.string()});
       const test::RunResult r = test::run_program("/usr/bin/env", args, dir_ / "work");
-      ASSERT_EQ(r.status, 0) << r.err;
+      ASSERT_NO_FATAL_FAILURE(test::expect_run_status(r.status, out, r.err));
       series[path] = read_text(out / "series.csv");
       vtk[path] = read_text(out / "final.vtk");
       ASSERT_GT(lines_of(series[path]).size(), 10u);

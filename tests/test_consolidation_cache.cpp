@@ -24,6 +24,7 @@
 #include "demcal/scene/triaxial.hpp"
 #include "support/files.hpp"
 #include "support/process.hpp"
+#include "support/run_status.hpp"
 #include "support/same_bits.hpp"
 #include "support/same_spheres.hpp"
 #include "support/scenes.hpp"
@@ -208,7 +209,10 @@ TEST(ConsolidationCacheCli, ConcurrentRunsShareOneEntryWithUncachedResults) {
     a.insert(a.end(), {"-o", (dir / out).string()});
     return a;
   };
-  ASSERT_EQ(test::run_demcal(with_output("uncached"), dir.path()).status, 0);
+  // `demcal run`'s status is its verdict (2000 steps: FAIL, 1): every run
+  // here ends as the uncached one.
+  const int verdict = test::run_demcal(with_output("uncached"), dir.path()).status;
+  ASSERT_NO_FATAL_FAILURE(test::expect_run_status(verdict, dir / "uncached"));
   ::setenv("DEMCAL_CACHE_DIR", cache.c_str(), 1);
   std::vector<pid_t> pids;
   for (int k = 0; k < 3; ++k)
@@ -217,8 +221,8 @@ TEST(ConsolidationCacheCli, ConcurrentRunsShareOneEntryWithUncachedResults) {
   for (pid_t p : pids) status.push_back(test::wait_exit(p));
   const test::RunResult again = test::run_demcal(with_output("hit"), dir.path());
   ::setenv("DEMCAL_CACHE_DIR", "off", 1);
-  for (int s : status) EXPECT_EQ(s, 0);
-  EXPECT_EQ(again.status, 0) << again.err;
+  for (int s : status) EXPECT_EQ(s, verdict);
+  EXPECT_EQ(again.status, verdict) << again.err;
   EXPECT_EQ(test::names_in(cache).size(), 1u);
   const std::string series = test::read_text(dir / "uncached" / "series.csv");
   ASSERT_FALSE(series.empty());
@@ -453,13 +457,15 @@ TEST(ConsolidationCacheCli, SphereRunsReadTheCacheWithUncachedResults) {
                  "assembly.count=60", "--set", "algorithm.steps=3000", "-o", (dir / out).string()});
     return test::run_program("/usr/bin/env", args, dir.path());
   };
+  // `demcal run`'s status is its verdict (3000 steps: FAIL, 1): every run
+  // here ends as the uncached one.
   const test::RunResult off = run("off", "off");
-  ASSERT_EQ(off.status, 0) << off.err;
+  ASSERT_NO_FATAL_FAILURE(test::expect_run_status(off.status, dir / "off", off.err));
   const test::RunResult miss = run("miss", cache);
-  ASSERT_EQ(miss.status, 0) << miss.err;
+  ASSERT_EQ(miss.status, off.status) << miss.err;
   EXPECT_EQ(test::names_in(cache).size(), 1u);
   const test::RunResult hit = run("hit", cache);
-  ASSERT_EQ(hit.status, 0) << hit.err;
+  ASSERT_EQ(hit.status, off.status) << hit.err;
   EXPECT_EQ(off.out.find("from the cache"), std::string::npos);
   EXPECT_EQ(miss.out.find("from the cache"), std::string::npos);
   EXPECT_NE(hit.out.find("from the cache"), std::string::npos) << hit.out;
@@ -479,7 +485,7 @@ TEST(ConsolidationCacheCli, SphereRunsReadTheCacheWithUncachedResults) {
   const std::string other = std::string(kernel_simd()) == "sse2" ? "" : "sse2";
   if (other.empty()) GTEST_SKIP() << "this CPU runs the SSE2 path only";
   const test::RunResult sse2 = run("sse2", cache, other);
-  ASSERT_EQ(sse2.status, 0) << sse2.err;
+  ASSERT_NO_FATAL_FAILURE(test::expect_run_status(sse2.status, dir / "sse2", sse2.err));
   EXPECT_EQ(sse2.out.find("from the cache"), std::string::npos);
   EXPECT_EQ(test::names_in(cache).size(), 2u);
 }

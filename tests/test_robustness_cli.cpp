@@ -138,8 +138,8 @@ TEST_F(RobustCli, ResumeWithOtherSettingsIsRefusedAndChangesNothing) {
 // study's sizes, so that a later resume cannot take them for its own.
 TEST_F(RobustCli, ScalingResumeWithOtherSettingsIsRefusedAndAFreshStartClearsTheSizes) {
   const std::vector<std::string> study = {
-      "scaling", kHex5, "--sizes", "16,25,36", "--calibrate-max", "25", "--max-trials", "8", "-j",
-      "1",       "-q",  "-o",      "out",      "--work",          "S"};
+      "scaling", kHex5, "--sizes", "16,25,36", "--calibrate-max", "25", "--max-trials",
+      "8",       "-j",  "1",       "-q",       "--work",          "S"};
   const auto with = [&](std::vector<std::string> extra) {
     std::vector<std::string> args = study;
     args.insert(args.end(), extra.begin(), extra.end());
@@ -149,6 +149,11 @@ TEST_F(RobustCli, ScalingResumeWithOtherSettingsIsRefusedAndAFreshStartClearsThe
   std::ofstream(work() / "S" / "size-99" / "result.json") << "{}\n";  // an earlier study's
   const Result first = demcal(study);
   ASSERT_TRUE(first.status == 0 || first.status == 1) << first.err;  // 1: the forward check
+  // Without -o the report goes to demcal-scaling-NAME, as every command's
+  // does: not to reports/, which from the repository's root is the shipped
+  // study's.
+  EXPECT_FALSE(fs::exists(work() / "reports"));
+  EXPECT_TRUE(fs::exists(work() / "demcal-scaling-hex_5x5" / "scaling.md"));
   EXPECT_FALSE(fs::exists(work() / "S" / "size-99"));
   ASSERT_TRUE(fs::exists(work() / "S" / "size-25" / "result.json"));
   expect_refused(with({"--resume", "--set", "material.friction=0.5"}), "config_sha256");

@@ -277,12 +277,19 @@ TEST(Sweep, CommandWritesTheAtlas) {
   // hex_5x5 at a benchmark of 2000 steps: the whole atlas in about a second.
   const test::TempDir tmp("sweep");
   const fs::path dir = tmp / "atlas";
+  // An earlier sweep's case that this one has not (its alpha scan was
+  // another's): gone with the rest; the user's own files stay.
+  fs::create_directories(dir / "series");
+  std::ofstream(dir / "series" / "alpha_0.999.csv") << "an earlier sweep's\n";
+  std::ofstream(dir / "series" / "notes.txt") << "mine\n";
   const test::RunResult r =
       test::run_demcal({"sweep", test::shipped_config("hex_5x5"), "--set", "algorithm.steps=2000",
                         "--jobs", "2", "-o", dir.string()},
                        tmp.path());
   ASSERT_NE(r.status, -1);
   EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "series" / "alpha_0.999.csv"));
+  EXPECT_TRUE(fs::exists(dir / "series" / "notes.txt"));
   for (const char* f : {"atlas.md", "atlas.json", "evidence.csv", "series/benchmark.csv",
                         "series/steps_x33.csv", "series/mass_1e8_undamped.csv"})
     EXPECT_TRUE(fs::exists(dir / f)) << f;
