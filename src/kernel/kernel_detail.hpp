@@ -1,9 +1,12 @@
 // What both kernels' private state is made of: 64-byte aligned arrays and
-// the handle of a World's worker threads (solver.cpp runs them). Private to
-// src/kernel, like world_impl.hpp and sphere_world_impl.hpp.
+// the handle of a World's worker threads (solver.cpp runs them), and how
+// both share their passes among those threads. Private to src/kernel, like
+// world_impl.hpp and sphere_world_impl.hpp.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <new>
 #include <vector>
@@ -65,9 +68,60 @@ struct TeamHandle {
 };
 /// Run fn(ctx, t) for t = 0 .. size − 1 on `handle`'s team of `size`
 /// threads (started on first use, restarted if its size differs; t = 0 runs
-/// on the calling thread) and return when all are done. For the sphere
-/// kernel, which shares the 2D kernel's team.
+/// on the calling thread) and return when all are done. Both kernels' passes
+/// (run_pass).
 void team_run(TeamHandle& handle, int size, void (*fn)(void*, int), void* ctx);
+
+/// The threads worth using for `nblocks` blocks of 8 particles, of the
+/// `threads` asked for: at least 8 blocks (64 particles) per thread, or the
+/// hand-over costs more than it saves; at most 64.
+inline int active_threads(int threads, int nblocks) {
+  return std::max(1, std::min({threads, nblocks / 8, 64}));
+}
+
+/// The block ranges of `t` threads, thread k taking [bounds[k], bounds[k +
+/// 1]): for the particle passes equal shares of the blocks; for the pair
+/// pass equal shares of the slots (`block_slot`, non-decreasing, holds each
+/// block's first slot, its last entry the total).
+inline void thread_bounds(int t, int nblocks, const std::vector<int>& block_slot,
+                          std::vector<int>& particle_bounds, std::vector<int>& pair_bounds) {
+  particle_bounds.assign(static_cast<size_t>(t) + 1, 0);
+  pair_bounds.assign(static_cast<size_t>(t) + 1, 0);
+  for (int k = 0; k <= t; ++k)
+    particle_bounds[k] = static_cast<int>(static_cast<int64_t>(nblocks) * k / t);
+  const int64_t total = block_slot.back();
+  int b = 0;
+  for (int k = 1; k < t; ++k) {
+    const int64_t target = total * k / t;
+    while (b < nblocks && block_slot[b] < target) ++b;
+    pair_bounds[k] = b;
+  }
+  pair_bounds[t] = nblocks;
+}
+
+/// One pass (w->*pass)(b0, b1) over blocks [0, nblocks), split among `t`
+/// threads of `team` by `bounds` (one thread: a single call on the calling
+/// thread); returns the largest value the calls returned. Maxima are exact
+/// whatever the split: the result does not depend on t.
+template <class Impl>
+double run_pass(TeamHandle& team, int t, int nblocks, Impl* w, double (Impl::*pass)(int, int),
+                const std::vector<int>& bounds) {
+  if (t <= 1) return (w->*pass)(0, nblocks);
+  struct Ctx {
+    Impl* w;
+    double (Impl::*pass)(int, int);
+    const std::vector<int>* bounds;
+    double out[64];
+  } ctx{w, pass, &bounds, {}};
+  team_run(
+      team, t,
+      [](void* p, int k) {
+        auto* c = static_cast<Ctx*>(p);
+        c->out[k] = (c->w->*c->pass)((*c->bounds)[k], (*c->bounds)[k + 1]);
+      },
+      &ctx);
+  return *std::max_element(ctx.out, ctx.out + t);
+}
 }  // namespace detail
 
 }  // namespace demcal

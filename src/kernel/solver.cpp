@@ -202,48 +202,15 @@ void WorldImpl::set_options(const KernelOptions& options) {
   set_threads(options.threads);
 }
 
-int WorldImpl::active_threads() const {
-  // At least 8 blocks (64 particles) per thread, or the hand-over costs
-  // more than it saves.
-  return std::max(1, std::min({threads_, nblocks_ / 8, 64}));
-}
+int WorldImpl::active_threads() const { return detail::active_threads(threads_, nblocks_); }
 
 void WorldImpl::update_thread_bounds() {
-  const int t = active_threads();
-  particle_bounds_.assign(static_cast<size_t>(t) + 1, 0);
-  pair_bounds_.assign(static_cast<size_t>(t) + 1, 0);
-  for (int k = 0; k <= t; ++k)
-    particle_bounds_[k] = static_cast<int>(static_cast<int64_t>(nblocks_) * k / t);
-  // Pair pass: equal shares of slots (block_slot_ is non-decreasing).
-  const int64_t total = block_slot_.back();
-  int b = 0;
-  for (int k = 1; k < t; ++k) {
-    const int64_t target = total * k / t;
-    while (b < nblocks_ && block_slot_[b] < target) ++b;
-    pair_bounds_[k] = b;
-  }
-  pair_bounds_[t] = nblocks_;
+  detail::thread_bounds(active_threads(), nblocks_, block_slot_, particle_bounds_, pair_bounds_);
   layout_terms();
 }
 
 double WorldImpl::run_pass(double (WorldImpl::*pass)(int, int), const std::vector<int>& bounds) {
-  const int t = active_threads();
-  if (t <= 1) return (this->*pass)(0, nblocks_);
-  if (!team_.team) team_.team = std::make_unique<detail::KernelTeam>(t);
-  struct Ctx {
-    WorldImpl* w;
-    double (WorldImpl::*pass)(int, int);
-    const std::vector<int>* bounds;
-    double out[64];
-  } ctx{this, pass, &bounds, {}};
-  team_.team->run(
-      [](void* p, int k) {
-        auto* c = static_cast<Ctx*>(p);
-        c->out[k] = (c->w->*c->pass)((*c->bounds)[k], (*c->bounds)[k + 1]);
-      },
-      &ctx);
-  // Maxima are exact whatever the split: the result does not depend on t.
-  return *std::max_element(ctx.out, ctx.out + t);
+  return detail::run_pass(team_, active_threads(), nblocks_, this, pass, bounds);
 }
 
 double WorldImpl::run_pair_pass() {

@@ -21,6 +21,7 @@
 #include <limits>
 
 #include "contact_law.hpp"
+#include "measure_formulas.hpp"
 #include "sphere_world_impl.hpp"
 #include "tridiagonal.hpp"
 
@@ -205,14 +206,7 @@ StabilityEstimate SphereWorldImpl::stability_estimate(int iterations) const {
   // of stability.cpp (each pair's normal dashpot, a wall's with the
   // particle's mass).
   const double gamma = law::dashpot_gamma_max(contacts, m_, material_.contact_damping_ratio);
-  auto step_for = [gamma](double w2) { return stable_step(w2, gamma); };
-  est.dt_stable = step_for(est.omega2_max);
-  est.dt_stable_gershgorin = step_for(est.omega2_gershgorin);
-  if (dt_crit > 0.0) {
-    est.dt_ratio_stable = est.dt_stable / dt_crit;
-    est.dt_ratio_stable_gershgorin = est.dt_stable_gershgorin / dt_crit;
-    est.dt_ratio_stable_translation = step_for(omega2_translation) / dt_crit;
-  }
+  detail::set_stable_steps(est, omega2_translation, gamma, dt_crit);
   return est;
 }
 

@@ -11,6 +11,7 @@
 #include <cmath>
 
 #include "contact_law.hpp"
+#include "measure_formulas.hpp"
 #include "sphere_world_impl.hpp"
 
 namespace demcal {
@@ -84,13 +85,12 @@ SphereMeasures SphereWorldImpl::measure(double strain_rate) const {
   }
   out.kinetic_energy_translation = ke_t;
   out.kinetic_energy_rotation = ke_r;
-  const double mean_contact = contact_count ? sum_contact_force / contact_count : 0.0;
-  out.unbalanced_force_ratio = (n_ && mean_contact > 0.0) ? (sum_net / n_) / mean_contact : 0.0;
+  out.unbalanced_force_ratio =
+      detail::unbalanced_force_ratio(sum_net, n_, sum_contact_force, contact_count);
   out.mean_pressure = -out.homogenized_stress.trace() / 3.0;
-  out.coordination_number = n_ ? 2.0 * out.particle_contacts / n_ : 0.0;
-  const double rho = material_.density * integration_.mass_scaling;
-  if (n_ && out.mean_pressure > 0.0)
-    out.inertial_number = std::abs(strain_rate) * (sum_d / n_) * std::sqrt(rho / out.mean_pressure);
+  out.coordination_number = detail::coordination_number(out.particle_contacts, n_);
+  out.inertial_number = detail::inertial_number(
+      strain_rate, sum_d, n_, material_.density * integration_.mass_scaling, out.mean_pressure);
   return out;
 }
 

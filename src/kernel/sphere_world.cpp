@@ -87,48 +87,15 @@ void SphereWorldImpl::set_threads(int threads) {
   update_thread_bounds();
 }
 
-int SphereWorldImpl::active_threads() const {
-  // At least 8 blocks (64 spheres) per thread, or the hand-over costs more
-  // than it saves.
-  return std::max(1, std::min({threads_, nblocks_ / 8, 64}));
-}
+int SphereWorldImpl::active_threads() const { return detail::active_threads(threads_, nblocks_); }
 
 void SphereWorldImpl::update_thread_bounds() {
-  const int t = active_threads();
-  particle_bounds_.assign(static_cast<size_t>(t) + 1, 0);
-  pair_bounds_.assign(static_cast<size_t>(t) + 1, 0);
-  for (int k = 0; k <= t; ++k)
-    particle_bounds_[k] = static_cast<int>(static_cast<int64_t>(nblocks_) * k / t);
-  // Pair pass: equal shares of slots (block_slot_ is non-decreasing).
-  const int64_t total = block_slot_.back();
-  int b = 0;
-  for (int k = 1; k < t; ++k) {
-    const int64_t target = total * k / t;
-    while (b < nblocks_ && block_slot_[b] < target) ++b;
-    pair_bounds_[k] = b;
-  }
-  pair_bounds_[t] = nblocks_;
+  detail::thread_bounds(active_threads(), nblocks_, block_slot_, particle_bounds_, pair_bounds_);
 }
 
 double SphereWorldImpl::run_pass(double (SphereWorldImpl::*pass)(int, int),
                                  const std::vector<int>& bounds) {
-  const int t = active_threads();
-  if (t <= 1) return (this->*pass)(0, nblocks_);
-  struct Ctx {
-    SphereWorldImpl* w;
-    double (SphereWorldImpl::*pass)(int, int);
-    const std::vector<int>* bounds;
-    double out[64];
-  } ctx{this, pass, &bounds, {}};
-  detail::team_run(
-      team_, t,
-      [](void* p, int k) {
-        auto* c = static_cast<Ctx*>(p);
-        c->out[k] = (c->w->*c->pass)((*c->bounds)[k], (*c->bounds)[k + 1]);
-      },
-      &ctx);
-  // Maxima are exact whatever the split: the result does not depend on t.
-  return *std::max_element(ctx.out, ctx.out + t);
+  return detail::run_pass(team_, active_threads(), nblocks_, this, pass, bounds);
 }
 
 void SphereWorldImpl::set_options(const KernelOptions& options) {

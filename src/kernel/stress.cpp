@@ -10,6 +10,7 @@
 #include <numbers>
 
 #include "contact_law.hpp"
+#include "measure_formulas.hpp"
 #include "world_impl.hpp"
 
 namespace demcal {
@@ -89,13 +90,12 @@ Measures WorldImpl::measure(double strain_rate) const {
   }
   out.kinetic_energy_translation = ke_t;
   out.kinetic_energy_rotation = ke_r;
-  const double mean_contact = contact_count ? sum_contact_force / contact_count : 0.0;
-  out.unbalanced_force_ratio = (n && mean_contact > 0.0) ? (sum_net / n) / mean_contact : 0.0;
+  out.unbalanced_force_ratio =
+      detail::unbalanced_force_ratio(sum_net, n, sum_contact_force, contact_count);
   out.mean_pressure = -0.5 * out.homogenized_stress.trace();
-  out.coordination_number = n ? 2.0 * out.particle_contacts / n : 0.0;
-  const double rho = material_.density * integration_.mass_scaling;
-  if (n && out.mean_pressure > 0.0)
-    out.inertial_number = std::abs(strain_rate) * (sum_d / n) * std::sqrt(rho / out.mean_pressure);
+  out.coordination_number = detail::coordination_number(out.particle_contacts, n);
+  out.inertial_number = detail::inertial_number(
+      strain_rate, sum_d, n, material_.density * integration_.mass_scaling, out.mean_pressure);
   return out;
 }
 
