@@ -509,10 +509,11 @@ Diagnosis diagnose(const Criteria& c, const Tolerances& t, bool diverged, const 
     return {"damping_rotation", "decrease",
             high_zr ? 0.85 : confidence_from(mb / std::max(1.0, rate_excess), 0.55, 0.8),
             (drag ? "the rotational damping takes " + percent(*c.moment_from_drag) +
-                        " of the axial wall's power (rotational drag) without chatter"
-                  : pair + " differ steadily without chatter") +
-                ": rotational damping holds the particles' rotations and stiffens the response; "
-                "decrease damping_ratio_rotation",
+                        " of the axial wall's power (rotational drag) without chatter: it holds "
+                        "the particles' rotations and stiffens the response"
+                  : pair + " differ steadily without chatter: rotational damping holds the "
+                           "particles' rotations and stiffens the response") +
+                "; decrease damping_ratio_rotation",
             "moment imbalance, peak over-predicted"};
   const bool small_dt = known(p.dt_ratio, [](double a) { return a <= kSmallDtRatio; });
   // 6. The servo walls lag behind σ3: only Nstep sets how fast they must move.
