@@ -133,7 +133,8 @@ TriaxialCriteria compute_triaxial_criteria(const std::vector<TriaxialPoint>& ser
   return c;
 }
 
-TriaxialCriteria compute_triaxial_criteria(const TriaxialResult& run, double s3) {
+TriaxialCriteria compute_triaxial_criteria(const TriaxialResult& run, double s3,
+                                           std::optional<double> reference_peak) {
   TriaxialCriteria c = compute_triaxial_criteria(run.series, s3);
   // The step-level peak when the run tracked one (it cannot be missed
   // between monitoring points), else the monitored one.
@@ -143,6 +144,7 @@ TriaxialCriteria compute_triaxial_criteria(const TriaxialResult& run, double s3)
       k->peak_strain_yy = run.peak_strain_zz;
     }
   }
+  c.combined.peak_error = peak_error_of(c.combined.peak_stress_yy, reference_peak);
   return c;
 }
 

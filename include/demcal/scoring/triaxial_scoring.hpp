@@ -86,8 +86,10 @@ Criteria scored_criteria(const TriaxialCriteria& c, const Tolerances& t);
 TriaxialCriteria compute_triaxial_criteria(const std::vector<TriaxialPoint>& series, double s3);
 /// The same with the peak tracked at every step (run.peak_stress_zz, as the
 /// 2D compute_criteria(LoadingResult) takes run.peak_stress_yy), when the
-/// run has one.
-TriaxialCriteria compute_triaxial_criteria(const TriaxialResult& run, double s3);
+/// run has one; `reference_peak` (b_zz, negative: e.g. −analytical_peak_ratio_3d·σ3)
+/// adds the combined criteria's peak_error.
+TriaxialCriteria compute_triaxial_criteria(const TriaxialResult& run, double s3,
+                                           std::optional<double> reference_peak = std::nullopt);
 
 /// The planes' criteria as summary.json holds them ("criteria_planes": xz,
 /// yz, the xy shear and moment terms, the four walls' servo errors, the
