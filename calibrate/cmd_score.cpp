@@ -85,13 +85,17 @@ int cmd_score(const ScoreOptions& o) {
   if (c.peak_error)
     std::cout << "  peak error against " << *reference << " Pa: " << 100.0 * *c.peak_error
               << " %\n";
-  // The verdict with its real reason; a run that did not end as planned
-  // has its diagnosis (of the steps it has) apart.
+  // The verdict with its real reason: a diverged run's as `demcal run`
+  // prints it, the divergence's own reason (its rows' or its metadata's)
+  // beside it; an incomplete one's diagnosis (of the steps it has) apart.
   std::cout << "  " << score_verdict(series, scored) << "\n";
-  if (score.diverged)
-    std::cout << "  diagnosis: " << score.diagnosis.message << "\n";
-  else if (!score.complete)
+  if (score.diverged) {
+    const int64_t step = is_3d ? series.triaxial.divergence_step : series.run.divergence_step;
+    std::cout << "  DIVERGED" << (step >= 0 ? " at step " + std::to_string(step) : "") << ": "
+              << series.divergence_reason << "\n";
+  } else if (!score.complete) {
     std::cout << "  on the steps it has: " << score.diagnosis.message << "\n";
+  }
   std::cout << "  wrote " << dir << "/summary.json\n";
   return score.passed ? 0 : 1;
 }

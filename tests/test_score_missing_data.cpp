@@ -193,9 +193,11 @@ TEST(ScoreVerdict, ADivergenceIsToldByItsOwnReason) {
                                                       reason + "\n",
                                                   200, {}, ",lateral_stress_error", ",0"));
   ASSERT_EQ(ledger.status, 1) << ledger.out;
-  EXPECT_TRUE(has(ledger.out, "FAIL: diverged at step 200: " + reason)) << ledger.out;
+  // The verdict as `demcal run` says it, the reason as its run's summary.
+  EXPECT_TRUE(has(ledger.out, "  FAIL: the run diverged")) << ledger.out;
+  EXPECT_TRUE(has(ledger.out, "  DIVERGED at step 200: " + reason + "\n")) << ledger.out;
   EXPECT_FALSE(has(ledger.out, "non-finite")) << ledger.out;
-  EXPECT_TRUE(has(ledger.summary.at("divergence").at("reason").get<std::string>(), reason));
+  EXPECT_EQ(ledger.summary.at("divergence").at("reason"), reason);
   // An engine that blew up writes non-finite values: that is its reason.
   std::string text = series_2d("# steps = 400\n", 400, {}, ",lateral_stress_error", ",0");
   const auto row = text.find("\n200,") + 1;
@@ -204,8 +206,8 @@ TEST(ScoreVerdict, ADivergenceIsToldByItsOwnReason) {
   const Scored blown = score("blown", text);
   ASSERT_EQ(blown.status, 1) << blown.out << text;
   EXPECT_TRUE(has(blown.out,
-                  "FAIL: diverged at step 200: non-finite values in the series' row "
-                  "of step 200"))
+                  "  DIVERGED at step 200: non-finite values in the series' row of "
+                  "step 200\n"))
       << blown.out;
 }
 

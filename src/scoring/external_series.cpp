@@ -316,8 +316,7 @@ void read_run_facts(const Table& t, ExternalSeries& out, Run& run) {
     run.divergence = divergence_named(out);
     const auto why = out.meta.find("divergence");
     out.divergence_reason =
-        (why != out.meta.end() ? why->second : std::string("its reason not given")) +
-        " (the series' metadata: # divergence_step, # divergence)";
+        why != out.meta.end() ? why->second : "its reason not given (no # divergence)";
   }
   const auto steps = meta_number(out, "steps");
   run.steps_planned = steps ? count(*steps, out.source, "# steps") : last;
@@ -443,8 +442,7 @@ ExternalScore score_external(const ExternalSeries& series, const Tolerances& tol
     // balance; 0 without the power columns); the peak tracked at every step
     // where the file gives one (demcal's own), else the monitored one.
     const TriaxialResult& run = series.triaxial;
-    TriaxialCriteria c = compute_triaxial_criteria(run, series.lateral_stress);
-    c.combined.peak_error = peak_error_of(c.combined.peak_stress_yy, reference_peak);
+    TriaxialCriteria c = compute_triaxial_criteria(run, series.lateral_stress, reference_peak);
     mark_not_available(c, series.not_available);
     out.score =
         score_of(scored_criteria(c, tolerances), outcome(run, series.parameters), tolerances);
@@ -469,12 +467,7 @@ ExternalScore score_external(const ExternalSeries& series, const Tolerances& tol
 std::string score_verdict(const ExternalSeries& series, const ExternalScore& score) {
   const Score& s = score.score;
   const bool is_3d = series.dimension == 3;
-  if (s.diverged) {
-    const int64_t step = is_3d ? series.triaxial.divergence_step : series.run.divergence_step;
-    return "FAIL: diverged" + (step >= 0 ? " at step " + std::to_string(step) : std::string()) +
-           ": " + series.divergence_reason;
-  }
-  if (!s.complete) {
+  if (!s.diverged && !s.complete) {
     const int64_t run = is_3d ? series.triaxial.steps_run : series.run.steps_run;
     const int64_t planned = is_3d ? series.triaxial.steps_planned : series.run.steps_planned;
     return "FAIL: incomplete: the series ran " + std::to_string(run) + " of the " +

@@ -80,7 +80,8 @@ struct ExternalSeries {
   /// The parameters its metadata give (the diagnosis reads only these).
   RunParameters parameters;
   /// A diverged series: why, in words (its non-finite row, or its
-  /// metadata's "# divergence").
+  /// metadata's "# divergence" as written: demcal's to_string(Divergence),
+  /// the reason its run's summary gives).
   std::string divergence_reason;
 };
 
@@ -102,9 +103,10 @@ ExternalScore score_external(const ExternalSeries& series, const Tolerances& tol
                              std::optional<double> reference_peak = std::nullopt);
 
 /// The verdict, one line: "PASS: ..." or "FAIL: ..." with the reason — the
-/// diagnosis for a complete run; for a diverged one the step and
-/// divergence_reason; for an incomplete one the steps it ran of those
-/// planned (the diagnosis of the steps it has is then apart).
+/// diagnosis ("the run diverged: ..." for a diverged run, as `demcal run`
+/// says it; the step and divergence_reason on a line of their own, as
+/// there); for an incomplete one the steps it ran of those planned (the
+/// diagnosis of the steps it has is then apart).
 std::string score_verdict(const ExternalSeries& series, const ExternalScore& score);
 
 /// summary.json of `demcal score`: a measure not available is omitted (as
