@@ -46,9 +46,21 @@ int cmd_score(const ScoreOptions& o) {
   const bool is_3d = series.dimension == 3;
   const size_t points = is_3d ? series.triaxial.series.size() : series.run.series.size();
   const int64_t steps = is_3d ? series.triaxial.steps_run : series.run.steps_run;
+  const int64_t planned = is_3d ? series.triaxial.steps_planned : series.run.steps_planned;
+  // A measure the series cannot give: "n/a (no column X)", never a number.
+  auto value = [&](const char* key, double v) {
+    std::ostringstream s;
+    s << std::setprecision(4);
+    if (c.available(key))
+      s << v;
+    else
+      s << "n/a (" << c.not_available.at(key) << ")";
+    return s.str();
+  };
   std::cout << std::setprecision(4) << "series " << o.file << ": "
             << (is_3d ? "3D (triaxial), " : "") << points << " monitoring points, " << steps
-            << " steps" << (score.complete ? "" : " (incomplete)") << "\n"
+            << (score.complete ? "" : " of " + std::to_string(planned)) << " steps"
+            << (score.complete ? "" : " (incomplete)") << "\n"
             << "  peak sigma_" << (is_3d ? "zz " : "yy ") << c.peak_stress_yy << " Pa at strain "
             << c.peak_strain_yy << " (sigma1/sigma3 " << -c.peak_stress_yy / sigma3 << ")\n";
   if (scored.planes) {
@@ -60,17 +72,30 @@ int cmd_score(const ScoreOptions& o) {
   } else {
     std::cout << "  force balance " << c.force_balance << " (tol " << tolerances.force_balance
               << "; paper form " << c.force_balance_paper << "), moment balance "
-              << c.moment_balance << " (tol " << tolerances.moment_balance << "), servo " << c.servo
-              << " (tol " << tolerances.servo << "), oscillation " << c.oscillation << " (tol "
-              << tolerances.oscillation << ")\n";
+              << c.moment_balance << " (tol " << tolerances.moment_balance << "), servo "
+              << value("servo", c.servo) << " (tol " << tolerances.servo << "), oscillation "
+              << c.oscillation << " (tol " << tolerances.oscillation << ")\n";
   }
+  std::cout << "  kinetic/elastic energy max "
+            << value("kinetic_energy_ratio_max", c.kinetic_energy_ratio_max)
+            << ", unbalanced-force ratio mean "
+            << value("unbalanced_force_ratio_mean", c.unbalanced_force_ratio_mean)
+            << ", inertial number max " << value("inertial_number_max", c.inertial_number_max)
+            << "\n";
   if (c.peak_error)
     std::cout << "  peak error against " << *reference << " Pa: " << 100.0 * *c.peak_error
               << " %\n";
-  std::cout << "  " << (score.passed ? "PASS" : "FAIL") << ": " << score.diagnosis.message << "\n";
-  if (is_3d ? series.triaxial.diverged : series.run.diverged)
-    std::cout << "  DIVERGED: non-finite values from step "
-              << (is_3d ? series.triaxial.divergence_step : series.run.divergence_step) << "\n";
+  // The verdict with its real reason: a diverged run's as `demcal run`
+  // prints it, the divergence's own reason (its rows' or its metadata's)
+  // beside it; an incomplete one's diagnosis (of the steps it has) apart.
+  std::cout << "  " << score_verdict(series, scored) << "\n";
+  if (score.diverged) {
+    const int64_t step = is_3d ? series.triaxial.divergence_step : series.run.divergence_step;
+    std::cout << "  DIVERGED" << (step >= 0 ? " at step " + std::to_string(step) : "") << ": "
+              << series.divergence_reason << "\n";
+  } else if (!score.complete) {
+    std::cout << "  on the steps it has: " << score.diagnosis.message << "\n";
+  }
   std::cout << "  wrote " << dir << "/summary.json\n";
   return score.passed ? 0 : 1;
 }

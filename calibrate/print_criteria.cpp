@@ -1,19 +1,39 @@
 #include "print_criteria.hpp"
 
+#include <sstream>
+
 namespace demcal::cli {
 
 void print_triaxial_criteria(std::ostream& out, const TriaxialCriteria& c, const Criteria& judged) {
   const Criteria& m = judged;
+  // A measure the series could not give (`demcal score`): "n/a (why)".
+  auto value = [&](const std::map<std::string, std::string>& missing, const char* key, double v) {
+    std::ostringstream s;
+    s.copyfmt(out);
+    if (missing.count(key))
+      s << "n/a (" << missing.at(key) << ")";
+    else
+      s << v;
+    return s.str();
+  };
+  const bool drag = !c.not_available.count("rotational_drag");
+  std::ostringstream folded;
+  folded.copyfmt(out);
+  folded << (drag ? " folded in at " : ", moment balance judged without it");
+  if (drag) folded << kRotationalDragTolerance;
   out << "  force balance " << m.force_balance << " (axial " << m.force_balance_yy << ", lateral x "
       << c.xz.force_balance_xx << ", lateral y " << c.yz.force_balance_xx << ", shear xz "
       << c.xz.force_balance_shear << ", yz " << c.yz.force_balance_shear << ", xy "
       << c.xy.force_balance_shear << ")\n"
       << "  moment balance " << m.moment_balance << " (xz " << c.xz.moment_balance << ", yz "
       << c.yz.moment_balance << ", xy " << c.xy.moment_balance << "; rotational drag "
-      << c.rotational_drag << " folded in at " << kRotationalDragTolerance << "), servo " << m.servo
-      << " (walls x min " << c.servo_walls[0] << ", x max " << c.servo_walls[1] << ", y min "
-      << c.servo_walls[2] << ", y max " << c.servo_walls[3] << "), oscillation " << m.oscillation
-      << "\n";
+      << value(c.not_available, "rotational_drag", c.rotational_drag) << folded.str() << "), servo "
+      << value(m.not_available, "servo", m.servo) << " (walls x min "
+      << value(c.not_available, "servo_xmin", c.servo_walls[0]) << ", x max "
+      << value(c.not_available, "servo_xmax", c.servo_walls[1]) << ", y min "
+      << value(c.not_available, "servo_ymin", c.servo_walls[2]) << ", y max "
+      << value(c.not_available, "servo_ymax", c.servo_walls[3]) << "), oscillation "
+      << m.oscillation << "\n";
 }
 
 }  // namespace demcal::cli

@@ -132,7 +132,32 @@ std::string component(const char* prefix, int i, int j) {
   return std::string(prefix) + kAxis[i] + kAxis[j];
 }
 
-/// The measures MonitorPoint and TriaxialPoint share, by the same names.
+/// The measures of Criteria (to_json keys) that a column the series does
+/// not have leaves unknown, with the column: ExternalSeries::not_available.
+/// Their points hold 0 (read_measures), which nothing then reads.
+void note_missing_measures(const Table& t, std::map<std::string, std::string>& missing) {
+  auto need = [&](std::initializer_list<const char*> keys,
+                  std::initializer_list<const char*> columns) {
+    for (const char* column : columns)
+      if (!t.has(column)) {
+        for (const char* key : keys) missing.emplace(key, std::string("no column ") + column);
+        return;
+      }
+  };
+  need({"kinetic_energy_ratio_median", "kinetic_energy_ratio_max"},
+       {"kinetic_energy", "elastic_energy"});
+  need({"rotational_energy_share"}, {"kinetic_energy", "kinetic_energy_rotation"});
+  need({"unbalanced_force_ratio_mean", "unbalanced_force_ratio_max"}, {"unbalanced_force_ratio"});
+  need({"inertial_number_max"}, {"inertial_number"});
+}
+
+/// The servo measures of Criteria, unknown for want of `why`.
+void note_missing_servo(std::map<std::string, std::string>& missing, const std::string& why) {
+  for (const char* key : {"servo", "servo_rms", "servo_noise"}) missing.emplace(key, why);
+}
+
+/// The measures MonitorPoint and TriaxialPoint share, by the same names
+/// (0 where the column is missing: note_missing_measures() marks them).
 template <class Point>
 void read_measures(const Table& t, const std::vector<double>& row, Point& p) {
   p.kinetic_energy = t.value(row, "kinetic_energy", 0);
@@ -149,6 +174,9 @@ void read_biaxial_rows(const Table& t, ExternalSeries& out) {
   const bool has_error = t.has("lateral_stress_error");
   const bool has_pressures = t.has("p_left") && t.has("p_right");
   out.torque_column = t.has("torque_stress");
+  note_missing_measures(t, out.not_available);
+  if (!has_error && !has_pressures)
+    note_missing_servo(out.not_available, "no column lateral_stress_error, nor p_left and p_right");
   for (const auto& row : t.rows) {
     MonitorPoint p;
     p.step = count(t.value(row, "step", 0), out.source, "step");
@@ -187,6 +215,34 @@ void read_biaxial_rows(const Table& t, ExternalSeries& out) {
 void read_triaxial_rows(const Table& t, ExternalSeries& out) {
   static const char* const kWall[6] = {"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"};
   const double s3 = out.lateral_stress;
+  note_missing_measures(t, out.not_available);
+  // Each lateral wall's servo error: its column, else its pressure, else
+  // unknown ("servo_xmin" .. "servo_ymax"); the mean of the four
+  // (lateral_stress_error, the xy pair's servo) needs the four.
+  bool all_walls = true;
+  for (int w = 0; w < 4; ++w)
+    if (!t.has(("servo_error_" + std::string(kWall[w])).c_str()) &&
+        !t.has(("p_" + std::string(kWall[w])).c_str())) {
+      all_walls = false;
+      out.not_available.emplace(
+          std::string("servo_") + kWall[w],
+          std::string("no column servo_error_") + kWall[w] + ", nor p_" + kWall[w]);
+    }
+  if (!t.has("lateral_stress_error") && !all_walls)
+    out.not_available.emplace("lateral_stress_error",
+                              "no column lateral_stress_error, nor the four lateral walls' "
+                              "servo_error_* or p_*");
+  // The drags are shares of the axial wall's power.
+  for (const char* column : {"axial_power", "damping_power_rotation"})
+    if (!t.has(column)) {
+      out.not_available.emplace("rotational_drag", std::string("no column ") + column);
+      break;
+    }
+  for (const char* column : {"axial_power", "damping_power_translation"})
+    if (!t.has(column)) {
+      out.not_available.emplace("translational_drag", std::string("no column ") + column);
+      break;
+    }
   for (const auto& row : t.rows) {
     TriaxialPoint p;
     p.step = count(t.value(row, "step", 0), out.source, "step");
@@ -215,7 +271,8 @@ void read_triaxial_rows(const Table& t, ExternalSeries& out) {
 }
 
 /// The reason of "# divergence = REASON" (to_string(Divergence)); a
-/// missing or unknown one reads as values that are not finite.
+/// missing or unknown one reads as values that are not finite (the
+/// reason's words are kept apart: ExternalSeries::divergence_reason).
 Divergence divergence_named(const ExternalSeries& s) {
   const auto it = s.meta.find("divergence");
   for (Divergence d : {Divergence::kOverlap, Divergence::kEnergy, Divergence::kEnergyCreated})
@@ -223,12 +280,24 @@ Divergence divergence_named(const ExternalSeries& s) {
   return Divergence::kNotFinite;
 }
 
+/// What the series says of the parameters the diagnosis reads: only what
+/// its metadata give (α needs both dt and dt_crit).
+RunParameters known_parameters(const ExternalSeries& s) {
+  RunParameters p;
+  const auto dt = meta_number(s, "dt"), dt_crit = meta_number(s, "dt_crit");
+  if (dt && dt_crit && *dt_crit > 0.0) p.dt_ratio = *dt / *dt_crit;
+  p.damping_ratio_translation = meta_number(s, "damping_ratio_translation");
+  p.damping_ratio_rotation = meta_number(s, "damping_ratio_rotation");
+  p.mass_scaling = meta_number(s, "mass_scaling");
+  return p;
+}
+
 /// What the metadata and the rows say of the run (LoadingResult and
 /// TriaxialResult name these fields alike). Its last monitoring point may
 /// fall short of the last step by less than one interval (Nstep not a
 /// multiple of M).
 template <class Run>
-void read_run_facts(const Table& t, const ExternalSeries& out, Run& run) {
+void read_run_facts(const Table& t, ExternalSeries& out, Run& run) {
   const auto& series = run.series;
   const int64_t last = series.empty() ? 0 : series.back().step;
   const int64_t interval = series.size() >= 2 ? last - series[series.size() - 2].step : 0;
@@ -236,11 +305,18 @@ void read_run_facts(const Table& t, const ExternalSeries& out, Run& run) {
   if (t.diverged) {
     run.divergence = Divergence::kNotFinite;
     run.divergence_step = t.diverged_step;
+    out.divergence_reason =
+        t.diverged_step >= 0
+            ? "non-finite values in the series' row of step " + std::to_string(t.diverged_step)
+            : "non-finite values in the series after step " + std::to_string(last);
   } else if (const auto step = meta_number(out, "divergence_step")) {
     // A run whose own checks stopped it (demcal's): its rows are finite.
     run.diverged = true;
     run.divergence_step = count(*step, out.source, "# divergence_step");
     run.divergence = divergence_named(out);
+    const auto why = out.meta.find("divergence");
+    out.divergence_reason =
+        why != out.meta.end() ? why->second : "its reason not given (no # divergence)";
   }
   const auto steps = meta_number(out, "steps");
   run.steps_planned = steps ? count(*steps, out.source, "# steps") : last;
@@ -256,6 +332,49 @@ void read_run_facts(const Table& t, const ExternalSeries& out, Run& run) {
       meta_number(out, "damping_ratio_translation").value_or(0);
   run.integration.damping_ratio_rotation = meta_number(out, "damping_ratio_rotation").value_or(0);
   run.integration.mass_scaling = meta_number(out, "mass_scaling").value_or(1);
+  // The integration above fills the run's fields; the diagnosis reads only
+  // what the metadata gave.
+  out.parameters = known_parameters(out);
+}
+
+/// How the run ended, and the parameters the series gives.
+template <class Run>
+RunOutcome outcome(const Run& run, const RunParameters& parameters) {
+  return {run.diverged,      run.stopped_early, run.steps_run,
+          run.steps_planned, run.particles,     parameters};
+}
+
+/// The 3D measures the series cannot give, on the criteria that hold them:
+/// each plane's servo (its two walls; the xy pair's is the four walls'
+/// mean), the walls', the drags, and the combined ones (servo: any wall).
+void mark_not_available(TriaxialCriteria& c, const std::map<std::string, std::string>& missing) {
+  static const char* const kWall[4] = {"servo_xmin", "servo_xmax", "servo_ymin", "servo_ymax"};
+  auto servo_of = [&](Criteria& plane, std::initializer_list<int> walls) {
+    for (int w : walls)
+      if (missing.count(kWall[w])) {
+        note_missing_servo(plane.not_available, missing.at(kWall[w]));
+        return;
+      }
+  };
+  // The energies' and the other codes' measures: every plane's (the same
+  // series); the drags are TriaxialCriteria's, the rotational one also
+  // judged (folded into the combined moment balance).
+  for (Criteria* k : {&c.xz, &c.yz, &c.xy, &c.combined})
+    for (const auto& [key, why] : missing)
+      if (key.rfind("servo_", 0) != 0 && key != "lateral_stress_error" &&
+          key.find("_drag") == std::string::npos)
+        k->not_available[key] = why;
+  if (missing.count("rotational_drag"))
+    c.combined.not_available["rotational_drag"] = missing.at("rotational_drag");
+  servo_of(c.xz, {0, 1});
+  servo_of(c.yz, {2, 3});
+  if (missing.count("lateral_stress_error"))
+    note_missing_servo(c.xy.not_available, missing.at("lateral_stress_error"));
+  servo_of(c.combined, {0, 1, 2, 3});
+  for (int w = 0; w < 4; ++w)
+    if (missing.count(kWall[w])) c.not_available.emplace(kWall[w], missing.at(kWall[w]));
+  for (const char* key : {"rotational_drag", "translational_drag"})
+    if (missing.count(key)) c.not_available.emplace(key, missing.at(key));
 }
 
 }  // namespace
@@ -323,13 +442,16 @@ ExternalScore score_external(const ExternalSeries& series, const Tolerances& tol
     // balance; 0 without the power columns); the peak tracked at every step
     // where the file gives one (demcal's own), else the monitored one.
     const TriaxialResult& run = series.triaxial;
-    TriaxialCriteria c = compute_triaxial_criteria(run, series.lateral_stress);
-    c.combined.peak_error = peak_error_of(c.combined.peak_stress_yy, reference_peak);
-    out.score = score_triaxial_run(run, c, tolerances);
+    TriaxialCriteria c = compute_triaxial_criteria(run, series.lateral_stress, reference_peak);
+    mark_not_available(c, series.not_available);
+    out.score =
+        score_of(scored_criteria(c, tolerances), outcome(run, series.parameters), tolerances);
     out.planes = c;
     return out;
   }
-  out.score = score_run(series.run, series.lateral_stress, tolerances, reference_peak);
+  Criteria c = compute_criteria(series.run, series.lateral_stress, reference_peak);
+  c.not_available = series.not_available;
+  out.score = score_of(c, outcome(series.run, series.parameters), tolerances);
   // As the criteria, the start point (static by construction) is left out.
   double sum = 0.0;
   int n = 0;
@@ -340,6 +462,18 @@ ExternalScore score_external(const ExternalSeries& series, const Tolerances& tol
   }
   out.lever_arm_floor_rms = n ? std::sqrt(sum / n) : 0.0;
   return out;
+}
+
+std::string score_verdict(const ExternalSeries& series, const ExternalScore& score) {
+  const Score& s = score.score;
+  const bool is_3d = series.dimension == 3;
+  if (!s.diverged && !s.complete) {
+    const int64_t run = is_3d ? series.triaxial.steps_run : series.run.steps_run;
+    const int64_t planned = is_3d ? series.triaxial.steps_planned : series.run.steps_planned;
+    return "FAIL: incomplete: the series ran " + std::to_string(run) + " of the " +
+           std::to_string(planned) + " steps planned";
+  }
+  return std::string(s.passed ? "PASS: " : "FAIL: ") + s.diagnosis.message;
 }
 
 nlohmann::json external_summary(const ExternalSeries& series, const ExternalScore& score,
@@ -369,7 +503,9 @@ nlohmann::json external_summary(const ExternalSeries& series, const ExternalScor
        {{"stress_" + axial, s.criteria.peak_stress_yy},
         {"strain_" + axial, s.criteria.peak_strain_yy},
         {"ratio", -s.criteria.peak_stress_yy / series.lateral_stress}}},
-      {"diverged", diverged}};
+      {"diverged", diverged},
+      {"verdict", score_verdict(series, score)}};
+  if (!s.not_checked.empty()) j["not_checked"] = s.not_checked;
   if (score.planes) j["criteria_planes"] = to_json(*score.planes);
   j["moment_balance_source"] = series.torque_column
                                    ? "torque_stress (the engine's net contact torques / V)"
@@ -382,7 +518,7 @@ nlohmann::json external_summary(const ExternalSeries& series, const ExternalScor
          "((s_xy - s_yx) - torque_stress)/sigma3: the static moment term of an engine that "
          "applies tangential forces at r_i instead of r_i - delta/2; not counted in moment "
          "balance"}};
-  if (diverged) j["divergence"] = {{"step", divergence_step}};
+  if (diverged) j["divergence"] = {{"step", divergence_step}, {"reason", series.divergence_reason}};
   return j;
 }
 

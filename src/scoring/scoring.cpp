@@ -69,8 +69,12 @@ constexpr double kHighPassGain = 8.366600265340756;  // sqrt(70)
 }  // namespace
 
 Excesses excesses(const Criteria& c, const Tolerances& t) {
-  return {c.force_balance / t.force_balance, c.moment_balance / t.moment_balance, c.servo / t.servo,
-          c.oscillation / t.oscillation};
+  auto excess = [&](const char* key, double value, double tolerance) {
+    return c.available(key) ? value / tolerance : 0.0;
+  };
+  return {excess("force_balance", c.force_balance, t.force_balance),
+          excess("moment_balance", c.moment_balance, t.moment_balance),
+          excess("servo", c.servo, t.servo), excess("oscillation", c.oscillation, t.oscillation)};
 }
 
 double Excesses::worst() const {
@@ -359,12 +363,31 @@ double confidence_from(double excess, double base, double top) {
 /// Two significant digits: "140 %", "3.5 %".
 std::string percent(double v) { return num(100.0 * v, 2) + " %"; }
 
+/// "servo (no column lateral_stress_error ...), rotational_drag (...)".
+std::string not_checked_list(const std::map<std::string, std::string>& not_checked) {
+  std::string out;
+  for (const auto& [name, why] : not_checked)
+    out += (out.empty() ? "" : ", ") + name + " (" + why + ")";
+  return out;
+}
+
+/// The criteria among `c.not_available`: what a verdict did not check.
+std::map<std::string, std::string> criteria_not_checked(const Criteria& c) {
+  std::map<std::string, std::string> out;
+  for (const char* key :
+       {"force_balance", "moment_balance", "servo", "oscillation", "rotational_drag"})
+    if (!c.available(key)) out.emplace(key, c.not_available.at(key));
+  return out;
+}
+
 }  // namespace
 
-Diagnosis diagnose(const Criteria& c, const Tolerances& t, bool diverged,
-                   const std::optional<AlgorithmSpec>& p) {
+Diagnosis diagnose(const Criteria& c, const Tolerances& t, bool diverged, const RunParameters& p) {
+  // A parameter is "known and ..." only when the run says it.
+  auto known = [](const std::optional<double>& v, auto test) { return v && test(*v); };
   if (diverged) {
-    if (p && p->mass_scaling > 1.0 && p->dt_ratio < 0.05)
+    if (known(p.mass_scaling, [](double f) { return f > 1.0; }) &&
+        known(p.dt_ratio, [](double a) { return a < 0.05; }))
       return {"mass_scaling", "decrease", 0.6,
               "the run diverged with heavily scaled masses and no stable dynamics; reduce "
               "mass_scaling",
@@ -373,11 +396,15 @@ Diagnosis diagnose(const Criteria& c, const Tolerances& t, bool diverged,
             "the run diverged: the time step is beyond the stable limit; decrease dt_ratio",
             "divergence"};
   }
-  const double fb = c.force_balance / t.force_balance;
-  const double mb = c.moment_balance / t.moment_balance;
-  const double osc = c.oscillation / t.oscillation;
-  const double sv = c.servo / t.servo;
-  const double worst = std::max({fb, mb, osc, sv});
+  // A measure not available reads as nothing: its excess 0 (excesses()),
+  // the energies' patterns not seen.
+  const Excesses e = excesses(c, t);
+  const double fb = e.force_balance, mb = e.moment_balance, osc = e.oscillation, sv = e.servo;
+  const double worst = e.worst();
+  const std::map<std::string, std::string> not_checked = criteria_not_checked(c);
+  const double ke_ratio =
+      c.available("kinetic_energy_ratio_median") ? c.kinetic_energy_ratio_median : 0.0;
+  const double rot_share = c.available("rotational_energy_share") ? c.rotational_energy_share : 0.0;
 
   if (worst <= 1.0) {
     if (c.zigzag > t.oscillation && c.zigzag > 3.0 * c.oscillation)
@@ -385,18 +412,29 @@ Diagnosis diagnose(const Criteria& c, const Tolerances& t, bool diverged,
               "quasi-static, but b and sigma share a zigzag (stick-slip): the loading is slower "
               "than it needs to be; fewer steps would do",
               "shared zigzag"};
-    std::string msg = "quasi-static: every criterion is within tolerance (worst at " +
-                      percent(worst) + " of its tolerance)";
+    std::string msg = not_checked.empty()
+                          ? "quasi-static: every criterion is within tolerance (worst at " +
+                                percent(worst) + " of its tolerance)"
+                          : "quasi-static on the criteria checked: each is within tolerance "
+                            "(worst at " +
+                                percent(worst) + " of its tolerance)";
     if (worst < 0.1) msg += "; far within: fewer steps would do";
-    return {"none", "", 0.9, msg, "none"};
+    if (!not_checked.empty()) msg += "; not checked: " + not_checked_list(not_checked);
+    return {"none", "", not_checked.empty() ? 0.9 : 0.6, msg, "none"};
   }
+
+  // 3D: the rotational drag folded into moment balance set it; the words
+  // name the drag, and the asymmetry thresholds below do not apply to it.
+  const bool drag = c.moment_from_drag.has_value();
+  const double asymmetry = drag ? 0.0 : c.moment_balance;
+  const std::string& pair = c.moment_pair;
 
   // 1. A dynamic run with scaled masses: inertia, not the contacts, carries
   //    the load.
-  const bool dynamic = fb > 1.0 && c.kinetic_energy_ratio_median > kDynamicEnergyRatio;
-  if (dynamic && p && p->mass_scaling > 1.0)
+  const bool dynamic = fb > 1.0 && ke_ratio > kDynamicEnergyRatio;
+  if (dynamic && known(p.mass_scaling, [](double f) { return f > 1.0; }))
     return {"mass_scaling", "decrease", 0.8,
-            "the run is dynamic (kinetic energy " + percent(c.kinetic_energy_ratio_median) +
+            "the run is dynamic (kinetic energy " + percent(ke_ratio) +
                 " of the elastic energy) and b and sigma follow different trends: the scaled "
                 "masses are too heavy for this loading; decrease mass_scaling",
             "dynamic run, b and sigma follow different trends"};
@@ -405,27 +443,29 @@ Diagnosis diagnose(const Criteria& c, const Tolerances& t, bool diverged,
   // to 20 on hex_10x10): beyond it, unless ζ_r is large, it is the onset of
   // the chatter (at 1.05 α_stable on random_400 the rotational energy share
   // is still low on most monitoring points).
-  const bool large_zr = p && p->damping_ratio_rotation >= kHighDamping;
-  if (mb > 1.0 &&
-      (c.rotational_energy_share > kChatterEnergyShare || c.moment_balance > kChatterAsymmetry ||
-       (c.moment_balance > kDragAsymmetryMax && !large_zr))) {
-    const double clarity = std::max(std::min(1.0, c.rotational_energy_share / 0.6),
-                                    std::min(1.0, c.moment_balance / 0.1));
+  const bool large_zr = known(p.damping_ratio_rotation, [](double z) { return z >= kHighDamping; });
+  if (mb > 1.0 && (rot_share > kChatterEnergyShare || asymmetry > kChatterAsymmetry ||
+                   (asymmetry > kDragAsymmetryMax && !large_zr))) {
+    const double clarity = std::max(std::min(1.0, rot_share / 0.6), std::min(1.0, asymmetry / 0.1));
     return {"dt", "decrease", std::min(0.95, 0.6 + 0.3 * clarity),
-            "sigma_xy and sigma_yx are far apart and the particles' rotations chatter: the time "
-            "step is beyond the rotational stability limit; decrease dt_ratio",
+            (drag ? "the rotational damping takes " + percent(*c.moment_from_drag) +
+                        " of the axial wall's power"
+                  : pair + " are far apart") +
+                " and the particles' rotations chatter: the time step is beyond the rotational "
+                "stability limit; decrease dt_ratio",
             "moment imbalance with rotational chatter"};
   }
   // 3. A dynamic run without scaled masses: loading too fast for inertia.
   if (dynamic)
     return {"steps", "increase", 0.7,
-            "the run is dynamic (kinetic energy " + percent(c.kinetic_energy_ratio_median) +
+            "the run is dynamic (kinetic energy " + percent(ke_ratio) +
                 " of the elastic energy): the loading is too fast for the particles' inertia; "
                 "increase steps",
             "dynamic run, b and sigma follow different trends"};
   // 4. Noise where b and σ disagree.
   if (osc > 1.0 && osc >= 0.5 * worst) {
-    if (p && p->damping_ratio_translation >= kLowDampingRatio && p->dt_ratio > 0.25)
+    if (known(p.damping_ratio_translation, [](double z) { return z >= kLowDampingRatio; }) &&
+        known(p.dt_ratio, [](double a) { return a > 0.25; }))
       return {"dt", "decrease", 0.5,
               "b and sigma disagree by step-to-step noise although the run is damped: the time "
               "step is near its stability limit; decrease dt_ratio",
@@ -441,26 +481,44 @@ Diagnosis diagnose(const Criteria& c, const Tolerances& t, bool diverged,
   const bool high_zr = large_zr;
   const double rate_excess = std::max(fb, sv);
   // Without damping the particles' spins ring (σ's antisymmetric part is
-  // Σ I·dω/dt): noisy b − σ, and no rotational damping to blame.
-  const bool ringing = p ? p->damping_ratio_translation < kLowDampingRatio &&
-                               p->damping_ratio_rotation < kLowDampingRatio
-                         : c.oscillation > kRingingNoise * t.oscillation;
-  if (mb > 1.0 && ringing && (rate_excess <= 1.0 || mb >= rate_excess))
-    return {"damping_translation", "increase", 0.6,
-            "sigma_xy and sigma_yx differ while the run is (almost) undamped: the particles' "
-            "rotations ring; add damping (damping_ratio_translation 0.1 or more)",
+  // Σ I·dω/dt): noisy b − σ, and no rotational damping to blame. Known
+  // damping ratios decide; without them (a series that does not give
+  // them) the pattern does, and the words say it is a guess. A drag is
+  // damping's own: never ringing.
+  const bool damping_known = p.damping_ratio_translation && p.damping_ratio_rotation;
+  const bool ringing = !drag && (damping_known ? *p.damping_ratio_translation < kLowDampingRatio &&
+                                                     *p.damping_ratio_rotation < kLowDampingRatio
+                                               : c.oscillation > kRingingNoise * t.oscillation);
+  if (mb > 1.0 && ringing && (rate_excess <= 1.0 || mb >= rate_excess)) {
+    if (damping_known)
+      return {"damping_translation", "increase", 0.6,
+              pair +
+                  " differ while the run is (almost) undamped: the particles' rotations ring; "
+                  "add damping (damping_ratio_translation 0.1 or more)",
+              "moment imbalance without damping"};
+    return {"damping_translation", "increase", 0.4,
+            pair +
+                " differ and b - sigma is noisy, the pattern of a run whose rotations ring "
+                "without damping; its damping ratios are not known (the series does not give "
+                "them): if it has none, add damping (damping_ratio_translation 0.1 or more)",
             "moment imbalance without damping"};
+  }
   const bool rot_drag =
       mb > 1.0 && (rate_excess <= 1.0 || mb >= 5.0 * rate_excess || (high_zr && mb >= rate_excess));
   if (rot_drag)
     return {"damping_rotation", "decrease",
             high_zr ? 0.85 : confidence_from(mb / std::max(1.0, rate_excess), 0.55, 0.8),
-            "sigma_xy and sigma_yx differ steadily without chatter: rotational damping holds the "
-            "particles' rotations and stiffens the response; decrease damping_ratio_rotation",
+            (drag ? "the rotational damping takes " + percent(*c.moment_from_drag) +
+                        " of the axial wall's power (rotational drag) without chatter: it holds "
+                        "the particles' rotations and stiffens the response"
+                  : pair + " differ steadily without chatter: rotational damping holds the "
+                           "particles' rotations and stiffens the response") +
+                "; decrease damping_ratio_rotation",
             "moment imbalance, peak over-predicted"};
+  const bool small_dt = known(p.dt_ratio, [](double a) { return a <= kSmallDtRatio; });
   // 6. The servo walls lag behind σ3: only Nstep sets how fast they must move.
   if (sv > 1.0) {
-    if (p && p->dt_ratio <= kSmallDtRatio && fb > sv)
+    if (small_dt && fb > sv)
       return {"dt", "increase", 0.7,
               "b and sigma disagree (gap " + percent(c.force_balance) +
                   ") and the walls lag: the time step is small, so the same steps load the "
@@ -476,13 +534,13 @@ Diagnosis diagnose(const Criteria& c, const Tolerances& t, bool diverged,
     const std::string gap =
         "b and sigma disagree smoothly (gap " + percent(c.force_balance) + ", mostly " +
         (c.force_balance_xx >= c.force_balance_yy ? "lateral" : "vertical") + ")";
-    if (p && p->damping_ratio_translation >= kHighDamping)
+    if (known(p.damping_ratio_translation, [](double z) { return z >= kHighDamping; }))
       return {"damping_translation", "decrease", 0.8,
               gap +
                   ": global damping drags against the lateral expansion like extra "
                   "confinement; decrease damping_ratio_translation",
               "gap without oscillation, peak over-predicted"};
-    if (p && p->dt_ratio <= kSmallDtRatio)
+    if (small_dt)
       return {"dt", "increase", 0.75,
               gap +
                   ": the time step is small, so the same steps load the sample fast; "
@@ -507,6 +565,7 @@ Score score_of(const Criteria& criteria, const RunOutcome& run, const Tolerances
                                                : 0.0;
   s.particle_steps = static_cast<double>(run.particles) * static_cast<double>(run.steps_planned);
   s.worst_excess = excesses(s.criteria, t).worst();
+  s.not_checked = criteria_not_checked(s.criteria);
   s.passed = !s.diverged && s.complete && s.worst_excess <= 1.0;
   s.diagnosis = diagnose(s.criteria, t, s.diverged, run.parameters);
   return s;
@@ -612,9 +671,11 @@ constexpr CriteriaField kCriteriaFields[] = {
 
 nlohmann::json to_json(const Criteria& c) {
   nlohmann::json j = nlohmann::json::object();
-  for (const auto& f : kCriteriaFields) j[f.key] = c.*(f.member);
+  for (const auto& f : kCriteriaFields)
+    if (c.available(f.key)) j[f.key] = c.*(f.member);
   j["points"] = c.points;
   if (c.peak_error) j["peak_error"] = *c.peak_error;
+  if (!c.not_available.empty()) j["not_available"] = c.not_available;
   return j;
 }
 
@@ -625,6 +686,8 @@ Criteria criteria_from_json(const nlohmann::json& j) {
   if (j.contains("points"))
     c.points = static_cast<int>(json_integer(j.at("points"), 0, std::numeric_limits<int>::max()));
   if (j.contains("peak_error")) c.peak_error = j.at("peak_error").get<double>();
+  if (j.contains("not_available"))
+    c.not_available = j.at("not_available").get<std::map<std::string, std::string>>();
   return c;
 }
 

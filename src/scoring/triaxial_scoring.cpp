@@ -114,7 +114,15 @@ TriaxialCriteria compute_triaxial_criteria(const std::vector<TriaxialPoint>& ser
   m.force_balance = std::max({m.force_balance_xx, m.force_balance_yy, m.force_balance_shear});
   m.force_balance_whole =
       std::max({c.xz.force_balance_whole, c.yz.force_balance_whole, c.xy.force_balance_whole});
-  m.moment_balance = std::max({c.xz.moment_balance, c.yz.moment_balance, c.xy.moment_balance});
+  // The pair the diagnosis names: the plane whose asymmetry is largest.
+  c.xz.moment_pair = "sigma_xz and sigma_zx";
+  c.yz.moment_pair = "sigma_yz and sigma_zy";
+  c.xy.moment_pair = "sigma_xy and sigma_yx";
+  const Criteria* most = &c.xz;
+  for (const Criteria* k : {&c.yz, &c.xy})
+    if (k->moment_balance > most->moment_balance) most = k;
+  m.moment_pair = most->moment_pair;
+  m.moment_balance = most->moment_balance;
   m.moment_noise = std::max({c.xz.moment_noise, c.yz.moment_noise, c.xy.moment_noise});
   m.servo = std::max({c.xz.servo, c.yz.servo, c.servo_walls[0], c.servo_walls[1], c.servo_walls[2],
                       c.servo_walls[3]});
@@ -125,7 +133,8 @@ TriaxialCriteria compute_triaxial_criteria(const std::vector<TriaxialPoint>& ser
   return c;
 }
 
-TriaxialCriteria compute_triaxial_criteria(const TriaxialResult& run, double s3) {
+TriaxialCriteria compute_triaxial_criteria(const TriaxialResult& run, double s3,
+                                           std::optional<double> reference_peak) {
   TriaxialCriteria c = compute_triaxial_criteria(run.series, s3);
   // The step-level peak when the run tracked one (it cannot be missed
   // between monitoring points), else the monitored one.
@@ -135,21 +144,32 @@ TriaxialCriteria compute_triaxial_criteria(const TriaxialResult& run, double s3)
       k->peak_strain_yy = run.peak_strain_zz;
     }
   }
+  c.combined.peak_error = peak_error_of(c.combined.peak_stress_yy, reference_peak);
   return c;
 }
 
 nlohmann::json to_json(const TriaxialCriteria& c) {
-  return {{"xz", to_json(c.xz)},
-          {"yz", to_json(c.yz)},
-          {"xy",
-           {{"force_balance_shear", c.xy.force_balance_shear},
-            {"oscillation_shear", c.xy.oscillation_shear},
-            {"moment_balance", c.xy.moment_balance},
-            {"moment_noise", c.xy.moment_noise}}},
-          {"servo_walls", c.servo_walls},
-          {"rotational_drag", c.rotational_drag},
-          {"translational_drag", c.translational_drag},
-          {"combined_without_drag", to_json(c.combined)}};
+  // A wall's servo error not available is null (an array keeps its four
+  // places), a drag not available is left out, as to_json(Criteria) leaves
+  // out its measures.
+  static const char* const kWall[4] = {"servo_xmin", "servo_xmax", "servo_ymin", "servo_ymax"};
+  nlohmann::json walls = nlohmann::json::array();
+  for (int w = 0; w < 4; ++w)
+    walls.push_back(c.not_available.count(kWall[w]) ? nlohmann::json(nullptr)
+                                                    : nlohmann::json(c.servo_walls[w]));
+  nlohmann::json j{{"xz", to_json(c.xz)},
+                   {"yz", to_json(c.yz)},
+                   {"xy",
+                    {{"force_balance_shear", c.xy.force_balance_shear},
+                     {"oscillation_shear", c.xy.oscillation_shear},
+                     {"moment_balance", c.xy.moment_balance},
+                     {"moment_noise", c.xy.moment_noise}}},
+                   {"servo_walls", walls},
+                   {"combined_without_drag", to_json(c.combined)}};
+  if (!c.not_available.count("rotational_drag")) j["rotational_drag"] = c.rotational_drag;
+  if (!c.not_available.count("translational_drag")) j["translational_drag"] = c.translational_drag;
+  if (!c.not_available.empty()) j["not_available"] = c.not_available;
+  return j;
 }
 
 AlgorithmSpec run_parameters(const TriaxialResult& run) {
@@ -169,8 +189,12 @@ Tolerances default_tolerances(const SceneConfig& config) {
 
 Criteria scored_criteria(const TriaxialCriteria& c, const Tolerances& t) {
   Criteria m = c.combined;
-  m.moment_balance =
-      std::max(m.moment_balance, t.moment_balance * c.rotational_drag / kRotationalDragTolerance);
+  if (!m.available("rotational_drag")) return m;
+  const double from_drag = t.moment_balance * c.rotational_drag / kRotationalDragTolerance;
+  if (from_drag > m.moment_balance) {
+    m.moment_balance = from_drag;
+    m.moment_from_drag = c.rotational_drag;
+  }
   return m;
 }
 

@@ -16,7 +16,13 @@
 // s_xy, s_yx, s_yy; optional kinetic_energy, kinetic_energy_rotation,
 // elastic_energy, unbalanced_force_ratio, inertial_number,
 // coordination_number, lateral_stress_error (else from p_left and p_right),
-// wall_left, wall_right, wall_bottom, wall_top, torque_stress. demcal's own
+// wall_left, wall_right, wall_bottom, wall_top, torque_stress. What a
+// missing optional column or metadata key would give is not known, never 0:
+// the measure is left out of summary.json (its key omitted, listed under
+// "not_available" with the column missing), the terminal prints "n/a (no
+// column X)", a criterion it is is not checked (the verdict says so), and
+// the diagnosis reads neither it nor a parameter the metadata do not give
+// (a series without damping ratios is not an undamped run). demcal's own
 // series.csv is such a file, with the metadata its run was scored with:
 // scored here, it gives the run's criteria, verdict and diagnosis.
 //
@@ -24,9 +30,10 @@
 // strain_zz: required step, strain_zz and the nine components of b
 // (b_xx .. b_zz) and of σ (s_xx .. s_zz); optional the energies and ratios
 // above, servo_error_xmin, _xmax, _ymin, _ymax (else from the pressures
-// p_xmin .. p_ymax, else 0), lateral_stress_error (else their mean),
+// p_xmin .. p_ymax, else unknown), lateral_stress_error (else their mean),
 // wall_xmin .. wall_zmax, damping_power_translation, damping_power_rotation
-// and axial_power (the drag criteria; without them the drag reads 0). demcal's 3D series.csv and
+// and axial_power (the drag criteria; without them the drag is not known and
+// moment balance is judged without it). demcal's 3D series.csv and
 // the exported 3D LAMMPS deck's are such files; they are scored as `demcal run` scores a triaxial
 // run (triaxial_scoring.hpp).
 //
@@ -66,6 +73,16 @@ struct ExternalSeries {
   /// Per monitoring point: ((σxy − σyx) − torque_stress)/σ3 (empty without
   /// torque_stress).
   std::vector<double> lever_arm_floor;
+  /// The measures the series cannot give (Criteria::not_available keys; 3D
+  /// also "servo_xmin" .. "servo_ymax", "lateral_stress_error",
+  /// "rotational_drag", "translational_drag"), with the column missing.
+  std::map<std::string, std::string> not_available;
+  /// The parameters its metadata give (the diagnosis reads only these).
+  RunParameters parameters;
+  /// A diverged series: why, in words (its non-finite row, or its
+  /// metadata's "# divergence" as written: demcal's to_string(Divergence),
+  /// the reason its run's summary gives).
+  std::string divergence_reason;
 };
 
 /// Parse `text` (the content of `source`). `lateral_stress` overrides the
@@ -85,7 +102,16 @@ struct ExternalScore {
 ExternalScore score_external(const ExternalSeries& series, const Tolerances& tolerances,
                              std::optional<double> reference_peak = std::nullopt);
 
-/// summary.json of `demcal score`.
+/// The verdict, one line: "PASS: ..." or "FAIL: ..." with the reason — the
+/// diagnosis ("the run diverged: ..." for a diverged run, as `demcal run`
+/// says it; the step and divergence_reason on a line of their own, as
+/// there); for an incomplete one the steps it ran of those planned (the
+/// diagnosis of the steps it has is then apart).
+std::string score_verdict(const ExternalSeries& series, const ExternalScore& score);
+
+/// summary.json of `demcal score`: a measure not available is omitted (as
+/// to_json(Criteria) omits it); "not_checked" names the criteria not
+/// checked; "verdict" is score_verdict().
 nlohmann::json external_summary(const ExternalSeries& series, const ExternalScore& score,
                                 const Tolerances& tolerances);
 

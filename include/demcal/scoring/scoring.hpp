@@ -36,6 +36,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
@@ -118,6 +119,23 @@ struct Criteria {
   double peak_strain_yy = 0.0;
   std::optional<double> peak_error;
   int points = 0;  ///< monitoring points scored (after the first)
+  /// Measures the series could not give (another engine's series without
+  /// the column: `demcal score`), by their to_json key, with what is missing,
+  /// e.g. "servo" → "no column lateral_stress_error (nor p_left and
+  /// p_right)". Their members hold 0 and mean nothing: to_json leaves them
+  /// out (as peak_error without a reference) and lists them under
+  /// "not_available", excesses() and the diagnosis do not read them, and a
+  /// Score names the criteria among them not_checked. Empty for demcal's
+  /// own runs. 3D adds "rotational_drag" (TriaxialCriteria).
+  std::map<std::string, std::string> not_available;
+  bool available(const std::string& key) const { return !not_available.count(key); }
+  /// For the diagnosis' words: the pair of σ moment_balance measured (3D:
+  /// the plane's whose asymmetry is largest).
+  std::string moment_pair = "sigma_xy and sigma_yx";
+  /// 3D: the rotational drag when it, folded in, sets moment_balance
+  /// (scored_criteria()): the diagnosis then names the drag, not an
+  /// asymmetry of σ.
+  std::optional<double> moment_from_drag;
 };
 
 struct Diagnosis {
@@ -130,7 +148,8 @@ struct Diagnosis {
   std::string signature;    ///< the pattern seen, short (wording of reports/signature-atlas.md §5)
 };
 
-/// Each criterion divided by its tolerance (≤ 1 passes).
+/// Each criterion divided by its tolerance (≤ 1 passes); 0 for a criterion
+/// the series could not give (Criteria::not_available).
 struct Excesses {
   double force_balance = 0.0, moment_balance = 0.0, servo = 0.0, oscillation = 0.0;
   double worst() const;
@@ -143,7 +162,12 @@ struct Score {
   Criteria criteria;
   bool diverged = false;
   bool complete = true;  ///< false when the run stopped early
-  bool passed = false;   ///< every criterion within tolerance, not diverged
+  /// Every criterion checked within tolerance, not diverged.
+  bool passed = false;
+  /// The criteria not checked, for want of data (Criteria::not_available
+  /// among force_balance, moment_balance, servo, oscillation and, 3D,
+  /// rotational_drag), with what is missing.
+  std::map<std::string, std::string> not_checked;
   /// excesses(criteria, tolerances).worst(): the largest value/tolerance
   double worst_excess = 0.0;
   double completed_fraction = 1.0;  ///< steps_run / steps_planned
@@ -156,13 +180,26 @@ Criteria compute_criteria(const LoadingResult& run, double lateral_stress,
                           std::optional<double> reference_peak = std::nullopt);
 Criteria compute_criteria(const std::vector<MonitorPoint>& series, double lateral_stress,
                           std::optional<double> reference_peak = std::nullopt);
+/// The algorithmic parameters the diagnosis reads, each known or not: a
+/// series from another engine may not say them (`demcal score`), and an
+/// unknown one is never read as 0 (a missing damping ratio is not an
+/// undamped run). From an AlgorithmSpec all are known.
+struct RunParameters {
+  std::optional<double> dt_ratio, damping_ratio_translation, damping_ratio_rotation, mass_scaling;
+  RunParameters() = default;
+  RunParameters(const AlgorithmSpec& a)  // NOLINT(google-explicit-constructor): all known
+      : dt_ratio(a.dt_ratio),
+        damping_ratio_translation(a.damping_ratio_translation),
+        damping_ratio_rotation(a.damping_ratio_rotation),
+        mass_scaling(a.mass_scaling) {}
+};
 /// How a run ended, whatever its dimension: what a Score needs besides the
 /// criteria.
 struct RunOutcome {
   bool diverged = false, stopped_early = false;
   int64_t steps_run = 0, steps_planned = 0;
   int64_t particles = 0;
-  AlgorithmSpec parameters;
+  RunParameters parameters;
 };
 /// The Score of a run's criteria (score_run and score_triaxial_run call it).
 Score score_of(const Criteria& criteria, const RunOutcome& run, const Tolerances& tolerances);
@@ -181,8 +218,10 @@ std::optional<double> peak_error_of(double peak, std::optional<double> reference
 /// translational drag); when the run's parameters are given (score_run
 /// gives them) they pick the knob within the class, e.g. a drag gap with
 /// ζ_t = 4 is "damping_translation decrease", with α = 0.02 "dt increase".
+/// A parameter not known is not read; measures not available
+/// (Criteria::not_available) are not either.
 Diagnosis diagnose(const Criteria& criteria, const Tolerances& tolerances, bool diverged,
-                   const std::optional<AlgorithmSpec>& parameters = std::nullopt);
+                   const RunParameters& parameters = {});
 /// The algorithmic parameters a run was made with (α from Δt/Δt_crit).
 AlgorithmSpec run_parameters(const LoadingResult& run);
 /// The same from a run's integration, Δt_crit and planned steps (2D and 3D
@@ -296,11 +335,13 @@ double gap_identity_residual(const World& world);
 class SphereWorld;
 double gap_identity_residual(const SphereWorld& world);
 
-/// Every field of Criteria (peak included) by its name.
+/// Every field of Criteria (peak included) by its name; a measure not
+/// available is left out, and "not_available" (only when some are) maps
+/// its key to what is missing.
 nlohmann::json to_json(const Criteria& criteria);
 /// The inverse of to_json(Criteria) (a trial record read back on resume);
-/// keys missing (older records) keep their defaults, a wrong type throws
-/// nlohmann::json::exception.
+/// keys missing (older records) keep their defaults, "not_available" is
+/// read back, a wrong type throws nlohmann::json::exception.
 Criteria criteria_from_json(const nlohmann::json& json);
 nlohmann::json to_json(const Tolerances& tolerances);
 nlohmann::json to_json(const Diagnosis& diagnosis);

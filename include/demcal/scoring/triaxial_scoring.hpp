@@ -5,6 +5,7 @@
 #pragma once
 
 #include <array>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <vector>
 
@@ -46,6 +47,13 @@ struct TriaxialCriteria {
   /// (combined.peak_stress_yy holds the step-level peak when the run
   /// tracked one: compute_triaxial_criteria(TriaxialResult)).
   double monitored_peak_stress_zz = 0.0, monitored_peak_strain_zz = 0.0;
+  /// Measures of these criteria the series could not give (`demcal score`
+  /// on a series without the column): "servo_xmin" .. "servo_ymax" (the
+  /// walls' servo_walls), "rotational_drag", "translational_drag", with
+  /// what is missing; the planes' own in their Criteria::not_available
+  /// (combined: "rotational_drag" too, so the verdict says it was not
+  /// checked). Empty for demcal's own runs.
+  std::map<std::string, std::string> not_available;
 };
 
 /// Tolerance on the rotational drag: a quarter of the 2 % peak accuracy
@@ -66,7 +74,9 @@ Tolerances default_tolerances(const SceneConfig& config);
 /// rotational drag folded into moment balance (both measure rotational
 /// disequilibrium: the net torques' sum, and each sphere's torque against
 /// its damping): moment_balance = max(its own value,
-/// t.moment_balance·rotational_drag/kRotationalDragTolerance), so its
+/// t.moment_balance·rotational_drag/kRotationalDragTolerance) (the drag's
+/// share, when the drag's is the larger, in moment_from_drag; not folded
+/// in when the drag is not available), so its
 /// excess is the larger of the two excesses and every user of the four
 /// criteria (search constraints, rate excess, diagnosis: moment imbalance
 /// with high ζ_r is "damping_rotation decrease") sees the drag.
@@ -76,8 +86,10 @@ Criteria scored_criteria(const TriaxialCriteria& c, const Tolerances& t);
 TriaxialCriteria compute_triaxial_criteria(const std::vector<TriaxialPoint>& series, double s3);
 /// The same with the peak tracked at every step (run.peak_stress_zz, as the
 /// 2D compute_criteria(LoadingResult) takes run.peak_stress_yy), when the
-/// run has one.
-TriaxialCriteria compute_triaxial_criteria(const TriaxialResult& run, double s3);
+/// run has one; `reference_peak` (b_zz, negative: e.g. −analytical_peak_ratio_3d·σ3)
+/// adds the combined criteria's peak_error.
+TriaxialCriteria compute_triaxial_criteria(const TriaxialResult& run, double s3,
+                                           std::optional<double> reference_peak = std::nullopt);
 
 /// The planes' criteria as summary.json holds them ("criteria_planes": xz,
 /// yz, the xy shear and moment terms, the four walls' servo errors, the
