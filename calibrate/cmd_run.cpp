@@ -146,8 +146,10 @@ int run_3d(const SceneConfig& config, const std::string& out_dir, bool allow_uns
   const TriaxialResult run =
       run_triaxial_loading(state, config.test, config.algorithm, {}, &final_state);
   const double s3 = config.test.lateral_stress;
-  // The step-level peak, as the calibration's trials score it.
-  const TriaxialCriteria c = compute_triaxial_criteria(run, s3);
+  // The step-level peak, as the calibration's trials score it; its error
+  // against theory where theory applies (rotation locked, FCC).
+  const std::optional<double> reference_peak = reference_peak_3d(config);
+  const TriaxialCriteria c = compute_triaxial_criteria(run, s3, reference_peak);
   const Tolerances tolerances = triaxial_tolerances();
   // The criteria judged (the rotational drag folded in), as `demcal score`
   // judges the run's series.csv.
@@ -158,7 +160,9 @@ int run_3d(const SceneConfig& config, const std::string& out_dir, bool allow_uns
   {
     OutputFolder out(dir);
     out.write("summary.json", summary.dump(2) + "\n");
-    out.write("series.csv", series_csv(series_metadata(config.name, config.test, run), run.series));
+    out.write(
+        "series.csv",
+        series_csv(series_metadata(config.name, config.test, run, reference_peak), run.series));
     if (config.output.vtk)
       out.write("final.vtk", world_vtk(final_state, "demcal " + config.name));
     else

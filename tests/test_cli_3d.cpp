@@ -180,6 +180,39 @@ TEST_F(Cli3D, ScoreOnARunsSeriesGivesTheRunsVerdict) {
   EXPECT_TRUE(drag_decided) << "wanted a run whose moment balance the rotational drag decides";
 }
 
+// With rotation locked the walled FCC peak is Thornton's (the 2 %):
+// `demcal run` scores the run against it and writes it into series.csv, so
+// `demcal score` gives the same peak error. Free spheres roll and peak
+// lower: no reference, rather than a wrong one.
+TEST_F(Cli3D, RunScoresTheRotationLockedFccPeakAgainstTheory) {
+  const std::string config = write("fcc2.json", fcc_config());
+  for (const bool lock : {true, false}) {
+    SCOPED_TRACE(lock ? "rotation locked" : "rotation free");
+    const fs::path out = dir_ / "work" / (lock ? "locked" : "free");
+    const test::RunResult r =
+        demcal({"run", config, "--set", "algorithm.steps=20000", "--set",
+                std::string("algorithm.lock_rotation=") + (lock ? "true" : "false"), "--set",
+                "output.vtk=false", "-o", out.string()});
+    ASSERT_NO_FATAL_FAILURE(test::expect_run_status(r.status, out, r.err));
+    const auto ran = nlohmann::json::parse(read_text(out / "summary.json"));
+    const std::string series = read_text(out / "series.csv");
+    const test::RunResult sc = test::run_demcal({"score", "series.csv", "-o", "scored"}, out);
+    ASSERT_LE(sc.status, 1) << sc.err;
+    const auto scored = nlohmann::json::parse(read_text(out / "scored" / "summary.json"));
+    if (lock) {
+      ASSERT_TRUE(ran.at("criteria").contains("peak_error")) << ran.dump(2);
+      EXPECT_LT(std::abs(ran.at("criteria").at("peak_error").get<double>()), 0.02);
+      EXPECT_NE(series.find("# reference_peak = "), std::string::npos);
+      EXPECT_NEAR(scored.at("criteria").at("peak_error").get<double>(),
+                  ran.at("criteria").at("peak_error").get<double>(), 1e-9);
+    } else {
+      EXPECT_FALSE(ran.at("criteria").contains("peak_error"));
+      EXPECT_EQ(series.find("reference_peak"), std::string::npos);
+      EXPECT_FALSE(scored.at("criteria").contains("peak_error"));
+    }
+  }
+}
+
 TEST_F(Cli3D, CheckPrintsTheSphereScales) {
   const std::string config = write("fcc2.json", fcc_config());
   const test::RunResult r = demcal({"check", config});

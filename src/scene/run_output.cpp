@@ -101,12 +101,13 @@ SeriesMetadata series_metadata(const std::string& scene, const TestSpec& test,
 }
 
 SeriesMetadata series_metadata(const std::string& scene, const TestSpec& test,
-                               const TriaxialResult& run) {
+                               const TriaxialResult& run, std::optional<double> reference_peak) {
   SeriesMetadata m = run_metadata(scene, test, run);
   if (run.peak_stress_zz < 0.0) {  // tracked (compute_triaxial_criteria takes it then)
     m.peak_stress_zz = round_trip(run.peak_stress_zz);
     m.peak_strain_zz = round_trip(run.peak_strain_zz);
   }
+  if (reference_peak) m.reference_peak = round_trip(*reference_peak);
   return m;
 }
 

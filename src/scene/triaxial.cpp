@@ -279,4 +279,11 @@ std::optional<double> analytical_peak_ratio_3d(const SceneConfig& config) {
   return ratio;
 }
 
+std::optional<double> reference_peak_3d(const SceneConfig& config) {
+  if (!config.algorithm.lock_rotation) return std::nullopt;
+  const auto ratio = analytical_peak_ratio_3d(config);
+  if (!ratio) return std::nullopt;
+  return -*ratio * config.test.lateral_stress;
+}
+
 }  // namespace demcal

@@ -61,13 +61,14 @@ std::vector<std::string> series_result_lines(const SeriesMetadata& m);
 /// The metadata of a run of demcal (2D, 3D): every value written to
 /// round-trip the double (the scores of `demcal score` and `demcal run`
 /// then agree), σ3 from `test`, the writer "demcal run"; the peak tracked
-/// at every step, and in 2D the reference peak the run was scored against,
-/// if any.
+/// at every step, and the reference peak the run was scored against, if
+/// any.
 SeriesMetadata series_metadata(const std::string& scene, const TestSpec& test,
                                const LoadingResult& run,
                                std::optional<double> reference_peak = std::nullopt);
 SeriesMetadata series_metadata(const std::string& scene, const TestSpec& test,
-                               const TriaxialResult& run);
+                               const TriaxialResult& run,
+                               std::optional<double> reference_peak = std::nullopt);
 
 /// series.csv with its metadata: the lines of series_metadata_lines(), then
 /// series_csv(series).

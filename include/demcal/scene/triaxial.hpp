@@ -139,4 +139,10 @@ TriaxialResult run_triaxial_loading(const TriaxialState& start, const TestSpec& 
 /// absent). Nothing for other assemblies.
 std::optional<double> analytical_peak_ratio_3d(const SceneConfig& config);
 
+/// The peak b_zz a run of the config is scored against (its peak error):
+/// −analytical_peak_ratio_3d·σ3 when the config locks rotation, the case
+/// the theory is for; nothing otherwise (free spheres roll, and the walled
+/// FCC peak falls below Thornton's: no reference, not a wrong one).
+std::optional<double> reference_peak_3d(const SceneConfig& config);
+
 }  // namespace demcal
