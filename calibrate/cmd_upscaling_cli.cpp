@@ -80,8 +80,10 @@ std::function<int()> add_upscaling_commands(CLI::App& app) {
   scaling->add_option("--work", sc->work_dir, "per-size work folder (default demcal-scaling-NAME)");
   scaling->add_option("-j,--jobs", sc->jobs, "trials in parallel (default: cores)")
       ->check(whole_number(1, kMaxJobs));
-  scaling->add_option("--max-trials", sc->max_trials, "search trials per size (default: config)")
-      ->check(whole_number(1, kMaxTrials));
+  scaling
+      ->add_option("--max-trials", sc->max_trials,
+                   "the search's trials per size at most, from 12 (default: config)")
+      ->check(whole_number(kMinSearchTrials, kMaxTrials, kMinSearchTrialsWhy));
   scaling->add_flag("--resume", sc->resume, "reuse the sizes already done in the work folder");
   scaling->add_flag("-q,--quiet", sc->quiet, "no progress lines on stderr");
 

@@ -133,4 +133,47 @@ TEST_F(ParamsFixes, ResumeFromAnotherFolderReusesTrialsAndWritesTheSameParams) {
                                                  "calrev/params.json")["config"]["assembly"];
 }
 
+// Defect 3: --max-trials 3 ran 12 search trials ("trial 4/3" ... "15/3").
+TEST_F(ParamsFixes, MaxTrialsBelowTheSearchMinimumIsRefused) {
+  expect_refused({"calibrate", kHex5, "--max-trials", "3", "-o", "out"}, {"--max-trials", "12"});
+  const std::string config =
+      test::write_text(tmp_.path() / "three.json",
+                       R"({"material": {"density": 2600, "kn": 1e7, "kt": 1e7, "friction": 0.5},)"
+                       R"( "calibration": {"max_trials": 3}})");
+  expect_refused({"calibrate", config, "-o", "out"}, {config, "calibration.max_trials", "12"});
+  expect_refused({"scaling", kHex5, "--max-trials", "3"}, {"--max-trials", "12"});
+}
+
+// --max-trials N bounds the search's trials, and the progress line counts
+// them against N; verification and the certificate come on top, without a
+// denominator they would overrun.
+TEST_F(ParamsFixes, MaxTrialsBoundsTheSearchAndItsProgressCount) {
+  for (const std::string strategy : {"model", "cobyla", "direct"}) {
+    SCOPED_TRACE(strategy);
+    const std::string dir = "mt-" + strategy;
+    const Result r = demcal(
+        {"calibrate", kHex5, "--max-trials", "12", "--strategy", strategy, "-j", "1", "-o", dir});
+    ASSERT_NE(r.status, 2) << r.err;
+    int search = 0;
+    for (const auto& t : trials_of(work_ / dir)) search += t["phase"] == "search";
+    EXPECT_GE(search, 1);
+    EXPECT_LE(search, 12);
+    const std::regex line(R"(trial (\d+) \(([a-z-]+)(?: (\d+)/(\d+))?\):)");
+    int progress = 0;
+    for (const auto& l : test::lines_of(r.err)) {
+      std::smatch m;
+      if (!std::regex_search(l, m, line)) continue;
+      ++progress;
+      if (m[2] == "search") {
+        ASSERT_TRUE(m[3].matched) << l;
+        EXPECT_EQ(m[4], "12") << l;
+        EXPECT_LE(std::stoi(m[3]), 12) << l;
+      } else {
+        EXPECT_FALSE(m[3].matched) << l;
+      }
+    }
+    EXPECT_GT(progress, search) << r.err;  // verify/certificate lines matched too
+  }
+}
+
 }  // namespace

@@ -416,6 +416,9 @@ SceneConfig parse_config(const nlohmann::json& root_json, const std::string& sou
     s.accuracy = k.positive("accuracy", s.accuracy);
     if (s.accuracy >= 1.0) k.fail("accuracy", "must be < 1 (a fraction, 0.02 = 2 %)");
     s.max_trials = static_cast<int>(k.integer("max_trials", s.max_trials, 1, 100000));
+    if (s.max_trials < kMinSearchTrials)
+      k.fail("max_trials", "must be at least " + std::to_string(kMinSearchTrials) + " (" +
+                               kMinSearchTrialsWhy + "), got " + std::to_string(s.max_trials));
     s.seed = static_cast<uint64_t>(
         k.integer("seed", static_cast<int64_t>(s.seed), 0, std::numeric_limits<int64_t>::max()));
     k.reject_unknown();

@@ -117,9 +117,20 @@ AlgorithmSpec algorithm_from_json(const nlohmann::json& json, const std::string&
 /// takes its defaults from here.
 struct CalibrationSpec {
   double accuracy = 0.02;  ///< target relative error of the peak
+  /// The first search's trials at most (--max-trials); verification of the
+  /// model's prediction, the convergence certificate and the tightened
+  /// searches after a failed certificate come on top.
   int max_trials = 80;
   uint64_t seed = 1;
 };
+
+/// The fewest search trials a calibration accepts (max_trials, --max-trials):
+/// the model strategy's two starts need 4 + 2 probes each (calibration.cpp
+/// asserts it), and every strategy's two starts at least 5 (COBYLA's simplex
+/// in 4 parameters). Less is refused, not raised.
+inline constexpr int kMinSearchTrials = 12;
+inline constexpr const char* kMinSearchTrialsWhy =
+    "the search's two starts need 6 trials each; verification and the certificate come on top";
 
 struct PrototypeSpec {
   int64_t particles = 0;  ///< 0: the REV itself
