@@ -15,10 +15,13 @@ std::function<int()> add_upscaling_commands(CLI::App& app) {
   auto* upscale = app.add_subcommand(
       "upscale", "the calibrated parameters for a prototype of N particles (or a particle file)");
   upscale->add_option("params", up->params, "params.json of a calibration")->required();
-  upscale->add_option("--particles", up->particles, "the prototype's particle count")
-      ->check(whole_number(1, kMaxParticles));
-  upscale->add_option("--prototype", up->prototype,
-                      "the prototype's particle file (CSV x,y,r; 3D: x,y,z,r)");
+  auto* up_particles =
+      upscale->add_option("--particles", up->particles, "the prototype's particle count")
+          ->check(whole_number(1, kMaxParticles));
+  upscale
+      ->add_option("--prototype", up->prototype,
+                   "the prototype's particle file (CSV x,y,r; 3D: x,y,z,r); not with --particles")
+      ->excludes(up_particles);
   upscale->add_option("--config", up->config, "scene config, if params.json carries none");
   upscale->add_option("--set", up->sets, "override a config key: section.key=value");
   upscale->add_option("--law", up->law, "scaling.json of demcal scaling: use its measured law");
@@ -32,10 +35,13 @@ std::function<int()> add_upscaling_commands(CLI::App& app) {
   auto* verify =
       app.add_subcommand("verify", "run the prototype with the upscaled parameters and score it");
   verify->add_option("params", ve->params, "params.json of a calibration")->required();
-  verify->add_option("--prototype", ve->prototype,
-                     "the prototype's particle file (CSV x,y,r; 3D: x,y,z,r)");
-  verify->add_option("--particles", ve->particles, "a generated prototype of N particles")
-      ->check(whole_number(1, kMaxParticles));
+  auto* ve_prototype = verify->add_option("--prototype", ve->prototype,
+                                          "the prototype's particle file (CSV x,y,r; 3D: x,y,z,r)");
+  verify
+      ->add_option("--particles", ve->particles,
+                   "a generated prototype of N particles; not with --prototype")
+      ->check(whole_number(1, kMaxParticles))
+      ->excludes(ve_prototype);
   verify->add_option("--config", ve->config, "scene config, if params.json carries none");
   verify->add_option("--set", ve->sets, "override a config key: section.key=value");
   verify->add_option("--law", ve->law, "scaling.json of demcal scaling: use its measured law");
@@ -93,10 +99,12 @@ std::function<int()> add_upscaling_commands(CLI::App& app) {
   // Values are checked by the command (exit 2, one message), not by CLI11.
   exp->add_option("--format", ex->format, "lammps (default) or liggghts");
   exp->add_option("-o,--output", ex->output, "the deck (default demcal-NAME.FORMAT)");
-  exp->add_option("--prototype", ex->prototype,
-                  "the prototype's particle file (CSV x,y,r; 3D: x,y,z,r)");
-  exp->add_option("--particles", ex->particles, "a generated prototype of N particles")
-      ->check(whole_number(1, kMaxParticles));
+  auto* ex_prototype = exp->add_option("--prototype", ex->prototype,
+                                       "the prototype's particle file (CSV x,y,r; 3D: x,y,z,r)");
+  exp->add_option("--particles", ex->particles,
+                  "a generated prototype of N particles; not with --prototype")
+      ->check(whole_number(1, kMaxParticles))
+      ->excludes(ex_prototype);
   exp->add_option("--config", ex->config, "scene config, if params.json carries none");
   exp->add_option("--set", ex->sets, "override a config key: section.key=value");
   exp->add_option("--law", ex->law, "scaling.json of demcal scaling: use its measured law");

@@ -176,4 +176,22 @@ TEST_F(ParamsFixes, MaxTrialsBoundsTheSearchAndItsProgressCount) {
   }
 }
 
+class ParamsOfACalibration : public ParamsFixes {
+ protected:
+  void SetUp() override {
+    ParamsFixes::SetUp();
+    ASSERT_EQ(calibrate({kHex5}, "good"), 0);
+  }
+};
+
+// Defect 8: --particles with --prototype used the file and ignored the count.
+TEST_F(ParamsOfACalibration, ParticlesAndPrototypeAreExclusive) {
+  const std::string proto = test::write_text(tmp_.path() / "proto.csv",
+                                             "x,y,r\n0,0,0.0005\n0.001,0,0.0005\n0,0.001,0.0005\n");
+  const std::string p = "good/params.json";
+  for (const std::string command : {"upscale", "export", "verify"})
+    expect_refused({command, p, "--particles", "400", "--prototype", proto},
+                   {"--particles", "--prototype"});
+}
+
 }  // namespace
