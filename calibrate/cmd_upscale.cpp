@@ -37,6 +37,21 @@ SceneConfig same_dimension(SceneConfig config, const nlohmann::json& params,
 
 }  // namespace
 
+void check_calibrated(const std::string& path, bool allow_failed, const char* command) {
+  // The JSON only (its other faults are the command's to name, in its order).
+  const nlohmann::json params = parse_config_json(read_text_file(path), path);
+  if (!allow_failed) return require_calibrated(params, path);
+  try {
+    require_calibrated(params, path);
+  } catch (const InputError&) {
+    // No parameters at all (rev null): the reader refuses it, no warning first.
+    if (params.contains("rev") && params["rev"].is_null()) return;
+    std::cerr << "demcal " << command << ": warning: " << path
+              << ": success is false: the calibration failed, and its parameters are not "
+                 "certified; used because of --allow-failed\n";
+  }
+}
+
 std::optional<SceneConfig> params_scene(const nlohmann::json& params, const std::string& path,
                                         const std::string& config_path,
                                         const std::vector<std::string>& sets) {

@@ -10,6 +10,16 @@
 
 namespace demcal::cli {
 
+namespace {
+
+void add_allow_failed(CLI::App* command, bool& allow_failed) {
+  command->add_flag("--allow-failed", allow_failed,
+                    "use the parameters of a params.json whose calibration failed (success "
+                    "false: passed, not certified); refused without it");
+}
+
+}  // namespace
+
 std::function<int()> add_upscaling_commands(CLI::App& app) {
   auto up = std::make_shared<UpscaleOptions>();
   auto* upscale = app.add_subcommand(
@@ -22,6 +32,7 @@ std::function<int()> add_upscaling_commands(CLI::App& app) {
       ->add_option("--prototype", up->prototype,
                    "the prototype's particle file (CSV x,y,r; 3D: x,y,z,r); not with --particles")
       ->excludes(up_particles);
+  add_allow_failed(upscale, up->allow_failed);
   upscale->add_option("--config", up->config, "scene config, if params.json carries none");
   upscale->add_option("--set", up->sets, "override a config key: section.key=value");
   upscale->add_option("--law", up->law, "scaling.json of demcal scaling: use its measured law");
@@ -42,6 +53,7 @@ std::function<int()> add_upscaling_commands(CLI::App& app) {
                    "a generated prototype of N particles; not with --prototype")
       ->check(whole_number(1, kMaxParticles))
       ->excludes(ve_prototype);
+  add_allow_failed(verify, ve->allow_failed);
   verify->add_option("--config", ve->config, "scene config, if params.json carries none");
   verify->add_option("--set", ve->sets, "override a config key: section.key=value");
   verify->add_option("--law", ve->law, "scaling.json of demcal scaling: use its measured law");
@@ -105,6 +117,7 @@ std::function<int()> add_upscaling_commands(CLI::App& app) {
                   "a generated prototype of N particles; not with --prototype")
       ->check(whole_number(1, kMaxParticles))
       ->excludes(ex_prototype);
+  add_allow_failed(exp, ex->allow_failed);
   exp->add_option("--config", ex->config, "scene config, if params.json carries none");
   exp->add_option("--set", ex->sets, "override a config key: section.key=value");
   exp->add_option("--law", ex->law, "scaling.json of demcal scaling: use its measured law");
@@ -133,11 +146,22 @@ std::function<int()> add_upscaling_commands(CLI::App& app) {
   rev->add_option("--method", rv->method, "cut (a window of the prototype) or generate");
   rev->add_option("-o,--output", rv->out_dir, "output folder (default demcal-rev-NAME)");
 
+  // A failed calibration's params.json is refused before anything else is
+  // read or written (its "success" named), unless --allow-failed.
   return [=]() -> int {
-    if (upscale->parsed()) return cmd_upscale(*up);
-    if (verify->parsed()) return cmd_verify(*ve);
+    if (upscale->parsed()) {
+      check_calibrated(up->params, up->allow_failed, "upscale");
+      return cmd_upscale(*up);
+    }
+    if (verify->parsed()) {
+      check_calibrated(ve->params, ve->allow_failed, "verify");
+      return cmd_verify(*ve);
+    }
     if (scaling->parsed()) return cmd_scaling(*sc);
-    if (exp->parsed()) return cmd_export(*ex);
+    if (exp->parsed()) {
+      check_calibrated(ex->params, ex->allow_failed, "export");
+      return cmd_export(*ex);
+    }
     if (rev->parsed()) return cmd_rev(*rv);
     return -1;
   };

@@ -133,6 +133,55 @@ TEST_F(ParamsFixes, ResumeFromAnotherFolderReusesTrialsAndWritesTheSameParams) {
                                                  "calrev/params.json")["config"]["assembly"];
 }
 
+// Defect 2, no trial passed: params.json held the built-in defaults (α 0.2,
+// Nstep 100000, ζ 1) as "best found", and export used them silently.
+TEST_F(ParamsFixes, FailedCalibrationHoldsNoParametersAndIsRefused) {
+  // auglag within 12 trials finds no passing trial on hex_5x5.
+  ASSERT_EQ(calibrate({kHex5, "--max-trials", "12", "--strategy", "auglag"}, "calfail"), 1);
+  const nlohmann::json params = test::read_json(work_ / "calfail/params.json");
+  EXPECT_EQ(params["success"], false);
+  EXPECT_TRUE(params["rev"].is_null()) << params["rev"].dump();
+  EXPECT_TRUE(params["prototype"].is_null());
+  const std::string report = test::read_text(work_ / "calfail/report.md");
+  EXPECT_EQ(report.find("best found"), std::string::npos);
+
+  const std::string p = "calfail/params.json";
+  expect_refused({"upscale", p, "--particles", "25", "-o", "x.json"}, {p, "success"});
+  expect_refused({"export", p, "--particles", "25", "-o", "x/d.lammps"}, {p, "success"});
+  expect_refused({"verify", p, "--particles", "25", "-o", "v"}, {p, "success"});
+  // The override cannot make parameters out of none.
+  expect_refused({"upscale", p, "--particles", "25", "--allow-failed"}, {p, "rev"});
+}
+
+// Defect 2, passing trials but no certificate (an accuracy no Nstep meets):
+// the result is the passing trial whose certificate failed, as run, and it
+// is used only with --allow-failed.
+TEST_F(ParamsFixes, UncertifiedCalibrationHoldsATrialItRanAndNeedsAllowFailed) {
+  ASSERT_EQ(calibrate({kHex5, "--accuracy", "0.00001"}, "uncert"), 1);
+  const nlohmann::json params = test::read_json(work_ / "uncert/params.json");
+  EXPECT_EQ(params["success"], false);
+  ASSERT_TRUE(params["rev"].is_object()) << params["rev"].dump();
+  const auto& rev = params["rev"];
+  bool ran = false;
+  for (const auto& t : trials_of(work_ / "uncert"))
+    ran = ran ||
+          (t["params"]["dt_ratio"] == rev["dt_ratio"] && t["params"]["steps"] == rev["steps"] &&
+           t["params"]["damping_ratio_translation"] == rev["damping_ratio_translation"] &&
+           t["passed"] == true);
+  EXPECT_TRUE(ran) << "rev is no passing trial of trials.jsonl: " << rev.dump();
+  EXPECT_FALSE(params["certificate"]["passed"]);
+  EXPECT_NE(test::read_text(work_ / "uncert/report.md").find("REV (passed, NOT certified)"),
+            std::string::npos);
+
+  const std::string p = "uncert/params.json";
+  expect_refused({"upscale", p, "--particles", "25", "-o", "x.json"}, {p, "success"});
+  expect_refused({"export", p, "--particles", "25", "-o", "x/d.lammps"}, {p, "success"});
+  const Result r = demcal({"upscale", p, "--particles", "25", "--allow-failed", "-o", "x.json"});
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("warning"), std::string::npos) << r.err;
+  EXPECT_TRUE(fs::exists(work_ / "x.json"));
+}
+
 // Defect 3: --max-trials 3 ran 12 search trials ("trial 4/3" ... "15/3").
 TEST_F(ParamsFixes, MaxTrialsBelowTheSearchMinimumIsRefused) {
   expect_refused({"calibrate", kHex5, "--max-trials", "3", "-o", "out"}, {"--max-trials", "12"});

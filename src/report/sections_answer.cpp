@@ -137,7 +137,10 @@ void write_parameter_table(Doc& d, const ReportFacts& f) {
       p.row("rotational damping ratio", "ζ_r = D_r/D_r^crit", "-", "damping_ratio_rotation"),
       p.row("rotational damping", "D_r (lightest particle)", "N·m·s", "damping_rotation"),
       p.row("mass scaling", "f_ms", "-", "mass_scaling")};
-  d.table({"parameter", "symbol", "unit", S.success ? "REV (calibrated)" : "REV (best found)",
+  d.table({"parameter", "symbol", "unit",
+           S.success     ? "REV (calibrated)"
+           : f.have_best ? "REV (passed, NOT certified)"
+                         : "REV (none: no trial passed)",
            "prototype (upscaled)"},
           rows);
   d.para(

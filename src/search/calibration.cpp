@@ -1050,12 +1050,17 @@ CalibrationSummary calibrate(const TrialRunner& runner, const AlgorithmSpec& bas
   // Certificate; when it fails, tighten the tolerances and search again
   // from the best point, then fall back to doubling Nstep.
   std::optional<TrialRecord> best;
+  // The last trial certified, out.certificate's: the result. A round that
+  // finds nothing passing its tightened tolerances ends the loop, and the
+  // result stays the passing trial whose certificate failed.
+  std::optional<TrialRecord> certified;
   int64_t steps_floor = 0;  // raised by the fallback, so that it moves on
   for (int round = 0; round < 6; ++round) {
     // Judged against the current (possibly tightened) tolerances.
     best = cheapest_passing(evaluator.all(), &tolerances, steps_floor);
     if (!best) break;
     out.certificate = certify(evaluator, *best, options.accuracy, jobs, out.dimension == 3);
+    certified = best;
     if (evaluator.stopped()) return finish_interrupted();
     if (out.certificate.passed) break;
     if (round < 2) {
@@ -1094,16 +1099,22 @@ CalibrationSummary calibrate(const TrialRunner& runner, const AlgorithmSpec& bas
   out.trials = evaluator.all();
   out.trials_run = evaluator.run_count();
   out.trials_reused = evaluator.reused_count();
-  if (best) {
-    out.best = rounded_params(best->params);
-    out.best_trial = *best;
+  if (certified) {
+    out.best = rounded_params(certified->params);
+    out.best_trial = *certified;
   }
-  out.success = best.has_value() && out.certificate.passed;
-  if (!best)
+  out.success = certified.has_value() && out.certificate.passed;
+  // Without a passing trial out.best stays the default, never run: params.json
+  // then holds no parameters (params_file), and says why here.
+  if (!certified)
     out.message = "no trial passed every criterion within " + std::to_string(budget) +
-                  " trials; raise --max-trials or loosen the tolerances";
+                  " search trials, so there are no parameters; raise --max-trials or loosen the "
+                  "tolerances";
   else if (!out.certificate.passed)
-    out.message = "the best passing parameters did not pass the convergence certificate";
+    out.message =
+        "the best passing parameters did not pass the convergence certificate (params.json "
+        "holds them, uncertified: upscale, verify and export refuse them without "
+        "--allow-failed)";
   else
     out.message = "calibrated: every criterion passed and Nstep doubled moves the peak by " +
                   std::to_string(100.0 * out.certificate.steps_doubled_peak_change) + " %";
@@ -1156,7 +1167,7 @@ std::string CalibrationSummary::BriefReport() const {
   std::ostringstream s;
   s.precision(4);
   s << (success ? "SUCCESS" : interrupted ? "INTERRUPTED" : "FAILURE") << ": " << message << "\n";
-  if (best_trial.score.particle_steps > 0)
+  if (has_best())
     s << "  dt_ratio " << best.dt_ratio << ", steps " << best.steps
       << ", damping_ratio_translation " << best.damping_ratio_translation
       << ", damping_ratio_rotation " << best.damping_ratio_rotation << "\n";
@@ -1170,7 +1181,7 @@ std::string CalibrationSummary::FullReport() const {
   s.precision(4);
   s << BriefReport();
   s << "  strategy " << to_string(strategy) << ", stable dt_ratio " << dt_ratio_stable << "\n";
-  if (best_trial.score.particle_steps > 0) {
+  if (has_best()) {
     const auto& c = best_trial.score.criteria;
     s << "  criteria: force balance " << c.force_balance << ", moment balance " << c.moment_balance
       << ", servo " << c.servo << ", oscillation " << c.oscillation << "\n"
