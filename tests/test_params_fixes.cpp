@@ -243,4 +243,21 @@ TEST_F(ParamsOfACalibration, ParticlesAndPrototypeAreExclusive) {
                    {"--particles", "--prototype"});
 }
 
+// Defect 7b: a params.json whose rev.dt_ratio exceeds the stable step it
+// records (dt_ratio_stable) exported a deck without complaint.
+TEST_F(ParamsOfACalibration, DtRatioBeyondTheRecordedStableStepIsRefused) {
+  nlohmann::json params = test::read_json(work_ / "good/params.json");
+  const double stable = params["dt_ratio_stable"];
+  ASSERT_LT(params["rev"]["dt_ratio"].get<double>(), stable);
+  params["rev"]["dt_ratio"] = 1.5 * stable;
+  const std::string p = test::write_text(tmp_.path() / "edited.json", params.dump(2));
+  expect_refused({"upscale", p, "--particles", "100", "-o", "x.json"}, {p, "rev.dt_ratio"});
+  expect_refused({"export", p, "--particles", "100", "-o", "x/d.lammps"}, {p, "rev.dt_ratio"});
+  expect_refused({"verify", p, "--particles", "100", "-o", "v"}, {p, "rev.dt_ratio"});
+  // At the stable step itself it is accepted.
+  params["rev"]["dt_ratio"] = stable;
+  const std::string q = test::write_text(tmp_.path() / "at.json", params.dump(2));
+  EXPECT_EQ(demcal({"upscale", q, "--particles", "100"}).status, 0);
+}
+
 }  // namespace

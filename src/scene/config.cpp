@@ -8,6 +8,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <limits>
 #include <set>
 #include <sstream>
@@ -277,6 +278,16 @@ int64_t particle_count(const nlohmann::json& value, int64_t min, const std::stri
         file, field,
         std::string(e.what()) + " (a particle count: at most " + kMaxParticlesWhy + ")");
   }
+}
+
+void require_stable_dt_ratio(double dt_ratio, double stable, const std::string& file,
+                             const std::string& field, const std::string& remedy) {
+  if (dt_ratio <= stable) return;
+  std::ostringstream s;
+  s << std::setprecision(4) << dt_ratio
+    << " is beyond the stable step estimated from the consolidated contact network, " << stable
+    << " (" << remedy << ")";
+  throw InputError(file, field, s.str());
 }
 
 nlohmann::json to_json(const AlgorithmSpec& g) {

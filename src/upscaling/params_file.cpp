@@ -37,7 +37,14 @@ nlohmann::json parse_params_text(std::string_view text, const std::string& path)
     throw InputError(path, "rev",
                      "is null: the calibration found no passing trial, so there are no "
                      "parameters to use; re-run demcal calibrate with more trials (--max-trials)");
-  rev_params_from_json(params, path);  // the values used first: their key named first
+  const RevParams rev = rev_params_from_json(params, path);  // the values used first: named first
+  // The stable step the calibration measured on the REV bounds its α, as
+  // it bounds `demcal run`'s (a params.json edited beyond it is refused).
+  if (const auto stable = params.find("dt_ratio_stable");
+      stable != params.end() && stable->is_number() && stable->get<double>() > 0.0)
+    require_stable_dt_ratio(rev.params.dt_ratio, stable->get<double>(), path, "rev.dt_ratio",
+                            "the stable dt_ratio this params.json records as dt_ratio_stable; "
+                            "use a smaller value, or calibrate again");
   const auto schema = params.find("schema");
   if (schema == params.end() || !schema->is_string() || *schema != kParamsSchema)
     throw InputError(

@@ -156,6 +156,13 @@ struct SceneConfig {
   std::string text;    ///< the JSON as read (for the config hash)
 };
 
+/// The stable-step rule (`demcal run`, params.json): a dt_ratio beyond the
+/// stable dt_ratio estimated from the consolidated contact network is bad
+/// input, an InputError naming `file` and `field`, with `remedy` (what to
+/// do instead) in parentheses.
+void require_stable_dt_ratio(double dt_ratio, double stable, const std::string& file,
+                             const std::string& field, const std::string& remedy);
+
 /// Parse and validate. `source` names the file in errors; relative paths in
 /// the config (assembly.file, prototype.file) are resolved against its
 /// folder and made absolute, so that to_json() writes paths that read the
