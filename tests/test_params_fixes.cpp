@@ -260,4 +260,25 @@ TEST_F(ParamsOfACalibration, DtRatioBeyondTheRecordedStableStepIsRefused) {
   EXPECT_EQ(demcal({"upscale", q, "--particles", "100"}).status, 0);
 }
 
+// Defect 14a: the 3D certificate table printed Nstep/2 = 14,785 for a trial
+// that ran 14,790 steps (each trial's Nstep is rounded): the rows name the
+// step counts of the certificate trials as run.
+TEST_F(ParamsFixes, CertificateRowsNameTheStepsRun) {
+  ASSERT_EQ(demcal({"calibrate", kFcc, "-j", "2", "-q", "-o", "fcc"}).status, 0);
+  std::set<int64_t> certificate;
+  for (const auto& t : trials_of(work_ / "fcc"))
+    if (t["phase"] == "certificate") certificate.insert(t["params"]["steps"].get<int64_t>());
+  const std::string report = test::read_text(work_ / "fcc/report.md");
+  int rows = 0;
+  const std::regex row(R"(at (2·Nstep|Nstep/2) = ([0-9,]+))");
+  for (auto it = std::sregex_iterator(report.begin(), report.end(), row);
+       it != std::sregex_iterator(); ++it) {
+    std::string digits = (*it)[2];
+    digits.erase(std::remove(digits.begin(), digits.end(), ','), digits.end());
+    EXPECT_TRUE(certificate.count(std::stoll(digits))) << (*it)[0];
+    ++rows;
+  }
+  EXPECT_EQ(rows, 2) << report;
+}
+
 }  // namespace
