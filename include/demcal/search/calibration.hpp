@@ -168,8 +168,8 @@ struct CalibrationSummary {
   /// best and best_trial hold a trial that passed every criterion (the
   /// cheapest; certified when success). False when no trial passed: best
   /// is then the default AlgorithmSpec, never run, and params.json holds
-  /// no parameters.
-  bool has_best() const { return best_trial.score.particle_steps > 0.0; }
+  /// no parameters. (A summary built by hand with success set has one.)
+  bool has_best() const { return success || best_trial.score.particle_steps > 0.0; }
 
   std::string BriefReport() const;
   std::string FullReport() const;
