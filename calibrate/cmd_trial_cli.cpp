@@ -38,8 +38,11 @@ void add_calibrate_options(CLI::App* calibrate, CalibrateOptions& cal) {
   calibrate->add_option("-o,--output", cal.out_dir, "output folder (default demcal-NAME)");
   calibrate->add_option("-j,--jobs", cal.jobs, "trials in parallel (default: cores)")
       ->check(whole_number(1, kMaxJobs));
-  calibrate->add_option("--max-trials", cal.max_trials, "search trials (default: config, 80)")
-      ->check(whole_number(1, kMaxTrials));
+  calibrate
+      ->add_option("--max-trials", cal.max_trials,
+                   "the search's trials at most, from 12 (default: config, 80); verification "
+                   "and the certificate come on top")
+      ->check(whole_number(kMinSearchTrials, kMaxTrials, kMinSearchTrialsWhy));
   calibrate
       ->add_option("--accuracy", cal.accuracy,
                    "peak accuracy target (default: the config's calibration.accuracy, 0.02)")

@@ -16,6 +16,8 @@
 
 namespace demcal::cli {
 
+namespace fs = std::filesystem;
+
 namespace {
 
 /// A params.json and the config it is applied to are of one dimension:
@@ -34,6 +36,21 @@ SceneConfig same_dimension(SceneConfig config, const nlohmann::json& params,
 }
 
 }  // namespace
+
+void check_calibrated(const std::string& path, bool allow_failed, const char* command) {
+  // The JSON only (its other faults are the command's to name, in its order).
+  const nlohmann::json params = parse_config_json(read_text_file(path), path);
+  if (!allow_failed) return require_calibrated(params, path);
+  try {
+    require_calibrated(params, path);
+  } catch (const InputError&) {
+    // No parameters at all (rev null): the reader refuses it, no warning first.
+    if (params.contains("rev") && params["rev"].is_null()) return;
+    std::cerr << "demcal " << command << ": warning: " << path
+              << ": success is false: the calibration failed, and its parameters are not "
+                 "certified; used because of --allow-failed\n";
+  }
+}
 
 std::optional<SceneConfig> params_scene(const nlohmann::json& params, const std::string& path,
                                         const std::string& config_path,
@@ -131,7 +148,11 @@ int cmd_upscale(const UpscaleOptions& o) {
   nlohmann::json block;
   int64_t n_proto = 0;
   if (config) {
-    block = prototype_block(*config, rev.params, rev.particles, law, o.particles, o.prototype);
+    // Named absolutely in the params.json written (its prototype.source.file),
+    // like the config's files: verify and export read it from any folder.
+    const std::string file =
+        o.prototype.empty() ? "" : fs::absolute(o.prototype).lexically_normal().string();
+    block = prototype_block(*config, rev.params, rev.particles, law, o.particles, file);
     n_proto = json_integer(block.at("particles"), 1);
   } else {
     if (!o.prototype.empty())

@@ -10,15 +10,29 @@
 
 namespace demcal::cli {
 
+namespace {
+
+void add_allow_failed(CLI::App* command, bool& allow_failed) {
+  command->add_flag("--allow-failed", allow_failed,
+                    "use the parameters of a params.json whose calibration failed (success "
+                    "false: passed, not certified); refused without it");
+}
+
+}  // namespace
+
 std::function<int()> add_upscaling_commands(CLI::App& app) {
   auto up = std::make_shared<UpscaleOptions>();
   auto* upscale = app.add_subcommand(
       "upscale", "the calibrated parameters for a prototype of N particles (or a particle file)");
   upscale->add_option("params", up->params, "params.json of a calibration")->required();
-  upscale->add_option("--particles", up->particles, "the prototype's particle count")
-      ->check(whole_number(1, kMaxParticles));
-  upscale->add_option("--prototype", up->prototype,
-                      "the prototype's particle file (CSV x,y,r; 3D: x,y,z,r)");
+  auto* up_particles =
+      upscale->add_option("--particles", up->particles, "the prototype's particle count")
+          ->check(whole_number(1, kMaxParticles));
+  upscale
+      ->add_option("--prototype", up->prototype,
+                   "the prototype's particle file (CSV x,y,r; 3D: x,y,z,r); not with --particles")
+      ->excludes(up_particles);
+  add_allow_failed(upscale, up->allow_failed);
   upscale->add_option("--config", up->config, "scene config, if params.json carries none");
   upscale->add_option("--set", up->sets, "override a config key: section.key=value");
   upscale->add_option("--law", up->law, "scaling.json of demcal scaling: use its measured law");
@@ -32,10 +46,14 @@ std::function<int()> add_upscaling_commands(CLI::App& app) {
   auto* verify =
       app.add_subcommand("verify", "run the prototype with the upscaled parameters and score it");
   verify->add_option("params", ve->params, "params.json of a calibration")->required();
-  verify->add_option("--prototype", ve->prototype,
-                     "the prototype's particle file (CSV x,y,r; 3D: x,y,z,r)");
-  verify->add_option("--particles", ve->particles, "a generated prototype of N particles")
-      ->check(whole_number(1, kMaxParticles));
+  auto* ve_prototype = verify->add_option("--prototype", ve->prototype,
+                                          "the prototype's particle file (CSV x,y,r; 3D: x,y,z,r)");
+  verify
+      ->add_option("--particles", ve->particles,
+                   "a generated prototype of N particles; not with --prototype")
+      ->check(whole_number(1, kMaxParticles))
+      ->excludes(ve_prototype);
+  add_allow_failed(verify, ve->allow_failed);
   verify->add_option("--config", ve->config, "scene config, if params.json carries none");
   verify->add_option("--set", ve->sets, "override a config key: section.key=value");
   verify->add_option("--law", ve->law, "scaling.json of demcal scaling: use its measured law");
@@ -80,8 +98,10 @@ std::function<int()> add_upscaling_commands(CLI::App& app) {
   scaling->add_option("--work", sc->work_dir, "per-size work folder (default demcal-scaling-NAME)");
   scaling->add_option("-j,--jobs", sc->jobs, "trials in parallel (default: cores)")
       ->check(whole_number(1, kMaxJobs));
-  scaling->add_option("--max-trials", sc->max_trials, "search trials per size (default: config)")
-      ->check(whole_number(1, kMaxTrials));
+  scaling
+      ->add_option("--max-trials", sc->max_trials,
+                   "the search's trials per size at most, from 12 (default: config)")
+      ->check(whole_number(kMinSearchTrials, kMaxTrials, kMinSearchTrialsWhy));
   scaling->add_flag("--resume", sc->resume, "reuse the sizes already done in the work folder");
   scaling->add_flag("-q,--quiet", sc->quiet, "no progress lines on stderr");
 
@@ -91,10 +111,13 @@ std::function<int()> add_upscaling_commands(CLI::App& app) {
   // Values are checked by the command (exit 2, one message), not by CLI11.
   exp->add_option("--format", ex->format, "lammps (default) or liggghts");
   exp->add_option("-o,--output", ex->output, "the deck (default demcal-NAME.FORMAT)");
-  exp->add_option("--prototype", ex->prototype,
-                  "the prototype's particle file (CSV x,y,r; 3D: x,y,z,r)");
-  exp->add_option("--particles", ex->particles, "a generated prototype of N particles")
-      ->check(whole_number(1, kMaxParticles));
+  auto* ex_prototype = exp->add_option("--prototype", ex->prototype,
+                                       "the prototype's particle file (CSV x,y,r; 3D: x,y,z,r)");
+  exp->add_option("--particles", ex->particles,
+                  "a generated prototype of N particles; not with --prototype")
+      ->check(whole_number(1, kMaxParticles))
+      ->excludes(ex_prototype);
+  add_allow_failed(exp, ex->allow_failed);
   exp->add_option("--config", ex->config, "scene config, if params.json carries none");
   exp->add_option("--set", ex->sets, "override a config key: section.key=value");
   exp->add_option("--law", ex->law, "scaling.json of demcal scaling: use its measured law");
@@ -123,11 +146,22 @@ std::function<int()> add_upscaling_commands(CLI::App& app) {
   rev->add_option("--method", rv->method, "cut (a window of the prototype) or generate");
   rev->add_option("-o,--output", rv->out_dir, "output folder (default demcal-rev-NAME)");
 
+  // A failed calibration's params.json is refused before anything else is
+  // read or written (its "success" named), unless --allow-failed.
   return [=]() -> int {
-    if (upscale->parsed()) return cmd_upscale(*up);
-    if (verify->parsed()) return cmd_verify(*ve);
+    if (upscale->parsed()) {
+      check_calibrated(up->params, up->allow_failed, "upscale");
+      return cmd_upscale(*up);
+    }
+    if (verify->parsed()) {
+      check_calibrated(ve->params, ve->allow_failed, "verify");
+      return cmd_verify(*ve);
+    }
     if (scaling->parsed()) return cmd_scaling(*sc);
-    if (exp->parsed()) return cmd_export(*ex);
+    if (exp->parsed()) {
+      check_calibrated(ex->params, ex->allow_failed, "export");
+      return cmd_export(*ex);
+    }
     if (rev->parsed()) return cmd_rev(*rv);
     return -1;
   };

@@ -22,9 +22,10 @@ struct UpscaleOptions {
   std::string prototype;  ///< or its particle file
   std::string config;     ///< scene config when params.json carries none
   std::vector<std::string> sets;
-  std::string law;        ///< scaling.json whose "law" to use
-  double exponent = 0.0;  ///< or an explicit exponent (0: params' or linear)
-  std::string output;     ///< "" or "-": stdout
+  std::string law;            ///< scaling.json whose "law" to use
+  double exponent = 0.0;      ///< or an explicit exponent (0: params' or linear)
+  std::string output;         ///< "" or "-": stdout
+  bool allow_failed = false;  ///< use a params.json with "success": false
 };
 int cmd_upscale(const UpscaleOptions& options);
 
@@ -51,6 +52,7 @@ struct VerifyOptions {
   /// all cores, measured on the prototype; results are bit-identical for
   /// any count).
   int threads = 0;
+  bool allow_failed = false;  ///< use a params.json with "success": false
 };
 int cmd_verify(const VerifyOptions& options);
 
@@ -85,6 +87,7 @@ struct ExportCmdOptions {
   std::string consolidate_in = "auto";
   /// Seconds between demcal's consolidation progress lines on stderr.
   double progress_every_s = kProgressEverySeconds;
+  bool allow_failed = false;  ///< use a params.json with "success": false
 };
 int cmd_export(const ExportCmdOptions& options);
 
@@ -104,6 +107,11 @@ int cmd_rev(const RevCmdOptions& options);
 std::optional<SceneConfig> params_scene(const nlohmann::json& params, const std::string& path,
                                         const std::string& config_path,
                                         const std::vector<std::string>& sets);
+/// Before `command` (upscale, verify, export) uses the params.json at
+/// `path`: a failed calibration's ("success": false) is refused
+/// (require_calibrated: exit 2, the file and the field named), or with
+/// `allow_failed` used with a warning on stderr.
+void check_calibrated(const std::string& path, bool allow_failed, const char* command);
 /// The scaling law: --exponent, else --law scaling.json, else params.json's
 /// "upscaling" block, else linear.
 /// params_scene(), or an InputError asking for --config when there is none.

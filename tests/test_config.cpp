@@ -168,7 +168,9 @@ TEST(ConfigDefaults, FileRelativeToTheConfigFolder) {
   const SceneConfig c = parse_config_text(
       with_required_material(R"({"assembly": {"type": "file", "file": "p.csv"}})"),
       "dir/sub/scene.json");
-  EXPECT_EQ(std::filesystem::path(c.assembly.file), std::filesystem::path("dir/sub/p.csv"));
+  // Made absolute: params.json holds the config, and is read from anywhere.
+  EXPECT_EQ(std::filesystem::path(c.assembly.file),
+            std::filesystem::current_path() / "dir/sub/p.csv");
   const SceneConfig abs = parse_config_text(
       with_required_material(R"({"assembly": {"type": "file", "file": "/x/p.csv"}})"),
       "dir/s.json");

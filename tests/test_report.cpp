@@ -830,10 +830,10 @@ TEST(Report3D, KeptRunsAreTheReruns) {
 // prototype said to be what params.json says, and final.vtk beside it.
 TEST(Report3D, CalibrateWritesThe3DReportAndTheVtk) {
   const fs::path dir = test::fresh_path("report3d");
-  const int status = test::wait_exit(
-      test::spawn_demcal({"calibrate", "-q", "--jobs", "2", "--max-trials", "6", "-o", dir.string(),
-                          test::shipped_config("fcc_4x4x4"), "--set", "assembly.cells_x=2", "--set",
-                          "assembly.cells_y=2", "--set", "assembly.cells_z=2"}));
+  const int status = test::wait_exit(test::spawn_demcal(
+      {"calibrate", "-q", "--jobs", "2", "--max-trials", "12", "-o", dir.string(),
+       test::shipped_config("fcc_4x4x4"), "--set", "assembly.cells_x=2", "--set",
+       "assembly.cells_y=2", "--set", "assembly.cells_z=2"}));
   ASSERT_TRUE(status == 0 || status == 1) << status;
   const std::string html = test::read_text(dir / "report.html"),
                     md = test::read_text(dir / "report.md");

@@ -64,7 +64,7 @@ class RobustCli : public ::testing::Test {
 
   /// A small finished calibration in work()/A (under a second).
   void calibrate_a() {
-    const Result r = demcal({"calibrate", kHex5, "-o", "A", "-q", "-j", "1", "--max-trials", "8"});
+    const Result r = demcal({"calibrate", kHex5, "-o", "A", "-q", "-j", "1", "--max-trials", "12"});
     ASSERT_EQ(r.status, 0) << r.err;
     ASSERT_TRUE(fs::exists(work() / "A" / "resume.json"));
   }
@@ -139,7 +139,7 @@ TEST_F(RobustCli, ResumeWithOtherSettingsIsRefusedAndChangesNothing) {
 TEST_F(RobustCli, ScalingResumeWithOtherSettingsIsRefusedAndAFreshStartClearsTheSizes) {
   const std::vector<std::string> study = {
       "scaling", kHex5, "--sizes", "16,25,36", "--calibrate-max", "25", "--max-trials",
-      "8",       "-j",  "1",       "-q",       "--work",          "S"};
+      "12",      "-j",  "1",       "-q",       "--work",          "S"};
   const auto with = [&](std::vector<std::string> extra) {
     std::vector<std::string> args = study;
     args.insert(args.end(), extra.begin(), extra.end());
@@ -158,7 +158,7 @@ TEST_F(RobustCli, ScalingResumeWithOtherSettingsIsRefusedAndAFreshStartClearsThe
   ASSERT_TRUE(fs::exists(work() / "S" / "size-25" / "result.json"));
   expect_refused(with({"--resume", "--set", "material.friction=0.5"}), "config_sha256");
   std::vector<std::string> more_trials = study;
-  more_trials[7] = "9";  // --max-trials
+  more_trials[7] = "13";  // --max-trials
   more_trials.push_back("--resume");
   expect_refused(more_trials, "max_trials");
   {
@@ -174,7 +174,7 @@ TEST_F(RobustCli, ScalingResumeWithOtherSettingsIsRefusedAndAFreshStartClearsThe
 TEST_F(RobustCli, ResumeWithTheSameSettingsReusesEveryTrial) {
   calibrate_a();
   const Result r =
-      demcal({"calibrate", kHex5, "-o", "A", "-q", "-j", "1", "--max-trials", "8", "--resume"});
+      demcal({"calibrate", kHex5, "-o", "A", "-q", "-j", "1", "--max-trials", "12", "--resume"});
   ASSERT_EQ(r.status, 0) << r.err;
   const auto run = nlohmann::json::parse(read_text(work() / "A" / "run.json"));
   EXPECT_EQ(run["trials_run"].get<int>(), 0);
@@ -248,7 +248,7 @@ TEST_F(RobustCli, CutLastTrialLineIsRepaired) {
   const std::string whole = read_text(trials);
   std::ofstream(trials, std::ios::binary | std::ios::app) << "{\"id\": 9";
   const Result r =
-      demcal({"calibrate", kHex5, "-o", "A", "-q", "-j", "1", "--max-trials", "8", "--resume"});
+      demcal({"calibrate", kHex5, "-o", "A", "-q", "-j", "1", "--max-trials", "12", "--resume"});
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(read_text(trials), whole);  // the cut line gone, no trial rerun
 }

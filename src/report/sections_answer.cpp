@@ -137,7 +137,10 @@ void write_parameter_table(Doc& d, const ReportFacts& f) {
       p.row("rotational damping ratio", "ζ_r = D_r/D_r^crit", "-", "damping_ratio_rotation"),
       p.row("rotational damping", "D_r (lightest particle)", "N·m·s", "damping_rotation"),
       p.row("mass scaling", "f_ms", "-", "mass_scaling")};
-  d.table({"parameter", "symbol", "unit", S.success ? "REV (calibrated)" : "REV (best found)",
+  d.table({"parameter", "symbol", "unit",
+           S.success     ? "REV (calibrated)"
+           : f.have_best ? "REV (passed, NOT certified)"
+                         : "REV (none: no trial passed)",
            "prototype (upscaled)"},
           rows);
   d.para(
@@ -213,17 +216,18 @@ void write_criteria(Doc& d, const ReportFacts& f) {
             in.analytical_peak ? kpa(*in.analytical_peak) : std::string("n/a")}});
 }
 
-/// Nstep of the certificate's doubled run as the search ran it (rounded like
-/// every trial's): the certificate trial with the result's multipliers.
-int64_t doubled_steps(const CalibrationSummary& S) {
+/// Nstep of the certificate's doubled (`factor` 2) or halved (0.5) run as
+/// the search ran it (rounded like every trial's, so not exactly factor ×
+/// Nstep): the certificate trial with the result's multipliers.
+int64_t certificate_steps(const CalibrationSummary& S, double factor) {
   const auto& C = S.certificate;
-  int64_t steps = 2 * C.steps;
+  const double planned = factor * static_cast<double>(C.steps);
+  int64_t steps = std::llround(planned);
   for (const auto& t : S.trials)
     if (t.phase == TrialPhase::certificate && t.params.dt_ratio == S.best.dt_ratio &&
         t.params.damping_ratio_translation == S.best.damping_ratio_translation &&
         t.params.damping_ratio_rotation == S.best.damping_ratio_rotation &&
-        std::abs(static_cast<double>(t.params.steps) / static_cast<double>(2 * C.steps) - 1.0) <
-            2e-3)
+        std::abs(static_cast<double>(t.params.steps) / planned - 1.0) < 2e-3)
       steps = t.params.steps;
   return steps;
 }
@@ -238,13 +242,14 @@ void write_certificate(Doc& d, const ReportFacts& f) {
   }
   std::vector<std::vector<std::string>> rows{
       {"peak " + f.axial + " at Nstep = " + grouped(C.steps), kpa(C.peak)},
-      {"peak " + f.axial + " at 2·Nstep = " + grouped(doubled_steps(in.summary)),
+      {"peak " + f.axial + " at 2·Nstep = " + grouped(certificate_steps(in.summary, 2.0)),
        kpa(C.peak_doubled)},
       {"change |P(N) − P(2N)|/|P(2N)|", pct(C.steps_doubled_peak_change, 3)}};
   if (C.peak_halved && C.steps_halved_peak_change) {
     // 3D: the third level (search/calibration.hpp, Certificate).
     rows.push_back(
-        {"peak " + f.axial + " at Nstep/2 = " + grouped(C.steps / 2), kpa(*C.peak_halved)});
+        {"peak " + f.axial + " at Nstep/2 = " + grouped(certificate_steps(in.summary, 0.5)),
+         kpa(*C.peak_halved)});
     rows.push_back({"change |P(N/2) − P(N)|/|P(N)|", pct(*C.steps_halved_peak_change, 3)});
     rows.push_back(
         {"error estimate of P(N): the larger of 2 × |P(N) − P(2N)| and the halved "

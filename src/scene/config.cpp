@@ -8,6 +8,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <limits>
 #include <set>
 #include <sstream>
@@ -250,6 +251,22 @@ void require_material(const Reader& root, const json& root_json, const std::stri
       .require({"density", "kn", "kt", "friction"}, why);
 }
 
+// A particle file named in `source`: a relative name is relative to the
+// folder of the file that names it (a config; for params.json's "config"
+// object, "DIR/params.json: config", the params.json's folder), and is made
+// absolute here. An absolute name reads the same from any working
+// directory, and to_json() writes it so into params.json: calibrate,
+// upscale -o and a calibration folder moved elsewhere all leave it naming
+// the same file (a relative one would be joined to params.json's folder
+// again on reading, or break when the folder moves without the data).
+// "<embedded default ...>" has no folder: the working directory.
+std::string resolved_file(const std::string& file, const std::string& source) {
+  namespace fs = std::filesystem;
+  fs::path path(file);
+  if (path.is_relative() && source.rfind('<', 0) != 0) path = fs::path(source).parent_path() / path;
+  return fs::absolute(path).lexically_normal().string();
+}
+
 }  // namespace
 
 int64_t particle_count(const nlohmann::json& value, int64_t min, const std::string& file,
@@ -261,6 +278,16 @@ int64_t particle_count(const nlohmann::json& value, int64_t min, const std::stri
         file, field,
         std::string(e.what()) + " (a particle count: at most " + kMaxParticlesWhy + ")");
   }
+}
+
+void require_stable_dt_ratio(double dt_ratio, double stable, const std::string& file,
+                             const std::string& field, const std::string& remedy) {
+  if (dt_ratio <= stable) return;
+  std::ostringstream s;
+  s << std::setprecision(4) << dt_ratio
+    << " is beyond the stable step estimated from the consolidated contact network, " << stable
+    << " (" << remedy << ")";
+  throw InputError(file, field, s.str());
 }
 
 nlohmann::json to_json(const AlgorithmSpec& g) {
@@ -353,9 +380,7 @@ SceneConfig parse_config(const nlohmann::json& root_json, const std::string& sou
     } else {
       s.file = a.string("file", "");
       if (s.file.empty()) a.fail("file", "required for type \"file\"");
-      const auto dir = std::filesystem::path(source).parent_path();
-      if (std::filesystem::path(s.file).is_relative() && !dir.empty())
-        s.file = (dir / s.file).string();
+      s.file = resolved_file(s.file, source);
     }
     a.reject_unknown();
   }
@@ -402,6 +427,9 @@ SceneConfig parse_config(const nlohmann::json& root_json, const std::string& sou
     s.accuracy = k.positive("accuracy", s.accuracy);
     if (s.accuracy >= 1.0) k.fail("accuracy", "must be < 1 (a fraction, 0.02 = 2 %)");
     s.max_trials = static_cast<int>(k.integer("max_trials", s.max_trials, 1, 100000));
+    if (s.max_trials < kMinSearchTrials)
+      k.fail("max_trials", "must be at least " + std::to_string(kMinSearchTrials) + " (" +
+                               kMinSearchTrialsWhy + "), got " + std::to_string(s.max_trials));
     s.seed = static_cast<uint64_t>(
         k.integer("seed", static_cast<int64_t>(s.seed), 0, std::numeric_limits<int64_t>::max()));
     k.reject_unknown();
@@ -412,11 +440,7 @@ SceneConfig parse_config(const nlohmann::json& root_json, const std::string& sou
     // the prototype is generated, consolidated and verified by our kernel.
     c.prototype.particles = p.particles("particles", 0, 0);
     c.prototype.file = p.string("file", "");
-    if (!c.prototype.file.empty()) {
-      const auto dir = std::filesystem::path(source).parent_path();
-      if (std::filesystem::path(c.prototype.file).is_relative() && !dir.empty())
-        c.prototype.file = (dir / c.prototype.file).string();
-    }
+    if (!c.prototype.file.empty()) c.prototype.file = resolved_file(c.prototype.file, source);
     p.reject_unknown();
   }
   {

@@ -13,6 +13,7 @@
 #include <mutex>
 #include <set>
 #include <sstream>
+#include <stdexcept>
 #include <utility>
 #include <vector>
 
@@ -349,6 +350,7 @@ class Evaluator {
     std::shared_future<TrialRecord> future;
     std::promise<TrialRecord> promise;
     bool mine = false;
+    int search_ordinal = 0;  // this trial's place among the search's (the budget)
     {
       std::lock_guard<std::mutex> lock(mutex_);
       auto it = cache_.find(key);
@@ -357,12 +359,14 @@ class Evaluator {
         cache_.emplace(key, future);
         first_request_[key] = {position, phase};
         mine = true;
+        if (phase == TrialPhase::search) search_ordinal = ++search_trials_;
       } else {
         future = it->second;
         const auto old = preloaded_.find(key);
         if (old != preloaded_.end()) {
           // Asked for again: numbered as if it had just finished.
           ++reused_;
+          if (phase == TrialPhase::search) ++search_trials_;
           first_request_[key] = {position, phase};
           unsettled_.push_back({key, old->second, to_json(old->second).dump()});
           preloaded_.erase(old);
@@ -413,8 +417,11 @@ class Evaluator {
         std::ostringstream s;
         s.precision(3);
         const double elapsed = seconds_since(t0_);
-        s << "trial " << r.id + 1 << "/" << options_.max_trials << " (" << to_string(phase)
-          << "): alpha " << params.dt_ratio << ", steps " << params.steps << ", zeta_t "
+        // --max-trials bounds the search's trials; verification, the
+        // certificate and tightened searches come on top (no denominator).
+        s << "trial " << r.id + 1 << " (" << to_string(phase);
+        if (search_ordinal > 0) s << " " << search_ordinal << "/" << options_.max_trials;
+        s << "): alpha " << params.dt_ratio << ", steps " << params.steps << ", zeta_t "
           << params.damping_ratio_translation << ", zeta_r " << params.damping_ratio_rotation
           << " -> "
           << (r.score.diverged ? "diverged"
@@ -427,8 +434,9 @@ class Evaluator {
           s << "; best so far " << best_steps_ << " steps";
         }
         s << "; " << elapsed << " s elapsed";
-        if (run_ < options_.max_trials)
-          s << ", at most ~" << elapsed / run_ * (options_.max_trials - run_) << " s left";
+        if (search_ordinal > 0 && search_ordinal < options_.max_trials)
+          s << ", the search at most ~" << elapsed / run_ * (options_.max_trials - search_ordinal)
+            << " s more";
         options_.progress(s.str());
       }
     }
@@ -557,6 +565,7 @@ class Evaluator {
   std::map<Key, TrialRecord> preloaded_;  ///< of the resumed file, not asked for yet
   bool resumed_ = false;
   int next_id_ = 0, run_ = 0, reused_ = 0;
+  int search_trials_ = 0;  ///< phase search trials asked for (run or reused)
   int64_t best_steps_ = 0;
 };
 
@@ -694,6 +703,16 @@ struct ModelSearch {
 constexpr double kModelMargin = 1.1;  // aim a little below the tolerances
 constexpr double kFidelity = 8.0;     // search trials at N*/8
 constexpr int kVerifyBudget = 4;
+/// Fewest low-fidelity probes of a model search's first round (its second
+/// runs half as many): below it BOBYQA has no model of N*(α, ζ_t, ζ_r).
+constexpr int kModelRoundMin = 4;
+// --max-trials N bounds the first search's trials; the smallest N accepted
+// (kMinSearchTrials, config.hpp) is the model search's floor: two starts of
+// kModelRoundMin + kModelRoundMin/2 probes. From it up, a start given b =
+// (N - kVerifyBudget)/2 runs at most p + p/2 probes, p = max(kModelRoundMin,
+// b/2): 12 in all below N = 20, at most 3/4 of N - kVerifyBudget above.
+static_assert(2 * (kModelRoundMin + kModelRoundMin / 2) <= kMinSearchTrials);
+static_assert((kMinSearchTrials - kVerifyBudget) / 2 >= kModelRoundMin);
 
 double model_objective(unsigned, const double* x, double*, void* data) {
   auto& m = *static_cast<ModelSearch*>(data);
@@ -745,7 +764,7 @@ std::optional<ModelPrediction> model_predict(Evaluator& evaluator, const SearchS
   const double lower[3] = {space.lower[0], space.lower[2], space.lower[3]};
   const double upper[3] = {space.upper[0], space.upper[2], space.upper[3]};
   for (int k = 0; k < 3; ++k) x[k] = std::clamp(x[k], lower[k], upper[k]);
-  const int per_round = std::max(4, max_evals / 2);
+  const int per_round = std::max(kModelRoundMin, max_evals / 2);
   for (int round = 0; round < 2; ++round) {
     nlopt_opt opt = nlopt_create(NLOPT_LN_BOBYQA, 3);
     m.opt = opt;
@@ -810,7 +829,9 @@ std::optional<TrialRecord> verify_prediction(Evaluator& evaluator, const SearchS
 std::optional<TrialRecord> model_search(Evaluator& evaluator, const SearchSpace& space,
                                         const Tolerances& tolerances, const double* a,
                                         const double* b, int max_evals, int jobs) {
-  const int evals = std::max(8, max_evals - kVerifyBudget);
+  // max_evals >= kMinSearchTrials (the budget is checked where it is read):
+  // evals >= 2 * kModelRoundMin, each start its first round's floor.
+  const int evals = max_evals - kVerifyBudget;
   const double first = std::min(a[1], b[1]);
   std::optional<ModelPrediction> pa, pb;
   evaluator.run_branches(
@@ -980,7 +1001,12 @@ CalibrationSummary calibrate(const TrialRunner& runner, const AlgorithmSpec& bas
   const double start0[4] = {start.dt_ratio, log_n0, start.damping_ratio_translation,
                             start.damping_ratio_rotation};
   const double start1[4] = {0.85 * space.upper[0], log_n0 - 0.3, 0.5, 0.5};
+  // The first search's budget (config and command line refuse less).
   const int budget = options.max_trials;
+  if (budget < kMinSearchTrials)
+    throw std::invalid_argument("calibrate: max_trials " + std::to_string(budget) +
+                                " is below the search's minimum " +
+                                std::to_string(kMinSearchTrials));
   Tolerances tolerances = options.tolerances;
 
   auto search_round = [&](const double* a, const double* b, int evals, TrialPhase phase) {
@@ -1024,12 +1050,17 @@ CalibrationSummary calibrate(const TrialRunner& runner, const AlgorithmSpec& bas
   // Certificate; when it fails, tighten the tolerances and search again
   // from the best point, then fall back to doubling Nstep.
   std::optional<TrialRecord> best;
+  // The last trial certified, out.certificate's: the result. A round that
+  // finds nothing passing its tightened tolerances ends the loop, and the
+  // result stays the passing trial whose certificate failed.
+  std::optional<TrialRecord> certified;
   int64_t steps_floor = 0;  // raised by the fallback, so that it moves on
   for (int round = 0; round < 6; ++round) {
     // Judged against the current (possibly tightened) tolerances.
     best = cheapest_passing(evaluator.all(), &tolerances, steps_floor);
     if (!best) break;
     out.certificate = certify(evaluator, *best, options.accuracy, jobs, out.dimension == 3);
+    certified = best;
     if (evaluator.stopped()) return finish_interrupted();
     if (out.certificate.passed) break;
     if (round < 2) {
@@ -1044,7 +1075,8 @@ CalibrationSummary calibrate(const TrialRunner& runner, const AlgorithmSpec& bas
                            best->params.damping_ratio_translation,
                            best->params.damping_ratio_rotation};
       if (options.strategy == Strategy::model) {
-        model_search(evaluator, space, tolerances, x, x, std::max(8, budget / 4), jobs);
+        model_search(evaluator, space, tolerances, x, x, std::max(kMinSearchTrials, budget / 4),
+                     jobs);
       } else {
         SearchContext context{&evaluator, &space, tolerances, TrialPhase::search_tightened};
         local_search(options.strategy == Strategy::direct ? Strategy::cobyla : options.strategy,
@@ -1067,16 +1099,22 @@ CalibrationSummary calibrate(const TrialRunner& runner, const AlgorithmSpec& bas
   out.trials = evaluator.all();
   out.trials_run = evaluator.run_count();
   out.trials_reused = evaluator.reused_count();
-  if (best) {
-    out.best = rounded_params(best->params);
-    out.best_trial = *best;
+  if (certified) {
+    out.best = rounded_params(certified->params);
+    out.best_trial = *certified;
   }
-  out.success = best.has_value() && out.certificate.passed;
-  if (!best)
+  out.success = certified.has_value() && out.certificate.passed;
+  // Without a passing trial out.best stays the default, never run: params.json
+  // then holds no parameters (params_file), and says why here.
+  if (!certified)
     out.message = "no trial passed every criterion within " + std::to_string(budget) +
-                  " trials; raise --max-trials or loosen the tolerances";
+                  " search trials, so there are no parameters; raise --max-trials or loosen the "
+                  "tolerances";
   else if (!out.certificate.passed)
-    out.message = "the best passing parameters did not pass the convergence certificate";
+    out.message =
+        "the best passing parameters did not pass the convergence certificate (params.json "
+        "holds them, uncertified: upscale, verify and export refuse them without "
+        "--allow-failed)";
   else
     out.message = "calibrated: every criterion passed and Nstep doubled moves the peak by " +
                   std::to_string(100.0 * out.certificate.steps_doubled_peak_change) + " %";
@@ -1129,7 +1167,7 @@ std::string CalibrationSummary::BriefReport() const {
   std::ostringstream s;
   s.precision(4);
   s << (success ? "SUCCESS" : interrupted ? "INTERRUPTED" : "FAILURE") << ": " << message << "\n";
-  if (best_trial.score.particle_steps > 0)
+  if (has_best())
     s << "  dt_ratio " << best.dt_ratio << ", steps " << best.steps
       << ", damping_ratio_translation " << best.damping_ratio_translation
       << ", damping_ratio_rotation " << best.damping_ratio_rotation << "\n";
@@ -1143,7 +1181,7 @@ std::string CalibrationSummary::FullReport() const {
   s.precision(4);
   s << BriefReport();
   s << "  strategy " << to_string(strategy) << ", stable dt_ratio " << dt_ratio_stable << "\n";
-  if (best_trial.score.particle_steps > 0) {
+  if (has_best()) {
     const auto& c = best_trial.score.criteria;
     s << "  criteria: force balance " << c.force_balance << ", moment balance " << c.moment_balance
       << ", servo " << c.servo << ", oscillation " << c.oscillation << "\n"

@@ -15,12 +15,36 @@ nlohmann::json read_params_file(const std::string& path) {
   return parse_params_text(read_text_file(path), path);  // a folder, a loop: one clear error
 }
 
+void require_calibrated(const nlohmann::json& params, const std::string& path) {
+  const auto success = params.is_object() ? params.find("success") : params.end();
+  if (success == params.end() || *success != false) return;
+  std::string why;
+  if (const auto m = params.find("message"); m != params.end() && m->is_string())
+    why = " (" + quoted_value(m->get<std::string>(), 200) + ")";
+  throw InputError(path, "success",
+                   "is false: the calibration failed" + why +
+                       "; re-run demcal calibrate with more trials (--max-trials), or pass "
+                       "--allow-failed to use its uncertified parameters anyway");
+}
+
 nlohmann::json parse_params_text(std::string_view text, const std::string& path) {
   // The config's JSON reader: every nlohmann error (1e999 is out_of_range,
   // not a parse error) an InputError with its line, duplicate keys refused.
   const nlohmann::json params = parse_config_json(text, path);
   if (!params.is_object()) throw InputError(path, "", "must be a JSON object (a params.json)");
-  rev_params_from_json(params, path);  // the values used first: their key named first
+  // A calibration in which no trial passed has no parameters (params_file).
+  if (const auto rev = params.find("rev"); rev != params.end() && rev->is_null())
+    throw InputError(path, "rev",
+                     "is null: the calibration found no passing trial, so there are no "
+                     "parameters to use; re-run demcal calibrate with more trials (--max-trials)");
+  const RevParams rev = rev_params_from_json(params, path);  // the values used first: named first
+  // The stable step the calibration measured on the REV bounds its α, as
+  // it bounds `demcal run`'s (a params.json edited beyond it is refused).
+  if (const auto stable = params.find("dt_ratio_stable");
+      stable != params.end() && stable->is_number() && stable->get<double>() > 0.0)
+    require_stable_dt_ratio(rev.params.dt_ratio, stable->get<double>(), path, "rev.dt_ratio",
+                            "the stable dt_ratio this params.json records as dt_ratio_stable; "
+                            "use a smaller value, or calibrate again");
   const auto schema = params.find("schema");
   if (schema == params.end() || !schema->is_string() || *schema != kParamsSchema)
     throw InputError(
@@ -86,6 +110,14 @@ nlohmann::json calibration_record(const SceneConfig& config, int64_t n_rev,
           {"version", DEMCAL_VERSION}};
 }
 
+/// No trial passed: there is no parameter set, and none is written (a
+/// default or a failed trial's values would be taken for a result). rev,
+/// prototype, criteria and certificate are null; success is false and the
+/// message says why.
+void without_parameters(nlohmann::json& params) {
+  for (const char* key : {"rev", "prototype", "criteria", "certificate"}) params[key] = nullptr;
+}
+
 }  // namespace
 
 nlohmann::json params_file(const SceneConfig& config, const ConsolidatedState& state,
@@ -94,10 +126,14 @@ nlohmann::json params_file(const SceneConfig& config, const ConsolidatedState& s
   const int64_t n_proto = config.prototype.particles > 0 ? config.prototype.particles : n_rev;
   nlohmann::json params = calibration_record(config, n_rev, options, summary);
   params["schema"] = kParamsSchema;
-  params["rev"] = param_block(summary.best, particle_scales(state.world.radius(), config.material,
-                                                            summary.best.mass_scaling));
-  // Δt and damping recomputed from the prototype's own particles.
-  params["prototype"] = prototype_block(config, summary.best, n_rev);
+  if (summary.has_best()) {
+    params["rev"] = param_block(summary.best, particle_scales(state.world.radius(), config.material,
+                                                              summary.best.mass_scaling));
+    // Δt and damping recomputed from the prototype's own particles.
+    params["prototype"] = prototype_block(config, summary.best, n_rev);
+  } else {
+    without_parameters(params);
+  }
   params["upscaling"] = upscaling_block(n_rev, n_proto);
   if (auto a = analytical_peak_stress(config)) params["analytical_peak_stress_yy"] = *a;
   return params;
@@ -106,20 +142,23 @@ nlohmann::json params_file(const SceneConfig& config, const ConsolidatedState& s
 nlohmann::json params_file(const SceneConfig& config, const TriaxialState& state,
                            const CalibrationOptions& options, const CalibrationSummary& summary) {
   const int64_t n_rev = state.world.size();
-  nlohmann::json rev =
-      param_block(summary.best, sphere_scales(state.world, config.material, summary.best));
-  // Δt and damping recomputed from the prototype's own spheres; Nstep by
-  // the default 3D law (N^(2/3); `demcal upscale --law` applies another).
   const ScalingLaw law = default_law(3);
-  nlohmann::json prototype = prototype_block(config, summary.best, n_rev, law);
-  const int64_t n_proto = json_integer(prototype.at("particles"), 1);
   nlohmann::json params = calibration_record(config, n_rev, options, summary);
   params["schema"] = kParamsSchema;
   params["dimension"] = 3;
   params["test"] = "triaxial";
-  params["rev"] = rev;
-  params["prototype"] = prototype;
-  params["upscaling"] = upscaling_block(n_rev, n_proto, law);
+  if (summary.has_best()) {
+    params["rev"] =
+        param_block(summary.best, sphere_scales(state.world, config.material, summary.best));
+    // Δt and damping recomputed from the prototype's own spheres; Nstep by
+    // the default 3D law (N^(2/3); `demcal upscale --law` applies another).
+    params["prototype"] = prototype_block(config, summary.best, n_rev, law);
+    const int64_t n_proto = json_integer(params["prototype"].at("particles"), 1);
+    params["upscaling"] = upscaling_block(n_rev, n_proto, law);
+  } else {
+    without_parameters(params);
+    params["upscaling"] = upscaling_block(n_rev, n_rev, law);
+  }
   params["axial_component"] =
       "criteria.peak_stress_yy and certificate.peak_stress_yy* hold the axial b_zz (the triaxial "
       "test's axis is z)";

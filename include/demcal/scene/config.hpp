@@ -64,7 +64,8 @@ struct AssemblySpec {
   double radius_std = 1e-4;              ///< random lognormal: standard deviation [m]
   double aspect = 1.0;                   ///< random: width/height of the initial box
   uint64_t seed = 1;                     ///< random
-  /// file: CSV x,y,r (2D) or x,y,z,r (3D), relative to the config
+  /// file: CSV x,y,r (2D) or x,y,z,r (3D); written relative to the config's
+  /// folder, held (and written to params.json) as an absolute path
   std::string file;
 };
 
@@ -116,9 +117,20 @@ AlgorithmSpec algorithm_from_json(const nlohmann::json& json, const std::string&
 /// takes its defaults from here.
 struct CalibrationSpec {
   double accuracy = 0.02;  ///< target relative error of the peak
+  /// The first search's trials at most (--max-trials); verification of the
+  /// model's prediction, the convergence certificate and the tightened
+  /// searches after a failed certificate come on top.
   int max_trials = 80;
   uint64_t seed = 1;
 };
+
+/// The fewest search trials a calibration accepts (max_trials, --max-trials):
+/// the model strategy's two starts need 4 + 2 probes each (calibration.cpp
+/// asserts it), and every strategy's two starts at least 5 (COBYLA's simplex
+/// in 4 parameters). Less is refused, not raised.
+inline constexpr int kMinSearchTrials = 12;
+inline constexpr const char* kMinSearchTrialsWhy =
+    "the search's two starts need 6 trials each; verification and the certificate come on top";
 
 struct PrototypeSpec {
   int64_t particles = 0;  ///< 0: the REV itself
@@ -144,8 +156,17 @@ struct SceneConfig {
   std::string text;    ///< the JSON as read (for the config hash)
 };
 
+/// The stable-step rule (`demcal run`, params.json): a dt_ratio beyond the
+/// stable dt_ratio estimated from the consolidated contact network is bad
+/// input, an InputError naming `file` and `field`, with `remedy` (what to
+/// do instead) in parentheses.
+void require_stable_dt_ratio(double dt_ratio, double stable, const std::string& file,
+                             const std::string& field, const std::string& remedy);
+
 /// Parse and validate. `source` names the file in errors; relative paths in
-/// the config are resolved against its folder.
+/// the config (assembly.file, prototype.file) are resolved against its
+/// folder and made absolute, so that to_json() writes paths that read the
+/// same from any folder.
 SceneConfig parse_config(const nlohmann::json& json, const std::string& source);
 SceneConfig parse_config_text(std::string_view text, const std::string& source);
 SceneConfig load_config(const std::string& path);

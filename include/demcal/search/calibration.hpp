@@ -165,6 +165,12 @@ struct CalibrationSummary {
   Strategy strategy = CalibrationOptions{}.strategy;  ///< options.strategy
   int dimension = 2;  ///< of the scene calibrated (TrialRunner::dimension())
 
+  /// best and best_trial hold a trial that passed every criterion (the
+  /// cheapest; certified when success). False when no trial passed: best
+  /// is then the default AlgorithmSpec, never run, and params.json holds
+  /// no parameters. (A summary built by hand with success set has one.)
+  bool has_best() const { return success || best_trial.score.particle_steps > 0.0; }
+
   std::string BriefReport() const;
   std::string FullReport() const;
 };

@@ -44,9 +44,18 @@ inline constexpr const char* kParamsSchema = "demcal.params/1";
 /// 2). Every fault is an InputError naming the file
 /// and the key (exit 2).
 nlohmann::json read_params_file(const std::string& path);
+/// Also refused: a "rev" of null (a calibration in which no trial passed
+/// writes no parameters), and a rev.dt_ratio beyond the "dt_ratio_stable"
+/// recorded beside it (require_stable_dt_ratio, the rule of `demcal run`).
 /// The same checks on a params.json's text (`path` names it in errors);
 /// read_params_file reads the file and calls this.
 nlohmann::json parse_params_text(std::string_view text, const std::string& path);
+/// What `upscale`, `verify` and `export` ask of a params.json before using
+/// it (unless --allow-failed): a calibration that succeeded. "success":
+/// false is an InputError naming `path` and the field success, with the
+/// calibration's message and the remedy. Nothing is asked of a params.json
+/// without the key.
+void require_calibrated(const nlohmann::json& params, const std::string& path);
 /// The dimension a params.json was calibrated in: its "dimension" (2 when
 /// absent, as 2D params.json files have always been written).
 int params_dimension(const nlohmann::json& params);
