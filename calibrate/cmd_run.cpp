@@ -52,14 +52,12 @@ void print_scales(const SceneConfig& config, const World& world) {
 }  // namespace
 
 void require_stable_step(const SceneConfig& config, double stable, bool allow_unstable) {
-  if (allow_unstable || config.algorithm.dt_ratio <= stable) return;
-  std::ostringstream s;
-  s << std::setprecision(4) << config.algorithm.dt_ratio
-    << " is beyond the stable step estimated from the consolidated contact network, " << stable
-    << " (use a smaller value; "
-    << (config.dimension == 2 ? "`demcal stability` measures the limit, " : "")
-    << "`demcal run --allow-unstable` runs it anyway)";
-  throw InputError(config.source, "algorithm.dt_ratio", s.str());
+  if (allow_unstable) return;
+  require_stable_dt_ratio(
+      config.algorithm.dt_ratio, stable, config.source, "algorithm.dt_ratio",
+      std::string("use a smaller value; ") +
+          (config.dimension == 2 ? "`demcal stability` measures the limit, " : "") +
+          "`demcal run --allow-unstable` runs it anyway");
 }
 
 namespace {

@@ -61,7 +61,7 @@ struct ScalingOptions {
   std::vector<std::string> sets;
   std::string sizes = "25,100,400,1600";
   int64_t calibrate_max = 400;  ///< larger sizes are only checked forward
-  std::string out_dir;          ///< report folder (default reports)
+  std::string out_dir;          ///< report folder (default demcal-scaling-NAME)
   std::string work_dir;         ///< per-size work (default demcal-scaling-NAME)
   int jobs = 0;
   int max_trials = 0;

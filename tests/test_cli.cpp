@@ -472,7 +472,7 @@ TEST_F(CliEndToEnd, CalibrateNamesWhatItWroteAndLeavesNoEarlierResult) {
   std::ofstream(out / "evidence.jsonl") << "{}\n";
   std::ofstream(out / "keep.txt") << "mine\n";
   const Result r =
-      demcal({"calibrate", kHex5, "-o", out.string(), "-q", "-j", "1", "--max-trials", "8"});
+      demcal({"calibrate", kHex5, "-o", out.string(), "-q", "-j", "1", "--max-trials", "12"});
   ASSERT_EQ(r.status, 0) << r.err;
   std::set<std::string> named{"keep.txt"};
   for (const std::string& line : lines_of(r.out)) {

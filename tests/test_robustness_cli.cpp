@@ -323,4 +323,15 @@ TEST_F(RobustCli, FailedRevLeavesNoFolder) {
   EXPECT_FALSE(fs::exists(work() / "out"));
 }
 
+// A bad value given by --set is named as the --set's, not the config
+// file's (the file is fine); a check across keys still names the file.
+TEST_F(RobustCli, ABadSetValueIsNamedAsTheSets) {
+  expect_refused({"check", kHex5, "--set", "algorithm.dt_ratio=-1"},
+                 "--set algorithm.dt_ratio=-1: algorithm.dt_ratio: must be > 0");
+  expect_refused({"check", kHex5, "--set", "algorithm.nosuch=1"},
+                 "--set algorithm.nosuch=1: algorithm.nosuch: unknown key");
+  const Result r = demcal({"check", kHex5, "--set", "algorithm.dt_ratio=-1"});
+  EXPECT_EQ(r.err.find("hex_5x5.json"), std::string::npos) << r.err;
+}
+
 }  // namespace

@@ -533,7 +533,21 @@ SceneConfig load_config(const std::string& path, const std::vector<std::string>&
   const std::string text = embedded ? std::string(default_config_text()) : read_text_file(path);
   nlohmann::json j = parse_config_json(text, source);
   apply_overrides(j, sets, source);
-  SceneConfig config = parse_config(j, source);
+  SceneConfig config;
+  try {
+    config = parse_config(j, source);
+  } catch (const InputError& e) {
+    // A value a --set gave is the --set's fault, not the file's: the error
+    // names it (a check across keys still names the file).
+    const std::string prefix = e.file() + ": " + (e.field().empty() ? "" : e.field() + ": ");
+    const std::string what = std::string(e.what()).substr(prefix.size());
+    for (const auto& set : sets) {
+      const std::string key = set.substr(0, set.find('='));
+      if (e.field() == key || e.field().rfind(key + ".", 0) == 0)
+        throw InputError("--set " + set, e.field(), what);
+    }
+    throw;
+  }
   config.text = sets.empty() ? text : j.dump();
   return config;
 }
