@@ -121,10 +121,11 @@ TEST_F(CliEndToEnd, BadOverridesAndMissingFilesExitTwo) {
   const std::string out = (dir_ / "work" / "out").string();
   expect_bad_input({"run", kHex5, "--set", "algorithm.steps", "-o", out},
                    {kHex5, "algorithm.steps"});
+  // A value or key a --set gave is named as the --set's (the file is fine).
   expect_bad_input({"run", kHex5, "--set", "algorithm.steps=-5", "-o", out},
-                   {kHex5, "algorithm.steps"});
+                   {"--set algorithm.steps=-5: algorithm.steps"});
   expect_bad_input({"run", kHex5, "--set", "algorithm.stepz=5", "-o", out},
-                   {kHex5, "algorithm.stepz"});
+                   {"--set algorithm.stepz=5: algorithm.stepz"});
   expect_bad_input({"run", kHex5, "--set", "material.kn=1e999", "-o", out}, {kHex5, "material.kn"});
   const std::string missing = (dir_ / "missing.json").string();
   expect_bad_input({"run", missing, "-o", out}, {missing});
