@@ -149,8 +149,11 @@ TEST_F(ParamsFixes, FailedCalibrationHoldsNoParametersAndIsRefused) {
   expect_refused({"upscale", p, "--particles", "25", "-o", "x.json"}, {p, "success"});
   expect_refused({"export", p, "--particles", "25", "-o", "x/d.lammps"}, {p, "success"});
   expect_refused({"verify", p, "--particles", "25", "-o", "v"}, {p, "success"});
-  // The override cannot make parameters out of none.
+  // The override cannot make parameters out of none, so the message does
+  // not offer it.
   expect_refused({"upscale", p, "--particles", "25", "--allow-failed"}, {p, "rev"});
+  const Result none = demcal({"upscale", p, "--particles", "25", "-o", "x.json"});
+  EXPECT_EQ(none.err.find("--allow-failed"), std::string::npos) << none.err;
 }
 
 // Defect 2, passing trials but no certificate (an accuracy no Nstep meets):
@@ -176,6 +179,8 @@ TEST_F(ParamsFixes, UncertifiedCalibrationHoldsATrialItRanAndNeedsAllowFailed) {
   const std::string p = "uncert/params.json";
   expect_refused({"upscale", p, "--particles", "25", "-o", "x.json"}, {p, "success"});
   expect_refused({"export", p, "--particles", "25", "-o", "x/d.lammps"}, {p, "success"});
+  const Result refused = demcal({"upscale", p, "--particles", "25", "-o", "x.json"});
+  EXPECT_NE(refused.err.find("--allow-failed"), std::string::npos) << refused.err;
   const Result r = demcal({"upscale", p, "--particles", "25", "--allow-failed", "-o", "x.json"});
   EXPECT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.err.find("warning"), std::string::npos) << r.err;

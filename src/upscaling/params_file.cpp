@@ -21,10 +21,15 @@ void require_calibrated(const nlohmann::json& params, const std::string& path) {
   std::string why;
   if (const auto m = params.find("message"); m != params.end() && m->is_string())
     why = " (" + quoted_value(m->get<std::string>(), 200) + ")";
+  // --allow-failed helps only where there are parameters (rev not null).
+  const auto rev = params.find("rev");
+  const bool has_parameters = rev != params.end() && !rev->is_null();
   throw InputError(path, "success",
                    "is false: the calibration failed" + why +
-                       "; re-run demcal calibrate with more trials (--max-trials), or pass "
-                       "--allow-failed to use its uncertified parameters anyway");
+                       "; re-run demcal calibrate with more trials (--max-trials)" +
+                       (has_parameters ? std::string(", or pass --allow-failed to use its "
+                                                     "uncertified parameters anyway")
+                                       : std::string()));
 }
 
 nlohmann::json parse_params_text(std::string_view text, const std::string& path) {
