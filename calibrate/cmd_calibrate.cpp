@@ -183,6 +183,7 @@ Invocation prepare(const CalibrateOptions& o) {
   SceneConfig& config = v.config;
   v.three_d = config.dimension == 3;
   if (o.max_trials > 0) config.calibration.max_trials = o.max_trials;
+  require_calibration_budget(config);  // --max-trials is checked at parse time
   if (o.accuracy > 0) config.calibration.accuracy = o.accuracy;
   if (o.accuracy < 0 || o.accuracy >= 1)
     throw InputError("--accuracy", "", "must be a fraction in (0, 1), e.g. 0.02");
@@ -247,15 +248,18 @@ void ready_output_folder(const CalibrateOptions& o, const Invocation& v) {
     std::filesystem::remove(v.trials_path);
     write_resume_key(dir, v.key);
   }
-  // Results of an earlier run in this folder would not match the trials
-  // from here on: every file a calibration writes at the end goes, whether
-  // or not this one writes it again (final.vtk of a 3D report stayed beside
-  // a 2D one). Not a refusal of a non-empty folder: --resume and a
-  // recalibration into the same -o are how the folder is meant to be used,
-  // and the user's own files in it stay.
-  for (const char* name :
-       {"params.json", "run.json", "report.html", "report.md", "evidence.jsonl", "final.vtk"})
+  // Results of an earlier calibration in this folder would not match the
+  // trials from here on: every file a calibration writes at the end goes,
+  // whether or not this one writes it again (final.vtk of a 3D report
+  // stayed beside a 2D one). Not a refusal of a non-empty folder: --resume
+  // and a recalibration into the same -o are how the folder is meant to be
+  // used, and the user's own files in it stay — so final.vtk, which `demcal
+  // run` writes too, goes only where an earlier calibration's run.json says
+  // it was that calibration's.
+  const bool earlier_calibration = std::filesystem::exists(dir + "/run.json");
+  for (const char* name : {"params.json", "run.json", "report.html", "report.md", "evidence.jsonl"})
     std::filesystem::remove(dir + "/" + name);
+  if (earlier_calibration) std::filesystem::remove(dir + "/final.vtk");
 }
 
 /// The --evidence runs: the paper's recipe done mechanically (α = 0.2,

@@ -18,6 +18,7 @@ int cmd_scaling(const ScalingOptions& o) {
   // 2D (disks, biaxial) and 3D (spheres, triaxial) families alike.
   SceneConfig config = load_config(o.config, o.sets);
   if (o.max_trials > 0) config.calibration.max_trials = o.max_trials;
+  require_calibration_budget(config);  // --max-trials is checked at parse time
   ScalingStudyOptions so;
   so.sizes = parse_sizes(o.sizes, "--sizes");
   so.sizes_text = o.sizes;

@@ -69,12 +69,15 @@ int cmd_sweep(const SweepOptions& options) {
       out.write("series/" + r.spec.name + ".csv", r.run.series_csv);
       written.insert(r.spec.name + ".csv");
     }
-    // An earlier sweep's series that this one does not write (the alpha
-    // scan's names follow the estimated stable step) would pass for this
-    // sweep's cases: they go with the rest.
+    // An earlier sweep's α-scan series that this one does not write (their
+    // names follow the estimated stable step) would pass for this sweep's
+    // cases: they go with the rest. Every other name a sweep writes is
+    // fixed, so it is replaced; anything else in series/ is not a sweep's
+    // and stays.
     std::error_code ec;
     for (const auto& e : std::filesystem::directory_iterator(dir + "/series", ec))
       if (e.is_regular_file() && e.path().extension() == ".csv" &&
+          e.path().filename().string().rfind("alpha_", 0) == 0 &&
           !written.count(e.path().filename().string()))
         out.retire("series/" + e.path().filename().string());
     out.write("evidence.csv", evidence_csv(result));

@@ -61,16 +61,14 @@ std::optional<SceneConfig> params_scene(const nlohmann::json& params, const std:
     if (c->dimension != params_dimension(params)) same_dimension(*c, params, path);
     if (sets.empty()) return c;
     nlohmann::json j = to_json(*c);
-    apply_overrides(j, sets, path + ": config");
-    return parse_config(j, path + ": config");
+    return parse_config_with_overrides(j, sets, path + ": config");
   }
   // A params.json of the embedded default scene needs no config.
   const SceneConfig def = default_config();
   if (params.is_object() && params.value("scene", std::string()) == def.name) {
     if (sets.empty()) return def;
     nlohmann::json j = to_json(def);
-    apply_overrides(j, sets, def.source);
-    return parse_config(j, def.source);
+    return parse_config_with_overrides(j, sets, def.source);
   }
   return std::nullopt;
 }
@@ -150,8 +148,7 @@ int cmd_upscale(const UpscaleOptions& o) {
   if (config) {
     // Named absolutely in the params.json written (its prototype.source.file),
     // like the config's files: verify and export read it from any folder.
-    const std::string file =
-        o.prototype.empty() ? "" : fs::absolute(o.prototype).lexically_normal().string();
+    const std::string file = o.prototype.empty() ? "" : fs::absolute(o.prototype).string();
     block = prototype_block(*config, rev.params, rev.particles, law, o.particles, file);
     n_proto = json_integer(block.at("particles"), 1);
   } else {

@@ -120,13 +120,14 @@ TEST_F(CliEndToEnd, BadConfigsExitTwoNameFileAndKeyAndWriteNothing) {
 TEST_F(CliEndToEnd, BadOverridesAndMissingFilesExitTwo) {
   const std::string out = (dir_ / "work" / "out").string();
   expect_bad_input({"run", kHex5, "--set", "algorithm.steps", "-o", out},
-                   {kHex5, "algorithm.steps"});
+                   {"--set algorithm.steps", "section.key=value"});
   // A value or key a --set gave is named as the --set's (the file is fine).
   expect_bad_input({"run", kHex5, "--set", "algorithm.steps=-5", "-o", out},
                    {"--set algorithm.steps=-5: algorithm.steps"});
   expect_bad_input({"run", kHex5, "--set", "algorithm.stepz=5", "-o", out},
                    {"--set algorithm.stepz=5: algorithm.stepz"});
-  expect_bad_input({"run", kHex5, "--set", "material.kn=1e999", "-o", out}, {kHex5, "material.kn"});
+  expect_bad_input({"run", kHex5, "--set", "material.kn=1e999", "-o", out},
+                   {"--set material.kn=1e999", "material.kn"});
   const std::string missing = (dir_ / "missing.json").string();
   expect_bad_input({"run", missing, "-o", out}, {missing});
   expect_bad_input({"run", dir_.string(), "-o", out}, {dir_.string()});  // a folder
@@ -470,6 +471,7 @@ TEST_F(CliEndToEnd, CalibrateNamesWhatItWroteAndLeavesNoEarlierResult) {
   const fs::path out = dir_ / "work" / "out";
   fs::create_directories(out);
   std::ofstream(out / "final.vtk") << "an earlier 3D calibration's\n";
+  std::ofstream(out / "run.json") << "{}\n";  // that calibration's
   std::ofstream(out / "evidence.jsonl") << "{}\n";
   std::ofstream(out / "keep.txt") << "mine\n";
   const Result r =
@@ -488,6 +490,16 @@ TEST_F(CliEndToEnd, CalibrateNamesWhatItWroteAndLeavesNoEarlierResult) {
   EXPECT_TRUE(named.count("resume.json")) << r.out;
   EXPECT_EQ(test::names_in(out), named) << r.out;
   EXPECT_FALSE(fs::exists(out / "final.vtk"));
+
+  // A final.vtk with no calibration's run.json beside it is a `demcal run`'s
+  // (or the user's): a calibration does not write it in 2D, so it stays.
+  const fs::path ran = dir_ / "work" / "ran";
+  fs::create_directories(ran);
+  std::ofstream(ran / "final.vtk") << "a run's\n";
+  const Result c =
+      demcal({"calibrate", kHex5, "-o", ran.string(), "-q", "-j", "1", "--max-trials", "12"});
+  ASSERT_EQ(c.status, 0) << c.err;
+  EXPECT_EQ(read_text(ran / "final.vtk"), "a run's\n");
 }
 
 // A computation that fails (consolidation gives up) is not bad input: exit

@@ -196,6 +196,28 @@ TEST_F(ParamsFixes, MaxTrialsBelowTheSearchMinimumIsRefused) {
                        R"( "calibration": {"max_trials": 3}})");
   expect_refused({"calibrate", config, "-o", "out"}, {config, "calibration.max_trials", "12"});
   expect_refused({"scaling", kHex5, "--max-trials", "3"}, {"--max-trials", "12"});
+  // Only a calibration needs the budget: the config stays valid for the
+  // other commands (and in params.json files made from it).
+  const Result checked = demcal({"check", config});
+  EXPECT_EQ(checked.status, 0) << checked.err;
+}
+
+// A relative particle file is found as the system finds it: through a
+// symbolic link to the config's folder, "../p.csv" is beside the link's
+// target, not beside the link (the text is not normalised).
+TEST_F(ParamsFixes, ARelativeParticleFileIsResolvedThroughALinkedFolder) {
+  const fs::path real = tmp_.path() / "b" / "real", linked = tmp_.path() / "a" / "link";
+  fs::create_directories(real);
+  fs::create_directories(linked.parent_path());
+  fs::create_directory_symlink(real, linked);
+  test::write_text(real.parent_path() / "p.csv",
+                   "x,y,r\n0.001,0.001,0.0005\n0.002,0.001,0.0005\n"
+                   "0.001,0.002,0.0005\n0.002,0.002,0.0005\n");
+  const std::string config = test::write_text(
+      real / "cfg.json", R"({"material": {"density": 2600, "kn": 1e7, "kt": 1e7, "friction": 0.5},)"
+                         R"( "assembly": {"type": "file", "file": "../p.csv"}})");
+  const Result r = demcal({"check", (linked / "cfg.json").string()});
+  EXPECT_EQ(r.status, 0) << r.err;
 }
 
 // --max-trials N bounds the search's trials, and the progress line counts

@@ -175,7 +175,7 @@ TEST(ScoreVerdict, AnIncompleteSeriesFailsForBeingIncomplete) {
       score("incomplete", series_2d("# steps = 400\n", 100, {}, ",lateral_stress_error", ",0"));
   ASSERT_EQ(s.status, 1) << s.out;
   EXPECT_FALSE(s.summary.at("complete").get<bool>());
-  EXPECT_EQ(s.summary.at("verdict"),
+  EXPECT_EQ(s.summary.at("verdict_line"),
             "FAIL: incomplete: the series ran 100 of the 400 steps planned");
   EXPECT_TRUE(has(s.out, "  FAIL: incomplete: the series ran 100 of the 400 steps planned\n"))
       << s.out;

@@ -282,6 +282,7 @@ TEST(Sweep, CommandWritesTheAtlas) {
   fs::create_directories(dir / "series");
   std::ofstream(dir / "series" / "alpha_0.999.csv") << "an earlier sweep's\n";
   std::ofstream(dir / "series" / "notes.txt") << "mine\n";
+  std::ofstream(dir / "series" / "my_probe.csv") << "mine too\n";
   const test::RunResult r =
       test::run_demcal({"sweep", test::shipped_config("hex_5x5"), "--set", "algorithm.steps=2000",
                         "--jobs", "2", "-o", dir.string()},
@@ -290,6 +291,7 @@ TEST(Sweep, CommandWritesTheAtlas) {
   EXPECT_EQ(r.status, 0) << r.err;
   EXPECT_FALSE(fs::exists(dir / "series" / "alpha_0.999.csv"));
   EXPECT_TRUE(fs::exists(dir / "series" / "notes.txt"));
+  EXPECT_TRUE(fs::exists(dir / "series" / "my_probe.csv"));
   for (const char* f : {"atlas.md", "atlas.json", "evidence.csv", "series/benchmark.csv",
                         "series/steps_x33.csv", "series/mass_1e8_undamped.csv"})
     EXPECT_TRUE(fs::exists(dir / f)) << f;

@@ -264,7 +264,9 @@ std::string resolved_file(const std::string& file, const std::string& source) {
   namespace fs = std::filesystem;
   fs::path path(file);
   if (path.is_relative() && source.rfind('<', 0) != 0) path = fs::path(source).parent_path() / path;
-  return fs::absolute(path).lexically_normal().string();
+  // Not lexically_normal(): "link/../p.csv" is for the system to resolve
+  // (through the link), not for the text to cancel.
+  return fs::absolute(path).string();
 }
 
 }  // namespace
@@ -278,6 +280,14 @@ int64_t particle_count(const nlohmann::json& value, int64_t min, const std::stri
         file, field,
         std::string(e.what()) + " (a particle count: at most " + kMaxParticlesWhy + ")");
   }
+}
+
+void require_calibration_budget(const SceneConfig& config) {
+  if (config.calibration.max_trials >= kMinSearchTrials) return;
+  throw InputError(config.source, "calibration.max_trials",
+                   "must be at least " + std::to_string(kMinSearchTrials) + " (" +
+                       kMinSearchTrialsWhy + "), got " +
+                       std::to_string(config.calibration.max_trials));
 }
 
 void require_stable_dt_ratio(double dt_ratio, double stable, const std::string& file,
@@ -427,9 +437,6 @@ SceneConfig parse_config(const nlohmann::json& root_json, const std::string& sou
     s.accuracy = k.positive("accuracy", s.accuracy);
     if (s.accuracy >= 1.0) k.fail("accuracy", "must be < 1 (a fraction, 0.02 = 2 %)");
     s.max_trials = static_cast<int>(k.integer("max_trials", s.max_trials, 1, 100000));
-    if (s.max_trials < kMinSearchTrials)
-      k.fail("max_trials", "must be at least " + std::to_string(kMinSearchTrials) + " (" +
-                               kMinSearchTrialsWhy + "), got " + std::to_string(s.max_trials));
     s.seed = static_cast<uint64_t>(
         k.integer("seed", static_cast<int64_t>(s.seed), 0, std::numeric_limits<int64_t>::max()));
     k.reject_unknown();
@@ -532,36 +539,39 @@ SceneConfig load_config(const std::string& path, const std::vector<std::string>&
   const std::string source = embedded ? "<embedded default: configs/hex_10x10.json>" : path;
   const std::string text = embedded ? std::string(default_config_text()) : read_text_file(path);
   nlohmann::json j = parse_config_json(text, source);
-  apply_overrides(j, sets, source);
-  SceneConfig config;
+  SceneConfig config = parse_config_with_overrides(j, sets, source);
+  config.text = sets.empty() ? text : j.dump();
+  return config;
+}
+
+SceneConfig parse_config_with_overrides(nlohmann::json& j, const std::vector<std::string>& sets,
+                                        const std::string& source) {
+  apply_overrides(j, sets);
   try {
-    config = parse_config(j, source);
+    return parse_config(j, source);
   } catch (const InputError& e) {
     // A value a --set gave is the --set's fault, not the file's: the error
     // names it (a check across keys still names the file).
     const std::string prefix = e.file() + ": " + (e.field().empty() ? "" : e.field() + ": ");
     const std::string what = std::string(e.what()).substr(prefix.size());
-    for (const auto& set : sets) {
-      const std::string key = set.substr(0, set.find('='));
+    for (auto set = sets.rbegin(); set != sets.rend(); ++set) {
+      const std::string key = set->substr(0, set->find('='));
       if (e.field() == key || e.field().rfind(key + ".", 0) == 0)
-        throw InputError("--set " + set, e.field(), what);
+        throw InputError("--set " + *set, e.field(), what);
     }
     throw;
   }
-  config.text = sets.empty() ? text : j.dump();
-  return config;
 }
 
 SceneConfig default_config() {
   return parse_config_text(default_config_text(), "<embedded default: configs/hex_10x10.json>");
 }
 
-void apply_overrides(nlohmann::json& j, const std::vector<std::string>& sets,
-                     const std::string& source) {
+void apply_overrides(nlohmann::json& j, const std::vector<std::string>& sets) {
   for (const auto& set : sets) {
+    const std::string source = "--set " + set;  // what the errors name
     const auto eq = set.find('=');
-    if (eq == std::string::npos || eq == 0)
-      throw InputError(source, "--set " + set, "wants section.key=value");
+    if (eq == std::string::npos || eq == 0) throw InputError(source, "", "wants section.key=value");
     const std::string key = set.substr(0, eq), value = set.substr(eq + 1);
     nlohmann::json v;
     try {
@@ -569,14 +579,14 @@ void apply_overrides(nlohmann::json& j, const std::vector<std::string>& sets,
     } catch (const nlohmann::json::parse_error&) {
       v = value;  // a bare word is a string
     } catch (const nlohmann::json::exception& e) {
-      throw InputError(source, key, "--set value " + quoted_value(value) + " is out of range");
+      throw InputError(source, key, "value " + quoted_value(value) + " is out of range");
     }
     nlohmann::json* node = &j;
     std::string rest = key;
     for (;;) {
       const auto dot = rest.find('.');
       const std::string part = rest.substr(0, dot);
-      if (part.empty()) throw InputError(source, "--set " + set, "key has an empty part");
+      if (part.empty()) throw InputError(source, "", "key has an empty part");
       if (dot == std::string::npos) {
         (*node)[part] = v;
         break;
@@ -585,8 +595,7 @@ void apply_overrides(nlohmann::json& j, const std::vector<std::string>& sets,
       node = &(*node)[part];
       if (!node->is_object())
         throw InputError(source, key.substr(0, key.size() - rest.size() + part.size()),
-                         "--set " + quoted_value(set) + ": not a section (holds " +
-                             quoted_value(node->dump()) + ")");
+                         "not a section (holds " + quoted_value(node->dump()) + ")");
       rest = rest.substr(dot + 1);
     }
   }

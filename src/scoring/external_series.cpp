@@ -504,7 +504,7 @@ nlohmann::json external_summary(const ExternalSeries& series, const ExternalScor
         {"strain_" + axial, s.criteria.peak_strain_yy},
         {"ratio", -s.criteria.peak_stress_yy / series.lateral_stress}}},
       {"diverged", diverged},
-      {"verdict", score_verdict(series, score)}};
+      {"verdict_line", score_verdict(series, score)}};
   if (!s.not_checked.empty()) j["not_checked"] = s.not_checked;
   if (score.planes) j["criteria_planes"] = to_json(*score.planes);
   j["moment_balance_source"] = series.torque_column

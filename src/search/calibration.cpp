@@ -420,7 +420,13 @@ class Evaluator {
         // --max-trials bounds the search's trials; verification, the
         // certificate and tightened searches come on top (no denominator).
         s << "trial " << r.id + 1 << " (" << to_string(phase);
-        if (search_ordinal > 0) s << " " << search_ordinal << "/" << options_.max_trials;
+        // (A tightened re-search after a failed certificate runs search
+        // trials beyond the first search's N: counted, not out of N.)
+        if (search_ordinal > options_.max_trials)
+          s << " " << search_ordinal - options_.max_trials << " after the first "
+            << options_.max_trials;
+        else if (search_ordinal > 0)
+          s << " " << search_ordinal << "/" << options_.max_trials;
         s << "): alpha " << params.dt_ratio << ", steps " << params.steps << ", zeta_t "
           << params.damping_ratio_translation << ", zeta_r " << params.damping_ratio_rotation
           << " -> "

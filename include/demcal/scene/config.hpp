@@ -163,6 +163,12 @@ struct SceneConfig {
 void require_stable_dt_ratio(double dt_ratio, double stable, const std::string& file,
                              const std::string& field, const std::string& remedy);
 
+/// What a calibration (calibrate, scaling) needs of config.calibration
+/// before it runs: max_trials at least kMinSearchTrials. Checked there, not
+/// when the config is read, so that run, check, upscale and a params.json
+/// of an older config still read a config with fewer.
+void require_calibration_budget(const SceneConfig& config);
+
 /// Parse and validate. `source` names the file in errors; relative paths in
 /// the config (assembly.file, prototype.file) are resolved against its
 /// folder and made absolute, so that to_json() writes paths that read the
@@ -182,9 +188,15 @@ nlohmann::json parse_config_json(std::string_view text, const std::string& sourc
 SceneConfig default_config();
 std::string_view default_config_text();
 
-/// Apply `section.key=value` overrides (value parsed as JSON, else string).
-void apply_overrides(nlohmann::json& json, const std::vector<std::string>& sets,
-                     const std::string& source);
+/// Apply `section.key=value` overrides (value parsed as JSON, else string);
+/// a malformed one is an InputError naming the --set.
+void apply_overrides(nlohmann::json& json, const std::vector<std::string>& sets);
+
+/// `json` with the overrides applied (in place), parsed: an error in a key
+/// a --set gave names that --set (the last one for the key: its value is
+/// the one read), any other error `source`.
+SceneConfig parse_config_with_overrides(nlohmann::json& json, const std::vector<std::string>& sets,
+                                        const std::string& source);
 
 /// The config back as JSON (every key, defaults filled in).
 nlohmann::json to_json(const SceneConfig& config);
