@@ -97,14 +97,16 @@ nlohmann::json run_record(double wall_time_s, const CalibrationSummary& summary,
 /// DIR/resume.json: what the trials of DIR/trials.jsonl were run with.
 /// Written when a calibration starts afresh; --resume reuses the trials only
 /// when everything that changes a trial's outcome or the search is the same
-/// (the config as given with its --set, --accuracy, --strategy, demcal's
-/// version and build: add_build). --max-trials, --jobs and --evidence do not
-/// change a trial.
+/// (the config as given with its --set, the REV's particle file,
+/// --accuracy, --strategy, demcal's version and build: add_build).
+/// --max-trials, --jobs and --evidence do not change a trial, nor does the
+/// prototype's file (its size is read again after the search).
 nlohmann::json resume_key(const SceneConfig& config, const Strategy strategy) {
   nlohmann::json key{{"schema", "demcal.resume/1"},
                      {"config_sha256", sha256_hex(config.text)},
                      {"accuracy", config.calibration.accuracy},
                      {"strategy", to_string(strategy)}};
+  add_particle_files(key, config, false);
   add_build(key);
   return key;
 }
@@ -114,7 +116,7 @@ nlohmann::json resume_key(const SceneConfig& config, const Strategy strategy) {
 /// nothing changed).
 void require_same_trials(const std::string& dir, const nlohmann::json& key) {
   require_same_run(dir, key, "the trials in " + dir + "/trials.jsonl",
-                   "config, --set, --accuracy, --strategy and demcal build",
+                   "config, --set, particle file, --accuracy, --strategy and demcal build",
                    "calibrate afresh without --resume (or into another -o)");
 }
 

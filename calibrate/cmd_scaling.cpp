@@ -33,17 +33,18 @@ int cmd_scaling(const ScalingOptions& o) {
   OutputFolder::check(out_dir);  // an unwritable -o fails now, not after the study
   // What the work folder's results (per size: calibration, fixed-multiplier
   // runs, references, consolidated samples) were made with: --resume reuses
-  // them only under the same config (with its --set), --max-trials and
-  // build. A work folder that does not exist yet has nothing to reuse.
+  // them only under the same config (with its --set), particle files'
+  // contents, --max-trials and build. A work folder that does not exist yet has nothing to reuse.
   nlohmann::json key{{"schema", "demcal.scaling-resume/1"},
                      {"config_sha256", sha256_hex(config.text)},
                      {"max_trials", config.calibration.max_trials}};
+  add_particle_files(key, config, true);  // the family is cut from them
   add_build(key);
   std::error_code ec;
   const bool reuse = o.resume && std::filesystem::exists(so.work_dir, ec);
   if (reuse)
     require_same_run(so.work_dir, key, "the results in " + so.work_dir,
-                     "config, --set, --max-trials and demcal build",
+                     "config, --set, particle files, --max-trials and demcal build",
                      "run the study afresh without --resume (or with another --work)");
   so.resume = reuse;
 

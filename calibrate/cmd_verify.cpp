@@ -111,10 +111,12 @@ int verify_in_lammps(const VerifyOptions& o, const SceneConfig& config,
                    {"dt", deck.dt},
                    {"step_factor", deck.step_factor},
                    {"notes", deck.notes}};
+  // Everything `demcal score` writes of this series, in its one JSON form
+  // (external_summary): the verdict line, the criteria a column was missing
+  // for (not_checked), a divergence's step and reason; verify's own schema.
   const nlohmann::json summary = external_summary(series, scored, tolerances);
-  for (const char* key : {"passed", "criteria", "tolerances", "diagnosis", "peak", "diverged",
-                          "moment_balance_source", "lever_arm_floor"})
-    if (summary.contains(key)) out[key] = summary[key];
+  for (const auto& [key, value] : summary.items())
+    if (key != "schema") out[key] = value;
   write_file_atomic(dir + "/verify.json", out.dump(2) + "\n");
   const auto& c = score.criteria;
   std::cout << (score.passed ? "PASS" : "FAIL") << " in LAMMPS (" << o.np

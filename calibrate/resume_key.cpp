@@ -15,6 +15,13 @@ void add_build(nlohmann::json& key) {
   key["program_sha256"] = program_digest();
 }
 
+void add_particle_files(nlohmann::json& key, const SceneConfig& config, const bool prototype) {
+  if (config.assembly.type == "file")
+    key["assembly_file_sha256"] = sha256_hex(read_text_file(config.assembly.file));
+  if (prototype && !config.prototype.file.empty())
+    key["prototype_file_sha256"] = sha256_hex(read_text_file(config.prototype.file));
+}
+
 void write_resume_key(const std::string& dir, const nlohmann::json& key) {
   write_file_atomic(dir + "/resume.json", key.dump(2) + "\n");
 }

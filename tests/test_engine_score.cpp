@@ -895,6 +895,18 @@ TEST(EngineLammps, VerifyInLammpsAgreesWithDemcal) {
   EXPECT_EQ(d["passed"], l["passed"]);
   EXPECT_NEAR(l["peak"]["stress_yy"].get<double>() / d["peak"]["stress_yy"].get<double>(), 1.0,
               0.005);
+  // verify.json holds what `demcal score` says of the same series, whole:
+  // the verdict line, what could not be checked, the counts of steps.
+  ASSERT_TRUE(series_written);
+  const int scored =
+      test::run_demcal({"score", "vl/lammps/series.csv", "-o", "sc"}, dir.path()).status;
+  ASSERT_TRUE(scored == 0 || scored == 1);
+  const nlohmann::json s = test::read_json(dir / "sc" / "summary.json");
+  for (const auto& [key, value] : s.items()) {
+    if (key == "schema") continue;  // verify's own
+    EXPECT_EQ(l[key], value) << key;
+  }
+  EXPECT_TRUE(l.contains("verdict_line"));
 }
 
 /// The thermo rows of a LIGGGHTS deck's loading run (after its thermo_style

@@ -9,6 +9,7 @@
 #include <sys/file.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -130,6 +131,57 @@ TEST_F(RobustCli, ResumeWithOtherSettingsIsRefusedAndChangesNothing) {
   // Without the record of its settings a folder's trials cannot be reused.
   fs::remove(work() / "A" / "resume.json");
   expect_refused({"calibrate", kHex5, "-o", "A", "-q", "-j", "1", "--resume"}, "resume.json");
+}
+
+// The config names its particle file, not what it holds: a REV file edited
+// under the same name gives other trials, so --resume refuses the earlier
+// ones (assembly_file_sha256 in resume.json) and takes them again once the
+// file is back as it was; a scaling study, whose REVs are cut from the
+// file, too.
+TEST_F(RobustCli, ResumeAfterTheParticleFileChangedIsRefused) {
+  const fs::path csv = work() / "rev.csv";
+  // A hexagonal n x n, not touching; the last disk's radius `last`.
+  const auto write_rev = [&](int n, double last) {
+    std::ofstream out(csv);
+    out << "x,y,r\n";
+    const double r = 5e-4, gap = 1.001;
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i)
+        out << (2 * i + (j % 2)) * r * gap << "," << j * std::sqrt(3.0) * r * gap << ","
+            << (i == n - 1 && j == n - 1 ? last : r) << "\n";
+  };
+  write_rev(5, 5e-4);
+  const std::string from_file = R"(assembly={"type": "file", "file": ")" + csv.string() + "\"}";
+  const std::vector<std::string> calibrate = {
+      "calibrate", kHex5, "--set", from_file, "-o", "F", "-q", "-j", "1", "--max-trials", "12"};
+  const auto resumed = [&] {
+    std::vector<std::string> args = calibrate;
+    args.push_back("--resume");
+    return args;
+  };
+  const Result first = demcal(calibrate);
+  ASSERT_EQ(first.status, 0) << first.err;
+  ASSERT_TRUE(nlohmann::json::parse(read_text(work() / "F" / "resume.json"))
+                  .contains("assembly_file_sha256"));
+  write_rev(5, 4.5e-4);
+  expect_refused(resumed(), "assembly_file_sha256");
+  write_rev(5, 5e-4);
+  const Result r = demcal(resumed());
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto run = nlohmann::json::parse(read_text(work() / "F" / "run.json"));
+  EXPECT_EQ(run["trials_run"].get<int>(), 0);
+  EXPECT_GT(run["trials_reused"].get<int>(), 0);
+
+  write_rev(7, 5e-4);
+  std::vector<std::string> study = {
+      "scaling", kHex5,          "--set", from_file, "--sizes", "16,25", "--calibrate-max",
+      "25",      "--max-trials", "12",    "-j",      "1",       "-q",    "--work",
+      "S",       "-o",           "R"};
+  const Result scaled = demcal(study);
+  ASSERT_TRUE(scaled.status == 0 || scaled.status == 1) << scaled.err;  // 1: the forward check
+  write_rev(7, 4.5e-4);
+  study.push_back("--resume");
+  expect_refused(study, "assembly_file_sha256");
 }
 
 // `demcal scaling --resume` reuses the per-size results of its --work

@@ -49,6 +49,18 @@ void expect_rejected(const std::string& text, const std::string& field,
 
 // --- §3 messages --------------------------------------------------------------
 
+// A wrong-typed value is named by its type and its text, quoted once: a
+// string's JSON text carries its own quotes (`got string ""x""` before).
+TEST(RobustScene, AWrongTypedValueIsQuotedOnce) {
+  expect_rejected(with_material(R"("algorithm": {"dt_ratio": "x"})"), "algorithm.dt_ratio",
+                  R"(must be a number, got string "x")");
+  expect_rejected(with_material(R"("algorithm": {"lock_rotation": "yes"})"),
+                  "algorithm.lock_rotation", R"(must be true or false, got string "yes")");
+  expect_rejected(with_material(R"("name": 5)"), "name", R"(must be a string, got number "5")");
+  expect_rejected(with_material(R"("assembly": {"type": "random", "count": "12"})"),
+                  "assembly.count", R"(got string "12")");
+}
+
 // A wrong-typed 7 MB array was echoed whole: the quoted value is cut.
 TEST(RobustScene, QuotedValuesAreCapped) {
   std::string big = "[";

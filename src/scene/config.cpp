@@ -17,6 +17,7 @@
 
 #include "demcal/io/files.hpp"
 #include "demcal/io/json_integer.hpp"
+#include "demcal/io/quoted_json.hpp"
 
 namespace demcal {
 
@@ -53,9 +54,7 @@ class Reader {
     used_.insert(key);
     if (!has(key)) return fallback;
     const json& v = object_.at(key);
-    if (!v.is_number())
-      fail(key,
-           "must be a number, got " + std::string(v.type_name()) + " " + quoted_value(v.dump()));
+    if (!v.is_number()) fail(key, "must be a number, got " + quoted_json(v));
     const double d = v.get<double>();
     if (!std::isfinite(d)) fail(key, "must be finite");
     return d;
@@ -87,7 +86,7 @@ class Reader {
     used_.insert(key);
     if (!has(key)) return fallback;
     const json& v = object_.at(key);
-    if (!v.is_boolean()) fail(key, "must be true or false, got " + quoted_value(v.dump()));
+    if (!v.is_boolean()) fail(key, "must be true or false, got " + quoted_json(v));
     return v.get<bool>();
   }
   std::string string(const std::string& key, const std::string& fallback,
@@ -95,7 +94,7 @@ class Reader {
     used_.insert(key);
     if (!has(key)) return fallback;
     const json& v = object_.at(key);
-    if (!v.is_string()) fail(key, "must be a string, got " + quoted_value(v.dump()));
+    if (!v.is_string()) fail(key, "must be a string, got " + quoted_json(v));
     std::string s = v.get<std::string>();
     if (!choices.empty()) {
       bool ok = false;
@@ -595,7 +594,7 @@ void apply_overrides(nlohmann::json& j, const std::vector<std::string>& sets) {
       node = &(*node)[part];
       if (!node->is_object())
         throw InputError(source, key.substr(0, key.size() - rest.size() + part.size()),
-                         "not a section (holds " + quoted_value(node->dump()) + ")");
+                         "not a section (holds " + quoted_json(*node) + ")");
       rest = rest.substr(dot + 1);
     }
   }

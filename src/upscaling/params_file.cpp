@@ -5,6 +5,7 @@
 
 #include "demcal/io/files.hpp"
 #include "demcal/io/json_integer.hpp"
+#include "demcal/io/quoted_json.hpp"
 #include "demcal/scene/triaxial.hpp"
 #include "demcal/scoring/trial.hpp"
 #include "demcal/upscaling/upscaling.hpp"
@@ -67,7 +68,7 @@ nlohmann::json parse_params_text(std::string_view text, const std::string& path)
                            "nopqrstuvwxyz") == std::string::npos;
     if (!plain)
       throw InputError(path, "version",
-                       "must be a demcal version string, got " + quoted_value(version->dump()));
+                       "must be a demcal version string, got " + quoted_json(*version));
   }
   if (const auto d = params.find("dimension"); d != params.end())
     json_integer(*d, 2, 3, path, "dimension");

@@ -9,6 +9,7 @@
 
 #include "demcal/io/files.hpp"
 #include "demcal/io/json_integer.hpp"
+#include "demcal/io/quoted_json.hpp"
 #include "demcal/scene/triaxial.hpp"
 #include "demcal/upscaling/rev.hpp"
 #include "demcal/upscaling/rev_3d.hpp"
@@ -329,8 +330,7 @@ double number_at(const nlohmann::json& block, const std::string& key, const std:
   if (!block.contains(key))
     throw InputError(source, where + "." + key, "missing (not a demcal params.json?)");
   if (!block[key].is_number())
-    throw InputError(source, where + "." + key,
-                     "must be a number, got " + quoted_value(block[key].dump()));
+    throw InputError(source, where + "." + key, "must be a number, got " + quoted_json(block[key]));
   const double v = block[key].get<double>();
   if (!std::isfinite(v))
     throw InputError(source, where + "." + key, "must be finite, got " + block[key].dump());

@@ -13,6 +13,7 @@
 #include <string>
 
 #include "demcal/io/input_error.hpp"
+#include "demcal/io/quoted_json.hpp"
 
 namespace demcal {
 
@@ -44,9 +45,7 @@ inline int64_t whole_number(double d, int64_t min, int64_t max, const std::strin
 inline int64_t json_integer(const nlohmann::json& v,
                             int64_t min = std::numeric_limits<int64_t>::min(),
                             int64_t max = std::numeric_limits<int64_t>::max()) {
-  if (!v.is_number())
-    throw std::invalid_argument("must be a whole number, got " + std::string(v.type_name()) + " " +
-                                quoted_value(v.dump()));
+  if (!v.is_number()) throw std::invalid_argument("must be a whole number, got " + quoted_json(v));
   if (v.is_number_float()) return whole_number(v.get<double>(), min, max, v.dump());
   const bool in_range = v.is_number_unsigned()
                             ? max >= 0 && v.get<uint64_t>() <= static_cast<uint64_t>(max) &&
