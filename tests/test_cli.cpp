@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -500,6 +501,31 @@ TEST_F(CliEndToEnd, CalibrateNamesWhatItWroteAndLeavesNoEarlierResult) {
       demcal({"calibrate", kHex5, "-o", ran.string(), "-q", "-j", "1", "--max-trials", "12"});
   ASSERT_EQ(c.status, 0) << c.err;
   EXPECT_EQ(read_text(ran / "final.vtk"), "a run's\n");
+}
+
+// The progress lines count as trials finish: with two jobs the trial asked
+// for fourth can finish third, and its line said "trial 3 (search 4/12)".
+// Trial numbers and search counts both go up by one, line after line
+// (whatever order the jobs finish in; on the earlier count two of three
+// runs of this calibration broke it).
+TEST_F(CliEndToEnd, ProgressCountsTrialsInTheOrderTheyFinish) {
+  for (int round = 0; round < 3; ++round) {
+    const Result r = demcal({"calibrate", kHex5, "-o", "out", "-j", "2"});
+    ASSERT_EQ(r.status, 0) << r.err;
+    int trial = 0, search = 0;
+    for (const std::string& line : lines_of(r.err)) {
+      int t = 0, k = 0, n = 0;
+      if (std::sscanf(line.c_str(), "trial %d (search %d/%d)", &t, &k, &n) == 3) {
+        EXPECT_EQ(k, search + 1) << line;
+        search = k;
+      }
+      if (t > 0) {
+        EXPECT_EQ(t, trial + 1) << line;
+        trial = t;
+      }
+    }
+    EXPECT_GE(search, 12) << r.err;
+  }
 }
 
 // A computation that fails (consolidation gives up) is not bad input: exit

@@ -350,7 +350,6 @@ class Evaluator {
     std::shared_future<TrialRecord> future;
     std::promise<TrialRecord> promise;
     bool mine = false;
-    int search_ordinal = 0;  // this trial's place among the search's (the budget)
     {
       std::lock_guard<std::mutex> lock(mutex_);
       auto it = cache_.find(key);
@@ -359,14 +358,13 @@ class Evaluator {
         cache_.emplace(key, future);
         first_request_[key] = {position, phase};
         mine = true;
-        if (phase == TrialPhase::search) search_ordinal = ++search_trials_;
       } else {
         future = it->second;
         const auto old = preloaded_.find(key);
         if (old != preloaded_.end()) {
           // Asked for again: numbered as if it had just finished.
           ++reused_;
-          if (phase == TrialPhase::search) ++search_trials_;
+          if (phase == TrialPhase::search) ++search_finished_;
           first_request_[key] = {position, phase};
           unsettled_.push_back({key, old->second, to_json(old->second).dump()});
           preloaded_.erase(old);
@@ -413,6 +411,9 @@ class Evaluator {
       const std::string line = to_json(r).dump();
       if (!options_.trials_path.empty()) append_line_durable(options_.trials_path, line);
       unsettled_.push_back({key, r, line});
+      // Counted as they finish, as the trial numbers are: with jobs > 1 the
+      // trial asked for fourth can finish third ("trial 3 (search 3/12)").
+      const int search_done = phase == TrialPhase::search ? ++search_finished_ : 0;
       if (options_.progress) {
         std::ostringstream s;
         s.precision(3);
@@ -422,11 +423,11 @@ class Evaluator {
         s << "trial " << r.id + 1 << " (" << to_string(phase);
         // (A tightened re-search after a failed certificate runs search
         // trials beyond the first search's N: counted, not out of N.)
-        if (search_ordinal > options_.max_trials)
-          s << " " << search_ordinal - options_.max_trials << " after the first "
+        if (search_done > options_.max_trials)
+          s << " " << search_done - options_.max_trials << " after the first "
             << options_.max_trials;
-        else if (search_ordinal > 0)
-          s << " " << search_ordinal << "/" << options_.max_trials;
+        else if (search_done > 0)
+          s << " " << search_done << "/" << options_.max_trials;
         s << "): alpha " << params.dt_ratio << ", steps " << params.steps << ", zeta_t "
           << params.damping_ratio_translation << ", zeta_r " << params.damping_ratio_rotation
           << " -> "
@@ -440,8 +441,8 @@ class Evaluator {
           s << "; best so far " << best_steps_ << " steps";
         }
         s << "; " << elapsed << " s elapsed";
-        if (search_ordinal > 0 && search_ordinal < options_.max_trials)
-          s << ", the search at most ~" << elapsed / run_ * (options_.max_trials - search_ordinal)
+        if (search_done > 0 && search_done < options_.max_trials)
+          s << ", the search at most ~" << elapsed / run_ * (options_.max_trials - search_done)
             << " s more";
         options_.progress(s.str());
       }
@@ -571,7 +572,7 @@ class Evaluator {
   std::map<Key, TrialRecord> preloaded_;  ///< of the resumed file, not asked for yet
   bool resumed_ = false;
   int next_id_ = 0, run_ = 0, reused_ = 0;
-  int search_trials_ = 0;  ///< phase search trials asked for (run or reused)
+  int search_finished_ = 0;  ///< phase search trials finished or reused (progress lines)
   int64_t best_steps_ = 0;
 };
 
