@@ -160,7 +160,6 @@ double servo_velocity(const World& world, WallSide side, double target_stress, d
   const bool vertical = side == kLeft || side == kRight;
   const double length = vertical ? world.height() : world.width();
   const double dt = world.integration().dt;
-  const int contacts = std::max(1, world.wall(side).contacts);
   const double error = target_stress - wall_pressure(world, side);
   // The wall's contacts resist a move by kw per unit length, and their
   // dashpots by c/Δt more within the step (c = 2ζ_c·sqrt(kw·m), the heaviest
@@ -172,17 +171,24 @@ double servo_velocity(const World& world, WallSide side, double target_stress, d
   const Material& mat = world.material();
   const double m_max =
       disk_mass(disk_areal_density(mat, world.integration().mass_scaling), world.max_radius());
-  const double resistance = servo_resistance(mat, m_max, dt);
-  double move = gain * error * length * mat.thickness / (resistance * contacts);
+  const ServoWall wall{error, length * mat.thickness, world.wall(side).contacts, kInward[side],
+                       world.wall(side).velocity};
+  return servo_step_velocity(wall, gain, servo_resistance(mat, m_max, dt), mat.wall.kn, dt,
+                             world.min_radius());
+}
+
+double servo_step_velocity(const ServoWall& wall, const double gain, const double resistance,
+                           const double kn_wall, const double dt, const double r_min) {
+  double move = gain * wall.error * wall.area / (resistance * std::max(1, wall.contacts));
   // A moving wall's dashpot force is in its reading: carry servo_carry of
   // the last move (velocity·Δt, toward the sample) into this one.
-  const double carry = servo_carry(mat.wall.kn, resistance);
-  if (carry > 0.0) move += carry * kInward[side] * world.wall(side).velocity * dt;
+  const double carry = servo_carry(kn_wall, resistance);
+  if (carry > 0.0) move += carry * wall.inward * wall.velocity * dt;
   // Never more than servo_move_cap (kServoMoveCapRatio of the smallest
   // radius) per step.
-  const double cap = servo_move_cap(world.min_radius());
+  const double cap = servo_move_cap(r_min);
   move = std::clamp(move, -cap, cap);
-  return kInward[side] * move / dt;
+  return wall.inward * move / dt;
 }
 
 Integration integration_for(const World& world, const AlgorithmSpec& algorithm) {

@@ -106,7 +106,6 @@ double wall_pressure(const SphereWorld& world, SphereWallSide side) {
 double servo_velocity(const SphereWorld& world, SphereWallSide side, double target_stress,
                       double gain) {
   const double dt = world.integration().dt;
-  const int contacts = std::max(1, world.wall(side).contacts);
   const double error = target_stress - wall_pressure(world, side);
   // R = kn_wall + c/Δt with the wall contacts' dashpots (servo_resistance,
   // the 2D servo's formula and reason, biaxial.cpp; c of the heaviest
@@ -115,13 +114,9 @@ double servo_velocity(const SphereWorld& world, SphereWallSide side, double targ
   const double m_max =
       sphere_mass(mat.density * world.integration().mass_scaling, world.max_radius());
   const double resistance = servo_resistance(mat.wall.kn, mat.contact_damping_ratio, m_max, dt);
-  double move = gain * error * wall_area(world, side) / (resistance * contacts);
-  // servo_carry of the last move (velocity·Δt, toward the sample), as in 2D.
-  const double carry = servo_carry(mat.wall.kn, resistance);
-  if (carry > 0.0) move += carry * inward(side) * world.wall(side).velocity * dt;
-  const double cap = servo_move_cap(world.min_radius());
-  move = std::clamp(move, -cap, cap);
-  return inward(side) * move / dt;
+  const ServoWall wall{error, wall_area(world, side), world.wall(side).contacts, inward(side),
+                       world.wall(side).velocity};
+  return servo_step_velocity(wall, gain, resistance, mat.wall.kn, dt, world.min_radius());
 }
 
 Integration integration_for(const SphereWorld& world, const AlgorithmSpec& algorithm) {

@@ -88,6 +88,20 @@ double servo_resistance(const Material& material, double m_max, double dt);
 inline double servo_carry(double kn_wall, double resistance) {
   return resistance > kn_wall ? (resistance - kn_wall) / resistance : 0.0;
 }
+/// What one servo step reads of its wall (2D or 3D).
+struct ServoWall {
+  double error = 0.0;     ///< σ3 − p, the stress still missing [Pa]
+  double area = 0.0;      ///< the wall's area (2D: length × thickness) [m²]
+  int contacts = 0;       ///< its contacts now (0 counts as 1)
+  double inward = 0.0;    ///< +1 or −1: the direction toward the sample
+  double velocity = 0.0;  ///< its velocity along its axis (the last move / Δt)
+};
+/// The servo law of servo_velocity, 2D and 3D alike: the move
+/// gain·error·A/(R·n_c) toward the sample, R = `resistance`
+/// (servo_resistance), plus servo_carry(kn_wall, R) of the last move, at
+/// most servo_move_cap(r_min); returns the wall velocity inward·move/Δt.
+double servo_step_velocity(const ServoWall& wall, double gain, double resistance, double kn_wall,
+                           double dt, double r_min);
 /// Λ, the bound on the dashpot network's "reduced-mass Laplacian"
 /// G = Σ m_eff·b·bᵀ over the contacts (walls included) against the mass
 /// matrix, vᵀGv ≤ Λ·vᵀMv, for any packing of particles of one density with
