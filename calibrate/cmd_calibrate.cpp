@@ -446,7 +446,7 @@ int cmd_calibrate(const CalibrateOptions& o) {
 
   nlohmann::json params = v.three_d ? params_file(config, *rev.spheres, options, summary)
                                     : params_file(config, *rev.disks, options, summary);
-  const bool have_best = summary.best_trial.score.particle_steps > 0.0;
+  const bool have_best = summary.has_best_trial();
   auto say = [&](const std::string& line) {
     if (!o.quiet) std::cerr << "demcal: " << line << "\n";
   };

@@ -146,7 +146,7 @@ void gather_facts(const ReportInput& in, ReportFacts& f) {
   f.dimension = in.dimension;
   f.axial = in.dimension == 3 ? "b_zz" : "b_yy";
   const auto& S = in.summary;
-  f.have_best = S.best_trial.score.particle_steps > 0.0;  // default-constructed: none
+  f.have_best = S.has_best_trial();
   auto add = [&](const TrialRecord& t, const std::string& label) {
     f.points.push_back(point_of(in, f.have_best, t, label));
   };

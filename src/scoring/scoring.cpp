@@ -380,161 +380,222 @@ std::map<std::string, std::string> criteria_not_checked(const Criteria& c) {
   return out;
 }
 
-}  // namespace
+// A parameter is "known and ..." only when the run says it.
+template <class Test>
+bool known(const std::optional<double>& v, Test test) {
+  return v && test(*v);
+}
 
-Diagnosis diagnose(const Criteria& c, const Tolerances& t, bool diverged, const RunParameters& p) {
-  // A parameter is "known and ..." only when the run says it.
-  auto known = [](const std::optional<double>& v, auto test) { return v && test(*v); };
-  if (diverged) {
-    if (known(p.mass_scaling, [](double f) { return f > 1.0; }) &&
-        known(p.dt_ratio, [](double a) { return a < 0.05; }))
-      return {"mass_scaling", "decrease", 0.6,
-              "the run diverged with heavily scaled masses and no stable dynamics; reduce "
-              "mass_scaling",
-              "divergence"};
-    return {"dt", "decrease", 0.95,
-            "the run diverged: the time step is beyond the stable limit; decrease dt_ratio",
+/// A diverged run: cut mass_scaling when heavy masses ran with a tiny step,
+/// else the time step.
+Diagnosis diagnose_divergence(const RunParameters& p) {
+  if (known(p.mass_scaling, [](double f) { return f > 1.0; }) &&
+      known(p.dt_ratio, [](double a) { return a < 0.05; }))
+    return {"mass_scaling", "decrease", 0.6,
+            "the run diverged with heavily scaled masses and no stable dynamics; reduce "
+            "mass_scaling",
             "divergence"};
-  }
+  return {"dt", "decrease", 0.95,
+          "the run diverged: the time step is beyond the stable limit; decrease dt_ratio",
+          "divergence"};
+}
+
+/// Every criterion within tolerance: quasi-static (fewer steps would do
+/// when b and sigma share a zigzag or the worst criterion is far within).
+Diagnosis diagnose_within_tolerance(const Criteria& c, const Tolerances& t, double worst,
+                                    const std::map<std::string, std::string>& not_checked) {
+  if (c.zigzag > t.oscillation && c.zigzag > 3.0 * c.oscillation)
+    return {"steps", "decrease", 0.5,
+            "quasi-static, but b and sigma share a zigzag (stick-slip): the loading is slower "
+            "than it needs to be; fewer steps would do",
+            "shared zigzag"};
+  std::string msg = not_checked.empty()
+                        ? "quasi-static: every criterion is within tolerance (worst at " +
+                              percent(worst) + " of its tolerance)"
+                        : "quasi-static on the criteria checked: each is within tolerance "
+                          "(worst at " +
+                              percent(worst) + " of its tolerance)";
+  if (worst < 0.1) msg += "; far within: fewer steps would do";
+  if (!not_checked.empty()) msg += "; not checked: " + not_checked_list(not_checked);
+  return {"none", "", not_checked.empty() ? 0.9 : 0.6, msg, "none"};
+}
+
+/// What the causes of a run out of tolerance read: the criteria's excesses,
+/// the energies, and how moment balance is named (3D: the rotational drag
+/// folded into it; 2D: the pair of measures that differ).
+struct Symptoms {
+  const Criteria& c;
+  const Tolerances& t;
+  const RunParameters& p;
+  double fb, mb, osc, sv, worst;
+  double ke_ratio;   ///< kinetic over elastic energy; 0 when not available
+  double rot_share;  ///< the rotational share of the kinetic energy; 0 when not available
+  bool drag;         ///< 3D: the rotational drag set moment balance
+  double asymmetry;  ///< moment balance, 0 for a drag (the asymmetry thresholds do not apply)
+  const std::string& pair;
+  bool dynamic;   ///< force balance out and the kinetic energy a dynamic run's
+  bool large_zr;  ///< ζ_r known and large
+};
+
+/// The symptoms of a run out of tolerance (`e` its excesses).
+Symptoms symptoms_of(const Criteria& c, const Tolerances& t, const RunParameters& p,
+                     const Excesses& e) {
   // A measure not available reads as nothing: its excess 0 (excesses()),
   // the energies' patterns not seen.
-  const Excesses e = excesses(c, t);
-  const double fb = e.force_balance, mb = e.moment_balance, osc = e.oscillation, sv = e.servo;
-  const double worst = e.worst();
-  const std::map<std::string, std::string> not_checked = criteria_not_checked(c);
   const double ke_ratio =
       c.available("kinetic_energy_ratio_median") ? c.kinetic_energy_ratio_median : 0.0;
   const double rot_share = c.available("rotational_energy_share") ? c.rotational_energy_share : 0.0;
-
-  if (worst <= 1.0) {
-    if (c.zigzag > t.oscillation && c.zigzag > 3.0 * c.oscillation)
-      return {"steps", "decrease", 0.5,
-              "quasi-static, but b and sigma share a zigzag (stick-slip): the loading is slower "
-              "than it needs to be; fewer steps would do",
-              "shared zigzag"};
-    std::string msg = not_checked.empty()
-                          ? "quasi-static: every criterion is within tolerance (worst at " +
-                                percent(worst) + " of its tolerance)"
-                          : "quasi-static on the criteria checked: each is within tolerance "
-                            "(worst at " +
-                                percent(worst) + " of its tolerance)";
-    if (worst < 0.1) msg += "; far within: fewer steps would do";
-    if (!not_checked.empty()) msg += "; not checked: " + not_checked_list(not_checked);
-    return {"none", "", not_checked.empty() ? 0.9 : 0.6, msg, "none"};
-  }
-
   // 3D: the rotational drag folded into moment balance set it; the words
   // name the drag, and the asymmetry thresholds below do not apply to it.
   const bool drag = c.moment_from_drag.has_value();
-  const double asymmetry = drag ? 0.0 : c.moment_balance;
-  const std::string& pair = c.moment_pair;
+  return {.c = c,
+          .t = t,
+          .p = p,
+          .fb = e.force_balance,
+          .mb = e.moment_balance,
+          .osc = e.oscillation,
+          .sv = e.servo,
+          .worst = e.worst(),
+          .ke_ratio = ke_ratio,
+          .rot_share = rot_share,
+          .drag = drag,
+          .asymmetry = drag ? 0.0 : c.moment_balance,
+          .pair = c.moment_pair,
+          .dynamic = e.force_balance > 1.0 && ke_ratio > kDynamicEnergyRatio,
+          .large_zr = known(p.damping_ratio_rotation, [](double z) { return z >= kHighDamping; })};
+}
 
+/// "the rotational damping takes 12 % of the axial wall's power": the 3D
+/// words for a moment balance the drag set.
+std::string drag_power(const Criteria& c) {
+  return "the rotational damping takes " + percent(*c.moment_from_drag) +
+         " of the axial wall's power";
+}
+
+/// Causes 1-3, a dynamic run or rotational chatter: whether the scaled
+/// masses, the time step or too few steps are to blame.
+std::optional<Diagnosis> diagnose_dynamics(const Symptoms& s) {
   // 1. A dynamic run with scaled masses: inertia, not the contacts, carries
   //    the load.
-  const bool dynamic = fb > 1.0 && ke_ratio > kDynamicEnergyRatio;
-  if (dynamic && known(p.mass_scaling, [](double f) { return f > 1.0; }))
-    return {"mass_scaling", "decrease", 0.8,
-            "the run is dynamic (kinetic energy " + percent(ke_ratio) +
-                " of the elastic energy) and b and sigma follow different trends: the scaled "
-                "masses are too heavy for this loading; decrease mass_scaling",
-            "dynamic run, b and sigma follow different trends"};
+  if (s.dynamic && known(s.p.mass_scaling, [](double f) { return f > 1.0; }))
+    return Diagnosis{"mass_scaling", "decrease", 0.8,
+                     "the run is dynamic (kinetic energy " + percent(s.ke_ratio) +
+                         " of the elastic energy) and b and sigma follow different trends: the "
+                         "scaled masses are too heavy for this loading; decrease mass_scaling",
+                     "dynamic run, b and sigma follow different trends"};
   // 2. Rotational chatter: Δt beyond the rotational stability limit.
   // Rotational drag never reached kDragAsymmetryMax in the atlas (ζ_r up
   // to 20 on hex_10x10): beyond it, unless ζ_r is large, it is the onset of
   // the chatter (at 1.05 α_stable on random_400 the rotational energy share
   // is still low on most monitoring points).
-  const bool large_zr = known(p.damping_ratio_rotation, [](double z) { return z >= kHighDamping; });
-  if (mb > 1.0 && (rot_share > kChatterEnergyShare || asymmetry > kChatterAsymmetry ||
-                   (asymmetry > kDragAsymmetryMax && !large_zr))) {
-    const double clarity = std::max(std::min(1.0, rot_share / 0.6), std::min(1.0, asymmetry / 0.1));
-    return {"dt", "decrease", std::min(0.95, 0.6 + 0.3 * clarity),
-            (drag ? "the rotational damping takes " + percent(*c.moment_from_drag) +
-                        " of the axial wall's power"
-                  : pair + " are far apart") +
-                " and the particles' rotations chatter: the time step is beyond the rotational "
-                "stability limit; decrease dt_ratio",
-            "moment imbalance with rotational chatter"};
+  if (s.mb > 1.0 && (s.rot_share > kChatterEnergyShare || s.asymmetry > kChatterAsymmetry ||
+                     (s.asymmetry > kDragAsymmetryMax && !s.large_zr))) {
+    const double clarity =
+        std::max(std::min(1.0, s.rot_share / 0.6), std::min(1.0, s.asymmetry / 0.1));
+    return Diagnosis{"dt", "decrease", std::min(0.95, 0.6 + 0.3 * clarity),
+                     (s.drag ? drag_power(s.c) : s.pair + " are far apart") +
+                         " and the particles' rotations chatter: the time step is beyond the "
+                         "rotational stability limit; decrease dt_ratio",
+                     "moment imbalance with rotational chatter"};
   }
   // 3. A dynamic run without scaled masses: loading too fast for inertia.
-  if (dynamic)
-    return {"steps", "increase", 0.7,
-            "the run is dynamic (kinetic energy " + percent(ke_ratio) +
-                " of the elastic energy): the loading is too fast for the particles' inertia; "
-                "increase steps",
-            "dynamic run, b and sigma follow different trends"};
-  // 4. Noise where b and σ disagree.
-  if (osc > 1.0 && osc >= 0.5 * worst) {
-    if (known(p.damping_ratio_translation, [](double z) { return z >= kLowDampingRatio; }) &&
-        known(p.dt_ratio, [](double a) { return a > 0.25; }))
-      return {"dt", "decrease", 0.5,
-              "b and sigma disagree by step-to-step noise although the run is damped: the time "
-              "step is near its stability limit; decrease dt_ratio",
-              "oscillation"};
-    return {"damping_translation", "increase", confidence_from(osc, 0.6, 0.85),
-            "b and sigma disagree by step-to-step noise: the run is under-damped; increase "
-            "damping_ratio_translation",
-            "oscillation, b != sigma"};
-  }
-  // 5. Rotational drag: a steady asymmetry out of proportion with the
-  //    rate-driven measures (they all scale with the loading rate; a
-  //    rotational damping far too large lifts the asymmetry alone).
-  const bool high_zr = large_zr;
-  const double rate_excess = std::max(fb, sv);
+  if (s.dynamic)
+    return Diagnosis{"steps", "increase", 0.7,
+                     "the run is dynamic (kinetic energy " + percent(s.ke_ratio) +
+                         " of the elastic energy): the loading is too fast for the particles' "
+                         "inertia; increase steps",
+                     "dynamic run, b and sigma follow different trends"};
+  return std::nullopt;
+}
+
+/// Cause 4, noise where b and sigma disagree: a time step near its limit
+/// (the run is damped) or too little translational damping.
+std::optional<Diagnosis> diagnose_noise(const Symptoms& s) {
+  if (!(s.osc > 1.0 && s.osc >= 0.5 * s.worst)) return std::nullopt;
+  if (known(s.p.damping_ratio_translation, [](double z) { return z >= kLowDampingRatio; }) &&
+      known(s.p.dt_ratio, [](double a) { return a > 0.25; }))
+    return Diagnosis{"dt", "decrease", 0.5,
+                     "b and sigma disagree by step-to-step noise although the run is damped: the "
+                     "time step is near its stability limit; decrease dt_ratio",
+                     "oscillation"};
+  return Diagnosis{"damping_translation", "increase", confidence_from(s.osc, 0.6, 0.85),
+                   "b and sigma disagree by step-to-step noise: the run is under-damped; "
+                   "increase damping_ratio_translation",
+                   "oscillation, b != sigma"};
+}
+
+/// Cause 5, a steady moment imbalance out of proportion with the
+/// rate-driven measures: undamped rotations ringing, or rotational drag.
+std::optional<Diagnosis> diagnose_moment_imbalance(const Symptoms& s) {
+  // The rate-driven measures all scale with the loading rate; a rotational
+  // damping far too large lifts the asymmetry alone.
+  const double rate_excess = std::max(s.fb, s.sv);
   // Without damping the particles' spins ring (σ's antisymmetric part is
   // Σ I·dω/dt): noisy b − σ, and no rotational damping to blame. Known
   // damping ratios decide; without them (a series that does not give
   // them) the pattern does, and the words say it is a guess. A drag is
   // damping's own: never ringing.
+  const RunParameters& p = s.p;
   const bool damping_known = p.damping_ratio_translation && p.damping_ratio_rotation;
-  const bool ringing = !drag && (damping_known ? *p.damping_ratio_translation < kLowDampingRatio &&
-                                                     *p.damping_ratio_rotation < kLowDampingRatio
-                                               : c.oscillation > kRingingNoise * t.oscillation);
-  if (mb > 1.0 && ringing && (rate_excess <= 1.0 || mb >= rate_excess)) {
+  const bool ringing =
+      !s.drag && (damping_known ? *p.damping_ratio_translation < kLowDampingRatio &&
+                                      *p.damping_ratio_rotation < kLowDampingRatio
+                                : s.c.oscillation > kRingingNoise * s.t.oscillation);
+  if (s.mb > 1.0 && ringing && (rate_excess <= 1.0 || s.mb >= rate_excess)) {
     if (damping_known)
-      return {"damping_translation", "increase", 0.6,
-              pair +
-                  " differ while the run is (almost) undamped: the particles' rotations ring; "
-                  "add damping (damping_ratio_translation 0.1 or more)",
-              "moment imbalance without damping"};
-    return {"damping_translation", "increase", 0.4,
-            pair +
-                " differ and b - sigma is noisy, the pattern of a run whose rotations ring "
-                "without damping; its damping ratios are not known (the series does not give "
-                "them): if it has none, add damping (damping_ratio_translation 0.1 or more)",
-            "moment imbalance without damping"};
+      return Diagnosis{"damping_translation", "increase", 0.6,
+                       s.pair +
+                           " differ while the run is (almost) undamped: the particles' rotations "
+                           "ring; add damping (damping_ratio_translation 0.1 or more)",
+                       "moment imbalance without damping"};
+    return Diagnosis{"damping_translation", "increase", 0.4,
+                     s.pair +
+                         " differ and b - sigma is noisy, the pattern of a run whose rotations "
+                         "ring without damping; its damping ratios are not known (the series "
+                         "does not give them): if it has none, add damping "
+                         "(damping_ratio_translation 0.1 or more)",
+                     "moment imbalance without damping"};
   }
-  const bool rot_drag =
-      mb > 1.0 && (rate_excess <= 1.0 || mb >= 5.0 * rate_excess || (high_zr && mb >= rate_excess));
-  if (rot_drag)
-    return {"damping_rotation", "decrease",
-            high_zr ? 0.85 : confidence_from(mb / std::max(1.0, rate_excess), 0.55, 0.8),
-            (drag ? "the rotational damping takes " + percent(*c.moment_from_drag) +
-                        " of the axial wall's power (rotational drag) without chatter: it holds "
-                        "the particles' rotations and stiffens the response"
-                  : pair + " differ steadily without chatter: rotational damping holds the "
-                           "particles' rotations and stiffens the response") +
-                "; decrease damping_ratio_rotation",
-            "moment imbalance, peak over-predicted"};
-  const bool small_dt = known(p.dt_ratio, [](double a) { return a <= kSmallDtRatio; });
+  const bool rot_drag = s.mb > 1.0 && (rate_excess <= 1.0 || s.mb >= 5.0 * rate_excess ||
+                                       (s.large_zr && s.mb >= rate_excess));
+  if (!rot_drag) return std::nullopt;
+  return Diagnosis{
+      "damping_rotation", "decrease",
+      s.large_zr ? 0.85 : confidence_from(s.mb / std::max(1.0, rate_excess), 0.55, 0.8),
+      (s.drag ? drag_power(s.c) +
+                    " (rotational drag) without chatter: it holds the particles' rotations and "
+                    "stiffens the response"
+              : s.pair + " differ steadily without chatter: rotational damping holds the "
+                         "particles' rotations and stiffens the response") +
+          "; decrease damping_ratio_rotation",
+      "moment imbalance, peak over-predicted"};
+}
+
+/// Causes 6-7 and the rest, a gap between b and sigma: the walls' lag or
+/// translational drag, cured by more steps, a larger time step or less
+/// damping.
+Diagnosis diagnose_gap(const Symptoms& s) {
+  const Criteria& c = s.c;
+  const bool small_dt = known(s.p.dt_ratio, [](double a) { return a <= kSmallDtRatio; });
   // 6. The servo walls lag behind σ3: only Nstep sets how fast they must move.
-  if (sv > 1.0) {
-    if (small_dt && fb > sv)
+  if (s.sv > 1.0) {
+    if (small_dt && s.fb > s.sv)
       return {"dt", "increase", 0.7,
               "b and sigma disagree (gap " + percent(c.force_balance) +
                   ") and the walls lag: the time step is small, so the same steps load the "
                   "sample fast; increase dt_ratio",
               "gap without oscillation, peak over-predicted"};
-    return {"steps", "increase", confidence_from(sv, 0.6, 0.9),
+    return {"steps", "increase", confidence_from(s.sv, 0.6, 0.9),
             "the lateral walls cannot hold sigma3 (error " + percent(c.servo) +
                 ") and b and sigma drift apart: the loading is too fast; increase steps",
             "gap b != sigma, servo lag, peak over-predicted"};
   }
   // 7. Translational drag: damping acts as extra confinement (smooth gap).
-  if (fb > 1.0 || mb > 1.0) {
+  if (s.fb > 1.0 || s.mb > 1.0) {
     const std::string gap =
         "b and sigma disagree smoothly (gap " + percent(c.force_balance) + ", mostly " +
         (c.force_balance_xx >= c.force_balance_yy ? "lateral" : "vertical") + ")";
-    if (known(p.damping_ratio_translation, [](double z) { return z >= kHighDamping; }))
+    if (known(s.p.damping_ratio_translation, [](double z) { return z >= kHighDamping; }))
       return {"damping_translation", "decrease", 0.8,
               gap +
                   ": global damping drags against the lateral expansion like extra "
@@ -546,13 +607,27 @@ Diagnosis diagnose(const Criteria& c, const Tolerances& t, bool diverged, const 
                   ": the time step is small, so the same steps load the sample fast; "
                   "increase dt_ratio",
               "gap without oscillation, peak over-predicted"};
-    return {"steps", "increase", confidence_from(fb, 0.55, 0.85),
+    return {"steps", "increase", confidence_from(s.fb, 0.55, 0.85),
             gap +
                 ": the loading is too fast for this damping; increase steps (or decrease "
                 "damping_ratio_translation)",
             "gap b != sigma, peak over-predicted"};
   }
   return {"steps", "increase", 0.5, "a criterion is out of tolerance; increase steps", "other"};
+}
+
+}  // namespace
+
+Diagnosis diagnose(const Criteria& c, const Tolerances& t, bool diverged, const RunParameters& p) {
+  if (diverged) return diagnose_divergence(p);
+  const Excesses e = excesses(c, t);
+  if (e.worst() <= 1.0) return diagnose_within_tolerance(c, t, e.worst(), criteria_not_checked(c));
+  // The causes in order, the first that fits.
+  const Symptoms s = symptoms_of(c, t, p, e);
+  if (auto d = diagnose_dynamics(s)) return *d;
+  if (auto d = diagnose_noise(s)) return *d;
+  if (auto d = diagnose_moment_imbalance(s)) return *d;
+  return diagnose_gap(s);
 }
 
 Score score_of(const Criteria& criteria, const RunOutcome& run, const Tolerances& t) {

@@ -962,29 +962,19 @@ CalibrationSummary calibrate(const SceneConfig& config, const TriaxialState& sta
   return calibrate(TriaxialRunner(config, state), config.algorithm, options);
 }
 
-CalibrationSummary calibrate(const TrialRunner& runner, const AlgorithmSpec& base,
-                             const CalibrationOptions& options) {
-  const auto t0 = std::chrono::steady_clock::now();
-  CalibrationSummary out;
-  out.strategy = options.strategy;
-  out.dimension = runner.dimension();
-  const int jobs = resolve_jobs(options.jobs);
-  const int64_t n = runner.particles();
+namespace {
 
-  // Positions are counted from this call's top level (ids, Evaluator).
-  const PlaceScope top_level(Place{});
-  Evaluator evaluator(runner, options);
-  if (options.resume && !options.trials_path.empty())
-    preload_trials(evaluator, options.trials_path);
-
-  // Bounds. The stable step comes from the consolidated contact network.
-  out.dt_ratio_stable = runner.stable_dt_ratio(base);
+/// The search's bounds: α up to the bound the stable step sets, Nstep from
+/// steps_min to steps_max (50 and 20000 per particle unless given), the
+/// damping ratios within the options' range.
+SearchSpace search_space(const AlgorithmSpec& base, const CalibrationOptions& options, int64_t n,
+                         double dt_ratio_stable) {
   SearchSpace space;
   space.base = base;
   const int64_t steps_min = options.steps_min > 0 ? options.steps_min : 50LL * n;
   const int64_t steps_max = options.steps_max > 0 ? options.steps_max : 20000LL * n;
   space.lower[0] = options.dt_ratio_min;
-  space.upper[0] = dt_ratio_max(options, out.dt_ratio_stable);
+  space.upper[0] = dt_ratio_max(options, dt_ratio_stable);
   space.lower[1] = std::log10(static_cast<double>(steps_min));
   space.upper[1] = std::log10(static_cast<double>(steps_max));
   space.lower[2] = options.damping_min;
@@ -997,98 +987,142 @@ CalibrationSummary calibrate(const TrialRunner& runner, const AlgorithmSpec& bas
   // otherwise be searched at N*/4 instead of N*/8.
   space.fidelity_min = static_cast<double>(
       options.steps_min > 0 ? steps_min : std::min<int64_t>(16LL * n, steps_min));
+  return space;
+}
 
-  // Starts: the paper's recommendation with a size-based Nstep (500 per
-  // particle: the model strategy extrapolates from there, so it need not
-  // be a passing value), and a second one nearer the stability bound with
-  // lighter damping. Both always run (in parallel when jobs > 1), so the
-  // result does not depend on jobs.
+/// The first search's two starts, x = (α, log10 Nstep, ζ_t, ζ_r).
+struct Starts {
+  double first[4], second[4];
+};
+
+/// Where the first search starts: two points, both always searched from.
+Starts search_starts(const AlgorithmSpec& base, int64_t n, const SearchSpace& space) {
+  // The paper's recommendation with a size-based Nstep (500 per particle:
+  // the model strategy extrapolates from there, so it need not be a passing
+  // value), and a second one nearer the stability bound with lighter
+  // damping. Both always run (in parallel when jobs > 1), so the result does
+  // not depend on jobs.
   const AlgorithmSpec start = search_start(base, n, space.upper[0]);
   const double log_n0 = std::log10(static_cast<double>(start.steps));
-  const double start0[4] = {start.dt_ratio, log_n0, start.damping_ratio_translation,
-                            start.damping_ratio_rotation};
-  const double start1[4] = {0.85 * space.upper[0], log_n0 - 0.3, 0.5, 0.5};
-  // The first search's budget (config and command line refuse less).
+  return {{start.dt_ratio, log_n0, start.damping_ratio_translation, start.damping_ratio_rotation},
+          {0.85 * space.upper[0], log_n0 - 0.3, 0.5, 0.5}};
+}
+
+/// The first search's budget: options.max_trials, refused below the
+/// search's minimum (config and command line refuse less).
+int search_budget(const CalibrationOptions& options) {
   const int budget = options.max_trials;
   if (budget < kMinSearchTrials)
     throw std::invalid_argument("calibrate: max_trials " + std::to_string(budget) +
                                 " is below the search's minimum " +
                                 std::to_string(kMinSearchTrials));
+  return budget;
+}
+
+/// The first search, from both starts, by the options' strategy: how the
+/// budget is spent (model, DIRECT then COBYLA, or one local search per
+/// start). The trials are in the evaluator.
+void search_from_starts(Evaluator& evaluator, const SearchSpace& space,
+                        const CalibrationOptions& options, const Starts& starts, int evals,
+                        int jobs) {
+  const Tolerances& tolerances = options.tolerances;
+  const double* a = starts.first;
+  const double* b = starts.second;
+  SearchContext context{&evaluator, &space, tolerances, TrialPhase::search};
+  if (options.strategy == Strategy::model) {
+    model_search(evaluator, space, tolerances, a, b, evals, jobs);
+    return;
+  }
+  if (options.strategy == Strategy::direct) {
+    global_phase(context, evals / 3);
+    auto best = cheapest_passing(evaluator.all());
+    double x[4] = {a[0], a[1], a[2], a[3]};
+    if (best) {
+      x[0] = best->params.dt_ratio;
+      x[1] = std::log10(static_cast<double>(best->params.steps));
+      x[2] = best->params.damping_ratio_translation;
+      x[3] = best->params.damping_ratio_rotation;
+    }
+    local_search(Strategy::cobyla, context, x, evals - evals / 3);
+    return;
+  }
+  evaluator.run_branches({[&] { local_search(options.strategy, context, a, evals / 2); },
+                          [&] { local_search(options.strategy, context, b, evals - evals / 2); }},
+                         jobs);
+}
+
+/// Every trial of the calibration into `out` (the resumed file's trials
+/// this run never asked for kept, numbered after its own); once, at the end.
+void keep_trials(CalibrationSummary& out, Evaluator& evaluator) {
+  evaluator.keep_unrequested();
+  out.trials = evaluator.all();
+  out.trials_run = evaluator.run_count();
+  out.trials_reused = evaluator.reused_count();
+}
+
+/// A stopped calibration's result: its finished trials kept, and a message
+/// saying where they are and that a resume continues.
+CalibrationSummary interrupted_result(CalibrationSummary out, Evaluator& evaluator,
+                                      const CalibrationOptions& options,
+                                      std::chrono::steady_clock::time_point t0) {
+  keep_trials(out, evaluator);
+  out.interrupted = true;
+  out.message = "interrupted: " + std::to_string(out.trials.size()) + " finished trials are kept" +
+                (options.trials_path.empty() ? "" : " in " + options.trials_path) +
+                "; resume to continue";
+  out.wall_time_s = seconds_since(t0);
+  return out;
+}
+
+/// A failed certificate's early rounds: the tolerances tightened by how far
+/// the error missed (factor 0.25 to 0.8), and a search again from the best
+/// point with Nstep raised by the same factor.
+void search_tightened(Evaluator& evaluator, const SearchSpace& space, Tolerances& tolerances,
+                      const TrialRecord& best, double richardson_error,
+                      const CalibrationOptions& options, int budget, int jobs) {
+  const double factor = std::clamp(options.accuracy / std::max(richardson_error, 1e-12), 0.25, 0.8);
+  tolerances.force_balance *= factor;
+  tolerances.moment_balance *= factor;
+  tolerances.servo *= factor;
+  tolerances.oscillation *= factor;
+  const double x[4] = {best.params.dt_ratio,
+                       std::log10(static_cast<double>(best.params.steps)) - std::log10(factor),
+                       best.params.damping_ratio_translation, best.params.damping_ratio_rotation};
+  if (options.strategy == Strategy::model) {
+    model_search(evaluator, space, tolerances, x, x, std::max(kMinSearchTrials, budget / 4), jobs);
+  } else {
+    SearchContext context{&evaluator, &space, tolerances, TrialPhase::search_tightened};
+    local_search(options.strategy == Strategy::direct ? Strategy::cobyla : options.strategy,
+                 context, x, std::max(8, budget / 4));
+  }
+}
+
+/// The certificate rounds: which passing trial is the result and whether it
+/// is certified. The cheapest passing trial is certified; when that fails,
+/// the tolerances are tightened and searched again from it (two rounds),
+/// then Nstep doubled. Returns the last trial certified (`certificate` its
+/// certificate), none when no trial passed; stops early when the evaluator
+/// is stopped.
+std::optional<TrialRecord> certify_best(Evaluator& evaluator, const SearchSpace& space,
+                                        const CalibrationOptions& options, int budget, int jobs,
+                                        bool three_level, Certificate& certificate) {
   Tolerances tolerances = options.tolerances;
-
-  auto search_round = [&](const double* a, const double* b, int evals, TrialPhase phase) {
-    SearchContext context{&evaluator, &space, tolerances, phase};
-    if (options.strategy == Strategy::model) {
-      model_search(evaluator, space, tolerances, a, b, evals, jobs);
-      return;
-    }
-    if (options.strategy == Strategy::direct) {
-      global_phase(context, evals / 3);
-      auto best = cheapest_passing(evaluator.all());
-      double x[4] = {a[0], a[1], a[2], a[3]};
-      if (best) {
-        x[0] = best->params.dt_ratio;
-        x[1] = std::log10(static_cast<double>(best->params.steps));
-        x[2] = best->params.damping_ratio_translation;
-        x[3] = best->params.damping_ratio_rotation;
-      }
-      local_search(Strategy::cobyla, context, x, evals - evals / 3);
-      return;
-    }
-    evaluator.run_branches({[&] { local_search(options.strategy, context, a, evals / 2); },
-                            [&] { local_search(options.strategy, context, b, evals - evals / 2); }},
-                           jobs);
-  };
-  search_round(start0, start1, budget, TrialPhase::search);
-  const auto finish_interrupted = [&] {
-    evaluator.keep_unrequested();
-    out.trials = evaluator.all();
-    out.trials_run = evaluator.run_count();
-    out.trials_reused = evaluator.reused_count();
-    out.interrupted = true;
-    out.message =
-        "interrupted: " + std::to_string(out.trials.size()) + " finished trials are kept" +
-        (options.trials_path.empty() ? "" : " in " + options.trials_path) + "; resume to continue";
-    out.wall_time_s = seconds_since(t0);
-    return out;
-  };
-  if (evaluator.stopped()) return finish_interrupted();
-
-  // Certificate; when it fails, tighten the tolerances and search again
-  // from the best point, then fall back to doubling Nstep.
-  std::optional<TrialRecord> best;
-  // The last trial certified, out.certificate's: the result. A round that
+  // The last trial certified, `certificate`'s: the result. A round that
   // finds nothing passing its tightened tolerances ends the loop, and the
   // result stays the passing trial whose certificate failed.
   std::optional<TrialRecord> certified;
   int64_t steps_floor = 0;  // raised by the fallback, so that it moves on
   for (int round = 0; round < 6; ++round) {
     // Judged against the current (possibly tightened) tolerances.
-    best = cheapest_passing(evaluator.all(), &tolerances, steps_floor);
+    const std::optional<TrialRecord> best =
+        cheapest_passing(evaluator.all(), &tolerances, steps_floor);
     if (!best) break;
-    out.certificate = certify(evaluator, *best, options.accuracy, jobs, out.dimension == 3);
+    certificate = certify(evaluator, *best, options.accuracy, jobs, three_level);
     certified = best;
-    if (evaluator.stopped()) return finish_interrupted();
-    if (out.certificate.passed) break;
+    if (evaluator.stopped() || certificate.passed) break;
     if (round < 2) {
-      const double factor = std::clamp(
-          options.accuracy / std::max(out.certificate.richardson_error, 1e-12), 0.25, 0.8);
-      tolerances.force_balance *= factor;
-      tolerances.moment_balance *= factor;
-      tolerances.servo *= factor;
-      tolerances.oscillation *= factor;
-      const double x[4] = {best->params.dt_ratio,
-                           std::log10(static_cast<double>(best->params.steps)) - std::log10(factor),
-                           best->params.damping_ratio_translation,
-                           best->params.damping_ratio_rotation};
-      if (options.strategy == Strategy::model) {
-        model_search(evaluator, space, tolerances, x, x, std::max(kMinSearchTrials, budget / 4),
-                     jobs);
-      } else {
-        SearchContext context{&evaluator, &space, tolerances, TrialPhase::search_tightened};
-        local_search(options.strategy == Strategy::direct ? Strategy::cobyla : options.strategy,
-                     context, x, std::max(8, budget / 4));
-      }
+      search_tightened(evaluator, space, tolerances, *best, certificate.richardson_error, options,
+                       budget, jobs);
     } else {
       // Fall back: the same multipliers, Nstep doubled.
       AlgorithmSpec p = best->params;
@@ -1100,12 +1134,15 @@ CalibrationSummary calibrate(const TrialRunner& runner, const AlgorithmSpec& bas
       steps_floor = rounded_params(p).steps;
     }
   }
+  return certified;
+}
 
-  if (evaluator.stopped()) return finish_interrupted();
-  evaluator.keep_unrequested();
-  out.trials = evaluator.all();
-  out.trials_run = evaluator.run_count();
-  out.trials_reused = evaluator.reused_count();
+/// The result of a calibration that ran to the end: the certified trial
+/// (if any), success, and the message saying what was found: no
+/// parameters, parameters uncertified, or calibrated.
+void finish_result(CalibrationSummary& out, Evaluator& evaluator,
+                   const std::optional<TrialRecord>& certified, int budget) {
+  keep_trials(out, evaluator);
   if (certified) {
     out.best = rounded_params(certified->params);
     out.best_trial = *certified;
@@ -1125,6 +1162,37 @@ CalibrationSummary calibrate(const TrialRunner& runner, const AlgorithmSpec& bas
   else
     out.message = "calibrated: every criterion passed and Nstep doubled moves the peak by " +
                   std::to_string(100.0 * out.certificate.steps_doubled_peak_change) + " %";
+}
+
+}  // namespace
+
+CalibrationSummary calibrate(const TrialRunner& runner, const AlgorithmSpec& base,
+                             const CalibrationOptions& options) {
+  const auto t0 = std::chrono::steady_clock::now();
+  CalibrationSummary out;
+  out.strategy = options.strategy;
+  out.dimension = runner.dimension();
+  const int jobs = resolve_jobs(options.jobs);
+  const int64_t n = runner.particles();
+
+  // Positions are counted from this call's top level (ids, Evaluator).
+  const PlaceScope top_level(Place{});
+  Evaluator evaluator(runner, options);
+  if (options.resume && !options.trials_path.empty())
+    preload_trials(evaluator, options.trials_path);
+
+  // Bounds. The stable step comes from the consolidated contact network.
+  out.dt_ratio_stable = runner.stable_dt_ratio(base);
+  const SearchSpace space = search_space(base, options, n, out.dt_ratio_stable);
+  const Starts starts = search_starts(base, n, space);
+  const int budget = search_budget(options);
+  search_from_starts(evaluator, space, options, starts, budget, jobs);
+  if (evaluator.stopped()) return interrupted_result(std::move(out), evaluator, options, t0);
+
+  const std::optional<TrialRecord> certified =
+      certify_best(evaluator, space, options, budget, jobs, out.dimension == 3, out.certificate);
+  if (evaluator.stopped()) return interrupted_result(std::move(out), evaluator, options, t0);
+  finish_result(out, evaluator, certified, budget);
   out.wall_time_s = seconds_since(t0);
   return out;
 }

@@ -77,7 +77,7 @@ ResultRuns rerun_start_and_result(const SceneConfig& config, const ConsolidatedS
     return r;
   };
   ResultRuns out;
-  const bool have_best = summary.best_trial.score.particle_steps > 0.0;  // a trial ran
+  const bool have_best = summary.has_best_trial();
   run_parallel({[&] { out.start = one("start point", start); },
                 [&] {
                   if (have_best)
@@ -134,7 +134,7 @@ ResultRuns3D rerun_start_and_result(const SceneConfig& config, const TriaxialSta
                                     const AlgorithmSpec& start, const CalibrationSummary& summary,
                                     const Tolerances& tolerances, int jobs, KnownRuns3D known) {
   ResultRuns3D out;
-  const bool have_best = summary.best_trial.score.particle_steps > 0.0;  // a trial ran
+  const bool have_best = summary.has_best_trial();
   const std::string best_label = summary.success ? "calibrated" : "best found";
   // What already ran, when it ran exactly these parameters to the end.
   const auto whole = [](const TriaxialResult& run) { return !run.stopped_early; };

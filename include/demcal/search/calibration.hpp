@@ -165,11 +165,17 @@ struct CalibrationSummary {
   Strategy strategy = CalibrationOptions{}.strategy;  ///< options.strategy
   int dimension = 2;  ///< of the scene calibrated (TrialRunner::dimension())
 
+  /// best_trial is a trial that ran: the cheapest passing one, certified
+  /// or not (the evidence runs rerun it, the report marks it). False when
+  /// no trial passed: best_trial is then default-constructed, with no
+  /// particle-steps.
+  bool has_best_trial() const { return best_trial.score.particle_steps > 0.0; }
   /// best and best_trial hold a trial that passed every criterion (the
   /// cheapest; certified when success). False when no trial passed: best
   /// is then the default AlgorithmSpec, never run, and params.json holds
-  /// no parameters. (A summary built by hand with success set has one.)
-  bool has_best() const { return success || best_trial.score.particle_steps > 0.0; }
+  /// no parameters. (A summary built by hand with success set has one,
+  /// though its best_trial may be left default.)
+  bool has_best() const { return success || has_best_trial(); }
 
   std::string BriefReport() const;
   std::string FullReport() const;
