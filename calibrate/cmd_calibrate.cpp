@@ -100,13 +100,14 @@ nlohmann::json run_record(double wall_time_s, const CalibrationSummary& summary,
 /// (the config as given with its --set, the REV's particle file,
 /// --accuracy, --strategy, demcal's version and build: add_build).
 /// --max-trials, --jobs and --evidence do not change a trial, nor does the
-/// prototype's file (its size is read again after the search).
+/// prototype's file (read again after the search).
 nlohmann::json resume_key(const SceneConfig& config, const Strategy strategy) {
   nlohmann::json key{{"schema", "demcal.resume/1"},
                      {"config_sha256", sha256_hex(config.text)},
                      {"accuracy", config.calibration.accuracy},
                      {"strategy", to_string(strategy)}};
-  add_particle_files(key, config, false);
+  if (config.assembly.type == "file")
+    add_file_digest(key, "assembly_file_sha256", config.assembly.file);
   add_build(key);
   return key;
 }

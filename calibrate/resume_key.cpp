@@ -15,11 +15,8 @@ void add_build(nlohmann::json& key) {
   key["program_sha256"] = program_digest();
 }
 
-void add_particle_files(nlohmann::json& key, const SceneConfig& config, const bool prototype) {
-  if (config.assembly.type == "file")
-    key["assembly_file_sha256"] = sha256_hex(read_text_file(config.assembly.file));
-  if (prototype && !config.prototype.file.empty())
-    key["prototype_file_sha256"] = sha256_hex(read_text_file(config.prototype.file));
+void add_file_digest(nlohmann::json& key, const std::string& name, const std::string& path) {
+  if (!path.empty()) key[name] = sha256_hex(read_text_file(path));
 }
 
 void write_resume_key(const std::string& dir, const nlohmann::json& key) {

@@ -6,10 +6,6 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-namespace demcal {
-struct SceneConfig;
-}
-
 namespace demcal::cli {
 
 /// The build's part of every key: demcal's version and the SHA-256 of the
@@ -17,12 +13,10 @@ namespace demcal::cli {
 /// the version is not bumped for every change of a law or of the rounding.
 void add_build(nlohmann::json& key);
 
-/// The particle files' part of a key: the SHA-256 of the contents of the
-/// REV's file (`assembly_file_sha256`, when assembly.type is "file") and,
-/// with `prototype`, of the prototype's file (`prototype_file_sha256`, when
-/// prototype.file is given). The config's text names a file, not what it
-/// holds: edited under the same name, it makes other trials.
-void add_particle_files(nlohmann::json& key, const SceneConfig& config, bool prototype);
+/// A particle file's part of a key: the SHA-256 of its contents under
+/// `name` (nothing for an empty path). The config's text names a file, not
+/// what it holds: edited under the same name, it makes other trials.
+void add_file_digest(nlohmann::json& key, const std::string& name, const std::string& path);
 
 /// The key written to DIR/resume.json at a fresh start.
 void write_resume_key(const std::string& dir, const nlohmann::json& key);

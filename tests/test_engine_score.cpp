@@ -904,7 +904,8 @@ TEST(EngineLammps, VerifyInLammpsAgreesWithDemcal) {
   const nlohmann::json s = test::read_json(dir / "sc" / "summary.json");
   for (const auto& [key, value] : s.items()) {
     if (key == "schema") continue;  // verify's own
-    EXPECT_EQ(l[key], value) << key;
+    ASSERT_TRUE(l.contains(key)) << key;
+    EXPECT_EQ(l.at(key), value) << key;
   }
   EXPECT_TRUE(l.contains("verdict_line"));
 }

@@ -181,7 +181,16 @@ TEST_F(RobustCli, ResumeAfterTheParticleFileChangedIsRefused) {
   ASSERT_TRUE(scaled.status == 0 || scaled.status == 1) << scaled.err;  // 1: the forward check
   write_rev(7, 4.5e-4);
   study.push_back("--resume");
-  expect_refused(study, "assembly_file_sha256");
+  expect_refused(study, "family_file_sha256");
+
+  // A generated family reads no file: a prototype file named but not made
+  // yet (verify writes one later) keys nothing and stops nothing.
+  const Result generated = demcal({"scaling", kHex5, "--set", R"(prototype={"file": "later.csv"})",
+                                   "--sizes", "16,25", "--calibrate-max", "25", "--max-trials",
+                                   "12", "-j", "1", "-q", "--work", "G", "-o", "RG"});
+  EXPECT_TRUE(generated.status == 0 || generated.status == 1) << generated.err;
+  EXPECT_FALSE(nlohmann::json::parse(read_text(work() / "G" / "resume.json"))
+                   .contains("family_file_sha256"));
 }
 
 // `demcal scaling --resume` reuses the per-size results of its --work

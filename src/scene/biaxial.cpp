@@ -171,6 +171,8 @@ double servo_velocity(const World& world, WallSide side, double target_stress, d
   const Material& mat = world.material();
   const double m_max =
       disk_mass(disk_areal_density(mat, world.integration().mass_scaling), world.max_radius());
+  // (The area L·t is rounded first: where thickness is not 1 the move
+  // differs from the one before servo_step_velocity in its last bits.)
   const ServoWall wall{error, length * mat.thickness, world.wall(side).contacts, kInward[side],
                        world.wall(side).velocity};
   return servo_step_velocity(wall, gain, servo_resistance(mat, m_max, dt), mat.wall.kn, dt,

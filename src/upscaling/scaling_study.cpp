@@ -126,6 +126,11 @@ Spread spread_of(const std::vector<double>& v) {
   return s;
 }
 
+std::string scaling_family_file(const SceneConfig& config) {
+  if (config.assembly.type != "file" || config.dimension == 3) return "";
+  return config.prototype.file.empty() ? config.assembly.file : config.prototype.file;
+}
+
 namespace {
 
 json read_json(const std::string& path) {
@@ -163,8 +168,7 @@ class Family {
       throw InputError(config.source, "assembly.type",
                        "a 3D scaling study needs a generated family (fcc or random): REVs cut "
                        "from a sphere file are `demcal rev`'s");
-    file_prototype_ = read_particle_file(config.prototype.file.empty() ? config.assembly.file
-                                                                       : config.prototype.file);
+    file_prototype_ = read_particle_file(scaling_family_file(config));
     if (file_prototype_.size() < o.sizes.back())
       throw InputError(
           "--sizes", "",

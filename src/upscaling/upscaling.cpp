@@ -29,7 +29,7 @@ ScalingLaw scaling_law_from_json(const nlohmann::json& j, const std::string& sou
   if (!j.is_object()) throw InputError(source, "", "scaling law: expected an object");
   if (j.contains("exponent")) {
     if (!j["exponent"].is_number())
-      throw InputError(source, "exponent", "must be a number, got " + j["exponent"].dump());
+      throw InputError(source, "exponent", "must be a number, got " + quoted_json(j["exponent"]));
     law.exponent = j["exponent"].get<double>();
     if (!(law.exponent > 0.0 && law.exponent <= 3.0))
       throw InputError(source, "exponent", "must be in (0, 3], got " + j["exponent"].dump());
