@@ -53,7 +53,8 @@ mkdir -p "$work"
 [[ -n "${KEEP:-}" ]] || trap 'rm -rf "$work"' EXIT
 export OMP_NUM_THREADS=1
 pin=(taskset -c "$CORE")
-echo "# machine: $(lscpu | sed -n 's/^Model name: *//p' | head -1), $(nproc) cores; pinned to core $CORE"
+# (--all: OMP_NUM_THREADS=1, exported above, makes plain nproc say 1)
+echo "# machine: $(lscpu | sed -n 's/^Model name: *//p' | head -1), $(nproc --all) cores; pinned to core $CORE"
 echo "# $(lmp -h | grep -m1 'Large-scale' | sed 's/^ *//')"
 echo "# start $(date -u +%FT%TZ), load average $(cut -d' ' -f1-3 /proc/loadavg)"
 median() { python3 -c "import statistics,sys; print('%.4g' % statistics.median(float(v) for v in sys.argv[1:]))" "$@"; }
