@@ -14,12 +14,6 @@
 namespace demcal::cli {
 namespace {
 
-/// The scene every REV command reads: a config file and its overrides.
-void add_scene_options(CLI::App* command, std::string& config, std::vector<std::string>& sets) {
-  command->add_option("config", config, "scene config (JSON); default: the embedded one");
-  command->add_option("--set", sets, "override a key: section.key=value (repeatable)");
-}
-
 /// check and run: one scene, one trial.
 struct TrialOptions {
   std::string config, out_dir;

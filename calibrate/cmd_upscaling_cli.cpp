@@ -86,8 +86,7 @@ std::function<int()> add_upscaling_commands(CLI::App& app) {
   auto sc = std::make_shared<ScalingOptions>();
   auto* scaling = app.add_subcommand(
       "scaling", "calibrate at several sizes, fit Nstep against N, check the law forward");
-  scaling->add_option("config", sc->config, "scene config (JSON); default: the embedded one");
-  scaling->add_option("--set", sc->sets, "override a key: section.key=value (repeatable)");
+  add_scene_options(scaling, sc->config, sc->sets);
   scaling->add_option("--sizes", sc->sizes, "particle counts (default 25,100,400,1600)");
   scaling
       ->add_option("--calibrate-max", sc->calibrate_max,
@@ -126,8 +125,7 @@ std::function<int()> add_upscaling_commands(CLI::App& app) {
   auto rv = std::make_shared<RevCmdOptions>();
   auto* rev = app.add_subcommand(
       "rev", "cut or generate a REV from the prototype and report how representative it is");
-  rev->add_option("config", rv->config, "scene config (JSON); default: the embedded one");
-  rev->add_option("--set", rv->sets, "override a key: section.key=value (repeatable)");
+  add_scene_options(rev, rv->config, rv->sets);
   rev->add_option("--prototype", rv->prototype,
                   "the prototype's particle file (CSV x,y,r; 3D: x,y,z,r)");
   rev->add_option("--particles", rv->particles, "particles in the REV (default 400)")
