@@ -207,26 +207,26 @@ Invocation prepare(const CalibrateOptions& o) {
 /// The consolidated REV: disks (biaxial) or spheres (triaxial), cached.
 Consolidated consolidate_rev(const CalibrateOptions& o, const SceneConfig& config, bool three_d) {
   Consolidated c;
+  auto announce = [&](int64_t size, const char* what) {
+    if (!o.quiet)
+      std::cerr << "demcal: consolidating " << size << " " << what << " of " << config.name
+                << " to sigma3 = " << config.test.lateral_stress << " Pa"
+                << (three_d ? " (3D, triaxial)" : "") << "\n";
+  };
+  auto account = [&](const auto& state) {
+    c.particles = state.world.size();
+    c.steps = state.steps;
+    c.wall_time_s = state.wall_time_s;
+    c.from_cache = state.from_cache;
+  };
   if (three_d) {
     const SphereAssembly assembly = make_sphere_assembly(config);
-    if (!o.quiet)
-      std::cerr << "demcal: consolidating " << assembly.size() << " spheres of " << config.name
-                << " to sigma3 = " << config.test.lateral_stress << " Pa (3D, triaxial)\n";
-    c.spheres.emplace(consolidate_triaxial(config, assembly));
-    c.particles = c.spheres->world.size();
-    c.steps = c.spheres->steps;
-    c.wall_time_s = c.spheres->wall_time_s;
-    c.from_cache = c.spheres->from_cache;
+    announce(assembly.size(), "spheres");
+    account(c.spheres.emplace(consolidate_triaxial(config, assembly)));
   } else {
     Assembly assembly = make_assembly(config);
-    if (!o.quiet)
-      std::cerr << "demcal: consolidating " << assembly.size() << " particles of " << config.name
-                << " to sigma3 = " << config.test.lateral_stress << " Pa\n";
-    c.disks.emplace(consolidate(config, assembly));
-    c.particles = c.disks->world.size();
-    c.steps = c.disks->steps;
-    c.wall_time_s = c.disks->wall_time_s;
-    c.from_cache = c.disks->from_cache;
+    announce(assembly.size(), "particles");
+    account(c.disks.emplace(consolidate(config, assembly)));
   }
   if (!o.quiet)
     std::cerr << "demcal: consolidated in " << c.steps << " steps ("

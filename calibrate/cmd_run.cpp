@@ -89,6 +89,24 @@ void print_unscored_criteria(const LoadingRun<Point>& run, const Criteria& c, bo
   std::cout << "\n";
 }
 
+/// A run's files, 2D and 3D: summary.json; series.csv with the metadata
+/// `demcal score` needs to score it as this run; final.vtk unless
+/// output.vtk is off (an earlier run's retired then, not left as this one's).
+template <class Run, class FinalState>
+void write_run_files(const std::string& dir, const SceneConfig& config,
+                     const nlohmann::json& summary, const Run& run,
+                     std::optional<double> reference_peak, const FinalState& final_state) {
+  OutputFolder out(dir);
+  out.write("summary.json", summary.dump(2) + "\n");
+  out.write("series.csv",
+            series_csv(series_metadata(config.name, config.test, run, reference_peak), run.series));
+  if (config.output.vtk)
+    out.write("final.vtk", world_vtk(final_state, "demcal " + config.name));
+  else
+    out.retire("final.vtk");
+  out.commit();
+}
+
 }  // namespace
 
 namespace {
@@ -155,18 +173,7 @@ int run_3d(const SceneConfig& config, const std::string& out_dir, bool allow_uns
   const bool within = score.passed;
   nlohmann::json summary = triaxial_run_summary(config, state, run, c, score, tolerances);
   summary["consolidation"]["from_cache"] = state.from_cache;
-  {
-    OutputFolder out(dir);
-    out.write("summary.json", summary.dump(2) + "\n");
-    out.write(
-        "series.csv",
-        series_csv(series_metadata(config.name, config.test, run, reference_peak), run.series));
-    if (config.output.vtk)
-      out.write("final.vtk", world_vtk(final_state, "demcal " + config.name));
-    else
-      out.retire("final.vtk");
-    out.commit();
-  }
+  write_run_files(dir, config, summary, run, reference_peak, final_state);
   const Criteria& m = score.criteria;
   std::cout << std::setprecision(4) << "scene " << config.name
             << " (3D, triaxial): " << run.particles << " spheres, " << steps_words(run) << ", dt "
@@ -245,20 +252,7 @@ int cmd_run(const std::string& path, const std::vector<std::string>& sets,
       {"steps", state.steps}, {"wall_time_s", state.wall_time_s}, {"from_cache", state.from_cache}};
   summary["config_sha256"] = sha256_hex(config.text);
   summary["version"] = DEMCAL_VERSION;
-
-  {
-    OutputFolder out(dir);
-    out.write("summary.json", summary.dump(2) + "\n");
-    // With the metadata `demcal score` needs to score it as this run.
-    out.write(
-        "series.csv",
-        series_csv(series_metadata(config.name, config.test, run, reference_peak), run.series));
-    if (config.output.vtk)
-      out.write("final.vtk", world_vtk(final_state, "demcal " + config.name));
-    else
-      out.retire("final.vtk");  // an earlier run's, not this one's
-    out.commit();
-  }
+  write_run_files(dir, config, summary, run, reference_peak, final_state);
 
   const auto& c = score.criteria;
   std::cout << std::setprecision(4) << "scene " << config.name << ": " << run.particles

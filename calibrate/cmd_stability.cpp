@@ -16,18 +16,13 @@
 namespace demcal::cli {
 
 int cmd_stability(const StabilityOptions& o) {
-  if (!(o.to > o.from)) throw InputError("--to", "", "must be larger than --from");
+  if (!(o.scan.to > o.scan.from)) throw InputError("--to", "", "must be larger than --from");
   // 2D (disks, biaxial test) and 3D (spheres, triaxial test) alike.
   SceneConfig config = load_config(o.config, o.sets);
   const std::string dir = o.out_dir.empty() ? "demcal-stability-" + config.name : o.out_dir;
   OutputFolder::check(dir);  // an unwritable -o fails now, not after the scan
 
-  StabilityScanOptions options;
-  options.from = o.from;
-  options.to = o.to;
-  options.points = o.points;
-  options.steps = o.steps;
-  options.jobs = o.jobs;
+  const StabilityScanOptions& options = o.scan;
   StabilityScanResult r;
   if (config.dimension == 3) {
     const SphereAssembly assembly = make_sphere_assembly(config);

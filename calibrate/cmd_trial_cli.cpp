@@ -14,12 +14,6 @@
 namespace demcal::cli {
 namespace {
 
-/// The scene every REV command reads: a config file and its overrides.
-void add_scene_options(CLI::App* command, std::string& config, std::vector<std::string>& sets) {
-  command->add_option("config", config, "scene config (JSON); default: the embedded one");
-  command->add_option("--set", sets, "override a key: section.key=value (repeatable)");
-}
-
 /// check and run: one scene, one trial.
 struct TrialOptions {
   std::string config, out_dir;
@@ -59,13 +53,14 @@ void add_stability_options(CLI::App* stability, StabilityOptions& stab) {
   add_scene_options(stability, stab.config, stab.sets);
   stability->add_option("-o,--output", stab.out_dir,
                         "output folder (default demcal-stability-NAME)");
-  stability->add_option("-j,--jobs", stab.jobs, "trials in parallel (default: cores)")
+  stability->add_option("-j,--jobs", stab.scan.jobs, "trials in parallel (default: cores)")
       ->check(whole_number(1, kMaxJobs));
-  stability->add_option("--from", stab.from, "first rung, x the estimated stable dt_ratio (0.5)")
+  stability
+      ->add_option("--from", stab.scan.from, "first rung, x the estimated stable dt_ratio (0.5)")
       ->check(real_above(0.0, 100.0));
-  stability->add_option("--to", stab.to, "last rung, x the estimated stable dt_ratio (2)")
+  stability->add_option("--to", stab.scan.to, "last rung, x the estimated stable dt_ratio (2)")
       ->check(real_above(0.0, 100.0));
-  stability->add_option("--points", stab.points, "rungs of the ladder (16)")
+  stability->add_option("--points", stab.scan.points, "rungs of the ladder (16)")
       ->check(CLI::Range(2, 1000));
   // Fewer steps than this cannot show a divergence: the energy ledger is
   // sampled every energy_check_interval steps, and a step past the stable
@@ -73,7 +68,7 @@ void add_stability_options(CLI::App* stability, StabilityOptions& stab) {
   // (KernelOptions in demcal/kernel/world.hpp); 100 steps called 2x the
   // stable step "stable".
   const int interval = KernelOptions{}.energy_check_interval;
-  stability->add_option("--steps", stab.steps, "loading steps per trial (20000)")
+  stability->add_option("--steps", stab.scan.steps, "loading steps per trial (20000)")
       ->check(whole_number(16LL * interval, 1'000'000'000,
                            "fewer steps cannot show a divergence: the energy ledger is sampled "
                            "every " +

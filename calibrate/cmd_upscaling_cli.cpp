@@ -12,10 +12,30 @@ namespace demcal::cli {
 
 namespace {
 
-void add_allow_failed(CLI::App* command, bool& allow_failed) {
-  command->add_flag("--allow-failed", allow_failed,
+/// verify's and export's --prototype FILE or --particles N, not both.
+void add_prototype_options(CLI::App* command, UpscaledParamsOptions& o) {
+  auto* prototype = command->add_option("--prototype", o.prototype,
+                                        "the prototype's particle file (CSV x,y,r; 3D: x,y,z,r)");
+  command
+      ->add_option("--particles", o.particles,
+                   "a generated prototype of N particles; not with --prototype")
+      ->check(whole_number(1, kMaxParticles))
+      ->excludes(prototype);
+}
+
+/// What upscale, verify and export read about params.json after the
+/// prototype: --allow-failed, --config, --set, --law, --exponent.
+void add_params_options(CLI::App* command, UpscaledParamsOptions& o) {
+  command->add_flag("--allow-failed", o.allow_failed,
                     "use the parameters of a params.json whose calibration failed (success "
                     "false: passed, not certified); refused without it");
+  command->add_option("--config", o.config, "scene config, if params.json carries none");
+  command->add_option("--set", o.sets, "override a config key: section.key=value");
+  command->add_option("--law", o.law, "scaling.json of demcal scaling: use its measured law");
+  command
+      ->add_option("--exponent", o.exponent,
+                   "Nstep ~ N^exponent (default: 1 for disks, 2/3 for spheres)")
+      ->check(real_above(0.0, kMaxExponent));
 }
 
 }  // namespace
@@ -32,35 +52,15 @@ std::function<int()> add_upscaling_commands(CLI::App& app) {
       ->add_option("--prototype", up->prototype,
                    "the prototype's particle file (CSV x,y,r; 3D: x,y,z,r); not with --particles")
       ->excludes(up_particles);
-  add_allow_failed(upscale, up->allow_failed);
-  upscale->add_option("--config", up->config, "scene config, if params.json carries none");
-  upscale->add_option("--set", up->sets, "override a config key: section.key=value");
-  upscale->add_option("--law", up->law, "scaling.json of demcal scaling: use its measured law");
-  upscale
-      ->add_option("--exponent", up->exponent,
-                   "Nstep ~ N^exponent (default: 1 for disks, 2/3 for spheres)")
-      ->check(real_above(0.0, kMaxExponent));
+  add_params_options(upscale, *up);
   upscale->add_option("-o,--output", up->output, "write params.json here (default stdout)");
 
   auto ve = std::make_shared<VerifyOptions>();
   auto* verify =
       app.add_subcommand("verify", "run the prototype with the upscaled parameters and score it");
   verify->add_option("params", ve->params, "params.json of a calibration")->required();
-  auto* ve_prototype = verify->add_option("--prototype", ve->prototype,
-                                          "the prototype's particle file (CSV x,y,r; 3D: x,y,z,r)");
-  verify
-      ->add_option("--particles", ve->particles,
-                   "a generated prototype of N particles; not with --prototype")
-      ->check(whole_number(1, kMaxParticles))
-      ->excludes(ve_prototype);
-  add_allow_failed(verify, ve->allow_failed);
-  verify->add_option("--config", ve->config, "scene config, if params.json carries none");
-  verify->add_option("--set", ve->sets, "override a config key: section.key=value");
-  verify->add_option("--law", ve->law, "scaling.json of demcal scaling: use its measured law");
-  verify
-      ->add_option("--exponent", ve->exponent,
-                   "Nstep ~ N^exponent (default: 1 for disks, 2/3 for spheres)")
-      ->check(real_above(0.0, kMaxExponent));
+  add_prototype_options(verify, *ve);
+  add_params_options(verify, *ve);
   verify->add_option("-o,--output", ve->out_dir, "output folder (default demcal-verify-NAME)");
   verify
       ->add_option("--max-minutes", ve->max_minutes,
@@ -86,8 +86,7 @@ std::function<int()> add_upscaling_commands(CLI::App& app) {
   auto sc = std::make_shared<ScalingOptions>();
   auto* scaling = app.add_subcommand(
       "scaling", "calibrate at several sizes, fit Nstep against N, check the law forward");
-  scaling->add_option("config", sc->config, "scene config (JSON); default: the embedded one");
-  scaling->add_option("--set", sc->sets, "override a key: section.key=value (repeatable)");
+  add_scene_options(scaling, sc->config, sc->sets);
   scaling->add_option("--sizes", sc->sizes, "particle counts (default 25,100,400,1600)");
   scaling
       ->add_option("--calibrate-max", sc->calibrate_max,
@@ -111,19 +110,8 @@ std::function<int()> add_upscaling_commands(CLI::App& app) {
   // Values are checked by the command (exit 2, one message), not by CLI11.
   exp->add_option("--format", ex->format, "lammps (default) or liggghts");
   exp->add_option("-o,--output", ex->output, "the deck (default demcal-NAME.FORMAT)");
-  auto* ex_prototype = exp->add_option("--prototype", ex->prototype,
-                                       "the prototype's particle file (CSV x,y,r; 3D: x,y,z,r)");
-  exp->add_option("--particles", ex->particles,
-                  "a generated prototype of N particles; not with --prototype")
-      ->check(whole_number(1, kMaxParticles))
-      ->excludes(ex_prototype);
-  add_allow_failed(exp, ex->allow_failed);
-  exp->add_option("--config", ex->config, "scene config, if params.json carries none");
-  exp->add_option("--set", ex->sets, "override a config key: section.key=value");
-  exp->add_option("--law", ex->law, "scaling.json of demcal scaling: use its measured law");
-  exp->add_option("--exponent", ex->exponent,
-                  "Nstep ~ N^exponent (default: 1 for disks, 2/3 for spheres)")
-      ->check(real_above(0.0, kMaxExponent));
+  add_prototype_options(exp, *ex);
+  add_params_options(exp, *ex);
   exp->add_flag("--no-consolidate", ex->no_consolidate,
                 "write the prototype as read (it is already consolidated to sigma3)");
   exp->add_option("--consolidate-in", ex->consolidate_in,
@@ -137,8 +125,7 @@ std::function<int()> add_upscaling_commands(CLI::App& app) {
   auto rv = std::make_shared<RevCmdOptions>();
   auto* rev = app.add_subcommand(
       "rev", "cut or generate a REV from the prototype and report how representative it is");
-  rev->add_option("config", rv->config, "scene config (JSON); default: the embedded one");
-  rev->add_option("--set", rv->sets, "override a key: section.key=value (repeatable)");
+  add_scene_options(rev, rv->config, rv->sets);
   rev->add_option("--prototype", rv->prototype,
                   "the prototype's particle file (CSV x,y,r; 3D: x,y,z,r)");
   rev->add_option("--particles", rv->particles, "particles in the REV (default 400)")

@@ -66,6 +66,24 @@ SeriesMetadata verify_metadata(const SceneConfig& config, const Run& run) {
   return m;
 }
 
+/// verify.json's opening, 2D and 3D, either engine: the schema, the scene,
+/// the params file, the prototype (its `n` particles and their source), the
+/// REV, the upscaling to `n` and the upscaled parameters `up` at the
+/// prototype's `scales`.
+nlohmann::json verify_head(const VerifyOptions& o, const SceneConfig& config, int64_t n,
+                           const PrototypeSource& source, const RevParams& rev,
+                           const ScalingLaw& law, const AlgorithmSpec& up,
+                           const ParticleScales& scales) {
+  return {{"schema", "demcal.verify/1"},
+          {"scene", config.name},
+          {"params_file", o.params},
+          {"prototype",
+           {{"particles", n}, {"source", source.kind}, {"description", source.description}}},
+          {"rev", {{"particles", rev.particles}, {"steps", rev.params.steps}}},
+          {"upscaling", upscaling_block(rev.particles, n, law)},
+          {"params", param_block(up, scales)}};
+}
+
 /// `verify --engine lammps`: the exported deck of the consolidated
 /// prototype, run by lmp in DIR/lammps, its series scored.
 int verify_in_lammps(const VerifyOptions& o, const SceneConfig& config,
@@ -266,33 +284,26 @@ int verify_3d(const VerifyOptions& o, const nlohmann::json& params, const RevPar
     peak["relative_to_rev"] = (c.peak_stress_yy - *peak_rev) / std::abs(*peak_rev);
   }
   const double rate_run = trial.wall_time_s > 0 ? particle_steps / trial.wall_time_s : 0.0;
-  nlohmann::json out{
-      {"schema", "demcal.verify/1"},
-      {"dimension", 3},
-      {"scene", config.name},
-      {"params_file", o.params},
-      {"prototype",
-       {{"particles", n}, {"source", source.kind}, {"description", source.description}}},
-      {"rev", {{"particles", rev.particles}, {"steps", rev.params.steps}}},
-      {"upscaling", upscaling_block(rev.particles, n, law)},
-      {"params", param_block(up, sphere_scales(state.world, config.material, up))},
-      {"passed", score.passed},
-      {"criteria", to_json(c)},
-      {"tolerances", to_json(tolerances)},
-      {"diagnosis", to_json(score.diagnosis)},
-      {"peak", peak},
-      {"diverged", score.diverged},
-      {"axial_component", "criteria.peak_stress_yy holds the axial b_zz (the axis is z)"},
-      {"consolidation", {{"steps", state.steps}, {"wall_time_s", state.wall_time_s}}},
-      {"loading",
-       {{"steps", up.steps},
-        {"particle_steps", particle_steps},
-        {"threads", state.world.threads()},
-        {"estimated_s", estimate_s},
-        {"wall_time_s", trial.wall_time_s},
-        {"particle_steps_per_s", rate_run}}},
-      {"wall_time_s", total_s},
-      {"version", DEMCAL_VERSION}};
+  nlohmann::json out = verify_head(o, config, n, source, rev, law, up,
+                                   sphere_scales(state.world, config.material, up));
+  out.update({{"dimension", 3},
+              {"passed", score.passed},
+              {"criteria", to_json(c)},
+              {"tolerances", to_json(tolerances)},
+              {"diagnosis", to_json(score.diagnosis)},
+              {"peak", peak},
+              {"diverged", score.diverged},
+              {"axial_component", "criteria.peak_stress_yy holds the axial b_zz (the axis is z)"},
+              {"consolidation", {{"steps", state.steps}, {"wall_time_s", state.wall_time_s}}},
+              {"loading",
+               {{"steps", up.steps},
+                {"particle_steps", particle_steps},
+                {"threads", state.world.threads()},
+                {"estimated_s", estimate_s},
+                {"wall_time_s", trial.wall_time_s},
+                {"particle_steps_per_s", rate_run}}},
+              {"wall_time_s", total_s},
+              {"version", DEMCAL_VERSION}});
   write_verify_files(dir, out, series_csv(verify_metadata(config, run), run.series));
   print_verdict(score.passed, "3D prototype of " + std::to_string(n) + " spheres", up, c,
                 tolerances);
@@ -390,17 +401,10 @@ int cmd_verify(const VerifyOptions& o) {
   }
 
   if (in_lammps) {
-    const nlohmann::json head{
-        {"schema", "demcal.verify/1"},
-        {"scene", config.name},
-        {"params_file", o.params},
-        {"prototype",
-         {{"particles", n}, {"source", source.kind}, {"description", source.description}}},
-        {"rev", {{"particles", rev.particles}, {"steps", rev.params.steps}}},
-        {"upscaling", upscaling_block(rev.particles, n, law)},
-        {"params", param_block(up, particle_scales(proto.r, config.material, up.mass_scaling))},
-        {"consolidation", {{"steps", state.steps}, {"wall_time_s", state.wall_time_s}}},
-        {"version", DEMCAL_VERSION}};
+    nlohmann::json head = verify_head(o, config, n, source, rev, law, up,
+                                      particle_scales(proto.r, config.material, up.mass_scaling));
+    head["consolidation"] = {{"steps", state.steps}, {"wall_time_s", state.wall_time_s}};
+    head["version"] = DEMCAL_VERSION;
     return verify_in_lammps(o, config, state, up, dir, lmp, head);
   }
   LoadingResult run;
@@ -411,36 +415,26 @@ int cmd_verify(const VerifyOptions& o) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const ParticleScales scales = particle_scales(proto.r, config.material, up.mass_scaling);
 
-  nlohmann::json out{
-      {"schema", "demcal.verify/1"},
-      {"scene", config.name},
-      {"params_file", o.params},
-      {"prototype",
-       {{"particles", n},
-        {"source", source.kind},
-        {"description", source.description},
-        {"stats", to_json(packing_stats(state.world))}}},
-      {"rev", {{"particles", rev.particles}, {"steps", rev.params.steps}}},
-      {"upscaling", upscaling_block(rev.particles, n, law)},
-      {"params", param_block(up, scales)},
-      {"passed", trial.score.passed},
-      {"criteria", to_json(trial.score.criteria)},
-      {"tolerances", to_json(tolerances)},
-      {"diagnosis", to_json(score.diagnosis)},
-      {"peak",
-       {{"stress_yy", trial.score.criteria.peak_stress_yy},
-        {"strain_yy", trial.score.criteria.peak_strain_yy},
-        {"ratio", -trial.score.criteria.peak_stress_yy / config.test.lateral_stress}}},
-      {"diverged", trial.score.diverged},
-      {"consolidation", {{"steps", state.steps}, {"wall_time_s", state.wall_time_s}}},
-      {"loading",
-       {{"steps", up.steps},
-        {"particle_steps", particle_steps},
-        {"wall_time_s", trial.wall_time_s},
-        {"particle_steps_per_s",
-         trial.wall_time_s > 0 ? particle_steps / trial.wall_time_s : 0.0}}},
-      {"wall_time_s", total_s},
-      {"version", DEMCAL_VERSION}};
+  nlohmann::json out = verify_head(o, config, n, source, rev, law, up, scales);
+  out["prototype"]["stats"] = to_json(packing_stats(state.world));
+  out.update({{"passed", trial.score.passed},
+              {"criteria", to_json(trial.score.criteria)},
+              {"tolerances", to_json(tolerances)},
+              {"diagnosis", to_json(score.diagnosis)},
+              {"peak",
+               {{"stress_yy", trial.score.criteria.peak_stress_yy},
+                {"strain_yy", trial.score.criteria.peak_strain_yy},
+                {"ratio", -trial.score.criteria.peak_stress_yy / config.test.lateral_stress}}},
+              {"diverged", trial.score.diverged},
+              {"consolidation", {{"steps", state.steps}, {"wall_time_s", state.wall_time_s}}},
+              {"loading",
+               {{"steps", up.steps},
+                {"particle_steps", particle_steps},
+                {"wall_time_s", trial.wall_time_s},
+                {"particle_steps_per_s",
+                 trial.wall_time_s > 0 ? particle_steps / trial.wall_time_s : 0.0}}},
+              {"wall_time_s", total_s},
+              {"version", DEMCAL_VERSION}});
   write_verify_files(dir, out, series_csv(verify_metadata(config, run), run.series));
 
   const auto& c = trial.score.criteria;

@@ -8,6 +8,7 @@
 
 #include "demcal/scene/config.hpp"
 #include "demcal/search/calibration.hpp"
+#include "demcal/search/stability_scan.hpp"
 
 namespace CLI {
 class App;
@@ -59,10 +60,7 @@ struct StabilityOptions {
   std::string config;
   std::vector<std::string> sets;
   std::string out_dir;
-  int jobs = 0;
-  double from = 0.5, to = 2.0;
-  int points = 16;
-  long long steps = 20000;
+  StabilityScanOptions scan;  ///< --jobs, --from, --to, --points, --steps
 };
 int cmd_stability(const StabilityOptions& options);
 

@@ -1,7 +1,8 @@
 // Range checks for the numeric options of every subcommand, as CLI11
 // validators: a value out of range (0, -5, nan, 1e999, a count that does
 // not fit) fails the parse with one line naming the option, exit 2, before
-// anything is read or written. An option left out keeps its default.
+// anything is read or written. An option left out keeps its default. Also
+// the scene options (config, --set) every command on a config registers.
 #pragma once
 
 #include <CLI/CLI.hpp>
@@ -10,6 +11,7 @@
 #include <cstdint>
 #include <cstdlib>
 #include <string>
+#include <vector>
 
 namespace demcal::cli {
 
@@ -71,5 +73,13 @@ inline constexpr int64_t kMaxTrials = 100'000;
 inline constexpr double kMaxExponent = 3.0;
 /// Durations in minutes: up to a year.
 inline constexpr double kMaxMinutes = 525'600.0;
+
+/// The scene every command on a config reads (check, run, sweep, calibrate,
+/// stability, scaling, rev): a config file and its overrides.
+inline void add_scene_options(CLI::App* command, std::string& config,
+                              std::vector<std::string>& sets) {
+  command->add_option("config", config, "scene config (JSON); default: the embedded one");
+  command->add_option("--set", sets, "override a key: section.key=value (repeatable)");
+}
 
 }  // namespace demcal::cli

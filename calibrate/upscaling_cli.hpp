@@ -16,27 +16,26 @@
 
 namespace demcal::cli {
 
-struct UpscaleOptions {
+/// What upscale, verify and export read alike: a calibration's params.json
+/// and the prototype it is upscaled to (registered by add_params_options and
+/// add_prototype_options, cmd_upscaling_cli.cpp).
+struct UpscaledParamsOptions {
   std::string params;     ///< params.json of a calibration
-  int64_t particles = 0;  ///< the prototype's particle count
-  std::string prototype;  ///< or its particle file
+  std::string prototype;  ///< the prototype's particle file
+  int64_t particles = 0;  ///< or its particle count
   std::string config;     ///< scene config when params.json carries none
   std::vector<std::string> sets;
   std::string law;            ///< scaling.json whose "law" to use
   double exponent = 0.0;      ///< or an explicit exponent (0: params' or linear)
-  std::string output;         ///< "" or "-": stdout
   bool allow_failed = false;  ///< use a params.json with "success": false
+};
+
+struct UpscaleOptions : UpscaledParamsOptions {
+  std::string output;  ///< "" or "-": stdout
 };
 int cmd_upscale(const UpscaleOptions& options);
 
-struct VerifyOptions {
-  std::string params;
-  std::string prototype;
-  int64_t particles = 0;
-  std::string config;
-  std::vector<std::string> sets;
-  std::string law;
-  double exponent = 0.0;
+struct VerifyOptions : UpscaledParamsOptions {
   std::string out_dir;
   double max_minutes = 8.0;  ///< refuse loading runs estimated beyond this
   /// Consolidate the prototype, write DIR/prototype.csv and stop: a
@@ -52,7 +51,6 @@ struct VerifyOptions {
   /// all cores, measured on the prototype; results are bit-identical for
   /// any count).
   int threads = 0;
-  bool allow_failed = false;  ///< use a params.json with "success": false
 };
 int cmd_verify(const VerifyOptions& options);
 
@@ -70,16 +68,9 @@ struct ScalingOptions {
 };
 int cmd_scaling(const ScalingOptions& options);
 
-struct ExportCmdOptions {
-  std::string params;
+struct ExportCmdOptions : UpscaledParamsOptions {
   std::string format = "lammps";
   std::string output;
-  std::string prototype;
-  int64_t particles = 0;
-  std::string config;
-  std::vector<std::string> sets;
-  std::string law;
-  double exponent = 0.0;
   bool no_consolidate = false;
   /// Where the prototype is consolidated: demcal (its kernel, before
   /// writing), deck (a first stage of the LAMMPS deck) or auto (the deck
@@ -87,7 +78,6 @@ struct ExportCmdOptions {
   std::string consolidate_in = "auto";
   /// Seconds between demcal's consolidation progress lines on stderr.
   double progress_every_s = kProgressEverySeconds;
-  bool allow_failed = false;  ///< use a params.json with "success": false
 };
 int cmd_export(const ExportCmdOptions& options);
 

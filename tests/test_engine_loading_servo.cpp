@@ -24,22 +24,16 @@
 #include "demcal/upscaling/export_3d.hpp"
 #include "demcal/upscaling/rev.hpp"
 #include "support/carried_servo.hpp"
+#include "support/deck_text.hpp"
 #include "support/files.hpp"
 #include "support/process.hpp"
 #include "support/programs.hpp"
 #include "support/trace_rows.hpp"
 
 namespace demcal {
-namespace {
 
-/// `what` replaced by `with` in `text` (which must hold it once).
-std::string replaced(std::string text, const std::string& what, const std::string& with) {
-  const auto at = text.find(what);
-  EXPECT_NE(at, std::string::npos) << what;
-  EXPECT_EQ(text.find(what, at + 1), std::string::npos) << what;
-  if (at != std::string::npos) text.replace(at, what.size(), with);
-  return text;
-}
+using test::replaced;
+namespace {
 
 /// The number a deck line "variable NAME equal X" gives NAME.
 double deck_value(const std::string& deck, const std::string& name) {

@@ -29,6 +29,7 @@
 #include "demcal/upscaling/export_3d.hpp"
 #include "demcal/upscaling/rev.hpp"
 #include "support/carried_servo.hpp"
+#include "support/deck_text.hpp"
 #include "support/files.hpp"
 #include "support/liggghts_servo.hpp"
 #include "support/process.hpp"
@@ -36,6 +37,8 @@
 #include "support/trace_rows.hpp"
 
 namespace demcal {
+
+using test::replaced;
 namespace {
 
 namespace fs = std::filesystem;
@@ -313,14 +316,6 @@ TEST(EngineLammps, WithContactDampingTheDecksServoIsDemcals) {
 TEST(EngineLiggghts, WithContactDampingTheDecksServoIsDemcals) {
   DEMCAL_FIND_PROGRAM(liggghts, "liggghts", "liggghts", "the deck is not run");
   expect_demcals_servo_with_contact_damping(liggghts, "liggghts");
-}
-
-/// `what` replaced by `with` in `text` (which must hold it once at least).
-std::string replaced(std::string text, const std::string& what, const std::string& with) {
-  const auto at = text.find(what);
-  EXPECT_NE(at, std::string::npos) << what;
-  if (at != std::string::npos) text.replace(at, what.size(), with);
-  return text;
 }
 
 /// A lateral wall of a LIGGGHTS deck with contact damping: its mesh fix,

@@ -23,24 +23,18 @@
 #include "demcal/scene/triaxial.hpp"
 #include "demcal/upscaling/export.hpp"
 #include "demcal/upscaling/export_3d.hpp"
+#include "support/deck_text.hpp"
 #include "support/files.hpp"
 #include "support/process.hpp"
 #include "support/programs.hpp"
 #include "support/trace_rows.hpp"
 
 namespace demcal {
+
+using test::replaced;
 namespace {
 
 namespace fs = std::filesystem;
-
-/// `what` replaced by `with` in `text` (which must hold it once).
-std::string replaced(std::string text, const std::string& what, const std::string& with) {
-  const auto at = text.find(what);
-  EXPECT_NE(at, std::string::npos) << what;
-  EXPECT_EQ(text.find(what, at + 1), std::string::npos) << what;
-  if (at != std::string::npos) text.replace(at, what.size(), with);
-  return text;
-}
 
 /// The whole line of `deck` that starts with `head`.
 std::string line_of(const std::string& deck, const std::string& head) {

@@ -19,12 +19,15 @@
 #include "demcal/scoring/external_series.hpp"
 #include "demcal/upscaling/export.hpp"
 #include "demcal/upscaling/rev.hpp"
+#include "support/deck_text.hpp"
 #include "support/files.hpp"
 #include "support/liggghts_servo.hpp"
 #include "support/process.hpp"
 #include "support/programs.hpp"
 
 namespace demcal {
+
+using test::deck_variable;
 namespace {
 
 namespace fs = std::filesystem;
@@ -210,20 +213,6 @@ TEST(Export, LiggghtsDeckHasMeshesAndServo) {
   EXPECT_NE(r.files.at("proto.data").find(" 0.001 2650 "), std::string::npos);
   EXPECT_EQ(r.files.count("proto-top.stl"), 1u);
   EXPECT_EQ(r.files.count("proto-left.stl"), 1u);
-}
-
-/// The number of `variable NAME equal NUMBER` in a deck (NaN if absent).
-double deck_variable(const std::string& deck, const std::string& name) {
-  std::istringstream lines(deck);
-  for (std::string line; std::getline(lines, line);) {
-    std::istringstream in(line);
-    std::string word, var, style;
-    double v = 0.0;
-    if (in >> word >> var >> style && word == "variable" && var == name && style == "equal" &&
-        in >> v)
-      return v;
-  }
-  return std::nan("");
 }
 
 /// demcal's servo move per unit of force error, gain/(R·max(1, n)) [m/N]

@@ -23,6 +23,7 @@
 #include "demcal/scoring/external_series.hpp"
 #include "demcal/scoring/triaxial_scoring.hpp"
 #include "demcal/upscaling/export_3d.hpp"
+#include "support/deck_text.hpp"
 #include "support/files.hpp"
 #include "support/head_on.hpp"
 #include "support/liggghts_servo.hpp"
@@ -30,6 +31,9 @@
 #include "support/programs.hpp"
 
 namespace demcal {
+
+using test::deck_variable;
+using test::replaced;
 namespace {
 
 namespace fs = std::filesystem;
@@ -181,20 +185,6 @@ TEST(Export3d, LiggghtsDeckHasSixWallsAndTheServo) {
                            "moment_lever_arm = radius - overlap/2", "title \"step,strain_zz,b_xx"})
     EXPECT_NE(r.deck.find(line), std::string::npos) << line;
   EXPECT_EQ(r.deck.find("dimension 2"), std::string::npos);
-}
-
-/// The number of `variable NAME equal NUMBER` in a deck (NaN if absent).
-double deck_variable(const std::string& deck, const std::string& name) {
-  std::istringstream lines(deck);
-  for (std::string line; std::getline(lines, line);) {
-    std::istringstream in(line);
-    std::string word, var, style;
-    double v = 0.0;
-    if (in >> word >> var >> style && word == "variable" && var == name && style == "equal" &&
-        in >> v)
-      return v;
-  }
-  return std::nan("");
 }
 
 TEST(Export3d, TheLoadingServosGainIsDemcalsWithTheWallDashpots) {
@@ -524,14 +514,6 @@ TEST(Export3dLammps, WithContactDampingTheDecksServoIsDemcals) {
       m.servo, t.servo, -d.peak_stress_zz, l.peak_axial);
   EXPECT_NEAR(t.servo / m.servo, 1.0, 0.05);
   EXPECT_NEAR(l.peak_axial / -d.peak_stress_zz, 1.0, 0.01);
-}
-
-/// `what` replaced by `with` in `text` (which must hold it once at least).
-std::string replaced(std::string text, const std::string& what, const std::string& with) {
-  const auto at = text.find(what);
-  EXPECT_NE(at, std::string::npos) << what;
-  if (at != std::string::npos) text.replace(at, what.size(), with);
-  return text;
 }
 
 /// Every `what` in `text` replaced by `with`.

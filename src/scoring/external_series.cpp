@@ -156,10 +156,19 @@ void note_missing_servo(std::map<std::string, std::string>& missing, const std::
   for (const char* key : {"servo", "servo_rms", "servo_noise"}) missing.emplace(key, why);
 }
 
-/// The measures MonitorPoint and TriaxialPoint share, by the same names
-/// (0 where the column is missing: note_missing_measures() marks them).
+/// The measures MonitorPoint and TriaxialPoint share (MonitorMeasures), by
+/// the same names: the step, b and σ (b_ij, s_ij, 2×2 or 3×3), the energies
+/// and ratios (0 where the column is missing: note_missing_measures() marks
+/// them).
 template <class Point>
-void read_measures(const Table& t, const std::vector<double>& row, Point& p) {
+void read_measures(const Table& t, const std::vector<double>& row, const std::string& source,
+                   Point& p) {
+  p.step = count(t.value(row, "step", 0), source, "step");
+  for (int i = 0; i < p.b.rows(); ++i)
+    for (int j = 0; j < p.b.cols(); ++j) {
+      p.b(i, j) = t.value(row, component("b_", i, j), 0);
+      p.sigma(i, j) = t.value(row, component("s_", i, j), 0);
+    }
   p.kinetic_energy = t.value(row, "kinetic_energy", 0);
   p.kinetic_energy_rotation = t.value(row, "kinetic_energy_rotation", 0);
   p.elastic_energy = t.value(row, "elastic_energy", 0);
@@ -179,13 +188,8 @@ void read_biaxial_rows(const Table& t, ExternalSeries& out) {
     note_missing_servo(out.not_available, "no column lateral_stress_error, nor p_left and p_right");
   for (const auto& row : t.rows) {
     MonitorPoint p;
-    p.step = count(t.value(row, "step", 0), out.source, "step");
+    read_measures(t, row, out.source, p);
     p.strain_yy = t.value(row, "strain_yy", 0);
-    for (int i = 0; i < 2; ++i)
-      for (int j = 0; j < 2; ++j) {
-        p.b(i, j) = t.value(row, component("b_", i, j), 0);
-        p.sigma(i, j) = t.value(row, component("s_", i, j), 0);
-      }
     if (out.torque_column) {
       // Moment balance on the engine's own rotational disequilibrium (see the
       // header); the symmetric part, all force balance uses, is unchanged.
@@ -196,7 +200,6 @@ void read_biaxial_rows(const Table& t, ExternalSeries& out) {
       p.sigma(0, 1) = sym + 0.5 * tau;
       p.sigma(1, 0) = sym - 0.5 * tau;
     }
-    read_measures(t, row, p);
     if (has_error)
       p.lateral_stress_error = t.value(row, "lateral_stress_error", 0);
     else if (has_pressures)
@@ -245,14 +248,8 @@ void read_triaxial_rows(const Table& t, ExternalSeries& out) {
     }
   for (const auto& row : t.rows) {
     TriaxialPoint p;
-    p.step = count(t.value(row, "step", 0), out.source, "step");
+    read_measures(t, row, out.source, p);
     p.strain_zz = t.value(row, "strain_zz", 0);
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) {
-        p.b(i, j) = t.value(row, component("b_", i, j), 0);
-        p.sigma(i, j) = t.value(row, component("s_", i, j), 0);
-      }
-    read_measures(t, row, p);
     double mean_error = 0.0;
     for (int w = 0; w < 4; ++w) {
       const std::string pressure = std::string("p_") + kWall[w];

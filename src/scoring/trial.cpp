@@ -35,25 +35,14 @@ nlohmann::json run_summary(const SceneConfig& config, const LoadingResult& run,
   json criteria = to_json(score.criteria);
   json j{{"schema", "demcal.run/1"},
          {"scene", config.name},
-         {"particles", run.particles},
-         {"params", params_json(config.algorithm, run.integration, run.scales)},
          {"criteria", criteria},
          {"passed", score.passed},
          {"diagnosis", to_json(score.diagnosis)},
          {"peak",
           {{"stress_yy", score.criteria.peak_stress_yy},
            {"strain_yy", score.criteria.peak_strain_yy},
-           {"ratio", -score.criteria.peak_stress_yy / config.test.lateral_stress}}},
-         {"diverged", run.diverged},
-         {"steps_run", run.steps_run},
-         {"wall_time_s", run.wall_time_s},
-         {"particle_steps_per_s",
-          particle_steps_per_second(run.particles, static_cast<double>(run.steps_run),
-                                    run.wall_time_s)},
-         {"strain_rate", run.strain_rate}};
-  if (run.diverged) {
-    j["divergence"] = {{"reason", to_string(run.divergence)}, {"step", run.divergence_step}};
-  }
+           {"ratio", -score.criteria.peak_stress_yy / config.test.lateral_stress}}}};
+  j.update(run_account_json(config.algorithm, run));
   if (analytical) {
     j["analytical_peak"] = {
         {"stress_yy", *analytical},

@@ -266,8 +266,6 @@ nlohmann::json triaxial_run_summary(const SceneConfig& config, const TriaxialSta
          {"scene", config.name},
          {"dimension", 3},
          {"test", "triaxial"},
-         {"particles", run.particles},
-         {"params", params_json(config.algorithm, run.integration, run.scales)},
          {"criteria", to_json(score.criteria)},
          {"criteria_planes", to_json(c)},
          {"tolerances", to_json(t)},
@@ -289,13 +287,6 @@ nlohmann::json triaxial_run_summary(const SceneConfig& config, const TriaxialSta
            {"ratio_wall_lateral_strain", run.peak_ratio_strain},
            {"monitored_stress_zz", c.monitored_peak_stress_zz},
            {"monitored_strain_zz", c.monitored_peak_strain_zz}}},
-         {"diverged", run.diverged},
-         {"steps_run", run.steps_run},
-         {"wall_time_s", run.wall_time_s},
-         {"particle_steps_per_s",
-          particle_steps_per_second(run.particles, static_cast<double>(run.steps_run),
-                                    run.wall_time_s)},
-         {"strain_rate", run.strain_rate},
          {"consolidation",
           {{"steps", state.steps},
            {"wall_time_s", state.wall_time_s},
@@ -304,8 +295,7 @@ nlohmann::json triaxial_run_summary(const SceneConfig& config, const TriaxialSta
            {"box", state.extent0}}},
          {"config_sha256", sha256_hex(config.text)},
          {"version", DEMCAL_VERSION}};
-  if (run.diverged)
-    j["divergence"] = {{"reason", to_string(run.divergence)}, {"step", run.divergence_step}};
+  j.update(run_account_json(config.algorithm, run));
   if (auto a = analytical_peak_ratio_3d(config))
     j["analytical_peak"] = {{"ratio", *a},
                             {"ratio_periodic", fcc_peak_ratio(config.material.particle.friction)},

@@ -84,14 +84,36 @@ std::string header_wall_law(const Material& m) {
          " N/m, mu = " + num(m.wall.friction);
 }
 
-ExportResult plan_result(double dt, int64_t steps, double step_factor, int types,
-                         double class_error) {
+void set_plan_classes(PlanCommon& plan, const std::vector<double>& radii, int max_types) {
+  plan.n = static_cast<int>(radii.size());
+  RadiusClasses classes = radius_class_bounds(radii, max_types);
+  plan.types = classes.types;
+  plan.type = std::move(classes.type);
+  plan.r_lo = std::move(classes.r_lo);
+  plan.r_hi = std::move(classes.r_hi);
+}
+
+void set_plan_timing(PlanCommon& plan, const AlgorithmSpec& p, const Material& m, double m_max) {
+  const DeckTiming timing =
+      deck_timing(p.dt_ratio, p.steps, p.damping_ratio_translation, plan.dt_crit);
+  plan.step_factor = timing.step_factor;
+  plan.dt = timing.dt;
+  plan.demcal_dt = timing.demcal_dt;
+  plan.steps = timing.steps;
+  plan.m_max = m_max;
+  plan.wall_dashpot = servo_wall_dashpot(m, m_max);
+  plan.servo_resist = servo_resistance(m, m_max, plan.demcal_dt);
+  plan.servo_carry = servo_carry_at(m, m_max, plan.demcal_dt);
+}
+
+ExportResult plan_result(const PlanCommon& plan) {
   ExportResult out;
-  out.dt = dt;
-  out.steps = steps;
-  out.step_factor = step_factor;
-  out.types = types;
-  out.damping_class_error = class_error;
+  out.dt = plan.dt;
+  out.steps = plan.steps;
+  out.step_factor = plan.step_factor;
+  out.types = plan.types;
+  out.damping_class_error = plan.class_error;
+  const double step_factor = plan.step_factor;
   out.notes.push_back(
       "tangential contact forces are not carried over: the deck's contacts start with zero "
       "tangential springs (normal forces are in the positions)");
@@ -337,6 +359,33 @@ std::string lammps_consolidation_parameters(const TestSpec& test) {
 
 double consolidation_dt(double alpha, double zeta, double dt_crit) {
   return alpha * dashpot_step_factor(zeta) * dt_crit;
+}
+
+std::string lammps_consolidation_comment(double zeta, const std::string& particle,
+                                         const std::string& start_walls) {
+  std::ostringstream s;
+  s << "# mu until static again; critical damping (zeta 1, timestep * f(1)/f(" << num(zeta)
+    << "))\n"
+    << "# from step cons_quarter on if not static by then. Static: every wall\n"
+    << "# within cons_tol of sigma3 and the unbalanced-force ratio mean|F_p| / mean\n"
+    << "# |f_c| below cons_unbalanced (demcal's test.consolidation_* values), checked\n"
+    << "# every cons_check steps by fix halt; |f_c| of a " << particle << " contact is its normal\n"
+    << "# force (compute pair/local; the tangential part left out: a stricter ratio).\n"
+    << "# The end state's walls become " << start_walls << " of the loading, whose step\n"
+    << "# count starts at 0; the pair contacts keep their tangential springs, the\n"
+    << "# walls' start at zero. Progress: the thermo lines (cons_err, cons_ufr).\n";
+  return s.str();
+}
+
+std::string lammps_consolidation_start(double alpha, double dt_light, int64_t max_steps) {
+  std::ostringstream s;
+  s << "variable        cap equal $(" << num(kServoMoveCapRatio) << "*v_r_min)\n"
+    << "timestep        " << num(dt_light) << "      # alpha*f(zeta)*dt_crit, alpha " << num(alpha)
+    << "\n"
+    << "variable        cons_s0 equal $(step)\n"
+    << "# runs end on check steps, where the criterion's computes are current\n"
+    << lammps_consolidation_quarter(alpha, max_steps);
+  return s.str();
 }
 
 std::string lammps_consolidation_quarter(double alpha, int64_t max_steps) {

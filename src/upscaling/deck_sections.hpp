@@ -45,6 +45,37 @@ struct DeckTiming {
 };
 DeckTiming deck_timing(double dt_ratio, int64_t steps, double zeta_t, double dt_crit);
 
+/// What the 2D and the 3D plan (export.cpp's Plan, export_3d.cpp's Plan3)
+/// share, set once for both by set_plan_classes and set_plan_timing.
+struct PlanCommon {
+  int n = 0, types = 0;
+  std::vector<int> type;           // per particle, 1-based
+  std::vector<double> r_lo, r_hi;  // per class (index type−1)
+  double r_min = 0.0, r_max = 0.0, dt_crit = 0.0;
+  double step_factor = 1.0;  // f = sqrt(1 + zeta_t^2) - zeta_t: explicit fix viscous
+  double dt = 0.0;
+  double demcal_dt = 0.0;  // α·Δt_crit: demcal's step, the servo law's time unit
+  int64_t steps = 0;
+  double top_speed = 0.0;                // [m/s], downward
+  std::vector<double> gamma_t, gamma_r;  // per class [N·s/m], [N·m·s]
+  std::vector<double> class_mass;        // per class, at its mid radius [kg]
+  double class_error = 0.0;
+  // The servo's (as the scene's servo_velocity): the heaviest particle's
+  // mass m_max [kg] at the mass scaling, the wall dashpots' c [N·s/m]
+  // (servo_wall_dashpot, 0 without contact damping), R = kn_wall +
+  // c/demcal_dt [N/m] (servo_resistance), and the share of its last move
+  // that the servo carries into the next (servo_carry_at demcal_dt, 0
+  // without contact damping).
+  double m_max = 0.0, wall_dashpot = 0.0, servo_resist = 0.0, servo_carry = 0.0;
+};
+
+/// A plan's count and radius classes (radius_class_bounds of `radii`).
+void set_plan_classes(PlanCommon& plan, const std::vector<double>& radii, int max_types);
+
+/// A plan's step and run length (deck_timing at plan.dt_crit, which must be
+/// set) and its servo's figures at the heaviest particle's mass `m_max`.
+void set_plan_timing(PlanCommon& plan, const AlgorithmSpec& p, const Material& m, double m_max);
+
 /// Steps between two monitoring rows: Nstep / monitor_points, at least 1.
 int monitor_interval(int64_t steps, int monitor_points);
 
@@ -70,8 +101,7 @@ std::string header_wall_law(const Material& m);
 /// The figures every export reports (the files and deck are added after),
 /// with the notes both writers give: the tangential springs start at zero,
 /// and the step factor f when the explicit damping shrinks the step.
-ExportResult plan_result(double dt, int64_t steps, double step_factor, int types,
-                         double class_error);
+ExportResult plan_result(const PlanCommon& plan);
 
 /// The pair style's gamma_n for demcal's contact damping: demcal
 /// ratio·2·sqrt(kn·m_eff), LAMMPS m_eff·gamma_n, so gamma_n =
@@ -273,6 +303,19 @@ std::string lammps_consolidation_quarter(double alpha, int64_t max_steps);
 
 /// Stage 1's fix viscous per radius class, gamma[k] for type k+1.
 std::string lammps_consolidation_viscous(const std::vector<double>& gamma);
+
+/// The end of stage 1's header comment, 2D and 3D: friction phases,
+/// critical damping from cons_quarter (the step's factor f(1)/f(zeta)), the
+/// static criterion, what the loading takes from the end state. `particle`
+/// names one ("particle", "sphere"), `start_walls` the loading's start
+/// walls ("xl0 xr0 yb0 yt0", "xmin0 .. zmax0").
+std::string lammps_consolidation_comment(double zeta, const std::string& particle,
+                                         const std::string& start_walls);
+
+/// Stage 1's first lines after its jump: the servo's cap (kServoMoveCapRatio
+/// r_min), the light step `dt_light` (alpha·f(zeta)·dt_crit), the start step
+/// cons_s0, cons_quarter and cons_last (lammps_consolidation_quarter).
+std::string lammps_consolidation_start(double alpha, double dt_light, int64_t max_steps);
 
 /// Stage 1's static criterion, demcal's: every wall within cons_tol of
 /// sigma3 and the unbalanced-force ratio mean|F_p|/mean|f_c| below

@@ -18,56 +18,25 @@ using deck::fmt3;
 using deck::num;
 
 /// Everything both decks need, computed once.
-struct Plan {
-  int n = 0;
-  int types = 0;
-  std::vector<int> type;           // per particle, 1-based
-  std::vector<double> r_lo, r_hi;  // per class (index type−1)
-  double dt = 0.0, dt_crit = 0.0;
-  double demcal_dt = 0.0;    // α·Δt_crit: demcal's step, the servo law's time unit
-  double step_factor = 1.0;  // f = sqrt(1 + zeta_t^2) - zeta_t: explicit fix viscous
-  int64_t steps = 0;
+struct Plan : deck::PlanCommon {
   double areal_density = 0.0;  // f_ms·ρ·t [kg/m²]
   double width0 = 0.0, height0 = 0.0;
-  double top_speed = 0.0;                // [m/s], downward
-  std::vector<double> gamma_t, gamma_r;  // per class [N·s/m], [N·m·s]
-  std::vector<double> class_mass;        // per class, at its mid radius [kg]
-  double class_error = 0.0;
-  double r_min = 0.0, r_max = 0.0;
-  // The servo's: the heaviest disc's mass m_max [kg] (as scene/biaxial.cpp
-  // computes it), its wall dashpot c [N·s/m] (0 without contact damping)
-  // and R = kn_wall + c/demcal_dt [N/m] (servo_resistance), and the share
-  // of its last move that the servo carries into the next (servo_carry at
-  // demcal_dt, 0 without contact damping).
-  double m_max = 0.0, wall_dashpot = 0.0, servo_resist = 0.0, servo_carry = 0.0;
   int thermo_every = 1;
   ParticleScales scales;
 };
 
 Plan make_plan(const SceneConfig& c, const AlgorithmSpec& p, const Assembly& a, int max_types) {
   Plan plan;
-  plan.n = a.size();
-  deck::RadiusClasses classes = deck::radius_class_bounds(a.r, max_types);
-  plan.types = classes.types;
-  plan.type = std::move(classes.type);
-  plan.r_lo = std::move(classes.r_lo);
-  plan.r_hi = std::move(classes.r_hi);
+  deck::set_plan_classes(plan, a.r, max_types);
   plan.scales = particle_scales(a.r, c.material, p.mass_scaling);
   plan.r_min = plan.scales.radius_min;
   plan.r_max = plan.scales.radius_max;
   plan.dt_crit = plan.scales.dt_crit;
-  // alpha*f for Nstep/f steps: the engines' fix viscous is explicit.
-  const deck::DeckTiming timing =
-      deck::deck_timing(p.dt_ratio, p.steps, p.damping_ratio_translation, plan.dt_crit);
-  plan.step_factor = timing.step_factor;
-  plan.dt = timing.dt;
-  plan.demcal_dt = timing.demcal_dt;
-  plan.steps = timing.steps;
+  // alpha*f for Nstep/f steps: the engines' fix viscous is explicit; the
+  // servo's mass is the heaviest disc's (as scene/biaxial.cpp computes it).
+  deck::set_plan_timing(plan, p, c.material,
+                        disk_mass(disk_areal_density(c.material, p.mass_scaling), plan.r_max));
   plan.areal_density = p.mass_scaling * c.material.density * c.material.thickness;
-  plan.m_max = disk_mass(disk_areal_density(c.material, p.mass_scaling), plan.r_max);
-  plan.wall_dashpot = servo_wall_dashpot(c.material, plan.m_max);
-  plan.servo_resist = servo_resistance(c.material, plan.m_max, plan.demcal_dt);
-  plan.servo_carry = deck::servo_carry_at(c.material, plan.m_max, plan.demcal_dt);
   plan.width0 = a.right - a.left;
   plan.height0 = a.top - a.bottom;
   plan.top_speed =
@@ -149,9 +118,7 @@ std::string mapping_header(const SceneConfig& c, const AlgorithmSpec& p, const P
 }
 
 /// The figures of a plan every export reports (the files are added after).
-ExportResult result_of(const Plan& plan) {
-  return deck::plan_result(plan.dt, plan.steps, plan.step_factor, plan.types, plan.class_error);
-}
+ExportResult result_of(const Plan& plan) { return deck::plan_result(plan); }
 
 // ---------------------------------------------------------------------------
 // LAMMPS (29 Sep 2021)
@@ -455,22 +422,21 @@ std::string lammps_servo(bool carry) {
   return s.str();
 }
 
-// Data file: atom_style sphere rows "id type diameter density x y z"; the
-// density column is overwritten by set density/disc below.
-std::string lammps_data_file(const SceneConfig& c, const Assembly& a, const Plan& plan,
-                             bool consolidated) {
+/// A 2D data file after its title line, both engines: the counts, the box
+/// (half a width of room left and right, a tenth of the height above and
+/// below, the disc thickness in z), the `atoms` heading and the rows "id type
+/// diameter density x y z" (density: the areal density f_ms·ρ·t).
+std::string data_file_2d(const SceneConfig& c, const Assembly& a, const Plan& plan, int ntypes,
+                         const char* atoms) {
   const auto& m = c.material;
   std::ostringstream d;
   const double mx = 0.5 * plan.width0, my = 0.1 * plan.height0;
-  d << "LAMMPS data file written by demcal " << DEMCAL_VERSION << " (scene " << c.name
-    << (consolidated ? ", consolidated to sigma3)\n\n"
-                     : ", as generated: the deck consolidates it)\n\n")
-    << plan.n << " atoms\n"
-    << plan.types << " atom types\n\n"
+  d << plan.n << " atoms\n"
+    << ntypes << " atom types\n\n"
     << num(a.left - mx) << " " << num(a.right + mx) << " xlo xhi\n"
     << num(a.bottom - my) << " " << num(a.top + my) << " ylo yhi\n"
     << num(-0.5 * m.thickness) << " " << num(0.5 * m.thickness) << " zlo zhi\n\n"
-    << "Atoms # sphere\n\n";
+    << atoms << "\n\n";
   char line[160];
   for (int i = 0; i < plan.n; ++i) {
     std::snprintf(line, sizeof line, "%d %d %.17g %.10g %.17g %.17g 0\n", i + 1, plan.type[i],
@@ -478,6 +444,16 @@ std::string lammps_data_file(const SceneConfig& c, const Assembly& a, const Plan
     d << line;
   }
   return d.str();
+}
+
+// Data file: atom_style sphere rows "id type diameter density x y z"; the
+// density column is overwritten by set density/disc below.
+std::string lammps_data_file(const SceneConfig& c, const Assembly& a, const Plan& plan,
+                             bool consolidated) {
+  return std::string("LAMMPS data file written by demcal ") + DEMCAL_VERSION + " (scene " + c.name +
+         (consolidated ? ", consolidated to sigma3)\n\n"
+                       : ", as generated: the deck consolidates it)\n\n") +
+         data_file_2d(c, a, plan, plan.types, "Atoms # sphere");
 }
 
 /// What this LAMMPS cannot do as demcal does, in the deck's header; the
@@ -706,24 +682,10 @@ std::string lammps_consolidation_walls(const SceneConfig& c, const Plan& plan,
   s << "# " << deck::servo_cap_text() << "), global damping zeta " << num(zeta)
     << " on translation (demcal also damps\n"
     << "# rotation; this LAMMPS cannot), particle friction 0 until static, then\n"
-    << "# mu until static again; critical damping (zeta 1, timestep * f(1)/f(" << num(zeta)
-    << "))\n"
-    << "# from step cons_quarter on if not static by then. Static: every wall\n"
-    << "# within cons_tol of sigma3 and the unbalanced-force ratio mean|F_p| / mean\n"
-    << "# |f_c| below cons_unbalanced (demcal's test.consolidation_* values), checked\n"
-    << "# every cons_check steps by fix halt; |f_c| of a particle contact is its normal\n"
-    << "# force (compute pair/local; the tangential part left out: a stricter ratio).\n"
-    << "# The end state's walls become xl0 xr0 yb0 yt0 of the loading, whose step\n"
-    << "# count starts at 0; the pair contacts keep their tangential springs, the\n"
-    << "# walls' start at zero. Progress: the thermo lines (cons_err, cons_ufr).\n"
+    << deck::lammps_consolidation_comment(zeta, "particle", "xl0 xr0 yb0 yt0")
     << "if              \"${consolidate} == 0 || ${continued} != 0\" then \"jump SELF "
        "loading\"\n"
-    << "variable        cap equal $(" << num(kServoMoveCapRatio) << "*v_r_min)\n"
-    << "timestep        " << num(dt_light) << "      # alpha*f(zeta)*dt_crit, alpha " << num(alpha)
-    << "\n"
-    << "variable        cons_s0 equal $(step)\n"
-    << "# runs end on check steps, where the criterion's computes are current\n"
-    << deck::lammps_consolidation_quarter(alpha, c.test.consolidation_max_steps)
+    << deck::lammps_consolidation_start(alpha, dt_light, c.test.consolidation_max_steps)
     << "variable        cons_dxl equal f_cons_servo[1]*(step-${cons_s0})\n"
     << "variable        cons_dxr equal f_cons_servo[2]*(step-${cons_s0})\n"
     << "variable        cons_dyb equal f_cons_servo[3]*(step-${cons_s0})\n"
@@ -1046,23 +1008,8 @@ std::string liggghts_series_block(const SceneConfig& c, const AlgorithmSpec& p, 
 /// disc's mass f_ms·ρ·t·π·r².
 std::string liggghts_data_2d(const SceneConfig& c, const Plan& plan, const Assembly& a,
                              int ntypes) {
-  const auto& m = c.material;
-  std::ostringstream d;
-  const double mx = 0.5 * plan.width0, my = 0.1 * plan.height0;
-  d << "LIGGGHTS data file written by demcal " << DEMCAL_VERSION << " (scene " << c.name << ")\n\n"
-    << plan.n << " atoms\n"
-    << ntypes << " atom types\n\n"
-    << num(a.left - mx) << " " << num(a.right + mx) << " xlo xhi\n"
-    << num(a.bottom - my) << " " << num(a.top + my) << " ylo yhi\n"
-    << num(-0.5 * m.thickness) << " " << num(0.5 * m.thickness) << " zlo zhi\n\n"
-    << "Atoms\n\n";
-  char line[160];
-  for (int i = 0; i < plan.n; ++i) {
-    std::snprintf(line, sizeof line, "%d %d %.17g %.10g %.17g %.17g 0\n", i + 1, plan.type[i],
-                  2.0 * a.r[i], plan.areal_density, a.x[i], a.y[i]);
-    d << line;
-  }
-  return d.str();
+  return std::string("LIGGGHTS data file written by demcal ") + DEMCAL_VERSION + " (scene " +
+         c.name + ")\n\n" + data_file_2d(c, a, plan, ntypes, "Atoms");
 }
 
 /// The 2D LIGGGHTS deck's header: the mapping, how its servo follows

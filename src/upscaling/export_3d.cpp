@@ -82,39 +82,18 @@ std::string series_row_tail_3d(const std::string& p_suffix) {
 }
 
 /// Everything both decks need, computed once.
-struct Plan3 {
-  int n = 0, types = 0;
-  std::vector<int> type;  // per particle, 1-based
-  std::vector<double> r_lo, r_hi;
+struct Plan3 : deck::PlanCommon {
   double density = 0.0;  // f_ms·ρ [kg/m³]
-  double r_min = 0.0, r_max = 0.0, m_mean = 0.0;
-  double dt_crit = 0.0, step_factor = 1.0, dt = 0.0, demcal_dt = 0.0;
-  int64_t steps = 0;
+  double m_mean = 0.0;
   std::array<double, 3> lo{}, hi{};
-  double top_speed = 0.0;  // [m/s], downward
-  std::vector<double> gamma_t, gamma_r;
-  std::vector<double> class_mass;      // per class, at its mid radius [kg]
   std::vector<double> gamma_critical;  // per class, zeta 1 [N·s/m]: stage 1's damping
-  double class_error = 0.0;
   std::array<int, 6> wall_contacts{};  // at the start
-  // The servo's (as scene/triaxial.cpp servo_velocity): the heaviest
-  // sphere's mass m_max [kg] at the mass scaling, the wall dashpots' c
-  // [N·s/m] (servo_wall_dashpot, 0 without contact damping) and
-  // R = kn_wall + c/demcal_dt [N/m] (servo_resistance), and the share of
-  // its last move that the servo carries into the next (servo_carry at
-  // demcal_dt, 0 without contact damping).
-  double m_max = 0.0, wall_dashpot = 0.0, servo_resist = 0.0, servo_carry = 0.0;
 };
 
 Plan3 make_plan(const SceneConfig& c, const AlgorithmSpec& p, const SphereWorld& w, int max_types) {
   Plan3 plan;
-  plan.n = w.size();
   const std::vector<double> radii(w.radius().begin(), w.radius().end());
-  deck::RadiusClasses classes = deck::radius_class_bounds(radii, max_types);
-  plan.types = classes.types;
-  plan.type = std::move(classes.type);
-  plan.r_lo = std::move(classes.r_lo);
-  plan.r_hi = std::move(classes.r_hi);
+  deck::set_plan_classes(plan, radii, max_types);
   plan.density = c.material.density * p.mass_scaling;
   plan.r_min = w.min_radius();
   plan.r_max = w.max_radius();
@@ -124,17 +103,9 @@ Plan3 make_plan(const SceneConfig& c, const AlgorithmSpec& p, const SphereWorld&
   const double kn = c.material.particle.kn, kt = c.material.particle.kt;
   // Δt_crit of the lightest sphere, as integration_for (triaxial.cpp).
   plan.dt_crit = critical_time_step(sphere_mass(plan.density, plan.r_min), kn);
-  // The engines' fix viscous is explicit: α·f for Nstep/f steps (export.hpp).
-  const deck::DeckTiming timing =
-      deck::deck_timing(p.dt_ratio, p.steps, p.damping_ratio_translation, plan.dt_crit);
-  plan.step_factor = timing.step_factor;
-  plan.dt = timing.dt;
-  plan.demcal_dt = timing.demcal_dt;
-  plan.steps = timing.steps;
-  plan.m_max = sphere_mass(plan.density, plan.r_max);
-  plan.wall_dashpot = servo_wall_dashpot(c.material, plan.m_max);
-  plan.servo_resist = servo_resistance(c.material, plan.m_max, plan.demcal_dt);
-  plan.servo_carry = deck::servo_carry_at(c.material, plan.m_max, plan.demcal_dt);
+  // The engines' fix viscous is explicit: α·f for Nstep/f steps (export.hpp);
+  // the servo's mass is the heaviest sphere's (as scene/triaxial.cpp).
+  deck::set_plan_timing(plan, p, c.material, sphere_mass(plan.density, plan.r_max));
   for (int a = 0; a < 3; ++a) {
     plan.lo[a] = w.wall(static_cast<SphereWallSide>(2 * a)).position;
     plan.hi[a] = w.wall(static_cast<SphereWallSide>(2 * a + 1)).position;
@@ -164,9 +135,7 @@ Plan3 make_plan(const SceneConfig& c, const AlgorithmSpec& p, const SphereWorld&
 /// the wall dashpots), "R" with them (a comment then defines it).
 std::string resist_name(const Plan3& plan) { return plan.wall_dashpot > 0.0 ? "R" : "kn_wall"; }
 
-ExportResult result_of(const Plan3& plan) {
-  return deck::plan_result(plan.dt, plan.steps, plan.step_factor, plan.types, plan.class_error);
-}
+ExportResult result_of(const Plan3& plan) { return deck::plan_result(plan); }
 
 std::string mapping_header(const SceneConfig& c, const AlgorithmSpec& p, const Plan3& plan,
                            const Export3dOptions& o, const std::string& code) {
@@ -432,23 +401,9 @@ void lammps_3d_consolidation(std::ostream& s, const SceneConfig& c, const Plan3&
   s << "# area, cap " << deck::servo_cap_text() << "), global damping zeta " << num(zeta)
     << " on translation (demcal also\n"
     << "# damps rotation; this LAMMPS cannot), particle friction 0 until static, then\n"
-    << "# mu until static again; critical damping (zeta 1, timestep * f(1)/f(" << num(zeta)
-    << "))\n"
-    << "# from step cons_quarter on if not static by then. Static: every wall\n"
-    << "# within cons_tol of sigma3 and the unbalanced-force ratio mean|F_p| / mean\n"
-    << "# |f_c| below cons_unbalanced (demcal's test.consolidation_* values), checked\n"
-    << "# every cons_check steps by fix halt; |f_c| of a sphere contact is its normal\n"
-    << "# force (compute pair/local; the tangential part left out: a stricter ratio).\n"
-    << "# The end state's walls become xmin0 .. zmax0 of the loading, whose step\n"
-    << "# count starts at 0; the pair contacts keep their tangential springs, the\n"
-    << "# walls' start at zero. Progress: the thermo lines (cons_err, cons_ufr).\n"
+    << deck::lammps_consolidation_comment(zeta, "sphere", "xmin0 .. zmax0")
     << "if              \"${consolidate} == 0\" then \"jump SELF loading\"\n"
-    << "variable        cap equal $(" << deck::num(kServoMoveCapRatio) << "*v_r_min)\n"
-    << "timestep        " << num(dt_light) << "      # alpha*f(zeta)*dt_crit, alpha " << num(alpha)
-    << "\n"
-    << "variable        cons_s0 equal $(step)\n"
-    << "# runs end on check steps, where the criterion's computes are current\n"
-    << deck::lammps_consolidation_quarter(alpha, c.test.consolidation_max_steps);
+    << deck::lammps_consolidation_start(alpha, dt_light, c.test.consolidation_max_steps);
   for (int sd = 0; sd < 6; ++sd)
     s << "variable        cons_d" << kWall[sd] << " equal f_cons_servo[" << sd + 1
       << "]*(step-${cons_s0})\n";

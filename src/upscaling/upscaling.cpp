@@ -232,34 +232,43 @@ SphereAssembly generated_spheres(const SceneConfig& config, int64_t n, std::stri
 
 }  // namespace
 
-Assembly prototype_assembly(const SceneConfig& config, int64_t particles, const std::string& file,
-                            PrototypeSource* source) {
+namespace {
+
+/// The prototype choose_prototype picks, disks or spheres: `read` a file,
+/// `generate` a count, or `make` the REV; what it gave goes to `source`.
+template <class Read, class Generate, class Make>
+auto chosen_prototype(const SceneConfig& config, int64_t particles, const std::string& file,
+                      PrototypeSource* source, const std::string& noun, Read read,
+                      Generate generate, Make make) {
   const PrototypeChoice choice = choose_prototype(config, particles, file);
   std::string generated;
-  Assembly a;
+  decltype(make(config)) a;
   if (choice.kind == PrototypeChoice::kFile)
-    a = read_particle_file(choice.file);
+    a = read(choice.file);
   else if (choice.kind == PrototypeChoice::kCount)
-    a = generated_disks(config, choice.particles, generated);
+    a = generate(config, choice.particles, generated);
   else
-    a = make_assembly(config);
-  if (source) *source = prototype_source(choice, a.size(), "particles", std::move(generated));
+    a = make(config);
+  if (source) *source = prototype_source(choice, a.size(), noun, std::move(generated));
   return a;
+}
+
+}  // namespace
+
+Assembly prototype_assembly(const SceneConfig& config, int64_t particles, const std::string& file,
+                            PrototypeSource* source) {
+  return chosen_prototype(
+      config, particles, file, source, "particles",
+      [](const std::string& f) { return read_particle_file(f); }, generated_disks,
+      [](const SceneConfig& c) { return make_assembly(c); });
 }
 
 SphereAssembly prototype_spheres(const SceneConfig& config, int64_t particles,
                                  const std::string& file, PrototypeSource* source) {
-  const PrototypeChoice choice = choose_prototype(config, particles, file);
-  std::string generated;
-  SphereAssembly a;
-  if (choice.kind == PrototypeChoice::kFile)
-    a = read_sphere_file(choice.file);
-  else if (choice.kind == PrototypeChoice::kCount)
-    a = generated_spheres(config, choice.particles, generated);
-  else
-    a = make_sphere_assembly(config);
-  if (source) *source = prototype_source(choice, a.size(), "spheres", std::move(generated));
-  return a;
+  return chosen_prototype(
+      config, particles, file, source, "spheres",
+      [](const std::string& f) { return read_sphere_file(f); }, generated_spheres,
+      [](const SceneConfig& c) { return make_sphere_assembly(c); });
 }
 
 ParticleScales sphere_scales(const SphereWorld& w, const Material& material,

@@ -26,6 +26,25 @@ inline double particle_steps_per_second(double particles, double steps, double w
   return wall_time_s > 0 ? particles * steps / wall_time_s : 0.0;
 }
 
+/// A run's account in summary.json, 2D and 3D alike: particles, params
+/// (params_json of `algorithm`), diverged (and the divergence's reason and
+/// step), steps_run, wall_time_s, particle_steps_per_s, strain_rate.
+template <class Point>
+nlohmann::json run_account_json(const AlgorithmSpec& algorithm, const LoadingRun<Point>& run) {
+  nlohmann::json j{{"particles", run.particles},
+                   {"params", params_json(algorithm, run.integration, run.scales)},
+                   {"diverged", run.diverged},
+                   {"steps_run", run.steps_run},
+                   {"wall_time_s", run.wall_time_s},
+                   {"particle_steps_per_s",
+                    particle_steps_per_second(run.particles, static_cast<double>(run.steps_run),
+                                              run.wall_time_s)},
+                   {"strain_rate", run.strain_rate}};
+  if (run.diverged)
+    j["divergence"] = {{"reason", to_string(run.divergence)}, {"step", run.divergence_step}};
+  return j;
+}
+
 /// summary.json of a run (`demcal run`, README.md "Commands").
 nlohmann::json run_summary(const SceneConfig& config, const LoadingResult& run, const Score& score);
 
