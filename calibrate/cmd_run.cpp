@@ -54,7 +54,8 @@ void print_scales(const SceneConfig& config, const World& world) {
 void require_stable_step(const SceneConfig& config, double stable, bool allow_unstable) {
   if (allow_unstable) return;
   require_stable_dt_ratio(
-      config.algorithm.dt_ratio, stable, config.source, "algorithm.dt_ratio",
+      config.algorithm.dt_ratio, stable, source_of(config, "algorithm.dt_ratio"),
+      "algorithm.dt_ratio",
       std::string("use a smaller value; ") +
           (config.dimension == 2 ? "`demcal stability` measures the limit, " : "") +
           "`demcal run --allow-unstable` runs it anyway");
@@ -148,7 +149,8 @@ int check_3d(const SceneConfig& config) {
   print_stable_steps(est);
   if (auto r = analytical_peak_ratio_3d(config))
     std::cout << "  analytical peak sigma1/sigma3 " << *r << " (walled FCC, Thornton), "
-              << fcc_peak_ratio(config.material.particle.friction) << " (periodic)\n";
+              << fcc_peak_ratio(config.material.particle.friction)
+              << " (periodic); rotation locked\n";
   return 0;
 }
 
@@ -177,10 +179,9 @@ int run_3d(const SceneConfig& config, const std::string& out_dir, bool allow_uns
   const Criteria& m = score.criteria;
   std::cout << std::setprecision(4) << "scene " << config.name
             << " (3D, triaxial): " << run.particles << " spheres, " << steps_words(run) << ", dt "
-            << run.integration.dt << " s\n"
-            << "  peak sigma_zz " << run.peak_stress_zz << " Pa at strain " << run.peak_strain_zz
-            << " (sigma1/sigma3 " << -run.peak_stress_zz / s3 << "; against the lateral wall "
-            << "stress " << run.peak_ratio << ")\n";
+            << run.integration.dt << " s\n";
+  print_peak(std::cout, true, run.peak_stress_zz, run.peak_strain_zz, s3);
+  std::cout << "; against the lateral wall stress " << run.peak_ratio << ")\n";
   if (auto a = analytical_peak_ratio_3d(config))
     std::cout << "  analytical (walled FCC, Thornton, rotation locked) sigma1/sigma3 " << *a
               << "\n";
@@ -226,7 +227,7 @@ int cmd_check(const std::string& path, const std::vector<std::string>& sets) {
   if (auto peak = analytical_peak_stress(config)) {
     std::cout << "  analytical peak sigma1/sigma3 " << -*peak / config.test.lateral_stress
               << " (walled box), " << hexagonal_peak_ratio(config.material.particle.friction)
-              << " (periodic)\n";
+              << " (periodic); rotation locked\n";
   }
   return 0;
 }
@@ -256,9 +257,9 @@ int cmd_run(const std::string& path, const std::vector<std::string>& sets,
 
   const auto& c = score.criteria;
   std::cout << std::setprecision(4) << "scene " << config.name << ": " << run.particles
-            << " particles, " << steps_words(run) << ", dt " << run.integration.dt << " s\n"
-            << "  peak sigma_yy " << c.peak_stress_yy << " Pa at strain " << c.peak_strain_yy
-            << " (sigma1/sigma3 " << -c.peak_stress_yy / config.test.lateral_stress << ")\n";
+            << " particles, " << steps_words(run) << ", dt " << run.integration.dt << " s\n";
+  print_peak(std::cout, false, c.peak_stress_yy, c.peak_strain_yy, config.test.lateral_stress);
+  std::cout << ")\n";
   if (auto a = analytical_peak_stress(config))
     std::cout << "  analytical (walled, rotation locked) sigma1/sigma3 "
               << -*a / config.test.lateral_stress << "\n";

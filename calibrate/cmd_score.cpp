@@ -60,9 +60,9 @@ int cmd_score(const ScoreOptions& o) {
   std::cout << std::setprecision(4) << "series " << o.file << ": "
             << (is_3d ? "3D (triaxial), " : "") << points << " monitoring points, " << steps
             << (score.complete ? "" : " of " + std::to_string(planned)) << " steps"
-            << (score.complete ? "" : " (incomplete)") << "\n"
-            << "  peak sigma_" << (is_3d ? "zz " : "yy ") << c.peak_stress_yy << " Pa at strain "
-            << c.peak_strain_yy << " (sigma1/sigma3 " << -c.peak_stress_yy / sigma3 << ")\n";
+            << (score.complete ? "" : " (incomplete)") << "\n";
+  print_peak(std::cout, is_3d, c.peak_stress_yy, c.peak_strain_yy, sigma3);
+  std::cout << ")\n";
   if (scored.planes) {
     print_triaxial_criteria(std::cout, *scored.planes, c);
     std::cout << "  tolerances: force balance " << tolerances.force_balance << ", moment balance "

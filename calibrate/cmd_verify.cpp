@@ -33,6 +33,7 @@
 #include "demcal/upscaling/rev.hpp"
 #include "demcal/upscaling/upscaling.hpp"
 #include "output_folder.hpp"
+#include "print_criteria.hpp"
 #include "upscaling_cli.hpp"
 
 namespace demcal::cli {
@@ -147,9 +148,9 @@ int verify_in_lammps(const VerifyOptions& o, const SceneConfig& config,
             << "), moment balance " << c.moment_balance << " (tol " << tolerances.moment_balance
             << ", lever-arm floor RMS " << scored.lever_arm_floor_rms << " not counted), servo "
             << c.servo << " (tol " << tolerances.servo << "), oscillation " << c.oscillation
-            << " (tol " << tolerances.oscillation << ")\n"
-            << "  peak sigma_yy " << c.peak_stress_yy << " Pa (sigma1/sigma3 "
-            << -c.peak_stress_yy / config.test.lateral_stress << ")\n"
+            << " (tol " << tolerances.oscillation << ")\n";
+  print_peak(std::cout, false, c.peak_stress_yy, std::nullopt, config.test.lateral_stress);
+  std::cout << ")\n"
             << "  " << score.diagnosis.message << "\n"
             << "  LAMMPS " << engine_s << " s; wrote " << dir << "/verify.json, prototype.csv, "
             << work.string() << "/ (deck, series.csv, log.lammps)\n";
@@ -307,8 +308,8 @@ int verify_3d(const VerifyOptions& o, const nlohmann::json& params, const RevPar
   write_verify_files(dir, out, series_csv(verify_metadata(config, run), run.series));
   print_verdict(score.passed, "3D prototype of " + std::to_string(n) + " spheres", up, c,
                 tolerances);
-  std::cout << "  peak axial b_zz " << c.peak_stress_yy << " Pa (sigma1/sigma3 "
-            << -c.peak_stress_yy / s3 << ")";
+  print_peak(std::cout, true, c.peak_stress_yy, std::nullopt, s3);
+  std::cout << ")";
   if (peak_rev)
     std::cout << "; the REV's " << *peak_rev << " Pa ("
               << num(100.0 * (c.peak_stress_yy - *peak_rev) / std::abs(*peak_rev), 3) << " %)";
@@ -440,8 +441,8 @@ int cmd_verify(const VerifyOptions& o) {
   const auto& c = trial.score.criteria;
   print_verdict(trial.score.passed, "prototype of " + std::to_string(n) + " particles", up, c,
                 tolerances);
-  std::cout << "  peak sigma_yy " << c.peak_stress_yy << " Pa (sigma1/sigma3 "
-            << -c.peak_stress_yy / config.test.lateral_stress << ")\n"
+  print_peak(std::cout, false, c.peak_stress_yy, std::nullopt, config.test.lateral_stress);
+  std::cout << ")\n"
             << "  " << score.diagnosis.message << "\n"
             << "  consolidation " << state.wall_time_s << " s, loading " << trial.wall_time_s
             << " s (" << (trial.wall_time_s > 0 ? particle_steps / trial.wall_time_s : 0.0)

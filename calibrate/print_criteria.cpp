@@ -36,4 +36,11 @@ void print_triaxial_criteria(std::ostream& out, const TriaxialCriteria& c, const
       << m.oscillation << "\n";
 }
 
+void print_peak(std::ostream& out, bool three_d, double peak, std::optional<double> strain,
+                double sigma3) {
+  out << "  peak b_" << (three_d ? "zz " : "yy ") << peak << " Pa";
+  if (strain) out << " at strain " << *strain;
+  out << " (sigma1/sigma3 " << -peak / sigma3;
+}
+
 }  // namespace demcal::cli

@@ -2,6 +2,7 @@
 // `demcal run` and `demcal score` share.
 #pragma once
 
+#include <optional>
 #include <ostream>
 
 #include "demcal/scoring/triaxial_scoring.hpp"
@@ -12,5 +13,14 @@ namespace demcal::cli {
 /// combined ones are `judged` (the Score's: scored_criteria(), whose moment
 /// balance has the rotational drag folded in), the planes' from `c`.
 void print_triaxial_criteria(std::ostream& out, const TriaxialCriteria& c, const Criteria& judged);
+
+/// "  peak b_yy -6.927e+05 Pa at strain -0.0015 (sigma1/sigma3 6.927": the
+/// peak of the axial boundary stress b (b_zz in 3D), which the criteria,
+/// the report and params.json call the peak; not the homogenized sigma,
+/// which differs from it by the force-balance gap. Without `strain`, no
+/// "at strain"; the parenthesis is left open for the caller to add to or
+/// close.
+void print_peak(std::ostream& out, bool three_d, double peak, std::optional<double> strain,
+                double sigma3);
 
 }  // namespace demcal::cli

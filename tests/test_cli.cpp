@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
@@ -318,6 +319,26 @@ TEST_F(CliEndToEnd, CheckAcceptsAParticleFile) {
   EXPECT_NE(res.out.find("12 particles"), std::string::npos) << res.out;
 }
 
+// A particle file that is not there is the config's error: it names the
+// config and its key, then the path (2D and 3D; the particle file's own
+// errors name that file and its line).
+TEST_F(CliEndToEnd, AMissingParticleFileNamesTheConfigAndKey) {
+  const std::string out = (dir_ / "work" / "out").string();
+  const std::string config =
+      write("gone.json",
+            "{" + test::kMaterialMember + R"(, "assembly": {"type": "file", "file": "gone.csv"}})");
+  const std::string csv = (dir_ / "gone.csv").string();
+  expect_bad_input({"check", config}, {config + ": assembly.file: \"" + csv + "\": no such file"});
+  expect_bad_input({"run", config, "-o", out},
+                   {config + ": assembly.file: \"" + csv + "\": no such file"});
+  const std::string spheres = write(
+      "gone3d.json", "{" + test::kMaterialMember +
+                         R"(, "dimension": 3, "assembly": {"type": "file", "file": "gone.csv"},
+                                  "test": {"type": "triaxial"}})");
+  expect_bad_input({"run", spheres, "-o", out},
+                   {spheres + ": assembly.file: \"" + csv + "\": no such file"});
+}
+
 // --- run outputs ------------------------------------------------------------
 
 /// The run's VTK (support/vtk.hpp) with the 2D fields.
@@ -331,13 +352,19 @@ TEST_F(CliEndToEnd, RunWritesSummarySeriesAndVtk) {
   const fs::path out = dir_ / "work" / "a" / "b";  // parents are made
   const Result r = demcal({"run", kHex5, "--set", "algorithm.steps=2000", "-o", out.string()});
   ASSERT_NO_FATAL_FAILURE(test::expect_run_status(r.status, out, r.err));
-  EXPECT_NE(r.out.find("peak sigma_yy"), std::string::npos) << r.out;
+  // The peak is the axial boundary stress b_yy (the criteria's, the
+  // report's, params.json's), so the line names b, not sigma.
+  const size_t at = r.out.find("peak b_yy ");
+  ASSERT_NE(at, std::string::npos) << r.out;
+  const double printed = std::stod(r.out.substr(at + 10));
   // Exactly the three files: no temporary or probe file left behind.
   EXPECT_EQ(test::names_in(out),
             (std::set<std::string>{"summary.json", "series.csv", "final.vtk"}));
 
   const auto s = nlohmann::json::parse(read_text(out / "summary.json"));
   EXPECT_EQ(s.at("particles"), 25);
+  const double peak = s.at("criteria").at("peak_stress_yy").get<double>();
+  EXPECT_NEAR(printed, peak, 1e-3 * std::abs(peak));  // printed to 4 digits
   const auto& p = s.at("params");
   for (const char* key :
        {"dt", "dt_ratio", "steps", "damping_translation", "damping_ratio_translation",
@@ -512,20 +539,48 @@ TEST_F(CliEndToEnd, ProgressCountsTrialsInTheOrderTheyFinish) {
   for (int round = 0; round < 3; ++round) {
     const Result r = demcal({"calibrate", kHex5, "-o", "out", "-j", "2"});
     ASSERT_EQ(r.status, 0) << r.err;
-    int trial = 0, search = 0;
+    int next = 0, search = 0;
     for (const std::string& line : lines_of(r.err)) {
       int t = 0, k = 0, n = 0;
       if (std::sscanf(line.c_str(), "trial %d (search %d/%d)", &t, &k, &n) == 3) {
         EXPECT_EQ(k, search + 1) << line;
         search = k;
       }
-      if (t > 0) {
-        EXPECT_EQ(t, trial + 1) << line;
-        trial = t;
+      if (std::sscanf(line.c_str(), "trial %d (", &t) == 1) {
+        EXPECT_EQ(t, next) << line;
+        next = t + 1;
       }
     }
     EXPECT_GE(search, 12) << r.err;
   }
+}
+
+// With one job the trials finish in the order asked, so a progress line's
+// trial number is the id trials.jsonl and the report give that trial (the
+// lines counted from 1 and the files from 0: "trial 58 (verify)" was the
+// report's "57 (chosen)").
+TEST_F(CliEndToEnd, ProgressTrialNumbersAreTheFilesIdsWithOneJob) {
+  const fs::path out = dir_ / "work" / "one";
+  const Result r = demcal({"calibrate", kHex5, "-o", out.string(), "-j", "1"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::map<int, int64_t> steps_of;
+  for (const std::string& line : lines_of(read_text(out / "trials.jsonl"))) {
+    const auto j = nlohmann::json::parse(line);
+    steps_of[j.at("id").get<int>()] = j.at("params").at("steps").get<int64_t>();
+  }
+  int lines = 0;
+  for (const std::string& line : lines_of(r.err)) {
+    int t = -1;
+    long long steps = 0;
+    if (std::sscanf(line.c_str(), "trial %d (", &t) != 1) continue;
+    const size_t at = line.find(", steps ");
+    ASSERT_NE(at, std::string::npos) << line;
+    steps = std::stoll(line.substr(at + 8));
+    ASSERT_TRUE(steps_of.count(t)) << line;
+    EXPECT_EQ(steps_of.at(t), steps) << line;
+    ++lines;
+  }
+  EXPECT_EQ(lines, static_cast<int>(steps_of.size())) << r.err;
 }
 
 // A computation that fails (consolidation gives up) is not bad input: exit
@@ -546,16 +601,27 @@ TEST_F(CliEndToEnd, FailedConsolidationExitsOneAndWritesNothing) {
 // `check` (issue #9 §1), named with the estimate; for `sweep` too, whose
 // benchmark is the config's algorithm block (it wrote an atlas around a
 // diverging benchmark).
+// The error names where the value came from: the --set that gave it, else
+// the file.
 TEST_F(CliEndToEnd, DtBeyondTheStableStepIsBadInput) {
   const std::string out = (dir_ / "work" / "out").string();
+  const std::string set = "--set algorithm.dt_ratio=0.4";
   expect_bad_input({"run", kHex5, "--set", "algorithm.dt_ratio=0.4", "-o", out},
-                   {kHex5, "algorithm.dt_ratio", "0.4", "stable step", "0.30"});
+                   {set + ": algorithm.dt_ratio: 0.4", "stable step", "0.30"});
   expect_bad_input({"check", kHex5, "--set", "algorithm.dt_ratio=0.4"},
-                   {kHex5, "algorithm.dt_ratio"});
+                   {set + ": algorithm.dt_ratio"});
   expect_bad_input({"sweep", kHex5, "--set", "algorithm.dt_ratio=0.4", "-o", out},
-                   {kHex5, "algorithm.dt_ratio", "0.4", "stable step", "0.30"});
+                   {set + ": algorithm.dt_ratio: 0.4", "stable step", "0.30"});
   expect_bad_input({"sweep", kHex5, "--set", "algorithm.dt_ratio=0.4"},
-                   {kHex5, "algorithm.dt_ratio"});  // nor the default folder
+                   {set + ": algorithm.dt_ratio"});  // nor the default folder
+  nlohmann::json j = nlohmann::json::parse(read_text(kHex5));
+  j["algorithm"]["dt_ratio"] = 0.4;
+  const std::string file = write("fast.json", j.dump());
+  expect_bad_input({"run", file, "-o", out},
+                   {file + ": algorithm.dt_ratio: 0.4", "stable step", "0.30"});
+  // Another key's --set does not take the blame.
+  expect_bad_input({"run", file, "--set", "algorithm.steps=3000", "-o", out},
+                   {file + ": algorithm.dt_ratio: 0.4", "stable step"});
 }
 
 // A diverged trial is a result, not a crash: written and flagged, and

@@ -131,7 +131,7 @@ TEST(ScoreCli3d, ScoresATriaxialSeries) {
       dir.path());
   ASSERT_TRUE(r.status == 0 || r.status == 1) << r.out;  // a verdict, not an error
   EXPECT_NE(r.out.find("3D (triaxial)"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("peak sigma_zz"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("peak b_zz"), std::string::npos) << r.out;
   const nlohmann::json j = nlohmann::json::parse(test::read_text(dir / "s" / "summary.json"));
   EXPECT_EQ(j.at("dimension"), 3);
   EXPECT_TRUE(j.at("criteria_planes").contains("servo_walls"));

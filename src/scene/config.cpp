@@ -540,6 +540,7 @@ SceneConfig load_config(const std::string& path, const std::vector<std::string>&
   nlohmann::json j = parse_config_json(text, source);
   SceneConfig config = parse_config_with_overrides(j, sets, source);
   config.text = sets.empty() ? text : j.dump();
+  config.sets = sets;
   return config;
 }
 
@@ -551,14 +552,33 @@ SceneConfig parse_config_with_overrides(nlohmann::json& j, const std::vector<std
   } catch (const InputError& e) {
     // A value a --set gave is the --set's fault, not the file's: the error
     // names it (a check across keys still names the file).
-    const std::string prefix = e.file() + ": " + (e.field().empty() ? "" : e.field() + ": ");
-    const std::string what = std::string(e.what()).substr(prefix.size());
-    for (auto set = sets.rbegin(); set != sets.rend(); ++set) {
-      const std::string key = set->substr(0, set->find('='));
-      if (e.field() == key || e.field().rfind(key + ".", 0) == 0)
-        throw InputError("--set " + *set, e.field(), what);
-    }
+    if (const auto set = set_source(sets, e.field()))
+      throw InputError(*set, e.field(), e.message());
     throw;
+  }
+}
+
+std::optional<std::string> set_source(const std::vector<std::string>& sets,
+                                      const std::string& field) {
+  if (field.empty()) return std::nullopt;
+  for (auto set = sets.rbegin(); set != sets.rend(); ++set) {
+    const std::string key = set->substr(0, set->find('='));
+    if (field == key || field.rfind(key + ".", 0) == 0) return "--set " + *set;
+  }
+  return std::nullopt;
+}
+
+std::string source_of(const SceneConfig& config, const std::string& field) {
+  return set_source(config.sets, field).value_or(config.source);
+}
+
+void require_config_file(const SceneConfig& config, const std::string& field,
+                         const std::string& path) {
+  try {
+    require_readable_file(path);
+  } catch (const InputError& e) {
+    throw InputError(source_of(config, field), field,
+                     quoted_value(path, path.size()) + ": " + e.message());  // the whole path
   }
 }
 

@@ -267,8 +267,10 @@ Assembly make_assembly(const SceneConfig& config) {
     a = square_packing(s.columns, s.rows, s.radius);
   else if (s.type == "random")
     a = random_gas(s);
-  else
+  else {
+    require_config_file(config, "assembly.file", s.file);
     a = read_particle_file(s.file);
+  }
   check_resolvable(config, a);
   return a;
 }

@@ -89,9 +89,10 @@ SphereAssembly make_sphere_assembly(const SceneConfig& config) {
     a = fcc_packing(s.cells_x, s.cells_y, s.cells_z, s.radius);
   else if (s.type == "random")
     a = random_sphere_gas(s);
-  else if (s.type == "file")
+  else if (s.type == "file") {
+    require_config_file(config, "assembly.file", s.file);
     a = read_sphere_file(s.file);
-  else
+  } else
     throw InputError(config.source, "assembly.type",
                      "\"" + s.type + "\" is not a 3D assembly (fcc, random or file)");
   check_sphere_overlap(config, a);

@@ -420,7 +420,9 @@ class Evaluator {
         const double elapsed = seconds_since(t0_);
         // --max-trials bounds the search's trials; verification, the
         // certificate and tightened searches come on top (no denominator).
-        s << "trial " << r.id + 1 << " (" << to_string(phase);
+        // The id trials.jsonl and the report give it (from 0), whenever
+        // the trials finish in the order asked (always with one job).
+        s << "trial " << r.id << " (" << to_string(phase);
         // (A tightened re-search after a failed certificate runs search
         // trials beyond the first search's N: counted, not out of N.)
         if (search_done > options_.max_trials)

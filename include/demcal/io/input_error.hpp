@@ -15,12 +15,15 @@ class InputError : public std::runtime_error {
   InputError(const std::string& file, const std::string& field, const std::string& what)
       : std::runtime_error(file + ": " + (field.empty() ? "" : field + ": ") + what),
         file_(file),
-        field_(field) {}
+        field_(field),
+        message_(what) {}
   const std::string& file() const { return file_; }
   const std::string& field() const { return field_; }
+  /// What is wrong, without the file and the field.
+  const std::string& message() const { return message_; }
 
  private:
-  std::string file_, field_;
+  std::string file_, field_, message_;
 };
 
 /// A user's value quoted in a message, cut to `limit` characters (a 7 MB

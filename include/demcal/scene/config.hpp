@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -154,7 +155,25 @@ struct SceneConfig {
   OutputSpec output;
   std::string source;  ///< file name, or "<embedded default>"
   std::string text;    ///< the JSON as read (for the config hash)
+  /// The --set overrides applied to the file (load_config), for errors
+  /// found after reading: source_of() names the one that gave a key.
+  std::vector<std::string> sets;
 };
+
+/// What an error about `field` (e.g. "algorithm.dt_ratio") names: the last
+/// --set that gave it or a section holding it ("--set algorithm.dt_ratio=0.5":
+/// its value is the one read), else nothing. One rule for the errors found
+/// when the config is parsed and those found later (the stable step).
+std::optional<std::string> set_source(const std::vector<std::string>& sets,
+                                      const std::string& field);
+/// set_source(), else the config's file.
+std::string source_of(const SceneConfig& config, const std::string& field);
+/// A file the config names at `field` (assembly.file) can be read: else an
+/// InputError naming the config (or the --set that gave it) and the field,
+/// then the path and what is wrong with it ("no such file"). Errors inside
+/// the file name the file itself and its line.
+void require_config_file(const SceneConfig& config, const std::string& field,
+                         const std::string& path);
 
 /// The stable-step rule (`demcal run`, params.json): a dt_ratio beyond the
 /// stable dt_ratio estimated from the consolidated contact network is bad
