@@ -30,11 +30,6 @@ namespace demcal::cli {
 /// beyond a few thousand particles that takes minutes (reports/engines.md §8).
 constexpr int kDeckConsolidationAbove = 2000;
 
-/// From this many particles demcal's consolidation steps on every core: the
-/// kernel's two threads break even near 10^4 disks (reports/performance.md,
-/// "Threads": 1.78x at 10^4 on an idle machine; a loss on small REVs).
-constexpr int kConsolidationThreadsFrom = 10000;
-
 namespace {
 
 namespace fs = std::filesystem;
@@ -165,11 +160,11 @@ bool consolidate_in_deck(const ExportCmdOptions& o, int particles) {
 }
 
 /// demcal's consolidation of a prototype: every core from
-/// kConsolidationThreadsFrom particles, progress on stderr.
+/// kThreadsFrom particles, progress on stderr.
 ConsolidationOptions export_consolidation(const ExportCmdOptions& o, int particles,
                                           const std::string& what, const char* kernel) {
   ConsolidationOptions co;
-  co.threads = particles >= kConsolidationThreadsFrom ? 0 : 1;
+  co.threads = particles >= kThreadsFrom ? 0 : 1;
   co.progress = consolidation_progress(o.progress_every_s);
   std::cerr << "demcal export: consolidating the prototype (" << what
             << ") to sigma3 with demcal's " << kernel << ", "
@@ -205,7 +200,7 @@ int export_3d(const ExportCmdOptions& o, const nlohmann::json& params, const Rev
   const SphereAssembly proto = prototype_spheres(config, particles, file, &source);
   eo.consolidate_in_deck = consolidate_in_deck(o, proto.size());
   const AlgorithmSpec up = upscale(rev.params, rev.particles, proto.size(), law);
-  print_below_rev_note("export", rev.particles, proto.size(), law);
+  print_prototype_notes("export", particles, rev.particles, proto.size(), law);
   eo.provenance = o.params + " (REV " + std::to_string(rev.particles) + " spheres, " +
                   std::to_string(rev.params.steps) + " steps; " + law.name() + " law, exponent " +
                   std::to_string(law.exponent) + ")";
@@ -241,7 +236,7 @@ int cmd_export(const ExportCmdOptions& o) {
   PrototypeSource source;
   Assembly proto = prototype_assembly(config, particles, file, &source);
   const AlgorithmSpec up = upscale(rev.params, rev.particles, proto.size(), law);
-  print_below_rev_note("export", rev.particles, proto.size(), law);
+  print_prototype_notes("export", particles, rev.particles, proto.size(), law);
   eo.provenance = o.params + " (REV " + std::to_string(rev.particles) + " particles, " +
                   std::to_string(rev.params.steps) + " steps; " + law.name() + " law, exponent " +
                   std::to_string(law.exponent) + ")";

@@ -128,8 +128,12 @@ ScalingLaw resolve_law(const nlohmann::json& params, const std::string& params_p
   return default_law(params_dimension(params));
 }
 
-void print_below_rev_note(const char* command, int64_t n_rev, int64_t n_proto,
-                          const ScalingLaw& law) {
+void print_prototype_notes(const char* command, int64_t asked, int64_t n_rev, int64_t n_proto,
+                           const ScalingLaw& law) {
+  if (asked > 0 && asked != n_proto)
+    std::cerr << "demcal " << command << ": note: " << asked << " particles asked for, " << n_proto
+              << " made: the scene's generator makes whole samples of the config's "
+              << "shape (lattice cells, rows)\n";
   const std::string note = below_rev_note(n_rev, n_proto, law);
   if (!note.empty()) std::cerr << "demcal " << command << ": note: " << note << "\n";
 }
@@ -173,7 +177,8 @@ int cmd_upscale(const UpscaleOptions& o) {
   nlohmann::json out = params;
   out["prototype"] = block;
   out["upscaling"] = upscaling_block(rev.particles, n_proto, law);
-  print_below_rev_note("upscale", rev.particles, n_proto, law);
+  print_prototype_notes("upscale", o.prototype.empty() ? o.particles : 0, rev.particles, n_proto,
+                        law);
   const std::string text = out.dump(2) + "\n";
   // Which law scaled Nstep, on stderr whatever the output (the user must
   // know which law, measured or default, and its source).

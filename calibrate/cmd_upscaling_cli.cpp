@@ -77,10 +77,10 @@ std::function<int()> add_upscaling_commands(CLI::App& app) {
   verify->add_option("--np", ve->np, "MPI ranks for --engine lammps (mpirun -np N; default 1)")
       ->check(CLI::Range(1, 4096));
   verify
-      ->add_option(
-          "--threads", ve->threads,
-          "3D: threads for the prototype's loading run (default 0: the faster of 1 and all "
-          "cores, measured on the prototype)")
+      ->add_option("--threads", ve->threads,
+                   "3D: threads for the prototype's loading run (default 0: 1 below " +
+                       std::to_string(kThreadsFrom) +
+                       " spheres, else the faster of 1 and all cores, measured on the prototype)")
       ->check(CLI::Range(0, 4096));
 
   auto sc = std::make_shared<ScalingOptions>();

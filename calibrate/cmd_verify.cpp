@@ -165,7 +165,10 @@ double probe_rate(const SphereWorld& world, const AlgorithmSpec& params, int thr
   probe.set_threads(threads);
   probe.set_integration(integration_for(probe, params));
   probe.step(5);  // neighbour lists built, threads started
-  const int64_t steps = std::clamp<int64_t>(2000000 / std::max(1, probe.size()), 5, 200);
+  // About 2e6 particle-steps (a few hundredths of a second on one core):
+  // a probe of a small prototype over a few milliseconds read the load of
+  // the moment, not the rate.
+  const int64_t steps = std::clamp<int64_t>(2000000 / std::max(1, probe.size()), 5, 20000);
   const auto t0 = std::chrono::steady_clock::now();
   probe.step(steps);
   const double s = seconds_since(t0);
@@ -219,13 +222,13 @@ int verify_3d(const VerifyOptions& o, const nlohmann::json& params, const RevPar
   const SphereAssembly proto = prototype_spheres(config, particles, file, &source);
   const int64_t n = proto.size();
   const AlgorithmSpec up = upscale(rev.params, rev.particles, n, law);
-  print_below_rev_note("verify", rev.particles, n, law);
+  print_prototype_notes("verify", particles, rev.particles, n, law);
   const double particle_steps = static_cast<double>(n) * static_cast<double>(up.steps);
   const SphereWorld world(sphere_material(config.material), proto.x, proto.y, proto.z, proto.r,
                           proto.lo, proto.hi);
-  // --threads, else the faster of one thread and all cores, measured now:
-  // on a loaded machine, or for a small prototype, the threads' barriers
-  // can cost more than they share.
+  // --threads, else one thread below kThreadsFrom spheres and, from there,
+  // the faster of one thread and all cores, measured now: on a loaded
+  // machine the threads' barriers can cost more than they share.
   int threads = o.threads;
   double rate = 0.0;
   if (threads > 0) {
@@ -234,7 +237,7 @@ int verify_3d(const VerifyOptions& o, const nlohmann::json& params, const RevPar
     const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
     threads = 1;
     rate = probe_rate(world, up, 1);
-    if (cores > 1) {
+    if (cores > 1 && n >= kThreadsFrom) {
       const double rate_all = probe_rate(world, up, cores);
       std::cerr << "demcal verify: probe: " << rate << " particle-steps/s on 1 thread, " << rate_all
                 << " on " << cores << "\n";
@@ -356,7 +359,7 @@ int cmd_verify(const VerifyOptions& o) {
   }
   const int64_t n = proto.size();
   const AlgorithmSpec up = upscale(rev.params, rev.particles, n, law);
-  print_below_rev_note("verify", rev.particles, n, law);
+  print_prototype_notes("verify", particles, rev.particles, n, law);
   const double particle_steps = static_cast<double>(n) * static_cast<double>(up.steps);
   const double speed0 = in_lammps ? kAssumedLammpsSpeed * o.np : kAssumedSpeed;
   const double estimate_s = particle_steps / speed0;

@@ -115,8 +115,12 @@ std::pair<std::string, int64_t> named_prototype(const nlohmann::json& params,
 ScalingLaw resolve_law(const nlohmann::json& params, const std::string& params_path,
                        const std::string& law_path, double exponent);
 
-/// below_rev_note() on stderr as "demcal COMMAND: note: ...", when it applies.
-void print_below_rev_note(const char* command, int64_t n_rev, int64_t n_proto,
-                          const ScalingLaw& law);
+/// The prototype's notes on stderr, "demcal COMMAND: note: ...", where
+/// they apply: a count `asked` for (--particles, or params.json's
+/// prototype.particles; 0 for a file) that the generator could not make
+/// exactly (it makes whole lattices and rows: 300 spheres asked, 256 made),
+/// and below_rev_note().
+void print_prototype_notes(const char* command, int64_t asked, int64_t n_rev, int64_t n_proto,
+                           const ScalingLaw& law);
 
 }  // namespace demcal::cli

@@ -215,6 +215,21 @@ TEST_F(Upscale3DCli, NstepByTheMeasuredLawOrTheDefault) {
   EXPECT_EQ(up3.at("prototype").at("steps").get<int64_t>(), std::llround(3000.0 * 500.0 / 32.0));
 }
 
+// A count the generator cannot make exactly is said, not silently changed:
+// 300 spheres asked for, FCC 4×4×4 = 256 made; 500 (5×5×5) is made as asked.
+TEST_F(Upscale3DCli, ACountTheGeneratorCannotMakeIsSaid) {
+  const auto r = demcal({"upscale", params_, "--particles", "300", "-o", "up.json"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const nlohmann::json up = nlohmann::json::parse(test::read_text(dir_ / "work" / "up.json"));
+  EXPECT_EQ(up.at("prototype").at("particles"), 256);
+  EXPECT_NE(r.err.find("demcal upscale: note: 300 particles asked for, 256 made"),
+            std::string::npos)
+      << r.err;
+  const auto exact = demcal({"upscale", params_, "--particles", "500", "-o", "up2.json"});
+  ASSERT_EQ(exact.status, 0) << exact.err;
+  EXPECT_EQ(exact.err.find("asked for"), std::string::npos) << exact.err;
+}
+
 TEST_F(Upscale3DCli, DimensionMismatchesAreBadInput) {
   // A 2D params.json (no "dimension", no embedded config) of the same REV.
   nlohmann::json p2 = nlohmann::json::parse(test::read_text(params_));
