@@ -1,15 +1,18 @@
 // The formulas both kernels' measures and stable-step estimates end with,
 // written once (private to src/kernel): the scalar ratios of Measures and
 // SphereMeasures from the sums each kernel's measure() gathers
-// (stress.cpp, sphere_stress.cpp), and the steps and ratios of a
-// StabilityEstimate from its ω² (stability.cpp, sphere_stability.cpp).
+// (stress.cpp, sphere_stress.cpp); a StabilityEstimate from a linearised
+// contact network, its steps and ratios from its ω² (stability.cpp,
+// sphere_stability.cpp).
 #pragma once
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "demcal/kernel/particle_scales.hpp"  // stable_step
 #include "demcal/kernel/world.hpp"            // StabilityEstimate
+#include "tridiagonal.hpp"                    // lanczos_max_eigenvalue
 
 namespace demcal::detail {
 
@@ -46,6 +49,43 @@ inline void set_stable_steps(StabilityEstimate& est, double omega2_translation, 
     est.dt_ratio_stable_gershgorin = est.dt_stable_gershgorin / dt_crit;
     est.dt_ratio_stable_translation = step_for(omega2_translation) / dt_crit;
   }
+}
+
+/// The stable-step estimate of a kernel's linearised contact network
+/// `contacts` (its LinearContact: i, j, kn; stability.cpp's file comment)
+/// over `n` particles of masses `m` and moments of inertia `inertia`, of
+/// `dofs_per_particle` dofs each, the first `translation_dofs` of them
+/// translations. The kernel gives its Gershgorin bound
+/// `gershgorin(contacts, ism, isi, rotation)` and its y = A·x,
+/// `apply(contacts, ism, isi, rotation, x, y)` (ism, isi: 1/sqrt of the
+/// masses and of the moments of inertia), and the contact dashpots' γ_max
+/// `gamma` (law::dashpot_gamma_max: each pair's normal dashpot, a wall's
+/// with the particle's mass). ω²_max is the Lanczos value with the rotations
+/// coupled unless they are locked (`rotation` false); the steps come from
+/// it, the Gershgorin bound and the translational Lanczos value.
+template <class Contacts, class Masses, class Gershgorin, class Apply>
+StabilityEstimate network_stability(const Contacts& contacts, const Masses& m,
+                                    const Masses& inertia, int n, int dofs_per_particle,
+                                    int translation_dofs, bool rotation, int iterations,
+                                    const Gershgorin& gershgorin, const Apply& apply, double gamma,
+                                    double dt_crit) {
+  std::vector<double> ism(n), isi(n);
+  for (int p = 0; p < n; ++p) {
+    ism[p] = 1.0 / std::sqrt(m[p]);
+    isi[p] = 1.0 / std::sqrt(inertia[p]);
+  }
+  auto lanczos = [&](bool rot) {
+    if (contacts.empty()) return 0.0;
+    return lanczos_max_eigenvalue(n, dofs_per_particle, translation_dofs, rot, iterations,
+                                  [&](const Eigen::VectorXd& x, Eigen::VectorXd& y) {
+                                    apply(contacts, ism, isi, rot, x, y);
+                                  });
+  };
+  StabilityEstimate est;
+  est.omega2_gershgorin = gershgorin(contacts, ism, isi, rotation);
+  est.omega2_max = lanczos(rotation);
+  set_stable_steps(est, lanczos(false), gamma, dt_crit);
+  return est;
 }
 
 }  // namespace demcal::detail
