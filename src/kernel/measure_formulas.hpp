@@ -1,9 +1,9 @@
 // The formulas both kernels' measures and stable-step estimates end with,
-// written once (private to src/kernel): the scalar ratios of Measures and
-// SphereMeasures from the sums each kernel's measure() gathers
-// (stress.cpp, sphere_stress.cpp); a StabilityEstimate from a linearised
-// contact network, its steps and ratios from its ω² (stability.cpp,
-// sphere_stability.cpp).
+// written once (private to src/kernel): the sums each kernel's measure()
+// gathers contact by contact and particle by particle, and Measures and
+// SphereMeasures from them (stress.cpp, sphere_stress.cpp); a
+// StabilityEstimate from a linearised contact network, its steps and ratios
+// from its ω² (stability.cpp, sphere_stability.cpp).
 #pragma once
 
 #include <algorithm>
@@ -34,6 +34,62 @@ inline double coordination_number(int particle_contacts, int n) {
 inline double inertial_number(double strain_rate, double sum_d, int n, double rho, double p) {
   if (!(n && p > 0.0)) return 0.0;
   return std::abs(strain_rate) * (sum_d / n) * std::sqrt(rho / p);
+}
+
+/// What a kernel's measure() sums over its contacts in D dimensions: V·σ and
+/// V·b (tension positive, origin of b at the box centre), the contact
+/// forces' magnitudes and their number, and the springs' energy (which the
+/// kernel adds itself: the contacts' energy does not need a force).
+template <int D>
+struct ContactSums {
+  using Vec = Eigen::Matrix<double, D, 1>;
+  using Mat = Eigen::Matrix<double, D, D>;
+  Mat sigma = Mat::Zero(), b = Mat::Zero();
+  double force = 0.0, elastic = 0.0;
+  int pairs = 0, walls = 0;
+
+  /// A particle pair: `branch` x^j − x^i, `f` the force on i (the two
+  /// particles' terms of σ add up to branch ⊗ f wherever the contact sits).
+  void add_pair(const Vec& branch, const Vec& f) {
+    sigma += branch * f.transpose();
+    force += f.norm();
+    ++pairs;
+  }
+  /// A wall contact: `arm` from the particle's centre to the contact point,
+  /// `xc` the contact point from the box centre, `f` the wall's force on the
+  /// particle.
+  void add_wall(const Vec& arm, const Vec& xc, const Vec& f) {
+    sigma += arm * f.transpose();
+    b += xc * f.transpose();
+    force += f.norm();
+    ++walls;
+  }
+};
+
+/// What a kernel's measure() sums over its `n` particles: the kinetic
+/// energies, the net forces' magnitudes, the diameters.
+struct ParticleSums {
+  double ke_translation = 0.0, ke_rotation = 0.0, net_force = 0.0, diameter = 0.0;
+};
+
+/// Measures (2D) or SphereMeasures (3D) `out`, its volume set by the
+/// caller, from its sums over `n` particles; `rho` the scaled density, `strain_rate` for the
+/// inertial number. The mean pressure is −tr(σ)/D.
+template <class M, int D>
+void set_measures(M& out, const ContactSums<D>& contacts, const ParticleSums& particles, int n,
+                  double strain_rate, double rho) {
+  out.homogenized_stress = contacts.sigma / out.volume;
+  out.boundary_stress = contacts.b / out.volume;
+  out.elastic_energy = contacts.elastic;
+  out.particle_contacts = contacts.pairs;
+  out.wall_contacts = contacts.walls;
+  out.kinetic_energy_translation = particles.ke_translation;
+  out.kinetic_energy_rotation = particles.ke_rotation;
+  out.unbalanced_force_ratio = unbalanced_force_ratio(particles.net_force, n, contacts.force,
+                                                      contacts.pairs + contacts.walls);
+  out.mean_pressure = -out.homogenized_stress.trace() / D;
+  out.coordination_number = coordination_number(out.particle_contacts, n);
+  out.inertial_number = inertial_number(strain_rate, particles.diameter, n, rho, out.mean_pressure);
 }
 
 /// The steps of `est` from its ω² (omega2_max, omega2_gershgorin, set by the

@@ -149,6 +149,17 @@ class SphereWorldImpl {
     const int s = pair_slot_[k];
     return {hx_[s], hy_[s], hz_[s]};
   }
+  // sphere_stress.cpp: pair k of the half list (i < j = nbr_j_[k]) as
+  // measure() and contacts() read it: its geometry, its history h (the
+  // tangential force on i) and its normal force fn (0 apart).
+  struct PairForce {
+    int j;
+    PairGeometry g;
+    Eigen::Vector3d h;
+    double fn;
+    bool carries_force() const { return !(fn <= 0.0 && h.squaredNorm() == 0.0); }
+  };
+  PairForce pair_force(int i, int k) const;
   // The SIMD passes over particle blocks [b0, b1) (sphere_contact.cpp):
   // pair forces (returns the largest overlap/r), the mirrored sums, and integration (returns
   // the largest squared displacement since the last build).
