@@ -13,7 +13,6 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
-#include <optional>
 #include <stdexcept>
 #include <thread>
 
@@ -307,30 +306,8 @@ bool WorldImpl::check_divergence() {
     ke += m_[i] * (vx_[i] * vx_[i] + vy_[i] * vy_[i]) + inertia_[i] * omega_[i] * omega_[i];
   }
   ke *= 0.5;
-  if (!finite || !std::isfinite(ke)) {
-    divergence_ = Divergence::kNotFinite;
-    return true;
-  }
-  if (max_overlap_ratio_seen_ > options_.max_overlap_ratio) {
-    divergence_ = Divergence::kOverlap;
-    return true;
-  }
-  // The pair loop of the energy ledger also refreshes the energy scale (every
-  // energy_check_interval steps; the scale is a running maximum, so a
-  // slightly older value only makes the check below a little stricter).
-  std::optional<EnergySample> sample;
-  if (ledger_due()) {
-    sample = energy_sample();
-    energy_scale_ = std::max({energy_scale_, sample->elastic, initial_energy_});
-  }
-  // Kinetic energy far beyond anything the springs have ever stored cannot
-  // come from the loading: an unstable mode is growing.
-  const double scale = std::max(energy_scale_, initial_energy_);
-  if (scale > 0.0 && ke > options_.max_energy_ratio * scale) {
-    divergence_ = Divergence::kEnergy;
-    return true;
-  }
-  return sample && ledger_record(*sample);
+  // The energy scale without the walls' work (the 2D ledger samples it).
+  return detail::divergence_checks(*this, finite, ke, 0.0);
 }
 
 bool WorldImpl::step(int64_t count) {

@@ -6,6 +6,7 @@
 #pragma once
 
 #include "demcal/kernel/sphere_world.hpp"
+#include "divergence.hpp"
 #include "kernel_detail.hpp"
 
 namespace demcal {
@@ -183,13 +184,14 @@ class SphereWorldImpl {
     double energy = 0.0, elastic = 0.0;
   };
   EnergySample energy_sample() const;
-  bool ledger_due() const;
   bool ledger_record(const EnergySample& sample);
   // sphere_world.cpp
   void integrate();
   void book_wall_work();
   void update_damping_coefficients();
   bool check_divergence();
+  template <class Impl>
+  friend bool detail::divergence_checks(Impl& w, bool finite, double ke, double extra_scale);
 
   SphereMaterial material_;
   KernelOptions options_;
