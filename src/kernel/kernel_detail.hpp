@@ -5,6 +5,8 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -52,6 +54,21 @@ inline double block_lanes_sum(const double* lanes, int nblocks) {
   for (int b = 0; b < nblocks; ++b)
     for (int l = 0; l < 8; ++l) lane[l] += lanes[8 * b + l];
   return lane_sum(lane);
+}
+
+/// Whether a neighbour list built with Verlet skin `skin` is out of date:
+/// the particles moved by at most sqrt(max_d2) since it was built, the walls
+/// from `built` (their positions then) to walls[w].position. Two particles
+/// approach each other by at most 2·max_disp; a particle and a wall by
+/// max_disp + max_wall.
+template <class Walls, std::size_t N>
+bool skin_exceeded(double max_d2, const Walls& walls, const std::array<double, N>& built,
+                   double skin) {
+  const double max_disp = std::sqrt(max_d2);
+  double max_wall = 0.0;
+  for (std::size_t w = 0; w < N; ++w)
+    max_wall = std::max(max_wall, std::abs(walls[w].position - built[w]));
+  return 2.0 * max_disp >= skin || max_disp + max_wall >= skin;
 }
 
 class KernelTeam;  // worker threads of one World (solver.cpp)

@@ -287,14 +287,7 @@ void WorldImpl::integrate() {
   // Fused with the displacement scan of the neighbour-list check.
   const double max_d2 = run_integrate_pass();
   for (auto& w : walls_) w.position += w.velocity * integration_.dt;
-  if (!list_valid_) return;
-  const double max_disp = std::sqrt(max_d2);
-  double max_wall = 0.0;
-  for (int w = 0; w < 4; ++w)
-    max_wall = std::max(max_wall, std::abs(walls_[w].position - wall_built_[w]));
-  // Two particles approach each other by at most 2·max_disp; a particle and
-  // a wall by max_disp + max_wall.
-  if (2.0 * max_disp >= skin_ || max_disp + max_wall >= skin_) list_valid_ = false;
+  if (list_valid_ && detail::skin_exceeded(max_d2, walls_, wall_built_, skin_)) list_valid_ = false;
 }
 
 bool WorldImpl::check_divergence() {

@@ -205,14 +205,7 @@ void SphereWorldImpl::integrate() {
     wall_move_[s] = walls_[s].velocity * dt;
     walls_[s].position += wall_move_[s];
   }
-  if (!list_valid_) return;
-  const double max_disp = std::sqrt(max_d2);
-  double max_wall = 0.0;
-  for (int s = 0; s < 6; ++s)
-    max_wall = std::max(max_wall, std::abs(walls_[s].position - wall_built_[s]));
-  // Two particles approach each other by at most 2·max_disp; a particle and
-  // a wall by max_disp + max_wall.
-  if (2.0 * max_disp >= skin_ || max_disp + max_wall >= skin_) list_valid_ = false;
+  if (list_valid_ && detail::skin_exceeded(max_d2, walls_, wall_built_, skin_)) list_valid_ = false;
 }
 
 bool SphereWorldImpl::check_divergence() {
