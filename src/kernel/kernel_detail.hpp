@@ -11,6 +11,9 @@
 #include <cstdint>
 #include <memory>
 #include <new>
+#include <stdexcept>
+#include <string>
+#include <thread>
 #include <vector>
 
 namespace demcal {
@@ -88,6 +91,15 @@ struct TeamHandle {
 /// on the calling thread) and return when all are done. Both kernels' passes
 /// (run_pass).
 void team_run(TeamHandle& handle, int size, void (*fn)(void*, int), void* ctx);
+
+/// KernelOptions::threads as a count (0: the machine's hardware threads,
+/// at least 1); a negative count throws std::invalid_argument naming
+/// `kernel` (World, SphereWorld).
+inline int thread_count(int threads, const char* kernel) {
+  if (threads < 0) throw std::invalid_argument(std::string(kernel) + ": threads must be >= 0");
+  if (threads == 0) threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  return threads;
+}
 
 /// The threads worth using for `nblocks` blocks of 8 particles, of the
 /// `threads` asked for: at least 8 blocks (64 particles) per thread, or the

@@ -185,10 +185,8 @@ WorldImpl::WorldImpl(const Material& material, std::span<const double> x, std::s
 }
 
 void WorldImpl::set_threads(int threads) {
-  if (threads < 0) throw std::invalid_argument("World: threads must be >= 0");
-  if (threads == 0) threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  options_.threads = threads;
-  threads_ = threads;
+  options_.threads = detail::thread_count(threads, "World");
+  threads_ = options_.threads;
   if (team_.team && team_.team->size() != active_threads()) team_.team.reset();
   update_thread_bounds();
 }

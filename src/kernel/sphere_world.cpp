@@ -79,10 +79,8 @@ SphereWorldImpl::SphereWorldImpl(const SphereMaterial& material, std::span<const
 }
 
 void SphereWorldImpl::set_threads(int threads) {
-  if (threads < 0) throw std::invalid_argument("SphereWorld: threads must be >= 0");
-  if (threads == 0) threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  options_.threads = threads;
-  threads_ = threads;
+  options_.threads = detail::thread_count(threads, "SphereWorld");
+  threads_ = options_.threads;
   update_thread_bounds();
 }
 
