@@ -38,11 +38,7 @@ bool WorldImpl::needs_rebuild() const {
     const double dy = y_[i] - y_built_[i];
     max_d2 = std::max(max_d2, dx * dx + dy * dy);
   }
-  const double max_disp = std::sqrt(max_d2);
-  double max_wall = 0.0;
-  for (int w = 0; w < 4; ++w)
-    max_wall = std::max(max_wall, std::abs(walls_[w].position - wall_built_[w]));
-  return 2.0 * max_disp >= skin_ || max_disp + max_wall >= skin_;
+  return detail::skin_exceeded(max_d2, walls_, wall_built_, skin_);
 }
 
 void WorldImpl::rebuild_neighbours() {

@@ -25,6 +25,7 @@
 #include <cmath>
 
 #include "contact_law.hpp"
+#include "divergence.hpp"
 #include "world_impl.hpp"
 
 namespace demcal {
@@ -86,17 +87,9 @@ double WorldImpl::wall_power() const {
   return power;
 }
 
-bool WorldImpl::ledger_due() const {
-  return !ledger_.started || steps_ - ledger_.step >= std::max(1, options_.energy_check_interval);
-}
-
 bool WorldImpl::ledger_record(const EnergySample& e) {
   Ledger& l = ledger_;
-  if (!l.started) {
-    l = {};
-    l.started = true;
-    l.step = steps_;
-    l.energy0 = e.energy;
+  if (detail::ledger_start(l, steps_, e.energy)) {
     l.power_in = e.power_in;
     l.power_lost = e.power_lost;
     return false;
@@ -106,14 +99,8 @@ bool WorldImpl::ledger_record(const EnergySample& e) {
   l.lost += 0.5 * (l.power_lost + e.power_lost) * h;
   l.power_in = e.power_in;
   l.power_lost = e.power_lost;
-  l.step = steps_;
-  const double lost = l.lost + l.dashpot;
-  const double created = e.energy - l.energy0 - l.work + lost;
-  const double scale = l.energy0 + std::abs(l.work) + lost;
-  l.created = scale > 0.0 ? created / scale : 0.0;
-  if (std::isfinite(l.created) && l.created <= options_.max_energy_created) return false;
-  divergence_ = Divergence::kEnergyCreated;
-  return true;
+  return detail::ledger_read(l, steps_, e.energy, l.work, l.lost + l.dashpot, options_,
+                             divergence_);
 }
 
 }  // namespace demcal

@@ -5,10 +5,15 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <new>
+#include <stdexcept>
+#include <string>
+#include <thread>
 #include <vector>
 
 namespace demcal {
@@ -54,6 +59,21 @@ inline double block_lanes_sum(const double* lanes, int nblocks) {
   return lane_sum(lane);
 }
 
+/// Whether a neighbour list built with Verlet skin `skin` is out of date:
+/// the particles moved by at most sqrt(max_d2) since it was built, the walls
+/// from `built` (their positions then) to walls[w].position. Two particles
+/// approach each other by at most 2·max_disp; a particle and a wall by
+/// max_disp + max_wall.
+template <class Walls, std::size_t N>
+bool skin_exceeded(double max_d2, const Walls& walls, const std::array<double, N>& built,
+                   double skin) {
+  const double max_disp = std::sqrt(max_d2);
+  double max_wall = 0.0;
+  for (std::size_t w = 0; w < N; ++w)
+    max_wall = std::max(max_wall, std::abs(walls[w].position - built[w]));
+  return 2.0 * max_disp >= skin || max_disp + max_wall >= skin;
+}
+
 class KernelTeam;  // worker threads of one World (solver.cpp)
 /// Owns a World's worker threads. Copying a World does not copy its threads:
 /// the copy starts its own on first use.
@@ -71,6 +91,15 @@ struct TeamHandle {
 /// on the calling thread) and return when all are done. Both kernels' passes
 /// (run_pass).
 void team_run(TeamHandle& handle, int size, void (*fn)(void*, int), void* ctx);
+
+/// KernelOptions::threads as a count (0: the machine's hardware threads,
+/// at least 1); a negative count throws std::invalid_argument naming
+/// `kernel` (World, SphereWorld).
+inline int thread_count(int threads, const char* kernel) {
+  if (threads < 0) throw std::invalid_argument(std::string(kernel) + ": threads must be >= 0");
+  if (threads == 0) threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  return threads;
+}
 
 /// The threads worth using for `nblocks` blocks of 8 particles, of the
 /// `threads` asked for: at least 8 blocks (64 particles) per thread, or the

@@ -13,7 +13,6 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
-#include <optional>
 #include <stdexcept>
 #include <thread>
 
@@ -186,10 +185,8 @@ WorldImpl::WorldImpl(const Material& material, std::span<const double> x, std::s
 }
 
 void WorldImpl::set_threads(int threads) {
-  if (threads < 0) throw std::invalid_argument("World: threads must be >= 0");
-  if (threads == 0) threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  options_.threads = threads;
-  threads_ = threads;
+  options_.threads = detail::thread_count(threads, "World");
+  threads_ = options_.threads;
   if (team_.team && team_.team->size() != active_threads()) team_.team.reset();
   update_thread_bounds();
 }
@@ -288,14 +285,7 @@ void WorldImpl::integrate() {
   // Fused with the displacement scan of the neighbour-list check.
   const double max_d2 = run_integrate_pass();
   for (auto& w : walls_) w.position += w.velocity * integration_.dt;
-  if (!list_valid_) return;
-  const double max_disp = std::sqrt(max_d2);
-  double max_wall = 0.0;
-  for (int w = 0; w < 4; ++w)
-    max_wall = std::max(max_wall, std::abs(walls_[w].position - wall_built_[w]));
-  // Two particles approach each other by at most 2·max_disp; a particle and
-  // a wall by max_disp + max_wall.
-  if (2.0 * max_disp >= skin_ || max_disp + max_wall >= skin_) list_valid_ = false;
+  if (list_valid_ && detail::skin_exceeded(max_d2, walls_, wall_built_, skin_)) list_valid_ = false;
 }
 
 bool WorldImpl::check_divergence() {
@@ -307,30 +297,8 @@ bool WorldImpl::check_divergence() {
     ke += m_[i] * (vx_[i] * vx_[i] + vy_[i] * vy_[i]) + inertia_[i] * omega_[i] * omega_[i];
   }
   ke *= 0.5;
-  if (!finite || !std::isfinite(ke)) {
-    divergence_ = Divergence::kNotFinite;
-    return true;
-  }
-  if (max_overlap_ratio_seen_ > options_.max_overlap_ratio) {
-    divergence_ = Divergence::kOverlap;
-    return true;
-  }
-  // The pair loop of the energy ledger also refreshes the energy scale (every
-  // energy_check_interval steps; the scale is a running maximum, so a
-  // slightly older value only makes the check below a little stricter).
-  std::optional<EnergySample> sample;
-  if (ledger_due()) {
-    sample = energy_sample();
-    energy_scale_ = std::max({energy_scale_, sample->elastic, initial_energy_});
-  }
-  // Kinetic energy far beyond anything the springs have ever stored cannot
-  // come from the loading: an unstable mode is growing.
-  const double scale = std::max(energy_scale_, initial_energy_);
-  if (scale > 0.0 && ke > options_.max_energy_ratio * scale) {
-    divergence_ = Divergence::kEnergy;
-    return true;
-  }
-  return sample && ledger_record(*sample);
+  // The energy scale without the walls' work (the 2D ledger samples it).
+  return detail::divergence_checks(*this, finite, ke, 0.0);
 }
 
 bool WorldImpl::step(int64_t count) {

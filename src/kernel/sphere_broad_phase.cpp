@@ -33,11 +33,7 @@ bool SphereWorldImpl::needs_rebuild() const {
     const double dx = x_[i] - x_built_[i], dy = y_[i] - y_built_[i], dz = z_[i] - z_built_[i];
     max_d2 = std::max(max_d2, dx * dx + dy * dy + dz * dz);
   }
-  const double max_disp = std::sqrt(max_d2);
-  double max_wall = 0.0;
-  for (int s = 0; s < 6; ++s)
-    max_wall = std::max(max_wall, std::abs(walls_[s].position - wall_built_[s]));
-  return 2.0 * max_disp >= skin_ || max_disp + max_wall >= skin_;
+  return detail::skin_exceeded(max_d2, walls_, wall_built_, skin_);
 }
 
 void SphereWorldImpl::rebuild_neighbours() {

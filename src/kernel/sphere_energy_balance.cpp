@@ -24,6 +24,7 @@
 #include <cmath>
 
 #include "contact_law.hpp"
+#include "divergence.hpp"
 #include "sphere_world_impl.hpp"
 
 namespace demcal {
@@ -65,31 +66,17 @@ SphereWorldImpl::EnergySample SphereWorldImpl::energy_sample() const {
   return e;
 }
 
-bool SphereWorldImpl::ledger_due() const {
-  return !ledger_.started || steps_ - ledger_.step >= std::max(1, options_.energy_check_interval);
-}
-
 bool SphereWorldImpl::ledger_record(const EnergySample& e) {
   Ledger& l = ledger_;
-  if (!l.started) {
-    l = {};
-    l.started = true;
-    l.step = steps_;
-    l.energy0 = e.energy;
+  if (detail::ledger_start(l, steps_, e.energy)) {
     damping_dissipated_ = 0.0;
     dashpot_dissipated_ = 0.0;
     wall_work_ = 0.0;
     friction_dissipated_ = 0.0;
     return false;
   }
-  l.step = steps_;
   const double lost = damping_dissipated_ + friction_dissipated_ + dashpot_dissipated_;
-  const double created = e.energy - l.energy0 - wall_work_ + lost;
-  const double scale = l.energy0 + std::abs(wall_work_) + lost;
-  l.created = scale > 0.0 ? created / scale : 0.0;
-  if (std::isfinite(l.created) && l.created <= options_.max_energy_created) return false;
-  divergence_ = Divergence::kEnergyCreated;
-  return true;
+  return detail::ledger_read(l, steps_, e.energy, wall_work_, lost, options_, divergence_);
 }
 
 }  // namespace demcal

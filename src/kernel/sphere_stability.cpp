@@ -17,13 +17,10 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
-#include <cstdint>
-#include <limits>
 
 #include "contact_law.hpp"
 #include "measure_formulas.hpp"
 #include "sphere_world_impl.hpp"
-#include "tridiagonal.hpp"
 
 namespace demcal {
 
@@ -90,38 +87,6 @@ void apply(const std::vector<LinearContact>& contacts, const std::vector<double>
   }
 }
 
-double lanczos_max(const std::vector<LinearContact>& contacts, const std::vector<double>& ism,
-                   const std::vector<double>& isi, bool rotation, int iterations) {
-  const int n = static_cast<int>(ism.size());
-  const int dofs = 6 * n;
-  if (dofs == 0 || contacts.empty()) return 0.0;
-  Eigen::VectorXd v(dofs), v_prev = Eigen::VectorXd::Zero(dofs), w(dofs);
-  uint64_t state = 0x9E3779B97F4A7C15ull;  // deterministic, generic start vector
-  for (int k = 0; k < dofs; ++k) {
-    state ^= state << 13;
-    state ^= state >> 7;
-    state ^= state << 17;
-    v[k] = static_cast<double>(state % 2001) / 1000.0 - 1.0;
-    if (!rotation && k % 6 >= 3) v[k] = 0.0;
-  }
-  v.normalize();
-  std::vector<double> alpha, beta;
-  double b = 0.0;
-  const int steps = std::min(iterations, rotation ? dofs : 3 * n);
-  for (int k = 0; k < steps; ++k) {
-    apply(contacts, ism, isi, rotation, v, w);
-    const double a = w.dot(v);
-    w -= a * v + b * v_prev;
-    alpha.push_back(a);
-    b = w.norm();
-    if (b < 1e-12 * std::abs(a) || k + 1 == steps) break;
-    beta.push_back(b);
-    v_prev = v;
-    v = w / b;
-  }
-  return detail::tridiagonal_max_eigenvalue(alpha, beta);
-}
-
 // Gershgorin: row sums of |A|, bounded contact by contact. With an
 // orthonormal frame (n, t1, t2) a contact's stiffness is
 // kn·b_n b_nᵀ + kt·(b_1 b_1ᵀ + b_2 b_2ᵀ), b the gradient of Δ·e over the
@@ -169,7 +134,6 @@ double gershgorin_bound(const std::vector<LinearContact>& contacts, const std::v
 }  // namespace
 
 StabilityEstimate SphereWorldImpl::stability_estimate(int iterations) const {
-  StabilityEstimate est;
   const bool rotation = !integration_.lock_rotation;
   std::vector<LinearContact> contacts;
   // A sliding contact can stick again: count its tangential spring too.
@@ -192,22 +156,10 @@ StabilityEstimate SphereWorldImpl::stability_estimate(int iterations) const {
       n[s / 2] = (s % 2 == 0) ? -1.0 : 1.0;  // from the particle to the wall
       contacts.push_back({i, -1, n, wall_distance(s, i), 0.0, kw, ktw});
     }
-  std::vector<double> ism(n_), isi(n_);
-  for (int p = 0; p < n_; ++p) {
-    ism[p] = 1.0 / std::sqrt(m_[p]);
-    isi[p] = 1.0 / std::sqrt(inertia_[p]);
-  }
-  est.omega2_gershgorin = gershgorin_bound(contacts, ism, isi, rotation);
-  est.omega2_max = lanczos_max(contacts, ism, isi, rotation, iterations);
-  const double omega2_translation = lanczos_max(contacts, ism, isi, false, iterations);
-
-  const double dt_crit = reference_scales().dt_crit;
-  // γ_max of the contact dashpots (0 without them), as in the file comment
-  // of stability.cpp (each pair's normal dashpot, a wall's with the
-  // particle's mass).
-  const double gamma = law::dashpot_gamma_max(contacts, m_, material_.contact_damping_ratio);
-  detail::set_stable_steps(est, omega2_translation, gamma, dt_crit);
-  return est;
+  return detail::network_stability(
+      contacts, m_, inertia_, n_, 6, 3, rotation, iterations, gershgorin_bound, apply,
+      law::dashpot_gamma_max(contacts, m_, material_.contact_damping_ratio),
+      reference_scales().dt_crit);
 }
 
 }  // namespace demcal

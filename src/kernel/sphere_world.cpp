@@ -7,7 +7,6 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
-#include <optional>
 #include <stdexcept>
 #include <thread>
 
@@ -80,10 +79,8 @@ SphereWorldImpl::SphereWorldImpl(const SphereMaterial& material, std::span<const
 }
 
 void SphereWorldImpl::set_threads(int threads) {
-  if (threads < 0) throw std::invalid_argument("SphereWorld: threads must be >= 0");
-  if (threads == 0) threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  options_.threads = threads;
-  threads_ = threads;
+  options_.threads = detail::thread_count(threads, "SphereWorld");
+  threads_ = options_.threads;
   update_thread_bounds();
 }
 
@@ -206,14 +203,7 @@ void SphereWorldImpl::integrate() {
     wall_move_[s] = walls_[s].velocity * dt;
     walls_[s].position += wall_move_[s];
   }
-  if (!list_valid_) return;
-  const double max_disp = std::sqrt(max_d2);
-  double max_wall = 0.0;
-  for (int s = 0; s < 6; ++s)
-    max_wall = std::max(max_wall, std::abs(walls_[s].position - wall_built_[s]));
-  // Two particles approach each other by at most 2·max_disp; a particle and
-  // a wall by max_disp + max_wall.
-  if (2.0 * max_disp >= skin_ || max_disp + max_wall >= skin_) list_valid_ = false;
+  if (list_valid_ && detail::skin_exceeded(max_d2, walls_, wall_built_, skin_)) list_valid_ = false;
 }
 
 bool SphereWorldImpl::check_divergence() {
@@ -226,29 +216,9 @@ bool SphereWorldImpl::check_divergence() {
           inertia_[i] * (wx_[i] * wx_[i] + wy_[i] * wy_[i] + wz_[i] * wz_[i]);
   }
   ke *= 0.5;
-  if (!finite || !std::isfinite(ke)) {
-    divergence_ = Divergence::kNotFinite;
-    return true;
-  }
-  if (max_overlap_ratio_seen_ > options_.max_overlap_ratio) {
-    divergence_ = Divergence::kOverlap;
-    return true;
-  }
-  std::optional<EnergySample> sample;
-  if (ledger_due()) {
-    sample = energy_sample();
-    energy_scale_ = std::max({energy_scale_, sample->elastic, initial_energy_});
-  }
-  // Kinetic energy far beyond anything the springs have ever stored, or the
-  // walls have ever done as work (a wall can throw a sphere within one
-  // sampling interval), cannot come from the loading: an unstable mode is
-  // growing.
-  const double scale = std::max({energy_scale_, initial_energy_, wall_work_abs_});
-  if (scale > 0.0 && ke > options_.max_energy_ratio * scale) {
-    divergence_ = Divergence::kEnergy;
-    return true;
-  }
-  return sample && ledger_record(*sample);
+  // The walls' work counts in the energy scale: a wall can throw a sphere
+  // within one sampling interval.
+  return detail::divergence_checks(*this, finite, ke, wall_work_abs_);
 }
 
 bool SphereWorldImpl::step(int64_t count) {

@@ -6,6 +6,7 @@
 #pragma once
 
 #include "demcal/kernel/sphere_world.hpp"
+#include "divergence.hpp"
 #include "kernel_detail.hpp"
 
 namespace demcal {
@@ -149,6 +150,17 @@ class SphereWorldImpl {
     const int s = pair_slot_[k];
     return {hx_[s], hy_[s], hz_[s]};
   }
+  // sphere_stress.cpp: pair k of the half list (i < j = nbr_j_[k]) as
+  // measure() and contacts() read it: its geometry, its history h (the
+  // tangential force on i) and its normal force fn (0 apart).
+  struct PairForce {
+    int j;
+    PairGeometry g;
+    Eigen::Vector3d h;
+    double fn;
+    bool carries_force() const { return !(fn <= 0.0 && h.squaredNorm() == 0.0); }
+  };
+  PairForce pair_force(int i, int k) const;
   // The SIMD passes over particle blocks [b0, b1) (sphere_contact.cpp):
   // pair forces (returns the largest overlap/r), the mirrored sums, and integration (returns
   // the largest squared displacement since the last build).
@@ -172,13 +184,14 @@ class SphereWorldImpl {
     double energy = 0.0, elastic = 0.0;
   };
   EnergySample energy_sample() const;
-  bool ledger_due() const;
   bool ledger_record(const EnergySample& sample);
   // sphere_world.cpp
   void integrate();
   void book_wall_work();
   void update_damping_coefficients();
   bool check_divergence();
+  template <class Impl>
+  friend bool detail::divergence_checks(Impl& w, bool finite, double ke, double extra_scale);
 
   SphereMaterial material_;
   KernelOptions options_;

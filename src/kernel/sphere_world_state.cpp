@@ -126,16 +126,13 @@ void SphereWorldImpl::visit_state(Self& w, Visitor& v) {
 }
 
 std::string SphereWorldImpl::save_state() const {
-  detail::StateWriter writer(kMark);
-  visit_state(*this, writer);
-  return std::move(writer.out);
+  return detail::write_state(kMark, [&](detail::StateWriter& v) { visit_state(*this, v); });
 }
 
 SphereWorldImpl SphereWorldImpl::load_state(std::string_view bytes) {
-  detail::StateReader reader(bytes, kMark, kWhat);
   SphereWorldImpl w;
-  visit_state(w, reader);
-  reader.finish();
+  const detail::StateReader reader =
+      detail::read_state(bytes, kMark, kWhat, [&](detail::StateReader& v) { visit_state(w, v); });
   // The arrays the passes index by particle, block, slot and wall candidate
   // must fit the sizes read (a checksum guards the cache's bytes; this
   // guards the reader).

@@ -26,11 +26,9 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
-#include <limits>
 
 #include "contact_law.hpp"
 #include "measure_formulas.hpp"
-#include "tridiagonal.hpp"
 #include "world_impl.hpp"
 
 namespace demcal {
@@ -90,78 +88,10 @@ void apply(const std::vector<LinearContact>& contacts, const std::vector<double>
   }
 }
 
-// Largest eigenvalue by Lanczos without re-orthogonalisation.
-double lanczos_max(const std::vector<LinearContact>& contacts,
-                   const std::vector<double>& inv_sqrt_mass,
-                   const std::vector<double>& inv_sqrt_inertia, bool rotation, int iterations) {
-  const int n = static_cast<int>(inv_sqrt_mass.size());
-  const int dofs = 3 * n;
-  if (dofs == 0 || contacts.empty()) return 0.0;
-  Eigen::VectorXd v(dofs), v_prev = Eigen::VectorXd::Zero(dofs), w(dofs);
-  // Deterministic, generic start vector.
-  uint64_t state = 0x9E3779B97F4A7C15ull;
-  for (int k = 0; k < dofs; ++k) {
-    state ^= state << 13;
-    state ^= state >> 7;
-    state ^= state << 17;
-    v[k] = static_cast<double>(state % 2001) / 1000.0 - 1.0;
-    if (!rotation && k % 3 == 2) v[k] = 0.0;
-  }
-  v.normalize();
-  std::vector<double> alpha, beta;
-  double b = 0.0;
-  const int steps = std::min(iterations, rotation ? dofs : 2 * n);
-  for (int k = 0; k < steps; ++k) {
-    apply(contacts, inv_sqrt_mass, inv_sqrt_inertia, rotation, v, w);
-    const double a = w.dot(v);
-    w -= a * v + b * v_prev;
-    alpha.push_back(a);
-    b = w.norm();
-    if (b < 1e-12 * std::abs(a) || k + 1 == steps) break;
-    beta.push_back(b);
-    v_prev = v;
-    v = w / b;
-  }
-  return detail::tridiagonal_max_eigenvalue(alpha, beta);
-}
-
-}  // namespace
-
-StabilityEstimate WorldImpl::stability_estimate(int iterations) const {
-  StabilityEstimate est;
-  const int n = size();
-  const bool rotation = !integration_.lock_rotation;
-  std::vector<LinearContact> contacts;
-  const double kn = material_.particle.kn;
-  // A sliding contact can stick again: count its tangential spring too.
-  const double kt = material_.particle.friction > 0.0 ? material_.particle.kt : 0.0;
-  for (size_t k = 0; k < pair_i_.size(); ++k) {
-    const int i = pair_i_[k], j = pair_j_[k];
-    const PairState p = pair_state(i, j);
-    if (p.fn_elastic <= 0.0) continue;  // apart (a dashpot's fn = 0 is still a contact)
-    contacts.push_back(
-        {i, j, p.nx, p.ny, r_[i] - 0.5 * p.overlap, r_[j] - 0.5 * p.overlap, kn, kt});
-  }
-  const double kw = material_.wall.kn;
-  const double ktw = material_.wall.friction > 0.0 ? material_.wall.kt : 0.0;
-  for (int s = 0; s < 4; ++s) {
-    for (int i : wall_candidates_[s]) {
-      const bool vertical = (s == kLeft || s == kRight);
-      const double dist = vertical ? (x_[i] - walls_[s].position) * law::kWallNormal[s][0]
-                                   : (y_[i] - walls_[s].position) * law::kWallNormal[s][1];
-      if (law::elastic_normal_force(kw, r_[i] - dist) <= 0.0) continue;
-      contacts.push_back(
-          {i, -1, law::kWallNormal[s][0], law::kWallNormal[s][1], dist, 0.0, kw, ktw});
-    }
-  }
-  std::vector<double> ism(n), isi(n);
-  for (int p = 0; p < n; ++p) {
-    ism[p] = 1.0 / std::sqrt(m_[p]);
-    isi[p] = 1.0 / std::sqrt(inertia_[p]);
-  }
-
-  // Gershgorin: row sums of |A| bounded contact by contact.
-  std::vector<double> row(3 * static_cast<size_t>(n), 0.0);
+// Gershgorin: row sums of |A| bounded contact by contact.
+double gershgorin_bound(const std::vector<LinearContact>& contacts, const std::vector<double>& ism,
+                        const std::vector<double>& isi, bool rotation) {
+  std::vector<double> row(3 * ism.size(), 0.0);
   for (const auto& c : contacts) {
     const double tx = -c.ny, ty = c.nx;
     // dof list, |B_n| and |B_t| entries, and the 1/sqrt(mass) of each dof
@@ -191,17 +121,41 @@ StabilityEstimate WorldImpl::stability_estimate(int iterations) const {
     for (int p = 0; p < nd; ++p)
       row[dof[p]] += s[p] * (c.kn * bn[p] * sum_n + c.kt * bt[p] * sum_t);
   }
-  est.omega2_gershgorin = row.empty() ? 0.0 : *std::max_element(row.begin(), row.end());
-  est.omega2_max = lanczos_max(contacts, ism, isi, rotation, iterations);
-  const double omega2_translation = lanczos_max(contacts, ism, isi, false, iterations);
+  return row.empty() ? 0.0 : *std::max_element(row.begin(), row.end());
+}
 
-  const double dt_crit = reference_scales().dt_crit;
-  // γ_max of the contact dashpots (0 without them), as in the file comment
-  // of stability.cpp (each pair's normal dashpot, a wall's with the
-  // particle's mass).
-  const double gamma = law::dashpot_gamma_max(contacts, m_, material_.contact_damping_ratio);
-  detail::set_stable_steps(est, omega2_translation, gamma, dt_crit);
-  return est;
+}  // namespace
+
+StabilityEstimate WorldImpl::stability_estimate(int iterations) const {
+  const int n = size();
+  const bool rotation = !integration_.lock_rotation;
+  std::vector<LinearContact> contacts;
+  const double kn = material_.particle.kn;
+  // A sliding contact can stick again: count its tangential spring too.
+  const double kt = material_.particle.friction > 0.0 ? material_.particle.kt : 0.0;
+  for (size_t k = 0; k < pair_i_.size(); ++k) {
+    const int i = pair_i_[k], j = pair_j_[k];
+    const PairState p = pair_state(i, j);
+    if (p.fn_elastic <= 0.0) continue;  // apart (a dashpot's fn = 0 is still a contact)
+    contacts.push_back(
+        {i, j, p.nx, p.ny, r_[i] - 0.5 * p.overlap, r_[j] - 0.5 * p.overlap, kn, kt});
+  }
+  const double kw = material_.wall.kn;
+  const double ktw = material_.wall.friction > 0.0 ? material_.wall.kt : 0.0;
+  for (int s = 0; s < 4; ++s) {
+    for (int i : wall_candidates_[s]) {
+      const bool vertical = (s == kLeft || s == kRight);
+      const double dist = vertical ? (x_[i] - walls_[s].position) * law::kWallNormal[s][0]
+                                   : (y_[i] - walls_[s].position) * law::kWallNormal[s][1];
+      if (law::elastic_normal_force(kw, r_[i] - dist) <= 0.0) continue;
+      contacts.push_back(
+          {i, -1, law::kWallNormal[s][0], law::kWallNormal[s][1], dist, 0.0, kw, ktw});
+    }
+  }
+  return detail::network_stability(
+      contacts, m_, inertia_, n, 3, 2, rotation, iterations, gershgorin_bound, apply,
+      law::dashpot_gamma_max(contacts, m_, material_.contact_damping_ratio),
+      reference_scales().dt_crit);
 }
 
 }  // namespace demcal

@@ -84,6 +84,28 @@ class StateReader {
   size_t at_ = 0;
 };
 
+/// A kernel's save_state(): its `mark`, then the members `visit(writer)`
+/// visits.
+template <class Visit>
+std::string write_state(std::string_view mark, Visit visit) {
+  StateWriter writer(mark);
+  visit(writer);
+  return std::move(writer.out);
+}
+
+/// A kernel's load_state() up to its checks of the sizes read: `bytes` that
+/// open with `mark`, the members `visit(reader)` visits, and not a byte more
+/// (else std::runtime_error naming `what`). Returns the reader for those
+/// checks (StateReader::require, fail).
+template <class Visit>
+StateReader read_state(std::string_view bytes, std::string_view mark, const char* what,
+                       Visit visit) {
+  StateReader reader(bytes, mark, what);
+  visit(reader);
+  reader.finish();
+  return reader;
+}
+
 // The value types both kernels hold, visited in one place each. A new
 // member must be visited here: the sizes catch one that is not (x86-64
 // layouts).

@@ -23,14 +23,9 @@ Eigen::Vector2d WorldImpl::centre() const {
 Measures WorldImpl::measure(double strain_rate) const {
   Measures out;
   const int n = size();
-  const double volume = this->volume();
-  out.volume = volume;
+  out.volume = volume();
   const Eigen::Vector2d c = centre();
-  Eigen::Matrix2d sigma = Eigen::Matrix2d::Zero();
-  Eigen::Matrix2d b = Eigen::Matrix2d::Zero();
-  double sum_contact_force = 0.0;
-  int contact_count = 0;
-  double elastic = 0.0;
+  detail::ContactSums<2> sums;
   const double kn = material_.particle.kn, kt = material_.particle.kt;
 
   for (size_t k = 0; k < pair_i_.size(); ++k) {
@@ -40,15 +35,11 @@ Measures WorldImpl::measure(double strain_rate) const {
     const double fn = p.fn;
     // The springs' energy, by the contact law: the elastic part of the
     // normal force (with a dashpot, fn is not kn·δ).
-    elastic += law::spring_energy(p.fn_elastic, kn) + law::spring_energy(ft, kt);
+    sums.elastic += law::spring_energy(p.fn_elastic, kn) + law::spring_energy(ft, kt);
     if (fn <= 0.0 && ft == 0.0) continue;
     const double nx = p.nx, ny = p.ny;
     const Eigen::Vector2d f(-fn * nx - ft * ny, -fn * ny + ft * nx);  // on i
-    const Eigen::Vector2d branch(x_[j] - x_[i], y_[j] - y_[i]);
-    sigma += branch * f.transpose();
-    sum_contact_force += f.norm();
-    ++contact_count;
-    ++out.particle_contacts;
+    sums.add_pair(Eigen::Vector2d(x_[j] - x_[i], y_[j] - y_[i]), f);
   }
 
   // Wall contacts, re-evaluated from the stored history (the force on each
@@ -64,38 +55,24 @@ Measures WorldImpl::measure(double strain_rate) const {
       const double ft = wall_ft_[s][i];
       const double overlap = r_[i] - dist;
       if (overlap > 0.0)
-        elastic += law::spring_energy(law::elastic_normal_force(kw, overlap), kw) +
-                   law::spring_energy(ft, ktw);
+        sums.elastic += law::spring_energy(law::elastic_normal_force(kw, overlap), kw) +
+                        law::spring_energy(ft, ktw);
       if (fn <= 0.0 && ft == 0.0) continue;
       const Eigen::Vector2d f(fn * gnx - ft * gny, fn * gny + ft * gnx);
       const Eigen::Vector2d xc(x_[i] - dist * gnx, y_[i] - dist * gny);
-      const Eigen::Vector2d arm = xc - Eigen::Vector2d(x_[i], y_[i]);
-      sigma += arm * f.transpose();
-      b += (xc - c) * f.transpose();
-      sum_contact_force += f.norm();
-      ++contact_count;
-      ++out.wall_contacts;
+      sums.add_wall(xc - Eigen::Vector2d(x_[i], y_[i]), xc - c, f);
     }
   }
-  out.homogenized_stress = sigma / volume;
-  out.boundary_stress = b / volume;
-  out.elastic_energy = elastic;
 
-  double ke_t = 0.0, ke_r = 0.0, sum_net = 0.0, sum_d = 0.0;
+  detail::ParticleSums particles;
   for (int i = 0; i < n; ++i) {
-    ke_t += 0.5 * m_[i] * (vx_[i] * vx_[i] + vy_[i] * vy_[i]);
-    ke_r += 0.5 * inertia_[i] * omega_[i] * omega_[i];
-    sum_net += std::hypot(fx_[i], fy_[i]);
-    sum_d += 2.0 * r_[i];
+    particles.ke_translation += 0.5 * m_[i] * (vx_[i] * vx_[i] + vy_[i] * vy_[i]);
+    particles.ke_rotation += 0.5 * inertia_[i] * omega_[i] * omega_[i];
+    particles.net_force += std::hypot(fx_[i], fy_[i]);
+    particles.diameter += 2.0 * r_[i];
   }
-  out.kinetic_energy_translation = ke_t;
-  out.kinetic_energy_rotation = ke_r;
-  out.unbalanced_force_ratio =
-      detail::unbalanced_force_ratio(sum_net, n, sum_contact_force, contact_count);
-  out.mean_pressure = -0.5 * out.homogenized_stress.trace();
-  out.coordination_number = detail::coordination_number(out.particle_contacts, n);
-  out.inertial_number = detail::inertial_number(
-      strain_rate, sum_d, n, material_.density * integration_.mass_scaling, out.mean_pressure);
+  detail::set_measures(out, sums, particles, n, strain_rate,
+                       material_.density * integration_.mass_scaling);
   return out;
 }
 

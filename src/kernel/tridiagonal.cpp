@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 namespace demcal::detail {
@@ -47,6 +48,37 @@ double tridiagonal_max_eigenvalue(const std::vector<double>& d, const std::vecto
       lo = mid;
   }
   return 0.5 * (lo + hi);
+}
+
+double lanczos_max_eigenvalue(int particles, int dofs_per_particle, int translation_dofs,
+                              bool rotation, int iterations, const LinearOperator& apply) {
+  const int dofs = dofs_per_particle * particles;
+  if (dofs == 0) return 0.0;
+  Eigen::VectorXd v(dofs), v_prev = Eigen::VectorXd::Zero(dofs), w(dofs);
+  uint64_t state = 0x9E3779B97F4A7C15ull;  // deterministic, generic start vector
+  for (int k = 0; k < dofs; ++k) {
+    state ^= state << 13;
+    state ^= state >> 7;
+    state ^= state << 17;
+    v[k] = static_cast<double>(state % 2001) / 1000.0 - 1.0;
+    if (!rotation && k % dofs_per_particle >= translation_dofs) v[k] = 0.0;
+  }
+  v.normalize();
+  std::vector<double> alpha, beta;
+  double b = 0.0;
+  const int steps = std::min(iterations, rotation ? dofs : translation_dofs * particles);
+  for (int k = 0; k < steps; ++k) {
+    apply(v, w);
+    const double a = w.dot(v);
+    w -= a * v + b * v_prev;
+    alpha.push_back(a);
+    b = w.norm();
+    if (b < 1e-12 * std::abs(a) || k + 1 == steps) break;
+    beta.push_back(b);
+    v_prev = v;
+    v = w / b;
+  }
+  return tridiagonal_max_eigenvalue(alpha, beta);
 }
 
 }  // namespace demcal::detail

@@ -7,6 +7,7 @@
 #pragma once
 
 #include "demcal/kernel/world.hpp"
+#include "divergence.hpp"
 #include "kernel_detail.hpp"
 
 namespace demcal {
@@ -168,7 +169,6 @@ class WorldImpl {
     double power_lost = 0.0;  // global damping [W]
   };
   EnergySample energy_sample() const;
-  bool ledger_due() const;                         // a ledger sample is due at this step
   bool ledger_record(const EnergySample& sample);  // true when diverged
   // Power of the contact dashpots at the last force evaluation [W] (0
   // without contact damping). The ledger integrates it step by step: it
@@ -182,6 +182,8 @@ class WorldImpl {
   void integrate();
   void update_damping_coefficients();
   bool check_divergence();
+  template <class Impl>
+  friend bool detail::divergence_checks(Impl& w, bool finite, double ke, double extra_scale);
   // The SIMD passes over all blocks, shared among the threads (solver.cpp).
   double run_pair_pass();
   double run_integrate_pass();

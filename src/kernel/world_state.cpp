@@ -97,16 +97,13 @@ void WorldImpl::visit_state(Self& w, Visitor& v) {
 }
 
 std::string WorldImpl::save_state() const {
-  detail::StateWriter writer(kMark);
-  visit_state(*this, writer);
-  return std::move(writer.out);
+  return detail::write_state(kMark, [&](detail::StateWriter& v) { visit_state(*this, v); });
 }
 
 WorldImpl WorldImpl::load_state(std::string_view bytes) {
-  detail::StateReader reader(bytes, kMark, kWhat);
   WorldImpl w;
-  visit_state(w, reader);
-  reader.finish();
+  const detail::StateReader reader =
+      detail::read_state(bytes, kMark, kWhat, [&](detail::StateReader& v) { visit_state(w, v); });
   // The arrays the passes index by particle, block and slot must fit the
   // sizes read (a checksum guards the cache's bytes; this guards the reader).
   const size_t cap = static_cast<size_t>(w.ghost_) + 8;
