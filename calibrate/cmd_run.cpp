@@ -75,21 +75,6 @@ std::string steps_words(const LoadingRun<Point>& run) {
   return s.str();
 }
 
-/// A diverged run's criteria are not scored (its verdict is FAIL whatever
-/// they read): the trend ones (force balance, servo) need a window of
-/// monitoring points it did not reach and read 0. 2D: the RMS lateral
-/// force balance and servo error over the points it did reach, as a clue.
-template <class Point>
-void print_unscored_criteria(const LoadingRun<Point>& run, const Criteria& c, bool rms) {
-  std::cout << std::setprecision(4) << "  criteria not scored: the run diverged at step "
-            << run.divergence_step << " of " << run.steps_planned << ", after " << c.points
-            << (c.points == 1 ? " monitoring point" : " monitoring points");
-  if (rms)
-    std::cout << " (over them: lateral force balance RMS " << c.force_balance_xx_rms
-              << ", servo RMS " << c.servo_rms << ")";
-  std::cout << "\n";
-}
-
 /// A run's files, 2D and 3D: summary.json; series.csv with the metadata
 /// `demcal score` needs to score it as this run; final.vtk unless
 /// output.vtk is off (an earlier run's retired then, not left as this one's).
@@ -186,7 +171,7 @@ int run_3d(const SceneConfig& config, const std::string& out_dir, bool allow_uns
     std::cout << "  analytical (walled FCC, Thornton, rotation locked) sigma1/sigma3 " << *a
               << "\n";
   if (run.diverged)
-    print_unscored_criteria(run, m, false);
+    print_unscored_criteria(std::cout, run.divergence_step, run.steps_planned, m, false);
   else
     print_triaxial_criteria(std::cout, c, score.criteria);
   std::cout << "  kinetic/elastic energy max " << m.kinetic_energy_ratio_max
@@ -264,7 +249,7 @@ int cmd_run(const std::string& path, const std::vector<std::string>& sets,
     std::cout << "  analytical (walled, rotation locked) sigma1/sigma3 "
               << -*a / config.test.lateral_stress << "\n";
   if (run.diverged)
-    print_unscored_criteria(run, c, true);
+    print_unscored_criteria(std::cout, run.divergence_step, run.steps_planned, c, true);
   else
     std::cout << "  force balance " << c.force_balance << " (paper form " << c.force_balance_paper
               << "), moment balance " << c.moment_balance << ", servo " << c.servo

@@ -63,7 +63,12 @@ int cmd_score(const ScoreOptions& o) {
             << (score.complete ? "" : " (incomplete)") << "\n";
   print_peak(std::cout, is_3d, c.peak_stress_yy, c.peak_strain_yy, sigma3);
   std::cout << ")\n";
-  if (scored.planes) {
+  const int64_t divergence_step =
+      is_3d ? series.triaxial.divergence_step : series.run.divergence_step;
+  if (score.diverged) {
+    // As `demcal run` prints the run that wrote it.
+    print_unscored_criteria(std::cout, divergence_step, planned, c, !is_3d);
+  } else if (scored.planes) {
     print_triaxial_criteria(std::cout, *scored.planes, c);
     std::cout << "  tolerances: force balance " << tolerances.force_balance << ", moment balance "
               << tolerances.moment_balance << ", servo " << tolerances.servo << ", oscillation "
@@ -90,8 +95,8 @@ int cmd_score(const ScoreOptions& o) {
   // beside it; an incomplete one's diagnosis (of the steps it has) apart.
   std::cout << "  " << score_verdict(series, scored) << "\n";
   if (score.diverged) {
-    const int64_t step = is_3d ? series.triaxial.divergence_step : series.run.divergence_step;
-    std::cout << "  DIVERGED" << (step >= 0 ? " at step " + std::to_string(step) : "") << ": "
+    std::cout << "  DIVERGED"
+              << (divergence_step >= 0 ? " at step " + std::to_string(divergence_step) : "") << ": "
               << series.divergence_reason << "\n";
   } else if (!score.complete) {
     std::cout << "  on the steps it has: " << score.diagnosis.message << "\n";

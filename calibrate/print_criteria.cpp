@@ -43,4 +43,15 @@ void print_peak(std::ostream& out, bool three_d, double peak, std::optional<doub
   out << " (sigma1/sigma3 " << -peak / sigma3;
 }
 
+void print_unscored_criteria(std::ostream& out, int64_t divergence_step, int64_t steps_planned,
+                             const Criteria& c, bool rms) {
+  out << "  criteria not scored: the run diverged";
+  if (divergence_step >= 0) out << " at step " << divergence_step << " of " << steps_planned;
+  out << ", after " << c.points << (c.points == 1 ? " monitoring point" : " monitoring points");
+  if (rms)
+    out << " (over them: lateral force balance RMS " << c.force_balance_xx_rms << ", servo RMS "
+        << c.servo_rms << ")";
+  out << "\n";
+}
+
 }  // namespace demcal::cli

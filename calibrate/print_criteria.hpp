@@ -2,6 +2,7 @@
 // `demcal run` and `demcal score` share.
 #pragma once
 
+#include <cstdint>
 #include <optional>
 #include <ostream>
 
@@ -22,5 +23,14 @@ void print_triaxial_criteria(std::ostream& out, const TriaxialCriteria& c, const
 /// close.
 void print_peak(std::ostream& out, bool three_d, double peak, std::optional<double> strain,
                 double sigma3);
+
+/// A diverged run's criteria are not scored (its verdict is FAIL whatever
+/// they read): the trend ones (force balance, servo) need a window of
+/// monitoring points it did not reach and read 0, which printed as numbers
+/// would read as a perfect run's. One line instead (`demcal run`, `demcal
+/// score`); `rms` (2D) adds the RMS lateral force balance and servo error
+/// over the points it did reach, as a clue.
+void print_unscored_criteria(std::ostream& out, int64_t divergence_step, int64_t steps_planned,
+                             const Criteria& c, bool rms);
 
 }  // namespace demcal::cli

@@ -454,6 +454,17 @@ void expect_scores_as_the_run(const fs::path& out, const Result& run) {
     return std::string("no verdict line");
   };
   EXPECT_EQ(verdict(r.out), verdict(run.out));
+  // A diverged run's criteria are said to be unscored by both, in the same
+  // words, not printed as numbers (the trend ones read 0).
+  auto unscored = [](const std::string& out) {
+    for (const std::string& line : lines_of(out))
+      if (line.rfind("  criteria not scored: ", 0) == 0) return line;
+    return std::string("no such line");
+  };
+  if (ran.at("diverged").get<bool>()) {
+    EXPECT_EQ(unscored(r.out), unscored(run.out)) << r.out;
+    EXPECT_EQ(r.out.find("  force balance "), std::string::npos) << r.out;
+  }
 }
 
 // The run's series.csv carries what the run was scored with (σ3, Nstep,
