@@ -107,7 +107,7 @@ nlohmann::json resume_key(const SceneConfig& config, const Strategy strategy) {
                      {"accuracy", config.calibration.accuracy},
                      {"strategy", to_string(strategy)}};
   if (config.assembly.type == "file")
-    add_file_digest(key, "assembly_file_sha256", config.assembly.file);
+    add_file_digest(key, "assembly_file_sha256", config, "assembly.file", config.assembly.file);
   add_build(key);
   return key;
 }

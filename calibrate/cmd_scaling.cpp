@@ -38,7 +38,8 @@ int cmd_scaling(const ScalingOptions& o) {
   nlohmann::json key{{"schema", "demcal.scaling-resume/1"},
                      {"config_sha256", sha256_hex(config.text)},
                      {"max_trials", config.calibration.max_trials}};
-  add_file_digest(key, "family_file_sha256", scaling_family_file(config));
+  const FamilyFile family = scaling_family_file(config);
+  add_file_digest(key, "family_file_sha256", config, family.key, family.path);
   add_build(key);
   std::error_code ec;
   const bool reuse = o.resume && std::filesystem::exists(so.work_dir, ec);

@@ -16,7 +16,8 @@ class App;
 
 namespace demcal::cli {
 
-/// From this many particles a run steps on every core: the kernels' two
+/// From this many particles `export`'s consolidation and 3D `verify`'s
+/// loading step on every core: the kernels' two
 /// threads break even near 10^4 disks (reports/performance.md, "Threads":
 /// 1.78x at 10^4 on an idle machine) and lose below, more so on a loaded
 /// machine, where a worker spinning at a barrier is preempted (a 256-sphere

@@ -47,7 +47,9 @@ void print_unscored_criteria(std::ostream& out, int64_t divergence_step, int64_t
                              const Criteria& c, bool rms) {
   out << "  criteria not scored: the run diverged";
   if (divergence_step >= 0) out << " at step " << divergence_step << " of " << steps_planned;
-  out << ", after " << c.points << (c.points == 1 ? " monitoring point" : " monitoring points");
+  // c.points leaves out the consolidated start (a series' first row).
+  out << ", " << c.points << (c.points == 1 ? " monitoring point" : " monitoring points")
+      << " after the start";
   if (rms)
     out << " (over them: lateral force balance RMS " << c.force_balance_xx_rms << ", servo RMS "
         << c.servo_rms << ")";

@@ -15,8 +15,11 @@ void add_build(nlohmann::json& key) {
   key["program_sha256"] = program_digest();
 }
 
-void add_file_digest(nlohmann::json& key, const std::string& name, const std::string& path) {
-  if (!path.empty()) key[name] = sha256_hex(read_text_file(path));
+void add_file_digest(nlohmann::json& key, const std::string& name, const SceneConfig& config,
+                     const std::string& field, const std::string& path) {
+  if (path.empty()) return;
+  require_config_file(config, field, path);
+  key[name] = sha256_hex(read_text_file(path));
 }
 
 void write_resume_key(const std::string& dir, const nlohmann::json& key) {

@@ -6,6 +6,8 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "demcal/scene/config.hpp"
+
 namespace demcal::cli {
 
 /// The build's part of every key: demcal's version and the SHA-256 of the
@@ -15,8 +17,10 @@ void add_build(nlohmann::json& key);
 
 /// A particle file's part of a key: the SHA-256 of its contents under
 /// `name` (nothing for an empty path). The config's text names a file, not
-/// what it holds: edited under the same name, it makes other trials.
-void add_file_digest(nlohmann::json& key, const std::string& name, const std::string& path);
+/// what it holds: edited under the same name, it makes other trials. A file
+/// that cannot be read is the config's error at `field` (require_config_file).
+void add_file_digest(nlohmann::json& key, const std::string& name, const SceneConfig& config,
+                     const std::string& field, const std::string& path);
 
 /// The key written to DIR/resume.json at a fresh start.
 void write_resume_key(const std::string& dir, const nlohmann::json& key);

@@ -47,9 +47,9 @@ struct VerifyOptions : UpscaledParamsOptions {
   /// (under mpirun -np `np` when np > 1) and score its series.
   std::string engine = "demcal";
   int np = 1;
-  /// Threads for the 3D prototype's loading run (0: the faster of one and
-  /// all cores, measured on the prototype; results are bit-identical for
-  /// any count).
+  /// Threads for the 3D prototype's loading run (0: one below kThreadsFrom
+  /// spheres, else the faster of one and all cores, measured on the
+  /// prototype; results are bit-identical for any count).
   int threads = 0;
 };
 int cmd_verify(const VerifyOptions& options);

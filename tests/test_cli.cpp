@@ -331,6 +331,12 @@ TEST_F(CliEndToEnd, AMissingParticleFileNamesTheConfigAndKey) {
   expect_bad_input({"check", config}, {config + ": assembly.file: \"" + csv + "\": no such file"});
   expect_bad_input({"run", config, "-o", out},
                    {config + ": assembly.file: \"" + csv + "\": no such file"});
+  // calibrate keys its resume file on the file's contents, before anything
+  // else reads it; scaling cuts its family from it.
+  expect_bad_input({"calibrate", config, "-o", out},
+                   {config + ": assembly.file: \"" + csv + "\": no such file"});
+  expect_bad_input({"scaling", config, "--sizes", "12,24", "-o", out},
+                   {config + ": assembly.file: \"" + csv + "\": no such file"});
   const std::string spheres = write(
       "gone3d.json", "{" + test::kMaterialMember +
                          R"(, "dimension": 3, "assembly": {"type": "file", "file": "gone.csv"},

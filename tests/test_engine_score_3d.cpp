@@ -78,6 +78,37 @@ TEST(ExternalSeries3d, DemcalsOwnSeriesScoresAsTheRun) {
   }
 }
 
+// The combined record holds combined values under the 2D names (xx lateral,
+// yy axial, shear off-diagonal), never one plane's alone: the x walls'
+// oscillation_xx read as the sample's; and the planes' off-diagonal gaps
+// (force_balance_xy/_yx: b_xz − σ_xz in the xz plane) are not written under
+// the combined names at all.
+TEST(TriaxialCriteria, TheCombinedRecordCombinesThePlanes) {
+  const SceneConfig c = fcc3();
+  const TriaxialResult run = fcc3_run(2000);
+  const TriaxialCriteria t = compute_triaxial_criteria(run.series, c.test.lateral_stress);
+  const Criteria &m = t.combined, &xz = t.xz, &yz = t.yz, &xy = t.xy;
+  EXPECT_EQ(m.oscillation_xx, std::max(xz.oscillation_xx, yz.oscillation_xx));
+  EXPECT_EQ(m.oscillation_yy, std::max(xz.oscillation_yy, yz.oscillation_yy));
+  EXPECT_EQ(m.oscillation_shear,
+            std::max({xz.oscillation_shear, yz.oscillation_shear, xy.oscillation_shear}));
+  EXPECT_EQ(m.force_balance_xx_rms, std::max(xz.force_balance_xx_rms, yz.force_balance_xx_rms));
+  EXPECT_EQ(m.servo_rms, std::max(xz.servo_rms, yz.servo_rms));
+  EXPECT_EQ(m.servo_noise, std::max(xz.servo_noise, yz.servo_noise));
+  EXPECT_EQ(m.moment_balance_trend,
+            std::max({xz.moment_balance_trend, yz.moment_balance_trend, xy.moment_balance_trend}));
+  // The two lateral planes differ in this run (else max() proves nothing).
+  EXPECT_NE(xz.oscillation_xx, yz.oscillation_xx);
+  EXPECT_FALSE(m.available("force_balance_xy"));
+  EXPECT_FALSE(m.available("force_balance_yx"));
+  EXPECT_TRUE(xz.available("force_balance_xy"));
+  const nlohmann::json j = to_json(scored_criteria(t, Tolerances{}));
+  EXPECT_FALSE(j.contains("force_balance_xy"));
+  EXPECT_TRUE(j.at("not_available").contains("force_balance_xy"));
+  // Not a criterion: the verdict says nothing went unchecked.
+  EXPECT_TRUE(score_triaxial_run(run, c.test.lateral_stress, Tolerances{}).not_checked.empty());
+}
+
 TEST(ExternalSeries3d, ServoErrorsComeFromThePressuresWhenNotGiven) {
   std::string csv = "# lateral_stress = 100000\n# steps = 10\nstep,strain_zz";
   for (const char* t : {"b_", "s_"})

@@ -540,7 +540,6 @@ SceneConfig load_config(const std::string& path, const std::vector<std::string>&
   nlohmann::json j = parse_config_json(text, source);
   SceneConfig config = parse_config_with_overrides(j, sets, source);
   config.text = sets.empty() ? text : j.dump();
-  config.sets = sets;
   return config;
 }
 
@@ -548,7 +547,9 @@ SceneConfig parse_config_with_overrides(nlohmann::json& j, const std::vector<std
                                         const std::string& source) {
   apply_overrides(j, sets);
   try {
-    return parse_config(j, source);
+    SceneConfig config = parse_config(j, source);
+    config.sets = sets;  // for errors found later (source_of)
+    return config;
   } catch (const InputError& e) {
     // A value a --set gave is the --set's fault, not the file's: the error
     // names it (a check across keys still names the file).

@@ -503,7 +503,10 @@ nlohmann::json external_summary(const ExternalSeries& series, const ExternalScor
       {"diverged", diverged},
       {"verdict_line", score_verdict(series, score)}};
   if (!s.not_checked.empty()) j["not_checked"] = s.not_checked;
-  if (score.planes) j["criteria_planes"] = to_json(*score.planes);
+  if (score.planes) {
+    j["criteria_planes"] = to_json(*score.planes);
+    j["axial_component"] = kTriaxialCriteriaNames;
+  }
   j["moment_balance_source"] = series.torque_column
                                    ? "torque_stress (the engine's net contact torques / V)"
                                    : "s_xy - s_yx as written";

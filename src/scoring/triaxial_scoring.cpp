@@ -107,8 +107,26 @@ TriaxialCriteria compute_triaxial_criteria(const std::vector<TriaxialPoint>& ser
 
   Criteria& m = c.combined;
   m = c.xz;  // peak, energies and the other codes' measures: the same series
+  // Every measure a plane gives is combined over the planes that have it,
+  // in the 2D names (xx lateral, yy axial, shear the plane's off-diagonal):
+  // a plane's value alone under the combined record's name read as the
+  // whole sample's (oscillation_xx was the x walls' only). The off-diagonal
+  // gaps themselves (a plane's force_balance_xy/_yx: b_xz − σ_xz and b_zx −
+  // σ_zx in the xz plane) have no combined meaning under those names: they
+  // are the planes' own (criteria_planes).
   m.force_balance_xx = std::max(c.xz.force_balance_xx, c.yz.force_balance_xx);
   m.force_balance_yy = std::max(c.xz.force_balance_yy, c.yz.force_balance_yy);
+  m.force_balance_xx_rms = std::max(c.xz.force_balance_xx_rms, c.yz.force_balance_xx_rms);
+  for (const char* key : {"force_balance_xy", "force_balance_yx"})
+    m.not_available.emplace(key, "3D: each plane's off-diagonal gaps, in criteria_planes");
+  m.oscillation_xx = std::max(c.xz.oscillation_xx, c.yz.oscillation_xx);
+  m.oscillation_yy = std::max(c.xz.oscillation_yy, c.yz.oscillation_yy);
+  m.oscillation_shear =
+      std::max({c.xz.oscillation_shear, c.yz.oscillation_shear, c.xy.oscillation_shear});
+  m.servo_rms = std::max(c.xz.servo_rms, c.yz.servo_rms);
+  m.servo_noise = std::max(c.xz.servo_noise, c.yz.servo_noise);
+  m.moment_balance_trend =
+      std::max({c.xz.moment_balance_trend, c.yz.moment_balance_trend, c.xy.moment_balance_trend});
   m.force_balance_shear =
       std::max({c.xz.force_balance_shear, c.yz.force_balance_shear, c.xy.force_balance_shear});
   m.force_balance = std::max({m.force_balance_xx, m.force_balance_yy, m.force_balance_shear});
@@ -256,6 +274,11 @@ const char* const kTriaxialVerdictNote =
     "converged one (reports/atlas-3d.md); `demcal calibrate` also certifies its answer with "
     "Nstep halved and doubled";
 
+const char* const kTriaxialCriteriaNames =
+    "criteria keep the 2D names: *_xx the lateral axes (the larger of x and y), *_yy the axial "
+    "z (peak_stress_yy, and a certificate's peak_stress_yy*, hold the axial b_zz), *_shear the "
+    "largest off-diagonal; each plane's own values are a run's criteria_planes (summary.json)";
+
 nlohmann::json triaxial_run_summary(const SceneConfig& config, const TriaxialState& state,
                                     const TriaxialResult& run, const TriaxialCriteria& c,
                                     const Score& score, const Tolerances& t) {
@@ -268,6 +291,7 @@ nlohmann::json triaxial_run_summary(const SceneConfig& config, const TriaxialSta
          {"test", "triaxial"},
          {"criteria", to_json(score.criteria)},
          {"criteria_planes", to_json(c)},
+         {"axial_component", kTriaxialCriteriaNames},
          {"tolerances", to_json(t)},
          // The 2D summary's keys (and `demcal score`'s): a script reads a
          // run of either dimension the same way.

@@ -412,7 +412,7 @@ class Evaluator {
       if (!options_.trials_path.empty()) append_line_durable(options_.trials_path, line);
       unsettled_.push_back({key, r, line});
       // Counted as they finish, as the trial numbers are: with jobs > 1 the
-      // trial asked for fourth can finish third ("trial 3 (search 3/12)").
+      // trial asked for fourth can finish third ("trial 2 (search 3/12)").
       const int search_done = phase == TrialPhase::search ? ++search_finished_ : 0;
       if (options_.progress) {
         std::ostringstream s;

@@ -8,6 +8,7 @@
 #include "demcal/io/quoted_json.hpp"
 #include "demcal/scene/triaxial.hpp"
 #include "demcal/scoring/trial.hpp"
+#include "demcal/scoring/triaxial_scoring.hpp"
 #include "demcal/upscaling/upscaling.hpp"
 
 namespace demcal {
@@ -165,9 +166,7 @@ nlohmann::json params_file(const SceneConfig& config, const TriaxialState& state
     without_parameters(params);
     params["upscaling"] = upscaling_block(n_rev, n_rev, law);
   }
-  params["axial_component"] =
-      "criteria.peak_stress_yy and certificate.peak_stress_yy* hold the axial b_zz (the triaxial "
-      "test's axis is z)";
+  params["axial_component"] = kTriaxialCriteriaNames;
   if (auto a = analytical_peak_ratio_3d(config))
     params["analytical_peak_stress_yy"] = -*a * config.test.lateral_stress;
   return params;

@@ -126,9 +126,10 @@ Spread spread_of(const std::vector<double>& v) {
   return s;
 }
 
-std::string scaling_family_file(const SceneConfig& config) {
-  if (config.assembly.type != "file" || config.dimension == 3) return "";
-  return config.prototype.file.empty() ? config.assembly.file : config.prototype.file;
+FamilyFile scaling_family_file(const SceneConfig& config) {
+  if (config.assembly.type != "file" || config.dimension == 3) return {};
+  if (config.prototype.file.empty()) return {"assembly.file", config.assembly.file};
+  return {"prototype.file", config.prototype.file};
 }
 
 namespace {
@@ -168,7 +169,9 @@ class Family {
       throw InputError(config.source, "assembly.type",
                        "a 3D scaling study needs a generated family (fcc or random): REVs cut "
                        "from a sphere file are `demcal rev`'s");
-    file_prototype_ = read_particle_file(scaling_family_file(config));
+    const FamilyFile family = scaling_family_file(config);
+    require_config_file(config, family.key, family.path);
+    file_prototype_ = read_particle_file(family.path);
     if (file_prototype_.size() < o.sizes.back())
       throw InputError(
           "--sizes", "",

@@ -198,6 +198,7 @@ PrototypeSource prototype_source(const PrototypeChoice& choice, int64_t size,
 /// file (no generator to resize) a gas of radii drawn from that file.
 Assembly generated_disks(const SceneConfig& config, int64_t n, std::string& description) {
   if (config.assembly.type == "file") {
+    require_config_file(config, "assembly.file", config.assembly.file);
     const Assembly rev = read_particle_file(config.assembly.file);
     description = std::to_string(n) + " particles with radii drawn from " + config.assembly.file;
     return gas_of_radii(resample_radii(rev.r, n, config.calibration.seed), 1.0,
@@ -213,6 +214,7 @@ Assembly generated_disks(const SceneConfig& config, int64_t n, std::string& desc
 /// `n` spheres, likewise (an fcc generator names its cells).
 SphereAssembly generated_spheres(const SceneConfig& config, int64_t n, std::string& description) {
   if (config.assembly.type == "file") {
+    require_config_file(config, "assembly.file", config.assembly.file);
     SphereAssembly a =
         generate_rev(read_sphere_file(config.assembly.file), n, config.calibration.seed);
     description =
@@ -243,9 +245,11 @@ auto chosen_prototype(const SceneConfig& config, int64_t particles, const std::s
   const PrototypeChoice choice = choose_prototype(config, particles, file);
   std::string generated;
   decltype(make(config)) a;
-  if (choice.kind == PrototypeChoice::kFile)
+  if (choice.kind == PrototypeChoice::kFile) {
+    // Not --prototype's (its own name says which file): the config's.
+    if (file.empty()) require_config_file(config, "prototype.file", choice.file);
     a = read(choice.file);
-  else if (choice.kind == PrototypeChoice::kCount)
+  } else if (choice.kind == PrototypeChoice::kCount)
     a = generate(config, choice.particles, generated);
   else
     a = make(config);

@@ -148,6 +148,11 @@ class TriaxialEarlyFailure {
 /// What `demcal run` says of a 3D verdict: the 3D tolerances and what they hold.
 extern const char* const kTriaxialVerdictNote;
 
+/// How a 3D record's "criteria" read (key "axial_component" of summary.json,
+/// params.json and verify.json): the 2D names, xx the lateral axes, yy the
+/// axial z, shear the off-diagonals, each combined over the planes.
+extern const char* const kTriaxialCriteriaNames;
+
 /// summary.json of a triaxial run (`demcal run` on a 3D config): "criteria"
 /// and the verdict are the Score's (score_triaxial_run(run, c, t): the
 /// criteria judged, as `demcal score` writes them for the run's series),

@@ -118,11 +118,15 @@ struct ScalingStudy {
 /// InputError naming --sizes; run_scaling_study() checks it first.
 void check_scaling_sizes(const ScalingStudyOptions& options);
 
-/// The particle file a scaling study cuts its family of REVs from: the
-/// prototype's file, else the assembly's, when assembly.type is "file" in
-/// 2D; "" for a generated family (and in 3D, where the study refuses a
-/// file: run_scaling_study says why).
-std::string scaling_family_file(const SceneConfig& config);
+/// The particle file a scaling study cuts its family of REVs from (path)
+/// and the config key naming it (key): the prototype's file, else the
+/// assembly's, when assembly.type is "file" in 2D; both "" for a generated
+/// family (and in 3D, where the study refuses a file: run_scaling_study
+/// says why).
+struct FamilyFile {
+  std::string key, path;
+};
+FamilyFile scaling_family_file(const SceneConfig& config);
 
 /// Run the study on the family of `config` (resized generators, or REVs cut
 /// from the prototype file for a 2D file assembly); 2D and 3D configs run
