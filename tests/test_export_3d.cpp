@@ -187,6 +187,64 @@ TEST(Export3d, LiggghtsDeckHasSixWallsAndTheServo) {
   EXPECT_EQ(r.deck.find("dimension 2"), std::string::npos);
 }
 
+// The series' header gives what the diagnosis of `demcal score` reads of
+// the run's parameters, as the 2D decks' does (one function writes every
+// deck's: deck::lammps_series_header): dt_crit, the lightest sphere's at
+// the mass scaling (with dt, the step ratio the deck runs, alpha*f), and
+// the mass scaling. A series with a smooth lateral gap b_xx - s_xx of
+// 4 % of sigma3 (6 times the tolerance) and its walls on target, loaded
+// at alpha 0.05, is then blamed on the small step (increase dt_ratio), as
+// in 2D; without dt_crit (the 3D decks before 2026-12-04) the step ratio
+// was not known and the same series read "increase steps".
+TEST(Export3d, TheSeriesHeaderGivesTheStepRatioAndTheMassScaling) {
+  const SceneConfig c = fcc444();
+  const double s3 = c.test.lateral_stress;
+  AlgorithmSpec p = fixed_params();
+  p.dt_ratio = 0.05;
+  p.mass_scaling = 2.0;
+  const double dt_crit = critical_time_step(
+      sphere_mass(p.mass_scaling * c.material.density, fcc_state().world.min_radius()),
+      c.material.particle.kn);
+  for (const char* format : {"lammps", "liggghts"}) {
+    Export3dOptions o;
+    o.format = format;
+    o.data_name = "fcc.data";
+    const ExportResult r = export_3d_decks(c, p, fcc_state(), o);
+    const std::string header = test::deck_series_header(r.deck);
+    std::ostringstream csv;
+    csv << header << "step,strain_zz";
+    const char* axis = "xyz";
+    for (const char* t : {"b_", "s_"})
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) csv << "," << t << axis[i] << axis[j];
+    csv << ",servo_error_xmin,servo_error_xmax,servo_error_ymin,servo_error_ymax\n";
+    for (int k = 0; k <= 40; ++k) {
+      const double diag[3] = {-s3, -s3, -s3 * (1.0 + 0.01 * k)};
+      csv << r.steps * k / 40 << "," << -1e-4 * k;
+      for (int t = 0; t < 2; ++t)
+        for (int i = 0; i < 3; ++i)
+          for (int j = 0; j < 3; ++j)
+            csv << "," << (i == j ? diag[i] + (t == 1 && i == 0 ? 0.04 * s3 : 0.0) : 0.0);
+      csv << ",0,0,0,0\n";
+    }
+    const ExternalSeries s = parse_external_series(csv.str(), format);
+    ASSERT_EQ(s.dimension, 3);
+    ASSERT_EQ(s.meta.count("dt_crit"), 1u) << format << "\n" << header;
+    EXPECT_NEAR(std::stod(s.meta.at("dt_crit")) / dt_crit, 1.0, 1e-9) << format;
+    EXPECT_EQ(s.meta.count("mass_scaling"), 1u) << format;
+    ASSERT_TRUE(s.parameters.dt_ratio.has_value()) << format;
+    EXPECT_NEAR(*s.parameters.dt_ratio / (p.dt_ratio * r.step_factor), 1.0, 1e-9) << format;
+    ASSERT_TRUE(s.parameters.mass_scaling.has_value()) << format;
+    EXPECT_EQ(*s.parameters.mass_scaling, p.mass_scaling) << format;
+    const ExternalScore scored = score_external(s, triaxial_tolerances());
+    EXPECT_TRUE(scored.score.complete) << format;
+    EXPECT_FALSE(scored.score.passed) << format;
+    EXPECT_EQ(scored.score.diagnosis.parameter, "dt")
+        << format << ": " << scored.score.diagnosis.message;
+    EXPECT_EQ(scored.score.diagnosis.direction, "increase") << format;
+  }
+}
+
 TEST(Export3d, TheLoadingServosGainIsDemcalsWithTheWallDashpots) {
   // demcal's 3D servo divides by R = kn_wall + c/Δt with contact damping
   // (c = 2ζ_c·sqrt(kn_wall·m_max), the heaviest sphere's at the mass
@@ -439,6 +497,13 @@ void check_lammps(int np, int64_t steps) {
   EXPECT_EQ(external.triaxial.particles, fcc_state().world.size());
   EXPECT_EQ(external.triaxial.steps_planned, r.steps);
   ASSERT_EQ(external.triaxial.series.size(), l.rows.size());
+  // The parameters the diagnosis reads, from the header LAMMPS wrote: the
+  // step ratio the deck runs (alpha*f: ${dt} to 15 digits, dt_crit to 10)
+  // and the mass scaling, as in 2D.
+  ASSERT_TRUE(external.parameters.dt_ratio.has_value());
+  EXPECT_NEAR(*external.parameters.dt_ratio / (p.dt_ratio * r.step_factor), 1.0, 1e-9);
+  ASSERT_TRUE(external.parameters.mass_scaling.has_value());
+  EXPECT_EQ(*external.parameters.mass_scaling, p.mass_scaling);
   const ExternalScore theirs = score_external(external, Tolerances{});
   const Score ours = score_triaxial_run(d.result, c.test.lateral_stress, Tolerances{});
   const Criteria &t = theirs.score.criteria, &m = ours.criteria;
@@ -853,6 +918,13 @@ TEST(Export3dLiggghts, PeakAgainstDemcal) {
   EXPECT_NEAR(peak_ratio / d.result.peak_ratio, 1.0, 0.01);
   // The servo held the lateral force (σ3·A0: within the strain of σ3).
   EXPECT_NEAR(last_lateral / fcc444().test.lateral_stress, 1.0, 0.005);
+  // The parameters the diagnosis of `demcal score` reads, from the header
+  // LIGGGHTS wrote: the deck's step ratio alpha*f and the mass scaling.
+  const ExternalSeries external = parse_external_series(g.csv, "series.csv");
+  ASSERT_TRUE(external.parameters.dt_ratio.has_value());
+  EXPECT_NEAR(*external.parameters.dt_ratio / (fixed_params().dt_ratio * r.step_factor), 1.0, 1e-9);
+  ASSERT_TRUE(external.parameters.mass_scaling.has_value());
+  EXPECT_EQ(*external.parameters.mass_scaling, fixed_params().mass_scaling);
 }
 
 TEST(Export3dLiggghts, TheDecksContactDashpotsGiveDemcalsRestitution) {

@@ -322,8 +322,8 @@ std::string lammps_servo_clamp(const std::string& x, const std::string& cap) {
 }
 
 std::string lammps_series_header(const std::string& deck, const std::string& scene, int particles,
-                                 double zeta_t, std::optional<double> dt_crit,
-                                 std::optional<double> mass_scaling, const std::string& lever_arm) {
+                                 double zeta_t, double dt_crit, double mass_scaling,
+                                 const std::string& lever_arm) {
   SeriesMetadata m;
   m.writer = deck;
   m.scene = scene;
@@ -331,10 +331,10 @@ std::string lammps_series_header(const std::string& deck, const std::string& sce
   m.lateral_stress = "${sigma3}";
   m.steps = "${nstep}";
   m.dt = "${dt}";
-  if (dt_crit) m.dt_crit = num(*dt_crit);
+  m.dt_crit = num(dt_crit);
   m.damping_ratio_translation = num(zeta_t);
   m.damping_ratio_rotation = "0";
-  if (mass_scaling) m.mass_scaling = num(*mass_scaling);
+  m.mass_scaling = num(mass_scaling);
   m.moment_lever_arm = lever_arm;
   // The first line starts the file, the others are appended to it.
   std::string out;
@@ -732,9 +732,8 @@ std::string liggghts_translational_damping(double zeta_t, const std::vector<doub
 }
 
 std::string liggghts_series(const std::string& deck, const std::string& scene, int particles,
-                            double zeta_t, std::optional<double> dt_crit,
-                            std::optional<double> mass_scaling, int every, const std::string& row,
-                            const std::string& columns) {
+                            double zeta_t, double dt_crit, double mass_scaling, int every,
+                            const std::string& row, const std::string& columns) {
   std::ostringstream s;
   s << lammps_series_header(deck, scene, particles, zeta_t, dt_crit, mass_scaling,
                             "radius - overlap/2")

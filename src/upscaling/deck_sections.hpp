@@ -6,7 +6,6 @@
 #pragma once
 
 #include <cstdint>
-#include <optional>
 #include <string>
 #include <vector>
 
@@ -230,12 +229,15 @@ std::string lammps_band(const std::string& name, const std::string& motion,
 /// LAMMPS: the series file's header (print lines of SeriesMetadata's
 /// lines, scene/run_output.hpp), what `demcal score`
 /// reads about the run: the deck (`deck`, e.g. "LAMMPS 3D deck"), scene,
-/// particles, sigma3, Nstep, dt, dt_crit (when given), the damping ratios
-/// applied (zeta_r 0: no rotational fix), f_ms (when given), the lever arm
-/// the engine applies a contact's tangential force at (LAMMPS: r_i).
+/// particles, sigma3, Nstep, dt, dt_crit (the lightest particle's, at the
+/// mass scaling), the damping ratios applied (zeta_r 0: no rotational
+/// fix), f_ms, the lever arm the engine applies a contact's tangential
+/// force at (LAMMPS: r_i). Every deck, 2D and 3D, gives dt_crit and f_ms:
+/// without them the diagnosis of `demcal score` does not know the time-step
+/// ratio dt/dt_crit (the deck's alpha*f) nor the mass scaling, and cannot
+/// blame a small step or heavy masses (scoring.cpp, diagnose).
 std::string lammps_series_header(const std::string& deck, const std::string& scene, int particles,
-                                 double zeta_t, std::optional<double> dt_crit,
-                                 std::optional<double> mass_scaling,
+                                 double zeta_t, double dt_crit, double mass_scaling,
                                  const std::string& lever_arm = "radius");
 
 /// Stage 1 of a deck that consolidates itself (LAMMPS; export.cpp in 2D,
@@ -382,9 +384,8 @@ std::string liggghts_translational_damping(double zeta_t, const std::vector<doub
 /// and the start's row, which LIGGGHTS 3.8's fix print does not write at
 /// setup, printed after a `run 0`.
 std::string liggghts_series(const std::string& deck, const std::string& scene, int particles,
-                            double zeta_t, std::optional<double> dt_crit,
-                            std::optional<double> mass_scaling, int every, const std::string& row,
-                            const std::string& columns);
+                            double zeta_t, double dt_crit, double mass_scaling, int every,
+                            const std::string& row, const std::string& columns);
 
 /// LIGGGHTS: a lateral servo mesh (fix mesh/surface/stress/servo) and
 /// what its gain is made of: `fix` its id, `target` its equal-style target

@@ -634,7 +634,7 @@ void lammps_3d_series(std::ostream& s, const SceneConfig& c, const AlgorithmSpec
     << "# before the servo's fix ave/time, so that at each step they see the walls\n"
     << "# where the forces were computed (the servo's running mean updates after).\n"
     << deck::lammps_series_header("LAMMPS 3D deck", c.name, plan.n, p.damping_ratio_translation,
-                                  std::nullopt, std::nullopt)
+                                  plan.dt_crit, p.mass_scaling)
     << "fix             series all print ${monitor_every} \"" << row
     << "\" append ${series} screen no title \"" << columns << "\"\n"
     << "# the peaks over every peak_every steps: axial pressure and sigma1/sigma3\n"
@@ -889,7 +889,7 @@ std::string liggghts_3d_series(const SceneConfig& c, const AlgorithmSpec& p, con
   row += series_row_tail_3d("_s");
   const std::string columns = series_columns_3d();
   s << deck::liggghts_series("LIGGGHTS 3D deck", c.name, plan.n, p.damping_ratio_translation,
-                             std::nullopt, std::nullopt, monitor_every, row, columns);
+                             plan.dt_crit, p.mass_scaling, monitor_every, row, columns);
   return s.str();
 }
 

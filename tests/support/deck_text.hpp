@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 #include <string>
 
@@ -32,6 +33,42 @@ inline double deck_variable(const std::string& deck, const std::string& name) {
       return v;
   }
   return std::nan("");
+}
+
+/// The header a deck's series file opens with, as the engine writes it
+/// (demcal score's metadata; upscaling/deck_sections.hpp,
+/// lammps_series_header): the text of the print line that starts the file
+/// (`print "..." file ${series} ...`) and of the `print "..." append
+/// ${series}` lines right after it, each `${NAME}` in them replaced by the
+/// deck's `variable NAME equal NUMBER` (%.17g; a test fails on one it
+/// cannot resolve), one line each.
+inline std::string deck_series_header(const std::string& deck) {
+  std::istringstream lines(deck);
+  std::string out;
+  bool started = false;
+  for (std::string line; std::getline(lines, line);) {
+    const bool starts = line.find("\" file ${series} ") != std::string::npos;
+    const bool appends = line.find("\" append ${series} ") != std::string::npos;
+    if (line.rfind("print", 0) != 0 || !(started ? appends : starts)) {
+      if (started) break;
+      continue;
+    }
+    started = true;
+    const auto open = line.find('"'), close = line.rfind('"');
+    std::string text = line.substr(open + 1, close - open - 1);
+    for (auto at = text.find("${"); at != std::string::npos; at = text.find("${", at)) {
+      const auto end = text.find('}', at);
+      const std::string name = text.substr(at + 2, end - at - 2);
+      const double v = deck_variable(deck, name);
+      EXPECT_FALSE(std::isnan(v)) << "${" << name << "} in " << line;
+      char number[32];
+      std::snprintf(number, sizeof number, "%.17g", v);
+      text.replace(at, end + 1 - at, number);
+    }
+    out += text + "\n";
+  }
+  EXPECT_TRUE(started) << "no print line starts the series file";
+  return out;
 }
 
 }  // namespace demcal::test
