@@ -63,15 +63,20 @@ void require_stable_step(const SceneConfig& config, double stable, bool allow_un
 
 namespace {
 
-/// "3000 steps"; a run that did not run them all: "143 of 3000 steps
-/// (diverged)".
+/// "3000 steps"; a run that stopped short: "143 of 3000 steps"; a diverged
+/// one in the words of its other lines (divergence_words), with the steps
+/// it completed: "diverged at step 144 of 3000 (143 steps completed)".
 template <class Point>
 std::string steps_words(const LoadingRun<Point>& run) {
   std::ostringstream s;
+  if (run.diverged) {
+    s << divergence_words(run.divergence_step, run.steps_planned) << " (" << run.steps_run
+      << (run.steps_run == 1 ? " step" : " steps") << " completed)";
+    return s.str();
+  }
   s << run.steps_run;
-  if (run.diverged || run.steps_run != run.steps_planned) s << " of " << run.steps_planned;
+  if (run.steps_run != run.steps_planned) s << " of " << run.steps_planned;
   s << " steps";
-  if (run.diverged) s << " (diverged)";
   return s.str();
 }
 

@@ -225,6 +225,20 @@ TEST_F(Cli3D, CheckPrintsTheSphereScales) {
   EXPECT_TRUE(work_empty());
 }
 
+// A diverged 3D run is told as a 2D one: its headline, criteria line and
+// last line name the step that diverged in the same words, the headline
+// also the steps completed before it.
+TEST_F(Cli3D, DivergedRunNamesTheStepThatDivergedOnce) {
+  const std::string config = write("fcc2.json", fcc_config());
+  const fs::path out = dir_ / "work" / "out";
+  const test::RunResult r =
+      demcal({"run", config, "--allow-unstable", "--set", "algorithm.dt_ratio=2", "--set",
+              "algorithm.damping_ratio_translation=0", "--set",
+              "algorithm.damping_ratio_rotation=0", "-o", out.string()});
+  ASSERT_EQ(r.status, 1) << r.err;
+  test::expect_one_divergence_numbering(r.out, out, 4000);
+}
+
 TEST_F(Cli3D, MismatchesAndUnsupportedCommandsAreBadInput) {
   struct Case {
     std::vector<std::string> args;
