@@ -668,4 +668,50 @@ TEST_F(CliEndToEnd, DivergedRunIsReportedNotFatal) {
   expect_scores_as_the_run(out, r);
 }
 
+// `demcal export` says how the deck's Nstep was upscaled, 2D and 3D in
+// one line: the prototype's Nstep (the one `demcal upscale` writes), from
+// the REV's particles and steps, by which law (the 2D export said nothing).
+TEST_F(CliEndToEnd, ExportSaysHowItsStepsWereUpscaledIn2dAnd3d) {
+  const fs::path reports = fs::path(test::kSourceDir) / "reports";
+  struct Case {
+    std::string params;
+    std::vector<std::string> extra;
+    const char* what;
+    const char* law;
+    const char* deck;
+  };
+  const std::vector<Case> cases = {{(reports / "example-hex_10x10" / "params.json").string(),
+                                    {},
+                                    "particles",
+                                    "linear",
+                                    "d2/deck.lammps"},
+                                   {(reports / "example-fcc_4x4x4" / "params.json").string(),
+                                    {"--config", test::shipped_config("random_500_3d")},
+                                    "spheres",
+                                    "power",
+                                    "d3/deck.lammps"}};
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.params);
+    std::vector<std::string> args = {"export",           c.params, "--particles", "150",
+                                     "--consolidate-in", "deck",   "-o",          c.deck};
+    args.insert(args.end(), c.extra.begin(), c.extra.end());
+    const Result r = demcal(args);
+    ASSERT_EQ(r.status, 0) << r.err;
+    std::vector<std::string> up = {"upscale", c.params, "--particles", "150"};
+    up.insert(up.end(), c.extra.begin(), c.extra.end());
+    const Result u = demcal(up);
+    ASSERT_EQ(u.status, 0) << u.err;
+    const auto upscaled = nlohmann::json::parse(u.out);
+    const auto rev = test::read_json(c.params).at("rev");
+    const std::string line =
+        "demcal export: " + std::to_string(upscaled.at("prototype").at("steps").get<int64_t>()) +
+        " steps upscaled from " + std::to_string(rev.at("particles").get<int64_t>()) + " " +
+        c.what + " / " + std::to_string(rev.at("steps").get<int64_t>()) + " steps (" + c.law +
+        " law, exponent ";
+    int said = 0;
+    for (const std::string& l : lines_of(r.err)) said += l.rfind(line, 0) == 0;
+    EXPECT_EQ(said, 1) << line << "\n" << r.err;
+  }
+}
+
 }  // namespace
