@@ -368,6 +368,7 @@ TEST_F(CliEndToEnd, RunWritesSummarySeriesAndVtk) {
             (std::set<std::string>{"summary.json", "series.csv", "final.vtk"}));
 
   const auto s = nlohmann::json::parse(read_text(out / "summary.json"));
+  EXPECT_EQ(s.at("schema"), "demcal.run/1");  // not a calibration's run.json
   EXPECT_EQ(s.at("particles"), 25);
   const double peak = s.at("criteria").at("peak_stress_yy").get<double>();
   EXPECT_NEAR(printed, peak, 1e-3 * std::abs(peak));  // printed to 4 digits
@@ -535,6 +536,14 @@ TEST_F(CliEndToEnd, CalibrateNamesWhatItWroteAndLeavesNoEarlierResult) {
   EXPECT_TRUE(named.count("resume.json")) << r.out;
   EXPECT_EQ(test::names_in(out), named) << r.out;
   EXPECT_FALSE(fs::exists(out / "final.vtk"));
+  // run.json is this invocation's record (wall time, jobs, trials), not a
+  // run's summary.json ("demcal.run/1"): its own schema (both said
+  // demcal.run/1 with different contents).
+  const auto record = test::read_json(out / "run.json");
+  EXPECT_EQ(record.at("schema"), "demcal.calibration-run/1");
+  for (const char* key : {"wall_time_s", "consolidation_wall_time_s", "consolidation_from_cache",
+                          "jobs", "trials_run", "trials_reused"})
+    EXPECT_TRUE(record.contains(key)) << key;
 
   // A final.vtk with no calibration's run.json beside it is a `demcal run`'s
   // (or the user's): a calibration does not write it in 2D, so it stays.

@@ -72,6 +72,7 @@ TEST_F(Cli3D, RunWritesSummaryNineComponentSeriesAndSphereVtk) {
             (std::set<std::string>{"summary.json", "series.csv", "final.vtk"}));
 
   const auto s = nlohmann::json::parse(read_text(out / "summary.json"));
+  EXPECT_EQ(s.at("schema"), "demcal.run/1");  // as a 2D run's, not a calibration's run.json
   EXPECT_EQ(s.at("dimension"), 3);
   EXPECT_EQ(s.at("particles"), 32);
   // Δt = 0.2·2·sqrt(m/kn), m = ρ(4/3)πr³ of a sphere.
