@@ -6,6 +6,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -675,6 +676,43 @@ TEST_F(CliEndToEnd, DivergedRunIsReportedNotFatal) {
   // Its series.csv (finite rows up to the divergence) scores as diverged,
   // with the run's diagnosis.
   expect_scores_as_the_run(out, r);
+}
+
+// A consolidated state read from the cache has the reading's wall time, not
+// the consolidation's: `check` (2D and 3D) and a 3D `run` say so ("read
+// from the cache in T s"; they printed "(T s, from the cache)", as if the
+// consolidation had taken T), a fresh one's line unchanged.
+TEST_F(CliEndToEnd, AConsolidationFromTheCacheIsSaidToBeRead) {
+  const std::string cache = "DEMCAL_CACHE_DIR=" + (dir_ / "cache").string();
+  auto line_of = [](const std::string& out, const std::string& start) {
+    for (const std::string& line : lines_of(out))
+      if (line.rfind(start, 0) == 0) return line;
+    return std::string("no line ") + start;
+  };
+  for (const std::string& config : {kHex5, test::shipped_config("fcc_4x4x4")}) {
+    SCOPED_TRACE(config);
+    const Result miss = demcal({"check", config}, {cache});
+    const Result hit = demcal({"check", config}, {cache});
+    ASSERT_EQ(miss.status, 0) << miss.err;
+    ASSERT_EQ(hit.status, 0) << hit.err;
+    const std::string fresh = line_of(miss.out, "  consolidated in ");
+    const std::string read = line_of(hit.out, "  consolidated in ");
+    const size_t open = fresh.find(" steps (");
+    ASSERT_NE(open, std::string::npos) << fresh;
+    // The same steps, then the fresh one's time, the cached one's reading.
+    const std::string steps = fresh.substr(0, open + 8);
+    EXPECT_EQ(fresh.find("cache"), std::string::npos) << fresh;
+    EXPECT_TRUE(std::isdigit(static_cast<unsigned char>(fresh[open + 8]))) << fresh;
+    EXPECT_EQ(read.rfind(steps + "read from the cache in ", 0), 0u) << read;
+    EXPECT_NE(read.find(" s), box "), std::string::npos) << read;
+  }
+  const Result run = demcal(
+      {"run", test::shipped_config("fcc_4x4x4"), "--set", "algorithm.steps=2000", "-o", "run3d"},
+      {cache});
+  ASSERT_NO_FATAL_FAILURE(test::expect_run_status(run.status, dir_ / "work" / "run3d", run.err));
+  EXPECT_NE(line_of(run.out, "  wall time ").find(" s (consolidation read from the cache in "),
+            std::string::npos)
+      << run.out;
 }
 
 // `demcal export` says how the deck's Nstep was upscaled, 2D and 3D in
