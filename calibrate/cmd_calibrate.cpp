@@ -78,10 +78,11 @@ std::string reproduce_command(const CalibrateOptions& o, const SceneConfig& conf
 }
 
 /// run.json: what varies between invocations (kept out of params.json).
+/// Its schema is its own: `demcal run`'s summary.json is "demcal.run/1".
 nlohmann::json run_record(double wall_time_s, const CalibrationSummary& summary,
                           double consolidation_wall_time_s, bool consolidation_from_cache, int jobs,
                           bool resumed) {
-  return {{"schema", "demcal.run/1"},
+  return {{"schema", "demcal.calibration-run/1"},
           {"wall_time_s", wall_time_s},
           {"calibration_wall_time_s", summary.wall_time_s},
           {"consolidation_wall_time_s", consolidation_wall_time_s},

@@ -179,6 +179,17 @@ ConsolidationOptions export_consolidation(const ExportCmdOptions& o, int particl
   return co;
 }
 
+/// The deck's Nstep and where it came from, 2D and 3D, on stderr: "demcal
+/// export: 2500 steps upscaled from 100 particles / 1000 steps (linear law,
+/// exponent 1: LAW'S SOURCE)"; nothing for the REV itself (nothing upscaled).
+void print_upscaled_steps(const PrototypeSource& source, const AlgorithmSpec& up,
+                          const RevParams& rev, const ScalingLaw& law, const char* what) {
+  if (source.kind == "rev") return;
+  std::cerr << "demcal export: " << up.steps << " steps upscaled from " << rev.particles << " "
+            << what << " / " << rev.params.steps << " steps (" << law.name() << " law, exponent "
+            << law.exponent << ": " << law.source << ")\n";
+}
+
 /// A 3D params.json: the deck of the prototype it names (--prototype FILE
 /// or --particles N override it; without any, the REV itself), Nstep
 /// upscaled by the scaling law (resolve_law: --exponent, --law, else
@@ -204,10 +215,7 @@ int export_3d(const ExportCmdOptions& o, const nlohmann::json& params, const Rev
   eo.provenance = o.params + " (REV " + std::to_string(rev.particles) + " spheres, " +
                   std::to_string(rev.params.steps) + " steps; " + law.name() + " law, exponent " +
                   std::to_string(law.exponent) + ")";
-  if (source.kind != "rev")
-    std::cerr << "demcal export: " << up.steps << " steps upscaled from " << rev.particles
-              << " spheres / " << rev.params.steps << " steps (" << law.name() << " law, exponent "
-              << law.exponent << ": " << law.source << ")\n";
+  print_upscaled_steps(source, up, rev, law, "spheres");
   if (eo.consolidate_in_deck) {
     const ExportResult r = export_3d_decks(config, up, proto, eo);
     write_deck(deck_fs, o, r, proto.size(), "spheres");
@@ -237,6 +245,7 @@ int cmd_export(const ExportCmdOptions& o) {
   Assembly proto = prototype_assembly(config, particles, file, &source);
   const AlgorithmSpec up = upscale(rev.params, rev.particles, proto.size(), law);
   print_prototype_notes("export", particles, rev.particles, proto.size(), law);
+  print_upscaled_steps(source, up, rev, law, "particles");
   eo.provenance = o.params + " (REV " + std::to_string(rev.particles) + " particles, " +
                   std::to_string(rev.params.steps) + " steps; " + law.name() + " law, exponent " +
                   std::to_string(law.exponent) + ")";

@@ -63,15 +63,20 @@ void require_stable_step(const SceneConfig& config, double stable, bool allow_un
 
 namespace {
 
-/// "3000 steps"; a run that did not run them all: "143 of 3000 steps
-/// (diverged)".
+/// "3000 steps"; a run that stopped short: "143 of 3000 steps"; a diverged
+/// one in the words of its other lines (divergence_words), with the steps
+/// it completed: "diverged at step 144 of 3000 (143 steps completed)".
 template <class Point>
 std::string steps_words(const LoadingRun<Point>& run) {
   std::ostringstream s;
+  if (run.diverged) {
+    s << divergence_words(run.divergence_step, run.steps_planned) << " (" << run.steps_run
+      << (run.steps_run == 1 ? " step" : " steps") << " completed)";
+    return s.str();
+  }
   s << run.steps_run;
-  if (run.diverged || run.steps_run != run.steps_planned) s << " of " << run.steps_planned;
+  if (run.steps_run != run.steps_planned) s << " of " << run.steps_planned;
   s << " steps";
-  if (run.diverged) s << " (diverged)";
   return s.str();
 }
 
@@ -127,9 +132,9 @@ int check_3d(const SceneConfig& config) {
   probe.update_forces();
   print_scales_3d(config, probe);
   const StabilityEstimate est = probe.stability_estimate();
-  std::cout << "  consolidated in " << state.steps << " steps (" << std::setprecision(3)
-            << state.wall_time_s << " s" << (state.from_cache ? ", from the cache" : "")
-            << "), box " << state.extent0[0] << " x " << state.extent0[1] << " x "
+  std::cout << "  consolidated in " << state.steps << " steps (" << std::setprecision(3);
+  print_consolidation_time(std::cout, state.wall_time_s, state.from_cache);
+  std::cout << "), box " << state.extent0[0] << " x " << state.extent0[1] << " x "
             << state.extent0[2] << " m\n";
   print_stable_steps(est);
   if (auto r = analytical_peak_ratio_3d(config))
@@ -182,9 +187,10 @@ int run_3d(const SceneConfig& config, const std::string& out_dir, bool allow_uns
               << (within ? "" : " (worst: " + summary["verdict"]["worst"].get<std::string>() + ")")
               << ". " << kTriaxialVerdictNote << "\n";
   std::cout << "  " << (within ? "PASS" : "FAIL") << ": " << score.diagnosis.message << "\n"
-            << "  wall time " << run.wall_time_s << " s (consolidation " << state.wall_time_s
-            << " s, " << state.steps << " steps" << (state.from_cache ? ", from the cache" : "")
-            << "), " << summary["particle_steps_per_s"].get<double>() << " particle-steps/s\n"
+            << "  wall time " << run.wall_time_s << " s (consolidation ";
+  print_consolidation_time(std::cout, state.wall_time_s, state.from_cache);
+  std::cout << ", " << state.steps << " steps), " << summary["particle_steps_per_s"].get<double>()
+            << " particle-steps/s\n"
             << "  wrote " << dir << "/summary.json, series.csv"
             << (config.output.vtk ? ", final.vtk" : "") << "\n";
   if (run.diverged)
@@ -205,9 +211,9 @@ int cmd_check(const std::string& path, const std::vector<std::string>& sets) {
   std::cout << "config " << config.source << ": valid\n";
   print_scales(config, state.world);
   const StabilityEstimate est = state.world.stability_estimate();
-  std::cout << "  consolidated in " << state.steps << " steps (" << std::setprecision(3)
-            << state.wall_time_s << " s" << (state.from_cache ? ", from the cache" : "")
-            << "), box " << state.width0 << " x " << state.height0 << " m\n";
+  std::cout << "  consolidated in " << state.steps << " steps (" << std::setprecision(3);
+  print_consolidation_time(std::cout, state.wall_time_s, state.from_cache);
+  std::cout << "), box " << state.width0 << " x " << state.height0 << " m\n";
   print_stable_steps(est);
   if (auto peak = analytical_peak_stress(config)) {
     std::cout << "  analytical peak sigma1/sigma3 " << -*peak / config.test.lateral_stress

@@ -37,4 +37,9 @@ ConsolidationCallback consolidation_progress(double every_s) {
   };
 }
 
+void print_consolidation_time(std::ostream& out, double wall_time_s, bool from_cache) {
+  if (from_cache) out << "read from the cache in ";
+  out << wall_time_s << " s";
+}
+
 }  // namespace demcal::cli

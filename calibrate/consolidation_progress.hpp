@@ -2,6 +2,8 @@
 // (2D and 3D): a consolidation never runs for minutes silently.
 #pragma once
 
+#include <ostream>
+
 #include "demcal/scene/consolidation_progress.hpp"
 
 namespace demcal::cli {
@@ -14,5 +16,11 @@ inline constexpr double kProgressEverySeconds = 2.0;
 /// so far and the estimate) when at least `every_s` seconds have passed
 /// since the start or the last line; 0 prints at every check.
 ConsolidationCallback consolidation_progress(double every_s = kProgressEverySeconds);
+
+/// A consolidated state's wall time on `out`, in its format, as `check` and
+/// `run` print it: "0.0249 s"; for a state read from the consolidation
+/// cache, whose wall_time_s is the reading's (the consolidation's own is
+/// not kept), "read from the cache in 0.0265 s".
+void print_consolidation_time(std::ostream& out, double wall_time_s, bool from_cache);
 
 }  // namespace demcal::cli

@@ -1,6 +1,7 @@
 #include "print_criteria.hpp"
 
 #include <sstream>
+#include <string>
 
 namespace demcal::cli {
 
@@ -43,10 +44,16 @@ void print_peak(std::ostream& out, bool three_d, double peak, std::optional<doub
   out << " (sigma1/sigma3 " << -peak / sigma3;
 }
 
+std::string divergence_words(int64_t divergence_step, int64_t steps_planned) {
+  std::string s = "diverged";
+  if (divergence_step >= 0)
+    s += " at step " + std::to_string(divergence_step) + " of " + std::to_string(steps_planned);
+  return s;
+}
+
 void print_unscored_criteria(std::ostream& out, int64_t divergence_step, int64_t steps_planned,
                              const Criteria& c, bool rms) {
-  out << "  criteria not scored: the run diverged";
-  if (divergence_step >= 0) out << " at step " << divergence_step << " of " << steps_planned;
+  out << "  criteria not scored: the run " << divergence_words(divergence_step, steps_planned);
   // c.points leaves out the consolidated start (a series' first row).
   out << ", " << c.points << (c.points == 1 ? " monitoring point" : " monitoring points")
       << " after the start";

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <optional>
 #include <ostream>
+#include <string>
 
 #include "demcal/scoring/triaxial_scoring.hpp"
 
@@ -23,6 +24,13 @@ void print_triaxial_criteria(std::ostream& out, const TriaxialCriteria& c, const
 /// close.
 void print_peak(std::ostream& out, bool three_d, double peak, std::optional<double> strain,
                 double sigma3);
+
+/// How far a diverged run got, in the words every line about it uses
+/// (`demcal run`'s headline, the unscored criteria of `run` and `score`):
+/// "diverged at step 16 of 25000", the step whose divergence checks failed
+/// (the steps before it completed) of those planned; "diverged" when the
+/// step is not known (-1: a series that does not say it).
+std::string divergence_words(int64_t divergence_step, int64_t steps_planned);
 
 /// A diverged run's criteria are not scored (its verdict is FAIL whatever
 /// they read): the trend ones (force balance, servo) need a window of

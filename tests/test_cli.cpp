@@ -6,6 +6,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -368,6 +369,7 @@ TEST_F(CliEndToEnd, RunWritesSummarySeriesAndVtk) {
             (std::set<std::string>{"summary.json", "series.csv", "final.vtk"}));
 
   const auto s = nlohmann::json::parse(read_text(out / "summary.json"));
+  EXPECT_EQ(s.at("schema"), "demcal.run/1");  // not a calibration's run.json
   EXPECT_EQ(s.at("particles"), 25);
   const double peak = s.at("criteria").at("peak_stress_yy").get<double>();
   EXPECT_NEAR(printed, peak, 1e-3 * std::abs(peak));  // printed to 4 digits
@@ -535,6 +537,14 @@ TEST_F(CliEndToEnd, CalibrateNamesWhatItWroteAndLeavesNoEarlierResult) {
   EXPECT_TRUE(named.count("resume.json")) << r.out;
   EXPECT_EQ(test::names_in(out), named) << r.out;
   EXPECT_FALSE(fs::exists(out / "final.vtk"));
+  // run.json is this invocation's record (wall time, jobs, trials), not a
+  // run's summary.json ("demcal.run/1"): its own schema (both said
+  // demcal.run/1 with different contents).
+  const auto record = test::read_json(out / "run.json");
+  EXPECT_EQ(record.at("schema"), "demcal.calibration-run/1");
+  for (const char* key : {"wall_time_s", "consolidation_wall_time_s", "consolidation_from_cache",
+                          "jobs", "trials_run", "trials_reused"})
+    EXPECT_TRUE(record.contains(key)) << key;
 
   // A final.vtk with no calibration's run.json beside it is a `demcal run`'s
   // (or the user's): a calibration does not write it in 2D, so it stays.
@@ -653,19 +663,102 @@ TEST_F(CliEndToEnd, DivergedRunIsReportedNotFatal) {
                            "algorithm.damping_ratio_rotation=0", "--set", "algorithm.steps=20000",
                            "-o", out.string()});
   ASSERT_EQ(r.status, 1) << r.err;
-  EXPECT_NE(r.out.find(" of 20000 steps (diverged), dt "), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("  criteria not scored: the run diverged at step "), std::string::npos)
-      << r.out;
   EXPECT_EQ(r.out.find("  force balance "), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("  FAIL: "), std::string::npos) << r.out;
   const auto s = nlohmann::json::parse(read_text(out / "summary.json"));
   EXPECT_EQ(s.at("diverged"), true);
   EXPECT_TRUE(s.at("divergence").at("reason").is_string());
   EXPECT_LT(s.at("steps_run").get<int>(), 20000);
+  // One numbering in every line (it said "15 of 20000 steps (diverged)"
+  // above "diverged at step 16").
+  test::expect_one_divergence_numbering(r.out, out, 20000);
   expect_valid_vtk(read_text(out / "final.vtk"), 25, false);  // finite, counts consistent
   // Its series.csv (finite rows up to the divergence) scores as diverged,
   // with the run's diagnosis.
   expect_scores_as_the_run(out, r);
+}
+
+// A consolidated state read from the cache has the reading's wall time, not
+// the consolidation's: `check` (2D and 3D) and a 3D `run` say so ("read
+// from the cache in T s"; they printed "(T s, from the cache)", as if the
+// consolidation had taken T), a fresh one's line unchanged.
+TEST_F(CliEndToEnd, AConsolidationFromTheCacheIsSaidToBeRead) {
+  const std::string cache = "DEMCAL_CACHE_DIR=" + (dir_ / "cache").string();
+  auto line_of = [](const std::string& out, const std::string& start) {
+    for (const std::string& line : lines_of(out))
+      if (line.rfind(start, 0) == 0) return line;
+    return std::string("no line ") + start;
+  };
+  for (const std::string& config : {kHex5, test::shipped_config("fcc_4x4x4")}) {
+    SCOPED_TRACE(config);
+    const Result miss = demcal({"check", config}, {cache});
+    const Result hit = demcal({"check", config}, {cache});
+    ASSERT_EQ(miss.status, 0) << miss.err;
+    ASSERT_EQ(hit.status, 0) << hit.err;
+    const std::string fresh = line_of(miss.out, "  consolidated in ");
+    const std::string read = line_of(hit.out, "  consolidated in ");
+    const size_t open = fresh.find(" steps (");
+    ASSERT_NE(open, std::string::npos) << fresh;
+    // The same steps, then the fresh one's time, the cached one's reading.
+    const std::string steps = fresh.substr(0, open + 8);
+    EXPECT_EQ(fresh.find("cache"), std::string::npos) << fresh;
+    EXPECT_TRUE(std::isdigit(static_cast<unsigned char>(fresh[open + 8]))) << fresh;
+    EXPECT_EQ(read.rfind(steps + "read from the cache in ", 0), 0u) << read;
+    EXPECT_NE(read.find(" s), box "), std::string::npos) << read;
+  }
+  const Result run = demcal(
+      {"run", test::shipped_config("fcc_4x4x4"), "--set", "algorithm.steps=2000", "-o", "run3d"},
+      {cache});
+  ASSERT_NO_FATAL_FAILURE(test::expect_run_status(run.status, dir_ / "work" / "run3d", run.err));
+  EXPECT_NE(line_of(run.out, "  wall time ").find(" s (consolidation read from the cache in "),
+            std::string::npos)
+      << run.out;
+}
+
+// `demcal export` says how the deck's Nstep was upscaled, 2D and 3D in
+// one line: the prototype's Nstep (the one `demcal upscale` writes), from
+// the REV's particles and steps, by which law (the 2D export said nothing).
+TEST_F(CliEndToEnd, ExportSaysHowItsStepsWereUpscaledIn2dAnd3d) {
+  const fs::path reports = fs::path(test::kSourceDir) / "reports";
+  struct Case {
+    std::string params;
+    std::vector<std::string> extra;
+    const char* what;
+    const char* law;
+    const char* deck;
+  };
+  const std::vector<Case> cases = {{(reports / "example-hex_10x10" / "params.json").string(),
+                                    {},
+                                    "particles",
+                                    "linear",
+                                    "d2/deck.lammps"},
+                                   {(reports / "example-fcc_4x4x4" / "params.json").string(),
+                                    {"--config", test::shipped_config("random_500_3d")},
+                                    "spheres",
+                                    "power",
+                                    "d3/deck.lammps"}};
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.params);
+    std::vector<std::string> args = {"export",           c.params, "--particles", "150",
+                                     "--consolidate-in", "deck",   "-o",          c.deck};
+    args.insert(args.end(), c.extra.begin(), c.extra.end());
+    const Result r = demcal(args);
+    ASSERT_EQ(r.status, 0) << r.err;
+    std::vector<std::string> up = {"upscale", c.params, "--particles", "150"};
+    up.insert(up.end(), c.extra.begin(), c.extra.end());
+    const Result u = demcal(up);
+    ASSERT_EQ(u.status, 0) << u.err;
+    const auto upscaled = nlohmann::json::parse(u.out);
+    const auto rev = test::read_json(c.params).at("rev");
+    const std::string line =
+        "demcal export: " + std::to_string(upscaled.at("prototype").at("steps").get<int64_t>()) +
+        " steps upscaled from " + std::to_string(rev.at("particles").get<int64_t>()) + " " +
+        c.what + " / " + std::to_string(rev.at("steps").get<int64_t>()) + " steps (" + c.law +
+        " law, exponent ";
+    int said = 0;
+    for (const std::string& l : lines_of(r.err)) said += l.rfind(line, 0) == 0;
+    EXPECT_EQ(said, 1) << line << "\n" << r.err;
+  }
 }
 
 }  // namespace

@@ -72,6 +72,7 @@ TEST_F(Cli3D, RunWritesSummaryNineComponentSeriesAndSphereVtk) {
             (std::set<std::string>{"summary.json", "series.csv", "final.vtk"}));
 
   const auto s = nlohmann::json::parse(read_text(out / "summary.json"));
+  EXPECT_EQ(s.at("schema"), "demcal.run/1");  // as a 2D run's, not a calibration's run.json
   EXPECT_EQ(s.at("dimension"), 3);
   EXPECT_EQ(s.at("particles"), 32);
   // Δt = 0.2·2·sqrt(m/kn), m = ρ(4/3)πr³ of a sphere.
@@ -223,6 +224,20 @@ TEST_F(Cli3D, CheckPrintsTheSphereScales) {
   EXPECT_NE(r.out.find("stable dt_ratio"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("3.714"), std::string::npos) << r.out;  // Thornton, μ = 0.3
   EXPECT_TRUE(work_empty());
+}
+
+// A diverged 3D run is told as a 2D one: its headline, criteria line and
+// last line name the step that diverged in the same words, the headline
+// also the steps completed before it.
+TEST_F(Cli3D, DivergedRunNamesTheStepThatDivergedOnce) {
+  const std::string config = write("fcc2.json", fcc_config());
+  const fs::path out = dir_ / "work" / "out";
+  const test::RunResult r =
+      demcal({"run", config, "--allow-unstable", "--set", "algorithm.dt_ratio=2", "--set",
+              "algorithm.damping_ratio_translation=0", "--set",
+              "algorithm.damping_ratio_rotation=0", "-o", out.string()});
+  ASSERT_EQ(r.status, 1) << r.err;
+  test::expect_one_divergence_numbering(r.out, out, 4000);
 }
 
 TEST_F(Cli3D, MismatchesAndUnsupportedCommandsAreBadInput) {

@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdint>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -22,6 +23,31 @@ inline void expect_run_status(int status, const std::filesystem::path& out,
   ASSERT_TRUE(std::filesystem::exists(out / "summary.json")) << "status " << status << ": " << err;
   const bool passed = read_json(out / "summary.json").at("passed").get<bool>();
   EXPECT_EQ(status, passed ? 0 : 1) << err;
+}
+
+/// A diverged run's lines in `out` (`demcal run`'s stdout) against its
+/// out_dir/summary.json: one numbering of the divergence. The headline, the
+/// criteria line and the last line name the step that diverged of the
+/// `planned` in the same words, the headline also the steps completed
+/// before it (the step that diverged is the first not completed).
+inline void expect_one_divergence_numbering(const std::string& out,
+                                            const std::filesystem::path& out_dir, int64_t planned) {
+  const nlohmann::json s = read_json(out_dir / "summary.json");
+  ASSERT_TRUE(s.at("diverged").get<bool>()) << out;
+  const int64_t ran = s.at("steps_run").get<int64_t>();
+  const int64_t at = s.at("divergence").at("step").get<int64_t>();
+  EXPECT_EQ(ran, at - 1) << out;
+  const std::string diverged =
+      "diverged at step " + std::to_string(at) + " of " + std::to_string(planned);
+  EXPECT_NE(out.find(", " + diverged + " (" + std::to_string(ran) + " steps completed), dt "),
+            std::string::npos)
+      << out;
+  EXPECT_NE(out.find("\n  criteria not scored: the run " + diverged + ", "), std::string::npos)
+      << out;
+  EXPECT_NE(out.find("\n  DIVERGED at step " + std::to_string(at) + ": "), std::string::npos)
+      << out;
+  // Before: "15 of 20000 steps (diverged)" above "diverged at step 16".
+  EXPECT_EQ(out.find(" of " + std::to_string(planned) + " steps"), std::string::npos) << out;
 }
 
 }  // namespace demcal::test
