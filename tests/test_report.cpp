@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "demcal/io/format.hpp"
 #include "demcal/report/report.hpp"
 #include "demcal/report/sphere_svg.hpp"
 #include "demcal/scene/packing.hpp"
@@ -438,6 +439,23 @@ TEST(Report, AFailedCalibrationStillReportsWhatItTried) {
     EXPECT_NE(r.markdown.find("Start point (α 0.2"), std::string::npos);
     EXPECT_NE(r.markdown.find("The answer: no parameter set passed"), std::string::npos);
   }
+}
+
+// The analytical peak is a row of the criteria table where the scene has
+// one (hexagonal) and no row at all where it has none (a random packing):
+// not an "n/a" that reads like a missing number.
+TEST(Report, AnalyticalPeakRowOnlyWhereThereIsOne) {
+  ReportInput in = synthetic_input(false);
+  ReportOptions options;
+  options.gnuplot = "";
+  const Report hex = make_report(in, options);
+  EXPECT_NE(hex.markdown.find("| analytical peak (rotation locked, walled box) | -748 kPa |"),
+            std::string::npos);
+  in.analytical_peak.reset();
+  const Report random = make_report(in, options);
+  EXPECT_EQ(html_problem(random.html), "");
+  EXPECT_EQ(random.markdown.find("analytical peak"), std::string::npos);
+  EXPECT_EQ(random.html.find("analytical peak"), std::string::npos);
 }
 
 TEST(Report, GnuplotRunnerNeedsNoShell) {
@@ -912,4 +930,36 @@ TEST(Report3D, NoResultAndThePrototypeBlock) {
                                 "test block; kind scaled)"),
             std::string::npos);
   EXPECT_NE(proto.markdown.find("| steps | 2,000,000 |"), std::string::npos);
+}
+
+// 3D alike: the FCC lattice's analytical peak is a row; a random packing
+// (no analytical value) has none.
+TEST(Report3D, AnalyticalPeakRowOnlyWhereThereIsOne) {
+  const TriaxialState& state = small_fcc();
+  const SceneConfig& c = fcc2_config();
+  ReportInput in;
+  in.scene = "fcc2";
+  in.command = "demcal calibrate fcc2.json";
+  in.lateral_stress = 1e5;
+  in.particles = in.prototype_particles = state.world.size();
+  AlgorithmSpec start = c.algorithm;
+  start.steps = 1500;
+  in.summary.success = true;
+  in.summary.best = start;
+  in.summary.best_trial.params = start;
+  in.summary.best_trial.score.particle_steps = 1.0;
+  attach_runs(in, rerun_start_and_result(c, state, start, in.summary, in.tolerances, 1));
+  ASSERT_TRUE(in.best3);
+  in.summary.best_trial.score = in.best3->score;
+  ReportOptions options;
+  options.gnuplot = "";
+  const Report random = make_report(in, options);
+  EXPECT_NE(random.markdown.find("| for comparison (not criteria) | value |"), std::string::npos);
+  EXPECT_EQ(random.markdown.find("analytical peak"), std::string::npos);
+  in.analytical_peak = -*analytical_peak_ratio_3d(c) * in.lateral_stress;
+  const Report fcc = make_report(in, options);
+  EXPECT_NE(fcc.markdown.find("| analytical peak (walled FCC lattice, rotation locked; Thornton "
+                              "1979) | " +
+                              num(*in.analytical_peak / 1e3, 4) + " kPa |"),
+            std::string::npos);
 }
