@@ -458,6 +458,53 @@ TEST(Report, AnalyticalPeakRowOnlyWhereThereIsOne) {
   EXPECT_EQ(random.html.find("analytical peak"), std::string::npos);
 }
 
+// A run tracks its peak at every loading step (the criteria's and the
+// certificate's) and records monitoring points (the plots', the picture's).
+// On a flat peak the step-level maximum can fall between two points: the
+// two peaks then differ a little in stress and more in strain. Every figure
+// of a peak's strain says which peak it is, and the panel table gives both
+// with the reason.
+TEST(Report, EveryPeakStrainSaysWhichPeakItIs) {
+  ReportInput in = synthetic_input(false);
+  // The synthetic monitored peak: 650 kPa at ε_yy = −0.5 %; the step-level
+  // one a little higher, between two monitoring points.
+  in.best->run.peak_stress_yy = -6.51e5;
+  in.best->run.peak_strain_yy = -0.0049;
+  in.best->score = score_run(in.best->run, in.lateral_stress, in.tolerances);
+  ASSERT_EQ(in.best->score.criteria.peak_strain_yy, -0.0049);
+  ReportOptions options;
+  options.gnuplot = "";
+  const Report r = make_report(in, options);
+  EXPECT_EQ(html_problem(r.html), "");
+  const std::string every = "peak b_yy, largest at any loading step (criteria, certificate)",
+                    monitored = "peak b_yy, largest at the monitoring points (plots, picture)";
+  // The criteria table: the step-level peak, named.
+  EXPECT_NE(r.markdown.find("| " + every + " | -651 kPa at ε_yy = -0.490 % |"), std::string::npos);
+  // The panel table: both, per run (start point, calibrated).
+  EXPECT_NE(r.markdown.find("| " + every +
+                            " | -650 kPa at ε_yy = -0.500 % | -651 kPa at ε_yy = "
+                            "-0.490 % |"),
+            std::string::npos);
+  EXPECT_NE(r.markdown.find("| " + monitored +
+                            " | -650 kPa at ε_yy = -0.500 % | -650 kPa at ε_yy = -0.500 % |"),
+            std::string::npos);
+  EXPECT_NE(r.markdown.find("The calibrated run: -651 kPa at ε_yy = -0.490 % against -650 kPa at "
+                            "ε_yy = -0.500 %, 0.15 % apart in stress."),
+            std::string::npos);
+  // No line gives a peak's strain without saying which peak it is.
+  std::istringstream lines(r.markdown);
+  int with_strain = 0;
+  for (std::string line; std::getline(lines, line);) {
+    if (line.find("ε_yy = ") == std::string::npos || line.find("peak") == std::string::npos)
+      continue;
+    ++with_strain;
+    EXPECT_TRUE(line.find("any loading step") != std::string::npos ||
+                line.find("monitoring points") != std::string::npos)
+        << line;
+  }
+  EXPECT_EQ(with_strain, 5);  // criteria row, two panel rows, the note, the picture
+}
+
 TEST(Report, GnuplotRunnerNeedsNoShell) {
   std::string error;
   auto none = run_gnuplot("demcal-test-no-such-gnuplot", "", {}, {"a.svg"}, &error);

@@ -209,8 +209,8 @@ void write_criteria(Doc& d, const ReportFacts& f) {
       {"unbalanced-force ratio, mean / max",
        num(c.unbalanced_force_ratio_mean, 3) + " / " + num(c.unbalanced_force_ratio_max, 3)},
       {"inertial number, max", num(c.inertial_number_max, 3)},
-      {"peak " + f.axial, kpa(c.peak_stress_yy) + " at ε_" + f.axial.substr(2) + " = " +
-                              strain_pct(c.peak_strain_yy, f.dimension)}};
+      {peak_label(f, PeakKind::every_step),
+       peak_text(f.axial, c.peak_stress_yy, c.peak_strain_yy, f.dimension)}};
   // Only the lattices have a closed-form peak (hexagonal, FCC): a random
   // packing has none, so no row rather than an empty one.
   if (in.analytical_peak)
