@@ -88,9 +88,10 @@ void write_two_peaks(Doc& d, const ReportFacts& f) {
   const std::string every = scored_peak_text(f, *r), monitored = monitored_peak_text(f, *r);
   if (c.peak_stress_yy < 0.0 && mon_peak > 0.0 &&
       strain_pct(c.peak_strain_yy, f.dimension) != strain_pct(-mon_strain / 100.0, f.dimension))
-    text += " The " + r->label + " run: " + every + " against " + monitored + ", " +
-            pct(std::abs(c.peak_stress_yy + 1e3 * mon_peak) / std::abs(c.peak_stress_yy), 2) +
-            " apart in stress.";
+    text +=
+        " The " + r->label + " run: " + every + " against " + monitored + ", " +
+        num(100.0 * std::abs(c.peak_stress_yy + 1e3 * mon_peak) / std::abs(c.peak_stress_yy), 2) +
+        " % apart in stress.";
   d.para(text, "small");
 }
 
