@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "demcal/io/format.hpp"
 #include "demcal/report/report.hpp"
 #include "demcal/report/sphere_svg.hpp"
 #include "demcal/scene/packing.hpp"
@@ -438,6 +439,70 @@ TEST(Report, AFailedCalibrationStillReportsWhatItTried) {
     EXPECT_NE(r.markdown.find("Start point (α 0.2"), std::string::npos);
     EXPECT_NE(r.markdown.find("The answer: no parameter set passed"), std::string::npos);
   }
+}
+
+// The analytical peak is a row of the criteria table where the scene has
+// one (hexagonal) and no row at all where it has none (a random packing):
+// not an "n/a" that reads like a missing number.
+TEST(Report, AnalyticalPeakRowOnlyWhereThereIsOne) {
+  ReportInput in = synthetic_input(false);
+  ReportOptions options;
+  options.gnuplot = "";
+  const Report hex = make_report(in, options);
+  EXPECT_NE(hex.markdown.find("| analytical peak (rotation locked, walled box) | -748 kPa |"),
+            std::string::npos);
+  in.analytical_peak.reset();
+  const Report random = make_report(in, options);
+  EXPECT_EQ(html_problem(random.html), "");
+  EXPECT_EQ(random.markdown.find("analytical peak"), std::string::npos);
+  EXPECT_EQ(random.html.find("analytical peak"), std::string::npos);
+}
+
+// A run tracks its peak at every loading step (the criteria's and the
+// certificate's) and records monitoring points (the plots', the picture's).
+// On a flat peak the step-level maximum can fall between two points: the
+// two peaks then differ a little in stress and more in strain. Every figure
+// of a peak's strain says which peak it is, and the panel table gives both
+// with the reason.
+TEST(Report, EveryPeakStrainSaysWhichPeakItIs) {
+  ReportInput in = synthetic_input(false);
+  // The synthetic monitored peak: 650 kPa at ε_yy = −0.5 %; the step-level
+  // one a little higher, between two monitoring points.
+  in.best->run.peak_stress_yy = -6.51e5;
+  in.best->run.peak_strain_yy = -0.0049;
+  in.best->score = score_run(in.best->run, in.lateral_stress, in.tolerances);
+  ASSERT_EQ(in.best->score.criteria.peak_strain_yy, -0.0049);
+  ReportOptions options;
+  options.gnuplot = "";
+  const Report r = make_report(in, options);
+  EXPECT_EQ(html_problem(r.html), "");
+  const std::string every = "peak b_yy, largest at any loading step (criteria, certificate)",
+                    monitored = "peak b_yy, largest at the monitoring points (plots, picture)";
+  // The criteria table: the step-level peak, named.
+  EXPECT_NE(r.markdown.find("| " + every + " | -651 kPa at ε_yy = -0.490 % |"), std::string::npos);
+  // The panel table: both, per run (start point, calibrated).
+  EXPECT_NE(r.markdown.find("| " + every +
+                            " | -650 kPa at ε_yy = -0.500 % | -651 kPa at ε_yy = "
+                            "-0.490 % |"),
+            std::string::npos);
+  EXPECT_NE(r.markdown.find("| " + monitored +
+                            " | -650 kPa at ε_yy = -0.500 % | -650 kPa at ε_yy = -0.500 % |"),
+            std::string::npos);
+  EXPECT_NE(r.markdown.find("The calibrated run: -651 kPa at ε_yy = -0.490 % against -650 kPa at "
+                            "ε_yy = -0.500 %, 0.15 % apart in stress."),
+            std::string::npos);
+  // No line gives a peak's strain without saying which peak it is.
+  std::istringstream lines(r.markdown);
+  int with_strain = 0;
+  for (std::string line; std::getline(lines, line);) {
+    if (line.find("ε_yy = ") == std::string::npos || line.find("peak") == std::string::npos)
+      continue;
+    ++with_strain;
+    EXPECT_TRUE(line.find("any loading step") != std::string::npos ||
+                line.find("monitoring points") != std::string::npos)
+        << line;
+  }
+  EXPECT_EQ(with_strain, 5);  // criteria row, two panel rows, the note, the picture
 }
 
 TEST(Report, GnuplotRunnerNeedsNoShell) {
@@ -912,4 +977,36 @@ TEST(Report3D, NoResultAndThePrototypeBlock) {
                                 "test block; kind scaled)"),
             std::string::npos);
   EXPECT_NE(proto.markdown.find("| steps | 2,000,000 |"), std::string::npos);
+}
+
+// 3D alike: the FCC lattice's analytical peak is a row; a random packing
+// (no analytical value) has none.
+TEST(Report3D, AnalyticalPeakRowOnlyWhereThereIsOne) {
+  const TriaxialState& state = small_fcc();
+  const SceneConfig& c = fcc2_config();
+  ReportInput in;
+  in.scene = "fcc2";
+  in.command = "demcal calibrate fcc2.json";
+  in.lateral_stress = 1e5;
+  in.particles = in.prototype_particles = state.world.size();
+  AlgorithmSpec start = c.algorithm;
+  start.steps = 1500;
+  in.summary.success = true;
+  in.summary.best = start;
+  in.summary.best_trial.params = start;
+  in.summary.best_trial.score.particle_steps = 1.0;
+  attach_runs(in, rerun_start_and_result(c, state, start, in.summary, in.tolerances, 1));
+  ASSERT_TRUE(in.best3);
+  in.summary.best_trial.score = in.best3->score;
+  ReportOptions options;
+  options.gnuplot = "";
+  const Report random = make_report(in, options);
+  EXPECT_NE(random.markdown.find("| for comparison (not criteria) | value |"), std::string::npos);
+  EXPECT_EQ(random.markdown.find("analytical peak"), std::string::npos);
+  in.analytical_peak = -*analytical_peak_ratio_3d(c) * in.lateral_stress;
+  const Report fcc = make_report(in, options);
+  EXPECT_NE(fcc.markdown.find("| analytical peak (walled FCC lattice, rotation locked; Thornton "
+                              "1979) | " +
+                              num(*in.analytical_peak / 1e3, 4) + " kPa |"),
+            std::string::npos);
 }

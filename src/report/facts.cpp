@@ -23,6 +23,17 @@ std::string strain_pct(double fraction, int dimension) {
   return dimension == 3 ? num(100.0 * fraction, 3) + " %" : pct(fraction, 3);
 }
 
+std::string peak_text(const std::string& axial, double stress, double strain, int dimension) {
+  if (!(stress < 0.0)) return "none (no compressive peak)";
+  return kpa(stress) + " at ε_" + axial.substr(2) + " = " + strain_pct(strain, dimension);
+}
+
+std::string peak_label(const ReportFacts& f, PeakKind kind) {
+  return "peak " + f.axial +
+         (kind == PeakKind::every_step ? ", largest at any loading step (criteria, certificate)"
+                                       : ", largest at the monitoring points (plots, picture)");
+}
+
 std::string sentence(std::string s) {
   while (!s.empty() && s.back() == ' ') s.pop_back();
   if (s.empty()) return s;

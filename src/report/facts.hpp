@@ -26,6 +26,10 @@ std::string sentence(std::string s);
 std::string params_text(const AlgorithmSpec& p);
 /// The same for gnuplot's enhanced text: plain digits and my own words only.
 std::string params_gp(const AlgorithmSpec& p);
+/// A peak of the axial boundary stress as "-206.8 kPa at ε_zz = -0.387 %":
+/// `stress` [Pa] (compression negative, as b) and `strain` (a fraction) of
+/// the loading axis; `axial` is ReportFacts::axial ("b_yy", "b_zz").
+std::string peak_text(const std::string& axial, double stress, double strain, int dimension);
 /// "diverged", "stopped early", "pass" or "FAIL".
 std::string verdict(const TrialRecord& t);
 
@@ -108,6 +112,15 @@ struct ReportFacts {
     return baseline_index < 0 ? nullptr : &points[static_cast<size_t>(baseline_index)];
   }
 };
+/// The report gives two peaks of a run's axial boundary stress: the largest
+/// at any loading step (the run tracks it every step; the criteria, the
+/// certificate and the trials' peaks are this one) and the largest at the
+/// monitoring points (what the plots show and where the assembly picture is
+/// taken). On a flat peak they differ little in stress but can lie far
+/// apart in strain. Each table names which one it gives, in these words.
+enum class PeakKind { every_step, monitored };
+std::string peak_label(const ReportFacts& f, PeakKind kind);
+
 /// Fills `f` (not copyable: it points into itself).
 void gather_facts(const ReportInput& in, ReportFacts& f);
 
