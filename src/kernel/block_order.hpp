@@ -14,21 +14,20 @@ namespace demcal::detail {
 /// (pair_i[k], pair_j[k]) (each pair once, either way round): order[k] is
 /// the particle to become particle k. The pair pass evaluates blocks of 8
 /// particles and pads their half rows (neighbours of higher index) and
-/// mirror rows (lower index) to the longest of the block; each window of 64
-/// consecutive particles (locality kept) is ordered so that the particles
-/// of a block have as many neighbours on either side. The identity unless
-/// that order needs fewer slot rows (block_slot_rows) than the current
-/// numbering: a greedy order can lose to one that is already regular.
+/// mirror rows (lower index) to the longest of the block; a greedy order
+/// (each window of 64 consecutive particles, locality kept, ordered so that
+/// the particles of a block have as many neighbours on either side) or the
+/// current numbering, whichever costs less (block_cost), is improved by a
+/// local search of swaps between nearby blocks. The identity unless that
+/// order costs less than the current numbering.
 std::vector<int> block_friendly_order(int n, std::span<const int> pair_i,
                                       std::span<const int> pair_j);
 
-/// The slots the pair pass evaluates per lane under `order` (as
-/// block_friendly_order returns it): over the blocks of 8 new indices, the
-/// longest half row plus the longest mirror row: what block_friendly_order
-/// compares its greedy order and the identity (a lattice in lattice order)
-/// by.
-long block_slot_rows(int n, std::span<const int> pair_i, std::span<const int> pair_j,
-                     std::span<const int> order);
+/// What the pair pass costs under `order` (as block_friendly_order returns
+/// it), in mirror-row units: over the blocks of 8 new indices, the longest
+/// half row, weighted 4 (the law), plus the longest mirror row (the sums).
+long block_cost(int n, std::span<const int> pair_i, std::span<const int> pair_j,
+                std::span<const int> order);
 
 /// True when `order` keeps every particle where it is (order[k] = k): both
 /// reorder()s then change nothing, not even the last bits of the forces,
