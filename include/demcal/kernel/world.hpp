@@ -189,10 +189,11 @@ class World {
   /// An order for reorder() that fills the SIMD blocks: the kernel evaluates
   /// 8 particles at once and pads their half rows (neighbours of higher
   /// index) and mirror rows (lower index) to the longest of the block, so
-  /// each window of 64 consecutive particles (locality kept) is ordered so
-  /// that the particles of a block have as many neighbours on either side;
-  /// the identity where that would not fill the blocks better (a lattice in
-  /// lattice order) (reports/performance.md).
+  /// particles with as many neighbours on either side share a block: a
+  /// greedy order of windows of 64 consecutive particles (locality kept) or
+  /// the current numbering, whichever fills better, improved by a local
+  /// search of swaps between nearby blocks; the identity where nothing
+  /// fills the blocks better (reports/performance.md).
   std::vector<int> block_friendly_order() const;
   int threads() const;
   /// Set the friction coefficient of particle–particle contacts (used by
