@@ -214,6 +214,33 @@ TEST_F(CliEndToEnd, VerifyConsolidateOnlyAnnouncesNoLoading) {
     EXPECT_EQ(r.err.find(announce), std::string::npos) << announce << " in " << r.err;
 }
 
+// verify's options that the run would not use are refused, one line naming
+// the option, nothing written: --np without --engine lammps (it was
+// ignored), --threads in 2D (3D only: ignored too), and --engine liggghts
+// is pointed to export.
+TEST_F(CliEndToEnd, VerifyRefusesTheOptionsItWouldIgnore) {
+  const demcal::SceneConfig c = demcal::default_config();
+  demcal::AlgorithmSpec p;
+  p.steps = 20000;
+  const auto scales = demcal::particle_scales(demcal::make_assembly(c).r, c.material);
+  const std::string params =
+      write("params.json", nlohmann::json{{"schema", "demcal.params/1"},
+                                          {"scene", c.name},
+                                          {"rev", demcal::param_block(p, scales)}}
+                               .dump());
+  const std::vector<std::string> verify{"verify", params, "--particles", "25", "-o", "v"};
+  auto with = [&](const std::vector<std::string>& more) {
+    std::vector<std::string> args = verify;
+    args.insert(args.end(), more.begin(), more.end());
+    return args;
+  };
+  expect_bad_input(with({"--np", "2"}), {"--np", "--engine lammps"});
+  expect_bad_input(with({"--engine", "demcal", "--np", "2"}), {"--np", "--engine lammps"});
+  expect_bad_input(with({"--threads", "2"}), {"--threads", "3D only"});
+  expect_bad_input(with({"--engine", "liggghts"}),
+                   {"--engine", "\"liggghts\"", "export --format liggghts"});
+}
+
 // `demcal stability`: the limit against the estimate, both files written.
 TEST_F(CliEndToEnd, StabilityScanWritesItsReport) {
   const fs::path out = dir_ / "work" / "scan";
