@@ -192,6 +192,7 @@ Invocation prepare(const CalibrateOptions& o) {
   if (o.accuracy < 0 || o.accuracy >= 1)
     throw InputError("--accuracy", "", "must be a fraction in (0, 1), e.g. 0.02");
   v.strategy = parse_strategy(o.strategy, "--strategy");
+  require_prototype(config);  // read again after the search, for params.json
   v.dir = o.out_dir.empty() ? "demcal-" + config.name : o.out_dir;
   v.trials_path = v.dir + "/trials.jsonl";
   OutputFolder::check(v.dir);  // an unwritable -o fails now, not after the search
@@ -238,7 +239,9 @@ Consolidated consolidate_rev(const CalibrateOptions& o, const SceneConfig& confi
 }
 
 /// The output folder made ready under its lock: a --resume checked once
-/// more, a fresh start's trials and key replaced, earlier results removed.
+/// more, a fresh start's trials and key replaced. An earlier calibration's
+/// results stay until this one's replace them (write_results): a stop or a
+/// failure before that leaves them as they were.
 void ready_output_folder(const CalibrateOptions& o, const Invocation& v) {
   const std::string& dir = v.dir;
   if (o.resume) {
@@ -252,18 +255,6 @@ void ready_output_folder(const CalibrateOptions& o, const Invocation& v) {
     std::filesystem::remove(v.trials_path);
     write_resume_key(dir, v.key);
   }
-  // Results of an earlier calibration in this folder would not match the
-  // trials from here on: every file a calibration writes at the end goes,
-  // whether or not this one writes it again (final.vtk of a 3D report
-  // stayed beside a 2D one). Not a refusal of a non-empty folder: --resume
-  // and a recalibration into the same -o are how the folder is meant to be
-  // used, and the user's own files in it stay — so final.vtk, which `demcal
-  // run` writes too, goes only where an earlier calibration's run.json says
-  // it was that calibration's.
-  const bool earlier_calibration = std::filesystem::exists(dir + "/run.json");
-  for (const char* name : {"params.json", "run.json", "report.html", "report.md", "evidence.jsonl"})
-    std::filesystem::remove(dir + "/" + name);
-  if (earlier_calibration) std::filesystem::remove(dir + "/final.vtk");
 }
 
 /// The --evidence runs: the paper's recipe done mechanically (α = 0.2,
@@ -377,10 +368,18 @@ std::string write_report(const CalibrateOptions& o, const Invocation& v, const C
 }
 
 /// params.json, run.json and evidence.jsonl of one calibration replace
-/// those of an earlier one together (an evidence.jsonl of an earlier
-/// --evidence run that this one does not redo goes with them).
+/// those of an earlier one together. The earlier one's other results go in
+/// the same commit, whether or not this one writes them again (its report
+/// comes next and may fail; an evidence.jsonl of an earlier --evidence run
+/// that this one does not redo), so nothing of it passes for this run's.
+/// Not a refusal of a non-empty folder: --resume and a recalibration into
+/// the same -o are how the folder is meant to be used, and the user's own
+/// files in it stay — so final.vtk, which `demcal run` writes too, goes only
+/// where an earlier calibration's run.json says it was that calibration's
+/// (a 3D report's final.vtk stayed beside a 2D one).
 void write_results(const std::string& dir, const nlohmann::json& params,
                    const std::string& evidence_lines, const std::string& run_json) {
+  const bool earlier_calibration = std::filesystem::exists(dir + "/run.json");
   OutputFolder out(dir);
   if (!evidence_lines.empty())
     out.write("evidence.jsonl", evidence_lines);
@@ -388,6 +387,8 @@ void write_results(const std::string& dir, const nlohmann::json& params,
     out.retire("evidence.jsonl");
   out.write("params.json", params.dump(2) + "\n");
   out.write("run.json", run_json);
+  for (const char* name : {"report.html", "report.md"}) out.retire(name);
+  if (earlier_calibration) out.retire("final.vtk");
   out.commit();
 }
 

@@ -20,6 +20,7 @@
 #include "demcal/scoring/scoring.hpp"
 #include "demcal/scoring/trial.hpp"
 #include "demcal/scoring/triaxial_scoring.hpp"
+#include "demcal/upscaling/upscaling.hpp"
 #include "output_folder.hpp"
 #include "print_criteria.hpp"
 
@@ -201,8 +202,16 @@ int run_3d(const SceneConfig& config, const std::string& out_dir, bool allow_uns
 
 }  // namespace
 
+void require_prototype(const SceneConfig& config) {
+  if (config.dimension == 3)
+    prototype_spheres(config);
+  else
+    prototype_assembly(config);
+}
+
 int cmd_check(const std::string& path, const std::vector<std::string>& sets) {
   SceneConfig config = load_config(path, sets);
+  require_prototype(config);  // before the consolidation: what calibrate reads after its search
   if (config.dimension == 3) return check_3d(config);
   Assembly assembly = make_assembly(config);
   const ConsolidatedState state =

@@ -74,7 +74,7 @@ std::function<int()> add_upscaling_commands(CLI::App& app) {
   verify->add_option("--engine", ve->engine,
                      "demcal (default) or, 2D, lammps: run the exported deck with lmp and score "
                      "it");
-  verify->add_option("--np", ve->np, "MPI ranks for --engine lammps (mpirun -np N; default 1)")
+  verify->add_option("--np", ve->np, "2D: MPI ranks for --engine lammps (mpirun -np N; default 1)")
       ->check(CLI::Range(1, 4096));
   verify
       ->add_option("--threads", ve->threads,

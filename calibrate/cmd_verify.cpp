@@ -43,9 +43,42 @@ namespace {
 /// 3–4·10⁷ on this machine; the estimate is then refined from the
 /// consolidation).
 constexpr double kAssumedSpeed = 3e7;
-/// LAMMPS' speed on the exported deck, per MPI rank (measured 1.7·10⁶
-/// particle-steps/s on 400 disks on a loaded machine; about 4·10⁶ quiet).
-constexpr double kAssumedLammpsSpeed = 3e6;
+/// LAMMPS on the exported 2D deck, one rank: a step costs
+/// kLammpsStepCost (the deck's fixes, variables and servo, whatever the
+/// size) plus one particle-step per particle at kLammpsSpeed. Measured
+/// (wall time, load 7 on 2 cores): 21, 30, 62 and 393 µs a step at 25, 100,
+/// 400 and 1 600 disks; 29 µs at 100 disks (353 442 steps in 10.4 s); on a
+/// quiet machine 5.2 ms at 20 022 disks (reports/engines.md §3.2). The
+/// model reads 26, 45, 120, 420 µs and 5.0 ms: within 2x, on the high side.
+/// (The bare granular step of reports/performance.md runs 2–3 times faster
+/// than the deck.)
+constexpr double kLammpsSpeed = 4e6;      // particle-steps/s
+constexpr double kLammpsStepCost = 2e-5;  // s a step
+/// Particles a rank from which MPI ranks share the deck's work: 2 ranks ran
+/// it 1.91x faster on 20 022 disks (reports/engines.md §3.2); below, no
+/// speed-up is assumed (100 disks on 2 ranks ran 5.6x slower than on one).
+constexpr double kLammpsParticlesPerRank = 1e4;
+/// Wall time the ranks' exchanges add to every step (s): 100 disks on 2
+/// ranks took 166 µs a step against 29 µs on one rank (2 shared cores).
+constexpr double kLammpsMpiStepCost = 1.5e-4;
+
+/// The estimated wall time of the LAMMPS deck's loading: `steps` (the
+/// deck's) of `n` particles on `np` ranks.
+double lammps_estimate_s(int64_t n, int64_t steps, int np) {
+  const double particles = static_cast<double>(n);
+  const double ranks =
+      std::clamp(particles / kLammpsParticlesPerRank, 1.0, static_cast<double>(np));
+  return static_cast<double>(steps) * (kLammpsStepCost + particles / (kLammpsSpeed * ranks) +
+                                       (np > 1 ? kLammpsMpiStepCost : 0.0));
+}
+
+/// The loading steps the LAMMPS deck of `proto` runs (Nstep/f: its fix
+/// viscous is explicit, export.hpp), read from the deck export_deck makes,
+/// so the estimate runs what the deck will.
+int64_t lammps_deck_steps(const SceneConfig& config, const AlgorithmSpec& up,
+                          const Assembly& proto) {
+  return export_deck(config, up, proto, ExportOptions{}).steps;
+}
 
 /// The first executable `name` on PATH, or "".
 std::string find_on_path(const std::string& name) {
@@ -89,7 +122,8 @@ nlohmann::json verify_head(const VerifyOptions& o, const SceneConfig& config, in
 /// prototype, run by lmp in DIR/lammps, its series scored.
 int verify_in_lammps(const VerifyOptions& o, const SceneConfig& config,
                      const ConsolidatedState& state, const AlgorithmSpec& up,
-                     const std::string& dir, const std::string& lmp, nlohmann::json out) {
+                     const std::string& dir, const std::string& lmp, double estimate_s,
+                     nlohmann::json out) {
   namespace fs = std::filesystem;
   ExportOptions eo;
   eo.data_name = "deck.data";
@@ -126,6 +160,7 @@ int verify_in_lammps(const VerifyOptions& o, const SceneConfig& config,
                    {"np", o.np},
                    {"deck", (work / "deck.lammps").string()},
                    {"wall_time_s", engine_s},
+                   {"estimated_s", estimate_s},
                    {"steps", deck.steps},
                    {"dt", deck.dt},
                    {"step_factor", deck.step_factor},
@@ -152,8 +187,9 @@ int verify_in_lammps(const VerifyOptions& o, const SceneConfig& config,
   print_peak(std::cout, false, c.peak_stress_yy, std::nullopt, config.test.lateral_stress);
   std::cout << ")\n"
             << "  " << score.diagnosis.message << "\n"
-            << "  LAMMPS " << engine_s << " s; wrote " << dir << "/verify.json, prototype.csv, "
-            << work.string() << "/ (deck, series.csv, log.lammps)\n";
+            << "  LAMMPS " << engine_s << " s (estimated " << estimate_s << " s); wrote " << dir
+            << "/verify.json, prototype.csv, " << work.string()
+            << "/ (deck, series.csv, log.lammps)\n";
   return score.passed ? 0 : 1;
 }
 
@@ -218,8 +254,15 @@ int verify_3d(const VerifyOptions& o, const nlohmann::json& params, const RevPar
               const SceneConfig& config, const ScalingLaw& law) {
   if (o.engine != "demcal")
     throw InputError("--engine", "",
-                     "3D: verify runs demcal's sphere kernel (the LAMMPS 3D deck is `demcal "
-                     "export`'s)");
+                     "3D: verify runs demcal's sphere kernel only, not " + quoted_value(o.engine) +
+                         (o.engine == "lammps"     ? " (`demcal export` writes the LAMMPS 3D deck)"
+                          : o.engine == "liggghts" ? " (`demcal export --format liggghts` writes "
+                                                     "the LIGGGHTS 3D deck)"
+                                                   : ""));
+  if (o.np != 1)
+    throw InputError("--np", "",
+                     "MPI ranks are for --engine lammps, 2D only; 3D verify runs demcal's sphere "
+                     "kernel (--threads)");
   if (!o.tile.empty()) throw InputError("--tile", "", "tiles 2D prototype files only");
   if (o.consolidate_only)
     throw InputError("--consolidate-only", "", "2D only (3D prototypes are consolidated per run)");
@@ -340,7 +383,15 @@ int cmd_verify(const VerifyOptions& o) {
   if (config.dimension == 3) return verify_3d(o, params, rev, config, law);
   const bool in_lammps = o.engine == "lammps";
   if (!in_lammps && o.engine != "demcal")
-    throw InputError("--engine", "", "must be demcal or lammps, got \"" + o.engine + "\"");
+    throw InputError("--engine", "",
+                     "must be demcal or lammps, got " + quoted_value(o.engine) +
+                         (o.engine == "liggghts"
+                              ? " (`demcal export --format liggghts` writes the LIGGGHTS deck)"
+                              : ""));
+  if (!in_lammps && o.np != 1)
+    throw InputError("--np", "",
+                     "MPI ranks are for --engine lammps; demcal's verify runs in this process");
+  if (o.threads != 0) throw InputError("--threads", "", "3D only (2D verify runs on one thread)");
   const std::string lmp = in_lammps ? find_on_path("lmp") : "";
   if (in_lammps && lmp.empty())
     throw InputError("--engine", "lammps",
@@ -367,14 +418,18 @@ int cmd_verify(const VerifyOptions& o) {
   const AlgorithmSpec up = upscale(rev.params, rev.particles, n, law);
   print_prototype_notes("verify", particles, rev.particles, n, law);
   const double particle_steps = static_cast<double>(n) * static_cast<double>(up.steps);
-  const double speed0 = in_lammps ? kAssumedLammpsSpeed * o.np : kAssumedSpeed;
-  const double estimate_s = particle_steps / speed0;
+  // LAMMPS runs the deck's steps (Nstep/f) at its own speed, its ranks
+  // sharing the work only on large prototypes.
+  const int64_t run_steps = in_lammps ? lammps_deck_steps(config, up, proto) : up.steps;
+  const double estimate_s =
+      in_lammps ? lammps_estimate_s(n, run_steps, o.np) : particle_steps / kAssumedSpeed;
   if (estimate_s > 60.0 * o.max_minutes && !o.consolidate_only)
     throw InputError("--max-minutes", "",
                      "the loading of " + std::to_string(n) + " particles over " +
-                         std::to_string(up.steps) + " steps is estimated at " +
-                         std::to_string(estimate_s / 60.0) + " min, beyond the budget of " +
-                         std::to_string(o.max_minutes) + " min; raise --max-minutes to run it");
+                         std::to_string(run_steps) + (in_lammps ? " LAMMPS" : "") +
+                         " steps is estimated at " + std::to_string(estimate_s / 60.0) +
+                         " min, beyond the budget of " + std::to_string(o.max_minutes) +
+                         " min; raise --max-minutes to run it");
   std::cerr << "demcal verify: prototype " << source.description << "; " << up.steps
             << " steps upscaled (" << law.name() << " law, exponent " << law.exponent << ") from "
             << rev.particles << " particles / " << rev.params.steps << " steps\n";
@@ -383,9 +438,19 @@ int cmd_verify(const VerifyOptions& o) {
   if (o.consolidate_only)
     std::cerr << "demcal verify: --consolidate-only: the consolidation alone ("
               << consolidation_time << "), no loading\n";
+  else if (in_lammps)
+    std::cerr << "demcal verify: LAMMPS loading = " << run_steps << " steps of the deck (Nstep/f), "
+              << static_cast<double>(n) * static_cast<double>(run_steps)
+              << " particle-steps, estimated " << estimate_s / 60.0 << " min at " << kLammpsSpeed
+              << " particle-steps/s a rank plus " << kLammpsStepCost << " s a step"
+              << (o.np > 1 ? " on " + std::to_string(o.np) + " ranks (sharing the work from " +
+                                 num(kLammpsParticlesPerRank) + " particles a rank) plus " +
+                                 num(kLammpsMpiStepCost) + " s a step of exchanges"
+                           : std::string())
+              << " (plus consolidation in demcal, " << consolidation_time << ")\n";
   else
     std::cerr << "demcal verify: loading = " << particle_steps << " particle-steps, estimated "
-              << estimate_s / 60.0 << " min at " << speed0
+              << estimate_s / 60.0 << " min at " << kAssumedSpeed
               << " particle-steps/s (plus consolidation, " << consolidation_time << ")\n";
   const std::string dir = o.out_dir.empty() ? "demcal-verify-" + config.name : o.out_dir;
   make_output_dir(dir);
@@ -398,7 +463,7 @@ int cmd_verify(const VerifyOptions& o) {
   std::cerr << "demcal verify: consolidated in " << state.steps << " steps, " << state.wall_time_s
             << " s";
   if (!o.consolidate_only)
-    std::cerr << "; loading now, about " << particle_steps / (in_lammps ? speed0 : speed) / 60.0
+    std::cerr << "; loading now, about " << (in_lammps ? estimate_s : particle_steps / speed) / 60.0
               << " min";
   std::cerr << "\n";
   // The prototype's state, reusable by `demcal export --prototype` and by
@@ -415,7 +480,7 @@ int cmd_verify(const VerifyOptions& o) {
                                       particle_scales(proto.r, config.material, up.mass_scaling));
     head["consolidation"] = {{"steps", state.steps}, {"wall_time_s", state.wall_time_s}};
     head["version"] = DEMCAL_VERSION;
-    return verify_in_lammps(o, config, state, up, dir, lmp, head);
+    return verify_in_lammps(o, config, state, up, dir, lmp, estimate_s, head);
   }
   LoadingResult run;
   const Tolerances tolerances = default_tolerances(config);

@@ -34,6 +34,15 @@ constexpr int kThreadsFrom = 10000;
 /// its own Δt, below dt_ratio_max).
 void require_stable_step(const SceneConfig& config, double stable, bool allow_unstable);
 
+/// The prototype the config names (prototype.file read, prototype.particles
+/// generated: prototype_assembly, 3D prototype_spheres), made now and
+/// dropped. `calibrate` makes it only after the search, for params.json's
+/// prototype block: a missing or malformed particle file or an impossible
+/// count found there cost the whole search and failed with the folder
+/// already changed. Called by calibrate before anything runs, and by check,
+/// which says the config is valid.
+void require_prototype(const SceneConfig& config);
+
 int cmd_check(const std::string& path, const std::vector<std::string>& sets);
 /// `allow_unstable`: run a Δt beyond the estimated stable step (otherwise
 /// bad input).

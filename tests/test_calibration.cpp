@@ -10,6 +10,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <random>
 #include <set>
@@ -258,6 +259,50 @@ TEST(Calibration, SigintAndSigtermStopCleanlyAndResumeContinues) {
   EXPECT_EQ(read_bytes(stopped / "params.json"), read_bytes(reference / "params.json"));
   fs::remove_all(reference);
   fs::remove_all(stopped);
+}
+
+// A calibration into the folder of an earlier one removed that one's results
+// (params.json, run.json, report.*) when it started: stopped during its
+// search, it left the folder with neither calibration's result. Now the
+// earlier results stay, byte for byte, until this calibration writes its
+// own; its --resume then replaces them all (the report too).
+TEST(Calibration, AStoppedRecalibrationKeepsTheEarlierResults) {
+  const fs::path dir = test::fresh_path("cal_keep");
+  // The default 10x10 scene on one job: seconds of trials, so the signal
+  // arrives mid-search.
+  ASSERT_EQ(wait_exit(test::spawn_demcal({"calibrate", "-q", "-o", dir.string(), "-j", "1"})), 0);
+  std::map<std::string, std::string> earlier;
+  for (const char* name : {"params.json", "run.json", "report.html", "report.md"})
+    earlier[name] = read_bytes(dir / name);
+  ASSERT_FALSE(earlier["params.json"].empty());
+  const std::vector<std::string> again{"calibrate", "-q", "-o",         dir.string(),
+                                       "-j",        "1",  "--accuracy", "0.03"};
+  const pid_t pid = test::spawn_demcal(again);
+  // Three trials of this calibration (the earlier one's trials.jsonl is
+  // there until this one's resume.json replaces it).
+  bool started = false;
+  for (int k = 0; k < 6000 && !started; ++k) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    try {
+      started = read_json(dir / "resume.json").at("accuracy") == 0.03;
+    } catch (const std::exception&) {  // being replaced
+    }
+  }
+  ASSERT_TRUE(started && wait_for_trials(dir / "trials.jsonl", 3, pid))
+      << "the calibration ended before the signal";
+  kill(pid, SIGINT);
+  EXPECT_EQ(wait_exit(pid), 128 + SIGINT);
+  for (const auto& [name, bytes] : earlier) EXPECT_EQ(read_bytes(dir / name), bytes) << name;
+  std::vector<std::string> resume = again;
+  resume.push_back("--resume");
+  ASSERT_EQ(wait_exit(test::spawn_demcal(resume)), 0);
+  EXPECT_EQ(read_json(dir / "params.json").at("accuracy"), 0.03);
+  EXPECT_TRUE(read_json(dir / "run.json").at("resumed").get<bool>());
+  for (const char* name : {"report.html", "report.md"}) {
+    EXPECT_TRUE(fs::exists(dir / name)) << name;
+    EXPECT_NE(read_bytes(dir / name), earlier[name]) << name;
+  }
+  fs::remove_all(dir);
 }
 
 // A kill in mid-write leaves .demcal-tmp-PID-NAME; the next run into the

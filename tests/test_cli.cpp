@@ -214,6 +214,33 @@ TEST_F(CliEndToEnd, VerifyConsolidateOnlyAnnouncesNoLoading) {
     EXPECT_EQ(r.err.find(announce), std::string::npos) << announce << " in " << r.err;
 }
 
+// verify's options that the run would not use are refused, one line naming
+// the option, nothing written: --np without --engine lammps (it was
+// ignored), --threads in 2D (3D only: ignored too), and --engine liggghts
+// is pointed to export.
+TEST_F(CliEndToEnd, VerifyRefusesTheOptionsItWouldIgnore) {
+  const demcal::SceneConfig c = demcal::default_config();
+  demcal::AlgorithmSpec p;
+  p.steps = 20000;
+  const auto scales = demcal::particle_scales(demcal::make_assembly(c).r, c.material);
+  const std::string params =
+      write("params.json", nlohmann::json{{"schema", "demcal.params/1"},
+                                          {"scene", c.name},
+                                          {"rev", demcal::param_block(p, scales)}}
+                               .dump());
+  const std::vector<std::string> verify{"verify", params, "--particles", "25", "-o", "v"};
+  auto with = [&](const std::vector<std::string>& more) {
+    std::vector<std::string> args = verify;
+    args.insert(args.end(), more.begin(), more.end());
+    return args;
+  };
+  expect_bad_input(with({"--np", "2"}), {"--np", "--engine lammps"});
+  expect_bad_input(with({"--engine", "demcal", "--np", "2"}), {"--np", "--engine lammps"});
+  expect_bad_input(with({"--threads", "2"}), {"--threads", "3D only"});
+  expect_bad_input(with({"--engine", "liggghts"}),
+                   {"--engine", "\"liggghts\"", "export --format liggghts"});
+}
+
 // `demcal stability`: the limit against the estimate, both files written.
 TEST_F(CliEndToEnd, StabilityScanWritesItsReport) {
   const fs::path out = dir_ / "work" / "scan";
@@ -344,6 +371,57 @@ TEST_F(CliEndToEnd, AMissingParticleFileNamesTheConfigAndKey) {
                                   "test": {"type": "triaxial"}})");
   expect_bad_input({"run", spheres, "-o", out},
                    {spheres + ": assembly.file: \"" + csv + "\": no such file"});
+}
+
+// The prototype the config names is read after calibrate's search (for
+// params.json's prototype block): a missing or malformed prototype file, or
+// a count no scene can have, ran the whole search, then failed with exit 2
+// having removed the earlier calibration's results from the folder, and
+// `check` called the config valid. Now check and calibrate refuse it before
+// any work, and the folder keeps every file, byte for byte (2D and 3D).
+TEST_F(CliEndToEnd, APrototypeTheConfigCannotMakeIsRefusedBeforeAnyWork) {
+  const std::string out = (dir_ / "work" / "out").string();
+  auto with_prototype = [&](const std::string& shipped, const std::string& name,
+                            const nlohmann::json& prototype) {
+    nlohmann::json config = nlohmann::json::parse(read_text(test::shipped_config(shipped)));
+    config["prototype"] = prototype;
+    return write(name, config.dump(2));
+  };
+  const std::string nope = with_prototype("hex_5x5", "nope.json", {{"file", "nope.csv"}});
+  const std::string missing = nope + ": prototype.file: \"" + (dir_ / "nope.csv").string() + "\"";
+  expect_bad_input({"check", nope}, {missing, "no such file"});
+  expect_bad_input({"calibrate", nope, "-o", out}, {missing, "no such file"});
+  const std::string bad_csv = write("bad.csv", "x,y,r\n0,0,5e-4\n1e-3,0\n");
+  const std::string bad = with_prototype("hex_5x5", "bad.json", {{"file", "bad.csv"}});
+  expect_bad_input({"check", bad}, {bad_csv, "line 3"});
+  expect_bad_input({"calibrate", bad, "-o", out}, {bad_csv, "line 3"});
+  expect_bad_input({"check", kHex5, "--set", "prototype.particles=1"}, {"at least 2 particles"});
+  expect_bad_input({"calibrate", kHex5, "--set", "prototype.particles=1", "-o", out},
+                   {"at least 2 particles"});
+  const std::string spheres = with_prototype("fcc_4x4x4", "nope3d.json", {{"file", "nope.csv"}});
+  const std::string missing3d =
+      spheres + ": prototype.file: \"" + (dir_ / "nope.csv").string() + "\"";
+  expect_bad_input({"check", spheres}, {missing3d});
+  expect_bad_input({"calibrate", spheres, "-o", out}, {missing3d});
+
+  // Into the folder of an earlier calibration: refused as above, nothing
+  // of that calibration removed or changed.
+  const Result first =
+      demcal({"calibrate", kHex5, "-o", out, "-q", "-j", "1", "--max-trials", "12"});
+  ASSERT_EQ(first.status, 0) << first.err;
+  auto contents = [&] {
+    std::map<std::string, std::string> files;
+    for (const std::string& name : test::names_in(out))
+      files[name] = read_text(fs::path(out) / name);
+    return files;
+  };
+  const auto before = contents();
+  ASSERT_TRUE(before.count("params.json") && before.count("report.md"));
+  const Result r = demcal({"calibrate", nope, "-o", out, "-q", "-j", "1", "--max-trials", "12"});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_EQ(lines_of(r.err).size(), 1u) << r.err;
+  EXPECT_NE(r.err.find(missing), std::string::npos) << r.err;
+  EXPECT_EQ(contents(), before);
 }
 
 // --- run outputs ------------------------------------------------------------

@@ -905,6 +905,48 @@ TEST(EngineLammps, VerifyInLammpsAgreesWithDemcal) {
   EXPECT_TRUE(l.contains("verdict_line"));
 }
 
+// `verify --engine lammps` estimates the run it refuses beyond --max-minutes
+// from what LAMMPS will run: the deck's Nstep/f steps (it counted demcal's
+// Nstep, half of them at the calibrated zeta_t), and on a small prototype
+// no speed-up from MPI ranks (it divided by --np: 100 disks on 2 ranks,
+// estimated 2.9 s, ran 58.7 s, slower than on one).
+TEST(EngineLammps, VerifyEstimatesTheDecksStepsAndNoRankSpeedUpOnASmallPrototype) {
+  DEMCAL_FIND_PROGRAM(lmp, "lmp", "lammps", "verify --engine lammps is not run");
+  const test::TempDir dir("engine_estimate");
+  ASSERT_EQ(
+      test::run_demcal({"calibrate", test::shipped_config("hex_5x5"), "-o", "cal", "-j1", "-q"},
+                       dir.path())
+          .status,
+      0);
+  ASSERT_EQ(
+      test::run_demcal(
+          {"export", "cal/params.json", "--particles", "100", "-o", "deck/deck.lammps"}, dir.path())
+          .status,
+      0);
+  const std::string deck = test::read_text(dir / "deck" / "deck.lammps");
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(deck, m, std::regex(R"(variable nstep +equal (\d+))"))) << deck;
+  const std::string deck_steps = m[1];
+  // Refused on a budget no run meets, the estimate in the message.
+  auto estimate_min = [&](const std::vector<std::string>& more) {
+    std::vector<std::string> args{"verify", "cal/params.json", "--particles", "100", "--engine",
+                                  "lammps", "--max-minutes",   "1e-9",        "-o",  "v"};
+    args.insert(args.end(), more.begin(), more.end());
+    const test::RunResult r = test::run_demcal(args, dir.path());
+    EXPECT_EQ(r.status, 2) << r.err;
+    EXPECT_NE(r.err.find("over " + deck_steps + " LAMMPS steps"), std::string::npos) << r.err;
+    std::smatch e;
+    EXPECT_TRUE(std::regex_search(r.err, e, std::regex(R"(estimated at ([0-9.]+) min)"))) << r.err;
+    return e.empty() ? 0.0 : std::stod(e[1]);
+  };
+  const double one_rank = estimate_min({});
+  EXPECT_GT(one_rank, 0.0);
+  if (!test::find_on_path("mpirun").empty()) {
+    EXPECT_GE(estimate_min({"--np", "2"}), one_rank);
+  }
+  EXPECT_FALSE(fs::exists(dir / "v"));
+}
+
 /// The thermo rows of a LIGGGHTS deck's loading run (after its thermo_style
 /// line with `after`), by step: the rows of `columns` numbers of every
 /// chunk of the run (the deck runs in chunks, `run ... every`, each with

@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "demcal/scene/triaxial.hpp"
 #include "demcal/upscaling/params_file.hpp"
@@ -23,8 +24,9 @@ namespace {
 namespace fs = std::filesystem;
 namespace test = demcal::test;
 
-TEST(Verify3D, SmallFccPrototypeRunsAndReports) {
-  test::TempDir dir("verify3d");
+/// params.json of a 32-sphere FCC REV (2 cells an edge) whose prototype
+/// is 256 spheres, in `dir`.
+std::string write_fcc2_params(const fs::path& dir) {
   const demcal::SceneConfig config =
       demcal::parse_config_text("{" + test::kMaterialMember + R"(, "name": "fcc2", "dimension": 3,
         "assembly": {"type": "fcc", "cells_x": 2, "cells_y": 2, "cells_z": 2, "radius": 5e-4},
@@ -40,9 +42,13 @@ TEST(Verify3D, SmallFccPrototypeRunsAndReports) {
   best.damping_ratio_translation = 0.7;
   best.damping_ratio_rotation = 0.5;
   const double rev_peak = -3.3e5;  // the REV's peak, as recorded
-  const std::string params = test::write_text(
-      dir / "params.json", test::params_3d(config, state, best, rev_peak).dump(2) + "\n");
+  return test::write_text(dir / "params.json",
+                          test::params_3d(config, state, best, rev_peak).dump(2) + "\n");
+}
 
+TEST(Verify3D, SmallFccPrototypeRunsAndReports) {
+  test::TempDir dir("verify3d");
+  const std::string params = write_fcc2_params(dir.path());
   const test::RunResult r = test::run_demcal({"verify", params, "-o", "v"}, dir.path());
   ASSERT_TRUE(r.status == 0 || r.status == 1) << r.err;  // PASS or FAIL, both reported
   // The estimate comes first, before the consolidation.
@@ -81,6 +87,36 @@ TEST(Verify3D, SmallFccPrototypeRunsAndReports) {
   EXPECT_EQ(scored.at("criteria").at("peak_stress_yy").get<double>(), peak);
   EXPECT_EQ(scored.at("passed").get<bool>(), v.at("passed").get<bool>());
   EXPECT_EQ(sc.status, r.status);
+}
+
+// verify's 2D-only options are refused in 3D, one line naming the option
+// (and the engine asked for: a refused --engine liggghts was told about
+// LAMMPS), nothing written; --np was ignored.
+TEST(Verify3D, TwoDimensionalOptionsAreRefusedByName) {
+  test::TempDir dir("verify3d_options");
+  const std::string params = write_fcc2_params(dir.path());
+  struct Case {
+    std::vector<std::string> args, mentions;
+    std::string absent;
+  };
+  const std::vector<Case> cases = {
+      {{"--engine", "liggghts"}, {"--engine", "\"liggghts\"", "--format liggghts"}, "LAMMPS"},
+      {{"--engine", "lammps"}, {"--engine", "\"lammps\"", "demcal export"}, ""},
+      {{"--np", "2"}, {"--np", "--engine lammps"}, ""},
+      {{"--tile", "2x2"}, {"--tile"}, ""},
+      {{"--consolidate-only"}, {"--consolidate-only"}, ""},
+  };
+  for (const Case& c : cases) {
+    std::vector<std::string> args{"verify", params, "-o", "v"};
+    args.insert(args.end(), c.args.begin(), c.args.end());
+    SCOPED_TRACE(c.args.front());
+    const test::RunResult r = test::run_demcal(args, dir.path());
+    EXPECT_EQ(r.status, 2) << r.err;
+    EXPECT_EQ(test::lines_of(r.err).size(), 1u) << r.err;
+    for (const std::string& m : c.mentions) EXPECT_NE(r.err.find(m), std::string::npos) << r.err;
+    if (!c.absent.empty()) EXPECT_EQ(r.err.find(c.absent), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir / "v"));
+  }
 }
 
 }  // namespace
