@@ -60,7 +60,7 @@ struct ScalingOptions {
   std::string sizes = "25,100,400,1600";
   int64_t calibrate_max = 400;  ///< larger sizes are only checked forward
   std::string out_dir;          ///< report folder (default demcal-scaling-NAME)
-  std::string work_dir;         ///< per-size work (default demcal-scaling-NAME)
+  std::string work_dir;         ///< per-size work (default: out_dir)
   int jobs = 0;
   int max_trials = 0;
   bool resume = false;

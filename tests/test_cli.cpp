@@ -363,7 +363,7 @@ TEST_F(CliEndToEnd, AMissingParticleFileNamesTheConfigAndKey) {
   // else reads it; scaling cuts its family from it.
   expect_bad_input({"calibrate", config, "-o", out},
                    {config + ": assembly.file: \"" + csv + "\": no such file"});
-  expect_bad_input({"scaling", config, "--sizes", "12,24", "-o", out},
+  expect_bad_input({"scaling", config, "--sizes", "12,24,800", "-o", out},
                    {config + ": assembly.file: \"" + csv + "\": no such file"});
   const std::string spheres = write(
       "gone3d.json", "{" + test::kMaterialMember +

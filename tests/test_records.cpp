@@ -270,7 +270,10 @@ TEST(Records, EvidenceBlockMeasuresPeakErrorsAgainstTheReference) {
 }
 
 TEST(ScalingStudy, SizesParseSortedAndBadPlansAreBadInput) {
-  EXPECT_EQ(parse_sizes("400,25,100,25"), (std::vector<int64_t>{25, 100, 400}));
+  EXPECT_EQ(parse_sizes("400,25,100"), (std::vector<int64_t>{25, 100, 400}));
+  // A size twice is a typo, not a plan.
+  EXPECT_NE(input_error_of([] { parse_sizes("400,25,100,25"); }).find("25 given twice"),
+            std::string::npos);
   EXPECT_THROW(parse_sizes("25"), InputError);
   EXPECT_THROW(parse_sizes("25,x"), InputError);
   EXPECT_THROW(parse_sizes("2,25"), InputError);
@@ -280,6 +283,19 @@ TEST(ScalingStudy, SizesParseSortedAndBadPlansAreBadInput) {
   EXPECT_NO_THROW(check_scaling_sizes(o));
   o.calibrate_max = 50;  // one calibrated size only
   EXPECT_NE(input_error_of([&] { check_scaling_sizes(o); }).find("--sizes"), std::string::npos);
+  // Every size calibrated: no forward check, which is the study's proof.
+  o.sizes = {25, 100};
+  o.calibrate_max = 400;
+  EXPECT_NE(input_error_of([&] {
+              check_scaling_sizes(o);
+            }).find("the forward check needs a size above --calibrate-max (400)"),
+            std::string::npos);
+  o.calibrate_max = 100;
+  EXPECT_NE(input_error_of([&] { check_scaling_sizes(o); }).find("--calibrate-max (100)"),
+            std::string::npos);
+  o.calibrate_max = 99;  // 100 is then the forward size, and 25 alone is calibrated
+  EXPECT_NE(input_error_of([&] { check_scaling_sizes(o); }).find("two sizes <= --calibrate-max"),
+            std::string::npos);
 }
 
 TEST(ScalingStudy, SpreadIsRangeOverMean) {

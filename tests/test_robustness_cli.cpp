@@ -174,8 +174,8 @@ TEST_F(RobustCli, ResumeAfterTheParticleFileChangedIsRefused) {
 
   write_rev(7, 5e-4);
   std::vector<std::string> study = {
-      "scaling", kHex5,          "--set", from_file, "--sizes", "16,25", "--calibrate-max",
-      "25",      "--max-trials", "12",    "-j",      "1",       "-q",    "--work",
+      "scaling", kHex5,          "--set", from_file, "--sizes", "16,25,36", "--calibrate-max",
+      "25",      "--max-trials", "12",    "-j",      "1",       "-q",       "--work",
       "S",       "-o",           "R"};
   const Result scaled = demcal(study);
   ASSERT_TRUE(scaled.status == 0 || scaled.status == 1) << scaled.err;  // 1: the forward check
@@ -186,7 +186,7 @@ TEST_F(RobustCli, ResumeAfterTheParticleFileChangedIsRefused) {
   // A generated family reads no file: a prototype file named but not made
   // yet (verify writes one later) keys nothing and stops nothing.
   const Result generated = demcal({"scaling", kHex5, "--set", R"(prototype={"file": "later.csv"})",
-                                   "--sizes", "16,25", "--calibrate-max", "25", "--max-trials",
+                                   "--sizes", "16,25,36", "--calibrate-max", "25", "--max-trials",
                                    "12", "-j", "1", "-q", "--work", "G", "-o", "RG"});
   EXPECT_TRUE(generated.status == 0 || generated.status == 1) << generated.err;
   EXPECT_FALSE(nlohmann::json::parse(read_text(work() / "G" / "resume.json"))

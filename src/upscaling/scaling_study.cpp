@@ -36,7 +36,11 @@ std::vector<int64_t> parse_sizes(const std::string& text, const std::string& opt
     sizes.push_back(v);
   }
   std::sort(sizes.begin(), sizes.end());
-  sizes.erase(std::unique(sizes.begin(), sizes.end()), sizes.end());
+  const auto twice = std::adjacent_find(sizes.begin(), sizes.end());
+  if (twice != sizes.end())
+    throw InputError(
+        option, "",
+        "size " + std::to_string(*twice) + " given twice in \"" + text + "\": each size once");
   if (sizes.size() < 2) throw InputError(option, "", "needs at least two sizes");
   return sizes;
 }
@@ -234,9 +238,12 @@ class Family {
   std::map<int64_t, std::unique_ptr<SizeState>> states_;
 };
 
-/// Step 1: calibrate a size (or reuse its result.json).
-ScalingSize calibrate_size(Family& family, const SceneConfig& config, const ScalingStudyOptions& o,
-                           int64_t n) {
+bool stop_asked(const ScalingStudyOptions& o) { return o.stop && o.stop->load(); }
+
+/// Step 1: calibrate a size (or reuse its result.json); nothing when a stop
+/// cut the calibration (its finished trials stay in the size's trials.jsonl).
+std::optional<ScalingSize> calibrate_size(Family& family, const SceneConfig& config,
+                                          const ScalingStudyOptions& o, int64_t n) {
   const std::string result_path = family.dir(n) + "/result.json";
   if (o.resume && fs::exists(result_path)) {
     ScalingSize r = scaling_size_from_json(read_json(result_path), result_path);
@@ -253,12 +260,18 @@ ScalingSize calibrate_size(Family& family, const SceneConfig& config, const Scal
   CalibrationOptions co = CalibrationOptions::from(config);
   co.jobs = o.jobs;
   co.trials_path = family.dir(n) + "/trials.jsonl";
-  fs::remove(co.trials_path);
+  // A size stopped in its calibration (a signal, a kill) left its finished
+  // trials: a resumed study continues from them (a resume matched the
+  // study's settings and build, and a fresh start cleared the sizes).
+  co.resume = o.resume && fs::exists(co.trials_path);
+  if (!co.resume) fs::remove(co.trials_path);
+  co.stop = o.stop;
   if (o.log)
     co.progress = [n, &o](const std::string& line) {
       o.log("size " + std::to_string(n) + ": " + line);
     };
   const CalibrationSummary s = family.calibrate_size(n, co);
+  if (s.interrupted) return std::nullopt;
   r.calibrated = true;
   r.success = s.success;
   r.best = s.best;
@@ -380,9 +393,15 @@ void check_scaling_sizes(const ScalingStudyOptions& o) {
     throw InputError(
         "--sizes", "",
         "needs at least two sizes <= --calibrate-max (" + std::to_string(o.calibrate_max) + ")");
-  // Sorted sizes: the smallest is below the largest unless all are equal.
-  if (o.sizes.front() >= o.sizes.back())
-    throw InputError("--sizes", "", "needs a calibrated size below the largest");
+  // The largest size runs the law carried from the REV: the study's proof.
+  // Calibrated, it would check nothing. (Sorted sizes: a largest size above
+  // --calibrate-max also has a calibrated size, the REV, below it.)
+  if (o.sizes.back() <= o.calibrate_max)
+    throw InputError("--sizes", "",
+                     "the forward check needs a size above --calibrate-max (" +
+                         std::to_string(o.calibrate_max) +
+                         "): every size given is calibrated, none runs the law carried from the "
+                         "REV");
 }
 
 ScalingStudy run_scaling_study(const SceneConfig& config, const ScalingStudyOptions& o) {
@@ -419,7 +438,18 @@ ScalingStudy run_scaling_study(const SceneConfig& config, const ScalingStudyOpti
              "; sizes " + o.sizes_text + "; calibrated up to " + std::to_string(o.calibrate_max) +
              "; the REV whose multipliers are carried: " + std::to_string(st.ref_size));
 
-  for (int64_t n : st.calibrated_sizes) st.results[n] = calibrate_size(family, config, o, n);
+  // A stop (o.stop) takes effect within a calibration and between the
+  // steps of the study: whatever finished is in the work folder.
+  const auto stopped = [&st] {
+    st.interrupted = true;
+    return st;
+  };
+  for (int64_t n : st.calibrated_sizes) {
+    if (stop_asked(o)) return stopped();
+    std::optional<ScalingSize> r = calibrate_size(family, config, o, n);
+    if (!r) return stopped();
+    st.results[n] = std::move(*r);
+  }
   const ScalingSize ref = st.results.at(st.ref_size);
   if (!ref.success)
     throw std::runtime_error("the REV (size " + std::to_string(st.ref_size) +
@@ -436,10 +466,12 @@ ScalingStudy run_scaling_study(const SceneConfig& config, const ScalingStudyOpti
       r.fixed.steps = r.best.steps;
       continue;
     }
+    if (stop_asked(o)) return stopped();
     fixed_multipliers(family, o, ref, st.candidate, st.tolerances, n, r);
   }
   fit_laws(st);
   const ScalingSize& fwd = st.results[st.forward_size];
+  if (stop_asked(o)) return stopped();
   if (st.forward_size > o.calibrate_max && !fwd.fixed.trials.empty())
     forward_check(family, o, st, fwd.fixed.trials.front());
   st.forward_ok =

@@ -16,6 +16,7 @@
 // scaling.md.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <functional>
 #include <map>
@@ -29,8 +30,8 @@
 
 namespace demcal {
 
-/// Particle counts "25,100,400": sorted, without repeats, each >= 4, at
-/// least two; errors name `option`.
+/// Particle counts "25,100,400": sorted, each >= 4 and given once (a
+/// repeat is an error), at least two; errors name `option`.
 std::vector<int64_t> parse_sizes(const std::string& text, const std::string& option = "--sizes");
 
 struct ScalingStudyOptions {
@@ -39,7 +40,12 @@ struct ScalingStudyOptions {
   int64_t calibrate_max = 400;  ///< larger sizes are only checked forward
   std::string work_dir;         ///< per-size work (created)
   int jobs = 0;
-  bool resume = false;  ///< reuse the sizes already done in work_dir
+  bool resume = false;  ///< reuse the sizes (and a size's trials) already done in work_dir
+  /// Set by the caller (a SIGINT handler) to stop cleanly: a calibration
+  /// winds down keeping its finished trials, a size's step search or the
+  /// forward reference run finishes, no further step starts, and the study
+  /// returns with `interrupted` set. May be null.
+  const std::atomic<bool>* stop = nullptr;
   /// Progress lines; may be empty.
   std::function<void(const std::string&)> log;
 };
@@ -110,12 +116,16 @@ struct ScalingStudy {
   double accuracy = 0.0;
   Tolerances tolerances;
   bool resumed = false;
+  /// options.stop was set: the study stopped before its end, nothing else
+  /// in it is complete (resume continues from the work folder).
+  bool interrupted = false;
   double wall_time_s = 0.0;
 };
 
-/// The sizes' plan is usable: at least two sizes up to calibrate_max, one
-/// of them below the largest (the REV the law is carried from). Throws
-/// InputError naming --sizes; run_scaling_study() checks it first.
+/// The sizes' plan is usable: at least two sizes up to calibrate_max (the
+/// largest of them is the REV the law is carried from) and the largest size
+/// above it (the forward check, without which the study proves nothing).
+/// Throws InputError naming --sizes; run_scaling_study() checks it first.
 void check_scaling_sizes(const ScalingStudyOptions& options);
 
 /// The particle file a scaling study cuts its family of REVs from (path)

@@ -1,0 +1,241 @@
+// `demcal scaling` on the command line: a plan of sizes without a forward
+// size, or with a size twice, is a usage error before any work; the per-size
+// work goes to the -o folder unless --work says otherwise; SIGINT stops the
+// study cleanly (finished sizes and trials kept, the resume command shown)
+// and --resume ends with the uninterrupted study's scaling.json.
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "support/files.hpp"
+#include "support/process.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+using Result = demcal::test::RunResult;
+using demcal::test::read_text;
+
+const std::string kHex5 = demcal::test::shipped_config("hex_5x5");
+
+/// The lines of a trials.jsonl, each parsed; a cut last line left out.
+std::vector<nlohmann::json> read_trials(const fs::path& path) {
+  std::vector<nlohmann::json> out;
+  std::ifstream in(path);
+  for (std::string line; std::getline(in, line);) {
+    if (line.empty()) continue;
+    try {
+      out.push_back(nlohmann::json::parse(line));
+    } catch (const nlohmann::json::exception&) {
+    }
+  }
+  return out;
+}
+
+/// `j` without its wall times (every key ending in "wall_time_s", at any
+/// depth): what differs between two runs of the same study.
+nlohmann::json without_timing(nlohmann::json j) {
+  if (j.is_object()) {
+    nlohmann::json out = nlohmann::json::object();
+    for (auto& [key, value] : j.items()) {
+      const std::string suffix = "wall_time_s";
+      if (key.size() >= suffix.size() &&
+          key.compare(key.size() - suffix.size(), suffix.size(), suffix) == 0)
+        continue;
+      out[key] = without_timing(value);
+    }
+    return out;
+  }
+  if (j.is_array())
+    for (auto& v : j) v = without_timing(v);
+  return j;
+}
+
+class ScalingCli : public ::testing::Test {
+ protected:
+  void SetUp() override { fs::create_directories(work()); }
+  fs::path work() const { return dir_ / "work"; }
+
+  Result demcal(const std::vector<std::string>& args) {
+    return ::demcal::test::run_demcal(args, work());
+  }
+
+  /// `demcal ARGS` started in work(), stdout and stderr to files beside it.
+  pid_t spawn(const std::vector<std::string>& args) {
+    std::vector<std::string> all{demcal::test::kDemcalBinary};
+    all.insert(all.end(), args.begin(), args.end());
+    std::vector<char*> argv;
+    for (auto& a : all) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    // Everything the child needs is made before the fork (a threaded
+    // parent's child may only make async-signal-safe calls until exec).
+    const std::string cwd = work().string(), out = (dir_ / "out.txt").string(),
+                      err = (dir_ / "err.txt").string();
+    const pid_t pid = ::fork();
+    if (pid == 0) {
+      const int o = ::open(out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+      const int e = ::open(err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+      if (o < 0 || e < 0 || ::dup2(o, STDOUT_FILENO) < 0 || ::dup2(e, STDERR_FILENO) < 0 ||
+          ::chdir(cwd.c_str()) != 0)
+        ::_exit(127);
+      ::execv(demcal::test::kDemcalBinary, argv.data());
+      ::_exit(127);
+    }
+    return pid;
+  }
+  std::string spawned_err() const { return read_text(dir_ / "err.txt"); }
+
+  const demcal::test::TempDir tmp_{"scaling_cli"};
+  const fs::path dir_ = tmp_.path();
+};
+
+// Every size up to --calibrate-max: nothing would check the law forward,
+// and the study printed "FAILED" for a check it never ran. A size given
+// twice is a typo, not a plan. Both are usage errors (exit 2, one line
+// naming --sizes) before any folder is made.
+TEST_F(ScalingCli, SizesWithoutAForwardSizeOrRepeatedAreUsageErrors) {
+  struct Case {
+    std::vector<std::string> args;
+    std::string mention;
+  };
+  const std::vector<Case> cases = {
+      {{"--sizes", "25,100"}, "the forward check needs a size above --calibrate-max (400)"},
+      {{"--sizes", "9,16,25", "--calibrate-max", "25"},
+       "the forward check needs a size above --calibrate-max (25)"},
+      {{"--sizes", "25,25,100,800"}, "25 given twice"},
+  };
+  for (const Case& c : cases) {
+    std::vector<std::string> args{"scaling", kHex5, "-o", "out", "-q", "-j", "1"};
+    args.insert(args.end(), c.args.begin(), c.args.end());
+    std::string trace = "demcal";
+    for (const auto& a : args) trace += " " + a;
+    SCOPED_TRACE(trace);
+    const Result r = demcal(args);
+    EXPECT_EQ(r.status, 2) << r.err;
+    EXPECT_EQ(r.err.rfind("demcal: error: --sizes: ", 0), 0u) << r.err;
+    EXPECT_NE(r.err.find(c.mention), std::string::npos) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_EQ(r.out, "");
+    EXPECT_TRUE(fs::is_empty(work())) << "left output behind";
+  }
+}
+
+// Without --work the per-size work goes to the -o folder (README: "default
+// the same folder"): two studies of one scene with different -o do not
+// share, and a fresh start of one leaves the other's sizes alone.
+TEST_F(ScalingCli, WorkDefaultsToTheOutputFolder) {
+  const std::vector<std::string> study = {
+      "scaling", kHex5, "--sizes",      "16,25,36", "--calibrate-max", "25", "-q",
+      "-j",      "1",   "--max-trials", "12"};
+  const auto into = [&](const std::string& out) {
+    std::vector<std::string> args = study;
+    args.insert(args.end(), {"-o", out});
+    return args;
+  };
+  const Result a = demcal(into("A"));
+  ASSERT_TRUE(a.status == 0 || a.status == 1) << a.err;  // 1: the forward check
+  for (const char* f : {"scaling.json", "scaling.md", "resume.json", "size-16/result.json",
+                        "size-25/result.json", "size-36/fixed.json"})
+    EXPECT_TRUE(fs::exists(work() / "A" / f)) << f;
+  EXPECT_FALSE(fs::exists(work() / "demcal-scaling-hex_5x5"));
+  const std::string a_result = read_text(work() / "A" / "size-16" / "result.json");
+  const Result b = demcal(into("B"));
+  ASSERT_TRUE(b.status == 0 || b.status == 1) << b.err;
+  EXPECT_TRUE(fs::exists(work() / "B" / "size-16" / "result.json"));
+  EXPECT_EQ(read_text(work() / "A" / "size-16" / "result.json"), a_result);
+  // The report in one folder, the work in another, as before.
+  const Result c = demcal([&] {
+    std::vector<std::string> args = into("C");
+    args.insert(args.end(), {"--work", "W"});
+    return args;
+  }());
+  ASSERT_TRUE(c.status == 0 || c.status == 1) << c.err;
+  EXPECT_TRUE(fs::exists(work() / "C" / "scaling.json"));
+  EXPECT_FALSE(fs::exists(work() / "C" / "resume.json"));
+  EXPECT_TRUE(fs::exists(work() / "W" / "size-16" / "result.json"));
+}
+
+// A study begun when --work defaulted to demcal-scaling-NAME whatever -o
+// said: --resume with that -o points there (exit 2, nothing made) rather
+// than start afresh in the -o folder.
+TEST_F(ScalingCli, ResumeOfAStudyWhoseWorkIsInTheOldDefaultFolderSaysWhere) {
+  demcal::test::write_text(work() / "demcal-scaling-hex_5x5" / "resume.json", "{}\n");
+  const Result r = demcal({"scaling", kHex5, "--sizes", "16,25,36", "--calibrate-max", "25", "-q",
+                           "-o", "X", "--resume"});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("add --work demcal-scaling-hex_5x5"), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_FALSE(fs::exists(work() / "X"));
+}
+
+// SIGINT during a size's calibration: exit 130, the sizes finished before
+// kept, the size's finished trials kept, no scaling.json, the resume command
+// on stderr. --resume reruns no finished trial and writes the uninterrupted
+// study's scaling.json (wall times apart).
+TEST_F(ScalingCli, SigintStopsCleanlyAndResumeEndsAsAnUninterruptedStudy) {
+  const std::vector<std::string> study = {
+      "scaling", kHex5, "--sizes",      "16,100,144", "--calibrate-max", "100", "-q",
+      "-j",      "1",   "--max-trials", "12"};
+  // Report and work in one folder, named (not left to the default: this
+  // test is about the stop alone).
+  const auto into = [&](const std::string& out) {
+    std::vector<std::string> args = study;
+    args.insert(args.end(), {"-o", out, "--work", out});
+    return args;
+  };
+  const Result reference = demcal(into("R"));
+  ASSERT_TRUE(reference.status == 0 || reference.status == 1) << reference.err;
+
+  const pid_t pid = spawn(into("S"));
+  const fs::path trials = work() / "S" / "size-100" / "trials.jsonl";
+  bool seen = false;
+  for (int k = 0; k < 12000 && !seen; ++k) {
+    int status = 0;
+    if (::waitpid(pid, &status, WNOHANG) == pid) break;
+    seen = fs::exists(trials) && read_trials(trials).size() >= 2;
+    if (!seen) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  ASSERT_TRUE(seen) << "the study ended before the signal: " << spawned_err();
+  ::kill(pid, SIGINT);
+  EXPECT_EQ(demcal::test::wait_exit(pid), 130) << spawned_err();
+  const std::string err = spawned_err();
+  EXPECT_NE(err.find("interrupted"), std::string::npos) << err;
+  EXPECT_NE(err.find("Continue with:\n  demcal scaling " + kHex5 +
+                     " --sizes 16,100,144 --calibrate-max 100 --max-trials 12 -o S --work S "
+                     "--resume\n"),
+            std::string::npos)
+      << err;
+  EXPECT_TRUE(fs::exists(work() / "S" / "size-16" / "result.json"));
+  EXPECT_FALSE(fs::exists(work() / "S" / "size-100" / "result.json"));
+  EXPECT_FALSE(fs::exists(work() / "S" / "scaling.json"));
+  EXPECT_FALSE(fs::exists(work() / "S" / "scaling.md"));
+  std::vector<nlohmann::json> kept = read_trials(trials);
+  ASSERT_GE(kept.size(), 2u);
+
+  std::vector<std::string> resume = into("S");
+  resume.push_back("--resume");
+  const Result resumed = demcal(resume);
+  ASSERT_EQ(resumed.status, reference.status) << resumed.err;
+  // The trials finished before the stop were reused, not rerun: the size's
+  // file begins with them.
+  std::vector<nlohmann::json> all = read_trials(trials);
+  ASSERT_GE(all.size(), kept.size());
+  for (size_t i = 0; i < kept.size(); ++i)
+    EXPECT_EQ(without_timing(all[i]), without_timing(kept[i])) << "line " << i + 1;
+  EXPECT_EQ(without_timing(demcal::test::read_json(work() / "S" / "scaling.json")),
+            without_timing(demcal::test::read_json(work() / "R" / "scaling.json")));
+}
+
+}  // namespace
