@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <optional>
 #include <thread>
 #include <vector>
 
@@ -89,10 +90,11 @@ void check_other_decks(const fs::path& dir, const std::string& deck,
 }
 
 /// Where the deck goes: -o FILE or demcal-NAME.FORMAT, checked writable now
-/// (not after a consolidation). The files it reads are named after the whole
-/// deck file name (NAME.lammps.data, NAME.liggghts.data, NAME.liggghts-top.stl),
-/// so two decks in one folder never share one; check_other_decks refuses
-/// what would overwrite another deck's files.
+/// (not after a consolidation). The files it reads and writes are named after
+/// the whole deck file name (deck_files: NAME.lammps.data,
+/// NAME.lammps.series.csv, NAME.liggghts-top.stl, ...), so two decks in one
+/// folder never share one; check_other_decks refuses what would overwrite
+/// another deck's files.
 fs::path deck_destination(const ExportCmdOptions& o, const SceneConfig& config, ExportOptions& eo) {
   if (o.format != "lammps" && o.format != "liggghts")
     throw InputError("--format", "", "must be lammps or liggghts, got \"" + o.format + "\"");
@@ -101,10 +103,19 @@ fs::path deck_destination(const ExportCmdOptions& o, const SceneConfig& config, 
     throw InputError(deck_fs.string(), "", "is a folder; give a file name");
   OutputFolder::check(deck_fs.has_parent_path() ? deck_fs.parent_path().string() : ".");
   eo.format = o.format;
-  eo.data_name = deck_fs.filename().string() + ".data";
-  check_other_decks(deck_fs.has_parent_path() ? deck_fs.parent_path() : fs::path("."),
-                    deck_fs.filename().string(), {eo.data_name});
+  eo.deck_name = deck_fs.filename().string();
+  check_other_decks(deck_fs.has_parent_path() ? deck_fs.parent_path() : fs::path("."), eo.deck_name,
+                    {deck_files(eo.deck_name).data});
   return deck_fs;
+}
+
+/// A failed calibration's parameters (--allow-failed): why they are not
+/// certified (params.json's message, else empty), for the deck's header.
+std::optional<std::string> uncertified(const nlohmann::json& params) {
+  const auto ok = params.find("success");
+  if (ok == params.end() || *ok != false) return std::nullopt;
+  const auto why = params.find("message");
+  return why != params.end() && why->is_string() ? why->get<std::string>() : std::string();
 }
 
 /// Writes the deck and the files it reads together (never a new deck beside
@@ -205,6 +216,7 @@ int export_3d(const ExportCmdOptions& o, const nlohmann::json& params, const Rev
                      "(--consolidate-in)");
   Export3dOptions eo;
   const fs::path deck_fs = deck_destination(o, config, eo);
+  eo.uncertified = uncertified(params);
   const ScalingLaw law = resolve_law(params, o.params, o.law, o.exponent);
   auto [file, particles] = named_prototype(params, o.prototype, o.particles);
   PrototypeSource source;
@@ -239,6 +251,7 @@ int cmd_export(const ExportCmdOptions& o) {
   if (config.dimension == 3) return export_3d(o, params, rev, config);
   ExportOptions eo;
   const fs::path deck_fs = deck_destination(o, config, eo);
+  eo.uncertified = uncertified(params);
   const ScalingLaw law = resolve_law(params, o.params, o.law, o.exponent);
   auto [file, particles] = named_prototype(params, o.prototype, o.particles);
   PrototypeSource source;

@@ -126,20 +126,21 @@ int verify_in_lammps(const VerifyOptions& o, const SceneConfig& config,
                      nlohmann::json out) {
   namespace fs = std::filesystem;
   ExportOptions eo;
-  eo.data_name = "deck.data";
+  eo.deck_name = "deck.lammps";  // it reads deck.lammps.data, writes deck.lammps.series.csv
   eo.provenance = o.params;
+  const DeckFiles files = deck_files(eo.deck_name);
   const ExportResult deck = export_deck(config, up, assembly_of(state.world), eo);
   const fs::path work = fs::path(dir) / "lammps";
   make_output_dir(work.string());
-  write_file_atomic((work / "deck.lammps").string(), deck.deck);
+  write_file_atomic((work / files.deck).string(), deck.deck);
   for (const auto& [name, content] : deck.files) write_file_atomic((work / name).string(), content);
   // OpenMPI refuses to start as root unless told; other MPIs ignore these.
   const std::string launch =
       o.np > 1 ? "OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 mpirun -np " +
                      std::to_string(o.np) + " "
                : "";
-  const std::string cmd = "cd '" + work.string() + "' && " + launch + "'" + lmp +
-                          "' -in deck.lammps -log log.lammps -screen none >/dev/null 2>&1";
+  const std::string cmd = "cd '" + work.string() + "' && " + launch + "'" + lmp + "' -in " +
+                          files.deck + " -log log.lammps -screen none >/dev/null 2>&1";
   std::cerr << "demcal verify: running the exported deck: " << cmd << "\n";
   const auto t0 = std::chrono::steady_clock::now();
   const int raw = std::system(cmd.c_str());
@@ -148,17 +149,17 @@ int verify_in_lammps(const VerifyOptions& o, const SceneConfig& config,
   if (!(WIFEXITED(raw) && WEXITSTATUS(raw) == 0))
     throw std::runtime_error("LAMMPS failed (status " + std::to_string(raw) + "); see " +
                              (work / "log.lammps").string());
-  std::ifstream in(work / "series.csv", std::ios::binary);
+  std::ifstream in(work / files.series, std::ios::binary);
   std::ostringstream text;
   text << in.rdbuf();
   const ExternalSeries series =
-      parse_external_series(text.str(), (work / "series.csv").string(), std::nullopt);
+      parse_external_series(text.str(), (work / files.series).string(), std::nullopt);
   const Tolerances tolerances = default_tolerances(config);
   const ExternalScore scored = score_external(series, tolerances);
   const Score& score = scored.score;
   out["engine"] = {{"name", "lammps"},
                    {"np", o.np},
-                   {"deck", (work / "deck.lammps").string()},
+                   {"deck", (work / files.deck).string()},
                    {"wall_time_s", engine_s},
                    {"estimated_s", estimate_s},
                    {"steps", deck.steps},
@@ -188,8 +189,8 @@ int verify_in_lammps(const VerifyOptions& o, const SceneConfig& config,
   std::cout << ")\n"
             << "  " << score.diagnosis.message << "\n"
             << "  LAMMPS " << engine_s << " s (estimated " << estimate_s << " s); wrote " << dir
-            << "/verify.json, prototype.csv, " << work.string()
-            << "/ (deck, series.csv, log.lammps)\n";
+            << "/verify.json, prototype.csv, " << work.string() << "/ (" << files.deck << ", "
+            << files.series << ", log.lammps)\n";
   return score.passed ? 0 : 1;
 }
 

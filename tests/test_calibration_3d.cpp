@@ -308,10 +308,10 @@ TEST(Calibration3D, ExportWritesTheRevsDeckAndAnUpscaledPrototypesDeck) {
   ASSERT_EQ(ran.status, 0) << ran.err;
   // The deck appends its axial peak to its series at the end, in demcal's
   // key: "# peak_stress_zz = -P".
-  const std::string series = test::read_text(dir / "deck" / "series.csv");
+  const std::string series = test::read_text(dir / "deck" / "fcc.lammps.series.csv");
   const std::string tag = "# peak_stress_zz = ";
   const size_t at = series.rfind(tag);
-  ASSERT_NE(at, std::string::npos) << "no peak in the deck's series.csv";
+  ASSERT_NE(at, std::string::npos) << "no peak in the deck's series";
   const double lammps_peak = -std::stod(series.substr(at + tag.size()));
 
   // demcal with the same parameters and ζ_r = 0 (LAMMPS 2021 has no

@@ -166,7 +166,7 @@ TEST(EngineLammpsLoading, WithContactDashpotsTheServoCarriesItsLastMoveAsDemcals
   p.damping_ratio_rotation = 0.0;
   p.dt_ratio = std::min(p.dt_ratio, 0.9 * estimated_stable_dt_ratio(state, p));
   ExportOptions o;
-  o.data_name = "hex5.data";
+  o.deck_name = "hex5";
   const Assembly a = assembly_of(state.world);
   const ExportResult r = export_deck(c, p, a, o);
   LoadingServo servo;
@@ -202,7 +202,7 @@ TEST(EngineLammpsLoading, WithContactDashpotsTheServoCarriesItsLastMoveAsDemcals
   p.damping_ratio_translation = 0.4;
   p.damping_ratio_rotation = 0.0;
   Export3dOptions o;
-  o.data_name = "fcc.data";
+  o.deck_name = "fcc";
   const ExportResult r = export_3d_decks(c, p, state, o);
   LoadingServo servo;
   servo.fix_before = "fix             servo all ave/time 1 1 1 v_movev mode vector ave running\n";

@@ -74,16 +74,16 @@ ExportResult fcc_liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p,
                                const TriaxialState& state) {
   Export3dOptions o;
   o.format = "liggghts";
-  o.data_name = "fcc.data";
+  o.deck_name = "fcc";
   return export_3d_decks(c, p, state, o);
 }
 
-/// The 2D LIGGGHTS deck of a consolidated state, its data file `data_name`.
+/// The 2D LIGGGHTS deck of a consolidated state, named `deck_name`.
 ExportResult liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p,
-                           const ConsolidatedState& state, const std::string& data_name) {
+                           const ConsolidatedState& state, const std::string& deck_name) {
   ExportOptions o;
   o.format = "liggghts";
-  o.data_name = data_name;
+  o.deck_name = deck_name;
   return export_deck(c, p, assembly_of(state.world), o);
 }
 
@@ -236,13 +236,13 @@ TEST(EngineLammps, TheDecksOwnSeriesScoresAsDemcalsRun) {
   const LoadingResult run = run_loading(state, c.test, p);
   const Score ours = score_run(run, c.test.lateral_stress, Tolerances{});
   ExportOptions o;
-  o.data_name = "hex5.data";
+  o.deck_name = "hex5";
   const ExportResult r = export_deck(c, p, assembly_of(state.world), o);
   const test::TempDir dir("engine_score");
   const test::DeckRun lammps = test::run_deck(lmp, dir.path(), r.deck, r.files);
-  const std::string csv = test::read_text(dir / "series.csv");
+  const std::string csv = test::read_text(dir / deck_files(o.deck_name).series);
   ASSERT_EQ(lammps.status, 0) << lammps.log;
-  const ExternalSeries series = parse_external_series(csv, "series.csv");
+  const ExternalSeries series = parse_external_series(csv, deck_files(o.deck_name).series);
   EXPECT_EQ(series.lateral_stress, c.test.lateral_stress);
   EXPECT_EQ(static_cast<int>(series.run.series.size()), c.test.monitor_points + 1);
   const ExternalScore theirs = score_external(series, Tolerances{});
@@ -282,7 +282,7 @@ void expect_demcals_servo_with_contact_damping(const std::string& engine,
   const Score ours = score_run(run, c.test.lateral_stress, Tolerances{});
   ExportOptions o;
   o.format = format;
-  o.data_name = "hex5.data";
+  o.deck_name = "hex5";
   const ExportResult r = export_deck(c, p, assembly_of(state.world), o);
   const test::TempDir dir("engine_dashpot_" + format);
   // LIGGGHTS with a screen (captured): 3.8 crashes reading meshes under -screen none.
@@ -290,8 +290,8 @@ void expect_demcals_servo_with_contact_damping(const std::string& engine,
                                  ? test::run_deck(engine, dir.path(), r.deck, r.files, {})
                                  : test::run_deck(engine, dir.path(), r.deck, r.files);
   ASSERT_EQ(deck.status, 0) << deck.log;
-  const ExternalSeries series =
-      parse_external_series(test::read_text(dir / "series.csv"), "series.csv");
+  const ExternalSeries series = parse_external_series(
+      test::read_text(dir / deck_files(o.deck_name).series), deck_files(o.deck_name).series);
   const ExternalScore theirs = score_external(series, Tolerances{});
   ASSERT_EQ(series.run.series.size(), run.series.size());
   const double end_demcal = run.series.back().lateral_stress_error;
@@ -454,7 +454,7 @@ TEST(EngineLiggghts, WithContactDampingTheLoadingServoCarriesItsLastMoveAsDemcal
   AlgorithmSpec p = quasi_static();
   p.steps = 20000;
   p.dt_ratio = std::min(p.dt_ratio, 0.9 * estimated_stable_dt_ratio(state, p));
-  const ExportResult r = liggghts_deck(c, p, state, "hex5.data");
+  const ExportResult r = liggghts_deck(c, p, state, "hex5");
   // demcal's R at its step: the wall dashpot of the heaviest disc at the
   // run's mass scaling
   const World& w = state.world;
@@ -482,7 +482,7 @@ TEST(EngineLiggghts, WithContactDampingAParticleOutsideAWallsBandStopsTheRun) {
   AlgorithmSpec p = quasi_static();
   p.steps = 20000;
   p.dt_ratio = std::min(p.dt_ratio, 0.9 * estimated_stable_dt_ratio(state, p));
-  const ExportResult r = liggghts_deck(c, p, state, "hex5.data");
+  const ExportResult r = liggghts_deck(c, p, state, "hex5");
   ASSERT_TRUE(std::isfinite(test::liggghts_band(r.deck, "mleft", 0, false).bound));
   const double left = state.world.wall(kLeft).position;
   const std::string narrowed =
@@ -557,7 +557,7 @@ TEST_P(LammpsSeriesSources, AreTheStoredContactForceAndTheWallArrays) {
   }
   const ConsolidatedState state = consolidate(c, make_assembly(c));
   ExportOptions o;
-  o.data_name = "sample.data";
+  o.deck_name = "sample";
   const ExportResult r = export_deck(c, quasi_static(), assembly_of(state.world), o);
   std::string deck = r.deck;
   EXPECT_EQ(deck.find("store/force"), std::string::npos);
@@ -645,7 +645,7 @@ TEST(EngineLammps, TheVectorServoIsThePerWallFormulaBitForBit) {
   const SceneConfig c = hex5();
   const ConsolidatedState state = consolidate(c, make_assembly(c));
   ExportOptions o;
-  o.data_name = "hex5.data";
+  o.deck_name = "hex5";
   const ExportResult r = export_deck(c, quasi_static(), assembly_of(state.world), o);
   auto line_of = [&](const std::string& head) {
     const auto at = r.deck.find(head);
@@ -700,8 +700,8 @@ TEST(EngineLammps, TheVectorServoIsThePerWallFormulaBitForBit) {
   const test::DeckRun scalar = test::run_deck(
       lmp, dir / "per_wall", traced(per_wall, "$(f_moves[1]) $(f_moves[2])"), r.files, args);
   ASSERT_EQ(scalar.status, 0) << scalar.log;
-  const std::string a = test::read_text(dir / "vector" / "series.csv"),
-                    b = test::read_text(dir / "per_wall" / "series.csv");
+  const std::string a = test::read_text(dir / "vector" / deck_files(o.deck_name).series),
+                    b = test::read_text(dir / "per_wall" / deck_files(o.deck_name).series);
   EXPECT_GE(parse_external_series(a, "vector.csv").run.series.size(), 10u);
   EXPECT_EQ(a, b);
   const std::string ta = test::read_text(dir / "vector" / "trace.txt"),
@@ -719,7 +719,7 @@ TEST(EngineLammps, EditingNstepInTheDeckKeepsTheStrain) {
   c.test.monitor_points = 20;
   const ConsolidatedState state = consolidate(c, make_assembly(c));
   ExportOptions o;
-  o.data_name = "hex5.data";
+  o.deck_name = "hex5";
   const ExportResult r = export_deck(c, quasi_static(), assembly_of(state.world), o);
   std::string deck = r.deck;
   const std::string line = "variable nstep     equal " + std::to_string(r.steps);
@@ -727,9 +727,9 @@ TEST(EngineLammps, EditingNstepInTheDeckKeepsTheStrain) {
   deck.replace(deck.find(line), line.size(), "variable nstep     equal 2000");
   const test::TempDir dir("engine_edit");
   const test::DeckRun lammps = test::run_deck(lmp, dir.path(), deck, r.files);
-  const std::string csv = test::read_text(dir / "series.csv");
+  const std::string csv = test::read_text(dir / deck_files(o.deck_name).series);
   ASSERT_EQ(lammps.status, 0) << lammps.log;
-  const ExternalSeries s = parse_external_series(csv, "series.csv");
+  const ExternalSeries s = parse_external_series(csv, deck_files(o.deck_name).series);
   ASSERT_EQ(s.run.series.size(), 21u);
   EXPECT_EQ(s.run.series.back().step, 2000);
   EXPECT_NEAR(s.run.series.back().strain_yy, -c.test.vertical_strain, 1e-9);
@@ -748,7 +748,7 @@ void expect_the_split_run_continues_the_test(const std::string& lmp, double zeta
   AlgorithmSpec p = quasi_static();
   if (zeta_c > 0.0) p.dt_ratio = std::min(p.dt_ratio, 0.9 * estimated_stable_dt_ratio(state, p));
   ExportOptions o;
-  o.data_name = "hex5.data";
+  o.deck_name = "hex5";
   const ExportResult r = export_deck(c, p, assembly_of(state.world), o);
   const test::TempDir dir(tag);
   const test::DeckRun whole_run = test::run_deck(lmp, dir / "whole", r.deck, r.files);
@@ -757,15 +757,16 @@ void expect_the_split_run_continues_the_test(const std::string& lmp, double zeta
       test::run_deck(lmp, dir / "split", r.deck, r.files,
                      {"-screen", "none", "-var", "run_steps", std::to_string(r.steps / 2)});
   ASSERT_EQ(first.status, 0) << first.log;
-  // The continuation: lmp $(cat final.restart.args) -in THE_DECK.
+  // The continuation: lmp $(cat NAME.restart.args) -in THE_DECK.
   std::vector<std::string> args;
-  std::stringstream restart_args(test::read_text(dir / "split" / "final.restart.args"));
+  std::stringstream restart_args(
+      test::read_text(dir / "split" / deck_files(o.deck_name).restart_args));
   for (std::string a; restart_args >> a;) args.push_back(a);
   for (const char* a : {"-in", "in.deck", "-log", "log2", "-screen", "none"}) args.emplace_back(a);
   const int raw = test::run_program(lmp, args, dir / "split").status;
   ASSERT_EQ(raw, 0) << test::read_text(dir / "split" / "log2");
-  const std::string whole = test::read_text(dir / "whole" / "series.csv"),
-                    split = test::read_text(dir / "split" / "series.csv");
+  const std::string whole = test::read_text(dir / "whole" / deck_files(o.deck_name).series),
+                    split = test::read_text(dir / "split" / deck_files(o.deck_name).series);
   const ExternalSeries a = parse_external_series(whole, "whole.csv");
   const ExternalSeries b = parse_external_series(split, "split.csv");
   ASSERT_EQ(a.run.series.size(), b.run.series.size());
@@ -882,10 +883,18 @@ TEST(EngineLammps, VerifyInLammpsAgreesWithDemcal) {
           .status;
   const nlohmann::json d = test::read_json(dir / "vd" / "verify.json");
   const nlohmann::json l = test::read_json(dir / "vl" / "verify.json");
-  const bool series_written = fs::exists(dir / "vl" / "lammps" / "series.csv");
+  // The deck and its files follow export's naming rule (README, "Export"):
+  // deck.lammps reads deck.lammps.data and writes deck.lammps.series.csv.
+  const fs::path work = dir / "vl" / "lammps";
+  const bool series_written = fs::exists(work / "deck.lammps.series.csv");
   ASSERT_TRUE(ours != -1 && theirs != -1);
   EXPECT_EQ(ours, theirs);
   EXPECT_TRUE(series_written);
+  EXPECT_TRUE(fs::exists(work / "deck.lammps.data"));
+  EXPECT_FALSE(fs::exists(work / "deck.data"));
+  EXPECT_FALSE(fs::exists(work / "series.csv"));
+  EXPECT_NE(test::read_text(work / "deck.lammps").find("read_data deck.lammps.data"),
+            std::string::npos);
   EXPECT_EQ(l["engine"]["name"], "lammps");
   EXPECT_EQ(d["passed"], l["passed"]);
   EXPECT_NEAR(l["peak"]["stress_yy"].get<double>() / d["peak"]["stress_yy"].get<double>(), 1.0,
@@ -894,7 +903,8 @@ TEST(EngineLammps, VerifyInLammpsAgreesWithDemcal) {
   // the verdict line, what could not be checked, the counts of steps.
   ASSERT_TRUE(series_written);
   const int scored =
-      test::run_demcal({"score", "vl/lammps/series.csv", "-o", "sc"}, dir.path()).status;
+      test::run_demcal({"score", "vl/lammps/deck.lammps.series.csv", "-o", "sc"}, dir.path())
+          .status;
   ASSERT_TRUE(scored == 0 || scored == 1);
   const nlohmann::json s = test::read_json(dir / "sc" / "summary.json");
   for (const auto& [key, value] : s.items()) {
@@ -992,7 +1002,7 @@ TEST(EngineLiggghts, TheDecksServoMovesAtDemcalsVelocity) {
     c.assembly.count = 60;
     const ConsolidatedState state = consolidate(c, make_assembly(c));
     const AlgorithmSpec p = quasi_static();
-    const ExportResult r = liggghts_deck(c, p, state, "s.data");
+    const ExportResult r = liggghts_deck(c, p, state, "s");
     const World& w = state.world;
     const double force = c.test.lateral_stress *
                          (w.wall(kTop).position - w.wall(kBottom).position) * c.material.thickness;
@@ -1061,7 +1071,7 @@ TEST(EngineLiggghts, TheDecksPeakIsDemcalsWithinOnePercent) {
   const ConsolidatedState state = consolidate(c, make_assembly(c));
   const AlgorithmSpec p = quasi_static();
   const LoadingResult run = run_loading(state, c.test, p);
-  const ExportResult r = liggghts_deck(c, p, state, "hex5.data");
+  const ExportResult r = liggghts_deck(c, p, state, "hex5");
   const test::TempDir dir("liggghts");
   // With a screen (captured): liggghts 3.8 crashes reading meshes under
   // -screen none.
@@ -1112,14 +1122,15 @@ TEST_P(LiggghtsSeries, ScoresAsDemcalsRun) {
   const AlgorithmSpec p = quasi_static();
   const LoadingResult run = run_loading(state, c.test, p);
   const Score ours = score_run(run, c.test.lateral_stress, Tolerances{});
-  const ExportResult r = liggghts_deck(c, p, state, "hex5.data");
+  const ExportResult r = liggghts_deck(c, p, state, "hex5");
   const test::TempDir dir(std::string("liggghts_score_") + GetParam());
   // With a screen (captured): liggghts 3.8 crashes reading meshes under
   // -screen none.
   const test::DeckRun lg = test::run_deck(liggghts, dir.path(), r.deck, r.files, {});
   ASSERT_EQ(lg.status, 0) << lg.log;
   ASSERT_EQ(lg.log.find("ERROR"), std::string::npos) << lg.log;
-  const test::RunResult scored = test::run_demcal({"score", "series.csv", "-o", "sc"}, dir.path());
+  const test::RunResult scored =
+      test::run_demcal({"score", deck_files("hex5").series, "-o", "sc"}, dir.path());
   ASSERT_TRUE(scored.status == 0 || scored.status == 1) << scored.err;
   const nlohmann::json summary = test::read_json(dir / "sc" / "summary.json");
   EXPECT_EQ(summary["passed"].get<bool>(), ours.passed) << scored.out;
@@ -1153,8 +1164,8 @@ TEST_P(LiggghtsSeries, ScoresAsDemcalsRun) {
     EXPECT_LT(summary["lever_arm_floor"]["max"].get<double>(), 1e-9);
   }
 
-  const ExternalSeries series =
-      parse_external_series(test::read_text(dir / "series.csv"), "series.csv");
+  const ExternalSeries series = parse_external_series(
+      test::read_text(dir / deck_files("hex5").series), deck_files("hex5").series);
   ASSERT_EQ(static_cast<int>(series.run.series.size()), c.test.monitor_points + 1);
   EXPECT_EQ(series.lateral_stress, c.test.lateral_stress);
   EXPECT_TRUE(series.torque_column);
@@ -1164,7 +1175,7 @@ TEST_P(LiggghtsSeries, ScoresAsDemcalsRun) {
   EXPECT_LT((first.b - first.sigma).norm() / s3, 1e-5);  // static start: b = σ
   // The raw columns, row by row, against the mesh totals of the thermo.
   const auto thermo = liggghts_thermo(lg.log);
-  std::stringstream lines(test::read_text(dir / "series.csv"));
+  std::stringstream lines(test::read_text(dir / deck_files("hex5").series));
   std::vector<std::string> names;
   int compared = 0, rows = 0;
   for (std::string line; std::getline(lines, line);) {
@@ -1225,7 +1236,7 @@ TEST_P(LiggghtsContactForce, IsTheStoredForceBeforeTheDamping) {
     c.assembly.count = 100;
   }
   const ConsolidatedState state = consolidate(c, make_assembly(c));
-  const ExportResult r = liggghts_deck(c, quasi_static(), state, "sample.data");
+  const ExportResult r = liggghts_deck(c, quasi_static(), state, "sample");
   std::string deck =
       replaced(r.deck, "fix dampt all viscous", "fix fchk all store/force\nfix dampt all viscous");
   deck = replaced(deck, "# thermo: the meshes' own forces",
@@ -1322,8 +1333,8 @@ TEST(EngineLiggghts, WithContactDampingThe3dDecksServoIsDemcals) {
   const test::DeckRun lg = test::run_deck(liggghts, dir.path(), r.deck, r.files, {});
   ASSERT_EQ(lg.status, 0) << lg.log;
   ASSERT_EQ(lg.log.find("ERROR"), std::string::npos) << lg.log;
-  const ExternalSeries series =
-      parse_external_series(test::read_text(dir / "series.csv"), "series.csv");
+  const ExternalSeries series = parse_external_series(
+      test::read_text(dir / deck_files("fcc").series), deck_files("fcc").series);
   const ExternalScore theirs = score_external(series, Tolerances{});
   const Score ours = score_triaxial_run(d, c.test.lateral_stress, Tolerances{});
   const Criteria &t = theirs.score.criteria, &m = ours.criteria;
@@ -1361,7 +1372,8 @@ TEST(EngineLiggghts, The3dDecksSeriesScoresAsDemcalsRun) {
   const test::DeckRun lg = test::run_deck(liggghts, dir.path(), r.deck, r.files, {});
   ASSERT_EQ(lg.status, 0) << lg.log;
   ASSERT_EQ(lg.log.find("ERROR"), std::string::npos) << lg.log;
-  const test::RunResult scored = test::run_demcal({"score", "series.csv", "-o", "sc"}, dir.path());
+  const test::RunResult scored =
+      test::run_demcal({"score", deck_files("fcc").series, "-o", "sc"}, dir.path());
   ASSERT_TRUE(scored.status == 0 || scored.status == 1) << scored.err;
   const nlohmann::json summary = test::read_json(dir / "sc" / "summary.json");
   EXPECT_EQ(summary["dimension"].get<double>(), 3.0);
@@ -1383,8 +1395,8 @@ TEST(EngineLiggghts, The3dDecksSeriesScoresAsDemcalsRun) {
   EXPECT_NEAR(crit["servo"].get<double>() / ours.criteria.servo, 1.0, 0.01);
   EXPECT_NEAR(peak / ours.criteria.peak_stress_yy, 1.0, 0.005);
 
-  const ExternalSeries series =
-      parse_external_series(test::read_text(dir / "series.csv"), "series.csv");
+  const ExternalSeries series = parse_external_series(
+      test::read_text(dir / deck_files("fcc").series), deck_files("fcc").series);
   ASSERT_EQ(series.dimension, 3);
   ASSERT_EQ(static_cast<int>(series.triaxial.series.size()), c.test.monitor_points + 1);
   // Thermo rows of the loading: step time ke strain_zz p_axial p_lat p_top
@@ -1393,7 +1405,7 @@ TEST(EngineLiggghts, The3dDecksSeriesScoresAsDemcalsRun) {
   const auto thermo = liggghts_thermo(lg.log, "v_p_axial", 10);
   ASSERT_FALSE(thermo.empty()) << lg.log;
   EXPECT_EQ(thermo.rbegin()->first, r.steps);
-  std::stringstream lines(test::read_text(dir / "series.csv"));
+  std::stringstream lines(test::read_text(dir / deck_files("fcc").series));
   std::vector<std::string> names;
   int compared = 0, rows = 0;
   for (std::string line; std::getline(lines, line);) {

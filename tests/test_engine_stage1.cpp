@@ -66,10 +66,12 @@ std::string stage1_outcome(const std::string& log) {
 /// step's moves and running means (%.20g), the printed step count, the end
 /// walls and the series compare character for character. Both decks' cap is
 /// `cap` times r_min (the export's 0.02: the clamp would rarely bind), and
-/// over a hundred moves must bind and as many not.
+/// over a hundred moves must bind and as many not. `series`: the deck's
+/// series file (deck_files).
 void expect_per_wall_bit_for_bit(const std::string& lmp, const ExportResult& r,
                                  const std::vector<std::string>& area, const std::string& tail,
-                                 const std::string& tag, int loading, const std::string& cap) {
+                                 const std::string& tag, int loading, const std::string& cap,
+                                 const std::string& series) {
   const size_t walls = area.size();
   const std::string rawv = line_of(r.deck, "variable        cons_rawv vector ");
   const std::string head =
@@ -185,8 +187,8 @@ void expect_per_wall_bit_for_bit(const std::string& lmp, const ExportResult& r,
   }
   EXPECT_GT(clamped, 100) << "the clamp never bound";
   EXPECT_GT(free, 100) << "the clamp always bound";
-  const std::string sa = test::read_text(dir / "vector" / "series.csv"),
-                    sb = test::read_text(dir / "per_wall" / "series.csv");
+  const std::string sa = test::read_text(dir / "vector" / series),
+                    sb = test::read_text(dir / "per_wall" / series);
   EXPECT_GE(std::count(sa.begin(), sa.end(), '\n'), 10);
   EXPECT_EQ(sa, sb);
 }
@@ -202,9 +204,9 @@ AlgorithmSpec stage1_loading() {
 
 /// Export options of a deck that consolidates itself (stage 1).
 template <class Options>
-Options stage1_options(const char* data_name) {
+Options stage1_options(const char* deck_name) {
   Options o;
-  o.data_name = data_name;
+  o.deck_name = deck_name;
   o.consolidate_in_deck = true;
   return o;
 }
@@ -218,11 +220,11 @@ TEST(EngineLammpsStage1, TheVectorServoIsThePerWallFormulaBitForBit2D) {
   c.assembly.columns = c.assembly.rows = 5;
   c.material.contact_damping_ratio = 0.1;
   const AlgorithmSpec p = stage1_loading();
-  const ExportOptions o = stage1_options<ExportOptions>("hex5.data");
+  const ExportOptions o = stage1_options<ExportOptions>("hex5");
   const ExportResult r = export_deck(c, p, make_assembly(c), o);
   EXPECT_NE(line_of(r.deck, "variable        cons_rawv vector ").find("/dt)"), std::string::npos);
   expect_per_wall_bit_for_bit(lmp, r, {"cons_H", "cons_H", "cons_W", "cons_W"}, "*${thick}",
-                              "engine_stage1_2d", 1000, "0.00001");
+                              "engine_stage1_2d", 1000, "0.00001", deck_files(o.deck_name).series);
 }
 
 TEST(EngineLammpsStage1, TheVectorServoIsThePerWallFormulaBitForBit3D) {
@@ -232,11 +234,11 @@ TEST(EngineLammpsStage1, TheVectorServoIsThePerWallFormulaBitForBit3D) {
   const SceneConfig c = load_config(test::shipped_config("fcc_4x4x4"));
   AlgorithmSpec p = stage1_loading();
   p.damping_ratio_translation = 0.4;
-  const Export3dOptions o = stage1_options<Export3dOptions>("r.data");
+  const Export3dOptions o = stage1_options<Export3dOptions>("r");
   const ExportResult r = export_3d_decks(c, p, make_sphere_assembly(c), o);
-  expect_per_wall_bit_for_bit(lmp, r,
-                              {"cons_Ax", "cons_Ax", "cons_Ay", "cons_Ay", "cons_Az", "cons_Az"},
-                              "", "engine_stage1_3d", 500, "0.00000001");
+  expect_per_wall_bit_for_bit(
+      lmp, r, {"cons_Ax", "cons_Ax", "cons_Ay", "cons_Ay", "cons_Az", "cons_Az"}, "",
+      "engine_stage1_3d", 500, "0.00000001", deck_files(o.deck_name).series);
 }
 
 /// A number the deck defines: the value LAMMPS echoed in `log` for
@@ -291,7 +293,7 @@ TEST(EngineLammpsStage1, WhenPhase0EndsAtTheBudgetsLastChecksPhase1StopsThereWit
   SceneConfig c = load_config(test::shipped_config("random_400"));
   c.assembly.count = 30;
   const AlgorithmSpec p = stage1_loading();
-  const ExportOptions o = stage1_options<ExportOptions>("r.data");
+  const ExportOptions o = stage1_options<ExportOptions>("r");
   const ExportResult r = export_deck(c, p, make_assembly(c), o);
   ASSERT_EQ(r.deck.find("/dt)"), std::string::npos) << "the sample has contact dashpots";
   const std::string deck = with_phase0_marker(r.deck);
@@ -356,7 +358,7 @@ TEST(EngineLammpsStage1, TheCriticalFallbackComesAtDemcalsCheck) {
     SceneConfig c = load_config(test::shipped_config("random_400"));
     c.assembly.count = 100;
     c.material.contact_damping_ratio = zeta_c;
-    const ExportOptions o = stage1_options<ExportOptions>("r.data");
+    const ExportOptions o = stage1_options<ExportOptions>("r");
     cases.push_back(
         {zeta_c > 0.0 ? "2D zeta_c 0.02" : "2D zeta_c 0", export_deck(c, p, make_assembly(c), o)});
   }
@@ -364,7 +366,7 @@ TEST(EngineLammpsStage1, TheCriticalFallbackComesAtDemcalsCheck) {
     SceneConfig c = load_config(test::shipped_config("random_500_3d"));
     c.assembly.count = 60;
     c.material.contact_damping_ratio = 0.7;
-    const Export3dOptions o = stage1_options<Export3dOptions>("r.data");
+    const Export3dOptions o = stage1_options<Export3dOptions>("r");
     cases.push_back({"3D zeta_c 0.7", export_3d_decks(c, p, make_sphere_assembly(c), o)});
     c.material.contact_damping_ratio = 0.0;
     cases.push_back({"3D zeta_c 0", export_3d_decks(c, p, make_sphere_assembly(c), o)});
@@ -425,7 +427,7 @@ TEST(EngineLammpsStage1, WithContactDashpotsTheDeckConsolidatesARandomSampleWith
   c.material.contact_damping_ratio = 0.3;
   c.test.consolidation_max_steps = 120000;
   const AlgorithmSpec p = stage1_loading();
-  const ExportOptions o = stage1_options<ExportOptions>("r.data");
+  const ExportOptions o = stage1_options<ExportOptions>("r");
   const Assembly a = make_assembly(c);
   const ExportResult r = export_deck(c, p, a, o);
   const test::TempDir dir("engine_stage1_damped");
@@ -595,7 +597,7 @@ TEST(EngineLammpsStage1, WithContactDashpotsTheServoCarriesItsLastMoveAsDemcals2
   c.assembly.count = 100;
   c.material.contact_damping_ratio = 0.3;
   const AlgorithmSpec p = stage1_loading();
-  const ExportOptions o = stage1_options<ExportOptions>("r.data");
+  const ExportOptions o = stage1_options<ExportOptions>("r");
   const Assembly a = make_assembly(c);
   const ExportResult r = export_deck(c, p, a, o);
   // the heaviest disc, with this run's mass scaling: the wall dashpot's
@@ -616,7 +618,7 @@ TEST(EngineLammpsStage1, WithContactDashpotsTheServoCarriesItsLastMoveAsDemcals3
   c.assembly.count = 60;
   c.material.contact_damping_ratio = 0.3;
   const AlgorithmSpec p = stage1_loading();
-  const Export3dOptions o = stage1_options<Export3dOptions>("r.data");
+  const Export3dOptions o = stage1_options<Export3dOptions>("r");
   const SphereAssembly a = make_sphere_assembly(c);
   const ExportResult r = export_3d_decks(c, p, a, o);
   const double m_max =

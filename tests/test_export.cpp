@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <tuple>
 
@@ -60,11 +61,45 @@ TEST(RadiusClasses, MonodisperseFewAndMany) {
       }
 }
 
+TEST(Export, EveryFileOfADeckIsNamedAfterIt) {
+  // The files a deck reads and writes: its whole file name and a suffix, so
+  // that decks in one folder share none (README, "Export").
+  const DeckFiles f = deck_files("h5.lammps");
+  EXPECT_EQ(f.deck, "h5.lammps");
+  EXPECT_EQ(f.data, "h5.lammps.data");
+  EXPECT_EQ(f.series, "h5.lammps.series.csv");
+  EXPECT_EQ(f.restart, "h5.lammps.restart");
+  EXPECT_EQ(f.restart_args, "h5.lammps.restart.args");
+  EXPECT_EQ(f.mesh("top"), "h5.lammps-top.stl");
+  // The decks write there: the series (each format), the restart and its
+  // args (LAMMPS), and the args continue the same series.
+  const SceneConfig c = default_config();
+  const Assembly a = hexagonal_packing(5, 5, 5e-4);
+  ExportOptions o;
+  o.deck_name = "h5.lammps";
+  const std::string lammps = export_deck(c, params(), a, o).deck;
+  for (const char* needle : {"variable series    index h5.lammps.series.csv ",
+                             "variable restart_from index h5.lammps.restart\n",
+                             "variable restart_out index h5.lammps.restart\n",
+                             "lmp $(cat h5.lammps.restart.args) -in THIS_DECK\n",
+                             "-var series ${series} ", "\" file ${restart_out}.args screen no\n"})
+    EXPECT_NE(lammps.find(needle), std::string::npos) << needle;
+  EXPECT_EQ(lammps.find("series.csv\n"), std::string::npos);
+  EXPECT_EQ(lammps.find("final.restart"), std::string::npos);
+  o.deck_name = "h5.liggghts";
+  o.format = "liggghts";
+  const ExportResult liggghts = export_deck(c, params(), a, o);
+  EXPECT_NE(liggghts.deck.find("variable series    index h5.liggghts.series.csv "),
+            std::string::npos);
+  EXPECT_EQ(liggghts.files.count("h5.liggghts.data"), 1u);
+  EXPECT_EQ(liggghts.files.count("h5.liggghts-top.stl"), 1u);
+}
+
 TEST(Export, LammpsDeckMapsEveryParameter) {
   const SceneConfig c = default_config();
   const Assembly a = hexagonal_packing(5, 5, 5e-4);
   ExportOptions o;
-  o.data_name = "proto.data";
+  o.deck_name = "proto";
   const ExportResult r = export_deck(c, params(), a, o);
   const ParticleScales s = particle_scales(a.r, c.material);
   // The engine's explicit fix viscous: alpha*f, Nstep/f, f(0.7) = 0.520656.
@@ -124,7 +159,7 @@ TEST(Export, OnlyFrictionalTopAndBottomWallsKeepTheirContactArrays) {
   SceneConfig c = default_config();
   const Assembly a = hexagonal_packing(5, 5, 5e-4);
   ExportOptions o;
-  o.data_name = "proto.data";
+  o.deck_name = "proto";
   const std::string plain = export_deck(c, params(), a, o).deck;
   c.material.wall.friction = 0.2;
   const std::string rough = export_deck(c, params(), a, o).deck;
@@ -197,7 +232,7 @@ TEST(Export, LiggghtsDeckHasMeshesAndServo) {
   const Assembly a = hexagonal_packing(5, 5, 5e-4);
   ExportOptions o;
   o.format = "liggghts";
-  o.data_name = "proto.data";
+  o.deck_name = "proto";
   const ExportResult r = export_deck(c, params(), a, o);
   for (const char* needle :
        {"pair_style gran model hooke/stiffness tangential history", "mesh/surface/stress/servo",
@@ -260,7 +295,7 @@ TEST(Export, TheLoadingServosGainIsDemcalsWithTheWallDashpots) {
     c.material.contact_damping_ratio = zeta_c;
     const double demcal = demcal_move_per_force(c, p, a);
     ExportOptions o;
-    o.data_name = "proto.data";
+    o.deck_name = "proto";
     const ExportResult r = export_deck(c, p, a, o);
     const std::string& d = r.deck;
     const double servo_dt = deck_variable(d, "servo_dt");
@@ -365,7 +400,7 @@ TEST(Export, AConsolidatedStateReadBackGivesTheSameDeck) {
   for (int i = 0; i < a.size(); ++i) extent_left = std::min(extent_left, a.x[i] - a.r[i]);
   EXPECT_GT(b.left, extent_left);
   ExportOptions o;
-  o.data_name = "p.data";
+  o.deck_name = "p";
   const ExportResult from_state = export_deck(c, params(), a, o);
   const ExportResult read_back = export_deck(c, params(), b, o);
   EXPECT_EQ(read_back.deck, from_state.deck);
@@ -397,7 +432,7 @@ TEST_P(LammpsRun, TheDeckStartsWithOurTimestepAndSigma3OnTheWalls) {
   const ConsolidatedState state = consolidate(c, make_assembly(c));
   const Assembly a = assembly_of(state.world);
   ExportOptions o;
-  o.data_name = "hex5.data";
+  o.deck_name = "hex5";
   const ExportResult r = export_deck(c, params(), a, o);
 
   const test::TempDir dir("lammps");
@@ -464,7 +499,7 @@ TEST(Export, LammpsReproducesDemcalsPeak) {
   const LoadingResult run = run_loading(state, c.test, p);
   ASSERT_FALSE(run.diverged);
   ExportOptions o;
-  o.data_name = "hex5.data";
+  o.deck_name = "hex5";
   const ExportResult r = export_deck(c, p, assembly_of(state.world), o);
   const test::TempDir dir("lammps_peak");
   const test::DeckRun lammps = test::run_deck(lmp, dir.path(), r.deck, r.files);
@@ -481,10 +516,11 @@ TEST(Export, LammpsReproducesDemcalsPeak) {
   EXPECT_NEAR(rows.back()[5] / c.test.lateral_stress, 1.0, 0.01);
 }
 
-/// The peak σ_yy of a deck's series.csv (tension positive: the most negative).
-double series_peak(const fs::path& dir, const SceneConfig& c) {
-  const ExternalSeries s = parse_external_series(test::read_text(dir / "series.csv"), "series.csv",
-                                                 c.test.lateral_stress);
+/// The peak σ_yy of the series file `series` a deck wrote in `dir` (tension
+/// positive: the most negative).
+double series_peak(const fs::path& dir, const std::string& series, const SceneConfig& c) {
+  const ExternalSeries s =
+      parse_external_series(test::read_text(dir / series), series, c.test.lateral_stress);
   double peak = 0.0;
   for (const auto& p : s.run.series) peak = std::min(peak, p.sigma(1, 1));
   return peak;
@@ -508,7 +544,7 @@ TEST(Export, LammpsDeckConsolidatesItselfToDemcalsPeak) {
   p.steps = 8000;  // a faster loading, the same in both decks: seconds per run
   const Assembly generated = make_assembly(c);
   ExportOptions o;
-  o.data_name = "hex5.data";
+  o.deck_name = "hex5";
   const ExportResult by_demcal =
       export_deck(c, p, assembly_of(consolidate(c, generated, "").world), o);
   o.consolidate_in_deck = true;
@@ -523,14 +559,16 @@ TEST(Export, LammpsDeckConsolidatesItselfToDemcalsPeak) {
   ASSERT_EQ(r2.status, 0) << r2.log;
   ASSERT_NE(r2.log.find("demcal deck: consolidated in"), std::string::npos) << r2.log;
   // The loading starts at sigma3 on all four walls (series row 0).
-  const ExternalSeries s2 = parse_external_series(test::read_text(d2.path() / "series.csv"),
-                                                  "series.csv", c.test.lateral_stress);
+  const std::string series = deck_files(o.deck_name).series;
+  const ExternalSeries s2 =
+      parse_external_series(test::read_text(d2.path() / series), series, c.test.lateral_stress);
   ASSERT_FALSE(s2.run.series.empty());
   const double tol = c.test.consolidation_tolerance;
   const auto& first = s2.run.series.front();
   EXPECT_NEAR(-first.sigma(0, 0) / c.test.lateral_stress, 1.0, 2 * tol);
   EXPECT_NEAR(-first.sigma(1, 1) / c.test.lateral_stress, 1.0, 2 * tol);
-  const double peak_demcal = series_peak(d1.path(), c), peak_deck = series_peak(d2.path(), c);
+  const double peak_demcal = series_peak(d1.path(), series, c),
+               peak_deck = series_peak(d2.path(), series, c);
   EXPECT_NEAR(peak_deck / peak_demcal, 1.0, 2 * tol)
       << "deck-consolidated " << peak_deck << " Pa, demcal-consolidated " << peak_demcal << " Pa";
 
@@ -545,14 +583,14 @@ TEST(Export, LammpsDeckConsolidatesItselfToDemcalsPeak) {
                      {"-var", "run_steps", std::to_string(half), "-screen", "none"});
   ASSERT_EQ(first_part.status, 0) << first_part.log;
   std::vector<std::string> args;
-  std::stringstream words(test::read_text(d4.path() / "final.restart.args"));
+  std::stringstream words(test::read_text(d4.path() / deck_files(o.deck_name).restart_args));
   for (std::string w; words >> w;) args.push_back(w);
   ASSERT_NE(std::find(args.begin(), args.end(), "yt0"), args.end());
   args.insert(args.end(), {"-screen", "none"});
   const test::DeckRun second_part = test::run_deck(lmp, d4.path(), in_deck.deck, {}, args);
   ASSERT_EQ(second_part.status, 0) << second_part.log;
   EXPECT_EQ(second_part.log.find("demcal deck: consolidated in"), std::string::npos);
-  EXPECT_NEAR(series_peak(d4.path(), c) / peak_deck, 1.0, 1e-10);
+  EXPECT_NEAR(series_peak(d4.path(), series, c) / peak_deck, 1.0, 1e-10);
 
   DEMCAL_FIND_PROGRAM(mpirun, "mpirun", "openmpi-bin", "the deck is not run under MPI");
   setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 0);
@@ -560,7 +598,7 @@ TEST(Export, LammpsDeckConsolidatesItselfToDemcalsPeak) {
   const test::DeckRun r3 = test::run_deck(mpirun, d3.path(), in_deck.deck, in_deck.files,
                                           {"-np", "2", lmp, "-screen", "none"});
   ASSERT_EQ(r3.status, 0) << r3.log;
-  EXPECT_NEAR(series_peak(d3.path(), c) / peak_deck, 1.0, 1e-9);
+  EXPECT_NEAR(series_peak(d3.path(), series, c) / peak_deck, 1.0, 1e-9);
 }
 
 TEST(ExportCli, ConsolidateInChoosesWhereAndRejectsBadCombinations) {
@@ -676,6 +714,146 @@ TEST(ExportCli, TwoDecksInOneFolderReadTheirOwnFiles) {
       liggghts_program, {"-var", "run_steps", "50", "-in", l_deck, "-log", "log.liggghts"}, both);
   EXPECT_EQ(ran.status, 0) << test::read_text(both / "log.liggghts");
   EXPECT_EQ(test::read_text(both / "log.liggghts").find("ERROR"), std::string::npos);
+}
+
+/// The example calibration the CLI tests export (hex_10x10's params.json).
+std::string example_params() {
+  return (fs::path(test::shipped_config("hex_5x5")).parent_path().parent_path() / "reports" /
+          "example-hex_10x10" / "params.json")
+      .string();
+}
+
+/// The data rows of a deck's series file (neither `#` lines nor the
+/// column header).
+size_t series_rows(const fs::path& file) {
+  size_t rows = 0;
+  for (const std::string& line : test::lines_of(test::read_text(file)))
+    rows += !line.empty() && line[0] != '#' && line.rfind("step,", 0) != 0;
+  return rows;
+}
+
+TEST(ExportCli, DecksInOneFolderWriteTheirOwnSeriesAndRestarts) {
+  // A first-time user's walk (2026-12-04): h5.lammps and h5.liggghts run in
+  // one folder both wrote series.csv (the second's replaced the first's),
+  // and two LAMMPS decks both wrote series.csv and final.restart(.args).
+  // A deck's outputs are named after its whole file name as its inputs are:
+  // NAME.series.csv, NAME.restart, NAME.restart.args; README's continuation
+  // `lmp $(cat NAME.restart.args) -in NAME` appends to its own series.
+  DEMCAL_FIND_PROGRAM(lmp, "lmp", "lammps", "the decks are not run");
+  DEMCAL_FIND_PROGRAM(liggghts, "liggghts", "liggghts", "the decks are not run");
+  const test::TempDir dir("export_deck_outputs");
+  const fs::path d = dir.path();
+  for (const std::string deck : {"a.lammps", "b.lammps", "a.liggghts"}) {
+    const std::string format = deck.substr(deck.find('.') + 1);
+    const test::RunResult r = test::run_demcal(
+        {"export", example_params(), "--particles", "25", "--format", format, "-o", deck}, d);
+    ASSERT_EQ(r.status, 0) << r.err;
+  }
+  const std::string a_text = test::read_text(d / "a.lammps");
+  const int every =
+      static_cast<int>(deck_variable(a_text, "nstep") / deck_variable(a_text, "monitor_points"));
+  ASSERT_GT(every, 1);
+  // a to its first monitoring step after 0, b and the LIGGGHTS deck a few steps
+  auto lammps = [&](std::vector<std::string> args, const std::string& log) {
+    args.insert(args.end(), {"-log", log, "-screen", "none"});
+    const int status = test::run_program(lmp, args, d).status;
+    EXPECT_EQ(status, 0) << test::read_text(d / log);
+  };
+  lammps({"-var", "run_steps", std::to_string(every), "-in", "a.lammps"}, "log.a");
+  lammps({"-var", "run_steps", "20", "-in", "b.lammps"}, "log.b");
+  // (LIGGGHTS 3.8 needs a screen)
+  const test::RunResult g = test::run_program(
+      liggghts, {"-var", "run_steps", "20", "-in", "a.liggghts", "-log", "log.liggghts"}, d);
+  ASSERT_EQ(g.status, 0) << test::read_text(d / "log.liggghts");
+  for (const char* shared : {"series.csv", "final.restart", "final.restart.args"})
+    EXPECT_FALSE(fs::exists(d / shared)) << shared;
+  for (const char* own :
+       {"a.lammps.restart", "a.lammps.restart.args", "b.lammps.restart", "b.lammps.restart.args"})
+    EXPECT_TRUE(fs::exists(d / own)) << own;
+  ASSERT_TRUE(fs::exists(d / "a.lammps.series.csv"));
+  ASSERT_TRUE(fs::exists(d / "b.lammps.series.csv"));
+  ASSERT_TRUE(fs::exists(d / "a.liggghts.series.csv"));
+  EXPECT_NE(test::lines_of(test::read_text(d / "a.lammps.series.csv"))[0].find("LAMMPS deck"),
+            std::string::npos);
+  EXPECT_NE(test::lines_of(test::read_text(d / "a.liggghts.series.csv"))[0].find("LIGGGHTS deck"),
+            std::string::npos);
+  EXPECT_EQ(series_rows(d / "a.lammps.series.csv"), 2u);  // steps 0 and `every`
+  EXPECT_EQ(series_rows(d / "b.lammps.series.csv"), 1u);  // step 0
+  const std::string b_series = test::read_text(d / "b.lammps.series.csv");
+
+  // The continuation of a, by README's command: its own restart and series.
+  std::vector<std::string> args;
+  std::stringstream words(test::read_text(d / "a.lammps.restart.args"));
+  for (std::string w; words >> w;) args.push_back(w);
+  const std::string joined = test::read_text(d / "a.lammps.restart.args");
+  EXPECT_NE(joined.find("-var restart_from a.lammps.restart "), std::string::npos) << joined;
+  args.insert(args.end(), {"-var", "run_steps", std::to_string(2 * every), "-in", "a.lammps"});
+  lammps(args, "log.a2");
+  EXPECT_EQ(series_rows(d / "a.lammps.series.csv"), 3u);
+  EXPECT_EQ(test::read_text(d / "b.lammps.series.csv"), b_series);
+  EXPECT_FALSE(fs::exists(d / "series.csv"));
+  // The series scores as the deck's (demcal score reads it by its name).
+  const test::RunResult scored = test::run_demcal({"score", "a.lammps.series.csv", "-o", "sc"}, d);
+  EXPECT_TRUE(scored.status == 0 || scored.status == 1) << scored.err;
+}
+
+TEST(ExportCli, AnUncertifiedCalibrationsDeckSaysSoInItsHeader) {
+  // `export --allow-failed` of a calibration whose parameters failed the
+  // certificate: the warning went to stderr only, and the deck carried no
+  // mark. Its header now says NOT CERTIFIED and why (params.json's
+  // message), in comment lines a LAMMPS reader cannot leave (a newline, a
+  // closing `&` or a `"` in the message would end the comment or join the
+  // next line); a certified calibration's deck has no such line.
+  const test::TempDir dir("export_uncertified");
+  nlohmann::json params = test::read_json(example_params());
+  ASSERT_EQ(params["success"], true);
+  const std::string why =
+      "the best passing parameters did not pass the convergence certificate\nrun 0 &";
+  params["success"] = false;
+  params["message"] = why;
+  test::write_text(dir / "failed.json", params.dump(1));
+  // the header's NOT CERTIFIED lines, up to the header's first "#" line
+  auto uncertified_of = [](const std::string& deck) {
+    const auto at = deck.find("# NOT CERTIFIED");
+    return at == std::string::npos ? std::string() : deck.substr(at, deck.find("\n#\n", at) - at);
+  };
+  for (const std::string format : {"lammps", "liggghts"}) {
+    SCOPED_TRACE(format);
+    const std::string name = "u." + format, certified = "c." + format;
+    const test::RunResult refused = test::run_demcal(
+        {"export", "failed.json", "--particles", "25", "--format", format, "-o", name}, dir.path());
+    EXPECT_EQ(refused.status, 2);
+    const test::RunResult r = test::run_demcal({"export", "failed.json", "--particles", "25",
+                                                "--format", format, "--allow-failed", "-o", name},
+                                               dir.path());
+    ASSERT_EQ(r.status, 0) << r.err;
+    const std::string text = test::read_text(dir / name);
+    const std::string header = uncertified_of(text);
+    EXPECT_LT(text.find("# NOT CERTIFIED: the calibration of these parameters failed"),
+              text.find("\n#\n"))
+        << text.substr(0, 2000);
+    EXPECT_NE(test::replaced_all(header, "\n# ", " ")
+                  .find("(--allow-failed): the best passing parameters did not pass the "
+                        "convergence certificate run 0 and"),
+              std::string::npos)
+        << header;
+    for (const std::string& line : test::lines_of(header)) {
+      EXPECT_EQ(line.rfind('#', 0), 0u) << line;
+      EXPECT_NE(line.back(), '&') << line;
+      EXPECT_LE(line.size(), 79u) << line;
+    }
+    const test::RunResult ok = test::run_demcal(
+        {"export", example_params(), "--particles", "25", "--format", format, "-o", certified},
+        dir.path());
+    ASSERT_EQ(ok.status, 0) << ok.err;
+    EXPECT_EQ(test::read_text(dir / certified).find("CERTIFIED"), std::string::npos);
+  }
+  // The LAMMPS deck runs (a short check): the header is comments only.
+  DEMCAL_FIND_PROGRAM(lmp, "lmp", "lammps", "the deck is not run");
+  const test::RunResult ran = test::run_program(
+      lmp, {"-var", "run_steps", "10", "-in", "u.lammps", "-log", "log.u", "-screen", "none"},
+      dir.path());
+  EXPECT_EQ(ran.status, 0) << test::read_text(dir / "log.u");
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <numbers>
 #include <regex>
 #include <sstream>
@@ -78,7 +79,7 @@ TEST(Export3d, LammpsDeckMapsEveryParameter) {
   AlgorithmSpec p = fixed_params();
   p.damping_ratio_rotation = 0.3;
   Export3dOptions o;
-  o.data_name = "fcc.data";
+  o.deck_name = "fcc";
   const TriaxialState& state = fcc_state();
   const ExportResult r = export_3d_decks(c, p, state, o);
   const double f = dashpot_step_factor(p.damping_ratio_translation);
@@ -171,7 +172,7 @@ TEST(Export3d, BadInputIsOneClearError) {
 TEST(Export3d, LiggghtsDeckHasSixWallsAndTheServo) {
   Export3dOptions o;
   o.format = "liggghts";
-  o.data_name = "fcc.data";
+  o.deck_name = "fcc";
   const ExportResult r = export_3d_decks(fcc444(), fixed_params(), fcc_state(), o);
   for (const char* name :
        {"fcc.data", "fcc-xmin.stl", "fcc-xmax.stl", "fcc-ymin.stl", "fcc-ymax.stl", "fcc-top.stl"})
@@ -208,7 +209,7 @@ TEST(Export3d, TheSeriesHeaderGivesTheStepRatioAndTheMassScaling) {
   for (const char* format : {"lammps", "liggghts"}) {
     Export3dOptions o;
     o.format = format;
-    o.data_name = "fcc.data";
+    o.deck_name = "fcc";
     const ExportResult r = export_3d_decks(c, p, fcc_state(), o);
     const std::string header = test::deck_series_header(r.deck);
     std::ostringstream csv;
@@ -274,7 +275,7 @@ TEST(Export3d, TheLoadingServosGainIsDemcalsWithTheWallDashpots) {
     const double demcal =
         servo_velocity(w, kXMin, target, c.test.servo_gain) * w.integration().dt / force;
     Export3dOptions o;
-    o.data_name = "proto.data";
+    o.deck_name = "proto";
     const ExportResult r = export_3d_decks(c, p, a, o);
     const std::string& d = r.deck;
     const double servo_dt = deck_variable(d, "servo_dt");
@@ -370,12 +371,14 @@ struct EngineRun {
   double seconds = 0.0;
   std::string log;
   int status = -1;
-  std::vector<std::vector<double>> rows;  // series.csv (LAMMPS)
+  std::vector<std::vector<double>> rows;  // the deck's series (LAMMPS)
   std::string csv;                        // its text
 };
 
+/// The deck `r` run by `program` in a new folder (`tag`); `series`: the
+/// series file it writes (deck_files of its deck_name).
 EngineRun run_engine(const std::string& program, const std::vector<std::string>& options,
-                     const ExportResult& r, const std::string& tag) {
+                     const ExportResult& r, const std::string& series, const std::string& tag) {
   const test::TempDir dir(tag);
   const auto t0 = std::chrono::steady_clock::now();
   const test::DeckRun run = test::run_deck(program, dir.path(), r.deck, r.files, options);
@@ -385,8 +388,8 @@ EngineRun run_engine(const std::string& program, const std::vector<std::string>&
   out.log = run.log;
   out.peak_axial = logged(run.log, "peak_axial_stress");
   out.peak_ratio = logged(run.log, "peak_ratio");
-  if (fs::exists(dir.path() / "series.csv")) {
-    out.csv = test::read_text(dir.path() / "series.csv");
+  if (fs::exists(dir.path() / series)) {
+    out.csv = test::read_text(dir.path() / series);
     std::stringstream lines(out.csv);
     for (std::string line; std::getline(lines, line);) {
       if (line.empty() || line[0] == '#' || line[0] == 's') continue;
@@ -427,16 +430,17 @@ void check_lammps(int np, int64_t steps) {
     DEMCAL_SKIP_MISSING("mpirun", "openmpi-bin", "the 3D deck is not run under MPI");
   const SceneConfig c = fcc444();
   Export3dOptions o;
-  o.data_name = "fcc.data";
+  o.deck_name = "fcc";
   const AlgorithmSpec p = fixed_params(steps);
   const ExportResult r = export_3d_decks(c, p, fcc_state(), o);
   const DemcalRun d = demcal_run(p);
   ASSERT_FALSE(d.result.diverged);
-  const EngineRun l = np > 1 ? run_engine(mpirun,
-                                          {"--allow-run-as-root", "--oversubscribe", "-np",
-                                           std::to_string(np), lmp, "-screen", "none"},
-                                          r, "lammps3d_np")
-                             : run_engine(lmp, {"-screen", "none"}, r, "lammps3d");
+  const EngineRun l =
+      np > 1 ? run_engine(mpirun,
+                          {"--allow-run-as-root", "--oversubscribe", "-np", std::to_string(np), lmp,
+                           "-screen", "none"},
+                          r, deck_files(o.deck_name).series, "lammps3d_np")
+             : run_engine(lmp, {"-screen", "none"}, r, deck_files(o.deck_name).series, "lammps3d");
   ASSERT_EQ(l.status, 0) << l.log;
   ASSERT_GT(l.rows.size(), 100u);
   for (const auto& row : l.rows) ASSERT_EQ(row.size(), kColumns);
@@ -564,9 +568,10 @@ TEST(Export3dLammps, WithContactDampingTheDecksServoIsDemcals) {
   const TriaxialResult d = run_triaxial_loading(state, c.test, p);
   ASSERT_FALSE(d.diverged);
   Export3dOptions o;
-  o.data_name = "fcc.data";
+  o.deck_name = "fcc";
   const ExportResult r = export_3d_decks(c, p, state, o);
-  const EngineRun l = run_engine(lmp, {"-screen", "none"}, r, "lammps3d_damped");
+  const EngineRun l =
+      run_engine(lmp, {"-screen", "none"}, r, deck_files(o.deck_name).series, "lammps3d_damped");
   ASSERT_EQ(l.status, 0) << l.log;
   const ExternalSeries external = parse_external_series(l.csv, "series.csv");
   const ExternalScore theirs = score_external(external, Tolerances{});
@@ -579,13 +584,6 @@ TEST(Export3dLammps, WithContactDampingTheDecksServoIsDemcals) {
       m.servo, t.servo, -d.peak_stress_zz, l.peak_axial);
   EXPECT_NEAR(t.servo / m.servo, 1.0, 0.05);
   EXPECT_NEAR(l.peak_axial / -d.peak_stress_zz, 1.0, 0.01);
-}
-
-/// Every `what` in `text` replaced by `with`.
-std::string replaced_all(std::string text, const std::string& what, const std::string& with) {
-  for (auto at = text.find(what); at != std::string::npos; at = text.find(what, at + with.size()))
-    text.replace(at, what.size(), with);
-  return text;
 }
 
 /// The formula of the deck's equal-style variable `name`.
@@ -632,7 +630,7 @@ TEST(Export3dLammps, TheDecksPerStepCutsLeaveTheSeriesAndPeaksBitForBit) {
   DEMCAL_FIND_PROGRAM(lmp, "lmp", "lammps", "the 3D deck is not run");
   const SceneConfig c = fcc444();
   Export3dOptions o;
-  o.data_name = "fcc.data";
+  o.deck_name = "fcc";
   // 2 000 demcal steps: the whole run is 2 954 deck steps, 200 rows.
   const ExportResult r = export_3d_decks(c, fixed_params(2000), fcc6_state(), o);
   const std::string& cut = r.deck;
@@ -667,8 +665,8 @@ TEST(Export3dLammps, TheDecksPerStepCutsLeaveTheSeriesAndPeaksBitForBit) {
   whole = replaced(whole, "compute         csf gxy ", "compute         csf all ");
   const std::string lengths[3] = {"Lx_now", "Ly_now", "H_now"};
   for (int k = 0; k < 3; ++k)
-    whole = replaced_all(whole, "f_geom[" + std::to_string(k + 1) + "]",
-                         "(" + formula(cut, lengths[k]) + ")");
+    whole = test::replaced_all(whole, "f_geom[" + std::to_string(k + 1) + "]",
+                               "(" + formula(cut, lengths[k]) + ")");
   EXPECT_EQ(whole.find("f_geom"), std::string::npos);
   EXPECT_EQ(whole.find("v_rawv"), std::string::npos);
   EXPECT_EQ(whole.find("f_servo_sign"), std::string::npos);
@@ -677,8 +675,9 @@ TEST(Export3dLammps, TheDecksPerStepCutsLeaveTheSeriesAndPeaksBitForBit) {
   ASSERT_EQ(a.status, 0) << a.log;
   const test::DeckRun b = test::run_deck(lmp, dir / "whole", whole, r.files);
   ASSERT_EQ(b.status, 0) << b.log;
-  const std::string sa = test::read_text(dir / "cut" / "series.csv"),
-                    sb = test::read_text(dir / "whole" / "series.csv");
+  const std::string series = deck_files(o.deck_name).series;
+  const std::string sa = test::read_text(dir / "cut" / series),
+                    sb = test::read_text(dir / "whole" / series);
   EXPECT_GE(std::count(sa.begin(), sa.end(), '\n'), 200);
   EXPECT_NE(sa.find("# peak_stress_zz = "), std::string::npos);
   EXPECT_NE(sa.find("# peak_strain_zz = "), std::string::npos);
@@ -691,7 +690,7 @@ TEST(Export3dLammps, ASphereOutsideAWallsBandStopsTheRun) {
   // clearance check stops the run with an error at the first monitoring step.
   DEMCAL_FIND_PROGRAM(lmp, "lmp", "lammps", "the 3D deck is not run");
   Export3dOptions o;
-  o.data_name = "fcc.data";
+  o.deck_name = "fcc";
   const ExportResult r = export_3d_decks(fcc444(), fixed_params(2000), fcc_state(), o);
   const std::string deck =
       replaced(r.deck, "region          bandzmin block INF INF INF INF INF $(v_zmin0+v_band_v)",
@@ -722,7 +721,7 @@ TEST(Export3d, LammpsDeckCarriesTheConsolidationStage) {
   const SceneConfig c = random3d(200);
   const SphereAssembly a = make_sphere_assembly(c);
   Export3dOptions o;
-  o.data_name = "r.data";
+  o.deck_name = "r";
   o.consolidate_in_deck = true;
   const ExportResult r = export_3d_decks(c, fixed_params(), a, o);
   const std::string& d = r.deck;
@@ -780,10 +779,11 @@ TEST(Export3dLammps, DeckConsolidatesARandomSampleAndLoads) {
   // A short loading (8 000 steps to ε = 1 %): the test is the consolidation.
   const AlgorithmSpec p = fixed_params(8000);
   Export3dOptions o;
-  o.data_name = "r.data";
+  o.deck_name = "r";
   o.consolidate_in_deck = true;
   const ExportResult r = export_3d_decks(c, p, a, o);
-  const EngineRun l = run_engine(lmp, {"-screen", "none"}, r, "lammps3d_cons");
+  const EngineRun l =
+      run_engine(lmp, {"-screen", "none"}, r, deck_files(o.deck_name).series, "lammps3d_cons");
   ASSERT_EQ(l.status, 0) << l.log;
   const std::regex done(
       "demcal deck: consolidated in ([0-9]+) steps \\(wall stress error ([-+0-9.eE]+), "
@@ -872,6 +872,53 @@ TEST(Export3dCli, ConsolidateInChoosesWhereAndPrintsProgress) {
   EXPECT_FALSE(fs::exists(dir.path() / "d"));
 }
 
+// The 3D decks in one folder (a first-time user's walk, 2026-12-04: every
+// deck wrote series.csv): each writes its series named after it,
+// NAME.series.csv, as it reads NAME.data. From a failed calibration's
+// params.json (--allow-failed) their headers say the parameters are not
+// certified, and why.
+TEST(Export3dCli, DecksInOneFolderWriteTheirOwnSeriesAndSayTheyAreUncertified) {
+  DEMCAL_FIND_PROGRAM(lmp, "lmp", "lammps", "the 3D decks are not run");
+  DEMCAL_FIND_PROGRAM(liggghts, "liggghts", "liggghts", "the 3D decks are not run");
+  const test::TempDir dir("export3d_outputs");
+  const fs::path d = dir.path();
+  nlohmann::json params =
+      test::read_json(fs::path(test::kSourceDir) / "reports" / "example-fcc_4x4x4" / "params.json");
+  params["success"] = false;
+  params["message"] = "no certificate: Nstep doubled moved the peak too far";
+  test::write_text(d / "failed.json", params.dump(1));
+  for (const std::string deck : {"f.lammps", "f.liggghts"}) {
+    const test::RunResult r =
+        test::run_demcal({"export", "failed.json", "--particles", "256", "--allow-failed",
+                          "--format", deck.substr(2), "-o", deck},
+                         d);
+    ASSERT_EQ(r.status, 0) << r.err;
+    const std::string text = test::read_text(d / deck);
+    const auto mark = text.find("# NOT CERTIFIED: the calibration of these parameters failed");
+    EXPECT_LT(mark, text.find("\n#\n")) << text.substr(0, 2000);
+    EXPECT_NE(test::replaced_all(text.substr(mark, text.find("\n#\n", mark) - mark), "\n# ", " ")
+                  .find("(--allow-failed): no certificate: Nstep doubled moved the peak too far"),
+              std::string::npos)
+        << text.substr(mark, 400);
+  }
+  const test::RunResult l = test::run_program(
+      lmp, {"-var", "run_steps", "20", "-in", "f.lammps", "-log", "log.lammps", "-screen", "none"},
+      d);
+  ASSERT_EQ(l.status, 0) << test::read_text(d / "log.lammps");
+  // (LIGGGHTS 3.8 needs a screen)
+  const test::RunResult g = test::run_program(
+      liggghts, {"-var", "run_steps", "20", "-in", "f.liggghts", "-log", "log.liggghts"}, d);
+  ASSERT_EQ(g.status, 0) << test::read_text(d / "log.liggghts");
+  EXPECT_FALSE(fs::exists(d / "series.csv"));
+  for (const auto& [series, writer] : std::vector<std::pair<std::string, std::string>>{
+           {"f.lammps.series.csv", "LAMMPS 3D deck"},
+           {"f.liggghts.series.csv", "LIGGGHTS 3D deck"}}) {
+    ASSERT_TRUE(fs::exists(d / series)) << series;
+    EXPECT_NE(test::lines_of(test::read_text(d / series))[0].find(writer), std::string::npos)
+        << series;
+  }
+}
+
 // The LIGGGHTS deck over the whole loading against demcal's run of the same
 // parameters (ζ_r = 0). Its axial stress is the mean of the top and bottom
 // meshes, as demcal's: the top wall alone reads 0.32 % higher at the peak
@@ -880,12 +927,13 @@ TEST(Export3dLiggghts, PeakAgainstDemcal) {
   DEMCAL_FIND_PROGRAM(liggghts, "liggghts", "liggghts", "the 3D deck is not run");
   Export3dOptions o;
   o.format = "liggghts";
-  o.data_name = "fcc.data";
+  o.deck_name = "fcc";
   const ExportResult r = export_3d_decks(fcc444(), fixed_params(), fcc_state(), o);
   const DemcalRun d = demcal_run(fixed_params());
   // With a screen: liggghts 3.8 crashes reading meshes under -screen none.
   // Thermo every step: the peaks over every step, as demcal's.
-  const EngineRun g = run_engine(liggghts, {"-var", "thermo_every", "1"}, r, "liggghts3d");
+  const EngineRun g = run_engine(liggghts, {"-var", "thermo_every", "1"}, r,
+                                 deck_files(o.deck_name).series, "liggghts3d");
   ASSERT_EQ(g.status, 0) << g.log;
   ASSERT_EQ(g.log.find("ERROR"), std::string::npos) << g.log;
   // Thermo rows: step time ke strain_zz p_axial p_lat p_top p_bottom Wx Wy.
@@ -948,7 +996,7 @@ TEST(Export3dLiggghts, TheDecksContactDashpotsGiveDemcalsRestitution) {
   c.material.contact_damping_ratio = zeta;
   Export3dOptions o;
   o.format = "liggghts";
-  o.data_name = "fcc.data";
+  o.deck_name = "fcc";
   const ExportResult r = export_3d_decks(c, fixed_params(), fcc_state(), o);
   const auto from = r.deck.find("# type 2 is the walls' material");
   const auto to = r.deck.find('\n', r.deck.find("\ntimestep ", from) + 1);
@@ -1035,10 +1083,11 @@ TEST(Export3dLammps, DISABLED_Random500) {
   // The export default (8 radius classes), then one class per sphere.
   for (int max_types : {8, c.assembly.count}) {
     Export3dOptions o;
-    o.data_name = "r500.data";
+    o.deck_name = "r500";
     o.max_types = max_types;
     const ExportResult r = export_3d_decks(c, p, state, o);
-    const EngineRun l = run_engine(lmp, {"-screen", "none"}, r, "lammps3d_r500");
+    const EngineRun l =
+        run_engine(lmp, {"-screen", "none"}, r, deck_files(o.deck_name).series, "lammps3d_r500");
     ASSERT_EQ(l.status, 0) << l.log;
     ASSERT_FALSE(l.rows.empty());
     std::printf(

@@ -148,13 +148,13 @@ void three_classes(Radii& r) {
 }
 
 /// The options of a LIGGGHTS deck (2D ExportOptions, 3D Export3dOptions)
-/// reading its particles from kDataName.
-constexpr const char* kDataName = "proto.data";
+/// named kDeckName (it reads its particles from kDeckName.data).
+constexpr const char* kDeckName = "proto";
 template <class Options>
 Options liggghts_options() {
   Options o;
   o.format = "liggghts";
-  o.data_name = kDataName;
+  o.deck_name = kDeckName;
   return o;
 }
 
@@ -173,8 +173,8 @@ void expect_materials(
     const ExportResult r = make(c, p);
     const double density = p.mass_scaling * c.material.density;
     expect_dashpots(
-        r, kDataName, c.material, [&](double radius) { return density * volume(radius); }, 3,
-        relative);
+        r, deck_files(kDeckName).data, c.material,
+        [&](double radius) { return density * volume(radius); }, 3, relative);
     EXPECT_EQ(expect_limit_force(r.deck, zeta > 0.0), wall_fixes);
   }
 }

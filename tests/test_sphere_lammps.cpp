@@ -102,15 +102,17 @@ std::vector<Sample> run_demcal(SphereWorld w, const Protocol& p, const ExportRes
   return out;
 }
 
-/// The deck run by LAMMPS: the rows of its series.csv after step 0 (step,
-/// b_xx b_yy b_zz, contacts); empty when it failed (the log goes to `log`).
-std::vector<Sample> run_lammps(const std::string& lmp, const ExportResult& deck, std::string& log) {
+/// The deck run by LAMMPS: the rows of its series file `series` after step 0
+/// (step, b_xx b_yy b_zz, contacts); empty when it failed (the log goes to
+/// `log`).
+std::vector<Sample> run_lammps(const std::string& lmp, const ExportResult& deck,
+                               const std::string& series, std::string& log) {
   const test::TempDir tmp("sphere_lammps");
   const test::DeckRun run = test::run_deck(lmp, tmp.path(), deck.deck, deck.files);
   log = run.log;
   std::vector<Sample> out;
-  if (run.status != 0 || !fs::exists(tmp.path() / "series.csv")) return out;
-  std::stringstream lines(test::read_text(tmp.path() / "series.csv"));
+  if (run.status != 0 || !fs::exists(tmp.path() / series)) return out;
+  std::stringstream lines(test::read_text(tmp.path() / series));
   for (std::string line; std::getline(lines, line);) {
     if (line.empty() || line[0] == '#' || line[0] == 's') continue;
     std::vector<double> v;
@@ -151,10 +153,10 @@ void check_against_lammps(const char* name, const SphereWorld& w, const Protocol
   Export3dOptions o;
   o.lateral_servo = false;
   o.max_types = w.size();  // one class per distinct radius: each sphere its own γ
-  o.data_name = "spheres.data";
+  o.deck_name = "spheres";
   const ExportResult deck = export_3d_decks(p.config, p.params, w, o);
   std::string log;
-  const std::vector<Sample> l = run_lammps(lmp, deck, log);
+  const std::vector<Sample> l = run_lammps(lmp, deck, deck_files(o.deck_name).series, log);
   ASSERT_GE(l.size(), 10u) << log;
   std::vector<int64_t> steps;
   for (const Sample& s : l) steps.push_back(s.step);

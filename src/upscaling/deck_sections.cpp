@@ -52,18 +52,51 @@ int monitor_interval(int64_t steps, int monitor_points) {
 }
 
 std::string header_opening(const std::string& code, const std::string& test,
-                           const std::string& sample, const std::string& provenance,
-                           double dt_ratio, double step_factor, double dt_crit, double dt) {
+                           const std::string& sample, const ExportOptions& o, double dt_ratio,
+                           double step_factor, double dt_crit, double dt) {
   std::ostringstream s;
   s << "# ===========================================================================\n"
     << "# demcal " << DEMCAL_VERSION << " export: " << code << " input deck, " << test << "\n"
     << "# " << sample << "\n";
-  if (!provenance.empty()) s << "# parameters: " << provenance << "\n";
+  if (!o.provenance.empty()) s << "# parameters: " << o.provenance << "\n";
+  if (o.uncertified)
+    s << comment_lines("# ",
+                       "NOT CERTIFIED: the calibration of these parameters failed, and "
+                       "they were exported anyway (--allow-failed)" +
+                           (o.uncertified->empty() ? std::string(".") : ": " + *o.uncertified));
   s << "#\n"
     << "# How demcal's parameters map (demcal -> " << code << "):\n"
     << "#   dt = alpha * f * dt_crit = " << num(dt_ratio) << " * " << num(step_factor) << " * "
     << num(dt_crit) << " s = " << num(dt) << " s -> timestep\n";
   return s.str();
+}
+
+std::string comment_lines(const std::string& prefix, const std::string& text) {
+  std::string clean;
+  for (const char ch : text) {
+    const auto u = static_cast<unsigned char>(ch);
+    if (ch == '&')
+      clean += " and ";
+    else
+      clean += u < 0x20 || u >= 0x7f ? ' ' : ch == '"' ? '\'' : ch;
+  }
+  std::ostringstream s;
+  std::istringstream words(clean);
+  std::string line = prefix;
+  for (std::string w; words >> w;) {
+    if (line.size() > prefix.size() && line.size() + 1 + w.size() > 79) {
+      s << line << "\n";
+      line = prefix;
+    }
+    line += (line.size() > prefix.size() ? " " : "") + w;
+  }
+  if (line.size() > prefix.size()) s << line << "\n";
+  return s.str();
+}
+
+std::string series_variable(const ExportOptions& o) {
+  return "variable series    index " + deck_files(o.deck_name).series +
+         "      # demcal score FILE; -var series NAME renames it\n";
 }
 
 std::string header_step_factor(const std::string& code, double step_factor, double zeta_t) {

@@ -80,11 +80,22 @@ int monitor_interval(int64_t steps, int monitor_points);
 
 /// The mapping header's opening: the banner naming the engine (`code`),
 /// the test (`test`, e.g. "2D biaxial test") and the sample (`sample`, one
-/// line without "# "), the parameters' provenance, and the step line
+/// line without "# "), the parameters' provenance (o.provenance), that they
+/// are not certified and why (o.uncertified, when set), and the step line
 /// dt = alpha·f·dt_crit.
 std::string header_opening(const std::string& code, const std::string& test,
-                           const std::string& sample, const std::string& provenance,
-                           double dt_ratio, double step_factor, double dt_crit, double dt);
+                           const std::string& sample, const ExportOptions& o, double dt_ratio,
+                           double step_factor, double dt_crit, double dt);
+
+/// `text` as deck comment lines, each `prefix` then words up to 79
+/// characters: a character LAMMPS' reader would act on even in a comment
+/// (a control character, a line's closing `&`, a `"`) or a non-ASCII byte
+/// is replaced, so the text cannot end the comment.
+std::string comment_lines(const std::string& prefix, const std::string& text);
+
+/// The deck's `variable series index FILE` line: its monitoring series,
+/// deck_files(o.deck_name).series unless `-var series NAME` renames it.
+std::string series_variable(const ExportOptions& o);
 
 /// The mapping header's line on the step factor f (the engine's explicit
 /// fix viscous).

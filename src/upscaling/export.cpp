@@ -65,8 +65,8 @@ std::string mapping_header(const SceneConfig& c, const AlgorithmSpec& p, const P
   const auto& m = c.material;
   s << deck::header_opening(code, "2D biaxial test",
                             "scene " + c.name + "; prototype " + std::to_string(plan.n) +
-                                " particles (" + o.data_name + ")",
-                            o.provenance, p.dt_ratio, plan.step_factor, plan.dt_crit, plan.dt)
+                                " particles (" + deck_files(o.deck_name).data + ")",
+                            o, p.dt_ratio, plan.step_factor, plan.dt_crit, plan.dt)
     << "#     dt_crit = 2 sqrt(m_min/kn) of the smallest disc (r = " << num(plan.r_min) << " m)\n"
     << deck::header_step_factor(code, plan.step_factor, p.damping_ratio_translation)
     << "#       (the drag -gamma*v uses the half-step velocity), which shrinks a damped\n"
@@ -506,6 +506,7 @@ std::string lammps_parameters(const SceneConfig& c, const Assembly& a, const Pla
                               const ExportOptions& o) {
   const auto& m = c.material;
   const char* wall_style = o.consolidate_in_deck ? "index " : "equal ";
+  const DeckFiles files = deck_files(o.deck_name);
   std::ostringstream s;
   s << "\n# --- parameters (edit here) -------------------------------------------------\n"
     << "# Everything below the block is derived from it: editing dt or nstep keeps the\n"
@@ -531,15 +532,15 @@ std::string lammps_parameters(const SceneConfig& c, const Assembly& a, const Pla
     << "variable xr0       " << wall_style << num(a.right) << "\n"
     << "variable yb0       " << wall_style << num(a.bottom) << "\n"
     << "variable yt0       " << wall_style << num(a.top) << "\n"
-    << "variable series    index series.csv      # the monitoring series (demcal score)\n"
+    << deck::series_variable(o)
     << "# A split run: the first part writes ${restart_out} and ${restart_out}.args at its\n"
-    << "# end; continue it with  lmp $(cat final.restart.args) -in THIS_DECK\n"
-    << "# (the args give continued, restart_from and the lateral walls' positions, xl_now, "
-    << (plan.servo_carry > 0.0 ? "xr_now,\n# and their last moves, ul_now, ur_now).\n"
-                               : "xr_now).\n")
+    << "# end; continue it with  lmp $(cat " << files.restart_args << ") -in THIS_DECK\n"
+    << "# (the args give continued, restart_from, series and the lateral walls' positions,\n"
+    << (plan.servo_carry > 0.0 ? "# xl_now, xr_now, and their last moves, ul_now, ur_now).\n"
+                               : "# xl_now, xr_now).\n")
     << "variable continued index 0      # 1: continue from ${restart_from}\n"
-    << "variable restart_from index final.restart\n"
-    << "variable restart_out index final.restart\n"
+    << "variable restart_from index " << files.restart << "\n"
+    << "variable restart_out index " << files.restart << "\n"
     << "variable xl_now    index ${xl0}      # lateral walls where this run starts\n"
     << "variable xr_now    index ${xr0}\n";
   if (plan.servo_carry > 0.0)
@@ -587,7 +588,7 @@ std::string lammps_system(const SceneConfig& c, const Plan& plan, const ExportOp
         "demcal's; fcc_4x4x4, zeta_c 0.3: both equal to 5 digits; engines.md sections 20, 24)");
   std::ostringstream s;
   s << deck::lammps_system_head(2, "f f p")
-    << "if              \"${continued} == 0\" then \"read_data " << o.data_name
+    << "if              \"${continued} == 0\" then \"read_data " << deck_files(o.deck_name).data
     << "\" else \"read_restart ${restart_from}\"\n"
     << "variable        step0 equal $(step)\n"
     << "# disc masses m = f_ms*rho*t*pi*r^2 and inertia m*r^2/2 (fix nve/sphere disc)\n"
@@ -786,7 +787,8 @@ std::string lammps_run(bool consolidate_in_deck, bool carry) {
     << "thermo          ${monitor_every}\n"
     << "run             ${run_steps} upto\n"
     << "write_restart   ${restart_out}\n"
-    << "print           \"-var continued 1 -var restart_from ${restart_out} -var xl_now "
+    << "print           \"-var continued 1 -var restart_from ${restart_out} -var series "
+       "${series} -var xl_now "
        "$(v_xl_now+f_servo_end[1]) -var xr_now $(v_xr_now+f_servo_end[2])"
     << (carry ? " -var ul_now $(f_servo_end[3]) -var ur_now $(f_servo_end[4])" : "")
     << (consolidate_in_deck ? " -var xl0 ${xl0} -var xr0 ${xr0} -var yb0 ${yb0} -var yt0 ${yt0}"
@@ -799,7 +801,7 @@ ExportResult lammps(const SceneConfig& c, const AlgorithmSpec& p, const Assembly
                     const ExportOptions& o) {
   const Plan plan = make_plan(c, p, a, o.max_types);
   ExportResult out = result_of(plan);
-  out.files[o.data_name] = lammps_data_file(c, a, plan, !o.consolidate_in_deck);
+  out.files[deck_files(o.deck_name).data] = lammps_data_file(c, a, plan, !o.consolidate_in_deck);
   std::ostringstream s;
   s << mapping_header(c, p, plan, o, "LAMMPS") << lammps_limitations(p, plan, out)
     << "# (the servo's per-step formula, defined below, comes first in LAMMPS'\n"
@@ -854,7 +856,7 @@ std::string stl_rectangle(const std::string& name, double x0, double y0, double 
 /// right add up on a particle, split at the corners with the meshes' own
 /// totals) and the total force.
 std::string liggghts_series_block(const SceneConfig& c, const AlgorithmSpec& p, const Plan& plan,
-                                  const Assembly& a) {
+                                  const Assembly& a, const ExportOptions& o) {
   const auto& m = c.material;
   const std::string t = num(m.thickness);
   std::ostringstream s;
@@ -888,8 +890,7 @@ std::string liggghts_series_block(const SceneConfig& c, const AlgorithmSpec& p, 
     << "# demcal does (walls: r_i - delta/2, demcal r_i - delta; the same without wall\n"
     << "# friction), so s_xy - s_yx = torque_stress: no lever-arm floor (the LAMMPS deck\n"
     << "# has one).\n"
-    << "variable series index series.csv\n"
-    << "variable sigma3 equal " << num(c.test.lateral_stress) << "\n"
+    << deck::series_variable(o) << "variable sigma3 equal " << num(c.test.lateral_stress) << "\n"
     << "variable nstep equal " << plan.steps << "\n"
     << "variable dt equal " << num(plan.dt) << "\n"
     << "variable yb equal " << num(a.bottom) << "\n"
@@ -1022,7 +1023,8 @@ std::string liggghts_header_2d(const SceneConfig& c, const AlgorithmSpec& p, con
   s << mapping_header(c, p, plan, o, "LIGGGHTS");
   s << "#\n# Checked with LIGGGHTS 3.8 (Debian): on a 25-disc sample it scores as demcal's\n"
     << "# run (same verdict, peak within 1 %: a test, where liggghts is installed;\n"
-    << "# reports/engines.md). It writes demcal's monitoring series: demcal score series.csv\n";
+    << "# reports/engines.md). It writes demcal's monitoring series: demcal score\n"
+    << "# " << deck_files(o.deck_name).series << "\n";
   if (carried)
     s << "# Servo: demcal's law with contact damping (below, before the run): each step\n"
       << "# a lateral wall moves by gain*(F_target - F)/(R*max(1, n)) + carry*(its last\n"
@@ -1091,12 +1093,12 @@ ExportResult liggghts(const SceneConfig& c, const AlgorithmSpec& p, const Assemb
   const double carry = servo_carry(m.wall.kn, plan.servo_resist);
   const bool carried = carry > 0.0;
 
-  out.files[o.data_name] = liggghts_data_2d(c, plan, a, ntypes);
+  const DeckFiles files = deck_files(o.deck_name);
+  out.files[files.data] = liggghts_data_2d(c, plan, a, ntypes);
   const double z0 = -0.5 * m.thickness, z1 = 0.5 * m.thickness;
   const double ylo = a.bottom - 0.1 * plan.height0, yhi = a.top + 0.1 * plan.height0;
   const double xlo = a.left - 0.5 * plan.width0, xhi = a.right + 0.5 * plan.width0;
-  const std::string stem = o.data_name.substr(0, o.data_name.rfind('.'));
-  const std::string top = stem + "-top.stl", left = stem + "-left.stl", right = stem + "-right.stl";
+  const std::string top = files.mesh("top"), left = files.mesh("left"), right = files.mesh("right");
   out.files[top] = stl_rectangle("top", xhi, a.top, xlo, a.top, z0, z1);
   out.files[left] = stl_rectangle("left", a.left, ylo, a.left, yhi, z0, z1);
   out.files[right] = stl_rectangle("right", a.right, yhi, a.right, ylo, z0, z1);
@@ -1107,7 +1109,7 @@ ExportResult liggghts(const SceneConfig& c, const AlgorithmSpec& p, const Assemb
                              "-" + num(plan.top_speed) + "*step*" + num(plan.dt) + ")";
   std::ostringstream s;
   s << liggghts_header_2d(c, p, plan, o, carry, n_left, n_right);
-  s << deck::liggghts_preamble(2, "f f p", o.data_name, plan.r_min)
+  s << deck::liggghts_preamble(2, "f f p", files.data, plan.r_min)
     << deck::liggghts_materials(m, plan.class_mass, plan.dt, num)
     << "# the lateral walls' target forces, sigma3*H*t (left +x, right -x)\n"
     << "variable ftl equal " << target << "\n"
@@ -1139,7 +1141,7 @@ ExportResult liggghts(const SceneConfig& c, const AlgorithmSpec& p, const Assemb
     << "fix integrate all nve/sphere\n";
   s << deck::liggghts_translational_damping(p.damping_ratio_translation, plan.gamma_t, num)
     << "fix twod all enforce2d\n"
-    << liggghts_series_block(c, p, plan, a)
+    << liggghts_series_block(c, p, plan, a, o)
     << "# thermo: the meshes' own forces (from the first step on): p_top axial,\n"
     << "# p_left and p_right lateral, on the current width and height (Pa)\n"
     << "variable p_top equal f_mtop[2]/(v_W*" << num(m.thickness) << ")\n"
@@ -1199,6 +1201,16 @@ std::vector<int> radius_classes(const std::vector<double>& radii, int max_types,
   }
   if (types) *types = n > 0 ? *std::max_element(type.begin(), type.end()) : 0;
   return type;
+}
+
+DeckFiles deck_files(const std::string& deck) {
+  DeckFiles f;
+  f.deck = deck;
+  f.data = deck + ".data";
+  f.series = deck + ".series.csv";
+  f.restart = deck + ".restart";
+  f.restart_args = f.restart + ".args";  // the deck writes ${restart_out}.args
+  return f;
 }
 
 ExportResult export_deck(const SceneConfig& config, const AlgorithmSpec& params,

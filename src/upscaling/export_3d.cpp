@@ -142,10 +142,10 @@ std::string mapping_header(const SceneConfig& c, const AlgorithmSpec& p, const P
   std::ostringstream s;
   const auto& m = c.material;
   const double h0 = plan.hi[2] - plan.lo[2];
-  s << deck::header_opening(
-           code, "3D triaxial test",
-           "scene " + c.name + "; " + std::to_string(plan.n) + " spheres (" + o.data_name + ")",
-           o.provenance, p.dt_ratio, plan.step_factor, plan.dt_crit, plan.dt)
+  s << deck::header_opening(code, "3D triaxial test",
+                            "scene " + c.name + "; " + std::to_string(plan.n) + " spheres (" +
+                                deck_files(o.deck_name).data + ")",
+                            o, p.dt_ratio, plan.step_factor, plan.dt_crit, plan.dt)
     << "#     dt_crit = 2 sqrt(m_min/kn) of the smallest sphere (r = " << num(plan.r_min)
     << " m, m = f_ms rho 4/3 pi r^3)\n"
     << deck::header_step_factor(code, plan.step_factor, p.damping_ratio_translation)
@@ -313,7 +313,7 @@ void lammps_3d_parameters(std::ostream& s, const SceneConfig& c, const Plan3& pl
       << exact(sd % 2 == 0 ? plan.lo[sd / 2] : plan.hi[sd / 2])
       << (o.consolidate_in_deck ? "      # wall at the start of stage 1, m\n"
                                 : "      # wall at the start, m\n");
-  s << "variable series    index series.csv\n"
+  s << deck::series_variable(o)
     << "variable run_steps index ${nstep}      # -var run_steps 300 for a check\n";
   if (o.consolidate_in_deck) s << deck::lammps_consolidation_parameters(c.test);
 }
@@ -344,7 +344,7 @@ void lammps_3d_system(std::ostream& s, const SceneConfig& c, const Plan3& plan,
         "(measured on hex_5x5, zeta_c 0.25: servo criterion 5e-4 and peak 5e-5 relative from "
         "demcal's; fcc_4x4x4, zeta_c 0.3: both equal to 5 digits; engines.md sections 20, 24)");
   s << deck::lammps_system_head(3, "f f f") << "newton          off\n"
-    << "read_data       " << o.data_name << "\n"
+    << "read_data       " << deck_files(o.deck_name).data << "\n"
     << "# sphere masses f_ms*rho*4/3*pi*r^3 (density column), inertia 2/5 m r^2\n"
     << deck::lammps_contact_law(gamma_n, plan.r_min, "");
 }
@@ -767,6 +767,7 @@ std::string stl_rectangle(const std::string& name, const Eigen::Vector3d& p0,
 /// total wall force. `lateral_pos[sd]`: lateral wall sd's position (a
 /// formula).
 std::string liggghts_3d_series(const SceneConfig& c, const AlgorithmSpec& p, const Plan3& plan,
+                               const Export3dOptions& o,
                                const std::array<std::string, 4>& lateral_pos, int monitor_every) {
   const char* mesh[6] = {"mxmin", "mxmax", "mymin", "mymax", "mbottom", "mtop"};
   std::ostringstream s;
@@ -796,8 +797,7 @@ std::string liggghts_3d_series(const SceneConfig& c, const AlgorithmSpec& p, con
     << "# of its walls: approximated.\n"
     << "# Lever arm: LIGGGHTS applies a contact's tangential force at r_i - delta/2 as\n"
     << "# demcal does (walls: demcal r_i - delta, the same without wall friction).\n"
-    << "variable series index series.csv\n"
-    << "variable sigma3 equal " << exact(c.test.lateral_stress) << "\n"
+    << deck::series_variable(o) << "variable sigma3 equal " << exact(c.test.lateral_stress) << "\n"
     << "variable nstep equal " << plan.steps << "\n"
     << "variable dt equal " << exact(plan.dt) << "\n";
   for (int sd = 0; sd < 4; ++sd)
@@ -903,14 +903,14 @@ std::array<std::string, 6> liggghts_3d_meshes(const Plan3& plan, const Export3dO
                                               ExportResult& out) {
   const std::array<double, 3> ext{plan.hi[0] - plan.lo[0], plan.hi[1] - plan.lo[1],
                                   plan.hi[2] - plan.lo[2]};
-  const std::string stem = o.data_name.substr(0, o.data_name.rfind('.'));
+  const DeckFiles files = deck_files(o.deck_name);
   const double mx = 0.1 * ext[0] + 2 * plan.r_max, my = 0.1 * ext[1] + 2 * plan.r_max;
   const double mz = 0.1 * ext[2] + 2 * plan.r_max;
   using V3 = Eigen::Vector3d;
   const V3 lo(plan.lo[0], plan.lo[1], plan.lo[2]), hi(plan.hi[0], plan.hi[1], plan.hi[2]);
   std::array<std::string, 6> mesh_file;
   const char* mesh_name[6] = {"xmin", "xmax", "ymin", "ymax", "top", "bottom"};
-  for (int k = 0; k < 6; ++k) mesh_file[k] = stem + "-" + mesh_name[k] + ".stl";
+  for (int k = 0; k < 6; ++k) mesh_file[k] = files.mesh(mesh_name[k]);
   const double z0 = lo.z() - mz, zh = ext[2] + 2 * mz;
   out.files[mesh_file[0]] =
       stl_rectangle("xmin", V3(lo.x(), lo.y() - my, z0), V3(0, ext[1] + 2 * my, 0), V3(0, 0, zh));
@@ -1007,7 +1007,7 @@ std::string liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p, const Pl
   const auto& m = c.material;
   const int wall_type = plan.types + 1, ntypes = plan.types + 1;
   const double h0 = plan.hi[2] - plan.lo[2];
-  out.files[o.data_name] = data_file("LIGGGHTS", c, plan, w, ntypes, "Atoms");
+  out.files[deck_files(o.deck_name).data] = data_file("LIGGGHTS", c, plan, w, ntypes, "Atoms");
   const std::array<std::string, 6> mesh_file = liggghts_3d_meshes(plan, o, out);
 
   // Servo: demcal's law over the same loading time (deck::liggghts_servo_kp
@@ -1075,7 +1075,7 @@ std::string liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p, const Pl
                         " steps; no rotational damping");
   if (!o.lateral_servo)
     out.notes.push_back("LIGGGHTS deck: lateral walls fixed (lateral_servo off)");
-  s << deck::liggghts_preamble(3, "f f f", o.data_name, plan.r_min)
+  s << deck::liggghts_preamble(3, "f f f", deck_files(o.deck_name).data, plan.r_min)
     << deck::liggghts_materials(m, plan.class_mass, plan.dt, exact)
     << "fix mbottom all mesh/surface/stress file " << mesh_file[5] << " type " << wall_type << "\n"
     << "fix mtop all mesh/surface/stress file " << mesh_file[4] << " type " << wall_type << "\n";
@@ -1102,7 +1102,7 @@ std::string liggghts_deck(const SceneConfig& c, const AlgorithmSpec& p, const Pl
     << "variable p_lat equal (-f_mxmin[1]+f_mxmax[1])/(4*v_Wy*v_H)+(-f_mymin[2]+f_mymax[2])/"
        "(4*v_Wx*v_H)\n"
     << "variable strain_zz equal (v_H-" << exact(h0) << ")/" << exact(h0) << "\n"
-    << liggghts_3d_series(c, p, plan, {wall_pos(0), wall_pos(1), wall_pos(2), wall_pos(3)},
+    << liggghts_3d_series(c, p, plan, o, {wall_pos(0), wall_pos(1), wall_pos(2), wall_pos(3)},
                           monitor_every)
     << "# LIGGGHTS 3.8 has no fix vector: the peaks are the largest p_axial and ratio\n"
     << "# over the thermo rows; -var thermo_every 1 for every step.\n"
@@ -1133,7 +1133,7 @@ ExportResult export_3d_decks(const SceneConfig& config, const AlgorithmSpec& par
   const Plan3 plan = make_plan(config, params, world, options.max_types);
   ExportResult out = result_of(plan);
   if (options.format == "lammps") {
-    out.files[options.data_name] =
+    out.files[deck_files(options.deck_name).data] =
         data_file("LAMMPS", config, plan, world, plan.types, "Atoms # sphere");
     out.deck = lammps_deck(config, params, plan, options, out);
     out.notes.push_back(

@@ -21,6 +21,14 @@ inline std::string replaced(std::string text, const std::string& what, const std
   return text;
 }
 
+/// Every `what` in `text` replaced by `with`.
+inline std::string replaced_all(std::string text, const std::string& what,
+                                const std::string& with) {
+  for (auto at = text.find(what); at != std::string::npos; at = text.find(what, at + with.size()))
+    text.replace(at, what.size(), with);
+  return text;
+}
+
 /// The number of `variable NAME equal NUMBER` in a deck (NaN if absent).
 inline double deck_variable(const std::string& deck, const std::string& name) {
   std::istringstream lines(deck);

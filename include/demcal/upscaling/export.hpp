@@ -12,8 +12,8 @@
 //              one flat formula each), run length Nstep. Every derived
 //              quantity is computed by LAMMPS from the parameters block; the
 //              run can be split (write_restart and an args file); the deck
-//              writes series.csv, which `demcal score` reads
-//              (demcal/scoring/external_series.hpp).
+//              writes its series (DeckFiles::series), which `demcal score`
+//              reads (demcal/scoring/external_series.hpp).
 //   liggghts — LIGGGHTS-PUBLIC 3.x (checked with 3.8): gran model
 //              hooke/stiffness with absolute damping off, per-atom-type-pair
 //              kn/kt, mesh walls with a servo (fix
@@ -28,6 +28,7 @@
 
 #include <cmath>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -38,14 +39,35 @@
 
 namespace demcal {
 
+/// The files of a deck, every one named after the deck's whole file name
+/// DECK (NAME.lammps, NAME.liggghts), so that decks of both formats, or two
+/// of one format under two names, share no file in one folder (README,
+/// "Export"). The one home of these names: the decks, export, verify and
+/// the tests take them from here.
+struct DeckFiles {
+  std::string data;          ///< DECK.data: the particles it reads
+  std::string series;        ///< DECK.series.csv: the monitoring series it writes
+  std::string restart;       ///< DECK.restart: a split run's restart (2D LAMMPS deck)
+  std::string restart_args;  ///< DECK.restart.args: the continuation's arguments
+  std::string deck;          ///< DECK itself
+  /// DECK-WALL.stl: a LIGGGHTS deck's wall mesh (WALL top, left, xmin, ...).
+  std::string mesh(const std::string& wall) const { return deck + "-" + wall + ".stl"; }
+};
+DeckFiles deck_files(const std::string& deck);
+
 struct ExportOptions {
   std::string format = "lammps";  ///< lammps | liggghts
-  /// File name the deck reads its particles from (written next to it).
-  std::string data_name = "prototype.data";
+  /// The deck's file name: the files it reads (written next to it) and
+  /// writes are named after it (deck_files).
+  std::string deck_name = "prototype";
   /// Radius classes (atom types) for the per-type translational damping;
   /// a monodisperse assembly gets one.
   int max_types = 8;
   std::string provenance;  ///< one line: where the parameters came from
+  /// Set: the parameters are not certified (a failed calibration's, used
+  /// with --allow-failed), and why when known (else empty); the deck's
+  /// header says so.
+  std::optional<std::string> uncertified;
   /// LAMMPS only: the deck consolidates the prototype itself (a first stage
   /// bringing it to isotropic sigma3 with demcal's servo, damping, friction
   /// phases and static criterion; scene/biaxial.cpp), then loads it. The

@@ -45,7 +45,7 @@
 
 namespace demcal {
 
-/// ExportOptions (format, data_name, max_types, provenance) and one 3D
+/// ExportOptions (format, deck_name, max_types, provenance, uncertified) and one 3D
 /// switch.
 struct Export3dOptions : ExportOptions {
   /// true: the four lateral walls are servo-controlled at σ3 (the triaxial
@@ -63,18 +63,18 @@ struct Export3dOptions : ExportOptions {
 /// next to it (the same contract as export_deck: nothing is written here);
 /// dt and steps are what the deck runs (α·f·Δt_crit, Nstep/f), notes what
 /// could not be mapped exactly. The LAMMPS deck's outputs:
-///   - `series.csv` (variable `series`), one row every max(1, ⌊Nstep'/M⌋)
-///     steps and at the start, the columns of series_csv(TriaxialPoint)
-///     (run_output.hpp) that LAMMPS can measure: step, strain_zz, b_ij, s_ij
-///     (row by row), kinetic_energy, kinetic_energy_rotation,
-///     lateral_stress_error, servo_error_xmin..ymax, wall_xmin..zmax, then
-///     p_xmin..p_zmax (compressive wall pressures) and contacts
-///     (particle–particle);
+///   - its series, deck_files(options.deck_name).series (variable `series`),
+///     one row every max(1, ⌊Nstep'/M⌋) steps and at the start, the columns
+///     of series_csv(TriaxialPoint) (run_output.hpp) that LAMMPS can
+///     measure: step, strain_zz, b_ij, s_ij (row by row), kinetic_energy,
+///     kinetic_energy_rotation, lateral_stress_error, servo_error_xmin..ymax,
+///     wall_xmin..zmax, then p_xmin..p_zmax (compressive wall pressures) and
+///     contacts (particle–particle);
 ///   - at the end, on screen and in the log, `peak_axial_stress = P` (the
 ///     largest (p_zmin + p_zmax)/2 over every step, compressive positive:
 ///     −TriaxialResult::peak_stress_zz) and `peak_ratio = R` (the largest
 ///     axial/mean lateral wall pressure, TriaxialResult::peak_ratio); and
-///     appended to `series.csv`, the axial peak in SeriesMetadata's keys
+///     appended to the series, the axial peak in SeriesMetadata's keys
 ///     (series_result_lines): `# peak_stress_zz = -P` and `# peak_strain_zz`,
 ///     the strain of its first step, which `demcal score` takes as it takes
 ///     demcal's own tracked peak.
