@@ -113,6 +113,12 @@ void check_params_options(const UpscaledParamsOptions& o, const char* command) {
       }
     }
   }
+  // The three run params.json's rev upscaled, never the config's algorithm.
+  for (const std::string& set : o.sets)
+    if (set_section(set) == "algorithm")
+      std::cerr << "demcal " << command << ": warning: --set " << set
+                << " has no effect: the algorithm parameters are " << o.params
+                << "'s rev, upscaled\n";
   // A law measured on another scene: said, with both scenes.
   if (!o.law.empty()) {
     const std::string law_scene = scene_of(read_json_file(o.law));

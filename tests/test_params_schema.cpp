@@ -225,6 +225,12 @@ TEST_F(ParamsSchema, UpscaleRefusesSetOnTheConfigItCarries) {
   EXPECT_EQ(ex.status, 0) << ex.err;
   EXPECT_NE(ex.err.find("warning: --set material.kn=1e9 changes the material"), std::string::npos)
       << ex.err;
+  // The config's algorithm is never used (the rev's, upscaled): said.
+  const Result alg = demcal({"export", p, "--particles", "100", "--set", "algorithm.steps=30000",
+                             "--no-consolidate", "-o", "e/x.lammps"});
+  EXPECT_EQ(alg.status, 0) << alg.err;
+  EXPECT_NE(alg.err.find("warning: --set algorithm.steps=30000 has no effect"), std::string::npos)
+      << alg.err;
 }
 
 // --law FILE was ignored when --exponent was given, even a FILE that does
