@@ -113,9 +113,10 @@ void check_params_options(const UpscaledParamsOptions& o, const char* command) {
       }
     }
   }
-  // The three run params.json's rev upscaled, never the config's algorithm.
+  // The three run params.json's rev upscaled, never the config's calibrated
+  // algorithm keys (its lock_rotation is the consolidation's: used).
   for (const std::string& set : o.sets)
-    if (set_section(set) == "algorithm")
+    if (set.rfind("algorithm.", 0) == 0 && set.rfind("algorithm.lock_rotation", 0) != 0)
       std::cerr << "demcal " << command << ": warning: --set " << set
                 << " has no effect: the algorithm parameters are " << o.params
                 << "'s rev, upscaled\n";

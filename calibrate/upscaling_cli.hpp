@@ -109,8 +109,9 @@ void check_calibrated(const std::string& path, bool allow_failed, const char* co
 /// file passes) and any --set: refused by upscale (it records that config
 /// as its result's), a warning from verify and export (they run what they
 /// are given; --set warns for material and test keys, what the multipliers
-/// were calibrated for); a --set algorithm.* (never used: the parameters
-/// are the rev's, upscaled): a warning; a --law measured on another scene than the
+/// were calibrated for); a --set of a calibrated algorithm key (never
+/// used: the parameters are the rev's, upscaled; lock_rotation is used by
+/// the consolidation): a warning; a --law measured on another scene than the
 /// params.json's: a note naming both. Notes and warnings on stderr,
 /// "demcal COMMAND: ...".
 void check_params_options(const UpscaledParamsOptions& options, const char* command);

@@ -231,6 +231,12 @@ TEST_F(ParamsSchema, UpscaleRefusesSetOnTheConfigItCarries) {
   EXPECT_EQ(alg.status, 0) << alg.err;
   EXPECT_NE(alg.err.find("warning: --set algorithm.steps=30000 has no effect"), std::string::npos)
       << alg.err;
+  // lock_rotation is the consolidation's: used, not warned about.
+  const Result lock =
+      demcal({"export", p, "--particles", "100", "--set", "algorithm.lock_rotation=true",
+              "--no-consolidate", "-o", "f/x.lammps"});
+  EXPECT_EQ(lock.status, 0) << lock.err;
+  EXPECT_EQ(lock.err.find("no effect"), std::string::npos) << lock.err;
 }
 
 // --law FILE was ignored when --exponent was given, even a FILE that does
