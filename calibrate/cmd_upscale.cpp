@@ -3,8 +3,10 @@
 // Multipliers unchanged, Nstep by the scaling law, Δt and damping from the
 // prototype's own particles. Also the config resolution that `verify` and
 // `export` share.
+#include <algorithm>
 #include <filesystem>
 #include <iostream>
+#include <string_view>
 
 #include "commands.hpp"
 #include "demcal/io/files.hpp"
@@ -12,6 +14,7 @@
 #include "demcal/scene/run_output.hpp"
 #include "demcal/upscaling/params_file.hpp"
 #include "demcal/upscaling/upscaling.hpp"
+#include "output_folder.hpp"
 #include "upscaling_cli.hpp"
 
 namespace demcal::cli {
@@ -40,15 +43,90 @@ SceneConfig same_dimension(SceneConfig config, const nlohmann::json& params,
 void check_calibrated(const std::string& path, bool allow_failed, const char* command) {
   // The JSON only (its other faults are the command's to name, in its order).
   const nlohmann::json params = parse_config_json(read_text_file(path), path);
+  // Not an object, or no "success": the reader names it (after rev).
+  if (!params.is_object() || !params.contains("success")) return;
   if (!allow_failed) return require_calibrated(params, path);
-  try {
-    require_calibrated(params, path);
-  } catch (const InputError&) {
-    // No parameters at all (rev null): the reader refuses it, no warning first.
-    if (params.contains("rev") && params["rev"].is_null()) return;
-    std::cerr << "demcal " << command << ": warning: " << path
-              << ": success is false: the calibration failed, and its parameters are not "
-                 "certified; used because of --allow-failed\n";
+  // A "success" missing or not true or false is refused, --allow-failed or not.
+  if (calibration_succeeded(params, path)) return;
+  // No parameters at all (rev null): the reader refuses it, no warning first.
+  if (params.contains("rev") && params["rev"].is_null()) return;
+  std::cerr << "demcal " << command << ": warning: " << path
+            << ": success is false: the calibration failed, and its parameters are not "
+               "certified; used because of --allow-failed\n";
+}
+
+namespace {
+
+/// "material" of "material.kn=1e9" (or of "material={...}").
+std::string set_section(const std::string& set) {
+  return set.substr(0, std::min(set.find('.'), set.find('=')));
+}
+
+std::string scene_of(const nlohmann::json& j) {
+  const auto s = j.find("scene");
+  return s != j.end() && s->is_string() ? s->get<std::string>() : std::string();
+}
+
+}  // namespace
+
+void check_params_options(const UpscaledParamsOptions& o, const char* command) {
+  check_calibrated(o.params, o.allow_failed, command);
+  const nlohmann::json params = read_params_file(o.params);
+  const bool upscale = std::string_view(command) == "upscale";
+  const std::string scene = scene_of(params);
+  if (const auto stored = config_from_params(params, o.params)) {
+    // README: the config is params.json's own when it has one; --config is
+    // for a params.json without. upscale writes that config back as the
+    // record of its result; verify and export run what they are given, and
+    // say it (a deck of another scene with these multipliers is a use).
+    if (!o.config.empty()) {
+      const SceneConfig given = same_dimension(load_config(o.config), params, o.params);
+      if (to_json(given) != to_json(*stored)) {
+        const std::string what = "--config " + o.config + " (scene " + given.name +
+                                 ") is not the config " + o.params +
+                                 " was calibrated on and carries (scene " + stored->name + ")";
+        if (upscale)
+          throw InputError(o.params, "config",
+                           what +
+                               ", which upscale applies and records: drop --config (it is for "
+                               "a params.json without a config)");
+        std::cerr << "demcal " << command << ": warning: " << what
+                  << "; its parameters are applied to " << given.name
+                  << ", where they are not certified\n";
+      }
+    }
+    if (!o.sets.empty()) {
+      if (upscale)
+        throw InputError("--set " + o.sets.front(), "",
+                         "upscale applies the calibration to the config " + o.params +
+                             " carries (scene " + stored->name +
+                             ") and records it unchanged: its multipliers were calibrated for "
+                             "that material and test, and the prototype is chosen by "
+                             "--particles or --prototype; for another material or test, "
+                             "calibrate again with --set");
+      for (const std::string& set : o.sets) {
+        const std::string section = set_section(set);
+        if (section == "material" || section == "test")
+          std::cerr << "demcal " << command << ": warning: --set " << set << " changes the "
+                    << section << " " << o.params
+                    << " was calibrated for: its parameters are not certified for it\n";
+      }
+    }
+  }
+  // The three run params.json's rev upscaled, never the config's calibrated
+  // algorithm keys (its lock_rotation is the consolidation's: used).
+  for (const std::string& set : o.sets)
+    if (set.rfind("algorithm.", 0) == 0 && set.rfind("algorithm.lock_rotation", 0) != 0)
+      std::cerr << "demcal " << command << ": warning: --set " << set
+                << " has no effect: the algorithm parameters are " << o.params
+                << "'s rev, upscaled\n";
+  // A law measured on another scene: said, with both scenes.
+  if (!o.law.empty()) {
+    const std::string law_scene = scene_of(read_json_file(o.law));
+    if (!law_scene.empty() && !scene.empty() && law_scene != scene)
+      std::cerr << "demcal " << command << ": note: " << o.law << " is the law measured on scene "
+                << law_scene << ", and " << o.params << " was calibrated on scene " << scene
+                << "\n";
   }
 }
 
@@ -144,6 +222,9 @@ int cmd_upscale(const UpscaleOptions& o) {
   if (o.particles < 0) throw InputError("--particles", "", "must be positive");
   if (o.particles == 0 && o.prototype.empty())
     throw InputError("--particles", "", "give the prototype's particle count or --prototype FILE");
+  // The destination is checked before the prototype is made (its folders
+  // are made as verify's and export's are).
+  if (!o.output.empty() && o.output != "-") check_output_file(o.output);
   const ScalingLaw law = resolve_law(params, o.params, o.law, o.exponent);
   const auto config = params_scene(params, o.params, o.config, o.sets);
 
@@ -187,7 +268,7 @@ int cmd_upscale(const UpscaleOptions& o) {
   if (o.output.empty() || o.output == "-") {
     std::cout << text;
   } else {
-    write_file_atomic(o.output, text);
+    write_output_file(o.output, text);
     std::cerr << "demcal upscale: " << n_proto
               << (params_dimension(params) == 3 ? " spheres, " : " particles, ") << block["steps"]
               << " steps, dt " << block["dt"] << " s; wrote " << o.output << "\n";

@@ -31,11 +31,13 @@ void add_params_options(CLI::App* command, UpscaledParamsOptions& o) {
                     "false: passed, not certified); refused without it");
   command->add_option("--config", o.config, "scene config, if params.json carries none");
   command->add_option("--set", o.sets, "override a config key: section.key=value");
-  command->add_option("--law", o.law, "scaling.json of demcal scaling: use its measured law");
+  auto* law =
+      command->add_option("--law", o.law, "scaling.json of demcal scaling: use its measured law");
   command
       ->add_option("--exponent", o.exponent,
-                   "Nstep ~ N^exponent (default: 1 for disks, 2/3 for spheres)")
-      ->check(real_above(0.0, kMaxExponent));
+                   "Nstep ~ N^exponent (default: 1 for disks, 2/3 for spheres); not with --law")
+      ->check(real_above(0.0, kMaxExponent))
+      ->excludes(law);
 }
 
 }  // namespace
@@ -134,19 +136,20 @@ std::function<int()> add_upscaling_commands(CLI::App& app) {
   rev->add_option("-o,--output", rv->out_dir, "output folder (default demcal-rev-NAME)");
 
   // A failed calibration's params.json is refused before anything else is
-  // read or written (its "success" named), unless --allow-failed.
+  // read or written (its "success" named), unless --allow-failed; then the
+  // options that read it are checked against it (check_params_options).
   return [=]() -> int {
     if (upscale->parsed()) {
-      check_calibrated(up->params, up->allow_failed, "upscale");
+      check_params_options(*up, "upscale");
       return cmd_upscale(*up);
     }
     if (verify->parsed()) {
-      check_calibrated(ve->params, ve->allow_failed, "verify");
+      check_params_options(*ve, "verify");
       return cmd_verify(*ve);
     }
     if (scaling->parsed()) return cmd_scaling(*sc);
     if (exp->parsed()) {
-      check_calibrated(ex->params, ex->allow_failed, "export");
+      check_params_options(*ex, "export");
       return cmd_export(*ex);
     }
     if (rev->parsed()) return cmd_rev(*rv);

@@ -81,6 +81,30 @@ void OutputFolder::fail(const std::string& what) {
   throw InputError(name_, "", "output folder unusable: " + what);
 }
 
+namespace {
+
+fs::path folder_of(const fs::path& file) {
+  return file.has_parent_path() ? file.parent_path() : fs::path(".");
+}
+
+}  // namespace
+
+void check_output_file(const std::string& path) {
+  std::error_code ec;
+  const fs::path file(path);
+  if (!file.has_filename() || fs::is_directory(file, ec))
+    throw InputError(path, "", "is a folder; give a file name");
+  OutputFolder::check(folder_of(file).string());
+}
+
+void write_output_file(const std::string& path, const std::string& content) {
+  const fs::path file(path);
+  if (!file.has_filename()) throw InputError(path, "", "is a folder; give a file name");
+  OutputFolder out(folder_of(file).string());
+  out.write(file.filename().string(), content);
+  out.commit();
+}
+
 FolderLock::FolderLock(const std::string& dir) {
   fd_ = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
   if (fd_ < 0)

@@ -46,6 +46,14 @@ class OutputFolder {
   bool committed_ = false;
 };
 
+/// Before the work: the file `path` can be written as write_output_file
+/// writes it (not a folder; its folder can be made and written; nothing
+/// left behind). Else an InputError naming it (exit 2).
+void check_output_file(const std::string& path);
+/// One output file (-o FILE) written as the commands write their folders:
+/// the missing folders made, the file put in place at once (OutputFolder).
+void write_output_file(const std::string& path, const std::string& content);
+
 /// An exclusive lock on an existing output folder (flock on the folder
 /// itself), held until destruction: two commands writing into one folder
 /// (two calibrations interleaving their trials.jsonl) cannot run at once.

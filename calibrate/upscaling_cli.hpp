@@ -102,8 +102,19 @@ std::optional<SceneConfig> params_scene(const nlohmann::json& params, const std:
 /// (require_calibrated: exit 2, the file and the field named), or with
 /// `allow_failed` used with a warning on stderr.
 void check_calibrated(const std::string& path, bool allow_failed, const char* command);
-/// The scaling law: --exponent, else --law scaling.json, else params.json's
-/// "upscaling" block, else linear.
+/// What `command` (upscale, verify, export) checks before it runs, in this
+/// order: check_calibrated(); the params.json read in full
+/// (read_params_file); with a params.json that carries its config, a
+/// --config that differs from it (compared as parsed: a copy of the same
+/// file passes) and any --set: refused by upscale (it records that config
+/// as its result's), a warning from verify and export (they run what they
+/// are given; --set warns for material and test keys, what the multipliers
+/// were calibrated for); a --set of a calibrated algorithm key (never
+/// used: the parameters are the rev's, upscaled; lock_rotation is used by
+/// the consolidation): a warning; a --law measured on another scene than the
+/// params.json's: a note naming both. Notes and warnings on stderr,
+/// "demcal COMMAND: ...".
+void check_params_options(const UpscaledParamsOptions& options, const char* command);
 /// params_scene(), or an InputError asking for --config when there is none.
 SceneConfig required_scene(const nlohmann::json& params, const std::string& path,
                            const std::string& config, const std::vector<std::string>& sets);
@@ -112,6 +123,9 @@ SceneConfig required_scene(const nlohmann::json& params, const std::string& path
 std::pair<std::string, int64_t> named_prototype(const nlohmann::json& params,
                                                 const std::string& file, int64_t particles);
 
+/// The scaling law: --exponent, else --law scaling.json, else params.json's
+/// "upscaling" block, else the default law of its dimension (the command
+/// line takes one of --exponent and --law).
 ScalingLaw resolve_law(const nlohmann::json& params, const std::string& params_path,
                        const std::string& law_path, double exponent);
 

@@ -200,8 +200,12 @@ TEST_F(CliEndToEnd, VerifyConsolidateOnlyAnnouncesNoLoading) {
   demcal::AlgorithmSpec p;
   p.steps = 20000;
   const auto scales = demcal::particle_scales(demcal::make_assembly(c).r, c.material);
+  // success and dt_ratio_stable as every params.json holds them (the
+  // stable step calibrating the default scene records: reports/example-hex_10x10).
   write("params.json", nlohmann::json{{"schema", "demcal.params/1"},
                                       {"scene", c.name},
+                                      {"success", true},
+                                      {"dt_ratio_stable", 0.2920194170417612},
                                       {"rev", demcal::param_block(p, scales)}}
                            .dump());
   const Result r = demcal({"verify", (dir_ / "params.json").string(), "--particles", "25",

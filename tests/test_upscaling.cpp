@@ -224,7 +224,13 @@ class UpscaleCli : public ::testing::Test {
     p.damping_ratio_translation = 0.39;
     p.damping_ratio_rotation = 0.0;
     const ParticleScales s = particle_scales(make_assembly(c).r, c.material);
-    nlohmann::json j{{"schema", "demcal.params/1"}, {"scene", c.name}, {"rev", param_block(p, s)}};
+    // success and dt_ratio_stable as calibrate writes them (the stable step
+    // calibrating the default scene records: reports/example-hex_10x10).
+    nlohmann::json j{{"schema", "demcal.params/1"},
+                     {"scene", c.name},
+                     {"success", true},
+                     {"dt_ratio_stable", 0.2920194170417612},
+                     {"rev", param_block(p, s)}};
     if (with_config) j["config"] = to_json(c);
     std::ofstream(dir_ / "params.json") << j.dump(2);
   }

@@ -1,6 +1,9 @@
 #include "demcal/upscaling/params_file.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <iterator>
+#include <limits>
 #include <string_view>
 
 #include "demcal/io/files.hpp"
@@ -17,9 +20,159 @@ nlohmann::json read_params_file(const std::string& path) {
   return parse_params_text(read_text_file(path), path);  // a folder, a loop: one clear error
 }
 
+namespace {
+
+/// How a params.json key is checked (check_keys): its JSON type as
+/// demcal writes it.
+enum class Kind { kString, kBoolean, kNumber, kCount, kObject, kObjectOrNull };
+
+struct KeyRule {
+  const char* key;
+  Kind kind;
+};
+
+// The top-level keys of every params.json demcal has written (params_file,
+// upscale, calibrate --evidence; wall_time_s in the first ones, 2026-11-22)
+// and their types. schema, version, success, dt_ratio_stable, dimension and
+// rev are checked in full before (parse_params_text); the nested blocks
+// other than rev, prototype and upscaling (criteria, certificate, evidence,
+// config: parse_config) are not checked here.
+constexpr KeyRule kTopKeys[] = {{"scene", Kind::kString},
+                                {"message", Kind::kString},
+                                {"config", Kind::kObject},
+                                {"criteria", Kind::kObjectOrNull},
+                                {"tolerances", Kind::kObject},
+                                {"accuracy", Kind::kNumber},
+                                {"certificate", Kind::kObjectOrNull},
+                                {"strategy", Kind::kString},
+                                {"trials", Kind::kCount},
+                                {"particle_steps_run", Kind::kNumber},
+                                {"seed", Kind::kCount},
+                                {"config_sha256", Kind::kString},
+                                {"test", Kind::kString},
+                                {"axial_component", Kind::kString},
+                                {"evidence", Kind::kObject},
+                                {"analytical_peak_stress_yy", Kind::kNumber},
+                                {"wall_time_s", Kind::kNumber},
+                                {"schema", Kind::kString},
+                                {"version", Kind::kString},
+                                {"success", Kind::kBoolean},
+                                {"dt_ratio_stable", Kind::kNumber},
+                                {"dimension", Kind::kCount},
+                                {"rev", Kind::kObject},
+                                {"prototype", Kind::kObject},
+                                {"upscaling", Kind::kObject}};
+
+// A parameter block (param_block): rev, and prototype with its "source".
+constexpr KeyRule kBlockKeys[] = {{"dt_ratio", Kind::kNumber},
+                                  {"steps", Kind::kCount},
+                                  {"damping_ratio_translation", Kind::kNumber},
+                                  {"damping_ratio_rotation", Kind::kNumber},
+                                  {"mass_scaling", Kind::kNumber},
+                                  {"particles", Kind::kCount},
+                                  {"dt", Kind::kNumber},
+                                  {"dt_crit", Kind::kNumber},
+                                  {"damping_translation", Kind::kNumber},
+                                  {"damping_rotation", Kind::kNumber},
+                                  {"damping_translation_mean", Kind::kNumber},
+                                  {"damping_rotation_mean", Kind::kNumber},
+                                  {"damping_translation_crit", Kind::kNumber},
+                                  {"damping_rotation_crit", Kind::kNumber},
+                                  {"radius_min", Kind::kNumber},
+                                  {"radius_max", Kind::kNumber},
+                                  {"radius_mean", Kind::kNumber},
+                                  {"mass_min", Kind::kNumber},
+                                  {"mass_mean", Kind::kNumber},
+                                  {"duration", Kind::kNumber}};
+constexpr KeyRule kSourceKeys[] = {
+    {"kind", Kind::kString}, {"description", Kind::kString}, {"file", Kind::kString}};
+// upscaling_block.
+constexpr KeyRule kUpscalingKeys[] = {{"law", Kind::kString},
+                                      {"exponent", Kind::kNumber},
+                                      {"factor", Kind::kNumber},
+                                      {"particles_rev", Kind::kCount},
+                                      {"particles_prototype", Kind::kCount},
+                                      {"source", Kind::kString},
+                                      {"formula", Kind::kString}};
+
+/// A key as written, or quoted when it is long or holds control characters.
+std::string shown_key(const std::string& key) {
+  const bool plain = key.size() <= 80 && std::none_of(key.begin(), key.end(), [](char c) {
+                       return static_cast<unsigned char>(c) < 0x20 || c == 0x7f;
+                     });
+  return plain ? key : quoted_value(key);
+}
+
+void check_value(const nlohmann::json& v, Kind kind, const std::string& path,
+                 const std::string& field) {
+  switch (kind) {
+    case Kind::kString:
+      if (!v.is_string()) throw InputError(path, field, "must be a string, got " + quoted_json(v));
+      return;
+    case Kind::kBoolean:
+      if (!v.is_boolean())
+        throw InputError(path, field, "must be true or false, got " + quoted_json(v));
+      return;
+    case Kind::kNumber:
+      if (!v.is_number()) throw InputError(path, field, "must be a number, got " + quoted_json(v));
+      if (!std::isfinite(v.get<double>()))
+        throw InputError(path, field, "must be finite, got " + v.dump());
+      return;
+    case Kind::kCount:
+      json_integer(v, 0, std::numeric_limits<int64_t>::max(), path, field);
+      return;
+    case Kind::kObjectOrNull:
+      if (v.is_null()) return;
+      [[fallthrough]];
+    case Kind::kObject:
+      if (!v.is_object()) throw InputError(path, field, "must be an object, got " + quoted_json(v));
+      return;
+  }
+}
+
+/// Every key of `object` is one of `rules` and of its type; `where` is the
+/// object's field ("" for the top level, "rev").
+template <size_t N>
+void check_keys(const nlohmann::json& object, const KeyRule (&rules)[N], const std::string& path,
+                const std::string& where) {
+  for (auto it = object.begin(); it != object.end(); ++it) {
+    const std::string field = (where.empty() ? "" : where + ".") + shown_key(it.key());
+    const auto rule = std::find_if(std::begin(rules), std::end(rules),
+                                   [&](const KeyRule& r) { return it.key() == r.key; });
+    if (rule == std::end(rules))
+      throw InputError(path, field, "unknown key (not one a demcal params.json holds)");
+    check_value(it.value(), rule->kind, path, field);
+  }
+}
+
+/// A parameter block (rev, prototype; check_keys made it an object): its
+/// keys, and the prototype's source.
+void check_block(const nlohmann::json& params, const std::string& key, const std::string& path) {
+  const auto block = params.find(key);
+  if (block == params.end()) return;
+  nlohmann::json numbers = *block;
+  if (key == "prototype" && block->contains("source")) {
+    check_value(block->at("source"), Kind::kObject, path, "prototype.source");
+    check_keys(block->at("source"), kSourceKeys, path, "prototype.source");
+    numbers.erase("source");
+  }
+  check_keys(numbers, kBlockKeys, path, key);
+}
+
+}  // namespace
+
+bool calibration_succeeded(const nlohmann::json& params, const std::string& path) {
+  const auto success = params.find("success");
+  if (success == params.end())
+    throw InputError(path, "success",
+                     "missing: every params.json demcal writes says whether its calibration "
+                     "succeeded (true or false)");
+  check_value(*success, Kind::kBoolean, path, "success");
+  return success->get<bool>();
+}
+
 void require_calibrated(const nlohmann::json& params, const std::string& path) {
-  const auto success = params.is_object() ? params.find("success") : params.end();
-  if (success == params.end() || *success != false) return;
+  if (calibration_succeeded(params, path)) return;
   std::string why;
   if (const auto m = params.find("message"); m != params.end() && m->is_string())
     why = " (" + quoted_value(m->get<std::string>(), 200) + ")";
@@ -45,13 +198,22 @@ nlohmann::json parse_params_text(std::string_view text, const std::string& path)
                      "is null: the calibration found no passing trial, so there are no "
                      "parameters to use; re-run demcal calibrate with more trials (--max-trials)");
   const RevParams rev = rev_params_from_json(params, path);  // the values used first: named first
+  calibration_succeeded(params, path);  // true or false (whether it may be used: the command's)
   // The stable step the calibration measured on the REV bounds its α, as
   // it bounds `demcal run`'s (a params.json edited beyond it is refused).
-  if (const auto stable = params.find("dt_ratio_stable");
-      stable != params.end() && stable->is_number() && stable->get<double>() > 0.0)
-    require_stable_dt_ratio(rev.params.dt_ratio, stable->get<double>(), path, "rev.dt_ratio",
-                            "the stable dt_ratio this params.json records as dt_ratio_stable; "
-                            "use a smaller value, or calibrate again");
+  // Every params.json demcal writes records it: without it, or not a
+  // number, the bound would be off.
+  const auto stable = params.find("dt_ratio_stable");
+  if (stable == params.end())
+    throw InputError(path, "dt_ratio_stable",
+                     "missing: every params.json demcal writes records the stable dt_ratio "
+                     "that bounds rev.dt_ratio");
+  check_value(*stable, Kind::kNumber, path, "dt_ratio_stable");
+  if (!(stable->get<double>() > 0.0))
+    throw InputError(path, "dt_ratio_stable", "must be > 0, got " + stable->dump());
+  require_stable_dt_ratio(rev.params.dt_ratio, stable->get<double>(), path, "rev.dt_ratio",
+                          "the stable dt_ratio this params.json records as dt_ratio_stable; "
+                          "use a smaller value, or calibrate again");
   const auto schema = params.find("schema");
   if (schema == params.end() || !schema->is_string() || *schema != kParamsSchema)
     throw InputError(
@@ -73,8 +235,14 @@ nlohmann::json parse_params_text(std::string_view text, const std::string& path)
   }
   if (const auto d = params.find("dimension"); d != params.end())
     json_integer(*d, 2, 3, path, "dimension");
-  if (params.contains("prototype") && params["prototype"].is_object() &&
-      params["prototype"].contains("particles")) {
+  // Every other key: one demcal writes, of the type it writes (a typo, or
+  // a value of the wrong type, is not taken for a setting that applies).
+  check_keys(params, kTopKeys, path, "");
+  check_block(params, "rev", path);
+  check_block(params, "prototype", path);
+  if (const auto up = params.find("upscaling"); up != params.end())
+    check_keys(*up, kUpscalingKeys, path, "upscaling");
+  if (params.contains("prototype") && params["prototype"].contains("particles")) {
     particle_count(params["prototype"]["particles"], 1, path, "prototype.particles");
   }
   return params;

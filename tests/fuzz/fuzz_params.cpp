@@ -1,7 +1,7 @@
 // libFuzzer target: the params.json reader (what `demcal upscale` and
 // `demcal export` trust) must turn any input into a checked tree or one
 // InputError, never crash, hang or leak. A tree it accepts must hold the
-// REV block it promises: reading that block again cannot fail.
+// REV block and the success it promises: reading them again cannot fail.
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
@@ -20,8 +20,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   }
   try {
     (void)demcal::rev_params_from_json(params, "fuzz.json");
+    (void)demcal::calibration_succeeded(params, "fuzz.json");
   } catch (const demcal::InputError&) {
-    std::abort();  // accepted, yet its rev block does not read
+    std::abort();  // accepted, yet its rev block or its success does not read
   }
   return 0;
 }

@@ -23,6 +23,8 @@ inline nlohmann::json params_3d(const SceneConfig& config, const TriaxialState& 
   summary.best_trial.params = best;
   if (rev_peak) summary.best_trial.score.criteria.peak_stress_yy = *rev_peak;
   summary.dimension = 3;
+  // The stable step calibrate records (its runner's, TriaxialRunner).
+  summary.dt_ratio_stable = estimated_stable_dt_ratio(state, config.algorithm);
   return params_file(config, state, CalibrationOptions::from(config.calibration), summary);
 }
 

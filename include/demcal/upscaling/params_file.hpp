@@ -41,8 +41,11 @@ inline constexpr const char* kParamsSchema = "demcal.params/1";
 /// duplicate keys, this schema, a version string, and a `rev` block whose
 /// numbers are finite and in range (rev_params_from_json), a prototype
 /// particle count that fits, a "dimension" of 2 or 3 when present (absent:
-/// 2). Every fault is an InputError naming the file
-/// and the key (exit 2).
+/// 2). Every key is one demcal writes, of the type it writes (unknown keys
+/// are refused, at the top and in rev, prototype and upscaling), and the
+/// two every params.json demcal has written holds are required: "success"
+/// (true or false) and "dt_ratio_stable" (a number > 0). Every fault is an
+/// InputError naming the file and the key (exit 2).
 nlohmann::json read_params_file(const std::string& path);
 /// Also refused: a "rev" of null (a calibration in which no trial passed
 /// writes no parameters), and a rev.dt_ratio beyond the "dt_ratio_stable"
@@ -50,11 +53,14 @@ nlohmann::json read_params_file(const std::string& path);
 /// The same checks on a params.json's text (`path` names it in errors);
 /// read_params_file reads the file and calls this.
 nlohmann::json parse_params_text(std::string_view text, const std::string& path);
+/// A params.json's "success": an InputError naming `path` and the field
+/// when it is missing or not true or false (a "false" string is not false).
+bool calibration_succeeded(const nlohmann::json& params, const std::string& path);
 /// What `upscale`, `verify` and `export` ask of a params.json before using
 /// it (unless --allow-failed): a calibration that succeeded. "success":
 /// false is an InputError naming `path` and the field success, with the
-/// calibration's message and the remedy. Nothing is asked of a params.json
-/// without the key.
+/// calibration's message and the remedy; so is a "success" missing or not
+/// true or false (calibration_succeeded).
 void require_calibrated(const nlohmann::json& params, const std::string& path);
 /// The dimension a params.json was calibrated in: its "dimension" (2 when
 /// absent, as 2D params.json files have always been written).
