@@ -237,6 +237,25 @@ TEST(ScoringJson, CriteriaRoundTrip) {
   ASSERT_TRUE(back.peak_error.has_value());
   EXPECT_DOUBLE_EQ(*back.peak_error, *c.peak_error);
   EXPECT_DOUBLE_EQ(back.peak_stress_yy, c.peak_stress_yy);
+  // 2D criteria have no burst; a 3D one (compute_triaxial_criteria) comes back.
+  EXPECT_FALSE(j.contains("moment_burst"));
+  Criteria three_d = c;
+  three_d.moment_burst = 9.36;
+  const Criteria back_3d = criteria_from_json(nlohmann::json::parse(to_json(three_d).dump()));
+  ASSERT_TRUE(back_3d.moment_burst.has_value());
+  EXPECT_DOUBLE_EQ(*back_3d.moment_burst, 9.36);
+}
+
+// RMS over median |x|: 1 for a steady level (either sign), large when a few
+// points carry the mean square, 0 without a median to compare with.
+TEST(ScoringNoise, BurstRatio) {
+  EXPECT_DOUBLE_EQ(burst_ratio({2e-4, -2e-4, 2e-4, -2e-4, 2e-4}), 1.0);
+  std::vector<double> burst(100, 1e-6);
+  burst[40] = burst[41] = 1e-3;  // two points of chatter
+  EXPECT_NEAR(burst_ratio(burst), std::sqrt((98e-12 + 2e-6) / 100.0) / 1e-6, 1e-9);
+  EXPECT_GT(burst_ratio(burst), 100.0);
+  EXPECT_DOUBLE_EQ(burst_ratio({}), 0.0);
+  EXPECT_DOUBLE_EQ(burst_ratio({0.0, 0.0, 1.0}), 0.0);
 }
 
 // --- objective and constraints ------------------------------------------
