@@ -189,14 +189,13 @@ nlohmann::json to_json(const TriaxialCriteria& c) {
   for (int w = 0; w < 4; ++w)
     walls.push_back(c.not_available.count(kWall[w]) ? nlohmann::json(nullptr)
                                                     : nlohmann::json(c.servo_walls[w]));
-  nlohmann::json xy{{"force_balance_shear", c.xy.force_balance_shear},
-                    {"oscillation_shear", c.xy.oscillation_shear},
-                    {"moment_balance", c.xy.moment_balance},
-                    {"moment_noise", c.xy.moment_noise}};
-  if (c.xy.moment_burst) xy["moment_burst"] = *c.xy.moment_burst;
   nlohmann::json j{{"xz", to_json(c.xz)},
                    {"yz", to_json(c.yz)},
-                   {"xy", xy},
+                   {"xy",
+                    {{"force_balance_shear", c.xy.force_balance_shear},
+                     {"oscillation_shear", c.xy.oscillation_shear},
+                     {"moment_balance", c.xy.moment_balance},
+                     {"moment_noise", c.xy.moment_noise}}},
                    {"servo_walls", walls},
                    {"combined_without_drag", to_json(c.combined)}};
   if (!c.not_available.count("rotational_drag")) j["rotational_drag"] = c.rotational_drag;
