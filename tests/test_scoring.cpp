@@ -239,6 +239,18 @@ TEST(ScoringJson, CriteriaRoundTrip) {
   EXPECT_DOUBLE_EQ(back.peak_stress_yy, c.peak_stress_yy);
 }
 
+// RMS over median |x|: 1 for a steady level (either sign), large when a few
+// points carry the mean square, 0 without a median to compare with.
+TEST(ScoringNoise, BurstRatio) {
+  EXPECT_DOUBLE_EQ(burst_ratio({2e-4, -2e-4, 2e-4, -2e-4, 2e-4}), 1.0);
+  std::vector<double> burst(100, 1e-6);
+  burst[40] = burst[41] = 1e-3;  // two points of chatter
+  EXPECT_NEAR(burst_ratio(burst), std::sqrt((98e-12 + 2e-6) / 100.0) / 1e-6, 1e-9);
+  EXPECT_GT(burst_ratio(burst), 100.0);
+  EXPECT_DOUBLE_EQ(burst_ratio({}), 0.0);
+  EXPECT_DOUBLE_EQ(burst_ratio({0.0, 0.0, 1.0}), 0.0);
+}
+
 // --- objective and constraints ------------------------------------------
 
 Score make_score(double fb, double mb, double sv, double osc, double particle_steps,

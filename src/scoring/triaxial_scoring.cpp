@@ -55,6 +55,14 @@ MonitorPoint horizontal_plane_point(const TriaxialPoint& t) {
   return p;
 }
 
+/// burst_ratio() of a plane's asymmetry a = moment_term(), over the points
+/// compute_criteria() scores (the consolidated start left out).
+double moment_burst_of(const std::vector<MonitorPoint>& plane, double s3) {
+  std::vector<double> a;
+  for (size_t k = 1; k < plane.size(); ++k) a.push_back(moment_term(plane[k], s3));
+  return burst_ratio(a);
+}
+
 }  // namespace
 
 double rotational_drag_share(const TriaxialPoint& p) {
@@ -75,6 +83,11 @@ TriaxialCriteria compute_triaxial_criteria(const std::vector<TriaxialPoint>& ser
   c.xz = compute_criteria(xz, s3);
   c.yz = compute_criteria(yz, s3);
   c.xy = compute_criteria(xy, s3);
+  if (s3 > 0.0) {
+    c.xz.moment_burst = moment_burst_of(xz, s3);
+    c.yz.moment_burst = moment_burst_of(yz, s3);
+    c.xy.moment_burst = moment_burst_of(xy, s3);
+  }
   // Each lateral wall on its own: the plane series with that wall's error
   // (compute_criteria's servo measure, nothing else of it is used).
   for (int w = 0; w < 4; ++w) {
@@ -141,6 +154,7 @@ TriaxialCriteria compute_triaxial_criteria(const std::vector<TriaxialPoint>& ser
     if (k->moment_balance > most->moment_balance) most = k;
   m.moment_pair = most->moment_pair;
   m.moment_balance = most->moment_balance;
+  m.moment_burst = most->moment_burst;
   m.moment_noise = std::max({c.xz.moment_noise, c.yz.moment_noise, c.xy.moment_noise});
   m.servo = std::max({c.xz.servo, c.yz.servo, c.servo_walls[0], c.servo_walls[1], c.servo_walls[2],
                       c.servo_walls[3]});

@@ -136,6 +136,14 @@ struct Criteria {
   /// (scored_criteria()): the diagnosis then names the drag, not an
   /// asymmetry of σ.
   std::optional<double> moment_from_drag;
+  /// 3D: how the asymmetry a comes, RMS(a)/median(|a|) over the plane
+  /// moment_balance measured (burst_ratio(); compute_triaxial_criteria sets
+  /// it, 2D leaves it unset and keeps the 2D atlas' chatter thresholds). A
+  /// steady asymmetry, the rotational drag's, reads 1-1.5; the rotational
+  /// chatter of a step at its stability limit comes in bursts, 9 and more
+  /// (reports/signature-atlas-3d.md, 2026-12-04): the 3D diagnosis names
+  /// the chatter from it.
+  std::optional<double> moment_burst;
 };
 
 struct Diagnosis {
@@ -317,6 +325,10 @@ double objective(const Score& score, const Tolerances& tolerances);
 /// smoothly curving response is not noise), scaled so that white noise of
 /// standard deviation s gives s.
 double robust_noise(const std::vector<double>& series);
+/// How a series comes in bursts: RMS over the median of |x|, 1 for a
+/// steady level, about 1.5 for white noise, large when a few points carry
+/// the mean square; 0 for an empty series or a median of 0.
+double burst_ratio(const std::vector<double>& series);
 /// RMS noise level from the same fourth differences, the largest fraction
 /// `trim` of them left out (sparse serrations count, one or two isolated
 /// events do not), scaled so that white noise of std s gives s.
