@@ -49,7 +49,7 @@ for n in $SIZES; do
   kinds="bare deck"
   if [[ -n "${OLD_BUILD:-}" ]]; then
     "$OLD_BUILD/demcal" export "$params" --particles "$n" ${EXPORT_FLAGS:-} -o "$d/old/deck.lammps" >/dev/null 2>&1
-    cmp -s "$d/old/deck.data" "$d/deck.data" || { echo "OLD_BUILD wrote another data file"; exit 1; }
+    cmp -s "$d/old/deck.lammps.data" "$d/deck.lammps.data" || { echo "OLD_BUILD wrote another data file"; exit 1; }
     cp "$d/old/deck.lammps" "$d/old.lammps"; kinds="bare old deck"
   fi
   # the deck's own numbers, for the bare run

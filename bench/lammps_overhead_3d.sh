@@ -52,7 +52,7 @@ for n in $SIZES; do
     if [[ "${REUSE:-0}" != 1 || ! -f "$d/old.lammps" ]]; then
       # shellcheck disable=SC2086
       "$OLD_BUILD/demcal" export "$params" --particles "$n" $EXPORT_FLAGS -o "$d/old/deck.lammps" >/dev/null 2>&1
-      cmp -s "$d/old/deck.data" "$d/deck.data" || { echo "OLD_BUILD wrote another data file"; exit 1; }
+      cmp -s "$d/old/deck.lammps.data" "$d/deck.lammps.data" || { echo "OLD_BUILD wrote another data file"; exit 1; }
       cp "$d/old/deck.lammps" "$d/old.lammps"
     fi
     kinds="bare old deck"
@@ -70,7 +70,7 @@ atom_style      sphere
 atom_modify     map array
 comm_modify     vel yes
 newton          off
-read_data       deck.data
+read_data       deck.lammps.data
 $(grep -m1 '^pair_style' "$d/deck.lammps" | sed "s/\${kn}/$(get kn)/; s/\${kt}/$(get kt)/; s/\${mu}/$(get mu)/")
 pair_coeff      * *
 $(grep -m1 '^neighbor' "$d/deck.lammps")

@@ -40,22 +40,12 @@
 #include "demcal/upscaling/upscaling.hpp"
 #include "output_folder.hpp"
 #include "resume_key.hpp"
+#include "shell_word.hpp"
 #include "stop_signal.hpp"
 
 namespace demcal::cli {
 
 namespace {
-
-/// Shell-quoted for display: the user copies it into a shell.
-std::string shell_word(const std::string& w) {
-  const bool plain = !w.empty() && std::all_of(w.begin(), w.end(), [](unsigned char c) {
-    return std::isalnum(c) || std::string_view("_./=:,+-@%").find(c) != std::string_view::npos;
-  });
-  if (plain) return w;
-  std::string q = "'";
-  for (char c : w) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
 
 std::string reproduce_command(const CalibrateOptions& o, const SceneConfig& config,
                               const std::string& dir) {
@@ -69,12 +59,7 @@ std::string reproduce_command(const CalibrateOptions& o, const SceneConfig& conf
                            "--accuracy", nlohmann::json(config.calibration.accuracy).dump(),
                            "--strategy", o.strategy});
   if (o.evidence) args.push_back("--evidence");
-  std::string out;
-  for (const auto& a : args) {
-    if (!out.empty()) out += ' ';
-    out += shell_word(a);
-  }
-  return out;
+  return shell_command(args);
 }
 
 /// run.json: what varies between invocations (kept out of params.json).

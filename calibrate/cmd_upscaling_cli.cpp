@@ -96,7 +96,7 @@ std::function<int()> add_upscaling_commands(CLI::App& app) {
                    "(default 400)")
       ->check(whole_number(1, kMaxParticles));
   scaling->add_option("-o,--output", sc->out_dir, "report folder (default demcal-scaling-NAME)");
-  scaling->add_option("--work", sc->work_dir, "per-size work folder (default demcal-scaling-NAME)");
+  scaling->add_option("--work", sc->work_dir, "per-size work folder (default: the -o folder)");
   scaling->add_option("-j,--jobs", sc->jobs, "trials in parallel (default: cores)")
       ->check(whole_number(1, kMaxJobs));
   scaling
