@@ -230,6 +230,8 @@ TEST_F(CliEndToEnd, VerifyRefusesTheOptionsItWouldIgnore) {
   const std::string params =
       write("params.json", nlohmann::json{{"schema", "demcal.params/1"},
                                           {"scene", c.name},
+                                          {"success", true},
+                                          {"dt_ratio_stable", 0.2920194170417612},
                                           {"rev", demcal::param_block(p, scales)}}
                                .dump());
   const std::vector<std::string> verify{"verify", params, "--particles", "25", "-o", "v"};
@@ -804,31 +806,21 @@ TEST_F(CliEndToEnd, ExportSaysHowItsStepsWereUpscaledIn2dAnd3d) {
   const fs::path reports = fs::path(test::kSourceDir) / "reports";
   struct Case {
     std::string params;
-    std::vector<std::string> extra;
+    const char* particles;  // the 3D FCC prototype: 4·n³ spheres
     const char* what;
     const char* law;
     const char* deck;
   };
-  const std::vector<Case> cases = {{(reports / "example-hex_10x10" / "params.json").string(),
-                                    {},
-                                    "particles",
-                                    "linear",
-                                    "d2/deck.lammps"},
-                                   {(reports / "example-fcc_4x4x4" / "params.json").string(),
-                                    {"--config", test::shipped_config("random_500_3d")},
-                                    "spheres",
-                                    "power",
-                                    "d3/deck.lammps"}};
+  const std::vector<Case> cases = {{(reports / "example-hex_10x10" / "params.json").string(), "150",
+                                    "particles", "linear", "d2/deck.lammps"},
+                                   {(reports / "example-fcc_4x4x4" / "params.json").string(), "500",
+                                    "spheres", "power", "d3/deck.lammps"}};
   for (const Case& c : cases) {
     SCOPED_TRACE(c.params);
-    std::vector<std::string> args = {"export",           c.params, "--particles", "150",
-                                     "--consolidate-in", "deck",   "-o",          c.deck};
-    args.insert(args.end(), c.extra.begin(), c.extra.end());
-    const Result r = demcal(args);
+    const Result r = demcal(
+        {"export", c.params, "--particles", c.particles, "--consolidate-in", "deck", "-o", c.deck});
     ASSERT_EQ(r.status, 0) << r.err;
-    std::vector<std::string> up = {"upscale", c.params, "--particles", "150"};
-    up.insert(up.end(), c.extra.begin(), c.extra.end());
-    const Result u = demcal(up);
+    const Result u = demcal({"upscale", c.params, "--particles", c.particles});
     ASSERT_EQ(u.status, 0) << u.err;
     const auto upscaled = nlohmann::json::parse(u.out);
     const auto rev = test::read_json(c.params).at("rev");
