@@ -18,7 +18,9 @@
 #include "demcal/scoring/scoring.hpp"
 #include "demcal/search/calibration.hpp"
 #include "demcal/upscaling/params_file.hpp"
+#include "demcal/upscaling/rev.hpp"
 #include "demcal/upscaling/scaling_study.hpp"
+#include "support/files.hpp"
 #include "support/input_errors.hpp"
 
 using namespace demcal;
@@ -249,6 +251,28 @@ TEST(Records, ParamsFileCarriesTheCalibratedBlocks) {
   EXPECT_DOUBLE_EQ(p.at("particle_steps_run").get<double>(),
                    2.0 * 12345 * static_cast<double>(state.world.size()));
   EXPECT_TRUE(p.contains("analytical_peak_stress_yy"));  // a hexagonal scene
+}
+
+// A prototype from a particle file: the upscaling block counts the file's
+// particles, as the prototype block does (it counted config.prototype.
+// particles, 0 for a file, so the REV's: particles_prototype 25 and factor 1
+// beside a prototype of 100 disks whose Nstep was scaled ×4).
+TEST(Records, ParamsFileUpscalesToTheParticlesOfAPrototypeFile) {
+  test::TempDir dir("records_proto_file");
+  SceneConfig config = default_config();
+  config.assembly.columns = config.assembly.rows = 5;
+  config.prototype.particles = 0;  // a config names a file or a count
+  config.prototype.file = test::write_text(
+      dir / "proto.csv", particle_csv(hexagonal_packing(10, 10, config.assembly.radius)));
+  const ConsolidatedState state = consolidate(config, make_assembly(config));
+  CalibrationSummary summary;
+  summary.success = true;
+  summary.best = sample_params();
+  summary.best_trial = sample_trial();
+  const json p = params_file(config, state, CalibrationOptions::from(config.calibration), summary);
+  EXPECT_EQ(p.at("prototype").at("particles"), 100);
+  EXPECT_EQ(p.at("upscaling").at("particles_prototype"), 100);
+  EXPECT_EQ(p.at("upscaling").at("particles_rev"), 25);
 }
 
 TEST(Records, EvidenceBlockMeasuresPeakErrorsAgainstTheReference) {

@@ -298,14 +298,17 @@ void without_parameters(nlohmann::json& params) {
 nlohmann::json params_file(const SceneConfig& config, const ConsolidatedState& state,
                            const CalibrationOptions& options, const CalibrationSummary& summary) {
   const int64_t n_rev = state.world.size();
-  const int64_t n_proto = config.prototype.particles > 0 ? config.prototype.particles : n_rev;
+  int64_t n_proto = config.prototype.particles > 0 ? config.prototype.particles : n_rev;
   nlohmann::json params = calibration_record(config, n_rev, options, summary);
   params["schema"] = kParamsSchema;
   if (summary.has_best()) {
     params["rev"] = param_block(summary.best, particle_scales(state.world.radius(), config.material,
                                                               summary.best.mass_scaling));
-    // Δt and damping recomputed from the prototype's own particles.
+    // Δt and damping recomputed from the prototype's own particles; the
+    // upscaling block counts them too (a prototype file's, not the config's
+    // prototype.particles, 0 there), as in 3D.
     params["prototype"] = prototype_block(config, summary.best, n_rev);
+    n_proto = json_integer(params["prototype"].at("particles"), 1);
   } else {
     without_parameters(params);
   }
