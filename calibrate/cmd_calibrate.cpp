@@ -296,7 +296,11 @@ ReportInput report_input(const CalibrateOptions& o, const Invocation& v, int64_t
     if (params.contains("analytical_peak_stress_yy"))
       in.analytical_peak = params["analytical_peak_stress_yy"].get<double>();
   } else {
-    in.prototype_particles = config.prototype.particles > 0 ? config.prototype.particles : n_rev;
+    // The prototype params.json's prototype block counts (a prototype
+    // file's, a generator's made count), as its upscaling block does.
+    const auto proto = params.find("prototype");
+    in.prototype_particles =
+        proto != params.end() && proto->is_object() ? proto->at("particles").get<int64_t>() : n_rev;
     in.analytical_peak = analytical_peak_stress(config);
   }
   return in;

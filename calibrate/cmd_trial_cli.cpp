@@ -78,7 +78,7 @@ void add_stability_options(CLI::App* stability, StabilityOptions& stab) {
 void add_score_options(CLI::App* score, ScoreOptions& options) {
   score
       ->add_option("file", options.file,
-                   "series file (e.g. the LAMMPS deck's series.csv, or demcal run's)")
+                   "series file (e.g. the LAMMPS deck's NAME.series.csv, or demcal run's)")
       ->required();
   score
       ->add_option("--lateral-stress", options.lateral_stress,

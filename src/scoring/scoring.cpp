@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <limits>
 
 #include "demcal/io/format.hpp"
 #include "demcal/io/json_integer.hpp"
@@ -107,7 +108,12 @@ double robust_noise(const std::vector<double>& x) {
 double burst_ratio(const std::vector<double>& x) {
   std::vector<double> magnitude(x.size());
   for (size_t k = 0; k < x.size(); ++k) magnitude[k] = std::abs(x[k]);
-  return ratio(rms(x), median(magnitude));
+  // Zero at most points and not everywhere: bursts above a zero floor (a
+  // symmetric lattice's asymmetry, or a series read back at CSV
+  // precision), the clearest case there is, not the absence of one.
+  const double floor = median(magnitude), size = rms(x);
+  if (floor > 0.0) return size / floor;
+  return size > 0.0 ? std::numeric_limits<double>::infinity() : 0.0;
 }
 
 double rms_noise(const std::vector<double>& x, double trim) {
@@ -500,11 +506,13 @@ std::optional<Diagnosis> diagnose_chatter(const Symptoms& s) {
     if (!(burst > kChatterBurst && s.c.moment_balance_trend > s.t.moment_balance))
       return std::nullopt;
     const double clarity = std::min(1.0, std::log(burst / kChatterBurst) / std::log(100.0));
-    return Diagnosis{"dt", "decrease", 0.6 + 0.3 * clarity,
-                     imbalance +
-                         " and the particles' rotations chatter in bursts (the asymmetry's RMS " +
-                         num(burst, 2) + " times its median):" + words,
-                     "moment imbalance with rotational chatter"};
+    return Diagnosis{
+        "dt", "decrease", 0.6 + 0.3 * clarity,
+        imbalance + " and the particles' rotations chatter in bursts (" +
+            (std::isinf(burst) ? std::string("the asymmetry is zero at most points")
+                               : "the asymmetry's RMS " + num(burst, 2) + " times its median") +
+            "):" + words,
+        "moment imbalance with rotational chatter"};
   }
   // 2D. Rotational drag never reached kDragAsymmetryMax in the atlas (ζ_r
   // up to 20 on hex_10x10): beyond it, unless ζ_r is large, it is the onset

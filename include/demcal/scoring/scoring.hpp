@@ -327,7 +327,8 @@ double objective(const Score& score, const Tolerances& tolerances);
 double robust_noise(const std::vector<double>& series);
 /// How a series comes in bursts: RMS over the median of |x|, 1 for a
 /// steady level, about 1.5 for white noise, large when a few points carry
-/// the mean square; 0 for an empty series or a median of 0.
+/// the mean square; 0 for an empty or all-zero series, +∞ for a median of 0
+/// under a nonzero RMS (bursts above a zero floor).
 double burst_ratio(const std::vector<double>& series);
 /// RMS noise level from the same fourth differences, the largest fraction
 /// `trim` of them left out (sparse serrations count, one or two isolated
