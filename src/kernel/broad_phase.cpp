@@ -60,8 +60,8 @@ void WorldImpl::rebuild_neighbours() {
   cell_next_.resize(n);
   auto cell_of = [&](int i, int& cx, int& cy) {
     const double fx = (x_[i] - x0) / csx, fy = (y_[i] - y0) / csy;
-    cx = std::isfinite(fx) ? std::clamp(static_cast<int>(std::floor(fx)), 0, ncx - 1) : 0;
-    cy = std::isfinite(fy) ? std::clamp(static_cast<int>(std::floor(fy)), 0, ncy - 1) : 0;
+    cx = std::isfinite(fx) ? static_cast<int>(std::clamp(std::floor(fx), 0.0, ncx - 1.0)) : 0;
+    cy = std::isfinite(fy) ? static_cast<int>(std::clamp(std::floor(fy), 0.0, ncy - 1.0)) : 0;
   };
   for (int i = n - 1; i >= 0; --i) {
     int cx, cy;

@@ -60,7 +60,11 @@ void SphereWorldImpl::rebuild_neighbours() {
   auto cell_of = [&](int i, std::array<int, 3>& c) {
     for (int a = 0; a < 3; ++a) {
       const double f = (pos[a][i] - origin[a]) / cs[a];
-      c[a] = std::isfinite(f) ? std::clamp(static_cast<int>(std::floor(f)), 0, nc[a] - 1) : 0;
+      // Clamped as a double before the cast: a particle flung far away
+      // (a diverging run) has a cell index beyond int's range.
+      c[a] = std::isfinite(f)
+                 ? static_cast<int>(std::clamp(std::floor(f), 0.0, static_cast<double>(nc[a] - 1)))
+                 : 0;
     }
   };
   auto index = [&](const std::array<int, 3>& c) { return (c[2] * nc[1] + c[1]) * nc[0] + c[0]; };
