@@ -541,5 +541,45 @@ TEST(SphereContact, WallFrictionOnEveryWallWithSpin) {
   }
 }
 
+// A frictionless wall (μ_w = 0, the shipped scenes' walls) exerts the
+// normal force alone, whatever the slip and spin: the tangential force and
+// the torque are exactly 0 on every wall — also for a slip so small that
+// the trial history's square underflows to 0 (1e-165 m/s here: kt_w·v·Δt
+// = 5e-164 N, squared below the smallest double), where a Coulomb cap
+// compared in squares would let the trial force through.
+TEST(SphereContact, FrictionlessWallsExertNoTangentialForce) {
+  const double r = kR, delta = 1e-6, L = 10 * r;
+  const SphereMaterial mat = test_material(0.3, 0.0);
+  for (const double V : {1e-3, 1e-165})
+    for (int side = 0; side < 6; ++side) {
+      SCOPED_TRACE(testing::Message() << "wall " << side << ", slip " << V << " m/s");
+      const int a = side / 2;
+      const double sign = (side % 2 == 0) ? 1.0 : -1.0;
+      const Vector3d g = sign * Vector3d::Unit(a);
+      const Vector3d e_b = Vector3d::Unit((a + 1) % 3), e_c = Vector3d::Unit((a + 2) % 3);
+      sphere_test::Scene s;
+      s.add(-sign * L * Vector3d::Unit(a) + (r - delta) * g, r);
+      s.lo = {-L, -L, -L};
+      s.hi = {L, L, L};
+      SphereWorld w = s.make(mat);
+      Integration in = sphere_test::set_undamped(w, 0.0, 1e15);
+      in.dt = 1e-6;
+      w.set_integration(in);
+      w.set_velocity(0, V * (e_b - 2.0 * e_c).normalized(), (0.7 * V / r) * e_b);
+      const double fn = mat.wall.kn * delta;
+      for (int k = 1; k <= 50; ++k) {
+        ASSERT_TRUE(w.step(1));
+        const Vector3d f = sphere_test::force(w, 0);
+        EXPECT_NEAR(f.dot(g), fn, 1e-6 * fn);
+        EXPECT_EQ(f.dot(e_b), 0.0);
+        EXPECT_EQ(f.dot(e_c), 0.0);
+        EXPECT_EQ(sphere_test::torque(w, 0), Vector3d::Zero());
+        const SphereWall& wall = w.wall(static_cast<SphereWallSide>(side));
+        EXPECT_EQ(wall.force, -f);
+        EXPECT_EQ(wall.contacts, 1);
+      }
+    }
+}
+
 }  // namespace
 }  // namespace demcal

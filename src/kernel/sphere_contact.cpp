@@ -97,7 +97,11 @@
 // gathered by index, histories stored per candidate, contiguous), and adds
 // each contact's force and torque to its particle: the same order as the
 // scalar pass it replaced, and one order whatever the thread count (the
-// pass is not split among threads: ≈ 1 % of the pair pass's work).
+// pass is not split among threads: ≈ 1 % of the pair pass's work). A
+// frictionless wall (μ = 0, the default) takes the normal force alone: the
+// full law would cut every trial history to 0 anyway, through a root and a
+// division per contact (the wall pass took 10 % of a 256-sphere step for
+// nothing), and would let a trial force through where |h|² underflows to 0.
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -540,7 +544,7 @@ struct WallArgs {
 // largest overlap/r; the dashpots' power Σ (fe − fn)·v_n}, each summed over the list in 8 lanes,
 // then over the lanes by detail::lane_sum: one order whatever the thread count and the path's
 // width.
-template <int W>
+template <int W, bool kFriction>
 DEMCAL_INLINE void wall_contacts(const WallArgs &a, double *out) {
   using D = typename Simd<W>::D;
   using M = typename Simd<W>::M;
@@ -580,9 +584,6 @@ DEMCAL_INLINE void wall_contacts(const WallArgs &a, double *out) {
       released += select<W>(touch, zero, hu0 * hu0 + hv0 * hv0);
       const D ratio = select<W>(touch, ov / select<W>(touch, r, one), zero);
       mo = mo > ratio ? mo : ratio;
-      const D sd = sg * dist;
-      const D dvu = sd * gather<W>(a.wv, J) - gather<W>(a.vu, J);
-      const D dvv = (zero - gather<W>(a.vv, J)) - sd * gather<W>(a.wu, J);
       D fn = law::elastic_normal_force(a.kn, ov);
       if (a.beta2 > 0.0) {
         const D vn = (gather<W>(a.va, J) - a.velocity) * sg;  // leaving the wall > 0
@@ -591,6 +592,22 @@ DEMCAL_INLINE void wall_contacts(const WallArgs &a, double *out) {
         power += select<W>(touch, law::dashpot_power(fe, fn, vn), zero);
       }
       fn = select<W>(touch, fn, zero);
+      if constexpr (!kFriction) {
+        // A frictionless wall (μ = 0): Coulomb's cap is 0, so the full
+        // evaluation below cuts every trial history to 0 with no slip work
+        // (cap·(|h| − cap) = 0): only the normal force is left.
+        store<W>(a.hu + k, zero);
+        store<W>(a.hv + k, zero);
+        store<W>(a.fn + k, fn);
+        const D fa = sg * fn;
+        for (int l = 0; l < W; ++l) a.fa[J[l]] += fa[l];
+        wfa -= fa;
+        count += select<W>(touch, one, zero);
+        continue;
+      }
+      const D sd = sg * dist;
+      const D dvu = sd * gather<W>(a.wv, J) - gather<W>(a.vu, J);
+      const D dvv = (zero - gather<W>(a.vv, J)) - sd * gather<W>(a.wu, J);
       D hu = hu0 + a.kdt * dvu, hv = hv0 + a.kdt * dvv;
       const D cap = a.mu * fn, h2 = hu * hu + hv * hv;
       if (D cut; coulomb_cut<W>(touch, h2, cap, slid, cut)) {
@@ -734,7 +751,12 @@ struct Kernels {
     return integrate_blocks<W, false>(a, b0, b1);                                                \
   }                                                                                              \
   TARGET void one_pair_##SUFFIX(const double *in, double *out) { one_pair<W>(in, out); }         \
-  TARGET void walls_##SUFFIX(const WallArgs &a, double *out) { wall_contacts<W>(a, out); }       \
+  TARGET void walls_##SUFFIX(const WallArgs &a, double *out) {                                   \
+    if (a.mu > 0.0)                                                                              \
+      wall_contacts<W, true>(a, out);                                                            \
+    else                                                                                         \
+      wall_contacts<W, false>(a, out);                                                           \
+  }                                                                                              \
   constexpr Kernels kKernels_##SUFFIX{                                                           \
       pairs_##SUFFIX, pairs_damped_##SUFFIX, pairs_t_##SUFFIX,          pairs_damped_t_##SUFFIX, \
       sums_##SUFFIX,  integrate_##SUFFIX,    integrate_locked_##SUFFIX, one_pair_##SUFFIX,       \
