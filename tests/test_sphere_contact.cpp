@@ -184,6 +184,42 @@ TEST(SphereContact, ObliqueContactSticksThenSlidesAtCoulombLimit) {
   EXPECT_GT(slid, 300);
 }
 
+// Frictionless spheres (μ = 0) touch with the normal force alone, whatever
+// the slip and the spins: the tangential force and both torques are exactly
+// 0 — along an oblique normal, and along an axis with a slip so small
+// (1e-165 m/s) that the trial history's square underflows to 0, where a
+// Coulomb cap compared in squares lets it through. (Along an oblique
+// normal the normal motion's round-off leaves a tangential slip far above
+// that: the axis keeps the components apart.)
+TEST(SphereContact, FrictionlessSpheresExertNoTangentialForce) {
+  const double r = kR, delta = 1e-6;
+  const SphereMaterial mat = test_material(0.0);
+  const Vector3d oblique_n = Vector3d(2.0, 3.0, 6.0) / 7.0,
+                 oblique_t = Vector3d(3.0, -6.0, 2.0) / 7.0;
+  for (const bool axis : {false, true})
+    for (const double V : {1e-3, 1e-165}) {
+      SCOPED_TRACE(testing::Message()
+                   << (axis ? "axis" : "oblique") << " normal, slip " << V << " m/s");
+      const Vector3d n0 = axis ? Vector3d::UnitZ() : oblique_n;
+      const Vector3d t = axis ? Vector3d::UnitX() : oblique_t;
+      Integration in;
+      SphereWorld w = oblique_pair(mat, n0, delta, in);
+      w.set_velocity(1, V * t, (0.7 * V / r) * n0.cross(t));
+      w.set_velocity(0, Vector3d::Zero(), (0.3 * V / r) * n0);
+      for (int k = 1; k <= 50; ++k) {
+        ASSERT_TRUE(w.step(1));
+        const auto c = w.contacts();
+        ASSERT_EQ(c.size(), 1u);
+        EXPECT_EQ(c[0].tangential, Vector3d::Zero());
+        const Vector3d n = c[0].normal, f0 = sphere_test::force(w, 0);
+        EXPECT_EQ(f0, -c[0].fn * n);
+        EXPECT_EQ(sphere_test::force(w, 1), -f0);
+        EXPECT_EQ(sphere_test::torque(w, 0), Vector3d::Zero());
+        EXPECT_EQ(sphere_test::torque(w, 1), Vector3d::Zero());
+      }
+    }
+}
+
 // The oblique contact of the test above, slid past the Coulomb limit, then
 // driven back: the spring unloads elastically from the capped force, by
 // kt·V·Δt per step along the current tangent, through zero after

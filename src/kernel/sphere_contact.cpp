@@ -785,6 +785,11 @@ const Kernels &kernels() {
 }  // namespace
 
 double SphereWorldImpl::pair_pass(int b0, int b1) {
+  // Frictionless spheres (μ = 0) carry no tangential spring: the Coulomb
+  // cap would cut it to 0 anyway, but it compares squares, and a trial |h|²
+  // that underflows to 0 would let a (tiny) tangential force through.
+  const double kdt =
+      material_.particle.friction > 0.0 ? material_.particle.kt * integration_.dt : 0.0;
   const PairArgs a{block_slot_.data(),
                    slot_j_.data(),
                    hx_.data(),
@@ -820,7 +825,7 @@ double SphereWorldImpl::pair_pass(int b0, int b1) {
                    block_slid_.data(),
                    block_power_.data(),
                    material_.particle.kn,
-                   material_.particle.kt * integration_.dt,
+                   kdt,
                    0.5 * integration_.dt,
                    material_.particle.friction,
                    2.0 * material_.contact_damping_ratio,
