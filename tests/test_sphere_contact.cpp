@@ -526,6 +526,22 @@ TEST(SphereContact, WallFrictionSticksThenSlidesWithTorque) {
   EXPECT_GT(slid, 600);
 }
 
+/// A heavy sphere (mass scaling 1e15, undamped, Δt = 1e-6 s) of radius kR
+/// pressed by δ onto wall `side` of the box [−L, L]³ (g its inward normal).
+SphereWorld sphere_on_wall(const SphereMaterial& mat, int side, double delta, double L) {
+  const int a = side / 2;
+  const double sign = (side % 2 == 0) ? 1.0 : -1.0;
+  sphere_test::Scene s;
+  s.add(-sign * L * Vector3d::Unit(a) + (kR - delta) * sign * Vector3d::Unit(a), kR);
+  s.lo = {-L, -L, -L};
+  s.hi = {L, L, L};
+  SphereWorld w = s.make(mat);
+  Integration in = sphere_test::set_undamped(w, 0.0, 1e15);
+  in.dt = 1e-6;
+  w.set_integration(in);
+  return w;
+}
+
 // The same law on each of the six walls, with the sphere spinning too: the
 // wall pass writes each wall along its own axis a and the two others, so
 // a slip of the contact point v_s = v + ω × (−dist·g) (g the inward
@@ -541,14 +557,8 @@ TEST(SphereContact, WallFrictionOnEveryWallWithSpin) {
     const int a = side / 2, b = (a + 1) % 3, c = (a + 2) % 3;
     const double sign = (side % 2 == 0) ? 1.0 : -1.0;
     const Vector3d g = sign * Vector3d::Unit(a);
-    sphere_test::Scene s;
-    s.add(-sign * L * Vector3d::Unit(a) + (r - delta) * g, r);
-    s.lo = {-L, -L, -L};
-    s.hi = {L, L, L};
-    SphereWorld w = s.make(mat);
-    Integration in = sphere_test::set_undamped(w, 0.0, 1e15);
-    in.dt = 1e-6;
-    w.set_integration(in);
+    SphereWorld w = sphere_on_wall(mat, side, delta, L);
+    const Integration in = w.integration();
     const Vector3d v = V * (Vector3d::Unit(b) - 2.0 * Vector3d::Unit(c)).normalized();
     const Vector3d omega = (0.7 * V / r) * Vector3d::Unit(b);
     w.set_velocity(0, v, omega);
@@ -593,14 +603,7 @@ TEST(SphereContact, FrictionlessWallsExertNoTangentialForce) {
       const double sign = (side % 2 == 0) ? 1.0 : -1.0;
       const Vector3d g = sign * Vector3d::Unit(a);
       const Vector3d e_b = Vector3d::Unit((a + 1) % 3), e_c = Vector3d::Unit((a + 2) % 3);
-      sphere_test::Scene s;
-      s.add(-sign * L * Vector3d::Unit(a) + (r - delta) * g, r);
-      s.lo = {-L, -L, -L};
-      s.hi = {L, L, L};
-      SphereWorld w = s.make(mat);
-      Integration in = sphere_test::set_undamped(w, 0.0, 1e15);
-      in.dt = 1e-6;
-      w.set_integration(in);
+      SphereWorld w = sphere_on_wall(mat, side, delta, L);
       w.set_velocity(0, V * (e_b - 2.0 * e_c).normalized(), (0.7 * V / r) * e_b);
       const double fn = mat.wall.kn * delta;
       for (int k = 1; k <= 50; ++k) {
