@@ -18,11 +18,9 @@
 #include <string>
 #include <vector>
 
-#include "demcal/kernel/particle_scales.hpp"
 #include "demcal/kernel/world.hpp"
 #include "demcal/scene/config.hpp"
-#include "demcal/scene/packing.hpp"
-#include "demcal/upscaling/upscaling.hpp"
+#include "support/calibrated_params.hpp"
 #include "support/csv.hpp"
 #include "support/files.hpp"
 #include "support/process.hpp"
@@ -62,12 +60,7 @@ class CliEndToEnd : public ::testing::Test {
     return test::write_text(dir_ / name, content);
   }
   /// Everything under dir_/work (the runs' working directory).
-  std::set<std::string> work_contents() {
-    std::set<std::string> names;
-    for (const auto& e : fs::recursive_directory_iterator(dir_ / "work"))
-      names.insert(fs::relative(e.path(), dir_ / "work").string());
-    return names;
-  }
+  std::set<std::string> work_contents() { return test::paths_under(dir_ / "work"); }
 
   /// Bad input: exit 2, exactly one line on stderr that contains every one
   /// of `mentions`, nothing on stdout, and nothing written.
@@ -196,20 +189,10 @@ TEST_F(CliEndToEnd, ASimdPathWithControlCharactersIsShownEscaped) {
 // stderr announces no loading (it said "loading now, about … min", then
 // stopped).
 TEST_F(CliEndToEnd, VerifyConsolidateOnlyAnnouncesNoLoading) {
-  const demcal::SceneConfig c = demcal::default_config();
   demcal::AlgorithmSpec p;
   p.steps = 20000;
-  const auto scales = demcal::particle_scales(demcal::make_assembly(c).r, c.material);
-  // success and dt_ratio_stable as every params.json holds them (the
-  // stable step calibrating the default scene records: reports/example-hex_10x10).
-  write("params.json", nlohmann::json{{"schema", "demcal.params/1"},
-                                      {"scene", c.name},
-                                      {"success", true},
-                                      {"dt_ratio_stable", 0.2920194170417612},
-                                      {"rev", demcal::param_block(p, scales)}}
-                           .dump());
-  const Result r = demcal({"verify", (dir_ / "params.json").string(), "--particles", "25",
-                           "--consolidate-only", "-o", "v"});
+  const std::string params = test::write_default_scene_params(dir_, p);
+  const Result r = demcal({"verify", params, "--particles", "25", "--consolidate-only", "-o", "v"});
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_TRUE(fs::exists(dir_ / "work" / "v" / "prototype.csv"));
   EXPECT_NE(r.out.find("consolidated prototype of 25 particles"), std::string::npos) << r.out;
@@ -223,17 +206,9 @@ TEST_F(CliEndToEnd, VerifyConsolidateOnlyAnnouncesNoLoading) {
 // ignored), --threads in 2D (3D only: ignored too), and --engine liggghts
 // is pointed to export.
 TEST_F(CliEndToEnd, VerifyRefusesTheOptionsItWouldIgnore) {
-  const demcal::SceneConfig c = demcal::default_config();
   demcal::AlgorithmSpec p;
   p.steps = 20000;
-  const auto scales = demcal::particle_scales(demcal::make_assembly(c).r, c.material);
-  const std::string params =
-      write("params.json", nlohmann::json{{"schema", "demcal.params/1"},
-                                          {"scene", c.name},
-                                          {"success", true},
-                                          {"dt_ratio_stable", 0.2920194170417612},
-                                          {"rev", demcal::param_block(p, scales)}}
-                               .dump());
+  const std::string params = test::write_default_scene_params(dir_, p);
   const std::vector<std::string> verify{"verify", params, "--particles", "25", "-o", "v"};
   auto with = [&](const std::vector<std::string>& more) {
     std::vector<std::string> args = verify;

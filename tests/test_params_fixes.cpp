@@ -17,6 +17,7 @@
 
 #include "support/files.hpp"
 #include "support/process.hpp"
+#include "support/refusals.hpp"
 
 namespace {
 
@@ -26,14 +27,6 @@ using Result = test::RunResult;
 
 const std::string kHex5 = test::shipped_config("hex_5x5");
 const std::string kFcc = test::shipped_config("fcc_4x4x4");
-
-/// Every file under `dir`, relative to it.
-std::set<std::string> contents(const fs::path& dir) {
-  std::set<std::string> names;
-  for (const auto& e : fs::recursive_directory_iterator(dir))
-    names.insert(fs::relative(e.path(), dir).string());
-  return names;
-}
 
 /// The trials of DIR/trials.jsonl.
 std::vector<nlohmann::json> trials_of(const fs::path& dir) {
@@ -56,16 +49,7 @@ class ParamsFixes : public ::testing::Test {
   /// nothing on stdout, nothing written in the working folder.
   void expect_refused(const std::vector<std::string>& args,
                       const std::vector<std::string>& mentions) {
-    std::string trace;
-    for (const auto& a : args) trace += a + " ";
-    SCOPED_TRACE(trace);
-    const std::set<std::string> before = contents(work_);
-    const Result r = demcal(args);
-    EXPECT_EQ(r.status, 2) << r.err;
-    EXPECT_EQ(test::lines_of(r.err).size(), 1u) << r.err;
-    for (const auto& m : mentions) EXPECT_NE(r.err.find(m), std::string::npos) << r.err;
-    EXPECT_EQ(r.out, "");
-    EXPECT_EQ(contents(work_), before) << "wrote something";
+    test::expect_refused(work_, args, mentions);
   }
 
   /// calibrate ARGS -j 1 -q -o DIR in the working folder; its exit status.

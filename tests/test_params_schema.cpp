@@ -16,6 +16,7 @@
 
 #include "support/files.hpp"
 #include "support/process.hpp"
+#include "support/refusals.hpp"
 
 namespace {
 
@@ -28,13 +29,6 @@ const std::string kHex5 = test::shipped_config("hex_5x5");
 
 std::string example(const std::string& name) {
   return (fs::path(test::kSourceDir) / "reports" / name / "params.json").string();
-}
-
-std::set<std::string> contents(const fs::path& dir) {
-  std::set<std::string> names;
-  for (const auto& e : fs::recursive_directory_iterator(dir))
-    names.insert(fs::relative(e.path(), dir).string());
-  return names;
 }
 
 class ParamsSchema : public ::testing::Test {
@@ -67,16 +61,7 @@ class ParamsSchema : public ::testing::Test {
   /// nothing on stdout, nothing written in the working folder.
   void expect_refused(const std::vector<std::string>& args,
                       const std::vector<std::string>& mentions) {
-    std::string trace;
-    for (const auto& a : args) trace += a + " ";
-    SCOPED_TRACE(trace);
-    const std::set<std::string> before = contents(work_);
-    const Result r = demcal(args);
-    EXPECT_EQ(r.status, 2) << r.err;
-    EXPECT_EQ(test::lines_of(r.err).size(), 1u) << r.err;
-    for (const auto& m : mentions) EXPECT_NE(r.err.find(m), std::string::npos) << r.err;
-    EXPECT_EQ(r.out, "");
-    EXPECT_EQ(contents(work_), before) << "wrote something";
+    test::expect_refused(work_, args, mentions);
   }
 
   /// The three commands that read a params.json refuse `p`, naming it and

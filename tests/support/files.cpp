@@ -62,4 +62,11 @@ std::set<std::string> names_in(const fs::path& dir) {
   return out;
 }
 
+std::set<std::string> paths_under(const fs::path& dir) {
+  std::set<std::string> out;
+  for (const auto& e : fs::recursive_directory_iterator(dir))
+    out.insert(fs::relative(e.path(), dir).string());
+  return out;
+}
+
 }  // namespace demcal::test

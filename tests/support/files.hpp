@@ -50,5 +50,8 @@ nlohmann::json read_json(const fs::path& path);
 std::vector<std::string> lines_of(const std::string& text);
 /// File names directly in `dir`.
 std::set<std::string> names_in(const fs::path& dir);
+/// Every file and folder under `dir` (recursively), relative to it: what a
+/// command wrote there.
+std::set<std::string> paths_under(const fs::path& dir);
 
 }  // namespace demcal::test

@@ -8,7 +8,7 @@
 #include "demcal/scene/config.hpp"
 #include "demcal/scene/triaxial.hpp"
 #include "demcal/search/calibration.hpp"
-#include "demcal/upscaling/params_file.hpp"
+#include "support/calibrated_params.hpp"
 
 namespace demcal::test {
 
@@ -17,15 +17,7 @@ namespace demcal::test {
 inline nlohmann::json params_3d(const SceneConfig& config, const TriaxialState& state,
                                 const AlgorithmSpec& best,
                                 std::optional<double> rev_peak = std::nullopt) {
-  CalibrationSummary summary;
-  summary.success = true;
-  summary.best = best;
-  summary.best_trial.params = best;
-  if (rev_peak) summary.best_trial.score.criteria.peak_stress_yy = *rev_peak;
-  summary.dimension = 3;
-  // The stable step calibrate records (its runner's, TriaxialRunner).
-  summary.dt_ratio_stable = estimated_stable_dt_ratio(state, config.algorithm);
-  return params_file(config, state, CalibrationOptions::from(config.calibration), summary);
+  return calibrated_params(config, state, best, rev_peak);
 }
 
 }  // namespace demcal::test
