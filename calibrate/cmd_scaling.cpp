@@ -2,11 +2,11 @@
 // Writes DIR/scaling.md and DIR/scaling.json; per-size work (trials,
 // results) goes to --work (default DIR) and is reused with --resume.
 // SIGINT/SIGTERM stop it cleanly, exit status 128 + signal: a size's
-// calibration winds down keeping its finished trials, a step search or a
-// reference run in progress finishes, nothing is written to DIR's report,
-// and the command to continue (--resume) is printed. The work folder is
-// locked for the study's length (FolderLock): a second study on it is
-// refused, exit 2.
+// calibration winds down keeping its finished trials, a consolidation, a
+// step search or the reference run in progress stops at its next check
+// and writes nothing, nothing is written to DIR's report, and the command
+// to continue (--resume) is printed. The work folder is locked for the
+// study's length (FolderLock): a second study on it is refused, exit 2.
 #include <filesystem>
 #include <iostream>
 #include <vector>
