@@ -2,9 +2,11 @@
 // Writes DIR/scaling.md and DIR/scaling.json; per-size work (trials,
 // results) goes to --work (default DIR) and is reused with --resume.
 // SIGINT/SIGTERM stop it cleanly, exit status 128 + signal: a size's
-// calibration winds down keeping its finished trials, a step search or a
-// reference run in progress finishes, nothing is written to DIR's report,
-// and the command to continue (--resume) is printed.
+// calibration winds down keeping its finished trials, a consolidation, a
+// step search or the reference run in progress stops at its next check
+// and writes nothing, nothing is written to DIR's report, and the command
+// to continue (--resume) is printed. The work folder is locked for the
+// study's length (FolderLock): a second study on it is refused, exit 2.
 #include <filesystem>
 #include <iostream>
 #include <vector>
@@ -84,7 +86,13 @@ int cmd_scaling(const ScalingOptions& o) {
   const FamilyFile family = scaling_family_file(config);
   add_file_digest(key, "family_file_sha256", config, family.key, family.path);
   add_build(key);
-  const bool reuse = o.resume && std::filesystem::exists(so.work_dir, ec);
+  const bool work_exists = std::filesystem::exists(so.work_dir, ec);
+  // Held to the end: a second study on this work folder (or a calibration
+  // into it) stops here, before it reads or clears anything; a crash or a
+  // kill drops it with the process.
+  make_output_dir(so.work_dir);
+  const FolderLock lock(so.work_dir, "--work");
+  const bool reuse = o.resume && work_exists;
   if (reuse)
     require_same_run(so.work_dir, key, "the results in " + so.work_dir,
                      "config, --set, particle files, --max-trials and demcal build",
@@ -95,7 +103,6 @@ int cmd_scaling(const ScalingOptions& o) {
     // A fresh start: an earlier study's per-size results would otherwise
     // stay under the new key until overwritten, and a resume after an
     // interruption would take them for this study's.
-    make_output_dir(so.work_dir);
     for (const auto& e : std::filesystem::directory_iterator(so.work_dir)) {
       const std::string name = e.path().filename().string();
       if (e.is_directory() && name.rfind("size-", 0) == 0 && name.size() > 5 &&

@@ -105,7 +105,7 @@ void write_output_file(const std::string& path, const std::string& content) {
   out.commit();
 }
 
-FolderLock::FolderLock(const std::string& dir) {
+FolderLock::FolderLock(const std::string& dir, const std::string& option) {
   fd_ = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
   if (fd_ < 0)
     throw InputError(dir, "",
@@ -117,7 +117,8 @@ FolderLock::FolderLock(const std::string& dir) {
     if (saved == EWOULDBLOCK)
       throw InputError(dir, "",
                        "another demcal command is writing into this folder; wait for it to end "
-                       "or give another -o");
+                       "or give another " +
+                           option);
     throw InputError(dir, "",
                      std::string("cannot lock the output folder (") + std::strerror(saved) + ")");
   }

@@ -57,11 +57,12 @@ void write_output_file(const std::string& path, const std::string& content);
 /// An exclusive lock on an existing output folder (flock on the folder
 /// itself), held until destruction: two commands writing into one folder
 /// (two calibrations interleaving their trials.jsonl) cannot run at once.
-/// A folder already locked: InputError naming it (exit 2). The kernel drops
-/// the lock when the process dies, so a killed run leaves none behind.
+/// A folder already locked: InputError naming it (exit 2) and `option`,
+/// the flag that names another folder. The kernel drops the lock when the
+/// process dies, so a killed run leaves none behind.
 class FolderLock {
  public:
-  explicit FolderLock(const std::string& dir);
+  explicit FolderLock(const std::string& dir, const std::string& option = "-o");
   FolderLock(const FolderLock&) = delete;
   FolderLock& operator=(const FolderLock&) = delete;
   ~FolderLock();

@@ -1,11 +1,13 @@
 // `demcal scaling` on the command line: a plan of sizes without a forward
 // size, or with a size twice, is a usage error before any work; the per-size
-// work goes to the -o folder unless --work says otherwise; SIGINT stops the
-// study cleanly (finished sizes and trials kept, the resume command shown)
-// and --resume ends with the uninterrupted study's scaling.json.
+// work goes to the -o folder unless --work says otherwise; a second study on
+// a work folder in use is refused; SIGINT stops the study cleanly (finished
+// sizes and trials kept, the resume command shown) and --resume ends with
+// the uninterrupted study's scaling.json.
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <sys/file.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -13,6 +15,7 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <thread>
@@ -178,6 +181,88 @@ TEST_F(ScalingCli, ResumeOfAStudyWhoseWorkIsInTheOldDefaultFolderSaysWhere) {
   EXPECT_NE(r.err.find("add --work demcal-scaling-hex_5x5"), std::string::npos) << r.err;
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
   EXPECT_FALSE(fs::exists(work() / "X"));
+}
+
+/// Path → content of every file under `dir` (folders as "<dir>").
+std::map<std::string, std::string> snapshot(const fs::path& dir) {
+  std::map<std::string, std::string> out;
+  for (const auto& e : fs::recursive_directory_iterator(dir))
+    out[fs::relative(e.path(), dir).string()] =
+        e.is_regular_file() ? read_text(e.path()) : std::string("<dir>");
+  return out;
+}
+
+// Two studies on one work folder at once interleaved their sizes' files
+// (the second's fresh start even cleared the first's). The study holds an
+// exclusive lock on its work folder (calibrate's FolderLock): a second one,
+// whatever its -o or --resume, is refused before it reads or writes
+// anything (exit 2, one line naming the folder). A study killed outright
+// leaves no lock behind: --resume continues it.
+TEST_F(ScalingCli, ASecondStudyOnALockedWorkFolderIsRefusedAndAKilledOneLeavesNoLock) {
+  const std::vector<std::string> study = {
+      "scaling", kHex5, "--sizes",      "16,100,144", "--calibrate-max", "100", "-q",
+      "-j",      "1",   "--max-trials", "12"};
+  const auto with = [&](const std::vector<std::string>& more) {
+    std::vector<std::string> args = study;
+    args.insert(args.end(), more.begin(), more.end());
+    return args;
+  };
+  const pid_t pid = spawn(with({"-o", "A"}));
+  const fs::path trials = work() / "A" / "size-16" / "trials.jsonl";
+  bool running = false;
+  for (int k = 0; k < 12000 && !running; ++k) {
+    int status = 0;
+    if (::waitpid(pid, &status, WNOHANG) == pid) break;
+    running = fs::exists(trials) && !read_trials(trials).empty();
+    if (!running) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  ASSERT_TRUE(running) << "the study ended before the second began: " << spawned_err();
+  for (const auto& more : std::vector<std::vector<std::string>>{
+           {"-o", "A"}, {"-o", "A", "--resume"}, {"-o", "B", "--work", "A"}}) {
+    const std::vector<std::string> args = with(more);
+    std::string trace = "demcal";
+    for (const auto& a : args) trace += " " + a;
+    SCOPED_TRACE(trace);
+    const Result r = demcal(args);
+    EXPECT_EQ(r.status, 2) << r.err;
+    EXPECT_EQ(
+        r.err.rfind("demcal: error: A: another demcal command is writing into this folder", 0), 0u)
+        << r.err;
+    EXPECT_NE(r.err.find("give another --work"), std::string::npos) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_FALSE(fs::exists(work() / "B"));
+  }
+  ::kill(pid, SIGKILL);
+  EXPECT_EQ(demcal::test::wait_exit(pid), -1);
+  EXPECT_TRUE(fs::exists(work() / "A" / "resume.json"));
+
+  // The kill dropped the lock with the process.
+  const Result resumed = demcal(with({"-o", "A", "--resume"}));
+  EXPECT_TRUE(resumed.status == 0 || resumed.status == 1) << resumed.err;
+  EXPECT_TRUE(fs::exists(work() / "A" / "scaling.json"));
+}
+
+// While a study holds the lock, the refused one changes nothing in the
+// work folder, also under --resume (which would otherwise read it) and
+// with another -o (which would otherwise be made).
+TEST_F(ScalingCli, ARefusedStudyWritesNothing) {
+  demcal::test::write_text(work() / "W" / "resume.json", "{}\n");
+  demcal::test::write_text(work() / "W" / "size-16" / "result.json", "{}\n");
+  const int fd = ::open((work() / "W").c_str(), O_RDONLY | O_DIRECTORY);
+  ASSERT_GE(fd, 0);
+  ASSERT_EQ(::flock(fd, LOCK_EX | LOCK_NB), 0);  // as a running study holds it
+  const auto before = snapshot(work());
+  for (const auto& more : std::vector<std::vector<std::string>>{
+           {"-o", "W"}, {"-o", "W", "--resume"}, {"-o", "B", "--work", "W"}}) {
+    std::vector<std::string> args = {"scaling", kHex5, "--sizes", "16,25,36", "--calibrate-max",
+                                     "25",      "-q",  "-j",      "1"};
+    args.insert(args.end(), more.begin(), more.end());
+    const Result r = demcal(args);
+    EXPECT_EQ(r.status, 2) << r.err;
+    EXPECT_NE(r.err.find("W: another demcal command"), std::string::npos) << r.err;
+    EXPECT_EQ(snapshot(work()), before);
+  }
+  ::close(fd);
 }
 
 // SIGINT during a size's calibration: exit 130, the sizes finished before

@@ -1200,8 +1200,8 @@ CalibrationSummary calibrate(const TrialRunner& runner, const AlgorithmSpec& bas
 }
 
 TrialRecord run_trial(const TrialRunner& runner, const AlgorithmSpec& params,
-                      const Tolerances& tolerances) {
-  const TrialRun run = runner.run(params, tolerances, false, 3.0, nullptr);
+                      const Tolerances& tolerances, const std::atomic<bool>* stop) {
+  const TrialRun run = runner.run(params, tolerances, false, 3.0, stop);
   return {.params = params,
           .score = run.score,
           .steps_run = run.steps_run,

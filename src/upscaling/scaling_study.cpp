@@ -147,6 +147,18 @@ json read_json(const std::string& path) {
   }
 }
 
+bool stop_asked(const ScalingStudyOptions& o) { return o.stop && o.stop->load(); }
+
+/// Thrown where a stop (options.stop) cuts a step of the study short: in a
+/// consolidation (from its progress callback, the one hook it offers), a
+/// step search or the forward reference. run_scaling_study() catches it and
+/// returns the study interrupted; the step cut writes nothing.
+struct StudyStopped {};
+
+void throw_if_stopped(const ScalingStudyOptions& o) {
+  if (stop_asked(o)) throw StudyStopped{};
+}
+
 /// One size's consolidated sample, disks or spheres, and the runner the
 /// search and the step search see it through (addresses stable: held by
 /// pointer).
@@ -190,11 +202,15 @@ class Family {
     if (it != states_.end()) return *it->second;
     auto st = std::make_unique<SizeState>();
     st->scene = scene(n);
+    // A stop ends the consolidation at its next check (every 200 steps).
+    ConsolidationOptions consolidation;
+    if (o_.stop)
+      consolidation.progress = [this](const ConsolidationProgress&) { throw_if_stopped(o_); };
     if (config_.dimension == 3) {
       const SphereAssembly a = make_sphere_assembly(st->scene);
       log("consolidating " + std::to_string(a.size()) + " spheres (size " + std::to_string(n) +
           ")");
-      st->spheres.emplace(consolidate_triaxial(st->scene, a));
+      st->spheres.emplace(consolidate_triaxial(st->scene, a, consolidation));
       st->runner = std::make_unique<TriaxialRunner>(st->scene, *st->spheres);
       st->steps = st->spheres->steps;
       st->wall_time_s = st->spheres->wall_time_s;
@@ -206,7 +222,7 @@ class Family {
                                       : make_assembly(st->scene);
       log("consolidating " + std::to_string(a.size()) + " particles (size " + std::to_string(n) +
           (cached ? ", from " + cache : std::string()) + ")");
-      st->disks.emplace(consolidate(st->scene, a));
+      st->disks.emplace(consolidate(st->scene, a, consolidation));
       st->runner = std::make_unique<BiaxialRunner>(st->scene, *st->disks);
       st->steps = st->disks->steps;
       st->wall_time_s = st->disks->wall_time_s;
@@ -237,8 +253,6 @@ class Family {
   Assembly file_prototype_;
   std::map<int64_t, std::unique_ptr<SizeState>> states_;
 };
-
-bool stop_asked(const ScalingStudyOptions& o) { return o.stop && o.stop->load(); }
 
 /// Step 1: calibrate a size (or reuse its result.json); nothing when a stop
 /// cut the calibration (its finished trials stay in the size's trials.jsonl).
@@ -288,7 +302,8 @@ std::optional<ScalingSize> calibrate_size(Family& family, const SceneConfig& con
 }
 
 /// Step 2: the smallest passing Nstep at the REV's multipliers at size n,
-/// from the prediction of `law` (the candidate; or reuse fixed.json).
+/// from the prediction of `law` (the candidate; or reuse fixed.json). A stop
+/// during it throws StudyStopped: no fixed.json, resume searches again.
 void fixed_multipliers(Family& family, const ScalingStudyOptions& o, const ScalingSize& ref,
                        const ScalingLaw& law, const Tolerances& tolerances, int64_t n,
                        ScalingSize& r) {
@@ -309,7 +324,8 @@ void fixed_multipliers(Family& family, const ScalingStudyOptions& o, const Scali
              " prediction " + std::to_string(start.steps) + " (" +
              num(static_cast<double>(start.steps) * r.particles, 3) + " particle-steps)");
   const auto t0 = std::chrono::steady_clock::now();
-  const StepSearch search = smallest_passing_steps(*state.runner, start, tolerances);
+  const StepSearch search = smallest_passing_steps(*state.runner, start, tolerances, o.stop);
+  if (search.interrupted) throw StudyStopped{};
   r.fixed.found = search.found;
   r.fixed.steps = search.found ? search.best.params.steps : 0;
   r.fixed.best = search.best;
@@ -360,7 +376,8 @@ void fit_laws(ScalingStudy& st) {
 }
 
 /// Step 4: the forward check at the largest size, the candidate law's run
-/// (the first of its search) against a reference with twice its steps.
+/// (the first of its search) against a reference with twice its steps. A
+/// stop during the reference throws StudyStopped: no reference.json.
 void forward_check(Family& family, const ScalingStudyOptions& o, ScalingStudy& st,
                    const TrialRecord& law_run) {
   st.have_forward = true;
@@ -373,7 +390,9 @@ void forward_check(Family& family, const ScalingStudyOptions& o, ScalingStudy& s
   } else {
     family.log("forward reference at " + std::to_string(st.forward_size) + ": " +
                std::to_string(ref_params.steps) + " steps");
-    st.reference = run_trial(*family.state(st.forward_size).runner, ref_params, st.tolerances);
+    st.reference =
+        run_trial(*family.state(st.forward_size).runner, ref_params, st.tolerances, o.stop);
+    throw_if_stopped(o);  // a run the stop may have cut short
     st.reference.phase = TrialPhase::reference;
     write_file_atomic(ref_path, to_json(st.reference).dump(2) + "\n");
   }
@@ -382,6 +401,41 @@ void forward_check(Family& family, const ScalingStudyOptions& o, ScalingStudy& s
                           ? (std::abs(law_run.score.criteria.peak_stress_yy) - std::abs(ref_peak)) /
                                 std::abs(ref_peak)
                           : 0.0;
+}
+
+/// Steps 1 to 4 in order; StudyStopped when a stop cut one short.
+void run_steps(Family& family, const SceneConfig& config, const ScalingStudyOptions& o,
+               ScalingStudy& st) {
+  for (int64_t n : st.calibrated_sizes) {
+    throw_if_stopped(o);
+    std::optional<ScalingSize> r = calibrate_size(family, config, o, n);
+    if (!r) throw StudyStopped{};
+    st.results[n] = std::move(*r);
+  }
+  const ScalingSize ref = st.results.at(st.ref_size);
+  if (!ref.success)
+    throw std::runtime_error("the REV (size " + std::to_string(st.ref_size) +
+                             ") did not calibrate: no multipliers to carry (see " + o.work_dir +
+                             ")");
+
+  // At a size beyond the calibrated ones the search starts at the
+  // candidate's prediction: that first run is the candidate's forward check.
+  for (int64_t n : o.sizes) {
+    ScalingSize& r = st.results[n];
+    r.requested = n;
+    if (n == st.ref_size) {
+      r.fixed.found = true;
+      r.fixed.steps = r.best.steps;
+      continue;
+    }
+    throw_if_stopped(o);
+    fixed_multipliers(family, o, ref, st.candidate, st.tolerances, n, r);
+  }
+  fit_laws(st);
+  const ScalingSize& fwd = st.results[st.forward_size];
+  throw_if_stopped(o);
+  if (st.forward_size > o.calibrate_max && !fwd.fixed.trials.empty())
+    forward_check(family, o, st, fwd.fixed.trials.front());
 }
 
 }  // namespace
@@ -438,42 +492,16 @@ ScalingStudy run_scaling_study(const SceneConfig& config, const ScalingStudyOpti
              "; sizes " + o.sizes_text + "; calibrated up to " + std::to_string(o.calibrate_max) +
              "; the REV whose multipliers are carried: " + std::to_string(st.ref_size));
 
-  // A stop (o.stop) takes effect within a calibration and between the
-  // steps of the study: whatever finished is in the work folder.
-  const auto stopped = [&st] {
+  // A stop (o.stop) takes effect within a calibration, a consolidation, a
+  // step search or the forward reference (at the run's next check or
+  // monitoring point) and between the steps of the study: whatever finished
+  // is in the work folder, the step it cut wrote nothing.
+  try {
+    run_steps(family, config, o, st);
+  } catch (const StudyStopped&) {
     st.interrupted = true;
     return st;
-  };
-  for (int64_t n : st.calibrated_sizes) {
-    if (stop_asked(o)) return stopped();
-    std::optional<ScalingSize> r = calibrate_size(family, config, o, n);
-    if (!r) return stopped();
-    st.results[n] = std::move(*r);
   }
-  const ScalingSize ref = st.results.at(st.ref_size);
-  if (!ref.success)
-    throw std::runtime_error("the REV (size " + std::to_string(st.ref_size) +
-                             ") did not calibrate: no multipliers to carry (see " + o.work_dir +
-                             ")");
-
-  // At a size beyond the calibrated ones the search starts at the
-  // candidate's prediction: that first run is the candidate's forward check.
-  for (int64_t n : o.sizes) {
-    ScalingSize& r = st.results[n];
-    r.requested = n;
-    if (n == st.ref_size) {
-      r.fixed.found = true;
-      r.fixed.steps = r.best.steps;
-      continue;
-    }
-    if (stop_asked(o)) return stopped();
-    fixed_multipliers(family, o, ref, st.candidate, st.tolerances, n, r);
-  }
-  fit_laws(st);
-  const ScalingSize& fwd = st.results[st.forward_size];
-  if (stop_asked(o)) return stopped();
-  if (st.forward_size > o.calibrate_max && !fwd.fixed.trials.empty())
-    forward_check(family, o, st, fwd.fixed.trials.front());
   st.forward_ok =
       st.have_forward && st.law_run.score.passed && std::abs(st.law_peak_error) <= st.accuracy;
   // The law upscaling uses: the candidate while the forward check confirms

@@ -452,17 +452,28 @@ namespace demcal {
 
 StepSearch smallest_passing_steps(const SceneConfig& config, const ConsolidatedState& state,
                                   const AlgorithmSpec& start, const Tolerances& tol, int max_runs) {
-  return smallest_passing_steps(BiaxialRunner(config, state), start, tol, max_runs);
+  return smallest_passing_steps(BiaxialRunner(config, state), start, tol, nullptr, max_runs);
 }
 
 StepSearch smallest_passing_steps(const TrialRunner& runner, const AlgorithmSpec& start,
-                                  const Tolerances& tol, int max_runs) {
+                                  const Tolerances& tol, const std::atomic<bool>* stop,
+                                  int max_runs) {
+  const auto stopped = [stop] { return stop && stop->load(); };
   StepSearch out;
   AlgorithmSpec p = start;
   p.steps = round_steps(static_cast<double>(start.steps));
   int64_t largest_failing = 0;
   for (int k = 0; k < max_runs; ++k) {
-    TrialRecord r = run_trial(runner, p, tol);
+    if (stopped()) {
+      out.interrupted = true;
+      break;
+    }
+    TrialRecord r = run_trial(runner, p, tol, stop);
+    // Possibly cut short by the stop: neither a run nor a guide to the next.
+    if (stopped()) {
+      out.interrupted = true;
+      break;
+    }
     r.id = k;
     r.phase = TrialPhase::steps_search;
     out.trials.push_back(r);

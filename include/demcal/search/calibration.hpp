@@ -236,8 +236,10 @@ BaselineResult paper_recipe_baseline(const TrialRunner& runner, const AlgorithmS
                                      const Tolerances& tolerances, int64_t start_steps,
                                      int max_doublings = 8);
 /// One whole trial (no early stop) through a runner, as a record (id 0, phase search).
+/// With `stop` set during the run, the run ends at its next monitoring
+/// point and the record is incomplete (check *stop before using it).
 TrialRecord run_trial(const TrialRunner& runner, const AlgorithmSpec& params,
-                      const Tolerances& tolerances);
+                      const Tolerances& tolerances, const std::atomic<bool>* stop = nullptr);
 
 /// Run one trial and score it (no cache, no file).
 /// With `stop` set during the run, the run ends at its next monitoring

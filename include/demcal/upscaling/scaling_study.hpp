@@ -42,8 +42,10 @@ struct ScalingStudyOptions {
   int jobs = 0;
   bool resume = false;  ///< reuse the sizes (and a size's trials) already done in work_dir
   /// Set by the caller (a SIGINT handler) to stop cleanly: a calibration
-  /// winds down keeping its finished trials, a size's step search or the
-  /// forward reference run finishes, no further step starts, and the study
+  /// winds down keeping its finished trials; a consolidation ends at its
+  /// next check, a run of a size's step search or the forward reference at
+  /// its next monitoring point, and what they cut writes nothing (no
+  /// fixed.json, reference.json); no further step starts, and the study
   /// returns with `interrupted` set. May be null.
   const std::atomic<bool>* stop = nullptr;
   /// Progress lines; may be empty.

@@ -12,6 +12,7 @@
 // them per particle).
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -152,15 +153,20 @@ std::optional<SceneConfig> config_from_params(const nlohmann::json& params,
 /// servo and moment balance fall like 1/Nstep at fixed multipliers
 /// (reports/optimizers.md), so each run predicts the next guess; the
 /// search brackets and stops when a passing run is within 7 % of the
-/// tolerances or after `max_runs` runs.
+/// tolerances or after `max_runs` runs. With `stop` set (a SIGINT handler's
+/// flag) the running run ends at its next monitoring point, no further run
+/// starts, and the search returns `interrupted`: not a result (the run the
+/// stop cut is left out of trials).
 struct StepSearch {
   bool found = false;
+  bool interrupted = false;
   TrialRecord best;                 ///< the smallest passing run
   std::vector<TrialRecord> trials;  ///< every run, in order
   double particle_steps = 0.0;      ///< total cost
 };
 StepSearch smallest_passing_steps(const TrialRunner& runner, const AlgorithmSpec& params,
-                                  const Tolerances& tolerances = {}, int max_runs = 8);
+                                  const Tolerances& tolerances = {},
+                                  const std::atomic<bool>* stop = nullptr, int max_runs = 8);
 /// The same on a consolidated disk REV (BiaxialRunner).
 StepSearch smallest_passing_steps(const SceneConfig& config, const ConsolidatedState& state,
                                   const AlgorithmSpec& params, const Tolerances& tolerances = {},
