@@ -215,20 +215,24 @@ class Family {
       st->steps = st->spheres->steps;
       st->wall_time_s = st->spheres->wall_time_s;
     } else {
-      const std::string cache = dir(n) + "/consolidated.csv";
-      const bool cached = o_.resume && n > o_.calibrate_max && fs::exists(cache);
-      const Assembly a = cached       ? read_particle_file(cache)
-                         : from_file_ ? cut_rev(file_prototype_, n)
-                                      : make_assembly(st->scene);
+      // A resumed study consolidates the same assembly again: the
+      // consolidation cache (DEMCAL_CACHE_DIR) returns the exact state, or
+      // the consolidation is redone, deterministic. (Settling the sample
+      // again from its consolidated.csv, as until 2026-12-04, gave a
+      // slightly different sample: criteria ~1e-7 away from an
+      // uninterrupted study's.) consolidated.csv stays an output: the
+      // forward size's sample, e.g. a prototype for `demcal verify`.
+      const Assembly a = from_file_ ? cut_rev(file_prototype_, n) : make_assembly(st->scene);
       log("consolidating " + std::to_string(a.size()) + " particles (size " + std::to_string(n) +
-          (cached ? ", from " + cache : std::string()) + ")");
+          ")");
       st->disks.emplace(consolidate(st->scene, a, consolidation));
       st->runner = std::make_unique<BiaxialRunner>(st->scene, *st->disks);
       st->steps = st->disks->steps;
       st->wall_time_s = st->disks->wall_time_s;
-      if (n > o_.calibrate_max && !cached) {
+      if (n > o_.calibrate_max) {
         make_output_dir(dir(n));
-        write_file_atomic(cache, particle_csv(assembly_of(st->disks->world)));
+        write_file_atomic(dir(n) + "/consolidated.csv",
+                          particle_csv(assembly_of(st->disks->world)));
       }
     }
     st->particles = st->runner->particles();
