@@ -72,14 +72,6 @@ double lammps_estimate_s(int64_t n, int64_t steps, int np) {
                                        (np > 1 ? kLammpsMpiStepCost : 0.0));
 }
 
-/// The loading steps the LAMMPS deck of `proto` runs (Nstep/f: its fix
-/// viscous is explicit, export.hpp), read from the deck export_deck makes,
-/// so the estimate runs what the deck will.
-int64_t lammps_deck_steps(const SceneConfig& config, const AlgorithmSpec& up,
-                          const Assembly& proto) {
-  return export_deck(config, up, proto, ExportOptions{}).steps;
-}
-
 /// The first executable `name` on PATH, or "".
 std::string find_on_path(const std::string& name) {
   const char* path = std::getenv("PATH");
@@ -419,9 +411,10 @@ int cmd_verify(const VerifyOptions& o) {
   const AlgorithmSpec up = upscale(rev.params, rev.particles, n, law);
   print_prototype_notes("verify", particles, rev.particles, n, law);
   const double particle_steps = static_cast<double>(n) * static_cast<double>(up.steps);
-  // LAMMPS runs the deck's steps (Nstep/f) at its own speed, its ranks
-  // sharing the work only on large prototypes.
-  const int64_t run_steps = in_lammps ? lammps_deck_steps(config, up, proto) : up.steps;
+  // LAMMPS runs the deck's steps (Nstep/f: deck_steps, what the deck
+  // writes) at its own speed, its ranks sharing the work only on large
+  // prototypes.
+  const int64_t run_steps = in_lammps ? deck_steps(up) : up.steps;
   const double estimate_s =
       in_lammps ? lammps_estimate_s(n, run_steps, o.np) : particle_steps / kAssumedSpeed;
   if (estimate_s > 60.0 * o.max_minutes && !o.consolidate_only)

@@ -1,0 +1,87 @@
+// `demcal verify` and `demcal export` as a first-time user met them (the
+// walk of 2026-12-04): a consolidation read from the cache printed as if it
+// had been computed; verify's LAMMPS deck of a failed calibration without
+// export's NOT CERTIFIED header; "steps upscaled" for a prototype of the
+// REV's own size; the deck's run length learnt from a throwaway deck; and
+// `export -o FOLDER/` checked by a rule of its own (it consolidated, then
+// failed with an internal error).
+#include <gtest/gtest.h>
+#include <sys/stat.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "demcal/scene/config.hpp"
+#include "demcal/scene/packing.hpp"
+#include "demcal/scene/triaxial.hpp"
+#include "demcal/upscaling/export.hpp"
+#include "demcal/upscaling/export_3d.hpp"
+#include "support/files.hpp"
+#include "support/process.hpp"
+
+namespace demcal {
+namespace {
+
+namespace fs = std::filesystem;
+
+/// The shipped example calibrations: hex_10x10 (REV 100 disks, 88140
+/// steps) and fcc_4x4x4 (REV 256 spheres).
+std::string example_params(const std::string& scene) {
+  return (fs::path(test::kSourceDir) / "reports" / ("example-" + scene) / "params.json").string();
+}
+
+/// demcal ARGS in `cwd` with the environment `env` ("KEY=VALUE") added.
+test::RunResult demcal_with(const std::vector<std::string>& env,
+                            const std::vector<std::string>& args, const fs::path& cwd) {
+  std::vector<std::string> all = env;
+  all.push_back(test::kDemcalBinary);
+  all.insert(all.end(), args.begin(), args.end());
+  return test::run_program("/usr/bin/env", all, cwd);
+}
+
+/// The first line of `text` that starts with `start`, else "no line START".
+std::string line_of(const std::string& text, const std::string& start) {
+  for (const std::string& line : test::lines_of(text))
+    if (line.rfind(start, 0) == 0) return line;
+  return "no line " + start;
+}
+
+bool contains(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
+// The deck's run length has one home, deck_steps (Nstep/f): the 2D and 3D
+// decks of both formats write it, and `verify --engine lammps` estimates
+// from it instead of building a throwaway deck.
+TEST(VerifyExportWalk, DeckStepsIsTheRunLengthEveryDeckWrites) {
+  const SceneConfig disks = load_config(test::shipped_config("hex_5x5"));
+  const Assembly assembly = make_assembly(disks);
+  const SceneConfig spheres = load_config(test::shipped_config("fcc_4x4x4"));
+  const SphereAssembly balls = make_sphere_assembly(spheres);
+  for (const double zeta : {0.0, 0.3, 0.7, 1.5})
+    for (const int64_t steps : {1, 7, 1000, 88140}) {
+      SCOPED_TRACE("zeta_t " + std::to_string(zeta) + ", Nstep " + std::to_string(steps));
+      AlgorithmSpec p = disks.algorithm;
+      p.damping_ratio_translation = zeta;
+      p.steps = steps;
+      const int64_t expected = std::max<int64_t>(
+          1, std::llround(static_cast<double>(steps) / dashpot_step_factor(zeta)));
+      EXPECT_EQ(deck_steps(p), expected);
+      for (const char* format : {"lammps", "liggghts"}) {
+        SCOPED_TRACE(format);
+        ExportOptions o;
+        o.format = format;
+        EXPECT_EQ(export_deck(disks, p, assembly, o).steps, deck_steps(p));
+        Export3dOptions o3;
+        o3.format = format;
+        EXPECT_EQ(export_3d_decks(spheres, p, balls, o3).steps, deck_steps(p));
+      }
+    }
+}
+
+}  // namespace
+}  // namespace demcal
