@@ -90,8 +90,8 @@ void check_other_decks(const fs::path& dir, const std::string& deck,
 }
 
 /// Where the deck goes: -o FILE or demcal-NAME.FORMAT, checked writable now
-/// (not after a consolidation). The files it reads and writes are named after
-/// the whole deck file name (deck_files: NAME.lammps.data,
+/// (not after a consolidation) as every -o FILE is (check_output_file). The files it reads and
+/// writes are named after the whole deck file name (deck_files: NAME.lammps.data,
 /// NAME.lammps.series.csv, NAME.liggghts-top.stl, ...), so two decks in one
 /// folder never share one; check_other_decks refuses what would overwrite
 /// another deck's files.
@@ -99,9 +99,7 @@ fs::path deck_destination(const ExportCmdOptions& o, const SceneConfig& config, 
   if (o.format != "lammps" && o.format != "liggghts")
     throw InputError("--format", "", "must be lammps or liggghts, got \"" + o.format + "\"");
   const fs::path deck_fs(o.output.empty() ? "demcal-" + config.name + "." + o.format : o.output);
-  if (fs::is_directory(deck_fs))
-    throw InputError(deck_fs.string(), "", "is a folder; give a file name");
-  OutputFolder::check(deck_fs.has_parent_path() ? deck_fs.parent_path().string() : ".");
+  check_output_file(deck_fs.string());
   eo.format = o.format;
   eo.deck_name = deck_fs.filename().string();
   check_other_decks(deck_fs.has_parent_path() ? deck_fs.parent_path() : fs::path("."), eo.deck_name,

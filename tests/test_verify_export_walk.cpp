@@ -83,5 +83,25 @@ TEST(VerifyExportWalk, DeckStepsIsTheRunLengthEveryDeckWrites) {
     }
 }
 
+// `export -o FOLDER/` (a name ending in a separator) passed export's own
+// check of the destination, consolidated the prototype, then failed with
+// "OutputTransaction: not a name inside the folder" (exit 1). The deck's
+// destination is checked as every -o FILE is (check_output_file): exit 2
+// before anything runs, nothing made.
+TEST(VerifyExportWalk, ExportToAFolderNameIsRefusedBeforeAnythingRuns) {
+  const test::TempDir dir("walk_deck_dir");
+  fs::create_directory(dir / "there");
+  for (const std::string out : {"new/", "there", "there/"}) {
+    SCOPED_TRACE(out);
+    const test::RunResult r = test::run_demcal(
+        {"export", example_params("hex_10x10"), "--particles", "25", "-o", out}, dir.path());
+    EXPECT_EQ(r.status, 2) << r.err;
+    EXPECT_TRUE(contains(r.err, "is a folder; give a file name")) << r.err;
+    EXPECT_FALSE(contains(r.err, "consolidat")) << r.err;
+  }
+  EXPECT_FALSE(fs::exists(dir / "new"));
+  EXPECT_TRUE(fs::is_empty(dir / "there"));
+}
+
 }  // namespace
 }  // namespace demcal
