@@ -190,10 +190,16 @@ ConsolidationOptions export_consolidation(const ExportCmdOptions& o, int particl
 
 /// The deck's Nstep and where it came from, 2D and 3D, on stderr: "demcal
 /// export: 2500 steps upscaled from 100 particles / 1000 steps (linear law,
-/// exponent 1: LAW'S SOURCE)"; nothing for the REV itself (nothing upscaled).
-void print_upscaled_steps(const PrototypeSource& source, const AlgorithmSpec& up,
+/// exponent 1: LAW'S SOURCE)"; for a prototype of the REV's `n` particles
+/// (factor 1), that nothing is upscaled (rev_size_steps_words); nothing for
+/// the REV itself.
+void print_upscaled_steps(const PrototypeSource& source, int64_t n, const AlgorithmSpec& up,
                           const RevParams& rev, const ScalingLaw& law, const char* what) {
   if (source.kind == "rev") return;
+  if (n == rev.particles) {
+    std::cerr << "demcal export: " << rev_size_steps_words(up.steps, rev.particles, what) << "\n";
+    return;
+  }
   std::cerr << "demcal export: " << up.steps << " steps upscaled from " << rev.particles << " "
             << what << " / " << rev.params.steps << " steps (" << law.name() << " law, exponent "
             << law.exponent << ": " << law.source << ")\n";
@@ -225,7 +231,7 @@ int export_3d(const ExportCmdOptions& o, const nlohmann::json& params, const Rev
   eo.provenance = o.params + " (REV " + std::to_string(rev.particles) + " spheres, " +
                   std::to_string(rev.params.steps) + " steps; " + law.name() + " law, exponent " +
                   std::to_string(law.exponent) + ")";
-  print_upscaled_steps(source, up, rev, law, "spheres");
+  print_upscaled_steps(source, proto.size(), up, rev, law, "spheres");
   if (eo.consolidate_in_deck) {
     const ExportResult r = export_3d_decks(config, up, proto, eo);
     write_deck(deck_fs, o, r, proto.size(), "spheres");
@@ -256,7 +262,7 @@ int cmd_export(const ExportCmdOptions& o) {
   Assembly proto = prototype_assembly(config, particles, file, &source);
   const AlgorithmSpec up = upscale(rev.params, rev.particles, proto.size(), law);
   print_prototype_notes("export", particles, rev.particles, proto.size(), law);
-  print_upscaled_steps(source, up, rev, law, "particles");
+  print_upscaled_steps(source, proto.size(), up, rev, law, "particles");
   eo.provenance = o.params + " (REV " + std::to_string(rev.particles) + " particles, " +
                   std::to_string(rev.params.steps) + " steps; " + law.name() + " law, exponent " +
                   std::to_string(law.exponent) + ")";

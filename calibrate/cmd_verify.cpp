@@ -287,11 +287,14 @@ int verify_3d(const VerifyOptions& o, const nlohmann::json& params, const RevPar
     }
   }
   const double estimate_s = rate > 0.0 ? particle_steps / rate : 0.0;
-  std::cerr << "demcal verify: prototype " << source.description << "; " << up.steps
-            << " steps upscaled (" << law.name() << " law, exponent " << law.exponent << ": "
-            << law.source << ") from " << rev.particles << " spheres / " << rev.params.steps
-            << " steps\n"
-            << "demcal verify: loading = " << particle_steps << " particle-steps, estimated "
+  std::cerr << "demcal verify: prototype " << source.description << "; ";
+  if (n == rev.particles)
+    std::cerr << rev_size_steps_words(up.steps, rev.particles, "spheres") << "\n";
+  else
+    std::cerr << up.steps << " steps upscaled (" << law.name() << " law, exponent " << law.exponent
+              << ": " << law.source << ") from " << rev.particles << " spheres / "
+              << rev.params.steps << " steps\n";
+  std::cerr << "demcal verify: loading = " << particle_steps << " particle-steps, estimated "
             << estimate_s / 60.0 << " min at " << rate
             << " particle-steps/s (measured now on the prototype, " << threads
             << " thread(s); plus a single-thread consolidation"
@@ -424,9 +427,12 @@ int cmd_verify(const VerifyOptions& o) {
                          " steps is estimated at " + std::to_string(estimate_s / 60.0) +
                          " min, beyond the budget of " + std::to_string(o.max_minutes) +
                          " min; raise --max-minutes to run it");
-  std::cerr << "demcal verify: prototype " << source.description << "; " << up.steps
-            << " steps upscaled (" << law.name() << " law, exponent " << law.exponent << ") from "
-            << rev.particles << " particles / " << rev.params.steps << " steps\n";
+  std::cerr << "demcal verify: prototype " << source.description << "; ";
+  if (n == rev.particles)
+    std::cerr << rev_size_steps_words(up.steps, rev.particles, "particles") << "\n";
+  else
+    std::cerr << up.steps << " steps upscaled (" << law.name() << " law, exponent " << law.exponent
+              << ") from " << rev.particles << " particles / " << rev.params.steps << " steps\n";
   const char* consolidation_time =
       proto.dense ? "short for a dense packing" : "long for a loose gas";
   if (o.consolidate_only)

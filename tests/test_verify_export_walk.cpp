@@ -54,6 +54,54 @@ bool contains(const std::string& text, const std::string& part) {
   return text.find(part) != std::string::npos;
 }
 
+// `export --particles N` with N the REV's own count said "88140 steps
+// upscaled from 100 particles / 88140 steps (linear law ...)" although
+// nothing is upscaled; it says so now (factor 1), as verify does; another
+// count still names the law.
+TEST(VerifyExportWalk, APrototypeOfTheRevsSizeIsSaidNotUpscaled) {
+  const test::TempDir dir("walk_rev_size");
+  struct Case {
+    std::string scene, rev, other, what;
+  };
+  for (const Case& c :
+       {Case{"hex_10x10", "100", "400", "particles"}, Case{"fcc_4x4x4", "256", "500", "spheres"}}) {
+    SCOPED_TRACE(c.scene);
+    const std::string params = example_params(c.scene);
+    const int64_t steps = test::read_json(params)["rev"]["steps"].get<int64_t>();
+    const std::string same = "demcal export: " + std::to_string(steps) +
+                             " steps, the REV's: not upscaled (the prototype has the REV's " +
+                             c.rev + " " + c.what + ", factor 1)";
+    // The deck consolidates (--consolidate-in deck): nothing runs here.
+    const test::RunResult at_rev =
+        test::run_demcal({"export", params, "--particles", c.rev, "--consolidate-in", "deck", "-o",
+                          c.scene + "-rev.lammps"},
+                         dir.path());
+    ASSERT_EQ(at_rev.status, 0) << at_rev.err;
+    EXPECT_FALSE(contains(at_rev.err, "upscaled from")) << at_rev.err;
+    EXPECT_EQ(line_of(at_rev.err, "demcal export: " + std::to_string(steps) + " steps"), same)
+        << at_rev.err;
+    const test::RunResult other =
+        test::run_demcal({"export", params, "--particles", c.other, "--consolidate-in", "deck",
+                          "-o", c.scene + "-other.lammps"},
+                         dir.path());
+    ASSERT_EQ(other.status, 0) << other.err;
+    EXPECT_TRUE(contains(other.err, " steps upscaled from " + c.rev + " " + c.what + " / " +
+                                        std::to_string(steps) + " steps ("))
+        << other.err;
+  }
+  // verify's line says the same (--consolidate-only: the line comes first).
+  const test::RunResult verified =
+      test::run_demcal({"verify", example_params("hex_10x10"), "--particles", "100",
+                        "--consolidate-only", "-o", "v"},
+                       dir.path());
+  ASSERT_EQ(verified.status, 0) << verified.err;
+  EXPECT_FALSE(contains(verified.err, "steps upscaled (")) << verified.err;
+  EXPECT_TRUE(contains(verified.err,
+                       "; 88140 steps, the REV's: not upscaled (the prototype has "
+                       "the REV's 100 particles, factor 1)\n"))
+      << verified.err;
+}
+
 // The deck's run length has one home, deck_steps (Nstep/f): the 2D and 3D
 // decks of both formats write it, and `verify --engine lammps` estimates
 // from it instead of building a throwaway deck.
