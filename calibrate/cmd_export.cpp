@@ -107,15 +107,6 @@ fs::path deck_destination(const ExportCmdOptions& o, const SceneConfig& config, 
   return deck_fs;
 }
 
-/// A failed calibration's parameters (--allow-failed): why they are not
-/// certified (params.json's message, else empty), for the deck's header.
-std::optional<std::string> uncertified(const nlohmann::json& params) {
-  const auto ok = params.find("success");
-  if (ok == params.end() || *ok != false) return std::nullopt;
-  const auto why = params.find("message");
-  return why != params.end() && why->is_string() ? why->get<std::string>() : std::string();
-}
-
 /// Writes the deck and the files it reads together (never a new deck beside
 /// an old data file) and says what was written and how to run it.
 void write_deck(const fs::path& deck_fs, const ExportCmdOptions& o, const ExportResult& r,
@@ -220,7 +211,7 @@ int export_3d(const ExportCmdOptions& o, const nlohmann::json& params, const Rev
                      "(--consolidate-in)");
   Export3dOptions eo;
   const fs::path deck_fs = deck_destination(o, config, eo);
-  eo.uncertified = uncertified(params);
+  eo.uncertified = uncertified_reason(params);
   const ScalingLaw law = resolve_law(params, o.params, o.law, o.exponent);
   auto [file, particles] = named_prototype(params, o.prototype, o.particles);
   PrototypeSource source;
@@ -255,7 +246,7 @@ int cmd_export(const ExportCmdOptions& o) {
   if (config.dimension == 3) return export_3d(o, params, rev, config);
   ExportOptions eo;
   const fs::path deck_fs = deck_destination(o, config, eo);
-  eo.uncertified = uncertified(params);
+  eo.uncertified = uncertified_reason(params);
   const ScalingLaw law = resolve_law(params, o.params, o.law, o.exponent);
   auto [file, particles] = named_prototype(params, o.prototype, o.particles);
   PrototypeSource source;

@@ -111,15 +111,18 @@ nlohmann::json verify_head(const VerifyOptions& o, const SceneConfig& config, in
 }
 
 /// `verify --engine lammps`: the exported deck of the consolidated
-/// prototype, run by lmp in DIR/lammps, its series scored.
-int verify_in_lammps(const VerifyOptions& o, const SceneConfig& config,
-                     const ConsolidatedState& state, const AlgorithmSpec& up,
-                     const std::string& dir, const std::string& lmp, double estimate_s,
-                     nlohmann::json out) {
+/// prototype, run by lmp in DIR/lammps, its series scored; the deck's
+/// header says NOT CERTIFIED as export's does for a failed calibration's
+/// `params` (--allow-failed).
+int verify_in_lammps(const VerifyOptions& o, const nlohmann::json& params,
+                     const SceneConfig& config, const ConsolidatedState& state,
+                     const AlgorithmSpec& up, const std::string& dir, const std::string& lmp,
+                     double estimate_s, nlohmann::json out) {
   namespace fs = std::filesystem;
   ExportOptions eo;
   eo.deck_name = "deck.lammps";  // it reads deck.lammps.data, writes deck.lammps.series.csv
   eo.provenance = o.params;
+  eo.uncertified = uncertified_reason(params);  // --allow-failed: the header says so
   const DeckFiles files = deck_files(eo.deck_name);
   const ExportResult deck = export_deck(config, up, assembly_of(state.world), eo);
   const fs::path work = fs::path(dir) / "lammps";
@@ -480,7 +483,7 @@ int cmd_verify(const VerifyOptions& o) {
                                       particle_scales(proto.r, config.material, up.mass_scaling));
     head["consolidation"] = {{"steps", state.steps}, {"wall_time_s", state.wall_time_s}};
     head["version"] = DEMCAL_VERSION;
-    return verify_in_lammps(o, config, state, up, dir, lmp, estimate_s, head);
+    return verify_in_lammps(o, params, config, state, up, dir, lmp, estimate_s, head);
   }
   LoadingResult run;
   const Tolerances tolerances = default_tolerances(config);

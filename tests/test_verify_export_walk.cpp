@@ -54,6 +54,57 @@ bool contains(const std::string& text, const std::string& part) {
   return text.find(part) != std::string::npos;
 }
 
+// `verify --engine lammps --allow-failed` ran a deck whose header did not
+// say that its parameters are not certified, which `export --allow-failed`
+// writes (deck_sections.cpp's header_opening, from params.json's success and
+// message: uncertified_reason). The deck is written before LAMMPS runs; a
+// stand-in lmp that fails at once keeps this test free of LAMMPS.
+TEST(VerifyExportWalk, VerifysLammpsDeckSaysNotCertifiedAsExportsDeckDoes) {
+  const test::TempDir dir("walk_uncertified");
+  nlohmann::json params = test::read_json(example_params("hex_10x10"));
+  ASSERT_EQ(params["success"], true);
+  params["success"] = false;
+  params["message"] = "the best passing parameters did not pass the convergence certificate";
+  test::write_text(dir / "failed.json", params.dump(1));
+  const std::string lmp = test::write_text(dir / "bin" / "lmp", "#!/bin/sh\nexit 3\n");
+  ASSERT_EQ(::chmod(lmp.c_str(), 0755), 0);
+  const std::string path = "PATH=" + (dir / "bin").string() + ":/usr/bin:/bin";
+  const test::RunResult verified = demcal_with({path},
+                                               {"verify", "failed.json", "--particles", "25",
+                                                "--engine", "lammps", "--allow-failed", "-o", "v"},
+                                               dir.path());
+  EXPECT_NE(verified.status, 0);  // the stand-in lmp failed
+  EXPECT_TRUE(contains(verified.err, "LAMMPS failed")) << verified.err;
+  const test::RunResult exported = test::run_demcal(
+      {"export", "failed.json", "--particles", "25", "--allow-failed", "-o", "e.lammps"},
+      dir.path());
+  ASSERT_EQ(exported.status, 0) << exported.err;
+  // The header's NOT CERTIFIED lines, up to the header's first "#" line.
+  auto uncertified_of = [](const std::string& deck) {
+    const auto at = deck.find("# NOT CERTIFIED");
+    return at == std::string::npos ? std::string() : deck.substr(at, deck.find("\n#\n", at) - at);
+  };
+  const std::string verify_deck = test::read_text(dir / "v" / "lammps" / "deck.lammps");
+  ASSERT_FALSE(verify_deck.empty());
+  const std::string header = uncertified_of(test::read_text(dir / "e.lammps"));
+  ASSERT_FALSE(header.empty());
+  EXPECT_EQ(uncertified_of(verify_deck), header) << verify_deck.substr(0, 1500);
+  EXPECT_LT(verify_deck.find("# NOT CERTIFIED"), verify_deck.find("\n#\n"));
+  // The estimate's run length (deck_steps) is the one the deck runs.
+  const std::string nstep = line_of(verify_deck, "variable nstep ");
+  const std::string estimated = line_of(verified.err, "demcal verify: LAMMPS loading = ");
+  const size_t at = estimated.find(" = ") + 3;
+  const std::string steps = estimated.substr(at, estimated.find(' ', at) - at);
+  EXPECT_TRUE(contains(nstep, " equal " + steps + " ")) << nstep << "\n" << estimated;
+  // A certified calibration's deck has no such line.
+  const test::RunResult certified = demcal_with(
+      {path},
+      {"verify", example_params("hex_10x10"), "--particles", "25", "--engine", "lammps", "-o", "c"},
+      dir.path());
+  EXPECT_NE(certified.status, 0);
+  EXPECT_FALSE(contains(test::read_text(dir / "c" / "lammps" / "deck.lammps"), "CERTIFIED"));
+}
+
 // `export --particles N` with N the REV's own count said "88140 steps
 // upscaled from 100 particles / 88140 steps (linear law ...)" although
 // nothing is upscaled; it says so now (factor 1), as verify does; another
