@@ -230,8 +230,9 @@ int export_3d(const ExportCmdOptions& o, const nlohmann::json& params, const Rev
   }
   const TriaxialState state = consolidate_triaxial(
       config, proto, export_consolidation(o, proto.size(), source.description, "sphere kernel"));
-  std::cerr << "demcal export: consolidated in " << state.steps << " steps, " << state.wall_time_s
-            << " s\n";
+  std::cerr << "demcal export: consolidated in " << state.steps << " steps, ";
+  print_consolidation_time(std::cerr, state.wall_time_s, state.from_cache);
+  std::cerr << "\n";
   const ExportResult r = export_3d_decks(config, up, state, eo);
   write_deck(deck_fs, o, r, state.world.size(), "spheres");
   return 0;
@@ -262,8 +263,9 @@ int cmd_export(const ExportCmdOptions& o) {
     const ConsolidationOptions co =
         export_consolidation(o, proto.size(), source.description, "kernel");
     const ConsolidatedState state = consolidate(config, proto, co);
-    std::cerr << "demcal export: consolidated in " << state.steps << " steps, " << state.wall_time_s
-              << " s\n";
+    std::cerr << "demcal export: consolidated in " << state.steps << " steps, ";
+    print_consolidation_time(std::cerr, state.wall_time_s, state.from_cache);
+    std::cerr << "\n";
     proto = assembly_of(state.world);
   }
   const ExportResult r = export_deck(config, up, proto, eo);

@@ -94,12 +94,15 @@ SeriesMetadata verify_metadata(const SceneConfig& config, const Run& run) {
 
 /// verify.json's opening, 2D and 3D, either engine: the schema, the scene,
 /// the params file, the prototype (its `n` particles and their source), the
-/// REV, the upscaling to `n` and the upscaled parameters `up` at the
-/// prototype's `scales`.
+/// REV, the upscaling to `n`, the upscaled parameters `up` at the
+/// prototype's `scales`, and the prototype's consolidation `state` (its
+/// steps, wall time and from_cache: read from the consolidation cache, the
+/// wall time is the reading's, as `run`'s summary.json says).
+template <class State>
 nlohmann::json verify_head(const VerifyOptions& o, const SceneConfig& config, int64_t n,
                            const PrototypeSource& source, const RevParams& rev,
                            const ScalingLaw& law, const AlgorithmSpec& up,
-                           const ParticleScales& scales) {
+                           const ParticleScales& scales, const State& state) {
   return {{"schema", "demcal.verify/1"},
           {"scene", config.name},
           {"params_file", o.params},
@@ -107,7 +110,11 @@ nlohmann::json verify_head(const VerifyOptions& o, const SceneConfig& config, in
            {{"particles", n}, {"source", source.kind}, {"description", source.description}}},
           {"rev", {{"particles", rev.particles}, {"steps", rev.params.steps}}},
           {"upscaling", upscaling_block(rev.particles, n, law)},
-          {"params", param_block(up, scales)}};
+          {"params", param_block(up, scales)},
+          {"consolidation",
+           {{"steps", state.steps},
+            {"wall_time_s", state.wall_time_s},
+            {"from_cache", state.from_cache}}}};
 }
 
 /// `verify --engine lammps`: the exported deck of the consolidated
@@ -316,8 +323,9 @@ int verify_3d(const VerifyOptions& o, const nlohmann::json& params, const RevPar
 
   const auto t0 = std::chrono::steady_clock::now();
   TriaxialState state = consolidate_triaxial(config, proto);
-  std::cerr << "demcal verify: consolidated in " << state.steps << " steps, " << state.wall_time_s
-            << " s; loading now\n";
+  std::cerr << "demcal verify: consolidated in " << state.steps << " steps, ";
+  print_consolidation_time(std::cerr, state.wall_time_s, state.from_cache);
+  std::cerr << "; loading now\n";
   state.world.set_threads(threads);
   const Tolerances tolerances = default_tolerances(config);
   TriaxialResult run;
@@ -337,7 +345,7 @@ int verify_3d(const VerifyOptions& o, const nlohmann::json& params, const RevPar
   }
   const double rate_run = trial.wall_time_s > 0 ? particle_steps / trial.wall_time_s : 0.0;
   nlohmann::json out = verify_head(o, config, n, source, rev, law, up,
-                                   sphere_scales(state.world, config.material, up));
+                                   sphere_scales(state.world, config.material, up), state);
   out.update({{"dimension", 3},
               {"passed", score.passed},
               {"criteria", to_json(c)},
@@ -346,7 +354,6 @@ int verify_3d(const VerifyOptions& o, const nlohmann::json& params, const RevPar
               {"peak", peak},
               {"diverged", score.diverged},
               {"axial_component", kTriaxialCriteriaNames},
-              {"consolidation", {{"steps", state.steps}, {"wall_time_s", state.wall_time_s}}},
               {"loading",
                {{"steps", up.steps},
                 {"particle_steps", particle_steps},
@@ -366,9 +373,11 @@ int verify_3d(const VerifyOptions& o, const nlohmann::json& params, const RevPar
               << num(100.0 * (c.peak_stress_yy - *peak_rev) / std::abs(*peak_rev), 3) << " %)";
   std::cout << "\n"
             << "  " << score.diagnosis.message << "\n"
-            << "  consolidation " << state.wall_time_s << " s, loading " << trial.wall_time_s
-            << " s (" << rate_run << " particle-steps/s on " << state.world.threads()
-            << " thread(s), estimated " << estimate_s << " s), total " << total_s << " s\n"
+            << "  consolidation ";
+  print_consolidation_time(std::cout, state.wall_time_s, state.from_cache);
+  std::cout << ", loading " << trial.wall_time_s << " s (" << rate_run << " particle-steps/s on "
+            << state.world.threads() << " thread(s), estimated " << estimate_s << " s), total "
+            << total_s << " s\n"
             << "  wrote " << dir << "/verify.json, series.csv\n";
   return score.passed ? 0 : 1;
 }
@@ -460,11 +469,13 @@ int cmd_verify(const VerifyOptions& o) {
 
   const auto t0 = std::chrono::steady_clock::now();
   const ConsolidatedState state = consolidate(config, proto);
-  const double speed = state.wall_time_s > 1.0 ? static_cast<double>(state.steps) *
-                                                     static_cast<double>(n) / state.wall_time_s
-                                               : kAssumedSpeed;
-  std::cerr << "demcal verify: consolidated in " << state.steps << " steps, " << state.wall_time_s
-            << " s";
+  // The kernel's speed from the consolidation, not from a cache's reading.
+  const double speed =
+      state.wall_time_s > 1.0 && !state.from_cache
+          ? static_cast<double>(state.steps) * static_cast<double>(n) / state.wall_time_s
+          : kAssumedSpeed;
+  std::cerr << "demcal verify: consolidated in " << state.steps << " steps, ";
+  print_consolidation_time(std::cerr, state.wall_time_s, state.from_cache);
   if (!o.consolidate_only)
     std::cerr << "; loading now, about " << (in_lammps ? estimate_s : particle_steps / speed) / 60.0
               << " min";
@@ -473,15 +484,16 @@ int cmd_verify(const VerifyOptions& o) {
   // later runs (read_particle_file reads it back).
   write_file_atomic(dir + "/prototype.csv", particle_csv(assembly_of(state.world)));
   if (o.consolidate_only) {
-    std::cout << "consolidated prototype of " << n << " particles: " << state.steps << " steps, "
-              << state.wall_time_s << " s; wrote " << dir << "/prototype.csv\n";
+    std::cout << "consolidated prototype of " << n << " particles: " << state.steps << " steps, ";
+    print_consolidation_time(std::cout, state.wall_time_s, state.from_cache);
+    std::cout << "; wrote " << dir << "/prototype.csv\n";
     return 0;
   }
 
   if (in_lammps) {
-    nlohmann::json head = verify_head(o, config, n, source, rev, law, up,
-                                      particle_scales(proto.r, config.material, up.mass_scaling));
-    head["consolidation"] = {{"steps", state.steps}, {"wall_time_s", state.wall_time_s}};
+    nlohmann::json head =
+        verify_head(o, config, n, source, rev, law, up,
+                    particle_scales(proto.r, config.material, up.mass_scaling), state);
     head["version"] = DEMCAL_VERSION;
     return verify_in_lammps(o, params, config, state, up, dir, lmp, estimate_s, head);
   }
@@ -493,7 +505,7 @@ int cmd_verify(const VerifyOptions& o) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const ParticleScales scales = particle_scales(proto.r, config.material, up.mass_scaling);
 
-  nlohmann::json out = verify_head(o, config, n, source, rev, law, up, scales);
+  nlohmann::json out = verify_head(o, config, n, source, rev, law, up, scales, state);
   out["prototype"]["stats"] = to_json(packing_stats(state.world));
   out.update({{"passed", trial.score.passed},
               {"criteria", to_json(trial.score.criteria)},
@@ -504,7 +516,6 @@ int cmd_verify(const VerifyOptions& o) {
                 {"strain_yy", trial.score.criteria.peak_strain_yy},
                 {"ratio", -trial.score.criteria.peak_stress_yy / config.test.lateral_stress}}},
               {"diverged", trial.score.diverged},
-              {"consolidation", {{"steps", state.steps}, {"wall_time_s", state.wall_time_s}}},
               {"loading",
                {{"steps", up.steps},
                 {"particle_steps", particle_steps},
@@ -521,8 +532,10 @@ int cmd_verify(const VerifyOptions& o) {
   print_peak(std::cout, false, c.peak_stress_yy, std::nullopt, config.test.lateral_stress);
   std::cout << ")\n"
             << "  " << score.diagnosis.message << "\n"
-            << "  consolidation " << state.wall_time_s << " s, loading " << trial.wall_time_s
-            << " s (" << (trial.wall_time_s > 0 ? particle_steps / trial.wall_time_s : 0.0)
+            << "  consolidation ";
+  print_consolidation_time(std::cout, state.wall_time_s, state.from_cache);
+  std::cout << ", loading " << trial.wall_time_s << " s ("
+            << (trial.wall_time_s > 0 ? particle_steps / trial.wall_time_s : 0.0)
             << " particle-steps/s), total " << total_s << " s\n"
             << "  wrote " << dir << "/verify.json, series.csv, prototype.csv\n";
   return trial.score.passed ? 0 : 1;

@@ -54,6 +54,66 @@ bool contains(const std::string& text, const std::string& part) {
   return text.find(part) != std::string::npos;
 }
 
+// A prototype's consolidation read from the cache (DEMCAL_CACHE_DIR) was
+// printed by verify as its computing time, unlabelled, and verify.json did
+// not say where it came from. Now verify (2D and 3D, --consolidate-only)
+// and export label it as check and run do ("read from the cache in T s",
+// print_consolidation_time) and verify.json's consolidation records
+// from_cache; a fresh consolidation's lines are unchanged.
+TEST(VerifyExportWalk, AConsolidationFromTheCacheIsLabelledAndRecorded) {
+  const test::TempDir dir("walk_cache");
+  const std::string cache = "DEMCAL_CACHE_DIR=" + (dir / "cache").string();
+  struct Case {
+    std::string scene, particles;
+  };
+  for (const Case& c : {Case{"hex_10x10", "25"}, Case{"fcc_4x4x4", "32"}}) {
+    SCOPED_TRACE(c.scene);
+    const std::string params = example_params(c.scene);
+    auto verify = [&](const std::string& out) {
+      const test::RunResult r = demcal_with(
+          {cache}, {"verify", params, "--particles", c.particles, "-o", out}, dir.path());
+      EXPECT_TRUE(r.status == 0 || r.status == 1) << r.err;  // PASS or FAIL, both reported
+      return r;
+    };
+    const test::RunResult miss = verify(c.scene + "-miss");
+    const test::RunResult hit = verify(c.scene + "-hit");
+    const nlohmann::json fresh = test::read_json(dir / (c.scene + "-miss") / "verify.json");
+    const nlohmann::json read = test::read_json(dir / (c.scene + "-hit") / "verify.json");
+    ASSERT_TRUE(fresh.at("consolidation").contains("from_cache")) << fresh.dump(1);
+    EXPECT_FALSE(fresh["consolidation"]["from_cache"].get<bool>());
+    EXPECT_TRUE(read.at("consolidation").at("from_cache").get<bool>());
+    EXPECT_EQ(read["consolidation"]["steps"], fresh["consolidation"]["steps"]);
+    // stdout: "  consolidation T s, loading ..."; read: "  consolidation
+    // read from the cache in T s, loading ...".
+    const std::string fresh_line = line_of(miss.out, "  consolidation ");
+    const std::string read_line = line_of(hit.out, "  consolidation ");
+    EXPECT_FALSE(contains(fresh_line, "cache")) << fresh_line;
+    EXPECT_TRUE(contains(fresh_line, " s, loading ")) << fresh_line;
+    EXPECT_EQ(read_line.rfind("  consolidation read from the cache in ", 0), 0u) << read_line;
+    EXPECT_TRUE(contains(read_line, " s, loading ")) << read_line;
+    // stderr: "consolidated in N steps, T s" / "..., read from the cache in T s".
+    const std::string steps = "demcal verify: consolidated in " +
+                              std::to_string(fresh["consolidation"]["steps"].get<int64_t>()) +
+                              " steps, ";
+    EXPECT_TRUE(contains(miss.err, steps)) << miss.err;
+    EXPECT_FALSE(contains(miss.err, "cache")) << miss.err;
+    EXPECT_TRUE(contains(hit.err, steps + "read from the cache in ")) << hit.err;
+  }
+  // --consolidate-only (2D) and export say it too.
+  const std::string params = example_params("hex_10x10");
+  const test::RunResult only = demcal_with(
+      {cache}, {"verify", params, "--particles", "25", "--consolidate-only", "-o", "only"},
+      dir.path());
+  ASSERT_EQ(only.status, 0) << only.err;
+  EXPECT_TRUE(contains(only.out, " steps, read from the cache in ")) << only.out;
+  const test::RunResult exported =
+      demcal_with({cache}, {"export", params, "--particles", "25", "-o", "d.lammps"}, dir.path());
+  ASSERT_EQ(exported.status, 0) << exported.err;
+  EXPECT_TRUE(contains(line_of(exported.err, "demcal export: consolidated in "),
+                       " steps, read from the cache in "))
+      << exported.err;
+}
+
 // `verify --engine lammps --allow-failed` ran a deck whose header did not
 // say that its parameters are not certified, which `export --allow-failed`
 // writes (deck_sections.cpp's header_opening, from params.json's success and
