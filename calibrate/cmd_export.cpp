@@ -90,8 +90,8 @@ void check_other_decks(const fs::path& dir, const std::string& deck,
 }
 
 /// Where the deck goes: -o FILE or demcal-NAME.FORMAT, checked writable now
-/// (not after a consolidation). The files it reads and writes are named after
-/// the whole deck file name (deck_files: NAME.lammps.data,
+/// (not after a consolidation) as every -o FILE is (check_output_file). The files it reads and
+/// writes are named after the whole deck file name (deck_files: NAME.lammps.data,
 /// NAME.lammps.series.csv, NAME.liggghts-top.stl, ...), so two decks in one
 /// folder never share one; check_other_decks refuses what would overwrite
 /// another deck's files.
@@ -99,23 +99,12 @@ fs::path deck_destination(const ExportCmdOptions& o, const SceneConfig& config, 
   if (o.format != "lammps" && o.format != "liggghts")
     throw InputError("--format", "", "must be lammps or liggghts, got \"" + o.format + "\"");
   const fs::path deck_fs(o.output.empty() ? "demcal-" + config.name + "." + o.format : o.output);
-  if (fs::is_directory(deck_fs))
-    throw InputError(deck_fs.string(), "", "is a folder; give a file name");
-  OutputFolder::check(deck_fs.has_parent_path() ? deck_fs.parent_path().string() : ".");
+  check_output_file(deck_fs.string());
   eo.format = o.format;
   eo.deck_name = deck_fs.filename().string();
   check_other_decks(deck_fs.has_parent_path() ? deck_fs.parent_path() : fs::path("."), eo.deck_name,
                     {deck_files(eo.deck_name).data});
   return deck_fs;
-}
-
-/// A failed calibration's parameters (--allow-failed): why they are not
-/// certified (params.json's message, else empty), for the deck's header.
-std::optional<std::string> uncertified(const nlohmann::json& params) {
-  const auto ok = params.find("success");
-  if (ok == params.end() || *ok != false) return std::nullopt;
-  const auto why = params.find("message");
-  return why != params.end() && why->is_string() ? why->get<std::string>() : std::string();
 }
 
 /// Writes the deck and the files it reads together (never a new deck beside
@@ -192,10 +181,16 @@ ConsolidationOptions export_consolidation(const ExportCmdOptions& o, int particl
 
 /// The deck's Nstep and where it came from, 2D and 3D, on stderr: "demcal
 /// export: 2500 steps upscaled from 100 particles / 1000 steps (linear law,
-/// exponent 1: LAW'S SOURCE)"; nothing for the REV itself (nothing upscaled).
-void print_upscaled_steps(const PrototypeSource& source, const AlgorithmSpec& up,
+/// exponent 1: LAW'S SOURCE)"; for a prototype of the REV's `n` particles
+/// (factor 1), that nothing is upscaled (rev_size_steps_words); nothing for
+/// the REV itself.
+void print_upscaled_steps(const PrototypeSource& source, int64_t n, const AlgorithmSpec& up,
                           const RevParams& rev, const ScalingLaw& law, const char* what) {
   if (source.kind == "rev") return;
+  if (n == rev.particles) {
+    std::cerr << "demcal export: " << rev_size_steps_words(up.steps, rev.particles, what) << "\n";
+    return;
+  }
   std::cerr << "demcal export: " << up.steps << " steps upscaled from " << rev.particles << " "
             << what << " / " << rev.params.steps << " steps (" << law.name() << " law, exponent "
             << law.exponent << ": " << law.source << ")\n";
@@ -216,7 +211,7 @@ int export_3d(const ExportCmdOptions& o, const nlohmann::json& params, const Rev
                      "(--consolidate-in)");
   Export3dOptions eo;
   const fs::path deck_fs = deck_destination(o, config, eo);
-  eo.uncertified = uncertified(params);
+  eo.uncertified = uncertified_reason(params);
   const ScalingLaw law = resolve_law(params, o.params, o.law, o.exponent);
   auto [file, particles] = named_prototype(params, o.prototype, o.particles);
   PrototypeSource source;
@@ -227,7 +222,7 @@ int export_3d(const ExportCmdOptions& o, const nlohmann::json& params, const Rev
   eo.provenance = o.params + " (REV " + std::to_string(rev.particles) + " spheres, " +
                   std::to_string(rev.params.steps) + " steps; " + law.name() + " law, exponent " +
                   std::to_string(law.exponent) + ")";
-  print_upscaled_steps(source, up, rev, law, "spheres");
+  print_upscaled_steps(source, proto.size(), up, rev, law, "spheres");
   if (eo.consolidate_in_deck) {
     const ExportResult r = export_3d_decks(config, up, proto, eo);
     write_deck(deck_fs, o, r, proto.size(), "spheres");
@@ -235,8 +230,9 @@ int export_3d(const ExportCmdOptions& o, const nlohmann::json& params, const Rev
   }
   const TriaxialState state = consolidate_triaxial(
       config, proto, export_consolidation(o, proto.size(), source.description, "sphere kernel"));
-  std::cerr << "demcal export: consolidated in " << state.steps << " steps, " << state.wall_time_s
-            << " s\n";
+  std::cerr << "demcal export: consolidated in " << state.steps << " steps, ";
+  print_consolidation_time(std::cerr, state.wall_time_s, state.from_cache);
+  std::cerr << "\n";
   const ExportResult r = export_3d_decks(config, up, state, eo);
   write_deck(deck_fs, o, r, state.world.size(), "spheres");
   return 0;
@@ -251,14 +247,14 @@ int cmd_export(const ExportCmdOptions& o) {
   if (config.dimension == 3) return export_3d(o, params, rev, config);
   ExportOptions eo;
   const fs::path deck_fs = deck_destination(o, config, eo);
-  eo.uncertified = uncertified(params);
+  eo.uncertified = uncertified_reason(params);
   const ScalingLaw law = resolve_law(params, o.params, o.law, o.exponent);
   auto [file, particles] = named_prototype(params, o.prototype, o.particles);
   PrototypeSource source;
   Assembly proto = prototype_assembly(config, particles, file, &source);
   const AlgorithmSpec up = upscale(rev.params, rev.particles, proto.size(), law);
   print_prototype_notes("export", particles, rev.particles, proto.size(), law);
-  print_upscaled_steps(source, up, rev, law, "particles");
+  print_upscaled_steps(source, proto.size(), up, rev, law, "particles");
   eo.provenance = o.params + " (REV " + std::to_string(rev.particles) + " particles, " +
                   std::to_string(rev.params.steps) + " steps; " + law.name() + " law, exponent " +
                   std::to_string(law.exponent) + ")";
@@ -267,8 +263,9 @@ int cmd_export(const ExportCmdOptions& o) {
     const ConsolidationOptions co =
         export_consolidation(o, proto.size(), source.description, "kernel");
     const ConsolidatedState state = consolidate(config, proto, co);
-    std::cerr << "demcal export: consolidated in " << state.steps << " steps, " << state.wall_time_s
-              << " s\n";
+    std::cerr << "demcal export: consolidated in " << state.steps << " steps, ";
+    print_consolidation_time(std::cerr, state.wall_time_s, state.from_cache);
+    std::cerr << "\n";
     proto = assembly_of(state.world);
   }
   const ExportResult r = export_deck(config, up, proto, eo);

@@ -72,14 +72,6 @@ double lammps_estimate_s(int64_t n, int64_t steps, int np) {
                                        (np > 1 ? kLammpsMpiStepCost : 0.0));
 }
 
-/// The loading steps the LAMMPS deck of `proto` runs (Nstep/f: its fix
-/// viscous is explicit, export.hpp), read from the deck export_deck makes,
-/// so the estimate runs what the deck will.
-int64_t lammps_deck_steps(const SceneConfig& config, const AlgorithmSpec& up,
-                          const Assembly& proto) {
-  return export_deck(config, up, proto, ExportOptions{}).steps;
-}
-
 /// The first executable `name` on PATH, or "".
 std::string find_on_path(const std::string& name) {
   const char* path = std::getenv("PATH");
@@ -102,12 +94,15 @@ SeriesMetadata verify_metadata(const SceneConfig& config, const Run& run) {
 
 /// verify.json's opening, 2D and 3D, either engine: the schema, the scene,
 /// the params file, the prototype (its `n` particles and their source), the
-/// REV, the upscaling to `n` and the upscaled parameters `up` at the
-/// prototype's `scales`.
+/// REV, the upscaling to `n`, the upscaled parameters `up` at the
+/// prototype's `scales`, and the prototype's consolidation `state` (its
+/// steps, wall time and from_cache: read from the consolidation cache, the
+/// wall time is the reading's, as `run`'s summary.json says).
+template <class State>
 nlohmann::json verify_head(const VerifyOptions& o, const SceneConfig& config, int64_t n,
                            const PrototypeSource& source, const RevParams& rev,
                            const ScalingLaw& law, const AlgorithmSpec& up,
-                           const ParticleScales& scales) {
+                           const ParticleScales& scales, const State& state) {
   return {{"schema", "demcal.verify/1"},
           {"scene", config.name},
           {"params_file", o.params},
@@ -115,19 +110,26 @@ nlohmann::json verify_head(const VerifyOptions& o, const SceneConfig& config, in
            {{"particles", n}, {"source", source.kind}, {"description", source.description}}},
           {"rev", {{"particles", rev.particles}, {"steps", rev.params.steps}}},
           {"upscaling", upscaling_block(rev.particles, n, law)},
-          {"params", param_block(up, scales)}};
+          {"params", param_block(up, scales)},
+          {"consolidation",
+           {{"steps", state.steps},
+            {"wall_time_s", state.wall_time_s},
+            {"from_cache", state.from_cache}}}};
 }
 
 /// `verify --engine lammps`: the exported deck of the consolidated
-/// prototype, run by lmp in DIR/lammps, its series scored.
-int verify_in_lammps(const VerifyOptions& o, const SceneConfig& config,
-                     const ConsolidatedState& state, const AlgorithmSpec& up,
-                     const std::string& dir, const std::string& lmp, double estimate_s,
-                     nlohmann::json out) {
+/// prototype, run by lmp in DIR/lammps, its series scored; the deck's
+/// header says NOT CERTIFIED as export's does for a failed calibration's
+/// `params` (--allow-failed).
+int verify_in_lammps(const VerifyOptions& o, const nlohmann::json& params,
+                     const SceneConfig& config, const ConsolidatedState& state,
+                     const AlgorithmSpec& up, const std::string& dir, const std::string& lmp,
+                     double estimate_s, nlohmann::json out) {
   namespace fs = std::filesystem;
   ExportOptions eo;
   eo.deck_name = "deck.lammps";  // it reads deck.lammps.data, writes deck.lammps.series.csv
   eo.provenance = o.params;
+  eo.uncertified = uncertified_reason(params);  // --allow-failed: the header says so
   const DeckFiles files = deck_files(eo.deck_name);
   const ExportResult deck = export_deck(config, up, assembly_of(state.world), eo);
   const fs::path work = fs::path(dir) / "lammps";
@@ -295,11 +297,14 @@ int verify_3d(const VerifyOptions& o, const nlohmann::json& params, const RevPar
     }
   }
   const double estimate_s = rate > 0.0 ? particle_steps / rate : 0.0;
-  std::cerr << "demcal verify: prototype " << source.description << "; " << up.steps
-            << " steps upscaled (" << law.name() << " law, exponent " << law.exponent << ": "
-            << law.source << ") from " << rev.particles << " spheres / " << rev.params.steps
-            << " steps\n"
-            << "demcal verify: loading = " << particle_steps << " particle-steps, estimated "
+  std::cerr << "demcal verify: prototype " << source.description << "; ";
+  if (n == rev.particles)
+    std::cerr << rev_size_steps_words(up.steps, rev.particles, "spheres") << "\n";
+  else
+    std::cerr << up.steps << " steps upscaled (" << law.name() << " law, exponent " << law.exponent
+              << ": " << law.source << ") from " << rev.particles << " spheres / "
+              << rev.params.steps << " steps\n";
+  std::cerr << "demcal verify: loading = " << particle_steps << " particle-steps, estimated "
             << estimate_s / 60.0 << " min at " << rate
             << " particle-steps/s (measured now on the prototype, " << threads
             << " thread(s); plus a single-thread consolidation"
@@ -318,8 +323,9 @@ int verify_3d(const VerifyOptions& o, const nlohmann::json& params, const RevPar
 
   const auto t0 = std::chrono::steady_clock::now();
   TriaxialState state = consolidate_triaxial(config, proto);
-  std::cerr << "demcal verify: consolidated in " << state.steps << " steps, " << state.wall_time_s
-            << " s; loading now\n";
+  std::cerr << "demcal verify: consolidated in " << state.steps << " steps, ";
+  print_consolidation_time(std::cerr, state.wall_time_s, state.from_cache);
+  std::cerr << "; loading now\n";
   state.world.set_threads(threads);
   const Tolerances tolerances = default_tolerances(config);
   TriaxialResult run;
@@ -339,7 +345,7 @@ int verify_3d(const VerifyOptions& o, const nlohmann::json& params, const RevPar
   }
   const double rate_run = trial.wall_time_s > 0 ? particle_steps / trial.wall_time_s : 0.0;
   nlohmann::json out = verify_head(o, config, n, source, rev, law, up,
-                                   sphere_scales(state.world, config.material, up));
+                                   sphere_scales(state.world, config.material, up), state);
   out.update({{"dimension", 3},
               {"passed", score.passed},
               {"criteria", to_json(c)},
@@ -348,7 +354,6 @@ int verify_3d(const VerifyOptions& o, const nlohmann::json& params, const RevPar
               {"peak", peak},
               {"diverged", score.diverged},
               {"axial_component", kTriaxialCriteriaNames},
-              {"consolidation", {{"steps", state.steps}, {"wall_time_s", state.wall_time_s}}},
               {"loading",
                {{"steps", up.steps},
                 {"particle_steps", particle_steps},
@@ -368,9 +373,11 @@ int verify_3d(const VerifyOptions& o, const nlohmann::json& params, const RevPar
               << num(100.0 * (c.peak_stress_yy - *peak_rev) / std::abs(*peak_rev), 3) << " %)";
   std::cout << "\n"
             << "  " << score.diagnosis.message << "\n"
-            << "  consolidation " << state.wall_time_s << " s, loading " << trial.wall_time_s
-            << " s (" << rate_run << " particle-steps/s on " << state.world.threads()
-            << " thread(s), estimated " << estimate_s << " s), total " << total_s << " s\n"
+            << "  consolidation ";
+  print_consolidation_time(std::cout, state.wall_time_s, state.from_cache);
+  std::cout << ", loading " << trial.wall_time_s << " s (" << rate_run << " particle-steps/s on "
+            << state.world.threads() << " thread(s), estimated " << estimate_s << " s), total "
+            << total_s << " s\n"
             << "  wrote " << dir << "/verify.json, series.csv\n";
   return score.passed ? 0 : 1;
 }
@@ -419,9 +426,10 @@ int cmd_verify(const VerifyOptions& o) {
   const AlgorithmSpec up = upscale(rev.params, rev.particles, n, law);
   print_prototype_notes("verify", particles, rev.particles, n, law);
   const double particle_steps = static_cast<double>(n) * static_cast<double>(up.steps);
-  // LAMMPS runs the deck's steps (Nstep/f) at its own speed, its ranks
-  // sharing the work only on large prototypes.
-  const int64_t run_steps = in_lammps ? lammps_deck_steps(config, up, proto) : up.steps;
+  // LAMMPS runs the deck's steps (Nstep/f: deck_steps, what the deck
+  // writes) at its own speed, its ranks sharing the work only on large
+  // prototypes.
+  const int64_t run_steps = in_lammps ? deck_steps(up) : up.steps;
   const double estimate_s =
       in_lammps ? lammps_estimate_s(n, run_steps, o.np) : particle_steps / kAssumedSpeed;
   if (estimate_s > 60.0 * o.max_minutes && !o.consolidate_only)
@@ -431,9 +439,12 @@ int cmd_verify(const VerifyOptions& o) {
                          " steps is estimated at " + std::to_string(estimate_s / 60.0) +
                          " min, beyond the budget of " + std::to_string(o.max_minutes) +
                          " min; raise --max-minutes to run it");
-  std::cerr << "demcal verify: prototype " << source.description << "; " << up.steps
-            << " steps upscaled (" << law.name() << " law, exponent " << law.exponent << ") from "
-            << rev.particles << " particles / " << rev.params.steps << " steps\n";
+  std::cerr << "demcal verify: prototype " << source.description << "; ";
+  if (n == rev.particles)
+    std::cerr << rev_size_steps_words(up.steps, rev.particles, "particles") << "\n";
+  else
+    std::cerr << up.steps << " steps upscaled (" << law.name() << " law, exponent " << law.exponent
+              << ") from " << rev.particles << " particles / " << rev.params.steps << " steps\n";
   const char* consolidation_time =
       proto.dense ? "short for a dense packing" : "long for a loose gas";
   if (o.consolidate_only)
@@ -458,11 +469,13 @@ int cmd_verify(const VerifyOptions& o) {
 
   const auto t0 = std::chrono::steady_clock::now();
   const ConsolidatedState state = consolidate(config, proto);
-  const double speed = state.wall_time_s > 1.0 ? static_cast<double>(state.steps) *
-                                                     static_cast<double>(n) / state.wall_time_s
-                                               : kAssumedSpeed;
-  std::cerr << "demcal verify: consolidated in " << state.steps << " steps, " << state.wall_time_s
-            << " s";
+  // The kernel's speed from the consolidation, not from a cache's reading.
+  const double speed =
+      state.wall_time_s > 1.0 && !state.from_cache
+          ? static_cast<double>(state.steps) * static_cast<double>(n) / state.wall_time_s
+          : kAssumedSpeed;
+  std::cerr << "demcal verify: consolidated in " << state.steps << " steps, ";
+  print_consolidation_time(std::cerr, state.wall_time_s, state.from_cache);
   if (!o.consolidate_only)
     std::cerr << "; loading now, about " << (in_lammps ? estimate_s : particle_steps / speed) / 60.0
               << " min";
@@ -471,17 +484,18 @@ int cmd_verify(const VerifyOptions& o) {
   // later runs (read_particle_file reads it back).
   write_file_atomic(dir + "/prototype.csv", particle_csv(assembly_of(state.world)));
   if (o.consolidate_only) {
-    std::cout << "consolidated prototype of " << n << " particles: " << state.steps << " steps, "
-              << state.wall_time_s << " s; wrote " << dir << "/prototype.csv\n";
+    std::cout << "consolidated prototype of " << n << " particles: " << state.steps << " steps, ";
+    print_consolidation_time(std::cout, state.wall_time_s, state.from_cache);
+    std::cout << "; wrote " << dir << "/prototype.csv\n";
     return 0;
   }
 
   if (in_lammps) {
-    nlohmann::json head = verify_head(o, config, n, source, rev, law, up,
-                                      particle_scales(proto.r, config.material, up.mass_scaling));
-    head["consolidation"] = {{"steps", state.steps}, {"wall_time_s", state.wall_time_s}};
+    nlohmann::json head =
+        verify_head(o, config, n, source, rev, law, up,
+                    particle_scales(proto.r, config.material, up.mass_scaling), state);
     head["version"] = DEMCAL_VERSION;
-    return verify_in_lammps(o, config, state, up, dir, lmp, estimate_s, head);
+    return verify_in_lammps(o, params, config, state, up, dir, lmp, estimate_s, head);
   }
   LoadingResult run;
   const Tolerances tolerances = default_tolerances(config);
@@ -491,7 +505,7 @@ int cmd_verify(const VerifyOptions& o) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const ParticleScales scales = particle_scales(proto.r, config.material, up.mass_scaling);
 
-  nlohmann::json out = verify_head(o, config, n, source, rev, law, up, scales);
+  nlohmann::json out = verify_head(o, config, n, source, rev, law, up, scales, state);
   out["prototype"]["stats"] = to_json(packing_stats(state.world));
   out.update({{"passed", trial.score.passed},
               {"criteria", to_json(trial.score.criteria)},
@@ -502,7 +516,6 @@ int cmd_verify(const VerifyOptions& o) {
                 {"strain_yy", trial.score.criteria.peak_strain_yy},
                 {"ratio", -trial.score.criteria.peak_stress_yy / config.test.lateral_stress}}},
               {"diverged", trial.score.diverged},
-              {"consolidation", {{"steps", state.steps}, {"wall_time_s", state.wall_time_s}}},
               {"loading",
                {{"steps", up.steps},
                 {"particle_steps", particle_steps},
@@ -519,8 +532,10 @@ int cmd_verify(const VerifyOptions& o) {
   print_peak(std::cout, false, c.peak_stress_yy, std::nullopt, config.test.lateral_stress);
   std::cout << ")\n"
             << "  " << score.diagnosis.message << "\n"
-            << "  consolidation " << state.wall_time_s << " s, loading " << trial.wall_time_s
-            << " s (" << (trial.wall_time_s > 0 ? particle_steps / trial.wall_time_s : 0.0)
+            << "  consolidation ";
+  print_consolidation_time(std::cout, state.wall_time_s, state.from_cache);
+  std::cout << ", loading " << trial.wall_time_s << " s ("
+            << (trial.wall_time_s > 0 ? particle_steps / trial.wall_time_s : 0.0)
             << " particle-steps/s), total " << total_s << " s\n"
             << "  wrote " << dir << "/verify.json, series.csv, prototype.csv\n";
   return trial.score.passed ? 0 : 1;

@@ -38,12 +38,12 @@ RadiusClasses radius_class_bounds(const std::vector<double>& radii, int max_type
   return out;
 }
 
-DeckTiming deck_timing(double dt_ratio, int64_t steps, double zeta_t, double dt_crit) {
+DeckTiming deck_timing(const AlgorithmSpec& p, double dt_crit) {
   DeckTiming out;
-  out.step_factor = dashpot_step_factor(zeta_t);
-  out.dt = dt_ratio * out.step_factor * dt_crit;
-  out.demcal_dt = dt_ratio * dt_crit;
-  out.steps = std::max<int64_t>(1, std::llround(static_cast<double>(steps) / out.step_factor));
+  out.step_factor = dashpot_step_factor(p.damping_ratio_translation);
+  out.dt = p.dt_ratio * out.step_factor * dt_crit;
+  out.demcal_dt = p.dt_ratio * dt_crit;
+  out.steps = deck_steps(p);
   return out;
 }
 
@@ -127,8 +127,7 @@ void set_plan_classes(PlanCommon& plan, const std::vector<double>& radii, int ma
 }
 
 void set_plan_timing(PlanCommon& plan, const AlgorithmSpec& p, const Material& m, double m_max) {
-  const DeckTiming timing =
-      deck_timing(p.dt_ratio, p.steps, p.damping_ratio_translation, plan.dt_crit);
+  const DeckTiming timing = deck_timing(p, plan.dt_crit);
   plan.step_factor = timing.step_factor;
   plan.dt = timing.dt;
   plan.demcal_dt = timing.demcal_dt;

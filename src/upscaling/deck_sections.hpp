@@ -42,7 +42,8 @@ struct DeckTiming {
   double demcal_dt = 0.0;  ///< α·Δt_crit: demcal's step, the servo law's time unit
   int64_t steps = 0;
 };
-DeckTiming deck_timing(double dt_ratio, int64_t steps, double zeta_t, double dt_crit);
+/// The run length is deck_steps(p) (export.hpp), the one home of Nstep/f.
+DeckTiming deck_timing(const AlgorithmSpec& p, double dt_crit);
 
 /// What the 2D and the 3D plan (export.cpp's Plan, export_3d.cpp's Plan3)
 /// share, set once for both by set_plan_classes and set_plan_timing.

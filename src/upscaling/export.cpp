@@ -1168,6 +1168,11 @@ ExportResult liggghts(const SceneConfig& c, const AlgorithmSpec& p, const Assemb
 
 }  // namespace
 
+int64_t deck_steps(const AlgorithmSpec& params) {
+  return std::max<int64_t>(1, std::llround(static_cast<double>(params.steps) /
+                                           dashpot_step_factor(params.damping_ratio_translation)));
+}
+
 std::vector<int> radius_classes(const std::vector<double>& radii, int max_types, int* types) {
   const int n = static_cast<int>(radii.size());
   std::vector<int> order(n);

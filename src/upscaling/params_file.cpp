@@ -187,6 +187,13 @@ void require_calibrated(const nlohmann::json& params, const std::string& path) {
                                        : std::string()));
 }
 
+std::optional<std::string> uncertified_reason(const nlohmann::json& params) {
+  const auto ok = params.find("success");
+  if (ok == params.end() || *ok != false) return std::nullopt;
+  const auto why = params.find("message");
+  return why != params.end() && why->is_string() ? why->get<std::string>() : std::string();
+}
+
 nlohmann::json parse_params_text(std::string_view text, const std::string& path) {
   // The config's JSON reader: every nlohmann error (1e999 is out_of_range,
   // not a parse error) an InputError with its line, duplicate keys refused.

@@ -76,6 +76,11 @@ std::string below_rev_note(int64_t n_rev, int64_t n_proto, const ScalingLaw& law
   return s.str();
 }
 
+std::string rev_size_steps_words(int64_t steps, int64_t n_rev, const char* what) {
+  return std::to_string(steps) + " steps, the REV's: not upscaled (the prototype has the REV's " +
+         std::to_string(n_rev) + " " + what + ", factor 1)";
+}
+
 AlgorithmSpec upscale(const AlgorithmSpec& rev, int64_t n_rev, int64_t n_proto,
                       const ScalingLaw& law) {
   AlgorithmSpec p = rev;

@@ -99,6 +99,14 @@ struct ExportResult {
 ExportResult export_deck(const SceneConfig& config, const AlgorithmSpec& params,
                          const Assembly& assembly, const ExportOptions& options);
 
+/// The run length a deck of `params` writes, 2D and 3D, either format
+/// (ExportResult::steps): Nstep/f rounded, at least 1, f =
+/// dashpot_step_factor(ζ_t) (the engines' fix viscous is explicit): the
+/// same loading time as demcal's Nstep. It depends on no particle: `demcal
+/// verify --engine lammps` estimates the deck's run from it before any
+/// deck is written.
+int64_t deck_steps(const AlgorithmSpec& params);
+
 /// Radius classes: type (1-based) of every particle, at most `max_types`
 /// classes of (nearly) equal counts; equal radii share a class.
 std::vector<int> radius_classes(const std::vector<double>& radii, int max_types, int* types);

@@ -62,6 +62,12 @@ bool calibration_succeeded(const nlohmann::json& params, const std::string& path
 /// calibration's message and the remedy; so is a "success" missing or not
 /// true or false (calibration_succeeded).
 void require_calibrated(const nlohmann::json& params, const std::string& path);
+/// A params.json whose calibration failed ("success": false), used anyway
+/// (--allow-failed): why its parameters are not certified, its "message"
+/// (empty when it has none); nothing for a calibration that succeeded. What
+/// a deck's header says of them (ExportOptions::uncertified), for
+/// `demcal export` and the deck `demcal verify --engine lammps` runs alike.
+std::optional<std::string> uncertified_reason(const nlohmann::json& params);
 /// The dimension a params.json was calibrated in: its "dimension" (2 when
 /// absent, as 2D params.json files have always been written).
 int params_dimension(const nlohmann::json& params);

@@ -65,6 +65,12 @@ int64_t upscale_steps(int64_t steps_rev, int64_t n_rev, int64_t n_proto,
 /// error grows as L/Nstep, the law keeps only the force balance's L²/Nstep),
 /// so `demcal verify` may fail there. One text for every command.
 std::string below_rev_note(int64_t n_rev, int64_t n_proto, const ScalingLaw& law);
+/// Nstep of a prototype of the REV's own size, which nothing upscales (the
+/// law's factor is 1), in words, where a command says how Nstep was
+/// upscaled: "88140 steps, the REV's: not upscaled (the prototype has the
+/// REV's 100 particles, factor 1)"; `what` names them (particles, spheres).
+/// One text for every command.
+std::string rev_size_steps_words(int64_t steps, int64_t n_rev, const char* what);
 /// The REV's parameters for the prototype: Nstep upscaled, every
 /// multiplier unchanged.
 AlgorithmSpec upscale(const AlgorithmSpec& rev, int64_t n_rev, int64_t n_proto,
