@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "consolidate_in.hpp"
 #include "consolidation_progress.hpp"
 #include "demcal/io/files.hpp"
 #include "demcal/scene/biaxial.hpp"
@@ -25,11 +26,6 @@
 #include "upscaling_cli.hpp"
 
 namespace demcal::cli {
-
-/// Above this many particles `--consolidate-in auto` leaves the consolidation
-/// to the LAMMPS deck: demcal's kernel consolidates single-threaded, and
-/// beyond a few thousand particles that takes minutes (reports/engines.md §8).
-constexpr int kDeckConsolidationAbove = 2000;
 
 namespace {
 
@@ -133,29 +129,14 @@ void write_deck(const fs::path& deck_fs, const ExportCmdOptions& o, const Export
             << "\n";
 }
 
-/// Checks --consolidate-in against the format and --no-consolidate; true
-/// when the deck consolidates the prototype itself (`deck`, or `auto` for
-/// LAMMPS above kDeckConsolidationAbove particles), and says so on stderr.
-bool consolidate_in_deck(const ExportCmdOptions& o, int particles) {
-  if (o.consolidate_in != "auto" && o.consolidate_in != "demcal" && o.consolidate_in != "deck")
-    throw InputError("--consolidate-in", "",
-                     "must be demcal, deck or auto, got \"" + o.consolidate_in + "\"");
-  if (o.consolidate_in == "deck" && o.format != "lammps")
-    throw InputError("--consolidate-in", "", "deck: only the LAMMPS deck consolidates itself");
-  if (o.consolidate_in != "auto" && o.no_consolidate)
-    throw InputError("--consolidate-in", "",
-                     "the prototype is not consolidated with --no-consolidate");
-  const bool in_deck =
-      !o.no_consolidate &&
-      (o.consolidate_in == "deck" ||
-       (o.consolidate_in == "auto" && o.format == "lammps" && particles > kDeckConsolidationAbove));
+/// consolidate_in_deck (the rule: consolidate_in.hpp), and says on stderr
+/// when the deck consolidates the prototype.
+bool deck_consolidates(const ExportCmdOptions& o, int particles) {
+  const bool in_deck = consolidate_in_deck(o.consolidate_in, o.format, o.no_consolidate, particles);
   if (in_deck)
-    std::cerr << "demcal export: " << particles << " particles"
-              << (o.consolidate_in == "auto"
-                      ? " (more than " + std::to_string(kDeckConsolidationAbove) + ")"
-                      : std::string())
-              << ": the deck consolidates the prototype to sigma3 itself (stage 1, under MPI; "
-                 "--consolidate-in demcal does it here instead)\n";
+    std::cerr << "demcal export: " << particles
+              << " particles: the deck consolidates the prototype to sigma3 itself (stage 1, under "
+                 "MPI; --consolidate-in demcal does it here instead)\n";
   return in_deck;
 }
 
@@ -201,8 +182,7 @@ void print_upscaled_steps(const PrototypeSource& source, int64_t n, const Algori
 /// upscaled by the scaling law (resolve_law: --exponent, --law, else
 /// params.json's, for spheres by default N^(2/3): default_law(3)),
 /// consolidated as in 2D: by the LAMMPS deck's stage 1 (--consolidate-in
-/// deck, or auto above kDeckConsolidationAbove spheres) or by demcal's
-/// sphere kernel (threads, progress).
+/// deck) or by demcal's sphere kernel (threads, progress).
 int export_3d(const ExportCmdOptions& o, const nlohmann::json& params, const RevParams& rev,
               const SceneConfig& config) {
   if (o.no_consolidate)
@@ -216,7 +196,7 @@ int export_3d(const ExportCmdOptions& o, const nlohmann::json& params, const Rev
   auto [file, particles] = named_prototype(params, o.prototype, o.particles);
   PrototypeSource source;
   const SphereAssembly proto = prototype_spheres(config, particles, file, &source);
-  eo.consolidate_in_deck = consolidate_in_deck(o, proto.size());
+  eo.consolidate_in_deck = deck_consolidates(o, proto.size());
   const AlgorithmSpec up = upscale(rev.params, rev.particles, proto.size(), law);
   print_prototype_notes("export", particles, rev.particles, proto.size(), law);
   eo.provenance = o.params + " (REV " + std::to_string(rev.particles) + " spheres, " +
@@ -258,7 +238,7 @@ int cmd_export(const ExportCmdOptions& o) {
   eo.provenance = o.params + " (REV " + std::to_string(rev.particles) + " particles, " +
                   std::to_string(rev.params.steps) + " steps; " + law.name() + " law, exponent " +
                   std::to_string(law.exponent) + ")";
-  eo.consolidate_in_deck = consolidate_in_deck(o, proto.size());
+  eo.consolidate_in_deck = deck_consolidates(o, proto.size());
   if (!eo.consolidate_in_deck && !o.no_consolidate) {
     const ConsolidationOptions co =
         export_consolidation(o, proto.size(), source.description, "kernel");

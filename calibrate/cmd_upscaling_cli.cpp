@@ -118,7 +118,7 @@ std::function<int()> add_upscaling_commands(CLI::App& app) {
                 "write the prototype as read (it is already consolidated to sigma3)");
   exp->add_option("--consolidate-in", ex->consolidate_in,
                   "demcal, deck (LAMMPS: the deck's first stage, under MPI) or auto (default: "
-                  "the deck above 2000 particles)");
+                  "demcal, whose kernel is faster than the deck's stage on the same cores)");
   exp->add_option("--progress", ex->progress_every_s,
                   "seconds between consolidation progress lines on stderr (default 2; 0: every "
                   "check)")

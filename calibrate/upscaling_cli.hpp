@@ -73,8 +73,8 @@ struct ExportCmdOptions : UpscaledParamsOptions {
   std::string output;
   bool no_consolidate = false;
   /// Where the prototype is consolidated: demcal (its kernel, before
-  /// writing), deck (a first stage of the LAMMPS deck) or auto (the deck
-  /// above kDeckConsolidationAbove particles).
+  /// writing), deck (a first stage of the LAMMPS deck) or auto (demcal:
+  /// the rule is consolidate_in.hpp's).
   std::string consolidate_in = "auto";
   /// Seconds between demcal's consolidation progress lines on stderr.
   double progress_every_s = kProgressEverySeconds;

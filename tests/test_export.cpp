@@ -15,6 +15,8 @@
 #include <sstream>
 #include <tuple>
 
+#include "consolidate_in.hpp"
+#include "demcal/io/input_error.hpp"
 #include "demcal/scene/biaxial.hpp"
 #include "demcal/scene/packing.hpp"
 #include "demcal/scoring/external_series.hpp"
@@ -601,8 +603,29 @@ TEST(Export, LammpsDeckConsolidatesItselfToDemcalsPeak) {
   EXPECT_NEAR(series_peak(d3.path(), series, c) / peak_deck, 1.0, 1e-9);
 }
 
+TEST(ConsolidateIn, AutoIsDemcalsKernelAtEverySizeDeckOnlyWhenAsked) {
+  // The rule (consolidate_in.hpp): the deck's stage 1 costs 19x demcal's CPU
+  // at 2 500 disks and more at 10 000 (reports/engines.md §27), so `auto` is
+  // demcal's consolidation for both formats, and the deck consolidates only
+  // with `deck`. Before, auto gave LAMMPS prototypes above 2 000 particles
+  // to the deck (this test's auto rows failed).
+  using demcal::cli::consolidate_in_deck;
+  for (const char* format : {"lammps", "liggghts"})
+    for (const int n : {25, 2000, 2500, 10000, 40000, 1000000}) {
+      EXPECT_FALSE(consolidate_in_deck("auto", format, false, n)) << format << " " << n;
+      EXPECT_FALSE(consolidate_in_deck("demcal", format, false, n)) << format << " " << n;
+      EXPECT_FALSE(consolidate_in_deck("auto", format, true, n)) << format << " " << n;
+    }
+  EXPECT_TRUE(consolidate_in_deck("deck", "lammps", false, 25));
+  EXPECT_TRUE(consolidate_in_deck("deck", "lammps", false, 40000));
+  EXPECT_THROW(consolidate_in_deck("gpu", "lammps", false, 25), demcal::InputError);
+  EXPECT_THROW(consolidate_in_deck("deck", "liggghts", false, 25), demcal::InputError);
+  EXPECT_THROW(consolidate_in_deck("deck", "lammps", true, 25), demcal::InputError);
+  EXPECT_THROW(consolidate_in_deck("demcal", "lammps", true, 25), demcal::InputError);
+}
+
 TEST(ExportCli, ConsolidateInChoosesWhereAndRejectsBadCombinations) {
-  // auto: demcal's kernel up to 2 000 particles, the deck's stage 1 above
+  // auto: demcal's kernel (consolidate_in.hpp); deck: the deck's stage 1
   // (said on stderr); bad values and combinations exit 2 writing nothing.
   const test::TempDir dir("export_cli");
   const std::string params =
@@ -613,12 +636,12 @@ TEST(ExportCli, ConsolidateInChoosesWhereAndRejectsBadCombinations) {
     args.insert(args.begin(), {"export", params});
     return test::run_demcal(args, dir.path());
   };
-  const auto small = run({"--particles", "25", "-o", "a/deck.lammps"});
-  const auto large = run({"--particles", "2500", "-o", "b/deck.lammps"});
-  ASSERT_EQ(small.status, 0) << small.err;
-  ASSERT_EQ(large.status, 0) << large.err;
-  EXPECT_NE(small.err.find("with demcal's kernel"), std::string::npos) << small.err;
-  EXPECT_NE(large.err.find("the deck consolidates the prototype"), std::string::npos) << large.err;
+  const auto automatic = run({"--particles", "25", "-o", "a/deck.lammps"});
+  const auto deck = run({"--particles", "25", "--consolidate-in", "deck", "-o", "b/deck.lammps"});
+  ASSERT_EQ(automatic.status, 0) << automatic.err;
+  ASSERT_EQ(deck.status, 0) << deck.err;
+  EXPECT_NE(automatic.err.find("with demcal's kernel"), std::string::npos) << automatic.err;
+  EXPECT_NE(deck.err.find("the deck consolidates the prototype"), std::string::npos) << deck.err;
   const std::string deck_a = test::read_text(dir.path() / "a" / "deck.lammps");
   const std::string deck_b = test::read_text(dir.path() / "b" / "deck.lammps");
   EXPECT_EQ(deck_a.find("stage 1: consolidation"), std::string::npos);

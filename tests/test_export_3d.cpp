@@ -830,7 +830,7 @@ TEST(Export3dLammps, DeckConsolidatesARandomSampleAndLoads) {
 
 // `demcal export` of a 3D params.json: --consolidate-in as in 2D (deck:
 // stage 1 in the LAMMPS deck; refused for LIGGGHTS; demcal: its threaded
-// sphere kernel with progress on stderr; auto: demcal up to 2 000 spheres).
+// sphere kernel with progress on stderr; auto: demcal, consolidate_in.hpp).
 TEST(Export3dCli, ConsolidateInChoosesWhereAndPrintsProgress) {
   const test::TempDir dir("export3d_cli");
   const std::string params =
@@ -860,7 +860,7 @@ TEST(Export3dCli, ConsolidateInChoosesWhereAndPrintsProgress) {
   EXPECT_NE(demcal.err.find("consolidating (friction on)"), std::string::npos) << demcal.err;
   EXPECT_EQ(test::read_text(dir.path() / "b" / "deck.lammps").find("cons_servo"),
             std::string::npos);
-  // auto at 150 spheres: demcal consolidates (the same deck as `demcal`).
+  // auto: demcal consolidates (the same deck as `demcal`).
   const auto automatic = with({"-o", "c/deck.lammps"});
   ASSERT_EQ(automatic.status, 0) << automatic.err;
   EXPECT_EQ(test::read_text(dir.path() / "c" / "deck.lammps"),
