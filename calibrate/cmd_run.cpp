@@ -165,7 +165,6 @@ int run_3d(const SceneConfig& config, const std::string& out_dir, bool allow_uns
   const Score score = score_triaxial_run(run, c, tolerances);
   const bool within = score.passed;
   nlohmann::json summary = triaxial_run_summary(config, state, run, c, score, tolerances);
-  summary["consolidation"]["from_cache"] = state.from_cache;
   write_run_files(dir, config, summary, run, reference_peak, final_state);
   const Criteria& m = score.criteria;
   std::cout << std::setprecision(4) << "scene " << config.name
@@ -249,8 +248,7 @@ int cmd_run(const std::string& path, const std::vector<std::string>& sets,
   const Score score = score_run(run, config.test.lateral_stress, tolerances, reference_peak);
   nlohmann::json summary = run_summary(config, run, score);
   summary["tolerances"] = to_json(tolerances);
-  summary["consolidation"] = {
-      {"steps", state.steps}, {"wall_time_s", state.wall_time_s}, {"from_cache", state.from_cache}};
+  summary["consolidation"] = consolidation_json(state);
   summary["config_sha256"] = sha256_hex(config.text);
   summary["version"] = DEMCAL_VERSION;
   write_run_files(dir, config, summary, run, reference_peak, final_state);

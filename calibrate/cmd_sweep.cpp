@@ -43,10 +43,12 @@ int cmd_sweep(const SweepOptions& options) {
     // cases beyond it are meant).
     require_stable_step(config, estimated_stable_dt_ratio(state, config.algorithm), false);
     const std::vector<SweepCase> cases = atlas_cases(config.algorithm, alpha_stable);
+    // Its time as check and run print it (print_consolidation_time).
     std::cerr << "sweep " << config.name << ": " << state.world.size() << " " << what
-              << " consolidated (once" << (state.from_cache ? ", from the cache" : "") << "); "
-              << cases.size() << " trials, benchmark Nstep " << config.algorithm.steps
-              << ", alpha_stable " << std::setprecision(3) << alpha_stable << "\n";
+              << " consolidated once, in " << state.steps << " steps (" << std::setprecision(3);
+    print_consolidation_time(std::cerr, state.wall_time_s, state.from_cache);
+    std::cerr << "); " << cases.size() << " trials, benchmark Nstep " << config.algorithm.steps
+              << ", alpha_stable " << alpha_stable << "\n";
     return run_sweep(config, state, cases, settings);
   };
   SweepResult result;

@@ -95,9 +95,9 @@ SeriesMetadata verify_metadata(const SceneConfig& config, const Run& run) {
 /// verify.json's opening, 2D and 3D, either engine: the schema, the scene,
 /// the params file, the prototype (its `n` particles and their source), the
 /// REV, the upscaling to `n`, the upscaled parameters `up` at the
-/// prototype's `scales`, and the prototype's consolidation `state` (its
-/// steps, wall time and from_cache: read from the consolidation cache, the
-/// wall time is the reading's, as `run`'s summary.json says).
+/// prototype's `scales`, and the prototype's consolidation `state`
+/// (consolidation_json: its steps, wall time and from_cache, as in `run`'s
+/// summary.json).
 template <class State>
 nlohmann::json verify_head(const VerifyOptions& o, const SceneConfig& config, int64_t n,
                            const PrototypeSource& source, const RevParams& rev,
@@ -111,10 +111,7 @@ nlohmann::json verify_head(const VerifyOptions& o, const SceneConfig& config, in
           {"rev", {{"particles", rev.particles}, {"steps", rev.params.steps}}},
           {"upscaling", upscaling_block(rev.particles, n, law)},
           {"params", param_block(up, scales)},
-          {"consolidation",
-           {{"steps", state.steps},
-            {"wall_time_s", state.wall_time_s},
-            {"from_cache", state.from_cache}}}};
+          {"consolidation", consolidation_json(state)}};
 }
 
 /// `verify --engine lammps`: the exported deck of the consolidated

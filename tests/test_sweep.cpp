@@ -8,6 +8,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -312,6 +313,38 @@ TEST(Sweep, CommandWritesTheAtlas) {
       EXPECT_EQ(scored["criteria"]["peak_stress_yy"], c["criteria"]["peak_stress_yy"]);
       EXPECT_EQ(scored["passed"], c["passed"]);
     }
+}
+
+// `demcal sweep` says how long its one consolidation took, as check, run,
+// verify and export say it (print_consolidation_time): a fresh one's time,
+// a cached one's "read from the cache in T s" (it said "(once)" and "(once,
+// from the cache)", no time).
+TEST(Sweep, CommandSaysItsConsolidationTimeAsTheOtherCommands) {
+  const test::TempDir tmp("sweepcache");
+  auto sweep_line = [&](const char* out) {
+    const test::RunResult r =
+        test::run_program("/usr/bin/env",
+                          {"DEMCAL_CACHE_DIR=" + (tmp / "cache").string(), test::kDemcalBinary,
+                           "sweep", test::shipped_config("hex_5x5"), "--set",
+                           "algorithm.steps=2000", "--jobs", "2", "-o", (tmp / out).string()},
+                          tmp.path());
+    EXPECT_EQ(r.status, 0) << r.err;
+    for (const std::string& line : test::lines_of(r.err))
+      if (line.rfind("sweep hex_5x5: ", 0) == 0) return line;
+    return "no sweep line in: " + r.err;
+  };
+  const std::string fresh = sweep_line("miss");
+  const std::string read = sweep_line("hit");
+  const size_t open = fresh.find(" steps (");
+  ASSERT_NE(open, std::string::npos) << fresh;
+  EXPECT_NE(fresh.find(" particles consolidated once, in "), std::string::npos) << fresh;
+  // The same steps, then the fresh one's time, the cached one's reading.
+  const std::string steps = fresh.substr(0, open + 8);
+  EXPECT_EQ(fresh.find("cache"), std::string::npos) << fresh;
+  EXPECT_TRUE(std::isdigit(static_cast<unsigned char>(fresh[open + 8]))) << fresh;
+  EXPECT_NE(fresh.find(" s); "), std::string::npos) << fresh;
+  EXPECT_EQ(read.rfind(steps + "read from the cache in ", 0), 0u) << read;
+  EXPECT_NE(read.find(" s); "), std::string::npos) << read;
 }
 
 }  // namespace

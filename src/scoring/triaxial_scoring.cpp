@@ -325,14 +325,12 @@ nlohmann::json triaxial_run_summary(const SceneConfig& config, const TriaxialSta
            {"ratio_wall_lateral_strain", run.peak_ratio_strain},
            {"monitored_stress_zz", c.monitored_peak_stress_zz},
            {"monitored_strain_zz", c.monitored_peak_strain_zz}}},
-         {"consolidation",
-          {{"steps", state.steps},
-           {"wall_time_s", state.wall_time_s},
-           {"stress_error", state.stress_error},
-           {"unbalanced_force_ratio", state.unbalanced_ratio},
-           {"box", state.extent0}}},
+         {"consolidation", consolidation_json(state)},
          {"config_sha256", sha256_hex(config.text)},
          {"version", DEMCAL_VERSION}};
+  j["consolidation"].update({{"stress_error", state.stress_error},
+                             {"unbalanced_force_ratio", state.unbalanced_ratio},
+                             {"box", state.extent0}});
   j.update(run_account_json(config.algorithm, run));
   if (auto a = analytical_peak_ratio_3d(config))
     j["analytical_peak"] = {{"ratio", *a},

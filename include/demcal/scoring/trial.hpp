@@ -45,6 +45,19 @@ nlohmann::json run_account_json(const AlgorithmSpec& algorithm, const LoadingRun
   return j;
 }
 
+/// A consolidation's record, 2D and 3D alike, in summary.json (`demcal
+/// run`, the "consolidation" block; a 3D run's adds the state's stress error,
+/// unbalanced-force ratio and box) and verify.json: steps, wall_time_s,
+/// from_cache. Read from the consolidation cache, the steps are those the
+/// consolidation took and the wall time is the reading's. `State` is a
+/// ConsolidatedState or a TriaxialState. (A calibration's run.json keeps its
+/// own flat keys, consolidation_wall_time_s and consolidation_from_cache.)
+template <class State>
+nlohmann::json consolidation_json(const State& state) {
+  return {
+      {"steps", state.steps}, {"wall_time_s", state.wall_time_s}, {"from_cache", state.from_cache}};
+}
+
 /// summary.json of a run (`demcal run`, README.md "Commands").
 nlohmann::json run_summary(const SceneConfig& config, const LoadingResult& run, const Score& score);
 

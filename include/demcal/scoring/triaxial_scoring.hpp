@@ -156,7 +156,8 @@ extern const char* const kTriaxialCriteriaNames;
 /// summary.json of a triaxial run (`demcal run` on a 3D config): "criteria"
 /// and the verdict are the Score's (score_triaxial_run(run, c, t): the
 /// criteria judged, as `demcal score` writes them for the run's series),
-/// "criteria_planes" to_json(c).
+/// "criteria_planes" to_json(c); "consolidation" consolidation_json(state)
+/// (trial.hpp) with the state's stress_error, unbalanced_force_ratio and box.
 nlohmann::json triaxial_run_summary(const SceneConfig& config, const TriaxialState& state,
                                     const TriaxialResult& run, const TriaxialCriteria& c,
                                     const Score& score, const Tolerances& t);
