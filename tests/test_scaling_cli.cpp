@@ -23,6 +23,7 @@
 
 #include "support/files.hpp"
 #include "support/process.hpp"
+#include "support/without_timing.hpp"
 
 namespace {
 
@@ -47,24 +48,7 @@ std::vector<nlohmann::json> read_trials(const fs::path& path) {
   return out;
 }
 
-/// `j` without its wall times (every key ending in "wall_time_s", at any
-/// depth): what differs between two runs of the same study.
-nlohmann::json without_timing(nlohmann::json j) {
-  if (j.is_object()) {
-    nlohmann::json out = nlohmann::json::object();
-    for (auto& [key, value] : j.items()) {
-      const std::string suffix = "wall_time_s";
-      if (key.size() >= suffix.size() &&
-          key.compare(key.size() - suffix.size(), suffix.size(), suffix) == 0)
-        continue;
-      out[key] = without_timing(value);
-    }
-    return out;
-  }
-  if (j.is_array())
-    for (auto& v : j) v = without_timing(v);
-  return j;
-}
+using ::demcal::test::without_timing;
 
 class ScalingCli : public ::testing::Test {
  protected:

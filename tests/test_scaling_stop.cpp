@@ -22,29 +22,14 @@
 #include "demcal/upscaling/upscaling.hpp"
 #include "support/files.hpp"
 #include "support/process.hpp"
+#include "support/without_timing.hpp"
 
 namespace demcal {
 namespace {
 
 namespace fs = std::filesystem;
 
-/// `j` without its wall times (every key ending in "wall_time_s").
-nlohmann::json without_timing(nlohmann::json j) {
-  if (j.is_object()) {
-    nlohmann::json out = nlohmann::json::object();
-    for (auto& [key, value] : j.items()) {
-      const std::string suffix = "wall_time_s";
-      if (key.size() >= suffix.size() &&
-          key.compare(key.size() - suffix.size(), suffix.size(), suffix) == 0)
-        continue;
-      out[key] = without_timing(value);
-    }
-    return out;
-  }
-  if (j.is_array())
-    for (auto& v : j) v = without_timing(v);
-  return j;
-}
+using ::demcal::test::without_timing;
 
 class ScalingStop : public ::testing::Test {
  protected:
