@@ -4,9 +4,11 @@
 // (a consolidation's, every 200 steps) or monitoring point (a run's), writes
 // nothing of the step it cut (no consolidated.csv, fixed.json,
 // reference.json), and --resume ends with the uninterrupted study's
-// scaling.json (but for the reference run's own numbers when the stop cut
-// it: see below). The stop is set from the study's own log line that opens
-// the step, so each case is deterministic.
+// scaling.json, every number of it. The stop is set from the study's own log
+// line that opens the step, so each case is deterministic. (The stop inside
+// the consolidation needs a consolidation that runs: this binary runs with
+// the cache off, test_consolidation_cache.cpp; a state read from the cache
+// is read whole.)
 #include <gtest/gtest.h>
 
 #include <atomic>

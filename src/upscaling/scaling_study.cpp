@@ -172,10 +172,11 @@ struct SizeState {
 };
 
 /// The family of scenes and their consolidated states, 2D or 3D. A 2D size
-/// that is not calibrated keeps its consolidated packing in the work
-/// folder, so that a resumed study re-settles a dense file in a few
-/// thousand steps instead of compressing a gas again (3D sizes are
-/// generated and re-consolidated).
+/// that is not calibrated writes its consolidated packing to the work
+/// folder (size-N/consolidated.csv, an output); a resumed study
+/// consolidates every size again from its generated or cut assembly: the
+/// consolidation cache's exact state, or with the cache off the whole
+/// consolidation again (deterministic; the largest size's is the cost).
 class Family {
  public:
   Family(const SceneConfig& config, const ScalingStudyOptions& o) : config_(config), o_(o) {

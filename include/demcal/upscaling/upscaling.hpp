@@ -69,7 +69,7 @@ std::string below_rev_note(int64_t n_rev, int64_t n_proto, const ScalingLaw& law
 /// law's factor is 1), in words, where a command says how Nstep was
 /// upscaled: "88140 steps, the REV's: not upscaled (the prototype has the
 /// REV's 100 particles, factor 1)"; `what` names them (particles, spheres).
-/// One text for every command.
+/// One text for export and verify (upscale names the law it applied).
 std::string rev_size_steps_words(int64_t steps, int64_t n_rev, const char* what);
 /// The REV's parameters for the prototype: Nstep upscaled, every
 /// multiplier unchanged.
