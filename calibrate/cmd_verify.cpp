@@ -378,6 +378,23 @@ int verify_3d(const VerifyOptions& o, const nlohmann::json& params, const RevPar
             << "  wrote " << dir << "/verify.json, series.csv\n";
   return score.passed ? 0 : 1;
 }
+/// The prototype file `proto` mirror-tiled NXxNY (--tile), its source's
+/// description and count updated.
+Assembly tiled_prototype(const Assembly& proto, const std::string& tile, PrototypeSource& source) {
+  int nx = 0, ny = 0;
+  char sep = 0, extra = 0;
+  if (std::sscanf(tile.c_str(), "%d%c%d%c", &nx, &sep, &ny, &extra) != 3 ||
+      (sep != 'x' && sep != 'X') || nx < 1 || ny < 1 || nx * ny > 10000)
+    throw InputError("--tile", "", "expected NXxNY, e.g. 2x2, got \"" + tile + "\"");
+  if (source.kind != "file")
+    throw InputError("--tile", "", "tiles a prototype file: give --prototype FILE");
+  Assembly tiled = tile_mirrored(proto, nx, ny);
+  source.description += ", mirror-tiled " + std::to_string(nx) + "x" + std::to_string(ny) + " = " +
+                        std::to_string(tiled.size()) + " particles";
+  source.particles = tiled.size();
+  return tiled;
+}
+
 }  // namespace
 
 int cmd_verify(const VerifyOptions& o) {
@@ -406,19 +423,7 @@ int cmd_verify(const VerifyOptions& o) {
   auto [file, particles] = named_prototype(params, o.prototype, o.particles);
   PrototypeSource source;
   Assembly proto = prototype_assembly(config, particles, file, &source);
-  if (!o.tile.empty()) {
-    int nx = 0, ny = 0;
-    char sep = 0, extra = 0;
-    if (std::sscanf(o.tile.c_str(), "%d%c%d%c", &nx, &sep, &ny, &extra) != 3 ||
-        (sep != 'x' && sep != 'X') || nx < 1 || ny < 1 || nx * ny > 10000)
-      throw InputError("--tile", "", "expected NXxNY, e.g. 2x2, got \"" + o.tile + "\"");
-    if (source.kind != "file")
-      throw InputError("--tile", "", "tiles a prototype file: give --prototype FILE");
-    proto = tile_mirrored(proto, nx, ny);
-    source.description += ", mirror-tiled " + std::to_string(nx) + "x" + std::to_string(ny) +
-                          " = " + std::to_string(proto.size()) + " particles";
-    source.particles = proto.size();
-  }
+  if (!o.tile.empty()) proto = tiled_prototype(proto, o.tile, source);
   const int64_t n = proto.size();
   const AlgorithmSpec up = upscale(rev.params, rev.particles, n, law);
   print_prototype_notes("verify", particles, rev.particles, n, law);
