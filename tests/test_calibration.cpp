@@ -396,3 +396,27 @@ TEST(StopOnSignal, FirstSignalSetsTheFlagSecondOfEitherKindIsFatal) {
   ignore.sa_handler = SIG_DFL;
   sigaction(SIGTERM, &ignore, nullptr);
 }
+
+// Stiff contact dashpots can put the stable step below dt_ratio_min (0.02):
+// the search then stays within the stable step (it took α = dt_ratio_min
+// beyond it, a params.json that diverges and that export refuses).
+TEST(Calibration, StaysWithinAStableStepBelowDtRatioMin) {
+  SceneConfig config = default_config();
+  config.assembly.columns = config.assembly.rows = 5;
+  config.material.contact_damping_ratio = 12.0;
+  const ConsolidatedState state = consolidate(config, make_assembly(config));
+  const BiaxialRunner runner(config, state);
+  const double stable = runner.stable_dt_ratio(config.algorithm);
+  CalibrationOptions options;
+  ASSERT_LT(options.dt_ratio_safety * stable, options.dt_ratio_min) << "α_stable " << stable;
+  options.max_trials = kMinSearchTrials;
+  options.jobs = 2;
+  const CalibrationSummary s = calibrate(runner, config.algorithm, options);
+  EXPECT_DOUBLE_EQ(s.dt_ratio_stable, stable);
+  ASSERT_FALSE(s.trials.empty());
+  for (const TrialRecord& t : s.trials) {
+    EXPECT_LE(t.params.dt_ratio, stable) << "trial " << t.id;
+    EXPECT_FALSE(t.score.diverged) << "trial " << t.id;
+  }
+  if (s.has_best()) EXPECT_LE(s.best.dt_ratio, stable);
+}

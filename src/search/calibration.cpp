@@ -129,7 +129,11 @@ AlgorithmSpec search_start(const AlgorithmSpec& base, int64_t particles, double 
 }
 
 double dt_ratio_max(const CalibrationOptions& options, double dt_ratio_stable) {
-  return std::max(options.dt_ratio_min, options.dt_ratio_safety * dt_ratio_stable);
+  return options.dt_ratio_safety * dt_ratio_stable;
+}
+
+double dt_ratio_lower(const CalibrationOptions& options, double dt_ratio_stable) {
+  return std::min(options.dt_ratio_min, 0.5 * dt_ratio_max(options, dt_ratio_stable));
 }
 
 nlohmann::json to_json(const Certificate& c) {
@@ -975,7 +979,7 @@ SearchSpace search_space(const AlgorithmSpec& base, const CalibrationOptions& op
   space.base = base;
   const int64_t steps_min = options.steps_min > 0 ? options.steps_min : 50LL * n;
   const int64_t steps_max = options.steps_max > 0 ? options.steps_max : 20000LL * n;
-  space.lower[0] = options.dt_ratio_min;
+  space.lower[0] = dt_ratio_lower(options, dt_ratio_stable);
   space.upper[0] = dt_ratio_max(options, dt_ratio_stable);
   space.lower[1] = std::log10(static_cast<double>(steps_min));
   space.upper[1] = std::log10(static_cast<double>(steps_max));

@@ -56,7 +56,9 @@ int64_t round_steps(double steps);
 
 /// Search space (all bounds inclusive):
 ///   α = Δt/Δt_crit in [dt_ratio_min, dt_ratio_safety · α_stable], α_stable
-///     from the stiffnesses of the consolidated state (never beyond it);
+///     from the stiffnesses of the consolidated state (never beyond it; the
+///     lower bound falls to half the upper one where that is below
+///     dt_ratio_min, dt_ratio_lower());
 ///   log10 Nstep in [log10 steps_min, log10 steps_max];
 ///   ζ_t in [damping_min, damping_max], ζ_r in [0, damping_max].
 /// Mass scaling stays at the config's value (1 by default).
@@ -216,8 +218,13 @@ AlgorithmSpec search_start(const AlgorithmSpec& base, int64_t particles, double 
 /// and ζ to 1e-6, Nstep by round_steps()).
 AlgorithmSpec rounded_params(const AlgorithmSpec& params);
 /// The largest α the search may try: dt_ratio_safety × the estimated
-/// stable α, at least dt_ratio_min.
+/// stable α (never more, even below dt_ratio_min: a step beyond the stable
+/// one diverges, and export refuses it).
 double dt_ratio_max(const CalibrationOptions& options, double dt_ratio_stable);
+/// The smallest α the search may try: dt_ratio_min, or half of
+/// dt_ratio_max() where the stable step is that small (stiff contact
+/// dashpots), so that the range is never empty.
+double dt_ratio_lower(const CalibrationOptions& options, double dt_ratio_stable);
 
 /// The paper's recipe done mechanically: α = 0.2, ζ_t = ζ_r = 1, Nstep
 /// doubled from `start_steps` until every criterion passes.
