@@ -3,10 +3,15 @@
 // formula, bit for bit (reports/engines.md §17); with contact dashpots the
 // critical-damping fallback comes at demcal's check (§21) and the servo
 // carries its last move as demcal's consolidation servo (§23).
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <functional>
@@ -14,6 +19,7 @@
 #include <regex>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "demcal/kernel/particle_scales.hpp"
@@ -632,6 +638,117 @@ TEST(EngineLammpsStage1, WithContactDashpotsTheServoCarriesItsLastMoveAsDemcals3
         return (x[2 * b + 1] - x[2 * b]) * (x[2 * d + 1] - x[2 * d]);
       },
       4000, "0.0005", "engine_stage1_carry_3d");
+}
+
+/// Start `program ARGS` in `dir` in the background (stdout and stderr to
+/// /dev/null); its pid.
+pid_t spawn_in(const std::string& program, const std::vector<std::string>& args,
+               const fs::path& dir) {
+  // argv and the folder are built before the fork: the child of a threaded
+  // process may call only async-signal-safe functions until exec
+  std::vector<std::string> all{program};
+  all.insert(all.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (auto& a : all) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  const std::string where = dir.string();
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    const int null = ::open("/dev/null", O_WRONLY);
+    if (null >= 0) {
+      ::dup2(null, STDOUT_FILENO);
+      ::dup2(null, STDERR_FILENO);
+    }
+    if (::chdir(where.c_str()) == 0) ::execvp(argv[0], argv.data());
+    ::_exit(127);
+  }
+  return pid;
+}
+
+/// Stage 1 of `r` run by `lmp` until a fix print the test adds (which
+/// flushes its file) says the run has passed step 4 000, then killed
+/// (SIGKILL, as a batch job's time limit ends it): its log must hold
+/// stage 1's progress rows of steps 0 and 2 000 (thermo every 10 checks),
+/// whole, with the columns of its header. The run must still be in stage 1
+/// when killed.
+void expect_progress_rows_in_the_log_of_a_killed_run(const std::string& lmp, const ExportResult& r,
+                                                     const std::string& tag) {
+  const std::string phase0 = "# phase 0: frictionless\n";
+  const std::string deck = replaced(r.deck, phase0,
+                                    "variable        progress_step equal step\n"
+                                    "fix             progress all print 2000 \"${progress_step}\" "
+                                    "file progress.txt screen no\n" +
+                                        phase0);
+  const test::TempDir dir(tag);
+  test::write_text(dir / "in.deck", deck);
+  test::write_files(dir.path(), r.files);
+  const pid_t pid = spawn_in(
+      lmp, {"-in", "in.deck", "-log", "log.txt", "-screen", "none", "-var", "run_steps", "0"},
+      dir.path());
+  ASSERT_GT(pid, 0);
+  bool passed = false, alive = true;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::minutes(3);
+  while (!passed && alive && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    const fs::path progress = dir / "progress.txt";
+    passed =
+        fs::exists(progress) && test::read_text(progress).find("\n4000\n") != std::string::npos;
+    int status = 0;
+    // alive after the read: the row was in the file while the run went on
+    alive = ::waitpid(pid, &status, WNOHANG) == 0;
+  }
+  if (alive) {
+    ::kill(pid, SIGKILL);
+    ::waitpid(pid, nullptr, 0);
+  }
+  ASSERT_TRUE(passed) << "the run did not pass step 4000";
+  ASSERT_TRUE(alive) << "the run ended before it was killed";
+  const std::string log = test::read_text(dir / "log.txt");
+  EXPECT_EQ(log.find("demcal deck: consolidated in"), std::string::npos) << "stage 1 ended";
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(log, m, std::regex("\nStep Dt v_cons_err[^\n]*\n")))
+      << log.substr(log.size() > 2000 ? log.size() - 2000 : 0);
+  const size_t header_end = static_cast<size_t>(m.position(0) + m.length(0));
+  std::stringstream header(m[0].str());
+  int columns = 0;
+  for (std::string w; header >> w;) ++columns;
+  for (const char* step : {"0", "2000"}) {
+    std::smatch row;
+    const std::string rest = log.substr(header_end - 1);
+    ASSERT_TRUE(std::regex_search(
+        rest, row, std::regex(std::string("\n +") + step + "(( +[-+0-9.eE]+)+) *\n")))
+        << "no whole row of step " << step << " in the log:\n"
+        << log.substr(header_end);
+    std::stringstream fields(row[1].str());
+    int count = 1;
+    for (std::string w; fields >> w;) ++count;
+    EXPECT_EQ(count, columns) << row[0].str();
+  }
+}
+
+// Stage 1's progress rows (thermo_modify flush yes, deck::lammps_thermo_modify)
+// reach the log as LAMMPS prints them, so a run that a signal stops (a batch
+// job's time limit, Ctrl-C) shows in its log where it got. The deck before
+// left them to the log's 4 KiB blocks: a 10 000-disk stage 1 stopped after
+// 150 s showed step 6 000, cut mid-row, when it had passed some 50 000, and
+// engines.md §27 read a cost per step 8x the real one from it (§28). Here
+// neither row was in the old deck's log. Random disks and spheres as
+// generated (a gas: stage 1 lasts far beyond step 4 000).
+TEST(EngineLammpsStage1, AKilledRunsLogHoldsTheProgressRowsItPrinted2D) {
+  DEMCAL_FIND_PROGRAM(lmp, "lmp", "lammps", "the deck is not run");
+  const SceneConfig c = load_config(test::shipped_config("random_400"));
+  const ExportOptions o = stage1_options<ExportOptions>("r");
+  const ExportResult r = export_deck(c, stage1_loading(), make_assembly(c), o);
+  expect_progress_rows_in_the_log_of_a_killed_run(lmp, r, "engine_stage1_killed_2d");
+}
+
+TEST(EngineLammpsStage1, AKilledRunsLogHoldsTheProgressRowsItPrinted3D) {
+  DEMCAL_FIND_PROGRAM(lmp, "lmp", "lammps", "the deck is not run");
+  SceneConfig c = load_config(test::shipped_config("random_500_3d"));
+  c.assembly.count = 300;
+  const Export3dOptions o = stage1_options<Export3dOptions>("r");
+  const ExportResult r = export_3d_decks(c, stage1_loading(), make_sphere_assembly(c), o);
+  expect_progress_rows_in_the_log_of_a_killed_run(lmp, r, "engine_stage1_killed_3d");
 }
 
 }  // namespace

@@ -232,6 +232,8 @@ std::string lammps_servo_dt(double servo_dt, NumberFormat f) {
          "      # s, demcal's step: its servo law is per servo_dt (keep)\n";
 }
 
+std::string lammps_thermo_modify() { return "thermo_modify   norm no flush yes\n"; }
+
 std::string lammps_system_head(int dimension, const std::string& boundary) {
   std::ostringstream s;
   s << "\n# --- system ------------------------------------------------------------------\n"
@@ -606,9 +608,7 @@ std::string lammps_consolidation_criterion(int dimension,
        "message no\n"
     << "thermo_style    custom step dt v_cons_err v_cons_ufr";
   for (const ConsolidationWall& w : walls) s << " v_cons_p" << w.name;
-  s << " ke\n"
-    << "thermo_modify   norm no\n"
-    << "thermo          $(10*v_cons_check)\n";
+  s << " ke\n" << lammps_thermo_modify() << "thermo          $(10*v_cons_check)\n";
   return s.str();
 }
 

@@ -169,6 +169,18 @@ std::string lammps_previous_moves(const std::string& fix, const std::string& mov
 /// The parameters block's line of servo_dt (demcal's step, s).
 std::string lammps_servo_dt(double servo_dt, NumberFormat f);
 
+/// LAMMPS: the thermo_modify line of every LAMMPS deck's progress lines
+/// (stage 1's and the loading's, 2D and 3D): totals, not per atom (norm
+/// no), and each line flushed to the log and the screen as it is printed
+/// (flush yes: one fflush per thermo line, every 2 000 steps in stage 1).
+/// Without the flush a log file, and the screen when it is a file (mpirun
+/// in a batch job), is written in 4 KiB blocks: stage 1's header promises
+/// progress in these lines, and a run stopped by a signal (a batch job's
+/// time limit, Ctrl-C, kill) loses the last block, tens of lines: a 10 000
+/// disk stage 1 stopped at 30 s showed step 6 000 in its log and had passed
+/// 12 000 (reports/engines.md §28, where this misread §27's cost per step).
+std::string lammps_thermo_modify();
+
 /// LAMMPS system block, head: units, dimension, boundary, atom style.
 std::string lammps_system_head(int dimension, const std::string& boundary);
 

@@ -702,8 +702,7 @@ void lammps_3d_servo_and_run(std::ostream& s, const Plan3& plan) {
 
   s << "# --- output and run ----------------------------------------------------------\n"
     << "thermo_style    custom step time v_strain_zz v_axial v_lateral v_ratio ke\n"
-    << "thermo_modify   norm no\n"
-    << "thermo          ${monitor_every}\n"
+    << deck::lammps_thermo_modify() << "thermo          ${monitor_every}\n"
     << "run             ${run_steps}\n"
     << "variable        peak_axial equal max(f_peaks[1])\n"
     << "variable        peak_ratio equal max(f_peaks[2])\n"
