@@ -25,6 +25,7 @@
 #include <string_view>
 
 #include "commands.hpp"
+#include "consolidation_progress.hpp"
 #include "demcal/io/files.hpp"
 #include "demcal/io/format.hpp"
 #include "demcal/report/report.hpp"
@@ -192,13 +193,18 @@ Invocation prepare(const CalibrateOptions& o) {
 }
 
 /// The consolidated REV: disks (biaxial) or spheres (triaxial), cached.
+/// "consolidating ..." is said only when it consolidates (not before a
+/// cache read), then its steps and time (print_consolidation_time: a cache
+/// read's labelled).
 Consolidated consolidate_rev(const CalibrateOptions& o, const SceneConfig& config, bool three_d) {
   Consolidated c;
   auto announce = [&](int64_t size, const char* what) {
-    if (!o.quiet)
-      std::cerr << "demcal: consolidating " << size << " " << what << " of " << config.name
-                << " to sigma3 = " << config.test.lateral_stress << " Pa"
-                << (three_d ? " (3D, triaxial)" : "") << "\n";
+    return [&o, &config, three_d, size, what] {
+      if (!o.quiet)
+        std::cerr << "demcal: consolidating " << size << " " << what << " of " << config.name
+                  << " to sigma3 = " << config.test.lateral_stress << " Pa"
+                  << (three_d ? " (3D, triaxial)" : "") << "\n";
+    };
   };
   auto account = [&](const auto& state) {
     c.particles = state.world.size();
@@ -208,18 +214,18 @@ Consolidated consolidate_rev(const CalibrateOptions& o, const SceneConfig& confi
   };
   if (three_d) {
     const SphereAssembly assembly = make_sphere_assembly(config);
-    announce(assembly.size(), "spheres");
-    account(c.spheres.emplace(consolidate_triaxial(config, assembly)));
+    account(c.spheres.emplace(
+        consolidate_announced(config, assembly, {}, announce(assembly.size(), "spheres"))));
   } else {
     Assembly assembly = make_assembly(config);
-    announce(assembly.size(), "particles");
-    account(c.disks.emplace(consolidate(config, assembly)));
+    account(c.disks.emplace(
+        consolidate_announced(config, assembly, {}, announce(assembly.size(), "particles"))));
   }
-  if (!o.quiet)
-    std::cerr << "demcal: consolidated in " << c.steps << " steps ("
-              << (c.from_cache ? "read from the consolidation cache"
-                               : std::to_string(c.wall_time_s) + " s")
-              << ")\n";
+  if (!o.quiet) {
+    std::cerr << "demcal: consolidated in " << c.steps << " steps (";
+    print_consolidation_time(std::cerr, c.wall_time_s, c.from_cache);
+    std::cerr << ")\n";
+  }
   return c;
 }
 

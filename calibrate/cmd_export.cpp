@@ -140,24 +140,33 @@ bool deck_consolidates(const ExportCmdOptions& o, int particles) {
   return in_deck;
 }
 
-/// demcal's consolidation of a prototype: every core from
-/// kThreadsFrom particles, progress on stderr.
-ConsolidationOptions export_consolidation(const ExportCmdOptions& o, int particles,
-                                          const std::string& what, const char* kernel) {
+/// demcal's consolidation of a prototype (disks or spheres): every core
+/// from kThreadsFrom particles, progress on stderr. "consolidating ..." is
+/// said only when it consolidates (not before a read from the
+/// consolidation cache), then its steps and time (print_consolidation_time:
+/// a cache read's labelled).
+template <class AnyAssembly>
+auto export_consolidated(const ExportCmdOptions& o, const SceneConfig& config,
+                         const AnyAssembly& proto, const std::string& what, const char* kernel) {
   ConsolidationOptions co;
-  co.threads = particles >= kThreadsFrom ? 0 : 1;
+  co.threads = proto.size() >= kThreadsFrom ? 0 : 1;
   co.progress = consolidation_progress(o.progress_every_s);
-  std::cerr << "demcal export: consolidating the prototype (" << what
-            << ") to sigma3 with demcal's " << kernel << ", "
-            << (co.threads == 1
-                    ? std::string("single-threaded")
-                    : "on " + std::to_string(std::max(1u, std::thread::hardware_concurrency())) +
-                          " threads")
-            << (o.format == "lammps"
-                    ? " (--consolidate-in deck leaves it to the LAMMPS deck, under "
-                      "MPI)\n"
-                    : "\n");
-  return co;
+  const auto state = consolidate_announced(config, proto, co, [&] {
+    std::cerr << "demcal export: consolidating the prototype (" << what
+              << ") to sigma3 with demcal's " << kernel << ", "
+              << (co.threads == 1
+                      ? std::string("single-threaded")
+                      : "on " + std::to_string(std::max(1u, std::thread::hardware_concurrency())) +
+                            " threads")
+              << (o.format == "lammps"
+                      ? " (--consolidate-in deck leaves it to the LAMMPS deck, under "
+                        "MPI)\n"
+                      : "\n");
+  });
+  std::cerr << "demcal export: consolidated in " << state.steps << " steps, ";
+  print_consolidation_time(std::cerr, state.wall_time_s, state.from_cache);
+  std::cerr << "\n";
+  return state;
 }
 
 /// The deck's Nstep and where it came from, 2D and 3D, on stderr: "demcal
@@ -208,11 +217,8 @@ int export_3d(const ExportCmdOptions& o, const nlohmann::json& params, const Rev
     write_deck(deck_fs, o, r, proto.size(), "spheres");
     return 0;
   }
-  const TriaxialState state = consolidate_triaxial(
-      config, proto, export_consolidation(o, proto.size(), source.description, "sphere kernel"));
-  std::cerr << "demcal export: consolidated in " << state.steps << " steps, ";
-  print_consolidation_time(std::cerr, state.wall_time_s, state.from_cache);
-  std::cerr << "\n";
+  const TriaxialState state =
+      export_consolidated(o, config, proto, source.description, "sphere kernel");
   const ExportResult r = export_3d_decks(config, up, state, eo);
   write_deck(deck_fs, o, r, state.world.size(), "spheres");
   return 0;
@@ -240,12 +246,8 @@ int cmd_export(const ExportCmdOptions& o) {
                   std::to_string(law.exponent) + ")";
   eo.consolidate_in_deck = deck_consolidates(o, proto.size());
   if (!eo.consolidate_in_deck && !o.no_consolidate) {
-    const ConsolidationOptions co =
-        export_consolidation(o, proto.size(), source.description, "kernel");
-    const ConsolidatedState state = consolidate(config, proto, co);
-    std::cerr << "demcal export: consolidated in " << state.steps << " steps, ";
-    print_consolidation_time(std::cerr, state.wall_time_s, state.from_cache);
-    std::cerr << "\n";
+    const ConsolidatedState state =
+        export_consolidated(o, config, proto, source.description, "kernel");
     proto = assembly_of(state.world);
   }
   const ExportResult r = export_deck(config, up, proto, eo);

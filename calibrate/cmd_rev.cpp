@@ -17,6 +17,7 @@
 #include "demcal/scene/run_output.hpp"
 #include "demcal/scene/sphere_packing.hpp"
 #include "demcal/scene/triaxial.hpp"
+#include "demcal/scoring/trial.hpp"
 #include "demcal/upscaling/rev.hpp"
 #include "demcal/upscaling/rev_3d.hpp"
 #include "demcal/upscaling/upscaling.hpp"
@@ -33,8 +34,7 @@ struct RevOutcome {
   std::string method;
   std::string csv;
   int particles = 0;
-  int64_t steps = 0;
-  double wall_time_s = 0.0;
+  ConsolidationRecord consolidation;  ///< the REV's (a cache read's time when from_cache)
   Representativeness representativeness;
 };
 
@@ -58,8 +58,8 @@ RevOutcome rev_2d(const SceneConfig& config, const std::string& file, const RevO
             << ro.particles << " particles from " << source.description
             << ", consolidating it to sigma3\n";
   const RevResult r = make_rev(config, proto, ro);
-  return {r.method,      particle_csv(r.assembly), r.assembly.size(),
-          r.state.steps, r.state.wall_time_s,      r.representativeness};
+  return {r.method, particle_csv(r.assembly), r.assembly.size(), consolidation_record(r.state),
+          r.representativeness};
 }
 
 RevOutcome rev_3d(const SceneConfig& config, const std::string& file, const RevOptions& ro,
@@ -84,8 +84,8 @@ RevOutcome rev_3d(const SceneConfig& config, const std::string& file, const RevO
             << " REV of " << ro.particles << " spheres from " << source.description
             << ", consolidating it to sigma3\n";
   const SphereRevResult r = make_rev(config, proto, ro);
-  return {r.method,      sphere_csv(r.assembly), r.assembly.size(),
-          r.state.steps, r.state.wall_time_s,    r.representativeness};
+  return {r.method, sphere_csv(r.assembly), r.assembly.size(), consolidation_record(r.state),
+          r.representativeness};
 }
 
 }  // namespace
@@ -121,7 +121,7 @@ int cmd_rev(const RevCmdOptions& o) {
       {"method", r.method},
       {"prototype", {{"source", source.kind}, {"description", source.description}}},
       {"particles", r.particles},
-      {"consolidation", {{"steps", r.steps}, {"wall_time_s", r.wall_time_s}}},
+      {"consolidation", consolidation_json(r.consolidation)},
       {"representativeness", to_json(r.representativeness)}};
   out.write("rev.json", report.dump(2) + "\n");
   // A config that calibrates on the REV and upscales to the prototype.

@@ -4,6 +4,9 @@
 #include <iostream>
 #include <memory>
 #include <sstream>
+#include <string>
+
+#include "demcal/scene/consolidation_cache.hpp"
 
 namespace demcal::cli {
 
@@ -40,6 +43,26 @@ ConsolidationCallback consolidation_progress(double every_s) {
 void print_consolidation_time(std::ostream& out, double wall_time_s, bool from_cache) {
   if (from_cache) out << "read from the cache in ";
   out << wall_time_s << " s";
+}
+
+// The cache's entry point with a fresh consolidation ("" for its cache
+// folder: none) that announces itself: consolidate()'s state, bit for bit.
+ConsolidatedState consolidate_announced(const SceneConfig& config, const Assembly& assembly,
+                                        const ConsolidationOptions& options,
+                                        const std::function<void()>& announce) {
+  return consolidate_cached<ConsolidatedState>(consolidation_cache_dir(), config, assembly, [&] {
+    announce();
+    return consolidate(config, assembly, std::string(), options);
+  });
+}
+
+TriaxialState consolidate_announced(const SceneConfig& config, const SphereAssembly& assembly,
+                                    const ConsolidationOptions& options,
+                                    const std::function<void()>& announce) {
+  return consolidate_cached<TriaxialState>(consolidation_cache_dir(), config, assembly, [&] {
+    announce();
+    return consolidate_triaxial(config, assembly, std::string(), options);
+  });
 }
 
 }  // namespace demcal::cli

@@ -2,9 +2,12 @@
 // (2D and 3D): a consolidation never runs for minutes silently.
 #pragma once
 
+#include <functional>
 #include <ostream>
 
+#include "demcal/scene/biaxial.hpp"
 #include "demcal/scene/consolidation_progress.hpp"
+#include "demcal/scene/triaxial.hpp"
 
 namespace demcal::cli {
 
@@ -22,5 +25,16 @@ ConsolidationCallback consolidation_progress(double every_s = kProgressEverySeco
 /// cache, whose wall_time_s is the reading's (the consolidation's own is
 /// not kept), "read from the cache in 0.0265 s".
 void print_consolidation_time(std::ostream& out, double wall_time_s, bool from_cache);
+
+/// consolidate() (disks) or consolidate_triaxial() (spheres) through the
+/// consolidation cache of the environment, the same state, with
+/// `announce()` called first only when it consolidates afresh: a command's
+/// "consolidating ..." line is never printed before a cache read.
+ConsolidatedState consolidate_announced(const SceneConfig& config, const Assembly& assembly,
+                                        const ConsolidationOptions& options,
+                                        const std::function<void()>& announce);
+TriaxialState consolidate_announced(const SceneConfig& config, const SphereAssembly& assembly,
+                                    const ConsolidationOptions& options,
+                                    const std::function<void()>& announce);
 
 }  // namespace demcal::cli

@@ -774,6 +774,69 @@ TEST_F(CliEndToEnd, AConsolidationFromTheCacheIsSaidToBeRead) {
       << run.out;
 }
 
+// `demcal calibrate` says its consolidation as check, run, verify and export
+// do (print_consolidation_time): a fresh one's "(T s)", a cache read's
+// "(read from the cache in T s)" (it printed "(read from the consolidation
+// cache)" of its own, no time), and "consolidating ..." only before a
+// consolidation (it was printed before the cache read too). run.json's
+// flat consolidation_from_cache records it.
+TEST_F(CliEndToEnd, CalibrateSaysItsConsolidationAsTheOtherCommands) {
+  const std::string cache = "DEMCAL_CACHE_DIR=" + (dir_ / "cache").string();
+  auto calibrate = [&](const std::string& out) {
+    const Result r =
+        demcal({"calibrate", kHex5, "-o", out, "-j", "1", "--max-trials", "12"}, {cache});
+    EXPECT_EQ(r.status, 0) << r.err;
+    return r;
+  };
+  auto line_of = [](const std::string& text, const std::string& start) {
+    for (const std::string& line : lines_of(text))
+      if (line.rfind(start, 0) == 0) return line;
+    return std::string("no line ") + start;
+  };
+  const Result miss = calibrate("miss");
+  const Result hit = calibrate("hit");
+  const std::string consolidating = "demcal: consolidating 25 particles of hex_5x5";
+  EXPECT_EQ(line_of(miss.err, consolidating).rfind(consolidating, 0), 0u) << miss.err;
+  EXPECT_EQ(hit.err.find("demcal: consolidating"), std::string::npos) << hit.err;
+  const std::string fresh = line_of(miss.err, "demcal: consolidated in ");
+  const std::string read = line_of(hit.err, "demcal: consolidated in ");
+  const size_t open = fresh.find(" steps (");
+  ASSERT_NE(open, std::string::npos) << fresh;
+  // The same steps, then the fresh one's time, the cached one's reading.
+  const std::string steps = fresh.substr(0, open + 8);
+  EXPECT_EQ(fresh.find("cache"), std::string::npos) << fresh;
+  EXPECT_TRUE(std::isdigit(static_cast<unsigned char>(fresh[open + 8]))) << fresh;
+  EXPECT_EQ(fresh.substr(fresh.size() - 3), " s)") << fresh;
+  EXPECT_EQ(read.rfind(steps + "read from the cache in ", 0), 0u) << read;
+  EXPECT_EQ(read.substr(read.size() - 3), " s)") << read;
+  EXPECT_FALSE(
+      test::read_json(dir_ / "work" / "miss" / "run.json")["consolidation_from_cache"].get<bool>());
+  EXPECT_TRUE(
+      test::read_json(dir_ / "work" / "hit" / "run.json")["consolidation_from_cache"].get<bool>());
+}
+
+// `demcal rev`'s rev.json recorded the REV's consolidation (steps, wall
+// time) without saying that it was read from the cache: its "consolidation"
+// is consolidation_json's record, from_cache added, as in summary.json and
+// verify.json; the REV is the same either way.
+TEST_F(CliEndToEnd, RevRecordsAConsolidationFromTheCache) {
+  const std::string cache = "DEMCAL_CACHE_DIR=" + (dir_ / "cache").string();
+  for (const char* out : {"miss", "hit"}) {
+    const Result r = demcal({"rev", kHex5, "--particles", "25", "-o", out}, {cache});
+    ASSERT_EQ(r.status, 0) << r.err;
+  }
+  const auto fresh = test::read_json(dir_ / "work" / "miss" / "rev.json").at("consolidation");
+  const auto read = test::read_json(dir_ / "work" / "hit" / "rev.json").at("consolidation");
+  ASSERT_TRUE(fresh.contains("from_cache")) << fresh.dump();
+  EXPECT_FALSE(fresh["from_cache"].get<bool>());
+  EXPECT_TRUE(read.at("from_cache").get<bool>());
+  EXPECT_GT(fresh.at("steps").get<int64_t>(), 0);
+  EXPECT_EQ(read.at("steps"), fresh.at("steps"));
+  EXPECT_TRUE(read.contains("wall_time_s"));
+  EXPECT_EQ(read_text(dir_ / "work" / "hit" / "rev.csv"),
+            read_text(dir_ / "work" / "miss" / "rev.csv"));
+}
+
 // `demcal export` says how the deck's Nstep was upscaled, 2D and 3D in
 // one line: the prototype's Nstep (the one `demcal upscale` writes), from
 // the REV's particles and steps, by which law (the 2D export said nothing).

@@ -357,13 +357,20 @@ TEST(ScalingStudy, ACountInAStoredSizeThatIsNoCountIsNamed) {
   r.calibrated = true;
   r.best = sample_params();
   r.trials = 30;
-  r.consolidation_steps = 4000;
+  r.consolidation.steps = 4000;
   r.fixed.found = true;
   r.fixed.steps = 12345;
   r.fixed.best = sample_trial();
   r.fixed.trials = {sample_trial()};
+  r.consolidation.wall_time_s = 0.5;
+  r.consolidation.from_cache = true;
   const json good = to_json(r);
   ASSERT_NO_THROW(scaling_size_from_json(good, "result.json"));
+  // The consolidation's record reads back whole (a resumed study's sizes).
+  const ScalingSize back = scaling_size_from_json(good, "result.json");
+  EXPECT_EQ(back.consolidation.steps, 4000);
+  EXPECT_EQ(back.consolidation.wall_time_s, 0.5);
+  EXPECT_TRUE(back.consolidation.from_cache);
   const std::vector<std::pair<std::string, std::string>> counts = {
       {"/requested", "requested"},
       {"/particles", "particles"},

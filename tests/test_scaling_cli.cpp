@@ -249,6 +249,65 @@ TEST_F(ScalingCli, ARefusedStudyWritesNothing) {
   ::close(fd);
 }
 
+// A size's consolidation read from the consolidation cache was recorded in
+// scaling.json as if consolidated (consolidation_wall_time_s, the reading's,
+// unlabelled), and the log said "consolidating" before the read: each size
+// now records consolidation_json's record flat (consolidation_steps,
+// consolidation_wall_time_s, consolidation_from_cache), a cache read's log
+// line says so, and the study is otherwise the same (wall times apart).
+TEST_F(ScalingCli, AConsolidationFromTheCacheIsLabelledInScalingJson) {
+  const std::string cache = "DEMCAL_CACHE_DIR=" + (dir_ / "cache").string();
+  auto study = [&](const std::string& out) {
+    const Result r = demcal::test::run_program(
+        "/usr/bin/env",
+        {cache, demcal::test::kDemcalBinary, "scaling", kHex5, "--sizes", "16,25,36",
+         "--calibrate-max", "25", "-j", "1", "--max-trials", "12", "-o", out},
+        work());
+    EXPECT_TRUE(r.status == 0 || r.status == 1) << r.err;  // 1: the forward check
+    return r;
+  };
+  const Result miss = study("miss");
+  const Result hit = study("hit");
+  nlohmann::json fresh = demcal::test::read_json(work() / "miss" / "scaling.json");
+  nlohmann::json read = demcal::test::read_json(work() / "hit" / "scaling.json");
+  ASSERT_EQ(fresh.at("results").size(), 3u);
+  ASSERT_EQ(read.at("results").size(), 3u);
+  for (size_t i = 0; i < 3; ++i) {
+    nlohmann::json& f = fresh["results"][i];
+    nlohmann::json& r = read["results"][i];
+    SCOPED_TRACE(f.at("requested").dump());
+    ASSERT_TRUE(f.contains("consolidation_from_cache")) << f.dump(1);
+    ASSERT_TRUE(r.contains("consolidation_from_cache")) << r.dump(1);
+    // The calibrated sizes (16, 25) record their consolidation.
+    const bool calibrated = f.at("calibrated").get<bool>();
+    EXPECT_EQ(calibrated, i < 2);
+    EXPECT_FALSE(f["consolidation_from_cache"].get<bool>());
+    EXPECT_EQ(r["consolidation_from_cache"].get<bool>(), calibrated);
+    if (calibrated) {
+      EXPECT_GT(f.at("consolidation_steps").get<int64_t>(), 0);
+    }
+    EXPECT_EQ(r.at("consolidation_steps"), f.at("consolidation_steps"));
+    EXPECT_TRUE(r.contains("consolidation_wall_time_s"));
+    f.erase("consolidation_from_cache");
+    r.erase("consolidation_from_cache");
+  }
+  EXPECT_EQ(without_timing(read), without_timing(fresh));
+  // stderr: a fresh size's "consolidating ..." and "  consolidated in N
+  // steps, T s"; a read one's "size 16: consolidated in N steps, read from
+  // the cache in T s", no "consolidating".
+  EXPECT_NE(miss.err.find("demcal scaling: consolidating 16 particles (size 16)\n"),
+            std::string::npos)
+      << miss.err;
+  EXPECT_EQ(miss.err.find("cache"), std::string::npos) << miss.err;
+  EXPECT_EQ(hit.err.find("consolidating"), std::string::npos) << hit.err;
+  const std::string steps =
+      std::to_string(fresh["results"][0]["consolidation_steps"].get<int64_t>());
+  EXPECT_NE(hit.err.find("demcal scaling: size 16: consolidated in " + steps +
+                         " steps, read from the cache in "),
+            std::string::npos)
+      << hit.err;
+}
+
 // SIGINT during a size's calibration: exit 130, the sizes finished before
 // kept, the size's finished trials kept, no scaling.json, the resume command
 // on stderr. --resume reruns no finished trial and writes the uninterrupted

@@ -347,5 +347,44 @@ TEST(Sweep, CommandSaysItsConsolidationTimeAsTheOtherCommands) {
   EXPECT_NE(read.find(" s); "), std::string::npos) << read;
 }
 
+// atlas.json and atlas.md say where the sweep's consolidation came from:
+// atlas.json's "consolidation" block is consolidation_json's record (steps,
+// wall_time_s, from_cache; consolidation_time_s kept), atlas.md's last line
+// "(consolidation read from the cache in T s, once)" for a cache read (both
+// recorded the reading's time as the consolidation's, unlabelled).
+TEST(Sweep, AtlasRecordsAConsolidationFromTheCache) {
+  const test::TempDir tmp("sweepatlascache");
+  auto sweep = [&](const char* out) {
+    const test::RunResult r =
+        test::run_program("/usr/bin/env",
+                          {"DEMCAL_CACHE_DIR=" + (tmp / "cache").string(), test::kDemcalBinary,
+                           "sweep", test::shipped_config("hex_5x5"), "--set",
+                           "algorithm.steps=2000", "--jobs", "2", "-o", (tmp / out).string()},
+                          tmp.path());
+    EXPECT_EQ(r.status, 0) << r.err;
+  };
+  sweep("miss");
+  sweep("hit");
+  const nlohmann::json fresh = test::read_json(tmp / "miss" / "atlas.json");
+  const nlohmann::json read = test::read_json(tmp / "hit" / "atlas.json");
+  ASSERT_TRUE(fresh.contains("consolidation")) << fresh.dump(1).substr(0, 2000);
+  EXPECT_FALSE(fresh["consolidation"].at("from_cache").get<bool>());
+  EXPECT_TRUE(read.at("consolidation").at("from_cache").get<bool>());
+  EXPECT_GT(fresh["consolidation"].at("steps").get<int64_t>(), 0);
+  EXPECT_EQ(read["consolidation"]["steps"], fresh["consolidation"]["steps"]);
+  for (const nlohmann::json* j : {&fresh, &read})
+    EXPECT_EQ(j->at("consolidation_time_s"), j->at("consolidation").at("wall_time_s"));
+  auto last_line = [&](const char* out) {
+    const std::vector<std::string> lines = test::lines_of(test::read_text(tmp / out / "atlas.md"));
+    return lines.empty() ? std::string() : lines.back();
+  };
+  const std::string fresh_md = last_line("miss"), read_md = last_line("hit");
+  EXPECT_NE(fresh_md.find(" threads (consolidation "), std::string::npos) << fresh_md;
+  EXPECT_EQ(fresh_md.find("cache"), std::string::npos) << fresh_md;
+  EXPECT_NE(read_md.find(" threads (consolidation read from the cache in "), std::string::npos)
+      << read_md;
+  EXPECT_NE(read_md.find(" s, once)."), std::string::npos) << read_md;
+}
+
 }  // namespace
 }  // namespace demcal

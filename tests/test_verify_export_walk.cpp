@@ -114,6 +114,44 @@ TEST(VerifyExportWalk, AConsolidationFromTheCacheIsLabelledAndRecorded) {
       << exported.err;
 }
 
+// `demcal export` printed "consolidating the prototype (...) to sigma3 ...,
+// single-threaded" before it found the state in the consolidation cache:
+// now that line comes only before a consolidation, 2D and 3D (--consolidate-in
+// demcal), and a cache read's line says it was read (print_consolidation_time).
+TEST(VerifyExportWalk, ExportSaysConsolidatingOnlyWhenItConsolidates) {
+  const test::TempDir dir("walk_export_cache");
+  const std::string cache = "DEMCAL_CACHE_DIR=" + (dir / "cache").string();
+  struct Case {
+    std::string scene, particles;
+  };
+  for (const Case& c : {Case{"hex_10x10", "25"}, Case{"fcc_4x4x4", "32"}}) {
+    SCOPED_TRACE(c.scene);
+    auto exported = [&](const std::string& deck) {
+      const test::RunResult r = demcal_with({cache},
+                                            {"export", example_params(c.scene), "--particles",
+                                             c.particles, "--consolidate-in", "demcal", "-o", deck},
+                                            dir.path());
+      EXPECT_EQ(r.status, 0) << r.err;
+      return r;
+    };
+    const test::RunResult miss = exported(c.scene + "-miss.lammps");
+    const test::RunResult hit = exported(c.scene + "-hit.lammps");
+    const std::string consolidating = "demcal export: consolidating the prototype (";
+    EXPECT_TRUE(contains(miss.err, consolidating)) << miss.err;
+    EXPECT_FALSE(contains(hit.err, consolidating)) << hit.err;
+    EXPECT_FALSE(contains(hit.err, "single-threaded")) << hit.err;
+    const std::string fresh = line_of(miss.err, "demcal export: consolidated in ");
+    const std::string read = line_of(hit.err, "demcal export: consolidated in ");
+    EXPECT_FALSE(contains(fresh, "cache")) << fresh;
+    const size_t comma = fresh.find(" steps, ");
+    ASSERT_NE(comma, std::string::npos) << fresh;
+    EXPECT_EQ(read.rfind(fresh.substr(0, comma + 8) + "read from the cache in ", 0), 0u) << read;
+    // The consolidated prototype (the deck's data file) is the same either way.
+    EXPECT_TRUE(test::read_text(dir / (c.scene + "-hit.lammps.data")) ==
+                test::read_text(dir / (c.scene + "-miss.lammps.data")));
+  }
+}
+
 // `verify --engine lammps --allow-failed` ran a deck whose header did not
 // say that its parameters are not certified, which `export --allow-failed`
 // writes (deck_sections.cpp's header_opening, from params.json's success and

@@ -355,14 +355,14 @@ SweepRun sweep_run(const Run& run, std::string series) {
 
 /// What a sweep records of its scene and sample, disks and spheres alike.
 SweepResult sweep_of(const SceneConfig& config, int dimension, int particles,
-                     double consolidation_time_s) {
+                     const ConsolidationRecord& consolidation) {
   SweepResult res;
   res.scene = config.name;
   res.dimension = dimension;
   res.particles = particles;
   res.benchmark = config.algorithm;
   res.lateral_stress = config.test.lateral_stress;
-  res.consolidation_time_s = consolidation_time_s;
+  res.consolidation = consolidation;
   return res;
 }
 
@@ -383,7 +383,7 @@ SeriesMetadata sweep_metadata(const SceneConfig& config, const Run& run) {
 
 SweepResult run_sweep(const SceneConfig& config, const ConsolidatedState& state,
                       const std::vector<SweepCase>& cases, const SweepSettings& settings) {
-  SweepResult res = sweep_of(config, 2, state.world.size(), state.wall_time_s);
+  SweepResult res = sweep_of(config, 2, state.world.size(), consolidation_record(state));
   res.analytical_peak = analytical_peak_stress(config);
   res.alpha_stable = state.world.stability_estimate().dt_ratio_stable;
   const double s3 = config.test.lateral_stress;
@@ -399,7 +399,7 @@ SweepResult run_sweep(const SceneConfig& config, const ConsolidatedState& state,
 
 SweepResult run_sweep(const SceneConfig& config, const TriaxialState& state,
                       const std::vector<SweepCase>& cases, const SweepSettings& settings) {
-  SweepResult res = sweep_of(config, 3, state.world.size(), state.wall_time_s);
+  SweepResult res = sweep_of(config, 3, state.world.size(), consolidation_record(state));
   const double s3 = config.test.lateral_stress;
   if (const auto ratio = analytical_peak_ratio_3d(config)) res.analytical_peak = -*ratio * s3;
   res.alpha_stable = estimated_stable_dt_ratio(state, config.algorithm);
@@ -490,7 +490,8 @@ nlohmann::json to_json(const SweepResult& res) {
          {"worst_paper_form_error", res.worst_paper_form_error},
          {"evidence", evidence},
          {"cases", cases},
-         {"consolidation_time_s", res.consolidation_time_s},
+         {"consolidation", consolidation_json(res.consolidation)},
+         {"consolidation_time_s", res.consolidation.wall_time_s},
          {"wall_time_s", res.wall_time_s},
          {"jobs", res.jobs}};
   if (res.analytical_peak)
@@ -657,7 +658,9 @@ std::string atlas_markdown(const SweepResult& res) {
        << "): " << r.score.diagnosis.message << "\n";
   }
   md << "\nSweep wall time " << fixed(res.wall_time_s, 1) << " s on " << res.jobs
-     << " threads (consolidation " << fixed(res.consolidation_time_s, 1) << " s, once).\n";
+     << " threads (consolidation "
+     << (res.consolidation.from_cache ? "read from the cache in " : "")
+     << fixed(res.consolidation.wall_time_s, 1) << " s, once).\n";
   return md.str();
 }
 

@@ -13,6 +13,7 @@
 #include "demcal/io/files.hpp"
 #include "demcal/io/format.hpp"
 #include "demcal/io/json_integer.hpp"
+#include "demcal/scene/consolidation_cache.hpp"
 #include "demcal/scene/packing.hpp"
 #include "demcal/scene/run_output.hpp"
 #include "demcal/scene/triaxial.hpp"
@@ -46,11 +47,10 @@ std::vector<int64_t> parse_sizes(const std::string& text, const std::string& opt
 }
 
 json to_json(const ScalingSize& r) {
-  json j{{"requested", r.requested},
-         {"particles", r.particles},
-         {"calibrated", r.calibrated},
-         {"consolidation_steps", r.consolidation_steps},
-         {"consolidation_wall_time_s", r.consolidation_s}};
+  json j{{"requested", r.requested}, {"particles", r.particles}, {"calibrated", r.calibrated}};
+  // consolidation_json's record, each key prefixed "consolidation_".
+  const json consolidation = consolidation_json(r.consolidation);
+  for (const auto& item : consolidation.items()) j["consolidation_" + item.key()] = item.value();
   if (r.calibrated)
     j.update({{"success", r.success},
               {"best", to_json(r.best)},
@@ -85,8 +85,9 @@ ScalingSize scaling_size_from_json(const json& j, const std::string& source) {
     r.particles = count(j, "particles", 1, kMaxParticles);
     r.calibrated = j.at("calibrated").get<bool>();
     if (j.contains("consolidation_steps"))
-      r.consolidation_steps = count(j, "consolidation_steps", 0, kAny);
-    r.consolidation_s = j.value("consolidation_wall_time_s", 0.0);
+      r.consolidation.steps = count(j, "consolidation_steps", 0, kAny);
+    r.consolidation.wall_time_s = j.value("consolidation_wall_time_s", 0.0);
+    r.consolidation.from_cache = j.value("consolidation_from_cache", false);
     if (r.calibrated) {
       r.success = j.at("success").get<bool>();
       r.best = algorithm_from_json(j.at("best"), source, "best");
@@ -167,8 +168,8 @@ struct SizeState {
   std::optional<ConsolidatedState> disks;
   std::optional<TriaxialState> spheres;
   std::unique_ptr<TrialRunner> runner;
-  int64_t particles = 0, steps = 0;
-  double wall_time_s = 0.0;
+  int64_t particles = 0;
+  ConsolidationRecord consolidation;
 };
 
 /// The family of scenes and their consolidated states, 2D or 3D. A 2D size
@@ -207,14 +208,18 @@ class Family {
     ConsolidationOptions consolidation;
     if (o_.stop)
       consolidation.progress = [this](const ConsolidationProgress&) { throw_if_stopped(o_); };
+    // consolidate() and consolidate_triaxial() through the cache, "consolidating"
+    // said only when it consolidates (not before a cache read).
+    const std::string cache = consolidation_cache_dir();
     if (config_.dimension == 3) {
       const SphereAssembly a = make_sphere_assembly(st->scene);
-      log("consolidating " + std::to_string(a.size()) + " spheres (size " + std::to_string(n) +
-          ")");
-      st->spheres.emplace(consolidate_triaxial(st->scene, a, consolidation));
+      st->spheres.emplace(consolidate_cached<TriaxialState>(cache, st->scene, a, [&] {
+        log("consolidating " + std::to_string(a.size()) + " spheres (size " + std::to_string(n) +
+            ")");
+        return consolidate_triaxial(st->scene, a, std::string(), consolidation);
+      }));
       st->runner = std::make_unique<TriaxialRunner>(st->scene, *st->spheres);
-      st->steps = st->spheres->steps;
-      st->wall_time_s = st->spheres->wall_time_s;
+      st->consolidation = consolidation_record(*st->spheres);
     } else {
       // A resumed study consolidates the same assembly again: the
       // consolidation cache (DEMCAL_CACHE_DIR) returns the exact state, or
@@ -224,12 +229,13 @@ class Family {
       // uninterrupted study's.) consolidated.csv stays an output: the
       // forward size's sample, e.g. a prototype for `demcal verify`.
       const Assembly a = from_file_ ? cut_rev(file_prototype_, n) : make_assembly(st->scene);
-      log("consolidating " + std::to_string(a.size()) + " particles (size " + std::to_string(n) +
-          ")");
-      st->disks.emplace(consolidate(st->scene, a, consolidation));
+      st->disks.emplace(consolidate_cached<ConsolidatedState>(cache, st->scene, a, [&] {
+        log("consolidating " + std::to_string(a.size()) + " particles (size " + std::to_string(n) +
+            ")");
+        return consolidate(st->scene, a, std::string(), consolidation);
+      }));
       st->runner = std::make_unique<BiaxialRunner>(st->scene, *st->disks);
-      st->steps = st->disks->steps;
-      st->wall_time_s = st->disks->wall_time_s;
+      st->consolidation = consolidation_record(*st->disks);
       if (n > o_.calibrate_max) {
         make_output_dir(dir(n));
         write_file_atomic(dir(n) + "/consolidated.csv",
@@ -237,8 +243,13 @@ class Family {
       }
     }
     st->particles = st->runner->particles();
-    log("  consolidated in " + std::to_string(st->steps) + " steps, " + num(st->wall_time_s, 3) +
-        " s");
+    // A cache read's time is the reading's: said so, as the commands say it
+    // (print_consolidation_time, calibrate/), on a line that names the size
+    // (no "consolidating" line came before it).
+    log((st->consolidation.from_cache ? "size " + std::to_string(n) + ": " : std::string("  ")) +
+        "consolidated in " + std::to_string(st->consolidation.steps) + " steps, " +
+        (st->consolidation.from_cache ? "read from the cache in " : "") +
+        num(st->consolidation.wall_time_s, 3) + " s");
     return *states_.emplace(n, std::move(st)).first->second;
   }
   /// Calibrate size n with the search of its dimension.
@@ -274,8 +285,7 @@ std::optional<ScalingSize> calibrate_size(Family& family, const SceneConfig& con
   ScalingSize r;
   r.requested = n;
   r.particles = state.particles;
-  r.consolidation_steps = state.steps;
-  r.consolidation_s = state.wall_time_s;
+  r.consolidation = state.consolidation;
   CalibrationOptions co = CalibrationOptions::from(config);
   co.jobs = o.jobs;
   co.trials_path = family.dir(n) + "/trials.jsonl";

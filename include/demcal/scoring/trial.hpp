@@ -3,6 +3,7 @@
 // sweep and the calibration.
 #pragma once
 
+#include <cstdint>
 #include <nlohmann/json.hpp>
 #include <optional>
 
@@ -47,7 +48,8 @@ nlohmann::json run_account_json(const AlgorithmSpec& algorithm, const LoadingRun
 
 /// A consolidation's record, 2D and 3D alike, in summary.json (`demcal
 /// run`, the "consolidation" block; a 3D run's adds the state's stress error,
-/// unbalanced-force ratio and box) and verify.json: steps, wall_time_s,
+/// unbalanced-force ratio and box), verify.json and atlas.json (`demcal
+/// sweep`; scaling.json's sizes flatten it: consolidation_steps, ...): steps, wall_time_s,
 /// from_cache. Read from the consolidation cache, the steps are those the
 /// consolidation took and the wall time is the reading's. `State` is a
 /// ConsolidatedState or a TriaxialState. (A calibration's run.json keeps its
@@ -56,6 +58,19 @@ template <class State>
 nlohmann::json consolidation_json(const State& state) {
   return {
       {"steps", state.steps}, {"wall_time_s", state.wall_time_s}, {"from_cache", state.from_cache}};
+}
+
+/// A consolidation's record kept past its state (the scaling study's sizes,
+/// the sweep): consolidation_json's fields, and consolidation_json of it
+/// gives the same JSON as of the state.
+struct ConsolidationRecord {
+  int64_t steps = 0;
+  double wall_time_s = 0.0;
+  bool from_cache = false;
+};
+template <class State>
+ConsolidationRecord consolidation_record(const State& state) {
+  return {state.steps, state.wall_time_s, state.from_cache};
 }
 
 /// summary.json of a run (`demcal run`, README.md "Commands").

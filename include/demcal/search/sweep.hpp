@@ -19,6 +19,7 @@
 #include "demcal/scene/config.hpp"
 #include "demcal/scene/triaxial.hpp"
 #include "demcal/scoring/scoring.hpp"
+#include "demcal/scoring/trial.hpp"
 #include "demcal/scoring/triaxial_scoring.hpp"
 
 namespace demcal {
@@ -124,7 +125,8 @@ struct SweepResult {
   int false_rejects = 0;  ///< accurate but failed a criterion
   double accuracy = 0.02;
   Tolerances tolerances;
-  double consolidation_time_s = 0.0;
+  /// The one consolidation (steps, wall time: a cache read's when from_cache).
+  ConsolidationRecord consolidation;
   double wall_time_s = 0.0;
   int jobs = 1;
 };
@@ -143,10 +145,13 @@ SweepResult run_sweep(const SceneConfig& config, const TriaxialState& state,
 ConvergedReference converged_reference(std::vector<std::pair<int64_t, double>> peaks,
                                        double tolerance = 0.005);
 
+/// atlas.json; its consolidation as consolidation_json records it (the
+/// "consolidation" block), its wall time also as consolidation_time_s.
 nlohmann::json to_json(const SweepResult& result);
 /// atlas.md: the table (case, measures, peak vs reference, diagnosis), the
 /// reference ladder and the tolerance evidence; in 3D with the per-plane
-/// columns (force balance x, y, z; moment balance xz, yz, xy; servo per wall).
+/// columns (force balance x, y, z; moment balance xz, yz, xy; servo per wall);
+/// the consolidation's time, labelled when read from the cache.
 std::string atlas_markdown(const SweepResult& result);
 /// One row per finished case, every measure and the peak error (for plots);
 /// in 3D the per-plane measures follow.

@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "demcal/scene/config.hpp"
+#include "demcal/scoring/trial.hpp"
 #include "demcal/search/calibration.hpp"
 #include "demcal/upscaling/upscaling.hpp"
 
@@ -68,12 +69,16 @@ struct ScalingSize {
   AlgorithmSpec best;
   double richardson = 0.0, peak = 0.0;
   int trials = 0;
-  double wall_time_s = 0.0, consolidation_s = 0.0;
-  int64_t consolidation_steps = 0;
+  double wall_time_s = 0.0;
+  /// A calibrated size's consolidation (steps, wall time: a cache read's
+  /// when from_cache).
+  ConsolidationRecord consolidation;
   FixedMultipliers fixed;
 };
 /// A size as scaling.json records it (and as result.json stores a
-/// calibrated size for resume), and back; errors name `source`.
+/// calibrated size for resume), and back; errors name `source`. Its
+/// consolidation is consolidation_json's record, flat: consolidation_steps,
+/// consolidation_wall_time_s, consolidation_from_cache.
 nlohmann::json to_json(const ScalingSize& size);
 ScalingSize scaling_size_from_json(const nlohmann::json& json, const std::string& source);
 
