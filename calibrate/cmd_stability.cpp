@@ -5,6 +5,7 @@
 #include <iostream>
 
 #include "commands.hpp"
+#include "consolidation_progress.hpp"
 #include "demcal/io/files.hpp"
 #include "demcal/scene/biaxial.hpp"
 #include "demcal/scene/packing.hpp"
@@ -22,19 +23,27 @@ int cmd_stability(const StabilityOptions& o) {
   const std::string dir = o.out_dir.empty() ? "demcal-stability-" + config.name : o.out_dir;
   OutputFolder::check(dir);  // an unwritable -o fails now, not after the scan
 
+  // The REV consolidated, said as the other commands say it: "consolidating
+  // ..." only when it consolidates, not before a read from the cache
+  // (consolidate_announced), then its steps and time
+  // (print_consolidation_time: a cache read's labelled).
+  auto consolidated = [&](const auto& assembly, const char* what) {
+    const auto state = consolidate_announced(config, assembly, {}, [&] {
+      std::cerr << "stability " << config.name << ": consolidating " << assembly.size() << " "
+                << what << "\n";
+    });
+    std::cerr << "stability " << config.name << ": consolidated in " << state.steps << " steps, ";
+    print_consolidation_time(std::cerr, state.wall_time_s, state.from_cache);
+    std::cerr << "\n";
+    return state;
+  };
   const StabilityScanOptions& options = o.scan;
   StabilityScanResult r;
-  if (config.dimension == 3) {
-    const SphereAssembly assembly = make_sphere_assembly(config);
-    std::cerr << "stability " << config.name << ": consolidating " << assembly.size()
-              << " spheres (3D, triaxial)\n";
-    r = stability_scan(config, consolidate_triaxial(config, assembly), options);
-  } else {
-    Assembly assembly = make_assembly(config);
-    std::cerr << "stability " << config.name << ": consolidating " << assembly.size()
-              << " particles\n";
-    r = stability_scan(config, consolidate(config, assembly), options);
-  }
+  if (config.dimension == 3)
+    r = stability_scan(config, consolidated(make_sphere_assembly(config), "spheres (3D, triaxial)"),
+                       options);
+  else
+    r = stability_scan(config, consolidated(make_assembly(config), "particles"), options);
 
   nlohmann::json j = to_json(r);
   j["scene"] = config.name;
