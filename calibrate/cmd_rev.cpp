@@ -12,6 +12,7 @@
 #include <iostream>
 
 #include "commands.hpp"
+#include "consolidation_progress.hpp"
 #include "demcal/io/files.hpp"
 #include "demcal/scene/biaxial.hpp"
 #include "demcal/scene/run_output.hpp"
@@ -38,6 +39,23 @@ struct RevOutcome {
   Representativeness representativeness;
 };
 
+// A consolidation (the prototype's or the REV's, disks or spheres) as the
+// other commands say it: `announce` ("consolidating ...") only when it
+// consolidates, not before a read from the cache (consolidate_announced),
+// then its steps and time (print_consolidation_time: a cache read's
+// labelled).
+template <class AnyAssembly>
+auto said_consolidation(const SceneConfig& config, const AnyAssembly& assembly, const char* what,
+                        const std::function<void()>& announce) {
+  const auto state = consolidate_announced(config, assembly, {}, announce);
+  std::cerr << "demcal rev: consolidated " << what << " in " << state.steps << " steps, ";
+  print_consolidation_time(std::cerr, state.wall_time_s, state.from_cache);
+  std::cerr << "\n";
+  return state;
+}
+
+void announce_rev() { std::cerr << "demcal rev: consolidating the REV to sigma3\n"; }
+
 // `ready` is called once the prototype is read and checked, before any
 // consolidation (it checks the output folder).
 RevOutcome rev_2d(const SceneConfig& config, const std::string& file, const RevOptions& ro,
@@ -48,16 +66,16 @@ RevOutcome rev_2d(const SceneConfig& config, const std::string& file, const RevO
                      "names no prototype: give prototype.file or prototype.particles, or "
                      "--prototype FILE");
   ready();
-  if (!proto.dense) {
-    // A generated gas is no packing to cut from or compare with.
-    std::cerr << "demcal rev: consolidating the prototype first (" << source.description
-              << "): a loose gas takes long\n";
-    proto = assembly_of(consolidate(config, proto).world);
-  }
+  if (!proto.dense)  // a generated gas is no packing to cut from or compare with
+    proto = assembly_of(said_consolidation(config, proto, "the prototype", [&] {
+                          std::cerr << "demcal rev: consolidating the prototype first ("
+                                    << source.description << "): a loose gas takes long\n";
+                        }).world);
   std::cerr << "demcal rev: " << (ro.method == "cut" ? "cutting" : "generating") << " a REV of "
-            << ro.particles << " particles from " << source.description
-            << ", consolidating it to sigma3\n";
-  const RevResult r = make_rev(config, proto, ro);
+            << ro.particles << " particles from " << source.description << "\n";
+  const RevResult r = make_rev(proto, ro, [&](const Assembly& raw) {
+    return said_consolidation(config, raw, "the REV", announce_rev);
+  });
   return {r.method, particle_csv(r.assembly), r.assembly.size(), consolidation_record(r.state),
           r.representativeness};
 }
@@ -74,16 +92,16 @@ RevOutcome rev_3d(const SceneConfig& config, const std::string& file, const RevO
                      "asked for a REV of " + std::to_string(ro.particles) +
                          " spheres, the prototype has only " + std::to_string(proto.size()));
   ready();
-  if (source.kind == "generated") {
-    // A generated gas is no packing to cut from or compare with.
-    std::cerr << "demcal rev: consolidating the prototype first (" << source.description
-              << "): a loose gas takes long\n";
-    proto = sphere_assembly_of(consolidate_triaxial(config, proto).world);
-  }
+  if (source.kind == "generated")  // a generated gas is no packing to cut from or compare with
+    proto = sphere_assembly_of(said_consolidation(config, proto, "the prototype", [&] {
+                                 std::cerr << "demcal rev: consolidating the prototype first ("
+                                           << source.description << "): a loose gas takes long\n";
+                               }).world);
   std::cerr << "demcal rev: " << (ro.method == "cut" ? "cutting a box" : "generating a")
-            << " REV of " << ro.particles << " spheres from " << source.description
-            << ", consolidating it to sigma3\n";
-  const SphereRevResult r = make_rev(config, proto, ro);
+            << " REV of " << ro.particles << " spheres from " << source.description << "\n";
+  const SphereRevResult r = make_rev(proto, ro, [&](const SphereAssembly& raw) {
+    return said_consolidation(config, raw, "the REV", announce_rev);
+  });
   return {r.method, sphere_csv(r.assembly), r.assembly.size(), consolidation_record(r.state),
           r.representativeness};
 }

@@ -505,11 +505,16 @@ Assembly assembly_of(const World& world) {
 }
 
 RevResult make_rev(const SceneConfig& config, const Assembly& prototype, const RevOptions& o) {
+  return make_rev(prototype, o, [&](const Assembly& raw) { return consolidate(config, raw); });
+}
+
+RevResult make_rev(const Assembly& prototype, const RevOptions& o,
+                   const std::function<ConsolidatedState(const Assembly&)>& consolidated) {
   if (o.method != "cut" && o.method != "generate")
     throw InputError("REV", "method", "must be cut or generate, got \"" + o.method + "\"");
   Assembly raw = o.method == "cut" ? cut_rev(prototype, o.particles, o.aspect)
                                    : generate_rev(prototype, o.particles, o.seed);
-  RevResult out{o.method, {}, consolidate(config, raw), {}};
+  RevResult out{o.method, {}, consolidated(raw), {}};
   out.assembly = assembly_of(out.state.world);
   out.representativeness = compare(packing_stats(out.state.world), packing_stats(prototype),
                                    out.assembly.r, prototype.r);

@@ -83,11 +83,17 @@ SphereAssembly sphere_assembly_of(const SphereWorld& world) {
 
 SphereRevResult make_rev(const SceneConfig& config, const SphereAssembly& prototype,
                          const RevOptions& o) {
+  return make_rev(prototype, o,
+                  [&](const SphereAssembly& raw) { return consolidate_triaxial(config, raw); });
+}
+
+SphereRevResult make_rev(const SphereAssembly& prototype, const RevOptions& o,
+                         const std::function<TriaxialState(const SphereAssembly&)>& consolidated) {
   if (o.method != "cut" && o.method != "generate")
     throw InputError("REV", "method", "must be cut or generate, got \"" + o.method + "\"");
   const SphereAssembly raw = o.method == "cut" ? cut_rev(prototype, o.particles, o.aspect)
                                                : generate_rev(prototype, o.particles, o.seed);
-  SphereRevResult out{o.method, {}, consolidate_triaxial(config, raw), {}};
+  SphereRevResult out{o.method, {}, consolidated(raw), {}};
   out.assembly = sphere_assembly_of(out.state.world);
   out.representativeness = compare(packing_stats(out.state.world), packing_stats(prototype),
                                    out.assembly.r, prototype.r);

@@ -16,6 +16,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <span>
 #include <string>
@@ -112,6 +113,11 @@ struct RevResult {
 /// Cut or generate, consolidate to σ3 with the config's material and test,
 /// and compare with the prototype.
 RevResult make_rev(const SceneConfig& config, const Assembly& prototype, const RevOptions& options);
+/// The same with the consolidation `consolidated(raw)` in place of
+/// consolidate(config, raw) (it must give that state: `demcal rev`'s says
+/// "consolidating ..." only when it consolidates, not before a cache read).
+RevResult make_rev(const Assembly& prototype, const RevOptions& options,
+                   const std::function<ConsolidatedState(const Assembly&)>& consolidated);
 
 /// `nx`×`ny` copies of a packing, every other copy mirrored, so that the
 /// disks along a seam meet their own mirror images (a seam is in contact,

@@ -8,6 +8,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -60,6 +61,10 @@ struct SphereRevResult {
 /// (consolidate_triaxial), and compare with the prototype (compare).
 SphereRevResult make_rev(const SceneConfig& config, const SphereAssembly& prototype,
                          const RevOptions& options);
+/// The same with the consolidation `consolidated(raw)` in place of
+/// consolidate_triaxial(config, raw) (it must give that state).
+SphereRevResult make_rev(const SphereAssembly& prototype, const RevOptions& options,
+                         const std::function<TriaxialState(const SphereAssembly&)>& consolidated);
 
 /// A sphere world state as an assembly (positions, radii, walls).
 SphereAssembly sphere_assembly_of(const SphereWorld& world);
