@@ -18,6 +18,7 @@
 #include <thread>
 
 #include "commands.hpp"
+#include "consolidation_progress.hpp"
 #include "demcal/io/files.hpp"
 #include "demcal/io/format.hpp"
 #include "demcal/scene/biaxial.hpp"
@@ -304,11 +305,7 @@ int verify_3d(const VerifyOptions& o, const nlohmann::json& params, const RevPar
   std::cerr << "demcal verify: loading = " << particle_steps << " particle-steps, estimated "
             << estimate_s / 60.0 << " min at " << rate
             << " particle-steps/s (measured now on the prototype, " << threads
-            << " thread(s); plus a single-thread consolidation"
-            << (source.kind == "generated" && config.assembly.type == "random"
-                    ? ", long for a loose gas)"
-                    : ")")
-            << "\n";
+            << " thread(s); plus the consolidation)\n";
   if (estimate_s > 60.0 * o.max_minutes)
     throw InputError("--max-minutes", "",
                      "the loading of " + std::to_string(n) + " spheres over " +
@@ -319,7 +316,14 @@ int verify_3d(const VerifyOptions& o, const nlohmann::json& params, const RevPar
   OutputFolder::check(dir);
 
   const auto t0 = std::chrono::steady_clock::now();
-  TriaxialState state = consolidate_triaxial(config, proto);
+  // "consolidating ..." only before a consolidation, not before a read
+  // from the cache (consolidate_announced).
+  TriaxialState state = consolidate_announced(config, proto, {}, [&] {
+    std::cerr << "demcal verify: consolidating the prototype (single-threaded"
+              << (source.kind == "generated" && config.assembly.type == "random"
+                      ? ", long for a loose gas)\n"
+                      : ")\n");
+  });
   std::cerr << "demcal verify: consolidated in " << state.steps << " steps, ";
   print_consolidation_time(std::cerr, state.wall_time_s, state.from_cache);
   std::cerr << "; loading now\n";
@@ -447,11 +451,8 @@ int cmd_verify(const VerifyOptions& o) {
   else
     std::cerr << up.steps << " steps upscaled (" << law.name() << " law, exponent " << law.exponent
               << ") from " << rev.particles << " particles / " << rev.params.steps << " steps\n";
-  const char* consolidation_time =
-      proto.dense ? "short for a dense packing" : "long for a loose gas";
   if (o.consolidate_only)
-    std::cerr << "demcal verify: --consolidate-only: the consolidation alone ("
-              << consolidation_time << "), no loading\n";
+    std::cerr << "demcal verify: --consolidate-only: the consolidation alone, no loading\n";
   else if (in_lammps)
     std::cerr << "demcal verify: LAMMPS loading = " << run_steps << " steps of the deck (Nstep/f), "
               << static_cast<double>(n) * static_cast<double>(run_steps)
@@ -461,16 +462,21 @@ int cmd_verify(const VerifyOptions& o) {
                                  num(kLammpsParticlesPerRank) + " particles a rank) plus " +
                                  num(kLammpsMpiStepCost) + " s a step of exchanges"
                            : std::string())
-              << " (plus consolidation in demcal, " << consolidation_time << ")\n";
+              << " (plus the consolidation in demcal)\n";
   else
     std::cerr << "demcal verify: loading = " << particle_steps << " particle-steps, estimated "
               << estimate_s / 60.0 << " min at " << kAssumedSpeed
-              << " particle-steps/s (plus consolidation, " << consolidation_time << ")\n";
+              << " particle-steps/s (plus the consolidation)\n";
   const std::string dir = o.out_dir.empty() ? "demcal-verify-" + config.name : o.out_dir;
   make_output_dir(dir);
 
   const auto t0 = std::chrono::steady_clock::now();
-  const ConsolidatedState state = consolidate(config, proto);
+  // "consolidating ..." only before a consolidation, not before a read
+  // from the cache (consolidate_announced).
+  const ConsolidatedState state = consolidate_announced(config, proto, {}, [&] {
+    std::cerr << "demcal verify: consolidating the prototype ("
+              << (proto.dense ? "short for a dense packing" : "long for a loose gas") << ")\n";
+  });
   // The kernel's speed from the consolidation, not from a cache's reading.
   const double speed =
       state.wall_time_s > 1.0 && !state.from_cache
