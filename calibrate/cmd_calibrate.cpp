@@ -66,13 +66,12 @@ std::string reproduce_command(const CalibrateOptions& o, const SceneConfig& conf
 /// run.json: what varies between invocations (kept out of params.json).
 /// Its schema is its own: `demcal run`'s summary.json is "demcal.run/1".
 nlohmann::json run_record(double wall_time_s, const CalibrationSummary& summary,
-                          double consolidation_wall_time_s, bool consolidation_from_cache, int jobs,
-                          bool resumed) {
+                          const ConsolidationRecord& consolidation, int jobs, bool resumed) {
   return {{"schema", "demcal.calibration-run/1"},
           {"wall_time_s", wall_time_s},
           {"calibration_wall_time_s", summary.wall_time_s},
-          {"consolidation_wall_time_s", consolidation_wall_time_s},
-          {"consolidation_from_cache", consolidation_from_cache},
+          {"consolidation_wall_time_s", consolidation.wall_time_s},
+          {"consolidation_from_cache", consolidation.from_cache},
           {"jobs", jobs},
           {"resumed", resumed},
           {"trials_run", summary.trials_run},
@@ -112,9 +111,8 @@ void require_same_trials(const std::string& dir, const nlohmann::json& key) {
 struct Consolidated {
   std::optional<ConsolidatedState> disks;  ///< 2D: biaxial
   std::optional<TriaxialState> spheres;    ///< 3D: triaxial
-  int64_t particles = 0, steps = 0;
-  double wall_time_s = 0.0;
-  bool from_cache = false;
+  int64_t particles = 0;
+  ConsolidationRecord record;  ///< its steps and time (a cache read's when from_cache)
 };
 
 /// The report's start point (3D), run beside the search when there is more
@@ -208,9 +206,7 @@ Consolidated consolidate_rev(const CalibrateOptions& o, const SceneConfig& confi
   };
   auto account = [&](const auto& state) {
     c.particles = state.world.size();
-    c.steps = state.steps;
-    c.wall_time_s = state.wall_time_s;
-    c.from_cache = state.from_cache;
+    c.record = consolidation_record(state);
   };
   if (three_d) {
     const SphereAssembly assembly = make_sphere_assembly(config);
@@ -222,8 +218,8 @@ Consolidated consolidate_rev(const CalibrateOptions& o, const SceneConfig& confi
         consolidate_announced(config, assembly, {}, announce(assembly.size(), "particles"))));
   }
   if (!o.quiet) {
-    std::cerr << "demcal: consolidated in " << c.steps << " steps (";
-    print_consolidation_time(std::cerr, c.wall_time_s, c.from_cache);
+    std::cerr << "demcal: consolidated in " << c.record.steps << " steps (";
+    print_consolidation_time(std::cerr, c.record.wall_time_s, c.record.from_cache);
     std::cerr << ")\n";
   }
   return c;
@@ -466,10 +462,7 @@ int cmd_calibrate(const CalibrateOptions& o) {
   // What varies between invocations stays out of params.json (run.json).
   // Written with params.json, and again after the report with the total.
   const auto run_json = [&] {
-    return run_record(seconds_since(t_start), summary, rev.wall_time_s, rev.from_cache, jobs,
-                      o.resume)
-               .dump(2) +
-           "\n";
+    return run_record(seconds_since(t_start), summary, rev.record, jobs, o.resume).dump(2) + "\n";
   };
   write_results(dir, params, evidence.lines, run_json());
   if (stop.stopped())
