@@ -62,6 +62,42 @@ class CliEndToEnd : public ::testing::Test {
   /// Everything under dir_/work (the runs' working directory).
   std::set<std::string> work_contents() { return test::paths_under(dir_ / "work"); }
 
+  /// `args` run twice (-o miss, -o hit) with one consolidation cache
+  /// folder: "consolidating ..." (`consolidating`, the whole line) only in
+  /// the fresh run, not before the cache read; both say their consolidation
+  /// in a line starting `consolidated`: "N steps, T s", the read's "N steps,
+  /// read from the cache in T s" (print_consolidation_time), the same N.
+  void expect_said_as_the_others(const std::vector<std::string>& args,
+                                 const std::string& consolidating,
+                                 const std::string& consolidated) {
+    const std::string cache = "DEMCAL_CACHE_DIR=" + (dir_ / "cache").string();
+    auto run = [&](const std::string& out) {
+      std::vector<std::string> with_out = args;
+      with_out.insert(with_out.end(), {"-o", out});
+      const Result r = demcal(with_out, {cache});
+      EXPECT_EQ(r.status, 0) << r.err;
+      return r;
+    };
+    const Result miss = run("miss");
+    const Result hit = run("hit");
+    auto line_of = [](const std::string& text, const std::string& start) {
+      for (const std::string& line : lines_of(text))
+        if (line.rfind(start, 0) == 0) return line;
+      return std::string("no line ") + start;
+    };
+    EXPECT_EQ(line_of(miss.err, consolidating), consolidating) << miss.err;
+    EXPECT_EQ(hit.err.find("consolidating"), std::string::npos) << hit.err;
+    const std::string fresh = line_of(miss.err, consolidated);
+    const std::string read = line_of(hit.err, consolidated);
+    const size_t comma = fresh.find(" steps, ");
+    ASSERT_NE(comma, std::string::npos) << miss.err;
+    EXPECT_EQ(fresh.find("cache"), std::string::npos) << fresh;
+    EXPECT_TRUE(std::isdigit(static_cast<unsigned char>(fresh[comma + 8]))) << fresh;
+    EXPECT_EQ(fresh.substr(fresh.size() - 2), " s") << fresh;
+    EXPECT_EQ(read.rfind(fresh.substr(0, comma + 8) + "read from the cache in ", 0), 0u) << read;
+    EXPECT_EQ(read.substr(read.size() - 2), " s") << read;
+  }
+
   /// Bad input: exit 2, exactly one line on stderr that contains every one
   /// of `mentions`, nothing on stdout, and nothing written.
   void expect_bad_input(const std::vector<std::string>& args,
@@ -835,6 +871,20 @@ TEST_F(CliEndToEnd, RevRecordsAConsolidationFromTheCache) {
   EXPECT_TRUE(read.contains("wall_time_s"));
   EXPECT_EQ(read_text(dir_ / "work" / "hit" / "rev.csv"),
             read_text(dir_ / "work" / "miss" / "rev.csv"));
+}
+
+// `demcal stability` and `demcal rev` said "consolidating ..." before a read
+// from the consolidation cache too, and no consolidation time: now they say
+// it as calibrate, export, sweep and scaling do (expect_said_as_the_others).
+TEST_F(CliEndToEnd, StabilitySaysItsConsolidationAsTheOtherCommands) {
+  expect_said_as_the_others({"stability", kHex5, "--points", "2", "--steps", "2048"},
+                            "stability hex_5x5: consolidating 25 particles",
+                            "stability hex_5x5: consolidated in ");
+}
+TEST_F(CliEndToEnd, RevSaysItsConsolidationAsTheOtherCommands) {
+  expect_said_as_the_others({"rev", kHex5, "--particles", "16"},
+                            "demcal rev: consolidating the REV to sigma3",
+                            "demcal rev: consolidated the REV in ");
 }
 
 // `demcal export` says how the deck's Nstep was upscaled, 2D and 3D in

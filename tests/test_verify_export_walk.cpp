@@ -152,6 +152,45 @@ TEST(VerifyExportWalk, ExportSaysConsolidatingOnlyWhenItConsolidates) {
   }
 }
 
+// `demcal verify` said before its consolidation what it would cost ("plus
+// consolidation, short for a dense packing", "--consolidate-only: the
+// consolidation alone (long for a loose gas)", 3D: "plus a single-thread
+// consolidation"), a read from the cache too: now "consolidating the
+// prototype (...)" says it only when it consolidates (consolidate_announced),
+// 2D (also --consolidate-only) and 3D, as export does.
+TEST(VerifyExportWalk, VerifySaysConsolidatingOnlyWhenItConsolidates) {
+  const test::TempDir dir("walk_verify_announce");
+  const std::string cache = "DEMCAL_CACHE_DIR=" + (dir / "cache").string();
+  struct Case {
+    std::string scene, particles, how;  // how: the announcement's words
+    std::vector<std::string> more;
+  };
+  for (const Case& c :
+       {Case{"hex_10x10", "25", "(short for a dense packing)", {}},
+        Case{"hex_10x10", "36", "(short for a dense packing)", {"--consolidate-only"}},
+        Case{"fcc_4x4x4", "32", "(single-threaded)", {}}}) {
+    SCOPED_TRACE(c.scene + " " + c.particles);
+    auto verify = [&](const std::string& out) {
+      std::vector<std::string> args = {"verify",      example_params(c.scene),
+                                       "--particles", c.particles,
+                                       "-o",          c.scene + c.particles + out};
+      args.insert(args.end(), c.more.begin(), c.more.end());
+      const test::RunResult r = demcal_with({cache}, args, dir.path());
+      EXPECT_TRUE(r.status == 0 || r.status == 1) << r.err;  // PASS or FAIL, both reported
+      return r;
+    };
+    const test::RunResult miss = verify("-miss");
+    const test::RunResult hit = verify("-hit");
+    const std::string consolidating = "demcal verify: consolidating the prototype ";
+    EXPECT_EQ(line_of(miss.err, consolidating), consolidating + c.how) << miss.err;
+    EXPECT_FALSE(contains(hit.err, "consolidating")) << hit.err;
+    EXPECT_FALSE(contains(hit.err, c.how.substr(1, c.how.size() - 2))) << hit.err;
+    EXPECT_TRUE(contains(line_of(hit.err, "demcal verify: consolidated in "),
+                         " steps, read from the cache in "))
+        << hit.err;
+  }
+}
+
 // `verify --engine lammps --allow-failed` ran a deck whose header did not
 // say that its parameters are not certified, which `export --allow-failed`
 // writes (deck_sections.cpp's header_opening, from params.json's success and
