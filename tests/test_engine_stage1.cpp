@@ -706,7 +706,7 @@ void expect_progress_rows_in_the_log_of_a_killed_run(const std::string& lmp, con
   const std::string log = test::read_text(dir / "log.txt");
   EXPECT_EQ(log.find("demcal deck: consolidated in"), std::string::npos) << "stage 1 ended";
   std::smatch m;
-  ASSERT_TRUE(std::regex_search(log, m, std::regex("\nStep Dt v_cons_err[^\n]*\n")))
+  ASSERT_TRUE(std::regex_search(log, m, std::regex("\n *Step +Dt +v_cons_err[^\n]*\n")))
       << log.substr(log.size() > 2000 ? log.size() - 2000 : 0);
   const size_t header_end = static_cast<size_t>(m.position(0) + m.length(0));
   std::stringstream header(m[0].str());
@@ -716,7 +716,7 @@ void expect_progress_rows_in_the_log_of_a_killed_run(const std::string& lmp, con
     std::smatch row;
     const std::string rest = log.substr(header_end - 1);
     ASSERT_TRUE(std::regex_search(
-        rest, row, std::regex(std::string("\n +") + step + "(( +[-+0-9.eE]+)+) *\n")))
+        rest, row, std::regex(std::string("\n *") + step + "(( +[-+0-9.eE]+)+) *\n")))
         << "no whole row of step " << step << " in the log:\n"
         << log.substr(header_end);
     std::stringstream fields(row[1].str());

@@ -387,6 +387,28 @@ TEST(ScalingStudy, ACountInAStoredSizeThatIsNoCountIsNamed) {
       EXPECT_EQ(e->file(), "result.json");
       EXPECT_EQ(e->field(), field) << e->what();
     }
+  // The consolidation's time and label of the wrong type are named too
+  // (were "not a demcal scaling result: [json.exception.type_error.302]").
+  for (const auto& [field, v] :
+       std::vector<std::pair<std::string, json>>{{"consolidation_wall_time_s", json("0.5")},
+                                                 {"consolidation_from_cache", json(1)},
+                                                 {"consolidation_from_cache", json("true")}}) {
+    json bad = good;
+    bad[field] = v;
+    SCOPED_TRACE(::testing::Message() << field << " = " << v.dump());
+    const auto e = test::input_error([&] { scaling_size_from_json(bad, "result.json"); });
+    ASSERT_TRUE(e);
+    EXPECT_EQ(e->file(), "result.json");
+    EXPECT_EQ(e->field(), field) << e->what();
+  }
+  // A size of an older demcal (no consolidation keys) still reads.
+  json older = good;
+  for (const char* k :
+       {"consolidation_steps", "consolidation_wall_time_s", "consolidation_from_cache"})
+    older.erase(k);
+  const ScalingSize old_size = scaling_size_from_json(older, "result.json");
+  EXPECT_EQ(old_size.consolidation.steps, 0);
+  EXPECT_FALSE(old_size.consolidation.from_cache);
   json whole = good;
   whole["particles"] = 100.0;  // a whole number written as a float reads
   EXPECT_EQ(scaling_size_from_json(whole, "result.json").particles, 100);

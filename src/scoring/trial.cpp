@@ -1,7 +1,9 @@
 #include "demcal/scoring/trial.hpp"
 
 #include <cmath>
+#include <limits>
 
+#include "demcal/io/json_integer.hpp"
 #include "demcal/scene/packing.hpp"
 
 namespace demcal {
@@ -52,6 +54,33 @@ nlohmann::json run_summary(const SceneConfig& config, const LoadingResult& run,
          "walled-box value; rotation-locked sliding mechanism (reports/hexagonal-peaks.md)"}};
   }
   return j;
+}
+
+void add_consolidation_flat(nlohmann::json& into, const ConsolidationRecord& record) {
+  const nlohmann::json block = consolidation_json(record);  // (items() of a temporary dangles)
+  for (const auto& item : block.items()) into["consolidation_" + item.key()] = item.value();
+}
+
+ConsolidationRecord consolidation_flat_from_json(const nlohmann::json& block,
+                                                 const std::string& file,
+                                                 const std::string& where) {
+  ConsolidationRecord r;
+  if (block.contains("consolidation_steps"))
+    r.steps = json_integer(block.at("consolidation_steps"), 0, std::numeric_limits<int64_t>::max(),
+                           file, where + "consolidation_steps");
+  if (const auto t = block.find("consolidation_wall_time_s"); t != block.end()) {
+    if (!t->is_number())
+      throw InputError(file, where + "consolidation_wall_time_s",
+                       "must be a number, got " + t->dump());
+    r.wall_time_s = t->get<double>();
+  }
+  if (const auto c = block.find("consolidation_from_cache"); c != block.end()) {
+    if (!c->is_boolean())
+      throw InputError(file, where + "consolidation_from_cache",
+                       "must be true or false, got " + c->dump());
+    r.from_cache = c->get<bool>();
+  }
+  return r;
 }
 
 }  // namespace demcal

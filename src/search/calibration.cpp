@@ -133,7 +133,8 @@ double dt_ratio_max(const CalibrationOptions& options, double dt_ratio_stable) {
 }
 
 double dt_ratio_lower(const CalibrationOptions& options, double dt_ratio_stable) {
-  return std::min(options.dt_ratio_min, 0.5 * dt_ratio_max(options, dt_ratio_stable));
+  const double upper = dt_ratio_max(options, dt_ratio_stable);
+  return upper >= options.dt_ratio_min ? options.dt_ratio_min : 0.5 * upper;
 }
 
 nlohmann::json to_json(const Certificate& c) {

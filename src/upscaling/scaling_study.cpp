@@ -48,9 +48,7 @@ std::vector<int64_t> parse_sizes(const std::string& text, const std::string& opt
 
 json to_json(const ScalingSize& r) {
   json j{{"requested", r.requested}, {"particles", r.particles}, {"calibrated", r.calibrated}};
-  // consolidation_json's record, each key prefixed "consolidation_".
-  const json consolidation = consolidation_json(r.consolidation);
-  for (const auto& item : consolidation.items()) j["consolidation_" + item.key()] = item.value();
+  add_consolidation_flat(j, r.consolidation);
   if (r.calibrated)
     j.update({{"success", r.success},
               {"best", to_json(r.best)},
@@ -84,10 +82,7 @@ ScalingSize scaling_size_from_json(const json& j, const std::string& source) {
     r.requested = count(j, "requested", 1, kMaxParticles);
     r.particles = count(j, "particles", 1, kMaxParticles);
     r.calibrated = j.at("calibrated").get<bool>();
-    if (j.contains("consolidation_steps"))
-      r.consolidation.steps = count(j, "consolidation_steps", 0, kAny);
-    r.consolidation.wall_time_s = j.value("consolidation_wall_time_s", 0.0);
-    r.consolidation.from_cache = j.value("consolidation_from_cache", false);
+    r.consolidation = consolidation_flat_from_json(j, source);
     if (r.calibrated) {
       r.success = j.at("success").get<bool>();
       r.best = algorithm_from_json(j.at("best"), source, "best");
@@ -326,6 +321,7 @@ void fixed_multipliers(Family& family, const ScalingStudyOptions& o, const Scali
   if (o.resume && fs::exists(fixed_path)) {
     const ScalingSize stored = scaling_size_from_json(read_json(fixed_path), fixed_path);
     r.particles = stored.particles;
+    if (!r.calibrated) r.consolidation = stored.consolidation;
     r.fixed = stored.fixed;
     family.log("size " + std::to_string(n) + ": reusing " + fixed_path);
     return;
@@ -333,6 +329,9 @@ void fixed_multipliers(Family& family, const ScalingStudyOptions& o, const Scali
   make_output_dir(family.dir(n));
   const SizeState& state = family.state(n);
   r.particles = state.particles;
+  // A size beyond the calibrated ones records the consolidation this step
+  // made or read (a calibrated size keeps its calibration's).
+  if (!r.calibrated) r.consolidation = state.consolidation;
   const AlgorithmSpec start = upscale(ref.best, ref.particles, r.particles, law);
   family.log("size " + std::to_string(r.particles) +
              ": smallest passing Nstep at the REV's multipliers, from the " + law_words(law) +

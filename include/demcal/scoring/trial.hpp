@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <string>
 
 #include "demcal/scene/biaxial.hpp"
 #include "demcal/scene/config.hpp"
@@ -72,6 +73,18 @@ template <class State>
 ConsolidationRecord consolidation_record(const State& state) {
   return {state.steps, state.wall_time_s, state.from_cache};
 }
+
+/// consolidation_json's keys flat, each prefixed "consolidation_"
+/// (consolidation_steps, consolidation_wall_time_s,
+/// consolidation_from_cache), added to `into`: scaling.json's sizes (and
+/// their result.json, fixed.json) and a calibration's run.json.
+void add_consolidation_flat(nlohmann::json& into, const ConsolidationRecord& record);
+/// add_consolidation_flat's keys read back from `block` of `file`; a key a
+/// file of an older demcal lacks is 0 / false; a key of the wrong type is
+/// an InputError naming the file and `where` + the key (exit status 2).
+ConsolidationRecord consolidation_flat_from_json(const nlohmann::json& block,
+                                                 const std::string& file,
+                                                 const std::string& where = "");
 
 /// summary.json of a run (`demcal run`, README.md "Commands").
 nlohmann::json run_summary(const SceneConfig& config, const LoadingResult& run, const Score& score);

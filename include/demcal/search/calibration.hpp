@@ -57,8 +57,8 @@ int64_t round_steps(double steps);
 /// Search space (all bounds inclusive):
 ///   α = Δt/Δt_crit in [dt_ratio_min, dt_ratio_safety · α_stable], α_stable
 ///     from the stiffnesses of the consolidated state (never beyond it; the
-///     lower bound falls to half the upper one where that is below
-///     dt_ratio_min, dt_ratio_lower());
+///     lower bound falls to half the upper one where the upper one is
+///     below dt_ratio_min, dt_ratio_lower());
 ///   log10 Nstep in [log10 steps_min, log10 steps_max];
 ///   ζ_t in [damping_min, damping_max], ζ_r in [0, damping_max].
 /// Mass scaling stays at the config's value (1 by default).
@@ -222,7 +222,7 @@ AlgorithmSpec rounded_params(const AlgorithmSpec& params);
 /// one diverges, and export refuses it).
 double dt_ratio_max(const CalibrationOptions& options, double dt_ratio_stable);
 /// The smallest α the search may try: dt_ratio_min, or half of
-/// dt_ratio_max() where the stable step is that small (stiff contact
+/// dt_ratio_max() where that is below dt_ratio_min (stiff contact
 /// dashpots), so that the range is never empty.
 double dt_ratio_lower(const CalibrationOptions& options, double dt_ratio_stable);
 

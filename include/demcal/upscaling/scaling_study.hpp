@@ -70,15 +70,16 @@ struct ScalingSize {
   double richardson = 0.0, peak = 0.0;
   int trials = 0;
   double wall_time_s = 0.0;
-  /// A calibrated size's consolidation (steps, wall time: a cache read's
-  /// when from_cache).
+  /// The size's consolidation (steps, wall time: a cache read's when
+  /// from_cache): a calibrated size's calibration's, another's step
+  /// search's (fixed multipliers).
   ConsolidationRecord consolidation;
   FixedMultipliers fixed;
 };
 /// A size as scaling.json records it (and as result.json stores a
 /// calibrated size for resume), and back; errors name `source`. Its
-/// consolidation is consolidation_json's record, flat: consolidation_steps,
-/// consolidation_wall_time_s, consolidation_from_cache.
+/// consolidation is consolidation_json's record, flat (add_consolidation_flat):
+/// consolidation_steps, consolidation_wall_time_s, consolidation_from_cache.
 nlohmann::json to_json(const ScalingSize& size);
 ScalingSize scaling_size_from_json(const nlohmann::json& json, const std::string& source);
 
