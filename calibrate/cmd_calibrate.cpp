@@ -67,17 +67,17 @@ std::string reproduce_command(const CalibrateOptions& o, const SceneConfig& conf
 /// Its schema is its own: `demcal run`'s summary.json is "demcal.run/1".
 nlohmann::json run_record(double wall_time_s, const CalibrationSummary& summary,
                           const ConsolidationRecord& consolidation, int jobs, bool resumed) {
-  return {{"schema", "demcal.calibration-run/1"},
-          {"wall_time_s", wall_time_s},
-          {"calibration_wall_time_s", summary.wall_time_s},
-          {"consolidation_wall_time_s", consolidation.wall_time_s},
-          {"consolidation_from_cache", consolidation.from_cache},
-          {"jobs", jobs},
-          {"resumed", resumed},
-          {"trials_run", summary.trials_run},
-          {"trials_reused", summary.trials_reused},
-          {"kernel_simd", kernel_simd()},
-          {"version", DEMCAL_VERSION}};
+  nlohmann::json j{{"schema", "demcal.calibration-run/1"},
+                   {"wall_time_s", wall_time_s},
+                   {"calibration_wall_time_s", summary.wall_time_s},
+                   {"jobs", jobs},
+                   {"resumed", resumed},
+                   {"trials_run", summary.trials_run},
+                   {"trials_reused", summary.trials_reused},
+                   {"kernel_simd", kernel_simd()},
+                   {"version", DEMCAL_VERSION}};
+  add_consolidation_flat(j, consolidation);
+  return j;
 }
 
 /// DIR/resume.json: what the trials of DIR/trials.jsonl were run with.

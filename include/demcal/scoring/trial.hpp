@@ -49,12 +49,12 @@ nlohmann::json run_account_json(const AlgorithmSpec& algorithm, const LoadingRun
 
 /// A consolidation's record, 2D and 3D alike, in summary.json (`demcal
 /// run`, the "consolidation" block; a 3D run's adds the state's stress error,
-/// unbalanced-force ratio and box), verify.json and atlas.json (`demcal
-/// sweep`; scaling.json's sizes flatten it: consolidation_steps, ...): steps, wall_time_s,
-/// from_cache. Read from the consolidation cache, the steps are those the
-/// consolidation took and the wall time is the reading's. `State` is a
-/// ConsolidatedState or a TriaxialState. (A calibration's run.json keeps its
-/// own flat keys, consolidation_wall_time_s and consolidation_from_cache.)
+/// unbalanced-force ratio and box), verify.json, rev.json and atlas.json
+/// (`demcal sweep`): steps, wall_time_s, from_cache; scaling.json's sizes
+/// and a calibration's run.json hold it flat (add_consolidation_flat:
+/// consolidation_steps, ...). Read from the consolidation cache, the steps
+/// are those the consolidation took and the wall time is the reading's.
+/// `State` is a ConsolidatedState, a TriaxialState or a ConsolidationRecord.
 template <class State>
 nlohmann::json consolidation_json(const State& state) {
   return {
