@@ -319,16 +319,23 @@ TEST(Sweep, CommandWritesTheAtlas) {
 // verify and export say it (print_consolidation_time): a fresh one's time,
 // a cached one's "read from the cache in T s" (it said "(once)" and "(once,
 // from the cache)", no time).
+// A sweep of hex_5x5 into tmp/out with tmp/cache as the consolidation
+// cache: the first consolidates, the next reads the state back.
+test::RunResult sweep_with_cache(const test::TempDir& tmp, const char* out) {
+  const test::RunResult r =
+      test::run_program("/usr/bin/env",
+                        {"DEMCAL_CACHE_DIR=" + (tmp / "cache").string(), test::kDemcalBinary,
+                         "sweep", test::shipped_config("hex_5x5"), "--set", "algorithm.steps=2000",
+                         "--jobs", "2", "-o", (tmp / out).string()},
+                        tmp.path());
+  EXPECT_EQ(r.status, 0) << r.err;
+  return r;
+}
+
 TEST(Sweep, CommandSaysItsConsolidationTimeAsTheOtherCommands) {
   const test::TempDir tmp("sweepcache");
   auto sweep_line = [&](const char* out) {
-    const test::RunResult r =
-        test::run_program("/usr/bin/env",
-                          {"DEMCAL_CACHE_DIR=" + (tmp / "cache").string(), test::kDemcalBinary,
-                           "sweep", test::shipped_config("hex_5x5"), "--set",
-                           "algorithm.steps=2000", "--jobs", "2", "-o", (tmp / out).string()},
-                          tmp.path());
-    EXPECT_EQ(r.status, 0) << r.err;
+    const test::RunResult r = sweep_with_cache(tmp, out);
     for (const std::string& line : test::lines_of(r.err))
       if (line.rfind("sweep hex_5x5: ", 0) == 0) return line;
     return "no sweep line in: " + r.err;
@@ -354,17 +361,8 @@ TEST(Sweep, CommandSaysItsConsolidationTimeAsTheOtherCommands) {
 // recorded the reading's time as the consolidation's, unlabelled).
 TEST(Sweep, AtlasRecordsAConsolidationFromTheCache) {
   const test::TempDir tmp("sweepatlascache");
-  auto sweep = [&](const char* out) {
-    const test::RunResult r =
-        test::run_program("/usr/bin/env",
-                          {"DEMCAL_CACHE_DIR=" + (tmp / "cache").string(), test::kDemcalBinary,
-                           "sweep", test::shipped_config("hex_5x5"), "--set",
-                           "algorithm.steps=2000", "--jobs", "2", "-o", (tmp / out).string()},
-                          tmp.path());
-    EXPECT_EQ(r.status, 0) << r.err;
-  };
-  sweep("miss");
-  sweep("hit");
+  sweep_with_cache(tmp, "miss");
+  sweep_with_cache(tmp, "hit");
   const nlohmann::json fresh = test::read_json(tmp / "miss" / "atlas.json");
   const nlohmann::json read = test::read_json(tmp / "hit" / "atlas.json");
   ASSERT_TRUE(fresh.contains("consolidation")) << fresh.dump(1).substr(0, 2000);
