@@ -209,6 +209,23 @@ TEST(Records, CalibrationOptionsTakeTheirDefaultsFromTheConfigBlock) {
   EXPECT_EQ(f.seed, 9u);
 }
 
+// The search's α range: [dt_ratio_min, 0.95 α_stable] while that is not
+// empty (as before 2026-12-04, so those calibrations are unchanged), and
+// [½ u, u] with u = 0.95 α_stable where u is below dt_ratio_min (stiff
+// contact dashpots): never beyond the stable step.
+TEST(Records, TheAlphaRangeNeverPassesTheStableStep) {
+  const CalibrationOptions o;
+  for (double f : {0.5, 1.0, 1.5, 2.5}) {
+    const double u = f * o.dt_ratio_min;
+    const double stable = u / o.dt_ratio_safety;
+    SCOPED_TRACE(f);
+    EXPECT_DOUBLE_EQ(dt_ratio_max(o, stable), u);
+    EXPECT_LE(dt_ratio_max(o, stable), stable);
+    EXPECT_DOUBLE_EQ(dt_ratio_lower(o, stable), f < 1.0 ? 0.5 * u : o.dt_ratio_min);
+    EXPECT_LE(dt_ratio_lower(o, stable), dt_ratio_max(o, stable));
+  }
+}
+
 TEST(Records, SearchStartIsThePapersRecipeWithASizeBasedNstep) {
   const AlgorithmSpec base = sample_params();
   const AlgorithmSpec s = search_start(base, 100, 0.5);
