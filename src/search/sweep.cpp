@@ -512,42 +512,13 @@ std::string compact(double v) {
 
 }  // namespace
 
-std::string atlas_markdown(const SweepResult& res) {
-  std::ostringstream md;
+namespace {
+
+/// atlas.md's table of every case, group by group (bold: beyond its
+/// tolerance); 3D adds the per-axis and per-plane columns.
+void atlas_case_tables(std::ostream& md, const SweepResult& res) {
   const double s3 = res.lateral_stress;
   const bool three_d = res.dimension == 3;
-  md << "# Signature atlas: " << res.scene << "\n\n"
-     << res.particles << (three_d ? " spheres, triaxial test (z axial)" : " particles")
-     << ". Benchmark: alpha " << res.benchmark.dt_ratio << ", Nstep " << res.benchmark.steps
-     << ", zeta_t " << res.benchmark.damping_ratio_translation << ", zeta_r "
-     << res.benchmark.damping_ratio_rotation << ", mass scaling " << res.benchmark.mass_scaling
-     << ". Stable alpha (rotation coupled) " << fixed(res.alpha_stable, 3) << ".\n\n";
-  md << "Converged quasi-static peak sigma1/sigma3 = "
-     << fixed(-res.reference.peak_stress_yy / s3, 4) << " (Richardson, Nstep ladder; last "
-     << "doubling changed the peak by " << fixed(100.0 * res.reference.last_change, 2) << " %, "
-     << (res.reference.converged ? "converged" : "NOT converged") << ")";
-  if (res.analytical_peak)
-    md << (three_d ? "; analytical (walled FCC, Thornton 1979, rotation locked) "
-                   : "; analytical (walled box, rotation locked) ")
-       << fixed(-*res.analytical_peak / s3, 4);
-  md << ".\n\n| Nstep | peak sigma1/sigma3 | Richardson with previous |\n|---:|---:|---:|\n";
-  for (const auto& r : res.reference.ladder)
-    md << "| " << r.steps << " | " << fixed(-r.peak_stress_yy / s3, 4) << " | "
-       << (r.richardson != 0.0 ? fixed(-r.richardson / s3, 4) : "–") << " |\n";
-
-  md << "\nTolerances: force balance " << res.tolerances.force_balance << ", moment balance "
-     << res.tolerances.moment_balance << ", servo " << res.tolerances.servo << ", oscillation "
-     << res.tolerances.oscillation << "; accuracy target " << 100.0 * res.accuracy << " %.\n\n";
-  md << "Columns: FB = force balance (max |trend| of b−σ; xx, yy, shear), paper = "
-        "RMS(b_yy−σ_yy)/RMS(b_yy), MB = moment balance RMS(σxy−σyx)/σ3, servo = max |trend| of "
-        "the lateral wall stress error, osc = noise of b−σ, zig = noise b_yy and σ_yy share, "
-        "soft = post-peak softening. Values above tolerance in **bold**.\n\n";
-  if (three_d)
-    md << "3D: FB, MB, servo and osc are the combined criteria (scoring/triaxial_scoring.hpp: "
-          "each the largest over the xz, yz and xy planes, servo over the four lateral walls "
-          "too); FB x, FB y = lateral gaps (b−σ)/σ3 on x and y, FB z = axial gap on |b_zz|, "
-          "FB sh = largest symmetric shear gap of the three planes, MB xz/yz/xy = moment balance "
-          "per plane, rot = median KE_rot/KE. paper and zig are those of b_zz, σ_zz.\n\n";
   auto bold = [](double v, double tol) { return v > tol ? "**" + compact(v) + "**" : compact(v); };
   const std::vector<std::string> groups = {"benchmark", "atlas", "convergence", "alpha_scan",
                                            "grid"};
@@ -602,6 +573,79 @@ std::string atlas_markdown(const SweepResult& res) {
          << " |\n";
     }
   }
+}
+
+/// atlas.md: each criterion against the peak error, the finished trials
+/// binned by value/tolerance.
+void atlas_criterion_bins(std::ostream& md, const SweepResult& res) {
+  const double edges[] = {0.0, 0.25, 0.5, 1.0, 2.0, 4.0, 10.0, 1e300};
+  const char* labels[] = {"<= 0.25", "0.25-0.5", "0.5-1", "1-2", "2-4", "4-10", "> 10"};
+  md << "\n### Each criterion against the peak error\n\n"
+     << "Finished trials binned by criterion value / tolerance; each cell: trials, largest "
+        "|peak error|.\n\n| value/tolerance |";
+  for (int i = 0; i < 4; ++i) md << " " << kCriteria[i].name << " |";
+  md << "\n|---|---:|---:|---:|---:|\n";
+  for (int b = 0; b < 7; ++b) {
+    md << "| " << labels[b] << " |";
+    for (int i = 0; i < 4; ++i) {
+      int n = 0;
+      double worst = 0.0;
+      for (const auto& r : res.cases) {
+        if (!scored(r)) continue;
+        const double x = kCriteria[i].get(r.score.criteria) / tolerance_of(res.tolerances, i);
+        if (x > edges[b] && x <= edges[b + 1]) {
+          ++n;
+          worst = std::max(worst, std::abs(*r.score.criteria.peak_error));
+        }
+      }
+      if (b == 0)
+        for (const auto& r : res.cases)
+          if (scored(r) && kCriteria[i].get(r.score.criteria) == 0.0) ++n;
+      md << " " << n << (n ? ", " + fixed(100.0 * worst, 1) + " %" : "") << " |";
+    }
+    md << "\n";
+  }
+}
+
+}  // namespace
+
+std::string atlas_markdown(const SweepResult& res) {
+  std::ostringstream md;
+  const double s3 = res.lateral_stress;
+  const bool three_d = res.dimension == 3;
+  md << "# Signature atlas: " << res.scene << "\n\n"
+     << res.particles << (three_d ? " spheres, triaxial test (z axial)" : " particles")
+     << ". Benchmark: alpha " << res.benchmark.dt_ratio << ", Nstep " << res.benchmark.steps
+     << ", zeta_t " << res.benchmark.damping_ratio_translation << ", zeta_r "
+     << res.benchmark.damping_ratio_rotation << ", mass scaling " << res.benchmark.mass_scaling
+     << ". Stable alpha (rotation coupled) " << fixed(res.alpha_stable, 3) << ".\n\n";
+  md << "Converged quasi-static peak sigma1/sigma3 = "
+     << fixed(-res.reference.peak_stress_yy / s3, 4) << " (Richardson, Nstep ladder; last "
+     << "doubling changed the peak by " << fixed(100.0 * res.reference.last_change, 2) << " %, "
+     << (res.reference.converged ? "converged" : "NOT converged") << ")";
+  if (res.analytical_peak)
+    md << (three_d ? "; analytical (walled FCC, Thornton 1979, rotation locked) "
+                   : "; analytical (walled box, rotation locked) ")
+       << fixed(-*res.analytical_peak / s3, 4);
+  md << ".\n\n| Nstep | peak sigma1/sigma3 | Richardson with previous |\n|---:|---:|---:|\n";
+  for (const auto& r : res.reference.ladder)
+    md << "| " << r.steps << " | " << fixed(-r.peak_stress_yy / s3, 4) << " | "
+       << (r.richardson != 0.0 ? fixed(-r.richardson / s3, 4) : "–") << " |\n";
+
+  md << "\nTolerances: force balance " << res.tolerances.force_balance << ", moment balance "
+     << res.tolerances.moment_balance << ", servo " << res.tolerances.servo << ", oscillation "
+     << res.tolerances.oscillation << "; accuracy target " << 100.0 * res.accuracy << " %.\n\n";
+  md << "Columns: FB = force balance (max |trend| of b−σ; xx, yy, shear), paper = "
+        "RMS(b_yy−σ_yy)/RMS(b_yy), MB = moment balance RMS(σxy−σyx)/σ3, servo = max |trend| of "
+        "the lateral wall stress error, osc = noise of b−σ, zig = noise b_yy and σ_yy share, "
+        "soft = post-peak softening. Values above tolerance in **bold**.\n\n";
+  if (three_d)
+    md << "3D: FB, MB, servo and osc are the combined criteria (scoring/triaxial_scoring.hpp: "
+          "each the largest over the xz, yz and xy planes, servo over the four lateral walls "
+          "too); FB x, FB y = lateral gaps (b−σ)/σ3 on x and y, FB z = axial gap on |b_zz|, "
+          "FB sh = largest symmetric shear gap of the three planes, MB xz/yz/xy = moment balance "
+          "per plane, rot = median KE_rot/KE. paper and zig are those of b_zz, σ_zz.\n\n";
+  atlas_case_tables(md, res);
   md << "\n## Tolerance evidence\n\n"
      << "Over the " << std::count_if(res.cases.begin(), res.cases.end(), scored)
      << " finished trials: a trial is accurate when |peak error| <= " << 100.0 * res.accuracy
@@ -621,36 +665,7 @@ std::string atlas_markdown(const SweepResult& res) {
        << compact(e.safe_alone) << " | " << (e.tolerance > 0.0 ? compact(e.safe_joint) : "–")
        << " | " << (e.tolerance > 0.0 ? std::to_string(e.binding) : "–") << " |\n";
   }
-  // Each criterion against the peak error, binned by value/tolerance.
-  {
-    const double edges[] = {0.0, 0.25, 0.5, 1.0, 2.0, 4.0, 10.0, 1e300};
-    const char* labels[] = {"<= 0.25", "0.25-0.5", "0.5-1", "1-2", "2-4", "4-10", "> 10"};
-    md << "\n### Each criterion against the peak error\n\n"
-       << "Finished trials binned by criterion value / tolerance; each cell: trials, largest "
-          "|peak error|.\n\n| value/tolerance |";
-    for (int i = 0; i < 4; ++i) md << " " << kCriteria[i].name << " |";
-    md << "\n|---|---:|---:|---:|---:|\n";
-    for (int b = 0; b < 7; ++b) {
-      md << "| " << labels[b] << " |";
-      for (int i = 0; i < 4; ++i) {
-        int n = 0;
-        double worst = 0.0;
-        for (const auto& r : res.cases) {
-          if (!scored(r)) continue;
-          const double x = kCriteria[i].get(r.score.criteria) / tolerance_of(res.tolerances, i);
-          if (x > edges[b] && x <= edges[b + 1]) {
-            ++n;
-            worst = std::max(worst, std::abs(*r.score.criteria.peak_error));
-          }
-        }
-        if (b == 0)
-          for (const auto& r : res.cases)
-            if (scored(r) && kCriteria[i].get(r.score.criteria) == 0.0) ++n;
-        md << " " << n << (n ? ", " + fixed(100.0 * worst, 1) + " %" : "") << " |";
-      }
-      md << "\n";
-    }
-  }
+  atlas_criterion_bins(md, res);
   md << "\nDiagnoses in words:\n\n";
   for (const auto& r : res.cases) {
     if (r.spec.group != "benchmark" && r.spec.group != "atlas") continue;
