@@ -208,14 +208,18 @@ Consolidated consolidate_rev(const CalibrateOptions& o, const SceneConfig& confi
     c.particles = state.world.size();
     c.record = consolidation_record(state);
   };
+  // Progress lines (--progress, every 2 s) as run, sweep and export print
+  // them, unless -q.
+  ConsolidationOptions co;
+  if (!o.quiet) co.progress = consolidation_progress(o.progress_every_s);
   if (three_d) {
     const SphereAssembly assembly = make_sphere_assembly(config);
     account(c.spheres.emplace(
-        consolidate_announced(config, assembly, {}, announce(assembly.size(), "spheres"))));
+        consolidate_announced(config, assembly, co, announce(assembly.size(), "spheres"))));
   } else {
     Assembly assembly = make_assembly(config);
     account(c.disks.emplace(
-        consolidate_announced(config, assembly, {}, announce(assembly.size(), "particles"))));
+        consolidate_announced(config, assembly, co, announce(assembly.size(), "particles"))));
   }
   if (!o.quiet) {
     std::cerr << "demcal: consolidated in " << c.record.steps << " steps (";

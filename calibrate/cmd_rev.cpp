@@ -43,11 +43,12 @@ struct RevOutcome {
 // other commands say it: `announce` ("consolidating ...") only when it
 // consolidates, not before a read from the cache (consolidate_announced),
 // then its steps and time (print_consolidation_time: a cache read's
-// labelled).
+// labelled); progress lines as run prints them (--progress).
 template <class AnyAssembly>
 auto said_consolidation(const SceneConfig& config, const AnyAssembly& assembly, const char* what,
-                        const std::function<void()>& announce) {
-  const auto state = consolidate_announced(config, assembly, {}, announce);
+                        double progress_every_s, const std::function<void()>& announce) {
+  const ConsolidationOptions co{.progress = consolidation_progress(progress_every_s)};
+  const auto state = consolidate_announced(config, assembly, co, announce);
   std::cerr << "demcal rev: consolidated " << what << " in " << state.steps << " steps, ";
   print_consolidation_time(std::cerr, state.wall_time_s, state.from_cache);
   std::cerr << "\n";
@@ -57,9 +58,10 @@ auto said_consolidation(const SceneConfig& config, const AnyAssembly& assembly, 
 void announce_rev() { std::cerr << "demcal rev: consolidating the REV to sigma3\n"; }
 
 // `ready` is called once the prototype is read and checked, before any
-// consolidation (it checks the output folder).
+// consolidation (it checks the output folder); `every_s`: seconds between
+// the consolidations' progress lines.
 RevOutcome rev_2d(const SceneConfig& config, const std::string& file, const RevOptions& ro,
-                  PrototypeSource& source, const std::function<void()>& ready) {
+                  PrototypeSource& source, double every_s, const std::function<void()>& ready) {
   Assembly proto = prototype_assembly(config, 0, file, &source);
   if (source.kind == "rev")
     throw InputError(config.source, "prototype",
@@ -67,21 +69,21 @@ RevOutcome rev_2d(const SceneConfig& config, const std::string& file, const RevO
                      "--prototype FILE");
   ready();
   if (!proto.dense)  // a generated gas is no packing to cut from or compare with
-    proto = assembly_of(said_consolidation(config, proto, "the prototype", [&] {
+    proto = assembly_of(said_consolidation(config, proto, "the prototype", every_s, [&] {
                           std::cerr << "demcal rev: consolidating the prototype first ("
                                     << source.description << "): a loose gas takes long\n";
                         }).world);
   std::cerr << "demcal rev: " << (ro.method == "cut" ? "cutting" : "generating") << " a REV of "
             << ro.particles << " particles from " << source.description << "\n";
   const RevResult r = make_rev(proto, ro, [&](const Assembly& raw) {
-    return said_consolidation(config, raw, "the REV", announce_rev);
+    return said_consolidation(config, raw, "the REV", every_s, announce_rev);
   });
   return {r.method, particle_csv(r.assembly), r.assembly.size(), consolidation_record(r.state),
           r.representativeness};
 }
 
 RevOutcome rev_3d(const SceneConfig& config, const std::string& file, const RevOptions& ro,
-                  PrototypeSource& source, const std::function<void()>& ready) {
+                  PrototypeSource& source, double every_s, const std::function<void()>& ready) {
   SphereAssembly proto = prototype_spheres(config, 0, file, &source);
   if (source.kind == "rev")
     throw InputError(config.source, "prototype",
@@ -93,14 +95,14 @@ RevOutcome rev_3d(const SceneConfig& config, const std::string& file, const RevO
                          " spheres, the prototype has only " + std::to_string(proto.size()));
   ready();
   if (source.kind == "generated")  // a generated gas is no packing to cut from or compare with
-    proto = sphere_assembly_of(said_consolidation(config, proto, "the prototype", [&] {
+    proto = sphere_assembly_of(said_consolidation(config, proto, "the prototype", every_s, [&] {
                                  std::cerr << "demcal rev: consolidating the prototype first ("
                                            << source.description << "): a loose gas takes long\n";
                                }).world);
   std::cerr << "demcal rev: " << (ro.method == "cut" ? "cutting a box" : "generating a")
             << " REV of " << ro.particles << " spheres from " << source.description << "\n";
   const SphereRevResult r = make_rev(proto, ro, [&](const SphereAssembly& raw) {
-    return said_consolidation(config, raw, "the REV", announce_rev);
+    return said_consolidation(config, raw, "the REV", every_s, announce_rev);
   });
   return {r.method, sphere_csv(r.assembly), r.assembly.size(), consolidation_record(r.state),
           r.representativeness};
@@ -125,9 +127,10 @@ int cmd_rev(const RevCmdOptions& o) {
   // A bad -o fails once the prototype is read, before any consolidation,
   // and leaves no folder.
   auto check_folder = [&] { OutputFolder::check(dir); };
-  const RevOutcome r = config.dimension == 3
-                           ? rev_3d(config, o.prototype, ro, source, check_folder)
-                           : rev_2d(config, o.prototype, ro, source, check_folder);
+  const RevOutcome r =
+      config.dimension == 3
+          ? rev_3d(config, o.prototype, ro, source, o.progress_every_s, check_folder)
+          : rev_2d(config, o.prototype, ro, source, o.progress_every_s, check_folder);
 
   // The three files together or none (a failure leaves no folder it made).
   OutputFolder out(dir);

@@ -26,9 +26,11 @@ int cmd_stability(const StabilityOptions& o) {
   // The REV consolidated, said as the other commands say it: "consolidating
   // ..." only when it consolidates, not before a read from the cache
   // (consolidate_announced), then its steps and time
-  // (print_consolidation_time: a cache read's labelled).
+  // (print_consolidation_time: a cache read's labelled); progress lines
+  // as run prints them (--progress, every 2 s).
   auto consolidated = [&](const auto& assembly, const char* what) {
-    const auto state = consolidate_announced(config, assembly, {}, [&] {
+    const ConsolidationOptions co{.progress = consolidation_progress(o.progress_every_s)};
+    const auto state = consolidate_announced(config, assembly, co, [&] {
       std::cerr << "stability " << config.name << ": consolidating " << assembly.size() << " "
                 << what << "\n";
     });

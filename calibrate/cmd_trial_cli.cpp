@@ -44,6 +44,7 @@ void add_calibrate_options(CLI::App* calibrate, CalibrateOptions& cal) {
   calibrate->add_option("--strategy", cal.strategy, "search strategy: " + strategy_names());
   calibrate->add_flag("--resume", cal.resume, "continue from DIR/trials.jsonl");
   calibrate->add_flag("-q,--quiet", cal.quiet, "no progress lines on stderr");
+  add_progress_option(calibrate, cal.progress_every_s);
   calibrate->add_flag("--evidence", cal.evidence,
                       "also run the paper-recipe baseline and a converged reference (8x and 16x "
                       "Nstep) so the report shows every trial's peak error");
@@ -53,6 +54,7 @@ void add_stability_options(CLI::App* stability, StabilityOptions& stab) {
   add_scene_options(stability, stab.config, stab.sets);
   stability->add_option("-o,--output", stab.out_dir,
                         "output folder (default demcal-stability-NAME)");
+  add_progress_option(stability, stab.progress_every_s);
   stability->add_option("-j,--jobs", stab.scan.jobs, "trials in parallel (default: cores)")
       ->check(whole_number(1, kMaxJobs));
   stability

@@ -84,6 +84,7 @@ std::function<int()> add_upscaling_commands(CLI::App& app) {
                        std::to_string(kThreadsFrom) +
                        " spheres, else the faster of 1 and all cores, measured on the prototype)")
       ->check(CLI::Range(0, 4096));
+  add_progress_option(verify, ve->progress_every_s);
 
   auto sc = std::make_shared<ScalingOptions>();
   auto* scaling = app.add_subcommand(
@@ -119,10 +120,7 @@ std::function<int()> add_upscaling_commands(CLI::App& app) {
   exp->add_option("--consolidate-in", ex->consolidate_in,
                   "demcal, deck (LAMMPS: the deck's first stage, under MPI) or auto (default: "
                   "demcal, whose kernel is faster than the deck's stage on the same cores)");
-  exp->add_option("--progress", ex->progress_every_s,
-                  "seconds between consolidation progress lines on stderr (default 2; 0: every "
-                  "check)")
-      ->check(CLI::Range(0.0, 1e9));
+  add_progress_option(exp, ex->progress_every_s);
 
   auto rv = std::make_shared<RevCmdOptions>();
   auto* rev = app.add_subcommand(
@@ -134,6 +132,7 @@ std::function<int()> add_upscaling_commands(CLI::App& app) {
       ->check(whole_number(1, kMaxParticles));
   rev->add_option("--method", rv->method, "cut (a window of the prototype) or generate");
   rev->add_option("-o,--output", rv->out_dir, "output folder (default demcal-rev-NAME)");
+  add_progress_option(rev, rv->progress_every_s);
 
   // A failed calibration's params.json is refused before anything else is
   // read or written (its "success" named), unless --allow-failed; then the

@@ -317,8 +317,9 @@ int verify_3d(const VerifyOptions& o, const nlohmann::json& params, const RevPar
 
   const auto t0 = std::chrono::steady_clock::now();
   // "consolidating ..." only before a consolidation, not before a read
-  // from the cache (consolidate_announced).
-  TriaxialState state = consolidate_announced(config, proto, {}, [&] {
+  // from the cache (consolidate_announced); progress lines (--progress).
+  const ConsolidationOptions co{.progress = consolidation_progress(o.progress_every_s)};
+  TriaxialState state = consolidate_announced(config, proto, co, [&] {
     std::cerr << "demcal verify: consolidating the prototype (single-threaded"
               << (source.kind == "generated" && config.assembly.type == "random"
                       ? ", long for a loose gas)\n"
@@ -472,8 +473,9 @@ int cmd_verify(const VerifyOptions& o) {
 
   const auto t0 = std::chrono::steady_clock::now();
   // "consolidating ..." only before a consolidation, not before a read
-  // from the cache (consolidate_announced).
-  const ConsolidatedState state = consolidate_announced(config, proto, {}, [&] {
+  // from the cache (consolidate_announced); progress lines (--progress).
+  const ConsolidationOptions co{.progress = consolidation_progress(o.progress_every_s)};
+  const ConsolidatedState state = consolidate_announced(config, proto, co, [&] {
     std::cerr << "demcal verify: consolidating the prototype ("
               << (proto.dense ? "short for a dense packing" : "long for a loose gas") << ")\n";
   });

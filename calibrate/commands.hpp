@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "consolidation_progress.hpp"
 #include "demcal/scene/config.hpp"
 #include "demcal/search/calibration.hpp"
 #include "demcal/search/stability_scan.hpp"
@@ -66,7 +67,9 @@ struct CalibrateOptions {
   double accuracy = 0.0;  ///< 0: the config's calibration.accuracy
   std::string strategy = to_string(CalibrationOptions{}.strategy);
   bool resume = false;
-  bool quiet = false;
+  bool quiet = false;  ///< no progress lines (the consolidation's included)
+  /// Seconds between the consolidation's progress lines on stderr.
+  double progress_every_s = kProgressEverySeconds;
   /// Also run the paper-recipe baseline and a converged reference (8× and
   /// 16× Nstep) for the report's accuracy evidence (costs trials).
   bool evidence = false;
@@ -78,6 +81,8 @@ struct StabilityOptions {
   std::vector<std::string> sets;
   std::string out_dir;
   StabilityScanOptions scan;  ///< --jobs, --from, --to, --points, --steps
+  /// Seconds between the consolidation's progress lines on stderr.
+  double progress_every_s = kProgressEverySeconds;
 };
 int cmd_stability(const StabilityOptions& options);
 

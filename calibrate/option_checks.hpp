@@ -82,4 +82,15 @@ inline void add_scene_options(CLI::App* command, std::string& config,
   command->add_option("--set", sets, "override a key: section.key=value (repeatable)");
 }
 
+/// --progress of every command that consolidates a sample (calibrate,
+/// stability, rev, verify, export): seconds between progress lines on
+/// stderr (default 2, kProgressEverySeconds; 0: every check).
+inline void add_progress_option(CLI::App* command, double& every_s) {
+  command
+      ->add_option("--progress", every_s,
+                   "seconds between consolidation progress lines on stderr (default 2; 0: every "
+                   "check)")
+      ->check(CLI::Range(0.0, 1e9));
+}
+
 }  // namespace demcal::cli

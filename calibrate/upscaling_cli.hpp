@@ -51,6 +51,8 @@ struct VerifyOptions : UpscaledParamsOptions {
   /// spheres, else the faster of one and all cores, measured on the
   /// prototype; results are bit-identical for any count).
   int threads = 0;
+  /// Seconds between the consolidation's progress lines on stderr.
+  double progress_every_s = kProgressEverySeconds;
 };
 int cmd_verify(const VerifyOptions& options);
 
@@ -88,6 +90,8 @@ struct RevCmdOptions {
   int64_t particles = 400;
   std::string method = "cut";
   std::string out_dir;
+  /// Seconds between the consolidations' progress lines on stderr.
+  double progress_every_s = kProgressEverySeconds;
 };
 int cmd_rev(const RevCmdOptions& options);
 

@@ -891,6 +891,48 @@ TEST_F(CliEndToEnd, RevSaysItsConsolidationAsTheOtherCommands) {
                             "demcal rev: consolidated the REV in ");
 }
 
+// Every command that consolidates prints its progress lines as run, sweep
+// and export do: calibrate, stability, rev and verify consolidated
+// silently, however long it took. --progress 0 prints at every check (the
+// default, 2 s, keeps these short consolidations quiet); calibrate -q
+// prints none.
+TEST_F(CliEndToEnd, EveryCommandThatConsolidatesPrintsItsProgress) {
+  const std::string hex10 =
+      (fs::path(test::kSourceDir) / "reports" / "example-hex_10x10" / "params.json").string();
+  const std::string fcc =
+      (fs::path(test::kSourceDir) / "reports" / "example-fcc_4x4x4" / "params.json").string();
+  auto progress_lines = [](const std::string& err) {
+    std::vector<std::string> lines;
+    for (const std::string& line : lines_of(err))
+      if (line.rfind("consolidating (", 0) == 0) lines.push_back(line);
+    return lines;
+  };
+  const std::vector<std::vector<std::string>> commands = {
+      {"calibrate", kHex5, "-j", "1", "--max-trials", "12", "-o", "cal"},
+      {"stability", kHex5, "--points", "2", "--steps", "2048", "-o", "stab"},
+      {"rev", kHex5, "--particles", "16", "-o", "rev"},
+      {"verify", hex10, "--particles", "100", "-o", "verify2d"},
+      {"verify", fcc, "--particles", "256", "-o", "verify3d"},
+  };
+  for (std::vector<std::string> args : commands) {
+    SCOPED_TRACE(args[0] + " " + args[1]);
+    args.insert(args.end(), {"--progress", "0"});
+    const Result r = demcal(args, {"DEMCAL_CACHE_DIR=off"});
+    ASSERT_EQ(r.status, 0) << r.err;
+    const std::vector<std::string> lines = progress_lines(r.err);
+    ASSERT_GE(lines.size(), 2u) << r.err;
+    EXPECT_EQ(lines.front().rfind("consolidating (frictionless): step 200 of at most ", 0), 0u)
+        << lines.front();
+    EXPECT_EQ(lines.back().rfind("consolidating (friction on)", 0), 0u) << lines.back();
+  }
+  const Result quiet = demcal(
+      {"calibrate", kHex5, "-j", "1", "--max-trials", "12", "-q", "--progress", "0", "-o", "q"},
+      {"DEMCAL_CACHE_DIR=off"});
+  ASSERT_EQ(quiet.status, 0) << quiet.err;
+  EXPECT_TRUE(progress_lines(quiet.err).empty()) << quiet.err;
+  EXPECT_EQ(demcal({"stability", kHex5, "--progress", "-1"}, {}).status, 2);
+}
+
 // `demcal export` says how the deck's Nstep was upscaled, 2D and 3D in
 // one line: the prototype's Nstep (the one `demcal upscale` writes), from
 // the REV's particles and steps, by which law (the 2D export said nothing).
