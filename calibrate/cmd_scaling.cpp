@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "consolidation_progress.hpp"
 #include "demcal/io/files.hpp"
 #include "demcal/io/format.hpp"
 #include "demcal/io/input_error.hpp"
@@ -53,8 +54,10 @@ int cmd_scaling(const ScalingOptions& o) {
   so.sizes_text = o.sizes;
   so.calibrate_max = o.calibrate_max > 0 ? o.calibrate_max : 400;
   so.jobs = o.jobs;
-  if (!o.quiet)
+  if (!o.quiet) {
     so.log = [](const std::string& line) { std::cerr << "demcal scaling: " << line << "\n"; };
+    so.consolidation_progress = consolidation_progress(o.progress_every_s);
+  }
   check_scaling_sizes(so);  // bad sizes fail before any folder is made
   // Not "reports": run from the repository it overwrote the shipped study.
   const std::string out_dir = o.out_dir.empty() ? "demcal-scaling-" + config.name : o.out_dir;

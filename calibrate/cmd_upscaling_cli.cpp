@@ -106,6 +106,7 @@ std::function<int()> add_upscaling_commands(CLI::App& app) {
       ->check(whole_number(kMinSearchTrials, kMaxTrials, kMinSearchTrialsWhy));
   scaling->add_flag("--resume", sc->resume, "reuse the sizes already done in the work folder");
   scaling->add_flag("-q,--quiet", sc->quiet, "no progress lines on stderr");
+  add_progress_option(scaling, sc->progress_every_s);
 
   auto ex = std::make_shared<ExportCmdOptions>();
   auto* exp = app.add_subcommand("export", "an input deck for LAMMPS or LIGGGHTS");

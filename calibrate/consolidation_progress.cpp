@@ -23,6 +23,9 @@ std::string seconds(double s) {
 ConsolidationCallback consolidation_progress(double every_s) {
   auto last = std::make_shared<double>(0.0);  // elapsed_s at the last line
   return [last, every_s](const ConsolidationProgress& p) {
+    // A later consolidation through the same callback (scaling's sizes)
+    // starts its clock at 0 again.
+    if (p.elapsed_s < *last) *last = 0.0;
     if (p.elapsed_s - *last < every_s) return;
     *last = p.elapsed_s;
     std::ostringstream o;

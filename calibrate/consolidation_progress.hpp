@@ -17,7 +17,8 @@ inline constexpr double kProgressEverySeconds = 2.0;
 
 /// A callback that prints one line on stderr (phase, step, criteria, time
 /// so far and the estimate) when at least `every_s` seconds have passed
-/// since the start or the last line; 0 prints at every check.
+/// since the start or the last line; 0 prints at every check. One callback
+/// may serve consolidations one after another (not at once).
 ConsolidationCallback consolidation_progress(double every_s = kProgressEverySeconds);
 
 /// A consolidated state's wall time on `out`, in its format, as `check` and

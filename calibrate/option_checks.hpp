@@ -83,7 +83,7 @@ inline void add_scene_options(CLI::App* command, std::string& config,
 }
 
 /// --progress of every command that consolidates a sample (calibrate,
-/// stability, rev, verify, export): seconds between progress lines on
+/// stability, rev, verify, scaling, export): seconds between progress lines on
 /// stderr (default 2, kProgressEverySeconds; 0: every check).
 inline void add_progress_option(CLI::App* command, double& every_s) {
   command

@@ -67,6 +67,8 @@ struct ScalingOptions {
   int max_trials = 0;
   bool resume = false;
   bool quiet = false;
+  /// Seconds between the consolidations' progress lines on stderr.
+  double progress_every_s = kProgressEverySeconds;
 };
 int cmd_scaling(const ScalingOptions& options);
 

@@ -892,7 +892,7 @@ TEST_F(CliEndToEnd, RevSaysItsConsolidationAsTheOtherCommands) {
 }
 
 // Every command that consolidates prints its progress lines as run, sweep
-// and export do: calibrate, stability, rev and verify consolidated
+// and export do: calibrate, stability, rev, verify and scaling consolidated
 // silently, however long it took. --progress 0 prints at every check (the
 // default, 2 s, keeps these short consolidations quiet); calibrate -q
 // prints none.
@@ -913,12 +913,16 @@ TEST_F(CliEndToEnd, EveryCommandThatConsolidatesPrintsItsProgress) {
       {"rev", kHex5, "--particles", "16", "-o", "rev"},
       {"verify", hex10, "--particles", "100", "-o", "verify2d"},
       {"verify", fcc, "--particles", "256", "-o", "verify3d"},
+      {"scaling", kHex5, "--sizes", "16,25,36", "--calibrate-max", "25", "--max-trials", "12", "-j",
+       "1", "-o", "scaling"},
   };
   for (std::vector<std::string> args : commands) {
     SCOPED_TRACE(args[0] + " " + args[1]);
     args.insert(args.end(), {"--progress", "0"});
     const Result r = demcal(args, {"DEMCAL_CACHE_DIR=off"});
-    ASSERT_EQ(r.status, 0) << r.err;
+    // scaling: 1 when its forward check fails (3 tiny sizes), after the
+    // consolidations.
+    ASSERT_TRUE(r.status == 0 || (args[0] == "scaling" && r.status == 1)) << r.err;
     const std::vector<std::string> lines = progress_lines(r.err);
     ASSERT_GE(lines.size(), 2u) << r.err;
     EXPECT_EQ(lines.front().rfind("consolidating (frictionless): step 200 of at most ", 0), 0u)

@@ -5,10 +5,12 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <iostream>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "consolidation_progress.hpp"
 #include "demcal/scene/biaxial.hpp"
 #include "demcal/scene/config.hpp"
 #include "demcal/scene/packing.hpp"
@@ -146,6 +148,34 @@ TEST(ConsolidationProgress, SphereThreadsAndReportsDoNotChangeTheState) {
   EXPECT_EQ(t.threads(), 1);
   std::printf("120-sphere gas: %lld steps, %zu reports\n", static_cast<long long>(plain.steps),
               seen.size());
+}
+
+// One callback serves consolidations one after another (scaling's sizes):
+// each starts its clock at 0 again, and its lines come every `every_s` of
+// its own time. (The callback kept the last line's time of the one before,
+// so a later consolidation printed nothing until it ran longer than that.)
+TEST(ConsolidationProgress, OneCallbackServesConsolidationsOneAfterAnother) {
+  const ConsolidationCallback callback = cli::consolidation_progress(2.0);
+  std::ostringstream captured;
+  std::streambuf* const old = std::cerr.rdbuf(captured.rdbuf());
+  for (int consolidation = 0; consolidation < 2; ++consolidation)
+    for (int k = 1; k <= 10; ++k) {
+      ConsolidationProgress p;
+      p.steps = 200 * k;
+      p.max_steps = 2'000'000;
+      p.elapsed_s = 0.5 * k;  // lines at 2 s and 4 s
+      callback(p);
+    }
+  std::cerr.rdbuf(old);
+  std::vector<std::string> lines;
+  std::istringstream in(captured.str());
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  ASSERT_EQ(lines.size(), 4u) << captured.str();
+  for (int c = 0; c < 2; ++c) {
+    EXPECT_NE(lines[2 * c].find("step 800 of at most "), std::string::npos) << lines[2 * c];
+    EXPECT_NE(lines[2 * c + 1].find("step 1600 of at most "), std::string::npos)
+        << lines[2 * c + 1];
+  }
 }
 
 std::vector<std::string> progress_lines(const std::string& err) {

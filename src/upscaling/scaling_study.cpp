@@ -199,10 +199,14 @@ class Family {
     if (it != states_.end()) return *it->second;
     auto st = std::make_unique<SizeState>();
     st->scene = scene(n);
-    // A stop ends the consolidation at its next check (every 200 steps).
+    // A stop ends the consolidation at its next check (every 200 steps);
+    // the caller's progress callback sees every check.
     ConsolidationOptions consolidation;
-    if (o_.stop)
-      consolidation.progress = [this](const ConsolidationProgress&) { throw_if_stopped(o_); };
+    if (o_.stop || o_.consolidation_progress)
+      consolidation.progress = [this](const ConsolidationProgress& p) {
+        throw_if_stopped(o_);
+        if (o_.consolidation_progress) o_.consolidation_progress(p);
+      };
     // consolidate() and consolidate_triaxial() through the cache, "consolidating"
     // said only when it consolidates (not before a cache read).
     const std::string cache = consolidation_cache_dir();

@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "demcal/scene/config.hpp"
+#include "demcal/scene/consolidation_progress.hpp"
 #include "demcal/scoring/trial.hpp"
 #include "demcal/search/calibration.hpp"
 #include "demcal/upscaling/upscaling.hpp"
@@ -51,6 +52,9 @@ struct ScalingStudyOptions {
   const std::atomic<bool>* stop = nullptr;
   /// Progress lines; may be empty.
   std::function<void(const std::string&)> log;
+  /// Called at every check (200 steps) of each size's fresh consolidation,
+  /// one size after another; may be empty.
+  ConsolidationCallback consolidation_progress;
 };
 
 /// The smallest passing Nstep at the REV's multipliers, at one size.
