@@ -105,9 +105,9 @@ namespace {
 
 // ---- 3D: spheres, triaxial test -------------------------------------------
 
-TriaxialState consolidate_3d(const SceneConfig& config) {
+TriaxialState consolidate_3d(const SceneConfig& config, double progress_every_s) {
   const SphereAssembly assembly = make_sphere_assembly(config);
-  return consolidate_triaxial(config, assembly, consolidation_progress());
+  return consolidate_triaxial(config, assembly, consolidation_progress(progress_every_s));
 }
 
 void print_scales_3d(const SceneConfig& config, const SphereWorld& world) {
@@ -121,8 +121,8 @@ void print_scales_3d(const SceneConfig& config, const SphereWorld& world) {
             << " N m s (2 sqrt(kt r^2 I), I = (2/5) m r^2, m_min)\n";
 }
 
-int check_3d(const SceneConfig& config) {
-  const TriaxialState state = consolidate_3d(config);
+int check_3d(const SceneConfig& config, double progress_every_s) {
+  const TriaxialState state = consolidate_3d(config, progress_every_s);
   require_stable_step(config, estimated_stable_dt_ratio(state, config.algorithm), false);
   std::cout << "config " << config.source << ": valid\n";
   // The scales at the config's mass scaling, from the kernel's masses.
@@ -145,11 +145,13 @@ int check_3d(const SceneConfig& config) {
   return 0;
 }
 
-int run_3d(const SceneConfig& config, const std::string& out_dir, bool allow_unstable) {
+int run_3d(const SceneConfig& config, const std::string& out_dir, bool allow_unstable,
+           double progress_every_s) {
   const SphereAssembly assembly = make_sphere_assembly(config);
   const std::string dir = out_dir.empty() ? "demcal-run-" + config.name : out_dir;
   OutputFolder::check(dir);  // an unwritable -o fails now, not after the run
-  const TriaxialState state = consolidate_triaxial(config, assembly, consolidation_progress());
+  const TriaxialState state =
+      consolidate_triaxial(config, assembly, consolidation_progress(progress_every_s));
   require_stable_step(config, estimated_stable_dt_ratio(state, config.algorithm), allow_unstable);
   SphereWorld final_state = state.world;
   const TriaxialResult run =
@@ -208,13 +210,14 @@ void require_prototype(const SceneConfig& config) {
     prototype_assembly(config);
 }
 
-int cmd_check(const std::string& path, const std::vector<std::string>& sets) {
+int cmd_check(const std::string& path, const std::vector<std::string>& sets,
+              double progress_every_s) {
   SceneConfig config = load_config(path, sets);
   require_prototype(config);  // before the consolidation: what calibrate reads after its search
-  if (config.dimension == 3) return check_3d(config);
+  if (config.dimension == 3) return check_3d(config, progress_every_s);
   Assembly assembly = make_assembly(config);
-  const ConsolidatedState state =
-      consolidate(config, assembly, ConsolidationOptions{.progress = consolidation_progress()});
+  const ConsolidatedState state = consolidate(
+      config, assembly, ConsolidationOptions{.progress = consolidation_progress(progress_every_s)});
   require_stable_step(config, estimated_stable_dt_ratio(state, config.algorithm), false);
   std::cout << "config " << config.source << ": valid\n";
   print_scales(config, state.world);
@@ -232,14 +235,14 @@ int cmd_check(const std::string& path, const std::vector<std::string>& sets) {
 }
 
 int cmd_run(const std::string& path, const std::vector<std::string>& sets,
-            const std::string& out_dir, bool allow_unstable) {
+            const std::string& out_dir, bool allow_unstable, double progress_every_s) {
   SceneConfig config = load_config(path, sets);
-  if (config.dimension == 3) return run_3d(config, out_dir, allow_unstable);
+  if (config.dimension == 3) return run_3d(config, out_dir, allow_unstable, progress_every_s);
   Assembly assembly = make_assembly(config);
   const std::string dir = out_dir.empty() ? "demcal-run-" + config.name : out_dir;
   OutputFolder::check(dir);  // an unwritable -o fails now, not after the run
-  const ConsolidatedState state =
-      consolidate(config, assembly, ConsolidationOptions{.progress = consolidation_progress()});
+  const ConsolidatedState state = consolidate(
+      config, assembly, ConsolidationOptions{.progress = consolidation_progress(progress_every_s)});
   require_stable_step(config, estimated_stable_dt_ratio(state, config.algorithm), allow_unstable);
   World final_state = state.world;
   const LoadingResult run = run_loading(state, config.test, config.algorithm, {}, &final_state);

@@ -54,13 +54,15 @@ int cmd_sweep(const SweepOptions& options) {
   SweepResult result;
   if (three_d) {
     const SphereAssembly assembly = make_sphere_assembly(config);
-    const TriaxialState state = consolidate_triaxial(config, assembly, consolidation_progress());
+    const TriaxialState state =
+        consolidate_triaxial(config, assembly, consolidation_progress(options.progress_every_s));
     result =
         sweep(state, estimated_stable_dt_ratio(state, config.algorithm), "spheres (3D, triaxial)");
   } else {
     Assembly assembly = make_assembly(config);
-    const ConsolidatedState state =
-        consolidate(config, assembly, ConsolidationOptions{.progress = consolidation_progress()});
+    const ConsolidatedState state = consolidate(
+        config, assembly,
+        ConsolidationOptions{.progress = consolidation_progress(options.progress_every_s)});
     result = sweep(state, state.world.stability_estimate().dt_ratio_stable, "particles");
   }
 

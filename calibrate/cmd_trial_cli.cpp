@@ -19,6 +19,7 @@ struct TrialOptions {
   std::string config, out_dir;
   std::vector<std::string> sets;
   bool allow_unstable = false;
+  double progress_every_s = kProgressEverySeconds;
 };
 
 std::string strategy_names() {
@@ -100,18 +101,21 @@ std::function<int()> add_trial_commands(CLI::App& app) {
   auto one = std::make_shared<TrialOptions>();
   auto* check = app.add_subcommand("check", "validate a config and print the derived scales");
   add_scene_options(check, one->config, one->sets);
+  add_progress_option(check, one->progress_every_s);
 
   auto* run = app.add_subcommand("run", "run one trial and print its criteria");
   add_scene_options(run, one->config, one->sets);
   run->add_option("-o,--output", one->out_dir, "output folder (default demcal-run-NAME)");
   run->add_flag("--allow-unstable", one->allow_unstable,
                 "run a dt_ratio beyond the estimated stable step (to watch it diverge)");
+  add_progress_option(run, one->progress_every_s);
 
   auto sw = std::make_shared<SweepOptions>();
   auto* sweep =
       app.add_subcommand("sweep", "the signature atlas: one parameter out of bounds at a time");
   add_scene_options(sweep, sw->config, sw->sets);
   sweep->add_option("-o,--output", sw->out_dir, "output folder (default demcal-sweep-NAME)");
+  add_progress_option(sweep, sw->progress_every_s);
   sweep->add_option("-j,--jobs", sw->jobs, "trials in parallel (default: cores)")
       ->check(whole_number(1, kMaxJobs));
 
@@ -132,8 +136,10 @@ std::function<int()> add_trial_commands(CLI::App& app) {
   add_score_options(score, *sc);
 
   return [=]() -> int {
-    if (check->parsed()) return cmd_check(one->config, one->sets);
-    if (run->parsed()) return cmd_run(one->config, one->sets, one->out_dir, one->allow_unstable);
+    if (check->parsed()) return cmd_check(one->config, one->sets, one->progress_every_s);
+    if (run->parsed())
+      return cmd_run(one->config, one->sets, one->out_dir, one->allow_unstable,
+                     one->progress_every_s);
     if (sweep->parsed()) return cmd_sweep(*sw);
     if (calibrate->parsed()) return cmd_calibrate(*cal);
     if (stability->parsed()) return cmd_stability(*stab);

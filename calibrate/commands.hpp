@@ -44,17 +44,23 @@ void require_stable_step(const SceneConfig& config, double stable, bool allow_un
 /// which says the config is valid.
 void require_prototype(const SceneConfig& config);
 
-int cmd_check(const std::string& path, const std::vector<std::string>& sets);
+/// `progress_every_s`: seconds between the consolidation's progress lines on
+/// stderr (--progress).
+int cmd_check(const std::string& path, const std::vector<std::string>& sets,
+              double progress_every_s = kProgressEverySeconds);
 /// `allow_unstable`: run a Δt beyond the estimated stable step (otherwise
 /// bad input).
 int cmd_run(const std::string& path, const std::vector<std::string>& sets,
-            const std::string& out_dir, bool allow_unstable = false);
+            const std::string& out_dir, bool allow_unstable = false,
+            double progress_every_s = kProgressEverySeconds);
 
 struct SweepOptions {
   std::string config;
   std::vector<std::string> sets;
   std::string out_dir;
   int jobs = 0;  ///< 0: one per core
+  /// Seconds between the consolidation's progress lines on stderr.
+  double progress_every_s = kProgressEverySeconds;
 };
 int cmd_sweep(const SweepOptions& options);
 

@@ -21,13 +21,18 @@ std::string seconds(double s) {
 }  // namespace
 
 ConsolidationCallback consolidation_progress(double every_s) {
-  auto last = std::make_shared<double>(0.0);  // elapsed_s at the last line
+  struct Last {
+    double line_s = 0.0;  // elapsed_s at the last line
+    int64_t steps = 0;    // at the last check
+  };
+  auto last = std::make_shared<Last>();
   return [last, every_s](const ConsolidationProgress& p) {
     // A later consolidation through the same callback (scaling's sizes)
-    // starts its clock at 0 again.
-    if (p.elapsed_s < *last) *last = 0.0;
-    if (p.elapsed_s - *last < every_s) return;
-    *last = p.elapsed_s;
+    // starts again, at step 200 and time 0: its lines count from there.
+    if (p.steps <= last->steps) last->line_s = 0.0;
+    last->steps = p.steps;
+    if (p.elapsed_s - last->line_s < every_s) return;
+    last->line_s = p.elapsed_s;
     std::ostringstream o;
     o << "consolidating (" << (p.phase == 0 ? "frictionless" : "friction on") << "): step "
       << p.steps << " of at most " << p.max_steps << ", wall stress error " << std::setprecision(3)

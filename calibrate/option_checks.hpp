@@ -82,15 +82,25 @@ inline void add_scene_options(CLI::App* command, std::string& config,
   command->add_option("--set", sets, "override a key: section.key=value (repeatable)");
 }
 
-/// --progress of every command that consolidates a sample (calibrate,
-/// stability, rev, verify, scaling, export): seconds between progress lines on
-/// stderr (default 2, kProgressEverySeconds; 0: every check).
+/// --progress of every command that consolidates a sample (check, run,
+/// sweep, calibrate, stability, rev, verify, scaling, export): seconds
+/// between progress lines on stderr (default 2, kProgressEverySeconds; 0:
+/// every check), a finite number from 0 to 1e9 (CLI::Range lets nan through).
 inline void add_progress_option(CLI::App* command, double& every_s) {
+  const std::string range = "a number from 0 to 1e9";
   command
       ->add_option("--progress", every_s,
                    "seconds between consolidation progress lines on stderr (default 2; 0: every "
                    "check)")
-      ->check(CLI::Range(0.0, 1e9));
+      ->check(CLI::Validator(
+          [=](std::string& s) -> std::string {
+            char* end = nullptr;
+            const double v = std::strtod(s.c_str(), &end);
+            if (s.empty() || *end != '\0' || !std::isfinite(v) || v < 0.0 || v > 1e9)
+              return "must be " + range + ", got " + s;
+            return "";
+          },
+          range));
 }
 
 }  // namespace demcal::cli

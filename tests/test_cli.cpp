@@ -891,11 +891,13 @@ TEST_F(CliEndToEnd, RevSaysItsConsolidationAsTheOtherCommands) {
                             "demcal rev: consolidated the REV in ");
 }
 
-// Every command that consolidates prints its progress lines as run, sweep
-// and export do: calibrate, stability, rev, verify and scaling consolidated
-// silently, however long it took. --progress 0 prints at every check (the
-// default, 2 s, keeps these short consolidations quiet); calibrate -q
-// prints none.
+// Every command that consolidates prints its progress lines, with
+// --progress S setting the interval (add_progress_option): calibrate,
+// stability, rev, verify and scaling consolidated silently, however long it
+// took, and check, run and sweep printed every 2 s with no option. --progress 0
+// prints at every check (the default, 2 s, keeps these short consolidations
+// quiet): each consolidation's first check, step 200, is on a line; scaling
+// consolidates each of its 3 sizes. calibrate -q and scaling -q print none.
 TEST_F(CliEndToEnd, EveryCommandThatConsolidatesPrintsItsProgress) {
   const std::string hex10 =
       (fs::path(test::kSourceDir) / "reports" / "example-hex_10x10" / "params.json").string();
@@ -907,34 +909,62 @@ TEST_F(CliEndToEnd, EveryCommandThatConsolidatesPrintsItsProgress) {
       if (line.rfind("consolidating (", 0) == 0) lines.push_back(line);
     return lines;
   };
-  const std::vector<std::vector<std::string>> commands = {
-      {"calibrate", kHex5, "-j", "1", "--max-trials", "12", "-o", "cal"},
-      {"stability", kHex5, "--points", "2", "--steps", "2048", "-o", "stab"},
-      {"rev", kHex5, "--particles", "16", "-o", "rev"},
-      {"verify", hex10, "--particles", "100", "-o", "verify2d"},
-      {"verify", fcc, "--particles", "256", "-o", "verify3d"},
-      {"scaling", kHex5, "--sizes", "16,25,36", "--calibrate-max", "25", "--max-trials", "12", "-j",
-       "1", "-o", "scaling"},
+  auto first_checks = [](const std::vector<std::string>& lines) {
+    int n = 0;
+    for (const std::string& line : lines)
+      n += line.rfind("consolidating (frictionless): step 200 of at most ", 0) == 0 ? 1 : 0;
+    return n;
   };
-  for (std::vector<std::string> args : commands) {
-    SCOPED_TRACE(args[0] + " " + args[1]);
-    args.insert(args.end(), {"--progress", "0"});
-    const Result r = demcal(args, {"DEMCAL_CACHE_DIR=off"});
-    // scaling: 1 when its forward check fails (3 tiny sizes), after the
-    // consolidations.
-    ASSERT_TRUE(r.status == 0 || (args[0] == "scaling" && r.status == 1)) << r.err;
+  const std::vector<std::string> scaling = {
+      "scaling", kHex5,          "--sizes", "16,25,36", "--calibrate-max",
+      "25",      "--max-trials", "12",      "-j",       "1"};
+  struct Case {
+    std::vector<std::string> args;
+    int consolidations;
+  };
+  std::vector<Case> cases = {
+      {{"check", kHex5}, 1},
+      {{"run", kHex5, "-o", "run"}, 1},
+      {{"sweep", kHex5, "--set", "algorithm.steps=2000", "-j", "1", "-o", "sweep"}, 1},
+      {{"calibrate", kHex5, "-j", "1", "--max-trials", "12", "-o", "cal"}, 1},
+      {{"stability", kHex5, "--points", "2", "--steps", "2048", "-o", "stab"}, 1},
+      {{"rev", kHex5, "--particles", "16", "-o", "rev"}, 1},
+      {{"verify", hex10, "--particles", "100", "-o", "verify2d"}, 1},
+      {{"verify", fcc, "--particles", "256", "-o", "verify3d"}, 1},
+      {scaling, 3},
+  };
+  cases.back().args.insert(cases.back().args.end(), {"-o", "scaling"});
+  for (Case& c : cases) {
+    SCOPED_TRACE(c.args[0] + " " + c.args[1]);
+    c.args.insert(c.args.end(), {"--progress", "0"});
+    const Result r = demcal(c.args, {"DEMCAL_CACHE_DIR=off"});
+    // run: 1 when its verdict fails (summary.json says so); scaling: 1 when
+    // the forward check of its 3 tiny sizes fails.
+    if (c.args[0] == "run")
+      ASSERT_NO_FATAL_FAILURE(test::expect_run_status(r.status, dir_ / "work" / "run", r.err));
+    else if (c.args[0] == "scaling" && r.status == 1)
+      EXPECT_NE(r.out.find("forward check of the linear law at 36: FAILED"), std::string::npos)
+          << r.out;
+    else
+      ASSERT_EQ(r.status, 0) << r.err;
     const std::vector<std::string> lines = progress_lines(r.err);
-    ASSERT_GE(lines.size(), 2u) << r.err;
-    EXPECT_EQ(lines.front().rfind("consolidating (frictionless): step 200 of at most ", 0), 0u)
-        << lines.front();
+    EXPECT_EQ(first_checks(lines), c.consolidations) << r.err;
+    ASSERT_FALSE(lines.empty()) << r.err;
     EXPECT_EQ(lines.back().rfind("consolidating (friction on)", 0), 0u) << lines.back();
   }
-  const Result quiet = demcal(
+  std::vector<std::string> quiet_scaling = scaling;
+  quiet_scaling.insert(quiet_scaling.end(), {"-q", "--progress", "0", "-o", "scaling-q"});
+  const std::vector<std::vector<std::string>> quiet_runs = {
       {"calibrate", kHex5, "-j", "1", "--max-trials", "12", "-q", "--progress", "0", "-o", "q"},
-      {"DEMCAL_CACHE_DIR=off"});
-  ASSERT_EQ(quiet.status, 0) << quiet.err;
-  EXPECT_TRUE(progress_lines(quiet.err).empty()) << quiet.err;
-  EXPECT_EQ(demcal({"stability", kHex5, "--progress", "-1"}, {}).status, 2);
+      quiet_scaling};
+  for (const std::vector<std::string>& args : quiet_runs) {
+    SCOPED_TRACE(args[0]);
+    const Result quiet = demcal(args, {"DEMCAL_CACHE_DIR=off"});
+    EXPECT_TRUE(quiet.status == 0 || (args[0] == "scaling" && quiet.status == 1)) << quiet.err;
+    EXPECT_TRUE(progress_lines(quiet.err).empty()) << quiet.err;
+  }
+  for (const char* bad : {"-1", "nan", "inf", "1e10", "two"})
+    EXPECT_EQ(demcal({"stability", kHex5, "--progress", bad}, {}).status, 2) << bad;
 }
 
 // `demcal export` says how the deck's Nstep was upscaled, 2D and 3D in

@@ -151,31 +151,34 @@ TEST(ConsolidationProgress, SphereThreadsAndReportsDoNotChangeTheState) {
 }
 
 // One callback serves consolidations one after another (scaling's sizes):
-// each starts its clock at 0 again, and its lines come every `every_s` of
-// its own time. (The callback kept the last line's time of the one before,
-// so a later consolidation printed nothing until it ran longer than that.)
+// each starts again at step 200 and time 0, and its lines come every
+// `every_s` of its own time. (The callback kept the last line's time of the
+// one before, so a later consolidation printed nothing until its clock
+// passed that time, then counted from it.) The second one here is slow to
+// start (its first check at 4.5 s): its first line is that check's.
 TEST(ConsolidationProgress, OneCallbackServesConsolidationsOneAfterAnother) {
   const ConsolidationCallback callback = cli::consolidation_progress(2.0);
   std::ostringstream captured;
   std::streambuf* const old = std::cerr.rdbuf(captured.rdbuf());
-  for (int consolidation = 0; consolidation < 2; ++consolidation)
+  for (const double start_s : {0.0, 4.0})
     for (int k = 1; k <= 10; ++k) {
       ConsolidationProgress p;
       p.steps = 200 * k;
       p.max_steps = 2'000'000;
-      p.elapsed_s = 0.5 * k;  // lines at 2 s and 4 s
+      p.elapsed_s = start_s + 0.5 * k;
       callback(p);
     }
   std::cerr.rdbuf(old);
   std::vector<std::string> lines;
   std::istringstream in(captured.str());
   for (std::string line; std::getline(in, line);) lines.push_back(line);
-  ASSERT_EQ(lines.size(), 4u) << captured.str();
-  for (int c = 0; c < 2; ++c) {
-    EXPECT_NE(lines[2 * c].find("step 800 of at most "), std::string::npos) << lines[2 * c];
-    EXPECT_NE(lines[2 * c + 1].find("step 1600 of at most "), std::string::npos)
-        << lines[2 * c + 1];
-  }
+  // The first: lines at 2 s and 4 s (steps 800, 1600); the second at 4.5,
+  // 6.5 and 8.5 s (steps 200, 1000, 1800).
+  const std::vector<int> steps = {800, 1600, 200, 1000, 1800};
+  ASSERT_EQ(lines.size(), steps.size()) << captured.str();
+  for (size_t k = 0; k < steps.size(); ++k)
+    EXPECT_NE(lines[k].find("step " + std::to_string(steps[k]) + " of at most "), std::string::npos)
+        << lines[k];
 }
 
 std::vector<std::string> progress_lines(const std::string& err) {
