@@ -317,10 +317,15 @@ int verify_3d(const VerifyOptions& o, const nlohmann::json& params, const RevPar
 
   const auto t0 = std::chrono::steady_clock::now();
   // "consolidating ..." only before a consolidation, not before a read
-  // from the cache (consolidate_announced); progress lines (--progress).
-  const ConsolidationOptions co{.progress = consolidation_progress(o.progress_every_s)};
+  // from the cache (consolidate_announced); progress lines (--progress). On
+  // the loading's threads: the state is the same bit for bit on any count,
+  // and a large prototype's consolidation is most of verify's time.
+  const ConsolidationOptions co{.threads = threads,
+                                .progress = consolidation_progress(o.progress_every_s)};
   TriaxialState state = consolidate_announced(config, proto, co, [&] {
-    std::cerr << "demcal verify: consolidating the prototype (single-threaded"
+    std::cerr << "demcal verify: consolidating the prototype ("
+              << (threads == 1 ? std::string("single-threaded")
+                               : "on " + std::to_string(threads) + " threads")
               << (source.kind == "generated" && config.assembly.type == "random"
                       ? ", long for a loose gas)\n"
                       : ")\n");

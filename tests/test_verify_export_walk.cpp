@@ -195,6 +195,31 @@ TEST(VerifyExportWalk, VerifySaysConsolidatingOnlyWhenItConsolidates) {
   }
 }
 
+// 3D `verify` consolidated its prototype on one thread whatever --threads
+// said (the loading alone used them), and a large prototype's
+// consolidation is most of its time: it now runs on the loading's threads,
+// says so, and reaches the same state, so the same series, bit for bit.
+TEST(VerifyExportWalk, Verify3dConsolidatesOnItsThreads) {
+  const test::TempDir dir("walk_verify_threads");
+  std::string series[2];
+  for (const int threads : {1, 2}) {
+    SCOPED_TRACE(threads);
+    const std::string out = "t" + std::to_string(threads);
+    const test::RunResult r = demcal_with({"DEMCAL_CACHE_DIR=off"},
+                                          {"verify", example_params("fcc_4x4x4"), "--particles",
+                                           "256", "--threads", std::to_string(threads), "-o", out},
+                                          dir.path());
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(line_of(r.err, "demcal verify: consolidating the prototype "),
+              threads == 1 ? "demcal verify: consolidating the prototype (single-threaded)"
+                           : "demcal verify: consolidating the prototype (on 2 threads)")
+        << r.err;
+    series[threads - 1] = test::read_text(dir.path() / out / "series.csv");
+    ASSERT_FALSE(series[threads - 1].empty());
+  }
+  EXPECT_TRUE(series[0] == series[1]);
+}
+
 // `verify --engine lammps --allow-failed` ran a deck whose header did not
 // say that its parameters are not certified, which `export --allow-failed`
 // writes (deck_sections.cpp's header_opening, from params.json's success and
