@@ -464,6 +464,17 @@ TEST(ScalingStudy, ReportStatesTheVerdictAndTheLaw) {
             std::string::npos);
   EXPECT_NE(md.find("the linear law holds"), std::string::npos);
   EXPECT_NE(md.find("peak 0.4 % from the reference, target ±2 %"), std::string::npos);
+  // The law's Nstep, and the run's where round_steps moved it (it printed
+  // the run's as the product: "92870 × 1600/400 = 371500").
+  st.law_run.params.steps = 200000;
+  EXPECT_NE(scaling_markdown(st, config).find("Nstep = 50000 × 400/100 = 200000; scored"),
+            std::string::npos);
+  st.results[100].best.steps = 46435;
+  st.law_run.params.steps = round_steps(4.0 * 46435);
+  EXPECT_NE(scaling_markdown(st, config)
+                .find("Nstep = 46435 × 400/100 = 185740, run as 185700 (four significant "
+                      "digits); scored"),
+            std::string::npos);
   const json j = to_json(st, config);
   EXPECT_EQ(j.at("law").at("law"), "linear");
   EXPECT_EQ(j.at("forward").at("passed"), true);

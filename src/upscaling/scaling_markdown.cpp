@@ -1,6 +1,9 @@
 // scaling.md: the scaling study as a reader follows it (calibration at each
 // size, Nstep at fixed multipliers, the forward check, the verdict).
+#include <algorithm>
+#include <cmath>
 #include <sstream>
+#include <thread>
 
 #include "demcal/io/format.hpp"
 #include "demcal/upscaling/scaling_study.hpp"
@@ -35,7 +38,8 @@ void write_intro(std::ostringstream& md, const ScalingStudy& st, const SceneConf
      << " particles; default tolerances (force balance " << t.force_balance << ", moment balance "
      << t.moment_balance << ", servo " << t.servo << ", oscillation " << t.oscillation
      << "); accuracy target " << pct_sig(st.accuracy, 2) << ". Wall time of this invocation "
-     << num(st.wall_time_s, 3) << " s on a shared 2-core machine"
+     << num(st.wall_time_s, 3) << " s on a machine of "
+     << std::max(1u, std::thread::hardware_concurrency()) << " cores"
      << (st.resumed ? " (finished sizes reused)" : "") << ". Machine-readable: `scaling.json`.\n\n";
   if (spheres)
     md << "In 3D the sample's linear size L grows as N^(1/3), not N^(1/2): a loading length set\n"
@@ -116,11 +120,18 @@ void write_forward(std::ostringstream& md, const ScalingStudy& st) {
     md << "No size beyond --calibrate-max: no forward check.\n\n";
     return;
   }
+  // The law's Nstep, and the run's where round_steps (four significant
+  // digits, what the searches resolve) moved it.
+  const int64_t by_law =
+      std::llround(static_cast<double>(ref.best.steps) *
+                   std::pow(static_cast<double>(fwd.particles) / static_cast<double>(ref.particles),
+                            linear ? 1.0 : st.candidate.exponent));
   md << "The REV's multipliers unchanged, Nstep = " << ref.best.steps << " × "
      << (linear ? "" : "(") << fwd.particles << "/" << ref.particles
-     << (linear ? std::string() : ")^" + num(st.candidate.exponent, 3)) << " = "
-     << st.law_run.params.steps
-     << "; scored with the same criteria; the reference is the same run with twice the steps.\n\n"
+     << (linear ? std::string() : ")^" + num(st.candidate.exponent, 3)) << " = " << by_law;
+  if (by_law != st.law_run.params.steps)
+    md << ", run as " << st.law_run.params.steps << " (four significant digits)";
+  md << "; scored with the same criteria; the reference is the same run with twice the steps.\n\n"
      << "| run | Nstep | passes | worst criterion / tolerance | force balance | servo | peak "
      << (st.dimension == 3 ? "b_zz (axial)" : "σ_yy") << " | peak vs reference | wall time |\n"
      << "|---|---|---|---|---|---|---|---|---|\n";
