@@ -32,35 +32,34 @@ inline CLI::Validator whole_number(int64_t lo, int64_t hi, const std::string& wh
       range);
 }
 
-/// A finite real number in (lo, hi] (lo excluded: 0 is never a valid
-/// accuracy, exponent or duration).
-inline CLI::Validator real_above(double lo, double hi) {
-  const std::string range =
-      "a number > " + CLI::detail::to_string(lo) + " and <= " + CLI::detail::to_string(hi);
+/// A finite real number (nan and inf refused: CLI::Range lets nan through)
+/// for which `in_range` holds; else "must be RANGE, got S".
+template <class InRange>
+CLI::Validator finite_real(const std::string& range, InRange in_range) {
   return CLI::Validator(
       [=](std::string& s) -> std::string {
         char* end = nullptr;
         const double v = std::strtod(s.c_str(), &end);
-        if (s.empty() || *end != '\0' || !std::isfinite(v) || !(v > lo) || !(v <= hi))
+        if (s.empty() || *end != '\0' || !std::isfinite(v) || !in_range(v))
           return "must be " + range + ", got " + s;
         return "";
       },
       range);
 }
 
+/// A finite real number in (lo, hi] (lo excluded: 0 is never a valid
+/// accuracy, exponent or duration).
+inline CLI::Validator real_above(double lo, double hi) {
+  return finite_real(
+      "a number > " + CLI::detail::to_string(lo) + " and <= " + CLI::detail::to_string(hi),
+      [=](double v) { return v > lo && v <= hi; });
+}
+
 /// The same with hi excluded: a fraction in (0, 1).
 inline CLI::Validator real_between(double lo, double hi) {
-  const std::string range = "a number strictly between " + CLI::detail::to_string(lo) + " and " +
-                            CLI::detail::to_string(hi);
-  return CLI::Validator(
-      [=](std::string& s) -> std::string {
-        char* end = nullptr;
-        const double v = std::strtod(s.c_str(), &end);
-        if (s.empty() || *end != '\0' || !std::isfinite(v) || !(v > lo) || !(v < hi))
-          return "must be " + range + ", got " + s;
-        return "";
-      },
-      range);
+  return finite_real("a number strictly between " + CLI::detail::to_string(lo) + " and " +
+                         CLI::detail::to_string(hi),
+                     [=](double v) { return v > lo && v < hi; });
 }
 
 /// --jobs: at least one; more threads than this is a typo, not a machine.
@@ -85,22 +84,13 @@ inline void add_scene_options(CLI::App* command, std::string& config,
 /// --progress of every command that consolidates a sample (check, run,
 /// sweep, calibrate, stability, rev, verify, scaling, export): seconds
 /// between progress lines on stderr (default 2, kProgressEverySeconds; 0:
-/// every check), a finite number from 0 to 1e9 (CLI::Range lets nan through).
+/// every check), a finite number from 0 to 1e9.
 inline void add_progress_option(CLI::App* command, double& every_s) {
-  const std::string range = "a number from 0 to 1e9";
   command
       ->add_option("--progress", every_s,
                    "seconds between consolidation progress lines on stderr (default 2; 0: every "
                    "check)")
-      ->check(CLI::Validator(
-          [=](std::string& s) -> std::string {
-            char* end = nullptr;
-            const double v = std::strtod(s.c_str(), &end);
-            if (s.empty() || *end != '\0' || !std::isfinite(v) || v < 0.0 || v > 1e9)
-              return "must be " + range + ", got " + s;
-            return "";
-          },
-          range));
+      ->check(finite_real("a number from 0 to 1e9", [](double v) { return v >= 0.0 && v <= 1e9; }));
 }
 
 }  // namespace demcal::cli

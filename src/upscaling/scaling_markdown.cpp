@@ -1,7 +1,6 @@
 // scaling.md: the scaling study as a reader follows it (calibration at each
 // size, Nstep at fixed multipliers, the forward check, the verdict).
 #include <algorithm>
-#include <cmath>
 #include <sstream>
 #include <thread>
 
@@ -120,12 +119,10 @@ void write_forward(std::ostringstream& md, const ScalingStudy& st) {
     md << "No size beyond --calibrate-max: no forward check.\n\n";
     return;
   }
-  // The law's Nstep, and the run's where round_steps (four significant
+  // The law's Nstep (upscale: the prediction the forward size's search
+  // started from), and the run's where round_steps (four significant
   // digits, what the searches resolve) moved it.
-  const int64_t by_law =
-      std::llround(static_cast<double>(ref.best.steps) *
-                   std::pow(static_cast<double>(fwd.particles) / static_cast<double>(ref.particles),
-                            linear ? 1.0 : st.candidate.exponent));
+  const int64_t by_law = upscale(ref.best, ref.particles, fwd.particles, st.candidate).steps;
   md << "The REV's multipliers unchanged, Nstep = " << ref.best.steps << " × "
      << (linear ? "" : "(") << fwd.particles << "/" << ref.particles
      << (linear ? std::string() : ")^" + num(st.candidate.exponent, 3)) << " = " << by_law;
