@@ -1,7 +1,8 @@
 #!/bin/bash
-# What a CPU model says the sphere pair pass's slot loop should cost: the
-# common path of one slot-vector (every lane touching, no lane sliding, no
-# lane turned far: one root, two divisions) cut from a built binary and
+# What a CPU model says a pair pass's slot loop should cost: the common
+# path of one slot-vector (for the sphere kernel: every lane touching, no
+# lane sliding, no lane turned far; one root, two divisions) cut from a
+# built binary and
 # given to llvm-mca, which simulates it on the named CPU's scheduling model
 # (ports, latencies, scheduler and queue sizes; every load an L1 hit, every
 # branch predicted). Machine-independent: it needs no hardware counters
@@ -15,8 +16,10 @@
 # AMD Zen 3; `llvm-mca -mcpu=help` lists them). Environment: FUNC (default
 # pairs_avx2; pairs_avx512 for the AVX-512 pass, on a CPU model that has
 # it), SRC (default sphere_contact.cpp: the source file whose FUNC is meant,
-# as the 2D kernel has a function of the same name), KEEP (a folder to keep
-# the extracted loop in). Needs objdump, readelf, python3 and llvm-mca
+# as the 2D kernel has a function of the same name: SRC=contact.cpp for
+# it), ROOTS and DIVS (the roots and divisions the common path must hold:
+# default 1 and 2, the sphere law's; the 2D law's are 1 and 1), KEEP (a
+# folder to keep the extracted loop in). Needs objdump, readelf, python3 and llvm-mca
 # (Debian: binutils, python3, llvm).
 #
 # How the path is cut: the slot loop is the function's backward conditional
@@ -24,8 +27,9 @@
 # branch to a target inside the body skips a rare block (a sliding lane, a
 # far turn: `if (any(...))` in sphere_contact.cpp), so the common path jumps
 # over it; a branch out of the body (no lane touching) is not taken. The
-# script checks the result against the file comment's count (1 root, 2
-# divisions) and stops if the layout was not understood.
+# script checks the result against the law's count (ROOTS, DIVS: for the
+# sphere law, sphere_contact.cpp's file comment) and stops if the layout was
+# not understood.
 set -euo pipefail
 bin=${1:-build/bench_sphere_side_by_side}
 mcpu=${2:-znver3}
@@ -47,7 +51,7 @@ read -r start size < <(readelf -sW "$bin" | awk -v src="$src" -v f="$func" '
 stop=$(printf '0x%x' $((0x$start + size)))
 objdump -d --no-show-raw-insn --start-address="0x$start" --stop-address="$stop" "$bin" > "$work/func.s"
 
-python3 - "$work/func.s" "$work/common.s" << 'EOF'
+python3 - "$work/func.s" "$work/common.s" "${ROOTS:-1}" "${DIVS:-2}" << 'EOF'
 import re, sys
 lines = []
 for l in open(sys.argv[1]):
@@ -82,9 +86,10 @@ for a, t in loop:
     out.append(t)
 text = '\n'.join(out) + '\n'
 roots, divs = text.count('vsqrtpd'), text.count('vdivpd')
-if (roots, divs) != (1, 2):
+want = (int(sys.argv[3]), int(sys.argv[4]))
+if (roots, divs) != want:
     sys.exit(f'mca_pair_loop.sh: the cut path has {roots} roots and {divs} divisions, '
-             'not 1 and 2: the loop\'s layout was not understood')
+             f'not {want[0]} and {want[1]}: the loop\'s layout was not understood')
 open(sys.argv[2], 'w').write(text)
 print(f'slot loop {lo:#x}..{hi:#x}: {len(loop)} instructions, common path {len(out)} '
       f'(roots {roots}, divisions {divs})')
