@@ -143,8 +143,8 @@ bool deck_consolidates(const ExportCmdOptions& o, int particles) {
 /// demcal's consolidation of a prototype (disks or spheres): every core
 /// from kThreadsFrom particles, progress on stderr. "consolidating ..." is
 /// said only when it consolidates (not before a read from the
-/// consolidation cache), then its steps and time (print_consolidation_time:
-/// a cache read's labelled).
+/// consolidation cache), then its steps and time (print_consolidated: a
+/// cache read's labelled).
 template <class AnyAssembly>
 auto export_consolidated(const ExportCmdOptions& o, const SceneConfig& config,
                          const AnyAssembly& proto, const std::string& what, const char* kernel) {
@@ -163,8 +163,8 @@ auto export_consolidated(const ExportCmdOptions& o, const SceneConfig& config,
                         "MPI)\n"
                       : "\n");
   });
-  std::cerr << "demcal export: consolidated in " << state.steps << " steps, ";
-  print_consolidation_time(std::cerr, state.wall_time_s, state.from_cache);
+  print_consolidated(std::cerr, "demcal export: ", "", state.steps, state.wall_time_s,
+                     state.from_cache);
   std::cerr << "\n";
   return state;
 }

@@ -42,15 +42,15 @@ struct RevOutcome {
 // A consolidation (the prototype's or the REV's, disks or spheres) as the
 // other commands say it: `announce` ("consolidating ...") only when it
 // consolidates, not before a read from the cache (consolidate_announced),
-// then its steps and time (print_consolidation_time: a cache read's
-// labelled); progress lines as run prints them (--progress).
+// then its steps and time (print_consolidated: a cache read's labelled);
+// progress lines as run prints them (--progress).
 template <class AnyAssembly>
 auto said_consolidation(const SceneConfig& config, const AnyAssembly& assembly, const char* what,
                         double progress_every_s, const std::function<void()>& announce) {
   const ConsolidationOptions co{.progress = consolidation_progress(progress_every_s)};
   const auto state = consolidate_announced(config, assembly, co, announce);
-  std::cerr << "demcal rev: consolidated " << what << " in " << state.steps << " steps, ";
-  print_consolidation_time(std::cerr, state.wall_time_s, state.from_cache);
+  print_consolidated(std::cerr, "demcal rev: ", what, state.steps, state.wall_time_s,
+                     state.from_cache);
   std::cerr << "\n";
   return state;
 }

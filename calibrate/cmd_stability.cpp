@@ -25,8 +25,8 @@ int cmd_stability(const StabilityOptions& o) {
 
   // The REV consolidated, said as the other commands say it: "consolidating
   // ..." only when it consolidates, not before a read from the cache
-  // (consolidate_announced), then its steps and time
-  // (print_consolidation_time: a cache read's labelled); progress lines
+  // (consolidate_announced), then its steps and time (print_consolidated:
+  // a cache read's labelled); progress lines
   // as run prints them (--progress, every 2 s).
   auto consolidated = [&](const auto& assembly, const char* what) {
     const ConsolidationOptions co{.progress = consolidation_progress(o.progress_every_s)};
@@ -34,8 +34,8 @@ int cmd_stability(const StabilityOptions& o) {
       std::cerr << "stability " << config.name << ": consolidating " << assembly.size() << " "
                 << what << "\n";
     });
-    std::cerr << "stability " << config.name << ": consolidated in " << state.steps << " steps, ";
-    print_consolidation_time(std::cerr, state.wall_time_s, state.from_cache);
+    print_consolidated(std::cerr, "stability " + config.name + ": ", "", state.steps,
+                       state.wall_time_s, state.from_cache);
     std::cerr << "\n";
     return state;
   };

@@ -330,8 +330,8 @@ int verify_3d(const VerifyOptions& o, const nlohmann::json& params, const RevPar
                       ? ", long for a loose gas)\n"
                       : ")\n");
   });
-  std::cerr << "demcal verify: consolidated in " << state.steps << " steps, ";
-  print_consolidation_time(std::cerr, state.wall_time_s, state.from_cache);
+  print_consolidated(std::cerr, "demcal verify: ", "", state.steps, state.wall_time_s,
+                     state.from_cache);
   std::cerr << "; loading now\n";
   state.world.set_threads(threads);
   const Tolerances tolerances = default_tolerances(config);
@@ -489,8 +489,8 @@ int cmd_verify(const VerifyOptions& o) {
       state.wall_time_s > 1.0 && !state.from_cache
           ? static_cast<double>(state.steps) * static_cast<double>(n) / state.wall_time_s
           : kAssumedSpeed;
-  std::cerr << "demcal verify: consolidated in " << state.steps << " steps, ";
-  print_consolidation_time(std::cerr, state.wall_time_s, state.from_cache);
+  print_consolidated(std::cerr, "demcal verify: ", "", state.steps, state.wall_time_s,
+                     state.from_cache);
   if (!o.consolidate_only)
     std::cerr << "; loading now, about " << (in_lammps ? estimate_s : particle_steps / speed) / 60.0
               << " min";

@@ -53,6 +53,13 @@ void print_consolidation_time(std::ostream& out, double wall_time_s, bool from_c
   out << wall_time_s << " s";
 }
 
+void print_consolidated(std::ostream& out, std::string_view prefix, std::string_view what,
+                        int64_t steps, double wall_time_s, bool from_cache) {
+  out << prefix << "consolidated " << what << (what.empty() ? "" : " ") << "in " << steps
+      << " steps, ";
+  print_consolidation_time(out, wall_time_s, from_cache);
+}
+
 // The cache's entry point with a fresh consolidation ("" for its cache
 // folder: none) that announces itself: consolidate()'s state, bit for bit.
 ConsolidatedState consolidate_announced(const SceneConfig& config, const Assembly& assembly,

@@ -2,8 +2,10 @@
 // (2D and 3D): a consolidation never runs for minutes silently.
 #pragma once
 
+#include <cstdint>
 #include <functional>
 #include <ostream>
+#include <string_view>
 
 #include "demcal/scene/biaxial.hpp"
 #include "demcal/scene/consolidation_progress.hpp"
@@ -26,6 +28,13 @@ ConsolidationCallback consolidation_progress(double every_s = kProgressEverySeco
 /// cache, whose wall_time_s is the reading's (the consolidation's own is
 /// not kept), "read from the cache in 0.0265 s".
 void print_consolidation_time(std::ostream& out, double wall_time_s, bool from_cache);
+
+/// What stability, rev, verify and export say on stderr once a
+/// consolidation is done: "<prefix>consolidated <what> in N steps, <time>"
+/// (print_consolidation_time; `what` may be empty), left open for the
+/// caller's ending.
+void print_consolidated(std::ostream& out, std::string_view prefix, std::string_view what,
+                        int64_t steps, double wall_time_s, bool from_cache);
 
 /// consolidate() (disks) or consolidate_triaxial() (spheres) through the
 /// consolidation cache of the environment, the same state, with
