@@ -1,11 +1,10 @@
 #!/bin/bash
 # What a CPU model says a pair pass's slot loop should cost: the common
-# path of one slot-vector (for the sphere kernel: every lane touching, no
-# lane sliding, no lane turned far; one root, two divisions) cut from a
-# built binary and
-# given to llvm-mca, which simulates it on the named CPU's scheduling model
-# (ports, latencies, scheduler and queue sizes; every load an L1 hit, every
-# branch predicted). Machine-independent: it needs no hardware counters
+# path of one slot-vector (for the sphere kernel: at least one lane
+# touching, no lane sliding, no lane turned far; one root, two divisions)
+# cut from a built binary and given to llvm-mca, which simulates it on the
+# named CPU's scheduling model (ports, latencies, scheduler and queue
+# sizes; every load an L1 hit, every branch predicted). Machine-independent: it needs no hardware counters
 # (there are none in the test machines' VMs) and runs on any x86-64 host.
 #
 #   bench/mca_pair_loop.sh [BIN] [MCPU]
@@ -39,14 +38,25 @@ for t in objdump readelf python3 llvm-mca; do
   command -v "$t" > /dev/null || { echo "mca_pair_loop.sh: $t not found (apt-get install binutils python3 llvm)" >&2; exit 2; }
 done
 [ -f "$bin" ] || { echo "mca_pair_loop.sh: $bin: no such file" >&2; exit 2; }
-work=${KEEP:-$(mktemp -d)}
-mkdir -p "$work"
+if ! echo nop | llvm-mca -mcpu="$mcpu" > /dev/null 2>&1; then
+  echo "mca_pair_loop.sh: llvm-mca knows no CPU \"$mcpu\" (llvm-mca -mcpu=help lists them)" >&2
+  exit 2
+fi
+if [ -n "${KEEP:-}" ]; then
+  work=$KEEP
+  mkdir -p "$work"
+else
+  work=$(mktemp -d)
+  trap 'rm -rf "$work"' EXIT
+fi
 
 # The function's address and size: the first symbol named FUNC after the
 # FILE symbol of SRC (local symbols follow their file's in the table).
+# (In the mangled name the function's own name comes with its length before
+# it, e.g. 10pairs_avx2, so no longer name that ends in FUNC matches.)
 read -r start size < <(readelf -sW "$bin" | awk -v src="$src" -v f="$func" '
   $4 == "FILE" { infile = ($8 == src) }
-  infile && $4 == "FUNC" && index($8, f "ERK") { print $2, $3; exit }')
+  infile && $4 == "FUNC" && index($8, length(f) f "ERK") { print $2, $3; exit }') || true
 [ -n "${start:-}" ] || { echo "mca_pair_loop.sh: no $func in $src's symbols of $bin" >&2; exit 2; }
 stop=$(printf '0x%x' $((0x$start + size)))
 objdump -d --no-show-raw-insn --start-address="0x$start" --stop-address="$stop" "$bin" > "$work/func.s"
@@ -80,7 +90,10 @@ for a, t in loop:
     skip_to = None
     b = branch(t)
     if b:
-        if b[0] != 'jmp' and lo < b[1] <= hi and b[1] > a:
+        if b[0] == 'jmp':  # an unconditional jump inside the loop: not this layout
+            sys.exit(f'mca_pair_loop.sh: a jmp at {a:#x} inside the slot loop: '
+                     'the loop\'s layout was not understood')
+        if lo < b[1] <= hi and b[1] > a:
             skip_to = b[1]  # a rare block: the common path jumps over it
         continue            # branches themselves are left out
     out.append(t)
@@ -103,4 +116,4 @@ echo "cycles per slot-vector (simulated): $(mca -instruction-info=false -resourc
 echo "multiplies and FMAs per slot-vector: $(grep -cE '^v(mul|f[n]?m(add|sub))' "$work/common.s")"
 mca -all-stats -instruction-info=false -resource-pressure=false | sed -n '/Dynamic Dispatch Stall Cycles/,/^$/p'
 mca -instruction-info=false -timeline=false | sed -n '/^Resources:/,/^Resource pressure by instruction/p' | sed '$d'
-echo "(the extracted path: $work/common.s)"
+if [ -n "${KEEP:-}" ]; then echo "(the extracted path: $work/common.s)"; fi

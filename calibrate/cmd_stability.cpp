@@ -26,8 +26,8 @@ int cmd_stability(const StabilityOptions& o) {
   // The REV consolidated, said as the other commands say it: "consolidating
   // ..." only when it consolidates, not before a read from the cache
   // (consolidate_announced), then its steps and time (print_consolidated:
-  // a cache read's labelled); progress lines
-  // as run prints them (--progress, every 2 s).
+  // a cache read's labelled); progress lines as run prints them
+  // (--progress, every 2 s).
   auto consolidated = [&](const auto& assembly, const char* what) {
     const ConsolidationOptions co{.progress = consolidation_progress(o.progress_every_s)};
     const auto state = consolidate_announced(config, assembly, co, [&] {
