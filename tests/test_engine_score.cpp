@@ -154,6 +154,16 @@ TEST(ExternalSeries, BadFilesNameTheFileAndTheLine) {
                 .find("# lateral_stress: missing"),
             std::string::npos);
   EXPECT_NE(message("").find("no column header"), std::string::npos);
+  // Rows of two runs (a continuation started again from an earlier
+  // restart): the steps go back. The restart's own row, repeated with its
+  // step, is not that (skipped: the split-run test).
+  EXPECT_NE(message(head + "0,0,1,2,3,4,5,6,7,8\n10,0,1,2,3,4,5,6,7,8\n20,0,1,2,3,4,5,6,7,8\n"
+                           "10,0,1,2,3,4,5,6,7,8\n")
+                .find("x.csv: line 5: step 10 after step 20: the steps go back"),
+            std::string::npos);
+  EXPECT_EQ(message(head + "0,0,1,2,3,4,5,6,7,8\n10,0,1,2,3,4,5,6,7,8\n10,0,1,2,3,4,5,6,7,8\n"
+                           "20,0,1,2,3,4,5,6,7,8\n"),
+            "no error");
   // A blown-up engine run: scored up to the first non-finite row, diverged.
   const ExternalSeries d = parse_external_series(
       head + "0,0,1,0,0,1,1,0,0,1\n10,0,1,0,0,1,1,0,0,1\n20,0,nan,0,0,1,1,0,0,1\n", "d.csv", 1e5);

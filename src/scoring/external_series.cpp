@@ -114,6 +114,18 @@ Table read_table(const std::string& text, ExternalSeries& out) {
       t.diverged_step = std::isfinite(row[0]) ? count(row[0], source, where + ": step") : -1;
     }
     if (!t.diverged && !t.rows.empty() && row[0] == t.rows.back()[0]) continue;
+    // Steps that go back: rows of two runs in one file (a continuation
+    // started again from an earlier restart appends rows the file holds
+    // already). Scored in file order they would give a verdict on neither.
+    // (A negative step is refused as a count, with the others, below.)
+    if (!t.diverged && !t.rows.empty() && row[0] >= 0.0 && row[0] < t.rows.back()[0])
+      throw InputError(source, where,
+                       "step " + std::to_string(count(row[0], source, where + ": step")) +
+                           " after step " +
+                           std::to_string(count(t.rows.back()[0], source, "step")) +
+                           ": the steps go back (the rows of two runs: a run continued from an "
+                           "earlier restart appends rows the file has already); keep one run's "
+                           "rows, in the order of their steps");
     if (!t.diverged) t.rows.push_back(std::move(row));
   }
   if (t.columns.empty()) throw InputError(source, "", "no column header (and no data)");
