@@ -164,6 +164,24 @@ TEST(ExternalSeries, BadFilesNameTheFileAndTheLine) {
   EXPECT_EQ(message(head + "0,0,1,2,3,4,5,6,7,8\n10,0,1,2,3,4,5,6,7,8\n10,0,1,2,3,4,5,6,7,8\n"
                            "20,0,1,2,3,4,5,6,7,8\n"),
             "no error");
+  // A row that goes back and diverges is refused too (not "diverged at
+  // step 10" after step 20).
+  EXPECT_NE(message(head + "0,0,1,2,3,4,5,6,7,8\n10,0,1,2,3,4,5,6,7,8\n20,0,1,2,3,4,5,6,7,8\n"
+                           "10,nan,1,2,3,4,5,6,7,8\n")
+                .find("line 5: step 10 after step 20: the steps go back"),
+            std::string::npos);
+  // The step is read from its column, wherever it stands: a first column
+  // that repeats or falls is no step.
+  const std::string moved = "b_xx,step,strain_yy,b_xy,b_yx,b_yy,s_xx,s_xy,s_yx,s_yy\n";
+  const ExternalSeries m = parse_external_series(
+      moved + "1,0,0,0,0,1,1,0,0,1\n1,10,-0.01,0,0,1,1,0,0,1\n0.5,20,-0.02,0,0,1,1,0,0,1\n",
+      "m.csv", 1e5);
+  ASSERT_EQ(m.run.series.size(), 3u);
+  EXPECT_EQ(m.run.series.back().step, 20);
+  EXPECT_NE(message(moved + "1,0,0,0,0,1,1,0,0,1\n1,20,-0.01,0,0,1,1,0,0,1\n1,10,-0.02,0,0,1,1,0,0,"
+                            "1\n")
+                .find("line 4: step 10 after step 20"),
+            std::string::npos);
   // A blown-up engine run: scored up to the first non-finite row, diverged.
   const ExternalSeries d = parse_external_series(
       head + "0,0,1,0,0,1,1,0,0,1\n10,0,1,0,0,1,1,0,0,1\n20,0,nan,0,0,1,1,0,0,1\n", "d.csv", 1e5);

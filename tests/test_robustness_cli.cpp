@@ -293,7 +293,7 @@ TEST_F(RobustCli, SeriesCountThatIsNoWholeNumberIsRefused) {
     return std::vector<std::string>{"score", "series.csv", "-o", "out"};
   };
   for (const char* step : {"1e300", "2.5", "-1"})
-    expect_refused(series("", step), "series.csv: step");
+    expect_refused(series("", step), "series.csv: line 4: step");
   expect_refused(series("# steps = 1e300\n", "1"), "series.csv: # steps");
   expect_refused(series("# particles = 1e20\n", "1"), "series.csv: # particles");
   // The row where the run diverged: its step is read the same way.

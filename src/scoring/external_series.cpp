@@ -6,6 +6,7 @@
 #include <limits>
 #include <sstream>
 
+#include "demcal/io/format.hpp"
 #include "demcal/io/input_error.hpp"
 #include "demcal/io/json_integer.hpp"
 #include "demcal/scene/config.hpp"
@@ -98,8 +99,8 @@ Table read_table(const std::string& text, ExternalSeries& out) {
       }
       continue;
     }
-    // The continuation of a split run repeats the header and the row of the
-    // step it restarted from: both are skipped.
+    // The continuation of a split run repeats the header (skipped here) and
+    // the row of the step it restarted from (below).
     const auto fields = split_commas(line);
     if (fields == t.columns) continue;
     if (fields.size() != t.columns.size())
@@ -108,24 +109,33 @@ Table read_table(const std::string& text, ExternalSeries& out) {
                            std::to_string(t.columns.size()) + " columns");
     std::vector<double> row;
     for (const auto& f : fields) row.push_back(parse_number(f, source, where));
+    // The step, from its column by name (columns may come in any order;
+    // without one the file is refused for want of it, after the table).
+    const auto step_column = t.col.find("step");
+    const bool stepped = step_column != t.col.end() && std::isfinite(row[step_column->second]);
+    const double step = stepped ? row[step_column->second] : 0.0;
+    const bool after_rows = stepped && !t.diverged && !t.rows.empty();
+    const double last = after_rows ? t.rows.back()[step_column->second] : 0.0;
+    // A step is a count: refused here, with its line, before it is compared.
+    if (stepped && !t.diverged) count(step, source, where + ": step");
+    // Steps that go back: the rows of two runs in one file (e.g. a split
+    // run continued a second time, from a restart older than the rows the
+    // file holds). Scored in file order they would give a verdict on
+    // neither.
+    if (after_rows && step < last)
+      throw InputError(source, where,
+                       "step " + num(step, 17) + " after step " + num(last, 17) +
+                           ": the steps go back (the rows of two runs in one file? as a split "
+                           "run continued a second time from an older restart leaves it); keep "
+                           "one run's rows, in the order of their steps");
     if (!t.diverged &&
         std::any_of(row.begin(), row.end(), [](double v) { return !std::isfinite(v); })) {
       t.diverged = true;  // the engine's run blew up here: score what came before
-      t.diverged_step = std::isfinite(row[0]) ? count(row[0], source, where + ": step") : -1;
+      t.diverged_step = stepped ? count(step, source, where + ": step") : -1;
     }
-    if (!t.diverged && !t.rows.empty() && row[0] == t.rows.back()[0]) continue;
-    // Steps that go back: rows of two runs in one file (a continuation
-    // started again from an earlier restart appends rows the file holds
-    // already). Scored in file order they would give a verdict on neither.
-    // (A negative step is refused as a count, with the others, below.)
-    if (!t.diverged && !t.rows.empty() && row[0] >= 0.0 && row[0] < t.rows.back()[0])
-      throw InputError(source, where,
-                       "step " + std::to_string(count(row[0], source, where + ": step")) +
-                           " after step " +
-                           std::to_string(count(t.rows.back()[0], source, "step")) +
-                           ": the steps go back (the rows of two runs: a run continued from an "
-                           "earlier restart appends rows the file has already); keep one run's "
-                           "rows, in the order of their steps");
+    // The continuation of a split run repeats the row of the step it
+    // restarted from: skipped.
+    if (after_rows && !t.diverged && step == last) continue;
     if (!t.diverged) t.rows.push_back(std::move(row));
   }
   if (t.columns.empty()) throw InputError(source, "", "no column header (and no data)");
