@@ -117,7 +117,7 @@ Table read_table(const std::string& text, ExternalSeries& out) {
     const bool after_rows = stepped && !t.diverged && !t.rows.empty();
     const double last = after_rows ? t.rows.back()[step_column->second] : 0.0;
     // A step is a count: refused here, with its line, before it is compared.
-    if (stepped && !t.diverged) count(step, source, where + ": step");
+    const int64_t step_count = stepped && !t.diverged ? count(step, source, where + ": step") : -1;
     // Steps that go back: the rows of two runs in one file (e.g. a split
     // run continued a second time, from a restart older than the rows the
     // file holds). Scored in file order they would give a verdict on
@@ -131,7 +131,7 @@ Table read_table(const std::string& text, ExternalSeries& out) {
     if (!t.diverged &&
         std::any_of(row.begin(), row.end(), [](double v) { return !std::isfinite(v); })) {
       t.diverged = true;  // the engine's run blew up here: score what came before
-      t.diverged_step = stepped ? count(step, source, where + ": step") : -1;
+      t.diverged_step = step_count;
     }
     // The continuation of a split run repeats the row of the step it
     // restarted from: skipped.
