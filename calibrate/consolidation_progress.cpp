@@ -50,7 +50,11 @@ ConsolidationCallback consolidation_progress(double every_s) {
 
 void print_consolidation_time(std::ostream& out, double wall_time_s, bool from_cache) {
   if (from_cache) out << "read from the cache in ";
+  // Three significant digits whatever the stream's precision: a wall time
+  // is not known better, and every command prints it alike.
+  const std::streamsize old = out.precision(3);
   out << wall_time_s << " s";
+  out.precision(old);
 }
 
 void print_consolidated(std::ostream& out, std::string_view prefix, std::string_view what,
