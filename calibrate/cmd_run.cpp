@@ -271,8 +271,10 @@ int cmd_run(const std::string& path, const std::vector<std::string>& sets,
               << "), moment balance " << c.moment_balance << ", servo " << c.servo
               << ", oscillation " << c.oscillation << "\n";
   std::cout << "  " << (score.passed ? "PASS" : "FAIL") << ": " << score.diagnosis.message << "\n"
-            << "  wall time " << run.wall_time_s << " s, "
-            << summary["particle_steps_per_s"].get<double>() << " particle-steps/s\n"
+            << "  wall time " << run.wall_time_s << " s (consolidation ";
+  print_consolidation_time(std::cout, state.wall_time_s, state.from_cache);
+  std::cout << ", " << state.steps << " steps), " << summary["particle_steps_per_s"].get<double>()
+            << " particle-steps/s\n"
             << "  wrote " << dir << "/summary.json, series.csv"
             << (config.output.vtk ? ", final.vtk" : "") << "\n";
   if (run.diverged)

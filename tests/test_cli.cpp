@@ -801,13 +801,18 @@ TEST_F(CliEndToEnd, AConsolidationFromTheCacheIsSaidToBeRead) {
     EXPECT_EQ(read.rfind(steps + "read from the cache in ", 0), 0u) << read;
     EXPECT_NE(read.find(" s), box "), std::string::npos) << read;
   }
-  const Result run = demcal(
-      {"run", test::shipped_config("fcc_4x4x4"), "--set", "algorithm.steps=2000", "-o", "run3d"},
-      {cache});
-  ASSERT_NO_FATAL_FAILURE(test::expect_run_status(run.status, dir_ / "work" / "run3d", run.err));
-  EXPECT_NE(line_of(run.out, "  wall time ").find(" s (consolidation read from the cache in "),
-            std::string::npos)
-      << run.out;
+  // run, 2D and 3D: "wall time T s (consolidation read from the cache in
+  // T s, N steps)" (the 2D run once said no word of its consolidation).
+  for (const std::string& config : {kHex5, test::shipped_config("fcc_4x4x4")}) {
+    SCOPED_TRACE(config);
+    const Result run =
+        demcal({"run", config, "--set", "algorithm.steps=2000", "-o", "run-out"}, {cache});
+    ASSERT_NO_FATAL_FAILURE(
+        test::expect_run_status(run.status, dir_ / "work" / "run-out", run.err));
+    const std::string wall = line_of(run.out, "  wall time ");
+    EXPECT_NE(wall.find(" s (consolidation read from the cache in "), std::string::npos) << run.out;
+    EXPECT_NE(wall.find(" steps), "), std::string::npos) << run.out;
+  }
 }
 
 // `demcal calibrate` says its consolidation as check, run, verify and export
