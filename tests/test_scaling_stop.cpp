@@ -11,8 +11,10 @@
 // is read whole.)
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <filesystem>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -43,6 +45,13 @@ class ScalingStop : public ::testing::Test {
   /// `work`; with `stop_at`, the stop is set when a log line begins with it.
   ScalingStudy study(const std::string& work, bool resume, const std::string& stop_at,
                      std::vector<std::string>& log) {
+    return study(work, resume, log, [stop_at](const std::string& line) {
+      return !stop_at.empty() && line.rfind(stop_at, 0) == 0;
+    });
+  }
+  /// The same with the stop set when `stop_after(line)` says so.
+  ScalingStudy study(const std::string& work, bool resume, std::vector<std::string>& log,
+                     const std::function<bool(const std::string&)>& stop_after) {
     ScalingStudyOptions o;
     o.sizes = parse_sizes("16,25,36");
     o.sizes_text = "16,25,36";
@@ -54,14 +63,15 @@ class ScalingStop : public ::testing::Test {
     stop_.store(false);
     o.log = [&](const std::string& line) {
       log.push_back(line);
-      if (!stop_at.empty() && line.rfind(stop_at, 0) == 0) stop_.store(true);
+      if (stop_after(line)) stop_.store(true);
     };
     return run_scaling_study(config_, o);
   }
 
-  nlohmann::json uninterrupted() {
+  nlohmann::json uninterrupted(std::vector<std::string>* log_out = nullptr) {
     std::vector<std::string> log;
     const ScalingStudy st = study("R", false, "", log);
+    if (log_out) *log_out = log;
     EXPECT_FALSE(st.interrupted);
     return without_timing(to_json(st, config_));
   }
@@ -124,6 +134,57 @@ TEST_F(ScalingStop, EachStepStopsWritesNothingOfItAndResumeEndsAsUninterrupted) 
     const nlohmann::json got = without_timing(to_json(resumed, config_)), want = reference;
     EXPECT_EQ(got, want);
   }
+}
+
+/// The runs a step search logged after its opening line `opening`, as they
+/// finished ("  N steps: pass|fail ...").
+std::vector<std::string> search_runs(const std::vector<std::string>& log,
+                                     const std::string& opening) {
+  std::vector<std::string> runs;
+  const std::vector<std::string> after = from_line(log, opening);
+  for (size_t i = 1; i < after.size() && after[i].rfind("  ", 0) == 0; ++i)
+    if (after[i].find(" steps: ") != std::string::npos) runs.push_back(after[i]);
+  return runs;
+}
+
+// A step search stopped after its first run keeps that run (steps_search.jsonl)
+// and a resumed study takes it instead of running it again: a search at a
+// large size, hours of runs, is not lost to a Ctrl-C. The resumed study ends
+// with the uninterrupted one's scaling.json, every number of it.
+TEST_F(ScalingStop, AStepSearchStoppedAfterARunResumesFromThatRun) {
+  std::vector<std::string> reference_log;
+  const nlohmann::json reference = uninterrupted(&reference_log);
+  const std::string opening = "size 16: smallest passing Nstep";
+  const std::vector<std::string> all_runs = search_runs(reference_log, opening);
+  ASSERT_GE(all_runs.size(), 2u) << "the search at 16 should need more than one run";
+
+  bool in_search = false;
+  std::vector<std::string> log;
+  const ScalingStudy stopped = study("T", false, log, [&](const std::string& line) {
+    if (line.rfind(opening, 0) == 0) in_search = true;
+    return in_search && line.rfind("  ", 0) == 0 && line.find(" steps: ") != std::string::npos;
+  });
+  EXPECT_TRUE(stopped.interrupted);
+  EXPECT_FALSE(fs::exists(tmp_ / "T" / "size-16" / "fixed.json"));
+  const std::vector<std::string> kept = search_runs(log, opening);
+  ASSERT_EQ(kept.size(), 1u) << "a run started after the stop";
+  // The same run as the uninterrupted search's first (its wall time aside).
+  EXPECT_EQ(kept[0].substr(0, kept[0].find("tol)")),
+            all_runs[0].substr(0, all_runs[0].find("tol)")));
+  const std::string runs_text = test::read_text(tmp_ / "T" / "size-16" / "steps_search.jsonl");
+  EXPECT_EQ(std::count(runs_text.begin(), runs_text.end(), '\n'), 1) << runs_text;
+
+  std::vector<std::string> resumed_log;
+  const ScalingStudy resumed = study("T", true, "", resumed_log);
+  EXPECT_FALSE(resumed.interrupted);
+  const std::vector<std::string> resumed_runs = search_runs(resumed_log, opening);
+  ASSERT_EQ(resumed_runs.size(), all_runs.size());
+  EXPECT_NE(resumed_runs[0].find("(finished before the stop, reused)"), std::string::npos)
+      << resumed_runs[0];
+  for (size_t i = 1; i < resumed_runs.size(); ++i)
+    EXPECT_EQ(resumed_runs[i].find("reused"), std::string::npos) << resumed_runs[i];
+  EXPECT_TRUE(fs::exists(tmp_ / "T" / "size-16" / "fixed.json"));
+  EXPECT_EQ(without_timing(to_json(resumed, config_)), reference);
 }
 
 /// A runner that asks to stop as its first run starts: the stop must end

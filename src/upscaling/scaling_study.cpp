@@ -316,8 +316,11 @@ std::optional<ScalingSize> calibrate_size(Family& family, const SceneConfig& con
 }
 
 /// Step 2: the smallest passing Nstep at the REV's multipliers at size n,
-/// from the prediction of `law` (the candidate; or reuse fixed.json). A stop
-/// during it throws StudyStopped: no fixed.json, resume searches again.
+/// from the prediction of `law` (the candidate; or reuse fixed.json). Each
+/// finished run goes to size-N/steps_search.jsonl (rewritten whole) and to
+/// the log as it ends. A stop during it throws StudyStopped: no fixed.json;
+/// a resumed search takes the finished runs from steps_search.jsonl and runs
+/// from the first one it does not find there.
 void fixed_multipliers(Family& family, const ScalingStudyOptions& o, const ScalingSize& ref,
                        const ScalingLaw& law, const Tolerances& tolerances, int64_t n,
                        ScalingSize& r) {
@@ -341,8 +344,25 @@ void fixed_multipliers(Family& family, const ScalingStudyOptions& o, const Scali
              ": smallest passing Nstep at the REV's multipliers, from the " + law_words(law) +
              " prediction " + std::to_string(start.steps) + " (" +
              num(static_cast<double>(start.steps) * r.particles, 3) + " particle-steps)");
+  const std::string runs_path = family.dir(n) + "/steps_search.jsonl";
+  StepSearchRecord record;
+  if (o.resume && fs::exists(runs_path))
+    record.earlier = read_trials_text(read_text_file(runs_path), runs_path);
+  else
+    fs::remove(runs_path);
+  record.on_trial = [&](const std::vector<TrialRecord>& trials, bool reused) {
+    std::string text;
+    for (const TrialRecord& t : trials) text += to_json(t).dump() + "\n";
+    write_file_atomic(runs_path, text);
+    const TrialRecord& t = trials.back();
+    family.log("  " + std::to_string(t.params.steps) +
+               " steps: " + (t.score.passed ? "pass" : "fail") + " (worst " +
+               num(t.score.worst_excess, 3) + "x tol), " + num(t.wall_time_s, 3) + " s" +
+               (reused ? " (finished before the stop, reused)" : ""));
+  };
   const auto t0 = std::chrono::steady_clock::now();
-  const StepSearch search = smallest_passing_steps(*state.runner, start, tolerances, o.stop);
+  const StepSearch search =
+      smallest_passing_steps(*state.runner, start, tolerances, o.stop, 8, record);
   if (search.interrupted) throw StudyStopped{};
   r.fixed.found = search.found;
   r.fixed.steps = search.found ? search.best.params.steps : 0;
@@ -350,10 +370,6 @@ void fixed_multipliers(Family& family, const ScalingStudyOptions& o, const Scali
   r.fixed.trials = search.trials;
   r.fixed.wall_time_s = seconds_since(t0);
   write_file_atomic(fixed_path, to_json(r).dump(2) + "\n");
-  for (const auto& t : search.trials)
-    family.log("  " + std::to_string(t.params.steps) +
-               " steps: " + (t.score.passed ? "pass" : "fail") + " (worst " +
-               num(t.score.worst_excess, 3) + "x tol), " + num(t.wall_time_s, 3) + " s");
 }
 
 /// Step 3: the fits and the law they measure.

@@ -462,7 +462,7 @@ StepSearch smallest_passing_steps(const SceneConfig& config, const ConsolidatedS
 
 StepSearch smallest_passing_steps(const TrialRunner& runner, const AlgorithmSpec& start,
                                   const Tolerances& tol, const std::atomic<bool>* stop,
-                                  int max_runs) {
+                                  int max_runs, const StepSearchRecord& record) {
   const auto stopped = [stop] { return stop && stop->load(); };
   StepSearch out;
   AlgorithmSpec p = start;
@@ -473,15 +473,22 @@ StepSearch smallest_passing_steps(const TrialRunner& runner, const AlgorithmSpec
       out.interrupted = true;
       break;
     }
-    TrialRecord r = run_trial(runner, p, tol, stop);
+    // An earlier search's k-th run, when it ran what this one asks (its
+    // parameters compared in their one JSON form, which keeps every bit).
+    const bool reuse = out.reused == k && k < static_cast<int>(record.earlier.size()) &&
+                       to_json(record.earlier[static_cast<size_t>(k)].params) == to_json(p);
+    TrialRecord r =
+        reuse ? record.earlier[static_cast<size_t>(k)] : run_trial(runner, p, tol, stop);
     // Possibly cut short by the stop: neither a run nor a guide to the next.
-    if (stopped()) {
+    if (!reuse && stopped()) {
       out.interrupted = true;
       break;
     }
     r.id = k;
     r.phase = TrialPhase::steps_search;
     out.trials.push_back(r);
+    if (reuse) ++out.reused;
+    if (record.on_trial) record.on_trial(out.trials, reuse);
     out.particle_steps += r.score.particle_steps;
     if (r.score.diverged) break;
     const double excess = rate_excess(r.score.criteria, tol);

@@ -14,6 +14,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <span>
@@ -169,10 +170,24 @@ struct StepSearch {
   TrialRecord best;                 ///< the smallest passing run
   std::vector<TrialRecord> trials;  ///< every run, in order
   double particle_steps = 0.0;      ///< total cost
+  int reused = 0;                   ///< of trials, taken from StepSearchRecord::earlier
+};
+/// What a step search reports as it goes and what it may reuse (both
+/// optional): a scaling study keeps a size's finished runs, so that a
+/// search stopped after hours of runs at a large size resumes, not restarts.
+struct StepSearchRecord {
+  /// Called after each run, reused or not, with the search's runs so far.
+  std::function<void(const std::vector<TrialRecord>& trials, bool reused)> on_trial;
+  /// The runs of an earlier search from the same start on the same runner,
+  /// in order. The search is deterministic, so its k-th run asks for the
+  /// parameters the k-th earlier one ran, and takes that run instead of
+  /// running it again; from the first one that differs on, it runs.
+  std::vector<TrialRecord> earlier;
 };
 StepSearch smallest_passing_steps(const TrialRunner& runner, const AlgorithmSpec& params,
                                   const Tolerances& tolerances = {},
-                                  const std::atomic<bool>* stop = nullptr, int max_runs = 8);
+                                  const std::atomic<bool>* stop = nullptr, int max_runs = 8,
+                                  const StepSearchRecord& record = {});
 /// The same on a consolidated disk REV (BiaxialRunner).
 StepSearch smallest_passing_steps(const SceneConfig& config, const ConsolidatedState& state,
                                   const AlgorithmSpec& params, const Tolerances& tolerances = {},
