@@ -119,8 +119,8 @@ std::function<int()> add_upscaling_commands(CLI::App& app) {
   exp->add_flag("--no-consolidate", ex->no_consolidate,
                 "write the prototype as read (it is already consolidated to sigma3)");
   exp->add_option("--consolidate-in", ex->consolidate_in,
-                  "demcal, deck (LAMMPS: the deck's first stage, under MPI) or auto (default: "
-                  "demcal, whose kernel is faster than the deck's stage on the same cores)");
+                  "demcal, deck (LAMMPS: the deck's first stage, under MPI) or auto (the default, "
+                  "which is demcal: its kernel is faster than the deck's stage on the same cores)");
   add_progress_option(exp, ex->progress_every_s);
 
   auto rv = std::make_shared<RevCmdOptions>();
