@@ -88,6 +88,9 @@ TEST_F(PackingFile, NonNumericLineNamesTheLine) {
   expect_rejected("0,0,1\n2,0,1x\n", "line 2");        // trailing garbage
   expect_rejected("0,0,1\nx,y,r\n2,0,1\n", "line 2");  // a header after data
   expect_rejected("x,y,r\nx,y,r\n0,0,1\n2,0,1\n", "line 2");
+  // A header in another order is refused: the axes are never guessed.
+  expect_rejected("y,x,r\n0,0,1\n2,0,1\n", "line 1", "x,y,r in this order");
+  expect_rejected("# c\nr,x,y\n1,0,0\n1,2,0\n", "line 2", "got \"r,x,y\"");
   // A first line with some numbers is a broken particle, not a header: it
   // must not be skipped silently.
   expect_rejected("0,0,abc\n2,0,1\n4,0,1\n", "line 1");

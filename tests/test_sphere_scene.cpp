@@ -126,6 +126,16 @@ TEST(SphereScene, ReaderRejectsBadLinesWithFileAndLine) {
   EXPECT_EQ(reader_error("0,0,0,1\n3,0,inf,1\n"),
             "s.csv: line 2: values must be finite, got \"3,0,inf,1\"");
   EXPECT_EQ(reader_error("x,y,z,r\n0,0,0,1\n"), "s.csv: needs at least two spheres, found 1");
+  // A header that names another order is refused, not read with the axes
+  // swapped (a sample tall in z read lying on its side, with no error).
+  EXPECT_EQ(reader_error("z,y,x,r\n0,0,0,1\n3,0,0,1\n"),
+            "s.csv: line 1: header: the columns must be x,y,z,r in this order (the radius may "
+            "be called radius), got \"z,y,x,r\"");
+  EXPECT_NE(reader_error("r,x,y,z\n1,0,0,0\n1,3,0,0\n").find("line 1: header:"), std::string::npos);
+  EXPECT_NE(reader_error("# c\nid,x,y,z\n0,0,0,1\n3,0,0,1\n").find("line 2: header:"),
+            std::string::npos);
+  // The names in any case, quoted, blanks around, the radius as radius.
+  EXPECT_EQ(reader_error("X, \"y\" ,Z,Radius\n0,0,0,1\n3,0,0,1\n"), "");
   // A header after the first sphere is a bad line.
   EXPECT_NE(reader_error("0,0,0,1\nx,y,z,r\n3,0,0,1\n").find("line 2"), std::string::npos);
   // Overlap limit 5 % of the smaller radius: 1.9 apart (10 %) is an error,

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -92,6 +93,30 @@ bool parse_particle_number(const std::string& field, double& value) {
   return *end == '\0';
 }
 
+/// A header field's name: blanks and double quotes around it dropped, in
+/// lower case ("X", " \"x\" " and "x" are one name).
+std::string header_name(const std::string& field) {
+  const auto first = field.find_first_not_of(" \t\"");
+  if (first == std::string::npos) return {};
+  const auto last = field.find_last_not_of(" \t\"");
+  std::string name = field.substr(first, last - first + 1);
+  for (char& c : name) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return name;
+}
+
+/// Whether a header names the columns the reader takes them for: x, y (z)
+/// and the radius (r or radius), in this order. A file whose header says
+/// another order ("z,y,x,r", "r,x,y,z") would otherwise be read with its
+/// axes swapped: a sample loaded on its side, and no error.
+bool header_names_the_columns(const std::vector<std::string>& fields) {
+  const size_t n = fields.size();
+  static const char* const axes[] = {"x", "y", "z"};
+  for (size_t k = 0; k + 1 < n; ++k)
+    if (header_name(fields[k]) != axes[k]) return false;
+  const std::string r = header_name(fields[n - 1]);
+  return r == "r" || r == "radius";
+}
+
 }  // namespace
 
 bool parse_particle_fields(const std::string& line, std::span<double> v, bool& seen_content,
@@ -106,6 +131,11 @@ bool parse_particle_fields(const std::string& line, std::span<double> v, bool& s
     numbers += parse_particle_number(fields[k], v[k]);
   if (fields.size() != n || numbers != n) {
     if (!seen_content && fields.size() == n && numbers == 0) {
+      if (!header_names_the_columns(fields))
+        throw InputError(
+            path, where,
+            std::string("header: the columns must be ") + (n == 3 ? "x,y,r" : "x,y,z,r") +
+                " in this order (the radius may be called radius), got " + quoted_value(line));
       seen_content = true;
       return false;  // the header ("x,y,r")
     }

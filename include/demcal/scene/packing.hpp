@@ -76,7 +76,9 @@ double centre_distance(const std::array<std::span<const double>, D>& x, int i, i
 /// each |coordinate| + 4 r finite (the overlap test adds radii to
 /// coordinates), and fewer than kMaxParticles particles read before it
 /// (`particles_read`): true, the numbers in `v`. The first content line (`seen_content` still
-/// false) whose fields are none of them numbers is the header: false.
+/// false) whose fields are none of them numbers is the header: false; it
+/// must name the columns x,y(,z),r in this order (r or radius, any case,
+/// quotes allowed), else an InputError: the reader never guesses an order.
 /// Anything else is an InputError naming `path` and `where` (a line with
 /// some numbers is a broken particle line, never silently skipped).
 bool parse_particle_fields(const std::string& line, std::span<double> v, bool& seen_content,
