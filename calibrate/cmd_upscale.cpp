@@ -67,6 +67,13 @@ std::string scene_of(const nlohmann::json& j) {
   return s != j.end() && s->is_string() ? s->get<std::string>() : std::string();
 }
 
+/// Whether `--set` gives one of the algorithm keys a params.json command
+/// never runs (the rev's parameters are, upscaled): all but lock_rotation,
+/// which is the consolidation's.
+bool set_without_effect(const std::string& set) {
+  return set.rfind("algorithm.", 0) == 0 && set.rfind("algorithm.lock_rotation", 0) != 0;
+}
+
 }  // namespace
 
 void check_params_options(const UpscaledParamsOptions& o, const char* command) {
@@ -116,7 +123,7 @@ void check_params_options(const UpscaledParamsOptions& o, const char* command) {
   // The three run params.json's rev upscaled, never the config's calibrated
   // algorithm keys (its lock_rotation is the consolidation's: used).
   for (const std::string& set : o.sets)
-    if (set.rfind("algorithm.", 0) == 0 && set.rfind("algorithm.lock_rotation", 0) != 0)
+    if (set_without_effect(set))
       std::cerr << "demcal " << command << ": warning: --set " << set
                 << " has no effect: the algorithm parameters are " << o.params
                 << "'s rev, upscaled\n";
@@ -132,7 +139,13 @@ void check_params_options(const UpscaledParamsOptions& o, const char* command) {
 
 std::optional<SceneConfig> params_scene(const nlohmann::json& params, const std::string& path,
                                         const std::string& config_path,
-                                        const std::vector<std::string>& sets) {
+                                        const std::vector<std::string>& all_sets) {
+  // A --set without effect (warned about) is not applied either: a value
+  // the config would refuse (steps below test.monitor_points) is then no
+  // error blamed on a key the command does not use.
+  std::vector<std::string> sets;
+  for (const std::string& set : all_sets)
+    if (!set_without_effect(set)) sets.push_back(set);
   // 2D and 3D configs alike (the commands dispatch on config.dimension).
   if (!config_path.empty()) return same_dimension(load_config(config_path, sets), params, path);
   if (auto c = config_from_params(params, path)) {

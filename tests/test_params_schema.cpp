@@ -216,6 +216,14 @@ TEST_F(ParamsSchema, UpscaleRefusesSetOnTheConfigItCarries) {
   EXPECT_EQ(alg.status, 0) << alg.err;
   EXPECT_NE(alg.err.find("warning: --set algorithm.steps=30000 has no effect"), std::string::npos)
       << alg.err;
+  // Without effect, not applied either: a value the config would refuse
+  // (fewer steps than test.monitor_points) is no error ("has no effect",
+  // then an error blaming params.json's config, before).
+  const Result few = demcal({"export", p, "--particles", "100", "--set", "algorithm.steps=10",
+                             "--no-consolidate", "-o", "g/x.lammps"});
+  EXPECT_EQ(few.status, 0) << few.err;
+  EXPECT_NE(few.err.find("warning: --set algorithm.steps=10 has no effect"), std::string::npos)
+      << few.err;
   // lock_rotation is the consolidation's: used, not warned about.
   const Result lock =
       demcal({"export", p, "--particles", "100", "--set", "algorithm.lock_rotation=true",
