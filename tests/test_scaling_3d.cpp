@@ -11,6 +11,8 @@
 #include <string>
 
 #include "demcal/scene/triaxial.hpp"
+#include "demcal/scoring/triaxial_scoring.hpp"
+#include "demcal/search/calibration.hpp"
 #include "demcal/upscaling/params_file.hpp"
 #include "demcal/upscaling/scaling_study.hpp"
 #include "demcal/upscaling/upscaling.hpp"
@@ -134,11 +136,57 @@ void check_default_law(const TinyStudy& study) {
   }
 }
 
-TEST(Scaling3D, TinyFccFamilyFitsTheExponentAndChoosesTheDefaultLaw) {
+// A 3D study recorded the 2D tolerances (force balance 0.008, servo
+// 0.0025) in scaling.json and scaling.md, and scored its step searches and
+// forward reference with them, while its calibrations used the 3D ones.
+// Every run (the calibrations' trials, the fixed-multiplier runs, the
+// forward run and its reference) is now scored with triaxial_tolerances(),
+// and both files say so: each run's worst excess is its criteria against
+// them.
+void check_tolerances(const TinyStudy& study) {
+  const test::TempDir& dir = study.dir;
+  ASSERT_TRUE(study.r.status == 0 || study.r.status == 1) << study.r.err;
+  const demcal::Tolerances t = demcal::triaxial_tolerances();
+  const nlohmann::json j = nlohmann::json::parse(test::read_text(dir / "out" / "scaling.json"));
+  EXPECT_EQ(j.at("tolerances"), demcal::to_json(t));
+  const std::string md = test::read_text(dir / "out" / "scaling.md");
+  EXPECT_NE(md.find("the 3D default tolerances (force balance 0.0064, moment balance 1e-05 with "
+                    "the rotational drag folded in at 0.003, servo 0.002, oscillation 0.001)"),
+            std::string::npos)
+      << md;
+  int runs = 0;
+  const auto scored_with_3d = [&](const demcal::TrialRecord& run, const std::string& what) {
+    ++runs;
+    EXPECT_DOUBLE_EQ(run.score.worst_excess, demcal::excesses(run.score.criteria, t).worst())
+        << what << ", " << run.params.steps << " steps";
+  };
+  for (const auto& size : j.at("results")) {
+    const int64_t n = size.at("requested");
+    if (size.at("calibrated"))
+      for (const auto& trial : demcal::read_trials_text(
+               test::read_text(dir / "work" / ("size-" + std::to_string(n)) / "trials.jsonl"),
+               "trials.jsonl"))
+        scored_with_3d(trial, "calibration trial at " + std::to_string(n));
+    if (size.contains("fixed_multipliers"))
+      for (const auto& run : size.at("fixed_multipliers").at("runs"))
+        scored_with_3d(demcal::trial_from_json(run, "fixed"),
+                       "fixed-multiplier run at " + std::to_string(n));
+  }
+  scored_with_3d(demcal::trial_from_json(j.at("forward").at("run"), "forward"), "forward run");
+  scored_with_3d(demcal::trial_from_json(j.at("forward").at("reference"), "reference"),
+                 "forward reference");
+  EXPECT_GT(runs, 4);
+}
+
+TEST(Scaling3D, TinyFccFamilyFitsTheExponentChoosesTheDefaultLawScoredWith3DTolerances) {
   const TinyStudy study;
   {
     SCOPED_TRACE("the fit");
     check_fit(study);
+  }
+  {
+    SCOPED_TRACE("the tolerances");
+    check_tolerances(study);
   }
   SCOPED_TRACE("the default law");
   check_default_law(study);

@@ -5,6 +5,7 @@
 #include <thread>
 
 #include "demcal/io/format.hpp"
+#include "demcal/scoring/triaxial_scoring.hpp"
 #include "demcal/upscaling/scaling_study.hpp"
 
 namespace demcal {
@@ -33,12 +34,13 @@ void write_intro(std::ostringstream& md, const ScalingStudy& st, const SceneConf
                       : "`" + config.assembly.type + "` assemblies")
      << " that differ only in size (same material, test, distribution"
      << (config.assembly.type == "random" ? " and seed" : "") << "). Sizes " << st.sizes_text
-     << "; calibrated up to " << st.calibrate_max
-     << " particles; default tolerances (force balance " << t.force_balance << ", moment balance "
-     << t.moment_balance << ", servo " << t.servo << ", oscillation " << t.oscillation
-     << "); accuracy target " << pct_sig(st.accuracy, 2) << ". Wall time of this invocation "
-     << num(st.wall_time_s, 3) << " s on a machine of "
-     << std::max(1u, std::thread::hardware_concurrency()) << " cores"
+     << "; calibrated up to " << st.calibrate_max << " particles; " << (spheres ? "the 3D " : "")
+     << "default tolerances (force balance " << t.force_balance << ", moment balance "
+     << t.moment_balance
+     << (spheres ? " with the rotational drag folded in at " + num(kRotationalDragTolerance) : "")
+     << ", servo " << t.servo << ", oscillation " << t.oscillation << "); accuracy target "
+     << pct_sig(st.accuracy, 2) << ". Wall time of this invocation " << num(st.wall_time_s, 3)
+     << " s on a machine of " << std::max(1u, std::thread::hardware_concurrency()) << " cores"
      << (st.resumed ? " (finished sizes reused)" : "") << ". Machine-readable: `scaling.json`.\n\n";
   if (spheres)
     md << "In 3D the sample's linear size L grows as N^(1/3), not N^(1/2): a loading length set\n"

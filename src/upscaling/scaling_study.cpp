@@ -271,7 +271,7 @@ class Family {
 
 /// Step 1: calibrate a size (or reuse its result.json); nothing when a stop
 /// cut the calibration (its finished trials stay in the size's trials.jsonl).
-std::optional<ScalingSize> calibrate_size(Family& family, const SceneConfig& config,
+std::optional<ScalingSize> calibrate_size(Family& family, const CalibrationOptions& calibration,
                                           const ScalingStudyOptions& o, int64_t n) {
   const std::string result_path = family.dir(n) + "/result.json";
   if (o.resume && fs::exists(result_path)) {
@@ -285,7 +285,7 @@ std::optional<ScalingSize> calibrate_size(Family& family, const SceneConfig& con
   r.requested = n;
   r.particles = state.particles;
   r.consolidation = state.consolidation;
-  CalibrationOptions co = CalibrationOptions::from(config);
+  CalibrationOptions co = calibration;
   co.jobs = o.jobs;
   co.trials_path = family.dir(n) + "/trials.jsonl";
   // A size stopped in its calibration (a signal, a kill) left its finished
@@ -437,12 +437,15 @@ void forward_check(Family& family, const ScalingStudyOptions& o, ScalingStudy& s
                           : 0.0;
 }
 
-/// Steps 1 to 4 in order; StudyStopped when a stop cut one short.
-void run_steps(Family& family, const SceneConfig& config, const ScalingStudyOptions& o,
+/// Steps 1 to 4 in order, the calibrations with `calibration`'s options
+/// (st.tolerances are theirs: the step searches and the forward reference
+/// are scored as the calibrations were); StudyStopped when a stop cut one
+/// short.
+void run_steps(Family& family, const CalibrationOptions& calibration, const ScalingStudyOptions& o,
                ScalingStudy& st) {
   for (int64_t n : st.calibrated_sizes) {
     throw_if_stopped(o);
-    std::optional<ScalingSize> r = calibrate_size(family, config, o, n);
+    std::optional<ScalingSize> r = calibrate_size(family, calibration, o, n);
     if (!r) throw StudyStopped{};
     st.results[n] = std::move(*r);
   }
@@ -506,6 +509,11 @@ ScalingStudy run_scaling_study(const SceneConfig& config, const ScalingStudyOpti
   // the dimension's default (Tu & Andrade's linear law for disks, N^(2/3)
   // for spheres, reports/scaling-3d.md §4).
   st.candidate = default_law(config.dimension);
+  // The tolerances every run of the study is scored with: the
+  // calibrations' (the dimension's defaults), recorded in scaling.json and
+  // scaling.md.
+  const CalibrationOptions calibration = CalibrationOptions::from(config);
+  st.tolerances = calibration.tolerances;
   check_scaling_sizes(o);
   for (int64_t n : o.sizes)
     if (n <= o.calibrate_max) st.calibrated_sizes.push_back(n);
@@ -531,7 +539,7 @@ ScalingStudy run_scaling_study(const SceneConfig& config, const ScalingStudyOpti
   // monitoring point) and between the steps of the study: whatever finished
   // is in the work folder, the step it cut wrote nothing.
   try {
-    run_steps(family, config, o, st);
+    run_steps(family, calibration, o, st);
   } catch (const StudyStopped&) {
     st.interrupted = true;
     return st;

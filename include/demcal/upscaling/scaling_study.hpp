@@ -126,6 +126,9 @@ struct ScalingStudy {
   TrialRecord law_run, reference;
   double law_peak_error = 0.0;
   double accuracy = 0.0;
+  /// What every run of the study was scored with: the calibrations'
+  /// (CalibrationOptions::from(config), the dimension's defaults), also the
+  /// step searches' and the forward reference's.
   Tolerances tolerances;
   bool resumed = false;
   /// options.stop was set: the study stopped before its end, nothing else
