@@ -58,7 +58,9 @@ int cmd_scaling(const ScalingOptions& o) {
     so.log = [](const std::string& line) { std::cerr << "demcal scaling: " << line << "\n"; };
     so.consolidation_progress = consolidation_progress(o.progress_every_s);
   }
-  check_scaling_sizes(so);  // bad sizes fail before any folder is made
+  // Bad sizes (also sizes that make one particle count) fail before any
+  // folder is made.
+  check_scaling_sizes(config, so);
   // Not "reports": run from the repository it overwrote the shipped study.
   const std::string out_dir = o.out_dir.empty() ? "demcal-scaling-" + config.name : o.out_dir;
   // The per-size work beside the report: two studies with different -o do

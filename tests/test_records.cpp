@@ -339,6 +339,25 @@ TEST(ScalingStudy, SizesParseSortedAndBadPlansAreBadInput) {
             std::string::npos);
 }
 
+// The counts the sizes make on the config's family, checked before any
+// consolidation: hexagonal 10x10 resized makes 25 for 25 and for 26.
+TEST(ScalingStudy, SizesThatMakeOneCountAreBadInput) {
+  const SceneConfig hex = default_config();
+  ScalingStudyOptions o;
+  o.sizes = {16, 24, 36};  // 16, 25 and 36 particles
+  o.calibrate_max = 24;
+  EXPECT_NO_THROW(check_scaling_sizes(hex, o));
+  o.sizes = {25, 26, 100};
+  o.calibrate_max = 26;
+  EXPECT_EQ(input_error_of([&] { check_scaling_sizes(hex, o); }),
+            "--sizes: 25 and 26 both make 25 particles (a hexagonal lattice of whole columns and "
+            "rows): each size must make a count of its own");
+  // The plan is checked first, as before.
+  o.calibrate_max = 25;
+  EXPECT_NE(input_error_of([&] { check_scaling_sizes(hex, o); }).find("two sizes"),
+            std::string::npos);
+}
+
 TEST(ScalingStudy, SpreadIsRangeOverMean) {
   const Spread s = spread_of({0.1, 0.2, 0.3});
   EXPECT_DOUBLE_EQ(s.mean, 0.2);

@@ -119,6 +119,62 @@ TEST_F(ScalingCli, SizesWithoutAForwardSizeOrRepeatedAreUsageErrors) {
   }
 }
 
+// Sizes that make one particle count passed: the FCC generator makes whole
+// cells, so `--sizes 256,300,864 --calibrate-max 300` calibrated the
+// 256-sphere sample twice (fit "linear Nstep = 0·N + 0", exit 0), and
+// `--sizes 108,256,300 --calibrate-max 256` "checked forward" the REV's own
+// sample (exponent 0, `--exponent 0` suggested). Hexagonal lattices round
+// too (5x5: 26 makes 25), and so do REVs cut from a lattice file (whole
+// rings of particles). Refused before any work (exit 2, one line naming
+// --sizes and the counts), from the counts the generator makes without
+// consolidating.
+TEST_F(ScalingCli, SizesThatMakeOneParticleCountAreUsageErrors) {
+  // A 10x10 square lattice in a file: windows centred on it hold 4, 16,
+  // 36, ... particles (5 and 6 both cut 4).
+  std::string csv = "x,y,r\n";
+  for (int i = 0; i < 10; ++i)
+    for (int j = 0; j < 10; ++j)
+      csv +=
+          std::to_string((2 * i + 1) * 5e-4) + "," + std::to_string((2 * j + 1) * 5e-4) + ",5e-4\n";
+  demcal::test::write_text(dir_ / "lattice.csv", csv);
+  const std::string file_config = demcal::test::write_text(
+      dir_ / "lattice.json",
+      R"({"material": {"density": 2650, "kn": 1e8, "kt": 5e7, "friction": 0.3},)"
+      R"( "assembly": {"type": "file", "file": "lattice.csv"}})");
+  const std::string fcc = demcal::test::shipped_config("fcc_4x4x4");
+  struct Case {
+    std::vector<std::string> args;
+    std::string mention;
+  };
+  const std::vector<Case> cases = {
+      {{fcc, "--sizes", "256,300,864", "--calibrate-max", "300"},
+       "--sizes: 256 and 300 both make 256 spheres (an FCC lattice of whole cells): each size "
+       "must make a count of its own"},
+      {{fcc, "--sizes", "108,256,300", "--calibrate-max", "256"},
+       "--sizes: 256 and 300 both make 256 spheres (an FCC lattice of whole cells): the forward "
+       "size must make more than the REV"},
+      {{kHex5, "--sizes", "25,26,36", "--calibrate-max", "26"},
+       "--sizes: 25 and 26 both make 25 particles (a hexagonal lattice of whole columns and "
+       "rows)"},
+      {{file_config, "--sizes", "5,6,50", "--calibrate-max", "6"},
+       "--sizes: 5 and 6 both make 4 particles (REVs cut from"},
+  };
+  for (const Case& c : cases) {
+    std::vector<std::string> args{"scaling", "-o", "out", "-q", "-j", "1"};
+    args.insert(args.begin() + 1, c.args.begin(), c.args.end());
+    std::string trace = "demcal";
+    for (const auto& a : args) trace += " " + a;
+    SCOPED_TRACE(trace);
+    const Result r = demcal(args);
+    EXPECT_EQ(r.status, 2) << r.err;
+    EXPECT_EQ(r.err.rfind("demcal: error: --sizes: ", 0), 0u) << r.err;
+    EXPECT_NE(r.err.find(c.mention), std::string::npos) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_EQ(r.out, "");
+    EXPECT_TRUE(fs::is_empty(work())) << "left output behind";
+  }
+}
+
 // Without --work the per-size work goes to the -o folder (README: "default
 // the same folder"): two studies of one scene with different -o do not
 // share, and a fresh start of one leaves the other's sizes alone.

@@ -166,6 +166,29 @@ TEST(Upscale, SceneOfSizeKeepsTheGeneratorAndChangesTheCount) {
   EXPECT_THROW(scene_of_size(c, 100), InputError);
 }
 
+// `scaling` checks its sizes on the counts they make before consolidating
+// any: particles_of_size() is the count the resized generator makes, a
+// lattice's rounded one (hexagonal 5x5: 26 makes 25, as 25 does).
+TEST(Upscale, ParticlesOfSizeIsTheCountTheGeneratorMakes) {
+  for (const char* type : {"hexagonal", "square", "random"}) {
+    SCOPED_TRACE(type);
+    SceneConfig c = hex(5);
+    c.assembly.type = type;
+    if (c.assembly.type == "random") c.assembly.count = 25;
+    for (int64_t n : {4, 9, 25, 26, 30, 31, 40, 99, 100, 150, 401}) {
+      SCOPED_TRACE(n);
+      EXPECT_EQ(particles_of_size(c, n), make_assembly(scene_of_size(c, n)).size());
+    }
+    if (c.assembly.type == "random") {
+      EXPECT_EQ(particles_of_size(c, 26), 26);
+      EXPECT_EQ(size_rounding(c), "");
+    } else {
+      EXPECT_EQ(particles_of_size(c, 26), 25);
+      EXPECT_EQ(size_rounding(c), "a " + c.assembly.type + " lattice of whole columns and rows");
+    }
+  }
+}
+
 TEST(Fits, LinearAndPower) {
   const std::vector<double> x{25, 100, 400, 1600};
   std::vector<double> y;

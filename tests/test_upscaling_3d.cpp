@@ -88,6 +88,29 @@ TEST(Upscaling3D, FccFamilyKeepsTheCellAspect) {
   EXPECT_EQ(demcal::make_sphere_assembly(gas2).size(), 300);
 }
 
+// The counts `scaling` checks its sizes on, without generating: an FCC
+// block of whole cells (300 spheres asked make 256, as 256 do), a random
+// gas the count asked.
+TEST(Upscaling3D, ParticlesOfSizeIsTheCountTheGeneratorMakes) {
+  SceneConfig c = fcc_config();
+  c.assembly.cells_x = 2, c.assembly.cells_y = 3, c.assembly.cells_z = 4;
+  for (const SceneConfig& family : {fcc_config(), c}) {
+    for (int64_t n : {4, 32, 100, 108, 256, 300, 864, 1000}) {
+      SCOPED_TRACE(n);
+      EXPECT_EQ(demcal::particles_of_size(family, n),
+                demcal::make_sphere_assembly(demcal::scene_of_size(family, n)).size());
+    }
+  }
+  EXPECT_EQ(demcal::particles_of_size(fcc_config(), 300), 256);
+  EXPECT_EQ(demcal::size_rounding(fcc_config()), "an FCC lattice of whole cells");
+  const SceneConfig gas = demcal::parse_config_text(
+      "{" + test::kMaterialMember + R"(, "dimension": 3, "assembly": {"type": "random",
+         "count": 50, "radius_min": 4e-4, "radius_max": 6e-4, "seed": 7}})",
+      "gas.json");
+  EXPECT_EQ(demcal::particles_of_size(gas, 301), 301);
+  EXPECT_EQ(demcal::make_sphere_assembly(demcal::scene_of_size(gas, 301)).size(), 301);
+}
+
 TEST(Upscaling3D, PrototypeSpheresAsTheConfigNamesThem) {
   demcal::PrototypeSource src;
   const auto a = demcal::prototype_spheres(fcc_config(), 0, "", &src);

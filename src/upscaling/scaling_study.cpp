@@ -192,6 +192,19 @@ class Family {
   }
   bool from_file() const { return from_file_; }
   int64_t file_particles() const { return file_prototype_.size(); }
+  /// The particles size n makes (the generator's rounded count, or the
+  /// REV cut from the file), without consolidating: what the study's sizes
+  /// are checked on before any work.
+  int64_t made_count(int64_t n) const {
+    return from_file_ ? cut_rev(file_prototype_, n).size() : particles_of_size(config_, n);
+  }
+  /// Why a size can make another count than it asks, for an error (""
+  /// when it makes the count asked).
+  std::string rounding() const {
+    return from_file_
+               ? "REVs cut from " + scaling_family_file(config_).path + " take whole particles"
+               : size_rounding(config_);
+  }
   SceneConfig scene(int64_t n) const { return from_file_ ? config_ : scene_of_size(config_, n); }
 
   const SizeState& state(int64_t n) {
@@ -475,9 +488,36 @@ void run_steps(Family& family, const CalibrationOptions& calibration, const Scal
     forward_check(family, o, st, fwd.fixed.trials.front());
 }
 
-}  // namespace
+/// The counts the sizes make (Family::made_count) rise with the sizes: two
+/// sizes that make one count would calibrate (or run) one sample twice, and
+/// a forward size that makes no more than the REV would check nothing.
+void check_made_counts(const Family& family, const ScalingStudyOptions& o, int dimension) {
+  const std::string noun = dimension == 3 ? " spheres" : " particles";
+  const std::string rounding = family.rounding();
+  const std::string why = rounding.empty() ? "" : " (" + rounding + ")";
+  int64_t below = 0, below_made = 0;
+  for (int64_t n : o.sizes) {
+    const int64_t made = family.made_count(n);
+    // The forward size against the REV (the size below it, when calibrated).
+    const bool forward = n == o.sizes.back() && below <= o.calibrate_max;
+    const std::string then =
+        forward ? ": the forward size must make more than the REV it checks the law from"
+                : ": each size must make a count of its own";
+    if (below > 0 && made == below_made)
+      throw InputError("--sizes", "",
+                       std::to_string(below) + " and " + std::to_string(n) + " both make " +
+                           std::to_string(made) + noun + why + then);
+    if (below > 0 && made < below_made)
+      throw InputError("--sizes", "",
+                       std::to_string(n) + " makes " + std::to_string(made) + noun +
+                           ", fewer than the " + std::to_string(below_made) + " " +
+                           std::to_string(below) + " makes" + why + then);
+    below = n, below_made = made;
+  }
+}
 
-void check_scaling_sizes(const ScalingStudyOptions& o) {
+/// The plan of sizes alone (check_scaling_sizes(options)).
+void check_plan(const ScalingStudyOptions& o) {
   const auto calibrated = std::count_if(o.sizes.begin(), o.sizes.end(),
                                         [&](int64_t n) { return n <= o.calibrate_max; });
   if (calibrated < 2)
@@ -493,6 +533,15 @@ void check_scaling_sizes(const ScalingStudyOptions& o) {
                          std::to_string(o.calibrate_max) +
                          "): every size given is calibrated, none runs the law carried from the "
                          "REV");
+}
+
+}  // namespace
+
+void check_scaling_sizes(const ScalingStudyOptions& o) { check_plan(o); }
+
+void check_scaling_sizes(const SceneConfig& config, const ScalingStudyOptions& o) {
+  check_plan(o);
+  check_made_counts(Family(config, o), o, config.dimension);
 }
 
 ScalingStudy run_scaling_study(const SceneConfig& config, const ScalingStudyOptions& o) {
@@ -514,7 +563,7 @@ ScalingStudy run_scaling_study(const SceneConfig& config, const ScalingStudyOpti
   // scaling.md.
   const CalibrationOptions calibration = CalibrationOptions::from(config);
   st.tolerances = calibration.tolerances;
-  check_scaling_sizes(o);
+  check_plan(o);
   for (int64_t n : o.sizes)
     if (n <= o.calibrate_max) st.calibrated_sizes.push_back(n);
   st.forward_size = o.sizes.back();
@@ -524,6 +573,7 @@ ScalingStudy run_scaling_study(const SceneConfig& config, const ScalingStudyOpti
     if (n < st.forward_size) st.ref_size = n;
 
   Family family(config, o);
+  check_made_counts(family, o, config.dimension);
   st.from_file = family.from_file();
   st.family = st.from_file ? "REVs cut from a particle file" : config.assembly.type + " generator";
   make_output_dir(o.work_dir);

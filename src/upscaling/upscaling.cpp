@@ -153,6 +153,21 @@ SceneConfig scene_of_size(const SceneConfig& config, int64_t particles) {
   return c;
 }
 
+int64_t particles_of_size(const SceneConfig& config, int64_t particles) {
+  const AssemblySpec a = scene_of_size(config, particles).assembly;
+  if (a.type == "fcc") return int64_t{4} * a.cells_x * a.cells_y * a.cells_z;
+  if (a.type == "hexagonal" || a.type == "square") return int64_t{a.columns} * a.rows;
+  return a.count;  // random: the count asked
+}
+
+std::string size_rounding(const SceneConfig& config) {
+  const std::string& type = config.assembly.type;
+  if (type == "fcc") return "an FCC lattice of whole cells";
+  if (type == "hexagonal" || type == "square")
+    return "a " + type + " lattice of whole columns and rows";
+  return "";
+}
+
 namespace {
 
 /// Which prototype a command describes, in the order the flags and the

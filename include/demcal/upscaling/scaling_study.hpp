@@ -142,6 +142,13 @@ struct ScalingStudy {
 /// above it (the forward check, without which the study proves nothing).
 /// Throws InputError naming --sizes; run_scaling_study() checks it first.
 void check_scaling_sizes(const ScalingStudyOptions& options);
+/// The same, and the particle counts the sizes make on `config`'s family
+/// (a lattice generator rounds to whole cells, rows and columns; a REV cut
+/// from a file takes whole particles; counted without consolidating) rise
+/// with the sizes: two sizes that make one count, or a forward size that
+/// makes no more than the REV, throw InputError naming --sizes and the
+/// counts. A 3D file family is refused (assembly.type), as the study does.
+void check_scaling_sizes(const SceneConfig& config, const ScalingStudyOptions& options);
 
 /// The particle file a scaling study cuts its family of REVs from (path)
 /// and the config key naming it (key): the prototype's file, else the

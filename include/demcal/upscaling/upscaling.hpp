@@ -100,6 +100,15 @@ struct PrototypeSource {
 /// or 3D: count). A family of scenes that differ only in size. Throws
 /// InputError for a file assembly (cut a REV instead, rev.hpp).
 SceneConfig scene_of_size(const SceneConfig& config, int64_t particles);
+/// The particle count scene_of_size(config, particles)'s generator makes,
+/// without generating it: columns·rows (hexagonal, square), 4 a cell (fcc),
+/// the count (random). Lattices round: two requests can make one count
+/// (`scaling` refuses such sizes before consolidating any).
+int64_t particles_of_size(const SceneConfig& config, int64_t particles);
+/// Why the config's generator may make another count than the one asked,
+/// for an error: "a hexagonal lattice of whole columns and rows", "an FCC
+/// lattice of whole cells"; "" for random (it makes the count asked).
+std::string size_rounding(const SceneConfig& config);
 
 /// The prototype the config names (prototype.file, else prototype.particles
 /// with the config's generator, else the REV itself); `particles` and
