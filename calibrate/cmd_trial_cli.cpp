@@ -8,6 +8,7 @@
 
 #include "commands.hpp"
 #include "demcal/kernel/world.hpp"
+#include "demcal/scene/config.hpp"
 #include "demcal/search/calibration.hpp"
 #include "option_checks.hpp"
 
@@ -86,12 +87,12 @@ void add_score_options(CLI::App* score, ScoreOptions& options) {
   score
       ->add_option("--lateral-stress", options.lateral_stress,
                    "sigma3 in Pa, if the file has no '# lateral_stress = ' line")
-      ->check(real_above(0.0, 1e12));
+      ->check(real_above(kLateralStress.lo, kLateralStress.hi));
   score
       ->add_option("--reference-peak", options.reference_peak,
                    "a reference peak |sigma_yy| (3D: |sigma_zz|) in Pa to report the peak error "
                    "against (default: the file's '# reference_peak = ' line, if any)")
-      ->check(real_above(0.0, 1e15));
+      ->check(real_above(kReferencePeak.lo, kReferencePeak.hi));
   score->add_option("-o,--output", options.out_dir, "output folder (default demcal-score-STEM)");
 }
 

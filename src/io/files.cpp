@@ -125,6 +125,10 @@ std::string read_text_file(const std::string& path) {
   return s.str();
 }
 
+void drop_utf8_bom(std::string& text) {
+  if (text.rfind("\xEF\xBB\xBF", 0) == 0) text.erase(0, 3);
+}
+
 void write_file_atomic(const std::string& path, const std::string& content) {
   require_regular_file_target(path);
   const fs::path target(path);

@@ -59,15 +59,17 @@ class Reader {
     if (!std::isfinite(d)) fail(key, "must be finite");
     return d;
   }
-  double positive(const std::string& key, double fallback) {
+  /// A number in `range` (finite: number()).
+  double in_range(const std::string& key, double fallback, const RealRange& range) {
     const double d = number(key, fallback);
-    if (!(d > 0.0)) fail(key, "must be > 0, got " + format(d));
+    if (!range.contains(d)) fail(key, "must be " + range.text() + ", got " + format(d));
     return d;
   }
+  double positive(const std::string& key, double fallback) {
+    return in_range(key, fallback, kPositive);
+  }
   double non_negative(const std::string& key, double fallback) {
-    const double d = number(key, fallback);
-    if (!(d >= 0.0)) fail(key, "must be >= 0, got " + format(d));
-    return d;
+    return in_range(key, fallback, RealRange{0.0, true});
   }
   /// A whole number, read as an integer (never through a double that could
   /// overflow the cast): 100000, or 1e5 in exponent form when that is exact.
@@ -151,9 +153,10 @@ AlgorithmSpec read_algorithm(Reader& a, AlgorithmSpec s) {
   if (s.dt_ratio > 2.0) a.fail("dt_ratio", "must be <= 2 (beyond the single-spring limit)");
   s.steps = a.integer("steps", s.steps, 10, kMaxSteps);
   s.damping_ratio_translation =
-      a.non_negative("damping_ratio_translation", s.damping_ratio_translation);
-  s.damping_ratio_rotation = a.non_negative("damping_ratio_rotation", s.damping_ratio_rotation);
-  s.mass_scaling = a.positive("mass_scaling", s.mass_scaling);
+      a.in_range("damping_ratio_translation", s.damping_ratio_translation, kDampingRatio);
+  s.damping_ratio_rotation =
+      a.in_range("damping_ratio_rotation", s.damping_ratio_rotation, kDampingRatio);
+  s.mass_scaling = a.in_range("mass_scaling", s.mass_scaling, kMassScaling);
   s.lock_rotation = a.boolean("lock_rotation", s.lock_rotation);
   a.reject_unknown();
   return s;
@@ -269,6 +272,13 @@ std::string resolved_file(const std::string& file, const std::string& source) {
 }
 
 }  // namespace
+
+std::string RealRange::text() const {
+  std::ostringstream s;
+  s << (lo_included ? ">= " : "> ") << lo;
+  if (std::isfinite(hi)) s << " and <= " << hi;
+  return s.str();
+}
 
 int64_t particle_count(const nlohmann::json& value, int64_t min, const std::string& file,
                        const std::string& field) {

@@ -161,7 +161,7 @@ bool parse_particle_fields(const std::string& line, std::span<double> v, bool& s
 }
 
 void prepare_particle_line(std::string& line, int line_no, const std::string& path) {
-  if (line_no == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);  // UTF-8 BOM
+  if (line_no == 1) drop_utf8_bom(line);
   if (!line.empty() && line.back() == '\r') line.pop_back();
   // strtod would stop at a NUL and take "1.5\0garbage" for 1.5.
   if (const auto nul = line.find('\0'); nul != std::string::npos)

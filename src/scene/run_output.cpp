@@ -37,17 +37,14 @@ std::vector<std::string> series_metadata_lines(const SeriesMetadata& m) {
 }
 
 std::vector<std::string> series_result_lines(const SeriesMetadata& m) {
+  // The values of kSeriesResultKeys, in its order.
+  const std::optional<std::string>* const values[] = {
+      &m.peak_stress_yy, &m.peak_strain_yy,  &m.peak_stress_zz, &m.peak_strain_zz,
+      &m.reference_peak, &m.divergence_step, &m.divergence};
+  static_assert(std::size(values) == kSeriesResultKeys.size());
   std::vector<std::string> out;
-  auto optional = [&](const char* key, const std::optional<std::string>& value) {
-    if (value) out.push_back(metadata_line(key, *value));
-  };
-  optional("peak_stress_yy", m.peak_stress_yy);
-  optional("peak_strain_yy", m.peak_strain_yy);
-  optional("peak_stress_zz", m.peak_stress_zz);
-  optional("peak_strain_zz", m.peak_strain_zz);
-  optional("reference_peak", m.reference_peak);
-  optional("divergence_step", m.divergence_step);
-  optional("divergence", m.divergence);
+  for (size_t k = 0; k < kSeriesResultKeys.size(); ++k)
+    if (*values[k]) out.push_back(metadata_line(kSeriesResultKeys[k], **values[k]));
   return out;
 }
 

@@ -35,6 +35,10 @@ void require_regular_file_target(const std::string& path);
 void require_readable_file(const std::string& path);
 /// The whole of a regular file (require_readable_file first).
 std::string read_text_file(const std::string& path);
+/// Drop the UTF-8 byte order mark an editor may put at the start of a text
+/// file (`text`: the file, or its first line); the readers of text files
+/// (particle files, `demcal score`'s series) take the file without it.
+void drop_utf8_bom(std::string& text);
 
 /// Write `content` to `path` atomically (temporary + fsync + rename). A
 /// non-regular target is an InputError; a failed write throws

@@ -5,7 +5,9 @@
 // range gives one InputError naming the file and the key.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <stdexcept>
@@ -42,6 +44,34 @@ int64_t particle_count(const nlohmann::json& value, int64_t min, const std::stri
 /// The largest overlap at sigma3, relative to the radius, a config may ask
 /// for (test.lateral_stress): see check_lateral_stress in config.cpp.
 inline constexpr double kMaxOverlapAtSigma3 = 0.05;
+
+/// The range of a real quantity that a config, a command-line option and a
+/// series' metadata (`demcal score`) all give: finite, above `lo` (or at it
+/// when `lo_included`), at most `hi`. One range per quantity, below, read
+/// by each of them.
+struct RealRange {
+  double lo = 0.0;
+  bool lo_included = false;
+  double hi = std::numeric_limits<double>::infinity();
+  bool contains(double v) const {
+    return std::isfinite(v) && (lo_included ? v >= lo : v > lo) && v <= hi;
+  }
+  /// "> 0", ">= 0", "> 0 and <= 1e+12": the message's "must be ...".
+  std::string text() const;
+};
+/// A positive quantity: a step (dt, dt_crit [s]), algorithm.mass_scaling.
+inline constexpr RealRange kPositive{0.0, false};
+/// algorithm.damping_ratio_translation and _rotation.
+inline constexpr RealRange kDampingRatio{0.0, true};
+/// algorithm.mass_scaling.
+inline constexpr RealRange kMassScaling = kPositive;
+/// σ3 [Pa] given on its own (--lateral-stress, a series' "# lateral_stress");
+/// a config's test.lateral_stress is positive and bounded by its contact
+/// stiffness instead (check_lateral_stress in config.cpp).
+inline constexpr RealRange kLateralStress{0.0, false, 1e12};
+/// A reference peak |σ| [Pa] (--reference-peak, the magnitude of a series'
+/// "# reference_peak").
+inline constexpr RealRange kReferencePeak{0.0, false, 1e15};
 
 /// The defaults of `assembly.type` and `test.type` in a 3D config
 /// (`"dimension": 3`): the 2D defaults (hexagonal, biaxial) have no 3D

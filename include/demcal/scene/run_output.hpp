@@ -2,6 +2,7 @@
 // gnuplot) and final.vtk (ParaView).
 #pragma once
 
+#include <array>
 #include <optional>
 #include <string>
 #include <vector>
@@ -57,6 +58,11 @@ std::vector<std::string> series_metadata_lines(const SeriesMetadata& m);
 /// that list, and what an engine's deck appends to its series once its run
 /// is over (a reader takes "# key = value" lines anywhere in the file).
 std::vector<std::string> series_result_lines(const SeriesMetadata& m);
+/// The keys of series_result_lines(), in its order: the only metadata a
+/// series may give after its column header (`demcal score`).
+inline constexpr std::array<const char*, 7> kSeriesResultKeys = {
+    "peak_stress_yy", "peak_strain_yy",  "peak_stress_zz", "peak_strain_zz",
+    "reference_peak", "divergence_step", "divergence"};
 
 /// The metadata of a run of demcal (2D, 3D): every value written to
 /// round-trip the double (the scores of `demcal score` and `demcal run`
