@@ -5,12 +5,12 @@
 // scored with), as `demcal run` prints them for its own runs;
 // DIR/summary.json.
 #include <filesystem>
-#include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <sstream>
 
 #include "commands.hpp"
+#include "demcal/io/files.hpp"
 #include "demcal/scoring/external_series.hpp"
 #include "output_folder.hpp"
 #include "print_criteria.hpp"
@@ -19,14 +19,11 @@ namespace demcal::cli {
 
 int cmd_score(const ScoreOptions& o) {
   namespace fs = std::filesystem;
-  if (fs::is_directory(o.file)) throw InputError(o.file, "", "is a folder, not a file");
-  std::ifstream in(o.file, std::ios::binary);
-  if (!in) throw InputError(o.file, "", "cannot open file");
-  std::ostringstream text;
-  text << in.rdbuf();
+  // A folder, a device (/dev/zero would never end), a fifo: one line, exit 2.
+  const std::string text = read_text_file(o.file);
   std::optional<double> s3;
   if (o.lateral_stress > 0.0) s3 = o.lateral_stress;
-  const ExternalSeries series = parse_external_series(text.str(), o.file, s3);
+  const ExternalSeries series = parse_external_series(text, o.file, s3);
   const std::string dir =
       o.out_dir.empty() ? "demcal-score-" + fs::path(o.file).stem().string() : o.out_dir;
   OutputFolder::check(dir);

@@ -303,6 +303,17 @@ TEST_F(RobustCli, SeriesCountThatIsNoWholeNumberIsRefused) {
   EXPECT_EQ(r.status, 0) << r.err;
 }
 
+// `demcal score` on what is no series file: a device that never ends
+// (/dev/zero, /dev/urandom) or a folder is one line, exit 2, as the other
+// readers say it (require_readable_file), not an allocation that runs out.
+TEST_F(RobustCli, ScoreRefusesADeviceOrAFolder) {
+  expect_refused({"score", "/dev/zero", "-o", "out"}, "/dev/zero: is a device node, not a file");
+  expect_refused({"score", "/dev/urandom", "-o", "out"},
+                 "/dev/urandom: is a device node, not a file");
+  fs::create_directories(work() / "folder");
+  expect_refused({"score", "folder", "-o", "out"}, "folder: is a folder, not a file");
+}
+
 TEST_F(RobustCli, CutLastTrialLineIsRepaired) {
   calibrate_a();
   const fs::path trials = work() / "A" / "trials.jsonl";
