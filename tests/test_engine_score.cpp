@@ -227,6 +227,21 @@ TEST(ExternalSeries, ReadsTheKeysOfDemcalsOwnRuns) {
   EXPECT_EQ(sd.diagnosis.signature, "divergence");
 }
 
+// An editor's UTF-8 byte order mark before the first line: dropped, as a
+// particle file's (the metadata line after it is metadata, not a header).
+TEST(ExternalSeries, AUtf8BomBeforeTheFirstLineIsDropped) {
+  const std::string text =
+      "# lateral_stress = 1e5\n# steps = 20\nstep,strain_yy,b_xx,b_xy,b_yx,b_yy,s_xx,s_xy,s_yx,"
+      "s_yy\n0,0,-1e5,0,0,-1e5,-1e5,0,0,-1e5\n10,-0.01,-1e5,0,0,-2e5,-1e5,0,0,-2e5\n"
+      "20,-0.02,-1e5,0,0,-2.5e5,-1e5,0,0,-2.5e5\n";
+  const ExternalSeries plain = parse_external_series(text, "t.csv");
+  const ExternalSeries bom = parse_external_series("\xEF\xBB\xBF" + text, "t.csv");
+  EXPECT_EQ(bom.meta, plain.meta);
+  EXPECT_EQ(bom.lateral_stress, 1e5);
+  ASSERT_EQ(bom.run.series.size(), 3u);
+  EXPECT_EQ(bom.run.steps_planned, 20);
+}
+
 TEST(ScoreCli, ScoresAFileAndRejectsBadInputWithStatus2) {
   const test::TempDir dir("score_cli");
   const SceneConfig c = hex5();

@@ -6,6 +6,7 @@
 #include <limits>
 #include <sstream>
 
+#include "demcal/io/files.hpp"
 #include "demcal/io/format.hpp"
 #include "demcal/io/input_error.hpp"
 #include "demcal/io/json_integer.hpp"
@@ -81,6 +82,7 @@ Table read_table(const std::string& text, ExternalSeries& out) {
   int line_no = 0;
   for (std::string raw; std::getline(lines, raw);) {
     ++line_no;
+    if (line_no == 1) drop_utf8_bom(raw);  // an editor's, as particle files
     const std::string line = trim(raw);
     if (line.empty()) continue;
     if (line[0] == '#') {
