@@ -242,6 +242,98 @@ TEST(ExternalSeries, AUtf8BomBeforeTheFirstLineIsDropped) {
   EXPECT_EQ(bom.run.steps_planned, 20);
 }
 
+/// The message of parsing `text` as "x.csv" ("no error" when it parses).
+std::string series_error(const std::string& text) {
+  try {
+    parse_external_series(text, "x.csv");
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+const std::string kTable =
+    "step,strain_yy,b_xx,b_xy,b_yx,b_yy,s_xx,s_xy,s_yx,s_yy\n"
+    "0,0,-1e5,0,0,-1e5,-1e5,0,0,-1e5\n10,-0.01,-1e5,0,0,-2e5,-1e5,0,0,-2e5\n"
+    "20,-0.02,-1e5,0,0,-2.5e5,-1e5,0,0,-2.5e5\n";
+
+// A row beyond "# steps" is a run that went on past the loading the file
+// plans (a deck run with a larger run_steps): refused with its line, never
+// "40 of 20 steps (incomplete)"; the steps planned are a positive count.
+TEST(ExternalSeries, ARowBeyondTheStepsPlannedIsRefused) {
+  const std::string s3 = "# lateral_stress = 1e5\n";
+  EXPECT_EQ(series_error(s3 + "# steps = 20\n" + kTable), "no error");
+  const std::string beyond =
+      series_error(s3 + "# steps = 20\n" + kTable + "30,-0.03,-1e5,0,0,-2e5,-1e5,0,0,-2e5\n");
+  EXPECT_NE(beyond.find("x.csv: line 7: step 30 is beyond the 20 steps planned (# steps, line 2): "
+                        "keep the rows up to step 20"),
+            std::string::npos)
+      << beyond;
+  EXPECT_NE(beyond.find("run_steps"), std::string::npos) << beyond;
+  // The row where a run blew up is a row too.
+  EXPECT_NE(series_error(s3 + "# steps = 20\n" + kTable + "30,nan,-1e5,0,0,-2e5,-1e5,0,0,-2e5\n")
+                .find("line 7: step 30 is beyond"),
+            std::string::npos);
+  for (const char* steps : {"0", "-5", "2.5", "nan"})
+    EXPECT_NE(
+        series_error(s3 + "# steps = " + steps + "\n" + kTable).find("x.csv: line 2: # steps: "),
+        std::string::npos)
+        << steps;
+}
+
+// The metadata's values in the ranges a config and the command line hold
+// them to, each refused with its line and key; a key given twice, and a
+// parameter of the run after the column header, are refused too.
+TEST(ExternalSeries, MetadataValuesAreCheckedWithTheirLineAndKey) {
+  const std::string base = "# lateral_stress = 1e5\n# steps = 20\n";
+  const std::pair<const char*, const char*> bad[] = {
+      {"dt", "-1"},
+      {"dt", "nan"},
+      {"dt", "0"},
+      {"dt_crit", "0"},
+      {"dt_crit", "inf"},
+      {"reference_peak", "0"},
+      {"reference_peak", "1e300"},
+      {"damping_ratio_translation", "-1"},
+      {"damping_ratio_rotation", "nan"},
+      {"mass_scaling", "0"},
+      {"mass_scaling", "-2"},
+  };
+  for (const auto& [key, value] : bad) {
+    const std::string m = series_error(base + "# " + key + " = " + value + "\n" + kTable);
+    EXPECT_NE(m.find(std::string("x.csv: line 3: # ") + key + ": must be"), std::string::npos)
+        << key << " = " << value << ": " << m;
+  }
+  // sigma3 as --lateral-stress holds it: (0, 1e12].
+  for (const char* s3 : {"1e300", "0", "-1e5", "nan"})
+    EXPECT_NE(series_error(std::string("# lateral_stress = ") + s3 + "\n" + kTable)
+                  .find("x.csv: line 1: # lateral_stress: must be > 0 and <= 1e+12"),
+              std::string::npos)
+        << s3;
+  // Given twice: neither is taken.
+  EXPECT_NE(series_error(base + "# lateral_stress = 2e5\n" + kTable)
+                .find("x.csv: line 3: # lateral_stress: given twice (first on line 1)"),
+            std::string::npos);
+  // A parameter among the rows would hold for the rows above it too.
+  const std::string among = series_error(base + kTable.substr(0, kTable.find("10,")) +
+                                         "# dt = 1e-6\n" + kTable.substr(kTable.find("10,")));
+  EXPECT_NE(among.find("x.csv: line 5: # dt: after the column header (line 3)"), std::string::npos)
+      << among;
+  EXPECT_NE(series_error("# steps = 20\n" + kTable + "# lateral_stress = 5e5\n")
+                .find("line 6: # lateral_stress: after the column header"),
+            std::string::npos);
+  // What a run found may follow its rows (the 3D deck appends its peak),
+  // and a reference peak has either sign (demcal writes it compressive).
+  EXPECT_EQ(series_error(base + kTable + "# peak_stress_yy = -3e5\n# reference_peak = -2.5e5\n"),
+            "no error");
+  EXPECT_EQ(series_error(base + "# reference_peak = 2.5e5\n" + kTable), "no error");
+  EXPECT_EQ(series_error(base +
+                         "# dt = 1e-6\n# dt_crit = 5e-6\n# damping_ratio_translation = "
+                         "0\n# damping_ratio_rotation = 0\n# mass_scaling = 1\n" +
+                         kTable),
+            "no error");
+}
+
 TEST(ScoreCli, ScoresAFileAndRejectsBadInputWithStatus2) {
   const test::TempDir dir("score_cli");
   const SceneConfig c = hex5();
@@ -300,6 +392,42 @@ TEST(EngineLammps, TheDecksOwnSeriesScoresAsDemcalsRun) {
   EXPECT_NEAR(theirs.score.criteria.force_balance / ours.criteria.force_balance, 1.0, 0.5);
   EXPECT_NEAR(theirs.score.criteria.servo / ours.criteria.servo, 1.0, 0.5);
   EXPECT_LT(theirs.score.criteria.moment_balance, Tolerances{}.moment_balance);
+}
+
+// The deck run past its loading (-var run_steps larger than its nstep: the
+// top wall goes on moving) writes rows beyond "# steps": `demcal score` of
+// its series is refused, exit 2, naming the file and the first such row, and
+// saying what to do; run up to nstep, the same deck's series scores.
+TEST(EngineLammps, ADeckRunPastItsStepsIsRefusedByScore) {
+  DEMCAL_FIND_PROGRAM(lmp, "lmp", "lammps", "the deck's series is not scored");
+  const SceneConfig c = hex5();
+  const ConsolidatedState state = consolidate(c, make_assembly(c));
+  AlgorithmSpec p = quasi_static();
+  p.steps = 400;
+  ExportOptions o;
+  o.deck_name = "hex5";
+  const ExportResult r = export_deck(c, p, assembly_of(state.world), o);
+  const std::string series = deck_files(o.deck_name).series;
+  const std::string nstep = std::to_string(deck_steps(p));  // the deck's loading
+  auto score = [&](const std::string& run_steps) {
+    const test::TempDir dir("engine_score_past_" + run_steps);
+    const test::DeckRun lammps = test::run_deck(
+        lmp, dir.path(), r.deck, r.files, {"-var", "run_steps", run_steps, "-screen", "none"});
+    EXPECT_EQ(lammps.status, 0) << lammps.log;
+    return test::run_demcal({"score", series, "-o", "out"}, dir.path());
+  };
+  const test::RunResult past = score(std::to_string(2 * deck_steps(p)));
+  EXPECT_EQ(past.status, 2) << past.out << past.err;
+  EXPECT_NE(past.err.find(series + ": line "), std::string::npos) << past.err;
+  EXPECT_NE(past.err.find(" is beyond the " + nstep + " steps planned (# steps, line "),
+            std::string::npos)
+      << past.err;
+  EXPECT_NE(past.err.find("without a run_steps larger than its nstep"), std::string::npos)
+      << past.err;
+  const test::RunResult planned = score(nstep);
+  EXPECT_NE(planned.status, 2) << planned.err;
+  EXPECT_NE(planned.out.find(", " + nstep + " steps\n"), std::string::npos)
+      << planned.out;  // complete
 }
 
 /// ζ_c = 0.25 on the 25-disc sample: demcal's servo divides by

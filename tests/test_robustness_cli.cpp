@@ -294,8 +294,8 @@ TEST_F(RobustCli, SeriesCountThatIsNoWholeNumberIsRefused) {
   };
   for (const char* step : {"1e300", "2.5", "-1"})
     expect_refused(series("", step), "series.csv: line 4: step");
-  expect_refused(series("# steps = 1e300\n", "1"), "series.csv: # steps");
-  expect_refused(series("# particles = 1e20\n", "1"), "series.csv: # particles");
+  expect_refused(series("# steps = 1e300\n", "1"), "series.csv: line 2: # steps");
+  expect_refused(series("# particles = 1e20\n", "1"), "series.csv: line 2: # particles");
   // The row where the run diverged: its step is read the same way.
   expect_refused(series("", "1", "1e300,nan,1,0,0,1,1,0,0,1"), "series.csv: line 5: step");
   // The same file with whole counts is scored.
@@ -312,6 +312,38 @@ TEST_F(RobustCli, ScoreRefusesADeviceOrAFolder) {
                  "/dev/urandom: is a device node, not a file");
   fs::create_directories(work() / "folder");
   expect_refused({"score", "folder", "-o", "out"}, "folder: is a folder, not a file");
+}
+
+// The series' metadata out of range, given twice, among the rows, and a
+// row beyond the steps planned: exit 2 naming the file, the line and the
+// key, nothing written; a UTF-8 BOM before the first line is dropped.
+TEST_F(RobustCli, ScoreRefusesBadMetadataAndRowsBeyondTheSteps) {
+  const std::string table =
+      "step,strain_yy,b_xx,b_xy,b_yx,b_yy,s_xx,s_xy,s_yx,s_yy\n"
+      "0,0,1,0,0,1,1,0,0,1\n1,-0.01,1,0,0,1,1,0,0,1\n2,-0.02,1,0,0,1,1,0,0,1\n";
+  const auto series = [&](const std::string& text) {
+    std::ofstream(work() / "series.csv") << text;
+    return std::vector<std::string>{"score", "series.csv", "-o", "out"};
+  };
+  const std::string head = "# lateral_stress = 1e5\n# steps = 2\n";
+  expect_refused(series(head + table + "3,-0.03,1,0,0,1,1,0,0,1\n"),
+                 "series.csv: line 7: step 3 is beyond the 2 steps planned");
+  expect_refused(series("# lateral_stress = 1e5\n# steps = 0\n" + table),
+                 "series.csv: line 2: # steps");
+  expect_refused(series(head + "# lateral_stress = 2e5\n" + table),
+                 "series.csv: line 3: # lateral_stress: given twice");
+  expect_refused(series(head + table + "# lateral_stress = 5e5\n"),
+                 "series.csv: line 7: # lateral_stress: after the column header");
+  expect_refused(series("# lateral_stress = 1e300\n" + table),
+                 "series.csv: line 1: # lateral_stress");
+  expect_refused(series(head + "# dt = -1\n" + table), "series.csv: line 3: # dt: must be > 0");
+  expect_refused(series(head + "# mass_scaling = 0\n" + table),
+                 "series.csv: line 3: # mass_scaling: must be > 0");
+  expect_refused(series(head + "# reference_peak = 0\n" + table),
+                 "series.csv: line 3: # reference_peak");
+  // With a BOM before its first line the file scores as without.
+  const Result r = demcal(series("\xEF\xBB\xBF" + head + table));
+  EXPECT_EQ(r.status, 0) << r.err;
 }
 
 TEST_F(RobustCli, CutLastTrialLineIsRepaired) {

@@ -11,6 +11,7 @@
 #include "demcal/io/input_error.hpp"
 #include "demcal/io/json_integer.hpp"
 #include "demcal/scene/config.hpp"
+#include "demcal/scene/run_output.hpp"
 #include "demcal/scoring/triaxial_scoring.hpp"
 
 namespace demcal {
@@ -67,6 +68,9 @@ struct Table {
   std::vector<std::vector<double>> rows;
   bool diverged = false;
   int64_t diverged_step = -1;
+  std::map<std::string, int> meta_line;  ///< the line of each "# key = value"
+  std::optional<int64_t> steps;          ///< "# steps": the steps planned
+  int header_line = 0;                   ///< the line of the column header
 
   bool has(const char* name) const { return col.count(name) > 0; }
   double value(const std::vector<double>& row, const std::string& name, double fallback) const {
@@ -74,6 +78,71 @@ struct Table {
     return it == col.end() ? fallback : row[it->second];
   }
 };
+
+/// A count of the metadata (steps, particles, a step), from `min` to `max`,
+/// shown as written.
+int64_t meta_count(const std::string& value, const std::string& source, const std::string& where,
+                   int64_t min, int64_t max) {
+  try {
+    return whole_number(parse_number(value, source, where), min, max, value);
+  } catch (const std::out_of_range& e) {
+    throw InputError(source, where, e.what());
+  }
+}
+
+/// A metadata value checked where it is read, with its line (`where`):
+/// the run's parameters in the ranges a config and the command line hold
+/// them to (config.hpp), the counts whole numbers. `t.steps` takes
+/// "# steps". Keys demcal does not read are kept as written.
+void check_metadata(const std::string& key, const std::string& value, const std::string& source,
+                    const std::string& where, Table& t) {
+  struct Ranged {
+    const char* key;
+    RealRange range;
+    const char* as;  ///< where the same range holds
+  };
+  static const Ranged kRanged[] = {
+      {"lateral_stress", kLateralStress, "sigma3 [Pa], as --lateral-stress"},
+      {"dt", kPositive, "the time step [s]"},
+      {"dt_crit", kPositive, "the critical time step [s]"},
+      {"damping_ratio_translation", kDampingRatio,
+       "as a config's algorithm.damping_ratio_translation"},
+      {"damping_ratio_rotation", kDampingRatio, "as a config's algorithm.damping_ratio_rotation"},
+      {"mass_scaling", kMassScaling, "as a config's algorithm.mass_scaling"},
+  };
+  for (const Ranged& r : kRanged)
+    if (key == r.key) {
+      const double v = parse_number(value, source, where);
+      if (!r.range.contains(v))
+        throw InputError(
+            source, where,
+            "must be " + r.range.text() + " (" + r.as + "), got " + quoted_value(value));
+      return;
+    }
+  if (key == "reference_peak") {
+    // A compressive peak whichever sign the file gives it: its magnitude.
+    const double v = parse_number(value, source, where);
+    if (!kReferencePeak.contains(std::abs(v)))
+      throw InputError(source, where,
+                       "must be " + kReferencePeak.text() +
+                           " in magnitude (Pa, as --reference-peak; either sign: a compressive "
+                           "peak), got " +
+                           quoted_value(value));
+  } else if (key == "steps") {
+    t.steps = meta_count(value, source, where, 1, kMaxSteps);
+  } else if (key == "particles") {
+    meta_count(value, source, where, 0, kMaxParticles);
+  } else if (key == "divergence_step") {
+    meta_count(value, source, where, 0, std::numeric_limits<int64_t>::max());
+  }
+}
+
+/// "peak_stress_yy, ..., divergence": the keys that may follow the rows.
+std::string result_keys() {
+  std::string out;
+  for (const char* key : kSeriesResultKeys) out += (out.empty() ? "" : ", ") + std::string(key);
+  return out;
+}
 
 Table read_table(const std::string& text, ExternalSeries& out) {
   const std::string& source = out.source;
@@ -85,14 +154,34 @@ Table read_table(const std::string& text, ExternalSeries& out) {
     if (line_no == 1) drop_utf8_bom(raw);  // an editor's, as particle files
     const std::string line = trim(raw);
     if (line.empty()) continue;
+    const std::string where = "line " + std::to_string(line_no);
     if (line[0] == '#') {
       const auto eq = line.find(" = ");
-      if (eq != std::string::npos)
-        out.meta[trim(line.substr(1, eq - 1))] = trim(line.substr(eq + 3));
+      if (eq == std::string::npos) continue;  // a comment
+      const std::string key = trim(line.substr(1, eq - 1)), value = trim(line.substr(eq + 3));
+      const std::string field = where + ": # " + key;
+      // After the header only what a run found, which an exported deck
+      // appends once its run is over (series_result_lines); a parameter of
+      // the run there would hold for the rows above it too.
+      if (!t.columns.empty() &&
+          std::find_if(kSeriesResultKeys.begin(), kSeriesResultKeys.end(),
+                       [&](const char* k) { return key == k; }) == kSeriesResultKeys.end())
+        throw InputError(source, field,
+                         "after the column header (line " + std::to_string(t.header_line) +
+                             "): the run's parameters come before the header; after it only "
+                             "what the run found (" +
+                             result_keys() + ")");
+      if (const auto first = t.meta_line.find(key); first != t.meta_line.end())
+        throw InputError(
+            source, field,
+            "given twice (first on line " + std::to_string(first->second) + "): keep one");
+      check_metadata(key, value, source, field, t);
+      t.meta_line[key] = line_no;
+      out.meta[key] = value;
       continue;
     }
-    const std::string where = "line " + std::to_string(line_no);
     if (t.columns.empty()) {
+      t.header_line = line_no;
       t.columns = split_commas(line);
       for (size_t k = 0; k < t.columns.size(); ++k) {
         if (t.columns[k].empty()) throw InputError(source, where, "an empty column name");
@@ -120,6 +209,17 @@ Table read_table(const std::string& text, ExternalSeries& out) {
     const double last = after_rows ? t.rows.back()[step_column->second] : 0.0;
     // A step is a count: refused here, with its line, before it is compared.
     const int64_t step_count = stepped && !t.diverged ? count(step, source, where + ": step") : -1;
+    // A row beyond the loading the file plans: the run went on past it (an
+    // exported deck run with a run_steps larger than its nstep, the walls
+    // still moving). Neither complete nor incomplete: refused.
+    if (t.steps && step_count > *t.steps)
+      throw InputError(source, where,
+                       "step " + std::to_string(step_count) + " is beyond the " +
+                           std::to_string(*t.steps) + " steps planned (# steps, line " +
+                           std::to_string(t.meta_line.at("steps")) +
+                           "): keep the rows up to step " + std::to_string(*t.steps) +
+                           " (an exported deck: run it without a run_steps larger than its "
+                           "nstep)");
     // Steps that go back: the rows of two runs in one file (e.g. a split
     // run continued a second time, from a restart older than the rows the
     // file holds). Scored in file order they would give a verdict on
