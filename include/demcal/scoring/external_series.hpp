@@ -9,8 +9,12 @@
 // own runs add: peak_stress_yy [Pa] and peak_strain_yy, the 2D peak tracked
 // at every step, taken over the monitored one; reference_peak [Pa], the
 // reference of the peak error; divergence_step and divergence, a run its
-// own checks stopped: SeriesMetadata, scene/run_output.hpp); the first other
-// line names the columns, comma-separated; every further line is one
+// own checks stopped: SeriesMetadata, scene/run_output.hpp), each key once,
+// its value in the range config.hpp gives the quantity (RealRange; steps a
+// whole number from 1), after the column header only the results
+// (kSeriesResultKeys); the first other line names the columns,
+// comma-separated (a UTF-8 BOM before the first line is dropped); a row
+// whose step is beyond "# steps" is refused; every further line is one
 // monitoring point, tension positive, SI units. Columns are found by name,
 // in any order: required step, strain_yy, b_xx, b_xy, b_yx, b_yy, s_xx,
 // s_xy, s_yx, s_yy; optional kinetic_energy, kinetic_energy_rotation,
