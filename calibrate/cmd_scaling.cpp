@@ -121,8 +121,8 @@ int cmd_scaling(const ScalingOptions& o) {
   so.stop = &stop.flag();
   const ScalingStudy st = run_scaling_study(config, so);
   if (st.interrupted) {
-    std::cerr << "demcal scaling: interrupted; the finished sizes (and a size's finished trials) "
-                 "are in "
+    std::cerr << "demcal scaling: interrupted; the finished sizes (and a size's finished trials "
+                 "and step-search runs) are in "
               << so.work_dir << ", no report was written. Continue with:\n  "
               << resume_command(o, config, out_dir) << "\n";
     return stop.exit_status();

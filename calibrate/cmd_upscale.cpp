@@ -67,11 +67,15 @@ std::string scene_of(const nlohmann::json& j) {
   return s != j.end() && s->is_string() ? s->get<std::string>() : std::string();
 }
 
-/// Whether `--set` gives one of the algorithm keys a params.json command
-/// never runs (the rev's parameters are, upscaled): all but lock_rotation,
-/// which is the consolidation's.
+/// Whether `--set` gives a value to one of the algorithm keys a params.json
+/// command never runs (the rev's parameters are, upscaled): all but
+/// lock_rotation, which is the consolidation's. A mistyped key or a --set
+/// without a value is not one of them: the config's reader refuses it.
 bool set_without_effect(const std::string& set) {
-  return set.rfind("algorithm.", 0) == 0 && set.rfind("algorithm.lock_rotation", 0) != 0;
+  for (const char* key :
+       {"dt_ratio", "steps", "damping_ratio_translation", "damping_ratio_rotation", "mass_scaling"})
+    if (set.rfind(std::string("algorithm.") + key + "=", 0) == 0) return true;
+  return false;
 }
 
 }  // namespace

@@ -50,11 +50,16 @@ ConsolidationCallback consolidation_progress(double every_s) {
 
 void print_consolidation_time(std::ostream& out, double wall_time_s, bool from_cache) {
   if (from_cache) out << "read from the cache in ";
-  // Three significant digits whatever the stream's precision: a wall time
-  // is not known better, and every command prints it alike.
-  const std::streamsize old = out.precision(3);
-  out << wall_time_s << " s";
-  out.precision(old);
+  // Three significant digits, whatever the stream's format: a wall time is
+  // not known better, and every command prints it alike; whole seconds
+  // from 1000 s on (a prototype's consolidation: "4012 s", not "4.01e+03 s").
+  std::ostringstream o;
+  if (wall_time_s >= 1000.0)
+    o << std::fixed << std::setprecision(0);
+  else
+    o << std::setprecision(3);
+  o << wall_time_s << " s";
+  out << o.str();
 }
 
 void print_consolidated(std::ostream& out, std::string_view prefix, std::string_view what,

@@ -23,9 +23,9 @@ inline constexpr double kProgressEverySeconds = 2.0;
 /// may serve consolidations one after another (not at once).
 ConsolidationCallback consolidation_progress(double every_s = kProgressEverySeconds);
 
-/// A consolidated state's wall time on `out` with three significant digits
-/// (the stream's precision is left as it was), as every command prints it:
-/// "0.0249 s"; for a state read from the consolidation
+/// A consolidated state's wall time on `out` with three significant digits,
+/// whole seconds from 1000 s on (the stream's format is left as it was), as
+/// every command prints it: "0.0249 s", "4012 s"; for a state read from the consolidation
 /// cache, whose wall_time_s is the reading's (the consolidation's own is
 /// not kept), "read from the cache in 0.0265 s".
 void print_consolidation_time(std::ostream& out, double wall_time_s, bool from_cache);

@@ -5,6 +5,7 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <iomanip>
 #include <iostream>
 #include <sstream>
 #include <string>
@@ -31,6 +32,28 @@ SceneConfig gas() {
                                R"({"assembly": {"type": "random", "count": 150, "radius_min": 4e-4,
               "radius_max": 6e-4, "seed": 3}})"),
                            "gas");
+}
+
+// A consolidation's wall time: three significant digits whatever the
+// stream's format, whole seconds from 1000 s on (a prototype's: "4012 s",
+// not "4.01e+03 s"), the stream's format left as it was.
+TEST(ConsolidationProgress, TheWallTimeHasOneFormat) {
+  const auto printed = [](double s, bool from_cache, std::ios_base& (*format)(std::ios_base&)) {
+    std::ostringstream o, reference;
+    o << format << std::setprecision(9);
+    reference << format << std::setprecision(9) << 0.5;
+    cli::print_consolidation_time(o, s, from_cache);
+    const std::string time = o.str();
+    o << 0.5;  // the stream's own format afterwards, as it was
+    EXPECT_EQ(o.str().substr(time.size()), reference.str());
+    return time;
+  };
+  for (auto* format : {&std::defaultfloat, &std::fixed, &std::scientific}) {
+    EXPECT_EQ(printed(0.00255984, false, format), "0.00256 s");
+    EXPECT_EQ(printed(12.3456, true, format), "read from the cache in 12.3 s");
+    EXPECT_EQ(printed(4012.35, false, format), "4012 s");
+    EXPECT_EQ(printed(0.5, false, format), "0.5 s");
+  }
 }
 
 TEST(ConsolidationProgress, EveryCheckIsReportedWithAPositiveEstimate) {

@@ -293,7 +293,7 @@ TEST(ExternalSeries, MetadataValuesAreCheckedWithTheirLineAndKey) {
       {"dt_crit", "0"},
       {"dt_crit", "inf"},
       {"reference_peak", "0"},
-      {"reference_peak", "1e300"},
+      {"reference_peak", "inf"},
       {"damping_ratio_translation", "-1"},
       {"damping_ratio_rotation", "nan"},
       {"mass_scaling", "0"},
@@ -304,10 +304,11 @@ TEST(ExternalSeries, MetadataValuesAreCheckedWithTheirLineAndKey) {
     EXPECT_NE(m.find(std::string("x.csv: line 3: # ") + key + ": must be"), std::string::npos)
         << key << " = " << value << ": " << m;
   }
-  // sigma3 as --lateral-stress holds it: (0, 1e12].
-  for (const char* s3 : {"1e300", "0", "-1e5", "nan"})
+  // sigma3 as a config holds it: positive and finite, with no fixed cap
+  // (a config bounds it by its stiffness, which a series does not carry).
+  for (const char* s3 : {"inf", "0", "-1e5", "nan"})
     EXPECT_NE(series_error(std::string("# lateral_stress = ") + s3 + "\n" + kTable)
-                  .find("x.csv: line 1: # lateral_stress: must be > 0 and <= 1e+12"),
+                  .find("x.csv: line 1: # lateral_stress: must be > 0"),
               std::string::npos)
         << s3;
   // Given twice: neither is taken.
@@ -327,6 +328,8 @@ TEST(ExternalSeries, MetadataValuesAreCheckedWithTheirLineAndKey) {
   EXPECT_EQ(series_error(base + kTable + "# peak_stress_yy = -3e5\n# reference_peak = -2.5e5\n"),
             "no error");
   EXPECT_EQ(series_error(base + "# reference_peak = 2.5e5\n" + kTable), "no error");
+  // A comment of the form "# text = text" after the rows is no parameter.
+  EXPECT_EQ(series_error(base + kTable + "# restarted with run_steps = 2000\n"), "no error");
   EXPECT_EQ(series_error(base +
                          "# dt = 1e-6\n# dt_crit = 5e-6\n# damping_ratio_translation = "
                          "0\n# damping_ratio_rotation = 0\n# mass_scaling = 1\n" +

@@ -224,6 +224,13 @@ TEST_F(ParamsSchema, UpscaleRefusesSetOnTheConfigItCarries) {
   EXPECT_EQ(few.status, 0) << few.err;
   EXPECT_NE(few.err.find("warning: --set algorithm.steps=10 has no effect"), std::string::npos)
       << few.err;
+  // A mistyped algorithm key is no key without effect: refused, as in a
+  // config (it was dropped with a "has no effect" warning for a while).
+  const Result typo =
+      demcal({"export", p, "--particles", "100", "--set", "algorithm.lock_rotaton=true",
+              "--no-consolidate", "-o", "h/x.lammps"});
+  EXPECT_EQ(typo.status, 2) << typo.err;
+  EXPECT_NE(typo.err.find("lock_rotaton"), std::string::npos) << typo.err;
   // lock_rotation is the consolidation's: used, not warned about.
   const Result lock =
       demcal({"export", p, "--particles", "100", "--set", "algorithm.lock_rotation=true",

@@ -334,7 +334,7 @@ TEST_F(RobustCli, ScoreRefusesBadMetadataAndRowsBeyondTheSteps) {
                  "series.csv: line 3: # lateral_stress: given twice");
   expect_refused(series(head + table + "# lateral_stress = 5e5\n"),
                  "series.csv: line 7: # lateral_stress: after the column header");
-  expect_refused(series("# lateral_stress = 1e300\n" + table),
+  expect_refused(series("# lateral_stress = inf\n" + table),
                  "series.csv: line 1: # lateral_stress");
   expect_refused(series(head + "# dt = -1\n" + table), "series.csv: line 3: # dt: must be > 0");
   expect_refused(series(head + "# mass_scaling = 0\n" + table),
@@ -344,6 +344,15 @@ TEST_F(RobustCli, ScoreRefusesBadMetadataAndRowsBeyondTheSteps) {
   // With a BOM before its first line the file scores as without.
   const Result r = demcal(series("\xEF\xBB\xBF" + head + table));
   EXPECT_EQ(r.status, 0) << r.err;
+  // demcal's own series at a sigma3 above --lateral-stress's cap (a config
+  // bounds sigma3 by its stiffness only) is scored, not refused.
+  const Result run =
+      demcal({"run", kHex5, "--set", "material.kn=2e15", "--set", "material.kt=1e15", "--set",
+              "material.wall.kn=2e15", "--set", "material.wall.kt=1e15", "--set",
+              "test.lateral_stress=2e12", "--set", "algorithm.steps=4000", "-o", "stiff"});
+  ASSERT_TRUE(run.status == 0 || run.status == 1) << run.err;
+  const Result own = demcal({"score", "stiff/series.csv", "-o", "stiff-score"});
+  EXPECT_TRUE(own.status == 0 || own.status == 1) << own.err;
 }
 
 TEST_F(RobustCli, CutLastTrialLineIsRepaired) {

@@ -102,7 +102,10 @@ void check_metadata(const std::string& key, const std::string& value, const std:
     const char* as;  ///< where the same range holds
   };
   static const Ranged kRanged[] = {
-      {"lateral_stress", kLateralStress, "sigma3 [Pa], as --lateral-stress"},
+      // sigma3 as a config holds it: positive, with no fixed cap (the
+      // config bounds it by its contact stiffness, which the series does
+      // not carry): a run of demcal's at 2e12 Pa writes its own series.
+      {"lateral_stress", kPositive, "sigma3 [Pa], as a config's test.lateral_stress"},
       {"dt", kPositive, "the time step [s]"},
       {"dt_crit", kPositive, "the critical time step [s]"},
       {"damping_ratio_translation", kDampingRatio,
@@ -120,13 +123,14 @@ void check_metadata(const std::string& key, const std::string& value, const std:
       return;
     }
   if (key == "reference_peak") {
-    // A compressive peak whichever sign the file gives it: its magnitude.
+    // A compressive peak whichever sign the file gives it: its magnitude,
+    // positive and finite (demcal writes its ratio times sigma3, uncapped
+    // as sigma3 is).
     const double v = parse_number(value, source, where);
-    if (!kReferencePeak.contains(std::abs(v)))
+    if (!kPositive.contains(std::abs(v)))
       throw InputError(source, where,
-                       "must be " + kReferencePeak.text() +
-                           " in magnitude (Pa, as --reference-peak; either sign: a compressive "
-                           "peak), got " +
+                       "must be " + kPositive.text() +
+                           " in magnitude (Pa; either sign: a compressive peak), got " +
                            quoted_value(value));
   } else if (key == "steps") {
     t.steps = meta_count(value, source, where, 1, kMaxSteps);
@@ -135,6 +139,22 @@ void check_metadata(const std::string& key, const std::string& value, const std:
   } else if (key == "divergence_step") {
     meta_count(value, source, where, 0, std::numeric_limits<int64_t>::max());
   }
+}
+
+/// The run's parameters the reader takes from the metadata (checked by
+/// check_metadata): before the column header only, since they hold for
+/// every row.
+bool is_run_parameter(const std::string& key) {
+  static const char* const kKeys[] = {"lateral_stress",
+                                      "steps",
+                                      "particles",
+                                      "dt",
+                                      "dt_crit",
+                                      "damping_ratio_translation",
+                                      "damping_ratio_rotation",
+                                      "mass_scaling"};
+  return std::find_if(std::begin(kKeys), std::end(kKeys),
+                      [&](const char* k) { return key == k; }) != std::end(kKeys);
 }
 
 /// "peak_stress_yy, ..., divergence": the keys that may follow the rows.
@@ -162,10 +182,14 @@ Table read_table(const std::string& text, ExternalSeries& out) {
       const std::string field = where + ": # " + key;
       // After the header only what a run found, which an exported deck
       // appends once its run is over (series_result_lines); a parameter of
-      // the run there would hold for the rows above it too.
-      if (!t.columns.empty() &&
+      // the run there would hold for the rows above it too. Any other
+      // "# text = text" there is a comment ("# restarted with run_steps =
+      // 2000"), neither read nor kept.
+      const bool result =
           std::find_if(kSeriesResultKeys.begin(), kSeriesResultKeys.end(),
-                       [&](const char* k) { return key == k; }) == kSeriesResultKeys.end())
+                       [&](const char* k) { return key == k; }) != kSeriesResultKeys.end();
+      if (!t.columns.empty() && !result && !is_run_parameter(key)) continue;
+      if (!t.columns.empty() && !result)
         throw InputError(source, field,
                          "after the column header (line " + std::to_string(t.header_line) +
                              "): the run's parameters come before the header; after it only "

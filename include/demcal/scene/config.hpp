@@ -65,12 +65,12 @@ inline constexpr RealRange kPositive{0.0, false};
 inline constexpr RealRange kDampingRatio{0.0, true};
 /// algorithm.mass_scaling.
 inline constexpr RealRange kMassScaling = kPositive;
-/// σ3 [Pa] given on its own (--lateral-stress, a series' "# lateral_stress");
-/// a config's test.lateral_stress is positive and bounded by its contact
-/// stiffness instead (check_lateral_stress in config.cpp).
+/// σ3 [Pa] given on the command line (--lateral-stress); a config's
+/// test.lateral_stress, and a series' "# lateral_stress" with it, is
+/// positive and bounded by its contact stiffness instead (check_lateral_stress
+/// in config.cpp), which a series does not carry.
 inline constexpr RealRange kLateralStress{0.0, false, 1e12};
-/// A reference peak |σ| [Pa] (--reference-peak, the magnitude of a series'
-/// "# reference_peak").
+/// A reference peak |σ| [Pa] given on the command line (--reference-peak).
 inline constexpr RealRange kReferencePeak{0.0, false, 1e15};
 
 /// The defaults of `assembly.type` and `test.type` in a 3D config
