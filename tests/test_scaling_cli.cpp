@@ -59,6 +59,21 @@ class ScalingCli : public ::testing::Test {
     return ::demcal::test::run_demcal(args, work());
   }
 
+  /// `demcal ARGS` refused as a usage error of --sizes: exit 2, one line
+  /// that mentions `mention`, nothing on stdout, nothing left in work().
+  void expect_sizes_refused(const std::vector<std::string>& args, const std::string& mention) {
+    std::string trace = "demcal";
+    for (const auto& a : args) trace += " " + a;
+    SCOPED_TRACE(trace);
+    const Result r = demcal(args);
+    EXPECT_EQ(r.status, 2) << r.err;
+    EXPECT_EQ(r.err.rfind("demcal: error: --sizes: ", 0), 0u) << r.err;
+    EXPECT_NE(r.err.find(mention), std::string::npos) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_EQ(r.out, "");
+    EXPECT_TRUE(fs::is_empty(work())) << "left output behind";
+  }
+
   /// `demcal ARGS` started in work(), stdout and stderr to files beside it.
   pid_t spawn(const std::vector<std::string>& args) {
     std::vector<std::string> all{demcal::test::kDemcalBinary};
@@ -106,16 +121,7 @@ TEST_F(ScalingCli, SizesWithoutAForwardSizeOrRepeatedAreUsageErrors) {
   for (const Case& c : cases) {
     std::vector<std::string> args{"scaling", kHex5, "-o", "out", "-q", "-j", "1"};
     args.insert(args.end(), c.args.begin(), c.args.end());
-    std::string trace = "demcal";
-    for (const auto& a : args) trace += " " + a;
-    SCOPED_TRACE(trace);
-    const Result r = demcal(args);
-    EXPECT_EQ(r.status, 2) << r.err;
-    EXPECT_EQ(r.err.rfind("demcal: error: --sizes: ", 0), 0u) << r.err;
-    EXPECT_NE(r.err.find(c.mention), std::string::npos) << r.err;
-    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
-    EXPECT_EQ(r.out, "");
-    EXPECT_TRUE(fs::is_empty(work())) << "left output behind";
+    expect_sizes_refused(args, c.mention);
   }
 }
 
@@ -162,16 +168,7 @@ TEST_F(ScalingCli, SizesThatMakeOneParticleCountAreUsageErrors) {
   for (const Case& c : cases) {
     std::vector<std::string> args{"scaling", "-o", "out", "-q", "-j", "1"};
     args.insert(args.begin() + 1, c.args.begin(), c.args.end());
-    std::string trace = "demcal";
-    for (const auto& a : args) trace += " " + a;
-    SCOPED_TRACE(trace);
-    const Result r = demcal(args);
-    EXPECT_EQ(r.status, 2) << r.err;
-    EXPECT_EQ(r.err.rfind("demcal: error: --sizes: ", 0), 0u) << r.err;
-    EXPECT_NE(r.err.find(c.mention), std::string::npos) << r.err;
-    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
-    EXPECT_EQ(r.out, "");
-    EXPECT_TRUE(fs::is_empty(work())) << "left output behind";
+    expect_sizes_refused(args, c.mention);
   }
 }
 
