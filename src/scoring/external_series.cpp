@@ -90,29 +90,31 @@ int64_t meta_count(const std::string& value, const std::string& source, const st
   }
 }
 
+/// The run's parameters with a range: each checked against it.
+struct Ranged {
+  const char* key;
+  RealRange range;
+  const char* as;  ///< where the same range holds
+};
+const Ranged kRanged[] = {
+    // sigma3 as a config holds it: positive, with no fixed cap (the
+    // config bounds it by its contact stiffness, which the series does
+    // not carry): a run of demcal's at 2e12 Pa writes its own series.
+    {"lateral_stress", kPositive, "sigma3 [Pa], as a config's test.lateral_stress"},
+    {"dt", kPositive, "the time step [s]"},
+    {"dt_crit", kPositive, "the critical time step [s]"},
+    {"damping_ratio_translation", kDampingRatio,
+     "as a config's algorithm.damping_ratio_translation"},
+    {"damping_ratio_rotation", kDampingRatio, "as a config's algorithm.damping_ratio_rotation"},
+    {"mass_scaling", kMassScaling, "as a config's algorithm.mass_scaling"},
+};
+
 /// A metadata value checked where it is read, with its line (`where`):
 /// the run's parameters in the ranges a config and the command line hold
 /// them to (config.hpp), the counts whole numbers. `t.steps` takes
 /// "# steps". Keys demcal does not read are kept as written.
 void check_metadata(const std::string& key, const std::string& value, const std::string& source,
                     const std::string& where, Table& t) {
-  struct Ranged {
-    const char* key;
-    RealRange range;
-    const char* as;  ///< where the same range holds
-  };
-  static const Ranged kRanged[] = {
-      // sigma3 as a config holds it: positive, with no fixed cap (the
-      // config bounds it by its contact stiffness, which the series does
-      // not carry): a run of demcal's at 2e12 Pa writes its own series.
-      {"lateral_stress", kPositive, "sigma3 [Pa], as a config's test.lateral_stress"},
-      {"dt", kPositive, "the time step [s]"},
-      {"dt_crit", kPositive, "the critical time step [s]"},
-      {"damping_ratio_translation", kDampingRatio,
-       "as a config's algorithm.damping_ratio_translation"},
-      {"damping_ratio_rotation", kDampingRatio, "as a config's algorithm.damping_ratio_rotation"},
-      {"mass_scaling", kMassScaling, "as a config's algorithm.mass_scaling"},
-  };
   for (const Ranged& r : kRanged)
     if (key == r.key) {
       const double v = parse_number(value, source, where);
@@ -145,16 +147,9 @@ void check_metadata(const std::string& key, const std::string& value, const std:
 /// check_metadata): before the column header only, since they hold for
 /// every row.
 bool is_run_parameter(const std::string& key) {
-  static const char* const kKeys[] = {"lateral_stress",
-                                      "steps",
-                                      "particles",
-                                      "dt",
-                                      "dt_crit",
-                                      "damping_ratio_translation",
-                                      "damping_ratio_rotation",
-                                      "mass_scaling"};
-  return std::find_if(std::begin(kKeys), std::end(kKeys),
-                      [&](const char* k) { return key == k; }) != std::end(kKeys);
+  return key == "steps" || key == "particles" ||
+         std::find_if(std::begin(kRanged), std::end(kRanged),
+                      [&](const Ranged& r) { return key == r.key; }) != std::end(kRanged);
 }
 
 /// "peak_stress_yy, ..., divergence": the keys that may follow the rows.
