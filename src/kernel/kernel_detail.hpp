@@ -6,9 +6,11 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <memory>
 #include <new>
 #include <stdexcept>
@@ -19,8 +21,32 @@
 namespace demcal {
 
 namespace detail {
+/// Where in its 4 KiB page the next array of `bytes` starts: a multiple of
+/// 64 from 64 to 4032, the next of 63 such offsets for every array of 4 KiB
+/// or more (consecutive arrays 19 lines apart), 0 for a smaller one (which
+/// malloc packs among others anyway).
+///
+/// Why: glibc serves a block beyond its mmap threshold (128 KiB at first,
+/// raised by each such block freed) from fresh pages, so such arrays all
+/// start at the same offset in their pages. A pass that reads element k of
+/// many of them at once — the sphere pair pass reads and writes 11 slot
+/// arrays at slot k and gathers 9 particle arrays at neighbour j — then
+/// maps them all to one set of the 8-way L1 cache (4 KiB per way) and makes
+/// every load look as if it may depend on the stores to the others (the
+/// same address mod 4096). Whether a run met this depended on what it had
+/// allocated and freed before: the benchmark's 4 000-sphere world did, and
+/// runs 1.2x faster staggered (reports/performance.md, 2026-12-05), while
+/// `demcal run` on the same sample did not. Addresses change no result.
+inline std::size_t page_offset_for(std::size_t bytes) {
+  if (bytes < 4096) return 0;
+  static std::atomic<unsigned> next{0};
+  const unsigned k = next.fetch_add(1, std::memory_order_relaxed) % 63;
+  return 64 * (1 + (19 * k) % 63);
+}
+
 /// 64-byte aligned storage for the particle and slot arrays (one SIMD
-/// register of 8 doubles per load).
+/// register of 8 doubles per load), large arrays at staggered offsets in
+/// their pages (page_offset_for).
 template <class T>
 struct AlignedAllocator {
   using value_type = T;
@@ -28,9 +54,24 @@ struct AlignedAllocator {
   template <class U>
   AlignedAllocator(const AlignedAllocator<U>&) noexcept {}
   T* allocate(std::size_t n) {
-    return static_cast<T*>(::operator new(n * sizeof(T), std::align_val_t(64)));
+    const std::size_t bytes = n * sizeof(T), offset = page_offset_for(bytes);
+    if (offset == 0) return static_cast<T*>(::operator new(bytes, std::align_val_t(64)));
+    // The page-aligned block, `offset` bytes of it skipped; the block's
+    // address is kept just before the array for deallocate.
+    char* block = static_cast<char*>(::operator new(bytes + offset, std::align_val_t(4096)));
+    char* array = block + offset;
+    std::memcpy(array - sizeof(char*), &block, sizeof(char*));
+    return reinterpret_cast<T*>(array);
   }
-  void deallocate(T* p, std::size_t) noexcept { ::operator delete(p, std::align_val_t(64)); }
+  void deallocate(T* p, std::size_t n) noexcept {
+    if (n * sizeof(T) < 4096) {
+      ::operator delete(p, std::align_val_t(64));
+      return;
+    }
+    char* block;
+    std::memcpy(&block, reinterpret_cast<char*>(p) - sizeof(char*), sizeof(char*));
+    ::operator delete(block, std::align_val_t(4096));
+  }
   template <class U>
   bool operator==(const AlignedAllocator<U>&) const noexcept {
     return true;
