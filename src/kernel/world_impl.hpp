@@ -226,7 +226,7 @@ class WorldImpl {
   // Per slot, written by the pair pass: the pair's force on i (pfx_, pfy_)
   // and its torques on i and j (pti_, ptj_). Block b's slot s has its terms
   // at term_block_[b] + s − block_slot_[b]: blocks share places in a ring
-  // once no sum needs their terms any more (layout_terms, broad_phase.cpp);
+  // once no sum needs their terms any more (layout_terms; term_ring.hpp);
   // index term_block_.back() is a zero slot.
   Array pfx_, pfy_, pti_, ptj_;
   std::vector<int> term_block_;
