@@ -11,6 +11,7 @@
 #include <cmath>
 
 #include "sphere_world_impl.hpp"
+#include "term_ring.hpp"
 
 namespace demcal {
 
@@ -147,11 +148,8 @@ void SphereWorldImpl::rebuild_neighbours() {
   hx_.swap(new_hx_);
   hy_.swap(new_hy_);
   hz_.swap(new_hz_);
-  // The pair terms, and the zero slot at index ns.
-  for (auto* p : {&pfx_, &pfy_, &pfz_, &ptx_, &pty_, &ptz_}) p->assign(ns + 1, 0.0);
-
   rebuild_mirror_list();
-  update_thread_bounds();
+  update_thread_bounds();  // and the places of the pair terms (layout_terms)
 
   rebuild_wall_candidates();
 
@@ -185,6 +183,16 @@ void SphereWorldImpl::rebuild_mirror_list() {
       const int row = mirror_count_[j]++;
       mirror_slot_[mirror_block_[j / kBlock] + j % kBlock + kBlock * row] = pair_slot_[k];
     }
+}
+
+void SphereWorldImpl::layout_terms() {
+  // A ring of places per thread, as the 2D kernel's (one algorithm:
+  // term_ring.hpp).
+  const int place = detail::layout_terms(block_slot_, mirror_src_block_, pair_bounds_, mirror_slot_,
+                                         threads_fuse_sums(), term_block_, mirror_term_);
+  // The terms, and the zero place at index place.
+  for (auto* p : {&pfx_, &pfy_, &pfz_, &ptx_, &pty_, &ptz_})
+    p->assign(static_cast<size_t>(place) + 1, 0.0);
 }
 
 void SphereWorldImpl::rebuild_wall_candidates() {

@@ -45,9 +45,11 @@
 // the SIMD path of this machine (the 2D kernel's, simd.hpp), so every pair
 // is evaluated once. Each particle's force and torque are written as the
 // plain sum over its own slots (pairs j > i, increasing j); per slot the
-// pass also writes the pair's force on i and the torque a_j·n × h on j, and
-// the sum pass (sum_blocks) then adds to each particle j, from its mirror
-// list in increasing i, the opposite of that force and that torque. Both
+// pass also writes the pair's force on i and the torque a_j·n × h on j (at
+// the slot's place in a ring that keeps them in cache until they are
+// summed: term_ring.hpp), and the sum pass (sum_blocks) then adds to each
+// particle j, from its mirror list in increasing i, the opposite of that
+// force and that torque. Both
 // sums run in a fixed order whatever the thread split (each pass writes
 // only its own particles' or slots' values), so results are deterministic
 // and bit-identical for any thread count; non-touching slots add exact
@@ -122,8 +124,9 @@ struct PairArgs {
   const int *__restrict slot_j;
   double *__restrict hx, *__restrict hy, *__restrict hz;
   const double *__restrict slot_r, *__restrict slot_ir;
-  double *__restrict pfx, *__restrict pfy, *__restrict pfz;  // pair force on i, per slot
-  double *__restrict ptx, *__restrict pty, *__restrict ptz;  // torque on j, per slot
+  // Per slot, at its place (term_block): the pair's force on i, the torque on j.
+  double *__restrict pfx, *__restrict pfy, *__restrict pfz;
+  double *__restrict ptx, *__restrict pty, *__restrict ptz;
   const double *__restrict x, *__restrict y, *__restrict z;
   const double *__restrict vx, *__restrict vy, *__restrict vz;
   const double *__restrict wx, *__restrict wy, *__restrict wz;
@@ -137,8 +140,9 @@ struct PairArgs {
   // written all its mirrored slots (its lowest source block src_block[b] ≥
   // the pass's first block); fused[b] says so to the sum pass. With one
   // thread (pair_blocks' kFuseAll), every block, fused not written.
+  const int *__restrict term_block;  // where block b's slots have their pair terms
   const int *__restrict mirror_block;
-  const int *__restrict mirror_slot;
+  const int *__restrict mirror_term;  // places of the mirrored pair terms
   const int *__restrict src_block;
   unsigned char *__restrict fused;
 };
@@ -322,7 +326,7 @@ struct BlockLanes {
 
 struct SumArgs {
   const int *__restrict mirror_block;
-  const int *__restrict mirror_slot;
+  const int *__restrict mirror_term;      // places of the mirrored pair terms
   const unsigned char *__restrict fused;  // blocks the pair pass summed already
   const double *__restrict pfx, *__restrict pfy, *__restrict pfz;
   const double *__restrict ptx, *__restrict pty, *__restrict ptz;
@@ -345,7 +349,7 @@ DEMCAL_INLINE double sum_blocks(const A &a, int b0, int b1) {
       D fx = load<W>(a.fx + i0), fy = load<W>(a.fy + i0), fz = load<W>(a.fz + i0);
       D tx = load<W>(a.tx + i0), ty = load<W>(a.ty + i0), tz = load<W>(a.tz + i0);
       for (int s = s0 + sub; s < s1; s += kBlock) {
-        const int *S = a.mirror_slot + s;
+        const int *S = a.mirror_term + s;
         fx -= gather<W>(a.pfx, S);
         fy -= gather<W>(a.pfy, S);
         fz -= gather<W>(a.pfz, S);
@@ -387,6 +391,7 @@ DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
   const double kn = a.kn, kdt = a.kdt, half_dt = a.half_dt, mu = a.mu;
   for (int b = b0; b < b1; ++b) {
     const int s0 = a.block_slot[b], s1 = a.block_slot[b + 1];
+    const int t0 = a.term_block[b] - s0;  // slot s's pair terms at t0 + s
     for (int sub = 0; sub < kBlock; sub += W) {
       const int i0 = kBlock * b + sub;
       // This sub-block's lanes, into block_* after the slots.
@@ -417,8 +422,8 @@ DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
         const D inv_mag2 = one / select<W>(held, mag2, one);
         if (!any<W>(touch)) {  // no lane touches: histories released, no force
           released += mag2;
-          for (double *p : {a.hx, a.hy, a.hz, a.pfx, a.pfy, a.pfz, a.ptx, a.pty, a.ptz})
-            store<W>(p + s, zero);
+          for (double *p : {a.hx, a.hy, a.hz}) store<W>(p + s, zero);
+          for (double *p : {a.pfx, a.pfy, a.pfz, a.ptx, a.pty, a.ptz}) store<W>(p + t0 + s, zero);
           continue;
         }
         const D nx = g.nx, ny = g.ny, nz = g.nz, ov = g.ov, fn = g.fn;
@@ -478,12 +483,12 @@ DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
         tx += ai * cx;
         ty += ai * cy;
         tz += ai * cz;
-        store<W>(a.pfx + s, qx);
-        store<W>(a.pfy + s, qy);
-        store<W>(a.pfz + s, qz);
-        store<W>(a.ptx + s, aj * cx);
-        store<W>(a.pty + s, aj * cy);
-        store<W>(a.ptz + s, aj * cz);
+        store<W>(a.pfx + t0 + s, qx);
+        store<W>(a.pfy + t0 + s, qy);
+        store<W>(a.pfz + t0 + s, qz);
+        store<W>(a.ptx + t0 + s, aj * cx);
+        store<W>(a.pty + t0 + s, aj * cy);
+        store<W>(a.ptz + t0 + s, aj * cz);
         // overlap/min(r_i, r_j) (ov ≥ 0 where touching: the product is
         // monotone, the maximum of the two ratios exactly).
         const D irj = load<W>(a.slot_ir + s);
@@ -719,6 +724,7 @@ struct Kernels {
   IntegrateFn integrate, integrate_locked;
   void (*one_pair)(const double *, double *);
   WallFn walls;
+  bool threads_fuse;  // pairs_t and pairs_damped_t sum the blocks they complete
 };
 
 // THREAD_FUSE: kFuseOwn or kFuseNone for the threaded pair pass. At 97 556
@@ -726,41 +732,41 @@ struct Kernels {
 // pass without it, 2026-12-02) the fusion gave avx512 1.05x (median; CPU
 // time 0.9x) but avx2 0.93x (CPU time 1.09x, every round): the AVX2 path
 // keeps the separate sum pass. One thread fuses every block on every path.
-#define DEMCAL_SPHERE_KERNELS(SUFFIX, TARGET, W, THREAD_FUSE)                                    \
-  TARGET double pairs_##SUFFIX(const PairArgs &a, int b0, int b1) {                              \
-    return pair_blocks<W, false, kFuseAll>(a, b0, b1);                                           \
-  }                                                                                              \
-  TARGET double pairs_damped_##SUFFIX(const PairArgs &a, int b0, int b1) {                       \
-    return pair_blocks<W, true, kFuseAll>(a, b0, b1);                                            \
-  }                                                                                              \
-  TARGET double pairs_t_##SUFFIX(const PairArgs &a, int b0, int b1) {                            \
-    return pair_blocks<W, false, THREAD_FUSE>(a, b0, b1);                                        \
-  }                                                                                              \
-  TARGET double pairs_damped_t_##SUFFIX(const PairArgs &a, int b0, int b1) {                     \
-    return pair_blocks<W, true, THREAD_FUSE>(a, b0, b1);                                         \
-  }                                                                                              \
-  TARGET double sums_##SUFFIX(const SumArgs &a, int b0, int b1) {                                \
-    for (int b = b0; b < b1; ++b)                                                                \
-      if (!a.fused[b]) sum_blocks<W, SumArgs>(a, b, b + 1);                                      \
-    return 0.0;                                                                                  \
-  }                                                                                              \
-  TARGET double integrate_##SUFFIX(const IntegrateArgs &a, int b0, int b1) {                     \
-    return integrate_blocks<W, true>(a, b0, b1);                                                 \
-  }                                                                                              \
-  TARGET double integrate_locked_##SUFFIX(const IntegrateArgs &a, int b0, int b1) {              \
-    return integrate_blocks<W, false>(a, b0, b1);                                                \
-  }                                                                                              \
-  TARGET void one_pair_##SUFFIX(const double *in, double *out) { one_pair<W>(in, out); }         \
-  TARGET void walls_##SUFFIX(const WallArgs &a, double *out) {                                   \
-    if (a.mu > 0.0)                                                                              \
-      wall_contacts<W, true>(a, out);                                                            \
-    else                                                                                         \
-      wall_contacts<W, false>(a, out);                                                           \
-  }                                                                                              \
-  constexpr Kernels kKernels_##SUFFIX{                                                           \
-      pairs_##SUFFIX, pairs_damped_##SUFFIX, pairs_t_##SUFFIX,          pairs_damped_t_##SUFFIX, \
-      sums_##SUFFIX,  integrate_##SUFFIX,    integrate_locked_##SUFFIX, one_pair_##SUFFIX,       \
-      walls_##SUFFIX};
+#define DEMCAL_SPHERE_KERNELS(SUFFIX, TARGET, W, THREAD_FUSE)                                     \
+  TARGET double pairs_##SUFFIX(const PairArgs &a, int b0, int b1) {                               \
+    return pair_blocks<W, false, kFuseAll>(a, b0, b1);                                            \
+  }                                                                                               \
+  TARGET double pairs_damped_##SUFFIX(const PairArgs &a, int b0, int b1) {                        \
+    return pair_blocks<W, true, kFuseAll>(a, b0, b1);                                             \
+  }                                                                                               \
+  TARGET double pairs_t_##SUFFIX(const PairArgs &a, int b0, int b1) {                             \
+    return pair_blocks<W, false, THREAD_FUSE>(a, b0, b1);                                         \
+  }                                                                                               \
+  TARGET double pairs_damped_t_##SUFFIX(const PairArgs &a, int b0, int b1) {                      \
+    return pair_blocks<W, true, THREAD_FUSE>(a, b0, b1);                                          \
+  }                                                                                               \
+  TARGET double sums_##SUFFIX(const SumArgs &a, int b0, int b1) {                                 \
+    for (int b = b0; b < b1; ++b)                                                                 \
+      if (!a.fused[b]) sum_blocks<W, SumArgs>(a, b, b + 1);                                       \
+    return 0.0;                                                                                   \
+  }                                                                                               \
+  TARGET double integrate_##SUFFIX(const IntegrateArgs &a, int b0, int b1) {                      \
+    return integrate_blocks<W, true>(a, b0, b1);                                                  \
+  }                                                                                               \
+  TARGET double integrate_locked_##SUFFIX(const IntegrateArgs &a, int b0, int b1) {               \
+    return integrate_blocks<W, false>(a, b0, b1);                                                 \
+  }                                                                                               \
+  TARGET void one_pair_##SUFFIX(const double *in, double *out) { one_pair<W>(in, out); }          \
+  TARGET void walls_##SUFFIX(const WallArgs &a, double *out) {                                    \
+    if (a.mu > 0.0)                                                                               \
+      wall_contacts<W, true>(a, out);                                                             \
+    else                                                                                          \
+      wall_contacts<W, false>(a, out);                                                            \
+  }                                                                                               \
+  constexpr Kernels kKernels_##SUFFIX{                                                            \
+      pairs_##SUFFIX, pairs_damped_##SUFFIX,  pairs_t_##SUFFIX,          pairs_damped_t_##SUFFIX, \
+      sums_##SUFFIX,  integrate_##SUFFIX,     integrate_locked_##SUFFIX, one_pair_##SUFFIX,       \
+      walls_##SUFFIX, THREAD_FUSE == kFuseOwn};
 
 #define DEMCAL_NO_TARGET
 DEMCAL_SPHERE_KERNELS(sse2, DEMCAL_NO_TARGET, 2, kFuseNone)
@@ -829,8 +835,9 @@ double SphereWorldImpl::pair_pass(int b0, int b1) {
                    0.5 * integration_.dt,
                    material_.particle.friction,
                    2.0 * material_.contact_damping_ratio,
+                   term_block_.data(),
                    mirror_block_.data(),
-                   mirror_slot_.data(),
+                   mirror_term_.data(),
                    mirror_src_block_.data(),
                    block_fused_.data()};
   const Kernels &k = kernels();
@@ -839,8 +846,10 @@ double SphereWorldImpl::pair_pass(int b0, int b1) {
   return damped ? k.pairs_damped_t(a, b0, b1) : k.pairs_t(a, b0, b1);
 }
 
+bool SphereWorldImpl::threads_fuse_sums() { return kernels().threads_fuse; }
+
 double SphereWorldImpl::sum_pass(int b0, int b1) {
-  const SumArgs a{mirror_block_.data(), mirror_slot_.data(), block_fused_.data(), pfx_.data(),
+  const SumArgs a{mirror_block_.data(), mirror_term_.data(), block_fused_.data(), pfx_.data(),
                   pfy_.data(),          pfz_.data(),         ptx_.data(),         pty_.data(),
                   ptz_.data(),          fx_.data(),          fy_.data(),          fz_.data(),
                   tx_.data(),           ty_.data(),          tz_.data()};

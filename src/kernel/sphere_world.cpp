@@ -64,7 +64,8 @@ SphereWorldImpl::SphereWorldImpl(const SphereMaterial& material, std::span<const
   for (auto* a : {&block_lost_, &block_released_, &block_slid_, &block_power_}) a->assign(cap, 0.0);
   block_slot_.assign(static_cast<size_t>(nblocks_) + 1, 0);
   mirror_block_.assign(static_cast<size_t>(nblocks_) + 1, 0);
-  mirror_src_block_.assign(static_cast<size_t>(nblocks_), 0);
+  mirror_src_block_.resize(static_cast<size_t>(nblocks_));
+  for (int b = 0; b < nblocks_; ++b) mirror_src_block_[b] = b;  // no mirrored slots yet
   block_fused_.assign(static_cast<size_t>(nblocks_), 0);
   for (int s = 0; s < 6; ++s) {
     walls_[s].position = (s % 2 == 0) ? lo[s / 2] : hi[s / 2];
@@ -88,6 +89,7 @@ int SphereWorldImpl::active_threads() const { return detail::active_threads(thre
 
 void SphereWorldImpl::update_thread_bounds() {
   detail::thread_bounds(active_threads(), nblocks_, block_slot_, particle_bounds_, pair_bounds_);
+  layout_terms();
 }
 
 double SphereWorldImpl::run_pass(double (SphereWorldImpl::*pass)(int, int),

@@ -137,6 +137,9 @@ class SphereWorldImpl {
   void rebuild_neighbours();
   void rebuild_mirror_list();      // part of rebuild_neighbours
   void rebuild_wall_candidates();  // part of rebuild_neighbours
+  // The places of the pair terms (term_block_, mirror_term_) for the list
+  // and the threads' block ranges (pair_bounds_): detail::layout_terms.
+  void layout_terms();
   bool needs_rebuild() const;
   // sphere_contact.cpp
   struct PairGeometry {
@@ -167,6 +170,9 @@ class SphereWorldImpl {
   double pair_pass(int b0, int b1);
   // Adds what each particle receives from its mirrored slots (returns 0).
   double sum_pass(int b0, int b1);
+  // Whether the threaded pair pass sums the blocks it completes (this
+  // machine's SIMD path; one thread always sums every block).
+  static bool threads_fuse_sums();
   double integrate_pass(int b0, int b1);
   // Run a pass over all blocks, shared among the threads by `bounds`;
   // returns the largest value it returned (sphere_world.cpp).
@@ -251,24 +257,28 @@ class SphereWorldImpl {
   // lane, then ghosts. hx_, hy_, hz_: each slot's tangential force on i,
   // kept across rebuilds; slot_r_, slot_ir_ the neighbour's radius and its
   // inverse. The pair pass writes, per slot, what j receives: the pair's
-  // force on i (pfx_.., j takes its opposite) and the torque on j (ptx_..);
-  // one more slot at the end (index block_slot_[nblocks_]) stays 0, the
-  // padding of the mirror list.
+  // force on i (pfx_.., j takes its opposite) and the torque on j (ptx_..).
+  // Block b's slot s has them at term_block_[b] + s − block_slot_[b]:
+  // blocks share places in a ring once no sum needs their terms any more
+  // (layout_terms; term_ring.hpp); one more place at the end (index
+  // term_block_.back()) stays 0, the padding of the mirror list.
   std::vector<int> block_slot_;
   detail::AlignedVector<int> slot_j_;
   Array hx_, hy_, hz_, slot_r_, slot_ir_;
   Array pfx_, pfy_, pfz_, ptx_, pty_, ptz_;
+  std::vector<int> term_block_;
   // Mirror list, sliced ELLPACK blocks of 8 like the half list: block b's
   // entries are [mirror_block_[b], mirror_block_[b + 1]), entry (row, lane)
   // the slot of the row-th pair (i, j) with i < j = 8b + lane, in increasing
-  // i, padded with the zero slot. The sum pass adds them, in this fixed
-  // order, to the sums the pair pass wrote over j's own slots.
+  // i, padded with the zero slot block_slot_.back(); mirror_term_ the same
+  // entries as places of the pair terms. The sum pass adds them, in this
+  // fixed order, to the sums the pair pass wrote over j's own slots.
   std::vector<int> mirror_block_, mirror_count_;
   // Per block: the lowest block holding one of its mirrored slots (itself
   // if none), and whether the pair pass did its sums (sphere_contact.cpp).
   std::vector<int> mirror_src_block_;
   std::vector<unsigned char> block_fused_;
-  detail::AlignedVector<int> mirror_slot_;
+  detail::AlignedVector<int> mirror_slot_, mirror_term_;
   // The half list (pairs i < j) in CSR form, each row sorted by j, and the
   // slot of each pair (for measures, views and the ledger).
   std::vector<int> nbr_start_, nbr_j_, pair_slot_;

@@ -8,7 +8,11 @@
 // read back is a copy of the one saved: it rebuilds its list, sums its
 // forces and steps exactly as the original would. The bytes:
 // state_bytes.hpp. The threads are not state: a SphereWorld read back
-// starts its own on first use, as a copy does.
+// starts its own on first use, as a copy does. Nor are the pair terms
+// (pfx_ .. ptz_: written by each pair pass before its sums read them) and
+// their places (term_block_, mirror_term_, term_ring.hpp): those depend on
+// whether this process's SIMD path sums in the threads' pair pass, so the
+// SphereWorld read back lays them out again.
 #include <algorithm>
 #include <array>
 #include <string>
@@ -20,16 +24,17 @@ namespace demcal {
 
 namespace {
 
-// The last character numbers the layout; another kernel's (the 2D World's
-// "demWorl…") or another layout's bytes do not read: rebuilt, not misread.
-constexpr std::string_view kMark("demSphr1", 8);
+// The last character numbers the layout ('2' since the pair terms are no
+// longer saved); another kernel's (the 2D World's "demWorl…") or another
+// layout's bytes do not read: rebuilt, not misread.
+constexpr std::string_view kMark("demSphr2", 8);
 constexpr const char* kWhat = "SphereWorld::load_state";
 
 // A new member of these structs, or of SphereWorldImpl, must be visited
 // below: the sizes catch one that is not (x86-64 layouts, libstdc++).
 static_assert(sizeof(SphereMaterial) == 8 * sizeof(double));
 static_assert(sizeof(SphereWall) == 48);  // 5 doubles and an int
-static_assert(sizeof(SphereWorldImpl) == 3256,
+static_assert(sizeof(SphereWorldImpl) == 3304,
               "a member was added to SphereWorldImpl: visit it in visit_state "
               "(sphere_world_state.cpp), renumber kMark, then update this size");
 
@@ -82,9 +87,7 @@ void SphereWorldImpl::visit_state(Self& w, Visitor& v) {
   for (auto& d : w.wall_move_) v(d);
   v(w.block_slot_);
   v(w.slot_j_);
-  for (auto* a : {&w.hx_, &w.hy_, &w.hz_, &w.slot_r_, &w.slot_ir_, &w.pfx_, &w.pfy_, &w.pfz_,
-                  &w.ptx_, &w.pty_, &w.ptz_})
-    v(*a);
+  for (auto* a : {&w.hx_, &w.hy_, &w.hz_, &w.slot_r_, &w.slot_ir_}) v(*a);
   for (auto* a : {&w.mirror_block_, &w.mirror_count_, &w.mirror_src_block_}) v(*a);
   v(w.block_fused_);
   v(w.mirror_slot_);
@@ -141,15 +144,12 @@ SphereWorldImpl SphereWorldImpl::load_state(std::string_view bytes) {
   const size_t n = static_cast<size_t>(w.n_), nb = static_cast<size_t>(w.nblocks_);
   const size_t cap = static_cast<size_t>(w.ghost_) + 8;
   for (const Array* a : particle_arrays(w)) reader.require(a->size() == cap);
-  // The half list: block_slot_ ascending, its slots' arrays of that size,
-  // the pair terms one more (the zero slot).
+  // The half list: block_slot_ ascending, its slots' arrays of that size.
   reader.require(w.block_slot_.size() == nb + 1 && ascending_from_zero(w.block_slot_));
   const size_t ns = static_cast<size_t>(w.block_slot_.back());
   reader.require(w.slot_j_.size() == ns && within(w.slot_j_, 0, w.ghost_));
   for (const Array* a : {&w.hx_, &w.hy_, &w.hz_, &w.slot_r_, &w.slot_ir_})
     reader.require(a->size() == ns);
-  for (const Array* a : {&w.pfx_, &w.pfy_, &w.pfz_, &w.ptx_, &w.pty_, &w.ptz_})
-    reader.require(a->size() == ns + 1);
   // The mirror list: entries of the pair terms.
   reader.require(w.mirror_block_.size() == nb + 1 && ascending_from_zero(w.mirror_block_) &&
                  static_cast<size_t>(w.mirror_block_.back()) <= w.mirror_slot_.size() &&
@@ -174,6 +174,9 @@ SphereWorldImpl SphereWorldImpl::load_state(std::string_view bytes) {
     for (const Array* a : {&w.wall_hx_[s], &w.wall_hy_[s], &w.wall_hz_[s], &w.wall_fn_[s]})
       reader.require(a->size() == padded);
   }
+  // The places of the pair terms for this process's SIMD path, from the
+  // members checked above, and the pair terms' arrays sized to them.
+  w.layout_terms();
   return w;
 }
 
