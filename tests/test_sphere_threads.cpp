@@ -35,13 +35,14 @@ using sphere_test::kR;
 
 using test::same_bits;
 
-// 5×5×5 FCC cells (500 spheres: 63 blocks, so up to 7 threads are used),
-// compressed, positions jittered, random velocities and spins. Walls with
-// friction μ_w (0.2 unless asked) run the wall pass's tangential law; the
-// shipped scenes' frictionless walls (μ_w = 0) take the normal force alone.
+// 5×5×5 FCC cells unless asked (n × n × nz; 500 spheres: 63 blocks, so up
+// to 7 threads are used), compressed, positions jittered, random velocities and
+// spins. Walls with friction μ_w (0.2 unless asked) run the wall pass's
+// tangential law; the shipped scenes' frictionless walls (μ_w = 0) take the
+// normal force alone.
 SphereWorld agitated_fcc(double contact_damping, KernelOptions options = {},
-                         double wall_friction = 0.2) {
-  const SphereAssembly a = fcc_packing(5, 5, 5, kR, 2e-3);
+                         double wall_friction = 0.2, int n = 5, int nz = 5) {
+  const SphereAssembly a = fcc_packing(n, n, nz, kR, 2e-3);
   std::mt19937_64 rng(11);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   std::vector<double> x = a.x, y = a.y, z = a.z;
@@ -67,11 +68,12 @@ SphereWorld agitated_fcc(double contact_damping, KernelOptions options = {},
 // time. (Until 118864c the ledger was off with dashpots, the run at α = 0.2
 // beyond their stable step; the comment blamed the ledger's sampling of
 // their loss, which now runs every step and flags the step itself.)
-SphereWorld run_threads(double contact_damping, int threads, double wall_friction = 0.2) {
+SphereWorld run_threads(double contact_damping, int threads, double wall_friction = 0.2, int n = 5,
+                        int nz = 5) {
   KernelOptions options;
   options.skin_ratio = 0.002;
   options.threads = threads;
-  SphereWorld w = agitated_fcc(contact_damping, options, wall_friction);
+  SphereWorld w = agitated_fcc(contact_damping, options, wall_friction, n, nz);
   const double alpha = contact_damping > 0.0 ? 0.07 : 0.2;
   sphere_test::set_damped(w, alpha, 0.05);
   w.wall(kZMax).velocity = -0.2;
@@ -97,6 +99,23 @@ TEST(SphereThreads, BitIdenticalForAnyThreadCount) {
       EXPECT_EQ(many.threads(), t);
       test::expect_same_spheres(one, many);
     }
+  }
+}
+
+// Many threads (5 and 8) on a column of 3×3×36 FCC cells (1 296 spheres,
+// 162 blocks, in z-major order): a block's mirrored slots lie a few blocks
+// behind it, so each thread's pair terms wait in a ring of places that
+// wraps (term_ring.hpp) where the threads' pair pass sums the blocks it
+// completes (the AVX-512 path; the others give the threads places of their
+// own), and one thread's ring wraps on every path.
+TEST(SphereThreads, ManyThreadsGiveBitIdenticalResultsToo) {
+  const SphereWorld one = run_threads(0.0, 1, 0.2, 3, 36);
+  EXPECT_GT(one.rebuilds(), 20);
+  for (int t : {5, 8}) {
+    SCOPED_TRACE(t);
+    const SphereWorld many = run_threads(0.0, t, 0.2, 3, 36);
+    EXPECT_EQ(many.threads(), t);
+    test::expect_same_spheres(one, many);
   }
 }
 
