@@ -187,7 +187,7 @@ void WorldImpl::layout_terms() {
   // A ring of places per thread, one algorithm for both kernels
   // (term_ring.hpp); the pair pass sums the blocks it completes.
   const int place = detail::layout_terms(block_slot_, mirror_src_block_, pair_bounds_, mirror_slot_,
-                                         true, term_block_, mirror_term_);
+                                         term_block_, mirror_term_);
   // The terms, and the zero slot at index place.
   for (Array* p : {&pfx_, &pfy_, &pti_, &ptj_}) p->assign(static_cast<size_t>(place) + 1, 0.0);
 }

@@ -189,7 +189,7 @@ void SphereWorldImpl::layout_terms() {
   // A ring of places per thread, as the 2D kernel's (one algorithm:
   // term_ring.hpp).
   const int place = detail::layout_terms(block_slot_, mirror_src_block_, pair_bounds_, mirror_slot_,
-                                         threads_fuse_sums(), term_block_, mirror_term_);
+                                         term_block_, mirror_term_);
   // The terms, and the zero place at index place.
   for (auto* p : {&pfx_, &pfy_, &pfz_, &ptx_, &pty_, &ptz_})
     p->assign(static_cast<size_t>(place) + 1, 0.0);

@@ -377,9 +377,8 @@ DEMCAL_INLINE double sum_blocks(const A &a, int b0, int b1) {
 // Returns the largest overlap/min(r_i, r_j).
 // Where the pair pass sums the mirrored terms (see PairArgs).
 enum FuseSums : int {
-  kFuseNone = 0,  // threads: every block's sums in the sum pass
-  kFuseOwn = 1,   // threads: the blocks this pass completes, the rest after
-  kFuseAll = 2,   // one thread: every block, right after its pairs
+  kFuseOwn = 1,  // threads: the blocks this pass completes, the rest after
+  kFuseAll = 2,  // one thread: every block, right after its pairs
 };
 
 template <int W, bool kDamped, int kFuse>
@@ -510,12 +509,10 @@ DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
     // terms still in cache.
     if constexpr (kFuse == kFuseAll) {
       sum_blocks<W>(a, b, b + 1);
-    } else if constexpr (kFuse == kFuseOwn) {
+    } else {
       const bool complete = a.src_block[b] >= b0;
       a.fused[b] = complete;
       if (complete) sum_blocks<W>(a, b, b + 1);
-    } else {
-      a.fused[b] = 0;
     }
   }
   return hmax<W>(mo);
@@ -724,55 +721,54 @@ struct Kernels {
   IntegrateFn integrate, integrate_locked;
   void (*one_pair)(const double *, double *);
   WallFn walls;
-  bool threads_fuse;  // pairs_t and pairs_damped_t sum the blocks they complete
 };
 
-// THREAD_FUSE: kFuseOwn or kFuseNone for the threaded pair pass. At 97 556
-// spheres on 2 threads (quiet machine, 7-8 alternating rounds against the
-// pass without it, 2026-12-02) the fusion gave avx512 1.05x (median; CPU
-// time 0.9x) but avx2 0.93x (CPU time 1.09x, every round): the AVX2 path
-// keeps the separate sum pass. One thread fuses every block on every path.
-#define DEMCAL_SPHERE_KERNELS(SUFFIX, TARGET, W, THREAD_FUSE)                                     \
-  TARGET double pairs_##SUFFIX(const PairArgs &a, int b0, int b1) {                               \
-    return pair_blocks<W, false, kFuseAll>(a, b0, b1);                                            \
-  }                                                                                               \
-  TARGET double pairs_damped_##SUFFIX(const PairArgs &a, int b0, int b1) {                        \
-    return pair_blocks<W, true, kFuseAll>(a, b0, b1);                                             \
-  }                                                                                               \
-  TARGET double pairs_t_##SUFFIX(const PairArgs &a, int b0, int b1) {                             \
-    return pair_blocks<W, false, THREAD_FUSE>(a, b0, b1);                                         \
-  }                                                                                               \
-  TARGET double pairs_damped_t_##SUFFIX(const PairArgs &a, int b0, int b1) {                      \
-    return pair_blocks<W, true, THREAD_FUSE>(a, b0, b1);                                          \
-  }                                                                                               \
-  TARGET double sums_##SUFFIX(const SumArgs &a, int b0, int b1) {                                 \
-    for (int b = b0; b < b1; ++b)                                                                 \
-      if (!a.fused[b]) sum_blocks<W, SumArgs>(a, b, b + 1);                                       \
-    return 0.0;                                                                                   \
-  }                                                                                               \
-  TARGET double integrate_##SUFFIX(const IntegrateArgs &a, int b0, int b1) {                      \
-    return integrate_blocks<W, true>(a, b0, b1);                                                  \
-  }                                                                                               \
-  TARGET double integrate_locked_##SUFFIX(const IntegrateArgs &a, int b0, int b1) {               \
-    return integrate_blocks<W, false>(a, b0, b1);                                                 \
-  }                                                                                               \
-  TARGET void one_pair_##SUFFIX(const double *in, double *out) { one_pair<W>(in, out); }          \
-  TARGET void walls_##SUFFIX(const WallArgs &a, double *out) {                                    \
-    if (a.mu > 0.0)                                                                               \
-      wall_contacts<W, true>(a, out);                                                             \
-    else                                                                                          \
-      wall_contacts<W, false>(a, out);                                                            \
-  }                                                                                               \
-  constexpr Kernels kKernels_##SUFFIX{                                                            \
-      pairs_##SUFFIX, pairs_damped_##SUFFIX,  pairs_t_##SUFFIX,          pairs_damped_t_##SUFFIX, \
-      sums_##SUFFIX,  integrate_##SUFFIX,     integrate_locked_##SUFFIX, one_pair_##SUFFIX,       \
-      walls_##SUFFIX, THREAD_FUSE == kFuseOwn};
+// The threaded pair pass sums the blocks it completes on every path. Before
+// the pair terms had their ring (term_ring.hpp), that cost the AVX2 path
+// 0.93x at 97 556 spheres on 2 threads (2026-12-02), so AVX2 and SSE2 left
+// every sum to the sum pass; with the ring it gains 1.16x on AVX2 (5
+// alternating rounds, 2026-12-05, reports/performance.md).
+#define DEMCAL_SPHERE_KERNELS(SUFFIX, TARGET, W)                                                 \
+  TARGET double pairs_##SUFFIX(const PairArgs &a, int b0, int b1) {                              \
+    return pair_blocks<W, false, kFuseAll>(a, b0, b1);                                           \
+  }                                                                                              \
+  TARGET double pairs_damped_##SUFFIX(const PairArgs &a, int b0, int b1) {                       \
+    return pair_blocks<W, true, kFuseAll>(a, b0, b1);                                            \
+  }                                                                                              \
+  TARGET double pairs_t_##SUFFIX(const PairArgs &a, int b0, int b1) {                            \
+    return pair_blocks<W, false, kFuseOwn>(a, b0, b1);                                           \
+  }                                                                                              \
+  TARGET double pairs_damped_t_##SUFFIX(const PairArgs &a, int b0, int b1) {                     \
+    return pair_blocks<W, true, kFuseOwn>(a, b0, b1);                                            \
+  }                                                                                              \
+  TARGET double sums_##SUFFIX(const SumArgs &a, int b0, int b1) {                                \
+    for (int b = b0; b < b1; ++b)                                                                \
+      if (!a.fused[b]) sum_blocks<W, SumArgs>(a, b, b + 1);                                      \
+    return 0.0;                                                                                  \
+  }                                                                                              \
+  TARGET double integrate_##SUFFIX(const IntegrateArgs &a, int b0, int b1) {                     \
+    return integrate_blocks<W, true>(a, b0, b1);                                                 \
+  }                                                                                              \
+  TARGET double integrate_locked_##SUFFIX(const IntegrateArgs &a, int b0, int b1) {              \
+    return integrate_blocks<W, false>(a, b0, b1);                                                \
+  }                                                                                              \
+  TARGET void one_pair_##SUFFIX(const double *in, double *out) { one_pair<W>(in, out); }         \
+  TARGET void walls_##SUFFIX(const WallArgs &a, double *out) {                                   \
+    if (a.mu > 0.0)                                                                              \
+      wall_contacts<W, true>(a, out);                                                            \
+    else                                                                                         \
+      wall_contacts<W, false>(a, out);                                                           \
+  }                                                                                              \
+  constexpr Kernels kKernels_##SUFFIX{                                                           \
+      pairs_##SUFFIX, pairs_damped_##SUFFIX, pairs_t_##SUFFIX,          pairs_damped_t_##SUFFIX, \
+      sums_##SUFFIX,  integrate_##SUFFIX,    integrate_locked_##SUFFIX, one_pair_##SUFFIX,       \
+      walls_##SUFFIX};
 
 #define DEMCAL_NO_TARGET
-DEMCAL_SPHERE_KERNELS(sse2, DEMCAL_NO_TARGET, 2, kFuseNone)
+DEMCAL_SPHERE_KERNELS(sse2, DEMCAL_NO_TARGET, 2)
 #ifdef DEMCAL_X86_64
-DEMCAL_SPHERE_KERNELS(avx2, __attribute__((target("arch=x86-64-v3"))), 4, kFuseNone)
-DEMCAL_SPHERE_KERNELS(avx512, __attribute__((target("arch=x86-64-v4"))), 8, kFuseOwn)
+DEMCAL_SPHERE_KERNELS(avx2, __attribute__((target("arch=x86-64-v3"))), 4)
+DEMCAL_SPHERE_KERNELS(avx512, __attribute__((target("arch=x86-64-v4"))), 8)
 #endif
 
 // The path the 2D kernel chose (kernel_simd(): CPU and DEMCAL_SIMD).
@@ -845,8 +841,6 @@ double SphereWorldImpl::pair_pass(int b0, int b1) {
   if (active_threads() <= 1) return damped ? k.pairs_damped(a, b0, b1) : k.pairs(a, b0, b1);
   return damped ? k.pairs_damped_t(a, b0, b1) : k.pairs_t(a, b0, b1);
 }
-
-bool SphereWorldImpl::threads_fuse_sums() { return kernels().threads_fuse; }
 
 double SphereWorldImpl::sum_pass(int b0, int b1) {
   const SumArgs a{mirror_block_.data(), mirror_term_.data(), block_fused_.data(), pfx_.data(),

@@ -170,9 +170,6 @@ class SphereWorldImpl {
   double pair_pass(int b0, int b1);
   // Adds what each particle receives from its mirrored slots (returns 0).
   double sum_pass(int b0, int b1);
-  // Whether the threaded pair pass sums the blocks it completes (this
-  // machine's SIMD path; one thread always sums every block).
-  static bool threads_fuse_sums();
   double integrate_pass(int b0, int b1);
   // Run a pass over all blocks, shared among the threads by `bounds`;
   // returns the largest value it returned (sphere_world.cpp).

@@ -10,9 +10,9 @@
 // state_bytes.hpp. The threads are not state: a SphereWorld read back
 // starts its own on first use, as a copy does. Nor are the pair terms
 // (pfx_ .. ptz_: written by each pair pass before its sums read them) and
-// their places (term_block_, mirror_term_, term_ring.hpp): those depend on
-// whether this process's SIMD path sums in the threads' pair pass, so the
-// SphereWorld read back lays them out again.
+// their places (term_block_, mirror_term_, term_ring.hpp): those follow
+// from the list and the threads' block ranges, so the SphereWorld read
+// back lays them out again.
 #include <algorithm>
 #include <array>
 #include <string>
@@ -174,8 +174,8 @@ SphereWorldImpl SphereWorldImpl::load_state(std::string_view bytes) {
     for (const Array* a : {&w.wall_hx_[s], &w.wall_hy_[s], &w.wall_hz_[s], &w.wall_fn_[s]})
       reader.require(a->size() == padded);
   }
-  // The places of the pair terms for this process's SIMD path, from the
-  // members checked above, and the pair terms' arrays sized to them.
+  // The places of the pair terms, from the members checked above, and the
+  // pair terms' arrays sized to them.
   w.layout_terms();
   return w;
 }

@@ -8,7 +8,7 @@ namespace demcal::detail {
 
 int layout_terms(std::span<const int> block_slot, std::span<const int> mirror_src_block,
                  std::span<const int> pair_bounds, std::span<const int> mirror_slot,
-                 bool threads_fuse, std::vector<int>& term_block, AlignedVector<int>& mirror_term) {
+                 std::vector<int>& term_block, AlignedVector<int>& mirror_term) {
   // The pair terms of block b are needed until the sums of the last block
   // that mirrors one of its slots; with the sums fused into the pair pass
   // (one thread: every block) that is at most the window of blocks
@@ -17,9 +17,9 @@ int layout_terms(std::span<const int> block_slot, std::span<const int> mirror_sr
   // in cache instead of streaming a per-slot array to memory and back (at
   // 10^5 disks, 32 B per slot each way). The blocks the sum pass needs after
   // the barrier (threads: the windows of the blocks not summed in the pair
-  // pass; all of them if the threads' pair pass sums none) get places of
-  // their own, outside the rings. The values and the order of the sums are
-  // those of a per-slot array: only where a term waits changes.
+  // pass) get places of their own, outside the rings. The values and the
+  // order of the sums are those of a per-slot array: only where a term
+  // waits changes.
   const int nb = static_cast<int>(block_slot.size()) - 1;
   const int ns = block_slot[nb];
   const int t = static_cast<int>(pair_bounds.size()) - 1;
@@ -27,13 +27,10 @@ int layout_terms(std::span<const int> block_slot, std::span<const int> mirror_sr
   auto src = [&](int b) { return mirrored ? mirror_src_block[b] : b; };
   auto size = [&](int b) { return block_slot[b + 1] - block_slot[b]; };
   std::vector<char> own_place(nb, 0);
-  if (t > 1 && !threads_fuse)
-    std::fill(own_place.begin(), own_place.end(), 1);
-  else
-    for (int k = 0; k < t; ++k)
-      for (int b = pair_bounds[k]; b < pair_bounds[k + 1]; ++b)
-        if (src(b) < pair_bounds[k])
-          for (int c = src(b); c <= b; ++c) own_place[c] = 1;
+  for (int k = 0; k < t; ++k)
+    for (int b = pair_bounds[k]; b < pair_bounds[k + 1]; ++b)
+      if (src(b) < pair_bounds[k])
+        for (int c = src(b); c <= b; ++c) own_place[c] = 1;
   term_block.assign(static_cast<size_t>(nb) + 1, 0);
   int place = 0;
   for (int b = 0; b < nb; ++b)

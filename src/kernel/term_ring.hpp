@@ -20,14 +20,13 @@ namespace demcal::detail {
 /// the padding at the zero place. mirror_src_block[b]: the lowest block
 /// holding one of b's mirrored slots (b itself if none; an empty span reads
 /// so for every block). pair_bounds: the threads' block ranges of the pair
-/// pass. threads_fuse: whether, with more than one thread, a thread's pair
-/// pass sums the blocks whose mirrored slots it wrote all of (one thread
-/// always sums every block right after its pairs); if not, every block keeps
-/// its terms until the sum pass after the barrier: a place of its own.
+/// pass (with more than one thread, a thread's pair pass sums the blocks
+/// whose mirrored slots it wrote all of, the sum pass after the barrier the
+/// others; one thread sums every block right after its pairs).
 /// Returns the number of places: term_block has nblocks + 1 entries, the
 /// last that number, which is also the index of the zero place.
 int layout_terms(std::span<const int> block_slot, std::span<const int> mirror_src_block,
                  std::span<const int> pair_bounds, std::span<const int> mirror_slot,
-                 bool threads_fuse, std::vector<int>& term_block, AlignedVector<int>& mirror_term);
+                 std::vector<int>& term_block, AlignedVector<int>& mirror_term);
 
 }  // namespace demcal::detail
