@@ -49,11 +49,11 @@
 // the slot's place in a ring that keeps them in cache until they are
 // summed: term_ring.hpp), and the sum pass (sum_blocks) then adds to each
 // particle j, from its mirror list in increasing i, the opposite of that
-// force and that torque. Both
-// sums run in a fixed order whatever the thread split (each pass writes
-// only its own particles' or slots' values), so results are deterministic
-// and bit-identical for any thread count; non-touching slots add exact
-// zeros, so the skin does not change a bit either. Each block's sums run
+// force and that torque. Both sums run in a fixed order whatever the thread
+// split (each pass writes only its own particles' or slots' values), so
+// results are deterministic and bit-identical for any thread count;
+// non-touching slots add exact zeros, so the skin does not change a bit
+// either. Each block's sums run
 // right after its own pairs, the pair terms still in cache, wherever the
 // same pass has written all of its mirrored slots: with one thread every
 // block; with threads the blocks whose mirrored slots all lie in the
