@@ -105,9 +105,8 @@ TEST(SphereThreads, BitIdenticalForAnyThreadCount) {
 // Many threads (5 and 8) on a column of 3×3×36 FCC cells (1 296 spheres,
 // 162 blocks, in z-major order): a block's mirrored slots lie a few blocks
 // behind it, so each thread's pair terms wait in a ring of places that
-// wraps (term_ring.hpp) where the threads' pair pass sums the blocks it
-// completes (the AVX-512 path; the others give the threads places of their
-// own), and one thread's ring wraps on every path.
+// wraps (term_ring.hpp): the threads' pair pass sums the blocks it
+// completes, on every path, and one thread's ring wraps too.
 TEST(SphereThreads, ManyThreadsGiveBitIdenticalResultsToo) {
   const SphereWorld one = run_threads(0.0, 1, 0.2, 3, 36);
   EXPECT_GT(one.rebuilds(), 20);
