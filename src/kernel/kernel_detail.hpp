@@ -21,10 +21,13 @@
 namespace demcal {
 
 namespace detail {
+/// Arrays from this size on start at staggered offsets in their pages.
+constexpr std::size_t kStaggeredBytes = 4096;
+
 /// Where in its 4 KiB page the next array of `bytes` starts: a multiple of
-/// 64 from 64 to 4032, the next of 63 such offsets for every array of 4 KiB
-/// or more (consecutive arrays 19 lines apart), 0 for a smaller one (which
-/// malloc packs among others anyway).
+/// 64 from 64 to 4032, the next of 63 such offsets for every array of
+/// kStaggeredBytes or more (consecutive arrays 19 lines apart), 0 for a
+/// smaller one (which malloc packs among others anyway).
 ///
 /// Why: glibc serves a block beyond its mmap threshold (128 KiB at first,
 /// raised by each such block freed) from fresh pages, so such arrays all
@@ -38,7 +41,7 @@ namespace detail {
 /// runs 1.2x faster staggered (reports/performance.md, 2026-12-05), while
 /// `demcal run` on the same sample did not. Addresses change no result.
 inline std::size_t page_offset_for(std::size_t bytes) {
-  if (bytes < 4096) return 0;
+  if (bytes < kStaggeredBytes) return 0;
   static std::atomic<unsigned> next{0};
   const unsigned k = next.fetch_add(1, std::memory_order_relaxed) % 63;
   return 64 * (1 + (19 * k) % 63);
@@ -64,7 +67,7 @@ struct AlignedAllocator {
     return reinterpret_cast<T*>(array);
   }
   void deallocate(T* p, std::size_t n) noexcept {
-    if (n * sizeof(T) < 4096) {
+    if (n * sizeof(T) < kStaggeredBytes) {
       ::operator delete(p, std::align_val_t(64));
       return;
     }
