@@ -55,7 +55,10 @@ auto said_consolidation(const SceneConfig& config, const AnyAssembly& assembly, 
   return state;
 }
 
-void announce_rev() { std::cerr << "demcal rev: consolidating the REV to sigma3\n"; }
+void announce_rev(int64_t particles, const char* noun) {
+  std::cerr << "demcal rev: consolidating the REV of " << particles << " " << noun
+            << " to sigma3\n";
+}
 
 // `ready` is called once the prototype is read and checked, before any
 // consolidation (it checks the output folder); `every_s`: seconds between
@@ -73,10 +76,12 @@ RevOutcome rev_2d(const SceneConfig& config, const std::string& file, const RevO
                           std::cerr << "demcal rev: consolidating the prototype first ("
                                     << source.description << "): a loose gas takes long\n";
                         }).world);
-  std::cerr << "demcal rev: " << (ro.method == "cut" ? "cutting" : "generating") << " a REV of "
+  std::cerr << "demcal rev: "
+            << (ro.method == "cut" ? "cutting a REV of about " : "generating a REV of ")
             << ro.particles << " particles from " << source.description << "\n";
   const RevResult r = make_rev(proto, ro, [&](const Assembly& raw) {
-    return said_consolidation(config, raw, "the REV", every_s, announce_rev);
+    return said_consolidation(config, raw, "the REV", every_s,
+                              [&] { announce_rev(raw.size(), "particles"); });
   });
   return {r.method, particle_csv(r.assembly), r.assembly.size(), consolidation_record(r.state),
           r.representativeness};
@@ -100,9 +105,11 @@ RevOutcome rev_3d(const SceneConfig& config, const std::string& file, const RevO
                                            << source.description << "): a loose gas takes long\n";
                                }).world);
   std::cerr << "demcal rev: " << (ro.method == "cut" ? "cutting a box" : "generating a")
-            << " REV of " << ro.particles << " spheres from " << source.description << "\n";
+            << " REV of " << (ro.method == "cut" ? "about " : "") << ro.particles
+            << " spheres from " << source.description << "\n";
   const SphereRevResult r = make_rev(proto, ro, [&](const SphereAssembly& raw) {
-    return said_consolidation(config, raw, "the REV", every_s, announce_rev);
+    return said_consolidation(config, raw, "the REV", every_s,
+                              [&] { announce_rev(raw.size(), "spheres"); });
   });
   return {r.method, sphere_csv(r.assembly), r.assembly.size(), consolidation_record(r.state),
           r.representativeness};
@@ -158,8 +165,14 @@ int cmd_rev(const RevCmdOptions& o) {
 
   const auto& rep = r.representativeness;
   std::cout << "REV of " << r.particles << (config.dimension == 3 ? " spheres (" : " particles (")
-            << r.method << ") from " << source.description << "\n  " << rep.verdict << "\n  wrote "
-            << dir << "/rev.csv, rev.json, rev-config.json (demcal calibrate " << dir
+            << r.method;
+  // A cut window's edge passes between layers of the prototype, never
+  // through one (cut_window.hpp): a lattice's REV holds whole layers.
+  if (r.particles != o.particles)
+    std::cout << "; asked for " << o.particles
+              << ", the nearest count whose window cuts between the prototype's layers";
+  std::cout << ") from " << source.description << "\n  " << rep.verdict << "\n  wrote " << dir
+            << "/rev.csv, rev.json, rev-config.json (demcal calibrate " << dir
             << "/rev-config.json)\n";
   return 0;
 }

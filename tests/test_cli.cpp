@@ -892,7 +892,7 @@ TEST_F(CliEndToEnd, StabilitySaysItsConsolidationAsTheOtherCommands) {
 }
 TEST_F(CliEndToEnd, RevSaysItsConsolidationAsTheOtherCommands) {
   expect_said_as_the_others({"rev", kHex5, "--particles", "16"},
-                            "demcal rev: consolidating the REV to sigma3",
+                            "demcal rev: consolidating the REV of 16 particles to sigma3",
                             "demcal rev: consolidated the REV in ");
 }
 

@@ -228,6 +228,49 @@ TEST(SphereRev, CutFromAnFccFileIsRepresentativeAfterReconsolidation) {
   EXPECT_EQ(j["prototype"]["dimension"].get<int>(), 3);
 }
 
+// A consolidated lattice keeps its layers only to within about an overlap
+// (5e-7 r in the FCC prototype `demcal rev configs/fcc_4x4x4.json` makes):
+// rounding orders a layer's centres, and a window cut to the exact count
+// asked took part of a layer, whose spheres the walls then squeezed into
+// the gaps beside them: `--particles 300` never reached a static state (2
+// million steps). The cut goes between layers: the same count as on the
+// exact lattice, and the REV consolidates.
+TEST(SphereRev, CutGoesBetweenTheLayersOfAConsolidatedLattice) {
+  const SphereAssembly exact = fcc_packing(8, 8, 8, 5e-4);
+  SphereAssembly proto = exact;
+  std::mt19937_64 rng(1);
+  std::uniform_real_distribution<double> jitter(-2.5e-7 * 5e-4, 2.5e-7 * 5e-4);
+  for (auto* c : {&proto.x, &proto.y, &proto.z})
+    for (double& v : *c) v += jitter(rng);
+  // Cubes of 2m whole (100) layers around the centre: 4m³ spheres.
+  for (auto [asked, whole] : {std::pair{172, 108}, {300, 256}, {400, 500}}) {
+    SCOPED_TRACE(asked);
+    EXPECT_EQ(cut_rev(exact, asked).size(), whole);
+    EXPECT_EQ(cut_rev(proto, asked).size(), whole);
+  }
+  RevOptions o;
+  o.particles = 300;
+  const SphereRevResult r = make_rev(fcc_scene(), proto, o);
+  EXPECT_TRUE(r.state.converged);
+  EXPECT_EQ(r.assembly.size(), 256);
+  EXPECT_NEAR(r.representativeness.rev.coordination_interior, 12.0, 1e-12);
+}
+
+// In a random packing nearly every gap between the centres' window scales
+// is wider than the tenth of their mean spacing that marks a layer, so the
+// cut holds the count asked, or one next to it.
+TEST(SphereRev, CutOfARandomPackingHoldsAboutTheCountAsked) {
+  AssemblySpec spec;
+  spec.count = 3000;
+  spec.radius_min = 4e-4;
+  spec.radius_max = 6e-4;
+  const SphereAssembly proto = random_sphere_gas(spec);
+  for (int asked : {50, 200, 333, 1000}) {
+    SCOPED_TRACE(asked);
+    EXPECT_NEAR(cut_rev(proto, asked).size(), asked, 2);
+  }
+}
+
 TEST(SphereRev, GeneratedRevIsADensePackingOfThePrototypesRadii) {
   // Radii uniform in [0.75, 1.25]·5e-4 m from a loose gas (porosity ≈ 0.8:
   // one sphere per cell of edge 2.2·r_max). The generated REV, consolidated,
@@ -288,11 +331,19 @@ TEST_F(Rev3dCli, CutsAReviewableRevFromASphereFile) {
       test::write_text(dir_ / "proto.csv", sphere_csv(fcc_packing(6, 6, 6, 5e-4)));
   const auto r = demcal({"rev", config_, "--prototype", proto, "--particles", "200", "-o", "R"});
   ASSERT_EQ(r.status, 0) << r.err;
-  EXPECT_NE(r.out.find("spheres (cut)"), std::string::npos) << r.out;
   const fs::path out = dir_ / "work" / "R";
   // The REV is a sphere file the 3D config reads...
   const SphereAssembly rev = read_sphere_file((out / "rev.csv").string());
   EXPECT_NEAR(rev.size(), 200, lattice_slack(200));
+  // ...of whole layers of the lattice, which the summary says moved the count.
+  EXPECT_NE(r.out.find("REV of " + std::to_string(rev.size()) + " spheres (cut"), std::string::npos)
+      << r.out;
+  if (rev.size() != 200) {
+    EXPECT_NE(r.out.find("asked for 200, the nearest count whose window cuts between the "
+                         "prototype's layers"),
+              std::string::npos)
+        << r.out;
+  }
   // ...and rev-config.json is a 3D config that builds it and names the prototype.
   const SceneConfig c = load_config((out / "rev-config.json").string());
   EXPECT_EQ(c.dimension, 3);

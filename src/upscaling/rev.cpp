@@ -439,15 +439,15 @@ Assembly cut_rev(const Assembly& proto, int64_t count, double aspect) {
   const double cx = 0.5 * (proto.left + proto.right), cy = 0.5 * (proto.bottom + proto.top);
   const double w = proto.right - proto.left, h = proto.top - proto.bottom;
   if (!(aspect > 0.0)) aspect = h > 0.0 ? w / h : 1.0;
-  // The window is s·aspect wide and s high, centred on the box centre; the
-  // count of centres inside is monotone in s.
-  auto inside = [&](double s, int i) {
-    return std::abs(proto.x[i] - cx) <= 0.5 * s * aspect && std::abs(proto.y[i] - cy) <= 0.5 * s;
+  // The window is s·aspect wide and s high, centred on the box centre:
+  // centre i is inside from the scale critical(i) on.
+  auto critical = [&](int i) {
+    return std::max(2.0 * std::abs(proto.x[i] - cx) / aspect, 2.0 * std::abs(proto.y[i] - cy));
   };
-  const double s = detail::window_scale(n, count, 2.0 * std::max(h, w / aspect) + 1e-12, inside);
+  const double s = detail::window_scale(n, count, critical);
   Assembly a;
   for (int i = 0; i < n; ++i) {
-    if (!inside(s, i)) continue;
+    if (critical(i) > s) continue;
     a.x.push_back(proto.x[i]);
     a.y.push_back(proto.y[i]);
     a.r.push_back(proto.r[i]);

@@ -16,8 +16,8 @@ namespace demcal {
 SphereAssembly cut_rev(const SphereAssembly& proto, int64_t count, double aspect) {
   const int n = proto.size();
   detail::check_rev_count(count, n, "spheres");
-  // The window's half-edges are s·e[d]/2, centred on the box centre; the
-  // count of centres inside is monotone in s.
+  // The window's half-edges are s·e[d]/2, centred on the box centre:
+  // centre i is inside from the scale critical(i) on.
   std::array<double, 3> centre, edge;
   for (int d = 0; d < 3; ++d) {
     centre[d] = 0.5 * (proto.lo[d] + proto.hi[d]);
@@ -25,21 +25,17 @@ SphereAssembly cut_rev(const SphereAssembly& proto, int64_t count, double aspect
   }
   if (aspect > 0.0) edge = {aspect, aspect, 1.0};
   const double scale = std::max({edge[0], edge[1], edge[2]});
-  for (double& e : edge) e /= scale;  // the largest is 1
+  for (double& e : edge) e = std::max(e / scale, 1e-12);  // the largest is 1
   const std::vector<double>* pos[3] = {&proto.x, &proto.y, &proto.z};
-  auto inside = [&](double s, int i) {
-    for (int d = 0; d < 3; ++d)
-      if (!(std::abs((*pos[d])[i] - centre[d]) <= 0.5 * s * edge[d])) return false;
-    return true;
+  auto critical = [&](int i) {
+    double t = 0.0;
+    for (int d = 0; d < 3; ++d) t = std::max(t, 2.0 * std::abs((*pos[d])[i] - centre[d]) / edge[d]);
+    return t;
   };
-  // Every centre is inside at s = 2·(largest edge/smallest relative edge).
-  double hi = 1e-12;
-  for (int d = 0; d < 3; ++d)
-    hi = std::max(hi, 2.0 * (proto.hi[d] - proto.lo[d]) / std::max(edge[d], 1e-12));
-  const double s = detail::window_scale(n, count, hi, inside);
+  const double s = detail::window_scale(n, count, critical);
   SphereAssembly a;
   for (int i = 0; i < n; ++i) {
-    if (!inside(s, i)) continue;
+    if (critical(i) > s) continue;
     a.x.push_back(proto.x[i]);
     a.y.push_back(proto.y[i]);
     a.z.push_back(proto.z[i]);
