@@ -5,9 +5,13 @@
 // that a World read back is a copy of the one saved: it rebuilds its list,
 // sums its forces and steps exactly as the original would (a state rebuilt
 // from positions alone would differ in the tangential histories and in when
-// the list is next rebuilt). The bytes: state_bytes.hpp (shared with the
-// sphere kernel, sphere_world_state.cpp). The threads are not state: a World
-// read back starts its own on first use, as a copy does.
+// the list is next rebuilt). Not the pair terms, which live within a
+// step, nor their places, which follow from the list (layout_terms). The
+// bytes: state_bytes.hpp (shared with the sphere kernel,
+// sphere_world_state.cpp). The threads are not state: a World read back
+// starts its own on first use, as a copy does.
+#include <algorithm>
+
 #include "state_bytes.hpp"
 #include "world_impl.hpp"
 
@@ -17,9 +21,10 @@ namespace {
 
 // The last character numbers the layout: '2' since the half neighbour list,
 // '3' since the pair terms' places (term_block_, mirror_term_), '4' since
-// block_power_ holds 8 lanes per block; a state of an older layout does not
-// read: rebuilt, not misread.
-constexpr std::string_view kMark("demWorl4", 8);
+// block_power_ holds 8 lanes per block, '5' since the pair terms and their
+// places are no longer saved; a state of an older layout does not read:
+// rebuilt, not misread.
+constexpr std::string_view kMark("demWorl5", 8);
 constexpr const char* kWhat = "World::load_state";
 
 // A new member of these structs must be visited below: the sizes catch one
@@ -47,7 +52,7 @@ void WorldImpl::visit_state(Self& w, Visitor& v) {
         &w.r_,       &w.inv_r_,       &w.m_,           &w.inertia_,    &w.fx_,      &w.fy_,
         &w.tq_,      &w.block_power_, &w.ca_t_,        &w.cb_t_,       &w.ca_r_,    &w.cb_r_,
         &w.slot_ft_, &w.slot_r_,      &w.new_slot_ft_, &w.new_slot_r_, &w.x_built_, &w.y_built_,
-        &w.slot_ir_, &w.new_slot_ir_, &w.pfx_,         &w.pfy_,        &w.pti_,     &w.ptj_})
+        &w.slot_ir_, &w.new_slot_ir_})
     v(*a);
   v(w.wall_dashpot_power_);
   for (int s = 0; s < 4; ++s) {
@@ -62,15 +67,13 @@ void WorldImpl::visit_state(Self& w, Visitor& v) {
     v(wall.force.y());
     v(wall.contacts);
   }
-  for (auto* a :
-       {&w.block_slot_, &w.pair_i_, &w.pair_j_, &w.pair_slot_, &w.pair_bounds_, &w.particle_bounds_,
-        &w.nbr_start_, &w.nbr_list_, &w.cell_start_, &w.cell_next_, &w.new_block_slot_,
-        &w.mirror_block_, &w.mirror_count_, &w.mirror_src_block_, &w.term_block_})
+  for (auto* a : {&w.block_slot_, &w.pair_i_, &w.pair_j_, &w.pair_slot_, &w.pair_bounds_,
+                  &w.particle_bounds_, &w.nbr_start_, &w.nbr_list_, &w.cell_start_, &w.cell_next_,
+                  &w.new_block_slot_, &w.mirror_block_, &w.mirror_count_, &w.mirror_src_block_})
     v(*a);
   v(w.slot_j_);
   v(w.new_slot_j_);
   v(w.mirror_slot_);
-  v(w.mirror_term_);
   v(w.block_fused_);
   v(w.skin_);
   v(w.r_max_);
@@ -118,16 +121,13 @@ WorldImpl WorldImpl::load_state(std::string_view bytes) {
       w.slot_j_.size() == w.slot_ft_.size() && w.slot_r_.size() == w.slot_ft_.size() &&
       static_cast<size_t>(w.block_slot_.back()) <= w.slot_j_.size() &&
       w.slot_ir_.size() == w.slot_ft_.size() &&
-      (w.pfx_.empty() ||
-       (w.term_block_.size() == static_cast<size_t>(w.nblocks_) + 1 &&
-        w.pfx_.size() == static_cast<size_t>(w.term_block_.back()) + 1 &&
-        w.pfy_.size() == w.pfx_.size() && w.pti_.size() == w.pfx_.size() &&
-        w.ptj_.size() == w.pfx_.size() && w.mirror_term_.size() == w.mirror_slot_.size())) &&
       (w.mirror_block_.empty() ||
        (w.mirror_block_.size() == static_cast<size_t>(w.nblocks_) + 1 &&
         static_cast<size_t>(w.mirror_block_.back()) <= w.mirror_slot_.size() &&
         w.mirror_src_block_.size() == static_cast<size_t>(w.nblocks_) &&
-        w.block_fused_.size() == static_cast<size_t>(w.nblocks_)));
+        w.block_fused_.size() == static_cast<size_t>(w.nblocks_) && w.pair_bounds_.size() >= 2 &&
+        w.pair_bounds_.front() == 0 && w.pair_bounds_.back() == w.nblocks_ &&
+        std::is_sorted(w.pair_bounds_.begin(), w.pair_bounds_.end())));
   for (int s = 0; s < 4; ++s)
     if (w.wall_ft_[s].size() != static_cast<size_t>(w.n_) ||
         w.wall_fn_[s].size() != static_cast<size_t>(w.n_))
@@ -137,13 +137,12 @@ WorldImpl WorldImpl::load_state(std::string_view bytes) {
     if (j < 0 || j > w.ghost_) reader.fail();
   for (int s : w.mirror_slot_)
     if (s < 0 || s > w.block_slot_.back()) reader.fail();
-  for (int s : w.mirror_term_)
-    if (s < 0 || static_cast<size_t>(s) >= w.pfx_.size()) reader.fail();
-  if (!w.pfx_.empty())
-    for (int b = 0; b < w.nblocks_; ++b)
-      if (w.term_block_[b] < 0 ||
-          w.term_block_[b] + (w.block_slot_[b + 1] - w.block_slot_[b]) > w.term_block_.back())
-        reader.fail();
+  for (int b : w.mirror_src_block_)
+    if (b < 0 || b >= w.nblocks_) reader.fail();
+  // The places of the pair terms, from the members checked above, and the
+  // pair terms' arrays sized to them (as the sphere state does): laid out
+  // once the list exists, as rebuild_neighbours does.
+  if (!w.mirror_block_.empty()) w.layout_terms();
   return w;
 }
 
