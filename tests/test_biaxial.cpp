@@ -194,6 +194,40 @@ TEST(BiaxialConsolidation, GivesUpWithAClearErrorAfterMaxSteps) {
     ADD_FAILURE() << "a computation that fails is not bad input";
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("consolidation_max_steps"), std::string::npos) << e.what();
+    EXPECT_EQ(std::string(e.what()).find("empty slab"), std::string::npos) << e.what();
+  }
+}
+
+// A stray disk (a wrong row of a particle file): a 10x10 block of touching
+// disks, 1 cm wide, and one disk 9 m above it. The walls close on the
+// block, whose face the stray holds 9 m tall, and squeeze it until an
+// overlap passes the kernel's limit; the error said only that. It now
+// names the empty slab and the disk beyond it.
+TEST(BiaxialConsolidation, FailureNamesAStrayDisk) {
+  const SceneConfig c = scene(R"({"test": {"consolidation_max_steps": 100000}})");
+  const double r = 5e-4;
+  Assembly a;
+  for (int i = 0; i < 10; ++i)
+    for (int j = 0; j < 10; ++j) {
+      a.x.push_back((2 * i + 1) * r);
+      a.y.push_back((2 * j + 1) * r);
+      a.r.push_back(r);
+    }
+  a.x.push_back(0.0045), a.y.push_back(9.0), a.r.push_back(r);
+  a.left = a.bottom = 0.0;
+  a.right = 0.01;
+  a.top = 9.0 + r;
+  try {
+    consolidate(c, a);
+    ADD_FAILURE() << "no error";
+  } catch (const std::runtime_error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("empty slab 8.99 m wide across the box along y (from 0.01 to 8.9995 m)"),
+              std::string::npos)
+        << what;
+    EXPECT_NE(what.find("1 particle lies beyond it (the nearest at (0.0045, 9) m)"),
+              std::string::npos)
+        << what;
   }
 }
 

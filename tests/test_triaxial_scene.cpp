@@ -323,6 +323,45 @@ TEST(TriaxialScene, ConsolidationThatCannotFinishSaysWhatItReached) {
     const std::string what = e.what();
     EXPECT_NE(what.find("did not reach a static state in 1000 steps"), std::string::npos) << what;
     EXPECT_NE(what.find("unbalanced-force ratio"), std::string::npos) << what;
+    EXPECT_EQ(what.find("empty slab"), std::string::npos) << what;  // a lattice has none
+  }
+}
+
+// A stray sphere (a wrong row of a particle file): a 5x5x5 block of
+// touching spheres, 5 mm wide, and one sphere 25 mm above it. The top wall
+// meets the stray alone and pushes it against the global damping's drag
+// alone, which its servo reads as stress: the wall stalls at 28.6 % short
+// of σ3 (2·10⁶ steps measured), and the error said only that. It now names
+// the empty slab and the sphere beyond it.
+TEST(TriaxialScene, ConsolidationThatFailsNamesAStraySphere) {
+  SceneConfig c = parse(fcc_text(2, 1e5, 5e-4, 1000, false));
+  c.test.consolidation_max_steps = 100000;
+  const double r = 5e-4;
+  SphereAssembly a;
+  for (int i = 0; i < 5; ++i)
+    for (int j = 0; j < 5; ++j)
+      for (int k = 0; k < 5; ++k) {
+        a.x.push_back((2 * i + 1) * r);
+        a.y.push_back((2 * j + 1) * r);
+        a.z.push_back((2 * k + 1) * r);
+        a.r.push_back(r);
+      }
+  a.x.push_back(0.0045), a.y.push_back(0.0045), a.z.push_back(0.03), a.r.push_back(r);
+  a.lo = {0.0, 0.0, 0.0};
+  a.hi = {0.005, 0.005, 0.03 + r};
+  try {
+    consolidate_triaxial(c, a);
+    FAIL() << "no error";
+  } catch (const std::runtime_error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("did not reach a static state"), std::string::npos) << what;
+    EXPECT_NE(what.find("empty slab 0.0245 m wide across the box along z (from 0.005 to 0.0295 m)"),
+              std::string::npos)
+        << what;
+    EXPECT_NE(what.find("1 particle lies beyond it (the nearest at (0.0045, 0.0045, 0.03) m)"),
+              std::string::npos)
+        << what;
+    EXPECT_EQ(what.find("raise test.consolidation_max_steps"), std::string::npos) << what;
   }
 }
 

@@ -20,11 +20,13 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <deque>
 #include <limits>
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -34,6 +36,7 @@
 #include "demcal/scene/biaxial.hpp"
 #include "demcal/scene/config.hpp"
 #include "demcal/scene/consolidation_progress.hpp"
+#include "empty_slab.hpp"
 
 namespace demcal::detail {
 
@@ -55,6 +58,7 @@ struct ConsolidationOutcome {
   double stress_error = 0.0;       ///< max |p − σ3|/σ3 over the walls, last check
   double unbalanced_ratio = 0.0;   ///< unbalanced-force ratio, last check
   ConsolidationProgress progress;  ///< the last check's report (wall-clock fields included)
+  std::string stray_note;          ///< stray_particle_note of the start, for a failure's error
 };
 
 /// The wall-clock side of ConsolidationProgress: elapsed time, the step
@@ -153,6 +157,13 @@ ConsolidationOutcome run_consolidation(Sample& world, const TestSpec& test, doub
   const int64_t critical_after =
       critical_damping_after(max_steps, consolidation_step_shrink(settle.dt_ratio));
   ConsolidationOutcome out;
+  {
+    std::array<std::span<const double>, walls / 2> centres;
+    centres[0] = world.x();
+    centres[1] = world.y();
+    if constexpr (walls == 6) centres[2] = world.z();
+    out.stray_note = stray_particle_note(centres, world.radius());
+  }
   ConsolidationClock clock(test);
   bool critical = false;
   for (out.phase = 0; out.phase < 2; ++out.phase) {
@@ -166,7 +177,7 @@ ConsolidationOutcome run_consolidation(Sample& world, const TestSpec& test, doub
         }
         if (!world.step(1))
           throw std::runtime_error(std::string("consolidation diverged: ") +
-                                   to_string(world.divergence()));
+                                   to_string(world.divergence()) + out.stray_note);
       }
       out.steps += kCheckEvery;
       if (!critical && out.steps >= critical_after) {
@@ -204,8 +215,9 @@ inline std::string consolidation_failure(const ConsolidationOutcome& o, const Te
          percent(o.stress_error) + " of sigma3, tolerance " +
          percent(test.consolidation_tolerance) + "; unbalanced-force ratio " +
          std::to_string(o.unbalanced_ratio) + ", tolerance " +
-         std::to_string(test.consolidation_unbalanced) +
-         "); raise test.consolidation_max_steps or loosen the tolerances";
+         std::to_string(test.consolidation_unbalanced) + ")" +
+         (o.stray_note.empty() ? "; raise test.consolidation_max_steps or loosen the tolerances"
+                               : o.stray_note);
 }
 
 /// The consolidated state's account of `o` (started at `t0`); throws
