@@ -165,6 +165,34 @@ TEST_F(CliEndToEnd, BadOverridesAndMissingFilesExitTwo) {
   expect_bad_input({"run", dir_.string(), "-o", out}, {dir_.string()});  // a folder
 }
 
+// A value that passes its own range check yet makes a scale the kernel
+// derives overflow or underflow (rho = 1e308: the mass is inf and the step
+// "must be finite"; a radius of 1e-150: the inertia is 0, the state turns
+// non-finite) is bad input found before any computing: the --set (or the
+// file) and the field that pushed the scale out, what is wrong.
+TEST_F(CliEndToEnd, DerivedScalesThatOverflowOrUnderflowAreBadInput) {
+  const std::string out = (dir_ / "work" / "out").string();
+  struct Case {
+    std::string set, field, what;
+  };
+  const std::vector<Case> cases = {
+      {"material.density=1e308", "material.density", "mass f_ms*rho*t*pi*r^2 is inf"},
+      {"material.density=1e-308", "material.density", "below the smallest normal double"},
+      {"algorithm.mass_scaling=1e308", "algorithm.mass_scaling", "mass f_ms*rho*t*pi*r^2 is inf"},
+      {"assembly.radius=1e-150", "assembly.radius", "moment of inertia m*r^2/2 is 0"},
+      {"assembly.radius=1e150", "assembly.radius", "moment of inertia m*r^2/2 is inf"},
+  };
+  for (const Case& c : cases) {
+    expect_bad_input({"run", kHex5, "--set", c.set, "-o", out},
+                     {"--set " + c.set + ": " + c.field + ": ", c.what});
+    expect_bad_input({"check", kHex5, "--set", c.set}, {"--set " + c.set + ": " + c.field});
+  }
+  // In the file: the file is named.
+  const std::string dense = write(
+      "dense.json", R"({"material": {"density": 1e308, "kn": 1e8, "kt": 5e7, "friction": 0.3}})");
+  expect_bad_input({"run", dense, "-o", out}, {dense + ": material.density: ", "overflows"});
+}
+
 // Usage errors (CLI11's checks) are bad input too: one line, exit 2.
 TEST_F(CliEndToEnd, UsageErrorsExitTwo) {
   const std::string out = (dir_ / "work" / "out").string();

@@ -265,6 +265,33 @@ TEST_F(Cli3D, MismatchesAndUnsupportedCommandsAreBadInput) {
   }
 }
 
+// The sphere kernel's derived scales (test_cli.cpp has the disks'): rho =
+// 1e308 made the mass inf and the run fail with "SphereWorld: dt must be
+// finite" (exit 1) after reading the config; now exit 2 before any work.
+TEST_F(Cli3D, DerivedScalesThatOverflowOrUnderflowAreBadInput) {
+  const std::string fcc = write("fcc.json", fcc_config());
+  struct Case {
+    std::string set, field, what;
+  };
+  const Case cases[] = {
+      {"material.density=1e308", "material.density", "mass f_ms*rho*(4/3)*pi*r^3 is inf"},
+      {"algorithm.mass_scaling=1e-300", "algorithm.mass_scaling", "below the smallest normal"},
+      {"assembly.radius=1e-150", "assembly.radius", "mass f_ms*rho*(4/3)*pi*r^3 is 0"},
+  };
+  for (const Case& c : cases) {
+    for (const char* command : {"run", "check"}) {
+      SCOPED_TRACE(std::string(command) + " --set " + c.set);
+      const test::RunResult r = demcal({command, fcc, "--set", c.set});
+      EXPECT_EQ(r.status, 2) << r.err;
+      EXPECT_EQ(lines_of(r.err).size(), 1u) << r.err;
+      EXPECT_NE(r.err.find("--set " + c.set + ": " + c.field + ": "), std::string::npos) << r.err;
+      EXPECT_NE(r.err.find(c.what), std::string::npos) << r.err;
+      EXPECT_EQ(r.out, "");
+      EXPECT_TRUE(work_empty());
+    }
+  }
+}
+
 TEST_F(Cli3D, RunAcceptsASphereFile) {
   // A 2×2×2 simple-cubic block of touching spheres, written as CSV x,y,z,r.
   std::string csv = "x,y,z,r\n";

@@ -16,6 +16,7 @@
 
 #include "demcal/io/files.hpp"
 #include "demcal/scene/random_radii.hpp"
+#include "derived_scales.hpp"
 #include "overlap_check.hpp"
 
 namespace demcal {
@@ -301,6 +302,7 @@ Assembly make_assembly(const SceneConfig& config) {
     require_config_file(config, "assembly.file", s.file);
     a = read_particle_file(s.file);
   }
+  detail::check_derived_scales(config, a.r);
   check_resolvable(config, a);
   return a;
 }

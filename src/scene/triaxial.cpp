@@ -16,6 +16,7 @@
 #include "demcal/kernel/particle_scales.hpp"
 #include "demcal/scene/biaxial.hpp"
 #include "demcal/scene/consolidation_cache.hpp"
+#include "derived_scales.hpp"
 #include "protocol_steps.hpp"
 
 namespace demcal {
@@ -95,6 +96,7 @@ SphereAssembly make_sphere_assembly(const SceneConfig& config) {
   } else
     throw InputError(config.source, "assembly.type",
                      "\"" + s.type + "\" is not a 3D assembly (fcc, random or file)");
+  detail::check_derived_scales(config, a.r);
   check_sphere_overlap(config, a);
   return a;
 }

@@ -1,0 +1,166 @@
+#include "derived_scales.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "demcal/io/input_error.hpp"
+#include "demcal/kernel/particle_scales.hpp"
+#include "demcal/scene/biaxial.hpp"
+
+namespace demcal::detail {
+
+namespace {
+
+/// One input of a derived scale: its field, its value and the power it
+/// enters with (log10 of its share: power·log10(value)).
+struct Input {
+  std::string field;
+  double value;
+  double power;
+  double share() const { return power * std::log10(value); }
+};
+
+/// The assembly's field that gives the smallest (or largest) radius.
+std::string radius_field(const AssemblySpec& a, bool smallest) {
+  if (a.type == "file") return "assembly.file";
+  if (a.type != "random") return "assembly.radius";
+  if (a.distribution == "lognormal") return "assembly.radius_mean";
+  return smallest ? "assembly.radius_min" : "assembly.radius_max";
+}
+
+std::string shown(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+/// `value` of `what` (its formula) must be a finite normal number; else the
+/// InputError names the input whose share is the largest (overflow) or the
+/// smallest (underflow) and lists them all.
+void require_normal(const SceneConfig& config, const std::string& what, double value,
+                    const std::vector<Input>& given) {
+  if (std::isnormal(value)) return;
+  std::vector<Input> inputs;  // one per field, powers summed (r^2 of the mass and of I)
+  for (const Input& in : given) {
+    auto same = std::find_if(inputs.begin(), inputs.end(),
+                             [&](const Input& i) { return i.field == in.field; });
+    if (same == inputs.end())
+      inputs.push_back(in);
+    else
+      same->power += in.power;
+  }
+  const bool overflow = !(std::abs(value) < std::numeric_limits<double>::max());  // inf, nan
+  const Input* blamed = nullptr;
+  for (const Input& in : inputs) {
+    if (!(in.value > 0.0) || in.power == 0.0) continue;
+    if (!blamed || (overflow ? in.share() > blamed->share() : in.share() < blamed->share()))
+      blamed = &in;
+  }
+  std::ostringstream msg;
+  msg << what << " is " << shown(value)
+      << (overflow       ? " (it overflows)"
+          : value == 0.0 ? " (it underflows to 0)"
+                         : " (below the smallest normal double, 2.2e-308)")
+      << " with";
+  const char* sep = " ";
+  for (const Input& in : inputs) {
+    msg << sep << in.field << " = " << shown(in.value);
+    sep = ", ";
+  }
+  msg << ": every particle's mass, inertia, critical step and damping must be a finite, "
+         "normal number";
+  const std::string field = blamed ? blamed->field : inputs.front().field;
+  if (blamed) msg << "; got " << shown(blamed->value);
+  throw InputError(source_of(config, field), field, msg.str());
+}
+
+}  // namespace
+
+void check_derived_scales(const SceneConfig& config, std::span<const double> radii) {
+  if (radii.empty()) return;
+  const bool three_d = config.dimension == 3;
+  const Material& mat = config.material;
+  const AlgorithmSpec& alg = config.algorithm;
+  const double r_min = *std::min_element(radii.begin(), radii.end());
+  const double r_max = *std::max_element(radii.begin(), radii.end());
+  const char* body = three_d ? "sphere" : "disk";
+
+  // The inputs of a mass: ρ, f_ms (2D: t) and r^3 (2D: r^2).
+  auto mass_inputs = [&](double r, bool smallest) {
+    std::vector<Input> in{{"material.density", mat.density, 1.0},
+                          {"algorithm.mass_scaling", alg.mass_scaling, 1.0}};
+    if (!three_d) in.push_back({"material.thickness", mat.thickness, 1.0});
+    in.push_back({radius_field(config.assembly, smallest), r, three_d ? 3.0 : 2.0});
+    return in;
+  };
+  auto scaled = [](std::vector<Input> in, double factor) {
+    for (Input& i : in) i.power *= factor;
+    return in;
+  };
+  auto with = [](std::vector<Input> in, std::vector<Input> more) {
+    in.insert(in.end(), more.begin(), more.end());
+    return in;
+  };
+  // The masses as the kernels compute them (triaxial.cpp, biaxial.cpp).
+  auto mass_of = [&](double r) {
+    return three_d ? sphere_mass(mat.density * alg.mass_scaling, r)
+                   : disk_mass(disk_areal_density(mat, alg.mass_scaling), r);
+  };
+  auto inertia_of = [&](double m, double r) {
+    return three_d ? sphere_inertia(m, r) : disk_inertia(m, r);
+  };
+  const std::string mass_formula = three_d ? "f_ms*rho*(4/3)*pi*r^3" : "f_ms*rho*t*pi*r^2";
+  const std::string inertia_formula = three_d ? "(2/5)*m*r^2" : "m*r^2/2";
+
+  double m_min = 0.0;
+  for (const bool smallest : {true, false}) {
+    const double r = smallest ? r_min : r_max;
+    const std::string which = std::string(smallest ? "the smallest " : "the largest ") + body +
+                              "'s (r = " + shown(r) + " m) ";
+    const std::vector<Input> m_in = mass_inputs(r, smallest);
+    const double m = mass_of(r);
+    require_normal(config, which + "mass " + mass_formula, m, m_in);
+    const double inertia = inertia_of(m, r);
+    const std::vector<Input> i_in = with(m_in, {{radius_field(config.assembly, smallest), r, 2.0}});
+    require_normal(config, which + "moment of inertia " + inertia_formula, inertia, i_in);
+    require_normal(config, which + "critical damping 2*sqrt(kn*m)",
+                   critical_damping_translation(mat.particle.kn, m),
+                   with(scaled(m_in, 0.5), {{"material.kn", mat.particle.kn, 0.5}}));
+    require_normal(config, which + "critical damping against a wall 2*sqrt(kn_wall*m)",
+                   critical_damping_translation(mat.wall.kn, m),
+                   with(scaled(m_in, 0.5), {{"material.wall.kn", mat.wall.kn, 0.5}}));
+    if (mat.particle.kt > 0.0)
+      require_normal(config, which + "rotational critical damping 2*sqrt(kt*r^2*I)",
+                     critical_damping_rotation(mat.particle.kt, r, inertia),
+                     with(scaled(i_in, 0.5), {{"material.kt", mat.particle.kt, 0.5},
+                                              {radius_field(config.assembly, smallest), r, 1.0}}));
+    if (smallest) m_min = m;
+  }
+  // The steps, at the lightest particle (the smallest: one density).
+  const std::vector<Input> m_in = scaled(mass_inputs(r_min, true), 0.5);
+  const std::string lightest =
+      std::string("the critical step 2*sqrt(m_min/kn) of the smallest ") + body;
+  const double dt_crit = critical_time_step(m_min, mat.particle.kn);
+  const std::vector<Input> crit_in = with(m_in, {{"material.kn", mat.particle.kn, -0.5}});
+  require_normal(config, lightest, dt_crit, crit_in);
+  require_normal(
+      config,
+      std::string("the critical step 2*sqrt(m_min/kn_wall) of the smallest ") + body + " on a wall",
+      critical_time_step(m_min, mat.wall.kn),
+      with(m_in, {{"material.wall.kn", mat.wall.kn, -0.5}}));
+  require_normal(config, "the loading's step dt_ratio*dt_crit", alg.dt_ratio * dt_crit,
+                 with(crit_in, {{"algorithm.dt_ratio", alg.dt_ratio, 1.0}}));
+  // The consolidation's step: its own α, shrunk for contact dashpots
+  // (consolidate_fresh in biaxial.cpp and triaxial.cpp).
+  const double shrink =
+      consolidation_dashpot_factor(mat.contact_damping_ratio, config.dimension, r_min, r_max);
+  require_normal(
+      config, "the consolidation's step", AlgorithmSpec{}.dt_ratio * shrink * dt_crit,
+      with(crit_in, {{"material.contact_damping_ratio", mat.contact_damping_ratio, -1.0}}));
+}
+
+}  // namespace demcal::detail

@@ -1,0 +1,26 @@
+// The scales a run derives from the material, the algorithm and the radii,
+// checked before any computing (private to the scene: make_assembly and
+// make_sphere_assembly call it).
+#pragma once
+
+#include <span>
+
+#include "demcal/scene/config.hpp"
+
+namespace demcal::detail {
+
+/// Every scale the kernels derive from the config and the radii: the
+/// smallest and the largest particle's mass and inertia, the critical step
+/// 2·sqrt(m_min/kn) against a particle and against a wall, the loading's
+/// and the consolidation's step, the critical dashpots. Each must be a
+/// finite, normal double (not inf, not 0, not subnormal): each value passes
+/// its own range check, yet ρ = 1e308 makes the mass overflow, a radius of
+/// 1e-150 the inertia underflow, and the kernel then refuses its step
+/// ("dt must be finite") or its state turns non-finite after the first
+/// step. Else an InputError naming the config (or the --set that gave it)
+/// and the field that pushed the scale furthest in the direction it left
+/// the range (exit status 2). Computed through particle_scales.hpp, the
+/// formulas' one home.
+void check_derived_scales(const SceneConfig& config, std::span<const double> radii);
+
+}  // namespace demcal::detail
