@@ -307,6 +307,39 @@ TEST(ConfigErrors, InfiniteAndUnderflowingNumbers) {
   EXPECT_EQ(e2->field(), "material.kn");
 }
 
+// A random gas needs 3 layers along every side (check_gas_layers in
+// config.cpp): aspect 1e6 made 400 disks one row in a box of 20 000 cells
+// (2 000 000 steps, then exit 1), 1e-6 one column; 100 (200 x 2) and 0.01
+// (2 x 200) stalled too. The shipped aspect (1) and the measured 60 and
+// 0.02 stay valid.
+TEST(ConfigErrors, AGasAspectTooFlatOrTooTallToConsolidateIsRejected) {
+  for (const char* aspect : {"1e6", "1e-6", "100", "0.01"}) {
+    SCOPED_TRACE(aspect);
+    for (const char* dimension : {"2", "3"}) {
+      const std::string text = std::string(R"({"dimension": )") + dimension +
+                               R"(, "assembly": {"type": "random", "count": 400, "aspect": )" +
+                               aspect + "}}";
+      expect_rejected(text, "assembly.aspect");
+      const auto e = input_error([&] { parse(text); });
+      ASSERT_TRUE(e);
+      EXPECT_NE(e->message().find("at least 3 along every side"), std::string::npos) << e->what();
+    }
+  }
+  for (const char* aspect : {"1", "60", "0.02"})
+    EXPECT_NO_THROW(parse(
+        std::string(R"({"assembly": {"type": "random", "count": 400, "aspect": )") + aspect + "}}"))
+        << aspect;
+  for (const char* aspect : {"1", "0.05", "5"})
+    EXPECT_NO_THROW(parse(std::string(R"({"dimension": 3, "assembly": {"type": "random", )"
+                                      R"("count": 400, "aspect": )") +
+                          aspect + "}}"))
+        << aspect;
+  // Too few particles for any aspect: the count is named.
+  expect_rejected(R"({"assembly": {"type": "random", "count": 6}})", "assembly.count");
+  expect_rejected(R"({"dimension": 3, "assembly": {"type": "random", "count": 18}})",
+                  "assembly.count");
+}
+
 TEST(ConfigErrors, IntegersOutOfRange) {
   expect_rejected(R"({"algorithm": {"steps": 1e20}})", "algorithm.steps");
   expect_rejected(R"({"algorithm": {"steps": 18446744073709551615}})", "algorithm.steps");

@@ -18,6 +18,7 @@
 #include "demcal/io/files.hpp"
 #include "demcal/io/json_integer.hpp"
 #include "demcal/io/quoted_json.hpp"
+#include "demcal/scene/packing.hpp"
 
 namespace demcal {
 
@@ -240,6 +241,49 @@ void check_servo_gain(const Reader& t, const TestSpec& test) {
   }
 }
 
+// A random gas is consolidated by walls closing in on its grid (gas_grid:
+// `across` cells wide, `layers` high, 2.2·r_max apart), and keeps about as
+// many particle layers (its solid fraction, 0.65 in 2D, rises to about
+// 0.85: lengths shrink by about 0.9). A sample needs, along every side, the
+// two layers against opposite walls and at least one between them: with
+// two or fewer every particle touches a wall, the servo walls chase it and
+// it never becomes static. Measured on random_400 (budget 2e6 steps):
+// aspect 60 (155 columns x 3 rows) and 0.02 (3 x 134) consolidate, 100
+// (200 x 2) and 0.01 (2 x 200) stall; 1e6 puts the 400 disks in one row of
+// a box of 20 000 cells (3D, random_500_3d: one row of 500 in a layer 500
+// cells wide, "overlap beyond limit"). Hence across, layers >=
+// kMinGasLayers = 3. With n = count, in 2D across = ceil(sqrt(n·a)) >= 3
+// iff a > 4/n, and layers = ceil(n/across) >= 3 iff across <= c = ceil(n/2)
+// - 1, iff a <= c²/n; in 3D a > 8/n and across <= c = ceil(sqrt(n/2)) - 1,
+// a <= c³/n. No aspect works when c < 3: fewer than 7 disks, 19 spheres.
+// The check is gas_grid itself; the bounds are the message's.
+constexpr int kMinGasLayers = 3;
+
+void check_gas_layers(const Reader& a, const AssemblySpec& s, int dimension) {
+  const GasGrid grid = gas_grid(dimension, s.count, s.aspect);
+  if (std::min(grid.across, grid.layers) >= kMinGasLayers) return;
+  const bool three_d = dimension == 3;
+  const double n = s.count;
+  const double c = three_d ? std::ceil(std::sqrt(n / 2.0)) - 1.0 : std::ceil(n / 2.0) - 1.0;
+  const char* what = three_d ? "spheres" : "disks";
+  std::ostringstream msg;
+  if (c < kMinGasLayers) {
+    msg << "too few " << what << " for a random gas with " << kMinGasLayers
+        << " layers along every side (the layers against two opposite walls and one between): "
+        << "at least " << (three_d ? 19 : 7) << "; got " << s.count;
+    a.fail("count", msg.str());
+  }
+  const double lo = (three_d ? 8.0 : 4.0) / n, hi = std::pow(c, three_d ? 3 : 2) / n;
+  msg << "gives a gas of " << grid.across
+      << (three_d ? " x " + std::to_string(grid.across) + " cells across and " : " columns and ")
+      << grid.layers << (three_d ? " layers" : " rows") << " of " << s.count << " " << what
+      << ": a sample needs at least " << kMinGasLayers
+      << " along every side (the layers against two opposite walls and one between; with fewer "
+         "the servo walls never bring it to a static state), i.e. aspect above "
+      << lo << " and up to about " << hi << " for count " << s.count << "; got " << s.aspect;
+  a.fail("aspect", msg.str());
+}
+
 // The material is the physics being calibrated: a default density,
 // stiffness or friction would be a calibration of a material the user never
 // gave. thickness (2D: per metre, 1 by convention), contact_damping_ratio
@@ -394,6 +438,7 @@ SceneConfig parse_config(const nlohmann::json& root_json, const std::string& sou
         s.radius_std = a.non_negative("radius_std", s.radius_std);
       }
       s.aspect = a.positive("aspect", s.aspect);
+      check_gas_layers(a, s, c.dimension);
       s.seed = static_cast<uint64_t>(
           a.integer("seed", static_cast<int64_t>(s.seed), 0, std::numeric_limits<int64_t>::max()));
     } else {

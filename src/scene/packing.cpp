@@ -57,6 +57,19 @@ Assembly square_packing(int columns, int rows, double radius) {
   return a;
 }
 
+GasGrid gas_grid(int dimension, int count, double aspect) {
+  const double n = static_cast<double>(std::max(1, count));
+  // Capped at count before the cast (aspect 1e300 would overflow an int).
+  const double across =
+      std::min(std::ceil(dimension == 3 ? std::cbrt(n * aspect) : std::sqrt(n * aspect)), n);
+  GasGrid g;
+  g.across = std::max(1, static_cast<int>(across));
+  const int64_t per_layer =
+      dimension == 3 ? int64_t{g.across} * g.across : static_cast<int64_t>(g.across);
+  g.layers = static_cast<int>((std::max(1, count) + per_layer - 1) / per_layer);
+  return g;
+}
+
 Assembly random_gas(const AssemblySpec& spec) {
   std::mt19937_64 rng(spec.seed);
   Assembly a;
@@ -65,8 +78,8 @@ Assembly random_gas(const AssemblySpec& spec) {
   a.r = random_radii::sample(spec, rng);
   const double r_max = *std::max_element(a.r.begin(), a.r.end());
   const double spacing = 2.2 * r_max;
-  const int columns = std::max(1, static_cast<int>(std::ceil(std::sqrt(n * spec.aspect))));
-  const int rows = (n + columns - 1) / columns;
+  const GasGrid grid = gas_grid(2, n, spec.aspect);
+  const int columns = grid.across, rows = grid.layers;
   a.x.resize(n);
   a.y.resize(n);
   for (int i = 0; i < n; ++i) {

@@ -58,9 +58,8 @@ SphereAssembly sphere_gas(std::vector<double> radii, double aspect, std::mt19937
   a.r = std::move(radii);
   const double r_max = *std::max_element(a.r.begin(), a.r.end());
   const double spacing = 2.2 * r_max;
-  const int across =
-      std::max(1, static_cast<int>(std::ceil(std::cbrt(static_cast<double>(n) * aspect))));
-  const int layers = (n + across * across - 1) / (across * across);
+  const GasGrid grid = gas_grid(3, n, aspect);
+  const int across = grid.across, layers = grid.layers;
   a.x.resize(n);
   a.y.resize(n);
   a.z.resize(n);

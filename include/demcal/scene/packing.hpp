@@ -32,9 +32,21 @@ struct Assembly {
 Assembly hexagonal_packing(int columns, int rows, double radius, double contact_strain = 0.0);
 /// Square lattice, walls touching.
 Assembly square_packing(int columns, int rows, double radius);
+/// The grid a random gas of `count` particles is placed on, one particle a
+/// cell (aspect = width/height): 2D `across` = ceil(sqrt(count·aspect))
+/// columns, `layers` = ceil(count/across) rows; 3D `across` =
+/// ceil(cbrt(count·aspect)) cells along x and along y, `layers` =
+/// ceil(count/across²) along z. `across` is at most `count` (a wider grid
+/// leaves cells empty whatever the aspect). The one home of the grid:
+/// random_gas, sphere_gas and the config's check of assembly.aspect.
+struct GasGrid {
+  int across = 1;
+  int layers = 1;
+};
+GasGrid gas_grid(int dimension, int count, double aspect);
 /// A loose random gas of polydisperse disks (no overlaps) on a jittered
-/// grid; consolidation makes it dense (frictionless compression, then
-/// friction on). Deterministic for a seed on every platform.
+/// grid (gas_grid); consolidation makes it dense (frictionless compression,
+/// then friction on). Deterministic for a seed on every platform.
 Assembly random_gas(const AssemblySpec& spec);
 /// The comment line that gives a particle file's walls:
 /// "# walls left right bottom top: L R B T" (written by particle_csv).
