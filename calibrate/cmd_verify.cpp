@@ -310,8 +310,8 @@ int verify_3d(const VerifyOptions& o, const nlohmann::json& params, const RevPar
     throw InputError("--max-minutes", "",
                      "the loading of " + std::to_string(n) + " spheres over " +
                          std::to_string(up.steps) + " steps is estimated at " +
-                         std::to_string(estimate_s / 60.0) + " min, beyond the budget of " +
-                         std::to_string(o.max_minutes) + " min; raise --max-minutes to run it");
+                         num(estimate_s / 60.0) + " min, beyond the budget of " +
+                         num(o.max_minutes) + " min; raise --max-minutes to run it");
   const std::string dir = o.out_dir.empty() ? "demcal-verify-" + config.name : o.out_dir;
   OutputFolder::check(dir);
 
@@ -448,8 +448,8 @@ int cmd_verify(const VerifyOptions& o) {
     throw InputError("--max-minutes", "",
                      "the loading of " + std::to_string(n) + " particles over " +
                          std::to_string(run_steps) + (in_lammps ? " LAMMPS" : "") +
-                         " steps is estimated at " + std::to_string(estimate_s / 60.0) +
-                         " min, beyond the budget of " + std::to_string(o.max_minutes) +
+                         " steps is estimated at " + num(estimate_s / 60.0) +
+                         " min, beyond the budget of " + num(o.max_minutes) +
                          " min; raise --max-minutes to run it");
   std::cerr << "demcal verify: prototype " << source.description << "; ";
   if (n == rev.particles)

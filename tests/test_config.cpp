@@ -340,6 +340,17 @@ TEST(ConfigErrors, AGasAspectTooFlatOrTooTallToConsolidateIsRejected) {
                   "assembly.count");
 }
 
+// The values in a message read as given: kn = 1e-300 printed with %f was
+// "must not exceed kn (0.000000) ... got 50000000.000000".
+TEST(ConfigErrors, TheTangentialStiffnessMessageShowsSmallAndLargeValues) {
+  const auto e = input_error([] { parse(R"({"material": {"kn": 1e-300, "kt": 5e7}})"); });
+  ASSERT_TRUE(e);
+  EXPECT_EQ(e->field(), "material.kt");
+  EXPECT_NE(e->message().find("must not exceed kn (1e-300)"), std::string::npos) << e->what();
+  EXPECT_NE(e->message().find("got 5e+07"), std::string::npos) << e->what();
+  EXPECT_EQ(e->message().find("000000"), std::string::npos) << e->what();
+}
+
 TEST(ConfigErrors, IntegersOutOfRange) {
   expect_rejected(R"({"algorithm": {"steps": 1e20}})", "algorithm.steps");
   expect_rejected(R"({"algorithm": {"steps": 18446744073709551615}})", "algorithm.steps");

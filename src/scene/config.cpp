@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "demcal/io/files.hpp"
+#include "demcal/io/format.hpp"
 #include "demcal/io/json_integer.hpp"
 #include "demcal/io/quoted_json.hpp"
 #include "demcal/scene/packing.hpp"
@@ -191,11 +192,11 @@ void check_scene_name(const Reader& root, const std::string& name) {
 // hex_5x5; kt = kn runs). Walls do not rotate: their kt is not bound.
 void check_tangential_stiffness(const Reader& m, const ContactLaw& particle) {
   if (particle.kt > particle.kn)
-    m.fail("kt", "must not exceed kn (" + std::to_string(particle.kn) +
+    m.fail("kt", "must not exceed kn (" + num(particle.kn, 6) +
                      "): kt/kn = 2(1-nu)/(2-nu) "
                      "<= 1 for an elastic contact, and beyond it the tangential-rotational mode "
                      "outruns the normal step dt_ratio refers to; got " +
-                     std::to_string(particle.kt));
+                     num(particle.kt, 6));
 }
 
 // Overlap at sigma3: a disk of radius r carries about sigma3*2r*t per

@@ -15,6 +15,7 @@
 #include <sstream>
 
 #include "demcal/io/files.hpp"
+#include "demcal/io/format.hpp"
 #include "demcal/scene/random_radii.hpp"
 #include "derived_scales.hpp"
 #include "overlap_check.hpp"
@@ -261,8 +262,8 @@ Assembly read_particles(std::istream& in, const std::string& path) {
       throw InputError(path, "line " + std::to_string(walls_line),
                        "walls press into the particles by more than 5 % of the smallest radius "
                        "(their extent is [" +
-                           std::to_string(a.left) + ", " + std::to_string(a.right) + "] x [" +
-                           std::to_string(a.bottom) + ", " + std::to_string(a.top) + "])");
+                           num(a.left, 6) + ", " + num(a.right, 6) + "] x [" + num(a.bottom, 6) +
+                           ", " + num(a.top, 6) + "])");
     a.left = l;
     a.right = r;
     a.bottom = b;
