@@ -31,7 +31,8 @@ std::string strategy_names() {
 
 void add_calibrate_options(CLI::App* calibrate, CalibrateOptions& cal) {
   add_scene_options(calibrate, cal.config, cal.sets);
-  calibrate->add_option("-o,--output", cal.out_dir, "output folder (default demcal-NAME)");
+  calibrate->add_option("-o,--output", cal.out_dir, "output folder (default demcal-NAME)")
+      ->check(non_empty_path());
   calibrate->add_option("-j,--jobs", cal.jobs, "trials in parallel (default: cores)")
       ->check(whole_number(1, kMaxJobs));
   calibrate
@@ -54,8 +55,9 @@ void add_calibrate_options(CLI::App* calibrate, CalibrateOptions& cal) {
 
 void add_stability_options(CLI::App* stability, StabilityOptions& stab) {
   add_scene_options(stability, stab.config, stab.sets);
-  stability->add_option("-o,--output", stab.out_dir,
-                        "output folder (default demcal-stability-NAME)");
+  stability
+      ->add_option("-o,--output", stab.out_dir, "output folder (default demcal-stability-NAME)")
+      ->check(non_empty_path());
   add_progress_option(stability, stab.progress_every_s);
   stability->add_option("-j,--jobs", stab.scan.jobs, "trials in parallel (default: cores)")
       ->check(whole_number(1, kMaxJobs));
@@ -93,7 +95,8 @@ void add_score_options(CLI::App* score, ScoreOptions& options) {
                    "a reference peak |sigma_yy| (3D: |sigma_zz|) in Pa to report the peak error "
                    "against (default: the file's '# reference_peak = ' line, if any)")
       ->check(real_above(kReferencePeak.lo, kReferencePeak.hi));
-  score->add_option("-o,--output", options.out_dir, "output folder (default demcal-score-STEM)");
+  score->add_option("-o,--output", options.out_dir, "output folder (default demcal-score-STEM)")
+      ->check(non_empty_path());
 }
 
 }  // namespace
@@ -106,7 +109,8 @@ std::function<int()> add_trial_commands(CLI::App& app) {
 
   auto* run = app.add_subcommand("run", "run one trial and print its criteria");
   add_scene_options(run, one->config, one->sets);
-  run->add_option("-o,--output", one->out_dir, "output folder (default demcal-run-NAME)");
+  run->add_option("-o,--output", one->out_dir, "output folder (default demcal-run-NAME)")
+      ->check(non_empty_path());
   run->add_flag("--allow-unstable", one->allow_unstable,
                 "run a dt_ratio beyond the estimated stable step (to watch it diverge)");
   add_progress_option(run, one->progress_every_s);
@@ -115,7 +119,8 @@ std::function<int()> add_trial_commands(CLI::App& app) {
   auto* sweep =
       app.add_subcommand("sweep", "the signature atlas: one parameter out of bounds at a time");
   add_scene_options(sweep, sw->config, sw->sets);
-  sweep->add_option("-o,--output", sw->out_dir, "output folder (default demcal-sweep-NAME)");
+  sweep->add_option("-o,--output", sw->out_dir, "output folder (default demcal-sweep-NAME)")
+      ->check(non_empty_path());
   add_progress_option(sweep, sw->progress_every_s);
   sweep->add_option("-j,--jobs", sw->jobs, "trials in parallel (default: cores)")
       ->check(whole_number(1, kMaxJobs));

@@ -55,7 +55,8 @@ std::function<int()> add_upscaling_commands(CLI::App& app) {
                    "the prototype's particle file (CSV x,y,r; 3D: x,y,z,r); not with --particles")
       ->excludes(up_particles);
   add_params_options(upscale, *up);
-  upscale->add_option("-o,--output", up->output, "write params.json here (default stdout)");
+  upscale->add_option("-o,--output", up->output, "write params.json here (default stdout)")
+      ->check(non_empty_path());
 
   auto ve = std::make_shared<VerifyOptions>();
   auto* verify =
@@ -63,7 +64,8 @@ std::function<int()> add_upscaling_commands(CLI::App& app) {
   verify->add_option("params", ve->params, "params.json of a calibration")->required();
   add_prototype_options(verify, *ve);
   add_params_options(verify, *ve);
-  verify->add_option("-o,--output", ve->out_dir, "output folder (default demcal-verify-NAME)");
+  verify->add_option("-o,--output", ve->out_dir, "output folder (default demcal-verify-NAME)")
+      ->check(non_empty_path());
   verify
       ->add_option("--max-minutes", ve->max_minutes,
                    "refuse a loading run estimated longer than this (default 8)")
@@ -96,7 +98,8 @@ std::function<int()> add_upscaling_commands(CLI::App& app) {
                    "calibrate sizes up to this count; larger ones are checked forward only "
                    "(default 400)")
       ->check(whole_number(1, kMaxParticles));
-  scaling->add_option("-o,--output", sc->out_dir, "report folder (default demcal-scaling-NAME)");
+  scaling->add_option("-o,--output", sc->out_dir, "report folder (default demcal-scaling-NAME)")
+      ->check(non_empty_path());
   scaling->add_option("--work", sc->work_dir, "per-size work folder (default: the -o folder)");
   scaling->add_option("-j,--jobs", sc->jobs, "trials in parallel (default: cores)")
       ->check(whole_number(1, kMaxJobs));
@@ -113,7 +116,8 @@ std::function<int()> add_upscaling_commands(CLI::App& app) {
   exp->add_option("params", ex->params, "params.json of a calibration")->required();
   // Values are checked by the command (exit 2, one message), not by CLI11.
   exp->add_option("--format", ex->format, "lammps (default) or liggghts");
-  exp->add_option("-o,--output", ex->output, "the deck (default demcal-NAME.FORMAT)");
+  exp->add_option("-o,--output", ex->output, "the deck (default demcal-NAME.FORMAT)")
+      ->check(non_empty_path());
   add_prototype_options(exp, *ex);
   add_params_options(exp, *ex);
   exp->add_flag("--no-consolidate", ex->no_consolidate,
@@ -132,7 +136,8 @@ std::function<int()> add_upscaling_commands(CLI::App& app) {
   rev->add_option("--particles", rv->particles, "particles in the REV (default 400)")
       ->check(whole_number(1, kMaxParticles));
   rev->add_option("--method", rv->method, "cut (a window of the prototype) or generate");
-  rev->add_option("-o,--output", rv->out_dir, "output folder (default demcal-rev-NAME)");
+  rev->add_option("-o,--output", rv->out_dir, "output folder (default demcal-rev-NAME)")
+      ->check(non_empty_path());
   add_progress_option(rev, rv->progress_every_s);
 
   // A failed calibration's params.json is refused before anything else is

@@ -474,7 +474,9 @@ int cmd_verify(const VerifyOptions& o) {
               << estimate_s / 60.0 << " min at " << kAssumedSpeed
               << " particle-steps/s (plus the consolidation)\n";
   const std::string dir = o.out_dir.empty() ? "demcal-verify-" + config.name : o.out_dir;
-  make_output_dir(dir);
+  // An unusable -o fails now, and nothing is made before the consolidation
+  // (a failed one leaves no empty folder); made where prototype.csv goes.
+  OutputFolder::check(dir);
 
   const auto t0 = std::chrono::steady_clock::now();
   // "consolidating ..." only before a consolidation, not before a read
@@ -497,6 +499,7 @@ int cmd_verify(const VerifyOptions& o) {
   std::cerr << "\n";
   // The prototype's state, reusable by `demcal export --prototype` and by
   // later runs (read_particle_file reads it back).
+  make_output_dir(dir);
   write_file_atomic(dir + "/prototype.csv", particle_csv(assembly_of(state.world)));
   if (o.consolidate_only) {
     std::cout << "consolidated prototype of " << n << " particles: " << state.steps << " steps, ";

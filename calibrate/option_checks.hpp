@@ -62,6 +62,17 @@ inline CLI::Validator real_between(double lo, double hi) {
                      [=](double v) { return v > lo && v < hi; });
 }
 
+/// -o of every command: a path, not empty. `-o ''` (an unset variable in a
+/// script) would otherwise mean the default, writing where the user did not
+/// ask; leaving -o out is how to ask for the default.
+inline CLI::Validator non_empty_path() {
+  return CLI::Validator(
+      [](std::string& s) -> std::string {
+        return s.empty() ? "must not be empty (leave the option out for the default)" : "";
+      },
+      "PATH");
+}
+
 /// --jobs: at least one; more threads than this is a typo, not a machine.
 inline constexpr int64_t kMaxJobs = 1024;
 /// --max-trials: a search of more trials than this is a typo (a REV trial

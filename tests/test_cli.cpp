@@ -344,6 +344,13 @@ TEST_F(CliEndToEnd, UnwritableOutputExitsTwoBeforeRunning) {
   EXPECT_FALSE(fs::exists("/proc/demcal-forbidden"));
 }
 
+// `-o ''` (an unset variable in a script) is bad input, not the default
+// folder: it ran and wrote demcal-run-NAME in the working directory.
+TEST_F(CliEndToEnd, AnEmptyOutputIsBadInput) {
+  for (const char* command : {"run", "calibrate", "stability", "sweep", "rev"})
+    expect_bad_input({command, kHex5, "-o", ""}, {"--output", "must not be empty"});
+}
+
 // --- check ----------------------------------------------------------------
 
 double number_after(const std::string& text, const std::string& label) {
