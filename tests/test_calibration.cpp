@@ -418,5 +418,7 @@ TEST(Calibration, StaysWithinAStableStepBelowDtRatioMin) {
     EXPECT_LE(t.params.dt_ratio, stable) << "trial " << t.id;
     EXPECT_FALSE(t.score.diverged) << "trial " << t.id;
   }
-  if (s.has_best()) EXPECT_LE(s.best.dt_ratio, stable);
+  if (s.has_best()) {
+    EXPECT_LE(s.best.dt_ratio, stable);
+  }
 }
