@@ -193,6 +193,21 @@ TEST_F(CliEndToEnd, DerivedScalesThatOverflowOrUnderflowAreBadInput) {
   expect_bad_input({"run", dense, "-o", out}, {dense + ": material.density: ", "overflows"});
 }
 
+// A wall stiffer than kn/α² (α = 0.2, the consolidation's step) cannot be
+// integrated: a particle it holds alone oscillates past ω·Δt = 2, so the
+// consolidation diverged ("overlap beyond limit", exit 1) within a few
+// hundred steps. A user's "rigid" wall is bad input, named before any
+// computing, in 2D and 3D.
+TEST_F(CliEndToEnd, AWallTooStiffForTheConsolidationStepIsBadInput) {
+  const std::string out = (dir_ / "work" / "out").string();
+  for (const std::string& config : {kHex5, test::shipped_config("fcc_4x4x4")}) {
+    SCOPED_TRACE(config);
+    expect_bad_input({"run", config, "--set", "material.wall.kn=3e9", "-o", out},
+                     {"--set material.wall.kn=3e9: material.wall.kn: 30 times kn",
+                      "below kn/alpha^2 = 2.5e+09"});
+  }
+}
+
 // Usage errors (CLI11's checks) are bad input too: one line, exit 2.
 TEST_F(CliEndToEnd, UsageErrorsExitTwo) {
   const std::string out = (dir_ / "work" / "out").string();

@@ -10,6 +10,7 @@
 #include "demcal/io/input_error.hpp"
 #include "demcal/kernel/particle_scales.hpp"
 #include "demcal/scene/biaxial.hpp"
+#include "protocol_steps.hpp"
 
 namespace demcal::detail {
 
@@ -158,9 +159,37 @@ void check_derived_scales(const SceneConfig& config, std::span<const double> rad
   // (consolidate_fresh in biaxial.cpp and triaxial.cpp).
   const double shrink =
       consolidation_dashpot_factor(mat.contact_damping_ratio, config.dimension, r_min, r_max);
+  const double alpha_c =
+      consolidation_settings(config, kConsolidationDampingRatio).dt_ratio * shrink;
   require_normal(
-      config, "the consolidation's step", AlgorithmSpec{}.dt_ratio * shrink * dt_crit,
+      config, "the consolidation's step", alpha_c * dt_crit,
       with(crit_in, {{"material.contact_damping_ratio", mat.contact_damping_ratio, -1.0}}));
+  // A particle held by a wall oscillates at least at sqrt(kn_wall/m), and
+  // the step is stable only while ω·Δt < 2: the global damping, semi-
+  // implicit, keeps the undamped bound (its amplification at ω·Δt = 2 is −1
+  // whatever the damping). So a wall stiffer than kn/α² makes every step of
+  // the consolidation, at α·2·sqrt(m/kn), grow the motion of the particles
+  // on the walls: "consolidation diverged: overlap beyond limit" within a
+  // few hundred steps (hex_5x5 and fcc_4x4x4 at wall.kn = 30·kn). A user's
+  // "rigid" wall is the usual cause. The loading's step is checked against
+  // the consolidated network, walls included, with --allow-unstable for
+  // whoever wants to watch it diverge (stable_dt_ratio_of).
+  const double wall_limit = mat.particle.kn / (alpha_c * alpha_c);
+  if (!(mat.wall.kn < wall_limit)) {
+    std::ostringstream msg;
+    msg << shown(mat.wall.kn / mat.particle.kn)
+        << " times kn: a particle on a wall is stable only at steps below 2*sqrt(m/kn_wall) = "
+        << shown(std::sqrt(mat.particle.kn / mat.wall.kn))
+        << " of the critical step 2*sqrt(m/kn), less still with its contacts with other "
+           "particles, and the consolidation steps at "
+        << shown(alpha_c)
+        << " of it (alpha 0.2, shrunk for the contact dashpots): its walls would diverge. A wall "
+           "as stiff as the particles keeps its overlaps as small as theirs; material.wall.kn must "
+           "stay below kn/alpha^2 = "
+        << shown(wall_limit) << ", and well below (hex_5x5 stalls at 20 kn); got "
+        << shown(mat.wall.kn);
+    throw InputError(source_of(config, "material.wall.kn"), "material.wall.kn", msg.str());
+  }
 }
 
 }  // namespace demcal::detail
