@@ -29,15 +29,16 @@ inline void check_rev_count(int64_t count, int n, const std::string& noun) {
 /// inside the window (centre i is inside at s exactly when critical(i) <=
 /// s). The window's edge passes through the middle of a gap between
 /// consecutive critical scales, and only through a gap at least a tenth of
-/// their mean spacing about `count`: a gap narrower than that splits a
-/// layer. A consolidated lattice keeps its layers to within about one
-/// overlap (5e-7 r for the shipped FCC at σ3), far below the spacing, but
-/// rounding orders the centres of a layer, and cutting through one leaves
-/// a part-layer whose spheres the walls squeeze into the gaps beside them:
-/// `demcal rev configs/fcc_4x4x4.json --particles 300` never reached a
-/// static state that way. In a random packing nearly every gap is wider
-/// than a tenth of the mean, so the count stays the nearest one. Of two
-/// counts as near, the larger; never fewer than two.
+/// their mean spacing about `count` (or over the whole prototype, if
+/// wider): a gap narrower than that splits a layer. A consolidated lattice
+/// keeps its layers to within about one overlap (5e-7 r for the shipped FCC
+/// at σ3), far below the spacing, but rounding orders the centres of a
+/// layer, and cutting through one leaves a part-layer whose spheres the
+/// walls squeeze into the gaps beside them: `demcal rev
+/// configs/fcc_4x4x4.json --particles 300` never reached a static state
+/// that way. In a random packing nearly every gap is wider than a tenth of
+/// the mean, so the count stays the nearest one. Of two counts as near, the
+/// larger; never fewer than two.
 template <class Critical>
 double window_scale(int n, int64_t count, const Critical& critical) {
   std::vector<double> t(static_cast<size_t>(n));
@@ -47,8 +48,12 @@ double window_scale(int n, int64_t count, const Critical& critical) {
   // gap (t[k-1], t[k]); past the last centre every window holds them all.
   const auto k_of = [&](int64_t k) { return static_cast<size_t>(std::clamp<int64_t>(k, 1, n)); };
   const size_t lo = k_of(count / 2), hi = k_of(2 * count);
-  const double spacing = hi > lo ? (t[hi - 1] - t[lo - 1]) / static_cast<double>(hi - lo) : 0.0;
-  const double narrowest = 0.1 * spacing;
+  const double local = hi > lo ? (t[hi - 1] - t[lo - 1]) / static_cast<double>(hi - lo) : 0.0;
+  // Where count/2 to 2·count lie within one layer (a small count in a
+  // lattice: 10 of the shells 4, 32, 108), the local spacing is the
+  // rounding's own: the prototype's mean spacing keeps it a layer.
+  const double mean = n > 1 ? (t[static_cast<size_t>(n) - 1] - t[0]) / (n - 1) : 0.0;
+  const double narrowest = 0.1 * std::max(local, mean);
   auto edge_after = [&](size_t k) {  // the edge holding the k smallest
     return k == static_cast<size_t>(n) ? t[k - 1] : 0.5 * (t[k - 1] + t[k]);
   };
