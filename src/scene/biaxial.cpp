@@ -156,6 +156,10 @@ double consolidation_dashpot_factor(double zeta_c, int dimension, double r_min, 
       zeta_c * std::sqrt(consolidation_dashpot_coordination(dimension, r_max / r_min)));
 }
 
+double consolidation_alpha(double zeta_c, int dimension, double r_min, double r_max) {
+  return AlgorithmSpec{}.dt_ratio * consolidation_dashpot_factor(zeta_c, dimension, r_min, r_max);
+}
+
 double servo_velocity(const World& world, WallSide side, double target_stress, double gain) {
   const bool vertical = side == kLeft || side == kRight;
   const double length = vertical ? world.height() : world.width();
@@ -226,11 +230,10 @@ ConsolidatedState consolidate_fresh(const SceneConfig& config, const Assembly& a
   // to 12 600 steps and a 500-disk lognormal REV from 1 536 200 to 61 200;
   // a 400-disk REV with radius ratio 3 did not converge in 2·10⁶ steps at
   // ζ = 1 and needs 60 600 at 0.02; hexagonal REVs need 1 400 at most.
-  AlgorithmSpec settle = detail::consolidation_settings(config, kConsolidationDampingRatio);
   // Contact dashpots lower the stable step: α·f(ζ_c·sqrt(Λ)) is stable
-  // wherever α is without them (consolidation_dashpot_factor).
-  settle.dt_ratio *= consolidation_dashpot_factor(config.material.contact_damping_ratio, 2,
-                                                  world.min_radius(), world.max_radius());
+  // wherever α is without them (consolidation_alpha).
+  const AlgorithmSpec settle = detail::consolidation_settings(
+      config, kConsolidationDampingRatio, world.min_radius(), world.max_radius());
   const detail::ConsolidationOutcome o =
       detail::run_consolidation<WallSide, 4>(world, test, mu, settle, integration_for, options);
   for (int i = 0; i < world.size(); ++i) world.set_velocity(i, 0.0, 0.0, 0.0);

@@ -10,7 +10,6 @@
 #include "demcal/io/input_error.hpp"
 #include "demcal/kernel/particle_scales.hpp"
 #include "demcal/scene/biaxial.hpp"
-#include "protocol_steps.hpp"
 
 namespace demcal::detail {
 
@@ -156,11 +155,9 @@ void check_derived_scales(const SceneConfig& config, std::span<const double> rad
   require_normal(config, "the loading's step dt_ratio*dt_crit", alg.dt_ratio * dt_crit,
                  with(crit_in, {{"algorithm.dt_ratio", alg.dt_ratio, 1.0}}));
   // The consolidation's step: its own α, shrunk for contact dashpots
-  // (consolidate_fresh in biaxial.cpp and triaxial.cpp).
-  const double shrink =
-      consolidation_dashpot_factor(mat.contact_damping_ratio, config.dimension, r_min, r_max);
+  // (consolidation_alpha, which the consolidation runs with).
   const double alpha_c =
-      consolidation_settings(config, kConsolidationDampingRatio).dt_ratio * shrink;
+      consolidation_alpha(mat.contact_damping_ratio, config.dimension, r_min, r_max);
   require_normal(
       config, "the consolidation's step", alpha_c * dt_crit,
       with(crit_in, {{"material.contact_damping_ratio", mat.contact_damping_ratio, -1.0}}));

@@ -40,11 +40,16 @@
 
 namespace demcal::detail {
 
-/// The step and damping consolidation settles with: α = 0.2 (the paper's
-/// start step), light damping kConsolidationDampingRatio on translation and
-/// rotation (biaxial.cpp says why), the config's rotation lock.
-inline AlgorithmSpec consolidation_settings(const SceneConfig& config, double damping_ratio) {
+/// The step and damping consolidation settles with: α = consolidation_alpha
+/// (0.2, the paper's start step, shrunk where contact dashpots lower the
+/// stable step) for particles with radii in [r_min, r_max], light damping
+/// kConsolidationDampingRatio on translation and rotation (biaxial.cpp says
+/// why), the config's rotation lock.
+inline AlgorithmSpec consolidation_settings(const SceneConfig& config, double damping_ratio,
+                                            double r_min, double r_max) {
   AlgorithmSpec settle;
+  settle.dt_ratio =
+      consolidation_alpha(config.material.contact_damping_ratio, config.dimension, r_min, r_max);
   settle.damping_ratio_translation = damping_ratio;
   settle.damping_ratio_rotation = damping_ratio;
   settle.lock_rotation = config.algorithm.lock_rotation;

@@ -149,10 +149,9 @@ TriaxialState consolidate_fresh(const SceneConfig& config, const SphereAssembly&
   const double mu = config.material.particle.friction;
   // Light damping for the fastest relaxation of the slow collective modes
   // (biaxial.cpp, consolidate(): measured there).
-  AlgorithmSpec settle = detail::consolidation_settings(config, kConsolidationDampingRatio);
-  // Contact dashpots lower the stable step: α shrunk as in 2D (biaxial.cpp).
-  settle.dt_ratio *= consolidation_dashpot_factor(config.material.contact_damping_ratio, 3,
-                                                  world.min_radius(), world.max_radius());
+  // Contact dashpots lower the stable step: α shrunk as in 2D (consolidation_alpha).
+  const AlgorithmSpec settle = detail::consolidation_settings(
+      config, kConsolidationDampingRatio, world.min_radius(), world.max_radius());
   const detail::ConsolidationOutcome o = detail::run_consolidation<SphereWallSide, 6>(
       world, test, mu, settle, integration_for, options);
   for (int i = 0; i < world.size(); ++i)

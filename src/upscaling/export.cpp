@@ -626,9 +626,7 @@ struct ConsolidationSteps {
 ConsolidationSteps consolidation_steps(const SceneConfig& c, const Plan& plan) {
   const auto& m = c.material;
   ConsolidationSteps st;
-  st.alpha = AlgorithmSpec{}.dt_ratio;
-  if (m.contact_damping_ratio > 0.0)
-    st.alpha *= consolidation_dashpot_factor(m.contact_damping_ratio, 2, plan.r_min, plan.r_max);
+  st.alpha = consolidation_alpha(m.contact_damping_ratio, 2, plan.r_min, plan.r_max);
   st.dt_light = deck::consolidation_dt(st.alpha, kConsolidationDampingRatio, plan.dt_crit);
   st.dt_damped = deck::consolidation_dt(st.alpha, 1.0, plan.dt_crit);
   // the wall dashpots' c (servo_wall_dashpot: demcal's formula)

@@ -372,14 +372,11 @@ std::vector<deck::ConsolidationWall> consolidation_walls() {
 /// damping, the criterion, the runs and the start walls of the loading.
 void lammps_3d_consolidation(std::ostream& s, const SceneConfig& c, const Plan3& plan) {
   const double zeta = kConsolidationDampingRatio;
-  // demcal's consolidation step: alpha of AlgorithmSpec{} (0.2), the
-  // sphere kernel's dt_crit; times the explicit damper's factor.
-  // alpha shrunk for the contact dashpots as demcal's consolidation
-  // (consolidation_dashpot_factor, scene/triaxial.cpp)
+  // demcal's consolidation step: consolidation_alpha (0.2, shrunk for the
+  // contact dashpots) times the sphere kernel's dt_crit, times the explicit
+  // damper's factor.
   const auto& m = c.material;
-  const double alpha =
-      AlgorithmSpec{}.dt_ratio *
-      consolidation_dashpot_factor(m.contact_damping_ratio, 3, plan.r_min, plan.r_max);
+  const double alpha = consolidation_alpha(m.contact_damping_ratio, 3, plan.r_min, plan.r_max);
   const double dt_light = deck::consolidation_dt(alpha, zeta, plan.dt_crit);
   const double dt_damped = deck::consolidation_dt(alpha, 1.0, plan.dt_crit);
   std::vector<double> light, critical;

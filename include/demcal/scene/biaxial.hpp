@@ -116,6 +116,11 @@ double consolidation_dashpot_coordination(int dimension, double radius_ratio);
 /// wherever the undamped α is (biaxial.cpp says why); 1 without contact
 /// damping (ζ_c ≤ 0).
 double consolidation_dashpot_factor(double zeta_c, int dimension, double r_min, double r_max);
+/// The consolidation's step ratio α, its one home (demcal's consolidation in
+/// 2D and 3D, the config checks and the exported decks): the undamped
+/// consolidation's AlgorithmSpec{}.dt_ratio (0.2, the paper's start step)
+/// times consolidation_dashpot_factor(zeta_c, dimension, r_min, r_max).
+double consolidation_alpha(double zeta_c, int dimension, double r_min, double r_max);
 /// The consolidation's step shrink: its α (`dt_ratio`, the undamped
 /// consolidation's AlgorithmSpec{}.dt_ratio shrunk by
 /// consolidation_dashpot_factor where contact dashpots lower the stable
