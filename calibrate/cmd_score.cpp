@@ -4,6 +4,7 @@
 // documented CSV) or by `demcal run` (its metadata carry what the run was
 // scored with), as `demcal run` prints them for its own runs;
 // DIR/summary.json.
+#include <cstdlib>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
@@ -11,6 +12,7 @@
 
 #include "commands.hpp"
 #include "demcal/io/files.hpp"
+#include "demcal/io/format.hpp"
 #include "demcal/scoring/external_series.hpp"
 #include "output_folder.hpp"
 #include "print_criteria.hpp"
@@ -24,6 +26,14 @@ int cmd_score(const ScoreOptions& o) {
   std::optional<double> s3;
   if (o.lateral_stress > 0.0) s3 = o.lateral_stress;
   const ExternalSeries series = parse_external_series(text, o.file, s3);
+  // The command line wins over the file, but a sigma3 other than the one
+  // the run was loaded at scores another test: say so.
+  if (const auto file_s3 = series.meta.find("lateral_stress");
+      s3 && file_s3 != series.meta.end() && std::strtod(file_s3->second.c_str(), nullptr) != *s3)
+    std::cerr << "demcal score: warning: --lateral-stress " << num(*s3, 10) << " replaces the "
+              << file_s3->second << " Pa of " << o.file
+              << "'s # lateral_stress line: the criteria are scored against " << num(*s3, 10)
+              << " Pa\n";
   const std::string dir =
       o.out_dir.empty() ? "demcal-score-" + fs::path(o.file).stem().string() : o.out_dir;
   OutputFolder::check(dir);

@@ -337,6 +337,26 @@ TEST(ExternalSeries, MetadataValuesAreCheckedWithTheirLineAndKey) {
             "no error");
 }
 
+// A one-word key without the spaces around '=' ("#lateral_stress=1e5", as a
+// hand-written print in an engine's script gives it) is metadata, checked as
+// the spaced form; a line of several words is metadata only with " = ".
+TEST(ExternalSeries, AOneWordKeyWithoutSpacesIsMetadata) {
+  const ExternalSeries s =
+      parse_external_series("#lateral_stress=1e5\n#  steps= 20\n" + kTable, "x.csv");
+  EXPECT_EQ(s.lateral_stress, 1e5);
+  EXPECT_EQ(s.run.steps_planned, 20);
+  EXPECT_NE(
+      series_error("#lateral_stress=1e5\n#dt=-1\n" + kTable).find("x.csv: line 2: # dt: must be"),
+      std::string::npos);
+  EXPECT_NE(series_error("# lateral_stress = 1e5\n#lateral_stress=2e5\n" + kTable)
+                .find("x.csv: line 2: # lateral_stress: given twice (first on line 1)"),
+            std::string::npos);
+  // Prose with an '=' stays a comment, before the header as after the rows.
+  EXPECT_EQ(series_error("# lateral_stress = 1e5\n# see x=1 in the script\n" + kTable +
+                         "# restarted with run_steps=2000\n"),
+            "no error");
+}
+
 TEST(ScoreCli, ScoresAFileAndRejectsBadInputWithStatus2) {
   const test::TempDir dir("score_cli");
   const SceneConfig c = hex5();
@@ -361,6 +381,30 @@ TEST(ScoreCli, ScoresAFileAndRejectsBadInputWithStatus2) {
   EXPECT_EQ(missing, 2);
   EXPECT_EQ(no_s3, 2);  // series_csv() without metadata has no "# lateral_stress"
   EXPECT_FALSE(partial);
+}
+
+// --lateral-stress wins over the file's line, with a warning when the two
+// differ (a sigma3 other than the run's scores another test); none when
+// they agree or the file has no line.
+TEST(ScoreCli, ALateralStressOtherThanTheFilesIsWarnedOf) {
+  const test::TempDir dir("score_s3");
+  test::write_text(dir / "with.csv", "# lateral_stress = 1e5\n# steps = 20\n" + kTable);
+  test::write_text(dir / "without.csv", "# steps = 20\n" + kTable);
+  const auto other =
+      test::run_demcal({"score", "with.csv", "--lateral-stress", "2e5", "-o", "a"}, dir.path());
+  const auto same =
+      test::run_demcal({"score", "with.csv", "--lateral-stress", "100000", "-o", "b"}, dir.path());
+  const auto only =
+      test::run_demcal({"score", "without.csv", "--lateral-stress", "2e5", "-o", "c"}, dir.path());
+  ASSERT_TRUE(other.status != -1 && same.status != -1 && only.status != -1);
+  EXPECT_NE(other.err.find("warning: --lateral-stress 200000 replaces the 1e5 Pa of with.csv's "
+                           "# lateral_stress line"),
+            std::string::npos)
+      << other.err;
+  EXPECT_EQ(same.err.find("warning"), std::string::npos) << same.err;
+  EXPECT_EQ(only.err.find("warning"), std::string::npos) << only.err;
+  // Scored at 2e5: the peak b_yy of -2.5e5 Pa is sigma1/sigma3 1.25.
+  EXPECT_NE(other.out.find("sigma1/sigma3 1.25"), std::string::npos) << other.out;
 }
 
 TEST(EngineLammps, TheDecksOwnSeriesScoresAsDemcalsRun) {

@@ -1,10 +1,13 @@
 #include "demcal/scoring/external_series.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdlib>
 #include <limits>
+#include <optional>
 #include <sstream>
+#include <utility>
 
 #include "demcal/io/files.hpp"
 #include "demcal/io/format.hpp"
@@ -159,6 +162,29 @@ std::string result_keys() {
   return out;
 }
 
+/// Whether `s` is one word of a metadata key: letters, digits, '_'.
+bool is_one_word(const std::string& s) {
+  return !s.empty() && std::all_of(s.begin(), s.end(), [](unsigned char c) {
+    return std::isalnum(c) != 0 || c == '_';
+  });
+}
+
+/// The key and value of a metadata line "# key = value" (`line` trimmed,
+/// starting with '#'), or nothing for a comment. A one-word key may leave
+/// out the spaces ("#lateral_stress=1e5", as a hand-written print in an
+/// engine's script gives it): read as the spaced form, never as a comment,
+/// which would make a given sigma3 "missing". A key of several words is
+/// read only with " = " ("# restarted with run_steps = 2000").
+std::optional<std::pair<std::string, std::string>> metadata_line(const std::string& line) {
+  const auto eq = line.find('=');
+  if (eq == std::string::npos) return std::nullopt;
+  if (std::string key = trim(line.substr(1, eq - 1)); is_one_word(key))
+    return std::make_pair(std::move(key), trim(line.substr(eq + 1)));
+  const auto spaced = line.find(" = ");
+  if (spaced == std::string::npos) return std::nullopt;
+  return std::make_pair(trim(line.substr(1, spaced - 1)), trim(line.substr(spaced + 3)));
+}
+
 Table read_table(const std::string& text, ExternalSeries& out) {
   const std::string& source = out.source;
   Table t;
@@ -171,9 +197,9 @@ Table read_table(const std::string& text, ExternalSeries& out) {
     if (line.empty()) continue;
     const std::string where = "line " + std::to_string(line_no);
     if (line[0] == '#') {
-      const auto eq = line.find(" = ");
-      if (eq == std::string::npos) continue;  // a comment
-      const std::string key = trim(line.substr(1, eq - 1)), value = trim(line.substr(eq + 3));
+      const auto meta = metadata_line(line);
+      if (!meta) continue;  // a comment
+      const auto& [key, value] = *meta;
       const std::string field = where + ": # " + key;
       // After the header only what a run found, which an exported deck
       // appends once its run is over (series_result_lines); a parameter of

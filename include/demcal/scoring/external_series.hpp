@@ -3,7 +3,8 @@
 // the criteria demcal applies to its own runs.
 //
 // The file (README "Scoring another engine's run"): comment lines start
-// with '#'; a comment "# key = value" is metadata (lateral_stress [Pa],
+// with '#'; a comment "# key = value" is metadata (a one-word key also
+// without the spaces, "#key=value": metadata_line) (lateral_stress [Pa],
 // steps, dt, dt_crit [s], particles, damping_ratio_translation,
 // damping_ratio_rotation, mass_scaling, moment_lever_arm; the keys demcal's
 // own runs add: peak_stress_yy [Pa] and peak_strain_yy, the 2D peak tracked
