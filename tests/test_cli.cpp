@@ -208,6 +208,36 @@ TEST_F(CliEndToEnd, AWallTooStiffForTheConsolidationStepIsBadInput) {
   }
 }
 
+// Contact dashpots beyond critical make every contact creep, and the
+// consolidation's step shrinks for them: beyond the ratio at which the
+// quickest contact's time constant outlasts test.consolidation_max_steps,
+// no contact settles (hex_5x5 ran all 2e6 steps and failed, exit 1, at
+// 1e6; at 1e4 it "consolidated" in 600 steps into a creeping state whose
+// loading diverged). Refused before any computing, naming the field, in 2D
+// and 3D; a larger budget moves the bound, and an over-damped 5 still runs.
+TEST_F(CliEndToEnd, AContactDampingThatOutlastsTheConsolidationBudgetIsBadInput) {
+  const std::string out = (dir_ / "work" / "out").string();
+  for (const std::string& config : {kHex5, test::shipped_config("fcc_4x4x4")}) {
+    SCOPED_TRACE(config);
+    for (const std::string set :
+         {"material.contact_damping_ratio=1e6", "material.contact_damping_ratio=1e100"})
+      expect_bad_input(
+          {"run", config, "--set", set, "-o", out},
+          {"--set " + set + ": material.contact_damping_ratio: over-damps every contact",
+           "more than test.consolidation_max_steps = 2000000",
+           "material.contact_damping_ratio must stay below"});
+  }
+  // hex_5x5: the bound is 342 at the default budget, 766 at 1e7 steps.
+  expect_bad_input({"check", kHex5, "--set", "material.contact_damping_ratio=400"},
+                   {"--set material.contact_damping_ratio=400", "must stay below 342.3"});
+  expect_bad_input({"check", kHex5, "--set", "material.contact_damping_ratio=800", "--set",
+                    "test.consolidation_max_steps=10000000"},
+                   {"--set material.contact_damping_ratio=800", "must stay below 765.4"});
+  const Result ok = demcal({"check", kHex5, "--set", "material.contact_damping_ratio=5", "--set",
+                            "algorithm.dt_ratio=0.005"});
+  EXPECT_EQ(ok.status, 0) << ok.err;
+}
+
 // Usage errors (CLI11's checks) are bad input too: one line, exit 2.
 TEST_F(CliEndToEnd, UsageErrorsExitTwo) {
   const std::string out = (dir_ / "work" / "out").string();
