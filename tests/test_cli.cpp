@@ -238,6 +238,31 @@ TEST_F(CliEndToEnd, AContactDampingThatOutlastsTheConsolidationBudgetIsBadInput)
   EXPECT_EQ(ok.status, 0) << ok.err;
 }
 
+// The loading's global damping, semi-implicit: c = D*dt/(2m) = 2*ratio*alpha.
+// A ratio of 1e306 made D inf and (1 - c)/(1 + c) NaN: the loading
+// "diverged: non-finite state" (exit 1, "decrease dt_ratio"). Any ratio
+// that keeps D finite and 1/(1 + c) normal is the overdamped limit, which
+// runs and the criteria judge (1e300 here).
+TEST_F(CliEndToEnd, AGlobalDampingBeyondTheKernelsDoublesIsBadInput) {
+  const std::string out = (dir_ / "work" / "out").string();
+  expect_bad_input({"run", kHex5, "--set", "algorithm.damping_ratio_translation=1e306", "-o", out},
+                   {"--set algorithm.damping_ratio_translation=1e306: "
+                    "algorithm.damping_ratio_translation: ",
+                    "global damping damping_ratio_translation*2*sqrt(kn*m) is inf"});
+  expect_bad_input({"run", kHex5, "--set", "algorithm.damping_ratio_rotation=1.7e308", "-o", out},
+                   {"--set algorithm.damping_ratio_rotation=1.7e308: "
+                    "algorithm.damping_ratio_rotation: ",
+                    "damped rotation's factor 1/(1 + D_r*dt/(2I))"});
+  // Spheres: the kernel's coefficients are the disks' (sphere_world.cpp).
+  expect_bad_input({"run", test::shipped_config("fcc_4x4x4"), "--set",
+                    "algorithm.damping_ratio_translation=1e308", "-o", out},
+                   {"--set algorithm.damping_ratio_translation=1e308: "
+                    "algorithm.damping_ratio_translation: ",
+                    "the smallest sphere's", "is inf"});
+  const Result ok = demcal({"check", kHex5, "--set", "algorithm.damping_ratio_translation=1e300"});
+  EXPECT_EQ(ok.status, 0) << ok.err;
+}
+
 // Usage errors (CLI11's checks) are bad input too: one line, exit 2.
 TEST_F(CliEndToEnd, UsageErrorsExitTwo) {
   const std::string out = (dir_ / "work" / "out").string();

@@ -138,6 +138,48 @@ void check_derived_scales(const SceneConfig& config, std::span<const double> rad
                      critical_damping_rotation(mat.particle.kt, r, inertia),
                      with(scaled(i_in, 0.5), {{"material.kt", mat.particle.kt, 0.5},
                                               {radius_field(config.assembly, smallest), r, 1.0}}));
+    // The loading's global damping, as the kernels apply it (solver.cpp,
+    // sphere_world.cpp): D = ratio·D_crit, semi-implicit, v⁺ = ((1 − c)·v⁻
+    // + Δt/m·F)/(1 + c) with c = D·Δt/(2m) (= 2·ratio·alpha for
+    // translation, 2·ratio·alpha·sqrt(kt·r²·m/(kn·I)) for rotation, whatever
+    // the mass). D must be finite and 1/(1 + c) normal: a ratio of 1e306
+    // made D inf, c inf, (1 − c)/(1 + c) NaN, and the loading "diverged:
+    // non-finite state" with the advice to decrease dt_ratio. Short of that
+    // a large ratio is the overdamped limit, integrated as such (the mean
+    // velocity F/D), which the criteria judge.
+    const double dt = alg.dt_ratio * critical_time_step(m, mat.particle.kn);
+    const double d_t =
+        alg.damping_ratio_translation * critical_damping_translation(mat.particle.kn, m);
+    if (d_t > 0.0) {
+      const std::vector<Input> d_in =
+          with(scaled(m_in, 0.5),
+               {{"material.kn", mat.particle.kn, 0.5},
+                {"algorithm.damping_ratio_translation", alg.damping_ratio_translation, 1.0}});
+      require_normal(config, which + "global damping damping_ratio_translation*2*sqrt(kn*m)", d_t,
+                     d_in);
+      require_normal(config, which + "damped step's factor 1/(1 + D*dt/(2m))",
+                     1.0 / (1.0 + d_t * dt / (2.0 * m)),
+                     {{"algorithm.damping_ratio_translation", alg.damping_ratio_translation, -1.0},
+                      {"algorithm.dt_ratio", alg.dt_ratio, -1.0}});
+    }
+    const double d_r =
+        alg.damping_ratio_rotation * critical_damping_rotation(mat.particle.kt, r, inertia);
+    if (d_r > 0.0) {
+      const std::vector<Input> d_in =
+          with(scaled(i_in, 0.5),
+               {{"material.kt", mat.particle.kt, 0.5},
+                {radius_field(config.assembly, smallest), r, 1.0},
+                {"algorithm.damping_ratio_rotation", alg.damping_ratio_rotation, 1.0}});
+      require_normal(config,
+                     which + "rotational global damping damping_ratio_rotation*2*sqrt(kt*r^2*I)",
+                     d_r, d_in);
+      require_normal(config, which + "damped rotation's factor 1/(1 + D_r*dt/(2I))",
+                     1.0 / (1.0 + d_r * dt / (2.0 * inertia)),
+                     {{"algorithm.damping_ratio_rotation", alg.damping_ratio_rotation, -1.0},
+                      {"algorithm.dt_ratio", alg.dt_ratio, -1.0},
+                      {"material.kt", mat.particle.kt, -0.5},
+                      {"material.kn", mat.particle.kn, 0.5}});
+    }
     if (smallest) m_min = m;
   }
   // The steps, at the lightest particle (the smallest: one density).
