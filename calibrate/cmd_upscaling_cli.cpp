@@ -100,7 +100,8 @@ std::function<int()> add_upscaling_commands(CLI::App& app) {
       ->check(whole_number(1, kMaxParticles));
   scaling->add_option("-o,--output", sc->out_dir, "report folder (default demcal-scaling-NAME)")
       ->check(non_empty_path());
-  scaling->add_option("--work", sc->work_dir, "per-size work folder (default: the -o folder)");
+  scaling->add_option("--work", sc->work_dir, "per-size work folder (default: the -o folder)")
+      ->check(non_empty_path());
   scaling->add_option("-j,--jobs", sc->jobs, "trials in parallel (default: cores)")
       ->check(whole_number(1, kMaxJobs));
   scaling

@@ -419,6 +419,11 @@ TEST_F(CliEndToEnd, UnwritableOutputExitsTwoBeforeRunning) {
 TEST_F(CliEndToEnd, AnEmptyOutputIsBadInput) {
   for (const char* command : {"run", "calibrate", "stability", "sweep", "rev"})
     expect_bad_input({command, kHex5, "-o", ""}, {"--output", "must not be empty"});
+  // scaling's work folder too: '' ran the study in the -o folder.
+  const std::string out = (dir_ / "work" / "out").string();
+  expect_bad_input(
+      {"scaling", kHex5, "--work", "", "-o", out, "--sizes", "25,36,100", "--calibrate-max", "36"},
+      {"--work", "must not be empty"});
 }
 
 // --- check ----------------------------------------------------------------
