@@ -267,6 +267,9 @@ int verify_3d(const VerifyOptions& o, const nlohmann::json& params, const RevPar
   if (!o.tile.empty()) throw InputError("--tile", "", "tiles 2D prototype files only");
   if (o.consolidate_only)
     throw InputError("--consolidate-only", "", "2D only (3D prototypes are consolidated per run)");
+  // An unusable -o fails before anything is printed or probed.
+  const std::string dir = o.out_dir.empty() ? "demcal-verify-" + config.name : o.out_dir;
+  OutputFolder::check(dir);
   auto [file, particles] = named_prototype(params, o.prototype, o.particles);
   PrototypeSource source;
   const SphereAssembly proto = prototype_spheres(config, particles, file, &source);
@@ -312,8 +315,6 @@ int verify_3d(const VerifyOptions& o, const nlohmann::json& params, const RevPar
                          std::to_string(up.steps) + " steps is estimated at " +
                          num(estimate_s / 60.0) + " min, beyond the budget of " +
                          num(o.max_minutes) + " min; raise --max-minutes to run it");
-  const std::string dir = o.out_dir.empty() ? "demcal-verify-" + config.name : o.out_dir;
-  OutputFolder::check(dir);
 
   const auto t0 = std::chrono::steady_clock::now();
   // "consolidating ..." only before a consolidation, not before a read
@@ -430,6 +431,11 @@ int cmd_verify(const VerifyOptions& o) {
                      "lmp is not on PATH: install LAMMPS (apt-get install lammps)");
   if (in_lammps && o.np > 1 && find_on_path("mpirun").empty())
     throw InputError("--np", "", "mpirun is not on PATH (apt-get install openmpi-bin)");
+  const std::string dir = o.out_dir.empty() ? "demcal-verify-" + config.name : o.out_dir;
+  // An unusable -o fails now, before anything is printed, and nothing is
+  // made before the consolidation (a failed one leaves no empty folder);
+  // made where prototype.csv goes.
+  OutputFolder::check(dir);
   auto [file, particles] = named_prototype(params, o.prototype, o.particles);
   PrototypeSource source;
   Assembly proto = prototype_assembly(config, particles, file, &source);
@@ -473,10 +479,6 @@ int cmd_verify(const VerifyOptions& o) {
     std::cerr << "demcal verify: loading = " << particle_steps << " particle-steps, estimated "
               << estimate_s / 60.0 << " min at " << kAssumedSpeed
               << " particle-steps/s (plus the consolidation)\n";
-  const std::string dir = o.out_dir.empty() ? "demcal-verify-" + config.name : o.out_dir;
-  // An unusable -o fails now, and nothing is made before the consolidation
-  // (a failed one leaves no empty folder); made where prototype.csv goes.
-  OutputFolder::check(dir);
 
   const auto t0 = std::chrono::steady_clock::now();
   // "consolidating ..." only before a consolidation, not before a read

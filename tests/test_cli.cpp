@@ -356,6 +356,24 @@ TEST_F(CliEndToEnd, VerifyRefusesTheOptionsItWouldIgnore) {
                    {"--engine", "\"liggghts\"", "export --format liggghts"});
 }
 
+// An -o that cannot be made (a path under a regular file) is bad input
+// found before anything is printed or run, as in 3D (test_verify_3d.cpp):
+// 2D verify printed its prototype and estimate lines first, the error after.
+TEST_F(CliEndToEnd, VerifyAnUnusableOutputFolderFailsBeforeAnythingIsPrinted) {
+  demcal::AlgorithmSpec p;
+  p.steps = 20000;
+  const std::string params = test::write_default_scene_params(dir_, p);
+  test::write_text(dir_ / "blocker", "a file\n");
+  const std::string out = (dir_ / "blocker" / "v").string();
+  for (const std::vector<std::string> more :
+       {std::vector<std::string>{}, std::vector<std::string>{"--consolidate-only"}})
+    for (const char* particles : {"25", "100"}) {
+      std::vector<std::string> args{"verify", params, "--particles", particles, "-o", out};
+      args.insert(args.end(), more.begin(), more.end());
+      expect_bad_input(args, {out});
+    }
+}
+
 // `demcal stability`: the limit against the estimate, both files written.
 TEST_F(CliEndToEnd, StabilityScanWritesItsReport) {
   const fs::path out = dir_ / "work" / "scan";

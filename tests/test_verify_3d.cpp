@@ -6,6 +6,7 @@
 // the particle-steps that the law's Nstep gives.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -119,6 +120,22 @@ TEST(Verify3D, TwoDimensionalOptionsAreRefusedByName) {
     }
     EXPECT_FALSE(fs::exists(dir / "v"));
   }
+}
+
+// An -o that cannot be made (a path under a regular file) is bad input
+// found before anything is printed or run: one line naming the folder,
+// exit 2 (test_cli.cpp has the 2D twin).
+TEST(Verify3D, AnUnusableOutputFolderFailsBeforeAnythingIsPrinted) {
+  test::TempDir dir("verify3d-folder");
+  const std::string params = write_fcc2_params(dir.path());
+  test::write_text(dir.path() / "blocker", "a file\n");
+  const std::string out = (dir.path() / "blocker" / "v").string();
+  const test::RunResult r = test::run_demcal({"verify", params, "-o", out}, dir.path());
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_EQ(r.err.rfind("demcal: error: ", 0), 0u) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_NE(r.err.find(out), std::string::npos) << r.err;
+  EXPECT_EQ(r.out, "");
 }
 
 }  // namespace
