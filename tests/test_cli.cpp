@@ -208,6 +208,34 @@ TEST_F(CliEndToEnd, AWallTooStiffForTheConsolidationStepIsBadInput) {
   }
 }
 
+// The overlap at sigma3 grows as sigma3/kn, and the checks of it with the
+// assembly (check_resolvable, check_sphere_overlap) named the config file
+// and test.lateral_stress whatever was extreme and wherever it came from:
+// `--set material.kn=1e300` read "configs/hex_5x5.json: test.lateral_stress:
+// must be at least 2.2e+290 Pa". Now the field further from the usual in
+// the failing direction, and the --set that gave it.
+TEST_F(CliEndToEnd, AnOverlapAtSigma3OutOfRangeNamesTheExtremeFieldAndItsSet) {
+  const std::string out = (dir_ / "work" / "out").string();
+  const std::string fcc = test::shipped_config("fcc_4x4x4");
+  struct Case {
+    std::string config, set, field, what;
+  };
+  const std::vector<Case> cases = {
+      {kHex5, "material.kn=1e300", "material.kn", "material.kn at most"},
+      {kHex5, "test.lateral_stress=1e-9", "test.lateral_stress",
+       "test.lateral_stress must be at least"},
+      {fcc, "material.kn=1e300", "material.kn", "material.kn at most"},
+      {fcc, "test.lateral_stress=1e-9", "test.lateral_stress", "not resolved"},
+      {fcc, "test.lateral_stress=1e10", "test.lateral_stress", "must be at most 2.5e+09 Pa"},
+      {fcc, "material.wall.kn=1e2", "material.wall.kn", "material.wall.kn at least 4000 N/m"},
+  };
+  for (const Case& c : cases) {
+    expect_bad_input({"run", c.config, "--set", c.set, "-o", out},
+                     {"--set " + c.set + ": " + c.field + ": ", c.what});
+    expect_bad_input({"check", c.config, "--set", c.set}, {"--set " + c.set + ": " + c.field});
+  }
+}
+
 // Contact dashpots beyond critical make every contact creep, and the
 // consolidation's step shrinks for them: beyond the ratio at which the
 // quickest contact's time constant outlasts test.consolidation_max_steps,

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <span>
+#include <string>
 
 #include "demcal/scene/config.hpp"
 
@@ -22,5 +23,15 @@ namespace demcal::detail {
 /// the range (exit status 2). Computed through particle_scales.hpp, the
 /// formulas' one home.
 void check_derived_scales(const SceneConfig& config, std::span<const double> radii);
+
+/// The field an overlap-at-sigma3 check names (check_resolvable in
+/// packing.cpp, check_sphere_overlap in triaxial.cpp). The overlap grows as
+/// sigma3/kn, so a ratio out of its range is sigma3's doing or the
+/// stiffness's (`kn_field`, material.kn or material.wall.kn: the one the
+/// check used): the one named is the one further, by a factor, from the
+/// embedded default scene's value in the direction that put the ratio out
+/// (`too_small`: sigma3 low or kn high; else sigma3 high or kn low).
+/// Ties name test.lateral_stress.
+std::string overlap_culprit(const SceneConfig& config, const std::string& kn_field, bool too_small);
 
 }  // namespace demcal::detail

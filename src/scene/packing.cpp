@@ -286,19 +286,27 @@ void check_resolvable(const SceneConfig& config, const Assembly& a) {
       std::max({std::abs(a.left), std::abs(a.right), std::abs(a.bottom), std::abs(a.top)});
   const double r_min = *std::min_element(a.r.begin(), a.r.end());
   const Material& m = config.material;
-  const double kn = std::max(m.particle.kn, m.wall.kn);
+  const bool wall = m.wall.kn > m.particle.kn;
+  const double kn = wall ? m.wall.kn : m.particle.kn;
+  const std::string kn_field = wall ? "material.wall.kn" : "material.kn";
   const double sigma3 = config.test.lateral_stress;
   const double delta = 2.0 * sigma3 * m.thickness * r_min / kn;
   const double roundoff = 0.5 * std::numeric_limits<double>::epsilon() * coordinate;
   const double wanted = 0.1 * config.test.consolidation_tolerance;  // relative
   if (roundoff <= wanted * delta) return;
   const double minimum = roundoff / wanted * kn / (2.0 * m.thickness * r_min);
+  const double kn_max = 2.0 * sigma3 * m.thickness * r_min * wanted / roundoff;
+  // sigma3 too low or kn too high: the error names the one further from
+  // the usual (detail::overlap_culprit) and the --set or file that gave it.
+  const std::string field = detail::overlap_culprit(config, kn_field, true);
   std::ostringstream msg;
-  msg << "must be at least " << minimum << " Pa for this assembly: the overlap at sigma3, "
-      << "2*sigma3*t*r_min/kn = " << delta << " m, is not resolved by positions up to "
+  msg << "the overlap at sigma3, 2*sigma3*t*r_min/kn = " << delta << " m (sigma3 = " << sigma3
+      << " Pa, " << kn_field << " = " << kn << " N/m), is not resolved by positions up to "
       << coordinate << " m (round-off " << roundoff << " m must stay below a tenth of "
-      << "consolidation_tolerance of it); got " << sigma3;
-  throw InputError(config.source, "test.lateral_stress", msg.str());
+      << "consolidation_tolerance of it): test.lateral_stress must be at least " << minimum
+      << " Pa for this assembly, or " << kn_field << " at most " << kn_max << " N/m; got "
+      << (field == kn_field ? kn : sigma3);
+  throw InputError(source_of(config, field), field, msg.str());
 }
 
 }  // namespace

@@ -46,28 +46,46 @@ void check_sphere_overlap(const SceneConfig& config, const SphereAssembly& a) {
   const double sigma3 = config.test.lateral_stress;
   const double r_min = *std::min_element(a.r.begin(), a.r.end());
   const double r_max = *std::max_element(a.r.begin(), a.r.end());
-  const double kn_soft = std::min(m.particle.kn, m.wall.kn);
+  // The error names sigma3 or the stiffness, whichever is further from the
+  // usual in the direction that failed (detail::overlap_culprit), and the
+  // --set or file that gave it.
+  const auto fail = [&](const std::string& kn_field, double kn, bool too_small,
+                        const std::string& what) {
+    const std::string field = detail::overlap_culprit(config, kn_field, too_small);
+    throw InputError(source_of(config, field), field,
+                     what + "; got " + num(field == kn_field ? kn : sigma3));
+  };
+  const bool soft_wall = m.wall.kn < m.particle.kn;
+  const double kn_soft = soft_wall ? m.wall.kn : m.particle.kn;
+  const std::string soft_field = soft_wall ? "material.wall.kn" : "material.kn";
   const double limit = kMaxOverlapAtSigma3 * kn_soft / (4.0 * r_max);
   std::ostringstream msg;
   if (sigma3 > limit) {
-    msg << "must be at most " << limit << " Pa for kn " << kn_soft << " N/m and the largest radius "
-        << r_max << " m: the overlap at sigma3, 4*sigma3*r/kn = " << 4.0 * sigma3 * r_max / kn_soft
-        << " of the radius, must stay below " << kMaxOverlapAtSigma3 << "; got " << sigma3;
-    throw InputError(config.source, "test.lateral_stress", msg.str());
+    msg << "the overlap at sigma3, 4*sigma3*r/kn = " << 4.0 * sigma3 * r_max / kn_soft
+        << " of the largest radius " << r_max << " m (sigma3 = " << sigma3 << " Pa, " << soft_field
+        << " = " << kn_soft << " N/m), must stay below " << kMaxOverlapAtSigma3
+        << ": test.lateral_stress must be at most " << limit << " Pa, or " << soft_field
+        << " at least " << 4.0 * sigma3 * r_max / kMaxOverlapAtSigma3 << " N/m";
+    fail(soft_field, kn_soft, false, msg.str());
   }
   double coordinate = 0.0;
   for (int axis = 0; axis < 3; ++axis)
     coordinate = std::max({coordinate, std::abs(a.lo[axis]), std::abs(a.hi[axis])});
-  const double kn = std::max(m.particle.kn, m.wall.kn);
+  const bool stiff_wall = m.wall.kn > m.particle.kn;
+  const double kn = stiff_wall ? m.wall.kn : m.particle.kn;
+  const std::string kn_field = stiff_wall ? "material.wall.kn" : "material.kn";
   const double delta = 4.0 * sigma3 * r_min * r_min / kn;
   const double roundoff = 0.5 * std::numeric_limits<double>::epsilon() * coordinate;
   const double wanted = 0.1 * config.test.consolidation_tolerance;
   if (roundoff <= wanted * delta) return;
-  msg << "must be at least " << roundoff / wanted * kn / (4.0 * r_min * r_min)
-      << " Pa for this assembly: the overlap at sigma3, 4*sigma3*r_min^2/kn = " << delta
-      << " m, is not resolved by positions up to " << coordinate << " m (round-off " << roundoff
-      << " m must stay below a tenth of consolidation_tolerance of it); got " << sigma3;
-  throw InputError(config.source, "test.lateral_stress", msg.str());
+  msg << "the overlap at sigma3, 4*sigma3*r_min^2/kn = " << delta << " m (sigma3 = " << sigma3
+      << " Pa, " << kn_field << " = " << kn << " N/m), is not resolved by positions up to "
+      << coordinate << " m (round-off " << roundoff
+      << " m must stay below a tenth of consolidation_tolerance of it): test.lateral_stress must "
+         "be at least "
+      << roundoff / wanted * kn / (4.0 * r_min * r_min) << " Pa for this assembly, or " << kn_field
+      << " at most " << 4.0 * sigma3 * r_min * r_min * wanted / roundoff << " N/m";
+  fail(kn_field, kn, true, msg.str());
 }
 
 }  // namespace
