@@ -212,8 +212,8 @@ TEST_F(CliEndToEnd, AWallTooStiffForTheConsolidationStepIsBadInput) {
 // assembly (check_resolvable, check_sphere_overlap) named the config file
 // and test.lateral_stress whatever was extreme and wherever it came from:
 // `--set material.kn=1e300` read "configs/hex_5x5.json: test.lateral_stress:
-// must be at least 2.2e+290 Pa". Now the field further from the usual in
-// the failing direction, and the --set that gave it.
+// must be at least 2.2e+290 Pa". Now the field a --set changed (sigma3 when
+// both or neither were), with the --set that gave it and both bounds.
 TEST_F(CliEndToEnd, AnOverlapAtSigma3OutOfRangeNamesTheExtremeFieldAndItsSet) {
   const std::string out = (dir_ / "work" / "out").string();
   const std::string fcc = test::shipped_config("fcc_4x4x4");
@@ -234,6 +234,8 @@ TEST_F(CliEndToEnd, AnOverlapAtSigma3OutOfRangeNamesTheExtremeFieldAndItsSet) {
                      {"--set " + c.set + ": " + c.field + ": ", c.what});
     expect_bad_input({"check", c.config, "--set", c.set}, {"--set " + c.set + ": " + c.field});
   }
+  expect_bad_input({"check", fcc, "--set", "material.kn=1e300", "--set", "test.lateral_stress=1e5"},
+                   {"--set test.lateral_stress=1e5: test.lateral_stress: ", "material.kn at most"});
 }
 
 // Contact dashpots beyond critical make every contact creep, and the
@@ -393,7 +395,7 @@ TEST_F(CliEndToEnd, VerifyAnUnusableOutputFolderFailsBeforeAnythingIsPrinted) {
   const std::string params = test::write_default_scene_params(dir_, p);
   test::write_text(dir_ / "blocker", "a file\n");
   const std::string out = (dir_ / "blocker" / "v").string();
-  for (const std::vector<std::string> more :
+  for (const std::vector<std::string>& more :
        {std::vector<std::string>{}, std::vector<std::string>{"--consolidate-only"}})
     for (const char* particles : {"25", "100"}) {
       std::vector<std::string> args{"verify", params, "--particles", particles, "-o", out};

@@ -80,20 +80,10 @@ void require_normal(const SceneConfig& config, const std::string& what, double v
 
 }  // namespace
 
-std::string overlap_culprit(const SceneConfig& config, const std::string& kn_field,
-                            bool too_small) {
-  static const SceneConfig reference = default_config();
-  const double kn =
-      kn_field == "material.wall.kn" ? config.material.wall.kn : config.material.particle.kn;
-  const double kn_ref =
-      kn_field == "material.wall.kn" ? reference.material.wall.kn : reference.material.particle.kn;
-  // log10 of each one's departure toward a smaller (too_small) or larger
-  // sigma3/kn.
-  const double sign = too_small ? 1.0 : -1.0;
-  const double stress =
-      sign * std::log10(reference.test.lateral_stress / config.test.lateral_stress);
-  const double stiffness = sign * std::log10(kn / kn_ref);
-  return stiffness > stress ? kn_field : "test.lateral_stress";
+std::string overlap_culprit(const SceneConfig& config, const std::string& kn_field) {
+  const bool kn_set = set_source(config.sets, kn_field).has_value();
+  const bool sigma3_set = set_source(config.sets, "test.lateral_stress").has_value();
+  return kn_set && !sigma3_set ? kn_field : "test.lateral_stress";
 }
 
 void check_derived_scales(const SceneConfig& config, std::span<const double> radii) {

@@ -26,12 +26,11 @@ void check_derived_scales(const SceneConfig& config, std::span<const double> rad
 
 /// The field an overlap-at-sigma3 check names (check_resolvable in
 /// packing.cpp, check_sphere_overlap in triaxial.cpp). The overlap grows as
-/// sigma3/kn, so a ratio out of its range is sigma3's doing or the
-/// stiffness's (`kn_field`, material.kn or material.wall.kn: the one the
-/// check used): the one named is the one further, by a factor, from the
-/// embedded default scene's value in the direction that put the ratio out
-/// (`too_small`: sigma3 low or kn high; else sigma3 high or kn low).
-/// Ties name test.lateral_stress.
-std::string overlap_culprit(const SceneConfig& config, const std::string& kn_field, bool too_small);
+/// sigma3/kn, so the physics cannot tell which of the two is out of range
+/// (their messages give both bounds): the one named is the stiffness
+/// (`kn_field`, material.kn or material.wall.kn: the one the check used)
+/// when a --set gave it and none gave sigma3 (the value the user just
+/// changed), else test.lateral_stress.
+std::string overlap_culprit(const SceneConfig& config, const std::string& kn_field);
 
 }  // namespace demcal::detail

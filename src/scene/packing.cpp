@@ -296,9 +296,9 @@ void check_resolvable(const SceneConfig& config, const Assembly& a) {
   if (roundoff <= wanted * delta) return;
   const double minimum = roundoff / wanted * kn / (2.0 * m.thickness * r_min);
   const double kn_max = 2.0 * sigma3 * m.thickness * r_min * wanted / roundoff;
-  // sigma3 too low or kn too high: the error names the one further from
-  // the usual (detail::overlap_culprit) and the --set or file that gave it.
-  const std::string field = detail::overlap_culprit(config, kn_field, true);
+  // sigma3 too low or kn too high: the error names the one a --set changed
+  // (detail::overlap_culprit) and the --set or file that gave it.
+  const std::string field = detail::overlap_culprit(config, kn_field);
   std::ostringstream msg;
   msg << "the overlap at sigma3, 2*sigma3*t*r_min/kn = " << delta << " m (sigma3 = " << sigma3
       << " Pa, " << kn_field << " = " << kn << " N/m), is not resolved by positions up to "

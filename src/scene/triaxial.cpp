@@ -46,12 +46,10 @@ void check_sphere_overlap(const SceneConfig& config, const SphereAssembly& a) {
   const double sigma3 = config.test.lateral_stress;
   const double r_min = *std::min_element(a.r.begin(), a.r.end());
   const double r_max = *std::max_element(a.r.begin(), a.r.end());
-  // The error names sigma3 or the stiffness, whichever is further from the
-  // usual in the direction that failed (detail::overlap_culprit), and the
-  // --set or file that gave it.
-  const auto fail = [&](const std::string& kn_field, double kn, bool too_small,
-                        const std::string& what) {
-    const std::string field = detail::overlap_culprit(config, kn_field, too_small);
+  // The error names sigma3 or the stiffness, the one a --set changed
+  // (detail::overlap_culprit), and the --set or file that gave it.
+  const auto fail = [&](const std::string& kn_field, double kn, const std::string& what) {
+    const std::string field = detail::overlap_culprit(config, kn_field);
     throw InputError(source_of(config, field), field,
                      what + "; got " + num(field == kn_field ? kn : sigma3));
   };
@@ -66,7 +64,7 @@ void check_sphere_overlap(const SceneConfig& config, const SphereAssembly& a) {
         << " = " << kn_soft << " N/m), must stay below " << kMaxOverlapAtSigma3
         << ": test.lateral_stress must be at most " << limit << " Pa, or " << soft_field
         << " at least " << 4.0 * sigma3 * r_max / kMaxOverlapAtSigma3 << " N/m";
-    fail(soft_field, kn_soft, false, msg.str());
+    fail(soft_field, kn_soft, msg.str());
   }
   double coordinate = 0.0;
   for (int axis = 0; axis < 3; ++axis)
@@ -85,7 +83,7 @@ void check_sphere_overlap(const SceneConfig& config, const SphereAssembly& a) {
          "be at least "
       << roundoff / wanted * kn / (4.0 * r_min * r_min) << " Pa for this assembly, or " << kn_field
       << " at most " << 4.0 * sigma3 * r_min * r_min * wanted / roundoff << " N/m";
-  fail(kn_field, kn, true, msg.str());
+  fail(kn_field, kn, msg.str());
 }
 
 }  // namespace
