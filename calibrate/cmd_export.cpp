@@ -149,15 +149,12 @@ template <class AnyAssembly>
 auto export_consolidated(const ExportCmdOptions& o, const SceneConfig& config,
                          const AnyAssembly& proto, const std::string& what, const char* kernel) {
   ConsolidationOptions co;
-  co.threads = proto.size() >= kThreadsFrom ? 0 : 1;
+  co.threads = prototype_consolidation_threads(proto.size());
   co.progress = consolidation_progress(o.progress_every_s);
   const auto state = consolidate_announced(config, proto, co, [&] {
     std::cerr << "demcal export: consolidating the prototype (" << what
               << ") to sigma3 with demcal's " << kernel << ", "
-              << (co.threads == 1
-                      ? std::string("single-threaded")
-                      : "on " + std::to_string(std::max(1u, std::thread::hardware_concurrency())) +
-                            " threads")
+              << consolidation_threads_words(co.threads)
               << (o.format == "lammps"
                       ? " (--consolidate-in deck leaves it to the LAMMPS deck, under "
                         "MPI)\n"

@@ -43,12 +43,16 @@ struct RevOutcome {
 // other commands say it: `announce` ("consolidating ...") only when it
 // consolidates, not before a read from the cache (consolidate_announced),
 // then its steps and time (print_consolidated: a cache read's labelled);
-// progress lines as run prints them (--progress).
+// progress lines as run prints them (--progress). On every core from
+// kThreadsFrom particles, as export's prototype (prototype_consolidation_threads):
+// a generated 20 000-sphere prototype is most of rev's time. `announce`
+// gets the threads (ConsolidationOptions::threads).
 template <class AnyAssembly>
 auto said_consolidation(const SceneConfig& config, const AnyAssembly& assembly, const char* what,
-                        double progress_every_s, const std::function<void()>& announce) {
-  const ConsolidationOptions co{.progress = consolidation_progress(progress_every_s)};
-  const auto state = consolidate_announced(config, assembly, co, announce);
+                        double progress_every_s, const std::function<void(int)>& announce) {
+  const ConsolidationOptions co{.threads = prototype_consolidation_threads(assembly.size()),
+                                .progress = consolidation_progress(progress_every_s)};
+  const auto state = consolidate_announced(config, assembly, co, [&] { announce(co.threads); });
   print_consolidated(std::cerr, "demcal rev: ", what, state.steps, state.wall_time_s,
                      state.from_cache);
   std::cerr << "\n";
@@ -72,16 +76,19 @@ RevOutcome rev_2d(const SceneConfig& config, const std::string& file, const RevO
                      "--prototype FILE");
   ready();
   if (!proto.dense)  // a generated gas is no packing to cut from or compare with
-    proto = assembly_of(said_consolidation(config, proto, "the prototype", every_s, [&] {
-                          std::cerr << "demcal rev: consolidating the prototype first ("
-                                    << source.description << "): a loose gas takes long\n";
-                        }).world);
+    proto =
+        assembly_of(said_consolidation(config, proto, "the prototype", every_s, [&](int threads) {
+                      std::cerr << "demcal rev: consolidating the prototype first ("
+                                << source.description << ", "
+                                << consolidation_threads_words(threads)
+                                << "): a loose gas takes long\n";
+                    }).world);
   std::cerr << "demcal rev: "
             << (ro.method == "cut" ? "cutting a REV of about " : "generating a REV of ")
             << ro.particles << " particles from " << source.description << "\n";
   const RevResult r = make_rev(proto, ro, [&](const Assembly& raw) {
     return said_consolidation(config, raw, "the REV", every_s,
-                              [&] { announce_rev(raw.size(), "particles"); });
+                              [&](int) { announce_rev(raw.size(), "particles"); });
   });
   return {r.method, particle_csv(r.assembly), r.assembly.size(), consolidation_record(r.state),
           r.representativeness};
@@ -100,16 +107,18 @@ RevOutcome rev_3d(const SceneConfig& config, const std::string& file, const RevO
                          " spheres, the prototype has only " + std::to_string(proto.size()));
   ready();
   if (source.kind == "generated")  // a generated gas is no packing to cut from or compare with
-    proto = sphere_assembly_of(said_consolidation(config, proto, "the prototype", every_s, [&] {
-                                 std::cerr << "demcal rev: consolidating the prototype first ("
-                                           << source.description << "): a loose gas takes long\n";
-                               }).world);
+    proto = sphere_assembly_of(
+        said_consolidation(config, proto, "the prototype", every_s, [&](int threads) {
+          std::cerr << "demcal rev: consolidating the prototype first (" << source.description
+                    << ", " << consolidation_threads_words(threads)
+                    << "): a loose gas takes long\n";
+        }).world);
   std::cerr << "demcal rev: " << (ro.method == "cut" ? "cutting a box" : "generating a")
             << " REV of " << (ro.method == "cut" ? "about " : "") << ro.particles
             << " spheres from " << source.description << "\n";
   const SphereRevResult r = make_rev(proto, ro, [&](const SphereAssembly& raw) {
     return said_consolidation(config, raw, "the REV", every_s,
-                              [&] { announce_rev(raw.size(), "spheres"); });
+                              [&](int) { announce_rev(raw.size(), "spheres"); });
   });
   return {r.method, sphere_csv(r.assembly), r.assembly.size(), consolidation_record(r.state),
           r.representativeness};

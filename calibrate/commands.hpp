@@ -17,13 +17,7 @@ class App;
 
 namespace demcal::cli {
 
-/// From this many particles `export`'s consolidation and 3D `verify`'s
-/// loading step on every core: the kernels' two
-/// threads break even near 10^4 disks (reports/performance.md, "Threads":
-/// 1.78x at 10^4 on an idle machine) and lose below, more so on a loaded
-/// machine, where a worker spinning at a barrier is preempted (a 256-sphere
-/// prototype ran 10-28x slower on two threads than on one).
-constexpr int kThreadsFrom = 10000;
+// kThreadsFrom: consolidation_progress.hpp.
 
 /// The config's Δt (algorithm.dt_ratio) against `stable`, the dt_ratio
 /// estimated from the consolidated contact network (estimated_stable_dt_ratio,

@@ -1,10 +1,12 @@
 #include "consolidation_progress.hpp"
 
+#include <algorithm>
 #include <iomanip>
 #include <iostream>
 #include <memory>
 #include <sstream>
 #include <string>
+#include <thread>
 
 #include "demcal/scene/consolidation_cache.hpp"
 
@@ -19,6 +21,14 @@ std::string seconds(double s) {
 }
 
 }  // namespace
+
+int prototype_consolidation_threads(int64_t particles) { return particles >= kThreadsFrom ? 0 : 1; }
+
+std::string consolidation_threads_words(int threads) {
+  const int n =
+      threads > 0 ? threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  return n == 1 ? std::string("single-threaded") : "on " + std::to_string(n) + " threads";
+}
 
 ConsolidationCallback consolidation_progress(double every_s) {
   struct Last {

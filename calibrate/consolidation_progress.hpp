@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <functional>
 #include <ostream>
+#include <string>
 #include <string_view>
 
 #include "demcal/scene/biaxial.hpp"
@@ -12,6 +13,24 @@
 #include "demcal/scene/triaxial.hpp"
 
 namespace demcal::cli {
+
+/// From this many particles a prototype's consolidation (`export`, `rev`)
+/// and 3D `verify`'s loading step on every core: the kernels' two
+/// threads break even near 10^4 disks (reports/performance.md, "Threads":
+/// 1.78x at 10^4 on an idle machine) and lose below, more so on a loaded
+/// machine, where a worker spinning at a barrier is preempted (a 256-sphere
+/// prototype ran 10-28x slower on two threads than on one).
+constexpr int kThreadsFrom = 10000;
+
+/// ConsolidationOptions::threads for a prototype of `particles` (disks or
+/// spheres): 0 (every core) from kThreadsFrom, else 1. The state is the
+/// same bit for bit on any count.
+int prototype_consolidation_threads(int64_t particles);
+
+/// How a consolidation on `threads` (ConsolidationOptions::threads, 0:
+/// every core) runs, for a command's "consolidating ..." line:
+/// "single-threaded" or "on N threads".
+std::string consolidation_threads_words(int threads);
 
 /// Seconds between progress lines by default: a consolidation that ends
 /// sooner prints none.

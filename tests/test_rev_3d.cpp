@@ -10,6 +10,8 @@
 #include <nlohmann/json.hpp>
 #include <numbers>
 #include <random>
+#include <string>
+#include <thread>
 
 #include "demcal/scene/sphere_packing.hpp"
 #include "demcal/scene/triaxial.hpp"
@@ -375,6 +377,29 @@ TEST_F(Rev3dCli, BadInputIsOneClearErrorAndNoFolder) {
   EXPECT_EQ(r.status, 2) << r.err;
   EXPECT_NE(r.err.find("prototype"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir_ / "work" / "R"));
+}
+
+TEST_F(Rev3dCli, ConsolidatesALargeGeneratedPrototypeOnEveryCore) {
+  // A generated gas of kThreadsFrom (10^4) spheres: rev consolidates it on
+  // every core, as export does, and says so before it starts (a 20 000-sphere
+  // prototype is most of rev's time). A budget of 1000 steps keeps the test
+  // short: the consolidation fails after the announcement.
+  const unsigned cores = std::thread::hardware_concurrency();
+  if (cores < 2) GTEST_SKIP() << "one core: every core is one thread";
+  const std::string config =
+      test::write_text(dir_ / "gas.json", R"({)" + test::kMaterialMember +
+                                              R"(, "name": "gas", "dimension": 3,
+        "assembly": {"type": "random", "count": 200, "radius_min": 3.75e-4, "radius_max": 6.25e-4},
+        "test": {"type": "triaxial", "lateral_stress": 1e5, "consolidation_max_steps": 1000},
+        "prototype": {"particles": 10000}})");
+  const auto r = demcal({"rev", config, "--particles", "200", "-o", "R"});
+  EXPECT_NE(r.status, 0) << r.err;  // 1000 steps do not consolidate a gas
+  EXPECT_NE(r.err.find("consolidating the prototype first (10000 spheres from the random "
+                       "generator of gas, on " +
+                       std::to_string(cores) + " threads)"),
+            std::string::npos)
+      << r.err;
+  EXPECT_EQ(r.err.find("single-threaded"), std::string::npos) << r.err;
 }
 
 }  // namespace
