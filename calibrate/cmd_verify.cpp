@@ -406,14 +406,9 @@ Assembly tiled_prototype(const Assembly& proto, const std::string& tile, Prototy
   return tiled;
 }
 
-}  // namespace
-
-int cmd_verify(const VerifyOptions& o) {
-  const nlohmann::json params = read_params_file(o.params);
-  const RevParams rev = rev_params_from_json(params, o.params);
-  const SceneConfig config = required_scene(params, o.params, o.config, o.sets);
-  const ScalingLaw law = resolve_law(params, o.params, o.law, o.exponent);
-  if (config.dimension == 3) return verify_3d(o, params, rev, config, law);
+/// 2D verify's engine from the options, checked: "" for demcal's kernel,
+/// else the path of lmp (--engine lammps, mpirun too for --np > 1).
+std::string engine_2d(const VerifyOptions& o) {
   const bool in_lammps = o.engine == "lammps";
   if (!in_lammps && o.engine != "demcal")
     throw InputError("--engine", "",
@@ -425,50 +420,52 @@ int cmd_verify(const VerifyOptions& o) {
     throw InputError("--np", "",
                      "MPI ranks are for --engine lammps; demcal's verify runs in this process");
   if (o.threads != 0) throw InputError("--threads", "", "3D only (2D verify runs on one thread)");
-  const std::string lmp = in_lammps ? find_on_path("lmp") : "";
-  if (in_lammps && lmp.empty())
+  if (!in_lammps) return "";
+  const std::string lmp = find_on_path("lmp");
+  if (lmp.empty())
     throw InputError("--engine", "lammps",
                      "lmp is not on PATH: install LAMMPS (apt-get install lammps)");
-  if (in_lammps && o.np > 1 && find_on_path("mpirun").empty())
+  if (o.np > 1 && find_on_path("mpirun").empty())
     throw InputError("--np", "", "mpirun is not on PATH (apt-get install openmpi-bin)");
-  const std::string dir = o.out_dir.empty() ? "demcal-verify-" + config.name : o.out_dir;
-  // An unusable -o fails now, before anything is printed, and nothing is
-  // made before the consolidation (a failed one leaves no empty folder);
-  // made where prototype.csv goes.
-  OutputFolder::check(dir);
-  auto [file, particles] = named_prototype(params, o.prototype, o.particles);
-  PrototypeSource source;
-  Assembly proto = prototype_assembly(config, particles, file, &source);
-  if (!o.tile.empty()) proto = tiled_prototype(proto, o.tile, source);
-  const int64_t n = proto.size();
-  const AlgorithmSpec up = upscale(rev.params, rev.particles, n, law);
-  print_prototype_notes("verify", particles, rev.particles, n, law);
-  const double particle_steps = static_cast<double>(n) * static_cast<double>(up.steps);
-  // LAMMPS runs the deck's steps (Nstep/f: deck_steps, what the deck
-  // writes) at its own speed, its ranks sharing the work only on large
-  // prototypes.
-  const int64_t run_steps = in_lammps ? deck_steps(up) : up.steps;
-  const double estimate_s =
-      in_lammps ? lammps_estimate_s(n, run_steps, o.np) : particle_steps / kAssumedSpeed;
-  if (estimate_s > 60.0 * o.max_minutes && !o.consolidate_only)
+  return lmp;
+}
+
+/// What a 2D verify will run: the prototype's size, the upscaled
+/// parameters, the loading's steps in the engine that runs it and its
+/// estimated time.
+struct Plan2d {
+  int64_t n = 0;
+  AlgorithmSpec up;
+  bool in_lammps = false;
+  int64_t run_steps = 0;  ///< LAMMPS runs the deck's Nstep/f (deck_steps)
+  double particle_steps = 0.0, estimate_s = 0.0;
+  ParticleScales scales;  ///< the prototype's, at the upscaled mass scaling
+};
+
+/// The plan's lines on stderr, after its budget check (--max-minutes).
+void announce_plan_2d(const VerifyOptions& o, const Plan2d& p, const PrototypeSource& source,
+                      const RevParams& rev, const ScalingLaw& law) {
+  if (p.estimate_s > 60.0 * o.max_minutes && !o.consolidate_only)
     throw InputError("--max-minutes", "",
-                     "the loading of " + std::to_string(n) + " particles over " +
-                         std::to_string(run_steps) + (in_lammps ? " LAMMPS" : "") +
-                         " steps is estimated at " + num(estimate_s / 60.0) +
+                     "the loading of " + std::to_string(p.n) + " particles over " +
+                         std::to_string(p.run_steps) + (p.in_lammps ? " LAMMPS" : "") +
+                         " steps is estimated at " + num(p.estimate_s / 60.0) +
                          " min, beyond the budget of " + num(o.max_minutes) +
                          " min; raise --max-minutes to run it");
   std::cerr << "demcal verify: prototype " << source.description << "; ";
-  if (n == rev.particles)
-    std::cerr << rev_size_steps_words(up.steps, rev.particles, "particles") << "\n";
+  if (p.n == rev.particles)
+    std::cerr << rev_size_steps_words(p.up.steps, rev.particles, "particles") << "\n";
   else
-    std::cerr << up.steps << " steps upscaled (" << law.name() << " law, exponent " << law.exponent
-              << ") from " << rev.particles << " particles / " << rev.params.steps << " steps\n";
+    std::cerr << p.up.steps << " steps upscaled (" << law.name() << " law, exponent "
+              << law.exponent << ") from " << rev.particles << " particles / " << rev.params.steps
+              << " steps\n";
   if (o.consolidate_only)
     std::cerr << "demcal verify: --consolidate-only: the consolidation alone, no loading\n";
-  else if (in_lammps)
-    std::cerr << "demcal verify: LAMMPS loading = " << run_steps << " steps of the deck (Nstep/f), "
-              << static_cast<double>(n) * static_cast<double>(run_steps)
-              << " particle-steps, estimated " << estimate_s / 60.0 << " min at " << kLammpsSpeed
+  else if (p.in_lammps)
+    std::cerr << "demcal verify: LAMMPS loading = " << p.run_steps
+              << " steps of the deck (Nstep/f), "
+              << static_cast<double>(p.n) * static_cast<double>(p.run_steps)
+              << " particle-steps, estimated " << p.estimate_s / 60.0 << " min at " << kLammpsSpeed
               << " particle-steps/s a rank plus " << kLammpsStepCost << " s a step"
               << (o.np > 1 ? " on " + std::to_string(o.np) + " ranks (sharing the work from " +
                                  num(kLammpsParticlesPerRank) + " particles a rank) plus " +
@@ -476,56 +473,26 @@ int cmd_verify(const VerifyOptions& o) {
                            : std::string())
               << " (plus the consolidation in demcal)\n";
   else
-    std::cerr << "demcal verify: loading = " << particle_steps << " particle-steps, estimated "
-              << estimate_s / 60.0 << " min at " << kAssumedSpeed
+    std::cerr << "demcal verify: loading = " << p.particle_steps << " particle-steps, estimated "
+              << p.estimate_s / 60.0 << " min at " << kAssumedSpeed
               << " particle-steps/s (plus the consolidation)\n";
+}
 
-  const auto t0 = std::chrono::steady_clock::now();
-  // "consolidating ..." only before a consolidation, not before a read
-  // from the cache (consolidate_announced); progress lines (--progress).
-  const ConsolidationOptions co{.progress = consolidation_progress(o.progress_every_s)};
-  const ConsolidatedState state = consolidate_announced(config, proto, co, [&] {
-    std::cerr << "demcal verify: consolidating the prototype ("
-              << (proto.dense ? "short for a dense packing" : "long for a loose gas") << ")\n";
-  });
-  // The kernel's speed from the consolidation, not from a cache's reading.
-  const double speed =
-      state.wall_time_s > 1.0 && !state.from_cache
-          ? static_cast<double>(state.steps) * static_cast<double>(n) / state.wall_time_s
-          : kAssumedSpeed;
-  print_consolidated(std::cerr, "demcal verify: ", "", state.steps, state.wall_time_s,
-                     state.from_cache);
-  if (!o.consolidate_only)
-    std::cerr << "; loading now, about " << (in_lammps ? estimate_s : particle_steps / speed) / 60.0
-              << " min";
-  std::cerr << "\n";
-  // The prototype's state, reusable by `demcal export --prototype` and by
-  // later runs (read_particle_file reads it back).
-  make_output_dir(dir);
-  write_file_atomic(dir + "/prototype.csv", particle_csv(assembly_of(state.world)));
-  if (o.consolidate_only) {
-    std::cout << "consolidated prototype of " << n << " particles: " << state.steps << " steps, ";
-    print_consolidation_time(std::cout, state.wall_time_s, state.from_cache);
-    std::cout << "; wrote " << dir << "/prototype.csv\n";
-    return 0;
-  }
-
-  if (in_lammps) {
-    nlohmann::json head =
-        verify_head(o, config, n, source, rev, law, up,
-                    particle_scales(proto.r, config.material, up.mass_scaling), state);
-    head["version"] = DEMCAL_VERSION;
-    return verify_in_lammps(o, params, config, state, up, dir, lmp, estimate_s, head);
-  }
+/// demcal's loading of the consolidated prototype with the upscaled
+/// parameters: verify.json and series.csv in `dir`, the verdict on stdout.
+int load_and_report_2d(const VerifyOptions& o, const SceneConfig& config,
+                       const ConsolidatedState& state, const Plan2d& p,
+                       const PrototypeSource& source, const RevParams& rev, const ScalingLaw& law,
+                       const std::string& dir, std::chrono::steady_clock::time_point t0) {
+  const AlgorithmSpec& up = p.up;
   LoadingResult run;
   const Tolerances tolerances = default_tolerances(config);
   const TrialRecord trial = run_trial(config, state, up, tolerances, false, 3.0, &run);
   const Score score = score_run(run, config.test.lateral_stress, tolerances);
   const double total_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  const ParticleScales scales = particle_scales(proto.r, config.material, up.mass_scaling);
 
-  nlohmann::json out = verify_head(o, config, n, source, rev, law, up, scales, state);
+  nlohmann::json out = verify_head(o, config, p.n, source, rev, law, up, p.scales, state);
   out["prototype"]["stats"] = to_json(packing_stats(state.world));
   out.update({{"passed", trial.score.passed},
               {"criteria", to_json(trial.score.criteria)},
@@ -538,16 +505,16 @@ int cmd_verify(const VerifyOptions& o) {
               {"diverged", trial.score.diverged},
               {"loading",
                {{"steps", up.steps},
-                {"particle_steps", particle_steps},
+                {"particle_steps", p.particle_steps},
                 {"wall_time_s", trial.wall_time_s},
                 {"particle_steps_per_s",
-                 trial.wall_time_s > 0 ? particle_steps / trial.wall_time_s : 0.0}}},
+                 trial.wall_time_s > 0 ? p.particle_steps / trial.wall_time_s : 0.0}}},
               {"wall_time_s", total_s},
               {"version", DEMCAL_VERSION}});
   write_verify_files(dir, out, series_csv(verify_metadata(config, run), run.series));
 
   const auto& c = trial.score.criteria;
-  print_verdict(trial.score.passed, "prototype of " + std::to_string(n) + " particles", up, c,
+  print_verdict(trial.score.passed, "prototype of " + std::to_string(p.n) + " particles", up, c,
                 tolerances);
   print_peak(std::cout, false, c.peak_stress_yy, std::nullopt, config.test.lateral_stress);
   std::cout << ")\n"
@@ -555,10 +522,85 @@ int cmd_verify(const VerifyOptions& o) {
             << "  consolidation ";
   print_consolidation_time(std::cout, state.wall_time_s, state.from_cache);
   std::cout << ", loading " << trial.wall_time_s << " s ("
-            << (trial.wall_time_s > 0 ? particle_steps / trial.wall_time_s : 0.0)
+            << (trial.wall_time_s > 0 ? p.particle_steps / trial.wall_time_s : 0.0)
             << " particle-steps/s), total " << total_s << " s\n"
             << "  wrote " << dir << "/verify.json, series.csv, prototype.csv\n";
   return trial.score.passed ? 0 : 1;
+}
+
+int verify_2d(const VerifyOptions& o, const nlohmann::json& params, const RevParams& rev,
+              const SceneConfig& config, const ScalingLaw& law) {
+  const std::string lmp = engine_2d(o);
+  const std::string dir = o.out_dir.empty() ? "demcal-verify-" + config.name : o.out_dir;
+  // An unusable -o fails now, before anything is printed, and nothing is
+  // made before the consolidation (a failed one leaves no empty folder);
+  // made where prototype.csv goes.
+  OutputFolder::check(dir);
+  auto [file, particles] = named_prototype(params, o.prototype, o.particles);
+  PrototypeSource source;
+  Assembly proto = prototype_assembly(config, particles, file, &source);
+  if (!o.tile.empty()) proto = tiled_prototype(proto, o.tile, source);
+  Plan2d p;
+  p.n = proto.size();
+  p.up = upscale(rev.params, rev.particles, p.n, law);
+  print_prototype_notes("verify", particles, rev.particles, p.n, law);
+  p.particle_steps = static_cast<double>(p.n) * static_cast<double>(p.up.steps);
+  p.scales = particle_scales(proto.r, config.material, p.up.mass_scaling);
+  // LAMMPS runs the deck's steps (Nstep/f: deck_steps, what the deck
+  // writes) at its own speed, its ranks sharing the work only on large
+  // prototypes.
+  p.in_lammps = !lmp.empty();
+  p.run_steps = p.in_lammps ? deck_steps(p.up) : p.up.steps;
+  p.estimate_s =
+      p.in_lammps ? lammps_estimate_s(p.n, p.run_steps, o.np) : p.particle_steps / kAssumedSpeed;
+  announce_plan_2d(o, p, source, rev, law);
+
+  const auto t0 = std::chrono::steady_clock::now();
+  // "consolidating ..." only before a consolidation, not before a read
+  // from the cache (consolidate_announced); progress lines (--progress).
+  const ConsolidationOptions co{.progress = consolidation_progress(o.progress_every_s)};
+  const ConsolidatedState state = consolidate_announced(config, proto, co, [&] {
+    std::cerr << "demcal verify: consolidating the prototype ("
+              << (proto.dense ? "short for a dense packing" : "long for a loose gas") << ")\n";
+  });
+  // The kernel's speed from the consolidation, not from a cache's reading.
+  const double speed =
+      state.wall_time_s > 1.0 && !state.from_cache
+          ? static_cast<double>(state.steps) * static_cast<double>(p.n) / state.wall_time_s
+          : kAssumedSpeed;
+  print_consolidated(std::cerr, "demcal verify: ", "", state.steps, state.wall_time_s,
+                     state.from_cache);
+  if (!o.consolidate_only)
+    std::cerr << "; loading now, about "
+              << (p.in_lammps ? p.estimate_s : p.particle_steps / speed) / 60.0 << " min";
+  std::cerr << "\n";
+  // The prototype's state, reusable by `demcal export --prototype` and by
+  // later runs (read_particle_file reads it back).
+  make_output_dir(dir);
+  write_file_atomic(dir + "/prototype.csv", particle_csv(assembly_of(state.world)));
+  if (o.consolidate_only) {
+    std::cout << "consolidated prototype of " << p.n << " particles: " << state.steps << " steps, ";
+    print_consolidation_time(std::cout, state.wall_time_s, state.from_cache);
+    std::cout << "; wrote " << dir << "/prototype.csv\n";
+    return 0;
+  }
+  if (p.in_lammps) {
+    nlohmann::json head = verify_head(o, config, p.n, source, rev, law, p.up, p.scales, state);
+    head["version"] = DEMCAL_VERSION;
+    return verify_in_lammps(o, params, config, state, p.up, dir, lmp, p.estimate_s, head);
+  }
+  return load_and_report_2d(o, config, state, p, source, rev, law, dir, t0);
+}
+
+}  // namespace
+
+int cmd_verify(const VerifyOptions& o) {
+  const nlohmann::json params = read_params_file(o.params);
+  const RevParams rev = rev_params_from_json(params, o.params);
+  const SceneConfig config = required_scene(params, o.params, o.config, o.sets);
+  const ScalingLaw law = resolve_law(params, o.params, o.law, o.exponent);
+  return config.dimension == 3 ? verify_3d(o, params, rev, config, law)
+                               : verify_2d(o, params, rev, config, law);
 }
 
 }  // namespace demcal::cli
