@@ -3,6 +3,7 @@
 // changing the state they reach; the CLI prints the reports on stderr.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <iomanip>
@@ -171,6 +172,56 @@ TEST(ConsolidationProgress, SphereThreadsAndReportsDoNotChangeTheState) {
   EXPECT_EQ(t.threads(), 1);
   std::printf("120-sphere gas: %lld steps, %zu reports\n", static_cast<long long>(plain.steps),
               seen.size());
+}
+
+// The frictionless phase gets at most the first quarter of the budget
+// (critical_damping_after): one not static by then ends there and friction
+// goes on, at the light damping, which locks the packing; critical damping
+// comes a quarter later. Before, the frictionless phase crept on at
+// critical damping: random_400 with a 40 000-step budget, and random_500_3d
+// with 100 000, never came to rest (exit 1); the shipped budgets' runs,
+// whose frictionless phases end before the quarter, are unchanged.
+template <class State, class Consolidate>
+void expect_the_frictionless_phase_cut_at_the_quarter(const SceneConfig& c,
+                                                      Consolidate consolidate_it) {
+  const int64_t quarter = c.test.consolidation_max_steps / 4;
+  std::vector<ConsolidationProgress> seen;
+  ConsolidationOptions o;
+  o.progress = [&](const ConsolidationProgress& p) { seen.push_back(p); };
+  const State s = consolidate_it(o);
+  ASSERT_TRUE(s.converged);
+  ASSERT_FALSE(seen.empty());
+  // The premise: still frictionless and not static at the quarter.
+  const auto at_quarter =
+      std::find_if(seen.begin(), seen.end(), [&](const auto& p) { return p.steps == quarter; });
+  ASSERT_NE(at_quarter, seen.end());
+  EXPECT_EQ(at_quarter->phase, 0);
+  EXPECT_FALSE(at_quarter->stress_error < c.test.consolidation_tolerance &&
+               at_quarter->unbalanced_ratio < c.test.consolidation_unbalanced);
+  // Friction from the next check on, static within the light-damping quarter.
+  ASSERT_NE(at_quarter + 1, seen.end());
+  EXPECT_EQ((at_quarter + 1)->phase, 1);
+  EXPECT_GT(s.steps, quarter);
+  EXPECT_LE(s.steps, 2 * quarter);
+  std::printf("%s, budget %lld: frictionless until %lld, static at %lld\n", c.name.c_str(),
+              static_cast<long long>(c.test.consolidation_max_steps),
+              static_cast<long long>(quarter), static_cast<long long>(s.steps));
+}
+
+TEST(ConsolidationProgress, AFrictionlessPhaseNotStaticByTheQuarterEndsThere) {
+  SceneConfig c = load_config(test::shipped_config("random_400"));
+  c.test.consolidation_max_steps = 40000;
+  const Assembly a = make_assembly(c);
+  expect_the_frictionless_phase_cut_at_the_quarter<ConsolidatedState>(
+      c, [&](const ConsolidationOptions& o) { return consolidate(c, a, "", o); });
+}
+
+TEST(ConsolidationProgress, AFrictionlessSpherePhaseNotStaticByTheQuarterEndsThere) {
+  SceneConfig c = load_config(test::shipped_config("random_500_3d"));
+  c.test.consolidation_max_steps = 100000;
+  const SphereAssembly a = make_sphere_assembly(c);
+  expect_the_frictionless_phase_cut_at_the_quarter<TriaxialState>(
+      c, [&](const ConsolidationOptions& o) { return consolidate_triaxial(c, a, o); });
 }
 
 // One callback serves consolidations one after another (scaling's sizes):

@@ -278,8 +278,8 @@ std::string with_phase0_marker(const std::string& deck) {
                   "print           \"PHASE0_END $(step)\"\n# phase 1: friction on");
 }
 
-// Phase 0 may end at the budget's last check or at the one before (with
-// light damping, or at critical damping after the fallback); phase 1's
+// Phase 0 may end at the budget's last check or at the one before (static,
+// at the light damping, when the quarter is the budget's end); phase 1's
 // first check interval then reaches or passes cons_last. demcal's
 // consolidation stops there, not static (it runs phase 1's first check
 // interval, then its budget is spent); the deck must too: quit 2 with its
@@ -470,6 +470,60 @@ TEST(EngineLammpsStage1, WithContactDashpotsTheDeckConsolidatesARandomSampleWith
       static_cast<long long>(d.steps));
 }
 
+// Stage 1 cuts a frictionless phase not static by cons_quarter there, as
+// demcal's run_consolidation does, and goes on with friction at the light
+// damping, critical damping only from cons_capped (twice the quarter): the
+// gases of the demcal tests (ConsolidationProgress.AFrictionless*), 400
+// disks with a 40 000-step budget and 500 spheres with 100 000, whose
+// phase 0 is not static at the quarter in demcal. The deck before ran phase
+// 0 on at critical damping to the budget's end (quit 2).
+TEST(EngineLammpsStage1, AFrictionlessPhaseNotStaticByTheQuarterEndsThereAsDemcals) {
+  DEMCAL_FIND_PROGRAM(lmp, "lmp", "lammps", "the deck is not run");
+  const AlgorithmSpec p = stage1_loading();
+  struct Case {
+    std::string name;
+    int64_t budget;
+    ExportResult deck;
+  };
+  std::vector<Case> cases;
+  {
+    SceneConfig c = load_config(test::shipped_config("random_400"));
+    c.test.consolidation_max_steps = 40000;
+    cases.push_back({"2D", c.test.consolidation_max_steps,
+                     export_deck(c, p, make_assembly(c), stage1_options<ExportOptions>("r"))});
+  }
+  {
+    SceneConfig c = load_config(test::shipped_config("random_500_3d"));
+    c.test.consolidation_max_steps = 100000;
+    cases.push_back(
+        {"3D", c.test.consolidation_max_steps,
+         export_3d_decks(c, p, make_sphere_assembly(c), stage1_options<Export3dOptions>("r"))});
+  }
+  const test::TempDir dir("engine_stage1_cut");
+  for (const Case& k : cases) {
+    SCOPED_TRACE(k.name);
+    const test::DeckRun run =
+        test::run_deck(lmp, dir / k.name, with_phase0_marker(k.deck.deck), k.deck.files,
+                       {"-var", "run_steps", "0", "-screen", "none"});
+    ASSERT_EQ(run.status, 0) << run.log.substr(run.log.size() > 3000 ? run.log.size() - 3000 : 0);
+    const int64_t quarter = k.budget / 4;
+    EXPECT_EQ(echoed(run.log, "cons_quarter"), static_cast<double>(quarter));
+    EXPECT_EQ(echoed(run.log, "cons_capped"), static_cast<double>(2 * quarter));
+    EXPECT_EQ(phase0_end(run.log), quarter) << "phase 0 did not end at the quarter";
+    std::smatch m;
+    ASSERT_TRUE(
+        std::regex_search(run.log, m, std::regex("\ndemcal deck: consolidated in ([0-9]+) steps")))
+        << run.log;
+    const int64_t steps = std::stoll(m[1].str());
+    EXPECT_GT(steps, quarter);
+    EXPECT_LE(steps, 2 * quarter);  // at the light damping
+    EXPECT_EQ(run.log.find("\nvariable cons_critical equal 1\n"), std::string::npos);
+    std::printf("%s, budget %lld: the deck's frictionless phase until %lld, static at %lld\n",
+                k.name.c_str(), static_cast<long long>(k.budget), static_cast<long long>(quarter),
+                static_cast<long long>(steps));
+  }
+}
+
 /// A step for a message, 10 significant digits.
 std::string deck_number(double v) {
   char b[32];
@@ -582,8 +636,14 @@ void expect_the_servo_carries_its_last_move(
   std::string counts;
   for (const auto& [dt, count] : carried)
     counts += ", at dt " + deck_number(dt) + " " + std::to_string(count) + " carried";
-  std::printf("%s: %zu steps, %d moves clamped, %d free%s\n", tag.c_str(), rows.size(), clamped,
-              free, counts.c_str());
+  int64_t switched = -1;  // the first step at the critical damping's dt
+  for (const auto& [step, v] : rows)
+    if (v[1] != rows.begin()->second[1]) {
+      switched = step;
+      break;
+    }
+  std::printf("%s: %zu steps, %d moves clamped, %d free%s; dt switched at step %lld\n", tag.c_str(),
+              rows.size(), clamped, free, counts.c_str(), static_cast<long long>(switched));
   ASSERT_EQ(carried.size(), 2u) << "the trace does not cross the critical-damping switch";
   for (const auto& [dt, count] : carried) EXPECT_GT(count, 100) << "dt " << dt;
 }
@@ -592,8 +652,10 @@ void expect_the_servo_carries_its_last_move(
 // of each wall's last move (servo_velocity: robustness.md, "The
 // 3D consolidation at contact damping 0.7"); the decks' stage 1 must too, with
 // R at its step, at light and at critical damping. 100 disks of random_400 and
-// 60 spheres of random_500_3d at zeta_c 0.3, budget 4 000 steps (the switch at
-// 2 200 and 2 800: demcal's check of (1 000/S) steps), the cap at 5e-4 r_min
+// 60 spheres of random_500_3d at zeta_c 0.1, budget 4 000 steps: their
+// frictionless phases are cut at demcal's check of (1 000/S) steps, and
+// critical damping comes at the first check at or after twice that (2 800 and 3 000),
+// within the budget for S >= 0.5 (zeta_c 0.3 has S < 0.5), the cap at 5e-4 r_min
 // (the export's 0.02 does not bind on these samples). The deck before moved
 // each wall by the per-step law alone: its moves miss the law by the carry
 // term, 0.84 of the last move at light damping.
@@ -601,7 +663,7 @@ TEST(EngineLammpsStage1, WithContactDashpotsTheServoCarriesItsLastMoveAsDemcals2
   DEMCAL_FIND_PROGRAM(lmp, "lmp", "lammps", "the deck is not run");
   SceneConfig c = load_config(test::shipped_config("random_400"));
   c.assembly.count = 100;
-  c.material.contact_damping_ratio = 0.3;
+  c.material.contact_damping_ratio = 0.1;
   const AlgorithmSpec p = stage1_loading();
   const ExportOptions o = stage1_options<ExportOptions>("r");
   const Assembly a = make_assembly(c);
@@ -622,7 +684,7 @@ TEST(EngineLammpsStage1, WithContactDashpotsTheServoCarriesItsLastMoveAsDemcals3
   DEMCAL_FIND_PROGRAM(lmp, "lmp", "lammps", "the deck is not run");
   SceneConfig c = load_config(test::shipped_config("random_500_3d"));
   c.assembly.count = 60;
-  c.material.contact_damping_ratio = 0.3;
+  c.material.contact_damping_ratio = 0.1;
   const AlgorithmSpec p = stage1_loading();
   const Export3dOptions o = stage1_options<Export3dOptions>("r");
   const SphereAssembly a = make_sphere_assembly(c);

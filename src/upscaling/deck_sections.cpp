@@ -398,9 +398,12 @@ double consolidation_dt(double alpha, double zeta, double dt_crit) {
 std::string lammps_consolidation_comment(double zeta, const std::string& particle,
                                          const std::string& start_walls) {
   std::ostringstream s;
-  s << "# mu until static again; critical damping (zeta 1, timestep * f(1)/f(" << num(zeta)
-    << "))\n"
-    << "# from step cons_quarter on if not static by then. Static: every wall\n"
+  s << "# mu until static again; the frictionless phase at most until step\n"
+    << "# cons_quarter (friction goes on there if it is not static: a frictionless\n"
+    << "# packing at sigma3 can creep for far longer), critical damping (zeta 1,\n"
+    << "# timestep * f(1)/f(" << num(zeta) << ")) from step cons_switch on if not static by\n"
+    << "# then: cons_quarter, or cons_capped when the frictionless phase was cut\n"
+    << "# there (demcal's run_consolidation). Static: every wall\n"
     << "# within cons_tol of sigma3 and the unbalanced-force ratio mean|F_p| / mean\n"
     << "# |f_c| below cons_unbalanced (demcal's test.consolidation_* values), checked\n"
     << "# every cons_check steps by fix halt; |f_c| of a " << particle << " contact is its normal\n"
@@ -446,7 +449,14 @@ std::string lammps_consolidation_quarter(double alpha, int64_t max_steps) {
        "$(v_cons_check*ceil(ceil(floor(v_cons_max_steps/4)/"
     << exact(shrink) << ")/v_cons_check))\n"
     << "variable        cons_quarter equal "
-       "$((v_cons_after+v_cons_last-abs(v_cons_after-v_cons_last))/2)\n";
+       "$((v_cons_after+v_cons_last-abs(v_cons_after-v_cons_last))/2)\n"
+    << "# a frictionless phase cut at cons_quarter: critical damping from the first\n"
+    << "# check at or after twice demcal's critical_damping_after, at most the budget\n"
+    << "variable        cons_after2 equal "
+       "$(v_cons_check*ceil(2*ceil(floor(v_cons_max_steps/4)/"
+    << exact(shrink) << ")/v_cons_check))\n"
+    << "variable        cons_capped equal "
+       "$((v_cons_after2+v_cons_last-abs(v_cons_after2-v_cons_last))/2)\n";
   return s.str();
 }
 
@@ -622,7 +632,6 @@ std::string lammps_consolidation_runs(double gamma_n, double dt_damped, const st
   // stale ("Compute used in variable between runs is not current"), one up
   // to a step already passed is an error. demcal's consolidation, too,
   // stops after phase 1's first check when that is at or past its budget.
-  const std::string may_switch = " && ${cons_quarter} < ${cons_last}";
   const std::string before_last = " && $(step) < ${cons_last}";
   // with the servo's carry, the carry of the critical step's R
   const std::string carry =
@@ -632,18 +641,18 @@ std::string lammps_consolidation_runs(double gamma_n, double dt_damped, const st
     << "pair_style      gran/hooke/history ${kn} ${kt} " << num(gamma_n) << " 0.0 0 0\n"
     << "variable        cons_critical equal 0\n"
     << "run             ${cons_quarter} upto\n"
-    << "if              \"${cons_static} == 0" << may_switch << "\" then \"" << critical << "\" &\n"
-    << "                \"timestep " << num(dt_damped) << "\" \"variable cons_critical equal 1\""
-    << carry << " \"run ${cons_last} upto\"\n"
-    << "if              \"${cons_static} == 0\" then \"print 'demcal deck: consolidation "
-       "(frictionless) did not reach a static state in ${cons_max_steps} steps: raise "
-       "cons_max_steps'\" \"quit 2\"\n"
+    << "if              \"${cons_static} == 0 && $(step) >= ${cons_last}\" then \"print 'demcal "
+       "deck: consolidation (frictionless) did not reach a static state in ${cons_max_steps} "
+       "steps: raise cons_max_steps'\" \"quit 2\"\n"
+    << "variable        cons_switch equal ${cons_quarter}\n"
+    << "if              \"${cons_static} == 0\" then \"variable cons_switch equal "
+       "${cons_capped}\"\n"
     << "# phase 1: friction on (at least one check interval)\n"
     << "pair_style      gran/hooke/history ${kn} ${kt} " << num(gamma_n) << " 0.0 ${mu} 0\n"
-    << "if              \"${cons_critical} == 0 && $(step+v_cons_check) <= ${cons_quarter}\" "
-       "then \"run ${cons_quarter} upto\" else \"run ${cons_check}\"\n"
-    << "if              \"${cons_static} == 0 && ${cons_critical} == 0" << may_switch
-    << "\" then \"" << critical << "\" &\n"
+    << "if              \"$(step+v_cons_check) <= ${cons_switch}\" "
+       "then \"run ${cons_switch} upto\" else \"run ${cons_check}\"\n"
+    << "if              \"${cons_static} == 0 && ${cons_switch} < ${cons_last}\" then \""
+    << critical << "\" &\n"
     << "                \"timestep " << num(dt_damped) << "\" \"variable cons_critical equal 1\""
     << carry << "\n"
     << "if              \"${cons_static} == 0" << before_last

@@ -315,9 +315,12 @@ std::string lammps_consolidation_parameters(const TestSpec& test);
 /// explicit damper's factor, as the loading's deck_timing).
 double consolidation_dt(double alpha, double zeta, double dt_crit);
 
-/// Stage 1's cons_quarter and cons_last (runs end on check steps): the
-/// budget's last check, and the check from which stage 1 runs at critical
-/// damping, demcal's (scene/biaxial.hpp, critical_damping_after): the first
+/// Stage 1's cons_quarter, cons_capped and cons_last (runs end on check
+/// steps): the budget's last check, and the check at which a frictionless
+/// phase not yet static ends and from which the friction phase runs at
+/// critical damping, demcal's (scene/biaxial.hpp, critical_damping_after;
+/// cons_capped: the first check at or after twice it, the switch when the
+/// frictionless phase was cut at cons_quarter): the first
 /// check at or after a quarter of cons_max_steps in the simulated time of
 /// the undamped step, (cons_max_steps/4)/S steps, S the step shrink
 /// (consolidation_step_shrink: 1 without contact dashpots), at most the
@@ -353,9 +356,11 @@ std::string lammps_consolidation_criterion(int dimension,
                                            const std::vector<ConsolidationWall>& walls,
                                            const std::vector<std::string>& axis_names);
 
-/// Stage 1's runs: frictionless, then friction on, each until static;
-/// critical damping (`critical`: its fix viscous line, step dt_damped) from
-/// cons_quarter (lammps_consolidation_quarter), none when that is the
+/// Stage 1's runs, demcal's run_consolidation: frictionless until static,
+/// at most until cons_quarter, then friction on until static; critical
+/// damping (`critical`: its fix viscous line, step dt_damped) in the
+/// friction phase from cons_quarter, or cons_capped when the frictionless
+/// phase was cut (lammps_consolidation_quarter), none when that is the
 /// budget's end; quit 2 when the budget is spent. `carry_damped` > 0: the
 /// servo's carry (lammps_consolidation_servo's cons_carry) from the switch
 /// on, servo_carry_at dt_damped.

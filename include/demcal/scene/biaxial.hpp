@@ -128,8 +128,10 @@ double consolidation_alpha(double zeta_c, int dimension, double r_min, double r_
 inline double consolidation_step_shrink(double dt_ratio) {
   return dt_ratio / AlgorithmSpec{}.dt_ratio;
 }
-/// The step from which the consolidation runs at critical damping (the
-/// first check at or after it switches): a quarter of the budget
+/// The step at which a frictionless phase not yet static ends (friction
+/// goes on: the first check at or after it), and from which the friction
+/// phase runs at critical damping (twice it when the frictionless phase was
+/// cut there; run_consolidation): a quarter of the budget
 /// `max_steps` in the simulated time of the undamped step, i.e. as many more
 /// steps as the step shrank (`step_shrink`: consolidation_step_shrink;
 /// scene/protocol_steps.hpp run_consolidation says why). The one home of the
