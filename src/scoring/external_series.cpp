@@ -199,7 +199,10 @@ Table read_table(const std::string& text, ExternalSeries& out) {
     if (line[0] == '#') {
       const auto meta = metadata_line(line);
       if (!meta) continue;  // a comment
-      const auto& [key, value] = *meta;
+      // (no structured binding: the lambda below captures the key, which
+      // clang before 16 refuses for a binding)
+      const std::string& key = meta->first;
+      const std::string& value = meta->second;
       const std::string field = where + ": # " + key;
       // After the header only what a run found, which an exported deck
       // appends once its run is over (series_result_lines); a parameter of
