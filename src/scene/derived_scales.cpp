@@ -78,6 +78,98 @@ void require_normal(const SceneConfig& config, const std::string& what, double v
   throw InputError(source_of(config, field), field, msg.str());
 }
 
+/// Refuses a wall too stiff for the consolidation's step ratio `alpha_c`.
+// A particle held by a wall oscillates at least at sqrt(kn_wall/m), and
+// the step is stable only while ω·Δt < 2: the global damping, semi-
+// implicit, keeps the undamped bound (its amplification at ω·Δt = 2 is −1
+// whatever the damping). So a wall stiffer than kn/α² makes every step of
+// the consolidation, at α·2·sqrt(m/kn), grow the motion of the particles
+// on the walls: "consolidation diverged: overlap beyond limit" within a
+// few hundred steps (hex_5x5 and fcc_4x4x4 at wall.kn = 30·kn). A user's
+// "rigid" wall is the usual cause. The loading's step is checked against
+// the consolidated network, walls included, with --allow-unstable for
+// whoever wants to watch it diverge (stable_dt_ratio_of).
+void check_wall_stiffness(const SceneConfig& config, double alpha_c) {
+  const Material& mat = config.material;
+  const double wall_limit = mat.particle.kn / (alpha_c * alpha_c);
+  if (!(mat.wall.kn < wall_limit)) {
+    std::ostringstream msg;
+    msg << shown(mat.wall.kn / mat.particle.kn)
+        << " times kn: a particle on a wall is stable only at steps below 2*sqrt(m/kn_wall) = "
+        << shown(std::sqrt(mat.particle.kn / mat.wall.kn))
+        << " of the critical step 2*sqrt(m/kn), less still with its contacts with other "
+           "particles, and the consolidation steps at "
+        << shown(alpha_c)
+        << " of it (alpha 0.2, shrunk for the contact dashpots): its walls would diverge. A wall "
+           "as stiff as the particles keeps its overlaps as small as theirs; material.wall.kn must "
+           "stay below kn/alpha^2 = "
+        << shown(wall_limit) << ", and well below (hex_5x5 stalls at 20 kn); got "
+        << shown(mat.wall.kn);
+    throw InputError(source_of(config, "material.wall.kn"), "material.wall.kn", msg.str());
+  }
+}
+
+/// Refuses a contact damping ratio whose quickest contact cannot settle
+/// within test.consolidation_max_steps of the consolidation's step (m_min the
+/// lightest particle's mass, dt_crit its critical step, radii in [r_min, r_max]).
+// An over-damped contact (ζ_c > 1) creeps: its relative motion, m_eff·ẍ
+// + c·ẋ + kn·x = 0 with c = 2ζ_c·sqrt(kn·m_eff), relaxes at best at the
+// slow root ω·(ζ_c − sqrt(ζ_c² − 1)), about ω/(2ζ_c), while the step
+// shrinks as 1/(2ζ_c·sqrt(Λ)) (consolidation_dashpot_factor): the steps
+// per time constant grow as ζ_c². The quickest contact is the stiffest
+// and lightest (ω = sqrt(2kn/m_min) for two of the smallest particles,
+// sqrt(kn_wall/m_min) for one on a wall); where even it needs more than
+// test.consolidation_max_steps steps for one time constant, no contact
+// can settle within the budget. The servo then reads the wall's dashpot
+// force as stress and the unbalanced-force ratio sees no inertia while
+// the particles still creep: hex_5x5 ran all 2·10⁶ steps and failed at
+// ζ_c = 1e6 (1e10, 1e100 the same), "consolidated" in 600 steps at 500
+// and 1e4 (one time constant is 4.3·10⁶ and 1.7·10⁹ steps there), at 1e4
+// into a state whose loading diverged ("kinetic energy growing without
+// bound") at dt_ratio 1e-6 and 1e-30, below its stable 4.6e-6; it
+// consolidated in 71 600, 208 400 and 429 000 steps at 50, 100 and 200
+// (42 600, 170 000 and 680 000 per time constant), and at 300 and 342,
+// its bound. The bounds at 2·10⁶ steps: hex_5x5 342, random_400 321,
+// fcc_4x4x4 288; all consolidate at 1, 2 and 5.
+void check_contact_damping_budget(const SceneConfig& config, double m_min, double dt_crit,
+                                  double r_min, double r_max) {
+  const Material& mat = config.material;
+  const double zeta_c = mat.contact_damping_ratio;
+  if (zeta_c > 1.0) {
+    const double omega =
+        std::sqrt(std::max(2.0 * mat.particle.kn, mat.wall.kn) / m_min);  // the quickest contact
+    const auto steps_per_time_constant = [&](double zeta) {
+      const double slow_root = omega / (zeta + std::sqrt((zeta - 1.0) * (zeta + 1.0)));
+      const double step = consolidation_alpha(zeta, config.dimension, r_min, r_max) * dt_crit;
+      return 1.0 / (slow_root * step);
+    };
+    const double budget = static_cast<double>(config.test.consolidation_max_steps);
+    const double needed = steps_per_time_constant(zeta_c);
+    if (!(needed <= budget)) {
+      double lo = 1.0, hi = zeta_c;  // the largest ratio the budget covers: bisected
+      for (int k = 0; k < 200 && hi - lo > 1e-6 * lo; ++k) {
+        const double mid = std::sqrt(lo * hi);  // geometric: zeta may be 1e100
+        (steps_per_time_constant(mid) <= budget ? lo : hi) = mid;
+      }
+      std::ostringstream msg;
+      msg << "over-damps every contact: the quickest (omega = " << shown(omega)
+          << " rad/s) creeps back with the time constant 1/(omega*(zeta - sqrt(zeta^2 - 1))) = "
+          << shown(1.0 / (omega / (zeta_c + std::sqrt((zeta_c - 1.0) * (zeta_c + 1.0))))) << " s, "
+          << shown(needed)
+          << " of the consolidation's steps (shrunk for the dashpots), more than "
+             "test.consolidation_max_steps = "
+          << config.test.consolidation_max_steps
+          << ": no contact could settle within the budget, and its criteria would read the "
+             "dashpots' forces as a static state. material.contact_damping_ratio must stay "
+             "below "
+          << shown(lo) << " for this budget (or raise test.consolidation_max_steps); got "
+          << shown(zeta_c);
+      throw InputError(source_of(config, "material.contact_damping_ratio"),
+                       "material.contact_damping_ratio", msg.str());
+    }
+  }
+}
+
 }  // namespace
 
 std::string overlap_culprit(const SceneConfig& config, const std::string& kn_field) {
@@ -209,85 +301,10 @@ void check_derived_scales(const SceneConfig& config, std::span<const double> rad
   require_normal(
       config, "the consolidation's step", alpha_c * dt_crit,
       with(crit_in, {{"material.contact_damping_ratio", mat.contact_damping_ratio, -1.0}}));
-  // A particle held by a wall oscillates at least at sqrt(kn_wall/m), and
-  // the step is stable only while ω·Δt < 2: the global damping, semi-
-  // implicit, keeps the undamped bound (its amplification at ω·Δt = 2 is −1
-  // whatever the damping). So a wall stiffer than kn/α² makes every step of
-  // the consolidation, at α·2·sqrt(m/kn), grow the motion of the particles
-  // on the walls: "consolidation diverged: overlap beyond limit" within a
-  // few hundred steps (hex_5x5 and fcc_4x4x4 at wall.kn = 30·kn). A user's
-  // "rigid" wall is the usual cause. The loading's step is checked against
-  // the consolidated network, walls included, with --allow-unstable for
-  // whoever wants to watch it diverge (stable_dt_ratio_of).
-  const double wall_limit = mat.particle.kn / (alpha_c * alpha_c);
-  if (!(mat.wall.kn < wall_limit)) {
-    std::ostringstream msg;
-    msg << shown(mat.wall.kn / mat.particle.kn)
-        << " times kn: a particle on a wall is stable only at steps below 2*sqrt(m/kn_wall) = "
-        << shown(std::sqrt(mat.particle.kn / mat.wall.kn))
-        << " of the critical step 2*sqrt(m/kn), less still with its contacts with other "
-           "particles, and the consolidation steps at "
-        << shown(alpha_c)
-        << " of it (alpha 0.2, shrunk for the contact dashpots): its walls would diverge. A wall "
-           "as stiff as the particles keeps its overlaps as small as theirs; material.wall.kn must "
-           "stay below kn/alpha^2 = "
-        << shown(wall_limit) << ", and well below (hex_5x5 stalls at 20 kn); got "
-        << shown(mat.wall.kn);
-    throw InputError(source_of(config, "material.wall.kn"), "material.wall.kn", msg.str());
-  }
-  // An over-damped contact (ζ_c > 1) creeps: its relative motion, m_eff·ẍ
-  // + c·ẋ + kn·x = 0 with c = 2ζ_c·sqrt(kn·m_eff), relaxes at best at the
-  // slow root ω·(ζ_c − sqrt(ζ_c² − 1)), about ω/(2ζ_c), while the step
-  // shrinks as 1/(2ζ_c·sqrt(Λ)) (consolidation_dashpot_factor): the steps
-  // per time constant grow as ζ_c². The quickest contact is the stiffest
-  // and lightest (ω = sqrt(2kn/m_min) for two of the smallest particles,
-  // sqrt(kn_wall/m_min) for one on a wall); where even it needs more than
-  // test.consolidation_max_steps steps for one time constant, no contact
-  // can settle within the budget. The servo then reads the wall's dashpot
-  // force as stress and the unbalanced-force ratio sees no inertia while
-  // the particles still creep: hex_5x5 ran all 2·10⁶ steps and failed at
-  // ζ_c = 1e6 (1e10, 1e100 the same), "consolidated" in 600 steps at 500
-  // and 1e4 (one time constant is 4.3·10⁶ and 1.7·10⁹ steps there), at 1e4
-  // into a state whose loading diverged ("kinetic energy growing without
-  // bound") at dt_ratio 1e-6 and 1e-30, below its stable 4.6e-6; it
-  // consolidated in 71 600, 208 400 and 429 000 steps at 50, 100 and 200
-  // (42 600, 170 000 and 680 000 per time constant), and at 300 and 342,
-  // its bound. The bounds at 2·10⁶ steps: hex_5x5 342, random_400 321,
-  // fcc_4x4x4 288; all consolidate at 1, 2 and 5.
-  const double zeta_c = mat.contact_damping_ratio;
-  if (zeta_c > 1.0) {
-    const double omega =
-        std::sqrt(std::max(2.0 * mat.particle.kn, mat.wall.kn) / m_min);  // the quickest contact
-    const auto steps_per_time_constant = [&](double zeta) {
-      const double slow_root = omega / (zeta + std::sqrt((zeta - 1.0) * (zeta + 1.0)));
-      const double step = consolidation_alpha(zeta, config.dimension, r_min, r_max) * dt_crit;
-      return 1.0 / (slow_root * step);
-    };
-    const double budget = static_cast<double>(config.test.consolidation_max_steps);
-    const double needed = steps_per_time_constant(zeta_c);
-    if (!(needed <= budget)) {
-      double lo = 1.0, hi = zeta_c;  // the largest ratio the budget covers: bisected
-      for (int k = 0; k < 200 && hi - lo > 1e-6 * lo; ++k) {
-        const double mid = std::sqrt(lo * hi);  // geometric: zeta may be 1e100
-        (steps_per_time_constant(mid) <= budget ? lo : hi) = mid;
-      }
-      std::ostringstream msg;
-      msg << "over-damps every contact: the quickest (omega = " << shown(omega)
-          << " rad/s) creeps back with the time constant 1/(omega*(zeta - sqrt(zeta^2 - 1))) = "
-          << shown(1.0 / (omega / (zeta_c + std::sqrt((zeta_c - 1.0) * (zeta_c + 1.0))))) << " s, "
-          << shown(needed)
-          << " of the consolidation's steps (shrunk for the dashpots), more than "
-             "test.consolidation_max_steps = "
-          << config.test.consolidation_max_steps
-          << ": no contact could settle within the budget, and its criteria would read the "
-             "dashpots' forces as a static state. material.contact_damping_ratio must stay "
-             "below "
-          << shown(lo) << " for this budget (or raise test.consolidation_max_steps); got "
-          << shown(zeta_c);
-      throw InputError(source_of(config, "material.contact_damping_ratio"),
-                       "material.contact_damping_ratio", msg.str());
-    }
-  }
+  // The walls against the consolidation's step.
+  check_wall_stiffness(config, alpha_c);
+  // Contact dashpots beyond critical: their creep against the budget.
+  check_contact_damping_budget(config, m_min, dt_crit, r_min, r_max);
 }
 
 }  // namespace demcal::detail
