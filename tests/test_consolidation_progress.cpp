@@ -175,53 +175,102 @@ TEST(ConsolidationProgress, SphereThreadsAndReportsDoNotChangeTheState) {
 }
 
 // The frictionless phase gets at most the first quarter of the budget
-// (critical_damping_after): one not static by then ends there and friction
-// goes on, at the light damping, which locks the packing; critical damping
-// comes a quarter later. Before, the frictionless phase crept on at
-// critical damping: random_400 with a 40 000-step budget, and random_500_3d
-// with 100 000, never came to rest (exit 1); the shipped budgets' runs,
-// whose frictionless phases end before the quarter, are unchanged.
+// (critical_damping_after), and at most half of it (frictionless_phase_cut):
+// one not static by then ends there and friction goes on, at the light
+// damping, which locks the packing; critical damping comes at twice the
+// quarter. Before, the frictionless phase crept on at critical damping:
+// random_400 with a 40 000-step budget, and random_500_3d with 100 000, never
+// came to rest (exit 1); the shipped budgets' runs, whose frictionless
+// phases end before the quarter, are unchanged. `cut`: the check phase 0
+// must end at.
 template <class State, class Consolidate>
-void expect_the_frictionless_phase_cut_at_the_quarter(const SceneConfig& c,
-                                                      Consolidate consolidate_it) {
-  const int64_t quarter = c.test.consolidation_max_steps / 4;
+void expect_the_frictionless_phase_cut(const SceneConfig& c, int64_t cut,
+                                       Consolidate consolidate_it) {
   std::vector<ConsolidationProgress> seen;
   ConsolidationOptions o;
   o.progress = [&](const ConsolidationProgress& p) { seen.push_back(p); };
   const State s = consolidate_it(o);
   ASSERT_TRUE(s.converged);
   ASSERT_FALSE(seen.empty());
-  // The premise: still frictionless and not static at the quarter.
-  const auto at_quarter =
-      std::find_if(seen.begin(), seen.end(), [&](const auto& p) { return p.steps == quarter; });
-  ASSERT_NE(at_quarter, seen.end());
-  EXPECT_EQ(at_quarter->phase, 0);
-  EXPECT_FALSE(at_quarter->stress_error < c.test.consolidation_tolerance &&
-               at_quarter->unbalanced_ratio < c.test.consolidation_unbalanced);
-  // Friction from the next check on, static within the light-damping quarter.
-  ASSERT_NE(at_quarter + 1, seen.end());
-  EXPECT_EQ((at_quarter + 1)->phase, 1);
-  EXPECT_GT(s.steps, quarter);
-  EXPECT_LE(s.steps, 2 * quarter);
-  std::printf("%s, budget %lld: frictionless until %lld, static at %lld\n", c.name.c_str(),
-              static_cast<long long>(c.test.consolidation_max_steps),
-              static_cast<long long>(quarter), static_cast<long long>(s.steps));
+  // The premise: still frictionless and not static at the cut.
+  const auto at_cut =
+      std::find_if(seen.begin(), seen.end(), [&](const auto& p) { return p.steps == cut; });
+  ASSERT_NE(at_cut, seen.end());
+  EXPECT_EQ(at_cut->phase, 0);
+  EXPECT_FALSE(at_cut->stress_error < c.test.consolidation_tolerance &&
+               at_cut->unbalanced_ratio < c.test.consolidation_unbalanced);
+  // Friction from the next check on, static within the budget.
+  ASSERT_NE(at_cut + 1, seen.end());
+  EXPECT_EQ((at_cut + 1)->phase, 1);
+  EXPECT_GT(s.steps, cut);
+  EXPECT_LE(s.steps, c.test.consolidation_max_steps);
+  std::printf("%s, contact damping %g, budget %lld: frictionless until %lld, static at %lld\n",
+              c.name.c_str(), c.material.contact_damping_ratio,
+              static_cast<long long>(c.test.consolidation_max_steps), static_cast<long long>(cut),
+              static_cast<long long>(s.steps));
 }
 
 TEST(ConsolidationProgress, AFrictionlessPhaseNotStaticByTheQuarterEndsThere) {
   SceneConfig c = load_config(test::shipped_config("random_400"));
   c.test.consolidation_max_steps = 40000;
   const Assembly a = make_assembly(c);
-  expect_the_frictionless_phase_cut_at_the_quarter<ConsolidatedState>(
-      c, [&](const ConsolidationOptions& o) { return consolidate(c, a, "", o); });
+  const int64_t quarter = c.test.consolidation_max_steps / 4;
+  expect_the_frictionless_phase_cut<ConsolidatedState>(
+      c, quarter, [&](const ConsolidationOptions& o) {
+        const ConsolidatedState s = consolidate(c, a, "", o);
+        EXPECT_LE(s.steps, 2 * quarter);  // at the light damping
+        return s;
+      });
 }
 
 TEST(ConsolidationProgress, AFrictionlessSpherePhaseNotStaticByTheQuarterEndsThere) {
   SceneConfig c = load_config(test::shipped_config("random_500_3d"));
   c.test.consolidation_max_steps = 100000;
   const SphereAssembly a = make_sphere_assembly(c);
-  expect_the_frictionless_phase_cut_at_the_quarter<TriaxialState>(
-      c, [&](const ConsolidationOptions& o) { return consolidate_triaxial(c, a, o); });
+  const int64_t quarter = c.test.consolidation_max_steps / 4;
+  expect_the_frictionless_phase_cut<TriaxialState>(c, quarter, [&](const ConsolidationOptions& o) {
+    const TriaxialState s = consolidate_triaxial(c, a, o);
+    EXPECT_LE(s.steps, 2 * quarter);  // at the light damping
+    return s;
+  });
+}
+
+// Contact dashpots strong enough that the consolidation's step shrinks
+// below a quarter of the undamped one (S < 1/4) put the quarter in
+// simulated time past the budget's end: the frictionless phase had no cut,
+// crept on to the end of the budget and failed (exit 1: random_400 at ζ_c 1
+// with a 60 000-step budget, random_500_3d at ζ_c 0.5 with 100 000; at the
+// shipped 2·10⁶, random_500_3d at ζ_c 5 after 2·10⁶ frictionless steps).
+// Now it ends at half the budget, and friction locks the packing.
+template <class State, class Make, class Consolidate>
+void expect_a_cut_at_half_the_budget(SceneConfig c, double zeta_c, int64_t budget, Make make,
+                                     Consolidate consolidate_it) {
+  c.material.contact_damping_ratio = zeta_c;
+  c.test.consolidation_max_steps = budget;
+  const auto a = make(c);
+  const auto radii = std::minmax_element(a.r.begin(), a.r.end());
+  const double shrink = consolidation_step_shrink(
+      consolidation_alpha(zeta_c, c.dimension, *radii.first, *radii.second));
+  ASSERT_LT(shrink, 0.25);  // the premise: the quarter lies past the budget
+  ASSERT_GT(critical_damping_after(budget, shrink), budget);
+  ASSERT_EQ(frictionless_phase_cut(budget, shrink), budget / 2);
+  expect_the_frictionless_phase_cut<State>(
+      c, budget / 2, [&](const ConsolidationOptions& o) { return consolidate_it(c, a, o); });
+}
+
+TEST(ConsolidationProgress, WithStrongContactDashpotsTheFrictionlessPhaseEndsAtHalfTheBudget) {
+  expect_a_cut_at_half_the_budget<ConsolidatedState>(
+      load_config(test::shipped_config("random_400")), 1.0, 60000,
+      [](const SceneConfig& c) { return make_assembly(c); },
+      [](const SceneConfig& c, const Assembly& a, const ConsolidationOptions& o) {
+        return consolidate(c, a, "", o);
+      });
+  expect_a_cut_at_half_the_budget<TriaxialState>(
+      load_config(test::shipped_config("random_500_3d")), 0.5, 100000,
+      [](const SceneConfig& c) { return make_sphere_assembly(c); },
+      [](const SceneConfig& c, const SphereAssembly& a, const ConsolidationOptions& o) {
+        return consolidate_triaxial(c, a, o);
+      });
 }
 
 // One callback serves consolidations one after another (scaling's sizes):

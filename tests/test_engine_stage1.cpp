@@ -290,10 +290,10 @@ std::string with_phase0_marker(const std::string& deck) {
 // disks, no contact damping: its phase 0 ends at light damping (step S0,
 // 2 600 here) and phase 1 needs more than one check interval; the same deck
 // with a budget whose last check is S0 + 200 or S0 takes the same path to
-// S0 once its quarter is the budget's last check (no fallback before:
-// without that edit phase 0 would end there only at critical damping, which
-// a budget cannot aim at; a shrunk deck's quarter is the last check by
-// itself when (cons_max_steps/4)/S passes it).
+// S0 once its cut and quarter are the budget's last check (without that
+// edit phase 0 would be cut at half the budget, before S0; a budget of a
+// few hundred steps puts the cut there by itself, frictionless_phase_cut
+// rounded up to a check).
 TEST(EngineLammpsStage1, WhenPhase0EndsAtTheBudgetsLastChecksPhase1StopsThereWithQuit2) {
   DEMCAL_FIND_PROGRAM(lmp, "lmp", "lammps", "the deck is not run");
   SceneConfig c = load_config(test::shipped_config("random_400"));
@@ -319,13 +319,15 @@ TEST(EngineLammpsStage1, WhenPhase0EndsAtTheBudgetsLastChecksPhase1StopsThereWit
   ASSERT_GT(steps - s0, 200) << "phase 1 was static at its first check: nothing to test";
   const std::string budget_line = line_of(deck, "variable cons_max_steps equal ");
   const std::string quarter_line = line_of(deck, "variable        cons_quarter equal ");
+  const std::string cut_line = line_of(deck, "variable        cons_cut equal ");
   for (int64_t budget : {s0 + 200, s0 + 399, s0}) {
     SCOPED_TRACE("cons_max_steps " + std::to_string(budget));
     std::string edited = replaced(deck, budget_line,
                                   "variable cons_max_steps equal " + std::to_string(budget) + "\n");
-    edited = replaced(edited, quarter_line,
-                      "variable        cons_quarter equal "
-                      "$(v_cons_check*floor(v_cons_max_steps/v_cons_check))\n");
+    for (const std::string* line : {&quarter_line, &cut_line})
+      edited = replaced(edited, *line,
+                        line->substr(0, line->find(" equal ")) +
+                            " equal $(v_cons_check*floor(v_cons_max_steps/v_cons_check))\n");
     const test::DeckRun run =
         test::run_deck(lmp, dir / std::to_string(budget), edited, r.files, args);
     EXPECT_EQ(phase0_end(run.log), s0) << run.log;
@@ -470,56 +472,71 @@ TEST(EngineLammpsStage1, WithContactDashpotsTheDeckConsolidatesARandomSampleWith
       static_cast<long long>(d.steps));
 }
 
-// Stage 1 cuts a frictionless phase not static by cons_quarter there, as
+// Stage 1 cuts a frictionless phase not static by cons_cut there, as
 // demcal's run_consolidation does, and goes on with friction at the light
 // damping, critical damping only from cons_capped (twice the quarter): the
 // gases of the demcal tests (ConsolidationProgress.AFrictionless*), 400
 // disks with a 40 000-step budget and 500 spheres with 100 000, whose
-// phase 0 is not static at the quarter in demcal. The deck before ran phase
-// 0 on at critical damping to the budget's end (quit 2).
+// phase 0 is not static at the quarter in demcal; and the same gases with
+// contact dashpots strong enough that the quarter lies past the budget
+// (ConsolidationProgress.WithStrongContactDashpots*: ζ_c 1 and 0.5), whose
+// cut is half the budget (frictionless_phase_cut). The deck before ran
+// phase 0 on at critical damping to the budget's end (quit 2); then, with
+// such dashpots, at the light damping (quit 2 too: the 3D deck after
+// 100 000 steps, wall stress error 0.4 %).
 TEST(EngineLammpsStage1, AFrictionlessPhaseNotStaticByTheQuarterEndsThereAsDemcals) {
   DEMCAL_FIND_PROGRAM(lmp, "lmp", "lammps", "the deck is not run");
   const AlgorithmSpec p = stage1_loading();
   struct Case {
     std::string name;
     int64_t budget;
+    int64_t cut;  ///< where phase 0 must end
+    bool light;   ///< static before critical damping's switch (within 2·cut)
     ExportResult deck;
   };
   std::vector<Case> cases;
-  {
+  for (const double zeta_c : {0.0, 1.0}) {
     SceneConfig c = load_config(test::shipped_config("random_400"));
-    c.test.consolidation_max_steps = 40000;
-    cases.push_back({"2D", c.test.consolidation_max_steps,
+    c.material.contact_damping_ratio = zeta_c;
+    c.test.consolidation_max_steps = zeta_c > 0.0 ? 60000 : 40000;
+    const int64_t budget = c.test.consolidation_max_steps;
+    cases.push_back({zeta_c > 0.0 ? "2D zeta_c 1" : "2D zeta_c 0", budget,
+                     zeta_c > 0.0 ? budget / 2 : budget / 4, zeta_c == 0.0,
                      export_deck(c, p, make_assembly(c), stage1_options<ExportOptions>("r"))});
   }
-  {
+  for (const double zeta_c : {0.0, 0.5}) {
     SceneConfig c = load_config(test::shipped_config("random_500_3d"));
+    c.material.contact_damping_ratio = zeta_c;
     c.test.consolidation_max_steps = 100000;
+    const int64_t budget = c.test.consolidation_max_steps;
     cases.push_back(
-        {"3D", c.test.consolidation_max_steps,
+        {zeta_c > 0.0 ? "3D zeta_c 0.5" : "3D zeta_c 0", budget,
+         zeta_c > 0.0 ? budget / 2 : budget / 4, zeta_c == 0.0,
          export_3d_decks(c, p, make_sphere_assembly(c), stage1_options<Export3dOptions>("r"))});
   }
   const test::TempDir dir("engine_stage1_cut");
   for (const Case& k : cases) {
     SCOPED_TRACE(k.name);
-    const test::DeckRun run =
-        test::run_deck(lmp, dir / k.name, with_phase0_marker(k.deck.deck), k.deck.files,
-                       {"-var", "run_steps", "0", "-screen", "none"});
+    const test::DeckRun run = test::run_deck(lmp, dir / std::to_string(&k - cases.data()),
+                                             with_phase0_marker(k.deck.deck), k.deck.files,
+                                             {"-var", "run_steps", "0", "-screen", "none"});
     ASSERT_EQ(run.status, 0) << run.log.substr(run.log.size() > 3000 ? run.log.size() - 3000 : 0);
-    const int64_t quarter = k.budget / 4;
-    EXPECT_EQ(echoed(run.log, "cons_quarter"), static_cast<double>(quarter));
-    EXPECT_EQ(echoed(run.log, "cons_capped"), static_cast<double>(2 * quarter));
-    EXPECT_EQ(phase0_end(run.log), quarter) << "phase 0 did not end at the quarter";
+    EXPECT_EQ(echoed(run.log, "cons_cut"), static_cast<double>(k.cut));
+    if (k.light) {  // undamped contacts: the quarter is the cut, capped twice it
+      EXPECT_EQ(echoed(run.log, "cons_quarter"), static_cast<double>(k.cut));
+      EXPECT_EQ(echoed(run.log, "cons_capped"), static_cast<double>(2 * k.cut));
+    }
+    EXPECT_EQ(phase0_end(run.log), k.cut) << "phase 0 did not end at the cut";
     std::smatch m;
     ASSERT_TRUE(
         std::regex_search(run.log, m, std::regex("\ndemcal deck: consolidated in ([0-9]+) steps")))
         << run.log;
     const int64_t steps = std::stoll(m[1].str());
-    EXPECT_GT(steps, quarter);
-    EXPECT_LE(steps, 2 * quarter);  // at the light damping
+    EXPECT_GT(steps, k.cut);
+    EXPECT_LE(steps, k.light ? 2 * k.cut : k.budget);
     EXPECT_EQ(run.log.find("\nvariable cons_critical equal 1\n"), std::string::npos);
     std::printf("%s, budget %lld: the deck's frictionless phase until %lld, static at %lld\n",
-                k.name.c_str(), static_cast<long long>(k.budget), static_cast<long long>(quarter),
+                k.name.c_str(), static_cast<long long>(k.budget), static_cast<long long>(k.cut),
                 static_cast<long long>(steps));
   }
 }

@@ -160,11 +160,12 @@ ConsolidationOutcome run_consolidation(Sample& world, const TestSpec& test, doub
   // near 0.2 % and the unbalanced-force ratio near 0.01 for the rest of a
   // 2·10⁶-step budget.
   //
-  // The frictionless phase gets at most those first steps (the quarter): a
+  // The frictionless phase gets at most those first steps (the quarter),
+  // and at most half the budget (frictionless_phase_cut: strong dashpots
+  // put the quarter past the half, from S < 1/4 past the budget's end): a
   // phase 0 not static by then ends there, friction goes on with the light
-  // damping, and critical damping comes a quarter later (twice the
-  // quarter's step). A frictionless packing at sigma3 can creep toward a
-  // denser state for far longer than a frictional one takes to lock (a
+  // damping, and critical damping comes at twice the quarter's step. A frictionless packing at
+  // sigma3 can creep toward a denser state for far longer than a frictional one takes to lock (a
   // likely reason, not measured: its overlaps there are ~1e-4 of the
   // radius, near jamming, where the softest collective modes may fall below
   // the light damping's ζ·ω_c and creep, over-damped). Measured: 5 000
@@ -173,8 +174,9 @@ ConsolidationOutcome run_consolidation(Sample& world, const TestSpec& test, doub
   // 560 000 steps, while friction switched on at 150 000 locked it in
   // 1 400 steps; 500 spheres in a 100 000-step budget: no static state in
   // it, frictionless, then 28 000 steps with the cut.
-  const int64_t critical_after =
-      critical_damping_after(max_steps, consolidation_step_shrink(settle.dt_ratio));
+  const double shrink = consolidation_step_shrink(settle.dt_ratio);
+  const int64_t critical_after = critical_damping_after(max_steps, shrink);
+  const int64_t cut_after = frictionless_phase_cut(max_steps, shrink);
   int64_t switch_at = critical_after;  ///< critical damping from here (phase 1)
   ConsolidationOutcome out;
   {
@@ -215,7 +217,7 @@ ConsolidationOutcome run_consolidation(Sample& world, const TestSpec& test, doub
       done = err < test.consolidation_tolerance &&
              out.unbalanced_ratio < test.consolidation_unbalanced;
       if (out.steps >= max_steps) break;
-      if (out.phase == 0 && !done && out.steps >= critical_after) {  // capped
+      if (out.phase == 0 && !done && out.steps >= cut_after) {  // capped
         switch_at = 2 * critical_after;
         break;
       }

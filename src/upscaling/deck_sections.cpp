@@ -399,7 +399,7 @@ std::string lammps_consolidation_comment(double zeta, const std::string& particl
                                          const std::string& start_walls) {
   std::ostringstream s;
   s << "# mu until static again; the frictionless phase at most until step\n"
-    << "# cons_quarter (friction goes on there if it is not static: a frictionless\n"
+    << "# cons_cut (friction goes on there if it is not static: a frictionless\n"
     << "# packing at sigma3 can creep for far longer), critical damping (zeta 1,\n"
     << "# timestep * f(1)/f(" << num(zeta) << ")) from step cons_switch on if not static by\n"
     << "# then: cons_quarter, or cons_capped when the frictionless phase was cut\n"
@@ -456,7 +456,14 @@ std::string lammps_consolidation_quarter(double alpha, int64_t max_steps) {
        "$(v_cons_check*ceil(2*ceil(floor(v_cons_max_steps/4)/"
     << exact(shrink) << ")/v_cons_check))\n"
     << "variable        cons_capped equal "
-       "$((v_cons_after2+v_cons_last-abs(v_cons_after2-v_cons_last))/2)\n";
+       "$((v_cons_after2+v_cons_last-abs(v_cons_after2-v_cons_last))/2)\n"
+    << "# the frictionless phase ends at cons_quarter, at most at the first check at\n"
+    << "# or after half the budget (friction keeps the other half; demcal's\n"
+    << "# frictionless_phase_cut: step " << frictionless_phase_cut(max_steps, shrink) << ")\n"
+    << "variable        cons_half equal "
+       "$(v_cons_check*ceil(floor(v_cons_max_steps/2)/v_cons_check))\n"
+    << "variable        cons_cut equal "
+       "$((v_cons_quarter+v_cons_half-abs(v_cons_quarter-v_cons_half))/2)\n";
   return s.str();
 }
 
@@ -640,7 +647,7 @@ std::string lammps_consolidation_runs(double gamma_n, double dt_damped, const st
   s << "# phase 0: frictionless\n"
     << "pair_style      gran/hooke/history ${kn} ${kt} " << num(gamma_n) << " 0.0 0 0\n"
     << "variable        cons_critical equal 0\n"
-    << "run             ${cons_quarter} upto\n"
+    << "run             ${cons_cut} upto\n"
     << "if              \"${cons_static} == 0 && $(step) >= ${cons_last}\" then \"print 'demcal "
        "deck: consolidation (frictionless) did not reach a static state in ${cons_max_steps} "
        "steps: raise cons_max_steps'\" \"quit 2\"\n"

@@ -315,17 +315,18 @@ std::string lammps_consolidation_parameters(const TestSpec& test);
 /// explicit damper's factor, as the loading's deck_timing).
 double consolidation_dt(double alpha, double zeta, double dt_crit);
 
-/// Stage 1's cons_quarter, cons_capped and cons_last (runs end on check
-/// steps): the budget's last check, and the check at which a frictionless
-/// phase not yet static ends and from which the friction phase runs at
-/// critical damping, demcal's (scene/biaxial.hpp, critical_damping_after;
+/// Stage 1's cons_quarter, cons_capped, cons_cut and cons_last (runs end on
+/// check steps): the budget's last check, and the check from which the
+/// friction phase runs at critical damping, demcal's (scene/biaxial.hpp, critical_damping_after;
 /// cons_capped: the first check at or after twice it, the switch when the
-/// frictionless phase was cut at cons_quarter): the first
+/// frictionless phase was cut at cons_cut): the first
 /// check at or after a quarter of cons_max_steps in the simulated time of
 /// the undamped step, (cons_max_steps/4)/S steps, S the step shrink
 /// (consolidation_step_shrink: 1 without contact dashpots), at most the
 /// last, computed by LAMMPS from cons_max_steps with S's 17 digits (the
-/// same doubles as demcal's). `alpha`: stage 1's, demcal's consolidation α
+/// same doubles as demcal's); and cons_cut, where a frictionless phase not
+/// yet static ends: cons_quarter, at most the first check at or after half
+/// the budget (frictionless_phase_cut). `alpha`: stage 1's, demcal's consolidation α
 /// (shrunk for contact dashpots); `max_steps` the exported budget, for the
 /// comment.
 std::string lammps_consolidation_quarter(double alpha, int64_t max_steps);

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <functional>
@@ -128,10 +129,9 @@ double consolidation_alpha(double zeta_c, int dimension, double r_min, double r_
 inline double consolidation_step_shrink(double dt_ratio) {
   return dt_ratio / AlgorithmSpec{}.dt_ratio;
 }
-/// The step at which a frictionless phase not yet static ends (friction
-/// goes on: the first check at or after it), and from which the friction
-/// phase runs at critical damping (twice it when the frictionless phase was
-/// cut there; run_consolidation): a quarter of the budget
+/// The step from which the friction phase runs at critical damping (the
+/// first check at or after it; twice it when the frictionless phase was cut:
+/// frictionless_phase_cut, run_consolidation): a quarter of the budget
 /// `max_steps` in the simulated time of the undamped step, i.e. as many more
 /// steps as the step shrank (`step_shrink`: consolidation_step_shrink;
 /// scene/protocol_steps.hpp run_consolidation says why). The one home of the
@@ -141,6 +141,20 @@ inline int64_t critical_damping_after(int64_t max_steps, double step_shrink) {
   return step_shrink < 1.0
              ? static_cast<int64_t>(std::ceil(static_cast<double>(max_steps / 4) / step_shrink))
              : max_steps / 4;
+}
+/// The step at which a frictionless phase not yet static ends (friction
+/// goes on: the first check at or after it): critical_damping_after, but at
+/// most half the budget, so that friction always has the other half to lock
+/// the packing. The half binds where contact dashpots shrank the step below
+/// half the undamped one (step_shrink < 1/2: ζ_c above 0.19 in 3D and 0.27
+/// in 2D at a radius ratio of 5/3); without it, below step_shrink 1/4 (ζ_c
+/// above 0.47 and 0.68) the quarter lay beyond the budget, and a
+/// frictionless phase that creeps (run_consolidation) ran the whole budget
+/// and failed. The one home
+/// of the rule: demcal's consolidations and the decks' stage 1
+/// (deck::lammps_consolidation_quarter, cons_cut).
+inline int64_t frictionless_phase_cut(int64_t max_steps, double step_shrink) {
+  return std::min(critical_damping_after(max_steps, step_shrink), max_steps / 2);
 }
 /// Compressive pressure on a wall from the particles [Pa].
 double wall_pressure(const World& world, WallSide side);
