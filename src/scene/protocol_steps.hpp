@@ -72,8 +72,10 @@ struct ConsolidationOutcome {
 /// consolidation does not depend on it.
 class ConsolidationClock {
  public:
-  explicit ConsolidationClock(const TestSpec& test)
-      : test_(test), start_(std::chrono::steady_clock::now()) {}
+  /// `phase0_end`: the check at which a frictionless phase not static ends
+  /// (frictionless_phase_cut's), where its estimate stops.
+  ConsolidationClock(const TestSpec& test, int64_t phase0_end)
+      : test_(test), phase0_end_(phase0_end), start_(std::chrono::steady_clock::now()) {}
 
   ConsolidationProgress check(int phase, int64_t steps, double stress_error,
                               double unbalanced_ratio) {
@@ -103,6 +105,9 @@ class ConsolidationClock {
       if (rate > 0.0 && std::isfinite(d0))
         p.steps_to_go =
             static_cast<int64_t>(std::ceil(std::min(d / rate, static_cast<double>(p.max_steps))));
+      // the frictionless phase ends at its cut, static or not
+      if (phase == 0 && p.steps_to_go > 0 && steps < phase0_end_)
+        p.steps_to_go = std::min(p.steps_to_go, phase0_end_ - steps);
     }
     if (p.steps_to_go >= 0)
       p.remaining_s = std::min(p.remaining_max_s, static_cast<double>(p.steps_to_go) * per_step);
@@ -112,6 +117,7 @@ class ConsolidationClock {
  private:
   static constexpr size_t kWindow = 10;  ///< checks the trend is taken over
   const TestSpec& test_;
+  int64_t phase0_end_;
   std::chrono::steady_clock::time_point start_;
   int phase_ = -1;
   std::deque<std::pair<int64_t, double>> window_;
@@ -186,7 +192,8 @@ ConsolidationOutcome run_consolidation(Sample& world, const TestSpec& test, doub
     if constexpr (walls == 6) centres[2] = world.z();
     out.stray_note = stray_particle_note(centres, world.radius());
   }
-  ConsolidationClock clock(test);
+  // the check at which phase 0 is cut (the first at or after cut_after)
+  ConsolidationClock clock(test, (cut_after + kCheckEvery - 1) / kCheckEvery * kCheckEvery);
   bool critical = false;
   for (out.phase = 0; out.phase < 2; ++out.phase) {
     world.set_particle_friction(out.phase == 0 ? 0.0 : friction);
