@@ -256,12 +256,16 @@ double echoed(const std::string& log, const std::string& name) {
   return std::stod(m[1].str());
 }
 
+/// The budget's last check in demcal's consolidation (every cons_check =
+/// 200 steps from 0): the first at or after the budget.
+int64_t demcal_last_check(int64_t budget) { return (budget + 199) / 200 * 200; }
+
 /// Where demcal's consolidation switches to critical damping, as a check of
-/// stage 1 (every cons_check = 200 steps from 0): the first check at or after
-/// critical_damping_after, never beyond the budget's last check.
+/// stage 1: the first check at or after critical_damping_after, never
+/// beyond the budget's last check (a switch there has no step left).
 int64_t demcal_switch_check(int64_t budget, double shrink) {
   const int64_t after = critical_damping_after(budget, shrink);
-  return std::min((after + 199) / 200 * 200, budget / 200 * 200);
+  return std::min((after + 199) / 200 * 200, demcal_last_check(budget));
 }
 
 /// The step at which stage 1's phase 0 ended in `log` (the marker
@@ -279,21 +283,25 @@ std::string with_phase0_marker(const std::string& deck) {
 }
 
 // Phase 0 may end at the budget's last check or at the one before (static,
-// at the light damping, when the quarter is the budget's end); phase 1's
-// first check interval then reaches or passes cons_last. demcal's
-// consolidation stops there, not static (it runs phase 1's first check
-// interval, then its budget is spent); the deck must too: quit 2 with its
-// message. The deck before ran phase 1 on `run ${cons_last} upto` when its
-// contacts had no dashpots: 0 steps at the last check, after which LAMMPS
-// stopped with "Compute used in variable between runs is not current", and
-// an error ("Invalid run command upto value") past it. A sample of 30
-// disks, no contact damping: its phase 0 ends at light damping (step S0,
-// 2 600 here) and phase 1 needs more than one check interval; the same deck
-// with a budget whose last check is S0 + 200 or S0 takes the same path to
-// S0 once its cut and quarter are the budget's last check (without that
-// edit phase 0 would be cut at half the budget, before S0; a budget of a
-// few hundred steps puts the cut there by itself, frictionless_phase_cut
-// rounded up to a check).
+// at the light damping, when the cut is the budget's end); phase 1's first
+// check interval then reaches or passes cons_last. demcal's consolidation
+// stops there, not static (it runs phase 1's first check interval, then
+// its budget is spent); the deck must too: quit 2 with its message. The
+// deck before ran phase 1 on `run ${cons_last} upto` when its contacts had
+// no dashpots: 0 steps at the last check, after which LAMMPS stopped with
+// "Compute used in variable between runs is not current", and an error
+// ("Invalid run command upto value") past it. A sample of 30 disks, no
+// contact damping: its phase 0 ends at light damping (step S0, 2 600 here)
+// and phase 1 needs more than one check interval, static at step E; the
+// same deck with a budget whose last check is S0 + 200 or S0 takes the same
+// path to S0 once its cut and quarter are the budget's last check (without
+// that edit phase 0 would be cut at half the budget, before S0; a budget of
+// a few hundred steps puts the cut there by itself, frictionless_phase_cut
+// rounded up to a check). The budget's last check is demcal's, the first at
+// or after it (its loop ends at the first check with steps >= the
+// budget): a budget of E − 1 steps consolidates in E steps, as demcal's
+// does. The deck before ended at the last check at or before it (E − 200:
+// quit 2), and a budget of S0 + 199 there at S0.
 TEST(EngineLammpsStage1, WhenPhase0EndsAtTheBudgetsLastChecksPhase1StopsThereWithQuit2) {
   DEMCAL_FIND_PROGRAM(lmp, "lmp", "lammps", "the deck is not run");
   SceneConfig c = load_config(test::shipped_config("random_400"));
@@ -308,10 +316,9 @@ TEST(EngineLammpsStage1, WhenPhase0EndsAtTheBudgetsLastChecksPhase1StopsThereWit
   const test::DeckRun full = test::run_deck(lmp, dir / "full", deck, r.files, args);
   ASSERT_EQ(full.status, 0) << full.log;
   const int64_t s0 = phase0_end(full.log);
+  const std::regex done("\ndemcal deck: consolidated in ([0-9]+) steps");
   std::smatch m;
-  ASSERT_TRUE(
-      std::regex_search(full.log, m, std::regex("\ndemcal deck: consolidated in ([0-9]+) steps")))
-      << full.log;
+  ASSERT_TRUE(std::regex_search(full.log, m, done)) << full.log;
   const int64_t steps = std::stoll(m[1].str());
   ASSERT_GT(s0, 0) << full.log;
   ASSERT_EQ(s0 % 200, 0);
@@ -320,22 +327,28 @@ TEST(EngineLammpsStage1, WhenPhase0EndsAtTheBudgetsLastChecksPhase1StopsThereWit
   const std::string budget_line = line_of(deck, "variable cons_max_steps equal ");
   const std::string quarter_line = line_of(deck, "variable        cons_quarter equal ");
   const std::string cut_line = line_of(deck, "variable        cons_cut equal ");
-  for (int64_t budget : {s0 + 200, s0 + 399, s0}) {
+  for (int64_t budget : {s0 + 200, s0 + 199, s0, s0 - 1, steps - 1}) {
     SCOPED_TRACE("cons_max_steps " + std::to_string(budget));
     std::string edited = replaced(deck, budget_line,
                                   "variable cons_max_steps equal " + std::to_string(budget) + "\n");
     for (const std::string* line : {&quarter_line, &cut_line})
       edited = replaced(edited, *line,
-                        line->substr(0, line->find(" equal ")) +
-                            " equal $(v_cons_check*floor(v_cons_max_steps/v_cons_check))\n");
+                        line->substr(0, line->find(" equal ")) + " equal $(v_cons_last)\n");
     const test::DeckRun run =
         test::run_deck(lmp, dir / std::to_string(budget), edited, r.files, args);
+    EXPECT_EQ(echoed(run.log, "cons_last"), static_cast<double>(demcal_last_check(budget)));
     EXPECT_EQ(phase0_end(run.log), s0) << run.log;
-    EXPECT_EQ(run.status, 2) << run.log;
-    EXPECT_NE(run.log.find("\ndemcal deck: consolidation did not reach a static state in " +
-                           std::to_string(budget) + " steps"),
-              std::string::npos)
-        << run.log;
+    if (steps <= demcal_last_check(budget)) {  // the same path to a static state
+      EXPECT_EQ(run.status, 0) << run.log;
+      ASSERT_TRUE(std::regex_search(run.log, m, done)) << run.log;
+      EXPECT_EQ(std::stoll(m[1].str()), steps);
+    } else {
+      EXPECT_EQ(run.status, 2) << run.log;
+      EXPECT_NE(run.log.find("\ndemcal deck: consolidation did not reach a static state in " +
+                             std::to_string(budget) + " steps"),
+                std::string::npos)
+          << run.log;
+    }
     EXPECT_EQ(run.log.find("ERROR"), std::string::npos) << run.log;
   }
 }
@@ -410,7 +423,7 @@ TEST(EngineLammpsStage1, TheCriticalFallbackComesAtDemcalsCheck) {
       ASSERT_EQ(run.status, 0) << run.log;
       const int64_t expected = demcal_switch_check(budget, shrink);
       EXPECT_EQ(echoed(run.log, "cons_quarter"), static_cast<double>(expected)) << run.log;
-      ++(expected < budget / 200 * 200 ? switching : never);
+      ++(expected < demcal_last_check(budget) ? switching : never);
     }
   }
   // both branches: a switch within the budget and none

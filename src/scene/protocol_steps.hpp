@@ -12,11 +12,13 @@
 // quarter of the budget has not brought the sample to rest, the rest runs
 // at critical damping (the paper's start point) — a quarter in simulated
 // time of the undamped step, so later where contact dashpots shrink the
-// step (run_consolidation says why).
+// step (run_consolidation says why). A frictionless phase not static by
+// then ends there, at half the budget at the latest, and friction goes on.
 //
-// Private to src/scene. The consolidation's critical-damping switch
-// (critical_damping_after, consolidation_step_shrink), which the decks'
-// stage 1 (src/upscaling) shares, is public: demcal/scene/biaxial.hpp.
+// Private to src/scene. The consolidation's critical-damping switch and
+// frictionless cut (critical_damping_after, frictionless_phase_cut,
+// consolidation_step_shrink), which the decks' stage 1 (src/upscaling)
+// shares, are public: demcal/scene/biaxial.hpp.
 #pragma once
 
 #include <algorithm>

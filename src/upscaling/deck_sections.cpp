@@ -443,14 +443,15 @@ std::string lammps_consolidation_quarter(double alpha, int64_t max_steps) {
   else
     s << "# (demcal's critical_damping_after: step ";
   s << critical_damping_after(max_steps, shrink) << "\n"
-    << "# at cons_max_steps " << max_steps << "), at most the budget\n"
-    << "variable        cons_last equal $(v_cons_check*floor(v_cons_max_steps/v_cons_check))\n"
+    << "# at cons_max_steps " << max_steps << "), at most the budget's last check,\n"
+    << "# the first at or after cons_max_steps (demcal's consolidation, too, ends there)\n"
+    << "variable        cons_last equal $(v_cons_check*ceil(v_cons_max_steps/v_cons_check))\n"
     << "variable        cons_after equal "
        "$(v_cons_check*ceil(ceil(floor(v_cons_max_steps/4)/"
     << exact(shrink) << ")/v_cons_check))\n"
     << "variable        cons_quarter equal "
        "$((v_cons_after+v_cons_last-abs(v_cons_after-v_cons_last))/2)\n"
-    << "# a frictionless phase cut at cons_quarter: critical damping from the first\n"
+    << "# a frictionless phase cut at cons_cut: critical damping from the first\n"
     << "# check at or after twice demcal's critical_damping_after, at most the budget\n"
     << "variable        cons_after2 equal "
        "$(v_cons_check*ceil(2*ceil(floor(v_cons_max_steps/4)/"

@@ -316,7 +316,8 @@ std::string lammps_consolidation_parameters(const TestSpec& test);
 double consolidation_dt(double alpha, double zeta, double dt_crit);
 
 /// Stage 1's cons_quarter, cons_capped, cons_cut and cons_last (runs end on
-/// check steps): the budget's last check, and the check from which the
+/// check steps): the budget's last check (the first at or after
+/// cons_max_steps, where demcal's consolidation ends), and the check from which the
 /// friction phase runs at critical damping, demcal's (scene/biaxial.hpp, critical_damping_after;
 /// cons_capped: the first check at or after twice it, the switch when the
 /// frictionless phase was cut at cons_cut): the first
@@ -344,7 +345,8 @@ std::string lammps_consolidation_comment(double zeta, const std::string& particl
 
 /// Stage 1's first lines after its jump: the servo's cap (kServoMoveCapRatio
 /// r_min), the light step `dt_light` (alpha·f(zeta)·dt_crit), the start step
-/// cons_s0, cons_quarter and cons_last (lammps_consolidation_quarter).
+/// cons_s0, and cons_quarter, cons_capped, cons_cut and cons_last
+/// (lammps_consolidation_quarter).
 std::string lammps_consolidation_start(double alpha, double dt_light, int64_t max_steps);
 
 /// Stage 1's static criterion, demcal's: every wall within cons_tol of
@@ -358,7 +360,7 @@ std::string lammps_consolidation_criterion(int dimension,
                                            const std::vector<std::string>& axis_names);
 
 /// Stage 1's runs, demcal's run_consolidation: frictionless until static,
-/// at most until cons_quarter, then friction on until static; critical
+/// at most until cons_cut, then friction on until static; critical
 /// damping (`critical`: its fix viscous line, step dt_damped) in the
 /// friction phase from cons_quarter, or cons_capped when the frictionless
 /// phase was cut (lammps_consolidation_quarter), none when that is the

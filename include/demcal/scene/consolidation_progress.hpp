@@ -22,8 +22,8 @@ struct ConsolidationProgress {
   /// two criteria to their tolerances, max(ln(err/tol), ln(ufr/ufr_tol)),
   /// taken as linear in steps over the phase's last ten checks (both decay
   /// exponentially once the packing has formed); in the frictionless phase
-  /// at most the steps to its cut, where it ends static or not
-  /// (frictionless_phase_cut). −1 when that distance is not shrinking (a
+  /// before its cut, at most the steps to the cut, where it ends static or
+  /// not (frictionless_phase_cut). −1 when that distance is not shrinking (a
   /// gas still being compressed, noise); 0 when both criteria are met.
   int64_t steps_to_go = -1;
   /// Estimated wall time until this phase is static: steps_to_go at the
