@@ -238,6 +238,49 @@ TEST_F(CliEndToEnd, AnOverlapAtSigma3OutOfRangeNamesTheExtremeFieldAndItsSet) {
                    {"--set test.lateral_stress=1e5: test.lateral_stress: ", "material.kn at most"});
 }
 
+// The 2D bound on the overlap at sigma3, 2*sigma3*t/kn, is checked when the
+// config is read (check_lateral_stress), and it named the config file and
+// test.lateral_stress whatever had made it too large: `--set material.kn=1e3`
+// read "configs/hex_5x5.json: test.lateral_stress: must be at most 25 Pa".
+// Now the rule of the checks with the assembly (above): the field a --set
+// changed (sigma3 when both or neither were), its --set, both bounds.
+TEST_F(CliEndToEnd, TheParseTimeOverlapAtSigma3NamesTheFieldASetChanged) {
+  const std::string out = (dir_ / "work" / "out").string();
+  struct Case {
+    std::vector<std::string> sets;
+    std::string named, what;
+  };
+  const std::vector<Case> cases = {
+      {{"material.kn=1e3", "material.kt=1e2"},
+       "--set material.kn=1e3: material.kn: ",
+       "test.lateral_stress must be at most 25 Pa, or material.kn at least 4e+06 N/m; got 1000"},
+      {{"material.wall.kn=1e3"},
+       "--set material.wall.kn=1e3: material.wall.kn: ",
+       "test.lateral_stress must be at most 25 Pa, or material.wall.kn at least 4e+06 N/m"},
+      {{"test.lateral_stress=1e9"},
+       "--set test.lateral_stress=1e9: test.lateral_stress: ",
+       "test.lateral_stress must be at most 2.5e+06 Pa, or material.kn at least 4e+10 N/m; got "
+       "1e+09"},
+      {{"material.kn=1e3", "material.kt=1e2", "test.lateral_stress=1e4"},
+       "--set test.lateral_stress=1e4: test.lateral_stress: ",
+       "test.lateral_stress must be at most 25 Pa, or material.kn at least 400000 N/m"},
+  };
+  for (const Case& c : cases) {
+    for (const std::string command : {"run", "check"}) {
+      std::vector<std::string> args = {command, kHex5};
+      for (const std::string& set : c.sets) args.insert(args.end(), {"--set", set});
+      if (command == "run") args.insert(args.end(), {"-o", out});
+      expect_bad_input(args, {c.named, c.what});
+    }
+  }
+  // In the file, with no --set: the file and sigma3.
+  const std::string high = write("high.json", R"({"material": {"density": 2650, "kn": 1e3,
+      "kt": 1e2, "friction": 0.3}, "test": {"lateral_stress": 1e5}})");
+  expect_bad_input({"check", high}, {high + ": test.lateral_stress: ",
+                                     "test.lateral_stress must be at most 25 Pa, or material.kn "
+                                     "at least 4e+06 N/m; got 100000"});
+}
+
 // Contact dashpots beyond critical make every contact creep, and the
 // consolidation's step shrinks for them: beyond the ratio at which the
 // quickest contact's time constant outlasts test.consolidation_max_steps,

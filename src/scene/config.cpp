@@ -20,6 +20,7 @@
 #include "demcal/io/json_integer.hpp"
 #include "demcal/io/quoted_json.hpp"
 #include "demcal/scene/packing.hpp"
+#include "derived_scales.hpp"
 
 namespace demcal {
 
@@ -205,20 +206,27 @@ void check_tangential_stiffness(const Reader& m, const ContactLaw& particle) {
 // (Options::max_overlap_ratio), and at the peak sigma1 reaches several
 // times sigma3: delta/r <= 5 % at sigma3 leaves a factor 10. (The lower
 // bound depends on the box and is checked with the assembly:
-// check_resolvable in packing.cpp.)
-void check_lateral_stress(const Reader& t, const Material& material, double sigma3) {
-  const double kn = std::min(material.particle.kn, material.wall.kn);
-  const double limit = kMaxOverlapAtSigma3 / 2.0 * kn / material.thickness;
-  if (sigma3 > limit) {
-    std::ostringstream msg;
-    msg << "must be at most " << limit << " Pa for kn " << kn << " N/m and thickness "
-        << material.thickness
-        << " m: the overlap at sigma3, 2*sigma3*t/kn = " << 2.0 * sigma3 * material.thickness / kn
-        << " of the radius, must stay below " << kMaxOverlapAtSigma3
-        << " (the run stops at 0.5 and the peak stress is several "
-        << "times sigma3); got " << sigma3;
-    t.fail("lateral_stress", msg.str());
-  }
+// check_resolvable in packing.cpp.) sigma3 too high or kn too low: the
+// error names the one a --set changed (detail::overlap_culprit, the rule of
+// the checks with the assembly), and gives both bounds.
+void check_lateral_stress(const SceneConfig& c) {
+  const Material& m = c.material;
+  const double sigma3 = c.test.lateral_stress;
+  const bool soft_wall = m.wall.kn < m.particle.kn;
+  const double kn = soft_wall ? m.wall.kn : m.particle.kn;
+  const std::string kn_field = soft_wall ? "material.wall.kn" : "material.kn";
+  const double limit = kMaxOverlapAtSigma3 / 2.0 * kn / m.thickness;
+  if (sigma3 <= limit) return;
+  const std::string field = detail::overlap_culprit(c, kn_field);
+  std::ostringstream msg;
+  msg << "the overlap at sigma3, 2*sigma3*t/kn = " << 2.0 * sigma3 * m.thickness / kn
+      << " of the radius (sigma3 = " << sigma3 << " Pa, thickness " << m.thickness << " m, "
+      << kn_field << " = " << kn << " N/m), must stay below " << kMaxOverlapAtSigma3
+      << " (the run stops at 0.5 and the peak stress is several times sigma3): "
+      << "test.lateral_stress must be at most " << limit << " Pa, or " << kn_field << " at least "
+      << 2.0 * sigma3 * m.thickness / kMaxOverlapAtSigma3 << " N/m; got "
+      << (field == kn_field ? kn : sigma3);
+  throw InputError(c.source, field, msg.str());
 }
 
 // The servo removes at most the fraction `gain` of the wall-stress error per
@@ -371,9 +379,11 @@ AlgorithmSpec algorithm_from_json(const nlohmann::json& json, const std::string&
   return read_algorithm(a, base);
 }
 
-SceneConfig parse_config(const nlohmann::json& root_json, const std::string& source) {
+SceneConfig parse_config(const nlohmann::json& root_json, const std::string& source,
+                         const std::vector<std::string>& sets) {
   SceneConfig c;
   c.source = source;
+  c.sets = sets;  // for the checks across keys (check_lateral_stress) and errors found later
   Reader root(root_json, source, "");
   c.name = root.string("name", c.name);
   check_scene_name(root, c.name);
@@ -474,7 +484,7 @@ SceneConfig parse_config(const nlohmann::json& root_json, const std::string& sou
         t.integer("consolidation_max_steps", s.consolidation_max_steps, 1000, 1000000000);
     // 3D: the overlap at sigma3 depends on the radii, checked with the
     // assembly (check_sphere_overlap in triaxial.cpp).
-    if (!three_d) check_lateral_stress(t, c.material, s.lateral_stress);
+    if (!three_d) check_lateral_stress(c);
     check_servo_gain(t, s);
     t.reject_unknown();
   }
@@ -605,9 +615,7 @@ SceneConfig parse_config_with_overrides(nlohmann::json& j, const std::vector<std
                                         const std::string& source) {
   apply_overrides(j, sets);
   try {
-    SceneConfig config = parse_config(j, source);
-    config.sets = sets;  // for errors found later (source_of)
-    return config;
+    return parse_config(j, source, sets);
   } catch (const InputError& e) {
     // A value a --set gave is the --set's fault, not the file's: the error
     // names it (a check across keys still names the file).

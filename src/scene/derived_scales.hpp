@@ -24,10 +24,11 @@ namespace demcal::detail {
 /// formulas' one home.
 void check_derived_scales(const SceneConfig& config, std::span<const double> radii);
 
-/// The field an overlap-at-sigma3 check names (check_resolvable in
-/// packing.cpp, check_sphere_overlap in triaxial.cpp). The overlap grows as
-/// sigma3/kn, so the physics cannot tell which of the two is out of range
-/// (their messages give both bounds): the one named is the stiffness
+/// The field an overlap-at-sigma3 check names (check_lateral_stress in
+/// config.cpp, check_resolvable in packing.cpp, check_sphere_overlap in
+/// triaxial.cpp). The overlap grows as sigma3/kn, so the physics cannot
+/// tell which of the two is out of range (their messages give both
+/// bounds): the one named is the stiffness
 /// (`kn_field`, material.kn or material.wall.kn: the one the check used)
 /// when a --set gave it and none gave sigma3 (the value the user just
 /// changed), else test.lateral_stress.

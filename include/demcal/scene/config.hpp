@@ -221,8 +221,11 @@ void require_calibration_budget(const SceneConfig& config);
 /// Parse and validate. `source` names the file in errors; relative paths in
 /// the config (assembly.file, prototype.file) are resolved against its
 /// folder and made absolute, so that to_json() writes paths that read the
-/// same from any folder.
-SceneConfig parse_config(const nlohmann::json& json, const std::string& source);
+/// same from any folder. `sets`: the --set overrides already applied to
+/// `json` (config.sets), for the checks across keys that name the one a
+/// --set changed (the overlap at sigma3).
+SceneConfig parse_config(const nlohmann::json& json, const std::string& source,
+                         const std::vector<std::string>& sets = {});
 SceneConfig parse_config_text(std::string_view text, const std::string& source);
 SceneConfig load_config(const std::string& path);
 /// What every command loads: `path` (empty: the embedded default) with the
