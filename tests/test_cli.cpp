@@ -336,6 +336,48 @@ TEST_F(CliEndToEnd, AGlobalDampingBeyondTheKernelsDoublesIsBadInput) {
   EXPECT_EQ(ok.status, 0) << ok.err;
 }
 
+// strtod, the particle files' number reader, took "0x1p-1" for 0.5, and
+// getline dropped the empty field after a trailing comma ("0,0,0.5,"):
+// both files were read as valid. A DEM tool never writes a hexadecimal
+// number, and a trailing comma usually means a missing column: refused,
+// naming the file, the line and the column, in 2D and 3D. Decimal forms
+// (sign, exponent, -0.0, ".5"), comments and the header read as before.
+TEST_F(CliEndToEnd, AParticleFileWithAHexNumberOrATrailingCommaIsBadInput) {
+  const std::string out = (dir_ / "work" / "out").string();
+  const std::string fcc = test::shipped_config("fcc_4x4x4");
+  const auto from_file = [](const std::string& csv) {
+    return R"(assembly={"type": "file", "file": ")" + csv + "\"}";
+  };
+  struct Case {
+    std::string config, name, text, where, what;
+  };
+  const std::vector<Case> cases = {
+      {kHex5, "hex.csv", "x,y,r\n0,0,0.5\n1,0,0x1p-1\n0,1,0.5\n1,1,0.5\n", "line 3, column 5",
+       "a hexadecimal number for r"},
+      {kHex5, "hex_x.csv", "0,0,0.5\n -0X1P0,0,0.5\n0,1,0.5\n", "line 2, column 2",
+       "a hexadecimal number for x"},
+      {kHex5, "comma.csv", "x,y,r\n0,0,0.5\n1,0,0.5,\n0,1,0.5\n", "line 3, column 8",
+       "a trailing comma after r: expected three numbers x,y,r"},
+      {fcc, "hex_3d.csv", "0,0,0,0.5\n1,0,+0x0p0,0.5\n0,1,0,0.5\n", "line 2, column 5",
+       "a hexadecimal number for z"},
+      {fcc, "comma_3d.csv", "x,y,z,r\n0,0,0,0.5\n1,0,0,0.5,\n", "line 3, column 10",
+       "a trailing comma after r: expected four numbers x,y,z,r"},
+  };
+  for (const Case& c : cases) {
+    const std::string csv = write(c.name, c.text);
+    expect_bad_input({"run", c.config, "--set", from_file(csv), "-o", out},
+                     {csv + ": " + c.where + ": " + c.what});
+    expect_bad_input({"check", c.config, "--set", from_file(csv)},
+                     {csv + ": " + c.where + ": " + c.what});
+  }
+  const std::string decimal = write("decimal.csv",
+                                    "# 0x1p-3,1,2,\nx,y,r\n  # a comment,\n+0,-0.0,5e-1\n"
+                                    "1e0,0,0.5\n0,1.0E+0,.5\n1,1,1.5E-1\n");
+  const Result ok = demcal({"check", kHex5, "--set", from_file(decimal)});
+  EXPECT_EQ(ok.status, 0) << ok.err;
+  EXPECT_NE(ok.out.find("4 particles"), std::string::npos) << ok.out;
+}
+
 // Usage errors (CLI11's checks) are bad input too: one line, exit 2.
 TEST_F(CliEndToEnd, UsageErrorsExitTwo) {
   const std::string out = (dir_ / "work" / "out").string();

@@ -108,6 +108,21 @@ bool parse_particle_number(const std::string& field, double& value) {
   return *end == '\0';
 }
 
+/// The position columns of a particle file, then the radius, r.
+constexpr const char* kAxes[] = {"x", "y", "z"};
+
+/// Where a hexadecimal number starts in `field` (after blanks and a sign),
+/// or npos. strtod reads "0x1p-3" as 0.125, but no DEM tool writes one:
+/// in a particle file it is a file that is not what it seems.
+size_t hexadecimal_at(const std::string& field) {
+  const size_t start = field.find_first_not_of(" \t");
+  if (start == std::string::npos) return std::string::npos;
+  const size_t digits = start + (field[start] == '+' || field[start] == '-');
+  const bool hex = field.size() > digits + 1 && field[digits] == '0' &&
+                   (field[digits + 1] == 'x' || field[digits + 1] == 'X');
+  return hex ? start : std::string::npos;
+}
+
 /// A header field's name: blanks and double quotes around it dropped, in
 /// lower case ("X", " \"x\" " and "x" are one name).
 std::string header_name(const std::string& field) {
@@ -125,9 +140,8 @@ std::string header_name(const std::string& field) {
 /// axes swapped: a sample loaded on its side, and no error.
 bool header_names_the_columns(const std::vector<std::string>& fields) {
   const size_t n = fields.size();
-  static const char* const axes[] = {"x", "y", "z"};
   for (size_t k = 0; k + 1 < n; ++k)
-    if (header_name(fields[k]) != axes[k]) return false;
+    if (header_name(fields[k]) != kAxes[k]) return false;
   const std::string r = header_name(fields[n - 1]);
   return r == "r" || r == "radius";
 }
@@ -138,6 +152,8 @@ bool parse_particle_fields(const std::string& line, std::span<double> v, bool& s
                            int64_t particles_read, const std::string& path,
                            const std::string& where) {
   const size_t n = v.size();
+  const std::string columns = n == 3 ? "x,y,r" : "x,y,z,r";
+  const std::string expected = std::string(n == 3 ? "three" : "four") + " numbers " + columns;
   std::vector<std::string> fields;
   std::stringstream ss(line);
   for (std::string f; std::getline(ss, f, ',');) fields.push_back(f);
@@ -147,18 +163,32 @@ bool parse_particle_fields(const std::string& line, std::span<double> v, bool& s
   if (fields.size() != n || numbers != n) {
     if (!seen_content && fields.size() == n && numbers == 0) {
       if (!header_names_the_columns(fields))
-        throw InputError(
-            path, where,
-            std::string("header: the columns must be ") + (n == 3 ? "x,y,r" : "x,y,z,r") +
-                " in this order (the radius may be called radius), got " + quoted_value(line));
+        throw InputError(path, where,
+                         "header: the columns must be " + columns +
+                             " in this order (the radius may be called radius), got " +
+                             quoted_value(line));
       seen_content = true;
       return false;  // the header ("x,y,r")
     }
-    throw InputError(path, where,
-                     std::string("expected ") +
-                         (n == 3 ? "three numbers x,y,r" : "four numbers x,y,z,r") + ", got " +
-                         quoted_value(line));
+    throw InputError(path, where, "expected " + expected + ", got " + quoted_value(line));
   }
+  // Refused, not read: a trailing comma ("0,0,0.5,", which getline reads
+  // as n fields) usually means a column is missing, and a hexadecimal
+  // number is no DEM tool's output. The column is the character's in the
+  // line.
+  const auto name = [&](size_t k) { return k + 1 == n ? "r" : kAxes[k]; };
+  const auto at = [&](size_t column) { return where + ", column " + std::to_string(column + 1); };
+  if (line.back() == ',')
+    throw InputError(path, at(line.size() - 1),
+                     std::string("a trailing comma after ") + name(n - 1) + ": expected " +
+                         expected + " (a trailing comma usually means a column is missing), got " +
+                         quoted_value(line));
+  for (size_t k = 0, column = 0; k < n; column += fields[k].size() + 1, ++k)
+    if (const size_t hex = hexadecimal_at(fields[k]); hex != std::string::npos)
+      throw InputError(path, at(column + hex),
+                       std::string("a hexadecimal number for ") + name(k) +
+                           ": particle files hold decimal numbers (0.125, 1.25e-1), got " +
+                           quoted_value(line));
   seen_content = true;
   if (!std::all_of(v.begin(), v.end(), [](double x) { return std::isfinite(x); }))
     throw InputError(path, where, "values must be finite, got " + quoted_value(line));

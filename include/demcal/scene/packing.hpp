@@ -83,8 +83,10 @@ double centre_distance(const std::array<std::span<const double>, D>& x, int i, i
 }
 
 /// One content line of a particle file (neither blank nor a comment), for
-/// the 2D and the sphere readers: v.size() comma-separated numbers, the
-/// position then the radius (x,y,r; x,y,z,r), each finite, the radius > 0,
+/// the 2D and the sphere readers: v.size() comma-separated decimal numbers
+/// (no hexadecimal, no trailing comma: an InputError naming the line and
+/// the column), the position then the radius (x,y,r; x,y,z,r), each
+/// finite, the radius > 0,
 /// each |coordinate| + 4 r finite (the overlap test adds radii to
 /// coordinates), and fewer than kMaxParticles particles read before it
 /// (`particles_read`): true, the numbers in `v`. The first content line (`seen_content` still
