@@ -82,6 +82,9 @@ bool set_without_effect(const std::string& set) {
 
 void check_params_options(const UpscaledParamsOptions& o, const char* command) {
   check_calibrated(o.params, o.allow_failed, command);
+  // Before the warnings on them, and before params_scene drops the ones
+  // without effect: a key given twice is bad input whatever the key.
+  require_distinct_set_keys(o.sets);
   const nlohmann::json params = read_params_file(o.params);
   const bool upscale = std::string_view(command) == "upscale";
   const std::string scene = scene_of(params);

@@ -400,9 +400,16 @@ TEST(ConfigOverrides, NestedTypedAndNewSections) {
   EXPECT_FALSE(c.output.vtk);  // a section that was absent
   EXPECT_EQ(c.test.servo_gain, 0.25);
   EXPECT_EQ(c.assembly.columns, 3);
-  // Later overrides win.
-  EXPECT_EQ(with_sets("{}", {"algorithm.steps=1000", "algorithm.steps=2000"}).algorithm.steps,
-            2000);
+  // A key given twice is refused (the last was read silently), naming the
+  // second --set; a section and a key in it are two keys, applied in order.
+  test::expect_input_error(
+      [] {
+        with_sets("{}", {"algorithm.steps=1000", "algorithm.steps=2000"});
+      },
+      "--set algorithm.steps=2000", "algorithm.steps", R"(given twice, "1000" then "2000")");
+  EXPECT_EQ(
+      with_sets("{}", {R"(algorithm={"steps": 1000})", "algorithm.steps=2000"}).algorithm.steps,
+      2000);
 }
 
 // Every error of a --set names it in the file's place (the config file is

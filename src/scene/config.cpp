@@ -10,6 +10,7 @@
 #include <fstream>
 #include <iomanip>
 #include <limits>
+#include <map>
 #include <set>
 #include <sstream>
 #include <string>
@@ -653,7 +654,23 @@ SceneConfig default_config() {
   return parse_config_text(default_config_text(), "<embedded default: configs/hex_10x10.json>");
 }
 
+void require_distinct_set_keys(const std::vector<std::string>& sets) {
+  std::map<std::string, std::string> given;  // key -> its value
+  for (const auto& set : sets) {
+    const auto eq = set.find('=');
+    if (eq == std::string::npos || eq == 0) continue;  // apply_overrides names it
+    const std::string key = set.substr(0, eq), value = set.substr(eq + 1);
+    const auto [first, fresh] = given.emplace(key, value);
+    if (!fresh)
+      throw InputError("--set " + set, key,
+                       "given twice, " + quoted_value(first->second) + " then " +
+                           quoted_value(value) +
+                           " (only the last would be read, silently): give each key once");
+  }
+}
+
 void apply_overrides(nlohmann::json& j, const std::vector<std::string>& sets) {
+  require_distinct_set_keys(sets);
   for (const auto& set : sets) {
     const std::string source = "--set " + set;  // what the errors name
     const auto eq = set.find('=');

@@ -241,12 +241,20 @@ SceneConfig default_config();
 std::string_view default_config_text();
 
 /// Apply `section.key=value` overrides (value parsed as JSON, else string);
-/// a malformed one is an InputError naming the --set.
+/// a malformed one is an InputError naming the --set, and so is a key
+/// given twice (require_distinct_set_keys).
 void apply_overrides(nlohmann::json& json, const std::vector<std::string>& sets);
+/// A key two --set give ("--set a.b=1 --set a.b=2") is an InputError naming
+/// the second, the key and both values: the last would be read silently,
+/// and the first would look applied (as a key given twice in one JSON object,
+/// parse_config_json). A key and a section holding it are different keys.
+/// Checked by apply_overrides, and by the params.json commands before they
+/// drop the --set they do not apply (check_params_options).
+void require_distinct_set_keys(const std::vector<std::string>& sets);
 
 /// `json` with the overrides applied (in place), parsed: an error in a key
-/// a --set gave names that --set (the last one for the key: its value is
-/// the one read), any other error `source`.
+/// a --set gave names that --set (the last one for the key or a section
+/// holding it: its value is the one read), any other error `source`.
 SceneConfig parse_config_with_overrides(nlohmann::json& json, const std::vector<std::string>& sets,
                                         const std::string& source);
 
