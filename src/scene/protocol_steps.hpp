@@ -172,16 +172,17 @@ ConsolidationOutcome run_consolidation(Sample& world, const TestSpec& test, doub
   // and at most half the budget (frictionless_phase_cut: strong dashpots
   // put the quarter past the half, from S < 1/4 past the budget's end): a
   // phase 0 not static by then ends there, friction goes on with the light
-  // damping, and critical damping comes at twice the quarter's step. A frictionless packing at
-  // sigma3 can creep toward a denser state for far longer than a frictional one takes to lock (a
-  // likely reason, not measured: its overlaps there are ~1e-4 of the
-  // radius, near jamming, where the softest collective modes may fall below
-  // the light damping's ζ·ω_c and creep, over-damped). Measured: 5 000
-  // spheres of random_500_3d's gas held sigma3 within
-  // 0.5 % with an unbalanced-force ratio of 0.005-0.02 from 150 000 to
-  // 560 000 steps, while friction switched on at 150 000 locked it in
-  // 1 400 steps; 500 spheres in a 100 000-step budget: no static state in
-  // it, frictionless, then 28 000 steps with the cut.
+  // damping, and critical damping comes at twice the quarter's step. A
+  // frictionless packing at sigma3 can creep toward a denser state for far
+  // longer than a frictional one takes to lock (a likely reason, not
+  // measured: its overlaps there are ~1e-4 of the radius, near jamming,
+  // where the softest collective modes may fall below the light damping's
+  // ζ·ω_c and creep, over-damped). Measured: 5 000 spheres of
+  // random_500_3d's gas held sigma3 within 0.5 % with an unbalanced-force
+  // ratio of 0.005-0.02 from 150 000 to 560 000 steps, while friction
+  // switched on at 150 000 locked it in 1 400 steps; 500 spheres in a
+  // 100 000-step budget: no static state in it, frictionless, then 28 000
+  // steps with the cut.
   const double shrink = consolidation_step_shrink(settle.dt_ratio);
   const int64_t critical_after = critical_damping_after(max_steps, shrink);
   const int64_t cut_after = frictionless_phase_cut(max_steps, shrink);

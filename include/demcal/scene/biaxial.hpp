@@ -145,12 +145,13 @@ inline int64_t critical_damping_after(int64_t max_steps, double step_shrink) {
 /// The step at which a frictionless phase not yet static ends (friction
 /// goes on: the first check at or after it): critical_damping_after, but at
 /// most half the budget, so that friction keeps about the other half (the
-/// cut comes at a check) to lock the packing. The half binds where contact dashpots shrank the step
-/// below half the undamped one (step_shrink < 1/2: ζ_c above 0.19 in 3D and 0.27 in 2D at a radius
-/// ratio of 5/3); without it, below step_shrink 1/4 (ζ_c above 0.47 and 0.68) the quarter lay
-/// beyond the budget, and a frictionless phase that creeps (run_consolidation) ran the whole budget
-/// and failed. The one home
-/// of the rule: demcal's consolidations and the decks' stage 1
+/// cut comes at a check) to lock the packing. The half binds where contact
+/// dashpots shrank the step below half the undamped one (step_shrink < 1/2:
+/// ζ_c above 0.19 in 3D and 0.27 in 2D at a radius ratio of 5/3); without
+/// it, below step_shrink 1/4 (ζ_c above 0.47 and 0.68) the quarter lay
+/// beyond the budget, and a frictionless phase that creeps
+/// (run_consolidation) ran the whole budget and failed. The one home of the
+/// rule: demcal's consolidations and the decks' stage 1
 /// (deck::lammps_consolidation_quarter, cons_cut).
 inline int64_t frictionless_phase_cut(int64_t max_steps, double step_shrink) {
   return std::min(critical_damping_after(max_steps, step_shrink), max_steps / 2);
