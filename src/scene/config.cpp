@@ -213,9 +213,7 @@ void check_tangential_stiffness(const Reader& m, const ContactLaw& particle) {
 void check_lateral_stress(const SceneConfig& c) {
   const Material& m = c.material;
   const double sigma3 = c.test.lateral_stress;
-  const bool soft_wall = m.wall.kn < m.particle.kn;
-  const double kn = soft_wall ? m.wall.kn : m.particle.kn;
-  const std::string kn_field = soft_wall ? "material.wall.kn" : "material.kn";
+  const auto [kn, kn_field] = detail::softer_normal_stiffness(m);
   const double limit = kMaxOverlapAtSigma3 / 2.0 * kn / m.thickness;
   if (sigma3 <= limit) return;
   const std::string field = detail::overlap_culprit(c, kn_field);

@@ -172,6 +172,11 @@ void check_contact_damping_budget(const SceneConfig& config, double m_min, doubl
 
 }  // namespace
 
+NamedStiffness softer_normal_stiffness(const Material& material) {
+  if (material.wall.kn < material.particle.kn) return {material.wall.kn, "material.wall.kn"};
+  return {material.particle.kn, "material.kn"};
+}
+
 std::string overlap_culprit(const SceneConfig& config, const std::string& kn_field) {
   const bool kn_set = set_source(config.sets, kn_field).has_value();
   const bool sigma3_set = set_source(config.sets, "test.lateral_stress").has_value();

@@ -34,4 +34,14 @@ void check_derived_scales(const SceneConfig& config, std::span<const double> rad
 /// changed), else test.lateral_stress.
 std::string overlap_culprit(const SceneConfig& config, const std::string& kn_field);
 
+/// The softer of the particles' and the walls' normal stiffness, and its
+/// field (material.kn or material.wall.kn; the particles' on a tie): the
+/// largest overlap at sigma3 is on the softer contact (check_lateral_stress
+/// in 2D, check_sphere_overlap in 3D).
+struct NamedStiffness {
+  double kn = 0.0;
+  std::string field;
+};
+NamedStiffness softer_normal_stiffness(const Material& material);
+
 }  // namespace demcal::detail

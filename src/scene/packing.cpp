@@ -152,8 +152,11 @@ bool parse_particle_fields(const std::string& line, std::span<double> v, bool& s
                            int64_t particles_read, const std::string& path,
                            const std::string& where) {
   const size_t n = v.size();
-  const std::string columns = n == 3 ? "x,y,r" : "x,y,z,r";
-  const std::string expected = std::string(n == 3 ? "three" : "four") + " numbers " + columns;
+  // for the errors (built there: this runs once per line of a large file)
+  const char* const columns = n == 3 ? "x,y,r" : "x,y,z,r";
+  const auto expected = [&] {
+    return std::string(n == 3 ? "three" : "four") + " numbers " + columns;
+  };
   std::vector<std::string> fields;
   std::stringstream ss(line);
   for (std::string f; std::getline(ss, f, ',');) fields.push_back(f);
@@ -164,13 +167,13 @@ bool parse_particle_fields(const std::string& line, std::span<double> v, bool& s
     if (!seen_content && fields.size() == n && numbers == 0) {
       if (!header_names_the_columns(fields))
         throw InputError(path, where,
-                         "header: the columns must be " + columns +
+                         std::string("header: the columns must be ") + columns +
                              " in this order (the radius may be called radius), got " +
                              quoted_value(line));
       seen_content = true;
       return false;  // the header ("x,y,r")
     }
-    throw InputError(path, where, "expected " + expected + ", got " + quoted_value(line));
+    throw InputError(path, where, "expected " + expected() + ", got " + quoted_value(line));
   }
   // Refused, not read: a trailing comma ("0,0,0.5,", which getline reads
   // as n fields) usually means a column is missing, and a hexadecimal
@@ -179,10 +182,10 @@ bool parse_particle_fields(const std::string& line, std::span<double> v, bool& s
   const auto name = [&](size_t k) { return k + 1 == n ? "r" : kAxes[k]; };
   const auto at = [&](size_t column) { return where + ", column " + std::to_string(column + 1); };
   if (line.back() == ',')
-    throw InputError(path, at(line.size() - 1),
-                     std::string("a trailing comma after ") + name(n - 1) + ": expected " +
-                         expected + " (a trailing comma usually means a column is missing), got " +
-                         quoted_value(line));
+    throw InputError(
+        path, at(line.size() - 1),
+        std::string("a trailing comma after ") + name(n - 1) + ": expected " + expected() +
+            " (a trailing comma usually means a column is missing), got " + quoted_value(line));
   for (size_t k = 0, column = 0; k < n; column += fields[k].size() + 1, ++k)
     if (const size_t hex = hexadecimal_at(fields[k]); hex != std::string::npos)
       throw InputError(path, at(column + hex),

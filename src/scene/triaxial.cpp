@@ -53,9 +53,7 @@ void check_sphere_overlap(const SceneConfig& config, const SphereAssembly& a) {
     throw InputError(source_of(config, field), field,
                      what + "; got " + num(field == kn_field ? kn : sigma3));
   };
-  const bool soft_wall = m.wall.kn < m.particle.kn;
-  const double kn_soft = soft_wall ? m.wall.kn : m.particle.kn;
-  const std::string soft_field = soft_wall ? "material.wall.kn" : "material.kn";
+  const auto [kn_soft, soft_field] = detail::softer_normal_stiffness(m);
   const double limit = kMaxOverlapAtSigma3 * kn_soft / (4.0 * r_max);
   std::ostringstream msg;
   if (sigma3 > limit) {
