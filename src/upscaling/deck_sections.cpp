@@ -459,7 +459,7 @@ std::string lammps_consolidation_quarter(double alpha, int64_t max_steps) {
     << "variable        cons_capped equal "
        "$((v_cons_after2+v_cons_last-abs(v_cons_after2-v_cons_last))/2)\n"
     << "# the frictionless phase ends at cons_quarter, at most at the first check at\n"
-    << "# or after half the budget (friction keeps the other half; demcal's\n"
+    << "# or after half the budget (friction keeps about the other half; demcal's\n"
     << "# frictionless_phase_cut: step " << frictionless_phase_cut(max_steps, shrink) << ")\n"
     << "variable        cons_half equal "
        "$(v_cons_check*ceil(floor(v_cons_max_steps/2)/v_cons_check))\n"
