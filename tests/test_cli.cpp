@@ -378,6 +378,42 @@ TEST_F(CliEndToEnd, AParticleFileWithAHexNumberOrATrailingCommaIsBadInput) {
   EXPECT_NE(ok.out.find("4 particles"), std::string::npos) << ok.out;
 }
 
+// A header with a trailing comma ("x,y,r,") was still read as the header,
+// though the same comma after a particle's r is refused: refused as that
+// one, naming the file, the line and the column, in 2D and 3D (after
+// comments, in any case and with the radius called radius, as headers
+// are read).
+TEST_F(CliEndToEnd, AParticleFileHeaderWithATrailingCommaIsBadInput) {
+  const std::string out = (dir_ / "work" / "out").string();
+  const std::string fcc = test::shipped_config("fcc_4x4x4");
+  const auto from_file = [](const std::string& csv) {
+    return R"(assembly={"type": "file", "file": ")" + csv + "\"}";
+  };
+  struct Case {
+    std::string config, name, text, where, what;
+  };
+  const std::vector<Case> cases = {
+      {kHex5, "header.csv", "x,y,r,\n0,0,0.5\n1,0,0.5\n0,1,0.5\n1,1,0.5\n", "line 1, column 6",
+       "a trailing comma in the header: expected the columns x,y,r"},
+      {kHex5, "radius.csv", "# exported\n\nX, Y, Radius,\r\n0,0,0.5\n1,0,0.5\n",
+       "line 3, column 13", "a trailing comma in the header: expected the columns x,y,r"},
+      {fcc, "header_3d.csv", "x,y,z,r,\n0,0,0,0.5\n1,0,0,0.5\n", "line 1, column 8",
+       "a trailing comma in the header: expected the columns x,y,z,r"},
+  };
+  for (const Case& c : cases) {
+    const std::string csv = write(c.name, c.text);
+    expect_bad_input({"run", c.config, "--set", from_file(csv), "-o", out},
+                     {csv + ": " + c.where + ": " + c.what});
+    expect_bad_input({"check", c.config, "--set", from_file(csv)},
+                     {csv + ": " + c.where + ": " + c.what});
+  }
+  // The header without it reads as before.
+  const std::string plain = write("plain.csv", "# exported\nX, Y, Radius\r\n0,0,0.5\n1,0,0.5\n");
+  const Result ok = demcal({"check", kHex5, "--set", from_file(plain)});
+  EXPECT_EQ(ok.status, 0) << ok.err;
+  EXPECT_NE(ok.out.find("2 particles"), std::string::npos) << ok.out;
+}
+
 // A key two --set give was read as the last, silently (the first looked
 // applied): `run cfg --set algorithm.steps=2000 --set algorithm.steps=3000`
 // ran 3000 steps, exit 0. Bad input now, naming the key and both values,

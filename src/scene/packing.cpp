@@ -163,6 +163,12 @@ bool parse_particle_fields(const std::string& line, std::span<double> v, bool& s
   size_t numbers = 0;
   for (size_t k = 0; k < fields.size() && k < n; ++k)
     numbers += parse_particle_number(fields[k], v[k]);
+  // Refused, not read: a trailing comma ("0,0,0.5,", which getline reads
+  // as n fields) usually means a column is missing, and a hexadecimal
+  // number is no DEM tool's output. The column is the character's in the
+  // line.
+  const auto name = [&](size_t k) { return k + 1 == n ? "r" : kAxes[k]; };
+  const auto at = [&](size_t column) { return where + ", column " + std::to_string(column + 1); };
   if (fields.size() != n || numbers != n) {
     if (!seen_content && fields.size() == n && numbers == 0) {
       if (!header_names_the_columns(fields))
@@ -170,17 +176,17 @@ bool parse_particle_fields(const std::string& line, std::span<double> v, bool& s
                          std::string("header: the columns must be ") + columns +
                              " in this order (the radius may be called radius), got " +
                              quoted_value(line));
+      // A header's trailing comma ("x,y,r,") as a particle's.
+      if (line.back() == ',')
+        throw InputError(
+            path, at(line.size() - 1),
+            std::string("a trailing comma in the header: expected the columns ") + columns +
+                " (a trailing comma usually means a column is missing), got " + quoted_value(line));
       seen_content = true;
       return false;  // the header ("x,y,r")
     }
     throw InputError(path, where, "expected " + expected() + ", got " + quoted_value(line));
   }
-  // Refused, not read: a trailing comma ("0,0,0.5,", which getline reads
-  // as n fields) usually means a column is missing, and a hexadecimal
-  // number is no DEM tool's output. The column is the character's in the
-  // line.
-  const auto name = [&](size_t k) { return k + 1 == n ? "r" : kAxes[k]; };
-  const auto at = [&](size_t column) { return where + ", column " + std::to_string(column + 1); };
   if (line.back() == ',')
     throw InputError(
         path, at(line.size() - 1),

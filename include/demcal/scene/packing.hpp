@@ -92,7 +92,8 @@ double centre_distance(const std::array<std::span<const double>, D>& x, int i, i
 /// (`particles_read`): true, the numbers in `v`. The first content line (`seen_content` still
 /// false) whose fields are none of them numbers is the header: false; it
 /// must name the columns x,y(,z),r in this order (r or radius, any case,
-/// quotes allowed), else an InputError: the reader never guesses an order.
+/// quotes allowed), else an InputError: the reader never guesses an order;
+/// a trailing comma after it is one too, as after a particle (the column).
 /// Anything else is an InputError naming `path` and `where` (a line with
 /// some numbers is a broken particle line, never silently skipped).
 bool parse_particle_fields(const std::string& line, std::span<double> v, bool& seen_content,
