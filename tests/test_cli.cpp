@@ -447,6 +447,48 @@ TEST_F(CliEndToEnd, ASetKeyGivenTwiceIsBadInput) {
   EXPECT_EQ(ok.status, 0) << ok.err;
 }
 
+// A section a --set gave after a key in it (`--set material.kn=1e6 --set
+// material={...}`) replaced the section, and the key with it: the earlier
+// --set was lost, silently (exit 0). Bad input now, naming both --sets, in
+// every command that takes --set, a section deeper in too (material.wall).
+// The prefix is one at a dot: material.k holds no material.kn (an unknown
+// key, as before). A section, then a key in it, still applies both in
+// order.
+TEST_F(CliEndToEnd, ASetSectionAfterAKeyInItIsBadInput) {
+  const std::string out = (dir_ / "work" / "out").string();
+  const std::string params =
+      (fs::path(test::kSourceDir) / "reports" / "example-hex_10x10" / "params.json").string();
+  const std::string material =
+      R"(material={"density": 2650, "kn": 1e8, "kt": 5e7, "friction": 0.3})";
+  const std::vector<std::vector<std::string>> commands = {
+      {"check", kHex5},
+      {"run", kHex5, "-o", out},
+      {"calibrate", kHex5, "-o", out},
+      {"verify", params, "--particles", "100", "-o", out},
+      {"export", params, "--particles", "100", "-o", out},
+  };
+  for (std::vector<std::string> args : commands) {
+    args.insert(args.end(), {"--set", "material.kn=1e6", "--set", material});
+    expect_bad_input(args, {"--set " + material + ": material: replaces the section",
+                            "--set material.kn=1e6 given before it"});
+  }
+  expect_bad_input({"check", kHex5, "--set", "material.wall.kn=1e7", "--set",
+                    "algorithm.steps=3000", "--set", R"(material.wall={"kn": 1e8})"},
+                   {R"(--set material.wall={"kn": 1e8}: material.wall: replaces the section)",
+                    "--set material.wall.kn=1e7 given before it"});
+  expect_bad_input({"check", kHex5, "--set", "material.wall.kn=1e7", "--set", material},
+                   {"--set " + material + ": material: ", "--set material.wall.kn=1e7 given"});
+  // Not a section of material.kn: the unknown key it is.
+  expect_bad_input({"check", kHex5, "--set", "material.kn=1e8", "--set", "material.k=1"},
+                   {"--set material.k=1: material.k: unknown key"});
+  // The section, then a key in it: the key is read (kt above the section's kn).
+  expect_bad_input({"check", kHex5, "--set", material, "--set", "material.kt=2e8"},
+                   {"--set material.kt=2e8: material.kt: must not exceed kn (1e+08)"});
+  const Result ok = demcal({"check", kHex5, "--set", material, "--set", "material.kn=2e8", "--set",
+                            "material.wall.kn=2e8"});
+  EXPECT_EQ(ok.status, 0) << ok.err;
+}
+
 // Usage errors (CLI11's checks) are bad input too: one line, exit 2.
 TEST_F(CliEndToEnd, UsageErrorsExitTwo) {
   const std::string out = (dir_ / "work" / "out").string();

@@ -654,6 +654,8 @@ SceneConfig default_config() {
 
 void require_distinct_set_keys(const std::vector<std::string>& sets) {
   std::map<std::string, std::string> given;  // key -> its value
+  // The keys before, in order, with their --set.
+  std::vector<std::pair<std::string, std::string>> before;
   for (const auto& set : sets) {
     const auto eq = set.find('=');
     if (eq == std::string::npos || eq == 0) continue;  // apply_overrides names it
@@ -664,6 +666,18 @@ void require_distinct_set_keys(const std::vector<std::string>& sets) {
                        "given twice, " + quoted_value(first->second) + " then " +
                            quoted_value(value) +
                            " (only the last would be read, silently): give each key once");
+    // A section after a key in it replaces the section, and the key with
+    // it: the earlier --set would be lost. Keys split at every dot
+    // (apply_overrides): "material" holds "material.kn" and
+    // "material.wall.kn", "material.k" neither. A key after its section
+    // is a change to the section given: applied in order.
+    for (const auto& [earlier_key, earlier] : before)
+      if (earlier_key.rfind(key + ".", 0) == 0)
+        throw InputError("--set " + set, key,
+                         "replaces the section, and with it --set " + earlier +
+                             " given before it (which would be lost, silently): give the "
+                             "section first, then the keys in it");
+    before.emplace_back(key, set);
   }
 }
 

@@ -247,7 +247,10 @@ void apply_overrides(nlohmann::json& json, const std::vector<std::string>& sets)
 /// A key two --set give ("--set a.b=1 --set a.b=2") is an InputError naming
 /// the second, the key and both values: the last would be read silently,
 /// and the first would look applied (as a key given twice in one JSON object,
-/// parse_config_json). A key and a section holding it are different keys.
+/// parse_config_json). A section and then a key in it are two keys (the
+/// section replaced, then the key changed in it); a key and then a section
+/// holding it ("--set a.b=1 --set a={...}") is an InputError naming both
+/// --sets: the section would replace the key, silently.
 /// Checked by apply_overrides, and by the params.json commands before they
 /// drop the --set they do not apply (check_params_options).
 void require_distinct_set_keys(const std::vector<std::string>& sets);
