@@ -81,10 +81,13 @@ bool set_without_effect(const std::string& set) {
 }  // namespace
 
 void check_params_options(const UpscaledParamsOptions& o, const char* command) {
-  check_calibrated(o.params, o.allow_failed, command);
-  // Before the warnings on them, and before params_scene drops the ones
-  // without effect: a key given twice is bad input whatever the key.
+  // A key given twice is bad input whatever the key: a command-line
+  // mistake, known before any file is read, said first (a failed
+  // params.json's error, or its --allow-failed warning, came before it);
+  // before the warnings on the --sets, and before params_scene drops the
+  // ones without effect.
   require_distinct_set_keys(o.sets);
+  check_calibrated(o.params, o.allow_failed, command);
   const nlohmann::json params = read_params_file(o.params);
   const bool upscale = std::string_view(command) == "upscale";
   const std::string scene = scene_of(params);

@@ -141,7 +141,8 @@ std::function<int()> add_upscaling_commands(CLI::App& app) {
       ->check(non_empty_path());
   add_progress_option(rev, rv->progress_every_s);
 
-  // A failed calibration's params.json is refused before anything else is
+  // After the --set keys (a command-line mistake, before any file), a
+  // failed calibration's params.json is refused before anything else is
   // read or written (its "success" named), unless --allow-failed; then the
   // options that read it are checked against it (check_params_options).
   return [=]() -> int {

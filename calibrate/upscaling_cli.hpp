@@ -109,7 +109,9 @@ std::optional<SceneConfig> params_scene(const nlohmann::json& params, const std:
 /// `allow_failed` used with a warning on stderr.
 void check_calibrated(const std::string& path, bool allow_failed, const char* command);
 /// What `command` (upscale, verify, export) checks before it runs, in this
-/// order: check_calibrated(); the params.json read in full
+/// order: the --set keys (require_distinct_set_keys: a command-line
+/// mistake, before any file is read); check_calibrated(); the params.json
+/// read in full
 /// (read_params_file); with a params.json that carries its config, a
 /// --config that differs from it (compared as parsed: a copy of the same
 /// file passes) and any --set: refused by upscale (it records that config

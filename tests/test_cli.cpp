@@ -447,6 +447,32 @@ TEST_F(CliEndToEnd, ASetKeyGivenTwiceIsBadInput) {
   EXPECT_EQ(ok.status, 0) << ok.err;
 }
 
+// verify and export (and upscale) read a failed params.json first: its
+// "success" error (with --allow-failed, its warning) came before a key two
+// --set gave, a command-line mistake known before any file is read. The
+// --set now, first and alone, with the message of the other commands.
+TEST_F(CliEndToEnd, ASetKeyGivenTwiceIsSaidBeforeAFailedParamsJson) {
+  const std::string out = (dir_ / "work" / "out").string();
+  nlohmann::json params = nlohmann::json::parse(
+      read_text(fs::path(test::kSourceDir) / "reports" / "example-hex_10x10" / "params.json"));
+  params["success"] = false;
+  const std::string failed = write("failed.json", params.dump());
+  const std::vector<std::string> twice = {"--set", "algorithm.steps=2000", "--set",
+                                          "algorithm.steps=3000"};
+  for (const std::string command : {"verify", "export", "upscale"}) {
+    for (const bool allow_failed : {false, true}) {
+      std::vector<std::string> args = {command, failed, "--particles", "100", "-o", out};
+      if (allow_failed) args.push_back("--allow-failed");
+      args.insert(args.end(), twice.begin(), twice.end());
+      expect_bad_input(args, {"--set algorithm.steps=3000: algorithm.steps: given twice, "
+                              "\"2000\" then \"3000\""});
+    }
+  }
+  // Without the --set mistake, the failed params.json is said as before.
+  expect_bad_input({"verify", failed, "--particles", "100", "-o", out},
+                   {failed + ": success: is false"});
+}
+
 // A section a --set gave after a key in it (`--set material.kn=1e6 --set
 // material={...}`) replaced the section, and the key with it: the earlier
 // --set was lost, silently (exit 0). Bad input now, naming both --sets, in
