@@ -281,6 +281,56 @@ TEST_F(CliEndToEnd, TheParseTimeOverlapAtSigma3NamesTheFieldASetChanged) {
                                      "at least 4e+06 N/m; got 100000"});
 }
 
+// In 2D the force on a disk per unit stress is sigma3*2r*t: the overlap at
+// sigma3 grows with the out-of-plane thickness t (2*sigma3*t/kn of the
+// radius). `--set material.thickness=1e3` on hex_5x5 was refused as
+// "configs/hex_5x5.json: test.lateral_stress: ... must be at most 2500 Pa",
+// and 1e-12 (an overlap round-off cannot resolve, check_resolvable) the
+// same way: the thickness and its --set never named. Now named, with its
+// bound beside the others', when a --set gave it and none gave sigma3 or
+// the stiffness (overlap_culprit, whose rule is otherwise unchanged).
+TEST_F(CliEndToEnd, TheOverlapAtSigma3NamesAThicknessASetChanged) {
+  const std::string out = (dir_ / "work" / "out").string();
+  struct Case {
+    std::vector<std::string> sets;
+    std::string named, what;
+  };
+  const std::vector<Case> cases = {
+      {{"material.thickness=1e3"},
+       "--set material.thickness=1e3: material.thickness: ",
+       "test.lateral_stress must be at most 2500 Pa, or material.kn at least 4e+09 N/m, or "
+       "material.thickness at most 25 m; got 1000"},
+      {{"material.thickness=25.1"},
+       "--set material.thickness=25.1: material.thickness: ",
+       "or material.thickness at most 25 m; got 25.1"},
+      {{"material.thickness=1e-12"},
+       "--set material.thickness=1e-12: material.thickness: ",
+       "is not resolved by positions"},
+      // sigma3 or the stiffness given too: named as before.
+      {{"material.thickness=1e3", "test.lateral_stress=1e5"},
+       "--set test.lateral_stress=1e5: test.lateral_stress: ",
+       "test.lateral_stress must be at most 2500 Pa, or material.kn at least 4e+09 N/m; got "
+       "100000"},
+      {{"material.thickness=1e3", "material.kn=1e8"},
+       "--set material.kn=1e8: material.kn: ",
+       "test.lateral_stress must be at most 2500 Pa, or material.kn at least 4e+09 N/m; got "
+       "1e+08"},
+  };
+  for (const Case& c : cases) {
+    for (const std::string command : {"run", "check"}) {
+      std::vector<std::string> args = {command, kHex5};
+      for (const std::string& set : c.sets) args.insert(args.end(), {"--set", set});
+      if (command == "run") args.insert(args.end(), {"-o", out});
+      expect_bad_input(args, {c.named, c.what});
+    }
+  }
+  expect_bad_input({"check", kHex5, "--set", "material.thickness=1e-12"},
+                   {"thickness 1e-12 m", "or material.thickness at least ", " m; got 1e-12"});
+  // At the bound it runs.
+  const Result ok = demcal({"check", kHex5, "--set", "material.thickness=25"});
+  EXPECT_EQ(ok.status, 0) << ok.err;
+}
+
 // Contact dashpots beyond critical make every contact creep, and the
 // consolidation's step shrinks for them: beyond the ratio at which the
 // quickest contact's time constant outlasts test.consolidation_max_steps,

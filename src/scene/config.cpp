@@ -207,9 +207,9 @@ void check_tangential_stiffness(const Reader& m, const ContactLaw& particle) {
 // (Options::max_overlap_ratio), and at the peak sigma1 reaches several
 // times sigma3: delta/r <= 5 % at sigma3 leaves a factor 10. (The lower
 // bound depends on the box and is checked with the assembly:
-// check_resolvable in packing.cpp.) sigma3 too high or kn too low: the
+// check_resolvable in packing.cpp.) sigma3 or t too high, or kn too low: the
 // error names the one a --set changed (detail::overlap_culprit, the rule of
-// the checks with the assembly), and gives both bounds.
+// the checks with the assembly), and gives both bounds (t's too when named).
 void check_lateral_stress(const SceneConfig& c) {
   const Material& m = c.material;
   const double sigma3 = c.test.lateral_stress;
@@ -223,8 +223,12 @@ void check_lateral_stress(const SceneConfig& c) {
       << kn_field << " = " << kn << " N/m), must stay below " << kMaxOverlapAtSigma3
       << " (the run stops at 0.5 and the peak stress is several times sigma3): "
       << "test.lateral_stress must be at most " << limit << " Pa, or " << kn_field << " at least "
-      << 2.0 * sigma3 * m.thickness / kMaxOverlapAtSigma3 << " N/m; got "
-      << (field == kn_field ? kn : sigma3);
+      << 2.0 * sigma3 * m.thickness / kMaxOverlapAtSigma3 << " N/m";
+  if (field == "material.thickness")
+    msg << ", or material.thickness at most " << kMaxOverlapAtSigma3 / 2.0 * kn / sigma3
+        << " m; got " << m.thickness;
+  else
+    msg << "; got " << (field == kn_field ? kn : sigma3);
   throw InputError(c.source, field, msg.str());
 }
 

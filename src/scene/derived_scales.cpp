@@ -178,9 +178,14 @@ NamedStiffness softer_normal_stiffness(const Material& material) {
 }
 
 std::string overlap_culprit(const SceneConfig& config, const std::string& kn_field) {
-  const bool kn_set = set_source(config.sets, kn_field).has_value();
-  const bool sigma3_set = set_source(config.sets, "test.lateral_stress").has_value();
-  return kn_set && !sigma3_set ? kn_field : "test.lateral_stress";
+  const auto set = [&](const std::string& field) {
+    return set_source(config.sets, field).has_value();
+  };
+  if (set("test.lateral_stress")) return "test.lateral_stress";
+  if (set(kn_field)) return kn_field;
+  // 2D: the force on a disk per unit stress is sigma3*2r*t.
+  if (config.dimension == 2 && set("material.thickness")) return "material.thickness";
+  return "test.lateral_stress";
 }
 
 void check_derived_scales(const SceneConfig& config, std::span<const double> radii) {

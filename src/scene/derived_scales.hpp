@@ -26,12 +26,13 @@ void check_derived_scales(const SceneConfig& config, std::span<const double> rad
 
 /// The field an overlap-at-sigma3 check names (check_lateral_stress in
 /// config.cpp, check_resolvable in packing.cpp, check_sphere_overlap in
-/// triaxial.cpp). The overlap grows as sigma3/kn, so the physics cannot
-/// tell which of the two is out of range (their messages give both
+/// triaxial.cpp). The overlap grows as sigma3/kn (2D: sigma3*t/kn), so
+/// the physics cannot tell which is out of range (their messages give the
 /// bounds): the one named is the stiffness
 /// (`kn_field`, material.kn or material.wall.kn: the one the check used)
 /// when a --set gave it and none gave sigma3 (the value the user just
-/// changed), else test.lateral_stress.
+/// changed), else in 2D material.thickness when a --set gave it and none
+/// gave sigma3 or the stiffness, else test.lateral_stress.
 std::string overlap_culprit(const SceneConfig& config, const std::string& kn_field);
 
 /// The softer of the particles' and the walls' normal stiffness, and its

@@ -335,16 +335,21 @@ void check_resolvable(const SceneConfig& config, const Assembly& a) {
   if (roundoff <= wanted * delta) return;
   const double minimum = roundoff / wanted * kn / (2.0 * m.thickness * r_min);
   const double kn_max = 2.0 * sigma3 * m.thickness * r_min * wanted / roundoff;
-  // sigma3 too low or kn too high: the error names the one a --set changed
-  // (detail::overlap_culprit) and the --set or file that gave it.
+  // sigma3 or t too low, or kn too high: the error names the one a --set
+  // changed (detail::overlap_culprit) and the --set or file that gave it.
   const std::string field = detail::overlap_culprit(config, kn_field);
   std::ostringstream msg;
   msg << "the overlap at sigma3, 2*sigma3*t*r_min/kn = " << delta << " m (sigma3 = " << sigma3
-      << " Pa, " << kn_field << " = " << kn << " N/m), is not resolved by positions up to "
-      << coordinate << " m (round-off " << roundoff << " m must stay below a tenth of "
+      << " Pa, thickness " << m.thickness << " m, " << kn_field << " = " << kn
+      << " N/m), is not resolved by positions up to " << coordinate << " m (round-off " << roundoff
+      << " m must stay below a tenth of "
       << "consolidation_tolerance of it): test.lateral_stress must be at least " << minimum
-      << " Pa for this assembly, or " << kn_field << " at most " << kn_max << " N/m; got "
-      << (field == kn_field ? kn : sigma3);
+      << " Pa for this assembly, or " << kn_field << " at most " << kn_max << " N/m";
+  if (field == "material.thickness")
+    msg << ", or material.thickness at least " << roundoff / wanted * kn / (2.0 * sigma3 * r_min)
+        << " m; got " << m.thickness;
+  else
+    msg << "; got " << (field == kn_field ? kn : sigma3);
   throw InputError(source_of(config, field), field, msg.str());
 }
 
