@@ -240,6 +240,28 @@ TEST_F(Cli3D, DivergedRunNamesTheStepThatDivergedOnce) {
   test::expect_one_divergence_numbering(r.out, out, 4000);
 }
 
+// A random gas 2 x 2 spheres across (random_500_3d at aspect 0.01: a
+// column that crept through its 2e6-step consolidation, exit 1 after about
+// a minute) is bad input before any work: exit 2, one line naming the file,
+// assembly.aspect and the bound.
+TEST_F(Cli3D, AColumnTwoSpheresAcrossIsBadInputBeforeAnyWork) {
+  const std::string config = write("column.json", "{" + test::kMaterialMember + R"(, "dimension": 3,
+    "assembly": {"type": "random", "count": 500, "radius_min": 3.75e-4,
+                 "radius_max": 6.25e-4, "aspect": 0.01},
+    "test": {"type": "triaxial"}})");
+  for (const char* command : {"check", "run"}) {
+    SCOPED_TRACE(command);
+    const test::RunResult r = demcal({command, config});
+    EXPECT_EQ(r.status, 2) << r.err;
+    EXPECT_EQ(lines_of(r.err).size(), 1u) << r.err;
+    EXPECT_NE(r.err.find(config + ": assembly.aspect: "), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("3 spheres across"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("aspect above 0.016"), std::string::npos) << r.err;
+    EXPECT_EQ(r.out, "");
+    EXPECT_TRUE(work_empty());
+  }
+}
+
 TEST_F(Cli3D, MismatchesAndUnsupportedCommandsAreBadInput) {
   struct Case {
     std::vector<std::string> args;

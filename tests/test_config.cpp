@@ -150,7 +150,9 @@ TEST(ConfigDefaults, EmbeddedDefaultIsTheShippedHex10x10) {
 }
 
 TEST(ConfigDefaults, ShippedConfigsAreValid) {
-  for (const char* name : {"hex_5x5", "hex_10x10", "hex_20x20", "random_400"}) {
+  // Every shipped config (the random gases pass check_gas_layers).
+  for (const char* name : {"hex_5x5", "hex_10x10", "hex_20x20", "random_400", "fcc_4x4x4",
+                           "random_500_3d", "poly_uniform_400", "poly_lognormal_500"}) {
     const SceneConfig c =
         load_config(std::string(DEMCAL_SOURCE_DIR) + "/configs/" + name + ".json");
     EXPECT_EQ(c.name, name);
@@ -307,11 +309,9 @@ TEST(ConfigErrors, InfiniteAndUnderflowingNumbers) {
   EXPECT_EQ(e2->field(), "material.kn");
 }
 
-// A random gas needs 3 layers along every side (check_gas_layers in
-// config.cpp): aspect 1e6 made 400 disks one row in a box of 20 000 cells
-// (2 000 000 steps, then exit 1), 1e-6 one column; 100 (200 x 2) and 0.01
-// (2 x 200) stalled too. The shipped aspect (1) and the measured 60 and
-// 0.02 stay valid.
+// Aspect 1e6 made 400 disks one row in a box of 20 000 cells (2 000 000
+// steps, then exit 1), 1e-6 one column. The shipped aspect (1) and the
+// measured 60 and 0.02 stay valid.
 // A gas one particle thick along a side (one row, column or layer) never
 // consolidates (config.cpp, check_gas_layers: measured); two layers do.
 TEST(ConfigErrors, AGasAspectTooFlatOrTooTallToConsolidateIsRejected) {
@@ -343,6 +343,43 @@ TEST(ConfigErrors, AGasAspectTooFlatOrTooTallToConsolidateIsRejected) {
   expect_rejected(R"({"assembly": {"type": "random", "count": 2}})", "assembly.count");
   expect_rejected(R"({"dimension": 3, "assembly": {"type": "random", "count": 4}})",
                   "assembly.count");
+}
+
+// A 3D gas 2 x 2 spheres across is a column of corner spheres, a chain
+// that creeps at isotropic sigma3 (check_gas_layers in config.cpp, measured:
+// random_500_3d at aspect 0.01, 2 x 2 x 125, failed its 2e6-step
+// consolidation after 63 s, seeds 1-4, and an 8e6-step one): refused up
+// front, naming assembly.aspect, the bound and why. Slabs two layers thick,
+// a 3 x 3 column and the 2D column two disks wide stay valid.
+TEST(ConfigErrors, A3DGasTwoSpheresAcrossIsRejected) {
+  for (auto [count, aspect] : {std::pair{"500", "0.01"}, {"500", "0.016"}, {"60", "0.1"}}) {
+    const std::string text = std::string(R"({"dimension": 3, "assembly": {"type": "random", )") +
+                             R"("count": )" + count + R"(, "aspect": )" + aspect + "}}";
+    expect_rejected(text, "assembly.aspect");
+    const auto e = input_error([&] { parse(text); });
+    ASSERT_TRUE(e);
+    const std::string m = e->message();
+    EXPECT_NE(m.find("gives a gas of 2 x 2 cells across"), std::string::npos) << m;
+    EXPECT_NE(m.find("3 spheres across"), std::string::npos) << m;
+    EXPECT_NE(m.find("creeps at isotropic sigma3"), std::string::npos) << m;
+    EXPECT_NE(m.find("got " + std::string(aspect)), std::string::npos) << m;
+  }
+  // The bound: 3 across for 500 spheres from aspect above 2^3/500 = 0.016.
+  const auto e = input_error([] {
+    parse(R"({"dimension": 3, "assembly": {"type": "random", "count": 500, "aspect": 0.01}})");
+  });
+  ASSERT_TRUE(e);
+  EXPECT_NE(e->message().find("aspect above 0.016 and up to about 21.296 for count 500"),
+            std::string::npos)
+      << e->message();
+  // Fewer than 10 spheres are 2 across or 1 layer at any aspect: the count.
+  expect_rejected(R"({"dimension": 3, "assembly": {"type": "random", "count": 9}})",
+                  "assembly.count");
+  for (auto [count, aspect] : {std::pair{"500", "0.03"}, {"10", "2"}, {"30", "1"}, {"500", "8"}})
+    EXPECT_NO_THROW(parse(std::string(R"({"dimension": 3, "assembly": {"type": "random", )") +
+                          R"("count": )" + count + R"(, "aspect": )" + aspect + "}}"))
+        << count << " " << aspect;
+  EXPECT_NO_THROW(parse(R"({"assembly": {"type": "random", "count": 400, "aspect": 0.01}})"));
 }
 
 // The values in a message read as given: kn = 1e-300 printed with %f was
