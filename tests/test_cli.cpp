@@ -331,6 +331,31 @@ TEST_F(CliEndToEnd, TheOverlapAtSigma3NamesAThicknessASetChanged) {
   EXPECT_EQ(ok.status, 0) << ok.err;
 }
 
+// `check` builds the prototype's assembly (prototype.particles: 40 000
+// disks on hex_5x5) before the scene's, and the round-off bound on sigma3
+// depends on the assembly's extent: `check configs/hex_5x5.json --set
+// test.lateral_stress=1e-3` said "positions up to 0.2005 m ... must be at
+// least 0.02226 Pa for this assembly" where `run` (the scene's 25 disks,
+// 0.0055 m) accepts 1e-3 and asks 0.000610623 Pa of 1e-4: two bounds for
+// "this assembly", the prototype never named. Now the assembly is named,
+// with its count (make_assembly's and make_sphere_assembly's `which`).
+TEST_F(CliEndToEnd, AnUnresolvableSigma3NamesThePrototypesAssembly) {
+  const std::string out = (dir_ / "work" / "out").string();
+  expect_bad_input(
+      {"check", kHex5, "--set", "test.lateral_stress=1e-3"},
+      {"--set test.lateral_stress=1e-3: test.lateral_stress: ", "positions up to 0.2005 m",
+       "at least 0.02226 Pa for the prototype's assembly (40000 particles)"});
+  expect_bad_input({"check", test::shipped_config("fcc_4x4x4"), "--set", "test.lateral_stress=1"},
+                   {"at least 2.85868 Pa for the prototype's assembly (23328 spheres)"});
+  // The scene's own, and the REV as its own prototype: the scene's.
+  expect_bad_input({"run", kHex5, "--set", "test.lateral_stress=1e-4", "-o", out},
+                   {"positions up to 0.0055 m",
+                    "at least 0.000610623 Pa for the scene's assembly (25 particles)"});
+  expect_bad_input(
+      {"check", kHex5, "--set", "test.lateral_stress=1e-4", "--set", "prototype.particles=0"},
+      {"at least 0.000610623 Pa for the scene's assembly (25 particles)"});
+}
+
 // Contact dashpots beyond critical make every contact creep, and the
 // consolidation's step shrinks for them: beyond the ratio at which the
 // quickest contact's time constant outlasts test.consolidation_max_steps,

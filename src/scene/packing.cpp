@@ -319,7 +319,8 @@ namespace {
 // wall stress within consolidation_tolerance of sigma3; unless that round-off
 // is below a tenth of it, the stress is noise (hex_5x5: 1e-3 Pa runs,
 // 1e-4 Pa "diverges" in the energy ledger, 1e-9 Pa fails the same way).
-void check_resolvable(const SceneConfig& config, const Assembly& a) {
+// `which` names the assembly (make_assembly).
+void check_resolvable(const SceneConfig& config, const Assembly& a, const std::string& which) {
   if (a.size() == 0) return;
   const double coordinate =
       std::max({std::abs(a.left), std::abs(a.right), std::abs(a.bottom), std::abs(a.top)});
@@ -344,7 +345,8 @@ void check_resolvable(const SceneConfig& config, const Assembly& a) {
       << " N/m), is not resolved by positions up to " << coordinate << " m (round-off " << roundoff
       << " m must stay below a tenth of "
       << "consolidation_tolerance of it): test.lateral_stress must be at least " << minimum
-      << " Pa for this assembly, or " << kn_field << " at most " << kn_max << " N/m";
+      << " Pa for " << which << "'s assembly (" << a.size() << " particles), or " << kn_field
+      << " at most " << kn_max << " N/m";
   if (field == "material.thickness")
     msg << ", or material.thickness at least " << roundoff / wanted * kn / (2.0 * sigma3 * r_min)
         << " m; got " << m.thickness;
@@ -355,7 +357,7 @@ void check_resolvable(const SceneConfig& config, const Assembly& a) {
 
 }  // namespace
 
-Assembly make_assembly(const SceneConfig& config) {
+Assembly make_assembly(const SceneConfig& config, const std::string& which) {
   const auto& s = config.assembly;
   Assembly a;
   if (s.type == "hexagonal")
@@ -369,7 +371,7 @@ Assembly make_assembly(const SceneConfig& config) {
     a = read_particle_file(s.file);
   }
   detail::check_derived_scales(config, a.r);
-  check_resolvable(config, a);
+  check_resolvable(config, a, which);
   return a;
 }
 

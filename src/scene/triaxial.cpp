@@ -40,7 +40,9 @@ constexpr SphereWallSide kLateral[4] = {kXMin, kXMax, kYMin, kYMax};
 // several times σ3 and the kernel stops at 0.5), and δ of the smallest
 // resolved by the positions' round-off to a tenth of the consolidation
 // tolerance.
-void check_sphere_overlap(const SceneConfig& config, const SphereAssembly& a) {
+// `which` names the assembly (make_sphere_assembly).
+void check_sphere_overlap(const SceneConfig& config, const SphereAssembly& a,
+                          const std::string& which) {
   if (a.size() == 0) return;
   const Material& m = config.material;
   const double sigma3 = config.test.lateral_stress;
@@ -79,8 +81,9 @@ void check_sphere_overlap(const SceneConfig& config, const SphereAssembly& a) {
       << coordinate << " m (round-off " << roundoff
       << " m must stay below a tenth of consolidation_tolerance of it): test.lateral_stress must "
          "be at least "
-      << roundoff / wanted * kn / (4.0 * r_min * r_min) << " Pa for this assembly, or " << kn_field
-      << " at most " << 4.0 * sigma3 * r_min * r_min * wanted / roundoff << " N/m";
+      << roundoff / wanted * kn / (4.0 * r_min * r_min) << " Pa for " << which << "'s assembly ("
+      << a.size() << " spheres), or " << kn_field << " at most "
+      << 4.0 * sigma3 * r_min * r_min * wanted / roundoff << " N/m";
   fail(kn_field, kn, msg.str());
 }
 
@@ -95,7 +98,7 @@ SphereMaterial sphere_material(const Material& material) {
   return m;
 }
 
-SphereAssembly make_sphere_assembly(const SceneConfig& config) {
+SphereAssembly make_sphere_assembly(const SceneConfig& config, const std::string& which) {
   if (config.dimension != 3)
     throw InputError(config.source, "dimension", "a sphere assembly needs \"dimension\": 3");
   const AssemblySpec& s = config.assembly;
@@ -111,7 +114,7 @@ SphereAssembly make_sphere_assembly(const SceneConfig& config) {
     throw InputError(config.source, "assembly.type",
                      "\"" + s.type + "\" is not a 3D assembly (fcc, random or file)");
   detail::check_derived_scales(config, a.r);
-  check_sphere_overlap(config, a);
+  check_sphere_overlap(config, a, which);
   return a;
 }
 

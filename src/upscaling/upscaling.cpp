@@ -225,7 +225,7 @@ Assembly generated_disks(const SceneConfig& config, int64_t n, std::string& desc
                         config.calibration.seed);
   }
   const SceneConfig c = scene_of_size(config, n);
-  Assembly a = make_assembly(c);
+  Assembly a = make_assembly(c, "the prototype");
   description = std::to_string(a.size()) + " particles from the " + c.assembly.type +
                 " generator of " + config.name;
   return a;
@@ -242,7 +242,7 @@ SphereAssembly generated_spheres(const SceneConfig& config, int64_t n, std::stri
     return a;
   }
   const SceneConfig c = scene_of_size(config, n);
-  SphereAssembly a = make_sphere_assembly(c);
+  SphereAssembly a = make_sphere_assembly(c, "the prototype");
   const auto& s = c.assembly;
   description =
       std::to_string(a.size()) + " spheres from the " + s.type + " generator of " + config.name +

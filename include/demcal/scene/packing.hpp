@@ -99,8 +99,10 @@ double centre_distance(const std::array<std::span<const double>, D>& x, int i, i
 bool parse_particle_fields(const std::string& line, std::span<double> v, bool& seen_content,
                            int64_t particles_read, const std::string& path,
                            const std::string& where);
-/// Build the assembly a config asks for.
-Assembly make_assembly(const SceneConfig& config);
+/// Build the assembly a config asks for. `which` names it in the errors
+/// about its own positions ("the prototype": a check of the scene also
+/// builds the prototype's, a bound for one is not the other's).
+Assembly make_assembly(const SceneConfig& config, const std::string& which = "the scene");
 
 /// σ1/σ3 at sliding failure of a periodic hexagonal packing (horizontal
 /// rows) with interparticle friction μ: tan 60°·tan(60° + φ_μ), tan φ_μ = μ.

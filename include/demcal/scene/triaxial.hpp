@@ -59,7 +59,8 @@ SphereMaterial sphere_material(const Material& material);
 /// Build the sphere assembly a 3D config asks for (fcc, random gas, file)
 /// and check that the overlap at σ3 is resolvable: InputError naming
 /// test.lateral_stress otherwise.
-SphereAssembly make_sphere_assembly(const SceneConfig& config);
+SphereAssembly make_sphere_assembly(const SceneConfig& config,
+                                    const std::string& which = "the scene");
 
 /// Compressive pressure on a wall from the spheres [Pa].
 double wall_pressure(const SphereWorld& world, SphereWallSide side);
