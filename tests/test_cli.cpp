@@ -356,6 +356,62 @@ TEST_F(CliEndToEnd, AnUnresolvableSigma3NamesThePrototypesAssembly) {
       {"at least 0.000610623 Pa for the scene's assembly (25 particles)"});
 }
 
+// A check across two keys named the file and its own field whatever a
+// --set had changed: `check configs/hex_5x5.json --set material.kn=1e6`
+// (the file's kt is 5e7) read "configs/hex_5x5.json: material.kt: must not
+// exceed kn (1e+06)", blaming a value the user never touched; and likewise
+// `--set algorithm.steps=100` (the file's monitor_points 200) and `--set
+// assembly.radius_max=3e-4` (radius_min 3.75e-4). Now the key a --set
+// changed, with that --set and both values (changed_field, the rule of the
+// overlap at sigma3); with both or neither changed, the check's own field.
+TEST_F(CliEndToEnd, ACheckAcrossTwoKeysNamesTheKeyASetChanged) {
+  const std::string out = (dir_ / "work" / "out").string();
+  const std::string random = test::shipped_config("random_400");
+  struct Case {
+    std::string config;
+    std::vector<std::string> sets;
+    std::string named, what;
+  };
+  const std::vector<Case> cases = {
+      {kHex5,
+       {"material.kn=1e6"},
+       "--set material.kn=1e6: material.kn: ",
+       "must be at least kt (5e+07): kt/kn = 2(1-nu)/(2-nu) <= 1"},
+      {kHex5,
+       {"material.kn=1e6", "material.kt=2e6"},
+       "--set material.kt=2e6: material.kt: ",
+       "must not exceed kn (1e+06)"},
+      {kHex5,
+       {"algorithm.steps=100"},
+       "--set algorithm.steps=100: algorithm.steps: ",
+       "must be at least test.monitor_points (200), got 100"},
+      {kHex5,
+       {"algorithm.steps=100", "test.monitor_points=150"},
+       "--set test.monitor_points=150: test.monitor_points: ",
+       "must not exceed algorithm.steps (100), got 150"},
+      {random,
+       {"assembly.radius_max=3e-4"},
+       "--set assembly.radius_max=3e-4: assembly.radius_max: ",
+       "must not be below radius_min (0.000375), got 0.0003"},
+      {random,
+       {"assembly.radius_min=7e-4"},
+       "--set assembly.radius_min=7e-4: assembly.radius_min: ",
+       "must not exceed radius_max (0.000625), got 0.0007"},
+  };
+  for (const Case& c : cases) {
+    for (const std::string command : {"run", "check"}) {
+      std::vector<std::string> args = {command, c.config};
+      for (const std::string& set : c.sets) args.insert(args.end(), {"--set", set});
+      if (command == "run") args.insert(args.end(), {"-o", out});
+      expect_bad_input(args, {c.named, c.what});
+    }
+  }
+  // In the file, with no --set: the file and kt, as before.
+  const std::string soft = write("soft.json", R"({"material": {"density": 2650, "kn": 1e8,
+      "kt": 2e8, "friction": 0.3}})");
+  expect_bad_input({"check", soft}, {soft + ": material.kt: must not exceed kn (1e+08)"});
+}
+
 // Contact dashpots beyond critical make every contact creep, and the
 // consolidation's step shrinks for them: beyond the ratio at which the
 // quickest contact's time constant outlasts test.consolidation_max_steps,

@@ -192,13 +192,17 @@ void check_scene_name(const Reader& root, const std::string& name) {
 // (omega^2 = 3 kt/m against kn/m for the normal one) then outruns the
 // normal springs, so consolidation at dt_ratio 0.2 diverges (kt = 1.2 kn on
 // hex_5x5; kt = kn runs). Walls do not rotate: their kt is not bound.
-void check_tangential_stiffness(const Reader& m, const ContactLaw& particle) {
-  if (particle.kt > particle.kn)
-    m.fail("kt", "must not exceed kn (" + num(particle.kn, 6) +
-                     "): kt/kn = 2(1-nu)/(2-nu) "
-                     "<= 1 for an elastic contact, and beyond it the tangential-rotational mode "
-                     "outruns the normal step dt_ratio refers to; got " +
-                     num(particle.kt, 6));
+// The error names kn when a --set gave it and none gave kt (changed_field).
+void check_tangential_stiffness(const Reader& m, const ContactLaw& particle,
+                                const std::vector<std::string>& sets) {
+  if (particle.kt <= particle.kn) return;
+  const std::string why =
+      "kt/kn = 2(1-nu)/(2-nu) "
+      "<= 1 for an elastic contact, and beyond it the tangential-rotational mode "
+      "outruns the normal step dt_ratio refers to; got ";
+  if (changed_field(sets, {"material.kt", "material.kn"}) == "material.kn")
+    m.fail("kn", "must be at least kt (" + num(particle.kt, 6) + "): " + why + num(particle.kn, 6));
+  m.fail("kt", "must not exceed kn (" + num(particle.kn, 6) + "): " + why + num(particle.kt, 6));
 }
 
 // Overlap at sigma3: a disk of radius r carries about sigma3*2r*t per
@@ -428,7 +432,7 @@ SceneConfig parse_config(const nlohmann::json& root_json, const std::string& sou
       m.fail("thickness", "has no meaning in 3D (spheres of mass rho*(4/3)*pi*r^3); remove it");
     c.material.thickness = m.positive("thickness", c.material.thickness);
     c.material.particle = read_contact(m, c.material.particle);
-    check_tangential_stiffness(m, c.material.particle);
+    check_tangential_stiffness(m, c.material.particle, sets);
     c.material.contact_damping_ratio =
         m.non_negative("contact_damping_ratio", c.material.contact_damping_ratio);
     Reader w = m.child("wall");
@@ -476,7 +480,15 @@ SceneConfig parse_config(const nlohmann::json& root_json, const std::string& sou
       if (s.distribution == "uniform") {
         s.radius_min = a.positive("radius_min", s.radius_min);
         s.radius_max = a.positive("radius_max", s.radius_max);
-        if (s.radius_min > s.radius_max) a.fail("radius_min", "must not exceed radius_max");
+        if (s.radius_min > s.radius_max) {
+          // Named as the bound a --set changed (changed_field).
+          if (changed_field(sets, {"assembly.radius_min", "assembly.radius_max"}) ==
+              "assembly.radius_max")
+            a.fail("radius_max", "must not be below radius_min (" + num(s.radius_min, 6) +
+                                     "), got " + num(s.radius_max, 6));
+          a.fail("radius_min", "must not exceed radius_max (" + num(s.radius_max, 6) + "), got " +
+                                   num(s.radius_min, 6));
+        }
       } else {
         s.radius_mean = a.positive("radius_mean", s.radius_mean);
         s.radius_std = a.non_negative("radius_std", s.radius_std);
@@ -524,10 +536,17 @@ SceneConfig parse_config(const nlohmann::json& root_json, const std::string& sou
     c.algorithm = read_algorithm(a, c.algorithm);
     // M points of the curve need at least M steps: more would repeat steps
     // in series.csv and slow every run by the extra measurements.
-    if (c.test.monitor_points > c.algorithm.steps)
+    // Named as the one a --set changed (changed_field).
+    if (c.test.monitor_points > c.algorithm.steps) {
+      if (changed_field(sets, {"test.monitor_points", "algorithm.steps"}) == "algorithm.steps")
+        throw InputError(source, "algorithm.steps",
+                         "must be at least test.monitor_points (" +
+                             std::to_string(c.test.monitor_points) + "), got " +
+                             std::to_string(c.algorithm.steps));
       throw InputError(source, "test.monitor_points",
                        "must not exceed algorithm.steps (" + std::to_string(c.algorithm.steps) +
                            "), got " + std::to_string(c.test.monitor_points));
+    }
   }
   {
     Reader k = root.child("calibration");
@@ -664,6 +683,13 @@ std::optional<std::string> set_source(const std::vector<std::string>& sets,
     if (field == key || field.rfind(key + ".", 0) == 0) return "--set " + *set;
   }
   return std::nullopt;
+}
+
+std::string changed_field(const std::vector<std::string>& sets,
+                          const std::vector<std::string>& fields) {
+  for (const auto& field : fields)
+    if (set_source(sets, field)) return field;
+  return fields.front();
 }
 
 std::string source_of(const SceneConfig& config, const std::string& field) {

@@ -178,14 +178,10 @@ NamedStiffness softer_normal_stiffness(const Material& material) {
 }
 
 std::string overlap_culprit(const SceneConfig& config, const std::string& kn_field) {
-  const auto set = [&](const std::string& field) {
-    return set_source(config.sets, field).has_value();
-  };
-  if (set("test.lateral_stress")) return "test.lateral_stress";
-  if (set(kn_field)) return kn_field;
+  std::vector<std::string> fields{"test.lateral_stress", kn_field};
   // 2D: the force on a disk per unit stress is sigma3*2r*t.
-  if (config.dimension == 2 && set("material.thickness")) return "material.thickness";
-  return "test.lateral_stress";
+  if (config.dimension == 2) fields.push_back("material.thickness");
+  return changed_field(config.sets, fields);
 }
 
 void check_derived_scales(const SceneConfig& config, std::span<const double> radii) {

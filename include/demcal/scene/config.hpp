@@ -196,6 +196,14 @@ struct SceneConfig {
 /// when the config is parsed and those found later (the stable step).
 std::optional<std::string> set_source(const std::vector<std::string>& sets,
                                       const std::string& field);
+/// The field a check across keys names (kt against kn, an overlap at
+/// sigma3 against sigma3, kn and t): the first of `fields` a --set gave
+/// (set_source()), else the first. The user's latest change is named with
+/// the --set that made it, not the file's value it broke against; with
+/// none, or both, the first (the check's own field). One rule for every
+/// such check (detail::overlap_culprit too). `fields` is not empty.
+std::string changed_field(const std::vector<std::string>& sets,
+                          const std::vector<std::string>& fields);
 /// set_source(), else the config's file.
 std::string source_of(const SceneConfig& config, const std::string& field);
 /// A file the config names at `field` (assembly.file) can be read: else an
