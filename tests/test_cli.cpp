@@ -646,6 +646,41 @@ TEST_F(CliEndToEnd, ASetSectionAfterAKeyInItIsBadInput) {
   EXPECT_EQ(ok.status, 0) << ok.err;
 }
 
+// A malformed --set key (an empty part: "material.", "material..kn") was
+// compared with the other --sets before apply_overrides refused it, and
+// could be said as something else: `--set material.=1 --set material={...}`
+// read "--set material={...}: material: replaces the section, and with it
+// --set material.=1 given before it", `--set material..kn=1 --set
+// material..kn=2` "given twice". Now every --set's key is checked first
+// (set_key, apply_overrides' wording), in every command that takes --set.
+TEST_F(CliEndToEnd, AMalformedSetKeyIsSaidBeforeItIsComparedWithOthers) {
+  const std::string out = (dir_ / "work" / "out").string();
+  const std::string params =
+      (fs::path(test::kSourceDir) / "reports" / "example-hex_10x10" / "params.json").string();
+  const std::string material =
+      R"(material={"density": 2650, "kn": 1e8, "kt": 5e7, "friction": 0.3})";
+  struct Case {
+    std::vector<std::string> sets;
+    std::string named;
+  };
+  const std::vector<Case> cases = {
+      {{"material.=1", material}, "--set material.=1: key has an empty part"},
+      {{"material..kn=1", "material..kn=2"}, "--set material..kn=1: key has an empty part"},
+      {{"material.kn=1e6", "material.kn=1e7", ".kn=2"}, "--set .kn=2: key has an empty part"},
+  };
+  const std::vector<std::vector<std::string>> commands = {
+      {"check", kHex5},
+      {"run", kHex5, "-o", out},
+      {"verify", params, "--particles", "100", "-o", out},
+  };
+  for (const Case& c : cases) {
+    for (std::vector<std::string> args : commands) {
+      for (const std::string& set : c.sets) args.insert(args.end(), {"--set", set});
+      expect_bad_input(args, {c.named});
+    }
+  }
+}
+
 // Usage errors (CLI11's checks) are bad input too: one line, exit 2.
 TEST_F(CliEndToEnd, UsageErrorsExitTwo) {
   const std::string out = (dir_ / "work" / "out").string();

@@ -710,14 +710,36 @@ SceneConfig default_config() {
   return parse_config_text(default_config_text(), "<embedded default: configs/hex_10x10.json>");
 }
 
+namespace {
+
+// A --set's key: else an InputError naming the --set, "wants
+// section.key=value" (no '=' or nothing before it) or "key has an empty
+// part" ("material..kn", "material."). Every --set is checked so before
+// any two are compared (require_distinct_set_keys): a malformed key is
+// said as such, not as a duplicate or a section of another.
+std::string set_key(const std::string& set) {
+  const auto eq = set.find('=');
+  if (eq == std::string::npos || eq == 0)
+    throw InputError("--set " + set, "", "wants section.key=value");
+  const std::string key = set.substr(0, eq);
+  for (size_t start = 0;;) {
+    const auto dot = key.find('.', start);
+    if (dot == start || start == key.size())
+      throw InputError("--set " + set, "", "key has an empty part");
+    if (dot == std::string::npos) return key;
+    start = dot + 1;
+  }
+}
+
+}  // namespace
+
 void require_distinct_set_keys(const std::vector<std::string>& sets) {
-  std::map<std::string, std::string> given;  // key -> its value
+  for (const auto& set : sets) set_key(set);  // a malformed key first
+  std::map<std::string, std::string> given;   // key -> its value
   // The keys before, in order, with their --set.
   std::vector<std::pair<std::string, std::string>> before;
   for (const auto& set : sets) {
-    const auto eq = set.find('=');
-    if (eq == std::string::npos || eq == 0) continue;  // apply_overrides names it
-    const std::string key = set.substr(0, eq), value = set.substr(eq + 1);
+    const std::string key = set_key(set), value = set.substr(key.size() + 1);
     const auto [first, fresh] = given.emplace(key, value);
     if (!fresh)
       throw InputError("--set " + set, key,
@@ -743,9 +765,7 @@ void apply_overrides(nlohmann::json& j, const std::vector<std::string>& sets) {
   require_distinct_set_keys(sets);
   for (const auto& set : sets) {
     const std::string source = "--set " + set;  // what the errors name
-    const auto eq = set.find('=');
-    if (eq == std::string::npos || eq == 0) throw InputError(source, "", "wants section.key=value");
-    const std::string key = set.substr(0, eq), value = set.substr(eq + 1);
+    const std::string key = set_key(set), value = set.substr(key.size() + 1);
     nlohmann::json v;
     try {
       v = nlohmann::json::parse(value);
@@ -758,8 +778,7 @@ void apply_overrides(nlohmann::json& j, const std::vector<std::string>& sets) {
     std::string rest = key;
     for (;;) {
       const auto dot = rest.find('.');
-      const std::string part = rest.substr(0, dot);
-      if (part.empty()) throw InputError(source, "", "key has an empty part");
+      const std::string part = rest.substr(0, dot);  // not empty: set_key
       if (dot == std::string::npos) {
         (*node)[part] = v;
         break;

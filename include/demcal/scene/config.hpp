@@ -258,9 +258,11 @@ void apply_overrides(nlohmann::json& json, const std::vector<std::string>& sets)
 /// parse_config_json). A section and then a key in it are two keys (the
 /// section replaced, then the key changed in it); a key and then a section
 /// holding it ("--set a.b=1 --set a={...}") is an InputError naming both
-/// --sets: the section would replace the key, silently.
-/// Checked by apply_overrides, and by the params.json commands before they
-/// drop the --set they do not apply (check_params_options).
+/// --sets: the section would replace the key, silently. A malformed --set
+/// (no '=', or a key with an empty part: "material..kn") is an InputError
+/// first, apply_overrides' (before any two keys are compared: "material."
+/// is no key inside "material"). Checked by apply_overrides, and by the params.json commands before
+/// they drop the --set they do not apply (check_params_options).
 void require_distinct_set_keys(const std::vector<std::string>& sets);
 
 /// `json` with the overrides applied (in place), parsed: an error in a key
