@@ -414,6 +414,38 @@ AlgorithmSpec algorithm_from_json(const nlohmann::json& json, const std::string&
   return read_algorithm(a, base);
 }
 
+namespace {
+
+// Uniform radii need radius_min <= radius_max; the error names the bound a
+// --set changed (changed_field), with both values.
+void check_radius_bounds(const Reader& a, const AssemblySpec& s,
+                         const std::vector<std::string>& sets) {
+  if (s.radius_min <= s.radius_max) return;
+  if (changed_field(sets, {"assembly.radius_min", "assembly.radius_max"}) == "assembly.radius_max")
+    a.fail("radius_max", "must not be below radius_min (" + num(s.radius_min, 6) + "), got " +
+                             num(s.radius_max, 6));
+  a.fail("radius_min",
+         "must not exceed radius_max (" + num(s.radius_max, 6) + "), got " + num(s.radius_min, 6));
+}
+
+// M points of the curve need at least M steps: more would repeat steps in
+// series.csv and slow every run by the extra measurements. The error names
+// the one a --set changed (changed_field).
+void check_monitor_points(const SceneConfig& c, const std::string& source,
+                          const std::vector<std::string>& sets) {
+  if (c.test.monitor_points <= c.algorithm.steps) return;
+  if (changed_field(sets, {"test.monitor_points", "algorithm.steps"}) == "algorithm.steps")
+    throw InputError(source, "algorithm.steps",
+                     "must be at least test.monitor_points (" +
+                         std::to_string(c.test.monitor_points) + "), got " +
+                         std::to_string(c.algorithm.steps));
+  throw InputError(source, "test.monitor_points",
+                   "must not exceed algorithm.steps (" + std::to_string(c.algorithm.steps) +
+                       "), got " + std::to_string(c.test.monitor_points));
+}
+
+}  // namespace
+
 SceneConfig parse_config(const nlohmann::json& root_json, const std::string& source,
                          const std::vector<std::string>& sets) {
   SceneConfig c;
@@ -480,15 +512,7 @@ SceneConfig parse_config(const nlohmann::json& root_json, const std::string& sou
       if (s.distribution == "uniform") {
         s.radius_min = a.positive("radius_min", s.radius_min);
         s.radius_max = a.positive("radius_max", s.radius_max);
-        if (s.radius_min > s.radius_max) {
-          // Named as the bound a --set changed (changed_field).
-          if (changed_field(sets, {"assembly.radius_min", "assembly.radius_max"}) ==
-              "assembly.radius_max")
-            a.fail("radius_max", "must not be below radius_min (" + num(s.radius_min, 6) +
-                                     "), got " + num(s.radius_max, 6));
-          a.fail("radius_min", "must not exceed radius_max (" + num(s.radius_max, 6) + "), got " +
-                                   num(s.radius_min, 6));
-        }
+        check_radius_bounds(a, s, sets);
       } else {
         s.radius_mean = a.positive("radius_mean", s.radius_mean);
         s.radius_std = a.non_negative("radius_std", s.radius_std);
@@ -534,19 +558,7 @@ SceneConfig parse_config(const nlohmann::json& root_json, const std::string& sou
   {
     Reader a = root.child("algorithm");
     c.algorithm = read_algorithm(a, c.algorithm);
-    // M points of the curve need at least M steps: more would repeat steps
-    // in series.csv and slow every run by the extra measurements.
-    // Named as the one a --set changed (changed_field).
-    if (c.test.monitor_points > c.algorithm.steps) {
-      if (changed_field(sets, {"test.monitor_points", "algorithm.steps"}) == "algorithm.steps")
-        throw InputError(source, "algorithm.steps",
-                         "must be at least test.monitor_points (" +
-                             std::to_string(c.test.monitor_points) + "), got " +
-                             std::to_string(c.algorithm.steps));
-      throw InputError(source, "test.monitor_points",
-                       "must not exceed algorithm.steps (" + std::to_string(c.algorithm.steps) +
-                           "), got " + std::to_string(c.test.monitor_points));
-    }
+    check_monitor_points(c, source, sets);
   }
   {
     Reader k = root.child("calibration");
