@@ -513,8 +513,7 @@ TEST_F(CliEndToEnd, AParticleFileWithAHexNumberOrATrailingCommaIsBadInput) {
 // the config is read.
 TEST_F(CliEndToEnd, ASetKeyGivenTwiceIsBadInput) {
   const std::string out = (dir_ / "work" / "out").string();
-  const std::string params =
-      (fs::path(test::kSourceDir) / "reports" / "example-hex_10x10" / "params.json").string();
+  const std::string params = test::example_params("hex_10x10");
   const std::vector<std::vector<std::string>> commands = {
       {"check", kHex5},
       {"run", kHex5, "-o", out},
@@ -544,8 +543,7 @@ TEST_F(CliEndToEnd, ASetKeyGivenTwiceIsBadInput) {
 // --set now, first and alone, with the message of the other commands.
 TEST_F(CliEndToEnd, ASetKeyGivenTwiceIsSaidBeforeAFailedParamsJson) {
   const std::string out = (dir_ / "work" / "out").string();
-  nlohmann::json params = nlohmann::json::parse(
-      read_text(fs::path(test::kSourceDir) / "reports" / "example-hex_10x10" / "params.json"));
+  nlohmann::json params = nlohmann::json::parse(read_text(test::example_params("hex_10x10")));
   params["success"] = false;
   const std::string failed = write("failed.json", params.dump());
   const std::vector<std::string> twice = {"--set", "algorithm.steps=2000", "--set",
@@ -573,8 +571,7 @@ TEST_F(CliEndToEnd, ASetKeyGivenTwiceIsSaidBeforeAFailedParamsJson) {
 // order.
 TEST_F(CliEndToEnd, ASetSectionAfterAKeyInItIsBadInput) {
   const std::string out = (dir_ / "work" / "out").string();
-  const std::string params =
-      (fs::path(test::kSourceDir) / "reports" / "example-hex_10x10" / "params.json").string();
+  const std::string params = test::example_params("hex_10x10");
   const std::string material =
       R"(material={"density": 2650, "kn": 1e8, "kt": 5e7, "friction": 0.3})";
   const std::vector<std::vector<std::string>> commands = {
@@ -615,8 +612,7 @@ TEST_F(CliEndToEnd, ASetSectionAfterAKeyInItIsBadInput) {
 // (set_key, apply_overrides' wording), in every command that takes --set.
 TEST_F(CliEndToEnd, AMalformedSetKeyIsSaidBeforeItIsComparedWithOthers) {
   const std::string out = (dir_ / "work" / "out").string();
-  const std::string params =
-      (fs::path(test::kSourceDir) / "reports" / "example-hex_10x10" / "params.json").string();
+  const std::string params = test::example_params("hex_10x10");
   const std::string material =
       R"(material={"density": 2650, "kn": 1e8, "kt": 5e7, "friction": 0.3})";
   struct Case {
@@ -1410,10 +1406,8 @@ TEST_F(CliEndToEnd, RevSaysItsConsolidationAsTheOtherCommands) {
 // quiet): each consolidation's first check, step 200, is on a line; scaling
 // consolidates each of its 3 sizes. calibrate -q and scaling -q print none.
 TEST_F(CliEndToEnd, EveryCommandThatConsolidatesPrintsItsProgress) {
-  const std::string hex10 =
-      (fs::path(test::kSourceDir) / "reports" / "example-hex_10x10" / "params.json").string();
-  const std::string fcc =
-      (fs::path(test::kSourceDir) / "reports" / "example-fcc_4x4x4" / "params.json").string();
+  const std::string hex10 = test::example_params("hex_10x10");
+  const std::string fcc = test::example_params("fcc_4x4x4");
   auto progress_lines = [](const std::string& err) {
     std::vector<std::string> lines;
     for (const std::string& line : lines_of(err))
@@ -1482,7 +1476,6 @@ TEST_F(CliEndToEnd, EveryCommandThatConsolidatesPrintsItsProgress) {
 // one line: the prototype's Nstep (the one `demcal upscale` writes), from
 // the REV's particles and steps, by which law (the 2D export said nothing).
 TEST_F(CliEndToEnd, ExportSaysHowItsStepsWereUpscaledIn2dAnd3d) {
-  const fs::path reports = fs::path(test::kSourceDir) / "reports";
   struct Case {
     std::string params;
     const char* particles;  // the 3D FCC prototype: 4·n³ spheres
@@ -1490,10 +1483,9 @@ TEST_F(CliEndToEnd, ExportSaysHowItsStepsWereUpscaledIn2dAnd3d) {
     const char* law;
     const char* deck;
   };
-  const std::vector<Case> cases = {{(reports / "example-hex_10x10" / "params.json").string(), "150",
-                                    "particles", "linear", "d2/deck.lammps"},
-                                   {(reports / "example-fcc_4x4x4" / "params.json").string(), "500",
-                                    "spheres", "power", "d3/deck.lammps"}};
+  const std::vector<Case> cases = {
+      {test::example_params("hex_10x10"), "150", "particles", "linear", "d2/deck.lammps"},
+      {test::example_params("fcc_4x4x4"), "500", "spheres", "power", "d3/deck.lammps"}};
   for (const Case& c : cases) {
     SCOPED_TRACE(c.params);
     const Result r = demcal(

@@ -325,8 +325,7 @@ TEST(ConsolidationProgress, ExportPrintsProgressOnStderr) {
   // --progress 0 prints at every check (the default, 2 s, keeps a short
   // consolidation quiet): the lines a long one prints, in a fast test.
   const test::TempDir dir("consolidation_progress");
-  const std::string params =
-      (fs::path(test::kSourceDir) / "reports" / "example-hex_10x10" / "params.json").string();
+  const std::string params = test::example_params("hex_10x10");
   const auto every = test::run_demcal({"export", params, "--particles", "100", "--consolidate-in",
                                        "demcal", "--progress", "0", "-o", "a/deck.lammps"},
                                       dir.path());

@@ -628,10 +628,7 @@ TEST(ExportCli, ConsolidateInChoosesWhereAndRejectsBadCombinations) {
   // auto: demcal's kernel (consolidate_in.hpp); deck: the deck's stage 1
   // (said on stderr); bad values and combinations exit 2 writing nothing.
   const test::TempDir dir("export_cli");
-  const std::string params =
-      (fs::path(test::shipped_config("hex_5x5")).parent_path().parent_path() / "reports" /
-       "example-hex_10x10" / "params.json")
-          .string();
+  const std::string params = test::example_params("hex_10x10");
   auto run = [&](std::vector<std::string> args) {
     args.insert(args.begin(), {"export", params});
     return test::run_demcal(args, dir.path());
@@ -665,10 +662,7 @@ TEST(ExportCli, TwoDecksInOneFolderReadTheirOwnFiles) {
   // LAMMPS data file's one atom type broke the LIGGGHTS deck's walls).
   // An export that would overwrite a file another deck reads is refused.
   const test::TempDir dir("export_two_decks");
-  const std::string params =
-      (fs::path(test::shipped_config("hex_5x5")).parent_path().parent_path() / "reports" /
-       "example-hex_10x10" / "params.json")
-          .string();
+  const std::string params = test::example_params("hex_10x10");
   auto run = [&](std::vector<std::string> args, const fs::path& where) {
     args.insert(args.begin(), {"export", params, "--particles", "25"});
     return test::run_demcal(args, where);
@@ -739,13 +733,6 @@ TEST(ExportCli, TwoDecksInOneFolderReadTheirOwnFiles) {
   EXPECT_EQ(test::read_text(both / "log.liggghts").find("ERROR"), std::string::npos);
 }
 
-/// The example calibration the CLI tests export (hex_10x10's params.json).
-std::string example_params() {
-  return (fs::path(test::shipped_config("hex_5x5")).parent_path().parent_path() / "reports" /
-          "example-hex_10x10" / "params.json")
-      .string();
-}
-
 /// The data rows of a deck's series file (neither `#` lines nor the
 /// column header).
 size_t series_rows(const fs::path& file) {
@@ -768,8 +755,10 @@ TEST(ExportCli, DecksInOneFolderWriteTheirOwnSeriesAndRestarts) {
   const fs::path d = dir.path();
   for (const std::string deck : {"a.lammps", "b.lammps", "a.liggghts"}) {
     const std::string format = deck.substr(deck.find('.') + 1);
-    const test::RunResult r = test::run_demcal(
-        {"export", example_params(), "--particles", "25", "--format", format, "-o", deck}, d);
+    const test::RunResult r =
+        test::run_demcal({"export", test::example_params("hex_10x10"), "--particles", "25",
+                          "--format", format, "-o", deck},
+                         d);
     ASSERT_EQ(r.status, 0) << r.err;
   }
   const std::string a_text = test::read_text(d / "a.lammps");
@@ -828,7 +817,7 @@ TEST(ExportCli, AnUncertifiedCalibrationsDeckSaysSoInItsHeader) {
   // closing `&` or a `"` in the message would end the comment or join the
   // next line); a certified calibration's deck has no such line.
   const test::TempDir dir("export_uncertified");
-  nlohmann::json params = test::read_json(example_params());
+  nlohmann::json params = test::read_json(test::example_params("hex_10x10"));
   ASSERT_EQ(params["success"], true);
   const std::string why =
       "the best passing parameters did not pass the convergence certificate\nrun 0 &";
@@ -865,9 +854,10 @@ TEST(ExportCli, AnUncertifiedCalibrationsDeckSaysSoInItsHeader) {
       EXPECT_NE(line.back(), '&') << line;
       EXPECT_LE(line.size(), 79u) << line;
     }
-    const test::RunResult ok = test::run_demcal(
-        {"export", example_params(), "--particles", "25", "--format", format, "-o", certified},
-        dir.path());
+    const test::RunResult ok =
+        test::run_demcal({"export", test::example_params("hex_10x10"), "--particles", "25",
+                          "--format", format, "-o", certified},
+                         dir.path());
     ASSERT_EQ(ok.status, 0) << ok.err;
     EXPECT_EQ(test::read_text(dir / certified).find("CERTIFIED"), std::string::npos);
   }

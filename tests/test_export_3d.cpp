@@ -833,8 +833,7 @@ TEST(Export3dLammps, DeckConsolidatesARandomSampleAndLoads) {
 // sphere kernel with progress on stderr; auto: demcal, consolidate_in.hpp).
 TEST(Export3dCli, ConsolidateInChoosesWhereAndPrintsProgress) {
   const test::TempDir dir("export3d_cli");
-  const std::string params =
-      (fs::path(test::kSourceDir) / "reports" / "example-fcc_4x4x4" / "params.json").string();
+  const std::string params = test::example_params("fcc_4x4x4");
   const std::string config = test::shipped_config("random_500_3d");
   const std::vector<std::string> base = {"export", params,        "--config",
                                          config,   "--particles", "150"};
@@ -882,8 +881,7 @@ TEST(Export3dCli, DecksInOneFolderWriteTheirOwnSeriesAndSayTheyAreUncertified) {
   DEMCAL_FIND_PROGRAM(liggghts, "liggghts", "liggghts", "the 3D decks are not run");
   const test::TempDir dir("export3d_outputs");
   const fs::path d = dir.path();
-  nlohmann::json params =
-      test::read_json(fs::path(test::kSourceDir) / "reports" / "example-fcc_4x4x4" / "params.json");
+  nlohmann::json params = test::read_json(test::example_params("fcc_4x4x4"));
   params["success"] = false;
   params["message"] = "no certificate: Nstep doubled moved the peak too far";
   test::write_text(d / "failed.json", params.dump(1));

@@ -27,10 +27,6 @@ using nlohmann::json;
 
 const std::string kHex5 = test::shipped_config("hex_5x5");
 
-std::string example(const std::string& name) {
-  return (fs::path(test::kSourceDir) / "reports" / name / "params.json").string();
-}
-
 class ParamsSchema : public ::testing::Test {
  protected:
   // One fresh calibration of hex_5x5 for the suite (a few seconds).
@@ -150,7 +146,7 @@ TEST_F(ParamsSchema, UnknownKeysAndWrongTypesAreRefused) {
 // upscaling block of law and factor) with --config.
 TEST_F(ParamsSchema, EveryParamsJsonDemcalWritesIsRead) {
   for (const std::string& p :
-       {fresh(), example("example-hex_10x10"), example("example-fcc_4x4x4")}) {
+       {fresh(), test::example_params("hex_10x10"), test::example_params("fcc_4x4x4")}) {
     SCOPED_TRACE(p);
     const Result r = demcal({"upscale", p, "--particles", "100", "-o", "up.json"});
     ASSERT_EQ(r.status, 0) << r.err;
@@ -160,7 +156,7 @@ TEST_F(ParamsSchema, EveryParamsJsonDemcalWritesIsRead) {
         demcal({"export", "up.json", "--consolidate-in", "deck", "-o", "d/deck.lammps"});
     EXPECT_EQ(ex.status, 0) << ex.err;
   }
-  json old = test::read_json(example("example-hex_10x10"));
+  json old = test::read_json(test::example_params("hex_10x10"));
   for (const char* k : {"config", "evidence", "particle_steps_run", "analytical_peak_stress_yy"})
     old.erase(k);
   old["wall_time_s"] = 12.5;

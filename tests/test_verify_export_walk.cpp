@@ -28,12 +28,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-/// The shipped example calibrations: hex_10x10 (REV 100 disks, 88140
-/// steps) and fcc_4x4x4 (REV 256 spheres).
-std::string example_params(const std::string& scene) {
-  return (fs::path(test::kSourceDir) / "reports" / ("example-" + scene) / "params.json").string();
-}
-
 /// demcal ARGS in `cwd` with the environment `env` ("KEY=VALUE") added.
 test::RunResult demcal_with(const std::vector<std::string>& env,
                             const std::vector<std::string>& args, const fs::path& cwd) {
@@ -68,7 +62,7 @@ TEST(VerifyExportWalk, AConsolidationFromTheCacheIsLabelledAndRecorded) {
   };
   for (const Case& c : {Case{"hex_10x10", "25"}, Case{"fcc_4x4x4", "32"}}) {
     SCOPED_TRACE(c.scene);
-    const std::string params = example_params(c.scene);
+    const std::string params = test::example_params(c.scene);
     auto verify = [&](const std::string& out) {
       const test::RunResult r = demcal_with(
           {cache}, {"verify", params, "--particles", c.particles, "-o", out}, dir.path());
@@ -100,7 +94,7 @@ TEST(VerifyExportWalk, AConsolidationFromTheCacheIsLabelledAndRecorded) {
     EXPECT_TRUE(contains(hit.err, steps + "read from the cache in ")) << hit.err;
   }
   // --consolidate-only (2D) and export say it too.
-  const std::string params = example_params("hex_10x10");
+  const std::string params = test::example_params("hex_10x10");
   const test::RunResult only = demcal_with(
       {cache}, {"verify", params, "--particles", "25", "--consolidate-only", "-o", "only"},
       dir.path());
@@ -128,7 +122,7 @@ TEST(VerifyExportWalk, ExportSaysConsolidatingOnlyWhenItConsolidates) {
     SCOPED_TRACE(c.scene);
     auto exported = [&](const std::string& deck) {
       const test::RunResult r = demcal_with({cache},
-                                            {"export", example_params(c.scene), "--particles",
+                                            {"export", test::example_params(c.scene), "--particles",
                                              c.particles, "--consolidate-in", "demcal", "-o", deck},
                                             dir.path());
       EXPECT_EQ(r.status, 0) << r.err;
@@ -171,7 +165,7 @@ TEST(VerifyExportWalk, VerifySaysConsolidatingOnlyWhenItConsolidates) {
         Case{"fcc_4x4x4", "32", "(single-threaded)", {}}}) {
     SCOPED_TRACE(c.scene + " " + c.particles);
     auto verify = [&](const std::string& out) {
-      std::vector<std::string> args = {"verify",      example_params(c.scene),
+      std::vector<std::string> args = {"verify",      test::example_params(c.scene),
                                        "--particles", c.particles,
                                        "-o",          c.scene + c.particles + out};
       args.insert(args.end(), c.more.begin(), c.more.end());
@@ -205,10 +199,11 @@ TEST(VerifyExportWalk, Verify3dConsolidatesOnItsThreads) {
   for (const int threads : {1, 2}) {
     SCOPED_TRACE(threads);
     const std::string out = "t" + std::to_string(threads);
-    const test::RunResult r = demcal_with({"DEMCAL_CACHE_DIR=off"},
-                                          {"verify", example_params("fcc_4x4x4"), "--particles",
-                                           "256", "--threads", std::to_string(threads), "-o", out},
-                                          dir.path());
+    const test::RunResult r =
+        demcal_with({"DEMCAL_CACHE_DIR=off"},
+                    {"verify", test::example_params("fcc_4x4x4"), "--particles", "256", "--threads",
+                     std::to_string(threads), "-o", out},
+                    dir.path());
     ASSERT_EQ(r.status, 0) << r.err;
     EXPECT_EQ(line_of(r.err, "demcal verify: consolidating the prototype "),
               threads == 1 ? "demcal verify: consolidating the prototype (single-threaded)"
@@ -227,7 +222,7 @@ TEST(VerifyExportWalk, Verify3dConsolidatesOnItsThreads) {
 // stand-in lmp that fails at once keeps this test free of LAMMPS.
 TEST(VerifyExportWalk, VerifysLammpsDeckSaysNotCertifiedAsExportsDeckDoes) {
   const test::TempDir dir("walk_uncertified");
-  nlohmann::json params = test::read_json(example_params("hex_10x10"));
+  nlohmann::json params = test::read_json(test::example_params("hex_10x10"));
   ASSERT_EQ(params["success"], true);
   params["success"] = false;
   params["message"] = "the best passing parameters did not pass the convergence certificate";
@@ -263,10 +258,11 @@ TEST(VerifyExportWalk, VerifysLammpsDeckSaysNotCertifiedAsExportsDeckDoes) {
   const std::string steps = estimated.substr(at, estimated.find(' ', at) - at);
   EXPECT_TRUE(contains(nstep, " equal " + steps + " ")) << nstep << "\n" << estimated;
   // A certified calibration's deck has no such line.
-  const test::RunResult certified = demcal_with(
-      {path},
-      {"verify", example_params("hex_10x10"), "--particles", "25", "--engine", "lammps", "-o", "c"},
-      dir.path());
+  const test::RunResult certified =
+      demcal_with({path},
+                  {"verify", test::example_params("hex_10x10"), "--particles", "25", "--engine",
+                   "lammps", "-o", "c"},
+                  dir.path());
   EXPECT_NE(certified.status, 0);
   EXPECT_FALSE(contains(test::read_text(dir / "c" / "lammps" / "deck.lammps"), "CERTIFIED"));
 }
@@ -283,7 +279,7 @@ TEST(VerifyExportWalk, APrototypeOfTheRevsSizeIsSaidNotUpscaled) {
   for (const Case& c :
        {Case{"hex_10x10", "100", "400", "particles"}, Case{"fcc_4x4x4", "256", "500", "spheres"}}) {
     SCOPED_TRACE(c.scene);
-    const std::string params = example_params(c.scene);
+    const std::string params = test::example_params(c.scene);
     const int64_t steps = test::read_json(params)["rev"]["steps"].get<int64_t>();
     const std::string same = "demcal export: " + std::to_string(steps) +
                              " steps, the REV's: not upscaled (the prototype has the REV's " +
@@ -308,7 +304,7 @@ TEST(VerifyExportWalk, APrototypeOfTheRevsSizeIsSaidNotUpscaled) {
   }
   // verify's line says the same (--consolidate-only: the line comes first).
   const test::RunResult verified =
-      test::run_demcal({"verify", example_params("hex_10x10"), "--particles", "100",
+      test::run_demcal({"verify", test::example_params("hex_10x10"), "--particles", "100",
                         "--consolidate-only", "-o", "v"},
                        dir.path());
   ASSERT_EQ(verified.status, 0) << verified.err;
@@ -359,7 +355,7 @@ TEST(VerifyExportWalk, ExportToAFolderNameIsRefusedBeforeAnythingRuns) {
   for (const std::string out : {"new/", "there", "there/"}) {
     SCOPED_TRACE(out);
     const test::RunResult r = test::run_demcal(
-        {"export", example_params("hex_10x10"), "--particles", "25", "-o", out}, dir.path());
+        {"export", test::example_params("hex_10x10"), "--particles", "25", "-o", out}, dir.path());
     EXPECT_EQ(r.status, 2) << r.err;
     EXPECT_TRUE(contains(r.err, "is a folder; give a file name")) << r.err;
     EXPECT_FALSE(contains(r.err, "consolidat")) << r.err;

@@ -19,6 +19,10 @@ std::string shipped_config(const std::string& name) {
   return std::string(kSourceDir) + "/configs/" + name + ".json";
 }
 
+std::string example_params(const std::string& scene) {
+  return std::string(kSourceDir) + "/reports/example-" + scene + "/params.json";
+}
+
 std::string find_on_path(const std::string& name) {
   const char* path = std::getenv("PATH");
   std::stringstream s(path ? path : "");

@@ -21,6 +21,10 @@ extern const char* const kDemcalBinary;
 extern const char* const kSourceDir;
 /// A shipped scene config, e.g. shipped_config("hex_5x5").
 std::string shipped_config(const std::string& name);
+/// A shipped example calibration's params.json, e.g.
+/// example_params("hex_10x10") (REV 100 disks, 88140 steps) or
+/// example_params("fcc_4x4x4") (REV 256 spheres): reports/example-SCENE/.
+std::string example_params(const std::string& scene);
 
 /// The first executable `name` on PATH (lmp, liggghts), or "" when there is
 /// none: the tests that need another engine skip without it.
