@@ -150,7 +150,7 @@ TEST(ConfigDefaults, EmbeddedDefaultIsTheShippedHex10x10) {
 }
 
 TEST(ConfigDefaults, ShippedConfigsAreValid) {
-  // Every shipped config (the random gases pass check_gas_layers).
+  // Every shipped config (the random gases pass gas_layers_fault).
   for (const char* name : {"hex_5x5", "hex_10x10", "hex_20x20", "random_400", "fcc_4x4x4",
                            "random_500_3d", "poly_uniform_400", "poly_lognormal_500"}) {
     const SceneConfig c =
@@ -313,7 +313,7 @@ TEST(ConfigErrors, InfiniteAndUnderflowingNumbers) {
 // steps, then exit 1), 1e-6 one column. The shipped aspect (1) and the
 // measured 60 and 0.02 stay valid.
 // A gas one particle thick along a side (one row, column or layer) never
-// consolidates (config.cpp, check_gas_layers: measured); two layers do.
+// consolidates (packing.cpp, gas_layers_fault: measured); two layers do.
 TEST(ConfigErrors, AGasAspectTooFlatOrTooTallToConsolidateIsRejected) {
   for (const char* aspect : {"1e6", "1e-6", "1000", "0.001"}) {
     SCOPED_TRACE(aspect);
@@ -346,7 +346,7 @@ TEST(ConfigErrors, AGasAspectTooFlatOrTooTallToConsolidateIsRejected) {
 }
 
 // A 3D gas 2 x 2 spheres across is a column of corner spheres, a chain
-// that creeps at isotropic sigma3 (check_gas_layers in config.cpp, measured:
+// that creeps at isotropic sigma3 (gas_layers_fault in packing.cpp, measured:
 // random_500_3d at aspect 0.01, 2 x 2 x 125, failed its 2e6-step
 // consolidation after 63 s, seeds 1-4, and an 8e6-step one): refused up
 // front, naming assembly.aspect, the bound and why. Slabs two layers thick,

@@ -257,79 +257,6 @@ void check_servo_gain(const Reader& t, const TestSpec& test) {
   }
 }
 
-// A random gas is consolidated by walls closing in on its grid (gas_grid:
-// `across` cells wide, `layers` high, 2.2·r_max apart), and keeps about as
-// many particle layers. A gas one particle thick along a side (one row,
-// column or layer) never becomes a sample: measured with a 2e6-step budget,
-// random_400 at aspect 1e6 (one row) and 0.0025 (one column) stall and
-// random_500_3d at 1e6 (one row in a layer 500 cells wide) diverges
-// ("overlap beyond limit"). Two layers do consolidate: 3D 30 spheres at
-// aspect 1 (4 x 4 x 2, 25 200 steps) and 500 at aspect 8 (16 x 16 x 2,
-// 335 800 steps); 2D 40 disks at aspect 10 (20 x 2), 100 at 25 (50 x 2),
-// 400 at 100 (200 x 2, 1 000 200 steps) and at 0.01 (2 x 200, 854 600
-// steps; seed 3 of 3 ended at an unbalanced-force ratio 1.03x its tolerance).
-// Hence layers >= kMinGasLayers = 2, and across >= 2 in 2D.
-//
-// In 3D `across` counts two sides (the grid is across x across): a gas 2
-// across is a column 2 x 2 spheres across, every sphere against two of its
-// four side walls, a chain of four-sphere layers rather than a packing, and
-// it creeps at isotropic sigma3 instead of coming to rest. Measured on
-// random_500_3d at aspect 0.01 (2 x 2 x 125): the side walls hold sigma3
-// within 1e-5 while the end walls creep in at the servo's lag (their
-// stress 0.25 % short of sigma3, the unbalanced-force ratio 0.0036 the
-// global damping's drag on the moving column) until the 2e6-step budget
-// ends, and an 8e6-step budget too (0.030 %, 0.00038); seeds 1-4 all
-// fail. With its end walls held still the column does not come to rest
-// either: its axial stress falls to about 0.76·sigma3 within 8e5 steps
-// while the side walls hold sigma3 (the cross-section shears, x wider, y
-// narrower). 200 spheres 2 x 2 x 50: one seed of two failed; 3 x 3 x 56
-// (aspect 0.03) consolidates in 506 000 steps. Short 2 x 2 columns (8, 20,
-// 60 spheres) did come to rest, but whether a chain holds depends on its
-// weakest layer, so on its length: no count-free bound but the
-// geometry's, kMinGasAcross3D = 3.
-//
-// With n = count, k = kMinGasLayers, m the least `across` (2 in 2D, 3 in
-// 3D) and D the dimension: across = ceil((n·a)^(1/D)) >= m iff a >
-// (m − 1)^D/n, and layers = ceil(n/across^(D−1)) >= k iff across <= c =
-// ceil((n/(k − 1))^(1/(D−1))) − 1, iff a <= c^D/n. No aspect works when
-// c < m: fewer than 3 disks, 10 spheres. The check is gas_grid itself; the
-// bounds are the message's.
-constexpr int kMinGasLayers = 2;
-constexpr int kMinGasAcross3D = 3;
-
-void check_gas_layers(const Reader& a, const AssemblySpec& s, int dimension) {
-  const GasGrid grid = gas_grid(dimension, s.count, s.aspect);
-  const bool three_d = dimension == 3;
-  const int min_across = three_d ? kMinGasAcross3D : kMinGasLayers;
-  if (grid.layers >= kMinGasLayers && grid.across >= min_across) return;
-  const double n = s.count, k = kMinGasLayers, m = min_across, dim = three_d ? 3.0 : 2.0;
-  const double c = std::ceil(std::pow(n / (k - 1.0), 1.0 / (dim - 1.0))) - 1.0;
-  const char* what = three_d ? "spheres" : "disks";
-  std::ostringstream msg;
-  if (c < m) {
-    msg << "too few " << what << " for a random gas with " << kMinGasLayers
-        << " layers along every side"
-        << (three_d ? " and " + std::to_string(kMinGasAcross3D) + " spheres across" : "")
-        << ": at least " << (three_d ? 10 : 3) << "; got " << s.count;
-    a.fail("count", msg.str());
-  }
-  const double lo = std::pow(m - 1.0, dim) / n, hi = std::pow(c, dim) / n;
-  msg << "gives a gas of " << grid.across
-      << (three_d ? " x " + std::to_string(grid.across) + " cells across and " : " columns and ")
-      << grid.layers << (three_d ? " layers" : " rows") << " of " << s.count << " " << what
-      << ": a sample needs at least " << kMinGasLayers << " along every side";
-  if (three_d)
-    msg << " and " << kMinGasAcross3D << " spheres across (a gas one particle thick never comes "
-        << "to a static state between the servo walls, and a column 2 x 2 spheres across, every "
-           "sphere against two side walls, is a chain, not a sample: it creeps at isotropic "
-           "sigma3 instead of coming to rest)";
-  else
-    msg << " (a gas one particle thick never comes to a static state between the servo walls)";
-  msg << ", i.e. aspect above " << lo << " and up to about " << hi << " for count " << s.count
-      << "; got " << s.aspect;
-  a.fail("aspect", msg.str());
-}
-
 // The material is the physics being calibrated: a default density,
 // stiffness or friction would be a calibration of a material the user never
 // gave. thickness (2D: per metre, 1 by convention), contact_damping_ratio
@@ -518,7 +445,10 @@ SceneConfig parse_config(const nlohmann::json& root_json, const std::string& sou
         s.radius_std = a.non_negative("radius_std", s.radius_std);
       }
       s.aspect = a.positive("aspect", s.aspect);
-      check_gas_layers(a, s, c.dimension);
+      // A gas that never consolidates to a static state (packing.cpp,
+      // gas_layers_fault: measured), named by the key to change.
+      if (const auto fault = gas_layers_fault(c.dimension, s.count, s.aspect))
+        a.fail(fault->key, fault->message);
       s.seed = static_cast<uint64_t>(
           a.integer("seed", static_cast<int64_t>(s.seed), 0, std::numeric_limits<int64_t>::max()));
     } else {

@@ -71,6 +71,88 @@ GasGrid gas_grid(int dimension, int count, double aspect) {
   return g;
 }
 
+// A random gas is consolidated by walls closing in on its grid (gas_grid:
+// `across` cells wide, `layers` high, 2.2·r_max apart), and keeps about as
+// many particle layers. A gas one particle thick along a side (one row,
+// column or layer) never becomes a sample: measured with a 2e6-step budget,
+// random_400 at aspect 1e6 (one row) and 0.0025 (one column) stall and
+// random_500_3d at 1e6 (one row in a layer 500 cells wide) diverges
+// ("overlap beyond limit"). Two layers do consolidate: 3D 30 spheres at
+// aspect 1 (4 x 4 x 2, 25 200 steps) and 500 at aspect 8 (16 x 16 x 2,
+// 335 800 steps); 2D 40 disks at aspect 10 (20 x 2), 100 at 25 (50 x 2),
+// 400 at 100 (200 x 2, 1 000 200 steps) and at 0.01 (2 x 200, 854 600
+// steps; seed 3 of 3 ended at an unbalanced-force ratio 1.03x its tolerance).
+// Hence layers >= kMinGasLayers = 2, and across >= 2 in 2D.
+//
+// In 3D `across` counts two sides (the grid is across x across): a gas 2
+// across is a column 2 x 2 spheres across, every sphere against two of its
+// four side walls, a chain of four-sphere layers rather than a packing, and
+// it creeps at isotropic sigma3 instead of coming to rest. Measured on
+// random_500_3d at aspect 0.01 (2 x 2 x 125): the side walls hold sigma3
+// within 1e-5 while the end walls creep in at the servo's lag (their
+// stress 0.25 % short of sigma3, the unbalanced-force ratio 0.0036 the
+// global damping's drag on the moving column) until the 2e6-step budget
+// ends, and an 8e6-step budget too (0.030 %, 0.00038); seeds 1-4 all
+// fail. With its end walls held still the column does not come to rest
+// either: its axial stress falls to about 0.76·sigma3 within 8e5 steps
+// while the side walls hold sigma3 (the cross-section shears, x wider, y
+// narrower). 200 spheres 2 x 2 x 50: one seed of two failed; 3 x 3 x 56
+// (aspect 0.03) consolidates in 506 000 steps. Short 2 x 2 columns (8, 20,
+// 60 spheres) did come to rest, but whether a chain holds depends on its
+// weakest layer, so on its length: no count-free bound but the
+// geometry's, kMinGasAcross3D = 3.
+//
+// With n = count, k = kMinGasLayers, m the least `across` (2 in 2D, 3 in
+// 3D) and D the dimension: across = ceil((n·a)^(1/D)) >= m iff a >
+// (m − 1)^D/n, and layers = ceil(n/across^(D−1)) >= k iff across <= c =
+// ceil((n/(k − 1))^(1/(D−1))) − 1, iff a <= c^D/n. No aspect works when
+// c < m: fewer than 3 disks, 10 spheres. The check is gas_grid itself; the
+// bounds are the message's.
+namespace {
+constexpr int kMinGasLayers = 2;
+constexpr int kMinGasAcross3D = 3;
+}  // namespace
+
+std::optional<GasLayersFault> gas_layers_fault(int dimension, int count, double aspect) {
+  const GasGrid grid = gas_grid(dimension, count, aspect);
+  const bool three_d = dimension == 3;
+  const int min_across = three_d ? kMinGasAcross3D : kMinGasLayers;
+  if (grid.layers >= kMinGasLayers && grid.across >= min_across) return std::nullopt;
+  const double n = count, k = kMinGasLayers, m = min_across, dim = three_d ? 3.0 : 2.0;
+  const double c = std::ceil(std::pow(n / (k - 1.0), 1.0 / (dim - 1.0))) - 1.0;
+  const char* what = three_d ? "spheres" : "disks";
+  std::ostringstream msg;
+  if (c < m) {
+    msg << "too few " << what << " for a random gas with " << kMinGasLayers
+        << " layers along every side"
+        << (three_d ? " and " + std::to_string(kMinGasAcross3D) + " spheres across" : "")
+        << ": at least " << (three_d ? 10 : 3) << "; got " << count;
+    return GasLayersFault{"count", msg.str()};
+  }
+  const double lo = std::pow(m - 1.0, dim) / n, hi = std::pow(c, dim) / n;
+  msg << "gives a gas of " << grid.across
+      << (three_d ? " x " + std::to_string(grid.across) + " cells across and " : " columns and ")
+      << grid.layers << (three_d ? " layers" : " rows") << " of " << count << " " << what
+      << ": a sample needs at least " << kMinGasLayers << " along every side";
+  if (three_d)
+    msg << " and " << kMinGasAcross3D << " spheres across (a gas one particle thick never comes "
+        << "to a static state between the servo walls, and a column 2 x 2 spheres across, every "
+           "sphere against two side walls, is a chain, not a sample: it creeps at isotropic "
+           "sigma3 instead of coming to rest)";
+  else
+    msg << " (a gas one particle thick never comes to a static state between the servo walls)";
+  msg << ", i.e. aspect above " << lo << " and up to about " << hi << " for count " << count
+      << "; got " << aspect;
+  return GasLayersFault{"aspect", msg.str()};
+}
+
+std::string gas_layers_problem(int dimension, int count, double aspect,
+                               const std::string& aspect_name) {
+  const auto fault = gas_layers_fault(dimension, count, aspect);
+  if (!fault) return "";
+  return fault->key == "aspect" ? aspect_name + " " + fault->message : fault->message;
+}
+
 Assembly random_gas(const AssemblySpec& spec) {
   std::mt19937_64 rng(spec.seed);
   Assembly a;

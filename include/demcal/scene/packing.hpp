@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <fstream>
 #include <istream>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -38,12 +39,29 @@ Assembly square_packing(int columns, int rows, double radius);
 /// ceil(cbrt(count·aspect)) cells along x and along y, `layers` =
 /// ceil(count/across²) along z. `across` is at most `count` (a wider grid
 /// leaves cells empty whatever the aspect). The one home of the grid:
-/// random_gas, sphere_gas and the config's check of assembly.aspect.
+/// random_gas, sphere_gas, gas_of_radii (rev.hpp) and gas_layers_fault.
 struct GasGrid {
   int across = 1;
   int layers = 1;
 };
 GasGrid gas_grid(int dimension, int count, double aspect);
+/// Why a random gas of `count` particles at `aspect` never becomes a sample
+/// (packing.cpp: fewer than 2 layers along a side, in 3D fewer than 3
+/// spheres across, measured): `key` is the one to change, "count" (no
+/// aspect works) or "aspect", and `message` says the rule and the bounds.
+/// The one home of the rule: the config's assembly.count and
+/// assembly.aspect, and every command that generates a gas at another
+/// count (scaling's --sizes, rev's --particles, a generated prototype).
+struct GasLayersFault {
+  std::string key;
+  std::string message;
+};
+std::optional<GasLayersFault> gas_layers_fault(int dimension, int count, double aspect);
+/// The same as one phrase for a command's error ("" when the gas can
+/// consolidate): the message, after `aspect_name` ("assembly.aspect") when
+/// it is the aspect's.
+std::string gas_layers_problem(int dimension, int count, double aspect,
+                               const std::string& aspect_name);
 /// A loose random gas of polydisperse disks (no overlaps) on a jittered
 /// grid (gas_grid); consolidation makes it dense (frictionless compression,
 /// then friction on). Deterministic for a seed on every platform.
