@@ -134,7 +134,15 @@ TEST_F(ScalingCli, SizesWithoutAForwardSizeOrRepeatedAreUsageErrors) {
 // rings of particles). Refused before any work (exit 2, one line naming
 // --sizes and the counts), from the counts the generator makes without
 // consolidating.
-TEST_F(ScalingCli, SizesThatMakeOneParticleCountAreUsageErrors) {
+//
+// A random family's sizes are gases at the config's aspect, which the
+// config's check of assembly.count never saw: random_500_3d `--sizes
+// 5,9,40 --calibrate-max 9` ran 5- and 9-sphere gases that never come to
+// rest and printed a negative slope and "worst 0x tol", exit 0. A size
+// that gives too few particles, or at the config's aspect one layer or (3D)
+// 2 spheres across, is refused in the config check's words, naming --sizes
+// and the size.
+TEST_F(ScalingCli, SizesThatMakeOneCountOrNoSampleAreUsageErrors) {
   // A 10x10 square lattice in a file: windows centred on it hold 4, 16,
   // 36, ... particles (5 and 6 both cut 4).
   std::string csv = "x,y,r\n";
@@ -148,6 +156,8 @@ TEST_F(ScalingCli, SizesThatMakeOneParticleCountAreUsageErrors) {
       R"({"material": {"density": 2650, "kn": 1e8, "kt": 5e7, "friction": 0.3},)"
       R"( "assembly": {"type": "file", "file": "lattice.csv"}})");
   const std::string fcc = demcal::test::shipped_config("fcc_4x4x4");
+  const std::string random_3d = demcal::test::shipped_config("random_500_3d");
+  const std::string random_2d = demcal::test::shipped_config("random_400");
   struct Case {
     std::vector<std::string> args;
     std::string mention;
@@ -164,6 +174,17 @@ TEST_F(ScalingCli, SizesThatMakeOneParticleCountAreUsageErrors) {
        "rows)"},
       {{file_config, "--sizes", "5,6,50", "--calibrate-max", "6"},
        "--sizes: 5 and 6 both make 4 particles (REVs cut from"},
+      {{random_3d, "--sizes", "5,9,40", "--calibrate-max", "9"},
+       "--sizes: size 5: too few spheres for a random gas with 2 layers along every side and 3 "
+       "spheres across: at least 10; got 5"},
+      {{random_3d, "--set", "assembly.aspect=8", "--sizes", "100,500,2000", "--calibrate-max",
+        "500"},
+       "--sizes: size 100: assembly.aspect gives a gas of 10 x 10 cells across and 1 layers of "
+       "100 spheres: a sample needs at least 2 along every side and 3 spheres across"},
+      {{random_2d, "--set", "assembly.aspect=0.01", "--sizes", "40,100,400", "--calibrate-max",
+        "100"},
+       "--sizes: size 40: assembly.aspect gives a gas of 1 columns and 40 rows of 40 disks: a "
+       "sample needs at least 2 along every side (a gas one particle thick"},
   };
   for (const Case& c : cases) {
     std::vector<std::string> args{"scaling", "-o", "out", "-q", "-j", "1"};

@@ -167,6 +167,10 @@ struct SizeState {
   ConsolidationRecord consolidation;
 };
 
+/// Size n of the study, as its assembly's errors name it
+/// (make_assembly's `which`: "... for size 40's assembly").
+std::string size_label(int64_t n) { return "size " + std::to_string(n); }
+
 /// The family of scenes and their consolidated states, 2D or 3D. A 2D size
 /// that is not calibrated writes its consolidated packing to the work
 /// folder (size-N/consolidated.csv, an output); a resumed study
@@ -516,6 +520,19 @@ void check_made_counts(const Family& family, const ScalingStudyOptions& o, int d
   }
 }
 
+/// A random family's sizes are gases of n particles at the config's
+/// aspect: each must be one that consolidates, by the rule the config's
+/// assembly.count is held to (gas_layers_fault), or the study calibrates
+/// a sample that never comes to rest.
+void check_gas_sizes(const SceneConfig& config, const ScalingStudyOptions& o) {
+  if (config.assembly.type != "random") return;
+  for (int64_t n : o.sizes) {
+    const std::string problem = gas_layers_problem(config.dimension, static_cast<int>(n),
+                                                   config.assembly.aspect, "assembly.aspect");
+    if (!problem.empty()) throw InputError("--sizes", "", size_label(n) + ": " + problem);
+  }
+}
+
 /// The plan of sizes alone (check_scaling_sizes(options)).
 void check_plan(const ScalingStudyOptions& o) {
   const auto calibrated = std::count_if(o.sizes.begin(), o.sizes.end(),
@@ -541,6 +558,7 @@ void check_scaling_sizes(const ScalingStudyOptions& o) { check_plan(o); }
 
 void check_scaling_sizes(const SceneConfig& config, const ScalingStudyOptions& o) {
   check_plan(o);
+  check_gas_sizes(config, o);
   check_made_counts(Family(config, o), o, config.dimension);
 }
 
@@ -572,6 +590,7 @@ ScalingStudy run_scaling_study(const SceneConfig& config, const ScalingStudyOpti
   for (int64_t n : st.calibrated_sizes)
     if (n < st.forward_size) st.ref_size = n;
 
+  check_gas_sizes(config, o);
   Family family(config, o);
   check_made_counts(family, o, config.dimension);
   st.from_file = family.from_file();

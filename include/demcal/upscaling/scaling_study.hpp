@@ -147,7 +147,11 @@ void check_scaling_sizes(const ScalingStudyOptions& options);
 /// from a file takes whole particles; counted without consolidating) rise
 /// with the sizes: two sizes that make one count, or a forward size that
 /// makes no more than the REV, throw InputError naming --sizes and the
-/// counts. A 3D file family is refused (assembly.type), as the study does.
+/// counts. A random family's sizes are gases that must consolidate
+/// (gas_layers_fault, the rule of assembly.count and assembly.aspect): a
+/// size that gives too few particles or one layer is refused, naming
+/// --sizes and the size. A 3D file family is refused (assembly.type), as
+/// the study does.
 void check_scaling_sizes(const SceneConfig& config, const ScalingStudyOptions& options);
 
 /// The particle file a scaling study cuts its family of REVs from (path)
