@@ -193,6 +193,38 @@ TEST_F(ScalingCli, SizesThatMakeOneCountOrNoSampleAreUsageErrors) {
   }
 }
 
+// A size's assembly is built when the study comes to it, and its errors
+// said "the scene's": the sigma3 round-off bound (positions up to the
+// size's extent) said "for the scene's assembly" of a 400-disk or
+// 2048-sphere size whose config holds 25 or 256. Now they name the size.
+// hex_5x5 at sigma3 1e-3 Pa and fcc_4x4x4 at 1 Pa pass the bound at the
+// config's size and fail it at the study's first.
+TEST_F(ScalingCli, ASizesAssemblyErrorNamesTheSize) {
+  const std::string fcc = demcal::test::shipped_config("fcc_4x4x4");
+  struct Case {
+    std::vector<std::string> args;
+    std::string mention;
+  };
+  const std::vector<Case> cases = {
+      {{kHex5, "--set", "test.lateral_stress=1e-3", "--sizes", "400,900,3600", "--calibrate-max",
+        "900", "-o", "hex"},
+       " Pa for size 400's assembly (400 particles)"},
+      {{fcc, "--set", "test.lateral_stress=1", "--sizes", "2048,4000,16384", "--calibrate-max",
+        "4000", "-o", "fcc"},
+       " Pa for size 2048's assembly (2048 spheres)"},
+  };
+  for (const Case& c : cases) {
+    std::vector<std::string> args{"scaling", "-q", "-j", "1"};
+    args.insert(args.begin() + 1, c.args.begin(), c.args.end());
+    SCOPED_TRACE(c.mention);
+    const Result r = demcal(args);
+    EXPECT_EQ(r.status, 2) << r.err;
+    EXPECT_NE(r.err.find("test.lateral_stress: the overlap at sigma3"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(c.mention), std::string::npos) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  }
+}
+
 // Without --work the per-size work goes to the -o folder (README: "default
 // the same folder"): two studies of one scene with different -o do not
 // share, and a fresh start of one leaves the other's sizes alone.

@@ -228,7 +228,7 @@ class Family {
     // said only when it consolidates (not before a cache read).
     const std::string cache = consolidation_cache_dir();
     if (config_.dimension == 3) {
-      const SphereAssembly a = make_sphere_assembly(st->scene);
+      const SphereAssembly a = make_sphere_assembly(st->scene, size_label(n));
       st->spheres.emplace(consolidate_cached<TriaxialState>(cache, st->scene, a, [&] {
         log("consolidating " + std::to_string(a.size()) + " spheres (size " + std::to_string(n) +
             ")");
@@ -244,7 +244,8 @@ class Family {
       // slightly different sample: criteria ~1e-7 away from an
       // uninterrupted study's.) consolidated.csv stays an output: the
       // forward size's sample, e.g. a prototype for `demcal verify`.
-      const Assembly a = from_file_ ? cut_rev(file_prototype_, n) : make_assembly(st->scene);
+      const Assembly a =
+          from_file_ ? cut_rev(file_prototype_, n) : make_assembly(st->scene, size_label(n));
       st->disks.emplace(consolidate_cached<ConsolidatedState>(cache, st->scene, a, [&] {
         log("consolidating " + std::to_string(a.size()) + " particles (size " + std::to_string(n) +
             ")");
