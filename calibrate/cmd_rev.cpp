@@ -7,6 +7,7 @@
 // that calibrates on the REV and names the prototype, so that
 //   demcal rev CONFIG --prototype P.csv -o R && demcal calibrate R/rev-config.json
 // is the whole path from a user's assembly to its parameters.
+#include <algorithm>
 #include <filesystem>
 #include <functional>
 #include <iostream>
@@ -64,6 +65,25 @@ void announce_rev(int64_t particles, const char* noun) {
             << " to sigma3\n";
 }
 
+// A generated REV is a gas of --particles particles at the prototype's
+// aspect (rev_gas_aspect): one that never consolidates is refused before
+// it is made, by the rule a config's assembly.count and assembly.aspect
+// are held to (gas_layers_fault). Checked on the prototype as read or
+// generated, before any consolidation, and again on a generated
+// prototype once consolidated (its box is the one the REV's gas takes).
+template <class AnyAssembly>
+void require_rev_gas(int dimension, const RevOptions& ro, const AnyAssembly& proto) {
+  if (ro.method != "generate") return;
+  const std::string problem = gas_layers_problem(
+      dimension, static_cast<int>(std::min<int64_t>(ro.particles, kMaxParticles)),
+      rev_gas_aspect(proto),
+      dimension == 3 ? "the prototype's sqrt(width*depth)/height" : "the prototype's width/height");
+  if (!problem.empty())
+    throw InputError("--particles", "",
+                     "a REV generated as a gas of " + std::to_string(ro.particles) +
+                         (dimension == 3 ? " spheres: " : " disks: ") + problem);
+}
+
 // `ready` is called once the prototype is read and checked, before any
 // consolidation (it checks the output folder); `every_s`: seconds between
 // the consolidations' progress lines.
@@ -74,8 +94,9 @@ RevOutcome rev_2d(const SceneConfig& config, const std::string& file, const RevO
     throw InputError(config.source, "prototype",
                      "names no prototype: give prototype.file or prototype.particles, or "
                      "--prototype FILE");
+  require_rev_gas(2, ro, proto);
   ready();
-  if (!proto.dense)  // a generated gas is no packing to cut from or compare with
+  if (!proto.dense) {  // a generated gas is no packing to cut from or compare with
     proto =
         assembly_of(said_consolidation(config, proto, "the prototype", every_s, [&](int threads) {
                       std::cerr << "demcal rev: consolidating the prototype first ("
@@ -83,6 +104,8 @@ RevOutcome rev_2d(const SceneConfig& config, const std::string& file, const RevO
                                 << consolidation_threads_words(threads)
                                 << "): a loose gas takes long\n";
                     }).world);
+    require_rev_gas(2, ro, proto);
+  }
   std::cerr << "demcal rev: "
             << (ro.method == "cut" ? "cutting a REV of about " : "generating a REV of ")
             << ro.particles << " particles from " << source.description << "\n";
@@ -105,14 +128,17 @@ RevOutcome rev_3d(const SceneConfig& config, const std::string& file, const RevO
     throw InputError(source.kind == "file" ? source.file : config.source, "",
                      "asked for a REV of " + std::to_string(ro.particles) +
                          " spheres, the prototype has only " + std::to_string(proto.size()));
+  require_rev_gas(3, ro, proto);
   ready();
-  if (source.kind == "generated")  // a generated gas is no packing to cut from or compare with
+  if (source.kind == "generated") {  // a generated gas is no packing to cut from or compare with
     proto = sphere_assembly_of(
         said_consolidation(config, proto, "the prototype", every_s, [&](int threads) {
           std::cerr << "demcal rev: consolidating the prototype first (" << source.description
                     << ", " << consolidation_threads_words(threads)
                     << "): a loose gas takes long\n";
         }).world);
+    require_rev_gas(3, ro, proto);
+  }
   std::cerr << "demcal rev: " << (ro.method == "cut" ? "cutting a box" : "generating a")
             << " REV of " << (ro.method == "cut" ? "about " : "") << ro.particles
             << " spheres from " << source.description << "\n";

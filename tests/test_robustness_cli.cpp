@@ -436,6 +436,45 @@ TEST_F(RobustCli, FailedRevLeavesNoFolder) {
   EXPECT_FALSE(fs::exists(work() / "out"));
 }
 
+// A random gas at another count than the config's never went through the
+// config's check of assembly.count and assembly.aspect: `rev
+// random_500_3d.json --particles 6 --method generate` consolidated the
+// 20000-sphere prototype and then a 6-sphere gas for minutes. Refused
+// before any consolidation, in the config check's words
+// (gas_layers_fault), naming what gave the count: --particles.
+TEST_F(RobustCli, AGasAtACountThatNeverConsolidatesIsRefusedBeforeAnyWork) {
+  const std::string random_3d = demcal::test::shipped_config("random_500_3d");
+  const std::string random_2d = demcal::test::shipped_config("random_400");
+  // A prototype one row of 20 disks: its box 20 times as wide as high.
+  std::string row = "x,y,r\n";
+  for (int i = 0; i < 20; ++i) row += std::to_string((2 * i + 1) * 5e-4) + ",5e-4,5e-4\n";
+  const std::string strip = demcal::test::write_text(dir_ / "strip.csv", row);
+  const std::string too_few_spheres =
+      "too few spheres for a random gas with 2 layers along every side and 3 spheres across: at "
+      "least 10; got 6";
+  struct Case {
+    std::vector<std::string> args;
+    std::string mention;
+  };
+  const Case cases[] = {
+      {{"rev", random_3d, "--particles", "6", "--method", "generate", "-o", "out"},
+       "--particles: a REV generated as a gas of 6 spheres: " + too_few_spheres},
+      {{"rev", random_3d, "--set", "assembly.aspect=8", "--particles", "100", "--method",
+        "generate", "-o", "out"},
+       "--particles: a REV generated as a gas of 100 spheres: the prototype's "
+       "sqrt(width*depth)/height gives a gas of 10 x 10 cells across and 1 layers of 100 "
+       "spheres"},
+      {{"rev", random_2d, "--prototype", strip, "--particles", "10", "--method", "generate", "-o",
+        "out"},
+       "--particles: a REV generated as a gas of 10 disks: the prototype's width/height gives a "
+       "gas of 10 columns and 1 rows of 10 disks"},
+      {{"rev", random_2d, "--particles", "2", "--method", "generate", "-o", "out"},
+       "--particles: a REV generated as a gas of 2 disks: too few disks for a random gas with 2 "
+       "layers along every side: at least 3; got 2"},
+  };
+  for (const Case& c : cases) expect_refused(c.args, c.mention);
+}
+
 // A bad value given by --set is named as the --set's, not the config
 // file's (the file is fine); a check across keys still names the file.
 TEST_F(RobustCli, ABadSetValueIsNamedAsTheSets) {

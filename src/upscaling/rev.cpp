@@ -416,8 +416,8 @@ Assembly gas_of_radii(std::vector<double> radii, double aspect, uint64_t seed) {
   a.r = std::move(radii);
   const double r_max = *std::max_element(a.r.begin(), a.r.end());
   const double spacing = 2.2 * r_max;
-  const int columns = std::max(1, static_cast<int>(std::ceil(std::sqrt(n * aspect))));
-  const int rows = (n + columns - 1) / columns;
+  const GasGrid grid = gas_grid(2, n, aspect);
+  const int columns = grid.across, rows = grid.layers;
   a.x.resize(n);
   a.y.resize(n);
   for (int i = 0; i < n; ++i) {
@@ -464,10 +464,14 @@ Assembly cut_rev(const Assembly& proto, int64_t count, double aspect) {
   return a;
 }
 
+double rev_gas_aspect(const Assembly& proto) {
+  const double w = proto.right - proto.left, h = proto.top - proto.bottom;
+  return h > 0.0 ? w / h : 1.0;
+}
+
 Assembly generate_rev(const Assembly& proto, int64_t count, uint64_t seed) {
   if (count < 2) throw InputError("REV", "particles", "needs at least 2 particles");
-  const double w = proto.right - proto.left, h = proto.top - proto.bottom;
-  return gas_of_radii(resample_radii(proto.r, count, seed), h > 0.0 ? w / h : 1.0, seed);
+  return gas_of_radii(resample_radii(proto.r, count, seed), rev_gas_aspect(proto), seed);
 }
 
 Assembly tile_mirrored(const Assembly& a, int nx, int ny) {

@@ -53,15 +53,17 @@ SphereAssembly cut_rev(const SphereAssembly& proto, int64_t count, double aspect
   return a;
 }
 
+double rev_gas_aspect(const SphereAssembly& proto) {
+  const double h = proto.hi[2] - proto.lo[2];
+  return h > 0.0 ? std::sqrt((proto.hi[0] - proto.lo[0]) * (proto.hi[1] - proto.lo[1])) / h : 1.0;
+}
+
 SphereAssembly generate_rev(const SphereAssembly& proto, int64_t count, uint64_t seed) {
   if (count < 2) throw InputError("REV", "particles", "needs at least 2 particles");
   if (count > kMaxParticles)
     throw InputError("REV", "particles", std::string("at most ") + kMaxParticlesWhy);
-  const double h = proto.hi[2] - proto.lo[2];
-  const double aspect =
-      h > 0.0 ? std::sqrt((proto.hi[0] - proto.lo[0]) * (proto.hi[1] - proto.lo[1])) / h : 1.0;
   std::mt19937_64 rng(seed);
-  return sphere_gas(resample_radii(proto.r, count, seed), aspect, rng);
+  return sphere_gas(resample_radii(proto.r, count, seed), rev_gas_aspect(proto), rng);
 }
 
 SphereAssembly sphere_assembly_of(const SphereWorld& world) {

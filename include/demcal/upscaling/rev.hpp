@@ -85,8 +85,8 @@ nlohmann::json to_json(const Representativeness& r);
 
 /// `count` radii drawn with replacement from `radii` (deterministic for a seed).
 std::vector<double> resample_radii(std::span<const double> radii, int64_t count, uint64_t seed);
-/// A loose gas of the given disks on a jittered grid (no overlaps), box
-/// width/height ≈ `aspect`; consolidation makes it dense.
+/// A loose gas of the given disks on a jittered grid (gas_grid, no
+/// overlaps), box width/height ≈ `aspect`; consolidation makes it dense.
 Assembly gas_of_radii(std::vector<double> radii, double aspect, uint64_t seed);
 
 /// The window cut: the particles whose centres lie in the axis-aligned
@@ -95,7 +95,11 @@ Assembly gas_of_radii(std::vector<double> radii, double aspect, uint64_t seed);
 /// closest to `count`; walls at the bounding box of the disks kept.
 /// Throws InputError when the prototype has fewer than `count` particles.
 Assembly cut_rev(const Assembly& prototype, int64_t count, double aspect = 0.0);
-/// Radii drawn from the prototype's, as a loose gas (consolidate it).
+/// The aspect (width/height) of the gas generate_rev makes from
+/// `prototype`: its box's (1 for an empty box).
+double rev_gas_aspect(const Assembly& prototype);
+/// Radii drawn from the prototype's, as a loose gas at rev_gas_aspect
+/// (consolidate it).
 Assembly generate_rev(const Assembly& prototype, int64_t count, uint64_t seed = 1);
 
 struct RevOptions {

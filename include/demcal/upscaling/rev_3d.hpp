@@ -47,8 +47,12 @@ PackingStats packing_stats(const SphereWorld& world, double contact_tolerance = 
 /// the spheres kept. Throws InputError when the prototype has fewer than
 /// `count` spheres.
 SphereAssembly cut_rev(const SphereAssembly& prototype, int64_t count, double aspect = 0.0);
-/// Radii drawn from the prototype's (resample_radii) as a loose gas
-/// (sphere_gas, the random_sphere_gas placement); consolidate it.
+/// The aspect of the gas generate_rev makes from `prototype`: its box's
+/// sqrt(width·depth)/height (1 for a flat box).
+double rev_gas_aspect(const SphereAssembly& prototype);
+/// Radii drawn from the prototype's (resample_radii) as a loose gas at
+/// rev_gas_aspect (sphere_gas, the random_sphere_gas placement);
+/// consolidate it.
 SphereAssembly generate_rev(const SphereAssembly& prototype, int64_t count, uint64_t seed = 1);
 
 struct SphereRevResult {
