@@ -439,9 +439,11 @@ TEST_F(RobustCli, FailedRevLeavesNoFolder) {
 // A random gas at another count than the config's never went through the
 // config's check of assembly.count and assembly.aspect: `rev
 // random_500_3d.json --particles 6 --method generate` consolidated the
-// 20000-sphere prototype and then a 6-sphere gas for minutes. Refused
-// before any consolidation, in the config check's words
-// (gas_layers_fault), naming what gave the count: --particles.
+// 20000-sphere prototype and then a 6-sphere gas for minutes, and a
+// prototype.particles of 6 was generated and consolidated as well. Each
+// is refused before any consolidation, in the config check's words
+// (gas_layers_fault), naming what gave the count: --particles, or
+// prototype.particles (here the --set that gave it).
 TEST_F(RobustCli, AGasAtACountThatNeverConsolidatesIsRefusedBeforeAnyWork) {
   const std::string random_3d = demcal::test::shipped_config("random_500_3d");
   const std::string random_2d = demcal::test::shipped_config("random_400");
@@ -471,6 +473,16 @@ TEST_F(RobustCli, AGasAtACountThatNeverConsolidatesIsRefusedBeforeAnyWork) {
       {{"rev", random_2d, "--particles", "2", "--method", "generate", "-o", "out"},
        "--particles: a REV generated as a gas of 2 disks: too few disks for a random gas with 2 "
        "layers along every side: at least 3; got 2"},
+      {{"check", random_3d, "--set", "prototype.particles=6"},
+       "--set prototype.particles=6: prototype.particles: a prototype generated as a gas of 6 "
+       "spheres: " +
+           too_few_spheres},
+      {{"check", random_2d, "--set", "prototype.particles=2"},
+       "prototype.particles: a prototype generated as a gas of 2 disks: too few disks for a "
+       "random gas with 2 layers along every side: at least 3; got 2"},
+      {{"check", random_2d, "--set", "assembly.aspect=0.01", "--set", "prototype.particles=40"},
+       "prototype.particles: a prototype generated as a gas of 40 disks: assembly.aspect gives a "
+       "gas of 1 columns and 40 rows of 40 disks"},
   };
   for (const Case& c : cases) expect_refused(c.args, c.mention);
 }

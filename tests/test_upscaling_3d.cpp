@@ -145,6 +145,38 @@ TEST(Upscaling3D, PrototypeSpheresAsTheConfigNamesThem) {
   EXPECT_EQ(src.kind, "file");
 }
 
+// A generated prototype is a gas: a count at which it never consolidates
+// was generated (and by verify, rev and export consolidated); now refused
+// before it is made, in the config check's words (gas_layers_fault), naming
+// --particles when the command gave the count. Lattices are unaffected.
+TEST(Upscaling3D, AGeneratedPrototypeGasThatNeverConsolidatesIsBadInput) {
+  const auto refusal = [](const auto& make) -> std::string {
+    try {
+      make();
+    } catch (const demcal::InputError& e) {
+      return e.file() + ": " + e.message();
+    }
+    return "not refused";
+  };
+  const SceneConfig spheres = demcal::parse_config_text(
+      "{" + test::kMaterialMember + R"(, "dimension": 3, "assembly": {"type": "random",
+         "count": 50, "radius_min": 4e-4, "radius_max": 6e-4, "seed": 7}})",
+      "gas.json");
+  EXPECT_EQ(refusal([&] { demcal::prototype_spheres(spheres, 6); }),
+            "--particles: a prototype generated as a gas of 6 spheres: too few spheres for a "
+            "random gas with 2 layers along every side and 3 spheres across: at least 10; got 6");
+  const SceneConfig disks = demcal::parse_config_text(
+      "{" + test::kMaterialMember + R"(, "assembly": {"type": "random", "count": 50,
+         "radius_min": 4e-4, "radius_max": 6e-4, "aspect": 0.1}})",
+      "gas2d.json");
+  EXPECT_NE(refusal([&] { demcal::prototype_assembly(disks, 5); })
+                .find("--particles: a prototype generated as a gas of 5 disks: assembly.aspect "
+                      "gives a gas of 1 columns and 5 rows of 5 disks"),
+            std::string::npos);
+  EXPECT_EQ(demcal::prototype_spheres(spheres, 10).size(), 10);
+  EXPECT_EQ(demcal::prototype_spheres(fcc_config(), 4).size(), 4);  // one FCC cell
+}
+
 TEST(Upscaling3D, ParamsFileCarriesThePrototypeBlock) {
   const SceneConfig config = fcc_config();
   const nlohmann::json p = params_3d(config);

@@ -214,16 +214,43 @@ PrototypeSource prototype_source(const PrototypeChoice& choice, int64_t size,
   return src;
 }
 
+/// Where a generated prototype's count came from, for its errors: a
+/// command's --particles (file "--particles", no field) or the config's
+/// prototype.particles.
+struct CountOrigin {
+  std::string file, field;
+};
+
+/// A generated prototype is a gas of `n` particles at `aspect` (named
+/// `aspect_name` in the error): refused, naming `origin`, when it never
+/// consolidates, by the rule a config's assembly.count and assembly.aspect
+/// are held to (gas_layers_fault). Checked before the gas is made.
+void require_prototype_gas(int dimension, int64_t n, double aspect, const std::string& aspect_name,
+                           const CountOrigin& origin) {
+  const std::string problem = gas_layers_problem(
+      dimension, static_cast<int>(std::min<int64_t>(n, kMaxParticles)), aspect, aspect_name);
+  if (!problem.empty())
+    throw InputError(origin.file, origin.field,
+                     "a prototype generated as a gas of " + std::to_string(n) +
+                         (dimension == 3 ? " spheres: " : " disks: ") + problem);
+}
+
 /// `n` disks: the config's generator resized, or for a REV read from a
 /// file (no generator to resize) a gas of radii drawn from that file.
-Assembly generated_disks(const SceneConfig& config, int64_t n, std::string& description) {
+/// A random gas, or a gas of the file's radii, must consolidate
+/// (require_prototype_gas, `origin`).
+Assembly generated_disks(const SceneConfig& config, int64_t n, const CountOrigin& origin,
+                         std::string& description) {
   if (config.assembly.type == "file") {
+    require_prototype_gas(2, n, 1.0, "a square box", origin);
     require_config_file(config, "assembly.file", config.assembly.file);
     const Assembly rev = read_particle_file(config.assembly.file);
     description = std::to_string(n) + " particles with radii drawn from " + config.assembly.file;
     return gas_of_radii(resample_radii(rev.r, n, config.calibration.seed), 1.0,
                         config.calibration.seed);
   }
+  if (config.assembly.type == "random")
+    require_prototype_gas(2, n, config.assembly.aspect, "assembly.aspect", origin);
   const SceneConfig c = scene_of_size(config, n);
   Assembly a = make_assembly(c, "the prototype");
   description = std::to_string(a.size()) + " particles from the " + c.assembly.type +
@@ -232,15 +259,20 @@ Assembly generated_disks(const SceneConfig& config, int64_t n, std::string& desc
 }
 
 /// `n` spheres, likewise (an fcc generator names its cells).
-SphereAssembly generated_spheres(const SceneConfig& config, int64_t n, std::string& description) {
+SphereAssembly generated_spheres(const SceneConfig& config, int64_t n, const CountOrigin& origin,
+                                 std::string& description) {
   if (config.assembly.type == "file") {
     require_config_file(config, "assembly.file", config.assembly.file);
-    SphereAssembly a =
-        generate_rev(read_sphere_file(config.assembly.file), n, config.calibration.seed);
+    const SphereAssembly rev = read_sphere_file(config.assembly.file);
+    require_prototype_gas(3, n, rev_gas_aspect(rev),
+                          config.assembly.file + "'s sqrt(width*depth)/height", origin);
+    SphereAssembly a = generate_rev(rev, n, config.calibration.seed);
     description =
         std::to_string(a.size()) + " spheres with radii drawn from " + config.assembly.file;
     return a;
   }
+  if (config.assembly.type == "random")
+    require_prototype_gas(3, n, config.assembly.aspect, "assembly.aspect", origin);
   const SceneConfig c = scene_of_size(config, n);
   SphereAssembly a = make_sphere_assembly(c, "the prototype");
   const auto& s = c.assembly;
@@ -270,7 +302,13 @@ auto chosen_prototype(const SceneConfig& config, int64_t particles, const std::s
     if (file.empty()) require_config_file(config, "prototype.file", choice.file);
     a = read(choice.file);
   } else if (choice.kind == PrototypeChoice::kCount)
-    a = generate(config, choice.particles, generated);
+    // The count is the command's (--particles, or verify's and export's
+    // from params.json) when given, else the config's.
+    a = generate(config, choice.particles,
+                 particles > 0
+                     ? CountOrigin{"--particles", ""}
+                     : CountOrigin{source_of(config, "prototype.particles"), "prototype.particles"},
+                 generated);
   else
     a = make(config);
   if (source) *source = prototype_source(choice, a.size(), noun, std::move(generated));
