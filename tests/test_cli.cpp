@@ -345,9 +345,16 @@ TEST_F(CliEndToEnd, AnUnresolvableSigma3NamesThePrototypesAssembly) {
 // assembly.radius_max=3e-4` (radius_min 3.75e-4). Now the key a --set
 // changed, with that --set and both values (changed_field, the rule of the
 // overlap at sigma3); with both or neither changed, the check's own field.
+// Likewise check_servo_gain (the gain against the consolidation's tolerance
+// and step budget) named "test.servo_gain" and the file when a --set had
+// changed consolidation_max_steps or the tolerance: now that key, with its
+// own bound (the gain when a --set gave it too).
 TEST_F(CliEndToEnd, ACheckAcrossTwoKeysNamesTheKeyASetChanged) {
   const std::string out = (dir_ / "work" / "out").string();
   const std::string random = test::shipped_config("random_400");
+  // servo_gain 1e-5 needs 690 772 steps to 1e-3 (check_servo_gain).
+  const std::string slow = write("slow_servo.json", R"({"material": {"density": 2650,
+      "kn": 1e8, "kt": 5e7, "friction": 0.3}, "test": {"servo_gain": 1e-5}})");
   struct Case {
     std::string config;
     std::vector<std::string> sets;
@@ -378,6 +385,20 @@ TEST_F(CliEndToEnd, ACheckAcrossTwoKeysNamesTheKeyASetChanged) {
        {"assembly.radius_min=7e-4"},
        "--set assembly.radius_min=7e-4: assembly.radius_min: ",
        "must not exceed radius_max (0.000625), got 0.0007"},
+      // The servo's budget and tolerance (check_servo_gain named the gain
+      // and the file whichever a --set had changed).
+      {slow,
+       {"test.consolidation_max_steps=100000"},
+       "--set test.consolidation_max_steps=100000: test.consolidation_max_steps: ",
+       "must be at least 690773: "},
+      {slow,
+       {"test.consolidation_tolerance=1e-12"},
+       "--set test.consolidation_tolerance=1e-12: test.consolidation_tolerance: ",
+       "must be at least 2.06095e-09: "},
+      {slow,
+       {"test.consolidation_max_steps=100000", "test.servo_gain=2e-5"},
+       "--set test.servo_gain=2e-5: test.servo_gain: ",
+       "must be at least 6.90752e-05"},
   };
   for (const Case& c : cases) {
     for (const std::string command : {"run", "check"}) {

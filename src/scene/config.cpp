@@ -240,21 +240,36 @@ void check_lateral_stress(const SceneConfig& c) {
 // step (the true stiffness is lower than the one it assumes), and a packing
 // starts unstressed (error 1): reaching consolidation_tolerance takes at
 // least ln(1/tol)/(-ln(1 - gain)) steps. A gain that needs more than
-// consolidation_max_steps can never consolidate.
-void check_servo_gain(const Reader& t, const TestSpec& test) {
-  const double needed =
-      std::log(1.0 / test.consolidation_tolerance) / -std::log1p(-test.servo_gain);
-  if (needed > static_cast<double>(test.consolidation_max_steps)) {
-    const double min_gain = -std::expm1(-std::log(1.0 / test.consolidation_tolerance) /
-                                        static_cast<double>(test.consolidation_max_steps));
-    std::ostringstream msg;
-    msg << "must be at least " << min_gain << ": the servo removes at most the fraction gain of "
-        << "the stress error per step, so reaching consolidation_tolerance "
-        << test.consolidation_tolerance << " takes at least ln(1/tol)/(-ln(1-gain)) = " << needed
-        << " steps, more than consolidation_max_steps " << test.consolidation_max_steps << "; got "
-        << test.servo_gain;
-    t.fail("servo_gain", msg.str());
+// consolidation_max_steps can never consolidate. The error names the key a
+// --set changed (changed_field: the gain when one changed it, else the
+// budget, else the tolerance), with that key's own bound.
+void check_servo_gain(const Reader& t, const TestSpec& test, const std::vector<std::string>& sets) {
+  const double per_step = -std::log1p(-test.servo_gain);  // -ln(1 - gain): the log-decrement a step
+  const double needed = std::log(1.0 / test.consolidation_tolerance) / per_step;
+  const auto budget = static_cast<double>(test.consolidation_max_steps);
+  if (needed <= budget) return;
+  std::ostringstream why;
+  why << "the servo removes at most the fraction gain of the stress error per step, so reaching "
+         "consolidation_tolerance "
+      << test.consolidation_tolerance << " at servo_gain " << test.servo_gain
+      << " takes at least ln(1/tol)/(-ln(1-gain)) = " << needed
+      << " steps, more than consolidation_max_steps " << test.consolidation_max_steps;
+  const std::string key = changed_field(
+      sets, {"test.servo_gain", "test.consolidation_max_steps", "test.consolidation_tolerance"});
+  std::ostringstream msg;
+  if (key == "test.consolidation_max_steps") {
+    msg << "must be at least " << std::ceil(needed) << ": " << why.str() << "; got "
+        << test.consolidation_max_steps;
+    t.fail("consolidation_max_steps", msg.str());
   }
+  if (key == "test.consolidation_tolerance") {
+    msg << "must be at least " << std::exp(-budget * per_step) << ": " << why.str() << "; got "
+        << test.consolidation_tolerance;
+    t.fail("consolidation_tolerance", msg.str());
+  }
+  msg << "must be at least " << -std::expm1(-std::log(1.0 / test.consolidation_tolerance) / budget)
+      << ": " << why.str() << "; got " << test.servo_gain;
+  t.fail("servo_gain", msg.str());
 }
 
 // The material is the physics being calibrated: a default density,
@@ -482,7 +497,7 @@ SceneConfig parse_config(const nlohmann::json& root_json, const std::string& sou
     // 3D: the overlap at sigma3 depends on the radii, checked with the
     // assembly (check_sphere_overlap in triaxial.cpp).
     if (!three_d) check_lateral_stress(c);
-    check_servo_gain(t, s);
+    check_servo_gain(t, s, sets);
     t.reject_unknown();
   }
   {
