@@ -214,6 +214,10 @@ TEST_F(CliEndToEnd, AWallTooStiffForTheConsolidationStepIsBadInput) {
 // `--set material.kn=1e300` read "configs/hex_5x5.json: test.lateral_stress:
 // must be at least 2.2e+290 Pa". Now the field a --set changed (sigma3 when
 // both or neither were), with the --set that gave it and both bounds.
+// The round-off bound's other input, consolidation_tolerance, was never
+// named: `check configs/hex_5x5.json --set test.consolidation_tolerance=1e-12`
+// blamed "configs/hex_5x5.json: test.lateral_stress" (2D and 3D). Now that
+// --set and the tolerance, with its own bound beside the others.
 TEST_F(CliEndToEnd, AnOverlapAtSigma3OutOfRangeNamesTheExtremeFieldAndItsSet) {
   const std::string out = (dir_ / "work" / "out").string();
   const std::string fcc = test::shipped_config("fcc_4x4x4");
@@ -228,6 +232,12 @@ TEST_F(CliEndToEnd, AnOverlapAtSigma3OutOfRangeNamesTheExtremeFieldAndItsSet) {
       {fcc, "test.lateral_stress=1e-9", "test.lateral_stress", "not resolved"},
       {fcc, "test.lateral_stress=1e10", "test.lateral_stress", "must be at most 2.5e+09 Pa"},
       {fcc, "material.wall.kn=1e2", "material.wall.kn", "material.wall.kn at least 4000 N/m"},
+      // The round-off bound is the tolerance's too: named, with its bound,
+      // when a --set gave it and none gave sigma3 or the stiffness.
+      {kHex5, "test.consolidation_tolerance=1e-12", "test.consolidation_tolerance",
+       "or test.consolidation_tolerance at least "},
+      {fcc, "test.consolidation_tolerance=1e-12", "test.consolidation_tolerance",
+       "or test.consolidation_tolerance at least "},
   };
   for (const Case& c : cases) {
     expect_bad_input({"run", c.config, "--set", c.set, "-o", out},
@@ -236,6 +246,19 @@ TEST_F(CliEndToEnd, AnOverlapAtSigma3OutOfRangeNamesTheExtremeFieldAndItsSet) {
   }
   expect_bad_input({"check", fcc, "--set", "material.kn=1e300", "--set", "test.lateral_stress=1e5"},
                    {"--set test.lateral_stress=1e5: test.lateral_stress: ", "material.kn at most"});
+  // The tolerance's bound beside sigma3's and the stiffness's (the scene's
+  // 25 disks at run, the prototype's 40 000 at check); with sigma3 given
+  // too, sigma3 as before.
+  expect_bad_input({"run", kHex5, "--set", "test.consolidation_tolerance=1e-12", "-o", out},
+                   {"test.lateral_stress must be at least ", "or material.kn at most ",
+                    "or test.consolidation_tolerance at least 6.10623e-12; got 1e-12"});
+  expect_bad_input({"check", kHex5, "--set", "test.consolidation_tolerance=1e-12"},
+                   {"or test.consolidation_tolerance at least 2.226e-10; got 1e-12"});
+  expect_bad_input({"check", fcc, "--set", "test.consolidation_tolerance=1e-12"},
+                   {"or test.consolidation_tolerance at least 2.85868e-08; got 1e-12"});
+  expect_bad_input({"check", kHex5, "--set", "test.consolidation_tolerance=1e-12", "--set",
+                    "test.lateral_stress=1e5"},
+                   {"--set test.lateral_stress=1e5: test.lateral_stress: ", "; got 100000"});
 }
 
 // The 2D bound on the overlap at sigma3, 2*sigma3*t/kn, is checked when the

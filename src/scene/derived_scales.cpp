@@ -177,10 +177,12 @@ NamedStiffness softer_normal_stiffness(const Material& material) {
   return {material.particle.kn, "material.kn"};
 }
 
-std::string overlap_culprit(const SceneConfig& config, const std::string& kn_field) {
+std::string overlap_culprit(const SceneConfig& config, const std::string& kn_field, bool roundoff) {
   std::vector<std::string> fields{"test.lateral_stress", kn_field};
   // 2D: the force on a disk per unit stress is sigma3*2r*t.
   if (config.dimension == 2) fields.push_back("material.thickness");
+  // The round-off must stay below a tenth of the tolerance of the overlap.
+  if (roundoff) fields.push_back("test.consolidation_tolerance");
   return changed_field(config.sets, fields);
 }
 

@@ -32,8 +32,12 @@ void check_derived_scales(const SceneConfig& config, std::span<const double> rad
 /// (`kn_field`, material.kn or material.wall.kn: the one the check used)
 /// when a --set gave it and none gave sigma3 (the value the user just
 /// changed), else in 2D material.thickness when a --set gave it and none
-/// gave sigma3 or the stiffness, else test.lateral_stress.
-std::string overlap_culprit(const SceneConfig& config, const std::string& kn_field);
+/// gave sigma3 or the stiffness, else, for the round-off bound
+/// (`roundoff`: check_resolvable, check_sphere_overlap's lower bound, whose
+/// input consolidation_tolerance is too), test.consolidation_tolerance when
+/// a --set gave it and none gave the others, else test.lateral_stress.
+std::string overlap_culprit(const SceneConfig& config, const std::string& kn_field,
+                            bool roundoff = false);
 
 /// The softer of the particles' and the walls' normal stiffness, and its
 /// field (material.kn or material.wall.kn; the particles' on a tie): the

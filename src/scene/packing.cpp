@@ -414,13 +414,15 @@ void check_resolvable(const SceneConfig& config, const Assembly& a, const std::s
   const double sigma3 = config.test.lateral_stress;
   const double delta = 2.0 * sigma3 * m.thickness * r_min / kn;
   const double roundoff = 0.5 * std::numeric_limits<double>::epsilon() * coordinate;
-  const double wanted = 0.1 * config.test.consolidation_tolerance;  // relative
+  const double tolerance = config.test.consolidation_tolerance;
+  const double wanted = 0.1 * tolerance;  // relative
   if (roundoff <= wanted * delta) return;
   const double minimum = roundoff / wanted * kn / (2.0 * m.thickness * r_min);
   const double kn_max = 2.0 * sigma3 * m.thickness * r_min * wanted / roundoff;
-  // sigma3 or t too low, or kn too high: the error names the one a --set
-  // changed (detail::overlap_culprit) and the --set or file that gave it.
-  const std::string field = detail::overlap_culprit(config, kn_field);
+  // sigma3 or t too low, kn too high, or the tolerance too fine: the error
+  // names the one a --set changed (detail::overlap_culprit) and the --set or
+  // file that gave it.
+  const std::string field = detail::overlap_culprit(config, kn_field, true);
   std::ostringstream msg;
   msg << "the overlap at sigma3, 2*sigma3*t*r_min/kn = " << delta << " m (sigma3 = " << sigma3
       << " Pa, thickness " << m.thickness << " m, " << kn_field << " = " << kn
@@ -432,6 +434,9 @@ void check_resolvable(const SceneConfig& config, const Assembly& a, const std::s
   if (field == "material.thickness")
     msg << ", or material.thickness at least " << roundoff / wanted * kn / (2.0 * sigma3 * r_min)
         << " m; got " << m.thickness;
+  else if (field == "test.consolidation_tolerance")
+    msg << ", or test.consolidation_tolerance at least " << 10.0 * roundoff / delta << "; got "
+        << tolerance;
   else
     msg << "; got " << (field == kn_field ? kn : sigma3);
   throw InputError(source_of(config, field), field, msg.str());

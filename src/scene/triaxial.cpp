@@ -48,10 +48,17 @@ void check_sphere_overlap(const SceneConfig& config, const SphereAssembly& a,
   const double sigma3 = config.test.lateral_stress;
   const double r_min = *std::min_element(a.r.begin(), a.r.end());
   const double r_max = *std::max_element(a.r.begin(), a.r.end());
-  // The error names sigma3 or the stiffness, the one a --set changed
-  // (detail::overlap_culprit), and the --set or file that gave it.
-  const auto fail = [&](const std::string& kn_field, double kn, const std::string& what) {
-    const std::string field = detail::overlap_culprit(config, kn_field);
+  // The error names sigma3 or the stiffness (the round-off bound: or the
+  // tolerance), the one a --set changed (detail::overlap_culprit), and the
+  // --set or file that gave it; `bound` is the tolerance's.
+  const auto fail = [&](const std::string& kn_field, double kn, const std::string& what,
+                        bool roundoff, double bound) {
+    const std::string field = detail::overlap_culprit(config, kn_field, roundoff);
+    const double tolerance = config.test.consolidation_tolerance;
+    if (field == "test.consolidation_tolerance")
+      throw InputError(source_of(config, field), field,
+                       what + ", or test.consolidation_tolerance at least " + num(bound, 6) +
+                           "; got " + num(tolerance));
     throw InputError(source_of(config, field), field,
                      what + "; got " + num(field == kn_field ? kn : sigma3));
   };
@@ -64,7 +71,7 @@ void check_sphere_overlap(const SceneConfig& config, const SphereAssembly& a,
         << " = " << kn_soft << " N/m), must stay below " << kMaxOverlapAtSigma3
         << ": test.lateral_stress must be at most " << limit << " Pa, or " << soft_field
         << " at least " << 4.0 * sigma3 * r_max / kMaxOverlapAtSigma3 << " N/m";
-    fail(soft_field, kn_soft, msg.str());
+    fail(soft_field, kn_soft, msg.str(), false, 0.0);
   }
   double coordinate = 0.0;
   for (int axis = 0; axis < 3; ++axis)
@@ -84,7 +91,7 @@ void check_sphere_overlap(const SceneConfig& config, const SphereAssembly& a,
       << roundoff / wanted * kn / (4.0 * r_min * r_min) << " Pa for " << which << "'s assembly ("
       << a.size() << " spheres), or " << kn_field << " at most "
       << 4.0 * sigma3 * r_min * r_min * wanted / roundoff << " N/m";
-  fail(kn_field, kn, msg.str());
+  fail(kn_field, kn, msg.str(), true, 10.0 * roundoff / delta);
 }
 
 }  // namespace
