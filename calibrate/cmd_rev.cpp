@@ -16,6 +16,7 @@
 #include "consolidation_progress.hpp"
 #include "demcal/io/files.hpp"
 #include "demcal/scene/biaxial.hpp"
+#include "demcal/scene/packing.hpp"
 #include "demcal/scene/run_output.hpp"
 #include "demcal/scene/sphere_packing.hpp"
 #include "demcal/scene/triaxial.hpp"
@@ -95,6 +96,12 @@ RevOutcome rev_2d(const SceneConfig& config, const std::string& file, const RevO
                      "names no prototype: give prototype.file or prototype.particles, or "
                      "--prototype FILE");
   require_rev_gas(2, ro, proto);
+  // A REV cut from a particle file keeps the file's positions, which never
+  // went through make_assembly's check of the overlap at sigma3: cut now
+  // (as make_rev will) and checked before any work. A generated prototype
+  // was checked when made; a generated REV is a gas at the origin.
+  if (ro.method == "cut" && source.kind == "file")
+    check_resolvable(config, cut_rev(proto, ro.particles, ro.aspect), "the REV", source.file);
   ready();
   if (!proto.dense) {  // a generated gas is no packing to cut from or compare with
     proto =
@@ -129,6 +136,8 @@ RevOutcome rev_3d(const SceneConfig& config, const std::string& file, const RevO
                      "asked for a REV of " + std::to_string(ro.particles) +
                          " spheres, the prototype has only " + std::to_string(proto.size()));
   require_rev_gas(3, ro, proto);
+  if (ro.method == "cut" && source.kind == "file")  // as in 2D
+    check_sphere_overlap(config, cut_rev(proto, ro.particles, ro.aspect), "the REV", source.file);
   ready();
   if (source.kind == "generated") {  // a generated gas is no packing to cut from or compare with
     proto = sphere_assembly_of(

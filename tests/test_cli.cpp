@@ -360,6 +360,62 @@ TEST_F(CliEndToEnd, AnUnresolvableSigma3NamesThePrototypesAssembly) {
       {"at least 0.000610623 Pa for the scene's assembly (25 particles)"});
 }
 
+// A prototype read from a particle file (--prototype, prototype.file, a
+// params.json's prototype) never went through check_resolvable, which
+// make_assembly applies to a generated one: `verify PARAMS --prototype
+// far.csv` (25 disks at x ~ 1e6 m: round-off 1.1e-10 m, above a tenth of
+// the tolerance of the 1e-6 m overlap at sigma3) consolidated and loaded
+// them, exit 0. Now the commands that consolidate the prototype (verify,
+// export) or a REV cut from it (rev: the file's positions) refuse it
+// before any work, in check_resolvable's (3D check_sphere_overlap's)
+// words, naming the file and how near the origin its positions must be.
+// upscale only counts the file's particles: accepted.
+TEST_F(CliEndToEnd, AnUnresolvablePrototypeFileIsRefusedBeforeItIsRun) {
+  const std::string out = (dir_ / "work" / "out").string();
+  const fs::path reports = fs::path(test::kSourceDir) / "reports";
+  const std::string params = (reports / "example-hex_10x10" / "params.json").string();
+  const std::string params3d = (reports / "example-fcc_4x4x4" / "params.json").string();
+  // Touching disks and spheres (r = 5e-4 m) far from the origin: 5x5 at
+  // x ~ 1e6 m, 3x3x3 at x ~ 1e4 m (fcc_4x4x4's overlap is 1e-9 m).
+  std::string disks = "x,y,r\n", spheres = "x,y,z,r\n";
+  for (int i = 0; i < 27; ++i) {
+    const std::string x = std::to_string(i % 3), y = std::to_string(i / 3 % 3);
+    spheres += "10000.00" + x + ",0.00" + y + ",0.00" + std::to_string(i / 9) + ",0.0005\n";
+  }
+  for (int i = 0; i < 25; ++i)
+    disks += "1000000.00" + std::to_string(i % 5) + ",0.00" + std::to_string(i / 5) + ",0.0005\n";
+  const std::string far = write("far.csv", disks), far3d = write("far3d.csv", spheres);
+  struct Case {
+    std::vector<std::string> args;
+    std::string file, assembly;
+  };
+  const std::vector<Case> cases = {
+      {{"verify", params, "--prototype", far, "-o", out},
+       far,
+       "prototype's assembly (25 particles"},
+      {{"export", params, "--prototype", far, "-o", out + "/deck.lammps"},
+       far,
+       "prototype's assembly (25 particles"},
+      {{"rev", kHex5, "--prototype", far, "--particles", "16", "-o", out}, far, "REV's assembly ("},
+      {{"verify", params3d, "--prototype", far3d, "-o", out},
+       far3d,
+       "prototype's assembly (27 spheres"},
+      {{"export", params3d, "--prototype", far3d, "-o", out + "/deck.lammps"},
+       far3d,
+       "prototype's assembly (27 spheres"},
+      {{"rev", test::shipped_config("fcc_4x4x4"), "--prototype", far3d, "--particles", "8", "-o",
+        out},
+       far3d,
+       "REV's assembly ("},
+  };
+  for (const Case& c : cases)
+    expect_bad_input(c.args, {": test.lateral_stress: ", "is not resolved by positions up to",
+                              "for the " + c.assembly, ", from " + c.file + "), or material.kn",
+                              ", or " + c.file + "'s positions within "});
+  const Result counted = demcal({"upscale", params, "--prototype", far, "-o", out});
+  EXPECT_EQ(counted.status, 0) << counted.err;
+}
+
 // A check across two keys named the file and its own field whatever a
 // --set had changed: `check configs/hex_5x5.json --set material.kn=1e6`
 // (the file's kt is 5e7) read "configs/hex_5x5.json: material.kt: must not

@@ -393,16 +393,14 @@ Assembly read_particles(std::istream& in, const std::string& path) {
   return a;
 }
 
-namespace {
-
 // The smallest sigma3 the kernel can resolve. A contact's overlap at sigma3
 // is delta = 2*sigma3*t*r/kn (force sigma3*2r*t on the disk), computed from
 // positions whose round-off is u*|x| (u = 2^-53). The consolidation asks the
 // wall stress within consolidation_tolerance of sigma3; unless that round-off
 // is below a tenth of it, the stress is noise (hex_5x5: 1e-3 Pa runs,
 // 1e-4 Pa "diverges" in the energy ledger, 1e-9 Pa fails the same way).
-// `which` names the assembly (make_assembly).
-void check_resolvable(const SceneConfig& config, const Assembly& a, const std::string& which) {
+void check_resolvable(const SceneConfig& config, const Assembly& a, const std::string& which,
+                      const std::string& file) {
   if (a.size() == 0) return;
   const double coordinate =
       std::max({std::abs(a.left), std::abs(a.right), std::abs(a.bottom), std::abs(a.top)});
@@ -429,8 +427,12 @@ void check_resolvable(const SceneConfig& config, const Assembly& a, const std::s
       << " N/m), is not resolved by positions up to " << coordinate << " m (round-off " << roundoff
       << " m must stay below a tenth of "
       << "consolidation_tolerance of it): test.lateral_stress must be at least " << minimum
-      << " Pa for " << which << "'s assembly (" << a.size() << " particles), or " << kn_field
-      << " at most " << kn_max << " N/m";
+      << " Pa for " << which << "'s assembly (" << a.size() << " particles"
+      << (file.empty() ? "" : ", from " + file) << "), or " << kn_field << " at most " << kn_max
+      << " N/m";
+  if (!file.empty())
+    msg << ", or " << file << "'s positions within " << wanted * delta / (roundoff / coordinate)
+        << " m of the origin";
   if (field == "material.thickness")
     msg << ", or material.thickness at least " << roundoff / wanted * kn / (2.0 * sigma3 * r_min)
         << " m; got " << m.thickness;
@@ -441,8 +443,6 @@ void check_resolvable(const SceneConfig& config, const Assembly& a, const std::s
     msg << "; got " << (field == kn_field ? kn : sigma3);
   throw InputError(source_of(config, field), field, msg.str());
 }
-
-}  // namespace
 
 Assembly make_assembly(const SceneConfig& config, const std::string& which) {
   const auto& s = config.assembly;

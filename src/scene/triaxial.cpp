@@ -33,6 +33,8 @@ double wall_area(const SphereWorld& world, SphereWallSide side) {
 
 constexpr SphereWallSide kLateral[4] = {kXMin, kXMax, kYMin, kYMax};
 
+}  // namespace
+
 // Overlap at σ3: a sphere of radius r carries about σ3·(2r)² per contact
 // (the wall area of its cube), so δ/r = 4·σ3·r/kn. As in 2D
 // (check_lateral_stress in config.cpp, check_resolvable in packing.cpp):
@@ -40,9 +42,8 @@ constexpr SphereWallSide kLateral[4] = {kXMin, kXMax, kYMin, kYMax};
 // several times σ3 and the kernel stops at 0.5), and δ of the smallest
 // resolved by the positions' round-off to a tenth of the consolidation
 // tolerance.
-// `which` names the assembly (make_sphere_assembly).
 void check_sphere_overlap(const SceneConfig& config, const SphereAssembly& a,
-                          const std::string& which) {
+                          const std::string& which, const std::string& file) {
   if (a.size() == 0) return;
   const Material& m = config.material;
   const double sigma3 = config.test.lateral_stress;
@@ -89,12 +90,13 @@ void check_sphere_overlap(const SceneConfig& config, const SphereAssembly& a,
       << " m must stay below a tenth of consolidation_tolerance of it): test.lateral_stress must "
          "be at least "
       << roundoff / wanted * kn / (4.0 * r_min * r_min) << " Pa for " << which << "'s assembly ("
-      << a.size() << " spheres), or " << kn_field << " at most "
-      << 4.0 * sigma3 * r_min * r_min * wanted / roundoff << " N/m";
+      << a.size() << " spheres" << (file.empty() ? "" : ", from " + file) << "), or " << kn_field
+      << " at most " << 4.0 * sigma3 * r_min * r_min * wanted / roundoff << " N/m";
+  if (!file.empty())
+    msg << ", or " << file << "'s positions within " << wanted * delta / (roundoff / coordinate)
+        << " m of the origin";
   fail(kn_field, kn, msg.str(), true, 10.0 * roundoff / delta);
 }
-
-}  // namespace
 
 SphereMaterial sphere_material(const Material& material) {
   SphereMaterial m;

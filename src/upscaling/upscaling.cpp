@@ -333,6 +333,27 @@ SphereAssembly prototype_spheres(const SceneConfig& config, int64_t particles,
       [](const SceneConfig& c) { return make_sphere_assembly(c); });
 }
 
+namespace {
+
+std::string prototype_words(const PrototypeSource& source) {
+  return source.kind == "rev" ? "the scene" : "the prototype";
+}
+std::string prototype_file(const PrototypeSource& source) {
+  return source.kind == "file" ? source.file : "";
+}
+
+}  // namespace
+
+void check_prototype_resolvable(const SceneConfig& config, const Assembly& prototype,
+                                const PrototypeSource& source) {
+  check_resolvable(config, prototype, prototype_words(source), prototype_file(source));
+}
+
+void check_prototype_resolvable(const SceneConfig& config, const SphereAssembly& prototype,
+                                const PrototypeSource& source) {
+  check_sphere_overlap(config, prototype, prototype_words(source), prototype_file(source));
+}
+
 ParticleScales sphere_scales(const SphereWorld& w, const Material& material,
                              const AlgorithmSpec& params) {
   // The sphere scales at the run's mass scaling, from the kernel's masses

@@ -121,6 +121,16 @@ bool parse_particle_fields(const std::string& line, std::span<double> v, bool& s
 /// about its own positions ("the prototype": a check of the scene also
 /// builds the prototype's, a bound for one is not the other's).
 Assembly make_assembly(const SceneConfig& config, const std::string& which = "the scene");
+/// Refuse (InputError) a sigma3 whose contact overlap, 2*sigma3*t*r_min/kn,
+/// the positions of `a` cannot resolve: their round-off, u*max|coordinate|,
+/// must stay below a tenth of consolidation_tolerance of it. make_assembly
+/// checks its own; a prototype read from a particle `file` (named in the
+/// message, with the distance from the origin its positions must keep) is
+/// checked by the commands that consolidate it. The error names the field a
+/// --set changed (detail::overlap_culprit) with its bound; `which` names the
+/// assembly ("the scene", "the prototype").
+void check_resolvable(const SceneConfig& config, const Assembly& a, const std::string& which,
+                      const std::string& file = "");
 
 /// σ1/σ3 at sliding failure of a periodic hexagonal packing (horizontal
 /// rows) with interparticle friction μ: tan 60°·tan(60° + φ_μ), tan φ_μ = μ.

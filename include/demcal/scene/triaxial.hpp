@@ -61,6 +61,15 @@ SphereMaterial sphere_material(const Material& material);
 /// test.lateral_stress otherwise.
 SphereAssembly make_sphere_assembly(const SceneConfig& config,
                                     const std::string& which = "the scene");
+/// Refuse (InputError) a sigma3 whose overlap the spheres of `a` cannot
+/// carry or resolve: 4*sigma3*r_max/kn at most kMaxOverlapAtSigma3, and
+/// the positions' round-off below a tenth of consolidation_tolerance of
+/// the overlap 4*sigma3*r_min^2/kn (check_resolvable's rule in 2D).
+/// make_sphere_assembly checks its own; a prototype read from a particle
+/// `file` (named in the message) is checked by the commands that
+/// consolidate it. `which` names the assembly.
+void check_sphere_overlap(const SceneConfig& config, const SphereAssembly& a,
+                          const std::string& which, const std::string& file = "");
 
 /// Compressive pressure on a wall from the spheres [Pa].
 double wall_pressure(const SphereWorld& world, SphereWallSide side);

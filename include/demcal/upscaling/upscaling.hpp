@@ -128,6 +128,20 @@ Assembly prototype_assembly(const SceneConfig& config, int64_t particles = 0,
 SphereAssembly prototype_spheres(const SceneConfig& config, int64_t particles = 0,
                                  const std::string& file = "", PrototypeSource* source = nullptr);
 
+/// Refuse, before any work, a prototype whose contact overlap at sigma3
+/// its positions cannot resolve to the consolidation's tolerance: the
+/// rule, and the message, of check_resolvable (3D: check_sphere_overlap),
+/// which make_assembly applies to a generated prototype but a particle
+/// file never went through (a packing at x ~ 1e6 m). For the commands that
+/// consolidate or run the prototype (verify, export); upscale and
+/// calibrate only count its particles. A prototype `source` read from a
+/// file is named, with the distance from the origin its positions must
+/// keep; the REV as its own prototype is "the scene".
+void check_prototype_resolvable(const SceneConfig& config, const Assembly& prototype,
+                                const PrototypeSource& source);
+void check_prototype_resolvable(const SceneConfig& config, const SphereAssembly& prototype,
+                                const PrototypeSource& source);
+
 /// The reference scales of spheres (the kernel's own masses m = ρ(4/3)πr³
 /// at `params`' mass scaling, via SphereWorld::reference_scales()) with the
 /// radius and mean-mass entries filled in: the 3D REV block and the 3D
