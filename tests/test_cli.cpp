@@ -372,9 +372,8 @@ TEST_F(CliEndToEnd, AnUnresolvableSigma3NamesThePrototypesAssembly) {
 // upscale only counts the file's particles: accepted.
 TEST_F(CliEndToEnd, AnUnresolvablePrototypeFileIsRefusedBeforeItIsRun) {
   const std::string out = (dir_ / "work" / "out").string();
-  const fs::path reports = fs::path(test::kSourceDir) / "reports";
-  const std::string params = (reports / "example-hex_10x10" / "params.json").string();
-  const std::string params3d = (reports / "example-fcc_4x4x4" / "params.json").string();
+  const std::string params = test::example_params("hex_10x10");
+  const std::string params3d = test::example_params("fcc_4x4x4");
   // Touching disks and spheres (r = 5e-4 m) far from the origin: 5x5 at
   // x ~ 1e6 m, 3x3x3 at x ~ 1e4 m (fcc_4x4x4's overlap is 1e-9 m).
   std::string disks = "x,y,r\n", spheres = "x,y,z,r\n";
