@@ -199,8 +199,27 @@ TEST_F(ScalingCli, SizesThatMakeOneCountOrNoSampleAreUsageErrors) {
 // 2048-sphere size whose config holds 25 or 256. Now they name the size.
 // hex_5x5 at sigma3 1e-3 Pa and fcc_4x4x4 at 1 Pa pass the bound at the
 // config's size and fail it at the study's first.
+//
+// And a size was refused only when the study came to it: after resume.json
+// and the smaller sizes' folders and calibrations were written (hex_5x5 at
+// 4e-3 Pa passes the bound at 400 and 900 disks, not at 3600; fcc_4x4x4 at
+// 2 Pa at 2048 spheres, not at 16384). REVs cut from a particle file were
+// never checked at all: they keep the file's positions, and a lattice at
+// x ~ 1e6 m ran. Every size's assembly is now built and checked before any
+// folder is made (exit 2, nothing written), a cut naming the file.
 TEST_F(ScalingCli, ASizesAssemblyErrorNamesTheSize) {
   const std::string fcc = demcal::test::shipped_config("fcc_4x4x4");
+  // A 10x10 square lattice of touching disks at x ~ 1e6 m (the round-off
+  // of its positions, 1.1e-10 m, above a tenth of the tolerance of the
+  // 1e-6 m overlap at sigma3).
+  std::string csv = "x,y,r\n";
+  for (int i = 0; i < 10; ++i)
+    for (int j = 0; j < 10; ++j)
+      csv += "1000000.00" + std::to_string(i) + ",0.00" + std::to_string(j) + ",0.0005\n";
+  const std::string far = demcal::test::write_text(dir_ / "far.csv", csv);
+  const std::string far_config = demcal::test::write_text(
+      dir_ / "far.json", R"({"material": {"density": 2650, "kn": 1e8, "kt": 5e7, "friction": 0.3},)"
+                         R"( "assembly": {"type": "file", "file": "far.csv"}})");
   struct Case {
     std::vector<std::string> args;
     std::string mention;
@@ -212,6 +231,14 @@ TEST_F(ScalingCli, ASizesAssemblyErrorNamesTheSize) {
       {{fcc, "--set", "test.lateral_stress=1", "--sizes", "2048,4000,16384", "--calibrate-max",
         "4000", "-o", "fcc"},
        " Pa for size 2048's assembly (2048 spheres)"},
+      {{kHex5, "--set", "test.lateral_stress=4e-3", "--sizes", "400,900,3600", "--calibrate-max",
+        "900", "-o", "hex"},
+       " Pa for size 3600's assembly (3600 particles)"},
+      {{fcc, "--set", "test.lateral_stress=2", "--sizes", "2048,4000,16384", "--calibrate-max",
+        "4000", "-o", "fcc"},
+       " Pa for size 16384's assembly (16384 spheres)"},
+      {{far_config, "--sizes", "16,36,64", "--calibrate-max", "36", "-o", "far"},
+       " Pa for size 16's assembly (16 particles, from " + far + "), or material.kn"},
   };
   for (const Case& c : cases) {
     std::vector<std::string> args{"scaling", "-q", "-j", "1"};
@@ -222,6 +249,8 @@ TEST_F(ScalingCli, ASizesAssemblyErrorNamesTheSize) {
     EXPECT_NE(r.err.find("test.lateral_stress: the overlap at sigma3"), std::string::npos) << r.err;
     EXPECT_NE(r.err.find(c.mention), std::string::npos) << r.err;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_EQ(r.out, "");
+    EXPECT_TRUE(fs::is_empty(work())) << "left output behind";
   }
 }
 

@@ -210,6 +210,28 @@ class Family {
                : size_rounding(config_);
   }
   SceneConfig scene(int64_t n) const { return from_file_ ? config_ : scene_of_size(config_, n); }
+  /// Size n's assembly, checked as a scene's is before it is consolidated
+  /// (make_assembly, make_sphere_assembly: the derived scales and the
+  /// overlap at sigma3), its errors naming the size; an REV cut from the
+  /// file keeps the file's positions: check_resolvable, naming the file.
+  Assembly disks(int64_t n) const {
+    if (!from_file_) return make_assembly(scene(n), size_label(n));
+    Assembly a = cut_rev(file_prototype_, n);
+    check_resolvable(config_, a, size_label(n), scaling_family_file(config_).path);
+    return a;
+  }
+  SphereAssembly spheres(int64_t n) const { return make_sphere_assembly(scene(n), size_label(n)); }
+  /// Every size's assembly built and checked, none consolidated: a size
+  /// the study cannot run is refused before any folder is made, not when
+  /// the study comes to it (after the smaller sizes' calibrations).
+  void check_assemblies() const {
+    for (int64_t n : o_.sizes) {
+      if (config_.dimension == 3)
+        spheres(n);
+      else
+        disks(n);
+    }
+  }
 
   const SizeState& state(int64_t n) {
     auto it = states_.find(n);
@@ -228,7 +250,7 @@ class Family {
     // said only when it consolidates (not before a cache read).
     const std::string cache = consolidation_cache_dir();
     if (config_.dimension == 3) {
-      const SphereAssembly a = make_sphere_assembly(st->scene, size_label(n));
+      const SphereAssembly a = spheres(n);
       st->spheres.emplace(consolidate_cached<TriaxialState>(cache, st->scene, a, [&] {
         log("consolidating " + std::to_string(a.size()) + " spheres (size " + std::to_string(n) +
             ")");
@@ -244,8 +266,7 @@ class Family {
       // slightly different sample: criteria ~1e-7 away from an
       // uninterrupted study's.) consolidated.csv stays an output: the
       // forward size's sample, e.g. a prototype for `demcal verify`.
-      const Assembly a =
-          from_file_ ? cut_rev(file_prototype_, n) : make_assembly(st->scene, size_label(n));
+      const Assembly a = disks(n);
       st->disks.emplace(consolidate_cached<ConsolidatedState>(cache, st->scene, a, [&] {
         log("consolidating " + std::to_string(a.size()) + " particles (size " + std::to_string(n) +
             ")");
@@ -560,7 +581,9 @@ void check_scaling_sizes(const ScalingStudyOptions& o) { check_plan(o); }
 void check_scaling_sizes(const SceneConfig& config, const ScalingStudyOptions& o) {
   check_plan(o);
   check_gas_sizes(config, o);
-  check_made_counts(Family(config, o), o, config.dimension);
+  const Family family(config, o);
+  check_made_counts(family, o, config.dimension);
+  family.check_assemblies();
 }
 
 ScalingStudy run_scaling_study(const SceneConfig& config, const ScalingStudyOptions& o) {
@@ -594,6 +617,7 @@ ScalingStudy run_scaling_study(const SceneConfig& config, const ScalingStudyOpti
   check_gas_sizes(config, o);
   Family family(config, o);
   check_made_counts(family, o, config.dimension);
+  family.check_assemblies();
   st.from_file = family.from_file();
   st.family = st.from_file ? "REVs cut from a particle file" : config.assembly.type + " generator";
   make_output_dir(o.work_dir);
