@@ -99,6 +99,24 @@ void write_run_files(const std::string& dir, const SceneConfig& config,
   out.commit();
 }
 
+/// A run's last lines, 2D and 3D: the verdict with its diagnosis, the wall
+/// time and speed, the files written, and where it diverged if it did.
+template <class Run, class State>
+void print_run_tail(const Score& score, const Run& run, const State& state,
+                    const nlohmann::json& summary, const std::string& dir,
+                    const SceneConfig& config) {
+  std::cout << "  " << (score.passed ? "PASS" : "FAIL") << ": " << score.diagnosis.message << "\n"
+            << "  wall time " << run.wall_time_s << " s (consolidation ";
+  print_consolidation_time(std::cout, state.wall_time_s, state.from_cache);
+  std::cout << ", " << state.steps << " steps), " << summary["particle_steps_per_s"].get<double>()
+            << " particle-steps/s\n"
+            << "  wrote " << dir << "/summary.json, series.csv"
+            << (config.output.vtk ? ", final.vtk" : "") << "\n";
+  if (run.diverged)
+    std::cout << "  DIVERGED at step " << run.divergence_step << ": " << to_string(run.divergence)
+              << "\n";
+}
+
 }  // namespace
 
 namespace {
@@ -188,16 +206,7 @@ int run_3d(const SceneConfig& config, const std::string& out_dir, bool allow_uns
     std::cout << "  " << (within ? "WITHIN" : "OUTSIDE") << " the 3D default tolerances"
               << (within ? "" : " (worst: " + summary["verdict"]["worst"].get<std::string>() + ")")
               << ". " << kTriaxialVerdictNote << "\n";
-  std::cout << "  " << (within ? "PASS" : "FAIL") << ": " << score.diagnosis.message << "\n"
-            << "  wall time " << run.wall_time_s << " s (consolidation ";
-  print_consolidation_time(std::cout, state.wall_time_s, state.from_cache);
-  std::cout << ", " << state.steps << " steps), " << summary["particle_steps_per_s"].get<double>()
-            << " particle-steps/s\n"
-            << "  wrote " << dir << "/summary.json, series.csv"
-            << (config.output.vtk ? ", final.vtk" : "") << "\n";
-  if (run.diverged)
-    std::cout << "  DIVERGED at step " << run.divergence_step << ": " << to_string(run.divergence)
-              << "\n";
+  print_run_tail(score, run, state, summary, dir, config);
   return score.passed ? 0 : 1;  // as `demcal score` judges the run's series.csv
 }
 
@@ -270,16 +279,7 @@ int cmd_run(const std::string& path, const std::vector<std::string>& sets,
     std::cout << "  force balance " << c.force_balance << " (paper form " << c.force_balance_paper
               << "), moment balance " << c.moment_balance << ", servo " << c.servo
               << ", oscillation " << c.oscillation << "\n";
-  std::cout << "  " << (score.passed ? "PASS" : "FAIL") << ": " << score.diagnosis.message << "\n"
-            << "  wall time " << run.wall_time_s << " s (consolidation ";
-  print_consolidation_time(std::cout, state.wall_time_s, state.from_cache);
-  std::cout << ", " << state.steps << " steps), " << summary["particle_steps_per_s"].get<double>()
-            << " particle-steps/s\n"
-            << "  wrote " << dir << "/summary.json, series.csv"
-            << (config.output.vtk ? ", final.vtk" : "") << "\n";
-  if (run.diverged)
-    std::cout << "  DIVERGED at step " << run.divergence_step << ": " << to_string(run.divergence)
-              << "\n";
+  print_run_tail(score, run, state, summary, dir, config);
   // Exit 1 on FAIL (a diverged run fails), as `demcal score` judges the
   // run's series.csv; the files are written either way.
   return score.passed ? 0 : 1;
