@@ -9,6 +9,7 @@
 // study's length (FolderLock): a second study on it is refused, exit 2.
 #include <filesystem>
 #include <iostream>
+#include <utility>
 #include <vector>
 
 #include "commands.hpp"
@@ -58,9 +59,10 @@ int cmd_scaling(const ScalingOptions& o) {
     so.log = [](const std::string& line) { std::cerr << "demcal scaling: " << line << "\n"; };
     so.consolidation_progress = consolidation_progress(o.progress_every_s);
   }
-  // Bad sizes (also sizes that make one particle count) fail before any
-  // folder is made.
-  check_scaling_sizes(config, so);
+  // Bad sizes (also sizes that make one particle count, or an assembly a
+  // size cannot run) fail before any folder is made; the checked
+  // assemblies are the ones run.
+  CheckedScalingStudy checked = check_scaling_sizes(config, so);
   // Not "reports": run from the repository it overwrote the shipped study.
   const std::string out_dir = o.out_dir.empty() ? "demcal-scaling-" + config.name : o.out_dir;
   // The per-size work beside the report: two studies with different -o do
@@ -119,7 +121,7 @@ int cmd_scaling(const ScalingOptions& o) {
   // From here on a signal stops cleanly.
   const StopOnSignal stop;
   so.stop = &stop.flag();
-  const ScalingStudy st = run_scaling_study(config, so);
+  const ScalingStudy st = run_scaling_study(std::move(checked), so);
   if (st.interrupted) {
     std::cerr << "demcal scaling: interrupted; the finished sizes (and a size's finished trials "
                  "and step-search runs) are in "

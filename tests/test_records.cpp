@@ -7,9 +7,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <functional>
 #include <nlohmann/json.hpp>
+#include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "demcal/io/input_error.hpp"
 #include "demcal/scene/biaxial.hpp"
@@ -356,6 +359,29 @@ TEST(ScalingStudy, SizesThatMakeOneCountAreBadInput) {
   o.calibrate_max = 25;
   EXPECT_NE(input_error_of([&] { check_scaling_sizes(hex, o); }).find("two sizes"),
             std::string::npos);
+}
+
+// run_scaling_study on a config alone checks it as `demcal scaling` does
+// (check_scaling_sizes) before it writes anything; a checked study (whose
+// assemblies were made and checked once, by the check) runs only the sizes
+// it was checked with.
+TEST(ScalingStudy, ARunChecksItsSizesFirstAndRunsOnlyTheCheckedOnes) {
+  test::TempDir dir("scaling_run_checks");
+  SceneConfig hex = default_config();
+  hex.test.lateral_stress = 4e-3;  // unresolvable at 3600 particles
+  ScalingStudyOptions o;
+  o.sizes = {400, 900, 3600};
+  o.calibrate_max = 900;
+  o.work_dir = (dir / "work").string();
+  EXPECT_NE(input_error_of([&] { run_scaling_study(hex, o); }).find("size 3600's assembly"),
+            std::string::npos);
+  EXPECT_FALSE(std::filesystem::exists(o.work_dir));
+  hex = default_config();
+  CheckedScalingStudy checked = check_scaling_sizes(hex, o);
+  ScalingStudyOptions other = o;
+  other.sizes = {400, 900, 1600};
+  EXPECT_THROW(run_scaling_study(std::move(checked), other), std::invalid_argument);
+  EXPECT_FALSE(std::filesystem::exists(o.work_dir));
 }
 
 TEST(ScalingStudy, SpreadIsRangeOverMean) {

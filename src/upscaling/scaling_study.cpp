@@ -171,15 +171,20 @@ struct SizeState {
 /// (make_assembly's `which`: "... for size 40's assembly").
 std::string size_label(int64_t n) { return "size " + std::to_string(n); }
 
+}  // namespace
+
 /// The family of scenes and their consolidated states, 2D or 3D. A 2D size
 /// that is not calibrated writes its consolidated packing to the work
 /// folder (size-N/consolidated.csv, an output); a resumed study
 /// consolidates every size again from its generated or cut assembly: the
 /// consolidation cache's exact state, or with the cache off the whole
 /// consolidation again (deterministic; the largest size's is the cost).
-class Family {
+/// Each size's assembly is made once: check_scaling_sizes() makes (a file
+/// family: cuts, counts) and checks them, state() consolidates them.
+class ScalingFamily {
  public:
-  Family(const SceneConfig& config, const ScalingStudyOptions& o) : config_(config), o_(o) {
+  ScalingFamily(const SceneConfig& config, const ScalingStudyOptions& o)
+      : config_(config), o_(&o), sizes_(o.sizes), calibrate_max_(o.calibrate_max) {
     from_file_ = config.assembly.type == "file";
     if (!from_file_) return;
     if (config.dimension == 3)
@@ -194,13 +199,26 @@ class Family {
           "--sizes", "",
           "the prototype file has only " + std::to_string(file_prototype_.size()) + " particles");
   }
+  /// The options the study runs with (the work folder, stop, logs): those
+  /// it was checked with but for these; other sizes or another
+  /// calibrate_max than the checked ones are a caller's error.
+  void run_with(const ScalingStudyOptions& o) {
+    if (o.sizes != sizes_ || o.calibrate_max != calibrate_max_)
+      throw std::invalid_argument(
+          "run_scaling_study: the options' sizes or calibrate_max are not the checked ones");
+    o_ = &o;
+  }
+  const SceneConfig& config() const { return config_; }
   bool from_file() const { return from_file_; }
   int64_t file_particles() const { return file_prototype_.size(); }
   /// The particles size n makes (the generator's rounded count, or the
-  /// REV cut from the file), without consolidating: what the study's sizes
-  /// are checked on before any work.
-  int64_t made_count(int64_t n) const {
-    return from_file_ ? cut_rev(file_prototype_, n).size() : particles_of_size(config_, n);
+  /// REV cut from the file, kept for the check and the run), without
+  /// consolidating: what the study's sizes are checked on before any work.
+  int64_t made_count(int64_t n) {
+    if (!from_file_) return particles_of_size(config_, n);
+    auto it = disks_.find(n);
+    if (it == disks_.end()) it = disks_.emplace(n, cut_rev(file_prototype_, n)).first;
+    return it->second.size();
   }
   /// Why a size can make another count than it asks, for an error (""
   /// when it makes the count asked).
@@ -210,26 +228,21 @@ class Family {
                : size_rounding(config_);
   }
   SceneConfig scene(int64_t n) const { return from_file_ ? config_ : scene_of_size(config_, n); }
-  /// Size n's assembly, checked as a scene's is before it is consolidated
-  /// (make_assembly, make_sphere_assembly: the derived scales and the
-  /// overlap at sigma3), its errors naming the size; an REV cut from the
-  /// file keeps the file's positions: check_resolvable, naming the file.
-  Assembly disks(int64_t n) const {
-    if (!from_file_) return make_assembly(scene(n), size_label(n));
-    Assembly a = cut_rev(file_prototype_, n);
-    check_resolvable(config_, a, size_label(n), scaling_family_file(config_).path);
-    return a;
-  }
-  SphereAssembly spheres(int64_t n) const { return make_sphere_assembly(scene(n), size_label(n)); }
-  /// Every size's assembly built and checked, none consolidated: a size
-  /// the study cannot run is refused before any folder is made, not when
-  /// the study comes to it (after the smaller sizes' calibrations).
-  void check_assemblies() const {
-    for (int64_t n : o_.sizes) {
+  /// Every size's assembly made and checked as a scene's is before it is
+  /// consolidated (make_assembly, make_sphere_assembly: the derived scales
+  /// and the overlap at sigma3), its errors naming the size; an REV cut
+  /// from the file (made_count's) keeps the file's positions:
+  /// check_resolvable, naming the file. None consolidated: a size the
+  /// study cannot run is refused before any folder is made, not when the
+  /// study comes to it (after the smaller sizes' calibrations).
+  void check_assemblies() {
+    for (int64_t n : sizes_) {
       if (config_.dimension == 3)
-        spheres(n);
+        spheres_.emplace(n, make_sphere_assembly(scene(n), size_label(n)));
+      else if (!from_file_)
+        disks_.emplace(n, make_assembly(scene(n), size_label(n)));
       else
-        disks(n);
+        check_resolvable(config_, disks_.at(n), size_label(n), scaling_family_file(config_).path);
     }
   }
 
@@ -241,16 +254,16 @@ class Family {
     // A stop ends the consolidation at its next check (every 200 steps);
     // the caller's progress callback sees every check.
     ConsolidationOptions consolidation;
-    if (o_.stop || o_.consolidation_progress)
+    if (o_->stop || o_->consolidation_progress)
       consolidation.progress = [this](const ConsolidationProgress& p) {
-        throw_if_stopped(o_);
-        if (o_.consolidation_progress) o_.consolidation_progress(p);
+        throw_if_stopped(*o_);
+        if (o_->consolidation_progress) o_->consolidation_progress(p);
       };
     // consolidate() and consolidate_triaxial() through the cache, "consolidating"
     // said only when it consolidates (not before a cache read).
     const std::string cache = consolidation_cache_dir();
     if (config_.dimension == 3) {
-      const SphereAssembly a = spheres(n);
+      const SphereAssembly a = take(spheres_, n);
       st->spheres.emplace(consolidate_cached<TriaxialState>(cache, st->scene, a, [&] {
         log("consolidating " + std::to_string(a.size()) + " spheres (size " + std::to_string(n) +
             ")");
@@ -266,7 +279,7 @@ class Family {
       // slightly different sample: criteria ~1e-7 away from an
       // uninterrupted study's.) consolidated.csv stays an output: the
       // forward size's sample, e.g. a prototype for `demcal verify`.
-      const Assembly a = disks(n);
+      const Assembly a = take(disks_, n);
       st->disks.emplace(consolidate_cached<ConsolidatedState>(cache, st->scene, a, [&] {
         log("consolidating " + std::to_string(a.size()) + " particles (size " + std::to_string(n) +
             ")");
@@ -274,7 +287,7 @@ class Family {
       }));
       st->runner = std::make_unique<BiaxialRunner>(st->scene, *st->disks);
       st->consolidation = consolidation_record(*st->disks);
-      if (n > o_.calibrate_max) {
+      if (n > calibrate_max_) {
         make_output_dir(dir(n));
         write_file_atomic(dir(n) + "/consolidated.csv",
                           particle_csv(assembly_of(st->disks->world)));
@@ -295,22 +308,40 @@ class Family {
     const SizeState& st = state(n);
     return st.spheres ? calibrate(st.scene, *st.spheres, co) : calibrate(st.scene, *st.disks, co);
   }
-  std::string dir(int64_t n) const { return o_.work_dir + "/size-" + std::to_string(n); }
+  std::string dir(int64_t n) const { return o_->work_dir + "/size-" + std::to_string(n); }
   void log(const std::string& line) const {
-    if (o_.log) o_.log(line);
+    if (o_->log) o_->log(line);
   }
 
  private:
-  const SceneConfig& config_;
-  const ScalingStudyOptions& o_;
+  /// Size n's checked assembly (check_assemblies()), handed to state() once.
+  template <class A>
+  static A take(std::map<int64_t, A>& assemblies, int64_t n) {
+    auto node = assemblies.extract(n);
+    if (node.empty())
+      throw std::logic_error("scaling study: size " + std::to_string(n) + " was not checked");
+    return std::move(node.mapped());
+  }
+
+  const SceneConfig config_;
+  const ScalingStudyOptions* o_;
+  const std::vector<int64_t> sizes_;
+  const int64_t calibrate_max_;
   bool from_file_ = false;
   Assembly file_prototype_;
+  /// Each size's assembly: a file family's cut (made_count), a generated
+  /// family's made and checked (check_assemblies).
+  std::map<int64_t, Assembly> disks_;
+  std::map<int64_t, SphereAssembly> spheres_;
   std::map<int64_t, std::unique_ptr<SizeState>> states_;
 };
 
+namespace {
+
 /// Step 1: calibrate a size (or reuse its result.json); nothing when a stop
 /// cut the calibration (its finished trials stay in the size's trials.jsonl).
-std::optional<ScalingSize> calibrate_size(Family& family, const CalibrationOptions& calibration,
+std::optional<ScalingSize> calibrate_size(ScalingFamily& family,
+                                          const CalibrationOptions& calibration,
                                           const ScalingStudyOptions& o, int64_t n) {
   const std::string result_path = family.dir(n) + "/result.json";
   if (o.resume && fs::exists(result_path)) {
@@ -360,7 +391,7 @@ std::optional<ScalingSize> calibrate_size(Family& family, const CalibrationOptio
 /// the log as it ends. A stop during it throws StudyStopped: no fixed.json;
 /// a resumed search takes the finished runs from steps_search.jsonl and runs
 /// from the first one it does not find there.
-void fixed_multipliers(Family& family, const ScalingStudyOptions& o, const ScalingSize& ref,
+void fixed_multipliers(ScalingFamily& family, const ScalingStudyOptions& o, const ScalingSize& ref,
                        const ScalingLaw& law, const Tolerances& tolerances, int64_t n,
                        ScalingSize& r) {
   const std::string fixed_path = family.dir(n) + "/fixed.json";
@@ -451,7 +482,7 @@ void fit_laws(ScalingStudy& st) {
 /// Step 4: the forward check at the largest size, the candidate law's run
 /// (the first of its search) against a reference with twice its steps. A
 /// stop during the reference throws StudyStopped: no reference.json.
-void forward_check(Family& family, const ScalingStudyOptions& o, ScalingStudy& st,
+void forward_check(ScalingFamily& family, const ScalingStudyOptions& o, ScalingStudy& st,
                    const TrialRecord& law_run) {
   st.have_forward = true;
   st.law_run = law_run;
@@ -480,8 +511,8 @@ void forward_check(Family& family, const ScalingStudyOptions& o, ScalingStudy& s
 /// (st.tolerances are theirs: the step searches and the forward reference
 /// are scored as the calibrations were); StudyStopped when a stop cut one
 /// short.
-void run_steps(Family& family, const CalibrationOptions& calibration, const ScalingStudyOptions& o,
-               ScalingStudy& st) {
+void run_steps(ScalingFamily& family, const CalibrationOptions& calibration,
+               const ScalingStudyOptions& o, ScalingStudy& st) {
   for (int64_t n : st.calibrated_sizes) {
     throw_if_stopped(o);
     std::optional<ScalingSize> r = calibrate_size(family, calibration, o, n);
@@ -514,10 +545,10 @@ void run_steps(Family& family, const CalibrationOptions& calibration, const Scal
     forward_check(family, o, st, fwd.fixed.trials.front());
 }
 
-/// The counts the sizes make (Family::made_count) rise with the sizes: two
+/// The counts the sizes make (ScalingFamily::made_count) rise with the sizes: two
 /// sizes that make one count would calibrate (or run) one sample twice, and
 /// a forward size that makes no more than the REV would check nothing.
-void check_made_counts(const Family& family, const ScalingStudyOptions& o, int dimension) {
+void check_made_counts(ScalingFamily& family, const ScalingStudyOptions& o, int dimension) {
   const std::string noun = dimension == 3 ? " spheres" : " particles";
   const std::string rounding = family.rounding();
   const std::string why = rounding.empty() ? "" : " (" + rounding + ")";
@@ -578,15 +609,30 @@ void check_plan(const ScalingStudyOptions& o) {
 
 void check_scaling_sizes(const ScalingStudyOptions& o) { check_plan(o); }
 
-void check_scaling_sizes(const SceneConfig& config, const ScalingStudyOptions& o) {
+CheckedScalingStudy::CheckedScalingStudy(std::unique_ptr<ScalingFamily> family)
+    : family_(std::move(family)) {}
+CheckedScalingStudy::CheckedScalingStudy(CheckedScalingStudy&&) noexcept = default;
+CheckedScalingStudy& CheckedScalingStudy::operator=(CheckedScalingStudy&&) noexcept = default;
+CheckedScalingStudy::~CheckedScalingStudy() = default;
+
+CheckedScalingStudy check_scaling_sizes(const SceneConfig& config, const ScalingStudyOptions& o) {
   check_plan(o);
   check_gas_sizes(config, o);
-  const Family family(config, o);
-  check_made_counts(family, o, config.dimension);
-  family.check_assemblies();
+  auto family = std::make_unique<ScalingFamily>(config, o);
+  check_made_counts(*family, o, config.dimension);
+  family->check_assemblies();
+  return CheckedScalingStudy(std::move(family));
 }
 
 ScalingStudy run_scaling_study(const SceneConfig& config, const ScalingStudyOptions& o) {
+  return run_scaling_study(check_scaling_sizes(config, o), o);
+}
+
+ScalingStudy run_scaling_study(CheckedScalingStudy checked, const ScalingStudyOptions& o) {
+  if (!checked.family_) throw std::invalid_argument("run_scaling_study: a study already run");
+  ScalingFamily& family = *checked.family_;
+  family.run_with(o);
+  const SceneConfig& config = family.config();
   const auto t_start = std::chrono::steady_clock::now();
   ScalingStudy st;
   st.scene = config.name;
@@ -605,7 +651,6 @@ ScalingStudy run_scaling_study(const SceneConfig& config, const ScalingStudyOpti
   // scaling.md.
   const CalibrationOptions calibration = CalibrationOptions::from(config);
   st.tolerances = calibration.tolerances;
-  check_plan(o);
   for (int64_t n : o.sizes)
     if (n <= o.calibrate_max) st.calibrated_sizes.push_back(n);
   st.forward_size = o.sizes.back();
@@ -614,10 +659,6 @@ ScalingStudy run_scaling_study(const SceneConfig& config, const ScalingStudyOpti
   for (int64_t n : st.calibrated_sizes)
     if (n < st.forward_size) st.ref_size = n;
 
-  check_gas_sizes(config, o);
-  Family family(config, o);
-  check_made_counts(family, o, config.dimension);
-  family.check_assemblies();
   st.from_file = family.from_file();
   st.family = st.from_file ? "REVs cut from a particle file" : config.assembly.type + " generator";
   make_output_dir(o.work_dir);

@@ -20,6 +20,7 @@
 #include <cstdint>
 #include <functional>
 #include <map>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -151,8 +152,27 @@ void check_scaling_sizes(const ScalingStudyOptions& options);
 /// (gas_layers_fault, the rule of assembly.count and assembly.aspect): a
 /// size that gives too few particles or one layer is refused, naming
 /// --sizes and the size. A 3D file family is refused (assembly.type), as
-/// the study does.
-void check_scaling_sizes(const SceneConfig& config, const ScalingStudyOptions& options);
+/// the study does. Every size's assembly is then made and checked as a
+/// scene's is before it is consolidated (the derived scales, the overlap
+/// at sigma3; an REV cut from a file: check_resolvable, naming the file),
+/// none consolidated, nothing written: the result holds them for
+/// run_scaling_study(), which runs them without making or checking any
+/// again.
+class ScalingFamily;
+class CheckedScalingStudy {
+ public:
+  CheckedScalingStudy(CheckedScalingStudy&&) noexcept;
+  CheckedScalingStudy& operator=(CheckedScalingStudy&&) noexcept;
+  ~CheckedScalingStudy();
+
+ private:
+  explicit CheckedScalingStudy(std::unique_ptr<ScalingFamily> family);
+  std::unique_ptr<ScalingFamily> family_;
+  friend CheckedScalingStudy check_scaling_sizes(const SceneConfig&, const ScalingStudyOptions&);
+  friend ScalingStudy run_scaling_study(CheckedScalingStudy, const ScalingStudyOptions&);
+};
+CheckedScalingStudy check_scaling_sizes(const SceneConfig& config,
+                                        const ScalingStudyOptions& options);
 
 /// The particle file a scaling study cuts its family of REVs from (path)
 /// and the config key naming it (key): the prototype's file, else the
@@ -167,7 +187,14 @@ FamilyFile scaling_family_file(const SceneConfig& config);
 /// Run the study on the family of `config` (resized generators, or REVs cut
 /// from the prototype file for a 2D file assembly); 2D and 3D configs run
 /// the same code (the search, step search and runs through TrialRunner).
+/// Checks first (check_scaling_sizes): bad input throws InputError before
+/// anything is written.
 ScalingStudy run_scaling_study(const SceneConfig& config, const ScalingStudyOptions& options);
+/// The same on a study check_scaling_sizes() checked with these options'
+/// sizes and calibrate_max (others: std::invalid_argument); the rest of
+/// `options` (work_dir, resume, stop, logs) may be set after the check. The
+/// check's config is the one run.
+ScalingStudy run_scaling_study(CheckedScalingStudy checked, const ScalingStudyOptions& options);
 
 /// scaling.json (schema demcal.scaling/1; "dimension" says which: a law is
 /// only applied to params.json of its dimension).
