@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <functional>
 #include <iostream>
+#include <optional>
 
 #include "commands.hpp"
 #include "consolidation_progress.hpp"
@@ -97,11 +98,15 @@ RevOutcome rev_2d(const SceneConfig& config, const std::string& file, const RevO
                      "--prototype FILE");
   require_rev_gas(2, ro, proto);
   // A REV cut from a particle file keeps the file's positions, which never
-  // went through make_assembly's check of the overlap at sigma3: cut now
-  // (as make_rev will) and checked before any work. A generated prototype
-  // was checked when made; a generated REV is a gas at the origin.
-  if (ro.method == "cut" && source.kind == "file")
-    check_resolvable(config, cut_rev(proto, ro.particles, ro.aspect), "the REV", source.file);
+  // went through make_assembly's check of the overlap at sigma3: cut now,
+  // checked before any work, and that cut consolidated (a file's prototype
+  // is dense: not consolidated below). A generated prototype was checked
+  // when made; a generated REV is a gas at the origin.
+  std::optional<Assembly> cut;
+  if (ro.method == "cut" && source.kind == "file") {
+    cut = unconsolidated_rev(proto, ro);
+    check_resolvable(config, *cut, "the REV", source.file);
+  }
   ready();
   if (!proto.dense) {  // a generated gas is no packing to cut from or compare with
     proto =
@@ -116,10 +121,12 @@ RevOutcome rev_2d(const SceneConfig& config, const std::string& file, const RevO
   std::cerr << "demcal rev: "
             << (ro.method == "cut" ? "cutting a REV of about " : "generating a REV of ")
             << ro.particles << " particles from " << source.description << "\n";
-  const RevResult r = make_rev(proto, ro, [&](const Assembly& raw) {
+  const auto consolidated = [&](const Assembly& raw) {
     return said_consolidation(config, raw, "the REV", every_s,
                               [&](int) { announce_rev(raw.size(), "particles"); });
-  });
+  };
+  const RevResult r =
+      cut ? make_rev(proto, ro, *cut, consolidated) : make_rev(proto, ro, consolidated);
   return {r.method, particle_csv(r.assembly), r.assembly.size(), consolidation_record(r.state),
           r.representativeness};
 }
@@ -136,8 +143,11 @@ RevOutcome rev_3d(const SceneConfig& config, const std::string& file, const RevO
                      "asked for a REV of " + std::to_string(ro.particles) +
                          " spheres, the prototype has only " + std::to_string(proto.size()));
   require_rev_gas(3, ro, proto);
-  if (ro.method == "cut" && source.kind == "file")  // as in 2D
-    check_sphere_overlap(config, cut_rev(proto, ro.particles, ro.aspect), "the REV", source.file);
+  std::optional<SphereAssembly> cut;  // as in 2D
+  if (ro.method == "cut" && source.kind == "file") {
+    cut = unconsolidated_rev(proto, ro);
+    check_sphere_overlap(config, *cut, "the REV", source.file);
+  }
   ready();
   if (source.kind == "generated") {  // a generated gas is no packing to cut from or compare with
     proto = sphere_assembly_of(
@@ -151,10 +161,12 @@ RevOutcome rev_3d(const SceneConfig& config, const std::string& file, const RevO
   std::cerr << "demcal rev: " << (ro.method == "cut" ? "cutting a box" : "generating a")
             << " REV of " << (ro.method == "cut" ? "about " : "") << ro.particles
             << " spheres from " << source.description << "\n";
-  const SphereRevResult r = make_rev(proto, ro, [&](const SphereAssembly& raw) {
+  const auto consolidated = [&](const SphereAssembly& raw) {
     return said_consolidation(config, raw, "the REV", every_s,
                               [&](int) { announce_rev(raw.size(), "spheres"); });
-  });
+  };
+  const SphereRevResult r =
+      cut ? make_rev(proto, ro, *cut, consolidated) : make_rev(proto, ro, consolidated);
   return {r.method, sphere_csv(r.assembly), r.assembly.size(), consolidation_record(r.state),
           r.representativeness};
 }

@@ -514,10 +514,18 @@ RevResult make_rev(const SceneConfig& config, const Assembly& prototype, const R
 
 RevResult make_rev(const Assembly& prototype, const RevOptions& o,
                    const std::function<ConsolidatedState(const Assembly&)>& consolidated) {
+  return make_rev(prototype, o, unconsolidated_rev(prototype, o), consolidated);
+}
+
+Assembly unconsolidated_rev(const Assembly& prototype, const RevOptions& o) {
   if (o.method != "cut" && o.method != "generate")
     throw InputError("REV", "method", "must be cut or generate, got \"" + o.method + "\"");
-  Assembly raw = o.method == "cut" ? cut_rev(prototype, o.particles, o.aspect)
-                                   : generate_rev(prototype, o.particles, o.seed);
+  return o.method == "cut" ? cut_rev(prototype, o.particles, o.aspect)
+                           : generate_rev(prototype, o.particles, o.seed);
+}
+
+RevResult make_rev(const Assembly& prototype, const RevOptions& o, const Assembly& raw,
+                   const std::function<ConsolidatedState(const Assembly&)>& consolidated) {
   RevResult out{o.method, {}, consolidated(raw), {}};
   out.assembly = assembly_of(out.state.world);
   out.representativeness = compare(packing_stats(out.state.world), packing_stats(prototype),

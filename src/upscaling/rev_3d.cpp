@@ -87,10 +87,19 @@ SphereRevResult make_rev(const SceneConfig& config, const SphereAssembly& protot
 
 SphereRevResult make_rev(const SphereAssembly& prototype, const RevOptions& o,
                          const std::function<TriaxialState(const SphereAssembly&)>& consolidated) {
+  return make_rev(prototype, o, unconsolidated_rev(prototype, o), consolidated);
+}
+
+SphereAssembly unconsolidated_rev(const SphereAssembly& prototype, const RevOptions& o) {
   if (o.method != "cut" && o.method != "generate")
     throw InputError("REV", "method", "must be cut or generate, got \"" + o.method + "\"");
-  const SphereAssembly raw = o.method == "cut" ? cut_rev(prototype, o.particles, o.aspect)
-                                               : generate_rev(prototype, o.particles, o.seed);
+  return o.method == "cut" ? cut_rev(prototype, o.particles, o.aspect)
+                           : generate_rev(prototype, o.particles, o.seed);
+}
+
+SphereRevResult make_rev(const SphereAssembly& prototype, const RevOptions& o,
+                         const SphereAssembly& raw,
+                         const std::function<TriaxialState(const SphereAssembly&)>& consolidated) {
   SphereRevResult out{o.method, {}, consolidated(raw), {}};
   out.assembly = sphere_assembly_of(out.state.world);
   out.representativeness = compare(packing_stats(out.state.world), packing_stats(prototype),

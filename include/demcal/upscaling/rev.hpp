@@ -122,6 +122,14 @@ RevResult make_rev(const SceneConfig& config, const Assembly& prototype, const R
 /// "consolidating ..." only when it consolidates, not before a cache read).
 RevResult make_rev(const Assembly& prototype, const RevOptions& options,
                    const std::function<ConsolidatedState(const Assembly&)>& consolidated);
+/// The REV make_rev() consolidates, as it makes it: cut_rev or
+/// generate_rev by options.method (another method: InputError).
+Assembly unconsolidated_rev(const Assembly& prototype, const RevOptions& options);
+/// make_rev() on `raw`, the REV unconsolidated_rev(prototype, options) made
+/// (made once, e.g. to be checked before any work): consolidated and
+/// compared with the prototype.
+RevResult make_rev(const Assembly& prototype, const RevOptions& options, const Assembly& raw,
+                   const std::function<ConsolidatedState(const Assembly&)>& consolidated);
 
 /// `nx`×`ny` copies of a packing, every other copy mirrored, so that the
 /// disks along a seam meet their own mirror images (a seam is in contact,

@@ -69,6 +69,15 @@ SphereRevResult make_rev(const SceneConfig& config, const SphereAssembly& protot
 /// consolidate_triaxial(config, raw) (it must give that state).
 SphereRevResult make_rev(const SphereAssembly& prototype, const RevOptions& options,
                          const std::function<TriaxialState(const SphereAssembly&)>& consolidated);
+/// The REV make_rev() consolidates, as it makes it: cut_rev or
+/// generate_rev by options.method (another method: InputError).
+SphereAssembly unconsolidated_rev(const SphereAssembly& prototype, const RevOptions& options);
+/// make_rev() on `raw`, the REV unconsolidated_rev(prototype, options) made
+/// (made once, e.g. to be checked before any work): consolidated and
+/// compared with the prototype.
+SphereRevResult make_rev(const SphereAssembly& prototype, const RevOptions& options,
+                         const SphereAssembly& raw,
+                         const std::function<TriaxialState(const SphereAssembly&)>& consolidated);
 
 /// A sphere world state as an assembly (positions, radii, walls).
 SphereAssembly sphere_assembly_of(const SphereWorld& world);
