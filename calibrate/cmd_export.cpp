@@ -202,7 +202,7 @@ int export_3d(const ExportCmdOptions& o, const nlohmann::json& params, const Rev
   auto [file, particles] = named_prototype(params, o.prototype, o.particles);
   PrototypeSource source;
   const SphereAssembly proto = prototype_spheres(config, particles, file, &source);
-  check_prototype_resolvable(config, proto, source);  // consolidated, here or by the deck
+  check_prototype_assembly(config, proto, source);  // consolidated, here or by the deck
   eo.consolidate_in_deck = deck_consolidates(o, proto.size());
   const AlgorithmSpec up = upscale(rev.params, rev.particles, proto.size(), law);
   print_prototype_notes("export", particles, rev.particles, proto.size(), law);
@@ -237,7 +237,7 @@ int cmd_export(const ExportCmdOptions& o) {
   PrototypeSource source;
   Assembly proto = prototype_assembly(config, particles, file, &source);
   // Consolidated here or by the deck, unless --no-consolidate (as given).
-  if (!o.no_consolidate) check_prototype_resolvable(config, proto, source);
+  if (!o.no_consolidate) check_prototype_assembly(config, proto, source);
   const AlgorithmSpec up = upscale(rev.params, rev.particles, proto.size(), law);
   print_prototype_notes("export", particles, rev.particles, proto.size(), law);
   print_upscaled_steps(source, proto.size(), up, rev, law, "particles");

@@ -97,15 +97,15 @@ RevOutcome rev_2d(const SceneConfig& config, const std::string& file, const RevO
                      "names no prototype: give prototype.file or prototype.particles, or "
                      "--prototype FILE");
   require_rev_gas(2, ro, proto);
-  // A REV cut from a particle file keeps the file's positions, which never
-  // went through make_assembly's check of the overlap at sigma3: cut now,
+  // A REV cut from a particle file keeps the file's positions and radii,
+  // which never went through make_assembly's checks: cut now,
   // checked before any work, and that cut consolidated (a file's prototype
   // is dense: not consolidated below). A generated prototype was checked
   // when made; a generated REV is a gas at the origin.
   std::optional<Assembly> cut;
   if (ro.method == "cut" && source.kind == "file") {
     cut = unconsolidated_rev(proto, ro);
-    check_resolvable(config, *cut, "the REV", source.file);
+    check_assembly(config, *cut, "the REV", source.file);
   }
   ready();
   if (!proto.dense) {  // a generated gas is no packing to cut from or compare with

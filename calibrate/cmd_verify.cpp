@@ -273,7 +273,7 @@ int verify_3d(const VerifyOptions& o, const nlohmann::json& params, const RevPar
   auto [file, particles] = named_prototype(params, o.prototype, o.particles);
   PrototypeSource source;
   const SphereAssembly proto = prototype_spheres(config, particles, file, &source);
-  check_prototype_resolvable(config, proto, source);  // before the probes and the run
+  check_prototype_assembly(config, proto, source);  // before the probes and the run
   const int64_t n = proto.size();
   const AlgorithmSpec up = upscale(rev.params, rev.particles, n, law);
   print_prototype_notes("verify", particles, rev.particles, n, law);
@@ -541,7 +541,7 @@ int verify_2d(const VerifyOptions& o, const nlohmann::json& params, const RevPar
   PrototypeSource source;
   Assembly proto = prototype_assembly(config, particles, file, &source);
   if (!o.tile.empty()) proto = tiled_prototype(proto, o.tile, source);
-  check_prototype_resolvable(config, proto, source);  // the tiles' too, before the consolidation
+  check_prototype_assembly(config, proto, source);  // the tiles' too, before the consolidation
   Plan2d p;
   p.n = proto.size();
   p.up = upscale(rev.params, rev.particles, p.n, law);

@@ -415,6 +415,53 @@ TEST_F(CliEndToEnd, AnUnresolvablePrototypeFileIsRefusedBeforeItIsRun) {
   EXPECT_EQ(counted.status, 0) << counted.err;
 }
 
+// A 2D prototype file's radii never went through check_derived_scales,
+// which make_assembly applies to a config's: a 10x10 lattice of touching
+// disks of r = 1e-150 m (masses underflow to 0) or 1e150 m (they
+// overflow) passed check_resolvable (the round-off and the overlap at
+// sigma3 both scale with r), and verify, export, rev and a scaling study
+// cut from it consolidated into "consolidation diverged: non-finite
+// state", exit 1. Now refused before any work (check_assembly), naming the
+// file and its radius. upscale only counts the particles: accepted.
+TEST_F(CliEndToEnd, APrototypeFileWhoseRadiiGiveNoNormalMassIsRefusedBeforeItIsRun) {
+  const std::string out = (dir_ / "work" / "out").string();
+  const std::string params = test::example_params("hex_10x10");
+  for (const std::string scale : {"1e-150", "1e+150"}) {
+    const double r = std::stod(scale);
+    std::string disks = "x,y,r\n";
+    char line[96];
+    for (int i = 0; i < 100; ++i) {
+      std::snprintf(line, sizeof line, "%.17g,%.17g,%s\n", (2 * (i % 10) + 1) * r,
+                    (2 * (i / 10) + 1) * r, scale.c_str());
+      disks += line;
+    }
+    const std::string file = write("r" + scale + ".csv", disks);
+    // A scaling study cuts its REVs from prototype.file beside a file REV.
+    write("rev.csv", "x,y,r\n0.0005,0.0005,0.0005\n0.0015,0.0005,0.0005\n");
+    const std::string family =
+        write("family" + scale + ".json",
+              R"({"material": {"density": 2650, "kn": 1e8, "kt": 5e7, "friction": 0.3},)"
+              R"( "assembly": {"type": "file", "file": "rev.csv"},)"
+              R"( "prototype": {"particles": 0, "file": ")" +
+                  file + R"("}})");
+    const std::vector<std::vector<std::string>> commands = {
+        {"verify", params, "--prototype", file, "-o", out},
+        {"verify", params, "--prototype", file, "--tile", "2x1", "-o", out},
+        {"export", params, "--prototype", file, "-o", out + "/deck.lammps"},
+        {"rev", kHex5, "--prototype", file, "--particles", "16", "-o", out},
+        {"scaling", family, "--sizes", "9,16,36", "--calibrate-max", "16", "--max-trials", "12",
+         "-o", out}};
+    const std::string flow = scale == "1e+150" ? "(it overflows)" : "(it underflows to 0)";
+    for (const auto& args : commands)
+      expect_bad_input(
+          args, {"demcal: error: " + file + ": r: the smallest disk's (r = " + scale + " m) ", flow,
+                 "; got " + scale});
+    const Result counted = demcal({"upscale", params, "--prototype", file, "-o", out});
+    EXPECT_EQ(counted.status, 0) << counted.err;
+    fs::remove_all(out);
+  }
+}
+
 // A check across two keys named the file and its own field whatever a
 // --set had changed: `check configs/hex_5x5.json --set material.kn=1e6`
 // (the file's kt is 5e7) read "configs/hex_5x5.json: material.kt: must not

@@ -21,6 +21,7 @@ struct Input {
   std::string field;
   double value;
   double power;
+  std::string file;  ///< the file that gave it (a particle file's radii), else the config's field
   double share() const { return power * std::log10(value); }
 };
 
@@ -73,9 +74,10 @@ void require_normal(const SceneConfig& config, const std::string& what, double v
   }
   msg << ": every particle's mass, inertia, critical step and damping must be a finite, "
          "normal number";
-  const std::string field = blamed ? blamed->field : inputs.front().field;
+  const Input& named = blamed ? *blamed : inputs.front();
   if (blamed) msg << "; got " << shown(blamed->value);
-  throw InputError(source_of(config, field), field, msg.str());
+  if (!named.file.empty()) throw InputError(named.file, named.field, msg.str());
+  throw InputError(source_of(config, named.field), named.field, msg.str());
 }
 
 /// Refuses a wall too stiff for the consolidation's step ratio `alpha_c`.
@@ -186,8 +188,14 @@ std::string overlap_culprit(const SceneConfig& config, const std::string& kn_fie
   return changed_field(config.sets, fields);
 }
 
-void check_derived_scales(const SceneConfig& config, std::span<const double> radii) {
+void check_derived_scales(const SceneConfig& config, std::span<const double> radii,
+                          const std::string& radii_file) {
   if (radii.empty()) return;
+  // A radius: the config's assembly field, or the particle file's column r.
+  auto radius = [&](double r, bool smallest, double power) {
+    return radii_file.empty() ? Input{radius_field(config.assembly, smallest), r, power}
+                              : Input{"r", r, power, radii_file};
+  };
   const bool three_d = config.dimension == 3;
   const Material& mat = config.material;
   const AlgorithmSpec& alg = config.algorithm;
@@ -200,7 +208,7 @@ void check_derived_scales(const SceneConfig& config, std::span<const double> rad
     std::vector<Input> in{{"material.density", mat.density, 1.0},
                           {"algorithm.mass_scaling", alg.mass_scaling, 1.0}};
     if (!three_d) in.push_back({"material.thickness", mat.thickness, 1.0});
-    in.push_back({radius_field(config.assembly, smallest), r, three_d ? 3.0 : 2.0});
+    in.push_back(radius(r, smallest, three_d ? 3.0 : 2.0));
     return in;
   };
   auto scaled = [](std::vector<Input> in, double factor) {
@@ -231,7 +239,7 @@ void check_derived_scales(const SceneConfig& config, std::span<const double> rad
     const double m = mass_of(r);
     require_normal(config, which + "mass " + mass_formula, m, m_in);
     const double inertia = inertia_of(m, r);
-    const std::vector<Input> i_in = with(m_in, {{radius_field(config.assembly, smallest), r, 2.0}});
+    const std::vector<Input> i_in = with(m_in, {radius(r, smallest, 2.0)});
     require_normal(config, which + "moment of inertia " + inertia_formula, inertia, i_in);
     require_normal(config, which + "critical damping 2*sqrt(kn*m)",
                    critical_damping_translation(mat.particle.kn, m),
@@ -242,8 +250,8 @@ void check_derived_scales(const SceneConfig& config, std::span<const double> rad
     if (mat.particle.kt > 0.0)
       require_normal(config, which + "rotational critical damping 2*sqrt(kt*r^2*I)",
                      critical_damping_rotation(mat.particle.kt, r, inertia),
-                     with(scaled(i_in, 0.5), {{"material.kt", mat.particle.kt, 0.5},
-                                              {radius_field(config.assembly, smallest), r, 1.0}}));
+                     with(scaled(i_in, 0.5),
+                          {{"material.kt", mat.particle.kt, 0.5}, radius(r, smallest, 1.0)}));
     // The loading's global damping, as the kernels apply it (solver.cpp,
     // sphere_world.cpp): D = ratio·D_crit, semi-implicit, v⁺ = ((1 − c)·v⁻
     // + Δt/m·F)/(1 + c) with c = D·Δt/(2m) (= 2·ratio·alpha for
@@ -274,7 +282,7 @@ void check_derived_scales(const SceneConfig& config, std::span<const double> rad
       const std::vector<Input> d_in =
           with(scaled(i_in, 0.5),
                {{"material.kt", mat.particle.kt, 0.5},
-                {radius_field(config.assembly, smallest), r, 1.0},
+                radius(r, smallest, 1.0),
                 {"algorithm.damping_ratio_rotation", alg.damping_ratio_rotation, 1.0}});
       require_normal(config,
                      which + "rotational global damping damping_ratio_rotation*2*sqrt(kt*r^2*I)",

@@ -21,8 +21,11 @@ namespace demcal::detail {
 /// step. Else an InputError naming the config (or the --set that gave it)
 /// and the field that pushed the scale furthest in the direction it left
 /// the range (exit status 2). Computed through particle_scales.hpp, the
-/// formulas' one home.
-void check_derived_scales(const SceneConfig& config, std::span<const double> radii);
+/// formulas' one home. Radii read from a particle file other than the
+/// config's assembly.file (a prototype, a REV cut from one) are named as
+/// `radii_file`'s column r.
+void check_derived_scales(const SceneConfig& config, std::span<const double> radii,
+                          const std::string& radii_file = "");
 
 /// The field an overlap-at-sigma3 check names (check_lateral_stress in
 /// config.cpp, check_resolvable in packing.cpp, check_sphere_overlap in

@@ -457,9 +457,14 @@ Assembly make_assembly(const SceneConfig& config, const std::string& which) {
     require_config_file(config, "assembly.file", s.file);
     a = read_particle_file(s.file);
   }
-  detail::check_derived_scales(config, a.r);
-  check_resolvable(config, a, which);
+  check_assembly(config, a, which);
   return a;
+}
+
+void check_assembly(const SceneConfig& config, const Assembly& a, const std::string& which,
+                    const std::string& file) {
+  detail::check_derived_scales(config, a.r, file);
+  check_resolvable(config, a, which, file);
 }
 
 double hexagonal_peak_ratio(double friction) {

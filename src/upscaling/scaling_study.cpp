@@ -231,8 +231,8 @@ class ScalingFamily {
   /// Every size's assembly made and checked as a scene's is before it is
   /// consolidated (make_assembly, make_sphere_assembly: the derived scales
   /// and the overlap at sigma3), its errors naming the size; an REV cut
-  /// from the file (made_count's) keeps the file's positions:
-  /// check_resolvable, naming the file. None consolidated: a size the
+  /// from the file (made_count's) keeps the file's positions and radii:
+  /// check_assembly, naming the file. None consolidated: a size the
   /// study cannot run is refused before any folder is made, not when the
   /// study comes to it (after the smaller sizes' calibrations).
   void check_assemblies() {
@@ -242,7 +242,7 @@ class ScalingFamily {
       else if (!from_file_)
         disks_.emplace(n, make_assembly(scene(n), size_label(n)));
       else
-        check_resolvable(config_, disks_.at(n), size_label(n), scaling_family_file(config_).path);
+        check_assembly(config_, disks_.at(n), size_label(n), scaling_family_file(config_).path);
     }
   }
 

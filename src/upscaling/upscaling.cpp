@@ -344,13 +344,13 @@ std::string prototype_file(const PrototypeSource& source) {
 
 }  // namespace
 
-void check_prototype_resolvable(const SceneConfig& config, const Assembly& prototype,
-                                const PrototypeSource& source) {
-  check_resolvable(config, prototype, prototype_words(source), prototype_file(source));
+void check_prototype_assembly(const SceneConfig& config, const Assembly& prototype,
+                              const PrototypeSource& source) {
+  check_assembly(config, prototype, prototype_words(source), prototype_file(source));
 }
 
-void check_prototype_resolvable(const SceneConfig& config, const SphereAssembly& prototype,
-                                const PrototypeSource& source) {
+void check_prototype_assembly(const SceneConfig& config, const SphereAssembly& prototype,
+                              const PrototypeSource& source) {
   check_sphere_overlap(config, prototype, prototype_words(source), prototype_file(source));
 }
 

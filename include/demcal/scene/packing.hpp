@@ -131,6 +131,15 @@ Assembly make_assembly(const SceneConfig& config, const std::string& which = "th
 /// assembly ("the scene", "the prototype").
 void check_resolvable(const SceneConfig& config, const Assembly& a, const std::string& which,
                       const std::string& file = "");
+/// The checks make_assembly gives the assembly it builds, before it is
+/// consolidated: the scales its radii derive (masses, inertias, steps,
+/// damping: finite, normal doubles; a particle file's radius of 1e-150 m
+/// or 1e150 m makes them 0 or inf, and the consolidation "diverged:
+/// non-finite state") and check_resolvable. For an assembly read or cut
+/// from a particle `file` (a prototype, a REV cut from one, a scaling
+/// study's REVs) the errors name the file (a radius as its column r).
+void check_assembly(const SceneConfig& config, const Assembly& a, const std::string& which,
+                    const std::string& file = "");
 
 /// σ1/σ3 at sliding failure of a periodic hexagonal packing (horizontal
 /// rows) with interparticle friction μ: tan 60°·tan(60° + φ_μ), tan φ_μ = μ.

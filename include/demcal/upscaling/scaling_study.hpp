@@ -154,7 +154,7 @@ void check_scaling_sizes(const ScalingStudyOptions& options);
 /// --sizes and the size. A 3D file family is refused (assembly.type), as
 /// the study does. Every size's assembly is then made and checked as a
 /// scene's is before it is consolidated (the derived scales, the overlap
-/// at sigma3; an REV cut from a file: check_resolvable, naming the file),
+/// at sigma3; an REV cut from a file: check_assembly, naming the file),
 /// none consolidated, nothing written: the result holds them for
 /// run_scaling_study(), which runs them without making or checking any
 /// again.

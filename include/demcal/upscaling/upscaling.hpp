@@ -132,15 +132,19 @@ SphereAssembly prototype_spheres(const SceneConfig& config, int64_t particles = 
 /// its positions cannot resolve to the consolidation's tolerance: the
 /// rule, and the message, of check_resolvable (3D: check_sphere_overlap),
 /// which make_assembly applies to a generated prototype but a particle
-/// file never went through (a packing at x ~ 1e6 m). For the commands that
+/// file never went through (a packing at x ~ 1e6 m); in 2D also radii
+/// whose masses, inertias or steps are no normal doubles (check_assembly,
+/// make_assembly's checks: a file of 1e-150 m disks consolidated into
+/// "diverged: non-finite state"; in 3D the overlap at sigma3, ~r^2,
+/// refuses such radii first). For the commands that
 /// consolidate or run the prototype (verify, export); upscale and
 /// calibrate only count its particles. A prototype `source` read from a
 /// file is named, with the distance from the origin its positions must
 /// keep; the REV as its own prototype is "the scene".
-void check_prototype_resolvable(const SceneConfig& config, const Assembly& prototype,
-                                const PrototypeSource& source);
-void check_prototype_resolvable(const SceneConfig& config, const SphereAssembly& prototype,
-                                const PrototypeSource& source);
+void check_prototype_assembly(const SceneConfig& config, const Assembly& prototype,
+                              const PrototypeSource& source);
+void check_prototype_assembly(const SceneConfig& config, const SphereAssembly& prototype,
+                              const PrototypeSource& source);
 
 /// The reference scales of spheres (the kernel's own masses m = ρ(4/3)πr³
 /// at `params`' mass scaling, via SphereWorld::reference_scales()) with the
