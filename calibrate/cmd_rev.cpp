@@ -146,7 +146,7 @@ RevOutcome rev_3d(const SceneConfig& config, const std::string& file, const RevO
   std::optional<SphereAssembly> cut;  // as in 2D
   if (ro.method == "cut" && source.kind == "file") {
     cut = unconsolidated_rev(proto, ro);
-    check_sphere_overlap(config, *cut, "the REV", source.file);
+    check_sphere_assembly(config, *cut, "the REV", source.file);
   }
   ready();
   if (source.kind == "generated") {  // a generated gas is no packing to cut from or compare with

@@ -462,6 +462,37 @@ TEST_F(CliEndToEnd, APrototypeFileWhoseRadiiGiveNoNormalMassIsRefusedBeforeItIsR
   }
 }
 
+// The same in 3D: a 3x3x3 cube of touching spheres of r = 1e-150 m or
+// 1e150 m was refused by the overlap at sigma3 alone ("test.lateral_stress
+// ... at least 2.8e146 Pa"), a stress no user could mean; now by its radii
+// (check_sphere_assembly: make_sphere_assembly's checks), naming the file
+// and its column r, before any work.
+TEST_F(CliEndToEnd, APrototypeSphereFileWhoseRadiiGiveNoNormalMassNamesItsRadii) {
+  const std::string out = (dir_ / "work" / "out").string();
+  const std::string params = test::example_params("fcc_4x4x4");
+  for (const std::string scale : {"1e-150", "1e+150"}) {
+    const double r = std::stod(scale);
+    std::string spheres = "x,y,z,r\n";
+    char line[128];
+    for (int i = 0; i < 27; ++i) {
+      std::snprintf(line, sizeof line, "%.17g,%.17g,%.17g,%s\n", (2 * (i % 3) + 1) * r,
+                    (2 * (i / 3 % 3) + 1) * r, (2 * (i / 9) + 1) * r, scale.c_str());
+      spheres += line;
+    }
+    const std::string file = write("s" + scale + ".csv", spheres);
+    const std::vector<std::vector<std::string>> commands = {
+        {"verify", params, "--prototype", file, "-o", out},
+        {"export", params, "--prototype", file, "-o", out + "/deck.lammps"},
+        {"rev", test::shipped_config("fcc_4x4x4"), "--prototype", file, "--particles", "8", "-o",
+         out}};
+    const std::string flow = scale == "1e+150" ? "(it overflows)" : "(it underflows to 0)";
+    for (const auto& args : commands)
+      expect_bad_input(
+          args, {"demcal: error: " + file + ": r: the smallest sphere's (r = " + scale + " m) mass",
+                 flow, "; got " + scale});
+  }
+}
+
 // A check across two keys named the file and its own field whatever a
 // --set had changed: `check configs/hex_5x5.json --set material.kn=1e6`
 // (the file's kt is 5e7) read "configs/hex_5x5.json: material.kt: must not

@@ -21,7 +21,8 @@ struct Input {
   std::string field;
   double value;
   double power;
-  std::string file;  ///< the file that gave it (a particle file's radii), else the config's field
+  std::string file =
+      {};  ///< the file that gave it (a particle file's radii), else the config's field
   double share() const { return power * std::log10(value); }
 };
 

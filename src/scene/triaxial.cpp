@@ -122,9 +122,14 @@ SphereAssembly make_sphere_assembly(const SceneConfig& config, const std::string
   } else
     throw InputError(config.source, "assembly.type",
                      "\"" + s.type + "\" is not a 3D assembly (fcc, random or file)");
-  detail::check_derived_scales(config, a.r);
-  check_sphere_overlap(config, a, which);
+  check_sphere_assembly(config, a, which);
   return a;
+}
+
+void check_sphere_assembly(const SceneConfig& config, const SphereAssembly& a,
+                           const std::string& which, const std::string& file) {
+  detail::check_derived_scales(config, a.r, file);
+  check_sphere_overlap(config, a, which, file);
 }
 
 double wall_pressure(const SphereWorld& world, SphereWallSide side) {

@@ -351,7 +351,7 @@ void check_prototype_assembly(const SceneConfig& config, const Assembly& prototy
 
 void check_prototype_assembly(const SceneConfig& config, const SphereAssembly& prototype,
                               const PrototypeSource& source) {
-  check_sphere_overlap(config, prototype, prototype_words(source), prototype_file(source));
+  check_sphere_assembly(config, prototype, prototype_words(source), prototype_file(source));
 }
 
 ParticleScales sphere_scales(const SphereWorld& w, const Material& material,

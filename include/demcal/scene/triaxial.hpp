@@ -70,6 +70,14 @@ SphereAssembly make_sphere_assembly(const SceneConfig& config,
 /// consolidate it. `which` names the assembly.
 void check_sphere_overlap(const SceneConfig& config, const SphereAssembly& a,
                           const std::string& which, const std::string& file = "");
+/// The checks make_sphere_assembly gives the assembly it builds, before it
+/// is consolidated: the scales its radii derive (masses, inertias, steps,
+/// damping: finite, normal doubles) and check_sphere_overlap; as
+/// check_assembly in 2D. For spheres read or cut from a particle `file`
+/// the errors name the file (a radius as its column r): a file of 1e-150 m
+/// spheres is refused for its radii, not for a sigma3 of 1e146 Pa.
+void check_sphere_assembly(const SceneConfig& config, const SphereAssembly& a,
+                           const std::string& which, const std::string& file = "");
 
 /// Compressive pressure on a wall from the spheres [Pa].
 double wall_pressure(const SphereWorld& world, SphereWallSide side);

@@ -128,15 +128,13 @@ Assembly prototype_assembly(const SceneConfig& config, int64_t particles = 0,
 SphereAssembly prototype_spheres(const SceneConfig& config, int64_t particles = 0,
                                  const std::string& file = "", PrototypeSource* source = nullptr);
 
-/// Refuse, before any work, a prototype whose contact overlap at sigma3
-/// its positions cannot resolve to the consolidation's tolerance: the
-/// rule, and the message, of check_resolvable (3D: check_sphere_overlap),
-/// which make_assembly applies to a generated prototype but a particle
-/// file never went through (a packing at x ~ 1e6 m); in 2D also radii
-/// whose masses, inertias or steps are no normal doubles (check_assembly,
-/// make_assembly's checks: a file of 1e-150 m disks consolidated into
-/// "diverged: non-finite state"; in 3D the overlap at sigma3, ~r^2,
-/// refuses such radii first). For the commands that
+/// Refuse, before any work, a prototype that make_assembly's checks
+/// (check_assembly; 3D: make_sphere_assembly's, check_sphere_assembly)
+/// refuse, which a generated prototype went through and a particle file
+/// did not: radii whose masses, inertias or steps are no normal doubles
+/// (a file of 1e-150 m disks consolidated into "diverged: non-finite
+/// state"), or a contact overlap at sigma3 its positions cannot resolve to
+/// the consolidation's tolerance (a packing at x ~ 1e6 m). For the commands that
 /// consolidate or run the prototype (verify, export); upscale and
 /// calibrate only count its particles. A prototype `source` read from a
 /// file is named, with the distance from the origin its positions must
