@@ -547,6 +547,12 @@ TEST_F(CliEndToEnd, ACheckAcrossTwoKeysNamesTheKeyASetChanged) {
        {"test.consolidation_max_steps=100000"},
        "--set test.consolidation_max_steps=100000: test.consolidation_max_steps: ",
        "must be at least 690773: "},
+      // Above 10^6 steps the budget's bound is the exact integer to type
+      // (it read "must be at least 1.38154e+06", six digits).
+      {slow,
+       {"test.consolidation_max_steps=100000", "test.consolidation_tolerance=1e-6"},
+       "--set test.consolidation_max_steps=100000: test.consolidation_max_steps: ",
+       "must be at least 1381545: "},
       {slow,
        {"test.consolidation_tolerance=1e-12"},
        "--set test.consolidation_tolerance=1e-12: test.consolidation_tolerance: ",

@@ -258,8 +258,10 @@ void check_servo_gain(const Reader& t, const TestSpec& test, const std::vector<s
       sets, {"test.servo_gain", "test.consolidation_max_steps", "test.consolidation_tolerance"});
   std::ostringstream msg;
   if (key == "test.consolidation_max_steps") {
-    msg << "must be at least " << std::ceil(needed) << ": " << why.str() << "; got "
-        << test.consolidation_max_steps;
+    // The smallest budget that passes, as the integer to type (a stream's
+    // 6 digits would say 1.38154e+06).
+    msg << "must be at least " << static_cast<int64_t>(std::ceil(needed)) << ": " << why.str()
+        << "; got " << test.consolidation_max_steps;
     t.fail("consolidation_max_steps", msg.str());
   }
   if (key == "test.consolidation_tolerance") {
