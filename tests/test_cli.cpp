@@ -508,9 +508,12 @@ TEST_F(CliEndToEnd, APrototypeSphereFileWhoseRadiiGiveNoNormalMassNamesItsRadii)
 TEST_F(CliEndToEnd, ACheckAcrossTwoKeysNamesTheKeyASetChanged) {
   const std::string out = (dir_ / "work" / "out").string();
   const std::string random = test::shipped_config("random_400");
-  // servo_gain 1e-5 needs 690 772 steps to 1e-3 (check_servo_gain).
+  // servo_gain 1e-5 needs 690 772 steps to 1e-3 (check_servo_gain), 1e-9
+  // about 6.9e9: more than any budget (at most 1e9).
   const std::string slow = write("slow_servo.json", R"({"material": {"density": 2650,
       "kn": 1e8, "kt": 5e7, "friction": 0.3}, "test": {"servo_gain": 1e-5}})");
+  const std::string stalled = write("stalled_servo.json", R"({"material": {"density": 2650,
+      "kn": 1e8, "kt": 5e7, "friction": 0.3}, "test": {"servo_gain": 1e-9}})");
   struct Case {
     std::string config;
     std::vector<std::string> sets;
@@ -553,6 +556,12 @@ TEST_F(CliEndToEnd, ACheckAcrossTwoKeysNamesTheKeyASetChanged) {
        {"test.consolidation_max_steps=100000", "test.consolidation_tolerance=1e-6"},
        "--set test.consolidation_max_steps=100000: test.consolidation_max_steps: ",
        "must be at least 1381545: "},
+      // A budget no valid one can meet is no culprit: the file's gain, with
+      // its bound (it asked for consolidation_max_steps 6907755276).
+      {stalled,
+       {"test.consolidation_max_steps=100000"},
+       stalled + ": test.servo_gain: must be at least 6.90752e-05: ",
+       "(and than the largest it may be, 1000000000); got 1e-09"},
       {slow,
        {"test.consolidation_tolerance=1e-12"},
        "--set test.consolidation_tolerance=1e-12: test.consolidation_tolerance: ",

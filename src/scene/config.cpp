@@ -27,6 +27,10 @@ namespace demcal {
 
 namespace {
 
+// The largest test.consolidation_max_steps accepted: read with it, and a
+// budget bound beyond it is no value to ask for (check_servo_gain).
+constexpr int64_t kMaxConsolidationSteps = 1'000'000'000;
+
 using nlohmann::json;
 
 /// A key as the user wrote it, or quoted and cut when it is long or holds
@@ -242,7 +246,9 @@ void check_lateral_stress(const SceneConfig& c) {
 // least ln(1/tol)/(-ln(1 - gain)) steps. A gain that needs more than
 // consolidation_max_steps can never consolidate. The error names the key a
 // --set changed (changed_field: the gain when one changed it, else the
-// budget, else the tolerance), with that key's own bound.
+// budget, else the tolerance), with that key's own bound; a budget whose
+// bound is beyond the largest it may be (kMaxConsolidationSteps) is no
+// culprit: the gain is named then.
 void check_servo_gain(const Reader& t, const TestSpec& test, const std::vector<std::string>& sets) {
   const double per_step = -std::log1p(-test.servo_gain);  // -ln(1 - gain): the log-decrement a step
   const double needed = std::log(1.0 / test.consolidation_tolerance) / per_step;
@@ -254,10 +260,13 @@ void check_servo_gain(const Reader& t, const TestSpec& test, const std::vector<s
       << test.consolidation_tolerance << " at servo_gain " << test.servo_gain
       << " takes at least ln(1/tol)/(-ln(1-gain)) = " << needed
       << " steps, more than consolidation_max_steps " << test.consolidation_max_steps;
+  if (needed > static_cast<double>(kMaxConsolidationSteps))
+    why << " (and than the largest it may be, " << kMaxConsolidationSteps << ")";
   const std::string key = changed_field(
       sets, {"test.servo_gain", "test.consolidation_max_steps", "test.consolidation_tolerance"});
   std::ostringstream msg;
-  if (key == "test.consolidation_max_steps") {
+  if (key == "test.consolidation_max_steps" &&
+      needed <= static_cast<double>(kMaxConsolidationSteps)) {
     // The smallest budget that passes, as the integer to type (a stream's
     // 6 digits would say 1.38154e+06).
     msg << "must be at least " << static_cast<int64_t>(std::ceil(needed)) << ": " << why.str()
@@ -494,8 +503,8 @@ SceneConfig parse_config(const nlohmann::json& root_json, const std::string& sou
     if (s.consolidation_tolerance >= 1.0)
       t.fail("consolidation_tolerance", "must be < 1 (a fraction of lateral_stress)");
     s.consolidation_unbalanced = t.positive("consolidation_unbalanced", s.consolidation_unbalanced);
-    s.consolidation_max_steps =
-        t.integer("consolidation_max_steps", s.consolidation_max_steps, 1000, 1000000000);
+    s.consolidation_max_steps = t.integer("consolidation_max_steps", s.consolidation_max_steps,
+                                          1000, kMaxConsolidationSteps);
     // 3D: the overlap at sigma3 depends on the radii, checked with the
     // assembly (check_sphere_overlap in triaxial.cpp).
     if (!three_d) check_lateral_stress(c);
