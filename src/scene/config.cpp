@@ -500,8 +500,9 @@ SceneConfig parse_config(const nlohmann::json& root_json, const std::string& sou
     s.servo_gain = t.positive("servo_gain", s.servo_gain);
     if (s.servo_gain > 1.0) t.fail("servo_gain", "must be <= 1 (a larger gain overshoots)");
     s.consolidation_tolerance = t.positive("consolidation_tolerance", s.consolidation_tolerance);
-    if (s.consolidation_tolerance >= 1.0)
-      t.fail("consolidation_tolerance", "must be < 1 (a fraction of lateral_stress)");
+    if (s.consolidation_tolerance >= kConsolidationToleranceBelow)
+      t.fail("consolidation_tolerance",
+             "must be < " + num(kConsolidationToleranceBelow) + " (a fraction of lateral_stress)");
     s.consolidation_unbalanced = t.positive("consolidation_unbalanced", s.consolidation_unbalanced);
     s.consolidation_max_steps = t.integer("consolidation_max_steps", s.consolidation_max_steps,
                                           1000, kMaxConsolidationSteps);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -180,13 +181,21 @@ NamedStiffness softer_normal_stiffness(const Material& material) {
   return {material.particle.kn, "material.kn"};
 }
 
-std::string overlap_culprit(const SceneConfig& config, const std::string& kn_field, bool roundoff) {
+std::string overlap_culprit(const SceneConfig& config, const std::string& kn_field,
+                            const std::optional<double>& tolerance) {
   std::vector<std::string> fields{"test.lateral_stress", kn_field};
   // 2D: the force on a disk per unit stress is sigma3*2r*t.
   if (config.dimension == 2) fields.push_back("material.thickness");
-  // The round-off must stay below a tenth of the tolerance of the overlap.
-  if (roundoff) fields.push_back("test.consolidation_tolerance");
+  // The round-off must stay below a tenth of the tolerance of the overlap:
+  // the tolerance, when one it may be resolves it.
+  if (tolerance) fields.push_back("test.consolidation_tolerance");
   return changed_field(config.sets, fields);
+}
+
+std::optional<double> resolving_tolerance(double roundoff, double delta) {
+  const double tolerance = 10.0 * roundoff / delta;
+  if (tolerance < kConsolidationToleranceBelow) return tolerance;
+  return std::nullopt;
 }
 
 void check_derived_scales(const SceneConfig& config, std::span<const double> radii,

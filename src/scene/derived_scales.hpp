@@ -3,6 +3,7 @@
 // make_sphere_assembly call it).
 #pragma once
 
+#include <optional>
 #include <span>
 #include <string>
 
@@ -36,11 +37,20 @@ void check_derived_scales(const SceneConfig& config, std::span<const double> rad
 /// when a --set gave it and none gave sigma3 (the value the user just
 /// changed), else in 2D material.thickness when a --set gave it and none
 /// gave sigma3 or the stiffness, else, for the round-off bound
-/// (`roundoff`: check_resolvable, check_sphere_overlap's lower bound, whose
-/// input consolidation_tolerance is too), test.consolidation_tolerance when
-/// a --set gave it and none gave the others, else test.lateral_stress.
+/// (check_resolvable, check_sphere_overlap's lower bound, whose input
+/// consolidation_tolerance is too: `tolerance`, resolving_tolerance()),
+/// test.consolidation_tolerance when a --set gave it and none gave the
+/// others, else test.lateral_stress. A tolerance whose bound is none
+/// (nullopt: no tolerance below 1 resolves the overlap) is never named.
 std::string overlap_culprit(const SceneConfig& config, const std::string& kn_field,
-                            bool roundoff = false);
+                            const std::optional<double>& tolerance = std::nullopt);
+
+/// The smallest test.consolidation_tolerance at which positions of
+/// round-off `roundoff` [m] resolve the overlap `delta` [m] (the round-off
+/// a tenth of the tolerance of it: 10*roundoff/delta), when that is a valid
+/// tolerance (below kConsolidationToleranceBelow); else nullopt: the
+/// round-off message then leaves the tolerance out.
+std::optional<double> resolving_tolerance(double roundoff, double delta);
 
 /// The softer of the particles' and the walls' normal stiffness, and its
 /// field (material.kn or material.wall.kn; the particles' on a tie): the

@@ -417,10 +417,11 @@ void check_resolvable(const SceneConfig& config, const Assembly& a, const std::s
   if (roundoff <= wanted * delta) return;
   const double minimum = roundoff / wanted * kn / (2.0 * m.thickness * r_min);
   const double kn_max = 2.0 * sigma3 * m.thickness * r_min * wanted / roundoff;
-  // sigma3 or t too low, kn too high, or the tolerance too fine: the error
-  // names the one a --set changed (detail::overlap_culprit) and the --set or
-  // file that gave it.
-  const std::string field = detail::overlap_culprit(config, kn_field, true);
+  // sigma3 or t too low, kn too high, or the tolerance too fine (when a
+  // tolerance below 1 resolves it): the error names the one a --set changed
+  // (detail::overlap_culprit) and the --set or file that gave it.
+  const std::optional<double> tolerance_min = detail::resolving_tolerance(roundoff, delta);
+  const std::string field = detail::overlap_culprit(config, kn_field, tolerance_min);
   std::ostringstream msg;
   msg << "the overlap at sigma3, 2*sigma3*t*r_min/kn = " << delta << " m (sigma3 = " << sigma3
       << " Pa, thickness " << m.thickness << " m, " << kn_field << " = " << kn
@@ -437,8 +438,7 @@ void check_resolvable(const SceneConfig& config, const Assembly& a, const std::s
     msg << ", or material.thickness at least " << roundoff / wanted * kn / (2.0 * sigma3 * r_min)
         << " m; got " << m.thickness;
   else if (field == "test.consolidation_tolerance")
-    msg << ", or test.consolidation_tolerance at least " << 10.0 * roundoff / delta << "; got "
-        << tolerance;
+    msg << ", or test.consolidation_tolerance at least " << *tolerance_min << "; got " << tolerance;
   else
     msg << "; got " << (field == kn_field ? kn : sigma3);
   throw InputError(source_of(config, field), field, msg.str());

@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -50,15 +51,16 @@ void check_sphere_overlap(const SceneConfig& config, const SphereAssembly& a,
   const double r_min = *std::min_element(a.r.begin(), a.r.end());
   const double r_max = *std::max_element(a.r.begin(), a.r.end());
   // The error names sigma3 or the stiffness (the round-off bound: or the
-  // tolerance), the one a --set changed (detail::overlap_culprit), and the
-  // --set or file that gave it; `bound` is the tolerance's.
+  // tolerance, when one below 1 resolves it), the one a --set changed
+  // (detail::overlap_culprit), and the --set or file that gave it; `bound`
+  // is the tolerance's (detail::resolving_tolerance; nullopt: none).
   const auto fail = [&](const std::string& kn_field, double kn, const std::string& what,
-                        bool roundoff, double bound) {
-    const std::string field = detail::overlap_culprit(config, kn_field, roundoff);
+                        const std::optional<double>& bound) {
+    const std::string field = detail::overlap_culprit(config, kn_field, bound);
     const double tolerance = config.test.consolidation_tolerance;
     if (field == "test.consolidation_tolerance")
       throw InputError(source_of(config, field), field,
-                       what + ", or test.consolidation_tolerance at least " + num(bound, 6) +
+                       what + ", or test.consolidation_tolerance at least " + num(*bound, 6) +
                            "; got " + num(tolerance));
     throw InputError(source_of(config, field), field,
                      what + "; got " + num(field == kn_field ? kn : sigma3));
@@ -72,7 +74,7 @@ void check_sphere_overlap(const SceneConfig& config, const SphereAssembly& a,
         << " = " << kn_soft << " N/m), must stay below " << kMaxOverlapAtSigma3
         << ": test.lateral_stress must be at most " << limit << " Pa, or " << soft_field
         << " at least " << 4.0 * sigma3 * r_max / kMaxOverlapAtSigma3 << " N/m";
-    fail(soft_field, kn_soft, msg.str(), false, 0.0);
+    fail(soft_field, kn_soft, msg.str(), std::nullopt);
   }
   double coordinate = 0.0;
   for (int axis = 0; axis < 3; ++axis)
@@ -95,7 +97,7 @@ void check_sphere_overlap(const SceneConfig& config, const SphereAssembly& a,
   if (!file.empty())
     msg << ", or " << file << "'s positions within " << wanted * delta / (roundoff / coordinate)
         << " m of the origin";
-  fail(kn_field, kn, msg.str(), true, 10.0 * roundoff / delta);
+  fail(kn_field, kn, msg.str(), detail::resolving_tolerance(roundoff, delta));
 }
 
 SphereMaterial sphere_material(const Material& material) {

@@ -44,6 +44,9 @@ int64_t particle_count(const nlohmann::json& value, int64_t min, const std::stri
 /// The largest overlap at sigma3, relative to the radius, a config may ask
 /// for (test.lateral_stress): see check_lateral_stress in config.cpp.
 inline constexpr double kMaxOverlapAtSigma3 = 0.05;
+/// test.consolidation_tolerance (a fraction of lateral_stress) must be
+/// below this, and positive.
+inline constexpr double kConsolidationToleranceBelow = 1.0;
 
 /// The range of a real quantity that a config, a command-line option and a
 /// series' metadata (`demcal score`) all give: finite, above `lo` (or at it
