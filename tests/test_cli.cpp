@@ -523,6 +523,7 @@ TEST_F(CliEndToEnd, APrototypeSphereFileWhoseRadiiGiveNoNormalMassNamesItsRadii)
 TEST_F(CliEndToEnd, ACheckAcrossTwoKeysNamesTheKeyASetChanged) {
   const std::string out = (dir_ / "work" / "out").string();
   const std::string random = test::shipped_config("random_400");
+  const std::string fcc = test::shipped_config("fcc_4x4x4");
   // servo_gain 1e-5 needs 690 772 steps to 1e-3 (check_servo_gain), 1e-9
   // about 6.9e9: more than any budget (at most 1e9).
   const std::string slow = write("slow_servo.json", R"({"material": {"density": 2650,
@@ -585,6 +586,16 @@ TEST_F(CliEndToEnd, ACheckAcrossTwoKeysNamesTheKeyASetChanged) {
        {"test.consolidation_max_steps=100000", "test.servo_gain=2e-5"},
        "--set test.servo_gain=2e-5: test.servo_gain: ",
        "must be at least 6.90752e-05"},
+      // A lattice's size (the product's limit) named cells_x, or columns,
+      // and the file whichever a --set had changed.
+      {fcc,
+       {"assembly.cells_y=1000000"},
+       "--set assembly.cells_y=1000000: assembly.cells_y: ",
+       "4 x cells_x x cells_y x cells_z = 64000000"},
+      {kHex5,
+       {"assembly.rows=10000000"},
+       "--set assembly.rows=10000000: assembly.rows: ",
+       "columns x rows = 50000000 particles, more than the limit 10000000"},
   };
   for (const Case& c : cases) {
     for (const std::string command : {"run", "check"}) {

@@ -381,6 +381,28 @@ void check_radius_bounds(const Reader& a, const AssemblySpec& s,
          "must not exceed radius_max (" + num(s.radius_max, 6) + "), got " + num(s.radius_min, 6));
 }
 
+// A lattice (fcc: 4 spheres a cell; hexagonal, square: a disk a column and
+// row) of at most kMaxParticles. The product's limit is the only bound, named
+// by the key a --set changed (changed_field: cells_x, or columns, when none
+// or several did).
+void check_lattice_size(const Reader& a, const AssemblySpec& s,
+                        const std::vector<std::string>& sets) {
+  if (s.type == "fcc") {
+    const double spheres = 4.0 * s.cells_x * static_cast<double>(s.cells_y) * s.cells_z;
+    if (spheres <= static_cast<double>(kMaxParticles)) return;
+    const std::string key =
+        changed_field(sets, {"assembly.cells_x", "assembly.cells_y", "assembly.cells_z"});
+    a.fail(key.substr(key.find('.') + 1),
+           "4 x cells_x x cells_y x cells_z = " + std::to_string(spheres) +
+               " particles, more than the limit " + kMaxParticlesWhy);
+  }
+  if (int64_t{s.columns} * s.rows <= kMaxParticles) return;
+  const std::string key = changed_field(sets, {"assembly.columns", "assembly.rows"});
+  a.fail(key.substr(key.find('.') + 1),
+         "columns x rows = " + std::to_string(int64_t{s.columns} * s.rows) +
+             " particles, more than the limit " + kMaxParticlesWhy);
+}
+
 // M points of the curve need at least M steps: more would repeat steps in
 // series.csv and slow every run by the extra measurements. The error names
 // the one a --set changed (changed_field).
@@ -443,18 +465,13 @@ SceneConfig parse_config(const nlohmann::json& root_json, const std::string& sou
       s.cells_x = static_cast<int>(a.integer("cells_x", s.cells_x, 1, kIntMax));
       s.cells_y = static_cast<int>(a.integer("cells_y", s.cells_y, 1, kIntMax));
       s.cells_z = static_cast<int>(a.integer("cells_z", s.cells_z, 1, kIntMax));
-      const double spheres = 4.0 * s.cells_x * static_cast<double>(s.cells_y) * s.cells_z;
-      if (spheres > static_cast<double>(kMaxParticles))
-        a.fail("cells_x", "4 x cells_x x cells_y x cells_z = " + std::to_string(spheres) +
-                              " particles, more than the limit " + kMaxParticlesWhy);
+      check_lattice_size(a, s, sets);
       s.radius = a.positive("radius", s.radius);
     } else if (s.type == "hexagonal" || s.type == "square") {
       constexpr int64_t kIntMax = std::numeric_limits<int>::max();
       s.columns = static_cast<int>(a.integer("columns", s.columns, 1, kIntMax));
       s.rows = static_cast<int>(a.integer("rows", s.rows, 1, kIntMax));
-      if (int64_t{s.columns} * s.rows > kMaxParticles)
-        a.fail("columns", "columns x rows = " + std::to_string(int64_t{s.columns} * s.rows) +
-                              " particles, more than the limit " + kMaxParticlesWhy);
+      check_lattice_size(a, s, sets);
       s.radius = a.positive("radius", s.radius);
     } else if (s.type == "random") {
       s.count = static_cast<int>(a.integer("count", s.count, 2, std::numeric_limits<int>::max()));
