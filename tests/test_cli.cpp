@@ -528,6 +528,8 @@ TEST_F(CliEndToEnd, ACheckAcrossTwoKeysNamesTheKeyASetChanged) {
   // about 6.9e9: more than any budget (at most 1e9).
   const std::string slow = write("slow_servo.json", R"({"material": {"density": 2650,
       "kn": 1e8, "kt": 5e7, "friction": 0.3}, "test": {"servo_gain": 1e-5}})");
+  const std::string damped = write("damped.json", R"({"material": {"density": 2650,
+      "kn": 1e8, "kt": 5e7, "friction": 0.3, "contact_damping_ratio": 300}})");
   const std::string stalled = write("stalled_servo.json", R"({"material": {"density": 2650,
       "kn": 1e8, "kt": 5e7, "friction": 0.3}, "test": {"servo_gain": 1e-9}})");
   struct Case {
@@ -586,6 +588,18 @@ TEST_F(CliEndToEnd, ACheckAcrossTwoKeysNamesTheKeyASetChanged) {
        {"test.consolidation_max_steps=100000", "test.servo_gain=2e-5"},
        "--set test.servo_gain=2e-5: test.servo_gain: ",
        "must be at least 6.90752e-05"},
+      // Contact dashpots against the consolidation's budget named the ratio
+      // and the file whichever a --set had changed: now the budget, with
+      // the smallest that covers the ratio (342 at 2e6 steps, 242 at 1e6).
+      {damped,
+       {"test.consolidation_max_steps=1000000"},
+       "--set test.consolidation_max_steps=1000000: test.consolidation_max_steps: ",
+       "must be at least 1536204 for material.contact_damping_ratio 300, which over-damps every "
+       "contact"},
+      {damped,
+       {"test.consolidation_max_steps=1000000", "material.contact_damping_ratio=300"},
+       "--set material.contact_damping_ratio=300: material.contact_damping_ratio: ",
+       "must stay below 242.045 for this budget"},
       // A lattice's size (the product's limit) named cells_x, or columns,
       // and the file whichever a --set had changed.
       {fcc,

@@ -27,10 +27,6 @@ namespace demcal {
 
 namespace {
 
-// The largest test.consolidation_max_steps accepted: read with it, and a
-// budget bound beyond it is no value to ask for (check_servo_gain).
-constexpr int64_t kMaxConsolidationSteps = 1'000'000'000;
-
 using nlohmann::json;
 
 /// A key as the user wrote it, or quoted and cut when it is long or holds

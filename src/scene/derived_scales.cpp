@@ -116,6 +116,9 @@ void check_wall_stiffness(const SceneConfig& config, double alpha_c) {
 /// Refuses a contact damping ratio whose quickest contact cannot settle
 /// within test.consolidation_max_steps of the consolidation's step (m_min the
 /// lightest particle's mass, dt_crit its critical step, radii in [r_min, r_max]).
+/// The error names the ratio, or the budget when a --set changed it and none
+/// the ratio (changed_field) and a budget it may be meets the ratio, each
+/// with its own bound.
 // An over-damped contact (ζ_c > 1) creeps: its relative motion, m_eff·ẍ
 // + c·ẋ + kn·x = 0 with c = 2ζ_c·sqrt(kn·m_eff), relaxes at best at the
 // slow root ω·(ζ_c − sqrt(ζ_c² − 1)), about ω/(2ζ_c), while the step
@@ -155,8 +158,8 @@ void check_contact_damping_budget(const SceneConfig& config, double m_min, doubl
         const double mid = std::sqrt(lo * hi);  // geometric: zeta may be 1e100
         (steps_per_time_constant(mid) <= budget ? lo : hi) = mid;
       }
-      std::ostringstream msg;
-      msg << "over-damps every contact: the quickest (omega = " << shown(omega)
+      std::ostringstream why;
+      why << "over-damps every contact: the quickest (omega = " << shown(omega)
           << " rad/s) creeps back with the time constant 1/(omega*(zeta - sqrt(zeta^2 - 1))) = "
           << shown(1.0 / (omega / (zeta_c + std::sqrt((zeta_c - 1.0) * (zeta_c + 1.0))))) << " s, "
           << shown(needed)
@@ -164,10 +167,20 @@ void check_contact_damping_budget(const SceneConfig& config, double m_min, doubl
              "test.consolidation_max_steps = "
           << config.test.consolidation_max_steps
           << ": no contact could settle within the budget, and its criteria would read the "
-             "dashpots' forces as a static state. material.contact_damping_ratio must stay "
-             "below "
-          << shown(lo) << " for this budget (or raise test.consolidation_max_steps); got "
-          << shown(zeta_c);
+             "dashpots' forces as a static state";
+      const std::string budget_field = "test.consolidation_max_steps";
+      const std::string field =
+          changed_field(config.sets, {"material.contact_damping_ratio", budget_field});
+      std::ostringstream msg;
+      if (field == budget_field && needed <= static_cast<double>(kMaxConsolidationSteps)) {
+        // The smallest budget that covers the ratio, the integer to type.
+        msg << "must be at least " << static_cast<int64_t>(std::ceil(needed))
+            << " for material.contact_damping_ratio " << shown(zeta_c) << ", which " << why.str()
+            << "; got " << config.test.consolidation_max_steps;
+        throw InputError(source_of(config, budget_field), budget_field, msg.str());
+      }
+      msg << why.str() << ". material.contact_damping_ratio must stay below " << shown(lo)
+          << " for this budget (or raise test.consolidation_max_steps); got " << shown(zeta_c);
       throw InputError(source_of(config, "material.contact_damping_ratio"),
                        "material.contact_damping_ratio", msg.str());
     }

@@ -33,6 +33,10 @@ inline constexpr const char* kMaxParticlesWhy =
 /// The longest loading (Nstep) a config's algorithm.steps or a params.json's
 /// rev.steps may ask for.
 inline constexpr int64_t kMaxSteps = 10'000'000'000;
+/// The largest test.consolidation_max_steps a config may give: a budget
+/// bound beyond it is no value to ask for (check_servo_gain, the contact
+/// damping's budget in derived_scales.cpp).
+inline constexpr int64_t kMaxConsolidationSteps = 1'000'000'000;
 /// A particle count a file holds (a config's prototype.particles, a
 /// params.json's rev.particles and prototype.particles): a whole number
 /// from `min` to kMaxParticles, read without a cast that can overflow
