@@ -57,8 +57,9 @@ struct TriaxialState {
 /// The sphere material of a config's material block (thickness unused).
 SphereMaterial sphere_material(const Material& material);
 /// Build the sphere assembly a 3D config asks for (fcc, random gas, file)
-/// and check that the overlap at σ3 is resolvable: InputError naming
-/// test.lateral_stress otherwise.
+/// and check that the overlap at σ3 is resolvable (check_sphere_overlap):
+/// otherwise an InputError naming the field a --set changed, with that
+/// --set (detail::overlap_culprit: test.lateral_stress when none did).
 SphereAssembly make_sphere_assembly(const SceneConfig& config,
                                     const std::string& which = "the scene");
 /// Refuse (InputError) a sigma3 whose overlap the spheres of `a` cannot
