@@ -404,6 +404,7 @@ Assembly tiled_prototype(const Assembly& proto, const std::string& tile, Prototy
   source.description += ", mirror-tiled " + std::to_string(nx) + "x" + std::to_string(ny) + " = " +
                         std::to_string(tiled.size()) + " particles";
   source.particles = tiled.size();
+  source.tiling = std::to_string(nx) + "x" + std::to_string(ny);
   return tiled;
 }
 

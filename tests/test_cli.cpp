@@ -426,6 +426,11 @@ TEST_F(CliEndToEnd, AnUnresolvablePrototypeFileIsRefusedBeforeItIsRun) {
     expect_bad_input(c.args, {": test.lateral_stress: ", "is not resolved by positions up to",
                               "for the " + c.assembly, ", from " + c.file + "), or material.kn",
                               ", or " + c.file + "'s positions within "});
+  // verify --tile checks the tiled packing, whose positions are not the
+  // file's: said so (it read "or FILE's positions within ... m").
+  expect_bad_input({"verify", params, "--prototype", far, "--tile", "2x2", "-o", out},
+                   {"prototype's assembly (100 particles, from " + far + " mirror-tiled 2x2)",
+                    ", or the tiled positions of " + far + " within "});
   const Result counted = demcal({"upscale", params, "--prototype", far, "-o", out});
   EXPECT_EQ(counted.status, 0) << counted.err;
 }

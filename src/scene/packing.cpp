@@ -400,7 +400,7 @@ Assembly read_particles(std::istream& in, const std::string& path) {
 // is below a tenth of it, the stress is noise (hex_5x5: 1e-3 Pa runs,
 // 1e-4 Pa "diverges" in the energy ledger, 1e-9 Pa fails the same way).
 void check_resolvable(const SceneConfig& config, const Assembly& a, const std::string& which,
-                      const std::string& file) {
+                      const std::string& file, const std::string& tiling) {
   if (a.size() == 0) return;
   const double coordinate =
       std::max({std::abs(a.left), std::abs(a.right), std::abs(a.bottom), std::abs(a.top)});
@@ -429,11 +429,11 @@ void check_resolvable(const SceneConfig& config, const Assembly& a, const std::s
       << " m must stay below a tenth of "
       << "consolidation_tolerance of it): test.lateral_stress must be at least " << minimum
       << " Pa for " << which << "'s assembly (" << a.size() << " particles"
-      << (file.empty() ? "" : ", from " + file) << "), or " << kn_field << " at most " << kn_max
-      << " N/m";
+      << (file.empty() ? "" : ", from " + file) << (tiling.empty() ? "" : " mirror-tiled " + tiling)
+      << "), or " << kn_field << " at most " << kn_max << " N/m";
   if (!file.empty())
-    msg << ", or " << file << "'s positions within " << wanted * delta / (roundoff / coordinate)
-        << " m of the origin";
+    msg << ", or " << (tiling.empty() ? file + "'s positions" : "the tiled positions of " + file)
+        << " within " << wanted * delta / (roundoff / coordinate) << " m of the origin";
   if (field == "material.thickness")
     msg << ", or material.thickness at least " << roundoff / wanted * kn / (2.0 * sigma3 * r_min)
         << " m; got " << m.thickness;
@@ -462,9 +462,9 @@ Assembly make_assembly(const SceneConfig& config, const std::string& which) {
 }
 
 void check_assembly(const SceneConfig& config, const Assembly& a, const std::string& which,
-                    const std::string& file) {
+                    const std::string& file, const std::string& tiling) {
   detail::check_derived_scales(config, a.r, file);
-  check_resolvable(config, a, which, file);
+  check_resolvable(config, a, which, file, tiling);
 }
 
 double hexagonal_peak_ratio(double friction) {

@@ -346,7 +346,7 @@ std::string prototype_file(const PrototypeSource& source) {
 
 void check_prototype_assembly(const SceneConfig& config, const Assembly& prototype,
                               const PrototypeSource& source) {
-  check_assembly(config, prototype, prototype_words(source), prototype_file(source));
+  check_assembly(config, prototype, prototype_words(source), prototype_file(source), source.tiling);
 }
 
 void check_prototype_assembly(const SceneConfig& config, const SphereAssembly& prototype,

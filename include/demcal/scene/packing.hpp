@@ -128,18 +128,21 @@ Assembly make_assembly(const SceneConfig& config, const std::string& which = "th
 /// message, with the distance from the origin its positions must keep) is
 /// checked by the commands that consolidate it. The error names the field a
 /// --set changed (detail::overlap_culprit) with its bound; `which` names the
-/// assembly ("the scene", "the prototype").
+/// assembly ("the scene", "the prototype"). `tiling` ("2x2": verify --tile)
+/// says that `a` is the file's packing mirror-tiled, its positions not the
+/// file's.
 void check_resolvable(const SceneConfig& config, const Assembly& a, const std::string& which,
-                      const std::string& file = "");
+                      const std::string& file = "", const std::string& tiling = "");
 /// The checks make_assembly gives the assembly it builds, before it is
 /// consolidated: the scales its radii derive (masses, inertias, steps,
 /// damping: finite, normal doubles; a particle file's radius of 1e-150 m
 /// or 1e150 m makes them 0 or inf, and the consolidation "diverged:
 /// non-finite state") and check_resolvable. For an assembly read or cut
 /// from a particle `file` (a prototype, a REV cut from one, a scaling
-/// study's REVs) the errors name the file (a radius as its column r).
+/// study's REVs) the errors name the file (a radius as its column r);
+/// `tiling` as check_resolvable's.
 void check_assembly(const SceneConfig& config, const Assembly& a, const std::string& which,
-                    const std::string& file = "");
+                    const std::string& file = "", const std::string& tiling = "");
 
 /// σ1/σ3 at sliding failure of a periodic hexagonal packing (horizontal
 /// rows) with interparticle friction μ: tan 60°·tan(60° + φ_μ), tan φ_μ = μ.

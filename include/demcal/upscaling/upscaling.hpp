@@ -87,8 +87,9 @@ nlohmann::json param_block(const AlgorithmSpec& params, const ParticleScales& sc
 
 /// Where a prototype's particles come from.
 struct PrototypeSource {
-  std::string kind;  ///< "file", "generated" or "rev" (the REV itself)
-  std::string file;  ///< for "file"
+  std::string kind;    ///< "file", "generated" or "rev" (the REV itself)
+  std::string file;    ///< for "file"
+  std::string tiling;  ///< "NXxNY" when the file's packing was mirror-tiled (verify --tile)
   int64_t particles = 0;
   std::string description;  ///< one line for reports
 };
