@@ -199,9 +199,10 @@ int export_3d(const ExportCmdOptions& o, const nlohmann::json& params, const Rev
   const fs::path deck_fs = deck_destination(o, config, eo);
   eo.uncertified = uncertified_reason(params);
   const ScalingLaw law = resolve_law(params, o.params, o.law, o.exponent);
-  auto [file, particles] = named_prototype(params, o.prototype, o.particles);
+  auto [file, particles, count_origin] =
+      named_prototype(params, o.params, o.prototype, o.particles);
   PrototypeSource source;
-  const SphereAssembly proto = prototype_spheres(config, particles, file, &source);
+  const SphereAssembly proto = prototype_spheres(config, particles, file, &source, count_origin);
   check_prototype_assembly(config, proto, source);  // consolidated, here or by the deck
   eo.consolidate_in_deck = deck_consolidates(o, proto.size());
   const AlgorithmSpec up = upscale(rev.params, rev.particles, proto.size(), law);
@@ -233,9 +234,10 @@ int cmd_export(const ExportCmdOptions& o) {
   const fs::path deck_fs = deck_destination(o, config, eo);
   eo.uncertified = uncertified_reason(params);
   const ScalingLaw law = resolve_law(params, o.params, o.law, o.exponent);
-  auto [file, particles] = named_prototype(params, o.prototype, o.particles);
+  auto [file, particles, count_origin] =
+      named_prototype(params, o.params, o.prototype, o.particles);
   PrototypeSource source;
-  Assembly proto = prototype_assembly(config, particles, file, &source);
+  Assembly proto = prototype_assembly(config, particles, file, &source, count_origin);
   // Consolidated here or by the deck, unless --no-consolidate (as given).
   if (!o.no_consolidate) check_prototype_assembly(config, proto, source);
   const AlgorithmSpec up = upscale(rev.params, rev.particles, proto.size(), law);

@@ -184,8 +184,8 @@ SceneConfig required_scene(const nlohmann::json& params, const std::string& path
   return *scene;
 }
 
-std::pair<std::string, int64_t> named_prototype(const nlohmann::json& params,
-                                                const std::string& file, int64_t particles) {
+NamedPrototype named_prototype(const nlohmann::json& params, const std::string& params_path,
+                               const std::string& file, int64_t particles) {
   if (!file.empty() || particles != 0 || !params.contains("prototype") ||
       !params["prototype"].is_object())
     return {file, particles};
@@ -193,7 +193,8 @@ std::pair<std::string, int64_t> named_prototype(const nlohmann::json& params,
   if (p.contains("source") && p["source"].contains("file"))
     return {p["source"]["file"].get<std::string>(), 0};
   if (p.contains("particles"))  // checked by read_params_file: 1 to kMaxParticles
-    return {"", json_integer(p["particles"], 1, kMaxParticles)};
+    return {"", json_integer(p["particles"], 1, kMaxParticles),
+            CountOrigin{params_path, "prototype.particles"}};
   return {file, particles};
 }
 

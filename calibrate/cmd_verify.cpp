@@ -270,9 +270,10 @@ int verify_3d(const VerifyOptions& o, const nlohmann::json& params, const RevPar
   // An unusable -o fails before anything is printed or probed.
   const std::string dir = o.out_dir.empty() ? "demcal-verify-" + config.name : o.out_dir;
   OutputFolder::check(dir);
-  auto [file, particles] = named_prototype(params, o.prototype, o.particles);
+  auto [file, particles, count_origin] =
+      named_prototype(params, o.params, o.prototype, o.particles);
   PrototypeSource source;
-  const SphereAssembly proto = prototype_spheres(config, particles, file, &source);
+  const SphereAssembly proto = prototype_spheres(config, particles, file, &source, count_origin);
   check_prototype_assembly(config, proto, source);  // before the probes and the run
   const int64_t n = proto.size();
   const AlgorithmSpec up = upscale(rev.params, rev.particles, n, law);
@@ -538,9 +539,10 @@ int verify_2d(const VerifyOptions& o, const nlohmann::json& params, const RevPar
   // made before the consolidation (a failed one leaves no empty folder);
   // made where prototype.csv goes.
   OutputFolder::check(dir);
-  auto [file, particles] = named_prototype(params, o.prototype, o.particles);
+  auto [file, particles, count_origin] =
+      named_prototype(params, o.params, o.prototype, o.particles);
   PrototypeSource source;
-  Assembly proto = prototype_assembly(config, particles, file, &source);
+  Assembly proto = prototype_assembly(config, particles, file, &source, count_origin);
   if (!o.tile.empty()) proto = tiled_prototype(proto, o.tile, source);
   check_prototype_assembly(config, proto, source);  // the tiles' too, before the consolidation
   Plan2d p;

@@ -127,9 +127,16 @@ void check_params_options(const UpscaledParamsOptions& options, const char* comm
 SceneConfig required_scene(const nlohmann::json& params, const std::string& path,
                            const std::string& config, const std::vector<std::string>& sets);
 /// The prototype to use: --prototype FILE or --particles N when given, else
-/// the one params.json names (its file, else its particle count).
-std::pair<std::string, int64_t> named_prototype(const nlohmann::json& params,
-                                                const std::string& file, int64_t particles);
+/// the one params.json (at `params_path`) names (its file, else its
+/// particle count); `origin` says which gave the count, for its errors
+/// (--particles, or params.json's prototype.particles).
+struct NamedPrototype {
+  std::string file;
+  int64_t particles = 0;
+  CountOrigin origin{"--particles", ""};
+};
+NamedPrototype named_prototype(const nlohmann::json& params, const std::string& params_path,
+                               const std::string& file, int64_t particles);
 
 /// The scaling law: --exponent, else --law scaling.json, else params.json's
 /// "upscaling" block, else the default law of its dimension (the command

@@ -485,6 +485,23 @@ TEST_F(RobustCli, AGasAtACountThatNeverConsolidatesIsRefusedBeforeAnyWork) {
        "gas of 1 columns and 40 rows of 40 disks"},
   };
   for (const Case& c : cases) expect_refused(c.args, c.mention);
+  // verify's and export's count from a params.json's prototype block is
+  // that file's prototype.particles: it was named "--particles", a flag
+  // nobody gave. (The example calibration on random_400's scene, its
+  // prototype 2 disks.)
+  nlohmann::json params =
+      nlohmann::json::parse(read_text(demcal::test::example_params("hex_10x10")));
+  params["config"] = nlohmann::json::parse(read_text(random_2d));
+  params["prototype"]["particles"] = 2;
+  const std::string two = demcal::test::write_text(dir_ / "params.json", params.dump());
+  const std::string from_params = two +
+                                  ": prototype.particles: a prototype generated as a gas "
+                                  "of 2 disks: too few disks for a random gas";
+  expect_refused({"verify", two, "-o", "out"}, from_params);
+  expect_refused({"export", two, "-o", "out/deck.lammps"}, from_params);
+  // --particles given: named so, as before.
+  expect_refused({"verify", two, "--particles", "2", "-o", "out"},
+                 "--particles: a prototype generated as a gas of 2 disks");
 }
 
 // A bad value given by --set is named as the --set's, not the config

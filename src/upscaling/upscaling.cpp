@@ -214,13 +214,6 @@ PrototypeSource prototype_source(const PrototypeChoice& choice, int64_t size,
   return src;
 }
 
-/// Where a generated prototype's count came from, for its errors: a
-/// command's --particles (file "--particles", no field) or the config's
-/// prototype.particles.
-struct CountOrigin {
-  std::string file, field;
-};
-
 /// A generated prototype is a gas of `n` particles at `aspect` (named
 /// `aspect_name` in the error): refused, naming `origin`, when it never
 /// consolidates, by the rule a config's assembly.count and assembly.aspect
@@ -292,8 +285,8 @@ namespace {
 /// `generate` a count, or `make` the REV; what it gave goes to `source`.
 template <class Read, class Generate, class Make>
 auto chosen_prototype(const SceneConfig& config, int64_t particles, const std::string& file,
-                      PrototypeSource* source, const std::string& noun, Read read,
-                      Generate generate, Make make) {
+                      PrototypeSource* source, const CountOrigin& count_origin,
+                      const std::string& noun, Read read, Generate generate, Make make) {
   const PrototypeChoice choice = choose_prototype(config, particles, file);
   std::string generated;
   decltype(make(config)) a;
@@ -303,10 +296,10 @@ auto chosen_prototype(const SceneConfig& config, int64_t particles, const std::s
     a = read(choice.file);
   } else if (choice.kind == PrototypeChoice::kCount)
     // The count is the command's (--particles, or verify's and export's
-    // from params.json) when given, else the config's.
+    // from params.json: `count_origin`) when given, else the config's.
     a = generate(config, choice.particles,
                  particles > 0
-                     ? CountOrigin{"--particles", ""}
+                     ? count_origin
                      : CountOrigin{source_of(config, "prototype.particles"), "prototype.particles"},
                  generated);
   else
@@ -318,17 +311,18 @@ auto chosen_prototype(const SceneConfig& config, int64_t particles, const std::s
 }  // namespace
 
 Assembly prototype_assembly(const SceneConfig& config, int64_t particles, const std::string& file,
-                            PrototypeSource* source) {
+                            PrototypeSource* source, const CountOrigin& count_origin) {
   return chosen_prototype(
-      config, particles, file, source, "particles",
+      config, particles, file, source, count_origin, "particles",
       [](const std::string& f) { return read_particle_file(f); }, generated_disks,
       [](const SceneConfig& c) { return make_assembly(c); });
 }
 
 SphereAssembly prototype_spheres(const SceneConfig& config, int64_t particles,
-                                 const std::string& file, PrototypeSource* source) {
+                                 const std::string& file, PrototypeSource* source,
+                                 const CountOrigin& count_origin) {
   return chosen_prototype(
-      config, particles, file, source, "spheres",
+      config, particles, file, source, count_origin, "spheres",
       [](const std::string& f) { return read_sphere_file(f); }, generated_spheres,
       [](const SceneConfig& c) { return make_sphere_assembly(c); });
 }

@@ -111,12 +111,22 @@ int64_t particles_of_size(const SceneConfig& config, int64_t particles);
 /// lattice of whole cells"; "" for random (it makes the count asked).
 std::string size_rounding(const SceneConfig& config);
 
+/// Where a prototype's particle count came from, for its errors: a
+/// command's --particles (file "--particles", no field), a params.json's
+/// prototype block (its path, "prototype.particles") or the config's
+/// prototype.particles.
+struct CountOrigin {
+  std::string file, field;
+};
+
 /// The prototype the config names (prototype.file, else prototype.particles
 /// with the config's generator, else the REV itself); `particles` and
-/// `file` override the config when set. The assembly is as generated or
+/// `file` override the config when set, `particles` given by
+/// `count_origin` (named in its errors). The assembly is as generated or
 /// read (not consolidated).
 Assembly prototype_assembly(const SceneConfig& config, int64_t particles = 0,
-                            const std::string& file = "", PrototypeSource* source = nullptr);
+                            const std::string& file = "", PrototypeSource* source = nullptr,
+                            const CountOrigin& count_origin = {"--particles", ""});
 
 /// The 3D prototype the config names, as prototype_assembly() for disks:
 /// prototype.file (CSV x,y,z,r), else prototype.particles spheres from the
@@ -127,7 +137,8 @@ Assembly prototype_assembly(const SceneConfig& config, int64_t particles = 0,
 /// gas (generate_rev). As read or generated, not consolidated; `rev`,
 /// `upscale`, `verify` and `params.json` all take their prototype here.
 SphereAssembly prototype_spheres(const SceneConfig& config, int64_t particles = 0,
-                                 const std::string& file = "", PrototypeSource* source = nullptr);
+                                 const std::string& file = "", PrototypeSource* source = nullptr,
+                                 const CountOrigin& count_origin = {"--particles", ""});
 
 /// Refuse, before any work, a prototype that make_assembly's checks
 /// (check_assembly; 3D: make_sphere_assembly's, check_sphere_assembly)
