@@ -610,7 +610,7 @@ TEST_F(CliEndToEnd, ACheckAcrossTwoKeysNamesTheKeyASetChanged) {
       {fcc,
        {"assembly.cells_y=1000000"},
        "--set assembly.cells_y=1000000: assembly.cells_y: ",
-       "4 x cells_x x cells_y x cells_z = 64000000"},
+       "4 x cells_x x cells_y x cells_z = 64000000 particles"},
       {kHex5,
        {"assembly.rows=10000000"},
        "--set assembly.rows=10000000: assembly.rows: ",

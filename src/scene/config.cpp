@@ -388,9 +388,13 @@ void check_lattice_size(const Reader& a, const AssemblySpec& s,
     if (spheres <= static_cast<double>(kMaxParticles)) return;
     const std::string key =
         changed_field(sets, {"assembly.cells_x", "assembly.cells_y", "assembly.cells_z"});
-    a.fail(key.substr(key.find('.') + 1),
-           "4 x cells_x x cells_y x cells_z = " + std::to_string(spheres) +
-               " particles, more than the limit " + kMaxParticlesWhy);
+    // The count as a whole number (std::to_string(double) wrote
+    // "64000000.000000"); a double, since the product can pass int64.
+    std::ostringstream count;
+    count << std::fixed << std::setprecision(0) << spheres;
+    a.fail(key.substr(key.find('.') + 1), "4 x cells_x x cells_y x cells_z = " + count.str() +
+                                              " particles, more than the limit " +
+                                              kMaxParticlesWhy);
   }
   if (int64_t{s.columns} * s.rows <= kMaxParticles) return;
   const std::string key = changed_field(sets, {"assembly.columns", "assembly.rows"});
