@@ -133,6 +133,7 @@ BENCHMARK(BM_StepRandom)->Unit(benchmark::kMillisecond)->MinTime(1.0)->UseRealTi
 
 int main(int argc, char** argv) {
   benchmark::AddCustomContext("demcal_simd", demcal::kernel_simd());
+  benchmark::AddCustomContext("demcal_gather", demcal::kernel_gather());
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   benchmark::RunSpecifiedBenchmarks();

@@ -173,10 +173,10 @@ int main(int argc, char** argv) {
   std::printf(
       "engine=demcal scene=%s particles=%d steps=%lld seconds=%.6f cpu_seconds=%.6f "
       "particle_steps_per_s=%.6e contacts=%d wall_contacts=%d Wxx_pair=%.6e Wyy_pair=%.6e "
-      "rebuilds=%lld threads=%d simd=%s slot_fill=%.3f\n",
+      "rebuilds=%lld threads=%d simd=%s gather=%s slot_fill=%.3f\n",
       scene.name.c_str(), world->size(), static_cast<long long>(steps), sec, cpu,
       world->size() * static_cast<double>(steps) / sec, m.particle_contacts, m.wall_contacts, wxx,
       wyy, static_cast<long long>(world->rebuilds() - rebuilds0), world->threads(),
-      demcal::kernel_simd(), world->neighbour_slot_fill());
+      demcal::kernel_simd(), demcal::kernel_gather(), world->neighbour_slot_fill());
   return 0;
 }

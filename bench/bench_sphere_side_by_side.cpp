@@ -139,10 +139,11 @@ int main(int argc, char** argv) {
   const double cpu = static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC;
   std::printf(
       "engine=demcal scene=fcc_%dx%dx%d particles=%d steps=%ld seconds=%.4g cpu_seconds=%.4g "
-      "particle_steps_per_s=%.4g contacts=%d rebuilds=%lld simd=%s threads=%d slot_fill=%.3f "
+      "particle_steps_per_s=%.4g contacts=%d rebuilds=%lld simd=%s gather=%s threads=%d "
+      "slot_fill=%.3f "
       "mirror_fill=%.3f ordered=%d\n",
       cells, cells, cells, w.size(), steps, sec, cpu, w.size() * static_cast<double>(steps) / sec,
       w.measure().particle_contacts, static_cast<long long>(w.rebuilds()), kernel_simd(),
-      w.threads(), w.neighbour_slot_fill(), w.mirror_slot_fill(), order ? 1 : 0);
+      kernel_gather(), w.threads(), w.neighbour_slot_fill(), w.mirror_slot_fill(), order ? 1 : 0);
   return 0;
 }

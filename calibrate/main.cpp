@@ -15,7 +15,7 @@ namespace {
 
 /// `text` with every byte outside printable ASCII (a control character, a
 /// byte of 0x80 and above) shown as \xNN: the kernel's message on a
-/// DEMCAL_SIMD it cannot honour quotes the environment's value as it is,
+/// DEMCAL_SIMD or DEMCAL_GATHER it cannot honour quotes the environment's value as it is,
 /// and the one-line error must stay one readable line.
 std::string printable(std::string_view text) {
   static const char* const kHex = "0123456789abcdef";
@@ -73,8 +73,9 @@ int main(int argc, char** argv) {
     return kBadInput;
   }
   try {
-    // A DEMCAL_SIMD the kernel cannot honour is bad input, found before a
-    // command reads or writes anything.
+    // A DEMCAL_SIMD or DEMCAL_GATHER the kernel cannot honour is bad
+    // input, found before a command reads or writes anything (kernel_simd
+    // makes both choices).
     try {
       demcal::kernel_simd();
     } catch (const std::invalid_argument& e) {

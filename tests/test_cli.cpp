@@ -913,6 +913,35 @@ TEST_F(CliEndToEnd, AnUnknownSimdPathIsBadInput) {
   EXPECT_EQ(unset.err, "");
 }
 
+// A way to gather (DEMCAL_GATHER) that is none, hardware gathers on a path
+// without them or in a build without them (Clang) are bad input too, named
+// the same way; the ways a path has run.
+TEST_F(CliEndToEnd, AnUnknownWayToGatherIsBadInput) {
+  const std::string out = (dir_ / "work" / "out").string();
+  for (const std::string value : {"bogus", "Hardware", "hardware "})
+    expect_bad_input({"run", kHex5, "-o", out},
+                     {"DEMCAL_GATHER", "\"" + value + "\"", "hardware|emulated"},
+                     {"DEMCAL_GATHER=" + value});
+  expect_bad_input({"run", kHex5, "-o", out},
+                   {"DEMCAL_GATHER", "hardware", "only the avx512 path", "sse2"},
+                   {"DEMCAL_SIMD=sse2", "DEMCAL_GATHER=hardware"});
+  const Result sse2 = demcal({"check", kHex5}, {"DEMCAL_SIMD=sse2", "DEMCAL_GATHER=emulated"});
+  EXPECT_EQ(sse2.status, 0) << sse2.err;
+  if (std::string(demcal::kernel_simd()) != "avx512") return;
+#if defined(__x86_64__) && !defined(__clang__)
+  const std::vector<std::string> ways = {"hardware", "emulated"};
+#else
+  const std::vector<std::string> ways = {"emulated"};
+  expect_bad_input({"run", kHex5, "-o", out}, {"DEMCAL_GATHER", "hardware", "Clang"},
+                   {"DEMCAL_GATHER=hardware"});
+#endif
+  for (const std::string& way : ways) {
+    const Result r = demcal({"check", kHex5}, {"DEMCAL_SIMD=avx512", "DEMCAL_GATHER=" + way});
+    EXPECT_EQ(r.status, 0) << way << ": " << r.err;
+    EXPECT_EQ(r.err, "") << way;
+  }
+}
+
 // The refusal quotes the environment's value: its control characters and
 // bytes beyond ASCII are shown as \xNN, so the message stays one line of
 // text (a newline in the value made it two, an escape sequence drove the

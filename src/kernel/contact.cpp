@@ -76,7 +76,7 @@ struct PairArgs {
 // exact opposites), so the forces are bit-identical to that kernel's. The
 // pair pass calls it fused (one thread) and the sum pass after the barrier
 // (threads): the same sums in the same order.
-template <int W>
+template <int W, Gather G>
 DEMCAL_INLINE void sum_blocks(const PairArgs &a, int b0, int b1, bool skip_fused = false) {
   using D = typename Simd<W>::D;
   const D zero{};
@@ -93,9 +93,9 @@ DEMCAL_INLINE void sum_blocks(const PairArgs &a, int b0, int b1, bool skip_fused
       D fx = zero, fy = zero, tq = zero;
       for (int s = m0 + sub; s < m1; s += kBlock) {
         const int *S = p_mirror_term + s;
-        fx -= gather<W>(p_pfx, S);
-        fy -= gather<W>(p_pfy, S);
-        tq += gather<W>(p_ptj, S);
+        fx -= gather<W, G>(p_pfx, S);
+        fy -= gather<W, G>(p_pfy, S);
+        tq += gather<W, G>(p_ptj, S);
       }
       for (int s = s0 + sub; s < s1; s += kBlock) {
         fx += load<W>(p_pfx + t0 + s);
@@ -118,7 +118,7 @@ DEMCAL_INLINE void sum_blocks(const PairArgs &a, int b0, int b1, bool skip_fused
 // the barrier (the same sums). Returns the largest
 // overlap/min(r_i, r_j). The damped pass also writes each block's dashpot
 // power, Σ (fe − fn)·v_n over its slots, for the energy ledger.
-template <int W, bool kDamped, bool kAll>
+template <int W, Gather G, bool kDamped, bool kAll>
 DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
   using D = typename Simd<W>::D;
   const D zero{};
@@ -147,7 +147,7 @@ DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
       for (int s = s0 + sub; s < s1; s += kBlock) {
         const int *J = p_slot_j + s;
         const D rj = load<W>(p_slot_r + s);
-        const D dx = gather<W>(p_x, J) - xi, dy = gather<W>(p_y, J) - yi;
+        const D dx = gather<W, G>(p_x, J) - xi, dy = gather<W, G>(p_y, J) - yi;
         const D d2 = dx * dx + dy * dy;
         const D rs = ri + rj;
         const typename Simd<W>::M touch = d2 < rs * rs;
@@ -156,11 +156,11 @@ DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
         const D nx = dx * inv, ny = dy * inv;
         const D ov = rs - d;
         const D ai = ri - 0.5 * ov, aj = rj - 0.5 * ov;
-        const D omj = gather<W>(p_om, J);
-        const D dvx = gather<W>(p_vx, J) - vxi, dvy = gather<W>(p_vy, J) - vyi;
+        const D omj = gather<W, G>(p_om, J);
+        const D dvx = gather<W, G>(p_vx, J) - vxi, dvy = gather<W, G>(p_vy, J) - vyi;
         D fn = law::elastic_normal_force(kn, ov);
         if constexpr (kDamped) {
-          const D meff = reduced_mass(mi, gather<W>(p_m, J));
+          const D meff = reduced_mass(mi, gather<W, G>(p_m, J));
           const D vn = dvx * nx + dvy * ny;  // > 0 when separating
           const D fe = fn;
           fn = law::damped_normal_force(fe, a.beta2, vsqrt(kn * meff), vn);
@@ -192,11 +192,11 @@ DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
       if constexpr (kDamped) store<W>(a.block_power + i0, power);
     }
     if constexpr (kAll) {
-      sum_blocks<W>(a, b, b + 1);
+      sum_blocks<W, G>(a, b, b + 1);
     } else {
       const bool complete = a.src_block[b] >= b0;
       a.fused[b] = complete;
-      if (complete) sum_blocks<W>(a, b, b + 1);
+      if (complete) sum_blocks<W, G>(a, b, b + 1);
     }
   }
   return hmax<W>(mo);
@@ -250,50 +250,86 @@ struct Kernels {
   PairFn pairs_split, pairs_damped_split;  // threads: the sums in the sum pass
   SumFn sums;
   IntegrateFn integrate, integrate_locked;
-  const char *name;
+  const char *name;    // the SIMD path (kernel_simd())
+  const char *gather;  // how it gathers (kernel_gather())
 };
 
-#define DEMCAL_KERNELS(SUFFIX, TARGET, W)                                                          \
-  TARGET double pairs_##SUFFIX(const PairArgs &a, int b0, int b1) {                                \
-    return pair_blocks<W, false, true>(a, b0, b1);                                                 \
-  }                                                                                                \
-  TARGET double pairs_damped_##SUFFIX(const PairArgs &a, int b0, int b1) {                         \
-    return pair_blocks<W, true, true>(a, b0, b1);                                                  \
-  }                                                                                                \
-  TARGET double pairs_split_##SUFFIX(const PairArgs &a, int b0, int b1) {                          \
-    return pair_blocks<W, false, false>(a, b0, b1);                                                \
-  }                                                                                                \
-  TARGET double pairs_damped_split_##SUFFIX(const PairArgs &a, int b0, int b1) {                   \
-    return pair_blocks<W, true, false>(a, b0, b1);                                                 \
-  }                                                                                                \
-  TARGET void sums_##SUFFIX(const PairArgs &a, int b0, int b1) { sum_blocks<W>(a, b0, b1, true); } \
-  TARGET double integrate_##SUFFIX(const IntegrateArgs &a, int b0, int b1) {                       \
-    return integrate_blocks<W, true>(a, b0, b1);                                                   \
-  }                                                                                                \
-  TARGET double integrate_locked_##SUFFIX(const IntegrateArgs &a, int b0, int b1) {                \
-    return integrate_blocks<W, false>(a, b0, b1);                                                  \
-  }                                                                                                \
-  constexpr Kernels kKernels_##SUFFIX{pairs_##SUFFIX,                                              \
-                                      pairs_damped_##SUFFIX,                                       \
-                                      pairs_split_##SUFFIX,                                        \
-                                      pairs_damped_split_##SUFFIX,                                 \
-                                      sums_##SUFFIX,                                               \
-                                      integrate_##SUFFIX,                                          \
-                                      integrate_locked_##SUFFIX,                                   \
-                                      #SUFFIX};
+#define DEMCAL_KERNELS(SUFFIX, NAME, TARGET, W, G)                                  \
+  TARGET double pairs_##SUFFIX(const PairArgs &a, int b0, int b1) {                 \
+    return pair_blocks<W, G, false, true>(a, b0, b1);                               \
+  }                                                                                 \
+  TARGET double pairs_damped_##SUFFIX(const PairArgs &a, int b0, int b1) {          \
+    return pair_blocks<W, G, true, true>(a, b0, b1);                                \
+  }                                                                                 \
+  TARGET double pairs_split_##SUFFIX(const PairArgs &a, int b0, int b1) {           \
+    return pair_blocks<W, G, false, false>(a, b0, b1);                              \
+  }                                                                                 \
+  TARGET double pairs_damped_split_##SUFFIX(const PairArgs &a, int b0, int b1) {    \
+    return pair_blocks<W, G, true, false>(a, b0, b1);                               \
+  }                                                                                 \
+  TARGET void sums_##SUFFIX(const PairArgs &a, int b0, int b1) {                    \
+    sum_blocks<W, G>(a, b0, b1, true);                                              \
+  }                                                                                 \
+  TARGET double integrate_##SUFFIX(const IntegrateArgs &a, int b0, int b1) {        \
+    return integrate_blocks<W, true>(a, b0, b1);                                    \
+  }                                                                                 \
+  TARGET double integrate_locked_##SUFFIX(const IntegrateArgs &a, int b0, int b1) { \
+    return integrate_blocks<W, false>(a, b0, b1);                                   \
+  }                                                                                 \
+  constexpr Kernels kKernels_##SUFFIX{pairs_##SUFFIX,                               \
+                                      pairs_damped_##SUFFIX,                        \
+                                      pairs_split_##SUFFIX,                         \
+                                      pairs_damped_split_##SUFFIX,                  \
+                                      sums_##SUFFIX,                                \
+                                      integrate_##SUFFIX,                           \
+                                      integrate_locked_##SUFFIX,                    \
+                                      NAME,                                         \
+                                      G == Gather::kHardware ? "hardware" : "emulated"};
 
 #define DEMCAL_NO_TARGET
-DEMCAL_KERNELS(sse2, DEMCAL_NO_TARGET, 2)
+DEMCAL_KERNELS(sse2, "sse2", DEMCAL_NO_TARGET, 2, Gather::kEmulated)
 #ifdef DEMCAL_X86_64
-DEMCAL_KERNELS(avx2, __attribute__((target("arch=x86-64-v3"))), 4)
-DEMCAL_KERNELS(avx512, __attribute__((target("arch=x86-64-v4"))), 8)
+#define DEMCAL_V3 __attribute__((target("arch=x86-64-v3")))
+#define DEMCAL_V4 __attribute__((target("arch=x86-64-v4")))
+DEMCAL_KERNELS(avx2, "avx2", DEMCAL_V3, 4, Gather::kEmulated)
+DEMCAL_KERNELS(avx512, "avx512", DEMCAL_V4, 8, Gather::kEmulated)
+#if !defined(__clang__)
+DEMCAL_KERNELS(avx512_hw, "avx512", DEMCAL_V4, 8, Gather::kHardware)
 #endif
+#endif
+
+// How the AVX-512 path gathers (simd.hpp, Gather): the DEMCAL_GATHER the
+// environment names, else in hardware on Intel CPUs and emulated on others.
+// A value that is no way, or "hardware" on another path or in a build
+// without it, throws std::invalid_argument, as DEMCAL_SIMD does.
+Gather choose_gather(const char *path) {
+  const char *env = std::getenv("DEMCAL_GATHER");
+  const std::string_view want = env ? env : "";
+  const bool avx512 = std::string_view(path) == "avx512";
+  auto refused = [&](const std::string &why) {
+    return std::invalid_argument("DEMCAL_GATHER=\"" + std::string(want) + "\"" + why);
+  };
+  if (want.empty()) {
+#ifdef DEMCAL_X86_64
+    if (avx512 && kHardwareGatherBuilt && __builtin_cpu_is("intel")) return Gather::kHardware;
+#endif
+    return Gather::kEmulated;
+  }
+  if (want == "emulated") return Gather::kEmulated;
+  if (want != "hardware") throw refused(" is not a way to gather; accepted: hardware|emulated");
+  if (!avx512)
+    throw refused(": only the avx512 path gathers in hardware, and this process runs " +
+                  std::string(path));
+  if (!kHardwareGatherBuilt)
+    throw refused(": this build has no hardware gathers (built with Clang)");
+  return Gather::kHardware;
+}
 
 // The path for this process: the widest this CPU runs, or the one
 // DEMCAL_SIMD names (unset or empty: the widest). A name that is no path,
 // or a path this CPU cannot run, throws std::invalid_argument (ignored
 // silently, a run meant for one path ran on another).
-const Kernels &choose_kernels() {
+const Kernels &choose_path() {
   const char *env = std::getenv("DEMCAL_SIMD");
   const std::string_view want = env ? env : "";
 #ifdef DEMCAL_X86_64
@@ -336,6 +372,16 @@ const Kernels &choose_kernels() {
 #endif
 }
 
+// The path, then its way to gather.
+const Kernels &choose_kernels() {
+  const Kernels &path = choose_path();
+  const Gather gather = choose_gather(path.name);
+#if defined(DEMCAL_X86_64) && !defined(__clang__)
+  if (gather == Gather::kHardware) return kKernels_avx512_hw;
+#endif
+  return path;
+}
+
 const Kernels &kernels() {
   static const Kernels &chosen = choose_kernels();
   return chosen;
@@ -351,6 +397,8 @@ const char *kernel_simd() {
   return "generic";
 #endif
 }
+
+const char *kernel_gather() { return kernels().gather; }
 
 double WorldImpl::pair_pass(int b0, int b1) { return pair_kernel(b0, b1, false); }
 

@@ -44,8 +44,43 @@ DEMCAL_INLINE void store(double *p, typename Simd<W>::D v) {
   typedef double U __attribute__((vector_size(8 * W), aligned(8)));
   *reinterpret_cast<U *>(p) = v;
 }
-template <int W>
+// How a pass reads the W values b[j[0..W-1]] of its neighbours. kEmulated:
+// W scalar loads put together in a register. kHardware: one AVX-512
+// vgatherdpd (W = 8; GCC only: Clang rejects a 512-bit asm operand in the
+// baseline target, see vsqrt, and gets kEmulated). The same loads of the
+// same addresses, so the same bits; only the cost differs, and by CPU: the
+// shuffles that put the scalars together run on the ports the law's
+// arithmetic needs, where Intel's 512-bit work has two (p0, p5) — hardware
+// gathers 1.13-1.26x faster there — while AMD's Zen 3 and Zen 5 run their
+// hardware gathers 1.3-1.7x slower (reports/performance.md, 2026-12-06).
+enum class Gather { kEmulated, kHardware };
+
+#if defined(DEMCAL_X86_64) && !defined(__clang__)
+constexpr bool kHardwareGatherBuilt = true;
+#else
+constexpr bool kHardwareGatherBuilt = false;
+#endif
+
+template <int W, Gather G>
 DEMCAL_INLINE typename Simd<W>::D gather(const double *__restrict b, const int *__restrict j) {
+  static_assert(G == Gather::kEmulated || W == 8, "hardware gathers: the AVX-512 path only");
+#if defined(DEMCAL_X86_64) && !defined(__clang__)
+  if constexpr (G == Gather::kHardware) {
+    typedef int I8 __attribute__((vector_size(32)));
+    I8 idx;
+    std::memcpy(&idx, j, sizeof idx);
+    typename Simd<W>::D r{};
+    // The asm reads memory at b: a memory operand as wide as any array.
+    struct Whole {
+      double v[1 << 26];
+    };
+    asm("kxnorw %%k1, %%k1, %%k1\n\tvgatherdpd (%1,%2,8), %0%{%%k1%}"
+        : "+&v"(r)
+        : "r"(b), "v"(idx), "m"(*reinterpret_cast<const Whole *>(b))
+        : "k1");
+    return r;
+  }
+#endif
   if constexpr (W == 8)
     return
         typename Simd<W>::D{b[j[0]], b[j[1]], b[j[2]], b[j[3]], b[j[4]], b[j[5]], b[j[6]], b[j[7]]};

@@ -338,7 +338,7 @@ struct SumArgs {
 // (i, j), i < j, in increasing i: −(force on i) and the torque on j.
 // (A: SumArgs, or PairArgs when fused into the pair pass, so that the
 // arrays are reached through the same restrict pointers.)
-template <int W, class A>
+template <int W, Gather G, class A>
 DEMCAL_INLINE double sum_blocks(const A &a, int b0, int b1) {
   using D = typename Simd<W>::D;
   for (int b = b0; b < b1; ++b) {
@@ -350,12 +350,12 @@ DEMCAL_INLINE double sum_blocks(const A &a, int b0, int b1) {
       D tx = load<W>(a.tx + i0), ty = load<W>(a.ty + i0), tz = load<W>(a.tz + i0);
       for (int s = s0 + sub; s < s1; s += kBlock) {
         const int *S = a.mirror_term + s;
-        fx -= gather<W>(a.pfx, S);
-        fy -= gather<W>(a.pfy, S);
-        fz -= gather<W>(a.pfz, S);
-        tx += gather<W>(a.ptx, S);
-        ty += gather<W>(a.pty, S);
-        tz += gather<W>(a.ptz, S);
+        fx -= gather<W, G>(a.pfx, S);
+        fy -= gather<W, G>(a.pfy, S);
+        fz -= gather<W, G>(a.pfz, S);
+        tx += gather<W, G>(a.ptx, S);
+        ty += gather<W, G>(a.pty, S);
+        tz += gather<W, G>(a.ptz, S);
       }
       store<W>(a.fx + i0, fx);
       store<W>(a.fy + i0, fy);
@@ -381,7 +381,7 @@ enum FuseSums : int {
   kFuseAll = 2,  // one thread: every block, right after its pairs
 };
 
-template <int W, bool kDamped, int kFuse>
+template <int W, Gather G, bool kDamped, int kFuse>
 DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
   using D = typename Simd<W>::D;
   using M = typename Simd<W>::M;
@@ -405,12 +405,12 @@ DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
       for (int s = s0 + sub; s < s1; s += kBlock) {
         const int *J = a.slot_j + s;
         const D rj = load<W>(a.slot_r + s);
-        const D dx = gather<W>(a.x, J) - xi, dy = gather<W>(a.y, J) - yi,
-                dz = gather<W>(a.z, J) - zi;
-        const D dvx = gather<W>(a.vx, J) - vxi, dvy = gather<W>(a.vy, J) - vyi,
-                dvz = gather<W>(a.vz, J) - vzi;
+        const D dx = gather<W, G>(a.x, J) - xi, dy = gather<W, G>(a.y, J) - yi,
+                dz = gather<W, G>(a.z, J) - zi;
+        const D dvx = gather<W, G>(a.vx, J) - vxi, dvy = gather<W, G>(a.vy, J) - vyi,
+                dvz = gather<W, G>(a.vz, J) - vzi;
         D mj = zero;
-        if constexpr (kDamped) mj = gather<W>(a.m, J);
+        if constexpr (kDamped) mj = gather<W, G>(a.m, J);
         const Normal<W> g =
             normal_part<W, kDamped>(dx, dy, dz, ri, rj, dvx, dvy, dvz, mi, mj, kn, a.beta2);
         const M touch = g.touch;
@@ -427,7 +427,8 @@ DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
         }
         const D nx = g.nx, ny = g.ny, nz = g.nz, ov = g.ov, fn = g.fn;
         const D ai = ri - 0.5 * ov, aj = rj - 0.5 * ov;
-        const D wxj = gather<W>(a.wx, J), wyj = gather<W>(a.wy, J), wzj = gather<W>(a.wz, J);
+        const D wxj = gather<W, G>(a.wx, J), wyj = gather<W, G>(a.wy, J),
+                wzj = gather<W, G>(a.wz, J);
         // a_i·ω_i + a_j·ω_j, and the spin sum of the twist.
         const D sx = wxi + wxj, sy = wyi + wyj, sz = wzi + wzj;
         const D rx = ai * wxi + aj * wxj;
@@ -508,11 +509,11 @@ DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
     // (i < j): if this pass did those, its sums are complete now, the pair
     // terms still in cache.
     if constexpr (kFuse == kFuseAll) {
-      sum_blocks<W>(a, b, b + 1);
+      sum_blocks<W, G>(a, b, b + 1);
     } else {
       const bool complete = a.src_block[b] >= b0;
       a.fused[b] = complete;
-      if (complete) sum_blocks<W>(a, b, b + 1);
+      if (complete) sum_blocks<W, G>(a, b, b + 1);
     }
   }
   return hmax<W>(mo);
@@ -546,7 +547,7 @@ struct WallArgs {
 // largest overlap/r; the dashpots' power Σ (fe − fn)·v_n}, each summed over the list in 8 lanes,
 // then over the lanes by detail::lane_sum: one order whatever the thread count and the path's
 // width.
-template <int W, bool kFriction>
+template <int W, Gather G, bool kFriction>
 DEMCAL_INLINE void wall_contacts(const WallArgs &a, double *out) {
   using D = typename Simd<W>::D;
   using M = typename Simd<W>::M;
@@ -569,8 +570,8 @@ DEMCAL_INLINE void wall_contacts(const WallArgs &a, double *out) {
       D &power = sum_power.part[q];
       const int *J = a.idx + k;
       const M valid = lane < static_cast<double>(a.count - k);
-      const D r = gather<W>(a.r, J);
-      const D dist = (gather<W>(a.pa, J) - a.position) * sg;
+      const D r = gather<W, G>(a.r, J);
+      const D dist = (gather<W, G>(a.pa, J) - a.position) * sg;
       // (Masks combined through selects and one compare each: GCC rebuilds
       // a mask made with & lane by lane on the AVX-512 path.)
       const D ov = select<W>(valid, r - dist, zero - one);
@@ -588,9 +589,9 @@ DEMCAL_INLINE void wall_contacts(const WallArgs &a, double *out) {
       mo = mo > ratio ? mo : ratio;
       D fn = law::elastic_normal_force(a.kn, ov);
       if (a.beta2 > 0.0) {
-        const D vn = (gather<W>(a.va, J) - a.velocity) * sg;  // leaving the wall > 0
+        const D vn = (gather<W, G>(a.va, J) - a.velocity) * sg;  // leaving the wall > 0
         const D fe = fn;
-        fn = law::damped_normal_force(fe, a.beta2, vsqrt(a.kn * gather<W>(a.m, J)), vn);
+        fn = law::damped_normal_force(fe, a.beta2, vsqrt(a.kn * gather<W, G>(a.m, J)), vn);
         power += select<W>(touch, law::dashpot_power(fe, fn, vn), zero);
       }
       fn = select<W>(touch, fn, zero);
@@ -608,8 +609,8 @@ DEMCAL_INLINE void wall_contacts(const WallArgs &a, double *out) {
         continue;
       }
       const D sd = sg * dist;
-      const D dvu = sd * gather<W>(a.wv, J) - gather<W>(a.vu, J);
-      const D dvv = (zero - gather<W>(a.vv, J)) - sd * gather<W>(a.wu, J);
+      const D dvu = sd * gather<W, G>(a.wv, J) - gather<W, G>(a.vu, J);
+      const D dvv = (zero - gather<W, G>(a.vv, J)) - sd * gather<W, G>(a.wu, J);
       D hu = hu0 + a.kdt * dvu, hv = hv0 + a.kdt * dvv;
       const D cap = a.mu * fn, h2 = hu * hu + hv * hv;
       if (D cut; coulomb_cut<W>(touch, h2, cap, slid, cut)) {
@@ -728,22 +729,22 @@ struct Kernels {
 // 0.93x at 97 556 spheres on 2 threads (2026-12-02), so AVX2 and SSE2 left
 // every sum to the sum pass; with the ring it gains 1.16x on AVX2 (5
 // alternating rounds, 2026-12-05, reports/performance.md).
-#define DEMCAL_SPHERE_KERNELS(SUFFIX, TARGET, W)                                                 \
+#define DEMCAL_SPHERE_KERNELS(SUFFIX, TARGET, W, G)                                              \
   TARGET double pairs_##SUFFIX(const PairArgs &a, int b0, int b1) {                              \
-    return pair_blocks<W, false, kFuseAll>(a, b0, b1);                                           \
+    return pair_blocks<W, G, false, kFuseAll>(a, b0, b1);                                        \
   }                                                                                              \
   TARGET double pairs_damped_##SUFFIX(const PairArgs &a, int b0, int b1) {                       \
-    return pair_blocks<W, true, kFuseAll>(a, b0, b1);                                            \
+    return pair_blocks<W, G, true, kFuseAll>(a, b0, b1);                                         \
   }                                                                                              \
   TARGET double pairs_t_##SUFFIX(const PairArgs &a, int b0, int b1) {                            \
-    return pair_blocks<W, false, kFuseOwn>(a, b0, b1);                                           \
+    return pair_blocks<W, G, false, kFuseOwn>(a, b0, b1);                                        \
   }                                                                                              \
   TARGET double pairs_damped_t_##SUFFIX(const PairArgs &a, int b0, int b1) {                     \
-    return pair_blocks<W, true, kFuseOwn>(a, b0, b1);                                            \
+    return pair_blocks<W, G, true, kFuseOwn>(a, b0, b1);                                         \
   }                                                                                              \
   TARGET double sums_##SUFFIX(const SumArgs &a, int b0, int b1) {                                \
     for (int b = b0; b < b1; ++b)                                                                \
-      if (!a.fused[b]) sum_blocks<W, SumArgs>(a, b, b + 1);                                      \
+      if (!a.fused[b]) sum_blocks<W, G, SumArgs>(a, b, b + 1);                                   \
     return 0.0;                                                                                  \
   }                                                                                              \
   TARGET double integrate_##SUFFIX(const IntegrateArgs &a, int b0, int b1) {                     \
@@ -755,9 +756,9 @@ struct Kernels {
   TARGET void one_pair_##SUFFIX(const double *in, double *out) { one_pair<W>(in, out); }         \
   TARGET void walls_##SUFFIX(const WallArgs &a, double *out) {                                   \
     if (a.mu > 0.0)                                                                              \
-      wall_contacts<W, true>(a, out);                                                            \
+      wall_contacts<W, G, true>(a, out);                                                         \
     else                                                                                         \
-      wall_contacts<W, false>(a, out);                                                           \
+      wall_contacts<W, G, false>(a, out);                                                        \
   }                                                                                              \
   constexpr Kernels kKernels_##SUFFIX{                                                           \
       pairs_##SUFFIX, pairs_damped_##SUFFIX, pairs_t_##SUFFIX,          pairs_damped_t_##SUFFIX, \
@@ -765,17 +766,26 @@ struct Kernels {
       walls_##SUFFIX};
 
 #define DEMCAL_NO_TARGET
-DEMCAL_SPHERE_KERNELS(sse2, DEMCAL_NO_TARGET, 2)
+DEMCAL_SPHERE_KERNELS(sse2, DEMCAL_NO_TARGET, 2, Gather::kEmulated)
 #ifdef DEMCAL_X86_64
-DEMCAL_SPHERE_KERNELS(avx2, __attribute__((target("arch=x86-64-v3"))), 4)
-DEMCAL_SPHERE_KERNELS(avx512, __attribute__((target("arch=x86-64-v4"))), 8)
+#define DEMCAL_V3 __attribute__((target("arch=x86-64-v3")))
+#define DEMCAL_V4 __attribute__((target("arch=x86-64-v4")))
+DEMCAL_SPHERE_KERNELS(avx2, DEMCAL_V3, 4, Gather::kEmulated)
+DEMCAL_SPHERE_KERNELS(avx512, DEMCAL_V4, 8, Gather::kEmulated)
+#if !defined(__clang__)
+DEMCAL_SPHERE_KERNELS(avx512_hw, DEMCAL_V4, 8, Gather::kHardware)
+#endif
 #endif
 
-// The path the 2D kernel chose (kernel_simd(): CPU and DEMCAL_SIMD).
+// The path and the way to gather the 2D kernel chose (kernel_simd() and
+// kernel_gather(): CPU, DEMCAL_SIMD and DEMCAL_GATHER).
 const Kernels &kernels() {
   static const Kernels chosen = [] {
 #ifdef DEMCAL_X86_64
     const char *name = kernel_simd();
+#if !defined(__clang__)
+    if (std::strcmp(kernel_gather(), "hardware") == 0) return kKernels_avx512_hw;
+#endif
     if (std::strcmp(name, "avx512") == 0) return kKernels_avx512;
     if (std::strcmp(name, "avx2") == 0) return kKernels_avx2;
 #endif
