@@ -13,6 +13,9 @@
 #                      path of PATHS, LAMMPS, and (if THREADS > 1) demcal on
 #                      THREADS threads; medians over the rounds are printed
 #   PATHS="default avx2"  demcal SIMD paths (DEMCAL_SIMD; default = the widest)
+#                      (DEMCAL_GATHER=hardware|emulated, if set, passes through
+#                      to every demcal run; the end line says how each path
+#                      gathered)
 #   THREADS=2          threads of the extra demcal run (pinned to cores 0..T-1;
 #                      1: no such run), only from THREADS_MIN spheres on
 #   THREADS_MIN=50000  (small samples run single-threaded: a calibration
@@ -59,6 +62,7 @@ echo "# $(lmp -h | grep -m1 'Large-scale' | sed 's/^ *//')"
 echo "# start $(date -u +%FT%TZ), load average $(cut -d' ' -f1-3 /proc/loadavg)"
 median() { python3 -c "import statistics,sys; print('%.4g' % statistics.median(float(v) for v in sys.argv[1:]))" "$@"; }
 field() { sed -n "s/.* $1=\([^ ]*\).*/\1/p" <<<"$2"; }
+declare -A gathers=()
 header="spheres steps"
 for p in $PATHS; do header+=" demcal_${p}_ps/s ratio_${p}"; done
 if [[ -n "$BASELINE" ]]; then
@@ -86,6 +90,7 @@ for n in $CELLS; do
       rates[$p]+=" $(python3 -c "print($spheres * $steps / $(field cpu_seconds "$d"))")"
       [[ "$p" == "${PATHS%% *}" ]] && wall1+=" $(field particle_steps_per_s "$d")"
       dcon=$(field contacts "$d")
+      gathers[$p]=$(field gather "$d")
       if [[ -n "$BASELINE" ]]; then
         d=$("${env[@]}" "${pin[@]}" "$BASELINE" --cells "$n" --steps "$steps" --preload "$pre")
         echo "baseline $d" >>"$work/raw.txt"
@@ -127,4 +132,7 @@ for n in $CELLS; do
   echo "$line"
   unset rates brates
 done
+ways=""
+for p in $PATHS; do ways+=" $p:${gathers[$p]:-?}"; done
+echo "# gathers (path:way):$ways"
 echo "# end $(date -u +%FT%TZ), load average $(cut -d' ' -f1-3 /proc/loadavg)"
