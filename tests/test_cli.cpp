@@ -578,7 +578,9 @@ TEST_F(CliEndToEnd, ACheckAcrossTwoKeysNamesTheKeyASetChanged) {
       {slow,
        {"test.consolidation_max_steps=100000", "test.consolidation_tolerance=1e-6"},
        "--set test.consolidation_max_steps=100000: test.consolidation_max_steps: ",
-       "must be at least 1381545: "},
+       "must be at least 1381545: the servo removes at most the fraction gain of the stress "
+       "error per step, so reaching consolidation_tolerance 1e-06 at servo_gain 1e-05 takes at "
+       "least ln(1/tol)/(-ln(1-gain)) = 1381545 steps, more than consolidation_max_steps 100000"},
       // A budget no valid one can meet is no culprit: the file's gain, with
       // its bound (it asked for consolidation_max_steps 6907755276).
       {stalled,

@@ -254,8 +254,14 @@ void check_servo_gain(const Reader& t, const TestSpec& test, const std::vector<s
   why << "the servo removes at most the fraction gain of the stress error per step, so reaching "
          "consolidation_tolerance "
       << test.consolidation_tolerance << " at servo_gain " << test.servo_gain
-      << " takes at least ln(1/tol)/(-ln(1-gain)) = " << needed
-      << " steps, more than consolidation_max_steps " << test.consolidation_max_steps;
+      << " takes at least ln(1/tol)/(-ln(1-gain)) = ";
+  // A whole number of steps where it is one to type (a stream's 6 digits
+  // would say 1.38154e+06).
+  if (needed < 1e18)
+    why << static_cast<int64_t>(std::ceil(needed));
+  else
+    why << needed;
+  why << " steps, more than consolidation_max_steps " << test.consolidation_max_steps;
   if (needed > static_cast<double>(kMaxConsolidationSteps))
     why << " (and than the largest it may be, " << kMaxConsolidationSteps << ")";
   const std::string key = changed_field(
