@@ -435,82 +435,76 @@ TEST_F(CliEndToEnd, AnUnresolvablePrototypeFileIsRefusedBeforeItIsRun) {
   EXPECT_EQ(counted.status, 0) << counted.err;
 }
 
-// A 2D prototype file's radii never went through check_derived_scales,
-// which make_assembly applies to a config's: a 10x10 lattice of touching
+// A cubic lattice of side^dim touching particles of radius `scale` (x,y,r or
+// x,y,z,r), for the checks of a particle file's radii below.
+std::string touching_lattice(int dim, int side, const std::string& scale) {
+  const double r = std::stod(scale);
+  std::string csv = dim == 2 ? "x,y,r\n" : "x,y,z,r\n";
+  const int count = dim == 2 ? side * side : side * side * side;
+  char value[32];
+  for (int i = 0; i < count; ++i) {
+    for (int k = 0, rest = i; k < dim; ++k, rest /= side) {
+      std::snprintf(value, sizeof value, "%.17g,", (2 * (rest % side) + 1) * r);
+      csv += value;
+    }
+    csv += scale + "\n";
+  }
+  return csv;
+}
+
+// A prototype file's radii never went through check_derived_scales, which
+// make_assembly applies to a config's. 2D: a 10x10 lattice of touching
 // disks of r = 1e-150 m (masses underflow to 0) or 1e150 m (they
 // overflow) passed check_resolvable (the round-off and the overlap at
 // sigma3 both scale with r), and verify, export, rev and a scaling study
 // cut from it consolidated into "consolidation diverged: non-finite
-// state", exit 1. Now refused before any work (check_assembly), naming the
-// file and its radius. upscale only counts the particles: accepted.
+// state", exit 1. 3D: a 3x3x3 cube of such spheres was refused by the
+// overlap at sigma3 alone ("test.lateral_stress ... at least 2.8e146 Pa"),
+// a stress no user could mean. Now both are refused before any work by
+// their radii (check_assembly, check_sphere_assembly: make_assembly's and
+// make_sphere_assembly's checks), naming the file and its column r. So
+// are upscale and calibrate (a config's prototype.file, before its
+// search), which never run the prototype but derive its Δt and damping
+// from these radii: upscale wrote a params.json with "damping_rotation":
+// null (2D, 1e150 m) or a Δt of 5e-153 s, exit 0, and in 3D stopped on
+// "SphereWorld: dt must be finite and >= 0", exit 1.
 TEST_F(CliEndToEnd, APrototypeFileWhoseRadiiGiveNoNormalMassIsRefusedBeforeItIsRun) {
   const std::string out = (dir_ / "work" / "out").string();
-  const std::string params = test::example_params("hex_10x10");
-  for (const std::string scale : {"1e-150", "1e+150"}) {
-    const double r = std::stod(scale);
-    std::string disks = "x,y,r\n";
-    char line[96];
-    for (int i = 0; i < 100; ++i) {
-      std::snprintf(line, sizeof line, "%.17g,%.17g,%s\n", (2 * (i % 10) + 1) * r,
-                    (2 * (i / 10) + 1) * r, scale.c_str());
-      disks += line;
+  // A scaling study cuts its REVs from prototype.file beside a file REV.
+  write("rev.csv", "x,y,r\n0.0005,0.0005,0.0005\n0.0015,0.0005,0.0005\n");
+  for (const int dim : {2, 3})
+    for (const std::string scale : {"1e-150", "1e+150"}) {
+      SCOPED_TRACE(std::to_string(dim) + "D, r = " + scale);
+      const std::string file = write(std::to_string(dim) + "d" + scale + ".csv",
+                                     touching_lattice(dim, dim == 2 ? 10 : 3, scale));
+      const std::string params = test::example_params(dim == 2 ? "hex_10x10" : "fcc_4x4x4");
+      const std::string config = dim == 2 ? kHex5 : test::shipped_config("fcc_4x4x4");
+      std::vector<std::vector<std::string>> commands = {
+          {"verify", params, "--prototype", file, "-o", out},
+          {"export", params, "--prototype", file, "-o", out + "/deck.lammps"},
+          {"upscale", params, "--prototype", file, "-o", out + "/params.json"},
+          {"calibrate", config, "--set", "prototype.file=" + file, "-o", out}};
+      if (dim == 2) {
+        const std::string family =
+            write("family" + scale + ".json",
+                  R"({"material": {"density": 2650, "kn": 1e8, "kt": 5e7, "friction": 0.3},)"
+                  R"( "assembly": {"type": "file", "file": "rev.csv"},)"
+                  R"( "prototype": {"particles": 0, "file": ")" +
+                      file + R"("}})");
+        commands.push_back({"verify", params, "--prototype", file, "--tile", "2x1", "-o", out});
+        commands.push_back({"rev", kHex5, "--prototype", file, "--particles", "16", "-o", out});
+        commands.push_back({"scaling", family, "--sizes", "9,16,36", "--calibrate-max", "16",
+                            "--max-trials", "12", "-o", out});
+      } else {
+        commands.push_back({"rev", config, "--prototype", file, "--particles", "8", "-o", out});
+      }
+      const std::string what = dim == 2 ? "disk's" : "sphere's";
+      const std::string flow = scale == "1e+150" ? "(it overflows)" : "(it underflows to 0)";
+      for (const auto& args : commands)
+        expect_bad_input(args, {"demcal: error: " + file + ": r: the smallest " + what +
+                                    " (r = " + scale + " m) ",
+                                flow, "; got " + scale});
     }
-    const std::string file = write("r" + scale + ".csv", disks);
-    // A scaling study cuts its REVs from prototype.file beside a file REV.
-    write("rev.csv", "x,y,r\n0.0005,0.0005,0.0005\n0.0015,0.0005,0.0005\n");
-    const std::string family =
-        write("family" + scale + ".json",
-              R"({"material": {"density": 2650, "kn": 1e8, "kt": 5e7, "friction": 0.3},)"
-              R"( "assembly": {"type": "file", "file": "rev.csv"},)"
-              R"( "prototype": {"particles": 0, "file": ")" +
-                  file + R"("}})");
-    const std::vector<std::vector<std::string>> commands = {
-        {"verify", params, "--prototype", file, "-o", out},
-        {"verify", params, "--prototype", file, "--tile", "2x1", "-o", out},
-        {"export", params, "--prototype", file, "-o", out + "/deck.lammps"},
-        {"rev", kHex5, "--prototype", file, "--particles", "16", "-o", out},
-        {"scaling", family, "--sizes", "9,16,36", "--calibrate-max", "16", "--max-trials", "12",
-         "-o", out}};
-    const std::string flow = scale == "1e+150" ? "(it overflows)" : "(it underflows to 0)";
-    for (const auto& args : commands)
-      expect_bad_input(
-          args, {"demcal: error: " + file + ": r: the smallest disk's (r = " + scale + " m) ", flow,
-                 "; got " + scale});
-    const Result counted = demcal({"upscale", params, "--prototype", file, "-o", out});
-    EXPECT_EQ(counted.status, 0) << counted.err;
-    fs::remove_all(out);
-  }
-}
-
-// The same in 3D: a 3x3x3 cube of touching spheres of r = 1e-150 m or
-// 1e150 m was refused by the overlap at sigma3 alone ("test.lateral_stress
-// ... at least 2.8e146 Pa"), a stress no user could mean; now by its radii
-// (check_sphere_assembly: make_sphere_assembly's checks), naming the file
-// and its column r, before any work.
-TEST_F(CliEndToEnd, APrototypeSphereFileWhoseRadiiGiveNoNormalMassNamesItsRadii) {
-  const std::string out = (dir_ / "work" / "out").string();
-  const std::string params = test::example_params("fcc_4x4x4");
-  for (const std::string scale : {"1e-150", "1e+150"}) {
-    const double r = std::stod(scale);
-    std::string spheres = "x,y,z,r\n";
-    char line[128];
-    for (int i = 0; i < 27; ++i) {
-      std::snprintf(line, sizeof line, "%.17g,%.17g,%.17g,%s\n", (2 * (i % 3) + 1) * r,
-                    (2 * (i / 3 % 3) + 1) * r, (2 * (i / 9) + 1) * r, scale.c_str());
-      spheres += line;
-    }
-    const std::string file = write("s" + scale + ".csv", spheres);
-    const std::vector<std::vector<std::string>> commands = {
-        {"verify", params, "--prototype", file, "-o", out},
-        {"export", params, "--prototype", file, "-o", out + "/deck.lammps"},
-        {"rev", test::shipped_config("fcc_4x4x4"), "--prototype", file, "--particles", "8", "-o",
-         out}};
-    const std::string flow = scale == "1e+150" ? "(it overflows)" : "(it underflows to 0)";
-    for (const auto& args : commands)
-      expect_bad_input(
-          args, {"demcal: error: " + file + ": r: the smallest sphere's (r = " + scale + " m) mass",
-                 flow, "; got " + scale});
-  }
 }
 
 // A check across two keys named the file and its own field whatever a

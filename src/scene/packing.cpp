@@ -467,6 +467,11 @@ void check_assembly(const SceneConfig& config, const Assembly& a, const std::str
   check_resolvable(config, a, which, file, tiling);
 }
 
+void check_particle_file_scales(const SceneConfig& config, std::span<const double> radii,
+                                const std::string& file) {
+  detail::check_derived_scales(config, radii, file);
+}
+
 double hexagonal_peak_ratio(double friction) {
   const double phi = std::atan(friction);
   const double theta = std::numbers::pi / 3.0;

@@ -314,8 +314,12 @@ Assembly prototype_assembly(const SceneConfig& config, int64_t particles, const 
                             PrototypeSource* source, const CountOrigin& count_origin) {
   return chosen_prototype(
       config, particles, file, source, count_origin, "particles",
-      [](const std::string& f) { return read_particle_file(f); }, generated_disks,
-      [](const SceneConfig& c) { return make_assembly(c); });
+      [&config](const std::string& f) {
+        Assembly a = read_particle_file(f);
+        check_particle_file_scales(config, a.r, f);
+        return a;
+      },
+      generated_disks, [](const SceneConfig& c) { return make_assembly(c); });
 }
 
 SphereAssembly prototype_spheres(const SceneConfig& config, int64_t particles,
@@ -323,8 +327,12 @@ SphereAssembly prototype_spheres(const SceneConfig& config, int64_t particles,
                                  const CountOrigin& count_origin) {
   return chosen_prototype(
       config, particles, file, source, count_origin, "spheres",
-      [](const std::string& f) { return read_sphere_file(f); }, generated_spheres,
-      [](const SceneConfig& c) { return make_sphere_assembly(c); });
+      [&config](const std::string& f) {
+        SphereAssembly a = read_sphere_file(f);
+        check_particle_file_scales(config, a.r, f);
+        return a;
+      },
+      generated_spheres, [](const SceneConfig& c) { return make_sphere_assembly(c); });
 }
 
 namespace {

@@ -144,6 +144,15 @@ void check_resolvable(const SceneConfig& config, const Assembly& a, const std::s
 void check_assembly(const SceneConfig& config, const Assembly& a, const std::string& which,
                     const std::string& file = "", const std::string& tiling = "");
 
+/// The first half of check_assembly (and of check_sphere_assembly, with the
+/// config's dimension): the scales that `radii`, read from the particle
+/// `file`, derive under the config — masses, inertias, steps, dashpots —
+/// must be finite, normal doubles; else an InputError naming the file's
+/// column r. For a prototype file whatever is done with it: even a command
+/// that never runs it derives its Δt and damping from these radii.
+void check_particle_file_scales(const SceneConfig& config, std::span<const double> radii,
+                                const std::string& file);
+
 /// σ1/σ3 at sliding failure of a periodic hexagonal packing (horizontal
 /// rows) with interparticle friction μ: tan 60°·tan(60° + φ_μ), tan φ_μ = μ.
 /// Infinite (no sliding failure) when μ ≥ 1/√3.

@@ -123,7 +123,9 @@ struct CountOrigin {
 /// with the config's generator, else the REV itself); `particles` and
 /// `file` override the config when set, `particles` given by
 /// `count_origin` (named in its errors). The assembly is as generated or
-/// read (not consolidated).
+/// read (not consolidated). A file's radii are checked as it is read
+/// (check_particle_file_scales): every command derives the prototype's Δt
+/// and damping from them.
 Assembly prototype_assembly(const SceneConfig& config, int64_t particles = 0,
                             const std::string& file = "", PrototypeSource* source = nullptr,
                             const CountOrigin& count_origin = {"--particles", ""});
@@ -148,7 +150,9 @@ SphereAssembly prototype_spheres(const SceneConfig& config, int64_t particles = 
 /// state"), or a contact overlap at sigma3 its positions cannot resolve to
 /// the consolidation's tolerance (a packing at x ~ 1e6 m). For the commands that
 /// consolidate or run the prototype (verify, export); upscale and
-/// calibrate only count its particles. A prototype `source` read from a
+/// calibrate only derive its scales (the radii's part, which
+/// prototype_assembly and prototype_spheres check for a file as they read
+/// it: here it repeats, at the cost of a pass over the radii). A prototype `source` read from a
 /// file is named, with the distance from the origin its positions must
 /// keep; the REV as its own prototype is "the scene".
 void check_prototype_assembly(const SceneConfig& config, const Assembly& prototype,
