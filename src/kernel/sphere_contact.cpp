@@ -402,11 +402,25 @@ DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
       D mi = zero;
       if constexpr (kDamped) mi = load<W>(a.m + i0);
       D fx = zero, fy = zero, fz = zero, tx = zero, ty = zero, tz = zero;
+      // The neighbours' positions are gathered one slot-vector ahead: they
+      // start the law's longest chain (d², its root, 1/|d|), and issued a
+      // slot-vector early their loads no longer wait behind that chain in
+      // the scheduler (1.05-1.08x on Intel's AVX-512 path at 256-4 000
+      // spheres; AVX2 at par; only the positions: gathering the velocities
+      // ahead too lost 1.03-1.04x). The same values, so the same bits.
+      D gx = zero, gy = zero, gz = zero;
+      if (s0 + sub < s1) {
+        const int *J = a.slot_j + s0 + sub;
+        gx = gather<W, G>(a.x, J), gy = gather<W, G>(a.y, J), gz = gather<W, G>(a.z, J);
+      }
       for (int s = s0 + sub; s < s1; s += kBlock) {
         const int *J = a.slot_j + s;
         const D rj = load<W>(a.slot_r + s);
-        const D dx = gather<W, G>(a.x, J) - xi, dy = gather<W, G>(a.y, J) - yi,
-                dz = gather<W, G>(a.z, J) - zi;
+        const D dx = gx - xi, dy = gy - yi, dz = gz - zi;
+        if (s + kBlock < s1) {
+          const int *next = J + kBlock;
+          gx = gather<W, G>(a.x, next), gy = gather<W, G>(a.y, next), gz = gather<W, G>(a.z, next);
+        }
         const D dvx = gather<W, G>(a.vx, J) - vxi, dvy = gather<W, G>(a.vy, J) - vyi,
                 dvz = gather<W, G>(a.vz, J) - vzi;
         D mj = zero;
