@@ -375,10 +375,11 @@ const Kernels &choose_path() {
 // The path, then its way to gather.
 const Kernels &choose_kernels() {
   const Kernels &path = choose_path();
-  const Gather gather = choose_gather(path.name);
+  if (choose_gather(path.name) == Gather::kHardware) {
 #if defined(DEMCAL_X86_64) && !defined(__clang__)
-  if (gather == Gather::kHardware) return kKernels_avx512_hw;
+    return kKernels_avx512_hw;
 #endif
+  }
   return path;
 }
 
