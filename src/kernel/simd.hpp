@@ -30,6 +30,13 @@ struct Simd {
 
 #define DEMCAL_INLINE inline __attribute__((always_inline))
 
+#ifdef DEMCAL_X86_64
+// The targets of the AVX2 and AVX-512 entry points (the kernels' dispatch
+// tables in contact.cpp and sphere_contact.cpp).
+#define DEMCAL_V3 __attribute__((target("arch=x86-64-v3")))
+#define DEMCAL_V4 __attribute__((target("arch=x86-64-v4")))
+#endif
+
 template <int W>
 DEMCAL_INLINE typename Simd<W>::D load(const double *p) {
   typename Simd<W>::D v;

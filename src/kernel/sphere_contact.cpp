@@ -782,8 +782,6 @@ struct Kernels {
 #define DEMCAL_NO_TARGET
 DEMCAL_SPHERE_KERNELS(sse2, DEMCAL_NO_TARGET, 2, Gather::kEmulated)
 #ifdef DEMCAL_X86_64
-#define DEMCAL_V3 __attribute__((target("arch=x86-64-v3")))
-#define DEMCAL_V4 __attribute__((target("arch=x86-64-v4")))
 DEMCAL_SPHERE_KERNELS(avx2, DEMCAL_V3, 4, Gather::kEmulated)
 DEMCAL_SPHERE_KERNELS(avx512, DEMCAL_V4, 8, Gather::kEmulated)
 #if !defined(__clang__)
