@@ -157,7 +157,8 @@ struct KernelOptions {
 const char* kernel_simd();
 
 /// How the "avx512" path reads its neighbours' values: "hardware" (AVX-512
-/// gather instructions, chosen on Intel CPUs, where they are faster) or
+/// gather instructions, chosen on Intel CPUs since Sapphire Rapids, where
+/// they are faster) or
 /// "emulated" (scalar loads put together; every other path and CPU, and
 /// builds made with Clang). DEMCAL_GATHER=hardware|emulated in the
 /// environment overrides it, for benchmarks. Both read the same values, so
