@@ -298,9 +298,9 @@ DEMCAL_KERNELS(avx512_hw, "avx512", DEMCAL_V4, 8, Gather::kHardware)
 
 // How the AVX-512 path gathers (simd.hpp, Gather): the DEMCAL_GATHER the
 // environment names, else in hardware on Intel CPUs since Sapphire Rapids
-// and emulated on others.
-// A value that is no way, or "hardware" on another path or in a build
-// without it, throws std::invalid_argument, as DEMCAL_SIMD does.
+// and emulated on others. A value that is no way, or "hardware" on another
+// path or in a build without it, throws std::invalid_argument, as
+// DEMCAL_SIMD does.
 Gather choose_gather(const char *path) {
   const char *env = std::getenv("DEMCAL_GATHER");
   const std::string_view want = env ? env : "";

@@ -58,7 +58,7 @@ DEMCAL_INLINE void store(double *p, typename Simd<W>::D v) {
 // same addresses, so the same bits; only the cost differs, and by CPU: the
 // shuffles that put the scalars together run on the ports the law's
 // arithmetic needs, where Intel's 512-bit work has two (p0, p5) — hardware
-// gathers 1.13-1.26x faster there — while AMD's Zen 3 and Zen 5 run their
+// gathers 1.13-1.28x faster there — while AMD's Zen 3 and Zen 5 run their
 // hardware gathers 1.3-1.7x slower (reports/performance.md, 2026-12-06).
 enum class Gather { kEmulated, kHardware };
 

@@ -158,14 +158,13 @@ const char* kernel_simd();
 
 /// How the "avx512" path reads its neighbours' values: "hardware" (AVX-512
 /// gather instructions, chosen on Intel CPUs since Sapphire Rapids, where
-/// they are faster) or
-/// "emulated" (scalar loads put together; every other path and CPU, and
-/// builds made with Clang). DEMCAL_GATHER=hardware|emulated in the
-/// environment overrides it, for benchmarks. Both read the same values, so
-/// results are the same bits either way. Throws std::invalid_argument,
-/// naming DEMCAL_GATHER and its value, for a value that is no way, or
-/// "hardware" on another path or in a build without it (so does every World
-/// and SphereWorld constructor).
+/// they are faster) or "emulated" (scalar loads put together; every other
+/// path and CPU, and builds made with Clang). DEMCAL_GATHER=hardware|emulated
+/// in the environment overrides it, for benchmarks. Both read the same
+/// values, so results are the same bits either way. Throws
+/// std::invalid_argument, naming DEMCAL_GATHER and its value, for a value
+/// that is no way, or "hardware" on another path or in a build without it
+/// (so does every World and SphereWorld constructor).
 const char* kernel_gather();
 
 class WorldImpl;

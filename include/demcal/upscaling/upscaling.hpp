@@ -148,13 +148,13 @@ SphereAssembly prototype_spheres(const SceneConfig& config, int64_t particles = 
 /// did not: radii whose masses, inertias or steps are no normal doubles
 /// (a file of 1e-150 m disks consolidated into "diverged: non-finite
 /// state"), or a contact overlap at sigma3 its positions cannot resolve to
-/// the consolidation's tolerance (a packing at x ~ 1e6 m). For the commands that
-/// consolidate or run the prototype (verify, export); upscale and
-/// calibrate only derive its scales (the radii's part, which
+/// the consolidation's tolerance (a packing at x ~ 1e6 m). For the
+/// commands that consolidate or run the prototype (verify, export); upscale
+/// and calibrate only derive its scales (the radii's part, which
 /// prototype_assembly and prototype_spheres check for a file as they read
-/// it: here it repeats, at the cost of a pass over the radii). A prototype `source` read from a
-/// file is named, with the distance from the origin its positions must
-/// keep; the REV as its own prototype is "the scene".
+/// it: here it repeats, at the cost of a pass over the radii). A prototype
+/// `source` read from a file is named, with the distance from the origin
+/// its positions must keep; the REV as its own prototype is "the scene".
 void check_prototype_assembly(const SceneConfig& config, const Assembly& prototype,
                               const PrototypeSource& source);
 void check_prototype_assembly(const SceneConfig& config, const SphereAssembly& prototype,
