@@ -292,6 +292,40 @@ DEMCAL_INLINE typename Simd<W>::D turn_scale(typename Simd<W>::D y, typename Sim
   return select<W>(far, select<W>(turnable, vsqrt(z), zero), series);
 }
 
+// Three components of one vector on W lanes.
+template <int W>
+struct Vec3 {
+  typename Simd<W>::D x, y, z;
+};
+
+// The history h of a touching contact turned with it over the step (file
+// comment): projected onto the contact plane (normal n) and rescaled to
+// its former length, then twisted about n by the spin sum s (Cayley form,
+// c = Δt·n·s/4 from half_dt = Δt/2), one scale A = sqrt(|h|²/|p|²)/(1 +
+// c²) for both. mag2 = |h|², held = mag2 > 0, inv_mag2 = 1/|h|² (1 where
+// not held).
+template <int W>
+DEMCAL_INLINE Vec3<W> turned_history(Vec3<W> n, Vec3<W> s, Vec3<W> h, typename Simd<W>::D mag2,
+                                     typename Simd<W>::M held, typename Simd<W>::D inv_mag2,
+                                     double half_dt) {
+  using D = typename Simd<W>::D;
+  const D one = D{} + 1.0;
+  const D hn = h.x * n.x + h.y * n.y + h.z * n.z;
+  const D px = h.x - hn * n.x, py = h.y - hn * n.y, pz = h.z - hn * n.z;
+  const D c = half_dt * 0.5 * (n.x * s.x + n.y * s.y + n.z * s.z);
+  const D c2 = c * c, t = 1.0 + c2;
+  // 1/A² = |p|²(1 + c²)²/|h|² with |p|² = |h|² − hn² (|n| = 1): no
+  // division on the chain (1/|h|² came with the load), and A by the
+  // series of y^(-1/2) near 1; where a lane is far from 1, the exact
+  // form (turn_scale). Lanes without history take y = 1 (p = 0 there,
+  // so A does not matter).
+  const D y = select<W>(held, (mag2 - hn * hn) * (t * t * inv_mag2), one);
+  const D A = turn_scale<W>(y, mag2, px, py, pz, t);
+  const D s1 = 1.0 - c2, s2 = 2.0 * c;
+  return {A * (px * s1 + (n.y * pz - n.z * py) * s2), A * (py * s1 + (n.z * px - n.x * pz) * s2),
+          A * (pz * s1 + (n.x * py - n.y * px) * s2)};
+}
+
 // Coulomb's cap on a tangential force h (|h|² = h2) of the touching lanes:
 // false when no touching lane slides (|h| ≤ cap = μ·fn in all of them);
 // else cut = cap/|h| where one slides and 1 elsewhere, and the slip work
@@ -402,22 +436,28 @@ DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
       D mi = zero;
       if constexpr (kDamped) mi = load<W>(a.m + i0);
       D fx = zero, fy = zero, fz = zero, tx = zero, ty = zero, tz = zero;
-      // The neighbours' positions are gathered one slot-vector ahead: they
-      // start the law's longest chain (d², its root, 1/|d|), and issued a
-      // slot-vector early their loads no longer wait behind that chain in
-      // the scheduler (1.05-1.08x on Intel's AVX-512 path at 256-4 000
-      // spheres; AVX2 at par; only the positions: gathering the velocities
-      // ahead too lost 1.03-1.04x). The same values, so the same bits.
+      // With hardware gathers, the neighbours' positions are gathered one
+      // slot-vector ahead: they start the law's longest chain (d², its
+      // root, 1/|d|), and issued a slot-vector early the gathers no longer
+      // wait behind that chain in the scheduler (1.05-1.08x on Intel's
+      // AVX-512 path at 256-4 000 spheres; only the positions: gathering the
+      // velocities ahead too lost 1.03-1.04x). Emulated gathers are gathered
+      // where they are used: ahead, they lost 1.05-1.06x on AMD Zen 5's
+      // AVX-512 path and were at par on Intel's AVX2 path (performance.md,
+      // 2026-12-06). Either way the same values, so the same bits.
+      constexpr bool kAhead = G == Gather::kHardware;
       D gx = zero, gy = zero, gz = zero;
-      if (s0 + sub < s1) {
+      if (kAhead && s0 + sub < s1) {
         const int *J = a.slot_j + s0 + sub;
         gx = gather<W, G>(a.x, J), gy = gather<W, G>(a.y, J), gz = gather<W, G>(a.z, J);
       }
       for (int s = s0 + sub; s < s1; s += kBlock) {
         const int *J = a.slot_j + s;
         const D rj = load<W>(a.slot_r + s);
+        if constexpr (!kAhead)
+          gx = gather<W, G>(a.x, J), gy = gather<W, G>(a.y, J), gz = gather<W, G>(a.z, J);
         const D dx = gx - xi, dy = gy - yi, dz = gz - zi;
-        if (s + kBlock < s1) {
+        if (kAhead && s + kBlock < s1) {
           const int *next = J + kBlock;
           gx = gather<W, G>(a.x, next), gy = gather<W, G>(a.y, next), gz = gather<W, G>(a.z, next);
         }
@@ -454,24 +494,11 @@ DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
         const D uz = dvz - (rx * ny - ry * nx);
         const D un = ux * nx + uy * ny + uz * nz;
         const D vtx = ux - un * nx, vty = uy - un * ny, vtz = uz - un * nz;
-        // Turn the history: projection onto the contact plane rescaled to
-        // its former length, then the twist about n (Cayley form), one
-        // scale A = sqrt(|h|²/|p|²)/(1 + c²) for both (file comment).
-        const D hn = hx0 * nx + hy0 * ny + hz0 * nz;
-        const D px = hx0 - hn * nx, py = hy0 - hn * ny, pz = hz0 - hn * nz;
-        const D c = half_dt * 0.5 * (nx * sx + ny * sy + nz * sz);
-        const D c2 = c * c, t = 1.0 + c2;
-        // 1/A² = |p|²(1 + c²)²/|h|² with |p|² = |h|² − hn² (|n| = 1): no
-        // division on the chain (1/|h|² came with the load), and A by the
-        // series of y^(-1/2) near 1; where a lane is far from 1, the exact
-        // form (turn_scale). Lanes without history take y = 1 (p = 0 there,
-        // so A does not matter).
-        const D y = select<W>(held, (mag2 - hn * hn) * (t * t * inv_mag2), one);
-        const D A = turn_scale<W>(y, mag2, px, py, pz, t);
-        const D s1 = 1.0 - c2, s2 = 2.0 * c;
-        D hx = A * (px * s1 + (ny * pz - nz * py) * s2) + kdt * vtx;
-        D hy = A * (py * s1 + (nz * px - nx * pz) * s2) + kdt * vty;
-        D hz = A * (pz * s1 + (nx * py - ny * px) * s2) + kdt * vtz;
+        const Vec3<W> turned = turned_history<W>({nx, ny, nz}, {sx, sy, sz}, {hx0, hy0, hz0}, mag2,
+                                                 held, inv_mag2, half_dt);
+        D hx = turned.x + kdt * vtx;
+        D hy = turned.y + kdt * vty;
+        D hz = turned.z + kdt * vtz;
         // Coulomb: |h| ≤ μ·fn. The root and the division only when a
         // touching lane slides (else cut = 1 in every lane that counts).
         const D cap = mu * fn, h2 = hx * hx + hy * hy + hz * hz;
