@@ -443,8 +443,9 @@ DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
       // AVX-512 path at 256-4 000 spheres; only the positions: gathering the
       // velocities ahead too lost 1.03-1.04x). Emulated gathers are gathered
       // where they are used: ahead, they lost 1.05-1.06x on AMD Zen 5's
-      // AVX-512 path and were at par on Intel's AVX2 path (performance.md,
-      // 2026-12-06). Either way the same values, so the same bits.
+      // AVX-512 path, and were at par on the AVX2 path of Intel and Zen 5
+      // (performance.md, 2026-12-06). Either way the same values, so the
+      // same bits.
       constexpr bool kAhead = G == Gather::kHardware;
       D gx = zero, gy = zero, gz = zero;
       if (kAhead && s0 + sub < s1) {
