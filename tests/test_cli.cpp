@@ -529,6 +529,14 @@ TEST_F(CliEndToEnd, ACheckAcrossTwoKeysNamesTheKeyASetChanged) {
       "kn": 1e8, "kt": 5e7, "friction": 0.3}, "test": {"servo_gain": 1e-5}})");
   const std::string damped = write("damped.json", R"({"material": {"density": 2650,
       "kn": 1e8, "kt": 5e7, "friction": 0.3, "contact_damping_ratio": 300}})");
+  // Random gases one layer thick at a count a --set gave (gas_layers_fault,
+  // packing.cpp): the file's aspect was named, a key the user never touched.
+  const std::string flat_2d = write("flat_2d.json", R"({"material": {"density": 2650,
+      "kn": 1e8, "kt": 5e7, "friction": 0.3}, "assembly": {"type": "random", "count": 40,
+      "aspect": 10}})");
+  const std::string flat_3d = write("flat_3d.json", R"({"dimension": 3, "material":
+      {"density": 2650, "kn": 1e8, "kt": 5e7, "friction": 0.3}, "assembly": {"type": "random",
+      "count": 30, "aspect": 1.79}})");
   const std::string stalled = write("stalled_servo.json", R"({"material": {"density": 2650,
       "kn": 1e8, "kt": 5e7, "friction": 0.3}, "test": {"servo_gain": 1e-9}})");
   struct Case {
@@ -611,6 +619,27 @@ TEST_F(CliEndToEnd, ACheckAcrossTwoKeysNamesTheKeyASetChanged) {
        {"assembly.rows=10000000"},
        "--set assembly.rows=10000000: assembly.rows: ",
        "columns x rows = 50000000 particles, more than the limit 10000000"},
+      // A gas one layer thick named the file's assembly.aspect when a --set
+      // had changed the count alone: now the count, with the nearest counts
+      // that consolidate at the file's aspect (none below 10 disks at aspect
+      // 10; in 3D 16 spheres at aspect 1.79 fall into a hole between 15 and
+      // 17, where gas_grid's cells across step from 3 to 4).
+      {flat_2d,
+       {"assembly.count=10"},
+       "--set assembly.count=10: assembly.count: gives a gas of 10 columns and 1 rows of 10 disks",
+       "; at aspect 10 the nearest count that does is 12 (or aspect above 0.1 and up to about 8.1 "
+       "for count 10); got 10"},
+      {flat_3d,
+       {"assembly.count=16"},
+       "--set assembly.count=16: assembly.count: gives a gas of 4 x 4 cells across and 1 layers "
+       "of 16 spheres",
+       "; at aspect 1.79 the nearest counts that do are 15 and 17 (or aspect above 0.5 and up to "
+       "about 1.6875 for count 16); got 16"},
+      // The aspect too: the aspect, as before.
+      {flat_2d,
+       {"assembly.count=10", "assembly.aspect=10"},
+       "--set assembly.aspect=10: assembly.aspect: gives a gas of 10 columns and 1 rows",
+       "i.e. aspect above 0.1 and up to about 8.1 for count 10; got 10"},
   };
   for (const Case& c : cases) {
     for (const std::string command : {"run", "check"}) {

@@ -495,8 +495,11 @@ SceneConfig parse_config(const nlohmann::json& root_json, const std::string& sou
       }
       s.aspect = a.positive("aspect", s.aspect);
       // A gas that never consolidates to a static state (packing.cpp,
-      // gas_layers_fault: measured), named by the key to change.
-      if (const auto fault = gas_layers_fault(c.dimension, s.count, s.aspect))
+      // gas_layers_fault: measured), named by the key to change: the count
+      // when a --set changed it and none the aspect (changed_field).
+      const bool count_changed =
+          changed_field(sets, {"assembly.aspect", "assembly.count"}) == "assembly.count";
+      if (const auto fault = gas_layers_fault(c.dimension, s.count, s.aspect, count_changed))
         a.fail(fault->key, fault->message);
       s.seed = static_cast<uint64_t>(
           a.integer("seed", static_cast<int64_t>(s.seed), 0, std::numeric_limits<int64_t>::max()));

@@ -13,6 +13,7 @@
 #include <optional>
 #include <random>
 #include <sstream>
+#include <utility>
 
 #include "demcal/io/files.hpp"
 #include "demcal/io/format.hpp"
@@ -113,11 +114,34 @@ constexpr int kMinGasLayers = 2;
 constexpr int kMinGasAcross3D = 3;
 }  // namespace
 
-std::optional<GasLayersFault> gas_layers_fault(int dimension, int count, double aspect) {
+namespace {
+
+bool gas_consolidates(int dimension, int count, double aspect) {
+  const GasGrid grid = gas_grid(dimension, count, aspect);
+  const int min_across = dimension == 3 ? kMinGasAcross3D : kMinGasLayers;
+  return grid.layers >= kMinGasLayers && grid.across >= min_across;
+}
+
+// The counts nearest `count` below and above it (up to kMaxParticles) whose
+// gas at `aspect` consolidates, 0 where none. A scan, not a bound: the set
+// of such counts has holes (3D, aspect 1.79: 10 does, 16 does not, 17 does,
+// as the ceilings of gas_grid fall).
+std::pair<int64_t, int64_t> nearest_consolidating_counts(int dimension, int count, double aspect) {
+  int64_t below = count - 1, above = int64_t{count} + 1;
+  while (below > 0 && !gas_consolidates(dimension, static_cast<int>(below), aspect)) --below;
+  while (above <= kMaxParticles && !gas_consolidates(dimension, static_cast<int>(above), aspect))
+    ++above;
+  return {below, above <= kMaxParticles ? above : 0};
+}
+
+}  // namespace
+
+std::optional<GasLayersFault> gas_layers_fault(int dimension, int count, double aspect,
+                                               bool count_changed) {
+  if (gas_consolidates(dimension, count, aspect)) return std::nullopt;
   const GasGrid grid = gas_grid(dimension, count, aspect);
   const bool three_d = dimension == 3;
   const int min_across = three_d ? kMinGasAcross3D : kMinGasLayers;
-  if (grid.layers >= kMinGasLayers && grid.across >= min_across) return std::nullopt;
   const double n = count, k = kMinGasLayers, m = min_across, dim = three_d ? 3.0 : 2.0;
   const double c = std::ceil(std::pow(n / (k - 1.0), 1.0 / (dim - 1.0))) - 1.0;
   const char* what = three_d ? "spheres" : "disks";
@@ -130,6 +154,9 @@ std::optional<GasLayersFault> gas_layers_fault(int dimension, int count, double 
     return GasLayersFault{"count", msg.str()};
   }
   const double lo = std::pow(m - 1.0, dim) / n, hi = std::pow(c, dim) / n;
+  const auto [below, above] = count_changed ? nearest_consolidating_counts(dimension, count, aspect)
+                                            : std::pair<int64_t, int64_t>{0, 0};
+  const bool blame_count = below > 0 || above > 0;
   msg << "gives a gas of " << grid.across
       << (three_d ? " x " + std::to_string(grid.across) + " cells across and " : " columns and ")
       << grid.layers << (three_d ? " layers" : " rows") << " of " << count << " " << what
@@ -141,6 +168,18 @@ std::optional<GasLayersFault> gas_layers_fault(int dimension, int count, double 
            "sigma3 instead of coming to rest)";
   else
     msg << " (a gas one particle thick never comes to a static state between the servo walls)";
+  if (blame_count) {
+    // The count changed (a --set) and the aspect did not: the count is named,
+    // with the nearest counts that consolidate at this aspect.
+    msg << "; at aspect " << aspect;
+    if (below > 0 && above > 0)
+      msg << " the nearest counts that do are " << below << " and " << above;
+    else
+      msg << " the nearest count that does is " << (below > 0 ? below : above);
+    msg << " (or aspect above " << lo << " and up to about " << hi << " for count " << count
+        << "); got " << count;
+    return GasLayersFault{"count", msg.str()};
+  }
   msg << ", i.e. aspect above " << lo << " and up to about " << hi << " for count " << count
       << "; got " << aspect;
   return GasLayersFault{"aspect", msg.str()};

@@ -52,11 +52,15 @@ GasGrid gas_grid(int dimension, int count, double aspect);
 /// The one home of the rule: the config's assembly.count and
 /// assembly.aspect, and every command that generates a gas at another
 /// count (scaling's --sizes, rev's --particles, a generated prototype).
+/// `count_changed` (the count was --set, the aspect not): where some count
+/// would consolidate at this aspect, `key` is "count" and the message gives
+/// the nearest such counts below and above, and still the aspect's bounds.
 struct GasLayersFault {
   std::string key;
   std::string message;
 };
-std::optional<GasLayersFault> gas_layers_fault(int dimension, int count, double aspect);
+std::optional<GasLayersFault> gas_layers_fault(int dimension, int count, double aspect,
+                                               bool count_changed = false);
 /// The same as one phrase for a command's error ("" when the gas can
 /// consolidate): the message, after `aspect_name` ("assembly.aspect") when
 /// it is the aspect's.
