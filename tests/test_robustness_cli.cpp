@@ -463,13 +463,12 @@ TEST_F(RobustCli, AGasAtACountThatNeverConsolidatesIsRefusedBeforeAnyWork) {
        "--particles: a REV generated as a gas of 6 spheres: " + too_few_spheres},
       {{"rev", random_3d, "--set", "assembly.aspect=8", "--particles", "100", "--method",
         "generate", "-o", "out"},
-       "--particles: a REV generated as a gas of 100 spheres: the prototype's "
-       "sqrt(width*depth)/height gives a gas of 10 x 10 cells across and 1 layers of 100 "
-       "spheres"},
+       "--particles: a REV generated as a gas of 100 spheres: the count gives a gas of 10 x 10 "
+       "cells across and 1 layers of 100 spheres"},
       {{"rev", random_2d, "--prototype", strip, "--particles", "10", "--method", "generate", "-o",
         "out"},
-       "--particles: a REV generated as a gas of 10 disks: the prototype's width/height gives a "
-       "gas of 10 columns and 1 rows of 10 disks"},
+       "--particles: a REV generated as a gas of 10 disks: the count gives a gas of 10 columns and "
+       "1 rows of 10 disks"},
       {{"rev", random_2d, "--particles", "2", "--method", "generate", "-o", "out"},
        "--particles: a REV generated as a gas of 2 disks: too few disks for a random gas with 2 "
        "layers along every side: at least 3; got 2"},
@@ -481,8 +480,11 @@ TEST_F(RobustCli, AGasAtACountThatNeverConsolidatesIsRefusedBeforeAnyWork) {
        "prototype.particles: a prototype generated as a gas of 2 disks: too few disks for a "
        "random gas with 2 layers along every side: at least 3; got 2"},
       {{"check", random_2d, "--set", "assembly.aspect=0.01", "--set", "prototype.particles=40"},
-       "prototype.particles: a prototype generated as a gas of 40 disks: assembly.aspect gives a "
-       "gas of 1 columns and 40 rows of 40 disks"},
+       "prototype.particles: a prototype generated as a gas of 40 disks: the count gives a gas of "
+       "1 columns and 40 rows of 40 disks: a sample needs at least 2 along every side (a gas one "
+       "particle thick never comes to a static state between the servo walls); at "
+       "assembly.aspect 0.01 the nearest count that does is 101 (or assembly.aspect above 0.025 "
+       "and up to about 38.025 for count 40); got 40"},
   };
   for (const Case& c : cases) expect_refused(c.args, c.mention);
   // verify's and export's count from a params.json's prototype block is

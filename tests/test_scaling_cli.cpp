@@ -179,12 +179,16 @@ TEST_F(ScalingCli, SizesThatMakeOneCountOrNoSampleAreUsageErrors) {
        "spheres across: at least 10; got 5"},
       {{random_3d, "--set", "assembly.aspect=8", "--sizes", "100,500,2000", "--calibrate-max",
         "500"},
-       "--sizes: size 100: assembly.aspect gives a gas of 10 x 10 cells across and 1 layers of "
-       "100 spheres: a sample needs at least 2 along every side and 3 spheres across"},
+       "--sizes: size 100: the count gives a gas of 10 x 10 cells across and 1 layers of 100 "
+       "spheres: a sample needs at least 2 along every side and 3 spheres across"},
+      {{random_3d, "--set", "assembly.aspect=8", "--sizes", "100,500,2000", "--calibrate-max",
+        "500"},
+       "; at assembly.aspect 8 the nearest counts that do are 91 and 101 (or assembly.aspect "
+       "above 0.08 and up to about 7.29 for count 100); got 100"},
       {{random_2d, "--set", "assembly.aspect=0.01", "--sizes", "40,100,400", "--calibrate-max",
         "100"},
-       "--sizes: size 40: assembly.aspect gives a gas of 1 columns and 40 rows of 40 disks: a "
-       "sample needs at least 2 along every side (a gas one particle thick"},
+       "--sizes: size 40: the count gives a gas of 1 columns and 40 rows of 40 disks: a sample "
+       "needs at least 2 along every side (a gas one particle thick"},
   };
   for (const Case& c : cases) {
     std::vector<std::string> args{"scaling", "-o", "out", "-q", "-j", "1"};

@@ -169,10 +169,14 @@ TEST(Upscaling3D, AGeneratedPrototypeGasThatNeverConsolidatesIsBadInput) {
       "{" + test::kMaterialMember + R"(, "assembly": {"type": "random", "count": 50,
          "radius_min": 4e-4, "radius_max": 6e-4, "aspect": 0.1}})",
       "gas2d.json");
-  EXPECT_NE(refusal([&] { demcal::prototype_assembly(disks, 5); })
-                .find("--particles: a prototype generated as a gas of 5 disks: assembly.aspect "
-                      "gives a gas of 1 columns and 5 rows of 5 disks"),
-            std::string::npos);
+  // The count named in the words as in the field, with the nearest count
+  // that consolidates at the config's aspect (11: 0.1·11 > 1 gives 2 columns).
+  EXPECT_EQ(refusal([&] { demcal::prototype_assembly(disks, 5); }),
+            "--particles: a prototype generated as a gas of 5 disks: the count gives a gas of 1 "
+            "columns and 5 rows of 5 disks: a sample needs at least 2 along every side (a gas one "
+            "particle thick never comes to a static state between the servo walls); at "
+            "assembly.aspect 0.1 the nearest count that does is 11 (or assembly.aspect above 0.2 "
+            "and up to about 3.2 for count 5); got 5");
   EXPECT_EQ(demcal::prototype_spheres(spheres, 10).size(), 10);
   EXPECT_EQ(demcal::prototype_spheres(fcc_config(), 4).size(), 4);  // one FCC cell
 }

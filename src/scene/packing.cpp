@@ -137,7 +137,7 @@ std::pair<int64_t, int64_t> nearest_consolidating_counts(int dimension, int coun
 }  // namespace
 
 std::optional<GasLayersFault> gas_layers_fault(int dimension, int count, double aspect,
-                                               bool count_changed) {
+                                               bool count_changed, const std::string& aspect_name) {
   if (gas_consolidates(dimension, count, aspect)) return std::nullopt;
   const GasGrid grid = gas_grid(dimension, count, aspect);
   const bool three_d = dimension == 3;
@@ -151,7 +151,7 @@ std::optional<GasLayersFault> gas_layers_fault(int dimension, int count, double 
         << " layers along every side"
         << (three_d ? " and " + std::to_string(kMinGasAcross3D) + " spheres across" : "")
         << ": at least " << (three_d ? 10 : 3) << "; got " << count;
-    return GasLayersFault{"count", msg.str()};
+    return GasLayersFault{"count", msg.str(), true};
   }
   const double lo = std::pow(m - 1.0, dim) / n, hi = std::pow(c, dim) / n;
   const auto [below, above] = count_changed ? nearest_consolidating_counts(dimension, count, aspect)
@@ -169,27 +169,28 @@ std::optional<GasLayersFault> gas_layers_fault(int dimension, int count, double 
   else
     msg << " (a gas one particle thick never comes to a static state between the servo walls)";
   if (blame_count) {
-    // The count changed (a --set) and the aspect did not: the count is named,
-    // with the nearest counts that consolidate at this aspect.
-    msg << "; at aspect " << aspect;
+    // The count changed and the aspect did not: the count is named, with
+    // the nearest counts that consolidate at this aspect.
+    msg << "; at " << aspect_name << " " << aspect;
     if (below > 0 && above > 0)
       msg << " the nearest counts that do are " << below << " and " << above;
     else
       msg << " the nearest count that does is " << (below > 0 ? below : above);
-    msg << " (or aspect above " << lo << " and up to about " << hi << " for count " << count
-        << "); got " << count;
-    return GasLayersFault{"count", msg.str()};
+    msg << " (or " << aspect_name << " above " << lo << " and up to about " << hi << " for count "
+        << count << "); got " << count;
+    return GasLayersFault{"count", msg.str(), false};
   }
   msg << ", i.e. aspect above " << lo << " and up to about " << hi << " for count " << count
       << "; got " << aspect;
-  return GasLayersFault{"aspect", msg.str()};
+  return GasLayersFault{"aspect", msg.str(), false};
 }
 
 std::string gas_layers_problem(int dimension, int count, double aspect,
                                const std::string& aspect_name) {
-  const auto fault = gas_layers_fault(dimension, count, aspect);
+  const auto fault = gas_layers_fault(dimension, count, aspect, true, aspect_name);
   if (!fault) return "";
-  return fault->key == "aspect" ? aspect_name + " " + fault->message : fault->message;
+  if (fault->too_few) return fault->message;
+  return (fault->key == "aspect" ? aspect_name : "the count") + " " + fault->message;
 }
 
 Assembly random_gas(const AssemblySpec& spec) {

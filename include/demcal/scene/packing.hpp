@@ -52,18 +52,23 @@ GasGrid gas_grid(int dimension, int count, double aspect);
 /// The one home of the rule: the config's assembly.count and
 /// assembly.aspect, and every command that generates a gas at another
 /// count (scaling's --sizes, rev's --particles, a generated prototype).
-/// `count_changed` (the count was --set, the aspect not): where some count
-/// would consolidate at this aspect, `key` is "count" and the message gives
-/// the nearest such counts below and above, and still the aspect's bounds.
+/// `count_changed` (the count was given apart from the aspect: a --set of
+/// it alone, or a command's count): where some count would consolidate at
+/// this aspect, `key` is "count" and the message gives the nearest such
+/// counts below and above, and still the aspect's bounds, the aspect named
+/// `aspect_name`. `too_few`: no aspect works (`key` "count").
 struct GasLayersFault {
   std::string key;
   std::string message;
+  bool too_few = false;
 };
 std::optional<GasLayersFault> gas_layers_fault(int dimension, int count, double aspect,
-                                               bool count_changed = false);
-/// The same as one phrase for a command's error ("" when the gas can
-/// consolidate): the message, after `aspect_name` ("assembly.aspect") when
-/// it is the aspect's.
+                                               bool count_changed = false,
+                                               const std::string& aspect_name = "aspect");
+/// The same as one phrase for a command's error at a count it was given
+/// ("" when the gas can consolidate; count_changed): the message, after
+/// "the count" when it names the count, or after `aspect_name`
+/// ("assembly.aspect") when no count works and it names the aspect.
 std::string gas_layers_problem(int dimension, int count, double aspect,
                                const std::string& aspect_name);
 /// A loose random gas of polydisperse disks (no overlaps) on a jittered
