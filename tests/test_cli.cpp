@@ -627,13 +627,15 @@ TEST_F(CliEndToEnd, ACheckAcrossTwoKeysNamesTheKeyASetChanged) {
       {flat_2d,
        {"assembly.count=10"},
        "--set assembly.count=10: assembly.count: gives a gas of 10 columns and 1 rows of 10 disks",
-       "; at aspect 10 the nearest count that does is 12 (or aspect above 0.1 and up to about 8.1 "
+       "; at aspect 10 the nearest count that gives a sample is 12 (or aspect above 0.1 and up to "
+       "about 8.1 "
        "for count 10); got 10"},
       {flat_3d,
        {"assembly.count=16"},
        "--set assembly.count=16: assembly.count: gives a gas of 4 x 4 cells across and 1 layers "
        "of 16 spheres",
-       "; at aspect 1.79 the nearest counts that do are 15 and 17 (or aspect above 0.5 and up to "
+       "; at aspect 1.79 the nearest counts that give a sample are 15 and 17 (or aspect above 0.5 "
+       "and up to "
        "about 1.6875 for count 16); got 16"},
       // The aspect too: the aspect, as before.
       {flat_2d,

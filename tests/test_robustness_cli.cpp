@@ -483,7 +483,8 @@ TEST_F(RobustCli, AGasAtACountThatNeverConsolidatesIsRefusedBeforeAnyWork) {
        "prototype.particles: a prototype generated as a gas of 40 disks: the count gives a gas of "
        "1 columns and 40 rows of 40 disks: a sample needs at least 2 along every side (a gas one "
        "particle thick never comes to a static state between the servo walls); at "
-       "assembly.aspect 0.01 the nearest count that does is 101 (or assembly.aspect above 0.025 "
+       "assembly.aspect 0.01 the nearest count that gives a sample is 101 (or assembly.aspect "
+       "above 0.025 "
        "and up to about 38.025 for count 40); got 40"},
   };
   for (const Case& c : cases) expect_refused(c.args, c.mention);

@@ -183,7 +183,8 @@ TEST_F(ScalingCli, SizesThatMakeOneCountOrNoSampleAreUsageErrors) {
        "spheres: a sample needs at least 2 along every side and 3 spheres across"},
       {{random_3d, "--set", "assembly.aspect=8", "--sizes", "100,500,2000", "--calibrate-max",
         "500"},
-       "; at assembly.aspect 8 the nearest counts that do are 91 and 101 (or assembly.aspect "
+       "; at assembly.aspect 8 the nearest counts that give a sample are 91 and 101 (or "
+       "assembly.aspect "
        "above 0.08 and up to about 7.29 for count 100); got 100"},
       {{random_2d, "--set", "assembly.aspect=0.01", "--sizes", "40,100,400", "--calibrate-max",
         "100"},

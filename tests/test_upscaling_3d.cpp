@@ -175,7 +175,8 @@ TEST(Upscaling3D, AGeneratedPrototypeGasThatNeverConsolidatesIsBadInput) {
             "--particles: a prototype generated as a gas of 5 disks: the count gives a gas of 1 "
             "columns and 5 rows of 5 disks: a sample needs at least 2 along every side (a gas one "
             "particle thick never comes to a static state between the servo walls); at "
-            "assembly.aspect 0.1 the nearest count that does is 11 (or assembly.aspect above 0.2 "
+            "assembly.aspect 0.1 the nearest count that gives a sample is 11 (or assembly.aspect "
+            "above 0.2 "
             "and up to about 3.2 for count 5); got 5");
   EXPECT_EQ(demcal::prototype_spheres(spheres, 10).size(), 10);
   EXPECT_EQ(demcal::prototype_spheres(fcc_config(), 4).size(), 4);  // one FCC cell

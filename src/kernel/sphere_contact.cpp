@@ -298,16 +298,18 @@ struct Vec3 {
   typename Simd<W>::D x, y, z;
 };
 
-// The history h of a touching contact turned with it over the step (file
-// comment): projected onto the contact plane (normal n) and rescaled to
-// its former length, then twisted about n by the spin sum s (Cayley form,
-// c = Δt·n·s/4 from half_dt = Δt/2), one scale A = sqrt(|h|²/|p|²)/(1 +
-// c²) for both. mag2 = |h|², held = mag2 > 0, inv_mag2 = 1/|h|² (1 where
-// not held).
+// The trial tangential force of a touching contact (file comment): its
+// history h turned with it over the step — projected onto the contact
+// plane (normal n) and rescaled to its former length, then twisted about n
+// by the spin sum s (Cayley form, c = Δt·n·s/4 from half_dt = Δt/2), one
+// scale A = sqrt(|h|²/|p|²)/(1 + c²) for both — plus the increment kt·Δt·
+// v_t (kdt = kt·Δt). mag2 = |h|², held = mag2 > 0, inv_mag2 = 1/|h|² (1
+// where not held). The turn and the increment stay one expression, so that
+// a compiler that contracts only within one (Clang) rounds as before.
 template <int W>
-DEMCAL_INLINE Vec3<W> turned_history(Vec3<W> n, Vec3<W> s, Vec3<W> h, typename Simd<W>::D mag2,
-                                     typename Simd<W>::M held, typename Simd<W>::D inv_mag2,
-                                     double half_dt) {
+DEMCAL_INLINE Vec3<W> trial_history(Vec3<W> n, Vec3<W> s, Vec3<W> h, typename Simd<W>::D mag2,
+                                    typename Simd<W>::M held, typename Simd<W>::D inv_mag2,
+                                    double half_dt, double kdt, Vec3<W> vt) {
   using D = typename Simd<W>::D;
   const D one = D{} + 1.0;
   const D hn = h.x * n.x + h.y * n.y + h.z * n.z;
@@ -322,8 +324,9 @@ DEMCAL_INLINE Vec3<W> turned_history(Vec3<W> n, Vec3<W> s, Vec3<W> h, typename S
   const D y = select<W>(held, (mag2 - hn * hn) * (t * t * inv_mag2), one);
   const D A = turn_scale<W>(y, mag2, px, py, pz, t);
   const D s1 = 1.0 - c2, s2 = 2.0 * c;
-  return {A * (px * s1 + (n.y * pz - n.z * py) * s2), A * (py * s1 + (n.z * px - n.x * pz) * s2),
-          A * (pz * s1 + (n.x * py - n.y * px) * s2)};
+  return {A * (px * s1 + (n.y * pz - n.z * py) * s2) + kdt * vt.x,
+          A * (py * s1 + (n.z * px - n.x * pz) * s2) + kdt * vt.y,
+          A * (pz * s1 + (n.x * py - n.y * px) * s2) + kdt * vt.z};
 }
 
 // Coulomb's cap on a tangential force h (|h|² = h2) of the touching lanes:
@@ -436,17 +439,16 @@ DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
       D mi = zero;
       if constexpr (kDamped) mi = load<W>(a.m + i0);
       D fx = zero, fy = zero, fz = zero, tx = zero, ty = zero, tz = zero;
-      // With hardware gathers, the neighbours' positions are gathered one
-      // slot-vector ahead: they start the law's longest chain (d², its
-      // root, 1/|d|), and issued a slot-vector early the gathers no longer
-      // wait behind that chain in the scheduler (1.05-1.08x on Intel's
-      // AVX-512 path at 256-4 000 spheres; only the positions: gathering the
-      // velocities ahead too lost 1.03-1.04x). Emulated gathers are gathered
-      // where they are used: ahead, they lost 1.05-1.06x on AMD Zen 5's
-      // AVX-512 path, and were at par on the AVX2 path of Intel and Zen 5
-      // (performance.md, 2026-12-06). Either way the same values, so the
-      // same bits.
-      constexpr bool kAhead = G == Gather::kHardware;
+      // The neighbours' positions are gathered one slot-vector ahead: they
+      // start the law's longest chain (d², its root, 1/|d|), and issued a
+      // slot-vector early the gathers no longer wait behind that chain in
+      // the scheduler (1.05-1.08x on Intel's AVX-512 path with hardware
+      // gathers at 256-4 000 spheres; AVX2 at par on Intel, 1.01-1.04x on
+      // AMD Zen 5; only the positions: gathering the velocities ahead too
+      // lost 1.03-1.04x). Not on the AVX-512 path with emulated gathers,
+      // where ahead lost 1.05-1.06x on Zen 5 (performance.md, 2026-12-06).
+      // Either way the same values, so the same bits.
+      constexpr bool kAhead = !(W == 8 && G == Gather::kEmulated);
       D gx = zero, gy = zero, gz = zero;
       if (kAhead && s0 + sub < s1) {
         const int *J = a.slot_j + s0 + sub;
@@ -495,11 +497,9 @@ DEMCAL_INLINE double pair_blocks(const PairArgs &a, int b0, int b1) {
         const D uz = dvz - (rx * ny - ry * nx);
         const D un = ux * nx + uy * ny + uz * nz;
         const D vtx = ux - un * nx, vty = uy - un * ny, vtz = uz - un * nz;
-        const Vec3<W> turned = turned_history<W>({nx, ny, nz}, {sx, sy, sz}, {hx0, hy0, hz0}, mag2,
-                                                 held, inv_mag2, half_dt);
-        D hx = turned.x + kdt * vtx;
-        D hy = turned.y + kdt * vty;
-        D hz = turned.z + kdt * vtz;
+        const Vec3<W> trial = trial_history<W>({nx, ny, nz}, {sx, sy, sz}, {hx0, hy0, hz0}, mag2,
+                                               held, inv_mag2, half_dt, kdt, {vtx, vty, vtz});
+        D hx = trial.x, hy = trial.y, hz = trial.z;
         // Coulomb: |h| ≤ μ·fn. The root and the division only when a
         // touching lane slides (else cut = 1 in every lane that counts).
         const D cap = mu * fn, h2 = hx * hx + hy * hy + hz * hz;

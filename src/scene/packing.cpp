@@ -124,8 +124,9 @@ bool gas_consolidates(int dimension, int count, double aspect) {
 
 // The counts nearest `count` below and above it (up to kMaxParticles) whose
 // gas at `aspect` consolidates, 0 where none. A scan, not a bound: the set
-// of such counts has holes (3D, aspect 1.79: 10 does, 16 does not, 17 does,
-// as the ceilings of gas_grid fall).
+// of such counts has holes (3D, aspect 1.79: 15 does, 16 does not, 17 does:
+// at 16, gas_grid's cells across step up from 3 to 4, and 16 spheres fill
+// one layer of 4 x 4).
 std::pair<int64_t, int64_t> nearest_consolidating_counts(int dimension, int count, double aspect) {
   int64_t below = count - 1, above = int64_t{count} + 1;
   while (below > 0 && !gas_consolidates(dimension, static_cast<int>(below), aspect)) --below;
@@ -173,9 +174,9 @@ std::optional<GasLayersFault> gas_layers_fault(int dimension, int count, double 
     // the nearest counts that consolidate at this aspect.
     msg << "; at " << aspect_name << " " << aspect;
     if (below > 0 && above > 0)
-      msg << " the nearest counts that do are " << below << " and " << above;
+      msg << " the nearest counts that give a sample are " << below << " and " << above;
     else
-      msg << " the nearest count that does is " << (below > 0 ? below : above);
+      msg << " the nearest count that gives a sample is " << (below > 0 ? below : above);
     msg << " (or " << aspect_name << " above " << lo << " and up to about " << hi << " for count "
         << count << "); got " << count;
     return GasLayersFault{"count", msg.str(), false};
