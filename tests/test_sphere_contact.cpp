@@ -467,6 +467,86 @@ TEST(SphereContact, TangentialForceTurnsWithRigidlyRotatingPair) {
   }
 }
 
+// KernelOptions::max_overlap_ratio bounds a pair's overlap by the smaller
+// of its two radii (a small sphere pressed into a big one is what goes
+// wrong first): spheres of r and 3r overlapping by 0.3·r pass a bound of
+// 0.25 measured on the big one (0.1) but not on the small one, and stop the
+// run as an overlap divergence at the next check; 0.2·r stays below it.
+TEST(SphereContact, OverlapBoundIsOnTheSmallerRadius) {
+  const double r = kR;
+  for (const double overlap : {0.2, 0.3}) {
+    SCOPED_TRACE(overlap);
+    sphere_test::Scene s;
+    s.add(Vector3d::Zero(), r);
+    s.add(Vector3d(4.0 * r - overlap * r, 0.0, 0.0), 3.0 * r);
+    s.lo = {-10 * r, -10 * r, -10 * r};
+    s.hi = {10 * r, 10 * r, 10 * r};
+    KernelOptions options;
+    options.check_interval = 1;
+    options.max_overlap_ratio = 0.25;
+    SphereWorld w = s.make(test_material(0.3), options);
+    sphere_test::set_undamped(w, 1e-3);  // a tiny step: the overlap stays
+    const bool ran = w.step(2);
+    EXPECT_EQ(ran, overlap < 0.25);
+    EXPECT_EQ(w.divergence(), overlap < 0.25 ? Divergence::kNone : Divergence::kOverlap);
+  }
+}
+
+// Two spheres on the x axis spin together about it, Ω·Δt = `turn` radians a
+// step: the contact turns about its normal n = e_x and nothing else moves
+// (the centres stay on the axis and both spin alike, so v_rel = −(a_i +
+// a_j)·Ω × n = 0: no increment). The history is turned by the twist alone,
+// the Cayley rotation about n with c = Δt·n·(ω_i + ω_j)/4 = turn/2
+// (sphere_contact.cpp): by φ = 2·atan(turn/2) a step, which is turn −
+// turn³/12 + O(turn⁵), and with its length kept exactly, however large the
+// turn. The exact form of the scale A (turn_scale) takes over from its
+// series where |y − 1| = 2c² + c⁴ ≥ 1e-4, i.e. from turn ≈ 0.014 on: the
+// cases below are on both sides. Heavy masses (scaling 1e22): the forces
+// move nothing within the run.
+TEST(SphereContact, TwistTurnsTheHistoryByTheCayleyAngleAndKeepsItsLengthAtAnyRate) {
+  const double r = kR, delta = 1e-5;  // Fn = 1000 N
+  for (const double turn : {0.002, 0.05, 0.3, 1.0}) {
+    SCOPED_TRACE(turn);
+    sphere_test::Scene s;
+    s.add(Vector3d::Zero(), r);
+    s.add(Vector3d(2.0 * r - delta, 0.0, 0.0), r);
+    s.lo = {-10 * r, -10 * r, -10 * r};
+    s.hi = {10 * r, 10 * r, 10 * r};
+    // No divergence checks within the run: the spin's kinetic energy dwarfs
+    // the springs' (their measure, not the law, is what this run strains).
+    KernelOptions options;
+    options.check_interval = 1 << 20;
+    SphereWorld w = s.make(test_material(1.0), options);
+    Integration in = sphere_test::set_undamped(w, 0.0, 1e22);
+    in.dt = 1e-6;
+    w.set_integration(in);
+    // Load the tangential spring (|Ft| ≈ kt·5.6e-6 m = 280 N < μ·Fn), then
+    // put the sphere back on the axis, so that n = e_x (up to the forces'
+    // ≈ 1e-26 m of motion a step); one step turns the history into the
+    // contact plane.
+    w.set_velocity(1, Vector3d(0.0, 1.0, 0.5), Vector3d::Zero());
+    w.step(5);
+    w.set_velocity(1, Vector3d::Zero(), Vector3d::Zero());
+    w.set_position(1, Vector3d(2.0 * r - delta, 0.0, 0.0));
+    w.step(1);
+    const Vector3d h0 = w.contacts().at(0).tangential;
+    ASSERT_GT(h0.norm(), 100.0);
+    ASSERT_LE(std::abs(h0.x()), 1e-15 * h0.norm());
+    const Vector3d spin(turn / in.dt, 0.0, 0.0);
+    w.set_velocity(0, Vector3d::Zero(), spin);
+    w.set_velocity(1, Vector3d::Zero(), spin);
+    const int steps = 40;
+    ASSERT_TRUE(w.step(steps));
+    const double phi = 2.0 * std::atan(0.5 * turn);
+    const Vector3d expected = Eigen::AngleAxisd(steps * phi, Vector3d::UnitX()) * h0;
+    const Vector3d got = w.contacts().at(0).tangential;
+    // A few roundings a step: the turn's arithmetic, and A within 1.5 ulp.
+    const double tol = 16.0 * steps * kEps * h0.norm();
+    EXPECT_NEAR(got.norm(), h0.norm(), tol);
+    EXPECT_LE((got - expected).norm(), tol);
+  }
+}
+
 }  // namespace
 }  // namespace demcal
 

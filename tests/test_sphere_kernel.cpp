@@ -60,7 +60,8 @@ Matrix3d torque_skew(const SphereWorld& w) {
 }
 
 // V·(b − σ) = Σ_p x^p ⊗ F_p and σ − σᵀ = ε·ΣM/V hold at every instant (they
-// are rearrangements of the same sums): checked to round-off during a
+// are rearrangements of the same sums), and so does b_aa = the walls'
+// traction along a (frictionless walls): checked to round-off during a
 // dynamic, frictional, sliding run with moving walls.
 TEST(SphereStress, IdentitiesHoldToRoundOffDuringDynamicRun) {
   SphereWorld w = fcc_world(2, 2e-4, 0.3);
@@ -78,7 +79,7 @@ TEST(SphereStress, IdentitiesHoldToRoundOffDuringDynamicRun) {
                    v / kR * Vector3d(u(rng), u(rng), u(rng)));
   w.wall(kZMax).velocity = -1e-3;
   w.wall(kXMin).velocity = 5e-4;
-  int checked = 0;
+  int checked = 0, walls_pressed = 0;
   for (int k = 0; k < 20; ++k) {
     ASSERT_TRUE(w.step(50));
     const SphereMeasures m = w.measure();
@@ -93,9 +94,23 @@ TEST(SphereStress, IdentitiesHoldToRoundOffDuringDynamicRun) {
               tol);
     // Not trivially: the run is far from equilibrium.
     EXPECT_GT(w.net_force_moment().cwiseAbs().maxCoeff(), 1e3 * tol);
+    // The walls are frictionless (test_material), so b's normal components
+    // are their traction: each wall contact point lies on its wall's plane,
+    // L_a/2 from the centre, and carries a force along the axis, so b_aa =
+    // −(F_lo + F_hi)·(L_a/2)/V = (f_lo − f_hi)/(2·A_a), f the spheres' force
+    // on each wall along a (F_lo = −f_lo, F_hi = f_hi the compressions) and
+    // A_a = V/L_a the wall's area.
+    for (int a = 0; a < 3; ++a) {
+      const SphereWall& lo = w.wall(static_cast<SphereWallSide>(2 * a));
+      const SphereWall& hi = w.wall(static_cast<SphereWallSide>(2 * a + 1));
+      const double area = w.volume() / (hi.position - lo.position);
+      EXPECT_NEAR(m.boundary_stress(a, a), (lo.force[a] - hi.force[a]) / (2.0 * area), tol);
+      walls_pressed += lo.contacts + hi.contacts > 0;
+    }
     ++checked;
   }
   EXPECT_EQ(checked, 20);
+  EXPECT_GT(walls_pressed, 20);  // pairs of walls with contacts, over the 20 checks
 }
 
 // At rest every particle is balanced (F_p = 0, M_p = 0), so b = σ and σ is
