@@ -112,7 +112,7 @@ TEST(KernelContactDamping, RestitutionOfTheDampedHeadOnCollision) {
 // ω·Δt and the ledger's largest reading, the ledger's stop on (a false
 // "energy created" fails).
 struct Bounce2D {
-  double restitution = 0.0, h = 0.0, ledger_max = -1e300;
+  double restitution = 0.0, h = 0.0, ledger_max = -1e300, ledger_min = 1e300;
   int contact_steps = 0;
   bool parted = false;
 };
@@ -159,6 +159,7 @@ TEST(KernelContactDamping, ADiskBouncesOffEachWallWithTheClampedDashpotsRestitut
       EXPECT_NEAR(b.restitution, clamped_restitution(zeta),
                   clamped_restitution_tolerance(zeta, b.h));
       EXPECT_LE(b.ledger_max, bounce_ledger_bound(zeta, b.h));
+      EXPECT_GE(b.ledger_min, -bounce_ledger_bound(zeta, b.h));
     }
 }
 
@@ -204,10 +205,11 @@ TEST(KernelContactDamping, UnequalDisksBounceWithTheReducedMassesRestitution) {
     b.restitution = ((w.vx()[1] - w.vx()[0]) * ux + (w.vy()[1] - w.vy()[0]) * uy) / (2.0 * v0);
     EXPECT_NEAR(b.restitution, clamped_restitution(zeta), clamped_restitution_tolerance(zeta, b.h));
     EXPECT_LE(b.ledger_max, bounce_ledger_bound(zeta, b.h));
-    std::printf("2D pair, zeta %.2f: e %.6f, clamped %.6f (%+.2e, bound %.1e), ledger <= %.1e\n",
-                zeta, b.restitution, clamped_restitution(zeta),
-                b.restitution - clamped_restitution(zeta), clamped_restitution_tolerance(zeta, b.h),
-                b.ledger_max);
+    EXPECT_GE(b.ledger_min, -bounce_ledger_bound(zeta, b.h));
+    std::printf(
+        "2D pair, zeta %.2f: e %.6f, clamped %.6f (%+.2e, bound %.1e), ledger in [%.1e, %.1e]\n",
+        zeta, b.restitution, clamped_restitution(zeta), b.restitution - clamped_restitution(zeta),
+        clamped_restitution_tolerance(zeta, b.h), b.ledger_min, b.ledger_max);
   }
 }
 

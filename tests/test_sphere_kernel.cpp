@@ -182,26 +182,34 @@ TEST(SphereDamping, FreeSphereDecaysAtTheDiscreteRate) {
 // tangential spring with both translations and spins, b = (−e, a·(e × n),
 // e, a·(e × n)) over (u_0, θ_0, u_1, θ_1): ω² = kt·|M^-½ b|² =
 // (2kt/m)·(1 + a²·m/I) = (2kt/m)·(1 + 2.5·a²/r²). With rotation locked only
-// translations: max(2kn/m, 2kt/m).
+// translations: max(2kn/m, 2kt/m). The Gershgorin bound must stay above:
+// with the branch along an axis its rows are nearest to the eigenvalue (the
+// spin rows' sum (kt/m)·√2.5·(2 + 2√2.5) = 8.16·kt/m against 7·kt/m),
+// with a skewed branch the directions' components spread over the axes and
+// loosen it.
 TEST(SphereStability, ContactPairEstimateMatchesEigenvalues) {
   const double delta = 1e-6;
-  sphere_test::Scene s;
-  s.add(Vector3d::Zero(), kR);
-  s.add((2.0 * kR - delta) * Vector3d(1.0, -2.0, 2.0) / 3.0, kR);
-  s.lo = {-10 * kR, -10 * kR, -10 * kR};
-  s.hi = {10 * kR, 10 * kR, 10 * kR};
-  SphereWorld w = s.make(test_material(0.3));
-  const double m = w.mass()[0], kn = 1e8, kt = 5e7, a = kR - 0.5 * delta;
-  const double w2_rot = 2.0 * kt / m * (1.0 + 2.5 * a * a / (kR * kR));
-  const double w2_trans = std::max(2.0 * kn / m, 2.0 * kt / m);
-  ASSERT_GT(w2_rot, w2_trans);  // the rotational mode binds
-  const StabilityEstimate e = w.stability_estimate();
-  EXPECT_NEAR(e.omega2_max, w2_rot, 1e-9 * w2_rot);
-  EXPECT_GE(e.omega2_gershgorin, e.omega2_max * (1.0 - 1e-12));
-  const double dt_crit = w.reference_scales().dt_crit;
-  EXPECT_NEAR(dt_crit, 2.0 * std::sqrt(m / kn), 1e-15 * dt_crit);
-  EXPECT_NEAR(e.dt_ratio_stable_translation, 2.0 / std::sqrt(w2_trans) / dt_crit, 1e-9);
-  EXPECT_NEAR(e.dt_ratio_stable, 2.0 / std::sqrt(w2_rot) / dt_crit, 1e-9);
+  for (const Vector3d& branch :
+       {Vector3d(Vector3d(1.0, -2.0, 2.0) / 3.0), Vector3d(1.0, 0.0, 0.0)}) {
+    SCOPED_TRACE(branch.transpose());
+    sphere_test::Scene s;
+    s.add(Vector3d::Zero(), kR);
+    s.add((2.0 * kR - delta) * branch, kR);
+    s.lo = {-10 * kR, -10 * kR, -10 * kR};
+    s.hi = {10 * kR, 10 * kR, 10 * kR};
+    SphereWorld w = s.make(test_material(0.3));
+    const double m = w.mass()[0], kn = 1e8, kt = 5e7, a = kR - 0.5 * delta;
+    const double w2_rot = 2.0 * kt / m * (1.0 + 2.5 * a * a / (kR * kR));
+    const double w2_trans = std::max(2.0 * kn / m, 2.0 * kt / m);
+    ASSERT_GT(w2_rot, w2_trans);  // the rotational mode binds
+    const StabilityEstimate e = w.stability_estimate();
+    EXPECT_NEAR(e.omega2_max, w2_rot, 1e-9 * w2_rot);
+    EXPECT_GE(e.omega2_gershgorin, e.omega2_max * (1.0 - 1e-12));
+    const double dt_crit = w.reference_scales().dt_crit;
+    EXPECT_NEAR(dt_crit, 2.0 * std::sqrt(m / kn), 1e-15 * dt_crit);
+    EXPECT_NEAR(e.dt_ratio_stable_translation, 2.0 / std::sqrt(w2_trans) / dt_crit, 1e-9);
+    EXPECT_NEAR(e.dt_ratio_stable, 2.0 / std::sqrt(w2_rot) / dt_crit, 1e-9);
+  }
 }
 
 // Energy conservation, undamped. Scene: FCC 2×2×2 (32 spheres)

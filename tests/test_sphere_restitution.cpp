@@ -114,7 +114,7 @@ struct Bounce {
   bool parted = false;
   Vector3d tangential_before, tangential_after;  // the sphere's velocity along the wall
   Vector3d spin_after;
-  double ledger_max = 0.0;  // the energy ledger's largest reading
+  double ledger_max = 0.0, ledger_min = 0.0;  // the energy ledger's largest and smallest readings
 };
 
 /// A sphere of radius kR a gap of 1e-5·r from wall `side` moving onto it at
@@ -209,6 +209,7 @@ TEST(SphereRestitution, ASphereBouncesOffEachWallWithTheClampedDashpotsRestituti
       EXPECT_EQ(b.tangential_after, b.tangential_before);
       EXPECT_EQ(b.spin_after, Vector3d::Zero());
       EXPECT_LE(b.ledger_max, bounce_ledger_bound(zeta, b.h));
+      EXPECT_GE(b.ledger_min, -bounce_ledger_bound(zeta, b.h));
       if (side == 0)
         std::printf("wall, zeta %.2f: e %.6f, clamped %.6f (%+.2e, bound %.1e), pulling %.6f\n",
                     zeta, b.restitution, e, b.restitution - e,
@@ -229,6 +230,7 @@ TEST(SphereRestitution, AMovingWallHitsARestingSphereWithTheSameRestitution) {
       EXPECT_NEAR(b.restitution, clamped_restitution(zeta),
                   clamped_restitution_tolerance(zeta, b.h));
       EXPECT_LE(b.ledger_max, bounce_ledger_bound(zeta, b.h));
+      EXPECT_GE(b.ledger_min, -bounce_ledger_bound(zeta, b.h));
     }
 }
 
@@ -241,9 +243,11 @@ TEST(SphereRestitution, UnequalSpheresBounceWithTheReducedMassesRestitution) {
     const double e = clamped_restitution(zeta);
     EXPECT_NEAR(b.restitution, e, clamped_restitution_tolerance(zeta, b.h));
     EXPECT_LE(b.ledger_max, bounce_ledger_bound(zeta, b.h));
-    std::printf("pair, zeta %.2f: e %.6f, clamped %.6f (%+.2e, bound %.1e), ledger <= %.1e\n", zeta,
-                b.restitution, e, b.restitution - e, clamped_restitution_tolerance(zeta, b.h),
-                b.ledger_max);
+    EXPECT_GE(b.ledger_min, -bounce_ledger_bound(zeta, b.h));
+    std::printf(
+        "pair, zeta %.2f: e %.6f, clamped %.6f (%+.2e, bound %.1e), ledger in [%.1e, %.1e]\n", zeta,
+        b.restitution, e, b.restitution - e, clamped_restitution_tolerance(zeta, b.h), b.ledger_min,
+        b.ledger_max);
   }
 }
 

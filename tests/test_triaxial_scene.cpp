@@ -3,6 +3,7 @@
 // σ3 on all six walls; Thornton's FCC peak with rotation locked).
 #include <gtest/gtest.h>
 
+#include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -432,6 +433,46 @@ TEST(TriaxialScene, WithContactDampingConsolidatesAndLoads) {
       static_cast<long long>(s.steps), ratio, analytical, 100.0 * (ratio / analytical - 1.0));
   EXPECT_NEAR(ratio, analytical, 0.02 * analytical);
   for (double e : r.series.back().servo_error) EXPECT_LT(std::abs(e), 0.05);
+}
+
+// The monitor's powers: the global damping's D·|v|² summed over the
+// spheres, with D_t = ζ_t·2·sqrt(kn·m) and D_r = ζ_r·2·sqrt(kt·r²·I) (the
+// damping the kernel applies, sphere_world.cpp), and the axial power the
+// top wall's push times its speed. The diagnosis reads their ratio as the
+// rotational drag (rotational_drag_share). Checked at every monitoring
+// point of a short loading with free rotation, against the world there.
+TEST(TriaxialScene, MonitoredPowersAreTheGlobalDampingsAndTheTopWalls) {
+  const int n = 3;
+  SceneConfig c = parse(fcc_text(n, 1e7, 5e-4, 5000, false));
+  const double zeta_t = 0.3, zeta_r = 0.5;
+  c.algorithm.damping_ratio_translation = zeta_t;
+  c.algorithm.damping_ratio_rotation = zeta_r;
+  const TriaxialState s = consolidate_triaxial(c, make_sphere_assembly(c));
+  ASSERT_TRUE(s.converged);
+  int checked = 0, pushing = 0;
+  auto observe = [&](const TriaxialPoint& p, const SphereWorld& w) {
+    const double kn = w.material().particle.kn, kt = w.material().particle.kt;
+    double pt = 0.0, pr = 0.0;
+    for (int i = 0; i < w.size(); ++i) {
+      const double m = w.mass()[i], inertia = w.inertia()[i], r = w.radius()[i];
+      const Eigen::Vector3d v(w.vx()[i], w.vy()[i], w.vz()[i]);
+      const Eigen::Vector3d om(w.omega_x()[i], w.omega_y()[i], w.omega_z()[i]);
+      pt += zeta_t * 2.0 * std::sqrt(kn * m) * v.squaredNorm();
+      pr += zeta_r * 2.0 * std::sqrt(kt * r * r * inertia) * om.squaredNorm();
+    }
+    EXPECT_NEAR(p.damping_power_translation, pt, 1e-12 * pt);
+    EXPECT_NEAR(p.damping_power_rotation, pr, 1e-12 * pr);
+    const SphereWall& top = w.wall(kZMax);  // moving down (v < 0), pushed up
+    const double axial = -top.force[2] * top.velocity;
+    EXPECT_NEAR(p.axial_power, axial, 1e-12 * std::abs(axial));
+    pushing += axial > 0.0;
+    ++checked;
+  };
+  const TriaxialResult r = run_triaxial_loading(s, c.test, c.algorithm, {}, nullptr, observe);
+  ASSERT_FALSE(r.diverged);
+  EXPECT_GT(checked, 40);
+  EXPECT_GT(pushing, 40);
+  EXPECT_GT(r.series.back().damping_power_rotation, 0.0);  // the spheres spin
 }
 
 }  // namespace
