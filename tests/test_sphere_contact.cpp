@@ -640,7 +640,10 @@ TEST(SphereContact, WallFrictionOnEveryWallWithSpin) {
     SphereWorld w = sphere_on_wall(mat, side, delta, L);
     const Integration in = w.integration();
     const Vector3d v = V * (Vector3d::Unit(b) - 2.0 * Vector3d::Unit(c)).normalized();
-    const Vector3d omega = (0.7 * V / r) * Vector3d::Unit(b);
+    // A spin about all three axes: about each of the wall's two tangents it
+    // rolls the contact point along the other; about the normal, nothing.
+    const Vector3d omega =
+        (V / r) * (0.7 * Vector3d::Unit(b) - 0.4 * Vector3d::Unit(c) + 0.5 * Vector3d::Unit(a));
     w.set_velocity(0, v, omega);
     const Vector3d slip = v + omega.cross(-(r - delta) * g);
     const double fn = mat.wall.kn * delta, ktw = mat.wall.kt;
