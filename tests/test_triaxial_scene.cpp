@@ -129,10 +129,13 @@ double max_wall_error(const SphereWorld& w, double sigma3) {
 // A loose random gas is compressed until every one of the six walls carries
 // σ3 within the consolidation tolerance and the sample is static. σ3 = 1e7
 // Pa: kn/(σ3·d) = 1e4, the stiffness level of configs/random_500_3d.json (kn 1e6 at 100 kPa there).
+// A box about 1.6 times as wide as high (assembly.aspect), so that each
+// wall's pressure must be its force over its own face: the boundary stress
+// b, from the contact points, reads σ3 on all three axes.
 TEST(TriaxialScene, ConsolidationReachesSigma3OnAllSixWalls) {
   const SceneConfig c = parse(
       R"({"dimension": 3, "assembly": {"type": "random", "count": 60, "radius_min": 4e-4,
-          "radius_max": 6e-4, "seed": 2}, "test": {"lateral_stress": 1e7}})");
+          "radius_max": 6e-4, "aspect": 1.6, "seed": 2}, "test": {"lateral_stress": 1e7}})");
   const SphereAssembly a = make_sphere_assembly(c);
   int calls = 0;
   const TriaxialState s =
@@ -142,8 +145,14 @@ TEST(TriaxialScene, ConsolidationReachesSigma3OnAllSixWalls) {
   EXPECT_TRUE(s.converged);
   EXPECT_GT(calls, 0);
   EXPECT_LT(max_wall_error(s.world, c.test.lateral_stress), c.test.consolidation_tolerance);
-  EXPECT_LT(s.world.measure().unbalanced_force_ratio, c.test.consolidation_unbalanced);
-  for (int axis = 0; axis < 3; ++axis) EXPECT_EQ(s.extent0[axis], s.world.extent(axis));
+  const SphereMeasures m = s.world.measure();
+  EXPECT_LT(m.unbalanced_force_ratio, c.test.consolidation_unbalanced);
+  EXPECT_GT(s.world.extent(0), 1.3 * s.world.extent(2));
+  for (int axis = 0; axis < 3; ++axis) {
+    EXPECT_EQ(s.extent0[axis], s.world.extent(axis));
+    EXPECT_NEAR(-m.boundary_stress(axis, axis), c.test.lateral_stress,
+                c.test.consolidation_tolerance * c.test.lateral_stress);
+  }
   // Friction is on for the loading.
   EXPECT_EQ(s.world.material().particle.friction, c.material.particle.friction);
 }
