@@ -38,6 +38,7 @@ using kernel_test::kR;
 using kernel_test::reference_material;
 
 using test::bounce_ledger_bound;
+using test::bounce_ledger_lower_bound;
 using test::clamped_restitution;
 using test::clamped_restitution_tolerance;
 
@@ -109,8 +110,8 @@ TEST(KernelContactDamping, RestitutionOfTheDampedHeadOnCollision) {
 
 // A bounce stepped one step at a time until the bodies part
 // (test::step_until_parted, as the sphere kernel's tests): restitution,
-// ω·Δt and the ledger's largest reading, the ledger's stop on (a false
-// "energy created" fails).
+// ω·Δt and the ledger's largest and smallest readings, the ledger's stop
+// on (a false "energy created" fails).
 struct Bounce2D {
   double restitution = 0.0, h = 0.0, ledger_max = -1e300, ledger_min = 1e300;
   int contact_steps = 0;
@@ -159,7 +160,7 @@ TEST(KernelContactDamping, ADiskBouncesOffEachWallWithTheClampedDashpotsRestitut
       EXPECT_NEAR(b.restitution, clamped_restitution(zeta),
                   clamped_restitution_tolerance(zeta, b.h));
       EXPECT_LE(b.ledger_max, bounce_ledger_bound(zeta, b.h));
-      EXPECT_GE(b.ledger_min, -bounce_ledger_bound(zeta, b.h));
+      EXPECT_GE(b.ledger_min, -bounce_ledger_lower_bound(zeta, b.h));
     }
 }
 
@@ -205,7 +206,7 @@ TEST(KernelContactDamping, UnequalDisksBounceWithTheReducedMassesRestitution) {
     b.restitution = ((w.vx()[1] - w.vx()[0]) * ux + (w.vy()[1] - w.vy()[0]) * uy) / (2.0 * v0);
     EXPECT_NEAR(b.restitution, clamped_restitution(zeta), clamped_restitution_tolerance(zeta, b.h));
     EXPECT_LE(b.ledger_max, bounce_ledger_bound(zeta, b.h));
-    EXPECT_GE(b.ledger_min, -bounce_ledger_bound(zeta, b.h));
+    EXPECT_GE(b.ledger_min, -bounce_ledger_lower_bound(zeta, b.h));
     std::printf(
         "2D pair, zeta %.2f: e %.6f, clamped %.6f (%+.2e, bound %.1e), ledger in [%.1e, %.1e]\n",
         zeta, b.restitution, clamped_restitution(zeta), b.restitution - clamped_restitution(zeta),

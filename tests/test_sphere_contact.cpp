@@ -647,7 +647,7 @@ TEST(SphereContact, WallFrictionOnEveryWallWithSpin) {
     w.set_velocity(0, v, omega);
     const Vector3d slip = v + omega.cross(-(r - delta) * g);
     const double fn = mat.wall.kn * delta, ktw = mat.wall.kt;
-    // Steps until the spring reaches the cap (400 to 1400 here): run twice
+    // Steps until the spring reaches the cap (500 to 920 here): run twice
     // as many.
     const double k_cap = mu_w * fn / (ktw * slip.norm() * in.dt);
     int stuck = 0, slid = 0;

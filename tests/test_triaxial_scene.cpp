@@ -131,7 +131,9 @@ double max_wall_error(const SphereWorld& w, double sigma3) {
 // Pa: kn/(σ3·d) = 1e4, the stiffness level of configs/random_500_3d.json (kn 1e6 at 100 kPa there).
 // A box about 1.6 times as wide as high (assembly.aspect), so that each
 // wall's pressure must be its force over its own face: the boundary stress
-// b, from the contact points, reads σ3 on all three axes.
+// b, from the contact points, reads σ3 on all three axes. (Its x and y
+// extents are equal, so this tells the z walls' face from the lateral
+// ones', not x's from y's.)
 TEST(TriaxialScene, ConsolidationReachesSigma3OnAllSixWalls) {
   const SceneConfig c = parse(
       R"({"dimension": 3, "assembly": {"type": "random", "count": 60, "radius_min": 4e-4,

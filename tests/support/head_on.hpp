@@ -117,18 +117,20 @@ inline double clamped_restitution_tolerance(double zeta, double h) {
 /// leapfrog energy (h), the dashpot's loss booked for the whole first
 /// touching step (4ζh) and at the half-step-old velocity (2ζh), each of
 /// the incoming kinetic energy (test_sphere_restitution.cpp derives it).
-/// It bounds the reading's size, on either side: below −bound the ledger
-/// would be missing a loss it should book.
 inline double bounce_ledger_bound(double zeta, double h) { return (1.0 + 6.0 * zeta) * h; }
+
+/// Its bound from below, (1 + 2ζ)·h: the first touching step's over-booking
+/// only raises the reading, the other two errors go either way. Below it
+/// the ledger would be missing a loss it should book.
+inline double bounce_ledger_lower_bound(double zeta, double h) { return (1.0 + 2.0 * zeta) * h; }
 
 /// Steps `w` one step at a time until the contact (overlap() > 0) has been
 /// made and has parted, at most 20 000 steps, with the energy ledger on:
 /// into `out` (fields contact_steps, parted, ledger_max, ledger_min) its
 /// steps in contact, whether it parted and the ledger's largest and
-/// smallest readings. A stop of
-/// the kernel (a false "energy created") fails the test. Both kernels'
-/// restitution tests (test_kernel_contact_damping.cpp,
-/// test_sphere_restitution.cpp).
+/// smallest readings. A stop of the kernel (a false "energy created")
+/// fails the test. Both kernels' restitution tests
+/// (test_kernel_contact_damping.cpp, test_sphere_restitution.cpp).
 template <class Sample, class Overlap, class Bounce>
 void step_until_parted(Sample& w, const Overlap& overlap, Bounce& out) {
   out.ledger_max = -1e300;
