@@ -116,10 +116,15 @@ constexpr int kMinGasAcross3D = 3;
 
 namespace {
 
+// The least cells across a gas needs: 2 disks, 3 spheres.
+int min_gas_across(int dimension) { return dimension == 3 ? kMinGasAcross3D : kMinGasLayers; }
+
+bool grid_consolidates(const GasGrid& grid, int dimension) {
+  return grid.layers >= kMinGasLayers && grid.across >= min_gas_across(dimension);
+}
+
 bool gas_consolidates(int dimension, int count, double aspect) {
-  const GasGrid grid = gas_grid(dimension, count, aspect);
-  const int min_across = dimension == 3 ? kMinGasAcross3D : kMinGasLayers;
-  return grid.layers >= kMinGasLayers && grid.across >= min_across;
+  return grid_consolidates(gas_grid(dimension, count, aspect), dimension);
 }
 
 // The counts nearest `count` below and above it (up to kMaxParticles) whose
@@ -139,11 +144,11 @@ std::pair<int64_t, int64_t> nearest_consolidating_counts(int dimension, int coun
 
 std::optional<GasLayersFault> gas_layers_fault(int dimension, int count, double aspect,
                                                bool count_changed, const std::string& aspect_name) {
-  if (gas_consolidates(dimension, count, aspect)) return std::nullopt;
   const GasGrid grid = gas_grid(dimension, count, aspect);
+  if (grid_consolidates(grid, dimension)) return std::nullopt;
   const bool three_d = dimension == 3;
-  const int min_across = three_d ? kMinGasAcross3D : kMinGasLayers;
-  const double n = count, k = kMinGasLayers, m = min_across, dim = three_d ? 3.0 : 2.0;
+  const double n = count, k = kMinGasLayers, m = min_gas_across(dimension),
+               dim = three_d ? 3.0 : 2.0;
   const double c = std::ceil(std::pow(n / (k - 1.0), 1.0 / (dim - 1.0))) - 1.0;
   const char* what = three_d ? "spheres" : "disks";
   std::ostringstream msg;
@@ -181,8 +186,8 @@ std::optional<GasLayersFault> gas_layers_fault(int dimension, int count, double 
         << count << "); got " << count;
     return GasLayersFault{"count", msg.str(), false};
   }
-  msg << ", i.e. aspect above " << lo << " and up to about " << hi << " for count " << count
-      << "; got " << aspect;
+  msg << ", i.e. " << aspect_name << " above " << lo << " and up to about " << hi << " for count "
+      << count << "; got " << aspect;
   return GasLayersFault{"aspect", msg.str(), false};
 }
 
