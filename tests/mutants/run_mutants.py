@@ -5,12 +5,15 @@
 
 Each mutant of MUTANTS_JSON (default: sphere_kernel.json beside this script)
 is one small, deliberate error in the source tree -- {"name", "file", "old",
-"new"}, "old" replaced by "new" where it occurs exactly once. First the
+"new"}, "old" replaced by "new" where it occurs exactly once. A listing is a
+JSON list of mutants, or {"filter": GTEST_FILTER, "mutants": [...]}: the
+tests its mutants are checked against (disk_kernel.json, protocols.json). First the
 tests run once on the tree as it is: they must pass, or every mutant would
 read as noticed. Then for each mutant in turn: the file is changed,
 BUILD_DIR's demcal_tests is rebuilt, the tests of the filter run (default
-DEFAULT_FILTER below: the sphere kernel's suites and the 3D scene's and
-scoring's that read it; a mutant may name its own "filter"), and the file is
+the listing's, else DEFAULT_FILTER below: the sphere kernel's suites and the
+3D scene's and scoring's that read it; a mutant may name its own "filter",
+--filter overrides both), and the file is
 put back. A mutant no test notices (SURVIVED) is a fact of the code no test
 pins, or an error that changes nothing measurable (say which, in
 reports/mutants-3d.md). Exit status 0 when every mutant was noticed, 1 when
@@ -107,12 +110,16 @@ def main():
     if not home or os.path.realpath(home[0]) != os.path.realpath(root):
         return usage_error(f"{build_dir} was configured from {home[0] if home else '?'}, "
                            f"not from {root}")
-    mutants = json.loads(read(listing))
+    listed = json.loads(read(listing))
+    if isinstance(listed, dict):
+        list_filter, mutants = listed.get("filter", DEFAULT_FILTER), listed["mutants"]
+    else:
+        list_filter, mutants = DEFAULT_FILTER, listed
 
     # The tests must pass on the tree as it is.
     if not build(build_dir):
         return usage_error("demcal_tests does not build on the unchanged tree")
-    for f in sorted({flt or m.get("filter", DEFAULT_FILTER) for m in mutants}):
+    for f in sorted({flt or m.get("filter", list_filter) for m in mutants}):
         failing, names = run_tests(build_dir, f)
         if failing:
             return usage_error(f"the unchanged tree fails {f}: {' '.join(names)}")
@@ -144,7 +151,7 @@ def main():
                 print(f"{m['name']}: BUILD FAILED")
                 counts["BUILD FAILED"] += 1
                 continue
-            noticed, failed = run_tests(build_dir, flt or m.get("filter", DEFAULT_FILTER))
+            noticed, failed = run_tests(build_dir, flt or m.get("filter", list_filter))
         finally:
             write(path, text)
             del current[path]
