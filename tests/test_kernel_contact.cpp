@@ -7,6 +7,7 @@
 #include <array>
 #include <cmath>
 #include <numbers>
+#include <string>
 #include <vector>
 
 #include "support/head_on.hpp"
@@ -146,6 +147,76 @@ TEST(KernelContact, WallFrictionSticksThenSlidesAtCoulombLimitWithTorque) {
   const double expected = mu_w * mat.wall.kn * delta / (ktw * V * in.dt);
   EXPECT_NEAR(first_slide, expected, 1.0);
   EXPECT_TRUE(sliding);
+}
+
+// An incremental spring belongs to one contact. A disk dragged along a
+// frictional wall loads the wall's tangential spring; lifted off and put
+// back straight down (by less than the skin: it stays on the wall's
+// candidate list, the spring's slot kept), it makes a new contact whose
+// spring starts at zero, and with no tangential motion since it carries no
+// tangential force at all: exactly 0, not the old spring cut to μ·Fn.
+// Heavy masses (scaling 1e9), no damping and the rotation locked: the set
+// velocities are the motion.
+TEST(KernelContact, WallSpringStartsAtZeroWhenADiskTouchesAgain) {
+  const Material mat = reference_material(0.3, 0.4);
+  const double r = kR, delta = 1e-6;  // Fn = 100 N, μ_w·Fn = 40 N
+  const std::vector<double> x{0.0}, y{r - delta}, rad{r};
+  World w(mat, x, y, rad, -20 * r, 20 * r, 0.0, 10 * r);
+  Integration in;
+  in.dt = 1e-6;
+  in.damping_ratio_translation = 0.0;  // the set velocities are the motion
+  in.mass_scaling = 1e9;
+  in.lock_rotation = true;
+  w.set_integration(in);
+  for (int s = 0; s < 200; ++s) {  // slip 1e-9 m a step: kt_w·2e-7 m = 10 N
+    w.set_velocity(0, 1e-3, 0.0, 0.0);
+    ASSERT_TRUE(w.step(1));
+  }
+  ASSERT_NEAR(w.wall(kBottom).force.x(), mat.wall.kt * 2e-7, 1e-6 * mat.wall.kt * 2e-7);
+  const int64_t rebuilds = w.rebuilds();
+  bool apart = false;
+  for (int s = 0; s < 400; ++s) {  // 2e-6 m up, then down again: 1e-8 m a step
+    w.set_velocity(0, 0.0, s < 200 ? 1e-2 : -1e-2, 0.0);
+    ASSERT_TRUE(w.step(1));
+    apart = apart || w.wall(kBottom).contacts == 0;
+    if (apart) {
+      ASSERT_EQ(w.wall(kBottom).force.x(), 0.0) << "step " << s;
+    }
+  }
+  EXPECT_TRUE(apart);
+  EXPECT_EQ(w.rebuilds(), rebuilds);  // the same list throughout
+  ASSERT_EQ(w.wall(kBottom).contacts, 1);
+  EXPECT_NEAR(-w.wall(kBottom).force.y(), mat.wall.kn * delta, 1e-3 * mat.wall.kn * delta);
+}
+
+// The overlap bound (KernelOptions::max_overlap_ratio) is on the smaller
+// radius, overlap/min(r_i, r_j): the smaller disk is the one an overlap
+// cuts deepest into. Disks r and 3r overlapping by 0.2·r and 0.3·r against
+// a bound of 0.25 (on the larger radius they would read 0.067 and 0.1); a
+// disk in a wall is measured on its own radius (on its diameter, 0.1 and
+// 0.15).
+TEST(KernelContact, OverlapBoundIsOnTheSmallerRadius) {
+  const double r = kR;
+  for (const bool wall : {false, true})
+    for (const double overlap : {0.2, 0.3}) {
+      SCOPED_TRACE(std::string(wall ? "wall, " : "pair, ") + std::to_string(overlap));
+      KernelOptions options;
+      options.check_interval = 1;
+      options.max_overlap_ratio = 0.25;
+      std::vector<double> x{0.0, 4.0 * r - overlap * r}, y{0.0, 0.0}, rad{r, 3.0 * r};
+      if (wall) {  // one disk in the left wall
+        x = {-10 * r + r - overlap * r};
+        y = {0.0};
+        rad = {r};
+      }
+      World w(reference_material(0.3), x, y, rad, -10 * r, 10 * r, -10 * r, 10 * r, options);
+      Integration in;
+      in.dt = 1e-3 * w.reference_scales().dt_crit;  // a tiny step: the overlap stays
+      w.set_integration(in);
+      const bool ran = w.step(2);
+      EXPECT_EQ(ran, overlap < 0.25);
+      EXPECT_EQ(w.divergence(), overlap < 0.25 ? Divergence::kNone : Divergence::kOverlap);
+    }
 }
 
 // Two heavy disks in contact, the upper one (j) dragged sideways over the

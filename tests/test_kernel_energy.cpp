@@ -130,5 +130,35 @@ TEST(KernelEnergy, StickingFrictionalHexPackingConservesEnergyUndamped) {
   expect_conserved(run_vibrating_hex(10.0, 0.1, 8));
 }
 
+// A wall's springs store ½·Fn²/kn_w + ½·Ft²/kt_w, with the wall's own
+// stiffnesses (here 3e8 and 2e7 N/m, not the particles' 1e8 and 5e7): a
+// disk pressed 1e-6 m into the bottom wall and dragged 2e-7 m along it
+// (heavy, undamped, rotation locked: the set velocity is the motion) holds
+// Fn = kn_w·δ and Ft = kt_w·2e-7 m, and World::measure's elastic energy
+// is their sum (to round-off).
+TEST(KernelEnergy, WallSpringsStoreTheirEnergyWithTheWallsStiffnesses) {
+  Material mat = kernel_test::reference_material(0.3, 0.4);
+  mat.wall.kn = 3e8;
+  mat.wall.kt = 2e7;
+  const double r = kernel_test::kR, delta = 1e-6;
+  const std::vector<double> x{0.0}, y{r - delta}, rad{r};
+  World w(mat, x, y, rad, -20 * r, 20 * r, 0.0, 10 * r);
+  Integration in;
+  in.dt = 1e-6;
+  in.damping_ratio_translation = 0.0;
+  in.mass_scaling = 1e9;
+  in.lock_rotation = true;
+  w.set_integration(in);
+  for (int s = 0; s < 200; ++s) {
+    w.set_velocity(0, 1e-3, 0.0, 0.0);
+    ASSERT_TRUE(w.step(1));
+  }
+  const double overlap = r - (w.y()[0] - w.wall(kBottom).position);
+  const double fn = mat.wall.kn * overlap, ft = w.wall(kBottom).force.x();
+  ASSERT_NEAR(ft, mat.wall.kt * 2e-7, 1e-6 * mat.wall.kt * 2e-7);
+  const double expected = 0.5 * fn * fn / mat.wall.kn + 0.5 * ft * ft / mat.wall.kt;
+  EXPECT_NEAR(w.measure().elastic_energy, expected, 1e-12 * expected);
+}
+
 }  // namespace
 }  // namespace demcal

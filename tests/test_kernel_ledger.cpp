@@ -13,7 +13,9 @@
 
 #include <cmath>
 #include <random>
+#include <string>
 #include <utility>
+#include <vector>
 
 #include "test_kernel_helpers.hpp"
 
@@ -115,6 +117,76 @@ TEST(KernelLedger, BeyondTheStableStepIsDivergedWhenDamped) {
     EXPECT_TRUE(stable.step(20000))
         << to_string(stable.divergence()) << ", zeta_t " << zeta_t << ", zeta_r " << zeta_r;
   }
+}
+
+// The kinetic-energy check (KernelOptions::max_energy_ratio) weighs the
+// spins as the velocities: a kinetic energy beyond that ratio of the largest
+// energy the springs have held is an unstable mode growing, whether it
+// turns or moves. Two frictionless disks pressed together along (0.6, 0.8)
+// hold E = ½·kn·δ² and nothing else; one of them is then given a spin of
+// ½·I·ω² = f·1e3·E (frictionless: the spin touches nothing else). f = 2 is
+// a divergence at the next check, f = 0.5 is not; a velocity of the same
+// energy, along the contact plane, reads the same.
+TEST(KernelLedger, TheKineticEnergyCheckWeighsSpinsAsVelocities) {
+  const double r = kernel_test::kR, delta = 1e-6;
+  const Material mat = kernel_test::reference_material(0.0);
+  const double d = 2.0 * r - delta;
+  const std::vector<double> x{0.0, 0.6 * d}, y{0.0, 0.8 * d}, rad{r, r};
+  for (const bool spin : {true, false})
+    for (const double f : {0.5, 2.0}) {
+      SCOPED_TRACE(std::string(spin ? "spin" : "velocity") + " at " + std::to_string(f));
+      KernelOptions options;
+      options.check_interval = 1;
+      World w(mat, x, y, rad, -10 * r, 10 * r, -10 * r, 10 * r, options);
+      Integration in;
+      in.dt = 0.01 * w.reference_scales().dt_crit;
+      in.damping_ratio_translation = in.damping_ratio_rotation = 0.0;
+      w.set_integration(in);
+      const double energy = w.measure().elastic_energy;
+      ASSERT_NEAR(energy, 0.5 * mat.particle.kn * delta * delta, 1e-6 * energy);
+      ASSERT_TRUE(w.step(1));  // the kernel's energy scale: E
+      const double ke = f * options.max_energy_ratio * energy;
+      const double m = w.mass()[0], inertia = 0.5 * m * r * r;
+      if (spin)
+        w.set_velocity(0, 0.0, 0.0, std::sqrt(2.0 * ke / inertia));
+      else
+        w.set_velocity(0, -0.8 * std::sqrt(2.0 * ke / m), 0.6 * std::sqrt(2.0 * ke / m), 0.0);
+      const bool ran = w.step(1);
+      EXPECT_EQ(ran, f < 1.0);
+      EXPECT_EQ(w.divergence(), f < 1.0 ? Divergence::kNone : Divergence::kEnergy);
+    }
+}
+
+// The ledger books the global damping of the spins with D_r (ζ_r), of the
+// velocities with D_t (ζ_t). A free disk spinning, ζ_r = 0.5 and ζ_t = 0,
+// sampled every step: the scheme takes ½·I·(ω₋² − ω₊²) a step, ω₊ =
+// ρ·ω₋, ρ = (1 − c)/(1 + c), c = D_r·Δt/(2I) = 2α·ζ_r (kt = kn/2); the
+// ledger books the trapezoid D_r·Δt·(ω₋² + ω₊²)/2, which is (1 + c²) times
+// that. With L the energy lost since the ledger's first sample (energy
+// E0), the reading (E − E0 + booked)/(E0 + booked) is c²·L/(E0 + (1 +
+// c²)·L): it rises from 0 to c²/(2 + c²) as the spin runs down (0.004975
+// at α = 0.1), where booking the spin with ζ_t would read −L/E0, about −1.
+TEST(KernelLedger, TheSpinsDampingIsBookedWithTheRotationalRatio) {
+  const double r = kernel_test::kR, alpha = 0.1, zeta_r = 0.5;
+  const std::vector<double> x{0.0}, y{0.0}, rad{r};
+  KernelOptions options;
+  options.check_interval = 1;
+  options.energy_check_interval = 1;
+  World w(kernel_test::reference_material(0.3), x, y, rad, -10 * r, 10 * r, -10 * r, 10 * r,
+          options);
+  Integration in;
+  in.dt = alpha * w.reference_scales().dt_crit;
+  in.damping_ratio_translation = 0.0;
+  in.damping_ratio_rotation = zeta_r;
+  w.set_integration(in);
+  w.set_velocity(0, 0.0, 0.0, 100.0);
+  const double c = 2.0 * alpha * zeta_r, limit = c * c / (2.0 + c * c);
+  for (int s = 0; s < 50; ++s) {  // ρ^100 = 2e-9 of the energy left
+    ASSERT_TRUE(w.step(1));
+    ASSERT_GE(w.energy_created(), 0.0) << "step " << s;
+    ASSERT_LE(w.energy_created(), limit * (1.0 + 1e-9)) << "step " << s;
+  }
+  EXPECT_NEAR(w.energy_created(), limit, 1e-6 * limit);
 }
 
 }  // namespace

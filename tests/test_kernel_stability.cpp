@@ -135,6 +135,38 @@ TEST(KernelStability, LanczosEstimateMatchesDenseEigenSolveAndGershgorinBoundsIt
   }
 }
 
+// Two disks in contact, no walls (the 3D kernel's
+// SphereStability.ContactPairEstimateMatchesEigenvalues). The linearised
+// pair has, for the normal, ω² = 2kn/m; for the tangent t, the mode of the
+// tangential spring with both translations and spins, b = (−t, −a, t, −a)
+// over (u_0, θ_0, u_1, θ_1): ω² = kt·|M^-½ b|² = (2kt/m)·(1 + a²·m/I) =
+// (2kt/m)·(1 + 2a²/r²), a = r − δ/2. With rotation locked only
+// translations: max(2kn/m, 2kt/m). Gershgorin must stay above: with the
+// branch along an axis its rows are nearest to the eigenvalue (the spin
+// rows' sum (kt/m)·(2√2 + 4) = 6.83·kt/m against 6·kt/m), with a skewed
+// branch the tangent's components spread over both axes and loosen it.
+TEST(KernelStability, ContactPairEstimateMatchesEigenvalues) {
+  const double r = kernel_test::kR, delta = 1e-6;
+  for (const double angle : {0.0, 0.6}) {
+    SCOPED_TRACE(angle);
+    const double d = 2.0 * r - delta;
+    const std::vector<double> x{0.0, d * std::cos(angle)}, y{0.0, d * std::sin(angle)}, rad{r, r};
+    World w(kernel_test::reference_material(0.3), x, y, rad, -10 * r, 10 * r, -10 * r, 10 * r);
+    const double m = w.mass()[0], kn = w.material().particle.kn, kt = w.material().particle.kt;
+    const double a = r - 0.5 * delta;
+    const double w2_rot = 2.0 * kt / m * (1.0 + 2.0 * a * a / (r * r));
+    const double w2_trans = std::max(2.0 * kn / m, 2.0 * kt / m);
+    ASSERT_GT(w2_rot, w2_trans);  // the rotational mode binds
+    const StabilityEstimate e = w.stability_estimate();
+    EXPECT_NEAR(e.omega2_max, w2_rot, 1e-9 * w2_rot);
+    EXPECT_GE(e.omega2_gershgorin, e.omega2_max * (1.0 - 1e-12));
+    const double dt_crit = w.reference_scales().dt_crit;
+    EXPECT_NEAR(dt_crit, 2.0 * std::sqrt(m / kn), 1e-15 * dt_crit);
+    EXPECT_NEAR(e.dt_ratio_stable_translation, 2.0 / std::sqrt(w2_trans) / dt_crit, 1e-9);
+    EXPECT_NEAR(e.dt_ratio_stable, 2.0 / std::sqrt(w2_rot) / dt_crit, 1e-9);
+  }
+}
+
 // Hexagonal packing, kt = kn/2: the in-phase rotation of all disks loads
 // every contact tangentially by 2a·θ (a = r − δ/2 = r(1 − ε)), six contacts
 // give the moment 12·kt·a²·θ, I = m·r²/2, so ω² = 24·kt·(1 − ε)²/m =

@@ -471,25 +471,32 @@ TEST(SphereContact, TangentialForceTurnsWithRigidlyRotatingPair) {
 // of its two radii (a small sphere pressed into a big one is what goes
 // wrong first): spheres of r and 3r overlapping by 0.3·r pass a bound of
 // 0.25 measured on the big one (0.1) but not on the small one, and stop the
-// run as an overlap divergence at the next check; 0.2·r stays below it.
+// run as an overlap divergence at the next check; 0.2·r stays below it. A
+// sphere in a wall is measured on its own radius (on its diameter 0.3·r
+// would read 0.15).
 TEST(SphereContact, OverlapBoundIsOnTheSmallerRadius) {
   const double r = kR;
-  for (const double overlap : {0.2, 0.3}) {
-    SCOPED_TRACE(overlap);
-    sphere_test::Scene s;
-    s.add(Vector3d::Zero(), r);
-    s.add(Vector3d(4.0 * r - overlap * r, 0.0, 0.0), 3.0 * r);
-    s.lo = {-10 * r, -10 * r, -10 * r};
-    s.hi = {10 * r, 10 * r, 10 * r};
-    KernelOptions options;
-    options.check_interval = 1;
-    options.max_overlap_ratio = 0.25;
-    SphereWorld w = s.make(test_material(0.3), options);
-    sphere_test::set_undamped(w, 1e-3);  // a tiny step: the overlap stays
-    const bool ran = w.step(2);
-    EXPECT_EQ(ran, overlap < 0.25);
-    EXPECT_EQ(w.divergence(), overlap < 0.25 ? Divergence::kNone : Divergence::kOverlap);
-  }
+  for (const bool wall : {false, true})
+    for (const double overlap : {0.2, 0.3}) {
+      SCOPED_TRACE(std::string(wall ? "wall, " : "pair, ") + std::to_string(overlap));
+      sphere_test::Scene s;
+      if (wall) {  // one sphere in the z-min wall
+        s.add(Vector3d(0.0, 0.0, -10 * r + r - overlap * r), r);
+      } else {
+        s.add(Vector3d::Zero(), r);
+        s.add(Vector3d(4.0 * r - overlap * r, 0.0, 0.0), 3.0 * r);
+      }
+      s.lo = {-10 * r, -10 * r, -10 * r};
+      s.hi = {10 * r, 10 * r, 10 * r};
+      KernelOptions options;
+      options.check_interval = 1;
+      options.max_overlap_ratio = 0.25;
+      SphereWorld w = s.make(test_material(0.3), options);
+      sphere_test::set_undamped(w, 1e-3);  // a tiny step: the overlap stays
+      const bool ran = w.step(2);
+      EXPECT_EQ(ran, overlap < 0.25);
+      EXPECT_EQ(w.divergence(), overlap < 0.25 ? Divergence::kNone : Divergence::kOverlap);
+    }
 }
 
 // Two spheres on the x axis spin together about it, Ω·Δt = `turn` radians a
@@ -620,6 +627,60 @@ SphereWorld sphere_on_wall(const SphereMaterial& mat, int side, double delta, do
   in.dt = 1e-6;
   w.set_integration(in);
   return w;
+}
+
+// An incremental spring belongs to one contact (the 2D kernel's
+// KernelContact.WallSpringStartsAtZeroWhenADiskTouchesAgain). Two spheres
+// dragged along the z-min wall load its springs (kt_w·2e-7 m = 10 N each);
+// lifted off and put back straight down (by less than the skin: they stay
+// on the wall's candidate list), they touch with new springs, at zero, and
+// with no tangential motion since carry no tangential force: exactly 0.
+// First one sphere leaves while the other stays (a group of candidates
+// partly touching), then both (none touching). Mass scaling 1e15: the set
+// velocities are the motion.
+TEST(SphereContact, WallSpringStartsAtZeroWhenASphereTouchesAgain) {
+  const double r = kR, delta = 1e-6, L = 10 * r;  // Fn = 100 N, μ_w·Fn = 40 N
+  const SphereMaterial mat = test_material(0.3, 0.4);
+  sphere_test::Scene s;
+  for (const double x : {-3.0 * r, 3.0 * r}) s.add(Vector3d(x, 0.0, -L + r - delta), r);
+  s.lo = {-L, -L, -L};
+  s.hi = {L, L, L};
+  SphereWorld w = s.make(mat);
+  Integration in = sphere_test::set_undamped(w, 0.0, 1e15);
+  in.dt = 1e-6;
+  w.set_integration(in);
+  const Vector3d drag(1e-3, 0.0, 0.0), up(0.0, 0.0, 1e-2);  // 1e-9 m, 1e-8 m a step
+  for (int k = 0; k < 200; ++k) {
+    for (int i = 0; i < 2; ++i) w.set_velocity(i, drag, Vector3d::Zero());
+    ASSERT_TRUE(w.step(1));
+  }
+  for (int i = 0; i < 2; ++i)
+    ASSERT_NEAR(-sphere_test::force(w, i).x(), mat.wall.kt * 2e-7, 1e-6 * mat.wall.kt * 2e-7);
+  const int64_t rebuilds = w.rebuilds();
+  for (const int leaving : {1, 2}) {  // sphere 1 alone, then both
+    SCOPED_TRACE(std::to_string(leaving) + " leaving");
+    bool apart = false;
+    for (int k = 0; k < 400; ++k) {  // 2e-6 m up, then down again
+      for (int i = 2 - leaving; i < 2; ++i)
+        w.set_velocity(i, k < 200 ? up : Vector3d(-up), Vector3d::Zero());
+      if (leaving == 1) w.set_velocity(0, Vector3d::Zero(), Vector3d::Zero());
+      ASSERT_TRUE(w.step(1));
+      apart = apart || w.wall(kZMin).contacts == 2 - leaving;
+      if (apart) {
+        for (int i = 2 - leaving; i < 2; ++i) {
+          const Vector3d f = sphere_test::force(w, i);
+          ASSERT_EQ(f.x(), 0.0) << "sphere " << i << " step " << k;
+          ASSERT_EQ(f.y(), 0.0) << "sphere " << i << " step " << k;
+        }
+      }
+    }
+    EXPECT_TRUE(apart);
+    ASSERT_EQ(w.wall(kZMin).contacts, 2);
+    if (leaving == 1) {  // the sphere that stayed kept its spring
+      EXPECT_NEAR(-sphere_test::force(w, 0).x(), mat.wall.kt * 2e-7, 1e-6 * mat.wall.kt * 2e-7);
+    }
+  }
+  EXPECT_EQ(w.rebuilds(), rebuilds);  // the same lists throughout
 }
 
 // The same law on each of the six walls, with the sphere spinning too: the

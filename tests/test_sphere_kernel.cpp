@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <numbers>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "demcal/scene/sphere_packing.hpp"
@@ -463,6 +464,88 @@ TEST(SphereEnergy, MovingWallWorkIsBookedWithinASamplingInterval) {
   EXPECT_LE(std::abs(w.energy_created()), 0.5 * h * h);
   std::printf("wall throws a sphere: ledger %.2e (scheme bound %.2e)\n", w.energy_created(),
               0.5 * h * h);
+}
+
+// The kinetic-energy check weighs the spins as the velocities (the 2D
+// kernel's KernelLedger.TheKineticEnergyCheckWeighsSpinsAsVelocities): two
+// frictionless spheres pressed together along (2, 3, 6)/7 hold E =
+// ½·kn·δ²; one of them spun, or moved along the contact plane, with
+// ½·I·|ω|² (or ½·m·|v|²) = f·1e3·E is a divergence at the next check for
+// f = 2 and not for f = 0.5.
+TEST(SphereEnergy, TheKineticEnergyCheckWeighsSpinsAsVelocities) {
+  const double r = kR, delta = 1e-6;
+  const Vector3d n = Vector3d(2.0, 3.0, 6.0) / 7.0, t = Vector3d(3.0, -2.0, 0.0).normalized();
+  for (const bool spin : {true, false})
+    for (const double f : {0.5, 2.0}) {
+      SCOPED_TRACE(std::string(spin ? "spin" : "velocity") + " at " + std::to_string(f));
+      sphere_test::Scene s;
+      s.add(Vector3d::Zero(), r);
+      s.add((2.0 * r - delta) * n, r);
+      s.lo = {-10 * r, -10 * r, -10 * r};
+      s.hi = {10 * r, 10 * r, 10 * r};
+      KernelOptions options;
+      options.check_interval = 1;
+      SphereWorld w = s.make(sphere_test::test_material(0.0), options);
+      sphere_test::set_undamped(w, 0.01);
+      const double energy = w.measure().elastic_energy;
+      ASSERT_NEAR(energy, 0.5 * w.material().particle.kn * delta * delta, 1e-6 * energy);
+      ASSERT_TRUE(w.step(1));  // the kernel's energy scale: E
+      const double ke = f * options.max_energy_ratio * energy;
+      const double m = w.mass()[0], inertia = 0.4 * m * r * r;
+      if (spin)
+        w.set_velocity(0, Vector3d::Zero(), std::sqrt(2.0 * ke / inertia) * Vector3d(1, 2, 2) / 3);
+      else
+        w.set_velocity(0, std::sqrt(2.0 * ke / m) * t, Vector3d::Zero());
+      const bool ran = w.step(1);
+      EXPECT_EQ(ran, f < 1.0);
+      EXPECT_EQ(w.divergence(), f < 1.0 ? Divergence::kNone : Divergence::kEnergy);
+    }
+}
+
+// The unbalanced-force ratio of two spheres pressed together along (2, 3,
+// 6)/7, the walls far: each sphere's net force is the one contact force,
+// so the ratio is 1 (to round-off).
+TEST(SphereStress, UnbalancedForceRatioOfALonePairIsOne) {
+  const double r = kR;
+  sphere_test::Scene s;
+  s.add(Vector3d::Zero(), r);
+  s.add((2.0 * r - 1e-6) * Vector3d(2.0, 3.0, 6.0) / 7.0, r);
+  s.lo = {-10 * r, -10 * r, -10 * r};
+  s.hi = {10 * r, 10 * r, 10 * r};
+  const SphereWorld w = s.make(sphere_test::test_material(0.3));
+  const SphereMeasures m = w.measure();
+  ASSERT_EQ(m.particle_contacts, 1);
+  ASSERT_EQ(m.wall_contacts, 0);
+  EXPECT_NEAR(m.unbalanced_force_ratio, 1.0, 16 * kEps);
+}
+
+// A wall's springs store ½·Fn²/kn_w + ½·|h|²/kt_w with the wall's own
+// stiffnesses (the 2D kernel's
+// KernelEnergy.WallSpringsStoreTheirEnergyWithTheWallsStiffnesses): a
+// sphere pressed 1e-6 m into the z-min wall and dragged 2e-7 m along x
+// (mass scaling 1e15: the set velocity is the motion).
+TEST(SphereEnergy, WallSpringsStoreTheirEnergyWithTheWallsStiffnesses) {
+  SphereMaterial mat = test_material(0.3, 0.4);
+  mat.wall.kn = 3e8;
+  mat.wall.kt = 2e7;
+  const double r = kR, delta = 1e-6, L = 10 * r;
+  sphere_test::Scene s;
+  s.add(Vector3d(0.0, 0.0, -L + r - delta), r);
+  s.lo = {-L, -L, -L};
+  s.hi = {L, L, L};
+  SphereWorld w = s.make(mat);
+  Integration in = sphere_test::set_undamped(w, 0.0, 1e15);
+  in.dt = 1e-6;
+  w.set_integration(in);
+  for (int k = 0; k < 200; ++k) {
+    w.set_velocity(0, Vector3d(1e-3, 0.0, 0.0), Vector3d::Zero());
+    ASSERT_TRUE(w.step(1));
+  }
+  const double overlap = r - (w.z()[0] - w.wall(kZMin).position);
+  const double fn = mat.wall.kn * overlap, ft = -sphere_test::force(w, 0).x();
+  ASSERT_NEAR(ft, mat.wall.kt * 2e-7, 1e-6 * mat.wall.kt * 2e-7);
+  const double expected = 0.5 * fn * fn / mat.wall.kn + 0.5 * ft * ft / mat.wall.kt;
+  EXPECT_NEAR(w.measure().elastic_energy, expected, 1e-12 * expected);
 }
 
 }  // namespace
