@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <vector>
 
 #include "demcal/scene/biaxial.hpp"
 #include "demcal/scene/config.hpp"
@@ -132,6 +133,102 @@ void expect_identical(const ConsolidatedState& a, const ConsolidatedState& b) {
   for (int side = 0; side < 4; ++side)
     EXPECT_EQ(a.world.wall(static_cast<WallSide>(side)).position,
               b.world.wall(static_cast<WallSide>(side)).position);
+}
+
+// A wall's pressure is its normal force over its area: length × the disks'
+// thickness t (a disk is a cylinder of thickness t, Material::thickness).
+// One disk pressed δ into each wall of a box, t = 0.01 m: each wall reads
+// kn_w·δ/(L·t), L the box's height for the side walls, its width for the
+// others, whatever t is.
+TEST(BiaxialConsolidation, WallPressureIsTheNormalForceOverLengthTimesThickness) {
+  Material mat = test::reference_material(0.3);
+  mat.thickness = 0.01;
+  const double r = 5e-4, delta = 1e-6, half_w = 10 * r, half_h = 6 * r;
+  const std::vector<double> x{-half_w + r - delta, half_w - r + delta, 0.0, 3 * r},
+      y{0.0, 0.0, -half_h + r - delta, half_h - r + delta}, rad{r, r, r, r};
+  const World w(mat, x, y, rad, -half_w, half_w, -half_h, half_h);
+  const double fn = mat.wall.kn * delta;
+  for (const WallSide side : {kLeft, kRight, kBottom, kTop}) {
+    SCOPED_TRACE(side);
+    ASSERT_EQ(w.wall(side).contacts, 1);
+    const double length = (side == kLeft || side == kRight) ? 2 * half_h : 2 * half_w;
+    const double expected = fn / (length * mat.thickness);
+    EXPECT_NEAR(wall_pressure(w, side), expected, 1e-9 * expected);
+  }
+}
+
+// The servo never moves a wall more than servo_move_cap(r_min) =
+// kServoMoveCapRatio·r_min a step, whatever the error: a wall facing a gas
+// (no contact, the whole σ3 missing) or a packing far beyond σ3 moves at
+// ±cap/Δt, toward the sample and away from it. A small error (its move
+// below 1e-3 of the cap) moves it by the law's own gain·error·A/(R·n_c).
+TEST(BiaxialConsolidation, TheServoMovesAWallAtMostItsCapAStep) {
+  const double r_min = 5e-4, dt = 1e-7, kw = 1e8, gain = 0.5, area = 1e-2;
+  const double cap = servo_move_cap(r_min);
+  for (const double inward : {1.0, -1.0})
+    for (const double error : {1e9, -1e9, 1e2}) {
+      SCOPED_TRACE(std::to_string(inward) + ", error " + std::to_string(error));
+      const ServoWall wall{error, area, 1, inward, 0.0};
+      const double law = gain * error * area / kw;
+      ASSERT_TRUE(std::abs(law) > 1e3 * cap || std::abs(law) < 1e-3 * cap);
+      const double move = std::clamp(law, -cap, cap);
+      EXPECT_NEAR(servo_step_velocity(wall, gain, kw, kw, dt, r_min), inward * move / dt,
+                  1e-12 * std::abs(move) / dt);
+    }
+}
+
+// The wall contacts' dashpot the servo divides by is the heaviest
+// particle's, c = 2ζ_c·sqrt(kn_w·m_max) (the most damping a contact can
+// bring: servo_velocity's comment), whichever particles touch the wall:
+// here a light disk (r) touches the left wall, the heavy one (2r) nothing.
+TEST(BiaxialConsolidation, TheServoCountsTheHeaviestParticlesDashpot) {
+  Material mat = test::reference_material(0.3);
+  mat.contact_damping_ratio = 0.5;
+  const double r = 5e-4, delta = 1e-6;
+  const std::vector<double> x{-10 * r + r - delta, 3 * r}, y{0.0, 0.0}, rad{r, 2 * r};
+  World w(mat, x, y, rad, -10 * r, 10 * r, -10 * r, 10 * r);
+  Integration in;
+  in.dt = 0.1 * w.reference_scales().dt_crit;
+  w.set_integration(in);
+  const double m_max = *std::max_element(w.mass().begin(), w.mass().end());
+  ASSERT_NEAR(m_max, 4.0 * w.mass()[0], 1e-12 * m_max);
+  const double p = wall_pressure(w, kLeft), target = 1.5 * p, gain = 0.5;
+  ASSERT_GT(p, 0.0);
+  const ServoWall wall{target - p, w.height() * mat.thickness, 1, 1.0, 0.0};
+  const double expected = servo_step_velocity(wall, gain, servo_resistance(mat, m_max, in.dt),
+                                              mat.wall.kn, in.dt, w.min_radius());
+  EXPECT_NEAR(servo_velocity(w, kLeft, target, gain), expected, 1e-12 * std::abs(expected));
+  // The light disk's dashpot alone would move the wall faster.
+  EXPECT_GT(servo_step_velocity(wall, gain, servo_resistance(mat, w.mass()[0], in.dt), mat.wall.kn,
+                                in.dt, w.min_radius()),
+            1.5 * expected);
+}
+
+// Consolidation is static when every wall, not some, reads σ3 (and the
+// forces balance): a single row of five disks spanning the box's width
+// holds σ3 on the side walls, in equilibrium, while the top and bottom
+// walls are still 99 radii away (the servo's cap brings them in 5 000
+// steps). The consolidation must go on until they come down and press the
+// row to σ3 too.
+TEST(BiaxialConsolidation, StaticMeansEveryWallAtSigma3) {
+  const SceneConfig c = scene(R"({"test": {"lateral_stress": 1e5}})");
+  const double r = 5e-4;
+  Assembly row;
+  for (int k = 0; k < 5; ++k) {
+    row.x.push_back((2 * k + 1) * r);
+    row.y.push_back(0.0);
+    row.r.push_back(r);
+  }
+  row.left = 0.0;
+  row.right = 10 * r;
+  row.bottom = -100 * r;
+  row.top = 100 * r;
+  const ConsolidatedState s = consolidate(c, row, "");
+  ASSERT_TRUE(s.converged);
+  for (const WallSide side : {kLeft, kRight, kBottom, kTop}) {
+    SCOPED_TRACE(side);
+    EXPECT_NEAR(wall_pressure(s.world, side), 1e5, c.test.consolidation_tolerance * 1e5);
+  }
 }
 
 TEST(BiaxialConsolidation, HexagonalReachesSigma3OnAllWallsDeterministically) {
@@ -431,6 +528,17 @@ TEST(BiaxialLoading, ReusesTheConsolidatedStateWithoutModifyingIt) {
     EXPECT_EQ(first.series.back().step, a.steps);
     EXPECT_EQ(first.steps_run, a.steps);
     EXPECT_NEAR(first.series.back().strain_yy, -c.test.vertical_strain, 1e-9);
+    // The strain rate: ε over the loading's duration Nstep·Δt; the inertial
+    // number of a point, I = ε̇·d̄·sqrt(ρ/p), with it (d̄ the mean diameter,
+    // ρ the scaled density, p = −tr σ/2).
+    const double rate = c.test.vertical_strain / (a.steps * first.integration.dt);
+    EXPECT_NEAR(first.strain_rate, rate, 1e-12 * rate);
+    const MonitorPoint& end = first.series.back();
+    double d = 0.0;
+    for (const double r : state.world.radius()) d += 2.0 * r / state.world.size();
+    const double rho = c.material.density * first.integration.mass_scaling;
+    const double inertial = rate * d * std::sqrt(rho / (-end.sigma.trace() / 2.0));
+    EXPECT_NEAR(end.inertial_number, inertial, 1e-9 * inertial);
     EXPECT_EQ(final_state.wall(kTop).position, first.series.back().top);
     EXPECT_EQ(final_state.steps_taken(), state.world.steps_taken() + a.steps);
     EXPECT_FALSE(first.diverged);
@@ -439,6 +547,31 @@ TEST(BiaxialLoading, ReusesTheConsolidatedStateWithoutModifyingIt) {
     const Peak p = find_peak(first.series);
     EXPECT_LE(first.peak_stress_yy, p.stress_yy * (1 - 1e-12));
   }
+}
+
+// Both lateral walls are servoed at σ3 during the loading: compressed
+// vertically, the sample widens (elastically, then by dilation), and each
+// wall follows its own side out. The two walls carry equal forces in
+// equilibrium, so one servoed wall alone would hold σ3 too, with the other
+// standing still and the sample drifting toward it; here each wall takes
+// at least a quarter of the widening (each takes about half: the
+// hexagonal sample is nearly symmetric about its vertical axis).
+TEST(BiaxialLoading, BothLateralWallsFollowTheServo) {
+  SceneConfig c = scene(R"({"assembly": {"columns": 5, "rows": 5}})");
+  c.test.monitor_points = 10;
+  const ConsolidatedState state = consolidate(c, make_assembly(c));
+  AlgorithmSpec a = c.algorithm;
+  a.steps = 4000;
+  const LoadingResult run = run_loading(state, c.test, a);
+  ASSERT_FALSE(run.diverged);
+  const MonitorPoint &first = run.series.front(), &last = run.series.back();
+  const double out_left = first.left - last.left, out_right = last.right - first.right;
+  const double widening = out_left + out_right;
+  std::printf("hex 5x5 loading: the left wall out by %.4g m, the right by %.4g m\n", out_left,
+              out_right);
+  ASSERT_GT(widening, 0.0);
+  EXPECT_GT(out_left, 0.25 * widening);
+  EXPECT_GT(out_right, 0.25 * widening);
 }
 
 TEST(BiaxialLoading, MonitorCallbackStopsTheRunEarly) {
