@@ -6,9 +6,11 @@
 // LAMMPS 3D deck's own series is scored in test_export_3d.cpp.)
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "demcal/io/input_error.hpp"
 #include "demcal/scene/run_output.hpp"
@@ -107,6 +109,55 @@ TEST(TriaxialCriteria, TheCombinedRecordCombinesThePlanes) {
   EXPECT_TRUE(j.at("not_available").contains("force_balance_xy"));
   // Not a criterion: the verdict says nothing went unchecked.
   EXPECT_TRUE(score_triaxial_run(run, c.test.lateral_stress, Tolerances{}).not_checked.empty());
+}
+
+// A synthetic triaxial series of `n` + 1 points: σ = b = the axial stress
+// −kS3·(1 + 5·min(k, peak)/peak − 2·max(0, k − peak)/n) on zz, −kS3 on xx
+// and yy; its most compressive b_zz at point `peak`.
+std::vector<TriaxialPoint> synthetic_triaxial(int n, int peak) {
+  constexpr double kS3 = 1e5;
+  std::vector<TriaxialPoint> s(n + 1);
+  for (int k = 0; k <= n; ++k) {
+    TriaxialPoint& p = s[k];
+    p.step = 100 * k;
+    p.strain_zz = -1e-4 * k;
+    const double axial = 1.0 + 5.0 * std::min(k, peak) / peak - 2.0 * std::max(0, k - peak) / n;
+    p.b = -kS3 * Eigen::Vector3d(1.0, 1.0, axial).asDiagonal();
+    p.sigma = p.b;
+    p.axial_power = 1.0;
+  }
+  return s;
+}
+
+// A vertical plane's servo error is the mean of its two walls' (the plane's
+// lateral stress is their mean): x min 1 % above σ3 and x max 1 % below
+// read 0 in the xz plane, and each wall alone reads its own 1 %.
+TEST(TriaxialCriteria, APlanesServoErrorIsItsTwoWallsMean) {
+  auto s = synthetic_triaxial(100, 60);
+  for (size_t k = 1; k < s.size(); ++k) s[k].servo_error = {0.01, -0.01, 0.0, 0.0};
+  const TriaxialCriteria c = compute_triaxial_criteria(s, 1e5);
+  EXPECT_NEAR(c.xz.servo, 0.0, 1e-15);
+  EXPECT_NEAR(c.servo_walls[0], 0.01, 1e-12);
+  EXPECT_NEAR(c.servo_walls[1], 0.01, 1e-12);
+  EXPECT_NEAR(c.servo_walls[2], 0.0, 1e-15);
+}
+
+// The rotational drag, the damping's share of the axial power, counts up
+// to the axial peak (as every gap: after it the failure mechanism moves
+// fast against the damping): 1 % before the peak at point 60, 50 % after.
+// The trend at the last point before the peak averages the 9 points 56-64,
+// 4 of them after it: (5·0.01 + 4·0.5)/9 = 0.2278, not the 0.5 after it.
+// Each drag is its own damping's share of the axial power alone: the
+// translational damping's 30 % beside it changes nothing of it.
+TEST(TriaxialCriteria, RotationalDragCountsUpToThePeak) {
+  auto s = synthetic_triaxial(100, 60);
+  for (size_t k = 1; k < s.size(); ++k) {
+    s[k].damping_power_rotation = k <= 60 ? 0.01 : 0.5;
+    s[k].damping_power_translation = 0.3;
+  }
+  const TriaxialCriteria c = compute_triaxial_criteria(s, 1e5);
+  EXPECT_NEAR(c.rotational_drag, (5 * 0.01 + 4 * 0.5) / 9, 1e-12);
+  EXPECT_NEAR(c.translational_drag, 0.3, 1e-12);
 }
 
 TEST(ExternalSeries3d, ServoErrorsComeFromThePressuresWhenNotGiven) {

@@ -210,6 +210,44 @@ TEST(ScoringNoise, EstimatorsReadTheStandardDeviationOfWhiteNoise) {
   for (double& x : v) x = 3.0 * n(rng) + 0.001 * static_cast<double>(&x - v.data());
   EXPECT_NEAR(robust_noise(v), 3.0, 0.1);
   EXPECT_NEAR(rms_noise(v), 3.0, 0.1);
+  // Trimmed (the zigzag's 5 %, and more): the mean of the kept squares is
+  // corrected by a Gaussian's E[z²; |z| < z_q]/q, so white noise still
+  // reads its s (without the correction 0.87·s at 5 %, 0.66·s at 20 %).
+  EXPECT_NEAR(rms_noise(v, 0.05), 3.0, 0.1);
+  EXPECT_NEAR(rms_noise(v, 0.2), 3.0, 0.1);
+}
+
+// The early stop's moment bound: the RMS of a over the M planned points is
+// at least sqrt(Σ a² so far / M), whatever the rest of the run does. A
+// steady asymmetry a = 0.041 against a bound of 2 × 0.01: sqrt(n/M)·0.041
+// passes 0.02 when n/M passes 0.238, at the 24th scored point of M = 100
+// (the consolidated start is not scored); not before.
+TEST(ScoringNoise, EarlyStopOnMomentBalanceWhenTheRmsOverTheRunMustFail) {
+  Tolerances t;
+  t.moment_balance = 0.01;
+  const int m = 100;
+  EarlyFailure watch(t, 2.0, m, kS3);
+  for (int k = 0; k <= m; ++k) {
+    MonitorPoint p;
+    p.b = -kS3 * Eigen::Matrix2d::Identity();
+    p.sigma = p.b;
+    if (k > 0) p.sigma(0, 1) = 0.041 * kS3;
+    const bool failed = watch.add(p);
+    ASSERT_EQ(failed, k >= 24) << "point " << k;
+    if (failed) break;
+  }
+}
+
+// The servo criterion is the largest |trend| of the wall's stress error
+// (a wall that lags for a stretch of the run fails it, however short the
+// stretch): 1 % on 20 of the 200 scored points, 0 elsewhere, reads 1 %,
+// where its RMS over the run would read 0.32 %.
+TEST(ScoringNoise, ServoIsTheLargestTrendOfTheWallsError) {
+  auto s = clean_series();
+  for (int k = 50; k < 70; ++k) s[k].lateral_stress_error = 0.01;
+  const Criteria c = compute_criteria(s, kS3);
+  EXPECT_NEAR(c.servo, 0.01, 1e-12);
+  EXPECT_NEAR(c.servo_rms, 0.01 * std::sqrt(20.0 / kPoints), 1e-12);
 }
 
 TEST(ScoringNoise, MovingTrendKeepsALineAndShrinksAtTheEnds) {
@@ -367,6 +405,20 @@ TEST(ScoringDiagnosis, PatternsNameTheirParameter) {
   EXPECT_EQ(diagnose(drag_t, t, false, tiny_dt).parameter, "dt");
   EXPECT_EQ(diagnose(drag_t, t, false, tiny_dt).direction, "increase");
   EXPECT_EQ(diagnose(drag_t, t, false, AlgorithmSpec{}).parameter, "steps");
+
+  // The chatter's energy rule (reports/signature-atlas.md, the diagnosis's
+  // rule 3): rotation carrying more than 30 % of the kinetic energy names
+  // the chatter even where ζ_r is large and the asymmetry (here 5e-3 of σ3)
+  // is within what a drag could be; 25 % is left to the drag's rule.
+  AlgorithmSpec large_zr;
+  large_zr.damping_ratio_rotation = 3.0;
+  for (const double share : {0.25, 0.35}) {
+    Criteria c;
+    c.moment_balance = 5e-3;
+    c.rotational_energy_share = share;
+    EXPECT_EQ(diagnose(c, t, false, large_zr).parameter, share > 0.3 ? "dt" : "damping_rotation")
+        << "share " << share;
+  }
 
   for (const Criteria* c : {&chatter, &drag_r, &fast, &noisy, &dynamic, &drag_t}) {
     const Diagnosis d = diagnose(*c, t, false);
