@@ -531,6 +531,10 @@ TEST(BiaxialLoading, ReusesTheConsolidatedStateWithoutModifyingIt) {
     // The strain rate: ε over the loading's duration Nstep·Δt; the inertial
     // number of a point, I = ε̇·d̄·sqrt(ρ/p), with it (d̄ the mean diameter,
     // ρ the scaled density, p = −tr σ/2).
+    // Δt = α·Δt_crit, Δt_crit = 2·sqrt(m_min/kn): the lightest particle's.
+    const double m_min = *std::min_element(state.world.mass().begin(), state.world.mass().end());
+    EXPECT_NEAR(first.integration.dt, a.dt_ratio * 2.0 * std::sqrt(m_min / c.material.particle.kn),
+                1e-12 * first.integration.dt);
     const double rate = c.test.vertical_strain / (a.steps * first.integration.dt);
     EXPECT_NEAR(first.strain_rate, rate, 1e-12 * rate);
     const MonitorPoint& end = first.series.back();

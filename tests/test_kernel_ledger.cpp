@@ -151,6 +151,11 @@ TEST(KernelLedger, TheKineticEnergyCheckWeighsSpinsAsVelocities) {
         w.set_velocity(0, 0.0, 0.0, std::sqrt(2.0 * ke / inertia));
       else
         w.set_velocity(0, -0.8 * std::sqrt(2.0 * ke / m), 0.6 * std::sqrt(2.0 * ke / m), 0.0);
+      // The measured kinetic energy is that energy: the spin's ½·I·ω² (I =
+      // m·r²/2), or ½·m·|v|² and the other disk's from the first step, under
+      // 1e-6 of it.
+      const Measures ms = w.measure();
+      EXPECT_NEAR(spin ? ms.kinetic_energy_rotation : ms.kinetic_energy_translation, ke, 1e-5 * ke);
       const bool ran = w.step(1);
       EXPECT_EQ(ran, f < 1.0);
       EXPECT_EQ(w.divergence(), f < 1.0 ? Divergence::kNone : Divergence::kEnergy);
