@@ -6,25 +6,25 @@
 Each mutant of MUTANTS_JSON (default: sphere_kernel.json beside this script)
 is one small, deliberate error in the source tree -- {"name", "file", "old",
 "new"}, "old" replaced by "new" where it occurs exactly once. A listing is a
-JSON list of mutants, or {"filter": GTEST_FILTER, "mutants": [...]}: the
-tests its mutants are checked against (disk_kernel.json, protocols.json). First the
-tests run once on the tree as it is: they must pass, or every mutant would
-read as noticed. Then for each mutant in turn: the file is changed,
-BUILD_DIR's demcal_tests is rebuilt, the tests of the filter run (default
-the listing's, else DEFAULT_FILTER below: the sphere kernel's suites and the
-3D scene's and scoring's that read it; a mutant may name its own "filter",
---filter overrides both), and the file is
-put back. A mutant no test notices (SURVIVED) is a fact of the code no test
-pins, or an error that changes nothing measurable (say which, in
-reports/mutants-3d.md). Exit status 0 when every mutant was noticed, 1 when
-one was not (or could not be applied or built), 2 on bad use.
+JSON list of mutants, or {"filter": GTEST_FILTER, "mutants": [...]} with the
+tests its mutants run against (disk_kernel.json, protocols.json,
+scoring.json). First the tests run once on the tree as it is: they must
+pass, or every mutant would read as noticed. Then for each mutant in turn:
+the file is changed, BUILD_DIR's demcal_tests is rebuilt, the tests of the
+filter run (--filter, else the mutant's own "filter", else the listing's,
+else DEFAULT_FILTER below: the sphere kernel's suites and the 3D scene's and
+scoring's that read it), and the file is put back. A mutant no test
+notices (SURVIVED) is a fact of the code no test pins, or an error that
+changes nothing measurable (say which, in reports/mutants-*.md). Exit
+status 0 when every mutant was noticed, 1 when one was not (or could not
+be applied or built), 2 on bad use.
 
 It edits the source tree it belongs to: run it in a clean scratch clone
 (git clone . /tmp/m && cmake -S /tmp/m -B /tmp/m/build ...), never in a
 tree with work in progress; it refuses a tree with uncommitted changes and
 a BUILD_DIR configured from another tree. Each mutant costs one rebuild of
 the changed file and the test run (about half a minute for the kernel with
-ccache, minutes for a widely included header).
+ccache, ten minutes for a header most of the library includes).
 """
 import json
 import os
