@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -194,14 +195,19 @@ TEST(BiaxialConsolidation, TheServoCountsTheHeaviestParticlesDashpot) {
   ASSERT_NEAR(m_max, 4.0 * w.mass()[0], 1e-12 * m_max);
   const double p = wall_pressure(w, kLeft), target = 1.5 * p, gain = 0.5;
   ASSERT_GT(p, 0.0);
-  const ServoWall wall{target - p, w.height() * mat.thickness, 1, 1.0, 0.0};
-  const double expected = servo_step_velocity(wall, gain, servo_resistance(mat, m_max, in.dt),
-                                              mat.wall.kn, in.dt, w.min_radius());
-  EXPECT_NEAR(servo_velocity(w, kLeft, target, gain), expected, 1e-12 * std::abs(expected));
+  // The servo law written out for one contact, the wall at rest (no carry)
+  // and the move under the cap: v = gain·(σ − p)·A/R/Δt, R = kn_w +
+  // 2ζ_c·sqrt(kn_w·m)/Δt.
+  const double area = w.height() * mat.thickness, kw = mat.wall.kn;
+  auto velocity_with = [&](double m) {
+    const double resistance = kw + 2.0 * mat.contact_damping_ratio * std::sqrt(kw * m) / in.dt;
+    return gain * (target - p) * area / resistance / in.dt;
+  };
+  const double expected = velocity_with(m_max);
+  ASSERT_LT(expected * in.dt, servo_move_cap(w.min_radius()));
+  EXPECT_NEAR(servo_velocity(w, kLeft, target, gain), expected, 1e-12 * expected);
   // The light disk's dashpot alone would move the wall faster.
-  EXPECT_GT(servo_step_velocity(wall, gain, servo_resistance(mat, w.mass()[0], in.dt), mat.wall.kn,
-                                in.dt, w.min_radius()),
-            1.5 * expected);
+  EXPECT_GT(velocity_with(w.mass()[0]), 1.5 * expected);
 }
 
 // Consolidation is static when every wall, not some, reads σ3 (and the
@@ -531,8 +537,12 @@ TEST(BiaxialLoading, ReusesTheConsolidatedStateWithoutModifyingIt) {
     // The strain rate: ε over the loading's duration Nstep·Δt; the inertial
     // number of a point, I = ε̇·d̄·sqrt(ρ/p), with it (d̄ the mean diameter,
     // ρ the scaled density, p = −tr σ/2).
-    // Δt = α·Δt_crit, Δt_crit = 2·sqrt(m_min/kn): the lightest particle's.
-    const double m_min = *std::min_element(state.world.mass().begin(), state.world.mass().end());
+    // Δt = α·Δt_crit, Δt_crit = 2·sqrt(m_min/kn): the lightest particle's,
+    // m = f_ms·ρ·t·π·r² (the random scene tells it from the heaviest's).
+    const double r_min =
+        *std::min_element(state.world.radius().begin(), state.world.radius().end());
+    const double m_min = a.mass_scaling * c.material.density * c.material.thickness *
+                         std::numbers::pi * r_min * r_min;
     EXPECT_NEAR(first.integration.dt, a.dt_ratio * 2.0 * std::sqrt(m_min / c.material.particle.kn),
                 1e-12 * first.integration.dt);
     const double rate = c.test.vertical_strain / (a.steps * first.integration.dt);
@@ -557,9 +567,9 @@ TEST(BiaxialLoading, ReusesTheConsolidatedStateWithoutModifyingIt) {
 // vertically, the sample widens (elastically, then by dilation), and each
 // wall follows its own side out. The two walls carry equal forces in
 // equilibrium, so one servoed wall alone would hold σ3 too, with the other
-// standing still and the sample drifting toward it; here each wall takes
-// at least a quarter of the widening (each takes about half: the
-// hexagonal sample is nearly symmetric about its vertical axis).
+// standing still and the sample drifting toward it. Each wall takes a
+// share of the widening (here about 59 % and 41 %); a quarter is the
+// margin asked, not a derived bound (the one-wall servo gives the other 0).
 TEST(BiaxialLoading, BothLateralWallsFollowTheServo) {
   SceneConfig c = scene(R"({"assembly": {"columns": 5, "rows": 5}})");
   c.test.monitor_points = 10;

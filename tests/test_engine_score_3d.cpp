@@ -2,7 +2,8 @@
 // series.csv read back scores as the run itself; the servo error of each
 // lateral wall comes from its pressure when the file has no servo column;
 // a 3D file missing a component is one clear InputError; `demcal score`
-// on a 3D file writes its summary with the planes' criteria. (The exported
+// on a 3D file writes its summary with the planes' criteria; on synthetic
+// series, a plane's servo error and the rotational drag. (The exported
 // LAMMPS 3D deck's own series is scored in test_export_3d.cpp.)
 #include <gtest/gtest.h>
 
@@ -145,8 +146,9 @@ TEST(TriaxialCriteria, APlanesServoErrorIsItsTwoWallsMean) {
 // The rotational drag, the damping's share of the axial power, counts up
 // to the axial peak (as every gap: after it the failure mechanism moves
 // fast against the damping): 1 % before the peak at point 60, 50 % after.
-// The trend at the last point before the peak averages the 9 points 56-64,
-// 4 of them after it: (5·0.01 + 4·0.5)/9 = 0.2278, not the 0.5 after it.
+// The trend at the peak (point 60, the last that counts) averages the 9
+// points 56-64, 4 of them after it: (5·0.01 + 4·0.5)/9 = 0.2278, not the
+// 0.5 after it.
 // Each drag is its own damping's share of the axial power alone: the
 // translational damping's 30 % beside it changes nothing of it.
 TEST(TriaxialCriteria, RotationalDragCountsUpToThePeak) {

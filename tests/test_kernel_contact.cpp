@@ -155,19 +155,11 @@ TEST(KernelContact, WallFrictionSticksThenSlidesAtCoulombLimitWithTorque) {
 // candidate list, the spring's slot kept), it makes a new contact whose
 // spring starts at zero, and with no tangential motion since it carries no
 // tangential force at all: exactly 0, not the old spring cut to μ·Fn.
-// Heavy masses (scaling 1e9), no damping and the rotation locked: the set
-// velocities are the motion.
+// (kernel_test::disk_on_bottom_wall: the set velocities are the motion.)
 TEST(KernelContact, WallSpringStartsAtZeroWhenADiskTouchesAgain) {
   const Material mat = reference_material(0.3, 0.4);
-  const double r = kR, delta = 1e-6;  // Fn = 100 N, μ_w·Fn = 40 N
-  const std::vector<double> x{0.0}, y{r - delta}, rad{r};
-  World w(mat, x, y, rad, -20 * r, 20 * r, 0.0, 10 * r);
-  Integration in;
-  in.dt = 1e-6;
-  in.damping_ratio_translation = 0.0;  // the set velocities are the motion
-  in.mass_scaling = 1e9;
-  in.lock_rotation = true;
-  w.set_integration(in);
+  const double delta = 1e-6;  // Fn = 100 N, μ_w·Fn = 40 N
+  World w = kernel_test::disk_on_bottom_wall(mat, delta);
   for (int s = 0; s < 200; ++s) {  // slip 1e-9 m a step: kt_w·2e-7 m = 10 N
     w.set_velocity(0, 1e-3, 0.0, 0.0);
     ASSERT_TRUE(w.step(1));

@@ -170,8 +170,8 @@ TEST(KernelDamping, RotationUnderdampedSuccessiveExtremaMatchDampedOscillator) {
   bool past_max = false;
   // θ is the angle the walls' springs see: each step both contact points
   // slip by dist·ω·Δt, the step's turn, so the couple is −2·kt_w·dist²·θ
-  // (to the round-off of sums of a few thousand increments, ~1e-12 of the
-  // largest couple; the amplitude of θ is ω(0)/ω_θ = Δt/h).
+  // (to the round-off of sums of the ~500 increments of the run, n·ε ≈
+  // 1e-13 of the largest couple; the amplitude of θ is ω(0)/ω_θ = Δt/h).
   const double dist = SpunDisk::r - SpunDisk::delta0, ktw = w.material().wall.kt;
   const double couple_scale = 2.0 * ktw * dist * dist * w.integration().dt / d.h;
   for (int s = 0; s < 5000; ++s) {
@@ -180,7 +180,7 @@ TEST(KernelDamping, RotationUnderdampedSuccessiveExtremaMatchDampedOscillator) {
     ASSERT_EQ(w.vx()[0], 0.0);
     ASSERT_EQ(w.vy()[0], 0.0);
     const double th = w.rotation()[0];
-    ASSERT_NEAR(w.torque()[0], -2.0 * ktw * dist * dist * th, 1e-9 * couple_scale) << "step " << s;
+    ASSERT_NEAR(w.torque()[0], -2.0 * ktw * dist * dist * th, 1e-12 * couple_scale) << "step " << s;
     if (!past_max) {
       th_max = std::max(th_max, th);
       past_max = w.omega()[0] < 0.0;

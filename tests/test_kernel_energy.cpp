@@ -140,15 +140,8 @@ TEST(KernelEnergy, WallSpringsStoreTheirEnergyWithTheWallsStiffnesses) {
   Material mat = kernel_test::reference_material(0.3, 0.4);
   mat.wall.kn = 3e8;
   mat.wall.kt = 2e7;
-  const double r = kernel_test::kR, delta = 1e-6;
-  const std::vector<double> x{0.0}, y{r - delta}, rad{r};
-  World w(mat, x, y, rad, -20 * r, 20 * r, 0.0, 10 * r);
-  Integration in;
-  in.dt = 1e-6;
-  in.damping_ratio_translation = 0.0;
-  in.mass_scaling = 1e9;
-  in.lock_rotation = true;
-  w.set_integration(in);
+  const double r = kernel_test::kR;
+  World w = kernel_test::disk_on_bottom_wall(mat, 1e-6);
   for (int s = 0; s < 200; ++s) {
     w.set_velocity(0, 1e-3, 0.0, 0.0);
     ASSERT_TRUE(w.step(1));

@@ -63,6 +63,24 @@ inline Scene random_loose_scene(int nx, int ny, uint32_t seed, double spread = 0
   return s;
 }
 
+/// One disk of radius kR pressed `delta` into the bottom wall of the box
+/// [−20r, 20r] × [0, 10r], heavy (mass scaling 1e9), undamped, rotation
+/// locked, Δt = 1e-6 s: the velocities set before each step are its motion
+/// (a 100 N force changes them by 5e-11 m/s a step).
+inline World disk_on_bottom_wall(const Material& mat, double delta) {
+  const double r = kR;
+  const std::vector<double> x{0.0}, y{r - delta}, rad{r};
+  World w(mat, x, y, rad, -20 * r, 20 * r, 0.0, 10 * r);
+  Integration in;
+  in.dt = 1e-6;
+  in.damping_ratio_translation = 0.0;
+  in.damping_ratio_rotation = 0.0;
+  in.mass_scaling = 1e9;
+  in.lock_rotation = true;
+  w.set_integration(in);
+  return w;
+}
+
 /// Mean compressive stress on the four walls [Pa] (the force of the
 /// particles on the left wall points left, etc.).
 inline double mean_wall_stress(const World& w) {

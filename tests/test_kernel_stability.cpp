@@ -18,8 +18,10 @@
 #if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic pop
 #endif
+#include <algorithm>
 #include <cmath>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "test_kernel_helpers.hpp"
@@ -300,6 +302,49 @@ TEST(KernelStability, RunWellAboveTranslationalLimitIsReportedDivergedWithoutHan
     SCOPED_TRACE(lock);
     expect_diverges_quickly(s.world);
   }
+}
+
+// The kinetic-energy check (KernelOptions::max_energy_ratio) weighs the
+// spins as the velocities: a kinetic energy beyond that ratio of the largest
+// energy the springs have held is an unstable mode growing, whether it
+// turns or moves. Two frictionless disks pressed together along (0.6, 0.8)
+// hold E = ½·kn·δ² and nothing else; one of them is then given a spin of
+// ½·I·ω² = f·1e3·E (frictionless: the spin touches nothing else). f = 2 is
+// a divergence at the next check, f = 0.5 is not; a velocity of the same
+// energy, along the contact plane, reads the same.
+TEST(KernelStability, TheKineticEnergyCheckWeighsSpinsAsVelocities) {
+  const double r = kernel_test::kR, delta = 1e-6;
+  const Material mat = kernel_test::reference_material(0.0);
+  const double d = 2.0 * r - delta;
+  const std::vector<double> x{0.0, 0.6 * d}, y{0.0, 0.8 * d}, rad{r, r};
+  for (const bool spin : {true, false})
+    for (const double f : {0.5, 2.0}) {
+      SCOPED_TRACE(std::string(spin ? "spin" : "velocity") + " at " + std::to_string(f));
+      KernelOptions options;
+      options.check_interval = 1;
+      World w(mat, x, y, rad, -10 * r, 10 * r, -10 * r, 10 * r, options);
+      Integration in;
+      in.dt = 0.01 * w.reference_scales().dt_crit;
+      in.damping_ratio_translation = in.damping_ratio_rotation = 0.0;
+      w.set_integration(in);
+      const double energy = w.measure().elastic_energy;
+      ASSERT_NEAR(energy, 0.5 * mat.particle.kn * delta * delta, 1e-6 * energy);
+      ASSERT_TRUE(w.step(1));  // the kernel's energy scale: E
+      const double ke = f * options.max_energy_ratio * energy;
+      const double m = w.mass()[0], inertia = 0.5 * m * r * r;
+      if (spin)
+        w.set_velocity(0, 0.0, 0.0, std::sqrt(2.0 * ke / inertia));
+      else
+        w.set_velocity(0, -0.8 * std::sqrt(2.0 * ke / m), 0.6 * std::sqrt(2.0 * ke / m), 0.0);
+      // The measured kinetic energy is that energy: the spin's ½·I·ω² (I =
+      // m·r²/2), or ½·m·|v|² and the other disk's from the first step (8e-7
+      // of it at f = 0.5).
+      const Measures ms = w.measure();
+      EXPECT_NEAR(spin ? ms.kinetic_energy_rotation : ms.kinetic_energy_translation, ke, 2e-6 * ke);
+      const bool ran = w.step(1);
+      EXPECT_EQ(ran, f < 1.0);
+      EXPECT_EQ(w.divergence(), f < 1.0 ? Divergence::kNone : Divergence::kEnergy);
+    }
 }
 
 }  // namespace

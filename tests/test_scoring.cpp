@@ -221,8 +221,9 @@ TEST(ScoringNoise, EstimatorsReadTheStandardDeviationOfWhiteNoise) {
 // at least sqrt(Σ a² so far / M), whatever the rest of the run does. A
 // steady asymmetry a = 0.041 against a bound of 2 × 0.01: sqrt(n/M)·0.041
 // passes 0.02 when n/M passes 0.238, at the 24th scored point of M = 100
-// (the consolidated start is not scored); not before.
-TEST(ScoringNoise, EarlyStopOnMomentBalanceWhenTheRmsOverTheRunMustFail) {
+// (the consolidated start is not scored); not before. b's shear
+// ½(b_xy + b_yx) is σ's, so the force-balance bound sees no gap.
+TEST(ScoringSynthetic, EarlyStopOnMomentBalanceWhenTheRmsOverTheRunMustFail) {
   Tolerances t;
   t.moment_balance = 0.01;
   const int m = 100;
@@ -231,7 +232,10 @@ TEST(ScoringNoise, EarlyStopOnMomentBalanceWhenTheRmsOverTheRunMustFail) {
     MonitorPoint p;
     p.b = -kS3 * Eigen::Matrix2d::Identity();
     p.sigma = p.b;
-    if (k > 0) p.sigma(0, 1) = 0.041 * kS3;
+    if (k > 0) {
+      p.sigma(0, 1) = 0.041 * kS3;
+      p.b(0, 1) = p.b(1, 0) = 0.0205 * kS3;
+    }
     const bool failed = watch.add(p);
     ASSERT_EQ(failed, k >= 24) << "point " << k;
     if (failed) break;
@@ -242,7 +246,7 @@ TEST(ScoringNoise, EarlyStopOnMomentBalanceWhenTheRmsOverTheRunMustFail) {
 // (a wall that lags for a stretch of the run fails it, however short the
 // stretch): 1 % on 20 of the 200 scored points, 0 elsewhere, reads 1 %,
 // where its RMS over the run would read 0.32 %.
-TEST(ScoringNoise, ServoIsTheLargestTrendOfTheWallsError) {
+TEST(ScoringSynthetic, ServoIsTheLargestTrendOfTheWallsError) {
   auto s = clean_series();
   for (int k = 50; k < 70; ++k) s[k].lateral_stress_error = 0.01;
   const Criteria c = compute_criteria(s, kS3);
@@ -409,7 +413,8 @@ TEST(ScoringDiagnosis, PatternsNameTheirParameter) {
   // The chatter's energy rule (reports/signature-atlas.md, the diagnosis's
   // rule 3): rotation carrying more than 30 % of the kinetic energy names
   // the chatter even where ζ_r is large and the asymmetry (here 5e-3 of σ3)
-  // is within what a drag could be; 25 % is left to the drag's rule.
+  // lies between the drag's 1e-3 and the chatter's 1 %, where a large ζ_r
+  // leaves it to the drag's rule; 25 % is left to it.
   AlgorithmSpec large_zr;
   large_zr.damping_ratio_rotation = 3.0;
   for (const double share : {0.25, 0.35}) {

@@ -613,28 +613,12 @@ TEST(SphereContact, WallFrictionSticksThenSlidesWithTorque) {
   EXPECT_GT(slid, 600);
 }
 
-/// A heavy sphere (mass scaling 1e15, undamped, Δt = 1e-6 s) of radius kR
-/// pressed by δ onto wall `side` of the box [−L, L]³ (g its inward normal).
-SphereWorld sphere_on_wall(const SphereMaterial& mat, int side, double delta, double L) {
-  const int a = side / 2;
-  const double sign = (side % 2 == 0) ? 1.0 : -1.0;
-  sphere_test::Scene s;
-  s.add(-sign * L * Vector3d::Unit(a) + (kR - delta) * sign * Vector3d::Unit(a), kR);
-  s.lo = {-L, -L, -L};
-  s.hi = {L, L, L};
-  SphereWorld w = s.make(mat);
-  Integration in = sphere_test::set_undamped(w, 0.0, 1e15);
-  in.dt = 1e-6;
-  w.set_integration(in);
-  return w;
-}
-
 // An incremental spring belongs to one contact (the 2D kernel's
 // KernelContact.WallSpringStartsAtZeroWhenADiskTouchesAgain). Two spheres
 // dragged along the z-min wall load its springs (kt_w·2e-7 m = 10 N each);
 // lifted off and put back straight down (by less than the skin: they stay
 // on the wall's candidate list), they touch with new springs, at zero, and
-// with no tangential motion since carry no tangential force: exactly 0.
+// with no tangential motion since they carry no tangential force: exactly 0.
 // First one sphere leaves while the other stays (a group of candidates
 // partly touching), then both (none touching). Mass scaling 1e15: the set
 // velocities are the motion.
@@ -698,7 +682,7 @@ TEST(SphereContact, WallFrictionOnEveryWallWithSpin) {
     const int a = side / 2, b = (a + 1) % 3, c = (a + 2) % 3;
     const double sign = (side % 2 == 0) ? 1.0 : -1.0;
     const Vector3d g = sign * Vector3d::Unit(a);
-    SphereWorld w = sphere_on_wall(mat, side, delta, L);
+    SphereWorld w = sphere_test::sphere_on_wall(mat, side, delta, L);
     const Integration in = w.integration();
     const Vector3d v = V * (Vector3d::Unit(b) - 2.0 * Vector3d::Unit(c)).normalized();
     // A spin about all three axes: about each of the wall's two tangents it
@@ -747,7 +731,7 @@ TEST(SphereContact, FrictionlessWallsExertNoTangentialForce) {
       const double sign = (side % 2 == 0) ? 1.0 : -1.0;
       const Vector3d g = sign * Vector3d::Unit(a);
       const Vector3d e_b = Vector3d::Unit((a + 1) % 3), e_c = Vector3d::Unit((a + 2) % 3);
-      SphereWorld w = sphere_on_wall(mat, side, delta, L);
+      SphereWorld w = sphere_test::sphere_on_wall(mat, side, delta, L);
       w.set_velocity(0, V * (e_b - 2.0 * e_c).normalized(), (0.7 * V / r) * e_b);
       const double fn = mat.wall.kn * delta;
       for (int k = 1; k <= 50; ++k) {

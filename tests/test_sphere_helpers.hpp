@@ -103,4 +103,20 @@ inline Energies synchronized_energies(const SphereWorld& w) {
   return e;
 }
 
+/// A heavy sphere (mass scaling 1e15, undamped, Δt = 1e-6 s) of radius kR
+/// pressed by δ onto wall `side` of the box [−L, L]³ (g its inward normal).
+inline SphereWorld sphere_on_wall(const SphereMaterial& mat, int side, double delta, double L) {
+  const int a = side / 2;
+  const double sign = (side % 2 == 0) ? 1.0 : -1.0;
+  Scene s;
+  s.add(-sign * L * Eigen::Vector3d::Unit(a) + (kR - delta) * sign * Eigen::Vector3d::Unit(a), kR);
+  s.lo = {-L, -L, -L};
+  s.hi = {L, L, L};
+  SphereWorld w = s.make(mat);
+  Integration in = set_undamped(w, 0.0, 1e15);
+  in.dt = 1e-6;
+  w.set_integration(in);
+  return w;
+}
+
 }  // namespace demcal::sphere_test

@@ -467,12 +467,12 @@ TEST(SphereEnergy, MovingWallWorkIsBookedWithinASamplingInterval) {
 }
 
 // The kinetic-energy check weighs the spins as the velocities (the 2D
-// kernel's KernelLedger.TheKineticEnergyCheckWeighsSpinsAsVelocities): two
+// kernel's KernelStability.TheKineticEnergyCheckWeighsSpinsAsVelocities): two
 // frictionless spheres pressed together along (2, 3, 6)/7 hold E =
 // ½·kn·δ²; one of them spun, or moved along the contact plane, with
 // ½·I·|ω|² (or ½·m·|v|²) = f·1e3·E is a divergence at the next check for
 // f = 2 and not for f = 0.5.
-TEST(SphereEnergy, TheKineticEnergyCheckWeighsSpinsAsVelocities) {
+TEST(SphereStability, TheKineticEnergyCheckWeighsSpinsAsVelocities) {
   const double r = kR, delta = 1e-6;
   const Vector3d n = Vector3d(2.0, 3.0, 6.0) / 7.0, t = Vector3d(3.0, -2.0, 0.0).normalized();
   for (const bool spin : {true, false})
@@ -528,15 +528,8 @@ TEST(SphereEnergy, WallSpringsStoreTheirEnergyWithTheWallsStiffnesses) {
   SphereMaterial mat = test_material(0.3, 0.4);
   mat.wall.kn = 3e8;
   mat.wall.kt = 2e7;
-  const double r = kR, delta = 1e-6, L = 10 * r;
-  sphere_test::Scene s;
-  s.add(Vector3d(0.0, 0.0, -L + r - delta), r);
-  s.lo = {-L, -L, -L};
-  s.hi = {L, L, L};
-  SphereWorld w = s.make(mat);
-  Integration in = sphere_test::set_undamped(w, 0.0, 1e15);
-  in.dt = 1e-6;
-  w.set_integration(in);
+  const double r = kR;
+  SphereWorld w = sphere_test::sphere_on_wall(mat, kZMin, 1e-6, 10 * r);
   for (int k = 0; k < 200; ++k) {
     w.set_velocity(0, Vector3d(1e-3, 0.0, 0.0), Vector3d::Zero());
     ASSERT_TRUE(w.step(1));
