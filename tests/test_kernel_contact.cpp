@@ -95,14 +95,8 @@ TEST(KernelContact, WallFrictionSticksThenSlidesAtCoulombLimitWithTorque) {
   const double mu_w = 0.4;
   const Material mat = reference_material(0.3, mu_w);
   const double r = kR, delta = 1e-6;  // Fn = kn·δ = 100 N
-  const std::vector<double> x{0.0}, y{r - delta}, rad{r};
-  World w(mat, x, y, rad, -20 * r, 20 * r, 0.0, 10 * r);
-  Integration in;
-  in.dt = 1e-6;
-  in.damping_ratio_translation = 0.0;
-  in.damping_ratio_rotation = 0.0;
-  in.mass_scaling = 1e9;
-  w.set_integration(in);
+  World w = kernel_test::disk_on_bottom_wall(mat, delta, true);
+  const Integration in = w.integration();
   const double V = 1e-3;  // slip 1e-9 m per step; sticking lasts μFn/(kt·V·Δt) = 800 steps
   w.set_velocity(0, V, 0.0, 0.0);
 

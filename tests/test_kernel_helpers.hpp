@@ -64,10 +64,10 @@ inline Scene random_loose_scene(int nx, int ny, uint32_t seed, double spread = 0
 }
 
 /// One disk of radius kR pressed `delta` into the bottom wall of the box
-/// [−20r, 20r] × [0, 10r], heavy (mass scaling 1e9), undamped, rotation
-/// locked, Δt = 1e-6 s: the velocities set before each step are its motion
-/// (a 100 N force changes them by 5e-11 m/s a step).
-inline World disk_on_bottom_wall(const Material& mat, double delta) {
+/// [−20r, 20r] × [0, 10r], heavy (mass scaling 1e9), undamped, Δt = 1e-6 s,
+/// its rotation locked unless `spin`: the velocities set before each step
+/// are its motion (a 100 N force changes them by 5e-11 m/s a step).
+inline World disk_on_bottom_wall(const Material& mat, double delta, bool spin = false) {
   const double r = kR;
   const std::vector<double> x{0.0}, y{r - delta}, rad{r};
   World w(mat, x, y, rad, -20 * r, 20 * r, 0.0, 10 * r);
@@ -76,7 +76,7 @@ inline World disk_on_bottom_wall(const Material& mat, double delta) {
   in.damping_ratio_translation = 0.0;
   in.damping_ratio_rotation = 0.0;
   in.mass_scaling = 1e9;
-  in.lock_rotation = true;
+  in.lock_rotation = !spin;
   w.set_integration(in);
   return w;
 }
