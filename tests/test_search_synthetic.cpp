@@ -211,6 +211,18 @@ TEST(SearchSynthetic, ModelSearchVerifiesTheSmallestPredictionAtTheOptimumMultip
   EXPECT_EQ(rounds, 2);  // the two starts
 }
 
+// Nstep stays within its bounds, 50 to 20 000 per particle by default: a
+// scene that would pass at 1 100 steps with 100 particles calibrates at
+// the floor, 5 000.
+TEST(SearchSynthetic, ASceneThatPassesBelowTheFloorCalibratesAtFiftyStepsPerParticle) {
+  SyntheticScene scene;
+  scene.n0 = 1000.0;
+  scene.a = 10.0;
+  const CalibrationSummary s = calibrate(SyntheticRunner(scene), AlgorithmSpec{}, one_job());
+  ASSERT_TRUE(s.success) << s.message;
+  EXPECT_EQ(s.best.steps, 50 * scene.particles);
+}
+
 // A peak that falls slower than 1/N, P = P∞(1 + c/√N): err(N) =
 // 2·|P(N) − P(2N)|/|P(2N)| falls like 1/√N only, so the two tightened
 // rounds (each aimed by the 1/N law) fall short and the certificate's

@@ -591,6 +591,10 @@ struct SearchSpace {
   double lower[4], upper[4];
   AlgorithmSpec base;         // mass scaling, lock_rotation
   double fidelity_min = 0.0;  // the smallest Nstep of a model-search trial
+  /// The smallest Nstep a result may have, as the search rounds it: the
+  /// model's probes may run below steps_min (fidelity_min), and one that
+  /// passes is no result.
+  int64_t result_min = 0;
 };
 
 AlgorithmSpec params_at(const SearchSpace& space, const double* x) {
@@ -983,6 +987,7 @@ SearchSpace search_space(const AlgorithmSpec& base, const CalibrationOptions& op
   space.lower[0] = dt_ratio_lower(options, dt_ratio_stable);
   space.upper[0] = dt_ratio_max(options, dt_ratio_stable);
   space.lower[1] = std::log10(static_cast<double>(steps_min));
+  space.result_min = round_steps(static_cast<double>(steps_min));
   space.upper[1] = std::log10(static_cast<double>(steps_max));
   space.lower[2] = options.damping_min;
   space.upper[2] = options.damping_max;
@@ -1118,7 +1123,8 @@ std::optional<TrialRecord> certify_best(Evaluator& evaluator, const SearchSpace&
   // finds nothing passing its tightened tolerances ends the loop, and the
   // result stays the passing trial whose certificate failed.
   std::optional<TrialRecord> certified;
-  int64_t steps_floor = 0;  // raised by the fallback, so that it moves on
+  // The search space's floor, raised by the fallback so that it moves on.
+  int64_t steps_floor = space.result_min;
   for (int round = 0; round < 6; ++round) {
     // Judged against the current (possibly tightened) tolerances.
     const std::optional<TrialRecord> best =
