@@ -253,6 +253,10 @@ TEST(SearchSynthetic, APeakSlowerThanOneOverNFallsBackToDoublingAndEndsCertified
   EXPECT_LE(s.certificate.richardson_error, options.accuracy);
   EXPECT_GE(static_cast<double>(s.best.steps), hi);
   EXPECT_LE(static_cast<double>(s.best.steps), 2.0 * hi);
+  // The two tightened rounds' probes say so (the first search's alone are
+  // search trials, counted out of max_trials on the progress lines).
+  EXPECT_FALSE(of_phase(s, TrialPhase::search_tightened).empty());
+  EXPECT_LE(of_phase(s, TrialPhase::search).size(), static_cast<size_t>(options.max_trials));
   // Reached by the fallback: the result is a doubled run.
   bool doubled = false;
   for (const auto& t : of_phase(s, TrialPhase::certificate))

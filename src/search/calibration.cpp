@@ -427,14 +427,10 @@ class Evaluator {
         // certificate and tightened searches come on top (no denominator).
         // The id trials.jsonl and the report give it (from 0), whenever
         // the trials finish in the order asked (always with one job).
+        // (Only the first search counts out of N: a tightened re-search
+        // after a failed certificate runs search-tightened trials.)
         s << "trial " << r.id << " (" << to_string(phase);
-        // (A tightened re-search after a failed certificate runs search
-        // trials beyond the first search's N: counted, not out of N.)
-        if (search_done > options_.max_trials)
-          s << " " << search_done - options_.max_trials << " after the first "
-            << options_.max_trials;
-        else if (search_done > 0)
-          s << " " << search_done << "/" << options_.max_trials;
+        if (search_done > 0) s << " " << search_done << "/" << options_.max_trials;
         s << "): alpha " << params.dt_ratio << ", steps " << params.steps << ", zeta_t "
           << params.damping_ratio_translation << ", zeta_r " << params.damping_ratio_rotation
           << " -> "
@@ -711,6 +707,7 @@ struct ModelSearch {
   Evaluator* evaluator;
   const SearchSpace* space;
   Tolerances tolerances;
+  TrialPhase phase;  ///< of its probes: search, or search_tightened after a failed certificate
   double n_guess = 0.0;
   double best_prediction = 0.0;
   double best_x[3] = {0, 0, 0};
@@ -739,7 +736,7 @@ double model_objective(unsigned, const double* x, double*, void* data) {
   AlgorithmSpec p = params_at(*m.space, full);
   p.steps = std::llround(m.n_guess);  // may lie below the search space: a probe
   // The whole run: an early-stopped trial's criteria would under-predict N*.
-  const TrialRecord r = m.evaluator->evaluate(p, TrialPhase::search, /*early_stop=*/false);
+  const TrialRecord r = m.evaluator->evaluate(p, m.phase, /*early_stop=*/false);
   if (m.evaluator->stopped()) {
     if (m.opt) nlopt_force_stop(m.opt);
     return HUGE_VAL;
@@ -774,9 +771,10 @@ double fidelity_steps(const SearchSpace& space, double target) {
 /// Nstep `log_target` (log10), the second at that of the first round's own
 /// prediction. At most `max_evals` low-fidelity trials.
 std::optional<ModelPrediction> model_predict(Evaluator& evaluator, const SearchSpace& space,
-                                             const Tolerances& tolerances, const double* start,
-                                             double log_target, int max_evals) {
-  ModelSearch m{&evaluator, &space, tolerances};
+                                             const Tolerances& tolerances, TrialPhase phase,
+                                             const double* start, double log_target,
+                                             int max_evals) {
+  ModelSearch m{&evaluator, &space, tolerances, phase};
   m.n_guess = fidelity_steps(space, std::pow(10.0, log_target));
   double x[3] = {start[0], start[2], start[3]};
   const double lower[3] = {space.lower[0], space.lower[2], space.lower[3]};
@@ -845,16 +843,18 @@ std::optional<TrialRecord> verify_prediction(Evaluator& evaluator, const SearchS
 /// 10.4; at the lower one, N*/7.4 and 3.4 of 6.4 in all. The second round
 /// re-centres on the first round's prediction.
 std::optional<TrialRecord> model_search(Evaluator& evaluator, const SearchSpace& space,
-                                        const Tolerances& tolerances, const double* a,
-                                        const double* b, int max_evals, int jobs) {
+                                        const Tolerances& tolerances, TrialPhase phase,
+                                        const double* a, const double* b, int max_evals, int jobs) {
   // max_evals >= kMinSearchTrials (the budget is checked where it is read):
   // evals >= 2 * kModelRoundMin, each start its first round's floor.
   const int evals = max_evals - kVerifyBudget;
   const double first = std::min(a[1], b[1]);
   std::optional<ModelPrediction> pa, pb;
   evaluator.run_branches(
-      {[&] { pa = model_predict(evaluator, space, tolerances, a, first, evals / 2); },
-       [&] { pb = model_predict(evaluator, space, tolerances, b, first, evals - evals / 2); }},
+      {[&] { pa = model_predict(evaluator, space, tolerances, phase, a, first, evals / 2); },
+       [&] {
+         pb = model_predict(evaluator, space, tolerances, phase, b, first, evals - evals / 2);
+       }},
       jobs);
   if (pa && pb && pb->steps < pa->steps) std::swap(pa, pb);
   for (const auto& p : {pa, pb}) {
@@ -1042,7 +1042,7 @@ void search_from_starts(Evaluator& evaluator, const SearchSpace& space,
   const double* b = starts.second;
   SearchContext context{&evaluator, &space, tolerances, TrialPhase::search};
   if (options.strategy == Strategy::model) {
-    model_search(evaluator, space, tolerances, a, b, evals, jobs);
+    model_search(evaluator, space, tolerances, TrialPhase::search, a, b, evals, jobs);
     return;
   }
   if (options.strategy == Strategy::direct) {
@@ -1101,7 +1101,8 @@ void search_tightened(Evaluator& evaluator, const SearchSpace& space, Tolerances
                        std::log10(static_cast<double>(best.params.steps)) - std::log10(factor),
                        best.params.damping_ratio_translation, best.params.damping_ratio_rotation};
   if (options.strategy == Strategy::model) {
-    model_search(evaluator, space, tolerances, x, x, std::max(kMinSearchTrials, budget / 4), jobs);
+    model_search(evaluator, space, tolerances, TrialPhase::search_tightened, x, x,
+                 std::max(kMinSearchTrials, budget / 4), jobs);
   } else {
     SearchContext context{&evaluator, &space, tolerances, TrialPhase::search_tightened};
     local_search(options.strategy == Strategy::direct ? Strategy::cobyla : options.strategy,
