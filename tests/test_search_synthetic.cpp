@@ -223,6 +223,45 @@ TEST(SearchSynthetic, ASceneThatPassesBelowTheFloorCalibratesAtFiftyStepsPerPart
   EXPECT_EQ(s.best.steps, 50 * scene.particles);
 }
 
+// A first certificate that fails: P = P∞(1 + a/N) with a = 8 000, whose
+// estimate err(N) = 2·|P(N) − P(2N)|/|P(2N)| = (a/N)/(1 + a/(2N)) is 5.7 % at
+// the first result N₁ = 1.1·N₀ = 135 800. The smallest Nstep it certifies
+// (err ≤ 2 %) is N_c = a·(1 − acc/2)/acc = 396 000. The tightened search
+// scales the tolerances by f = acc/(margin·err(N₁)), so its prediction
+// N₁/f lands the margin (1.1) inside the accuracy: err ≈ acc/1.1. Without
+// the margin it lands on the boundary itself, err(N₁/f) = acc·(1 +
+// a/(2N₁))/(1 + a/(2N₁/f)) > acc, and a second round (f clamped to 0.8)
+// ended at 485 700 = 1.23·N_c.
+TEST(SearchSynthetic, AFailedCertificateTightensOnceAndLandsWithinTheMarginOfTheCertifiableNstep) {
+  SyntheticScene scene;
+  scene.a = 8000.0;
+  const CalibrationOptions options = one_job();
+  const CalibrationSummary s = calibrate(SyntheticRunner(scene), AlgorithmSpec{}, options);
+  ASSERT_TRUE(s.success) << s.message;
+  const double acc = options.accuracy;
+  const double n_c = scene.a * (1.0 - 0.5 * acc) / acc;
+  const auto err = [&](double n) { return (scene.a / n) / (1.0 + scene.a / (2.0 * n)); };
+  const int64_t n1 = round_steps(1.1 * scene.n0);
+  ASSERT_GT(err(static_cast<double>(n1)), acc);
+  // The first result and its failed certificate, then one tightened round.
+  const std::vector<TrialRecord> verified = of_phase(s, TrialPhase::verify);
+  ASSERT_EQ(verified.size(), 2u);
+  EXPECT_EQ(verified[0].params.steps, n1);
+  const double f = acc / (1.1 * err(static_cast<double>(n1)));
+  EXPECT_NEAR(static_cast<double>(verified[1].params.steps), n1 / f, 1e-3 * n1 / f);
+  EXPECT_EQ(s.best.steps, verified[1].params.steps);
+  EXPECT_GE(static_cast<double>(s.best.steps), n_c);
+  EXPECT_LE(static_cast<double>(s.best.steps), 1.1 * n_c);
+  EXPECT_NEAR(s.certificate.richardson_error, err(static_cast<double>(s.best.steps)), 1e-15);
+  EXPECT_LT(s.certificate.richardson_error, acc / 1.05);
+  // The tightened search's probes ran at 1/8 of the Nstep it aimed at (the
+  // model's fidelity), the rounding of the search aside.
+  const std::vector<TrialRecord> tightened = of_phase(s, TrialPhase::search_tightened);
+  ASSERT_FALSE(tightened.empty());
+  for (const auto& t : tightened)
+    EXPECT_NEAR(static_cast<double>(t.params.steps), s.best.steps / 8.0, 2e-3 * s.best.steps / 8.0);
+}
+
 // A peak that falls slower than 1/N, P = P∞(1 + c/√N): err(N) =
 // 2·|P(N) − P(2N)|/|P(2N)| falls like 1/√N only, so the two tightened
 // rounds (each aimed by the 1/N law) fall short and the certificate's
