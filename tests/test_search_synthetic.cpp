@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "demcal/search/calibration.hpp"
+#include "demcal/search/evidence.hpp"
 #include "demcal/search/trial_runner.hpp"
 
 using namespace demcal;
@@ -419,4 +420,21 @@ TEST(SearchSynthetic, TheVerificationWalksDownAndTheCheapestPassingTrialIsTheRes
   EXPECT_EQ(s.best.steps, *std::min_element(passed.begin(), passed.end()));
   EXPECT_GE(static_cast<double>(s.best.steps), scene.n0);
   EXPECT_LE(static_cast<double>(s.best.steps), scene.n0 * std::pow(0.9, -1.0 / 1.2));
+}
+
+// The --evidence reference: the result's multipliers at 8N and 16N, and
+// the Richardson limit 2·P(16N) − P(8N), which for P = P∞(1 + a/N) is P∞
+// itself (the 1/N terms cancel), up to rounding.
+TEST(SearchSynthetic, TheEvidenceReferenceIsTheRichardsonLimitOfEightAndSixteenTimesNstep) {
+  SyntheticScene scene;
+  scene.a = 5000.0;
+  AlgorithmSpec best;
+  best.steps = 135800;
+  const ReferenceEvidence r =
+      run_refined_reference(SyntheticRunner(scene), best, Tolerances{}, /*jobs=*/1);
+  EXPECT_EQ(r.coarse.params.steps, 8 * best.steps);
+  EXPECT_EQ(r.fine.params.steps, 16 * best.steps);
+  EXPECT_DOUBLE_EQ(r.coarse.score.criteria.peak_stress_yy, scene.peak(8.0 * best.steps));
+  EXPECT_DOUBLE_EQ(r.fine.score.criteria.peak_stress_yy, scene.peak(16.0 * best.steps));
+  EXPECT_NEAR(r.peak, scene.peak_limit, 1e-12 * std::abs(scene.peak_limit));
 }
