@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <string>
+#include <vector>
 
 #include "demcal/scene/packing.hpp"
 #include "demcal/search/stability_scan.hpp"
@@ -19,6 +20,19 @@ StabilityScanResult scan(const std::string& scene, double zeta_t, double zeta_r)
   StabilityScanOptions options;
   options.steps = 20000;
   return stability_scan(config, state, options);
+}
+
+// The ladder: options.points rungs evenly spaced from `from` to `to` × the
+// estimate, both ends included (the bisections come on top).
+void expect_ladder(const StabilityScanResult& r, const StabilityScanOptions& o) {
+  std::vector<double> rungs;
+  for (const auto& t : r.trials)
+    if (!t.bisection) rungs.push_back(t.dt_ratio);
+  ASSERT_EQ(rungs.size(), static_cast<size_t>(o.points));
+  for (int k = 0; k < o.points; ++k)
+    EXPECT_NEAR(rungs[k], (o.from + (o.to - o.from) * k / (o.points - 1)) * r.dt_ratio_estimate,
+                1e-12 * r.dt_ratio_estimate)
+        << k;
 }
 
 void expect_sharp_limit(const StabilityScanResult& r) {
@@ -48,6 +62,7 @@ TEST(StabilityScan, MeasuredLimitMatchesTheEstimateWhenDamped) {
   for (const char* scene : {"hex_10x10", "random_400"}) {
     const StabilityScanResult r = scan(scene, 1.0, 1.0);
     SCOPED_TRACE(scene);
+    expect_ladder(r, StabilityScanOptions{});
     expect_sharp_limit(r);
     EXPECT_NEAR(r.ratio(), 1.0, 0.03);
     EXPECT_LT(r.dt_ratio_first_diverged - r.dt_ratio_last_stable, 0.01 * r.dt_ratio_estimate);
@@ -93,6 +108,17 @@ TEST(StabilityScan, OnAPolydisperseSampleTheEstimateIsTheLimitWhenNoContactCanSl
   ASSERT_GT(r.ratio(), 1.03);  // the rattle the checks miss (measured 1.093)
   EXPECT_NE(stability_markdown(r, "poly200").find(beyond_estimate_caveat(r)), std::string::npos);
   EXPECT_NE(beyond_estimate_caveat(r), "");
+}
+
+// The measured limit is the middle of the bracket [last stable, first
+// diverged] over the estimate; 0 without a bracket.
+TEST(StabilityScan, RatioIsTheBracketsMiddleOverTheEstimate) {
+  StabilityScanResult r;
+  r.dt_ratio_estimate = 0.5;
+  EXPECT_EQ(r.ratio(), 0.0);
+  r.dt_ratio_last_stable = 0.45;
+  r.dt_ratio_first_diverged = 0.55;
+  EXPECT_DOUBLE_EQ(r.ratio(), 1.0);
 }
 
 }  // namespace
