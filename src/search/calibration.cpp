@@ -809,8 +809,17 @@ std::optional<ModelPrediction> model_predict(Evaluator& evaluator, const SearchS
   return p;
 }
 
-/// Verify a prediction at full length and walk to the smallest passing
-/// Nstep: the cheapest passing trial found, if any.
+/// Whether a trial that passed the user's tolerances also meets
+/// `tolerances` (tightened after a failed certificate, or the user's own).
+bool meets(const Score& score, const Tolerances& tolerances) {
+  const auto g = constraint_values(score, tolerances);
+  return *std::max_element(g.begin(), g.end()) <= 0.0;
+}
+
+/// Verify a prediction at full length and walk to the smallest Nstep that
+/// passes under `tolerances` (the search's: tightened ones after a failed
+/// certificate, which the certificate then judges by): the cheapest such
+/// trial found, if any.
 std::optional<TrialRecord> verify_prediction(Evaluator& evaluator, const SearchSpace& space,
                                              const Tolerances& tolerances,
                                              const ModelPrediction& p) {
@@ -821,12 +830,12 @@ std::optional<TrialRecord> verify_prediction(Evaluator& evaluator, const SearchS
     const TrialRecord r = evaluator.evaluate(params_at(space, full), TrialPhase::verify);
     if (r.score.diverged || evaluator.stopped()) break;
     const double excess = rate_excess(r.score.criteria, tolerances);
-    if (r.score.passed && r.score.complete) {
+    const bool passed = r.score.passed && r.score.complete && meets(r.score, tolerances);
+    if (passed) {
       if (!best || r.params.steps < best->params.steps) best = r;
       if (excess > 0.9) break;  // close enough to the boundary
     }
-    n = static_cast<double>(r.params.steps) * std::max(excess, 0.5) *
-        (r.score.passed ? 1.02 : 1.05);
+    n = static_cast<double>(r.params.steps) * std::max(excess, 0.5) * (passed ? 1.02 : 1.05);
   }
   return best;
 }
@@ -875,10 +884,7 @@ std::optional<TrialRecord> cheapest_passing(const std::vector<TrialRecord>& tria
   std::optional<TrialRecord> best;
   for (const auto& t : trials) {
     if (!t.score.passed || !t.score.complete || t.params.steps < steps_floor) continue;
-    if (judged_by) {
-      const auto g = constraint_values(t.score, *judged_by);
-      if (*std::max_element(g.begin(), g.end()) > 0.0) continue;
-    }
+    if (judged_by && !meets(t.score, *judged_by)) continue;
     if (!best || t.params.steps < best->params.steps ||
         (t.params.steps == best->params.steps && key_of(t.params) < key_of(best->params)))
       best = t;
