@@ -3,11 +3,15 @@
 // formulas, so that what the calibration decides can be derived by hand.
 //
 // The scene (SyntheticRunner): the rate-driven criteria (force balance,
-// servo, moment balance) are c_k·q(α, ζ_t, ζ_r)/N — exactly the 1/Nstep law
-// the model strategy assumes (calibration.cpp; one test bends it) — so the smallest passing
-// Nstep at the multipliers is N₀·q with N₀ = max_k c_k/tolerance_k; the
-// oscillation is a constant below its tolerance; the peak is
-// P(N) = P∞·(1 + a/N + b/N² + c/√N). Every test derives its expectation from these.
+// servo, moment balance) are c_k·q(α, ζ_t, ζ_r)/N — exactly the 1/Nstep
+// law the model strategy assumes (calibration.cpp; two tests bend it) — so
+// the smallest passing Nstep at the multipliers is N₀·q with N₀ =
+// max_k c_k/tolerance_k; the oscillation is a constant below its tolerance
+// (or a ramp in α); the peak is P(N) = P∞·(1 + a/N + b/N² + c/√N). Every
+// test derives its expectation from these and from the search's documented
+// constants, written here once: the model aims kMargin inside the
+// tolerances (and a tightened round inside the accuracy), its probes run at
+// 1/kFidelity of the Nstep they aim at.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -23,6 +27,9 @@
 using namespace demcal;
 
 namespace {
+
+constexpr double kMargin = 1.1;    // calibration.cpp: kModelMargin, kAccuracyMargin
+constexpr double kFidelity = 8.0;  // calibration.cpp: kFidelity
 
 struct SyntheticScene {
   int dimension = 2;
@@ -65,6 +72,10 @@ struct SyntheticScene {
   }
   double peak(double n) const {
     return peak_limit * (1.0 + a / n + b / (n * n) + c / std::sqrt(n));
+  }
+  /// The certificate's change from Nstep n to n2, |P(n) − P(n2)|/|P(n2)|.
+  double change(double n, double n2) const {
+    return std::abs(peak(n) - peak(n2)) / std::abs(peak(n2));
   }
 };
 
@@ -119,6 +130,22 @@ std::vector<TrialRecord> of_phase(const CalibrationSummary& s, TrialPhase phase)
   return out;
 }
 
+/// Their Nsteps, in increasing order.
+std::vector<int64_t> steps_of(const std::vector<TrialRecord>& trials) {
+  std::vector<int64_t> out;
+  for (const auto& t : trials) out.push_back(t.params.steps);
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+/// What a probe predicts under the default tolerances: its Nstep times its
+/// worst rate criterion over its tolerance, with the margin (the 1/N law's
+/// smallest passing Nstep, the model's objective).
+double prediction(const TrialRecord& probe) {
+  return static_cast<double>(probe.params.steps) * rate_excess(probe.score.criteria, Tolerances{}) *
+         kMargin;
+}
+
 }  // namespace
 
 // With every probe exactly on the 1/Nstep law, each predicts the smallest
@@ -131,7 +158,7 @@ TEST(SearchSynthetic, FlatSceneCalibratesAtTheModelsMarginAboveTheSmallestPassin
   const SyntheticScene scene;
   const CalibrationSummary s = calibrate(SyntheticRunner(scene), AlgorithmSpec{}, one_job());
   ASSERT_TRUE(s.success) << s.message;
-  const int64_t n = round_steps(1.1 * scene.n0);
+  const int64_t n = round_steps(kMargin * scene.n0);
   EXPECT_EQ(s.best.steps, n);
   // Where the multipliers do not matter, the first probe's stay: the
   // paper's α = 0.2, ζ_t = ζ_r = 1 (search_start()).
@@ -142,17 +169,14 @@ TEST(SearchSynthetic, FlatSceneCalibratesAtTheModelsMarginAboveTheSmallestPassin
   EXPECT_EQ(c.steps, n);
   EXPECT_DOUBLE_EQ(c.peak, scene.peak(n));
   EXPECT_DOUBLE_EQ(c.peak_doubled, scene.peak(2 * n));
-  const double change = std::abs(scene.peak(n) - scene.peak(2 * n)) / std::abs(scene.peak(2 * n));
+  const double change = scene.change(n, 2 * n);
   EXPECT_DOUBLE_EQ(c.steps_doubled_peak_change, change);
   EXPECT_DOUBLE_EQ(c.richardson_error, 2.0 * change);
   EXPECT_FALSE(c.peak_halved.has_value());
   EXPECT_TRUE(c.passed);
   // The certificate's first run is the verified trial itself (the same
   // parameters: the cache's); it adds the run at 2N alone.
-  std::vector<int64_t> certificate_steps;
-  for (const auto& t : of_phase(s, TrialPhase::certificate))
-    certificate_steps.push_back(t.params.steps);
-  EXPECT_EQ(certificate_steps, (std::vector<int64_t>{2 * n}));
+  EXPECT_EQ(steps_of(of_phase(s, TrialPhase::certificate)), (std::vector<int64_t>{2 * n}));
   const std::vector<TrialRecord> verified = of_phase(s, TrialPhase::verify);
   ASSERT_EQ(verified.size(), 1u);
   EXPECT_EQ(verified[0].params.steps, n);
@@ -170,23 +194,18 @@ TEST(SearchSynthetic, ThreeDimensionalCertificateTakesTheLargerOfTheDoubledAndHa
   scene.b = 5e7;  // b/N² ≈ 0.0027 at N = 135 800: the halved change 0.8 %, within 2 %
   const CalibrationSummary s = calibrate(SyntheticRunner(scene), AlgorithmSpec{}, one_job());
   ASSERT_TRUE(s.success) << s.message;
-  const int64_t n = round_steps(1.1 * scene.n0);
+  const int64_t n = round_steps(kMargin * scene.n0);
   ASSERT_EQ(s.best.steps, n);
   const Certificate& c = s.certificate;
   ASSERT_TRUE(c.peak_halved.has_value());
   EXPECT_DOUBLE_EQ(*c.peak_halved, scene.peak(n / 2));
-  const double halved = std::abs(scene.peak(n / 2) - scene.peak(n)) / std::abs(scene.peak(n));
-  const double doubled = std::abs(scene.peak(n) - scene.peak(2 * n)) / std::abs(scene.peak(2 * n));
+  const double halved = scene.change(n / 2, n), doubled = scene.change(n, 2 * n);
   EXPECT_DOUBLE_EQ(*c.steps_halved_peak_change, halved);
   EXPECT_DOUBLE_EQ(c.steps_doubled_peak_change, doubled);
   ASSERT_GT(halved, 2.0 * doubled);
   EXPECT_DOUBLE_EQ(c.richardson_error, halved);
   EXPECT_TRUE(c.passed);
-  std::vector<int64_t> certificate_steps;
-  for (const auto& t : of_phase(s, TrialPhase::certificate))
-    certificate_steps.push_back(t.params.steps);
-  std::sort(certificate_steps.begin(), certificate_steps.end());
-  EXPECT_EQ(certificate_steps, (std::vector<int64_t>{n / 2, 2 * n}));
+  EXPECT_EQ(steps_of(of_phase(s, TrialPhase::certificate)), (std::vector<int64_t>{n / 2, 2 * n}));
 }
 
 // Where the multipliers matter (q = 1 + 4·|(α, ζ_t, ζ_r) − (0.3, 0.7, 0.4)|²),
@@ -196,36 +215,34 @@ TEST(SearchSynthetic, ThreeDimensionalCertificateTakesTheLargerOfTheDoubledAndHa
 // start's (500 per particle, and 10^-0.3 of it), the second at the first
 // round's prediction. BOBYQA's quadratic model finds the optimum of a
 // quadratic q: the result is within 0.5 % of 1.1·N₀ (its stopping test is
-// 0.5 % of Nstep).
+// 0.5 % of Nstep). (That the smallest prediction of all probes is the one
+// verified holds because the law is exact: each start verifies its second
+// round's best, and a first round's probes predict no less.)
 TEST(SearchSynthetic, ModelSearchVerifiesTheSmallestPredictionAtTheOptimumMultipliers) {
   SyntheticScene scene;
   scene.curvature = 4.0;
   const CalibrationSummary s = calibrate(SyntheticRunner(scene), AlgorithmSpec{}, one_job());
   ASSERT_TRUE(s.success) << s.message;
-  const Tolerances t;
   const std::vector<TrialRecord> probes = of_phase(s, TrialPhase::search);
   ASSERT_FALSE(probes.empty());
   double smallest = HUGE_VAL;
-  for (const auto& p : probes)
-    smallest = std::min(
-        smallest, static_cast<double>(p.params.steps) * rate_excess(p.score.criteria, t) * 1.1);
+  for (const auto& p : probes) smallest = std::min(smallest, prediction(p));
   EXPECT_EQ(s.best.steps, round_steps(smallest));
   EXPECT_LT(scene.q(s.best), 1.005);
-  EXPECT_NEAR(static_cast<double>(s.best.steps), 1.1 * scene.n0, 0.005 * 1.1 * scene.n0);
+  EXPECT_NEAR(static_cast<double>(s.best.steps), kMargin * scene.n0, 0.005 * kMargin * scene.n0);
   // Each start's first round probes at round_steps(500·n·10^-0.3/8), the
   // lower start's fidelity; its second round at 1/8 of the first round's
   // smallest prediction. With one job the trials come in the order asked:
   // a start's rounds one after the other, then the other start's.
   const int64_t first_round =
-      round_steps(kStartStepsPerParticle * scene.particles * std::pow(10.0, -0.3) / 8.0);
+      round_steps(kStartStepsPerParticle * scene.particles * std::pow(10.0, -0.3) / kFidelity);
   int rounds = 0;
   for (size_t k = 0; k < probes.size();) {
     ASSERT_EQ(probes[k].params.steps, first_round) << "probe " << probes[k].id;
-    double prediction = HUGE_VAL;
+    double first = HUGE_VAL;
     for (; k < probes.size() && probes[k].params.steps == first_round; ++k)
-      prediction = std::min(prediction, static_cast<double>(first_round) *
-                                            rate_excess(probes[k].score.criteria, t) * 1.1);
-    const int64_t second_round = round_steps(prediction / 8.0);
+      first = std::min(first, prediction(probes[k]));
+    const int64_t second_round = round_steps(first / kFidelity);
     ASSERT_LT(k, probes.size()) << "no second round";
     for (; k < probes.size() && probes[k].params.steps != first_round; ++k)
       EXPECT_EQ(probes[k].params.steps, second_round) << "probe " << probes[k].id;
@@ -235,8 +252,9 @@ TEST(SearchSynthetic, ModelSearchVerifiesTheSmallestPredictionAtTheOptimumMultip
 }
 
 // Nstep stays within its bounds, 50 to 20 000 per particle by default: a
-// scene that would pass at 1 100 steps with 100 particles calibrates at
-// the floor, 5 000.
+// scene that passes from N₀ = 1 000 steps, with 100 particles, calibrates at
+// the floor, 5 000 (a model probe at 16 per particle, 1 600 steps, passes
+// too, and is no result).
 TEST(SearchSynthetic, ASceneThatPassesBelowTheFloorCalibratesAtFiftyStepsPerParticle) {
   SyntheticScene scene;
   scene.n0 = 1000.0;
@@ -264,25 +282,26 @@ TEST(SearchSynthetic, AFailedCertificateTightensOnceAndLandsWithinTheMarginOfThe
   const double acc = options.accuracy;
   const double n_c = scene.a * (1.0 - 0.5 * acc) / acc;
   const auto err = [&](double n) { return (scene.a / n) / (1.0 + scene.a / (2.0 * n)); };
-  const int64_t n1 = round_steps(1.1 * scene.n0);
+  const int64_t n1 = round_steps(kMargin * scene.n0);
   ASSERT_GT(err(static_cast<double>(n1)), acc);
   // The first result and its failed certificate, then one tightened round.
   const std::vector<TrialRecord> verified = of_phase(s, TrialPhase::verify);
   ASSERT_EQ(verified.size(), 2u);
   EXPECT_EQ(verified[0].params.steps, n1);
-  const double f = acc / (1.1 * err(static_cast<double>(n1)));
+  const double f = acc / (kMargin * err(static_cast<double>(n1)));
   EXPECT_NEAR(static_cast<double>(verified[1].params.steps), n1 / f, 1e-3 * n1 / f);
   EXPECT_EQ(s.best.steps, verified[1].params.steps);
   EXPECT_GE(static_cast<double>(s.best.steps), n_c);
-  EXPECT_LE(static_cast<double>(s.best.steps), 1.1 * n_c);
+  EXPECT_LE(static_cast<double>(s.best.steps), kMargin * n_c);
   EXPECT_NEAR(s.certificate.richardson_error, err(static_cast<double>(s.best.steps)), 1e-15);
   EXPECT_LT(s.certificate.richardson_error, acc / 1.05);
-  // The tightened search's probes ran at 1/8 of the Nstep it aimed at (the
-  // model's fidelity), the rounding of the search aside.
+  // The tightened search's probes ran at 1/kFidelity of the Nstep it aimed
+  // at, the rounding of the search aside.
   const std::vector<TrialRecord> tightened = of_phase(s, TrialPhase::search_tightened);
   ASSERT_FALSE(tightened.empty());
   for (const auto& t : tightened)
-    EXPECT_NEAR(static_cast<double>(t.params.steps), s.best.steps / 8.0, 2e-3 * s.best.steps / 8.0);
+    EXPECT_NEAR(static_cast<double>(t.params.steps), s.best.steps / kFidelity,
+                2e-3 * s.best.steps / kFidelity);
 }
 
 // A peak that falls slower than 1/N, P = P∞(1 + c/√N): err(N) =
@@ -294,15 +313,13 @@ TEST(SearchSynthetic, AFailedCertificateTightensOnceAndLandsWithinTheMarginOfThe
 TEST(SearchSynthetic, APeakSlowerThanOneOverNFallsBackToDoublingAndEndsCertified) {
   SyntheticScene scene;
   scene.a = 0.0;
-  scene.c = 60.0;  // err(135 800) ≈ 0.586·c/√N ≈ 9.5 %
+  scene.c = 60.0;  // err(135 800) = 0.586·(c/√N)/(1 + c/√(2N)) ≈ 8.6 %
   const CalibrationOptions options = one_job();
   const CalibrationSummary s = calibrate(SyntheticRunner(scene), AlgorithmSpec{}, options);
   ASSERT_TRUE(s.success) << s.message;
   // The estimate as the certificate makes it (2N rounded by the search),
   // and its continuous form for the smallest certifiable Nstep N_c.
-  const auto err_at = [&](double n, double n2) {
-    return 2.0 * std::abs(scene.peak(n) - scene.peak(n2)) / std::abs(scene.peak(n2));
-  };
+  const auto err_at = [&](double n, double n2) { return 2.0 * scene.change(n, n2); };
   const auto err = [&](double n) { return err_at(n, 2.0 * n); };
   double lo = 1e3, hi = 1e9;  // err(lo) > acc ≥ err(hi): bisect for N_c
   for (int k = 0; k < 200; ++k) {
@@ -315,10 +332,9 @@ TEST(SearchSynthetic, APeakSlowerThanOneOverNFallsBackToDoublingAndEndsCertified
   EXPECT_LE(s.certificate.richardson_error, options.accuracy);
   EXPECT_GE(static_cast<double>(s.best.steps), hi);
   EXPECT_LE(static_cast<double>(s.best.steps), 2.0 * hi);
-  // The two tightened rounds' probes say so (the first search's alone are
-  // search trials, counted out of max_trials on the progress lines).
+  // The two tightened rounds' probes are search-tightened trials (the
+  // first search's alone are search trials).
   EXPECT_FALSE(of_phase(s, TrialPhase::search_tightened).empty());
-  EXPECT_LE(of_phase(s, TrialPhase::search).size(), static_cast<size_t>(options.max_trials));
   // Reached by the fallback: the result is a doubled run.
   bool doubled = false;
   for (const auto& t : of_phase(s, TrialPhase::certificate))
@@ -359,7 +375,6 @@ TEST(SearchSynthetic, OfTwoStartsPredictionsTheCheaperIsVerified) {
   // Each start's smallest prediction: with one job the first start's
   // rounds come first (its first round's probes, then its second's), then
   // the second start's, whose first round runs at the first's Nstep again.
-  const Tolerances t;
   const std::vector<TrialRecord> probes = of_phase(s, TrialPhase::search);
   ASSERT_FALSE(probes.empty());
   const int64_t first_round = probes.front().params.steps;
@@ -368,8 +383,7 @@ TEST(SearchSynthetic, OfTwoStartsPredictionsTheCheaperIsVerified) {
     if (k == 0 ||
         (probes[k].params.steps == first_round && probes[k - 1].params.steps != first_round))
       by_start.push_back(HUGE_VAL);
-    by_start.back() = std::min(by_start.back(), static_cast<double>(probes[k].params.steps) *
-                                                    rate_excess(probes[k].score.criteria, t) * 1.1);
+    by_start.back() = std::min(by_start.back(), prediction(probes[k]));
   }
   ASSERT_EQ(by_start.size(), 2u);
   ASSERT_GT(by_start[1], 1.02 * by_start[0]) << "the second start left its basin";
@@ -395,8 +409,9 @@ TEST(SearchSynthetic, TheModelKeepsOutOfTheOscillatingRange) {
   edge.dt_ratio = 0.44;
   edge.damping_ratio_translation = scene.zeta_t_best;
   edge.damping_ratio_rotation = scene.zeta_r_best;
-  EXPECT_GE(static_cast<double>(s.best.steps), 1.1 * scene.n0 * scene.q(edge) * (1.0 - 1e-3));
-  EXPECT_LE(static_cast<double>(s.best.steps), 1.1 * 1.1 * scene.n0 * scene.q(edge));
+  const double at_edge = kMargin * scene.n0 * scene.q(edge);
+  EXPECT_GE(static_cast<double>(s.best.steps), at_edge * (1.0 - 1e-3));
+  EXPECT_LE(static_cast<double>(s.best.steps), 1.1 * at_edge);
 }
 
 // Criteria that fall faster than the model's 1/N, as (N₀/N)^1.2: the

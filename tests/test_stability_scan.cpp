@@ -12,14 +12,19 @@
 namespace demcal {
 namespace {
 
+// The options of scan() below.
+StabilityScanOptions scan_options() {
+  StabilityScanOptions options;
+  options.steps = 20000;
+  return options;
+}
+
 StabilityScanResult scan(const std::string& scene, double zeta_t, double zeta_r) {
   SceneConfig config = load_config(std::string(DEMCAL_SOURCE_DIR) + "/configs/" + scene + ".json");
   config.algorithm.damping_ratio_translation = zeta_t;
   config.algorithm.damping_ratio_rotation = zeta_r;
   const ConsolidatedState state = consolidate(config, make_assembly(config));
-  StabilityScanOptions options;
-  options.steps = 20000;
-  return stability_scan(config, state, options);
+  return stability_scan(config, state, scan_options());
 }
 
 // The ladder: options.points rungs evenly spaced from `from` to `to` × the
@@ -62,7 +67,7 @@ TEST(StabilityScan, MeasuredLimitMatchesTheEstimateWhenDamped) {
   for (const char* scene : {"hex_10x10", "random_400"}) {
     const StabilityScanResult r = scan(scene, 1.0, 1.0);
     SCOPED_TRACE(scene);
-    expect_ladder(r, StabilityScanOptions{});
+    expect_ladder(r, scan_options());
     expect_sharp_limit(r);
     EXPECT_NEAR(r.ratio(), 1.0, 0.03);
     EXPECT_LT(r.dt_ratio_first_diverged - r.dt_ratio_last_stable, 0.01 * r.dt_ratio_estimate);
@@ -117,8 +122,9 @@ TEST(StabilityScan, RatioIsTheBracketsMiddleOverTheEstimate) {
   r.dt_ratio_estimate = 0.5;
   EXPECT_EQ(r.ratio(), 0.0);
   r.dt_ratio_last_stable = 0.45;
-  r.dt_ratio_first_diverged = 0.55;
-  EXPECT_DOUBLE_EQ(r.ratio(), 1.0);
+  EXPECT_EQ(r.ratio(), 0.0);  // no diverged end
+  r.dt_ratio_first_diverged = 0.65;
+  EXPECT_DOUBLE_EQ(r.ratio(), 1.1);
 }
 
 }  // namespace

@@ -423,12 +423,11 @@ class Evaluator {
         std::ostringstream s;
         s.precision(3);
         const double elapsed = seconds_since(t0_);
-        // --max-trials bounds the search's trials; verification, the
-        // certificate and tightened searches come on top (no denominator).
-        // The id trials.jsonl and the report give it (from 0), whenever
-        // the trials finish in the order asked (always with one job).
-        // (Only the first search counts out of N: a tightened re-search
-        // after a failed certificate runs search-tightened trials.)
+        // --max-trials bounds the first search's trials, counted out of N;
+        // verification, the certificate and a failed certificate's
+        // search-tightened trials come on top (no denominator). The id
+        // trials.jsonl and the report give it (from 0), whenever the
+        // trials finish in the order asked (always with one job).
         s << "trial " << r.id << " (" << to_string(phase);
         if (search_done > 0) s << " " << search_done << "/" << options_.max_trials;
         s << "): alpha " << params.dt_ratio << ", steps " << params.steps << ", zeta_t "
@@ -1098,8 +1097,8 @@ CalibrationSummary interrupted_result(CalibrationSummary out, Evaluator& evaluat
 /// alone put the new result's estimate on the accuracy itself, to first
 /// order: whether it passes is then up to the higher orders and the noise.
 /// (On the synthetic scene of SearchSynthetic.AFailedCertificateTightens…
-/// it failed, and a second round, at factor 0.8, certified 1.23× beyond
-/// the smallest certifiable Nstep; with the margin one round lands 1.08×.)
+/// it failed, and a second round, at factor 0.8, certified at 1.23× the
+/// smallest certifiable Nstep; with the margin one round lands at 1.08×.)
 constexpr double kAccuracyMargin = 1.1;
 
 /// A failed certificate's early rounds: the tolerances tightened by how far
