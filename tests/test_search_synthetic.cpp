@@ -122,6 +122,11 @@ CalibrationOptions one_job() {
   return o;
 }
 
+/// A calibration of the scene with the default options, on one job.
+CalibrationSummary calibrate_on(const SyntheticScene& scene) {
+  return calibrate(SyntheticRunner(scene), AlgorithmSpec{}, one_job());
+}
+
 /// The trials of one phase.
 std::vector<TrialRecord> of_phase(const CalibrationSummary& s, TrialPhase phase) {
   std::vector<TrialRecord> out;
@@ -156,7 +161,7 @@ double prediction(const TrialRecord& probe) {
 // and the Richardson estimate 2·change.
 TEST(SearchSynthetic, FlatSceneCalibratesAtTheModelsMarginAboveTheSmallestPassingNstep) {
   const SyntheticScene scene;
-  const CalibrationSummary s = calibrate(SyntheticRunner(scene), AlgorithmSpec{}, one_job());
+  const CalibrationSummary s = calibrate_on(scene);
   ASSERT_TRUE(s.success) << s.message;
   const int64_t n = round_steps(kMargin * scene.n0);
   EXPECT_EQ(s.best.steps, n);
@@ -192,7 +197,7 @@ TEST(SearchSynthetic, ThreeDimensionalCertificateTakesTheLargerOfTheDoubledAndHa
   scene.dimension = 3;
   scene.a = 0.0;
   scene.b = 5e7;  // b/N² ≈ 0.0027 at N = 135 800: the halved change 0.8 %, within 2 %
-  const CalibrationSummary s = calibrate(SyntheticRunner(scene), AlgorithmSpec{}, one_job());
+  const CalibrationSummary s = calibrate_on(scene);
   ASSERT_TRUE(s.success) << s.message;
   const int64_t n = round_steps(kMargin * scene.n0);
   ASSERT_EQ(s.best.steps, n);
@@ -221,7 +226,7 @@ TEST(SearchSynthetic, ThreeDimensionalCertificateTakesTheLargerOfTheDoubledAndHa
 TEST(SearchSynthetic, ModelSearchVerifiesTheSmallestPredictionAtTheOptimumMultipliers) {
   SyntheticScene scene;
   scene.curvature = 4.0;
-  const CalibrationSummary s = calibrate(SyntheticRunner(scene), AlgorithmSpec{}, one_job());
+  const CalibrationSummary s = calibrate_on(scene);
   ASSERT_TRUE(s.success) << s.message;
   const std::vector<TrialRecord> probes = of_phase(s, TrialPhase::search);
   ASSERT_FALSE(probes.empty());
@@ -259,7 +264,7 @@ TEST(SearchSynthetic, ASceneThatPassesBelowTheFloorCalibratesAtFiftyStepsPerPart
   SyntheticScene scene;
   scene.n0 = 1000.0;
   scene.a = 10.0;
-  const CalibrationSummary s = calibrate(SyntheticRunner(scene), AlgorithmSpec{}, one_job());
+  const CalibrationSummary s = calibrate_on(scene);
   ASSERT_TRUE(s.success) << s.message;
   EXPECT_EQ(s.best.steps, 50 * scene.particles);
 }
@@ -277,7 +282,7 @@ TEST(SearchSynthetic, AFailedCertificateTightensOnceAndLandsWithinTheMarginOfThe
   SyntheticScene scene;
   scene.a = 8000.0;
   const CalibrationOptions options = one_job();
-  const CalibrationSummary s = calibrate(SyntheticRunner(scene), AlgorithmSpec{}, options);
+  const CalibrationSummary s = calibrate_on(scene);
   ASSERT_TRUE(s.success) << s.message;
   const double acc = options.accuracy;
   const double n_c = scene.a * (1.0 - 0.5 * acc) / acc;
@@ -315,7 +320,7 @@ TEST(SearchSynthetic, APeakSlowerThanOneOverNFallsBackToDoublingAndEndsCertified
   scene.a = 0.0;
   scene.c = 60.0;  // err(135 800) = 0.586·(c/√N)/(1 + c/√(2N)) ≈ 8.6 %
   const CalibrationOptions options = one_job();
-  const CalibrationSummary s = calibrate(SyntheticRunner(scene), AlgorithmSpec{}, options);
+  const CalibrationSummary s = calibrate_on(scene);
   ASSERT_TRUE(s.success) << s.message;
   // The estimate as the certificate makes it (2N rounded by the search),
   // and its continuous form for the smallest certifiable Nstep N_c.
@@ -349,7 +354,7 @@ TEST(SearchSynthetic, APeakSlowerThanOneOverNFallsBackToDoublingAndEndsCertified
 TEST(SearchSynthetic, ACertificateWhoseDoubledRunDivergesCertifiesNothing) {
   SyntheticScene scene;
   scene.diverges_beyond = 200000;
-  const CalibrationSummary s = calibrate(SyntheticRunner(scene), AlgorithmSpec{}, one_job());
+  const CalibrationSummary s = calibrate_on(scene);
   EXPECT_FALSE(s.certificate.passed);
   EXPECT_FALSE(s.success);
   ASSERT_TRUE(s.has_best());
@@ -370,7 +375,7 @@ TEST(SearchSynthetic, OfTwoStartsPredictionsTheCheaperIsVerified) {
   scene.second_q = 1.03;
   scene.second_alpha = 0.4;
   scene.second_zeta_t = scene.second_zeta_r = 0.5;
-  const CalibrationSummary s = calibrate(SyntheticRunner(scene), AlgorithmSpec{}, one_job());
+  const CalibrationSummary s = calibrate_on(scene);
   ASSERT_TRUE(s.success) << s.message;
   // Each start's smallest prediction: with one job the first start's
   // rounds come first (its first round's probes, then its second's), then
@@ -402,7 +407,7 @@ TEST(SearchSynthetic, TheModelKeepsOutOfTheOscillatingRange) {
   scene.curvature = 4.0;
   scene.alpha_best = 0.47;
   scene.oscillation_slope = 10.0;
-  const CalibrationSummary s = calibrate(SyntheticRunner(scene), AlgorithmSpec{}, one_job());
+  const CalibrationSummary s = calibrate_on(scene);
   ASSERT_TRUE(s.success) << s.message;
   EXPECT_LE(scene.oscillation(s.best), 1.0);
   AlgorithmSpec edge = s.best;
@@ -423,7 +428,7 @@ TEST(SearchSynthetic, TheModelKeepsOutOfTheOscillatingRange) {
 TEST(SearchSynthetic, TheVerificationWalksDownAndTheCheapestPassingTrialIsTheResult) {
   SyntheticScene scene;
   scene.rate_exponent = 1.2;
-  const CalibrationSummary s = calibrate(SyntheticRunner(scene), AlgorithmSpec{}, one_job());
+  const CalibrationSummary s = calibrate_on(scene);
   ASSERT_TRUE(s.success) << s.message;
   std::vector<int64_t> passed;
   for (const auto& t : s.trials)
@@ -465,7 +470,7 @@ TEST(SearchSynthetic, ATightenedVerificationWalksOnUntilItMeetsTheTightenedToler
   SyntheticScene scene;
   scene.rate_exponent = 0.8;
   scene.a = 8000.0;
-  const CalibrationSummary s = calibrate(SyntheticRunner(scene), AlgorithmSpec{}, one_job());
+  const CalibrationSummary s = calibrate_on(scene);
   EXPECT_TRUE(s.success) << s.message;
   EXPECT_LE(s.certificate.richardson_error, CalibrationOptions{}.accuracy);
 }
