@@ -58,9 +58,9 @@ struct SyntheticScene {
   double peak_limit = -1e5, a = 1000.0, b = 0.0, c = 0.0;
 
   double q(const AlgorithmSpec& p) const {
-    const auto d2 = [&](double a, double t, double r) {
-      const double da = p.dt_ratio - a, dt = p.damping_ratio_translation - t,
-                   dr = p.damping_ratio_rotation - r;
+    const auto d2 = [&](double alpha, double zeta_t, double zeta_r) {
+      const double da = p.dt_ratio - alpha, dt = p.damping_ratio_translation - zeta_t,
+                   dr = p.damping_ratio_rotation - zeta_r;
       return da * da + dt * dt + dr * dr;
     };
     const double first = 1.0 + curvature * d2(alpha_best, zeta_t_best, zeta_r_best);
